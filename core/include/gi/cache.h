@@ -1,0 +1,34 @@
+/* The on-disk cache of precomputed data, keyed by content hashes.
+ *
+ * The cache directory is $GIBENCH_CACHE, else $XDG_CACHE_HOME/gibench, else
+ * ~/.cache/gibench. Methods name entries "<id>-<16 hex digits>.<ext>" where
+ * the hex is gi_hash64 of everything the data depends on (mesh bytes,
+ * parameters, format version). Writes are atomic (temporary + rename).
+ */
+#ifndef GI_CACHE_H
+#define GI_CACHE_H
+
+#include "gi/common.h"
+#include "gi/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* 64-bit hash (XXH64) of a byte range, continuing from `seed`. */
+uint64_t gi_hash64(const void *data, size_t size, uint64_t seed);
+/* Hash of one object's mesh in local space (positions, normals, uvs, indices). */
+uint64_t gi_scene_object_hash(const gi_scene *s, uint32_t object);
+/* Resolves (and creates) the cache directory; returns a malloc'd path or
+ * NULL + err. */
+char *gi_cache_dir(gi_error *err);
+/* dir/name; malloc'd. */
+char *gi_cache_path(const char *dir, const char *name);
+/* Reads a whole file (NULL if absent/unreadable); writes atomically. */
+void *gi_file_read_all(const char *path, size_t *size);
+gi_result gi_file_write_atomic(const char *path, const void *data, size_t size, gi_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

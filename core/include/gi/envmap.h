@@ -1,0 +1,55 @@
+/* Environment map: an equirectangular radiance image with a piecewise-
+ * constant importance-sampling distribution (luminance x sin(theta)).
+ * C twin of core/shaders/envmap.glsl.
+ *
+ * Mapping (fixed): for a unit world direction d (+Y up), first rotate by
+ * -rotation about +Y, then
+ *     u = 0.5 + atan2(d.x, -d.z) / (2 pi),   v = acos(d.y) / pi,
+ * with v = 0 the top row of the image. Radiance = texel x intensity.
+ *
+ * Sampling: a marginal CDF over rows and a conditional CDF per row, each
+ * stored with a leading 0 and normalised to end at 1 (width+1 and height+1
+ * entries). pdf is with respect to solid angle. The same tables are
+ * uploaded to the GPU (gpu.h) so both sides draw identical samples.
+ */
+#ifndef GI_ENVMAP_H
+#define GI_ENVMAP_H
+
+#include "gi/common.h"
+#include "gi/vecmath.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct gi_envmap {
+    uint32_t width, height;
+    float *rgb;          /* width*height*3 linear radiance, intensity applied */
+    float rotation;      /* radians about +Y */
+    float *cond_cdf;     /* height rows of (width+1) */
+    float *marg_cdf;     /* height+1 */
+    float *row_weight;   /* height: unnormalised row sums (for the pdf) */
+    double total_weight; /* sum of luminance x sin(theta) x texel area */
+} gi_envmap;
+
+/* Builds the map and its CDF from an RGBA image (copied). */
+gi_envmap *gi_envmap_create(const float *rgba, uint32_t width, uint32_t height, float intensity,
+                            float rotation_deg);
+void gi_envmap_free(gi_envmap *env);
+
+/* Direction <-> (u, v) in [0,1)^2, with the rotation applied. */
+void gi_envmap_dir_to_uv(const gi_envmap *env, gi_vec3 d, float *u, float *v);
+gi_vec3 gi_envmap_uv_to_dir(const gi_envmap *env, float u, float v);
+/* Radiance seen in direction d (nearest texel, as the GPU fetches it). */
+void gi_envmap_eval(const gi_envmap *env, gi_vec3 d, float out[3]);
+/* Draws a direction from (u1, u2) in [0,1)^2; returns its solid-angle pdf
+ * (0 if the map is black). */
+float gi_envmap_sample(const gi_envmap *env, float u1, float u2, gi_vec3 *dir);
+float gi_envmap_pdf(const gi_envmap *env, gi_vec3 d);
+/* Total power-like weight, for choosing between the map and other lights. */
+float gi_envmap_average_radiance(const gi_envmap *env);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,134 @@
+/* The GPU: a headless OpenGL 4.5 core context through EGL, and the scene
+ * uploaded once.
+ *
+ * Use:
+ *     gi_error err;
+ *     gi_gpu *gpu = gi_gpu_create(NULL, &err);      // context is current
+ *     gi_gpu_scene *gs = gi_gpu_scene_upload(gpu, scene, &err);
+ *     gi_gpu_scene_set_time(gs, t);                 // refresh object transforms
+ *     ... passes, plugins ...
+ *     gi_gpu_scene_free(gs); gi_gpu_destroy(gpu);
+ *
+ * Device choice: an EGL device that is not software (EGL_EXT_platform_device,
+ * e.g. NVIDIA) first, then Mesa's surfaceless platform (llvmpipe). The
+ * environment variable GIBENCH_EGL=device|surfaceless forces one. If neither
+ * gives a 4.5 core context the error says what each attempt returned.
+ * GL functions come from libepoxy; include <epoxy/gl.h>. The context is
+ * current on the creating thread only.
+ */
+#ifndef GI_GPU_H
+#define GI_GPU_H
+
+#include <epoxy/gl.h>
+
+#include "gi/common.h"
+#include "gi/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct gi_gpu gi_gpu;
+
+typedef struct gi_gpu_desc {
+    int debug;            /* GL debug context + KHR_debug messages to the log */
+    const char *platform; /* "device", "surfaceless" or NULL = auto (or $GIBENCH_EGL) */
+} gi_gpu_desc;
+
+gi_gpu *gi_gpu_create(const gi_gpu_desc *desc, gi_error *err);
+void gi_gpu_destroy(gi_gpu *gpu);
+/* GL_RENDERER, GL_VERSION, and how the context was made ("device" or "surfaceless"). */
+const char *gi_gpu_renderer(const gi_gpu *gpu);
+const char *gi_gpu_version(const gi_gpu *gpu);
+const char *gi_gpu_platform(const gi_gpu *gpu);
+/* True on software rasterisers (llvmpipe, softpipe, swrast), where GL timer
+ * queries are not trusted for compute work. */
+int gi_gpu_is_software(const gi_gpu *gpu);
+/* Checks glGetError; on error writes "what: GL_INVALID_..." into err. */
+gi_result gi_gl_check(const char *what, gi_error *err);
+
+/* Fixed bindings of the scene resources, mirrored in core/shaders/scene.glsl.
+ * Plugins use binding points >= GI_BINDING_PLUGIN_FIRST for their own. */
+enum {
+    GI_SSBO_VERTICES = 0,
+    GI_SSBO_INDICES = 1,
+    GI_SSBO_MATERIALS = 2,
+    GI_SSBO_LIGHTS = 3,
+    GI_SSBO_EMITTERS = 4,
+    GI_UBO_OBJECTS = 0,
+    GI_UBO_FRAME = 1,
+    GI_TEX_ENV = 0,       /* sampler2D: RGBA32F radiance, intensity applied */
+    GI_TEX_ENV_COND = 1,  /* sampler2D: R32F, (width+1) x height conditional CDF */
+    GI_TEX_ENV_MARG = 2,  /* sampler2D: R32F, (height+1) x 1 marginal CDF */
+    GI_TEX_ALBEDO = 3,    /* sampler2DArray: material textures, one layer each */
+    GI_BINDING_PLUGIN_FIRST = 8,
+};
+
+/* std430 material record (64 bytes), see scene.glsl. */
+typedef struct gi_gpu_material {
+    float albedo[3];
+    int32_t texture_layer; /* -1 none */
+    float ks[3];
+    float exponent;
+    float emission[3];
+    uint32_t flags; /* bit 0 mirror, bit 1 double-sided */
+} gi_gpu_material;
+
+/* std430 punctual light record (64 bytes), world space at the current time. */
+typedef struct gi_gpu_light {
+    float position[3];
+    uint32_t type; /* gi_light_type */
+    float direction[3];
+    float range;
+    float intensity[3];
+    float cos_inner;
+    float cos_outer;
+    float pad[3];
+} gi_gpu_light;
+
+/* std430 emitter record (16 bytes): an emissive triangle with its share of
+ * the area-light power (for sampling by radiance distribution). */
+typedef struct gi_gpu_emitter {
+    uint32_t triangle;
+    float area;      /* world area at the current time */
+    float cdf;       /* inclusive running sum of power, normalised to 1 at the end */
+    float pdf;       /* probability of choosing this emitter */
+} gi_gpu_emitter;
+
+/* The scene on the GPU. All handles are owned by the core; plugins read
+ * them and must not delete them. Vertex attributes of `vao`: 0 position
+ * (vec3), 1 object (uint), 2 normal (vec3), 3 material (uint), 4 uv (vec2),
+ * interleaved as gi_vertex; `ibo` holds the triangle indices. */
+typedef struct gi_gpu_scene {
+    gi_gpu *gpu;
+    const gi_scene *scene;
+    GLuint vao, vbo, ibo;
+    GLuint ssbo_materials, ssbo_lights, ssbo_emitters;
+    GLuint ubo_objects;   /* GI_MAX_OBJECTS x {mat4 world_from_local; mat4 normal matrix} */
+    GLuint tex_env, tex_env_cond, tex_env_marg; /* 0 when no environment */
+    GLuint tex_albedo;    /* 2D array, 1 x 1 x 1 white when the scene has no texture */
+    uint32_t triangle_count, vertex_count, light_count, emitter_count;
+    float emitter_power;  /* total area-light power (sum of area x luminance x pi) */
+    float time;           /* time the transforms were last set for */
+    float world_from_local[GI_MAX_OBJECTS][16]; /* CPU copy of the UBO */
+    float bounds[6];      /* world bounds at `time` */
+} gi_gpu_scene;
+
+gi_gpu_scene *gi_gpu_scene_upload(gi_gpu *gpu, const gi_scene *scene, gi_error *err);
+void gi_gpu_scene_free(gi_gpu_scene *gs);
+/* Recomputes object transforms, light frames and emitter areas at time t
+ * and refreshes the UBO/SSBOs. Cheap; call once per frame of an animation. */
+void gi_gpu_scene_set_time(gi_gpu_scene *gs, float t);
+/* Binds every scene resource to its fixed binding point. */
+void gi_gpu_scene_bind(const gi_gpu_scene *gs);
+/* Draws all triangles (or only object `object` when >= 0) with the scene
+ * VAO; the caller has a program bound. `instances` > 1 draws instanced. */
+void gi_gpu_scene_draw(const gi_gpu_scene *gs, int object, GLsizei instances);
+
+/* Reads an RGBA32F texture (level 0) into a new image, top row first. */
+struct gi_image *gi_gpu_read_texture(GLuint tex, uint32_t width, uint32_t height);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,172 @@
+/* The plugin ABI: one method (one paper) per shared library.
+ *
+ * A plugin exports exactly one symbol,
+ *     GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version);
+ * returning a pointer to static data, or NULL when the host's major version
+ * differs from the one the plugin was built for. The entry touches no GL.
+ *
+ * The host calls, in this order and on the thread that owns the GL context:
+ *     create(host, params, &inst)       once; no scene yet; GL is current
+ *     prepare(inst, gs)                 once per scene (precomputation; may
+ *                                       read/write host->cache_dir)
+ *     { update(inst, gs, changes) }     between frames when something moved
+ *     render(inst, view, target)        once per frame
+ *     destroy(inst)                     always, also after a failed call
+ * After any call returns an error the host reads last_error(inst) (never
+ * NULL; "" when there is nothing to say) and then calls destroy(inst). When
+ * create() fails there is no instance: the plugin reports through host->log.
+ *
+ * Growth: gi_method and gi_host only ever grow at their end. Each carries
+ * its struct_size; a reader checks that a field lies inside struct_size
+ * before touching it (GI_HAS_FIELD). A change that reorders or removes a
+ * field bumps GI_ABI_MAJOR; a change that appends bumps GI_ABI_MINOR.
+ *
+ * Ownership: plugins own and free every GL object they create; they read
+ * the scene's GPU buffers (gi_gpu_scene) but never delete or resize them;
+ * the target texture belongs to the host.
+ */
+#ifndef GI_METHOD_H
+#define GI_METHOD_H
+
+#include "gi/common.h"
+#include "gi/gpu.h"
+#include "gi/params.h"
+#include "gi/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define GI_ABI_MAJOR 1u
+#define GI_ABI_MINOR 0u
+#define GI_ABI_VERSION ((GI_ABI_MAJOR << 16) | GI_ABI_MINOR)
+#define GI_ABI_VERSION_MAJOR(v) ((v) >> 16)
+
+#if defined(__GNUC__)
+#define GI_EXPORT __attribute__((visibility("default")))
+#else
+#define GI_EXPORT
+#endif
+
+/* Does struct *p (with a struct_size field) contain `field` completely? */
+#define GI_HAS_FIELD(p, type, field)                                                               \
+    ((p)->struct_size >= offsetof(type, field) + sizeof(((type *)0)->field))
+
+/* What a method can do. The harness runs a method only on scenes and
+ * settings its caps cover, and marks other cells "n/a" with the reason. */
+typedef enum gi_caps {
+    GI_CAP_DIRECT = 1u << 0,         /* direct light */
+    GI_CAP_INDIRECT = 1u << 1,       /* at least one indirect (diffuse) bounce */
+    GI_CAP_GLOSSY = 1u << 2,         /* glossy final bounce (Phong lobe) */
+    GI_CAP_MIRROR = 1u << 3,         /* ideal mirrors */
+    GI_CAP_AREA_LIGHTS = 1u << 4,    /* emissive triangles */
+    GI_CAP_POINT_LIGHTS = 1u << 5,   /* KHR_lights_punctual point and spot */
+    GI_CAP_DIRECTIONAL = 1u << 6,    /* KHR_lights_punctual directional */
+    GI_CAP_ENVIRONMENT = 1u << 7,    /* environment map */
+    GI_CAP_RIGID_MOTION = 1u << 8,   /* objects move between frames */
+    GI_CAP_DEFORMATION = 1u << 9,    /* vertices change between frames */
+    GI_CAP_PROGRESSIVE = 1u << 10,   /* converges over frames of a still view */
+    GI_CAP_PRECOMPUTE = 1u << 11,    /* prepare() does real precomputation */
+    GI_CAP_VISIBILITY = 1u << 12,    /* direct light is shadowed */
+    GI_CAP_TEXTURES = 1u << 13,      /* albedo textures */
+} gi_caps;
+
+/* Which scene things changed since the last frame (gi_changes.flags). */
+enum {
+    GI_CHANGED_TRANSFORMS = 1u << 0, /* object transforms (animation time) */
+    GI_CHANGED_LIGHTS = 1u << 1,     /* light placement or power */
+    GI_CHANGED_MATERIALS = 1u << 2,
+    GI_CHANGED_CAMERA = 1u << 3,
+};
+
+typedef struct gi_changes {
+    uint32_t flags;
+    float time;                     /* the scene time now in effect */
+    uint64_t moved_objects;         /* bit k: object k moved (objects >= 64: see flags) */
+} gi_changes;
+
+/* One frame to render. Matrices column-major (vecmath.h). */
+typedef struct gi_view {
+    uint32_t width, height;
+    float view[16];          /* world -> eye */
+    float proj[16];          /* eye -> clip, GL convention */
+    float view_proj[16];
+    float inv_view_proj[16];
+    gi_vec3 eye;
+    float yfov, znear, zfar;
+    float time;              /* scene time of this frame, seconds */
+    uint32_t frame_index;    /* frames since the last reset of accumulation */
+    uint32_t seed;           /* per-run seed; frame randomness derives from it */
+    float exposure;          /* display exposure (stops) the report will use */
+} gi_view;
+
+/* Where render() writes: linear RGB radiance (alpha ignored) into an
+ * RGBA32F 2D texture of view->width x view->height owned by the host.
+ * Write it with an FBO attachment (`fbo` has it attached as colour 0) or
+ * with imageStore. Row 0 is the bottom row (GL convention). */
+typedef struct gi_target {
+    GLuint texture;
+    GLuint fbo;
+    uint32_t width, height;
+} gi_target;
+
+typedef struct gi_host gi_host;
+struct gi_host {
+    uint32_t struct_size;
+    uint32_t abi_version;
+    void *user; /* host-private */
+    /* Log a message (level as gi_log_level) prefixed with the method id. */
+    void (*log)(const gi_host *host, int level, const char *fmt, ...)
+#if defined(__GNUC__)
+        __attribute__((format(printf, 3, 4)))
+#endif
+        ;
+    /* Progress of a long task, fraction in [0, 1]; shown on a terminal. */
+    void (*progress)(const gi_host *host, const char *task, float fraction);
+    /* Named stage timers: begin/end pairs, may nest, same name may recur in
+     * a frame (times add). Usable in prepare() and render(). */
+    void (*stage_begin)(const gi_host *host, const char *name);
+    void (*stage_end)(const gi_host *host, const char *name);
+    /* A number worth reporting (bytes, element counts, samples/s); the last
+     * value set for a name wins. Written beside the timings. */
+    void (*stat)(const gi_host *host, const char *name, double value);
+    /* Non-zero once the user or the time limit asked to stop; long loops in
+     * prepare() poll it and return GI_ERR_CANCELLED. */
+    int (*cancelled)(const gi_host *host);
+    /* A directory the method may keep precomputed data in (exists,
+     * writable); name files by a hash of what they depend on (cache.h). */
+    const char *cache_dir;
+    /* GL function loader, for plugins that do not use libepoxy. */
+    void *(*gl_get_proc_address)(const char *name);
+    /* The scene on the GPU (set before prepare, NULL in create). */
+    const gi_gpu_scene *gpu_scene;
+    /* The GL context's facts. */
+    const char *gl_renderer;
+    int gl_is_software;
+};
+
+typedef struct gi_method {
+    uint32_t struct_size;  /* sizeof(gi_method) the plugin was built with */
+    uint32_t abi_version;  /* GI_ABI_VERSION the plugin was built with */
+    const char *id;        /* short unique name: [a-z0-9_]+, e.g. "csm" */
+    const char *title;     /* "Coherent Shadow Maps" */
+    const char *citation;  /* "Ritschel, Grosch, Kautz, Mueller. EGSR 2007" */
+    const char *version;   /* the plugin's own version string */
+    uint32_t caps;         /* gi_caps */
+    uint32_t max_bounces;  /* indirect bounces it can compute (0 = direct only) */
+    const gi_param_desc *params; /* terminated by an entry with name NULL */
+
+    gi_result (*create)(const gi_host *host, const gi_params *params, void **instance);
+    gi_result (*prepare)(void *instance, const gi_gpu_scene *scene);
+    gi_result (*update)(void *instance, const gi_gpu_scene *scene, const gi_changes *changes);
+    gi_result (*render)(void *instance, const gi_view *view, const gi_target *target);
+    void (*destroy)(void *instance);
+    const char *(*last_error)(void *instance);
+} gi_method;
+
+typedef const gi_method *(*gi_method_entry_fn)(uint32_t host_abi_version);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

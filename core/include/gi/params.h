@@ -1,0 +1,66 @@
+/* Method parameters: typed, ranged, named after the paper's symbols.
+ *
+ * A plugin declares a static gi_param_desc table. The host parses
+ * "name=value" strings against it (gi_params_parse): an unknown name, a
+ * value of the wrong type or outside [min, max], or an enum value not in
+ * the list is an error whose message names the method, the parameter and
+ * the allowed values. Parameters not given take their default. Plugins read
+ * values by name; asking for a name the table does not have is a bug
+ * (assert).
+ */
+#ifndef GI_PARAMS_H
+#define GI_PARAMS_H
+
+#include "gi/common.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum gi_param_type {
+    GI_PARAM_INT = 0,
+    GI_PARAM_FLOAT = 1,
+    GI_PARAM_BOOL = 2, /* true/false/1/0/on/off */
+    GI_PARAM_ENUM = 3, /* one of `choices`, "a|b|c"; value is the index */
+} gi_param_type;
+
+typedef struct gi_param_desc {
+    const char *name;    /* [a-z0-9_]+, e.g. "N", "vpls", "filter" */
+    gi_param_type type;
+    double def;          /* default (enum: index into choices) */
+    double min, max;     /* inclusive range (int, float) */
+    const char *choices; /* enum only: "nearest|pcf|rr" */
+    const char *symbol;  /* the paper's symbol or section, e.g. "N (Sec. 4.1)" */
+    const char *help;    /* one line */
+} gi_param_desc;
+
+typedef struct gi_params {
+    const gi_param_desc *desc; /* the method's table */
+    uint32_t count;
+    double *values;            /* count values, desc order */
+    uint32_t *given;           /* 1 where set explicitly */
+} gi_params;
+
+/* Fills defaults and applies each "name=value" in kv[0..n). `method_id`
+ * names the method in messages. Returns NULL + err on the first bad entry. */
+gi_params *gi_params_parse(const char *method_id, const gi_param_desc *desc, const char *const *kv,
+                           uint32_t n, gi_error *err);
+void gi_params_free(gi_params *p);
+/* Number of entries in a NULL-terminated table. */
+uint32_t gi_param_desc_count(const gi_param_desc *desc);
+
+int gi_params_int(const gi_params *p, const char *name);
+float gi_params_float(const gi_params *p, const char *name);
+int gi_params_bool(const gi_params *p, const char *name);
+/* Enum value as its index into choices. */
+int gi_params_enum(const gi_params *p, const char *name);
+/* Canonical "a=1,b=pcf" text of all values (for cache keys, runs.csv).
+ * Returns a malloc'd string. */
+char *gi_params_to_string(const gi_params *p);
+/* Choice `index` of an enum's "a|b|c" list copied into buf. */
+const char *gi_param_choice(const gi_param_desc *d, int index, char *buf, size_t size);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

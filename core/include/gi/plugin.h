@@ -1,0 +1,50 @@
+/* The plugin loader: finds, opens and checks method plugins.
+ *
+ * Search path: the directory given at creation (the build's plugin
+ * directory), then each entry of $GIBENCH_PLUGIN_PATH (':'-separated).
+ * A plugin is any file named gimethod_<id>.so there. Each is opened with
+ * dlopen(RTLD_NOW | RTLD_LOCAL), its gi_method_entry called, and its
+ * descriptor checked: entry present, non-NULL result, ABI major equal,
+ * struct_size at least the 1.0 size, every required function inside
+ * struct_size and non-NULL, a valid id, a valid parameter table, no
+ * duplicate id (the first found wins). A refused plugin gives one line
+ * "path: reason" in the registry's error list and is skipped.
+ * Libraries are never dlclose'd (shims with C++/TLS destructors crash
+ * after unload); gi_plugins_free releases only the registry.
+ */
+#ifndef GI_PLUGIN_H
+#define GI_PLUGIN_H
+
+#include "gi/method.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct gi_plugin {
+    const gi_method *method;
+    char *path;
+} gi_plugin;
+
+typedef struct gi_plugins {
+    gi_plugin *items;
+    uint32_t count;
+    char **errors; /* one "path: reason" line per refused plugin */
+    uint32_t error_count;
+} gi_plugins;
+
+/* Scans `build_dir` (may be NULL) and $GIBENCH_PLUGIN_PATH. Never fails as
+ * a whole: problems land in errors. */
+gi_plugins *gi_plugins_scan(const char *build_dir);
+/* Opens one plugin file and checks it; on refusal returns GI_ERR_* with
+ * "path: reason" in err. Adds it to `reg` (which may be NULL to only check). */
+gi_result gi_plugins_add(gi_plugins *reg, const char *path, gi_error *err);
+const gi_method *gi_plugins_find(const gi_plugins *reg, const char *id);
+void gi_plugins_free(gi_plugins *reg);
+/* Checks a descriptor as the loader does (exposed for tests). */
+gi_result gi_method_validate(const gi_method *m, gi_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,209 @@
+/* The scene: one immutable in-memory copy of a glTF 2.0 file.
+ *
+ * Use:
+ *     gi_error err;
+ *     gi_scene *s = gi_scene_load("scenes/cornell_box.gltf", &err);
+ *     if (!s) { fprintf(stderr, "%s\n", err.text); ... }   // "file: /json/path: reason"
+ *     ...
+ *     gi_scene_free(s);
+ * If gi_scene_load returns non-NULL you own the scene and must free it; the
+ * scene is never modified after loading, so any number of readers may share
+ * it. Time-dependent state (animated objects, lights, cameras) is computed
+ * on demand by the gi_scene_*_at(t) functions.
+ *
+ * Conventions (fixed; see README.md "Scene conventions"):
+ *  - +Y up, right-handed, unit-free lengths. All quantities radiometric:
+ *    emission is radiance, a point/spot light's intensity x colour is
+ *    radiant intensity, a directional light's is irradiance.
+ *  - Geometry is stored in object-local space, exactly as the glTF mesh
+ *    holds it; objects[k].world_from_local (at time t) places it. One object
+ *    is one glTF node carrying a mesh. Triangles of an object are contiguous.
+ *  - Vertices are never shared between objects or materials, so a vertex
+ *    carries its object and material index (the GPU layout relies on it).
+ *  - Materials: Lambert albedo (baseColorFactor x optional baseColorTexture,
+ *    linear), a normalised Phong lobe from material extras
+ *    {"gibench": {"phong": {"ks": [r,g,b], "exponent": n}, "mirror": false}},
+ *    emission = emissiveFactor x KHR_materials_emissive_strength.
+ *    exponent >= GI_MIRROR_EXPONENT or mirror:true means an ideal mirror.
+ *  - Environment: scenes[i].extras
+ *    {"gibench": {"environment": {"uri": "env/x.exr", "intensity": 1.0,
+ *    "rotation_deg": 0}}}, an equirectangular map (see envmap.h).
+ */
+#ifndef GI_SCENE_H
+#define GI_SCENE_H
+
+#include "gi/common.h"
+#include "gi/vecmath.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define GI_MIRROR_EXPONENT 10000.0f
+/* Limits that validation enforces ("absurd counts or sizes"). */
+#define GI_MAX_OBJECTS 256 /* the object-transform UBO holds this many */
+#define GI_MAX_TRIANGLES (16u * 1024u * 1024u)
+#define GI_MAX_VERTICES (48u * 1024u * 1024u)
+#define GI_MAX_MATERIALS 4096
+#define GI_MAX_TEXTURE_SIZE 8192
+#define GI_MAX_FILE_BYTES (1024ull * 1024ull * 1024ull)
+
+/* 48 bytes; this exact layout is uploaded as an SSBO (std430, see
+ * core/shaders/scene.glsl) and used as the vertex buffer. */
+typedef struct gi_vertex {
+    float position[3]; /* object-local */
+    uint32_t object;
+    float normal[3]; /* object-local, unit length */
+    uint32_t material;
+    float uv[2];
+    float pad[2];
+} gi_vertex;
+
+typedef struct gi_material {
+    char *name;
+    float albedo[3];      /* Lambert reflectance, multiplied by the texture */
+    int albedo_texture;   /* index into gi_scene.textures, -1 if none */
+    float ks[3];          /* Phong lobe reflectance */
+    float exponent;       /* Phong exponent n (0 when ks is 0) */
+    int mirror;           /* ideal specular reflection with reflectance ks */
+    float emission[3];    /* emitted radiance; non-zero makes triangles area lights */
+    int double_sided;
+} gi_material;
+
+typedef struct gi_texture {
+    char *name;
+    uint32_t width, height;
+    float *rgba; /* linear (sRGB-decoded) RGBA, row 0 = top of the image */
+} gi_texture;
+
+/* A sampled glTF animation channel set for one node: LINEAR or STEP
+ * translation/rotation/scale keyframes. Times in seconds. */
+typedef struct gi_track {
+    uint32_t count;
+    float *times;
+    float *values; /* 3 floats a key (translation, scale) or 4 (rotation xyzw) */
+    int step;      /* STEP interpolation instead of LINEAR */
+} gi_track;
+
+typedef struct gi_node {
+    char *name;
+    int parent; /* -1 for a root */
+    float translation[3], rotation[4], scale[3];
+    gi_track anim_t, anim_r, anim_s; /* count 0 when not animated */
+} gi_node;
+
+typedef struct gi_object {
+    char *name;
+    int node; /* gi_scene.nodes index */
+    uint32_t first_triangle, triangle_count;
+    uint32_t first_vertex, vertex_count;
+    float local_bounds[6]; /* min xyz, max xyz in object-local space */
+    int animated;          /* this node or an ancestor is animated */
+} gi_object;
+
+typedef enum gi_light_type {
+    GI_LIGHT_POINT = 0,
+    GI_LIGHT_SPOT = 1,
+    GI_LIGHT_DIRECTIONAL = 2,
+} gi_light_type;
+
+/* A KHR_lights_punctual light as placed by its node. */
+typedef struct gi_light {
+    char *name;
+    gi_light_type type;
+    int node;
+    float intensity[3];  /* colour x intensity: W/sr (point, spot) or W/m^2 (directional) */
+    float range;         /* 0 = infinite */
+    float inner_cone, outer_cone; /* spot half-angles in radians */
+} gi_light;
+
+/* The light's world-space frame at time t: position and the direction it
+ * points (the node's -Z). */
+typedef struct gi_light_frame {
+    gi_vec3 position;
+    gi_vec3 direction;
+} gi_light_frame;
+
+typedef struct gi_camera {
+    char *name;
+    int node;
+    float yfov;   /* radians */
+    float aspect; /* 0 when the file leaves it to the viewport */
+    float znear, zfar; /* zfar 0 = infinite in glTF; we substitute a bound-based far plane */
+} gi_camera;
+
+/* A camera resolved at time t: world placement and projection parameters. */
+typedef struct gi_camera_frame {
+    float world_from_camera[16]; /* camera looks down its -Z, +Y up */
+    gi_vec3 eye, forward, up;
+    float yfov, znear, zfar;
+} gi_camera_frame;
+
+typedef struct gi_environment {
+    char *uri;   /* as written in the file, relative to the scene */
+    char *path;  /* resolved path */
+    float intensity;
+    float rotation_deg;
+} gi_environment;
+
+typedef struct gi_scene {
+    char *path; /* the file it came from */
+    gi_vertex *vertices;
+    uint32_t vertex_count;
+    uint32_t *indices; /* 3 per triangle, indexes into vertices */
+    uint32_t triangle_count;
+    gi_material *materials;
+    uint32_t material_count;
+    gi_texture *textures;
+    uint32_t texture_count;
+    gi_node *nodes;
+    uint32_t node_count;
+    gi_object *objects;
+    uint32_t object_count;
+    gi_light *lights;
+    uint32_t light_count;
+    gi_camera *cameras;
+    uint32_t camera_count;
+    /* Emissive triangles (area lights), in triangle order. */
+    uint32_t *emitters;
+    uint32_t emitter_count;
+    int has_environment;
+    gi_environment environment;
+    struct gi_envmap *envmap; /* loaded map with its sampling CDF, or NULL */
+    float animation_length;   /* seconds; 0 for a static scene */
+    float bounds[6];          /* world bounds at t = 0 */
+} gi_scene;
+
+/* Loads and validates a .gltf or .glb file. On failure returns NULL and
+ * writes "file: /json/path: reason" into err. */
+gi_scene *gi_scene_load(const char *path, gi_error *err);
+/* The same from memory (the fuzz target uses this). `base_dir` resolves
+ * external URIs; NULL forbids them. `name` is used in messages. */
+gi_scene *gi_scene_load_memory(const void *data, size_t size, int binary, const char *base_dir,
+                               const char *name, gi_error *err);
+void gi_scene_free(gi_scene *scene);
+
+/* World transform of a node / an object at time t (animations sampled and
+ * composed up the parent chain). */
+void gi_scene_node_transform(const gi_scene *s, int node, float t, float out[16]);
+void gi_scene_object_transform(const gi_scene *s, uint32_t object, float t, float out[16]);
+/* World-space frame of punctual light i at time t. */
+gi_light_frame gi_scene_light_at(const gi_scene *s, uint32_t light, float t);
+/* Camera i at time t. With no camera in the file, camera -1 gives a default
+ * view of the scene bounds from +Z. */
+gi_camera_frame gi_scene_camera_at(const gi_scene *s, int camera, float t);
+/* Index of the camera named `name`, or of "#k", or -1 when none matches. */
+int gi_scene_find_camera(const gi_scene *s, const char *name);
+/* World-space corners of triangle `tri` at time t. */
+void gi_scene_triangle_world(const gi_scene *s, uint32_t tri, float t, gi_vec3 p[3]);
+/* World bounds at time t. */
+void gi_scene_bounds_at(const gi_scene *s, float t, float out[6]);
+/* Emitted radiance of a triangle (its material's emission). */
+const float *gi_scene_triangle_emission(const gi_scene *s, uint32_t tri);
+/* Albedo at a surface point: material albedo x texture(uv), bilinear. */
+void gi_scene_albedo(const gi_scene *s, uint32_t material, const float uv[2], float out[3]);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# Installs the Debian packages gibench needs that are missing on this machine.
+# As root it runs apt-get; otherwise it prints the exact command and exits 2.
+#   scripts/install-deps.sh            build, test and run dependencies
+#   scripts/install-deps.sh --sources  also the packages the scene-conversion
+#                                      scripts read (embree-tools, blender-data, npm)
+set -eu
+
+pkgs=(
+  build-essential cmake ninja-build pkg-config clang libclang-rt-14-dev
+  libembree-dev
+  libopenimageio-dev openimageio-tools
+  libtinygltf-dev nlohmann-json3-dev libstb-dev
+  libvtk9-dev
+  libglfw3-dev libepoxy-dev
+  libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libglx-mesa0
+  xvfb xauth
+  libjson-c-dev libxxhash-dev
+)
+if [ "${1:-}" = "--sources" ]; then
+  pkgs+=(embree-tools blender-data)
+  # npm runs the glTF validator and fetches the bunny and teapot meshes; a
+  # machine that already has a Node.js with npm (not from Debian) keeps it.
+  command -v npm >/dev/null 2>&1 || pkgs+=(nodejs npm)
+elif [ $# -gt 0 ]; then
+  echo "install-deps.sh: unknown option '$1' (use --sources or nothing)" >&2
+  exit 2
+fi
+
+missing=()
+for p in "${pkgs[@]}"; do
+  status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
+  case "$status" in
+    *" installed") ;;
+    *) missing+=("$p") ;;
+  esac
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+cmd="apt-get install -y --no-install-recommends ${missing[*]}"
+if [ "$(id -u)" -ne 0 ]; then
+  echo "install-deps.sh: missing packages; run as root:" >&2
+  echo "  apt-get update && $cmd" >&2
+  exit 2
+fi
+echo "install-deps.sh: installing ${missing[*]}" >&2
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq
+# shellcheck disable=SC2086
+$cmd
