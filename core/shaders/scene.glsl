@@ -53,17 +53,17 @@ uint gi_light_count() { return gi_counts.y; }
 uint gi_emitter_count() { return gi_counts.z; }
 bool gi_has_environment() { return gi_counts.w != 0u; }
 
-vec3 gi_to_world(uint object, vec3 p) { return (gi_objects[object].world_from_local * vec4(p, 1.0)).xyz; }
-vec3 gi_normal_to_world(uint object, vec3 n) { return normalize(mat3(gi_objects[object].normal_matrix) * n); }
+vec3 gi_object_point(uint object, vec3 p) { return (gi_objects[object].world_from_local * vec4(p, 1.0)).xyz; }
+vec3 gi_object_normal(uint object, vec3 n) { return normalize(mat3(gi_objects[object].normal_matrix) * n); }
 
 // World-space corners of triangle `tri`.
 void gi_triangle_world(uint tri, out vec3 p0, out vec3 p1, out vec3 p2)
 {
     uint i0 = gi_indices[3u * tri], i1 = gi_indices[3u * tri + 1u], i2 = gi_indices[3u * tri + 2u];
     uint o = gi_vertices[i0].object;
-    p0 = gi_to_world(o, gi_vertices[i0].position);
-    p1 = gi_to_world(o, gi_vertices[i1].position);
-    p2 = gi_to_world(o, gi_vertices[i2].position);
+    p0 = gi_object_point(o, gi_vertices[i0].position);
+    p1 = gi_object_point(o, gi_vertices[i1].position);
+    p2 = gi_object_point(o, gi_vertices[i2].position);
 }
 
 uint gi_triangle_material(uint tri) { return gi_vertices[gi_indices[3u * tri]].material; }
