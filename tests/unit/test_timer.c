@@ -6,6 +6,7 @@
 #include "gi/timer.h"
 
 #include <string.h>
+#include <stdlib.h>
 #include <time.h>
 
 static void sleep_ms(double ms)
