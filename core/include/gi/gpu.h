@@ -105,6 +105,7 @@ typedef struct gi_gpu_scene {
     GLuint vao, vbo, ibo;
     GLuint ssbo_materials, ssbo_lights, ssbo_emitters;
     GLuint ubo_objects;   /* GI_MAX_OBJECTS x {mat4 world_from_local; mat4 normal matrix} */
+    GLuint ubo_info;      /* scene counts, light powers, time, bounds (GiSceneInfo) */
     GLuint tex_env, tex_env_cond, tex_env_marg; /* 0 when no environment */
     GLuint tex_albedo;    /* 2D array, 1 x 1 x 1 white when the scene has no texture */
     uint32_t triangle_count, vertex_count, light_count, emitter_count;

@@ -32,6 +32,7 @@
 #define GI_PASSES_H
 
 #include "gi/gpu.h"
+#include "gi/shader.h"
 
 #ifdef __cplusplus
 extern "C" {

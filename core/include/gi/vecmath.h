@@ -107,7 +107,9 @@ gi_vec3 gi_mat4_dir(const float m[16], gi_vec3 d);
 void gi_mat4_trs(float out[16], const float t[3], const float q[4], const float s[3]);
 /* View matrix: world -> eye, eye looks down -Z with +Y up. */
 void gi_mat4_look_at(float out[16], gi_vec3 eye, gi_vec3 target, gi_vec3 up);
-/* OpenGL clip-space projections (z in [-1, 1]). */
+/* Clip-space projections with depth z/w in [0, 1] from near to far: the
+ * core sets glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE) on its context, so
+ * these are NOT the classic glFrustum/glOrtho matrices (z in [-1, 1]). */
 void gi_mat4_perspective(float out[16], float yfov_rad, float aspect, float znear, float zfar);
 void gi_mat4_ortho(float out[16], float l, float r, float b, float t, float n, float f);
 /* View matrix of cube face i (GL order +X, -X, +Y, -Y, +Z, -Z) at `eye`,

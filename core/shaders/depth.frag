@@ -1,0 +1,24 @@
+// Depth-map pass, fragment stage: depth peeling. Pass k keeps the nearest
+// surface strictly behind the one pass k-1 kept at this texel and writes its
+// linear depth into channel k of the map (colour mask) and into u_prev's
+// successor for the next pass.
+in vec3 v_eye;
+
+uniform int u_metric;   // 0 eye z, 1 radial
+uniform int u_peel;     // 0 for the first surface
+uniform sampler2D u_prev;
+
+layout(location = 0) out vec4 o_depth;  // the map layer, one channel unmasked
+layout(location = 1) out float o_next;  // this pass's depth, read by the next
+
+void main()
+{
+    float d = u_metric == 1 ? length(v_eye) : -v_eye.z;
+    if (u_peel > 0) {
+        float prev = texelFetch(u_prev, ivec2(gl_FragCoord.xy), 0).r;
+        if (d <= prev * (1.0 + 1e-6) + 1e-7)
+            discard;
+    }
+    o_depth = vec4(d);
+    o_next = d;
+}

@@ -1,0 +1,36 @@
+// G-buffer pass, fragment stage: writes the layout documented in passes.h.
+#include "scene.glsl"
+
+in vec3 v_world;
+in vec3 v_normal;
+in vec2 v_uv;
+in float v_eye_depth;
+flat in uint v_object;
+flat in uint v_material;
+
+uniform vec3 u_eye;
+
+layout(location = 0) out vec4 o_position;
+layout(location = 1) out vec4 o_normal;
+layout(location = 2) out vec4 o_albedo;
+layout(location = 3) out vec4 o_phong;
+layout(location = 4) out vec4 o_emission;
+layout(location = 5) out uvec4 o_ids;
+
+void main()
+{
+    GiMaterial m = gi_materials[v_material];
+    vec3 n = normalize(v_normal);
+    // Shade the side the eye sees: walls seen from inside, thin sheets.
+    if (dot(n, u_eye - v_world) < 0.0)
+        n = -n;
+    bool mirror = (m.flags & GI_MATERIAL_MIRROR) != 0u;
+    // Emitters radiate from their front face (CCW), both faces if double-sided.
+    bool emits = gl_FrontFacing || (m.flags & 2u) != 0u;
+    o_position = vec4(v_world, v_eye_depth);
+    o_normal = vec4(n, 0.0);
+    o_albedo = vec4(gi_material_albedo(v_material, v_uv), mirror ? 1.0 : 0.0);
+    o_phong = vec4(m.ks, m.exponent);
+    o_emission = vec4(emits ? m.emission : vec3(0.0), 1.0);
+    o_ids = uvec4(v_object, v_material, uint(gl_PrimitiveID), 0u);
+}

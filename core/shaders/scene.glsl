@@ -1,0 +1,90 @@
+// The scene on the GPU: buffer layouts and fetch helpers (mirrors gpu.h).
+// Bindings are fixed; plugins use binding points >= 8 for their own data.
+#ifndef GI_SCENE_GLSL
+#define GI_SCENE_GLSL
+#include "common.glsl"
+
+struct GiVertex {
+    vec3 position; uint object;
+    vec3 normal; uint material;
+    vec2 uv; vec2 pad;
+};
+struct GiMaterial {
+    vec3 albedo; int texture_layer;
+    vec3 ks; float exponent;
+    vec3 emission; uint flags; // bit 0 mirror, bit 1 double-sided
+};
+struct GiLight {
+    vec3 position; uint type;  // 0 point, 1 spot, 2 directional
+    vec3 direction; float range;
+    vec3 intensity; float cos_inner;
+    float cos_outer; float pad0, pad1, pad2;
+};
+struct GiEmitter {
+    uint triangle; float area; float cdf; float pdf;
+};
+struct GiObject {
+    mat4 world_from_local;
+    mat4 normal_matrix;
+};
+
+layout(std430, binding = 0) readonly buffer GiVertices { GiVertex gi_vertices[]; };
+layout(std430, binding = 1) readonly buffer GiIndices { uint gi_indices[]; };
+layout(std430, binding = 2) readonly buffer GiMaterials { GiMaterial gi_materials[]; };
+layout(std430, binding = 3) readonly buffer GiLights { GiLight gi_lights[]; };
+layout(std430, binding = 4) readonly buffer GiEmitters { GiEmitter gi_emitters[]; };
+layout(std140, binding = 0) uniform GiObjects { GiObject gi_objects[256]; };
+layout(std140, binding = 1) uniform GiSceneInfo {
+    uvec4 gi_counts;        // triangles, punctual lights, emitters, has environment
+    vec4 gi_scene_params;   // area-light power, environment power estimate, time, 0
+    vec4 gi_bounds_min;     // world bounds at the current time
+    vec4 gi_bounds_max;
+};
+layout(binding = 3) uniform sampler2DArray gi_albedo_textures;
+
+const uint GI_LIGHT_POINT = 0u;
+const uint GI_LIGHT_SPOT = 1u;
+const uint GI_LIGHT_DIRECTIONAL = 2u;
+const uint GI_MATERIAL_MIRROR = 1u;
+const uint GI_NO_ID = 0xFFFFFFFFu;
+
+uint gi_triangle_count() { return gi_counts.x; }
+uint gi_light_count() { return gi_counts.y; }
+uint gi_emitter_count() { return gi_counts.z; }
+bool gi_has_environment() { return gi_counts.w != 0u; }
+
+vec3 gi_object_point(uint object, vec3 p) { return (gi_objects[object].world_from_local * vec4(p, 1.0)).xyz; }
+vec3 gi_object_normal(uint object, vec3 n) { return normalize(mat3(gi_objects[object].normal_matrix) * n); }
+
+// World-space corners of triangle `tri`.
+void gi_triangle_world(uint tri, out vec3 p0, out vec3 p1, out vec3 p2)
+{
+    uint i0 = gi_indices[3u * tri], i1 = gi_indices[3u * tri + 1u], i2 = gi_indices[3u * tri + 2u];
+    uint o = gi_vertices[i0].object;
+    p0 = gi_object_point(o, gi_vertices[i0].position);
+    p1 = gi_object_point(o, gi_vertices[i1].position);
+    p2 = gi_object_point(o, gi_vertices[i2].position);
+}
+
+uint gi_triangle_material(uint tri) { return gi_vertices[gi_indices[3u * tri]].material; }
+
+// Lambert albedo of a material at texture coordinate uv.
+vec3 gi_material_albedo(uint m, vec2 uv)
+{
+    GiMaterial mat = gi_materials[m];
+    if (mat.texture_layer < 0)
+        return mat.albedo;
+    return mat.albedo * texture(gi_albedo_textures, vec3(uv, float(mat.texture_layer))).rgb;
+}
+
+// Index of the emitter whose CDF interval holds u (binary search).
+uint gi_emitter_find(float u)
+{
+    uint lo = 0u, hi = gi_emitter_count() - 1u;
+    while (lo < hi) {
+        uint mid = (lo + hi) / 2u;
+        if (gi_emitters[mid].cdf > u) hi = mid; else lo = mid + 1u;
+    }
+    return lo;
+}
+#endif

@@ -1,0 +1,252 @@
+/* Shared render passes: G-buffer and (peeled) depth maps; see passes.h. */
+#include "gi/passes.h"
+#include "gi/image.h"
+
+#include <float.h>
+#include <stdlib.h>
+#include <string.h>
+
+static GLuint make_tex(GLenum format, uint32_t w, uint32_t h)
+{
+    GLuint t;
+    glCreateTextures(GL_TEXTURE_2D, 1, &t);
+    glTextureStorage2D(t, 1, format, (GLsizei)w, (GLsizei)h);
+    glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTextureParameteri(t, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(t, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return t;
+}
+
+gi_gbuffer *gi_gbuffer_create(uint32_t width, uint32_t height, gi_error *err)
+{
+    if (width == 0 || height == 0 || width > 16384 || height > 16384) {
+        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "G-buffer size %ux%u is not in 1..16384", width, height);
+        return NULL;
+    }
+    gi_gbuffer *gb = calloc(1, sizeof *gb);
+    if (!gb) {
+        gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory");
+        return NULL;
+    }
+    gb->width = width;
+    gb->height = height;
+    gb->program = gi_program_build("gbuffer.vert", NULL, "gbuffer.frag", NULL, err);
+    if (!gb->program) {
+        free(gb);
+        return NULL;
+    }
+    gb->tex_position = make_tex(GL_RGBA32F, width, height);
+    gb->tex_normal = make_tex(GL_RGBA16F, width, height);
+    gb->tex_albedo = make_tex(GL_RGBA16F, width, height);
+    gb->tex_phong = make_tex(GL_RGBA16F, width, height);
+    gb->tex_emission = make_tex(GL_RGBA16F, width, height);
+    gb->tex_ids = make_tex(GL_RGBA32UI, width, height);
+    gb->tex_depth = make_tex(GL_DEPTH_COMPONENT32F, width, height);
+    glCreateFramebuffers(1, &gb->fbo);
+    GLuint color[6] = {gb->tex_position, gb->tex_normal, gb->tex_albedo, gb->tex_phong, gb->tex_emission, gb->tex_ids};
+    GLenum bufs[6];
+    for (int i = 0; i < 6; i++) {
+        glNamedFramebufferTexture(gb->fbo, GL_COLOR_ATTACHMENT0 + (GLenum)i, color[i], 0);
+        bufs[i] = GL_COLOR_ATTACHMENT0 + (GLenum)i;
+    }
+    glNamedFramebufferTexture(gb->fbo, GL_DEPTH_ATTACHMENT, gb->tex_depth, 0);
+    glNamedFramebufferDrawBuffers(gb->fbo, 6, bufs);
+    if (glCheckNamedFramebufferStatus(gb->fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        gi_error_set(err, GI_ERR_GL, "G-buffer framebuffer incomplete");
+        gi_gbuffer_free(gb);
+        return NULL;
+    }
+    return gb;
+}
+
+void gi_gbuffer_free(gi_gbuffer *gb)
+{
+    if (!gb)
+        return;
+    GLuint t[7] = {gb->tex_position, gb->tex_normal, gb->tex_albedo, gb->tex_phong,
+                   gb->tex_emission, gb->tex_ids,    gb->tex_depth};
+    glDeleteTextures(7, t);
+    glDeleteFramebuffers(1, &gb->fbo);
+    glDeleteProgram(gb->program);
+    free(gb);
+}
+
+gi_result gi_gbuffer_render(gi_gbuffer *gb, const gi_gpu_scene *gs, const float view[16], const float proj[16],
+                            gi_error *err)
+{
+    float inv[16];
+    if (!gi_mat4_invert(inv, view))
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "G-buffer: singular view matrix");
+    glBindFramebuffer(GL_FRAMEBUFFER, gb->fbo);
+    glViewport(0, 0, (GLsizei)gb->width, (GLsizei)gb->height);
+    const float zero[4] = {0, 0, 0, 0};
+    const GLuint none[4] = {0xFFFFFFFFu, 0xFFFFFFFFu, 0xFFFFFFFFu, 0};
+    for (int i = 0; i < 5; i++)
+        glClearBufferfv(GL_COLOR, i, zero);
+    glClearBufferuiv(GL_COLOR, 5, none);
+    glClearBufferfi(GL_DEPTH_STENCIL, 0, 1.0f, 0);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    glUseProgram(gb->program);
+    glUniformMatrix4fv(glGetUniformLocation(gb->program, "u_view"), 1, GL_FALSE, view);
+    glUniformMatrix4fv(glGetUniformLocation(gb->program, "u_proj"), 1, GL_FALSE, proj);
+    glUniform3f(glGetUniformLocation(gb->program, "u_eye"), inv[12], inv[13], inv[14]);
+    gi_gpu_scene_bind(gs);
+    gi_gpu_scene_draw(gs, -1, 1);
+    glUseProgram(0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    return gi_gl_check("G-buffer pass", err);
+}
+
+void gi_gbuffer_bind(const gi_gbuffer *gb, GLuint first_unit)
+{
+    GLuint t[6] = {gb->tex_position, gb->tex_normal, gb->tex_albedo, gb->tex_phong, gb->tex_emission, gb->tex_ids};
+    for (GLuint i = 0; i < 6; i++)
+        glBindTextureUnit(first_unit + i, t[i]);
+}
+
+/* ---- depth maps ---- */
+
+struct gi_depth_renderer {
+    gi_depth_desc desc;
+    GLuint program, fbo, depth_rb;
+    GLuint peel[2]; /* R32F ping-pong of the previous surface */
+};
+
+gi_depth_renderer *gi_depth_renderer_create(const gi_depth_desc *desc, gi_error *err)
+{
+    if (desc->size == 0 || desc->size > 16384 || desc->surfaces < 1 || desc->surfaces > 4) {
+        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth maps: size %u (1..16384) or surfaces %u (1..4) invalid",
+                     desc->size, desc->surfaces);
+        return NULL;
+    }
+    gi_depth_renderer *r = calloc(1, sizeof *r);
+    if (!r) {
+        gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory");
+        return NULL;
+    }
+    r->desc = *desc;
+    r->program = gi_program_build("depth.vert", NULL, "depth.frag", NULL, err);
+    if (!r->program) {
+        free(r);
+        return NULL;
+    }
+    glCreateFramebuffers(1, &r->fbo);
+    glCreateRenderbuffers(1, &r->depth_rb);
+    glNamedRenderbufferStorage(r->depth_rb, GL_DEPTH_COMPONENT32F, (GLsizei)desc->size, (GLsizei)desc->size);
+    glNamedFramebufferRenderbuffer(r->fbo, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, r->depth_rb);
+    r->peel[0] = make_tex(GL_R32F, desc->size, desc->size);
+    r->peel[1] = make_tex(GL_R32F, desc->size, desc->size);
+    return r;
+}
+
+void gi_depth_renderer_free(gi_depth_renderer *r)
+{
+    if (!r)
+        return;
+    glDeleteProgram(r->program);
+    glDeleteFramebuffers(1, &r->fbo);
+    glDeleteRenderbuffers(1, &r->depth_rb);
+    glDeleteTextures(2, r->peel);
+    free(r);
+}
+
+GLuint gi_depth_texture_create(const gi_depth_renderer *r, uint32_t layers)
+{
+    GLuint t;
+    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &t);
+    glTextureStorage3D(t, 1, GL_RGBA32F, (GLsizei)r->desc.size, (GLsizei)r->desc.size, (GLsizei)(layers ? layers : 1));
+    glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTextureParameteri(t, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(t, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return t;
+}
+
+void gi_depth_cube_views(gi_vec3 eye, float znear, float zfar, gi_depth_view out[6])
+{
+    for (int f = 0; f < 6; f++) {
+        gi_mat4_cube_face_view(out[f].view, eye, f);
+        gi_mat4_perspective(out[f].proj, GI_PI * 0.5f, 1.0f, znear, zfar);
+        out[f].projection = GI_PROJ_PERSPECTIVE;
+        out[f].znear = znear;
+        out[f].zfar = zfar;
+    }
+}
+
+gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi_depth_view *views, uint32_t count,
+                          GLuint array_tex, uint32_t first_layer, gi_error *err)
+{
+    const gi_depth_desc *d = &r->desc;
+    GLuint p = r->program;
+    glUseProgram(p);
+    gi_gpu_scene_bind(gs);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo);
+    glViewport(0, 0, (GLsizei)d->size, (GLsizei)d->size);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_BLEND);
+    if (d->cull) {
+        glEnable(GL_CULL_FACE);
+        glCullFace(d->cull == 1 ? GL_BACK : GL_FRONT);
+    } else {
+        glDisable(GL_CULL_FACE);
+    }
+    glUniform1i(glGetUniformLocation(p, "u_metric"), (GLint)d->metric);
+    glUniform1i(glGetUniformLocation(p, "u_local"), d->local);
+    glUniform1i(glGetUniformLocation(p, "u_prev"), 15);
+    GLint loc_view = glGetUniformLocation(p, "u_view"), loc_proj = glGetUniformLocation(p, "u_proj");
+    GLint loc_projection = glGetUniformLocation(p, "u_projection"), loc_range = glGetUniformLocation(p, "u_range");
+    GLint loc_peel = glGetUniformLocation(p, "u_peel");
+    const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glNamedFramebufferDrawBuffers(r->fbo, 2, bufs);
+    const float far_value[4] = {FLT_MAX, FLT_MAX, FLT_MAX, FLT_MAX};
+    for (uint32_t v = 0; v < count; v++) {
+        const gi_depth_view *dv = &views[v];
+        int para = dv->projection == GI_PROJ_PARABOLOID;
+        if (para)
+            glEnable(GL_CLIP_DISTANCE0);
+        else
+            glDisable(GL_CLIP_DISTANCE0);
+        glUniformMatrix4fv(loc_view, 1, GL_FALSE, dv->view);
+        glUniformMatrix4fv(loc_proj, 1, GL_FALSE, dv->proj);
+        glUniform1i(loc_projection, (GLint)dv->projection);
+        glUniform2f(loc_range, dv->znear, dv->zfar);
+        glNamedFramebufferTextureLayer(r->fbo, GL_COLOR_ATTACHMENT0, array_tex, 0, (GLint)(first_layer + v));
+        /* Every channel starts at +inf: fewer surfaces than channels. */
+        glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        glClearBufferfv(GL_COLOR, 0, far_value);
+        for (uint32_t k = 0; k < d->surfaces; k++) {
+            GLuint cur = r->peel[k & 1], prev = r->peel[(k + 1) & 1];
+            glNamedFramebufferTexture(r->fbo, GL_COLOR_ATTACHMENT1, cur, 0);
+            glColorMaski(0, k == 0, k == 1, k == 2, k == 3);
+            glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+            glClearBufferfv(GL_COLOR, 1, far_value);
+            glClear(GL_DEPTH_BUFFER_BIT);
+            glBindTextureUnit(15, prev);
+            glUniform1i(loc_peel, (GLint)k);
+            gi_gpu_scene_draw(gs, d->object, 1);
+        }
+    }
+    glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDisable(GL_CLIP_DISTANCE0);
+    glDisable(GL_CULL_FACE);
+    glBindTextureUnit(15, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glUseProgram(0);
+    return gi_gl_check("depth-map pass", err);
+}
+
+float *gi_depth_read_layer(GLuint array_tex, uint32_t size, uint32_t layer)
+{
+    size_t n = (size_t)size * size * 4;
+    float *out = malloc(n * sizeof *out);
+    if (!out)
+        return NULL;
+    glGetTextureSubImage(array_tex, 0, 0, 0, (GLint)layer, (GLsizei)size, (GLsizei)size, 1, GL_RGBA, GL_FLOAT,
+                         (GLsizei)(n * sizeof *out), out);
+    return out;
+}

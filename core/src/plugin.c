@@ -1,0 +1,230 @@
+/* The plugin loader (plugin.h): dlopen, entry, descriptor checks. */
+#define _POSIX_C_SOURCE 200809L
+#include "gi/plugin.h"
+#include "gi/log.h"
+
+#include <dirent.h>
+#include <dlfcn.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The size of gi_method in ABI 1.0: everything up to last_error. */
+#define GI_METHOD_SIZE_1_0 (offsetof(gi_method, last_error) + sizeof(void *))
+
+static char *dup_str(const char *s)
+{
+    size_t n = strlen(s) + 1;
+    char *d = malloc(n);
+    if (d)
+        memcpy(d, s, n);
+    return d;
+}
+
+static int valid_name(const char *s, int allow_upper)
+{
+    if (!s || !*s || strlen(s) > 31)
+        return 0;
+    for (const char *p = s; *p; p++)
+        if (!((*p >= 'a' && *p <= 'z') || (*p >= '0' && *p <= '9') || *p == '_' ||
+              (allow_upper && *p >= 'A' && *p <= 'Z')))
+            return 0;
+    return 1;
+}
+
+static gi_result validate_params(const gi_method *m, gi_error *err)
+{
+    for (uint32_t i = 0; m->params && m->params[i].name; i++) {
+        const gi_param_desc *d = &m->params[i];
+        if (!valid_name(d->name, 1))
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "parameter %u has an invalid name", i);
+        for (uint32_t k = 0; k < i; k++)
+            if (strcmp(m->params[k].name, d->name) == 0)
+                return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "parameter '%s' declared twice", d->name);
+        if (d->type > GI_PARAM_ENUM)
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "parameter '%s' has an unknown type", d->name);
+        if (d->type == GI_PARAM_ENUM) {
+            int n = 1;
+            if (!d->choices || !*d->choices)
+                return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "enum parameter '%s' has no choices", d->name);
+            for (const char *p = d->choices; *p; p++)
+                n += *p == '|';
+            if (d->def < 0 || d->def >= n)
+                return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "enum parameter '%s' default out of range",
+                                    d->name);
+        } else if ((d->type == GI_PARAM_INT || d->type == GI_PARAM_FLOAT) &&
+                   !(d->min <= d->def && d->def <= d->max)) {
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "parameter '%s' default %g outside [%g, %g]", d->name,
+                                d->def, d->min, d->max);
+        }
+    }
+    return GI_OK;
+}
+
+gi_result gi_method_validate(const gi_method *m, gi_error *err)
+{
+    if (GI_ABI_VERSION_MAJOR(m->abi_version) != GI_ABI_MAJOR)
+        return gi_error_set(err, GI_ERR_UNSUPPORTED, "built for plugin ABI %u.%u, this gibench speaks %u.%u",
+                            m->abi_version >> 16, m->abi_version & 0xFFFF, GI_ABI_MAJOR, GI_ABI_MINOR);
+    if (m->struct_size < GI_METHOD_SIZE_1_0)
+        return gi_error_set(err, GI_ERR_UNSUPPORTED, "descriptor is %u bytes, ABI %u.0 needs at least %zu",
+                            m->struct_size, GI_ABI_MAJOR, (size_t)GI_METHOD_SIZE_1_0);
+    if (!valid_name(m->id, 0))
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "method id '%s' is not [a-z0-9_]{1,31}",
+                            m->id ? m->id : "(null)");
+    if (!m->title || !m->citation || !m->version)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "method '%s' lacks a title, citation or version", m->id);
+    struct {
+        const char *name;
+        int present;
+        size_t end;
+    } fns[] = {
+        {"create", m->create != NULL, offsetof(gi_method, create) + sizeof(void *)},
+        {"prepare", m->prepare != NULL, offsetof(gi_method, prepare) + sizeof(void *)},
+        {"update", m->update != NULL, offsetof(gi_method, update) + sizeof(void *)},
+        {"render", m->render != NULL, offsetof(gi_method, render) + sizeof(void *)},
+        {"destroy", m->destroy != NULL, offsetof(gi_method, destroy) + sizeof(void *)},
+        {"last_error", m->last_error != NULL, offsetof(gi_method, last_error) + sizeof(void *)},
+    };
+    for (size_t i = 0; i < sizeof fns / sizeof fns[0]; i++)
+        if (fns[i].end > m->struct_size || !fns[i].present)
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "method '%s' lacks the required function %s()", m->id,
+                                fns[i].name);
+    gi_error perr;
+    if (validate_params(m, &perr) != GI_OK)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "method '%s': %s", m->id, perr.text);
+    return GI_OK;
+}
+
+static int push_error(gi_plugins *reg, const char *text)
+{
+    char **e = realloc(reg->errors, (reg->error_count + 1) * sizeof *e);
+    if (!e)
+        return 0;
+    reg->errors = e;
+    reg->errors[reg->error_count] = dup_str(text);
+    if (reg->errors[reg->error_count])
+        reg->error_count++;
+    return 1;
+}
+
+gi_result gi_plugins_add(gi_plugins *reg, const char *path, gi_error *err)
+{
+    /* Never dlclose: see plugin.h. A refused library stays mapped too; it is
+     * rare and closing it would run its destructors. */
+    void *lib = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (!lib) {
+        const char *why = dlerror();
+        return gi_error_set(err, GI_ERR_IO, "%s: cannot load: %s", path, why ? why : "unknown reason");
+    }
+    gi_method_entry_fn entry;
+    void *sym = dlsym(lib, "gi_method_entry");
+    memcpy(&entry, &sym, sizeof entry);
+    if (!sym)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: no gi_method_entry symbol (not a gibench plugin)",
+                            path);
+    const gi_method *m = entry(GI_ABI_VERSION);
+    if (!m)
+        return gi_error_set(err, GI_ERR_UNSUPPORTED,
+                            "%s: gi_method_entry returned NULL for host ABI %u.%u (built for another ABI major)",
+                            path, GI_ABI_MAJOR, GI_ABI_MINOR);
+    gi_error verr;
+    if (gi_method_validate(m, &verr) != GI_OK)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: %s", path, verr.text);
+    if (!reg)
+        return GI_OK;
+    for (uint32_t i = 0; i < reg->count; i++)
+        if (strcmp(reg->items[i].method->id, m->id) == 0)
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: duplicate method id '%s' (already loaded from %s)",
+                                path, m->id, reg->items[i].path);
+    gi_plugin *items = realloc(reg->items, (reg->count + 1) * sizeof *items);
+    if (!items)
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory");
+    reg->items = items;
+    reg->items[reg->count].method = m;
+    reg->items[reg->count].path = dup_str(path);
+    reg->count++;
+    return GI_OK;
+}
+
+static int cmp_str(const void *a, const void *b)
+{
+    return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+static void scan_dir(gi_plugins *reg, const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (!d)
+        return;
+    char **names = NULL;
+    size_t n = 0;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        size_t len = strlen(e->d_name);
+        if (strncmp(e->d_name, "gimethod_", 9) != 0 || len < 12 || strcmp(e->d_name + len - 3, ".so") != 0)
+            continue;
+        char **grown = realloc(names, (n + 1) * sizeof *names);
+        if (!grown)
+            break;
+        names = grown;
+        names[n] = dup_str(e->d_name);
+        if (names[n])
+            n++;
+    }
+    closedir(d);
+    /* Sorted, so that which duplicate wins does not depend on readdir order. */
+    qsort(names, n, sizeof *names, cmp_str);
+    for (size_t i = 0; i < n; i++) {
+        size_t len = strlen(dir) + strlen(names[i]) + 2;
+        char *path = malloc(len);
+        if (path) {
+            snprintf(path, len, "%s/%s", dir, names[i]);
+            gi_error err;
+            if (gi_plugins_add(reg, path, &err) != GI_OK)
+                push_error(reg, err.text);
+            free(path);
+        }
+        free(names[i]);
+    }
+    free(names);
+}
+
+gi_plugins *gi_plugins_scan(const char *build_dir)
+{
+    gi_plugins *reg = calloc(1, sizeof *reg);
+    if (!reg)
+        return NULL;
+    if (build_dir)
+        scan_dir(reg, build_dir);
+    const char *env = getenv("GIBENCH_PLUGIN_PATH");
+    if (env) {
+        char *copy = dup_str(env), *save = NULL;
+        for (char *tok = copy ? strtok_r(copy, ":", &save) : NULL; tok; tok = strtok_r(NULL, ":", &save))
+            if (*tok && (!build_dir || strcmp(tok, build_dir) != 0))
+                scan_dir(reg, tok);
+        free(copy);
+    }
+    return reg;
+}
+
+const gi_method *gi_plugins_find(const gi_plugins *reg, const char *id)
+{
+    for (uint32_t i = 0; i < reg->count; i++)
+        if (strcmp(reg->items[i].method->id, id) == 0)
+            return reg->items[i].method;
+    return NULL;
+}
+
+void gi_plugins_free(gi_plugins *reg)
+{
+    if (!reg)
+        return;
+    for (uint32_t i = 0; i < reg->count; i++)
+        free(reg->items[i].path);
+    for (uint32_t i = 0; i < reg->error_count; i++)
+        free(reg->errors[i]);
+    free(reg->items);
+    free(reg->errors);
+    free(reg);
+}

@@ -1,0 +1,245 @@
+/* Helpers shared by the gibench subcommands. */
+#define _POSIX_C_SOURCE 200809L
+#include "cli.h"
+
+#include "gi/cache.h"
+#include "gi/log.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+volatile sig_atomic_t cli_interrupted;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    cli_interrupted = 1;
+}
+
+void cli_install_signal_handlers(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+}
+
+int cli_fail(int code, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fputs("gibench: ", stderr);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+    return code;
+}
+
+int cli_parse_uint(const char *s, unsigned long min, unsigned long max, unsigned long *out)
+{
+    if (!s || !*s || *s == '-' || *s == '+')
+        return 0;
+    char *end;
+    errno = 0;
+    unsigned long v = strtoul(s, &end, 10);
+    if (errno || *end || v < min || v > max)
+        return 0;
+    *out = v;
+    return 1;
+}
+
+int cli_parse_float(const char *s, float *out)
+{
+    if (!s || !*s)
+        return 0;
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (errno || *end || !isfinite(v))
+        return 0;
+    *out = (float)v;
+    return 1;
+}
+
+int cli_parse_size(const char *s, uint32_t *w, uint32_t *h)
+{
+    const char *x = s ? strchr(s, 'x') : NULL;
+    if (!x)
+        return 0;
+    char buf[32];
+    size_t n = (size_t)(x - s);
+    if (n == 0 || n >= sizeof buf)
+        return 0;
+    memcpy(buf, s, n);
+    buf[n] = '\0';
+    unsigned long a, b;
+    if (!cli_parse_uint(buf, 1, 16384, &a) || !cli_parse_uint(x + 1, 1, 16384, &b))
+        return 0;
+    *w = (uint32_t)a;
+    *h = (uint32_t)b;
+    return 1;
+}
+
+gi_plugins *cli_load_plugins(int quiet)
+{
+    gi_plugins *reg = gi_plugins_scan(GIBENCH_PLUGIN_DIR);
+    if (reg && !quiet)
+        for (uint32_t i = 0; i < reg->error_count; i++)
+            fprintf(stderr, "gibench: warning: plugin refused: %s\n", reg->errors[i]);
+    return reg;
+}
+
+void cli_caps_string(uint32_t caps, char *buf, size_t size)
+{
+    static const char *names[] = {"direct",      "indirect",   "glossy",       "mirror",     "area-lights",
+                                  "point-lights", "directional", "environment", "rigid-motion", "deformation",
+                                  "progressive", "precompute", "visibility",   "textures"};
+    buf[0] = '\0';
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+        if (caps & (1u << i)) {
+            size_t used = strlen(buf);
+            snprintf(buf + used, size - used, "%s%s", used ? " " : "", names[i]);
+        }
+}
+
+const char *cli_param_type_name(gi_param_type t)
+{
+    switch (t) {
+    case GI_PARAM_INT:
+        return "int";
+    case GI_PARAM_FLOAT:
+        return "float";
+    case GI_PARAM_BOOL:
+        return "bool";
+    case GI_PARAM_ENUM:
+        return "enum";
+    }
+    return "?";
+}
+
+/* ---- host services ---- */
+
+static cli_host *self(const gi_host *h)
+{
+    return (cli_host *)h->user;
+}
+
+static void host_log(const gi_host *h, int level, const char *fmt, ...)
+{
+    char msg[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    gi_log((gi_log_level)(level < 0 ? 0 : level > 3 ? 3 : level), "%s: %s", self(h)->method_id, msg);
+}
+
+static void host_progress(const gi_host *h, const char *task, float fraction)
+{
+    if (!self(h)->show_progress)
+        return;
+    int pct = (int)(fraction * 100.0f + 0.5f);
+    fprintf(stderr, "\r%s: %s %3d%%%s", self(h)->method_id, task, pct, fraction >= 1.0f ? "\n" : "");
+    fflush(stderr);
+}
+
+static void host_stage_begin(const gi_host *h, const char *name)
+{
+    if (self(h)->timer)
+        gi_timer_begin(self(h)->timer, name);
+}
+
+static void host_stage_end(const gi_host *h, const char *name)
+{
+    if (self(h)->timer)
+        gi_timer_end(self(h)->timer, name);
+}
+
+static void host_stat(const gi_host *h, const char *name, double value)
+{
+    json_object_object_add(self(h)->stats, name, json_object_new_double(value));
+}
+
+static int host_cancelled(const gi_host *h)
+{
+    (void)h;
+    return cli_interrupted != 0;
+}
+
+static void *host_proc(const char *name)
+{
+    (void)name;
+    return NULL; /* plugins use libepoxy through gicore */
+}
+
+void cli_host_init(cli_host *h, const char *method_id, const char *cache_dir, const gi_gpu_scene *gs,
+                   const char *renderer, int software)
+{
+    memset(h, 0, sizeof *h);
+    h->method_id = method_id;
+    h->stats = json_object_new_object();
+    h->show_progress = isatty(STDERR_FILENO);
+    gi_host *g = &h->host;
+    g->struct_size = sizeof *g;
+    g->abi_version = GI_ABI_VERSION;
+    g->user = h;
+    g->log = host_log;
+    g->progress = host_progress;
+    g->stage_begin = host_stage_begin;
+    g->stage_end = host_stage_end;
+    g->stat = host_stat;
+    g->cancelled = host_cancelled;
+    g->cache_dir = cache_dir;
+    g->gl_get_proc_address = host_proc;
+    g->gpu_scene = gs;
+    g->gl_renderer = renderer;
+    g->gl_is_software = software;
+}
+
+void cli_host_free(cli_host *h)
+{
+    json_object_put(h->stats);
+    h->stats = NULL;
+}
+
+int cli_write_json(const char *path, json_object *obj, char *why, size_t why_size)
+{
+    const char *text = json_object_to_json_string_ext(obj, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_NOSLASHESCAPE);
+    gi_error err;
+    size_t n = strlen(text);
+    char *with_nl = malloc(n + 2);
+    if (!with_nl) {
+        snprintf(why, why_size, "out of memory");
+        return 0;
+    }
+    memcpy(with_nl, text, n);
+    with_nl[n] = '\n';
+    int ok = gi_file_write_atomic(path, with_nl, n + 1, &err) == GI_OK;
+    free(with_nl);
+    if (!ok)
+        snprintf(why, why_size, "%s", err.text);
+    return ok;
+}
+
+json_object *cli_timer_json(const gi_timer *t)
+{
+    json_object *o = json_object_new_object();
+    gi_stage_stats st[GI_TIMER_MAX_STAGES + 1];
+    uint32_t n = gi_timer_stats(t, st, GI_TIMER_MAX_STAGES + 1);
+    for (uint32_t i = 0; i < n; i++) {
+        json_object *s = json_object_new_object();
+        json_object_object_add(s, "median_ms", json_object_new_double(st[i].median_ms));
+        json_object_object_add(s, "min_ms", json_object_new_double(st[i].min_ms));
+        json_object_object_add(s, "max_ms", json_object_new_double(st[i].max_ms));
+        json_object_object_add(s, "mean_ms", json_object_new_double(st[i].mean_ms));
+        json_object_object_add(s, "samples", json_object_new_int((int32_t)st[i].samples));
+        json_object_object_add(o, st[i].name, s);
+    }
+    return o;
+}

@@ -1,0 +1,62 @@
+/* Shared pieces of the gibench command: argument helpers, the plugin
+ * registry, the host services handed to plugins, and JSON output. */
+#ifndef GIBENCH_CLI_H
+#define GIBENCH_CLI_H
+
+#include "gi/method.h"
+#include "gi/plugin.h"
+#include "gi/timer.h"
+
+#include <json-c/json.h>
+#include <signal.h>
+
+/* Exit codes (ARCHITECTURE.md): 0 ok, 1 failure while running, 2 bad usage or input. */
+enum { EXIT_OK = 0, EXIT_RUN = 1, EXIT_USAGE = 2 };
+
+/* Prints "gibench: <message>" on stderr and returns `code`. */
+int cli_fail(int code, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+/* Parses "WxH" into positive sizes (<= 16384); 0 on malformed text. */
+int cli_parse_size(const char *s, uint32_t *w, uint32_t *h);
+/* Parses an unsigned integer in [min, max]; 0 on failure. */
+int cli_parse_uint(const char *s, unsigned long min, unsigned long max, unsigned long *out);
+int cli_parse_float(const char *s, float *out);
+
+/* The plugin registry of this build plus $GIBENCH_PLUGIN_PATH; loader
+ * refusals are printed as warnings. */
+gi_plugins *cli_load_plugins(int quiet);
+/* The caps as a list of words ("direct area-lights ..."). */
+void cli_caps_string(uint32_t caps, char *buf, size_t size);
+const char *cli_param_type_name(gi_param_type t);
+
+/* Host services for one method instance. */
+typedef struct cli_host {
+    gi_host host;
+    const char *method_id;
+    gi_timer *timer;   /* where stage timers go now (prepare or render timer) */
+    json_object *stats;
+    int show_progress;
+} cli_host;
+
+void cli_host_init(cli_host *h, const char *method_id, const char *cache_dir, const gi_gpu_scene *gs,
+                   const char *renderer, int software);
+void cli_host_free(cli_host *h);
+
+/* Set by SIGINT/SIGTERM; the host reports it through cancelled(). */
+extern volatile sig_atomic_t cli_interrupted;
+void cli_install_signal_handlers(void);
+
+/* Writes a JSON object to a file atomically (pretty-printed). */
+int cli_write_json(const char *path, json_object *obj, char *why, size_t why_size);
+/* Stage statistics of a timer as a JSON object {stage: {median_ms, ...}}. */
+json_object *cli_timer_json(const gi_timer *t);
+
+int cmd_methods(int argc, char **argv);
+int cmd_info(int argc, char **argv);
+int cmd_render(int argc, char **argv);
+
+#endif

@@ -1,0 +1,101 @@
+/* gibench methods: the installed method plugins and their parameters. */
+#include "cli.h"
+
+#include <stdio.h>
+#include <string.h>
+
+static json_object *param_json(const gi_param_desc *d)
+{
+    json_object *p = json_object_new_object();
+    json_object_object_add(p, "name", json_object_new_string(d->name));
+    json_object_object_add(p, "type", json_object_new_string(cli_param_type_name(d->type)));
+    if (d->type == GI_PARAM_ENUM) {
+        char buf[64];
+        json_object_object_add(p, "default", json_object_new_string(gi_param_choice(d, (int)d->def, buf, sizeof buf)));
+        json_object_object_add(p, "choices", json_object_new_string(d->choices));
+    } else if (d->type == GI_PARAM_BOOL) {
+        json_object_object_add(p, "default", json_object_new_boolean(d->def != 0.0));
+    } else {
+        json_object_object_add(p, "default", json_object_new_double(d->def));
+        json_object_object_add(p, "min", json_object_new_double(d->min));
+        json_object_object_add(p, "max", json_object_new_double(d->max));
+    }
+    json_object_object_add(p, "symbol", json_object_new_string(d->symbol ? d->symbol : ""));
+    json_object_object_add(p, "help", json_object_new_string(d->help ? d->help : ""));
+    return p;
+}
+
+static void print_param(const gi_param_desc *d)
+{
+    char range[96] = "";
+    char def[64];
+    switch (d->type) {
+    case GI_PARAM_ENUM:
+        gi_param_choice(d, (int)d->def, def, sizeof def);
+        snprintf(range, sizeof range, "{%s}", d->choices);
+        break;
+    case GI_PARAM_BOOL:
+        snprintf(def, sizeof def, "%s", d->def != 0.0 ? "true" : "false");
+        break;
+    default:
+        snprintf(def, sizeof def, "%g", d->def);
+        snprintf(range, sizeof range, "[%g, %g]", d->min, d->max);
+        break;
+    }
+    printf("    %-12s %-5s default %-8s %-18s %s%s%s%s\n", d->name, cli_param_type_name(d->type), def, range,
+           d->help ? d->help : "", d->symbol ? " (" : "", d->symbol ? d->symbol : "", d->symbol ? ")" : "");
+}
+
+int cmd_methods(int argc, char **argv)
+{
+    int json = 0;
+    for (int i = 0; i < argc; i++) {
+        if (!strcmp(argv[i], "--json"))
+            json = 1;
+        else
+            return cli_fail(EXIT_USAGE, "methods: unknown argument '%s'", argv[i]);
+    }
+    gi_plugins *reg = cli_load_plugins(0);
+    if (!reg)
+        return cli_fail(EXIT_RUN, "out of memory");
+    if (json) {
+        json_object *arr = json_object_new_array();
+        for (uint32_t i = 0; i < reg->count; i++) {
+            const gi_method *m = reg->items[i].method;
+            json_object *o = json_object_new_object();
+            char caps[256];
+            cli_caps_string(m->caps, caps, sizeof caps);
+            json_object_object_add(o, "id", json_object_new_string(m->id));
+            json_object_object_add(o, "title", json_object_new_string(m->title));
+            json_object_object_add(o, "citation", json_object_new_string(m->citation));
+            json_object_object_add(o, "version", json_object_new_string(m->version));
+            json_object_object_add(o, "caps", json_object_new_string(caps));
+            json_object_object_add(o, "max_bounces", json_object_new_int((int32_t)m->max_bounces));
+            json_object_object_add(o, "path", json_object_new_string(reg->items[i].path));
+            json_object *ps = json_object_new_array();
+            for (const gi_param_desc *d = m->params; d && d->name; d++)
+                json_object_array_add(ps, param_json(d));
+            json_object_object_add(o, "params", ps);
+            json_object_array_add(arr, o);
+        }
+        puts(json_object_to_json_string_ext(arr, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_NOSLASHESCAPE));
+        json_object_put(arr);
+    } else {
+        if (reg->count == 0)
+            printf("no method plugins found (build directory %s, GIBENCH_PLUGIN_PATH)\n", GIBENCH_PLUGIN_DIR);
+        for (uint32_t i = 0; i < reg->count; i++) {
+            const gi_method *m = reg->items[i].method;
+            char caps[256];
+            cli_caps_string(m->caps, caps, sizeof caps);
+            printf("%s  %s (v%s)\n  %s\n  caps: %s; indirect bounces: %u\n", m->id, m->title, m->version,
+                   m->citation, caps, m->max_bounces);
+            if (m->params && m->params[0].name) {
+                printf("  parameters:\n");
+                for (const gi_param_desc *d = m->params; d->name; d++)
+                    print_param(d);
+            }
+        }
+    }
+    gi_plugins_free(reg);
+    return EXIT_OK;
+}

@@ -1,0 +1,331 @@
+/* gibench render: one method, one scene, one camera -> image + timings. */
+#include "cli.h"
+
+#include "gi/cache.h"
+#include "gi/image.h"
+#include "gi/log.h"
+#include "gi/passes.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_PARAMS 64
+#define MAX_OUTS 4
+
+typedef struct render_opts {
+    const char *scene, *method, *camera, *timings;
+    const char *outs[MAX_OUTS];
+    int out_count;
+    const char *params[MAX_PARAMS];
+    uint32_t param_count;
+    uint32_t width, height, frames, warmup, seed;
+    float time, animate_fps, exposure;
+} render_opts;
+
+static int image_ext_ok(const char *path)
+{
+    const char *dot = strrchr(path, '.');
+    return dot && (!strcmp(dot, ".exr") || !strcmp(dot, ".pfm") || !strcmp(dot, ".png"));
+}
+
+static int parse_opts(int argc, char **argv, render_opts *o)
+{
+    memset(o, 0, sizeof *o);
+    o->width = o->height = 256;
+    o->frames = 1;
+    o->seed = 1;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        unsigned long u;
+        if (!strcmp(a, "--scene") || !strcmp(a, "--method") || !strcmp(a, "--camera") || !strcmp(a, "--out") ||
+            !strcmp(a, "--size") || !strcmp(a, "--param") || !strcmp(a, "--frames") || !strcmp(a, "--warmup") ||
+            !strcmp(a, "--time") || !strcmp(a, "--animate") || !strcmp(a, "--seed") || !strcmp(a, "--exposure") ||
+            !strcmp(a, "--timings")) {
+            if (!v)
+                return cli_fail(EXIT_USAGE, "render: %s needs a value", a);
+            i++;
+        } else {
+            return cli_fail(EXIT_USAGE, "render: unknown argument '%s' (see gibench --help)", a);
+        }
+        if (!strcmp(a, "--scene"))
+            o->scene = v;
+        else if (!strcmp(a, "--method"))
+            o->method = v;
+        else if (!strcmp(a, "--camera"))
+            o->camera = v;
+        else if (!strcmp(a, "--timings"))
+            o->timings = v;
+        else if (!strcmp(a, "--out")) {
+            if (o->out_count == MAX_OUTS)
+                return cli_fail(EXIT_USAGE, "render: at most %d --out files", MAX_OUTS);
+            if (!image_ext_ok(v))
+                return cli_fail(EXIT_USAGE, "render: --out '%s': use a .exr, .pfm or .png file name", v);
+            o->outs[o->out_count++] = v;
+        } else if (!strcmp(a, "--size")) {
+            if (!cli_parse_size(v, &o->width, &o->height))
+                return cli_fail(EXIT_USAGE, "render: --size '%s' is not WxH with 1..16384 each", v);
+        } else if (!strcmp(a, "--param")) {
+            if (o->param_count == MAX_PARAMS)
+                return cli_fail(EXIT_USAGE, "render: at most %d --param", MAX_PARAMS);
+            o->params[o->param_count++] = v;
+        } else if (!strcmp(a, "--frames")) {
+            if (!cli_parse_uint(v, 1, 1000000, &u))
+                return cli_fail(EXIT_USAGE, "render: --frames '%s' is not an integer in 1..1000000", v);
+            o->frames = (uint32_t)u;
+        } else if (!strcmp(a, "--warmup")) {
+            if (!cli_parse_uint(v, 0, 1000, &u))
+                return cli_fail(EXIT_USAGE, "render: --warmup '%s' is not an integer in 0..1000", v);
+            o->warmup = (uint32_t)u;
+        } else if (!strcmp(a, "--seed")) {
+            if (!cli_parse_uint(v, 0, 0xFFFFFFFFul, &u))
+                return cli_fail(EXIT_USAGE, "render: --seed '%s' is not a 32-bit unsigned integer", v);
+            o->seed = (uint32_t)u;
+        } else if (!strcmp(a, "--time")) {
+            if (!cli_parse_float(v, &o->time) || o->time < 0)
+                return cli_fail(EXIT_USAGE, "render: --time '%s' is not a non-negative number", v);
+        } else if (!strcmp(a, "--animate")) {
+            if (!cli_parse_float(v, &o->animate_fps) || o->animate_fps <= 0)
+                return cli_fail(EXIT_USAGE, "render: --animate '%s' is not a positive frame rate", v);
+        } else if (!strcmp(a, "--exposure")) {
+            if (!cli_parse_float(v, &o->exposure))
+                return cli_fail(EXIT_USAGE, "render: --exposure '%s' is not a number", v);
+        }
+    }
+    if (!o->scene)
+        return cli_fail(EXIT_USAGE, "render: --scene is required");
+    if (!o->method)
+        return cli_fail(EXIT_USAGE, "render: --method is required (see gibench methods)");
+    if (o->out_count == 0)
+        return cli_fail(EXIT_USAGE, "render: --out is required");
+    if (o->warmup >= o->frames && o->frames > 1)
+        return cli_fail(EXIT_USAGE, "render: --warmup %u leaves no timed frame of %u", o->warmup, o->frames);
+    return EXIT_OK;
+}
+
+static void make_view(const gi_scene *s, int camera, const render_opts *o, float t, uint32_t frame, gi_view *v)
+{
+    gi_camera_frame cf = gi_scene_camera_at(s, camera, t);
+    memset(v, 0, sizeof *v);
+    v->width = o->width;
+    v->height = o->height;
+    gi_mat4_invert(v->view, cf.world_from_camera);
+    gi_mat4_perspective(v->proj, cf.yfov, (float)o->width / (float)o->height, cf.znear, cf.zfar);
+    gi_mat4_mul(v->view_proj, v->proj, v->view);
+    gi_mat4_invert(v->inv_view_proj, v->view_proj);
+    v->eye = cf.eye;
+    v->yfov = cf.yfov;
+    v->znear = cf.znear;
+    v->zfar = cf.zfar;
+    v->time = t;
+    v->frame_index = frame;
+    v->seed = o->seed;
+    v->exposure = o->exposure;
+}
+
+typedef struct run_state {
+    gi_scene *scene;
+    gi_gpu *gpu;
+    gi_gpu_scene *gs;
+    gi_plugins *reg;
+    gi_params *params;
+    char *cache_dir;
+    cli_host host;
+    int host_ready;
+    const gi_method *m;
+    void *inst;
+    gi_timer *prep_timer, *render_timer;
+    GLuint target_tex, target_fbo;
+    gi_image *image;
+} run_state;
+
+static void cleanup(run_state *r)
+{
+    if (r->inst)
+        r->m->destroy(r->inst);
+    if (r->target_fbo)
+        glDeleteFramebuffers(1, &r->target_fbo);
+    if (r->target_tex)
+        glDeleteTextures(1, &r->target_tex);
+    gi_timer_free(r->prep_timer);
+    gi_timer_free(r->render_timer);
+    gi_gpu_scene_free(r->gs);
+    gi_gpu_destroy(r->gpu);
+    gi_scene_free(r->scene);
+    gi_params_free(r->params);
+    gi_plugins_free(r->reg);
+    gi_image_free(r->image);
+    if (r->host_ready)
+        cli_host_free(&r->host);
+    free(r->cache_dir);
+}
+
+/* Reports a method failure with its own message. */
+static int method_fail(run_state *r, const char *what, gi_result res)
+{
+    const char *msg = r->m->last_error(r->inst);
+    return cli_fail(res == GI_ERR_INVALID_ARGUMENT || res == GI_ERR_UNSUPPORTED ? EXIT_USAGE : EXIT_RUN,
+                    "%s: %s failed (%s)%s%s", r->m->id, what, gi_result_name(res), msg && *msg ? ": " : "",
+                    msg ? msg : "");
+}
+
+static json_object *timings_json(const run_state *r, const render_opts *o)
+{
+    json_object *j = json_object_new_object();
+    char *pstr = gi_params_to_string(r->params);
+    json_object_object_add(j, "method", json_object_new_string(r->m->id));
+    json_object_object_add(j, "method_version", json_object_new_string(r->m->version));
+    json_object_object_add(j, "params", json_object_new_string(pstr ? pstr : ""));
+    free(pstr);
+    json_object_object_add(j, "scene", json_object_new_string(o->scene));
+    json_object_object_add(j, "camera", json_object_new_string(o->camera ? o->camera : "#0"));
+    json_object_object_add(j, "width", json_object_new_int((int32_t)o->width));
+    json_object_object_add(j, "height", json_object_new_int((int32_t)o->height));
+    json_object_object_add(j, "frames", json_object_new_int((int32_t)o->frames));
+    json_object_object_add(j, "warmup", json_object_new_int((int32_t)o->warmup));
+    json_object_object_add(j, "seed", json_object_new_int64(o->seed));
+    json_object_object_add(j, "time", json_object_new_double(o->time));
+    json_object_object_add(j, "gl_renderer", json_object_new_string(gi_gpu_renderer(r->gpu)));
+    json_object_object_add(j, "gl_version", json_object_new_string(gi_gpu_version(r->gpu)));
+    json_object_object_add(j, "egl_platform", json_object_new_string(gi_gpu_platform(r->gpu)));
+    json_object_object_add(j, "timer", json_object_new_string(gi_timer_mode_name(gi_timer_get_mode(r->render_timer))));
+    json_object_object_add(j, "prepare", cli_timer_json(r->prep_timer));
+    json_object_object_add(j, "render", cli_timer_json(r->render_timer));
+    json_object_object_add(j, "stats", json_object_get(r->host.stats));
+    double mean[4];
+    gi_image_mean(r->image, mean);
+    json_object *mj = json_object_new_array();
+    for (int c = 0; c < 3; c++)
+        json_object_array_add(mj, json_object_new_double(mean[c]));
+    json_object_object_add(j, "mean_rgb", mj);
+    json_object_object_add(j, "nonfinite_pixels", json_object_new_int64((int64_t)gi_image_count_nonfinite(r->image)));
+    return j;
+}
+
+static int run(run_state *r, const render_opts *o)
+{
+    gi_error err;
+    r->reg = cli_load_plugins(1);
+    if (!r->reg)
+        return cli_fail(EXIT_RUN, "out of memory");
+    r->m = gi_plugins_find(r->reg, o->method);
+    if (!r->m) {
+        char known[512] = "";
+        for (uint32_t i = 0; i < r->reg->count; i++) {
+            size_t used = strlen(known);
+            snprintf(known + used, sizeof known - used, "%s%s", i ? ", " : "", r->reg->items[i].method->id);
+        }
+        return cli_fail(EXIT_USAGE, "render: no method '%s' (installed: %s)", o->method, known[0] ? known : "none");
+    }
+    r->params = gi_params_parse(r->m->id, r->m->params, o->params, o->param_count, &err);
+    if (!r->params)
+        return cli_fail(EXIT_USAGE, "%s", err.text);
+    r->scene = gi_scene_load(o->scene, &err);
+    if (!r->scene)
+        return cli_fail(EXIT_USAGE, "%s", err.text);
+    int camera = 0;
+    if (o->camera) {
+        camera = gi_scene_find_camera(r->scene, o->camera);
+        if (camera < 0)
+            return cli_fail(EXIT_USAGE, "render: %s has no camera '%s' (%u cameras; use a name or #k)", o->scene,
+                            o->camera, r->scene->camera_count);
+    } else if (r->scene->camera_count == 0) {
+        camera = -1;
+    }
+    r->cache_dir = gi_cache_dir(&err);
+    if (!r->cache_dir)
+        return cli_fail(EXIT_RUN, "%s", err.text);
+    r->gpu = gi_gpu_create(NULL, &err);
+    if (!r->gpu)
+        return cli_fail(EXIT_RUN, "%s", err.text);
+    r->gs = gi_gpu_scene_upload(r->gpu, r->scene, &err);
+    if (!r->gs)
+        return cli_fail(EXIT_RUN, "%s", err.text);
+    gi_gpu_scene_set_time(r->gs, o->time);
+
+    gi_timer_mode mode = gi_timer_mode_for(gi_gpu_is_software(r->gpu));
+    r->prep_timer = gi_timer_create(mode, 0);
+    r->render_timer = gi_timer_create(mode, o->warmup);
+    cli_host_init(&r->host, r->m->id, r->cache_dir, r->gs, gi_gpu_renderer(r->gpu), gi_gpu_is_software(r->gpu));
+    r->host_ready = 1;
+
+    glCreateTextures(GL_TEXTURE_2D, 1, &r->target_tex);
+    glTextureStorage2D(r->target_tex, 1, GL_RGBA32F, (GLsizei)o->width, (GLsizei)o->height);
+    glCreateFramebuffers(1, &r->target_fbo);
+    glNamedFramebufferTexture(r->target_fbo, GL_COLOR_ATTACHMENT0, r->target_tex, 0);
+    const float black[4] = {0, 0, 0, 1};
+    glClearNamedFramebufferfv(r->target_fbo, GL_COLOR, 0, black);
+    gi_target target = {r->target_tex, r->target_fbo, o->width, o->height};
+
+    gi_result res = r->m->create(&r->host.host, r->params, &r->inst);
+    if (res != GI_OK || !r->inst) {
+        r->inst = NULL;
+        return cli_fail(res == GI_ERR_INVALID_ARGUMENT || res == GI_ERR_UNSUPPORTED ? EXIT_USAGE : EXIT_RUN,
+                        "%s: create failed (%s)", r->m->id, gi_result_name(res));
+    }
+    r->host.timer = r->prep_timer;
+    gi_timer_frame_begin(r->prep_timer);
+    res = r->m->prepare(r->inst, r->gs);
+    gi_timer_frame_end(r->prep_timer);
+    if (res != GI_OK)
+        return method_fail(r, "prepare", res);
+
+    r->host.timer = r->render_timer;
+    for (uint32_t f = 0; f < o->frames; f++) {
+        if (cli_interrupted)
+            return cli_fail(EXIT_RUN, "render: interrupted after %u of %u frames; no image written", f, o->frames);
+        float t = o->time + (o->animate_fps > 0 ? (float)f / o->animate_fps : 0.0f);
+        if (f > 0 && o->animate_fps > 0) {
+            gi_gpu_scene_set_time(r->gs, t);
+            gi_changes ch = {GI_CHANGED_TRANSFORMS | GI_CHANGED_LIGHTS, t, ~0ull};
+            res = r->m->update(r->inst, r->gs, &ch);
+            if (res != GI_OK)
+                return method_fail(r, "update", res);
+        }
+        gi_view view;
+        make_view(r->scene, camera, o, t, o->animate_fps > 0 ? 0 : f, &view);
+        gi_timer_frame_begin(r->render_timer);
+        res = r->m->render(r->inst, &view, &target);
+        gi_timer_frame_end(r->render_timer);
+        if (res != GI_OK)
+            return method_fail(r, "render", res);
+        if (gi_gl_check("after render", &err) != GI_OK)
+            return cli_fail(EXIT_RUN, "%s: %s", r->m->id, err.text);
+    }
+    r->image = gi_gpu_read_texture(r->target_tex, o->width, o->height);
+    if (!r->image)
+        return cli_fail(EXIT_RUN, "out of memory reading the image back");
+    for (size_t i = 0; i < (size_t)o->width * o->height; i++)
+        r->image->rgba[4 * i + 3] = 1.0f;
+    gi_image_write_opts wo = {o->exposure};
+    for (int i = 0; i < o->out_count; i++)
+        if (gi_image_write(o->outs[i], r->image, &wo, &err) != GI_OK)
+            return cli_fail(EXIT_RUN, "%s", err.text);
+    uint64_t bad = gi_image_count_nonfinite(r->image);
+    if (bad)
+        gi_log(GI_LOG_WARN, "%s: %llu pixels are NaN or Inf", r->m->id, (unsigned long long)bad);
+    if (o->timings) {
+        json_object *j = timings_json(r, o);
+        char why[GI_ERROR_MAX];
+        int ok = cli_write_json(o->timings, j, why, sizeof why);
+        json_object_put(j);
+        if (!ok)
+            return cli_fail(EXIT_RUN, "%s", why);
+    }
+    return EXIT_OK;
+}
+
+int cmd_render(int argc, char **argv)
+{
+    render_opts o;
+    int rc = parse_opts(argc, argv, &o);
+    if (rc != EXIT_OK)
+        return rc;
+    cli_install_signal_handlers();
+    run_state r;
+    memset(&r, 0, sizeof r);
+    rc = run(&r, &o);
+    cleanup(&r);
+    return rc;
+}

@@ -1,0 +1,55 @@
+/* gibench: the command-line front door (ARCHITECTURE.md "Command line"). */
+#include "cli.h"
+
+#include "gi/log.h"
+
+#include <stdio.h>
+#include <string.h>
+
+static const char usage[] =
+    "usage: gibench [-v|-q] COMMAND ...\n"
+    "commands:\n"
+    "  methods [--json]                       list method plugins and their parameters\n"
+    "  info SCENE [--json]                    describe a scene file\n"
+    "  render --scene S --method M --out FILE [--out FILE2] [--camera C] [--size WxH]\n"
+    "         [--param k=v]... [--frames N] [--warmup N] [--time T] [--animate FPS]\n"
+    "         [--seed N] [--exposure EV] [--timings FILE.json]\n"
+    "                                         render one method (EXR, PFM or PNG output)\n"
+    "exit status: 0 success, 1 failure while running, 2 bad usage or bad input\n";
+
+int main(int argc, char **argv)
+{
+    int i = 1;
+    gi_log_set_level(GI_LOG_WARN);
+    for (; i < argc && argv[i][0] == '-'; i++) {
+        if (!strcmp(argv[i], "-v"))
+            gi_log_set_level(GI_LOG_INFO);
+        else if (!strcmp(argv[i], "-vv"))
+            gi_log_set_level(GI_LOG_DEBUG);
+        else if (!strcmp(argv[i], "-q"))
+            gi_log_set_level(GI_LOG_ERROR);
+        else if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
+            fputs(usage, stdout);
+            return EXIT_OK;
+        } else
+            return cli_fail(EXIT_USAGE, "unknown option '%s' (see gibench --help)", argv[i]);
+    }
+    if (i >= argc) {
+        fputs(usage, stderr);
+        return EXIT_USAGE;
+    }
+    const char *cmd = argv[i];
+    int sub_argc = argc - i - 1;
+    char **sub_argv = argv + i + 1;
+    if (!strcmp(cmd, "methods"))
+        return cmd_methods(sub_argc, sub_argv);
+    if (!strcmp(cmd, "info"))
+        return cmd_info(sub_argc, sub_argv);
+    if (!strcmp(cmd, "render"))
+        return cmd_render(sub_argc, sub_argv);
+    if (!strcmp(cmd, "help")) {
+        fputs(usage, stdout);
+        return EXIT_OK;
+    }
+    return cli_fail(EXIT_USAGE, "unknown command '%s' (see gibench --help)", cmd);
+}

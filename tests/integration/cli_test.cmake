@@ -1,0 +1,60 @@
+# The gibench command-line contract: exit 0 / 1 / 2 with a one-line reason.
+# Run by ctest as: cmake -DGIB=... -DSCENES=... -DDATA=... -DOUT=... -P cli_test.cmake
+
+set(failures 0)
+
+# expect(<exit code> <substring of stderr or stdout> <args...>)
+function(expect code text)
+    execute_process(COMMAND ${GIB} ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    string(STRIP "${err}" err_stripped)
+    string(FIND "${out}${err}" "${text}" pos)
+    string(REGEX MATCHALL "\n" newlines "${err_stripped}")
+    list(LENGTH newlines extra_lines)
+    if(NOT rc EQUAL code OR pos EQUAL -1 OR (NOT code EQUAL 0 AND extra_lines GREATER 0))
+        message(SEND_ERROR "gibench ${ARGN}: expected exit ${code} and '${text}' (one stderr line on failure);\n"
+                           "got exit ${rc}\nstdout: ${out}\nstderr: ${err}")
+        math(EXPR f "${failures} + 1")
+        set(failures ${f} PARENT_SCOPE)
+    endif()
+endfunction()
+
+expect(0 "direct" methods)
+expect(0 "\"id\": \"direct\"" methods --json)
+expect(0 "light_samples" methods)
+expect(0 "13264 triangles" info ${SCENES}/cornell_box.gltf)
+expect(0 "\"triangles\": 13264" info ${SCENES}/cornell_box.gltf --json)
+expect(0 "environment" info ${SCENES}/bunny_env.glb)
+expect(2 "unknown command 'frobnicate'" frobnicate)
+expect(2 "info: no scene given" info)
+expect(2 "no-such-file.gltf" info ${OUT}/no-such-file.gltf)
+expect(2 "render: --scene is required" render --method direct --out ${OUT}/x.exr)
+expect(2 "render: --size '0x4'" render --scene ${SCENES}/cornell_box.gltf --method direct --size 0x4 --out ${OUT}/x.exr)
+expect(2 "render: --out '${OUT}/x.bmp': use a .exr, .pfm or .png" render --scene ${SCENES}/cornell_box.gltf --method direct --out ${OUT}/x.bmp)
+expect(2 "render: no method 'nope' (installed: " render --scene ${SCENES}/cornell_box.gltf --method nope --out ${OUT}/x.exr)
+expect(2 "direct: unknown parameter 'bogus'" render --scene ${SCENES}/cornell_box.gltf --method direct --param bogus=1 --out ${OUT}/x.exr)
+expect(2 "direct: light_samples=0 is outside" render --scene ${SCENES}/cornell_box.gltf --method direct --param light_samples=0 --out ${OUT}/x.exr)
+expect(2 "has no camera 'nope'" render --scene ${SCENES}/cornell_box.gltf --method direct --camera nope --out ${OUT}/x.exr)
+expect(2 "render: --frames 'many'" render --scene ${SCENES}/cornell_box.gltf --method direct --frames many --out ${OUT}/x.exr)
+expect(2 "render: unknown argument '--fast'" render --fast)
+# A malformed scene is bad input (2), with the loader's message.
+file(GLOB malformed ${DATA}/malformed/*.gltf)
+list(GET malformed 0 one_bad)
+expect(2 ": /" render --scene ${one_bad} --method direct --out ${OUT}/x.exr)
+# An output directory that does not exist is a run-time failure (1).
+expect(1 "${OUT}/missing-dir/x.exr" render --scene ${SCENES}/cornell_box_coarse.gltf --method direct --size 8x8 --out ${OUT}/missing-dir/x.exr)
+# Every scene renders with the direct baseline and gives a finite image.
+foreach(scene cornell_box_coarse.gltf cornell_glossy.gltf bunny_env.glb teapot_plane.glb teapot_area.glb u_room.gltf cornell_moving.gltf)
+    expect(0 "" render --scene ${SCENES}/${scene} --method direct --size 32x32 --frames 2 --out ${OUT}/all_${scene}.exr --timings ${OUT}/all_${scene}.json)
+    file(READ ${OUT}/all_${scene}.json j)
+    if(NOT j MATCHES "\"nonfinite_pixels\": 0")
+        message(SEND_ERROR "${scene}: non-finite pixels in the direct render")
+        math(EXPR failures "${failures} + 1")
+    endif()
+endforeach()
+# An animated render advances time and calls update.
+expect(0 "" render --scene ${SCENES}/cornell_moving.gltf --method direct --size 32x32 --frames 3 --animate 2 --out ${OUT}/moving.png)
+
+if(failures GREATER 0)
+    message(FATAL_ERROR "${failures} command-line expectation(s) failed")
+endif()
+message(STATUS "all command-line expectations met")

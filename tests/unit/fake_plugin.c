@@ -1,0 +1,92 @@
+/* Fake method plugins for the loader tests, one per defect: built several
+ * times with one FAKE_* macro defined (tests/CMakeLists.txt). */
+#include "gi/method.h"
+
+#include <stddef.h>
+
+static gi_result fake_create(const gi_host *host, const gi_params *params, void **inst)
+{
+    (void)host, (void)params;
+    static int dummy;
+    *inst = &dummy;
+    return GI_OK;
+}
+static gi_result fake_prepare(void *inst, const gi_gpu_scene *s)
+{
+    (void)inst, (void)s;
+    return GI_OK;
+}
+static gi_result fake_update(void *inst, const gi_gpu_scene *s, const gi_changes *c)
+{
+    (void)inst, (void)s, (void)c;
+    return GI_OK;
+}
+static gi_result fake_render(void *inst, const gi_view *v, const gi_target *t)
+{
+    (void)inst, (void)v, (void)t;
+    return GI_OK;
+}
+static void fake_destroy(void *inst)
+{
+    (void)inst;
+}
+static const char *fake_last_error(void *inst)
+{
+    (void)inst;
+    return "";
+}
+
+static const gi_param_desc fake_params[] = {
+#if defined(FAKE_BAD_PARAM)
+    {"n", GI_PARAM_INT, 100, 0, 10, NULL, "n", "default outside its range"},
+#else
+    {"n", GI_PARAM_INT, 4, 1, 64, NULL, "N", "a count"},
+    {"mode", GI_PARAM_ENUM, 1, 0, 0, "a|b|c", NULL, "a choice"},
+#endif
+    {0},
+};
+
+static const gi_method fake_method = {
+#if defined(FAKE_SMALL_STRUCT)
+    .struct_size = offsetof(gi_method, render),
+#else
+    .struct_size = sizeof(gi_method),
+#endif
+#if defined(FAKE_WRONG_ABI)
+    .abi_version = ((GI_ABI_MAJOR + 1u) << 16),
+#else
+    .abi_version = GI_ABI_VERSION,
+#endif
+#if defined(FAKE_BAD_ID)
+    .id = "Bad Id!",
+#elif defined(FAKE_DUPLICATE_ID)
+    .id = "fake_good",
+#else
+    .id = FAKE_ID,
+#endif
+    .title = "Fake method",
+    .citation = "none",
+    .version = "0",
+    .caps = GI_CAP_DIRECT,
+    .params = fake_params,
+    .create = fake_create,
+    .prepare = fake_prepare,
+    .update = fake_update,
+#if !defined(FAKE_MISSING_FN)
+    .render = fake_render,
+#endif
+    .destroy = fake_destroy,
+    .last_error = fake_last_error,
+};
+
+GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)
+{
+#if defined(FAKE_NULL_ENTRY)
+    (void)host_abi_version;
+    return NULL;
+#else
+    if (GI_ABI_VERSION_MAJOR(host_abi_version) != GI_ABI_MAJOR)
+        return NULL;
+    return &fake_method;
+#endif
+}

@@ -1,0 +1,57 @@
+/* The plugin loader refuses broken plugins with clear messages: wrong ABI,
+ * missing function, duplicate id, bad id, NULL entry, short descriptor, bad
+ * parameter table; and loads a good one. */
+#include "check.h"
+#include "gi/plugin.h"
+
+#include <stdio.h>
+#include <string.h>
+
+#define FAKE_DIR GI_BINARY_DIR "/tests/fake_plugins"
+
+static void expect_refused(const char *kind, const char *substring)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/gimethod_fake_%s.so", FAKE_DIR, kind);
+    gi_error err = {{0}};
+    gi_result r = gi_plugins_add(NULL, path, &err);
+    CHECK_MSG(r != GI_OK && strstr(err.text, substring) && strstr(err.text, path), "%s: '%s'", kind, err.text);
+}
+
+int main(void)
+{
+    expect_refused("wrong_abi", "gi_method_entry returned NULL for host ABI");
+    expect_refused("missing_fn", "lacks the required function render()");
+    expect_refused("bad_id", "method id 'Bad Id!' is not [a-z0-9_]{1,31}");
+    expect_refused("null_entry", "gi_method_entry returned NULL");
+    expect_refused("small_struct", "descriptor is");
+    expect_refused("bad_param", "parameter 'n' default 100 outside [0, 10]");
+
+    gi_error err;
+    CHECK(gi_plugins_add(NULL, FAKE_DIR "/does_not_exist.so", &err) == GI_ERR_IO);
+    CHECK(strstr(err.text, "cannot load") != NULL);
+
+    /* A directory scan: the good one loads, the duplicate of its id is refused
+     * with both paths named, every broken one gives one error line. */
+    gi_plugins *reg = gi_plugins_scan(FAKE_DIR);
+    CHECK(reg != NULL);
+    CHECK(gi_plugins_find(reg, "fake_good") != NULL);
+    CHECK(reg->count == 1);
+    int dup = 0;
+    for (uint32_t i = 0; i < reg->error_count; i++)
+        dup += strstr(reg->errors[i], "duplicate method id 'fake_good'") != NULL;
+    CHECK(dup == 1);
+    CHECK(reg->error_count == 7);
+    const gi_method *m = gi_plugins_find(reg, "fake_good");
+    CHECK(m && m->params && strcmp(m->params[1].choices, "a|b|c") == 0);
+    gi_plugins_free(reg);
+
+    /* Validation of a descriptor without a library. */
+    gi_method bad = *m;
+    bad.abi_version = (GI_ABI_MAJOR + 1) << 16;
+    CHECK(gi_method_validate(&bad, &err) == GI_ERR_UNSUPPORTED && strstr(err.text, "plugin ABI 2.0"));
+    bad = *m;
+    bad.destroy = NULL;
+    CHECK(gi_method_validate(&bad, &err) != GI_OK && strstr(err.text, "destroy()"));
+    return gi_test_finish();
+}

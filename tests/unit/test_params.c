@@ -1,0 +1,69 @@
+/* Method parameters: defaults, types, ranges, enums, unknown names. */
+#include "check.h"
+#include "gi/params.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static const gi_param_desc desc[] = {
+    {"N", GI_PARAM_INT, 32, 1, 512, NULL, "N (Sec. 4.1)", "maps per dimension"},
+    {"bias", GI_PARAM_FLOAT, 0.01, 0, 1, NULL, NULL, "depth bias"},
+    {"jitter", GI_PARAM_BOOL, 1, 0, 1, NULL, NULL, "jitter VPLs"},
+    {"filter", GI_PARAM_ENUM, 1, 0, 0, "nearest|pcf|rr", "Sec. 4.5", "visibility filter"},
+    {0},
+};
+
+static gi_params *parse(const char *a, const char *b, gi_error *err)
+{
+    const char *kv[2] = {a, b};
+    uint32_t n = a ? (b ? 2 : 1) : 0;
+    return gi_params_parse("csm", desc, kv, n, err);
+}
+
+int main(void)
+{
+    gi_error err;
+    gi_params *p = parse(NULL, NULL, &err);
+    CHECK(p != NULL);
+    CHECK(gi_params_int(p, "N") == 32);
+    CHECK_NEAR(gi_params_float(p, "bias"), 0.01, 1e-7);
+    CHECK(gi_params_bool(p, "jitter") == 1);
+    CHECK(gi_params_enum(p, "filter") == 1);
+    char *s = gi_params_to_string(p);
+    CHECK(s && strcmp(s, "N=32,bias=0.00999999978,jitter=true,filter=pcf") != 0); /* printed from double */
+    CHECK(s && strstr(s, "N=32,") == s && strstr(s, "filter=pcf"));
+    free(s);
+    gi_params_free(p);
+
+    p = parse("N=128", "filter=rr", &err);
+    CHECK(p && gi_params_int(p, "N") == 128 && gi_params_enum(p, "filter") == 2);
+    gi_params_free(p);
+    p = parse("jitter=off", "bias=0.5", &err);
+    CHECK(p && gi_params_bool(p, "jitter") == 0 && gi_params_float(p, "bias") == 0.5f);
+    gi_params_free(p);
+
+    struct {
+        const char *kv, *msg;
+    } bad[] = {
+        {"M=3", "csm: unknown parameter 'M' (known: N, bias, jitter, filter)"},
+        {"N=0", "csm: N=0 is outside [1, 512]"},
+        {"N=1000", "csm: N=1000 is outside [1, 512]"},
+        {"N=1.5", "csm: N='1.5' is not an integer"},
+        {"bias=abc", "csm: bias='abc' is not a number"},
+        {"bias=nan", "csm: bias='nan' is not a number"},
+        {"jitter=maybe", "csm: jitter='maybe' is not true or false"},
+        {"filter=box", "csm: filter='box' is not one of nearest|pcf|rr"},
+        {"N", "csm: parameter 'N' is not name=value"},
+        {"=3", "csm: parameter '=3' is not name=value"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        err.text[0] = '\0';
+        p = parse(bad[i].kv, NULL, &err);
+        CHECK_MSG(p == NULL && strcmp(err.text, bad[i].msg) == 0, "%s -> '%s'", bad[i].kv, err.text);
+        gi_params_free(p);
+    }
+    p = parse("N=4", "N=5", &err);
+    CHECK(p == NULL && strstr(err.text, "given twice"));
+    CHECK(gi_param_desc_count(desc) == 4);
+    return gi_test_finish();
+}
