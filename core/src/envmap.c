@@ -128,8 +128,11 @@ void gi_envmap_free(gi_envmap *env)
 void gi_envmap_dir_to_uv(const gi_envmap *env, gi_vec3 d, float *u, float *v)
 {
     gi_vec3 m = to_map_frame(env->rotation, d);
-    float uu = 0.5f + atan2f(m.x, -m.z) * (0.5f * GI_INV_PI);
-    float vv = acosf(fmaxf(-1.0f, fminf(1.0f, m.y))) * GI_INV_PI;
+    /* At the poles u is arbitrary; pin it (GLSL's atan(0, 0) is undefined). */
+    float uu = (m.x == 0.0f && m.z == 0.0f) ? 0.5f : 0.5f + atan2f(m.x, -m.z) * (0.5f * GI_INV_PI);
+    /* acos(d.y) as atan2(|d.xz|, d.y): accurate near the poles, and GPU
+     * acos can be poor (llvmpipe's is off by 1.6e-4 rad). */
+    float vv = atan2f(sqrtf(m.x * m.x + m.z * m.z), m.y) * GI_INV_PI;
     if (uu >= 1.0f)
         uu -= 1.0f;
     *u = clamp_unit(uu);

@@ -6,6 +6,8 @@
  * -rotation about +Y, then
  *     u = 0.5 + atan2(d.x, -d.z) / (2 pi),   v = acos(d.y) / pi,
  * with v = 0 the top row of the image. Radiance = texel x intensity.
+ * (Both sides compute acos(d.y) as atan2(|d.xz|, d.y), which is accurate
+ * near the poles; u is 0.5 at the poles themselves.)
  *
  * Sampling: a marginal CDF over rows and a conditional CDF per row, each
  * stored with a leading 0 and normalised to end at 1 (width+1 and height+1
