@@ -36,11 +36,13 @@ layout(std430, binding = 4) readonly buffer GiEmitters { GiEmitter gi_emitters[]
 layout(std140, binding = 0) uniform GiObjects { GiObject gi_objects[256]; };
 layout(std140, binding = 1) uniform GiSceneInfo {
     uvec4 gi_counts;        // triangles, punctual lights, emitters, has environment
-    vec4 gi_scene_params;   // area-light power, environment power estimate, time, 0
+    vec4 gi_scene_params;   // area-light power, environment power estimate, time, env rotation (rad)
     vec4 gi_bounds_min;     // world bounds at the current time
     vec4 gi_bounds_max;
 };
 layout(binding = 3) uniform sampler2DArray gi_albedo_textures;
+// envmap.glsl reads the map's rotation from here.
+#define GI_ENV_ROTATION gi_scene_params.w
 
 const uint GI_LIGHT_POINT = 0u;
 const uint GI_LIGHT_SPOT = 1u;

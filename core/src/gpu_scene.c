@@ -254,7 +254,8 @@ void gi_gpu_scene_set_time(gi_gpu_scene *gs, float t)
 
     gi_scene_bounds_at(s, t, gs->bounds);
     scene_info info = {{s->triangle_count, s->light_count, s->emitter_count, s->envmap ? 1u : 0u},
-                       {gs->emitter_power, s->envmap ? gi_envmap_average_radiance(s->envmap) * 4.0f * GI_PI : 0.0f, t, 0},
+                       {gs->emitter_power, s->envmap ? gi_envmap_average_radiance(s->envmap) * 4.0f * GI_PI : 0.0f, t,
+                        s->envmap ? s->envmap->rotation : 0.0f},
                        {gs->bounds[0], gs->bounds[1], gs->bounds[2], 0},
                        {gs->bounds[3], gs->bounds[4], gs->bounds[5], 0}};
     if (!gs->ubo_info)

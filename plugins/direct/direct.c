@@ -128,6 +128,7 @@ static gi_result direct_render(void *inst, const gi_view *view, const gi_target 
     glBindImageTexture(0, d->accum, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
     glBindImageTexture(1, target->texture, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glUniform3f(glGetUniformLocation(p, "u_eye"), view->eye.x, view->eye.y, view->eye.z);
+    glUniformMatrix4fv(glGetUniformLocation(p, "u_inv_view_proj"), 1, GL_FALSE, view->inv_view_proj);
     glUniform2i(glGetUniformLocation(p, "u_size"), (GLint)view->width, (GLint)view->height);
     glUniform1ui(glGetUniformLocation(p, "u_frame"), d->frames);
     glUniform1ui(glGetUniformLocation(p, "u_seed"), view->seed);
