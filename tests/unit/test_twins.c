@@ -178,9 +178,11 @@ static char *make_defines(const slots *s)
 #define DEF_IN(name) add_define(&text, &len, #name, name);
     DEF_IN(I_U1)
     DEF_IN(I_U2)
-    DEF_IN(I_U3) DEF_IN(I_U4) DEF_IN(I_N) DEF_IN(I_EXP) DEF_IN(I_WO) DEF_IN(I_COSMAX) DEF_IN(I_WI)
-        DEF_IN(I_EXPOSURE) DEF_IN(I_KD) DEF_IN(I_MIRROR) DEF_IN(I_KS) DEF_IN(I_LINEAR) DEF_IN(I_D)
-            DEF_IN(I_SRGB) DEF_IN(I_NF) DEF_IN(I_FPDF) DEF_IN(I_NG) DEF_IN(I_GPDF)
+    DEF_IN(I_U3)
+    DEF_IN(I_U4)
+    DEF_IN(I_N) DEF_IN(I_EXP) DEF_IN(I_WO) DEF_IN(I_COSMAX) DEF_IN(I_WI) DEF_IN(I_EXPOSURE)
+        DEF_IN(I_KD) DEF_IN(I_MIRROR) DEF_IN(I_KS) DEF_IN(I_LINEAR) DEF_IN(I_D) DEF_IN(I_SRGB)
+            DEF_IN(I_NF) DEF_IN(I_FPDF) DEF_IN(I_NG) DEF_IN(I_GPDF)
 #define DEF_U(name) add_define(&text, &len, #name, name);
                 UINT_SLOTS(DEF_U) for (int i = 0; i < FLOAT_SLOT_COUNT; i++)
                     add_define(&text, &len, float_slots[i].name, s->off[i]);
@@ -532,12 +534,12 @@ static void run_case_set(GLuint prog, const slots *s, const gi_envmap *env, cons
     free(gpu_f);
 }
 
-/* All shared files together with the scene's, and the rotation taken from
- * a scene uniform through GI_ENV_ROTATION instead of gi_env_rotation. */
+/* All shared files together with the scene's: scene.glsl defines
+ * GI_ENV_ROTATION (the scene-info block), which replaces the
+ * gi_env_rotation uniform of envmap.glsl. */
 static void check_combined_build(void)
 {
     const char *text =
-        "#define GI_ENV_ROTATION gi_scene_params.w\n"
         "#include \"scene.glsl\"\n"
         "#include \"lights.glsl\"\n"
         "#include \"common.glsl\"\n"
