@@ -541,9 +541,13 @@ void check_uris(const Context &c, const Json &j, const char *key)
         auto uri = e.find("uri");
         if (uri == e.end() || !uri->is_string())
             continue;
-        std::string s = uri->get<std::string>();
+        std::string s = uri->get<std::string>(), pointer = fmt("/%s/%zu/uri", key, i);
         if (!is_data_uri(s))
-            check_external_file(c, fmt("/%s/%zu/uri", key, i), s);
+            check_external_file(c, pointer, s);
+        else if (!tinygltf::IsDataURI(s))
+            fail(pointer, "data URI must be base64 with a glTF MIME type (" + shown(s) + ")");
+        else if (s.back() == ',')
+            fail(pointer, "data URI holds no data");
     }
 }
 
@@ -564,6 +568,12 @@ void check_before_tinygltf(const Context &c, const char *text, size_t n)
 bool finite(double v)
 {
     return std::isfinite(v);
+}
+
+/* Finite and representable as a float. */
+bool finite_float(double v)
+{
+    return std::isfinite(v) && std::fabs(v) <= 3.4e38;
 }
 
 uint64_t component_size(int type)
@@ -895,13 +905,17 @@ Reader Converter::reader(int accessor) const
     return r;
 }
 
-/* Rejects sparse accessors and those of the wrong type for `what`. */
+/* Rejects sparse accessors, accessors without data and those of the wrong
+ * type for `what`. Every element we read therefore lies in the file, which
+ * bounds every allocation by the input size. */
 void Converter::check_accessor_kind(int accessor, const char *what, bool ok) const
 {
     const tinygltf::Accessor &a = m.accessors[static_cast<size_t>(accessor)];
     std::string p = fmt("/accessors/%d", accessor);
     if (a.sparse.isSparse)
         fail(p + "/sparse", "sparse accessors are not supported");
+    if (a.bufferView < 0) /* glTF's all-zero accessor; without sparse data it is useless here */
+        fail(p, "accessor without a bufferView is not supported");
     if (!ok)
         fail(p, fmt("%s cannot be %s of %s%s", what, type_name(a.type),
                     a.normalized ? "normalized " : "", component_name(a.componentType)));
@@ -946,10 +960,10 @@ void Converter::convert_material(size_t i)
         double e = mt.emissiveFactor[static_cast<size_t>(k)];
         if (!finite(e) || e < 0.0)
             fail(p + "/emissiveFactor", "values must be finite and >= 0");
-        g.emission[k] = static_cast<float>(e * strength);
-        if (!std::isfinite(g.emission[k]))
+        if (!finite_float(e * strength))
             fail(p + "/extensions/KHR_materials_emissive_strength/emissiveStrength",
                  "emission overflows a float");
+        g.emission[k] = static_cast<float>(e * strength);
     }
     const tinygltf::TextureInfo &ti = mt.pbrMetallicRoughness.baseColorTexture;
     if (ti.index != -1) {
@@ -991,7 +1005,7 @@ void Converter::read_phong(size_t i, gi_material *g)
         double n = 0.0;
         if (!number(member(*ph, "exponent"), &n) || n < 0.0)
             fail(gp + "/phong/exponent", "must be a number >= 0");
-        g->exponent = static_cast<float>(n);
+        g->exponent = static_cast<float>(std::min(n, 1e30)); /* past GI_MIRROR_EXPONENT anyway */
         has_ks = true;
     }
     if (const Value *mi = member(*gb, "mirror")) {
@@ -1092,11 +1106,11 @@ void Converter::check_cameras() const
         const tinygltf::PerspectiveCamera &pc = cam.perspective;
         if (!finite(pc.yfov) || pc.yfov <= 0.0 || pc.yfov >= kPi)
             fail(p + "/perspective/yfov", "must lie in (0, pi)");
-        if (!finite(pc.znear) || pc.znear <= 0.0)
+        if (!finite_float(pc.znear) || static_cast<float>(pc.znear) <= 0.0f)
             fail(p + "/perspective/znear", "must be > 0");
-        if (!finite(pc.zfar) || (pc.zfar != 0.0 && pc.zfar <= pc.znear))
+        if (!finite_float(pc.zfar) || (pc.zfar != 0.0 && pc.zfar <= pc.znear))
             fail(p + "/perspective/zfar", "must be > znear");
-        if (!finite(pc.aspectRatio) || pc.aspectRatio < 0.0)
+        if (!finite_float(pc.aspectRatio) || pc.aspectRatio < 0.0)
             fail(p + "/perspective/aspectRatio", "must be > 0");
     }
 }
@@ -1111,11 +1125,11 @@ void Converter::check_lights() const
         if (!l.color.empty() && l.color.size() != 3)
             fail(p + "/color", "needs 3 numbers");
         for (double v : l.color)
-            if (!finite(v) || v < 0.0)
+            if (!finite(v) || v < 0.0 || !finite_float(v * l.intensity))
                 fail(p + "/color", "values must be finite and >= 0");
-        if (!finite(l.intensity) || l.intensity < 0.0)
+        if (!finite_float(l.intensity) || l.intensity < 0.0)
             fail(p + "/intensity", "must be finite and >= 0");
-        if (!finite(l.range) || l.range < 0.0)
+        if (!finite_float(l.range) || l.range < 0.0)
             fail(p + "/range", "must be > 0");
         double in = l.spot.innerConeAngle, out = l.spot.outerConeAngle;
         if (l.type == "spot" &&
@@ -1184,7 +1198,7 @@ void decompose(const std::vector<double> &mx, const std::string &p, NodeInfo *n)
     if (mx.size() != 16)
         fail(p, "needs 16 numbers");
     for (double v : mx)
-        if (!finite(v))
+        if (!finite_float(v))
             fail(p, "values must be finite");
     if (mx[3] != 0.0 || mx[7] != 0.0 || mx[11] != 0.0 || mx[15] != 1.0)
         fail(p, "is not affine (last row must be 0 0 0 1)");
@@ -1198,8 +1212,11 @@ void decompose(const std::vector<double> &mx, const std::string &p, NodeInfo *n)
                  mx[8] * (mx[1] * mx[6] - mx[2] * mx[5]);
     if (det < 0.0)
         s[0] = -s[0];
-    for (int col = 0; col < 3; col++)
+    for (int col = 0; col < 3; col++) {
+        if (!finite_float(s[col]))
+            fail(p, "scale is not finite");
         n->s[col] = static_cast<float>(s[col]);
+    }
     if (s[0] == 0.0 || s[1] == 0.0 || s[2] == 0.0)
         return; /* degenerate scale: rotation stays identity */
     for (int col = 0; col < 3; col++)
@@ -1229,7 +1246,7 @@ void Converter::node_transform(size_t i)
         if (v.size() != len)
             fail(p + "/" + key, fmt("needs %zu numbers", len));
         for (size_t k = 0; k < len; k++) {
-            if (!finite(v[k]) || !std::isfinite(static_cast<float>(v[k])))
+            if (!finite_float(v[k]))
                 fail(p + "/" + key, "values must be finite");
             out[k] = static_cast<float>(v[k]);
         }
@@ -1465,7 +1482,7 @@ void Converter::read_uvs(const std::string &pp, int acc, std::vector<gi_vertex> 
     for (size_t e = 0; e < a.count; e++)
         for (int k = 0; k < 2; k++) {
             double x = r.get(e, static_cast<uint64_t>(k));
-            if (!finite(x) || !std::isfinite(static_cast<float>(x)))
+            if (!finite_float(x))
                 fail(fmt("/accessors/%d", acc), fmt("TEXCOORD_0 element %zu is not finite", e));
             (*v)[e].uv[k] = static_cast<float>(x);
         }
@@ -1723,7 +1740,7 @@ void Converter::convert_channel(size_t a, size_t k)
         double l2 = 0.0;
         for (uint64_t j = 0; j < width; j++) {
             double x = ro.get(e, j);
-            if (!finite(x) || !std::isfinite(static_cast<float>(x)))
+            if (!finite_float(x))
                 fail(po, fmt("animation value %zu is not finite", e));
             t.values.push_back(static_cast<float>(x));
             l2 += x * x;
@@ -1766,7 +1783,7 @@ void Converter::read_environment()
     env_path = resolve_uri(c, pe + "/uri", env_uri);
     double v = 1.0;
     if (const Value *in = member(*env, "intensity")) {
-        if (!number(in, &v) || v < 0.0 || !std::isfinite(static_cast<float>(v)))
+        if (!number(in, &v) || v < 0.0 || !finite_float(v))
             fail(pe + "/intensity", "must be a number >= 0");
         env_intensity = static_cast<float>(v);
     }
