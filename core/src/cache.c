@@ -131,7 +131,7 @@ void *gi_file_read_all(const char *path, size_t *size)
 {
     assert(path && size);
     *size = 0;
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    int fd = open(path, O_RDONLY | O_CLOEXEC | O_NONBLOCK);
     if (fd < 0)
         return NULL;
     struct stat st;

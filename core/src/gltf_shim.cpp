@@ -263,7 +263,7 @@ bool path_allowed(const Context &c, const std::string &path)
 
 bool read_file(const std::string &path, std::vector<unsigned char> *out, std::string *why)
 {
-    int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
     if (fd < 0) {
         *why = strerror(errno);
         return false;

@@ -13,41 +13,53 @@
 
 #include <assert.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <float.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 /* ---- loading ------------------------------------------------------------ */
 
-/* Reads the whole file, refusing anything above GI_MAX_FILE_BYTES. */
+/* Reads the whole file, refusing anything but a regular file of at most
+ * GI_MAX_FILE_BYTES (O_NONBLOCK: a FIFO must not hang the loader). */
 static void *read_scene_file(const char *path, size_t *size, gi_error *err)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) {
+    int fd = open(path, O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+    if (fd < 0) {
         gi_error_set(err, GI_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
         return NULL;
     }
     struct stat st;
-    void *data = NULL;
-    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
+    char *data = NULL;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
         gi_error_set(err, GI_ERR_IO, "%s: not a regular file", path);
     } else if ((unsigned long long)st.st_size > GI_MAX_FILE_BYTES) {
         gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: %lld bytes exceed the 1 GiB file limit", path,
                      (long long)st.st_size);
     } else {
-        *size = (size_t)st.st_size;
-        data = malloc(*size ? *size : 1);
+        size_t n = (size_t)st.st_size, done = 0;
+        data = malloc(n ? n : 1);
         if (!data)
             gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
-        else if (fread(data, 1, *size, f) != *size) {
-            gi_error_set(err, GI_ERR_IO, "%s: read error", path);
-            free(data);
-            data = NULL;
+        while (data && done < n) {
+            ssize_t r = read(fd, data + done, n - done);
+            if (r < 0 && errno == EINTR)
+                continue;
+            if (r <= 0) {
+                gi_error_set(err, GI_ERR_IO, "%s: read error: %s", path,
+                             r < 0 ? strerror(errno) : "file shrank");
+                free(data);
+                data = NULL;
+            } else {
+                done += (size_t)r;
+            }
         }
+        *size = n;
     }
-    fclose(f);
+    close(fd);
     return data;
 }
 
