@@ -826,7 +826,10 @@ class Converter {
     void read_indices(const std::string &pp, const tinygltf::Primitive &prim, size_t nv,
                       std::vector<uint32_t> *out);
     void instantiate();
+    void check_totals();
     void add_object(int node);
+    void add_camera(int node);
+    void add_light(int node);
     void convert_animations();
     void convert_channel(size_t a, size_t k);
     void read_environment();
@@ -1581,46 +1584,22 @@ void Converter::convert_primitive(size_t mi, size_t k, MeshData *out)
         out->indices.push_back(base + i);
 }
 
-/* One object per scene node with a mesh, in scene order; then the meshes no
- * node uses, validated and dropped. */
+/* One object per scene node with a mesh, in scene order, after checking
+ * the totals against the limits (before any copy); then the meshes no node
+ * uses, validated and dropped. */
 void Converter::instantiate()
 {
     mesh_done.assign(m.meshes.size(), false);
     meshes.assign(m.meshes.size(), MeshData());
+    check_totals();
     for (int v : order) {
         const tinygltf::Node &nd = m.nodes[static_cast<size_t>(v)];
         if (nd.mesh >= 0)
             add_object(v);
-        if (nd.camera >= 0) {
-            const tinygltf::Camera &cam = m.cameras[static_cast<size_t>(nd.camera)];
-            gi_camera g = {};
-            g.node = v;
-            g.yfov = static_cast<float>(cam.perspective.yfov);
-            g.aspect = static_cast<float>(cam.perspective.aspectRatio);
-            g.znear = static_cast<float>(cam.perspective.znear);
-            g.zfar = static_cast<float>(cam.perspective.zfar);
-            cameras.push_back(g);
-            camera_names.push_back(!cam.name.empty() ? cam.name : nd.name);
-        }
-        int li = node_light(static_cast<size_t>(v));
-        if (li >= 0) {
-            const tinygltf::Light &l = m.lights[static_cast<size_t>(li)];
-            gi_light g = {};
-            g.node = v;
-            g.type = l.type == "point" ? GI_LIGHT_POINT
-                     : l.type == "spot" ? GI_LIGHT_SPOT
-                                        : GI_LIGHT_DIRECTIONAL;
-            for (int k = 0; k < 3; k++)
-                g.intensity[k] = static_cast<float>(
-                    (l.color.empty() ? 1.0 : l.color[static_cast<size_t>(k)]) * l.intensity);
-            g.range = static_cast<float>(l.range);
-            if (g.type == GI_LIGHT_SPOT) {
-                g.inner_cone = static_cast<float>(l.spot.innerConeAngle);
-                g.outer_cone = static_cast<float>(l.spot.outerConeAngle);
-            }
-            lights.push_back(g);
-            light_names.push_back(!l.name.empty() ? l.name : nd.name);
-        }
+        if (nd.camera >= 0)
+            add_camera(v);
+        if (node_light(static_cast<size_t>(v)) >= 0)
+            add_light(v);
     }
     for (size_t mi = 0; mi < m.meshes.size(); mi++)
         if (!mesh_done[mi]) {
@@ -1629,17 +1608,66 @@ void Converter::instantiate()
         }
 }
 
+void Converter::check_totals()
+{
+    uint64_t objs = 0, verts = 0, tris = 0;
+    for (int v : order) {
+        const tinygltf::Node &nd = m.nodes[static_cast<size_t>(v)];
+        if (nd.mesh < 0)
+            continue;
+        std::string p = fmt("/nodes/%d", v);
+        if (++objs > GI_MAX_OBJECTS)
+            fail(p, fmt("more than %d objects (nodes with a mesh) in the scene", GI_MAX_OBJECTS));
+        const MeshData &md = mesh(nd.mesh);
+        verts += md.vertices.size();
+        tris += md.indices.size() / 3;
+        if (verts > GI_MAX_VERTICES)
+            fail(p, fmt("scene exceeds the limit of %u vertices", GI_MAX_VERTICES));
+        if (tris > GI_MAX_TRIANGLES)
+            fail(p, fmt("scene exceeds the limit of %u triangles", GI_MAX_TRIANGLES));
+    }
+    vertices.reserve(verts);
+    indices.reserve(tris * 3);
+}
+
+void Converter::add_camera(int node)
+{
+    const tinygltf::Node &nd = m.nodes[static_cast<size_t>(node)];
+    const tinygltf::Camera &cam = m.cameras[static_cast<size_t>(nd.camera)];
+    gi_camera g = {};
+    g.node = node;
+    g.yfov = static_cast<float>(cam.perspective.yfov);
+    g.aspect = static_cast<float>(cam.perspective.aspectRatio);
+    g.znear = static_cast<float>(cam.perspective.znear);
+    g.zfar = static_cast<float>(cam.perspective.zfar);
+    cameras.push_back(g);
+    camera_names.push_back(!cam.name.empty() ? cam.name : nd.name);
+}
+
+void Converter::add_light(int node)
+{
+    const tinygltf::Light &l = m.lights[static_cast<size_t>(node_light(static_cast<size_t>(node)))];
+    gi_light g = {};
+    g.node = node;
+    g.type = l.type == "point" ? GI_LIGHT_POINT
+             : l.type == "spot" ? GI_LIGHT_SPOT
+                                : GI_LIGHT_DIRECTIONAL;
+    for (int k = 0; k < 3; k++)
+        g.intensity[k] = static_cast<float>(
+            (l.color.empty() ? 1.0 : l.color[static_cast<size_t>(k)]) * l.intensity);
+    g.range = static_cast<float>(l.range);
+    if (g.type == GI_LIGHT_SPOT) {
+        g.inner_cone = static_cast<float>(l.spot.innerConeAngle);
+        g.outer_cone = static_cast<float>(l.spot.outerConeAngle);
+    }
+    lights.push_back(g);
+    light_names.push_back(!l.name.empty() ? l.name : m.nodes[static_cast<size_t>(node)].name);
+}
+
 void Converter::add_object(int node)
 {
     const tinygltf::Node &nd = m.nodes[static_cast<size_t>(node)];
-    std::string p = fmt("/nodes/%d", node);
-    if (objects.size() >= GI_MAX_OBJECTS)
-        fail(p, fmt("more than %d objects (nodes with a mesh) in the scene", GI_MAX_OBJECTS));
-    const MeshData &md = mesh(nd.mesh);
-    if (vertices.size() + md.vertices.size() > GI_MAX_VERTICES)
-        fail(p, fmt("scene exceeds the limit of %u vertices", GI_MAX_VERTICES));
-    if ((indices.size() + md.indices.size()) / 3 > GI_MAX_TRIANGLES)
-        fail(p, fmt("scene exceeds the limit of %u triangles", GI_MAX_TRIANGLES));
+    const MeshData &md = mesh(nd.mesh); /* totals checked by check_totals */
     gi_object o = {};
     o.node = node;
     o.first_vertex = static_cast<uint32_t>(vertices.size());

@@ -423,6 +423,24 @@ def tex_uvs(doc, b):
     prim(doc)["attributes"]["TEXCOORD_0"] = b.accessor(floats([0, 0] * 4), 4, "VEC2")
 
 
+def triangle_limit():
+    """256 nodes sharing one mesh of 65537 triangles (UNSIGNED_BYTE indices,
+    all one degenerate triangle): 16777472 triangles, just past the limit."""
+    doc = base(with_mesh=False).doc
+    pos = floats([0, 0, 0, 1, 0, 0, 0, 1, 0])
+    idx = bytes([0, 1, 2]) * 65537
+    blob = pos + idx + b"\0" * (-len(idx) % 4)
+    doc["buffers"] = [{"byteLength": len(blob)}]
+    doc["bufferViews"] = [{"buffer": 0, "byteLength": len(pos)},
+                          {"buffer": 0, "byteOffset": len(pos), "byteLength": len(idx)}]
+    doc["accessors"] = [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"},
+                        {"bufferView": 1, "componentType": 5121, "count": len(idx), "type": "SCALAR"}]
+    doc["meshes"] = [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}]
+    doc["nodes"] = [{"mesh": 0} for _ in range(256)]
+    doc["scenes"][0]["nodes"] = list(range(256))
+    return glb(doc, blob)
+
+
 def glb_bytes(mut):
     """Raw GLB bytes of the base scene, then mut(bytearray) -> bytes."""
     def make():
@@ -605,6 +623,8 @@ CORPUS = [
     # limits
     ("too-many-objects.gltf", "/nodes/256: more than 256 objects (nodes with a mesh) in the scene",
      mutate(many_objects)),
+    ("too-many-triangles.glb", "/nodes/255: scene exceeds the limit of 16777216 triangles",
+     triangle_limit),
     ("too-many-materials.gltf", "/materials: 4097 materials exceed the limit of 4096",
      mutate(many_materials)),
     ("texture-too-large.gltf", "/images/0: image size 9000x16 outside 1..8192",
