@@ -159,12 +159,24 @@ def valid_quad():
     return doc
 
 
-def valid_quad_glb():
-    """quad.gltf as GLB with the buffer in the BIN chunk."""
-    doc = valid_quad()
-    blob = base64.b64decode(doc["buffers"][0]["uri"].split(",", 1)[1])
+def to_glb(doc):
+    """The same scene as GLB: buffer 0 becomes the BIN chunk and embedded
+    images move into buffer views (the loader decodes those itself)."""
+    doc = copy.deepcopy(doc)
+    blob = bytearray(base64.b64decode(doc["buffers"][0]["uri"].split(",", 1)[1]))
+    for image in doc.get("images", []):
+        uri = image.get("uri", "")
+        if not uri.startswith("data:"):
+            continue
+        data = base64.b64decode(uri.split(",", 1)[1])
+        blob += b"\0" * (-len(blob) % 4)
+        doc["bufferViews"].append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data)})
+        blob += data
+        image.pop("uri")
+        image["bufferView"] = len(doc["bufferViews"]) - 1
+        image["mimeType"] = uri[5:uri.index(";")]
     doc["buffers"] = [{"byteLength": len(blob)}]
-    return glb(doc, blob)
+    return glb(doc, bytes(blob))
 
 
 def valid_animated():
@@ -730,12 +742,12 @@ CORPUS = [
 def write_all():
     os.makedirs(os.path.join(VALID, "env"), exist_ok=True)
     os.makedirs(MALFORMED, exist_ok=True)
-    write_json(os.path.join(VALID, "quad.gltf"), valid_quad())
-    with open(os.path.join(VALID, "quad.glb"), "wb") as f:
-        f.write(valid_quad_glb())
-    write_json(os.path.join(VALID, "animated.gltf"), valid_animated())
-    write_json(os.path.join(VALID, "textured.gltf"), valid_textured())
-    write_json(os.path.join(VALID, "lights.gltf"), valid_lights())
+    for name, make in [("quad", valid_quad), ("animated", valid_animated),
+                       ("textured", valid_textured), ("lights", valid_lights)]:
+        doc = make()
+        write_json(os.path.join(VALID, name + ".gltf"), doc)
+        with open(os.path.join(VALID, name + ".glb"), "wb") as f:
+            f.write(to_glb(doc))
     with open(os.path.join(VALID, "env", "sky.pfm"), "wb") as f:
         f.write(sky_pfm())
 
