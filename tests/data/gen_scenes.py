@@ -45,6 +45,16 @@ def png(width, height, rows, color_type=6):
             chunk(b"IEND", b""))
 
 
+def png16(width, height, rows):
+    """RGBA 16-bit PNG; rows: lists of 16-bit values, 4 per pixel."""
+    def chunk(kind, body):
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+    raw = b"".join(b"\0" + struct.pack(">%dH" % len(r), *r) for r in rows)
+    ihdr = struct.pack(">IIBBBBB", width, height, 16, 6, 0, 0, 0)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(raw)) +
+            chunk(b"IEND", b""))
+
+
 def png_header_only(width, height):
     ihdr = struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0)
     body = b"IHDR" + ihdr
@@ -245,6 +255,19 @@ def valid_textured():
     ]
     doc["nodes"].append({"name": "mirror", "mesh": 1})
     doc["scenes"][0]["nodes"] = [0, 1]
+    return b.finish()
+
+
+def valid_texture16():
+    """A quad with a 1x1 16-bit texture (0x8000 grey, alpha 0x4000)."""
+    b = base()
+    doc = b.doc
+    prim(doc)["attributes"]["TEXCOORD_0"] = b.accessor(floats([0.5, 0.5] * 4), 4, "VEC2")
+    doc["images"] = [{"uri": data_uri(png16(1, 1, [[0x8000, 0x8000, 0x8000, 0x4000]]),
+                                      "image/png")}]
+    doc["textures"] = [{"source": 0}]
+    doc["materials"][0]["pbrMetallicRoughness"] = {"baseColorFactor": [1, 1, 1, 1],
+                                                   "baseColorTexture": {"index": 0}}
     return b.finish()
 
 
@@ -451,6 +474,18 @@ def triangle_limit():
     doc["nodes"] = [{"mesh": 0} for _ in range(256)]
     doc["scenes"][0]["nodes"] = list(range(256))
     return glb(doc, blob)
+
+
+def image_view_overrun():
+    """textured.glb with the image's buffer view running far past the buffer:
+    rejected before any decoder sees the pointer tinygltf computes."""
+    doc = valid_textured()
+    data = bytearray(to_glb(doc))
+    jlen = json_chunk_len(data)
+    js = json.loads(bytes(data[20:20 + jlen]))
+    view = js["images"][0]["bufferView"]
+    js["bufferViews"][view]["byteLength"] = 1 << 30
+    return glb(js, bytes(data[20 + jlen + 8:]))
 
 
 def glb_bytes(mut):
@@ -734,6 +769,9 @@ CORPUS = [
      glb_bytes(glb_set32(12, 100000))),
     ("glb-chunk-type.glb", "GLB: first chunk is not JSON", glb_bytes(glb_set32(16, 0x12345678))),
     ("glb-bin-overrun.glb", "GLB: BIN chunk of 64 bytes runs past the end", glb_bytes(glb_bin_too_long)),
+    ("glb-image-view-overrun.glb",
+     "/bufferViews/7: byteOffset 216 + byteLength 1073741824 past the end of buffer 0 (294 bytes)",
+     image_view_overrun),
     ("glb-short.glb", "GLB: 12 bytes is shorter than the 20-byte header",
      lambda: struct.pack("<4sII", b"glTF", 2, 12)),
 ]
@@ -743,7 +781,8 @@ def write_all():
     os.makedirs(os.path.join(VALID, "env"), exist_ok=True)
     os.makedirs(MALFORMED, exist_ok=True)
     for name, make in [("quad", valid_quad), ("animated", valid_animated),
-                       ("textured", valid_textured), ("lights", valid_lights)]:
+                       ("textured", valid_textured), ("lights", valid_lights),
+                       ("texture16", valid_texture16)]:
         doc = make()
         write_json(os.path.join(VALID, name + ".gltf"), doc)
         with open(os.path.join(VALID, name + ".glb"), "wb") as f:

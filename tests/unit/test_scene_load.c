@@ -120,6 +120,7 @@ static void test_glb(void)
     compare_glb("animated");
     compare_glb("textured");
     compare_glb("lights");
+    compare_glb("texture16");
 }
 
 /* The animated scene, worked by hand: parent = T(1,0,0) R_y(theta(t)) with
@@ -246,6 +247,21 @@ static void test_textured(void)
     gi_scene_free(s);
 }
 
+/* 16-bit texels: value / 65535, sRGB-decoded; alpha linear. */
+static void test_texture16(void)
+{
+    gi_scene *s = load(VALID "texture16.gltf");
+    if (!s)
+        return;
+    CHECK(s->texture_count == 1 && s->textures[0].width == 1);
+    CHECK_NEAR(s->textures[0].rgba[0], gi_srgb_decode(32768.0f / 65535.0f), 1e-6);
+    CHECK_NEAR(s->textures[0].rgba[3], 16384.0 / 65535.0, 1e-6);
+    float out[3];
+    gi_scene_albedo(s, 0, s->vertices[0].uv, out);
+    CHECK_NEAR(out[1], gi_srgb_decode(32768.0f / 65535.0f), 1e-6);
+    gi_scene_free(s);
+}
+
 static void test_lights(void)
 {
     gi_scene *s = load(VALID "lights.gltf");
@@ -327,6 +343,7 @@ int main(void)
     test_glb();
     test_animated();
     test_textured();
+    test_texture16();
     test_lights();
     test_memory();
     return gi_test_finish();
