@@ -781,6 +781,7 @@ class Converter {
     int default_material = -1;
     std::vector<TextureData> textures;
     std::map<int, int> texture_of; /* glTF texture -> textures index */
+    std::vector<tinygltf::Image> view_images; /* decoded images stored in buffer views */
     std::vector<int> parents;
     std::vector<NodeInfo> nodes;
     int scene_index = -1;
@@ -811,6 +812,7 @@ class Converter {
     int texture(int index, const std::string &pointer);
     void convert_texture(int index);
     void check_textures() const;
+    void check_images();
     void check_cameras() const;
     void check_lights() const;
     int node_light(size_t i) const;
@@ -1039,6 +1041,30 @@ void Converter::check_textures() const
     }
 }
 
+/* Every image must decode, as tinygltf requires of those it decodes itself:
+ * an external file it could not read left only a warning and no pixels;
+ * images in buffer views are decoded here, their bounds checked already. */
+void Converter::check_images()
+{
+    view_images.resize(m.images.size());
+    for (size_t i = 0; i < m.images.size(); i++) {
+        const tinygltf::Image &img = m.images[i];
+        std::string p = fmt("/images/%zu", i), why;
+        if (img.bufferView >= 0) {
+            const tinygltf::BufferView &bv = m.bufferViews[static_cast<size_t>(img.bufferView)];
+            const tinygltf::Buffer &b = m.buffers[static_cast<size_t>(bv.buffer)];
+            tinygltf::Image &d = view_images[i];
+            d.name = img.name;
+            if (!decode_image(&d, static_cast<int>(i), b.data.data() + bv.byteOffset,
+                              bv.byteLength, &why))
+                fail(p, why);
+        } else if (img.image.empty()) {
+            fail(p, "image data could not be read" +
+                        (img.uri.empty() ? std::string() : " from " + shown(img.uri)));
+        }
+    }
+}
+
 int Converter::texture(int index, const std::string &pointer)
 {
     if (index < 0 || static_cast<size_t>(index) >= m.textures.size())
@@ -1058,21 +1084,8 @@ void Converter::convert_texture(int index)
     if (t.source < 0)
         fail(fmt("/textures/%d", index), "has no source image");
     const tinygltf::Image *img = &m.images[static_cast<size_t>(t.source)];
-    std::string ip = fmt("/images/%d", t.source);
-    tinygltf::Image decoded;
-    if (img->image.empty() && img->bufferView >= 0) {
-        /* bounds of the view inside its buffer were checked by check_buffer_views */
-        const tinygltf::BufferView &bv = m.bufferViews[static_cast<size_t>(img->bufferView)];
-        const tinygltf::Buffer &b = m.buffers[static_cast<size_t>(bv.buffer)];
-        std::string why;
-        decoded.name = img->name;
-        decoded.bufferView = img->bufferView;
-        if (!decode_image(&decoded, t.source, b.data.data() + bv.byteOffset, bv.byteLength, &why))
-            fail(ip, why);
-        img = &decoded;
-    }
-    if (img->image.empty())
-        fail(ip, "image data could not be loaded" + (img->uri.empty() ? "" : " from " + shown(img->uri)));
+    if (img->bufferView >= 0)
+        img = &view_images[static_cast<size_t>(t.source)];
     TextureData td;
     td.name = !t.name.empty() ? t.name : !img->name.empty() ? img->name : img->uri;
     td.width = static_cast<uint32_t>(img->width);
@@ -1952,6 +1965,7 @@ gi_scene *Converter::run(char env_pointer[GI_GLTF_POINTER_MAX])
 {
     check_buffer_views();
     check_accessors();
+    check_images();
     check_textures();
     convert_materials();
     check_cameras();

@@ -488,6 +488,15 @@ def image_view_overrun():
     return glb(js, bytes(data[20 + jlen + 8:]))
 
 
+def image_view_garbage():
+    """An unused image in a buffer view that is not an image at all."""
+    b = base()
+    doc = b.doc
+    doc["images"] = [{"bufferView": b.view(b"not an image"), "mimeType": "image/png"}]
+    doc = b.finish()
+    return to_glb(doc)
+
+
 def glb_bytes(mut):
     """Raw GLB bytes of the base scene, then mut(bytearray) -> bytes."""
     def make():
@@ -665,6 +674,9 @@ CORPUS = [
      mutate(set_path(["buffers", 0, "uri"], "data:text/html,hello"))),
     ("uri-data-empty.gltf", "/images/0/uri: data URI holds no data",
      rebuilt(with_texture({"source": 0}, {"uri": "data:image/png;base64,"}))),
+    ("image-empty-file.gltf", "/images/0: image data could not be read from 'empty.png'",
+     mutate(lambda d, b: d.update(images=[{"uri": "empty.png"}]))),
+    ("image-view-not-png.glb", "/images/0: image is not PNG or JPEG", image_view_garbage),
     ("uri-image-parent.gltf", "/images/0/uri: URI 'img/../../x.png' leaves the scene directory",
      rebuilt(with_texture({"source": 0}, {"uri": "img/../../x.png"}))),
     # limits
@@ -811,6 +823,7 @@ def write_all():
         else:
             write_json(path, doc)
         lines.append("%s\t%s" % (name, expect))
+    open(os.path.join(MALFORMED, "empty.png"), "wb").close()
     with open(expected_path, "w") as f:
         f.write("\n".join(lines + kept) + "\n")
     print("wrote %d malformed files (+%d kept lines)" % (len(CORPUS), len(kept)))
