@@ -43,8 +43,8 @@ uint64_t gi_scene_object_hash(const gi_scene *s, uint32_t object)
         XXH64_update(st, v->normal, sizeof v->normal);
         XXH64_update(st, v->uv, sizeof v->uv);
     }
-    for (size_t k = (size_t)o->first_triangle * 3; k < ((size_t)o->first_triangle + o->triangle_count) * 3;
-         k++) {
+    for (size_t k = (size_t)o->first_triangle * 3;
+         k < ((size_t)o->first_triangle + o->triangle_count) * 3; k++) {
         uint32_t rel = s->indices[k] - o->first_vertex;
         XXH64_update(st, &rel, sizeof rel);
     }

@@ -44,7 +44,8 @@
 #include <stb_image.h>
 #include <tiny_gltf.h>
 
-namespace {
+namespace
+{
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -144,7 +145,8 @@ bool uri_scheme(const std::string &uri, std::string *scheme)
 bool is_data_uri(const std::string &uri)
 {
     std::string scheme;
-    return uri_scheme(uri, &scheme) && scheme.size() == 4 && strncasecmp(scheme.c_str(), "data", 4) == 0;
+    return uri_scheme(uri, &scheme) && scheme.size() == 4 &&
+           strncasecmp(scheme.c_str(), "data", 4) == 0;
 }
 
 int hex_value(char ch)
@@ -231,7 +233,8 @@ std::string resolve_uri(const Context &c, const std::string &pointer, const std:
         fail(pointer, "URI scheme " + shown(scheme) +
                           " is not allowed (only relative paths and data: URIs)");
     if (!c.has_base)
-        fail(pointer, "external URI " + shown(uri) + " needs a base directory (loaded from memory)");
+        fail(pointer,
+             "external URI " + shown(uri) + " needs a base directory (loaded from memory)");
     if (!decode_uri(uri, &path, &why) || !relative_path_ok(path, &why))
         fail(pointer, "URI " + shown(uri) + " " + why);
     return c.prefix + path;
@@ -334,7 +337,8 @@ bool fs_write_whole_file(std::string *err, const std::string &, const std::vecto
 bool is_png_or_jpeg(const unsigned char *b, size_t n)
 {
     static const unsigned char png[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    return (n >= 8 && memcmp(b, png, 8) == 0) || (n >= 3 && b[0] == 0xff && b[1] == 0xd8 && b[2] == 0xff);
+    return (n >= 8 && memcmp(b, png, 8) == 0) ||
+           (n >= 3 && b[0] == 0xff && b[1] == 0xd8 && b[2] == 0xff);
 }
 
 /* Decodes PNG/JPEG bytes into image->image (RGBA, 8 or 16 bits) after
@@ -368,8 +372,8 @@ bool decode_image(tinygltf::Image *image, int index, const unsigned char *bytes,
     }
     size_t expect = static_cast<size_t>(image->width) * static_cast<size_t>(image->height) * 4u *
                     static_cast<size_t>(image->bits / 8);
-    if (image->component != 4 || (image->bits != 8 && image->bits != 16) ||
-        image->width != w || image->height != h || image->image.size() != expect) {
+    if (image->component != 4 || (image->bits != 8 && image->bits != 16) || image->width != w ||
+        image->height != h || image->image.size() != expect) {
         *why = "image decoded to an unexpected layout";
         return false;
     }
@@ -424,7 +428,8 @@ Glb check_glb(const unsigned char *d, size_t n)
     if (le32(d + 16) != 0x4E4F534Au)
         fail("GLB", "first chunk is not JSON");
     if (json_len == 0 || 20 + json_len > length)
-        fail("GLB", fmt("JSON chunk of %llu bytes does not fit", static_cast<unsigned long long>(json_len)));
+        fail("GLB", fmt("JSON chunk of %llu bytes does not fit",
+                        static_cast<unsigned long long>(json_len)));
     uint64_t rest = length - 20 - json_len;
     if (rest > 0) {
         const unsigned char *bin = d + 20 + json_len;
@@ -496,8 +501,8 @@ void check_asset(const Json &j)
     if (!min->is_string() || !parse_version(min->get<std::string>(), &major, &minor))
         fail("/asset/minVersion", "not a version number");
     if (major > 2 || (major == 2 && minor > 0))
-        fail("/asset/minVersion", "file needs glTF " + shown(min->get<std::string>()) +
-                                      "; this loader reads 2.0");
+        fail("/asset/minVersion",
+             "file needs glTF " + shown(min->get<std::string>()) + "; this loader reads 2.0");
 }
 
 void check_required_extensions(const Json &j)
@@ -512,8 +517,9 @@ void check_required_extensions(const Json &j)
         std::string name = e.is_string() ? e.get<std::string>() : std::string();
         if (name != "KHR_lights_punctual" && name != "KHR_materials_emissive_strength")
             fail(fmt("/extensionsRequired/%zu", i),
-                 "extension " + shown(name) + " is required but not supported (supported: "
-                 "KHR_lights_punctual, KHR_materials_emissive_strength)");
+                 "extension " + shown(name) +
+                     " is required but not supported (supported: "
+                     "KHR_lights_punctual, KHR_materials_emissive_strength)");
     }
 }
 
@@ -658,8 +664,8 @@ const char *component_name(int type)
 
 const char *mode_name(int mode)
 {
-    static const char *names[] = {"POINTS",         "LINES",     "LINE_LOOP",     "LINE_STRIP",
-                                  "TRIANGLES",      "TRIANGLE_STRIP", "TRIANGLE_FAN"};
+    static const char *names[] = {"POINTS",    "LINES",          "LINE_LOOP",   "LINE_STRIP",
+                                  "TRIANGLES", "TRIANGLE_STRIP", "TRIANGLE_FAN"};
     return mode >= 0 && mode <= 6 ? names[mode] : "unknown";
 }
 
@@ -767,7 +773,8 @@ bool number(const Value *v, double *out)
     return finite(*out);
 }
 
-class Converter {
+class Converter
+{
   public:
     Converter(const tinygltf::Model &model, Context &ctx) : m(model), c(ctx) {}
     gi_scene *run(char env_pointer[GI_GLTF_POINTER_MAX]);
@@ -780,7 +787,7 @@ class Converter {
     std::vector<std::string> material_names;
     int default_material = -1;
     std::vector<TextureData> textures;
-    std::map<int, int> texture_of; /* glTF texture -> textures index */
+    std::map<int, int> texture_of;            /* glTF texture -> textures index */
     std::vector<tinygltf::Image> view_images; /* decoded images stored in buffer views */
     std::vector<int> parents;
     std::vector<NodeInfo> nodes;
@@ -931,8 +938,8 @@ void Converter::check_accessor_kind(int accessor, const char *what, bool ok) con
 void Converter::convert_materials()
 {
     if (m.materials.size() > GI_MAX_MATERIALS)
-        fail("/materials", fmt("%zu materials exceed the limit of %d", m.materials.size(),
-                               GI_MAX_MATERIALS));
+        fail("/materials",
+             fmt("%zu materials exceed the limit of %d", m.materials.size(), GI_MAX_MATERIALS));
     for (size_t i = 0; i < m.materials.size(); i++)
         convert_material(i);
 }
@@ -1055,8 +1062,8 @@ void Converter::check_images()
             const tinygltf::Buffer &b = m.buffers[static_cast<size_t>(bv.buffer)];
             tinygltf::Image &d = view_images[i];
             d.name = img.name;
-            if (!decode_image(&d, static_cast<int>(i), b.data.data() + bv.byteOffset,
-                              bv.byteLength, &why))
+            if (!decode_image(&d, static_cast<int>(i), b.data.data() + bv.byteOffset, bv.byteLength,
+                              &why))
                 fail(p, why);
         } else if (img.image.empty()) {
             fail(p, "image data could not be read" +
@@ -1224,8 +1231,8 @@ void decompose(const std::vector<double> &mx, const std::string &p, NodeInfo *n)
                            mx[col * 4 + 2] * mx[col * 4 + 2]);
         n->t[col] = static_cast<float>(mx[12 + col]);
     }
-    double det = mx[0] * (mx[5] * mx[10] - mx[6] * mx[9]) - mx[4] * (mx[1] * mx[10] - mx[2] * mx[9]) +
-                 mx[8] * (mx[1] * mx[6] - mx[2] * mx[5]);
+    double det = mx[0] * (mx[5] * mx[10] - mx[6] * mx[9]) -
+                 mx[4] * (mx[1] * mx[10] - mx[2] * mx[9]) + mx[8] * (mx[1] * mx[6] - mx[2] * mx[5]);
     if (det < 0.0)
         s[0] = -s[0];
     for (int col = 0; col < 3; col++) {
@@ -1311,8 +1318,8 @@ void Converter::check_graph()
             if (static_cast<size_t>(child) == i)
                 fail(p, fmt("node %d is its own child (cycle)", child));
             if (parents[static_cast<size_t>(child)] >= 0)
-                fail(p, fmt("node %d already has parent node %d (a node has at most one parent)", child,
-                            parents[static_cast<size_t>(child)]));
+                fail(p, fmt("node %d already has parent node %d (a node has at most one parent)",
+                            child, parents[static_cast<size_t>(child)]));
             parents[static_cast<size_t>(child)] = static_cast<int>(i);
         }
     }
@@ -1409,7 +1416,8 @@ void Converter::read_positions(const std::string &pp, int acc, std::vector<gi_ve
 {
     const tinygltf::Accessor &a = m.accessors[static_cast<size_t>(acc)];
     check_accessor_kind(acc, "POSITION",
-                        a.type == TINYGLTF_TYPE_VEC3 && a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT);
+                        a.type == TINYGLTF_TYPE_VEC3 &&
+                            a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT);
     if (a.count > GI_MAX_VERTICES)
         fail(pp, fmt("%zu vertices exceed the limit of %u", a.count, GI_MAX_VERTICES));
     Reader r = reader(acc);
@@ -1464,7 +1472,8 @@ void Converter::read_normals(const std::string &pp, int acc, std::vector<gi_vert
 {
     const tinygltf::Accessor &a = m.accessors[static_cast<size_t>(acc)];
     check_accessor_kind(acc, "NORMAL",
-                        a.type == TINYGLTF_TYPE_VEC3 && a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT);
+                        a.type == TINYGLTF_TYPE_VEC3 &&
+                            a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT);
     if (a.count != v->size())
         fail(pp + "/attributes/NORMAL",
              fmt("accessor %d has %zu elements but POSITION has %zu", acc, a.count, v->size()));
@@ -1516,7 +1525,8 @@ void Converter::read_indices(const std::string &pp, const tinygltf::Primitive &p
         return;
     }
     if (prim.indices < 0 || static_cast<size_t>(prim.indices) >= m.accessors.size())
-        fail(pp + "/indices", out_of_range("accessor", prim.indices, m.accessors.size(), "accessors"));
+        fail(pp + "/indices",
+             out_of_range("accessor", prim.indices, m.accessors.size(), "accessors"));
     const tinygltf::Accessor &a = m.accessors[static_cast<size_t>(prim.indices)];
     check_accessor_kind(prim.indices, "indices",
                         a.type == TINYGLTF_TYPE_SCALAR && !a.normalized &&
@@ -1526,7 +1536,8 @@ void Converter::read_indices(const std::string &pp, const tinygltf::Primitive &p
     if (a.count % 3 != 0)
         fail(pp + "/indices", fmt("index count %zu is not a multiple of 3", a.count));
     if (a.count / 3 > GI_MAX_TRIANGLES)
-        fail(pp + "/indices", fmt("%zu triangles exceed the limit of %u", a.count / 3, GI_MAX_TRIANGLES));
+        fail(pp + "/indices",
+             fmt("%zu triangles exceed the limit of %u", a.count / 3, GI_MAX_TRIANGLES));
     Reader r = reader(prim.indices);
     out->resize(a.count);
     for (size_t e = 0; e < a.count; e++) {
@@ -1662,7 +1673,7 @@ void Converter::add_light(int node)
     const tinygltf::Light &l = m.lights[static_cast<size_t>(node_light(static_cast<size_t>(node)))];
     gi_light g = {};
     g.node = node;
-    g.type = l.type == "point" ? GI_LIGHT_POINT
+    g.type = l.type == "point"  ? GI_LIGHT_POINT
              : l.type == "spot" ? GI_LIGHT_SPOT
                                 : GI_LIGHT_DIRECTIONAL;
     for (int k = 0; k < 3; k++)
@@ -1704,7 +1715,9 @@ void Converter::add_object(int node)
         indices.push_back(o.first_vertex + i);
     objects.push_back(o);
     const std::string &mesh_name = m.meshes[static_cast<size_t>(nd.mesh)].name;
-    object_names.push_back(!nd.name.empty() ? nd.name : !mesh_name.empty() ? mesh_name : fmt("node%d", node));
+    object_names.push_back(!nd.name.empty()     ? nd.name
+                           : !mesh_name.empty() ? mesh_name
+                                                : fmt("node%d", node));
 }
 
 /* ---- animation ---- */
@@ -1744,9 +1757,11 @@ void Converter::convert_channel(size_t a, size_t k)
     const tinygltf::AnimationSampler &s = an.samplers[static_cast<size_t>(ch.sampler)];
     std::string ps = fmt("/animations/%zu/samplers/%d", a, ch.sampler);
     if (s.interpolation == "CUBICSPLINE")
-        fail(ps + "/interpolation", "CUBICSPLINE interpolation is not supported (use LINEAR or STEP)");
+        fail(ps + "/interpolation",
+             "CUBICSPLINE interpolation is not supported (use LINEAR or STEP)");
     if (s.interpolation != "LINEAR" && s.interpolation != "STEP")
-        fail(ps + "/interpolation", "interpolation " + shown(s.interpolation) + " is not supported");
+        fail(ps + "/interpolation",
+             "interpolation " + shown(s.interpolation) + " is not supported");
     if (s.input < 0 || static_cast<size_t>(s.input) >= m.accessors.size())
         fail(ps + "/input", out_of_range("accessor", s.input, m.accessors.size(), "accessors"));
     if (s.output < 0 || static_cast<size_t>(s.output) >= m.accessors.size())
@@ -1754,11 +1769,14 @@ void Converter::convert_channel(size_t a, size_t k)
     const tinygltf::Accessor &in = m.accessors[static_cast<size_t>(s.input)];
     const tinygltf::Accessor &out = m.accessors[static_cast<size_t>(s.output)];
     check_accessor_kind(s.input, "animation input",
-                        in.type == TINYGLTF_TYPE_SCALAR && in.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT);
+                        in.type == TINYGLTF_TYPE_SCALAR &&
+                            in.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT);
     bool float_out = out.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT;
-    bool ok = path == 1 ? out.type == TINYGLTF_TYPE_VEC4 &&
-                              (float_out || (out.normalized && out.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
-                        : out.type == TINYGLTF_TYPE_VEC3 && float_out;
+    bool ok = path == 1
+                  ? out.type == TINYGLTF_TYPE_VEC4 &&
+                        (float_out || (out.normalized &&
+                                       out.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+                  : out.type == TINYGLTF_TYPE_VEC3 && float_out;
     check_accessor_kind(s.output, path == 1 ? "rotation output" : "translation/scale output", ok);
     if (out.count != in.count)
         fail(ps + "/output", fmt("output has %zu keys but input has %zu", out.count, in.count));
@@ -1877,7 +1895,8 @@ gi_scene *Converter::build() const
         s->vertex_count = static_cast<uint32_t>(vertices.size());
         s->indices = copy_array(indices);
         s->triangle_count = static_cast<uint32_t>(indices.size() / 3);
-        s->materials = static_cast<gi_material *>(calloc(materials.size() + 1, sizeof(gi_material)));
+        s->materials =
+            static_cast<gi_material *>(calloc(materials.size() + 1, sizeof(gi_material)));
         if (!s->materials)
             throw std::bad_alloc();
         s->material_count = static_cast<uint32_t>(materials.size());
@@ -1974,7 +1993,8 @@ gi_scene *Converter::run(char env_pointer[GI_GLTF_POINTER_MAX])
     choose_scene();
     instantiate();
     if (materials.size() > GI_MAX_MATERIALS)
-        fail("/materials", fmt("%zu materials exceed the limit of %d", materials.size(), GI_MAX_MATERIALS));
+        fail("/materials",
+             fmt("%zu materials exceed the limit of %d", materials.size(), GI_MAX_MATERIALS));
     if (indices.empty())
         fail(scene_index >= 0 ? fmt("/scenes/%d", scene_index) : std::string("/"),
              "the scene has no triangles");
@@ -2012,9 +2032,10 @@ gi_scene *parse(const gi_gltf_source *src, Context &c, char env_pointer[GI_GLTF_
     tinygltf::Model model;
     std::string err, warn;
     std::string base = c.has_base ? c.base : std::string();
-    bool ok = src->binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes, glb_length, base)
-                          : loader.LoadASCIIFromString(&model, &err, &warn, text,
-                                                       static_cast<unsigned>(text_size), base);
+    bool ok = src->binary
+                  ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes, glb_length, base)
+                  : loader.LoadASCIIFromString(&model, &err, &warn, text,
+                                               static_cast<unsigned>(text_size), base);
     if (!c.refused.empty())
         fail(c.refused_pointer, c.refused);
     if (!ok) {

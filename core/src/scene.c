@@ -37,8 +37,8 @@ static void *read_scene_file(const char *path, size_t *size, gi_error *err)
     if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
         gi_error_set(err, GI_ERR_IO, "%s: not a regular file", path);
     } else if ((unsigned long long)st.st_size > GI_MAX_FILE_BYTES) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: %lld bytes exceed the 1 GiB file limit", path,
-                     (long long)st.st_size);
+        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: %lld bytes exceed the 1 GiB file limit",
+                     path, (long long)st.st_size);
     } else {
         size_t n = (size_t)st.st_size, done = 0;
         data = malloc(n ? n : 1);
@@ -83,8 +83,9 @@ static int load_environment(gi_scene *s, const char *name, const char *pointer, 
     gi_error ierr = {{0}};
     gi_image *img = gi_image_read(s->environment.path, &ierr);
     if (!img) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: %s: cannot read environment map '%.100s': %s",
-                     name, pointer, s->environment.uri, ierr.text);
+        gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                     "%s: %s: cannot read environment map '%.100s': %s", name, pointer,
+                     s->environment.uri, ierr.text);
         return 0;
     }
     s->envmap = gi_envmap_create(img->rgba, img->width, img->height, s->environment.intensity,
@@ -396,8 +397,8 @@ void gi_scene_bounds_at(const gi_scene *s, float t, float out[6])
         float m[16];
         gi_scene_object_transform(s, o, t, m);
         for (int c = 0; c < 8; c++) {
-            gi_vec3 p = gi_mat4_point(m, gi_v3(lb[(c & 1) ? 3 : 0], lb[(c & 2) ? 4 : 1],
-                                                lb[(c & 4) ? 5 : 2]));
+            gi_vec3 p = gi_mat4_point(
+                m, gi_v3(lb[(c & 1) ? 3 : 0], lb[(c & 2) ? 4 : 1], lb[(c & 4) ? 5 : 2]));
             float v[3] = {p.x, p.y, p.z};
             for (int k = 0; k < 3; k++) {
                 b[k] = fminf(b[k], v[k]);

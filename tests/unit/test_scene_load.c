@@ -95,7 +95,8 @@ static void compare_glb(const char *name)
     gi_scene *a = load(a_path), *b = load(b_path);
     if (a && b) {
         CHECK_MSG(a->vertex_count == b->vertex_count && a->triangle_count == b->triangle_count &&
-                      a->object_count == b->object_count && a->material_count == b->material_count &&
+                      a->object_count == b->object_count &&
+                      a->material_count == b->material_count &&
                       a->texture_count == b->texture_count && a->light_count == b->light_count &&
                       a->camera_count == b->camera_count && a->node_count == b->node_count &&
                       a->emitter_count == b->emitter_count &&
@@ -277,7 +278,8 @@ static void test_lights(void)
     CHECK_NEAR(s->materials[0].emission[1], 2, TOL);
     CHECK_NEAR(s->materials[0].emission[2], 1, TOL);
     CHECK(s->emitter_count == 2 && s->emitters[0] == 0 && s->emitters[1] == 1);
-    CHECK(gi_scene_triangle_emission(s, 1)[0] == 4.0f && gi_scene_triangle_emission(s, 2)[0] == 0.0f);
+    CHECK(gi_scene_triangle_emission(s, 1)[0] == 4.0f &&
+          gi_scene_triangle_emission(s, 2)[0] == 0.0f);
 
     const gi_light *bulb = &s->lights[0], *cone = &s->lights[1], *sun = &s->lights[2];
     CHECK(bulb->type == GI_LIGHT_POINT && strcmp(bulb->name, "bulb") == 0);

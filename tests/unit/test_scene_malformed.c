@@ -54,10 +54,11 @@ static void check_file(const expectation *e)
     gi_scene *s = gi_scene_load(path, &err);
     CHECK_MSG(s == NULL, "%s: loaded although malformed", e->name);
     gi_scene_free(s);
-    CHECK_MSG(memchr(err.text, '\0', sizeof err.text) != NULL, "%s: message not terminated", e->name);
+    CHECK_MSG(memchr(err.text, '\0', sizeof err.text) != NULL, "%s: message not terminated",
+              e->name);
     err.text[sizeof err.text - 1] = '\0';
-    CHECK_MSG(strstr(err.text, e->text) != NULL, "%s:\n   got  \"%s\"\n   want \"...%s...\"", e->name,
-              err.text, e->text);
+    CHECK_MSG(strstr(err.text, e->text) != NULL, "%s:\n   got  \"%s\"\n   want \"...%s...\"",
+              e->name, err.text, e->text);
     size_t pl = strlen(path);
     CHECK_MSG(strncmp(err.text, path, pl) == 0 && strncmp(err.text + pl, ": ", 2) == 0,
               "%s: message does not start with the file name: \"%s\"", e->name, err.text);
@@ -117,7 +118,8 @@ static void check_api_failures(void)
     s = gi_scene_load_memory("glTF", 4, 1, NULL, "tiny.glb", &err);
     CHECK_MSG(s == NULL && strstr(err.text, "tiny.glb: GLB: 4 bytes is shorter") != NULL, "%s",
               err.text);
-    s = gi_scene_load_memory(ext, sizeof ext - 1, 0, NULL, "noerr.gltf", NULL); /* err may be NULL */
+    s = gi_scene_load_memory(ext, sizeof ext - 1, 0, NULL, "noerr.gltf",
+                             NULL); /* err may be NULL */
     CHECK(s == NULL);
 }
 

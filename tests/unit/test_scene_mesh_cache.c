@@ -50,7 +50,8 @@ static void check_sphere_contains(const gi_scene *s, uint32_t object, const floa
         const float *p = s->vertices[i].position;
         float d = sqrtf((p[0] - sp[0]) * (p[0] - sp[0]) + (p[1] - sp[1]) * (p[1] - sp[1]) +
                         (p[2] - sp[2]) * (p[2] - sp[2]));
-        CHECK_MSG(d <= sp[3], "vertex %u outside the sphere (%g > %g)", i, (double)d, (double)sp[3]);
+        CHECK_MSG(d <= sp[3], "vertex %u outside the sphere (%g > %g)", i, (double)d,
+                  (double)sp[3]);
     }
 }
 
@@ -77,7 +78,7 @@ static void test_spheres(void)
 static gi_scene *weld_scene(gi_vertex v[9], uint32_t idx[9], gi_object o[2], gi_node n[2])
 {
     static gi_scene s;
-    const float pos[9][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0},       {1, 0, 0}, {1, 1, 0},
+    const float pos[9][3] = {{0, 0, 0},        {1, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0},
                              {0, 1.00001f, 0}, {1, 0, 0}, {2, 0, 0}, {1, 1, 0}};
     memset(&s, 0, sizeof s);
     for (uint32_t i = 0; i < 9; i++) {
