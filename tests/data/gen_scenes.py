@@ -497,6 +497,17 @@ def image_view_garbage():
     return to_glb(doc)
 
 
+def bin_past_file():
+    """BIN chunk claiming 8 bytes more than the file holds, buffer as long as
+    the claim: tinygltf 2.7's own check misses the 8-byte chunk header and
+    copies past the end of the input (seen with an instrumented tinygltf)."""
+    js = json.dumps({"asset": {"version": "2.0"}, "buffers": [{"byteLength": 68}]}).encode()
+    js += b" " * (-len(js) % 4)
+    body = struct.pack("<II", len(js), 0x4E4F534A) + js + struct.pack("<II", 68, 0x004E4942)
+    body += bytes(60)
+    return struct.pack("<4sII", b"glTF", 2, 12 + len(body)) + body
+
+
 def glb_bytes(mut):
     """Raw GLB bytes of the base scene, then mut(bytearray) -> bytes."""
     def make():
@@ -781,6 +792,7 @@ CORPUS = [
      glb_bytes(glb_set32(12, 100000))),
     ("glb-chunk-type.glb", "GLB: first chunk is not JSON", glb_bytes(glb_set32(16, 0x12345678))),
     ("glb-bin-overrun.glb", "GLB: BIN chunk of 64 bytes runs past the end", glb_bytes(glb_bin_too_long)),
+    ("glb-bin-past-file.glb", "GLB: BIN chunk of 68 bytes runs past the end", bin_past_file),
     ("glb-image-view-overrun.glb",
      "/bufferViews/7: byteOffset 216 + byteLength 1073741824 past the end of buffer 0 (294 bytes)",
      image_view_overrun),
