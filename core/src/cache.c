@@ -1,0 +1,232 @@
+/* The on-disk cache of precomputed data (cache.h): content hashes (XXH64),
+ * the cache directory ($GIBENCH_CACHE, $XDG_CACHE_HOME/gibench or
+ * ~/.cache/gibench, created on demand), whole-file reads and atomic writes
+ * (a temporary file in the same directory, renamed into place, so a reader
+ * never sees half an entry and an interrupted study leaves no torn files).
+ */
+#define _XOPEN_SOURCE 700
+
+#include "gi/cache.h"
+
+#include <assert.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <xxhash.h>
+
+uint64_t gi_hash64(const void *data, size_t size, uint64_t seed)
+{
+    return XXH64(data, size, seed);
+}
+
+/* Positions, normals and uvs of every vertex, then the indices relative to
+ * the object's first vertex: the same mesh hashes the same wherever it sits
+ * in the scene, and any change to what a method precomputes from it changes
+ * the hash. The object's transform and material are not part of it. */
+uint64_t gi_scene_object_hash(const gi_scene *s, uint32_t object)
+{
+    assert(s && object < s->object_count);
+    const gi_object *o = &s->objects[object];
+    XXH64_state_t *st = XXH64_createState();
+    if (!st)
+        return 0;
+    XXH64_reset(st, 0x676962656e6368ull); /* "gibench" */
+    uint32_t counts[2] = {o->vertex_count, o->triangle_count};
+    XXH64_update(st, counts, sizeof counts);
+    for (uint32_t i = o->first_vertex; i < o->first_vertex + o->vertex_count; i++) {
+        const gi_vertex *v = &s->vertices[i];
+        XXH64_update(st, v->position, sizeof v->position);
+        XXH64_update(st, v->normal, sizeof v->normal);
+        XXH64_update(st, v->uv, sizeof v->uv);
+    }
+    for (size_t k = (size_t)o->first_triangle * 3; k < ((size_t)o->first_triangle + o->triangle_count) * 3;
+         k++) {
+        uint32_t rel = s->indices[k] - o->first_vertex;
+        XXH64_update(st, &rel, sizeof rel);
+    }
+    uint64_t h = XXH64_digest(st);
+    XXH64_freeState(st);
+    return h;
+}
+
+static char *join(const char *a, const char *b)
+{
+    size_t la = strlen(a), lb = strlen(b);
+    int slash = la > 0 && a[la - 1] != '/';
+    char *p = malloc(la + (size_t)slash + lb + 1);
+    if (p) {
+        memcpy(p, a, la);
+        if (slash)
+            p[la] = '/';
+        memcpy(p + la + slash, b, lb + 1);
+    }
+    return p;
+}
+
+char *gi_cache_path(const char *dir, const char *name)
+{
+    assert(dir && name);
+    return join(dir, name);
+}
+
+/* mkdir -p; 0 on success. */
+static int make_dirs(char *path, gi_error *err)
+{
+    for (char *p = path + 1;; p++) {
+        if (*p != '/' && *p != '\0')
+            continue;
+        char saved = *p;
+        *p = '\0';
+        int r = mkdir(path, 0755);
+        int e = errno;
+        struct stat st;
+        if (r != 0 && !(e == EEXIST && stat(path, &st) == 0 && S_ISDIR(st.st_mode))) {
+            gi_error_set(err, GI_ERR_IO, "cache directory %s: %s", path,
+                         e == EEXIST ? "exists and is not a directory" : strerror(e));
+            *p = saved;
+            return -1;
+        }
+        *p = saved;
+        if (saved == '\0')
+            return 0;
+    }
+}
+
+static const char *non_empty_env(const char *name)
+{
+    const char *v = getenv(name);
+    return v && v[0] ? v : NULL;
+}
+
+char *gi_cache_dir(gi_error *err)
+{
+    const char *v;
+    char *dir;
+    if ((v = non_empty_env("GIBENCH_CACHE")))
+        dir = strdup(v);
+    else if ((v = non_empty_env("XDG_CACHE_HOME")) && v[0] == '/') /* XDG: relative = unset */
+        dir = join(v, "gibench");
+    else if ((v = non_empty_env("HOME")))
+        dir = join(v, ".cache/gibench");
+    else {
+        gi_error_set(err, GI_ERR_IO, "no cache directory: set GIBENCH_CACHE or HOME");
+        return NULL;
+    }
+    if (!dir) {
+        gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory");
+        return NULL;
+    }
+    if (make_dirs(dir, err) != 0) {
+        free(dir);
+        return NULL;
+    }
+    return dir;
+}
+
+void *gi_file_read_all(const char *path, size_t *size)
+{
+    assert(path && size);
+    *size = 0;
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0)
+        return NULL;
+    struct stat st;
+    char *data = NULL;
+    if (fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && (unsigned long long)st.st_size < SIZE_MAX) {
+        size_t n = (size_t)st.st_size, done = 0;
+        data = malloc(n + 1); /* NUL-terminated for text readers; *size excludes it */
+        while (data && done < n) {
+            ssize_t r = read(fd, data + done, n - done);
+            if (r < 0 && errno == EINTR)
+                continue;
+            if (r <= 0) {
+                free(data);
+                data = NULL;
+            } else {
+                done += (size_t)r;
+            }
+        }
+        if (data) {
+            data[n] = '\0';
+            *size = n;
+        }
+    }
+    close(fd);
+    return data;
+}
+
+static int write_all(int fd, const void *data, size_t size)
+{
+    const char *p = data;
+    while (size > 0) {
+        ssize_t r = write(fd, p, size);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r <= 0)
+            return -1;
+        p += r;
+        size -= (size_t)r;
+    }
+    return 0;
+}
+
+/* Makes the rename itself durable; failure here is not an error. */
+static void sync_directory_of(const char *path)
+{
+    char *dir = strdup(path);
+    if (!dir)
+        return;
+    char *slash = strrchr(dir, '/');
+    if (slash)
+        *(slash == dir ? slash + 1 : slash) = '\0';
+    int fd = open(slash ? dir : ".", O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd >= 0) {
+        fsync(fd);
+        close(fd);
+    }
+    free(dir);
+}
+
+gi_result gi_file_write_atomic(const char *path, const void *data, size_t size, gi_error *err)
+{
+    assert(path && (data || size == 0));
+    char *tmp = malloc(strlen(path) + 16);
+    if (!tmp)
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+    sprintf(tmp, "%s.tmp.XXXXXX", path);
+    int fd = mkstemp(tmp);
+    if (fd < 0) {
+        gi_result r = gi_error_set(err, GI_ERR_IO, "%s: cannot create a temporary file: %s", path,
+                                   strerror(errno));
+        free(tmp);
+        return r;
+    }
+    const char *what = NULL;
+    if (fchmod(fd, 0644) != 0)
+        what = "chmod";
+    else if (write_all(fd, data, size) != 0)
+        what = "write";
+    else if (fsync(fd) != 0)
+        what = "fsync";
+    int e = errno;
+    if (close(fd) != 0 && !what) {
+        what = "close";
+        e = errno;
+    }
+    if (!what && rename(tmp, path) != 0) {
+        what = "rename";
+        e = errno;
+    }
+    if (what) {
+        unlink(tmp);
+        free(tmp);
+        return gi_error_set(err, GI_ERR_IO, "%s: %s failed: %s", path, what, strerror(e));
+    }
+    free(tmp);
+    sync_directory_of(path);
+    return GI_OK;
+}
