@@ -5,7 +5,8 @@
  * pixel. Writing picks the format from the file name:
  *   .exr  float32 RGBA (extra named channels with gi_image_write_exr_layers)
  *   .pfm  float32 RGB (alpha dropped)
- *   .png  8-bit sRGB after tonemapping (exposure in stops; see tonemap.h)
+ *   .png  8-bit sRGB RGB after tonemapping (exposure in stops; see tonemap.h;
+ *         alpha dropped)
  * Writes go to a temporary name in the same directory and are renamed into
  * place, so a reader never sees a half-written file.
  */
@@ -23,17 +24,23 @@ typedef struct gi_image {
     float *rgba;
 } gi_image;
 
+/* Zero-filled; NULL when a side is 0, the image is absurdly large (more than
+ * 2^28 pixels) or memory runs out. */
 gi_image *gi_image_create(uint32_t width, uint32_t height);
 void gi_image_free(gi_image *img);
 /* Reads any format OpenImageIO knows; 1-3 channel files are expanded to
- * RGBA (grey to RGB, alpha 1). NULL + err on failure. */
+ * RGBA (grey to RGB, alpha 1; 2 channels are grey + alpha). Channels named
+ * R, G, B (and A) are used wherever they are in the file. Values are as
+ * stored: an 8-bit sRGB PNG reads as its display values in [0, 1], not
+ * linearised. NULL + err ("path: reason") on failure. */
 gi_image *gi_image_read(const char *path, gi_error *err);
 
 typedef struct gi_image_write_opts {
     float exposure; /* stops, PNG only; 0 = none */
 } gi_image_write_opts;
 
-/* opts may be NULL (defaults). */
+/* opts may be NULL (defaults). Any other extension is an error
+ * (GI_ERR_INVALID_ARGUMENT); messages read "path: reason". */
 gi_result gi_image_write(const char *path, const gi_image *img, const gi_image_write_opts *opts,
                          gi_error *err);
 
@@ -42,7 +49,9 @@ gi_result gi_image_write(const char *path, const gi_image *img, const gi_image_w
 gi_result gi_image_write_exr_layers(const char *path, const gi_image *rgba,
                                     const gi_image *const *layers, const char *const *names,
                                     uint32_t layer_count, gi_error *err);
-/* Reads layer `name` (e.g. "variance") of such an EXR; NULL + err if absent. */
+/* Reads layer `name` (e.g. "variance") of such an EXR: channels name.R/G/B
+ * (name.A optional), or a single channel name.Y or name read as grey.
+ * NULL + err if absent. */
 gi_image *gi_image_read_layer(const char *path, const char *name, gi_error *err);
 
 /* Mean of each channel over all pixels (double accumulation). */

@@ -10,10 +10,10 @@
 extern "C" {
 #endif
 
-/* sRGB OETF of a linear value in [0, 1]. */
+/* sRGB OETF of a linear value, clamped to [0, 1] (NaN gives 0). */
 static inline float gi_srgb_encode(float x)
 {
-    x = x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : x);
+    x = x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f;
     return x <= 0.0031308f ? 12.92f * x : 1.055f * powf(x, 1.0f / 2.4f) - 0.055f;
 }
 /* Inverse of gi_srgb_encode, for 8-bit textures. */
