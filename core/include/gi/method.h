@@ -166,6 +166,10 @@ typedef struct gi_method {
 
 typedef const gi_method *(*gi_method_entry_fn)(uint32_t host_abi_version);
 
+/* The one symbol a plugin defines and exports (declared here so that the
+ * definition is checked against it). */
+GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version);
+
 #ifdef __cplusplus
 }
 #endif
