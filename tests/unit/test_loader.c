@@ -20,7 +20,7 @@ static void expect_refused(const char *kind, const char *substring)
 
 int main(void)
 {
-    expect_refused("wrong_abi", "gi_method_entry returned NULL for host ABI");
+    expect_refused("wrong_abi", "built for plugin ABI 2.0, this gibench speaks 1.0");
     expect_refused("missing_fn", "lacks the required function render()");
     expect_refused("bad_id", "method id 'Bad Id!' is not [a-z0-9_]{1,31}");
     expect_refused("null_entry", "gi_method_entry returned NULL");
