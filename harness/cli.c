@@ -210,7 +210,7 @@ void cli_host_free(cli_host *h)
 
 int cli_write_json(const char *path, json_object *obj, char *why, size_t why_size)
 {
-    const char *text = json_object_to_json_string_ext(obj, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_NOSLASHESCAPE);
+    const char *text = json_object_to_json_string_ext(obj, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_SPACED | JSON_C_TO_STRING_NOSLASHESCAPE);
     gi_error err;
     size_t n = strlen(text);
     char *with_nl = malloc(n + 2);

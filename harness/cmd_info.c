@@ -138,7 +138,7 @@ int cmd_info(int argc, char **argv)
         return cli_fail(EXIT_USAGE, "%s", err.text);
     if (json) {
         json_object *o = scene_json(s);
-        puts(json_object_to_json_string_ext(o, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_NOSLASHESCAPE));
+        puts(json_object_to_json_string_ext(o, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_SPACED | JSON_C_TO_STRING_NOSLASHESCAPE));
         json_object_put(o);
     } else {
         print_scene(s);

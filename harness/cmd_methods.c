@@ -15,6 +15,10 @@ static json_object *param_json(const gi_param_desc *d)
         json_object_object_add(p, "choices", json_object_new_string(d->choices));
     } else if (d->type == GI_PARAM_BOOL) {
         json_object_object_add(p, "default", json_object_new_boolean(d->def != 0.0));
+    } else if (d->type == GI_PARAM_INT) {
+        json_object_object_add(p, "default", json_object_new_int64((int64_t)d->def));
+        json_object_object_add(p, "min", json_object_new_int64((int64_t)d->min));
+        json_object_object_add(p, "max", json_object_new_int64((int64_t)d->max));
     } else {
         json_object_object_add(p, "default", json_object_new_double(d->def));
         json_object_object_add(p, "min", json_object_new_double(d->min));
@@ -78,7 +82,7 @@ int cmd_methods(int argc, char **argv)
             json_object_object_add(o, "params", ps);
             json_object_array_add(arr, o);
         }
-        puts(json_object_to_json_string_ext(arr, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_NOSLASHESCAPE));
+        puts(json_object_to_json_string_ext(arr, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_SPACED | JSON_C_TO_STRING_NOSLASHESCAPE));
         json_object_put(arr);
     } else {
         if (reg->count == 0)
