@@ -6,8 +6,9 @@
 // mapping, same binary searches over the same tables, same pdf.
 //
 // The map's rotation about +Y (radians, gi_envmap.rotation) comes from
-// GI_ENV_ROTATION: define it before including this file to read it from
-// your own uniform block, or set the uniform gi_env_rotation declared here.
+// GI_ENV_ROTATION. scene.glsl defines it (the scene-info block), so include
+// scene.glsl BEFORE this file; without scene.glsl, define it yourself or set
+// the uniform gi_env_rotation declared here.
 // Only call these when the scene has an environment (gi_has_environment()).
 #ifndef GI_ENVMAP_GLSL
 #define GI_ENVMAP_GLSL

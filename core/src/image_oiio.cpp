@@ -81,10 +81,9 @@ gi_result write_atomically(const std::string &path, const std::string &ext, gi_e
     if (fd < 0)
         return gi_error_set(err, GI_ERR_IO, "%s: cannot create a temporary file: %s", path.c_str(),
                             std::strerror(errno));
-    /* mkstemps makes the file 0600; results are meant to be shared. */
-    if (fchmod(fd, 0644) != 0) {
-        /* Not fatal: the file is still correct, only less readable. */
-    }
+    /* mkstemps makes the file 0600; results are meant to be shared. A
+     * failure is not fatal: the file is still right, only less readable. */
+    (void)fchmod(fd, 0644);
     close(fd);
     std::string tmp(name.data());
     gi_result r = GI_ERR_IO;

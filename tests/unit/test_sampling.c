@@ -145,7 +145,7 @@ static void test_sequences(void)
     CHECK(gi_sobol2(0) == 0.0f && gi_sobol2(1) == 0.5f && gi_sobol2(2) == 0.75f &&
           gi_sobol2(3) == 0.25f);
     enum { M = 10, N = 1 << M };
-    static float pts[N][2];
+    float pts[N][2];
     for (int i = 0; i < N; i++)
         gi_sobol02((uint32_t)i, pts[i]);
     CHECK(is_02_net((const float(*)[2])pts, M));

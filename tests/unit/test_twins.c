@@ -177,9 +177,12 @@ static char *make_defines(const slots *s)
     add_define(&text, &len, "OUT_F", s->out_f);
 #define DEF_IN(name) add_define(&text, &len, #name, name);
     DEF_IN(I_U1)
-    DEF_IN(I_U2) DEF_IN(I_U3) DEF_IN(I_U4) DEF_IN(I_N) DEF_IN(I_EXP) DEF_IN(I_WO) DEF_IN(I_COSMAX)
-        DEF_IN(I_WI) DEF_IN(I_EXPOSURE) DEF_IN(I_KD) DEF_IN(I_MIRROR) DEF_IN(I_KS) DEF_IN(I_LINEAR)
-            DEF_IN(I_D) DEF_IN(I_SRGB) DEF_IN(I_NF) DEF_IN(I_FPDF) DEF_IN(I_NG) DEF_IN(I_GPDF)
+    DEF_IN(I_U2)
+    DEF_IN(I_U3)
+    DEF_IN(I_U4)
+    DEF_IN(I_N) DEF_IN(I_EXP) DEF_IN(I_WO) DEF_IN(I_COSMAX) DEF_IN(I_WI) DEF_IN(I_EXPOSURE)
+        DEF_IN(I_KD) DEF_IN(I_MIRROR) DEF_IN(I_KS) DEF_IN(I_LINEAR) DEF_IN(I_D) DEF_IN(I_SRGB)
+            DEF_IN(I_NF) DEF_IN(I_FPDF) DEF_IN(I_NG) DEF_IN(I_GPDF)
 #define DEF_U(name) add_define(&text, &len, #name, name);
                 UINT_SLOTS(DEF_U) for (int i = 0; i < FLOAT_SLOT_COUNT; i++)
                     add_define(&text, &len, float_slots[i].name, s->off[i]);
@@ -531,6 +534,40 @@ static void run_case_set(GLuint prog, const slots *s, const gi_envmap *env, cons
     free(gpu_f);
 }
 
+/* All shared files together with the scene's: scene.glsl defines
+ * GI_ENV_ROTATION (the scene-info block), which replaces the
+ * gi_env_rotation uniform of envmap.glsl. */
+static void check_combined_build(void)
+{
+    const char *text =
+        "#include \"scene.glsl\"\n"
+        "#include \"lights.glsl\"\n"
+        "#include \"common.glsl\"\n"
+        "#include \"tonemap.glsl\"\n"
+        "#include \"envmap.glsl\"\n"
+        "#include \"brdf.glsl\"\n"
+        "#include \"sequences.glsl\"\n"
+        "#include \"rng.glsl\"\n"
+        "layout(local_size_x = 1) in;\n"
+        "layout(std430, binding = 8) buffer Out { vec4 o[]; };\n"
+        "void main()\n"
+        "{\n"
+        "    uint s = gi_rng_init(0u, 0u, 0u);\n"
+        "    vec3 d;\n"
+        "    float p = gi_envmap_sample(gi_rng_next_float(s), gi_halton(2u, 5u), d);\n"
+        "    gi_brdf b = gi_brdf(vec3(0.5), vec3(0.5), 10.0, 0);\n"
+        "    vec3 f = gi_brdf_eval(b, vec3(0.0, 1.0, 0.0), d, d);\n"
+        "    o[0] = vec4(gi_tonemap(f + gi_envmap_eval(d), 0.0), p);\n"
+        "}\n";
+    gi_error err;
+    GLuint prog = gi_program_build_compute_text("tests/unit/combined.comp", text, NULL, &err);
+    CHECK_MSG(prog != 0, "%s", err.text);
+    if (prog) {
+        CHECK(glGetUniformLocation(prog, "gi_env_rotation") < 0);
+        glDeleteProgram(prog);
+    }
+}
+
 int main(void)
 {
     gi_error err;
@@ -540,6 +577,7 @@ int main(void)
         return gi_test_finish();
     printf("renderer: %s\n", gi_gpu_renderer(gpu));
 
+    check_combined_build();
     slots s;
     layout_slots(&s);
     char *defines = make_defines(&s);
