@@ -65,7 +65,7 @@ static int count_entries(const char *dir)
 
 static void test_exr(const char *dir)
 {
-    char path[1024];
+    char path[1100];
     snprintf(path, sizeof path, "%s/a.exr", dir);
     gi_image *img = pattern(7, 5, 0.5f);
     gi_error err = {{0}};
@@ -84,7 +84,7 @@ static void test_exr(const char *dir)
 
 static void test_pfm(const char *dir)
 {
-    char path[1024];
+    char path[1100];
     snprintf(path, sizeof path, "%s/a.pfm", dir);
     gi_image *img = pattern(6, 4, 1.25f);
     gi_error err = {{0}};
@@ -131,7 +131,7 @@ static void test_pfm(const char *dir)
 
 static void test_png(const char *dir)
 {
-    char path[1024];
+    char path[1100];
     snprintf(path, sizeof path, "%s/a.png", dir);
     gi_image *img = pattern(9, 3, 0.0f);
     /* Cover the whole display range, the linear toe and a NaN. */
@@ -164,7 +164,7 @@ static void test_png(const char *dir)
 
 static void test_layers(const char *dir)
 {
-    char path[1024];
+    char path[1100];
     snprintf(path, sizeof path, "%s/layers.exr", dir);
     gi_image *rgba = pattern(5, 4, 0.0f);
     gi_image *var = pattern(5, 4, 3.0f);
