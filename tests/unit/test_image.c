@@ -210,7 +210,7 @@ static void test_layers(const char *dir)
 
 static void test_atomic_and_errors(const char *root)
 {
-    char dir[1024], path[1100];
+    char dir[1100], path[1200];
     snprintf(dir, sizeof dir, "%s/atomic", root);
     CHECK(mkdir(dir, 0755) == 0);
     gi_image *img = pattern(4, 4, 0.0f);
