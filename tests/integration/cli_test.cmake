@@ -54,6 +54,14 @@ endforeach()
 # An animated render advances time and calls update.
 expect(0 "" render --scene ${SCENES}/cornell_moving.gltf --method direct --size 32x32 --frames 3 --animate 2 --out ${OUT}/moving.png)
 
+# Plugins are also found on GIBENCH_PLUGIN_PATH; broken ones are refused
+# with a warning naming the file and the reason, and the rest still load.
+set(ENV{GIBENCH_PLUGIN_PATH} "${FAKE_PLUGINS}")
+expect(0 "fake_good" methods)
+expect(0 "plugin refused: ${FAKE_PLUGINS}/gimethod_fake_missing_fn.so: method 'fake_missing_fn' lacks the required function render()" methods)
+expect(0 "direct" methods)
+unset(ENV{GIBENCH_PLUGIN_PATH})
+
 if(failures GREATER 0)
     message(FATAL_ERROR "${failures} command-line expectation(s) failed")
 endif()
