@@ -15,6 +15,10 @@ static const char usage[] =
     "         [--param k=v]... [--frames N] [--warmup N] [--time T] [--animate FPS]\n"
     "         [--seed N] [--exposure EV] [--timings FILE.json]\n"
     "                                         render one method (EXR, PFM or PNG output)\n"
+    "  compare --scene S --methods a,b,...|all --out DIR [--size WxH] [--frames N] [--warmup N]\n"
+    "          [--camera C] [--reference FILE.exr] [--ref-spp N] [--ref-bounces B] [--timeout S]\n"
+    "          [--param method.k=v]... [--seed N] [--exposure EV] [--time T] [--fresh]\n"
+    "                                         methods side by side against the references\n"
     "exit status: 0 success, 1 failure while running, 2 bad usage or bad input\n";
 
 int main(int argc, char **argv)
@@ -47,6 +51,8 @@ int main(int argc, char **argv)
         return cmd_info(sub_argc, sub_argv);
     if (!strcmp(cmd, "render"))
         return cmd_render(sub_argc, sub_argv);
+    if (!strcmp(cmd, "compare"))
+        return cmd_compare(sub_argc, sub_argv);
     if (!strcmp(cmd, "help")) {
         fputs(usage, stdout);
         return EXIT_OK;
