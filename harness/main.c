@@ -19,6 +19,8 @@ static const char usage[] =
     "          [--camera C] [--reference FILE.exr] [--ref-spp N] [--ref-bounces B] [--timeout S]\n"
     "          [--param method.k=v]... [--seed N] [--exposure EV] [--time T] [--fresh]\n"
     "                                         methods side by side against the references\n"
+    "  study STUDY.json --out DIR [--jobs N] [--resume|--fresh]\n"
+    "                                         run a declarative experiment and write its report\n"
     "exit status: 0 success, 1 failure while running, 2 bad usage or bad input\n";
 
 int main(int argc, char **argv)
@@ -53,6 +55,8 @@ int main(int argc, char **argv)
         return cmd_render(sub_argc, sub_argv);
     if (!strcmp(cmd, "compare"))
         return cmd_compare(sub_argc, sub_argv);
+    if (!strcmp(cmd, "study"))
+        return cmd_study(sub_argc, sub_argv);
     if (!strcmp(cmd, "help")) {
         fputs(usage, stdout);
         return EXIT_OK;
