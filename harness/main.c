@@ -15,6 +15,8 @@ static const char usage[] =
     "         [--param k=v]... [--frames N] [--warmup N] [--time T] [--animate FPS]\n"
     "         [--seed N] [--exposure EV] [--timings FILE.json]\n"
     "                                         render one method (EXR, PFM or PNG output)\n"
+    "  diff TEST REFERENCE [--json] [--heatmap FILE.png] [--flip-map FILE.png]\n"
+    "       [--exposure EV] [--ppd N]         error metrics (RMSE, relMSE, MAE, PSNR, SSIM, FLIP)\n"
     "exit status: 0 success, 1 failure while running, 2 bad usage or bad input\n";
 
 int main(int argc, char **argv)
@@ -47,6 +49,8 @@ int main(int argc, char **argv)
         return cmd_info(sub_argc, sub_argv);
     if (!strcmp(cmd, "render"))
         return cmd_render(sub_argc, sub_argv);
+    if (!strcmp(cmd, "diff"))
+        return cmd_diff(sub_argc, sub_argv);
     if (!strcmp(cmd, "help")) {
         fputs(usage, stdout);
         return EXIT_OK;
