@@ -461,6 +461,192 @@ static void test_flip_values(void)
     gi_image_free(b);
 }
 
+/* A direct transcription of the paper for comparison: full 2-D kernels from
+ * its formulas (no separation), correlated with clamped borders. */
+static double clamp01(double v)
+{
+    return v < 0 ? 0 : v > 1 ? 1 : v;
+}
+
+static void conv2d(const double *in, double *out, int w, int h, const double *k, int r)
+{
+    int n = 2 * r + 1;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            double acc = 0;
+            for (int j = -r; j <= r; j++)
+                for (int i = -r; i <= r; i++) {
+                    int xx = x + i < 0 ? 0 : x + i >= w ? w - 1 : x + i;
+                    int yy = y + j < 0 ? 0 : y + j >= h ? h - 1 : y + j;
+                    acc += k[(j + r) * n + (i + r)] * in[yy * w + xx];
+                }
+            out[y * w + x] = acc;
+        }
+}
+
+static void brute_prepare(const float *srgb, int w, int h, double ppd, double *hlab[3],
+                          double *edge, double *point)
+{
+    int np = w * h;
+    double *opp[3], *yn = malloc(np * sizeof(double)), *t1 = malloc(np * sizeof(double)),
+                    *t2 = malloc(np * sizeof(double));
+    for (int c = 0; c < 3; c++)
+        opp[c] = malloc(np * sizeof(double));
+    for (int i = 0; i < np; i++) {
+        double rgb[3], xyz[3], o[3];
+        for (int c = 0; c < 3; c++)
+            rgb[c] = gi_srgb_decode(srgb[i * 3 + c]);
+        gi_flip_linrgb_to_xyz(rgb, xyz);
+        gi_flip_xyz_to_ycxcz(xyz, o);
+        for (int c = 0; c < 3; c++)
+            opp[c][i] = o[c];
+        yn[i] = (o[0] + 16.0) / 116.0;
+    }
+    /* CSF kernels straight from S(x) */
+    int r = gi_flip_csf_radius(ppd), n = 2 * r + 1;
+    double *k = malloc((size_t)n * n * sizeof *k);
+    for (int c = 0; c < 3; c++) {
+        const gi_flip_csf *p = &gi_flip_csf_params[c];
+        double total = 0;
+        for (int y = -r; y <= r; y++)
+            for (int x = -r; x <= r; x++) {
+                double d2 = (x * x + y * y) / (ppd * ppd);
+                double v = p->a1 * sqrt(M_PI / p->b1) * exp(-M_PI * M_PI * d2 / p->b1) +
+                           p->a2 * sqrt(M_PI / p->b2) * exp(-M_PI * M_PI * d2 / p->b2);
+                k[(y + r) * n + (x + r)] = v;
+                total += v;
+            }
+        for (int i = 0; i < n * n; i++)
+            k[i] /= total;
+        conv2d(opp[c], hlab[c], w, h, k, r);
+    }
+    free(k);
+    for (int i = 0; i < np; i++) {
+        double o[3] = {hlab[0][i], hlab[1][i], hlab[2][i]}, xyz[3], rgb[3], hl[3];
+        gi_flip_ycxcz_to_xyz(o, xyz);
+        gi_flip_xyz_to_linrgb(xyz, rgb);
+        for (int c = 0; c < 3; c++)
+            rgb[c] = clamp01(rgb[c]);
+        gi_flip_linrgb_to_hunt_lab(rgb, hl);
+        for (int c = 0; c < 3; c++)
+            hlab[c][i] = hl[c];
+    }
+    /* feature kernels: 2-D derivatives of a Gaussian, +/- sums normalised */
+    double sd = 0.5 * 0.082 * ppd;
+    int fr = (int)ceil(3 * sd), fn = 2 * fr + 1;
+    double *ke = malloc((size_t)fn * fn * sizeof *ke), *kp = malloc((size_t)fn * fn * sizeof *kp),
+           *kt = malloc((size_t)fn * fn * sizeof *kt);
+    double ep = 0, en = 0, pp = 0, pn = 0;
+    for (int y = -fr; y <= fr; y++)
+        for (int x = -fr; x <= fr; x++) {
+            double g = exp(-(x * x + y * y) / (2 * sd * sd));
+            double e = -x * g, p = (x * x / (sd * sd) - 1) * g;
+            ke[(y + fr) * fn + x + fr] = e;
+            kp[(y + fr) * fn + x + fr] = p;
+            if (e > 0)
+                ep += e;
+            else
+                en -= e;
+            if (p > 0)
+                pp += p;
+            else
+                pn -= p;
+        }
+    for (int i = 0; i < fn * fn; i++) {
+        ke[i] /= ke[i] > 0 ? ep : en;
+        kp[i] /= kp[i] > 0 ? pp : pn;
+    }
+    double *kk[2] = {ke, kp}, *res[2] = {edge, point};
+    for (int f = 0; f < 2; f++) {
+        for (int y = 0; y < fn; y++)
+            for (int x = 0; x < fn; x++)
+                kt[y * fn + x] = kk[f][x * fn + y]; /* transposed: the y detector */
+        conv2d(yn, t1, w, h, kk[f], fr);
+        conv2d(yn, t2, w, h, kt, fr);
+        for (int i = 0; i < np; i++)
+            res[f][i] = sqrt(t1[i] * t1[i] + t2[i] * t2[i]);
+    }
+    free(ke);
+    free(kp);
+    free(kt);
+    for (int c = 0; c < 3; c++)
+        free(opp[c]);
+    free(yn);
+    free(t1);
+    free(t2);
+}
+
+static void brute_flip(const float *ts, const float *rs, int w, int h, double ppd, float *out)
+{
+    int np = w * h;
+    double *ht[3], *hr[3], *et = malloc(np * sizeof(double)), *pt = malloc(np * sizeof(double)),
+                           *er = malloc(np * sizeof(double)), *pr = malloc(np * sizeof(double));
+    for (int c = 0; c < 3; c++) {
+        ht[c] = malloc(np * sizeof(double));
+        hr[c] = malloc(np * sizeof(double));
+    }
+    brute_prepare(ts, w, h, ppd, ht, et, pt);
+    brute_prepare(rs, w, h, ppd, hr, er, pr);
+    double cmax = pow(203.2973, 0.7);
+    for (int i = 0; i < np; i++) {
+        double a[3] = {ht[0][i], ht[1][i], ht[2][i]}, b[3] = {hr[0][i], hr[1][i], hr[2][i]};
+        double hy =
+            fabs(a[0] - b[0]) + sqrt((a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+        double e = pow(hy, 0.7), dc;
+        if (e < 0.4 * cmax)
+            dc = 0.95 / (0.4 * cmax) * e;
+        else
+            dc = 0.95 + (e - 0.4 * cmax) / (cmax - 0.4 * cmax) * 0.05;
+        double df = pow(fmax(fabs(er[i] - et[i]), fabs(pr[i] - pt[i])) / sqrt(2.0), 0.5);
+        out[i] = (float)pow(dc, 1.0 - df);
+    }
+    for (int c = 0; c < 3; c++) {
+        free(ht[c]);
+        free(hr[c]);
+    }
+    free(et);
+    free(pt);
+    free(er);
+    free(pr);
+}
+
+static void test_flip_against_direct(void)
+{
+    /* Random colours with edges, non-square so that x and y cannot be
+     * confused, at a low and the default ppd. */
+    const int w = 23, h = 17;
+    float *ts = malloc(w * h * 3 * sizeof *ts), *rs = malloc(w * h * 3 * sizeof *rs);
+    float *fast = malloc(w * h * sizeof *fast), *slow = malloc(w * h * sizeof *slow);
+    uint32_t s = 777;
+    for (int i = 0; i < w * h * 3; i++) {
+        s = s * 1664525u + 1013904223u;
+        float n = (float)(s >> 8) / 16777216.0f;
+        int x = (i / 3) % w, y = (i / 3) / w;
+        rs[i] = (x < 11 ? 0.2f : 0.7f) + 0.1f * (float)((i % 3) == (y % 3));
+        ts[i] = rs[i] + (n - 0.5f) * 0.3f; /* outside [0, 1] now and then: clamped */
+    }
+    const double ppds[2] = {20.0, GI_FLIP_PPD_DEFAULT};
+    for (int k = 0; k < 2; k++) {
+        gi_error err;
+        CHECK_MSG(gi_flip_map(ts, rs, w, h, ppds[k], fast, &err) == GI_OK, "%s", err.text);
+        for (int i = 0; i < w * h * 3; i++) { /* the direct version does not clamp its input */
+            ts[i] = ts[i] < 0 ? 0 : ts[i] > 1 ? 1 : ts[i];
+        }
+        brute_flip(ts, rs, w, h, ppds[k], slow);
+        double worst = 0, mean = 0;
+        for (int i = 0; i < w * h; i++) {
+            worst = fmax(worst, fabs((double)fast[i] - slow[i]));
+            mean += slow[i];
+        }
+        CHECK_MSG(worst < 1e-5, "ppd %g: separable and direct FLIP differ by %g", ppds[k], worst);
+        CHECK(mean / (w * h) > 0.05); /* there is something to see */
+    }
+    free(ts);
+    free(rs);
+    free(fast);
+    free(slow);
+}
+
 int main(void)
 {
     test_single_pixel();
@@ -472,5 +658,6 @@ int main(void)
     test_flip_colour();
     test_flip_kernels();
     test_flip_values();
+    test_flip_against_direct();
     return gi_test_finish();
 }
