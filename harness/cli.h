@@ -68,6 +68,7 @@ void cli_command_string(const char *cmd, int argc, char **argv, char *buf, size_
 int cmd_methods(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_render(int argc, char **argv);
+int cmd_diff(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
 int cmd_study(int argc, char **argv);
 

@@ -15,6 +15,8 @@ static const char usage[] =
     "         [--param k=v]... [--frames N] [--warmup N] [--time T] [--animate FPS]\n"
     "         [--seed N] [--exposure EV] [--timings FILE.json]\n"
     "                                         render one method (EXR, PFM or PNG output)\n"
+    "  diff TEST REFERENCE [--json] [--heatmap FILE.png] [--flip-map FILE.png]\n"
+    "       [--exposure EV] [--ppd N]         error metrics (RMSE, relMSE, MAE, PSNR, SSIM, FLIP)\n"
     "  compare --scene S --methods a,b,...|all --out DIR [--size WxH] [--frames N] [--warmup N]\n"
     "          [--camera C] [--reference FILE.exr] [--ref-spp N] [--ref-bounces B] [--timeout S]\n"
     "          [--param method.k=v]... [--seed N] [--exposure EV] [--time T] [--fresh]\n"
@@ -53,6 +55,8 @@ int main(int argc, char **argv)
         return cmd_info(sub_argc, sub_argv);
     if (!strcmp(cmd, "render"))
         return cmd_render(sub_argc, sub_argv);
+    if (!strcmp(cmd, "diff"))
+        return cmd_diff(sub_argc, sub_argv);
     if (!strcmp(cmd, "compare"))
         return cmd_compare(sub_argc, sub_argv);
     if (!strcmp(cmd, "study"))
