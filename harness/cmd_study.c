@@ -1,4 +1,4 @@
-/* gibench study: a declarative experiment (harness/studies/*.json)
+/* gibench study: a declarative experiment (harness/studies/NAME.json)
  * expanded into independent runs, executed in child processes by a worker
  * pool, cached by the hash of each run's configuration, and reported with
  * tables and error-against-time charts that include the path tracer's own
