@@ -58,5 +58,6 @@ json_object *cli_timer_json(const gi_timer *t);
 int cmd_methods(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_render(int argc, char **argv);
+int cmd_reference(int argc, char **argv);
 
 #endif

@@ -15,6 +15,10 @@ static const char usage[] =
     "         [--param k=v]... [--frames N] [--warmup N] [--time T] [--animate FPS]\n"
     "         [--seed N] [--exposure EV] [--timings FILE.json]\n"
     "                                         render one method (EXR, PFM or PNG output)\n"
+    "  reference --scene S --out FILE [--out FILE2] [--camera C] [--size WxH]\n"
+    "         [--spp N] [--time S] [--target-se E] [--max-bounces B|inf] [--seed N]\n"
+    "         [--threads N] [--time-of-scene T] [--exposure EV] [--stats FILE.json]\n"
+    "                                         Embree path-traced reference (EXR: mean + variance)\n"
     "exit status: 0 success, 1 failure while running, 2 bad usage or bad input\n";
 
 int main(int argc, char **argv)
@@ -47,6 +51,8 @@ int main(int argc, char **argv)
         return cmd_info(sub_argc, sub_argv);
     if (!strcmp(cmd, "render"))
         return cmd_render(sub_argc, sub_argv);
+    if (!strcmp(cmd, "reference"))
+        return cmd_reference(sub_argc, sub_argv);
     if (!strcmp(cmd, "help")) {
         fputs(usage, stdout);
         return EXIT_OK;
