@@ -277,16 +277,12 @@ static void tg_disk(tg_scene *b, float r, float height, uint32_t segments, int m
     free(idx);
 }
 
-/* A perspective camera at eye looking at target (+Y up unless looking
- * along it, then +Z up). */
-static void tg_camera(tg_scene *b, const float eye[3], const float target[3], float yfov_deg, float znear)
+/* Rotation (x, y, z, w) that turns -Z to the unit direction of f (+Y up
+ * unless f is along it, then +Z up): how glTF orients cameras and lights. */
+static void tg_look_quat(const float fwd[3], double q[4])
 {
-    double f[3], len = 0;
-    for (int k = 0; k < 3; k++) {
-        f[k] = target[k] - eye[k];
-        len += f[k] * f[k];
-    }
-    len = sqrt(len);
+    double f[3] = {fwd[0], fwd[1], fwd[2]};
+    double len = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
     for (int k = 0; k < 3; k++)
         f[k] /= len;
     double up[3] = {0, 1, 0};
@@ -299,9 +295,9 @@ static void tg_camera(tg_scene *b, const float eye[3], const float target[3], fl
     for (int k = 0; k < 3; k++)
         rt[k] /= rl;
     double u[3] = {rt[1] * f[2] - rt[2] * f[1], rt[2] * f[0] - rt[0] * f[2], rt[0] * f[1] - rt[1] * f[0]};
-    /* Rotation matrix columns: right, up, -forward (camera looks down -Z). */
+    /* Rotation matrix columns: right, up, -forward. */
     double m[3][3] = {{rt[0], u[0], -f[0]}, {rt[1], u[1], -f[1]}, {rt[2], u[2], -f[2]}}; /* m[row][col] */
-    double q[4], tr = m[0][0] + m[1][1] + m[2][2];
+    double tr = m[0][0] + m[1][1] + m[2][2];
     if (tr > 0) {
         double s = sqrt(tr + 1.0) * 2;
         q[3] = 0.25 * s;
@@ -327,6 +323,14 @@ static void tg_camera(tg_scene *b, const float eye[3], const float target[3], fl
         q[1] = (m[1][2] + m[2][1]) / s;
         q[2] = 0.25 * s;
     }
+}
+
+/* A perspective camera at eye looking at target. */
+static void tg_camera(tg_scene *b, const float eye[3], const float target[3], float yfov_deg, float znear)
+{
+    float f[3] = {target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]};
+    double q[4];
+    tg_look_quat(f, q);
     tg_printf(&b->camera_node,
               "{\"camera\":0,\"translation\":[%.9g,%.9g,%.9g],\"rotation\":[%.12g,%.12g,%.12g,%.12g]}", eye[0],
               eye[1], eye[2], q[0], q[1], q[2], q[3]);
@@ -335,21 +339,37 @@ static void tg_camera(tg_scene *b, const float eye[3], const float target[3], fl
     b->has_camera = 1;
 }
 
-/* A point light of radiant intensity I (white) at p. */
-static void tg_point_light(tg_scene *b, const float p[3], float intensity)
+/* A KHR_lights_punctual light: `type_json` is the light object's body
+ * without braces; placed at p pointing along dir. */
+static void tg_light(tg_scene *b, const char *type_json, const float p[3], const float dir[3])
 {
-    tg_printf(&b->lights, "%s{\"type\":\"point\",\"intensity\":%.9g}", b->n_lights ? "," : "", intensity);
-    tg_printf(&b->nodes, "%s{\"translation\":[%.9g,%.9g,%.9g],\"extensions\":{\"KHR_lights_punctual\":{\"light\":%d}}}",
-              b->n_nodes ? "," : "", p[0], p[1], p[2], b->n_lights);
+    double q[4];
+    tg_look_quat(dir, q);
+    tg_printf(&b->lights, "%s{%s}", b->n_lights ? "," : "", type_json);
+    tg_printf(&b->nodes,
+              "%s{\"translation\":[%.9g,%.9g,%.9g],\"rotation\":[%.12g,%.12g,%.12g,%.12g],"
+              "\"extensions\":{\"KHR_lights_punctual\":{\"light\":%d}}}",
+              b->n_nodes ? "," : "", p[0], p[1], p[2], q[0], q[1], q[2], q[3], b->n_lights);
     b->n_lights++;
     b->n_nodes++;
 }
 
-/* The scene's environment map (a file name relative to the base dir). */
-static void tg_environment(tg_scene *b, const char *uri, float intensity)
+/* A point light of radiant intensity I (white) at p. */
+static void tg_point_light(tg_scene *b, const float p[3], float intensity)
 {
-    tg_printf(&b->extras, "\"extras\":{\"gibench\":{\"environment\":{\"uri\":\"%s\",\"intensity\":%.9g}}},", uri,
-              intensity);
+    char body[64];
+    const float down[3] = {0, -1, 0};
+    snprintf(body, sizeof body, "\"type\":\"point\",\"intensity\":%.9g", intensity);
+    tg_light(b, body, p, down);
+}
+
+/* The scene's environment map (a file name relative to the base dir). */
+static void tg_environment(tg_scene *b, const char *uri, float intensity, float rotation_deg)
+{
+    tg_printf(&b->extras,
+              "\"extras\":{\"gibench\":{\"environment\":{\"uri\":\"%s\",\"intensity\":%.9g,"
+              "\"rotation_deg\":%.9g}}},",
+              uri, intensity, rotation_deg);
 }
 
 static void tg_base64(tg_str *out, const unsigned char *d, size_t n)

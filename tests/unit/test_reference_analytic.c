@@ -7,7 +7,13 @@
  *    L = rho I / (pi R^2 (1 - rho));
  *  - a diffuse plane under a uniform sky of radiance L: rho L;
  *  - on the axis of a disk light of radius r at height h above a diffuse
- *    plane: rho Le r^2 / (h^2 + r^2).
+ *    plane: rho Le r^2 / (h^2 + r^2);
+ *  - a diffuse plane under a non-uniform, rotated map: rho / pi times the
+ *    map's cosine-weighted integral over the upper hemisphere, summed
+ *    texel by texel in closed form;
+ *  - a spot light (on its axis and inside its falloff ramp) and a
+ *    directional light over a diffuse plane: rho / pi times the irradiance
+ *    of lights.h.
  * Each must hold within 1% (and within a few standard errors of the
  * estimate). The disk and the sky are also rendered with light-only and
  * BSDF-only sampling, which must agree as well. Under AddressSanitizer the
@@ -88,6 +94,11 @@ static int render(const gi_scene *s, uint32_t w, uint32_t h, uint32_t spp, gi_re
  * departure from the ideal shape). All scenes here are grey. */
 static void check_value(const char *what, const estimate *e, double expected)
 {
+    if (expected == 0.0) {
+        printf("%-34s %.6f expected 0\n", what, e->mean[1]);
+        CHECK_MSG(e->mean[0] == 0.0 && e->mean[1] == 0.0 && e->mean[2] == 0.0, "%s: %g", what, e->mean[1]);
+        return;
+    }
     double err = fabs(e->mean[1] - expected) / expected;
     printf("%-34s %.6f expected %.6f: error %.3f%%, standard error %.3f%%, %.2f s\n", what, e->mean[1], expected,
            100.0 * err, 100.0 * e->se[1] / expected, e->seconds);
@@ -153,16 +164,24 @@ static void test_point_in_sphere(void)
     gi_scene_free(s);
 }
 
-/* A constant 8x4 sky written next to the test binaries. */
-static int write_sky(const char *path, float L)
+/* Grey maps written next to the test binaries: constant, or the test
+ * pattern of map_texel. */
+static float map_texel(uint32_t i, uint32_t j)
 {
-    gi_image *img = gi_image_create(8, 4);
+    return (i == 5 && j == 2) ? 40.0f : 0.2f + 0.1f * (float)j + 0.05f * (float)i;
+}
+
+static int write_sky(const char *path, float L, uint32_t w, uint32_t h)
+{
+    gi_image *img = gi_image_create(w, h);
     if (!img)
         return 0;
-    for (size_t i = 0; i < 32; i++) {
-        img->rgba[4 * i] = img->rgba[4 * i + 1] = img->rgba[4 * i + 2] = L;
-        img->rgba[4 * i + 3] = 1.0f;
-    }
+    for (uint32_t j = 0; j < h; j++)
+        for (uint32_t i = 0; i < w; i++) {
+            float *p = img->rgba + 4 * ((size_t)j * w + i);
+            p[0] = p[1] = p[2] = L > 0 ? L : map_texel(i, j);
+            p[3] = 1.0f;
+        }
     gi_error err;
     int ok = gi_image_write(path, img, NULL, &err) == GI_OK;
     if (!ok)
@@ -177,7 +196,7 @@ static void test_plane_under_sky(void)
 {
     const float rho = 0.6f, L = 1.5f;
     const char *dir = GI_BINARY_DIR "/tests";
-    CHECK(write_sky(GI_BINARY_DIR "/tests/reference_sky_const.exr", 1.0f));
+    CHECK(write_sky(GI_BINARY_DIR "/tests/reference_sky_const.exr", 1.0f, 8, 4));
     static const gi_ref_strategy strategies[3] = {GI_REF_STRATEGY_MIS, GI_REF_STRATEGY_LIGHT,
                                                   GI_REF_STRATEGY_BSDF};
     /* Cosine-weighted BSDF sampling of a constant sky has no variance;
@@ -192,7 +211,7 @@ static void test_plane_under_sky(void)
         tg_plane(&b, 100.0f, 0.0f, tg_material(&b, alb, em, 0));
         const float eye[3] = {0.3f, 1.0f, -0.2f}, at[3] = {0.3f, 0.0f, -0.2f};
         tg_camera(&b, eye, at, 60.0f, 0.01f);
-        tg_environment(&b, "reference_sky_const.exr", L);
+        tg_environment(&b, "reference_sky_const.exr", L, 0.0f);
         gi_error err;
         gi_scene *s = tg_load(&b, dir, &err);
         CHECK_MSG(s != NULL, "%s", err.text);
@@ -205,6 +224,96 @@ static void test_plane_under_sky(void)
         check_value(what, &e, rho * L);
         gi_scene_free(s);
     }
+}
+
+/* Plane under a 16x8 map with a gradient and one very bright texel,
+ * rotated 30 degrees about +Y (which leaves the irradiance of a horizontal
+ * plane unchanged). The map is piecewise constant (nearest texel), so
+ * L = rho / pi Int L cos dw is a sum over the upper-hemisphere texels of
+ * L_ij pi du (sin^2(pi v1) - sin^2(pi v0)), from dw = 2 pi^2 sin(pi v) du dv
+ * and cos = cos(pi v). */
+static void test_plane_under_map(void)
+{
+    const float rho = 0.7f;
+    const uint32_t w = 16, h = 8;
+    CHECK(write_sky(GI_BINARY_DIR "/tests/reference_sky_map.exr", 0.0f, w, h));
+    double sum = 0;
+    for (uint32_t j = 0; j < h / 2; j++)
+        for (uint32_t i = 0; i < w; i++) {
+            double s0 = sin(TG_PI * j / h), s1 = sin(TG_PI * (j + 1) / h);
+            sum += map_texel(i, j) * (1.0 / w) * (s1 * s1 - s0 * s0);
+        }
+    double expected = rho * sum;
+    static const gi_ref_strategy strategies[3] = {GI_REF_STRATEGY_MIS, GI_REF_STRATEGY_LIGHT,
+                                                  GI_REF_STRATEGY_BSDF};
+    static const uint32_t spp[3] = {4096, 4096, 32768};
+    for (int k = 0; k < 3; k++) {
+        tg_scene b;
+        tg_init(&b);
+        float alb[3], em[3];
+        grey(rho, alb);
+        grey(0.0f, em);
+        tg_plane(&b, 100.0f, 0.0f, tg_material(&b, alb, em, 0));
+        const float eye[3] = {-0.4f, 1.0f, 0.1f}, at[3] = {-0.4f, 0.0f, 0.1f};
+        tg_camera(&b, eye, at, 60.0f, 0.01f);
+        tg_environment(&b, "reference_sky_map.exr", 1.0f, 30.0f);
+        gi_error err;
+        gi_scene *s = tg_load(&b, GI_BINARY_DIR "/tests", &err);
+        CHECK_MSG(s != NULL, "%s", err.text);
+        if (!s)
+            return;
+        estimate e;
+        CHECK(render(s, 8, 8, spp[k], strategies[k], &e));
+        char what[64];
+        snprintf(what, sizeof what, "plane under a bright texel (%s)", gi_ref_strategy_name(strategies[k]));
+        check_value(what, &e, expected);
+        gi_scene_free(s);
+    }
+}
+
+/* One punctual light over a diffuse plane; a narrow camera looks at
+ * `target` on the plane, whose radiance is rho / pi x irradiance. */
+static void punctual_case(const char *what, const char *light_json, const float pos[3], const float dir[3],
+                          const float target[3], double irradiance)
+{
+    const float rho = 0.5f;
+    tg_scene b;
+    tg_init(&b);
+    float alb[3], em[3];
+    grey(rho, alb);
+    grey(0.0f, em);
+    tg_plane(&b, 50.0f, 0.0f, tg_material(&b, alb, em, 0));
+    tg_light(&b, light_json, pos, dir);
+    const float eye[3] = {target[0] + 1.0f, 1.5f, target[2] + 2.0f};
+    tg_camera(&b, eye, target, 0.2f, 0.01f);
+    gi_error err;
+    gi_scene *s = tg_load(&b, NULL, &err);
+    CHECK_MSG(s != NULL, "%s", err.text);
+    if (!s)
+        return;
+    estimate e;
+    CHECK(render(s, 2, 2, 16, GI_REF_STRATEGY_MIS, &e));
+    check_value(what, &e, rho / GI_PI * irradiance);
+    gi_scene_free(s);
+}
+
+static void test_punctual(void)
+{
+    /* Spot: I = 8 at height 2 pointing down, cones 0.3 / 0.5 rad. On the
+     * axis E = I / h^2; at 0.4 rad off the axis E = I f cos^3 / h^2 with
+     * the ramp f = ((cos 0.4 - cos 0.5) / (cos 0.3 - cos 0.5))^2. */
+    const char *spot = "\"type\":\"spot\",\"intensity\":8,\"spot\":{\"innerConeAngle\":0.3,\"outerConeAngle\":0.5}";
+    const float top[3] = {0, 2, 0}, down[3] = {0, -1, 0}, foot[3] = {0, 0, 0};
+    punctual_case("spot light, on its axis", spot, top, down, foot, 8.0 / 4.0);
+    double th = 0.4, t = (cos(th) - cos(0.5)) / (cos(0.3) - cos(0.5));
+    const float ramp[3] = {(float)(2.0 * tan(th)), 0, 0};
+    punctual_case("spot light, in its falloff ramp", spot, top, down, ramp, 8.0 * t * t * pow(cos(th), 3) / 4.0);
+    const float beyond[3] = {(float)(2.0 * tan(0.55)), 0, 0};
+    punctual_case("spot light, outside its cone", spot, top, down, beyond, 0.0);
+    /* Directional: E = 3 arriving 30 degrees off the vertical. */
+    const float sun_dir[3] = {0.5f, -0.8660254f, 0.0f};
+    punctual_case("directional light at 30 degrees", "\"type\":\"directional\",\"intensity\":3", top, sun_dir,
+                  foot, 3.0 * cos(30.0 * TG_PI / 180.0));
 }
 
 /* Irradiance at the origin (normal +Y) from a unit-radiance polygon, by
@@ -279,6 +388,8 @@ int main(void)
     test_emitting_sphere();
     test_point_in_sphere();
     test_plane_under_sky();
+    test_plane_under_map();
     test_disk_light();
+    test_punctual();
     return gi_test_finish();
 }
