@@ -56,9 +56,10 @@ static int is_exr(const char *path)
 
 static int parse_opts(int argc, char **argv, ref_opts *o)
 {
-    static const char *valued[] = {"--scene", "--camera", "--size", "--spp", "--time", "--target-se",
-                                   "--max-bounces", "--seed", "--threads", "--time-of-scene", "--out",
-                                   "--stats", "--exposure", "--strategy"};
+    static const char *valued[] = {"--scene",    "--camera",        "--size",        "--spp",
+                                   "--time",     "--target-se",     "--max-bounces", "--seed",
+                                   "--threads",  "--time-of-scene", "--out",         "--stats",
+                                   "--exposure", "--strategy"};
     memset(o, 0, sizeof *o);
     o->width = o->height = 256;
     o->seed = 1;
@@ -86,22 +87,27 @@ static int parse_opts(int argc, char **argv, ref_opts *o)
             if (o->out_count == MAX_OUTS)
                 return cli_fail(EXIT_USAGE, "reference: at most %d --out files", MAX_OUTS);
             if (!image_ext_ok(v))
-                return cli_fail(EXIT_USAGE, "reference: --out '%s': use a .exr, .pfm or .png file name", v);
+                return cli_fail(EXIT_USAGE,
+                                "reference: --out '%s': use a .exr, .pfm or .png file name", v);
             o->outs[o->out_count++] = v;
         } else if (!strcmp(a, "--size")) {
             if (!cli_parse_size(v, &o->width, &o->height))
-                return cli_fail(EXIT_USAGE, "reference: --size '%s' is not WxH with 1..16384 each", v);
+                return cli_fail(EXIT_USAGE, "reference: --size '%s' is not WxH with 1..16384 each",
+                                v);
         } else if (!strcmp(a, "--spp")) {
             if (!cli_parse_uint(v, 1, 0xFFFFFFFFul, &u))
-                return cli_fail(EXIT_USAGE, "reference: --spp '%s' is not an integer in 1..4294967295", v);
+                return cli_fail(EXIT_USAGE,
+                                "reference: --spp '%s' is not an integer in 1..4294967295", v);
             o->spp = u;
         } else if (!strcmp(a, "--time")) {
             if (!cli_parse_float(v, &f) || !(f > 0.0f))
-                return cli_fail(EXIT_USAGE, "reference: --time '%s' is not a positive number of seconds", v);
+                return cli_fail(EXIT_USAGE,
+                                "reference: --time '%s' is not a positive number of seconds", v);
             o->time_limit = f;
         } else if (!strcmp(a, "--target-se")) {
             if (!cli_parse_float(v, &f) || !(f > 0.0f))
-                return cli_fail(EXIT_USAGE, "reference: --target-se '%s' is not a positive number", v);
+                return cli_fail(EXIT_USAGE, "reference: --target-se '%s' is not a positive number",
+                                v);
             o->target_se = f;
         } else if (!strcmp(a, "--max-bounces")) {
             if (!strcmp(v, "inf") || !strcmp(v, "unlimited") || !strcmp(v, "-1"))
@@ -109,25 +115,30 @@ static int parse_opts(int argc, char **argv, ref_opts *o)
             else if (cli_parse_uint(v, 0, 1000000, &u))
                 o->max_bounces = (int)u;
             else
-                return cli_fail(EXIT_USAGE, "reference: --max-bounces '%s' is not 0..1000000 or 'inf'", v);
+                return cli_fail(EXIT_USAGE,
+                                "reference: --max-bounces '%s' is not 0..1000000 or 'inf'", v);
         } else if (!strcmp(a, "--seed")) {
             if (!cli_parse_uint(v, 0, 0xFFFFFFFFul, &u))
-                return cli_fail(EXIT_USAGE, "reference: --seed '%s' is not a 32-bit unsigned integer", v);
+                return cli_fail(EXIT_USAGE,
+                                "reference: --seed '%s' is not a 32-bit unsigned integer", v);
             o->seed = (uint32_t)u;
         } else if (!strcmp(a, "--threads")) {
             if (!cli_parse_uint(v, 0, 1024, &u))
-                return cli_fail(EXIT_USAGE, "reference: --threads '%s' is not an integer in 0..1024", v);
+                return cli_fail(EXIT_USAGE,
+                                "reference: --threads '%s' is not an integer in 0..1024", v);
             o->threads = (uint32_t)u;
         } else if (!strcmp(a, "--time-of-scene")) {
             if (!cli_parse_float(v, &o->scene_time) || o->scene_time < 0.0f)
-                return cli_fail(EXIT_USAGE, "reference: --time-of-scene '%s' is not a non-negative number", v);
+                return cli_fail(EXIT_USAGE,
+                                "reference: --time-of-scene '%s' is not a non-negative number", v);
         } else if (!strcmp(a, "--exposure")) {
             if (!cli_parse_float(v, &o->exposure))
                 return cli_fail(EXIT_USAGE, "reference: --exposure '%s' is not a number", v);
         } else if (!strcmp(a, "--strategy")) {
             int s = gi_ref_strategy_parse(v);
             if (s < 0)
-                return cli_fail(EXIT_USAGE, "reference: --strategy '%s' is not mis, light or bsdf", v);
+                return cli_fail(EXIT_USAGE, "reference: --strategy '%s' is not mis, light or bsdf",
+                                v);
             o->strategy = (gi_ref_strategy)s;
         }
     }
@@ -147,7 +158,8 @@ typedef struct progress {
     double start;
 } progress;
 
-static void progress_show(const progress *p, const ref_opts *o, uint64_t spp, double se, double elapsed)
+static void progress_show(const progress *p, const ref_opts *o, uint64_t spp, double se,
+                          double elapsed)
 {
     if (!p->on)
         return;
@@ -191,7 +203,8 @@ static uint64_t next_checkpoint(uint64_t spp, double se, double target)
 {
     if (spp < 4)
         return 4;
-    double want = isfinite(se) ? 1.1 * (double)spp * (se / target) * (se / target) : 2.0 * (double)spp;
+    double want =
+        isfinite(se) ? 1.1 * (double)spp * (se / target) * (se / target) : 2.0 * (double)spp;
     uint64_t n = want > 2.0 * (double)spp ? 2 * spp : (uint64_t)ceil(want);
     return n > spp ? n : spp + 1;
 }
@@ -212,8 +225,10 @@ static json_object *stats_json(const run_state *r, const ref_opts *o, int camera
     json_object_object_add(j, "time_of_scene", json_object_new_double(o->scene_time));
     json_object_object_add(j, "spp", json_object_new_int64((int64_t)st.spp));
     json_object_object_add(j, "seed", json_object_new_int64(o->seed));
-    json_object_object_add(j, "max_bounces", json_object_new_int(o->max_bounces)); /* -1 = unlimited */
-    json_object_object_add(j, "strategy", json_object_new_string(gi_ref_strategy_name(o->strategy)));
+    json_object_object_add(j, "max_bounces",
+                           json_object_new_int(o->max_bounces)); /* -1 = unlimited */
+    json_object_object_add(j, "strategy",
+                           json_object_new_string(gi_ref_strategy_name(o->strategy)));
     json_object_object_add(j, "threads", json_object_new_int((int32_t)st.threads));
     json_object_object_add(j, "stop", json_object_new_string(stop));
     json_object_object_add(j, "wall_seconds", json_object_new_double(wall));
@@ -221,8 +236,9 @@ static json_object *stats_json(const run_state *r, const ref_opts *o, int camera
     json_object_object_add(j, "render_seconds", json_object_new_double(st.render_seconds));
     json_object_object_add(j, "rays", json_object_new_int64((int64_t)st.rays));
     json_object_object_add(j, "mrays_per_second",
-                           json_object_new_double(st.render_seconds > 0 ? 1e-6 * (double)st.rays / st.render_seconds
-                                                                        : 0.0));
+                           json_object_new_double(st.render_seconds > 0
+                                                      ? 1e-6 * (double)st.rays / st.render_seconds
+                                                      : 0.0));
     json_object_object_add(j, "nonfinite_samples", json_object_new_int64((int64_t)st.nonfinite));
     /* Mean over pixels of the standard error of the mean luminance, absolute
      * and relative (the --target-se statistic, README "Reference path tracer"). */
@@ -253,7 +269,8 @@ static int run(run_state *r, const ref_opts *o)
     if (o->camera) {
         camera = gi_scene_find_camera(r->scene, o->camera);
         if (camera < 0)
-            return cli_fail(EXIT_USAGE, "reference: %s has no camera '%s' (%u cameras; use a name or #k)",
+            return cli_fail(EXIT_USAGE,
+                            "reference: %s has no camera '%s' (%u cameras; use a name or #k)",
                             o->scene, o->camera, r->scene->camera_count);
     } else if (r->scene->camera_count == 0) {
         camera = -1;
@@ -324,7 +341,8 @@ static int run(run_state *r, const ref_opts *o)
         if (!stop && spp >= 0xFFFFFFFFull)
             stop = "spp";
         if (bar.on)
-            progress_show(&bar, o, spp, o->target_se > 0.0 ? se : gi_ref_mean_rel_se(r->ref), elapsed);
+            progress_show(&bar, o, spp, o->target_se > 0.0 ? se : gi_ref_mean_rel_se(r->ref),
+                          elapsed);
     }
     progress_end(&bar);
 
@@ -351,7 +369,8 @@ static int run(run_state *r, const ref_opts *o)
                (unsigned long long)st.nonfinite);
     gi_log(GI_LOG_INFO, "reference: %llu spp in %.2f s (%s), %.2f Mrays/s, mean relative SE %.4g",
            (unsigned long long)st.spp, st.render_seconds, stop,
-           st.render_seconds > 0 ? 1e-6 * (double)st.rays / st.render_seconds : 0.0, gi_ref_mean_rel_se(r->ref));
+           st.render_seconds > 0 ? 1e-6 * (double)st.rays / st.render_seconds : 0.0,
+           gi_ref_mean_rel_se(r->ref));
     if (o->stats) {
         json_object *j = stats_json(r, o, camera, now_seconds() - t_start, stop);
         char why[GI_ERROR_MAX];

@@ -15,17 +15,17 @@
 
 /* Per triangle, 32 bytes: what shading needs beside the vertices. */
 typedef struct ref_tri {
-    gi_vec3 ng;         /* unit geometric normal, cross(p1 - p0, p2 - p0) (front face) */
+    gi_vec3 ng; /* unit geometric normal, cross(p1 - p0, p2 - p0) (front face) */
     uint32_t material;
     float area;
-    float light_prob;   /* probability that next-event estimation picks it; 0 if not an emitter */
+    float light_prob; /* probability that next-event estimation picks it; 0 if not an emitter */
     float pad[2];
 } ref_tri;
 
 typedef struct ref_material {
-    gi_brdf brdf;        /* kd = untextured albedo */
-    int textured;        /* kd comes from gi_scene_albedo(uv) */
-    int emits;           /* emission non-zero */
+    gi_brdf brdf; /* kd = untextured albedo */
+    int textured; /* kd comes from gi_scene_albedo(uv) */
+    int emits;    /* emission non-zero */
     int double_sided;
     float emission[3];
 } ref_material;
@@ -48,20 +48,20 @@ typedef struct ref_scene {
     const gi_scene *scene;
     RTCDevice device;
     RTCScene rtc;
-    const float *pos;     /* world positions, 3 floats a vertex (Embree's vertex buffer) */
-    float *nrm;           /* world shading normals, 3 floats a vertex */
+    const float *pos; /* world positions, 3 floats a vertex (Embree's vertex buffer) */
+    float *nrm;       /* world shading normals, 3 floats a vertex */
     ref_tri *tris;
     ref_material *mats;
     uint32_t emitter_count;
-    uint32_t *emitters;   /* triangle of each emitter */
-    float *emitter_cdf;   /* emitter_count + 1 entries, 0 .. 1 */
+    uint32_t *emitters; /* triangle of each emitter */
+    float *emitter_cdf; /* emitter_count + 1 entries, 0 .. 1 */
     ref_light *lights;
     uint32_t light_count;
     const gi_envmap *env; /* NULL when the scene has none */
     int env_sampleable;   /* the map is not black */
     ref_camera cam;
     uint32_t width, height, seed;
-    int max_bounces;      /* < 0: unlimited */
+    int max_bounces; /* < 0: unlimited */
     gi_ref_strategy strategy;
 } ref_scene;
 

@@ -52,8 +52,8 @@ static inline float next(uint32_t *rng)
     return gi_rng_next_float(rng);
 }
 
-static inline int trace(const ref_scene *rs, gi_vec3 o, gi_vec3 d, float tnear, float tfar, ref_hit *h,
-                        ref_counters *c)
+static inline int trace(const ref_scene *rs, gi_vec3 o, gi_vec3 d, float tnear, float tfar,
+                        ref_hit *h, ref_counters *c)
 {
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -139,8 +139,9 @@ static void make_surface(const ref_scene *rs, const ref_hit *h, gi_vec3 dir, sur
     const gi_scene *sc = rs->scene;
     const uint32_t *idx = sc->indices + 3 * (size_t)h->prim;
     float b0 = 1.0f - h->u - h->v, b1 = h->u, b2 = h->v;
-    s->p = gi_v3_add(gi_v3_add(gi_v3_scale(vertex_pos(rs, idx[0]), b0), gi_v3_scale(vertex_pos(rs, idx[1]), b1)),
-                     gi_v3_scale(vertex_pos(rs, idx[2]), b2));
+    s->p = gi_v3_add(
+        gi_v3_add(gi_v3_scale(vertex_pos(rs, idx[0]), b0), gi_v3_scale(vertex_pos(rs, idx[1]), b1)),
+        gi_v3_scale(vertex_pos(rs, idx[2]), b2));
     s->tri = &rs->tris[h->prim];
     s->mat = &rs->mats[s->tri->material];
     s->wo = gi_v3_scale(dir, -1.0f);
@@ -155,7 +156,8 @@ static void make_surface(const ref_scene *rs, const ref_hit *h, gi_vec3 dir, sur
     s->n = gi_v3_dot(n, s->wo) < 0.0f ? gi_v3_scale(n, -1.0f) : n;
     s->brdf = s->mat->brdf;
     if (s->mat->textured) {
-        const float *t0 = sc->vertices[idx[0]].uv, *t1 = sc->vertices[idx[1]].uv, *t2 = sc->vertices[idx[2]].uv;
+        const float *t0 = sc->vertices[idx[0]].uv, *t1 = sc->vertices[idx[1]].uv,
+                    *t2 = sc->vertices[idx[2]].uv;
         float uv[2] = {b0 * t0[0] + b1 * t1[0] + b2 * t2[0], b0 * t0[1] + b1 * t1[1] + b2 * t2[1]};
         gi_scene_albedo(sc, s->tri->material, uv, s->brdf.kd);
     }
@@ -189,7 +191,8 @@ static inline int is_black(const float f[3])
 /* Weight of a light-sampled contribution whose BSDF pdf is pdf_b. */
 static inline float light_weight(const ref_scene *rs, float pdf_l, float pdf_b)
 {
-    return rs->strategy == GI_REF_STRATEGY_MIS ? gi_power_heuristic(1.0f, pdf_l, 1.0f, pdf_b) : 1.0f;
+    return rs->strategy == GI_REF_STRATEGY_MIS ? gi_power_heuristic(1.0f, pdf_l, 1.0f, pdf_b)
+                                               : 1.0f;
 }
 
 /* Weight of emission reached by a BSDF sample of pdf pdf_b, when light
@@ -209,8 +212,8 @@ static inline float bsdf_weight(const ref_scene *rs, float pdf_b, float pdf_l)
 }
 
 /* One emitter triangle by power, a uniform point on it. */
-static void sample_area_light(const ref_scene *rs, const surface *s, const float beta[3], uint32_t *rng,
-                              float L[3], ref_counters *c)
+static void sample_area_light(const ref_scene *rs, const surface *s, const float beta[3],
+                              uint32_t *rng, float L[3], ref_counters *c)
 {
     float u0 = next(rng), u1 = next(rng), u2 = next(rng);
     uint32_t t = rs->emitters[find_interval(rs->emitter_cdf, rs->emitter_count, u0)];
@@ -220,7 +223,8 @@ static void sample_area_light(const ref_scene *rs, const surface *s, const float
     const uint32_t *idx = rs->scene->indices + 3 * (size_t)t;
     float b[3];
     gi_sample_uniform_triangle(u1, u2, b);
-    gi_vec3 y = gi_v3_add(gi_v3_add(gi_v3_scale(vertex_pos(rs, idx[0]), b[0]), gi_v3_scale(vertex_pos(rs, idx[1]), b[1])),
+    gi_vec3 y = gi_v3_add(gi_v3_add(gi_v3_scale(vertex_pos(rs, idx[0]), b[0]),
+                                    gi_v3_scale(vertex_pos(rs, idx[1]), b[1])),
                           gi_v3_scale(vertex_pos(rs, idx[2]), b[2]));
     gi_vec3 d = gi_v3_sub(y, s->p);
     float dist2 = gi_v3_dot(d, d);
@@ -253,8 +257,8 @@ static void sample_area_light(const ref_scene *rs, const surface *s, const float
 }
 
 /* One direction from the environment map's luminance x sin(theta) CDF. */
-static void sample_environment(const ref_scene *rs, const surface *s, const float beta[3], uint32_t *rng,
-                               float L[3], ref_counters *c)
+static void sample_environment(const ref_scene *rs, const surface *s, const float beta[3],
+                               uint32_t *rng, float L[3], ref_counters *c)
 {
     float u1 = next(rng), u2 = next(rng);
     gi_vec3 w;
@@ -314,7 +318,8 @@ static void punctual_lights(const ref_scene *rs, const surface *s, const float b
     }
 }
 
-void ref_path_sample(const ref_scene *rs, uint32_t x, uint32_t y, uint32_t *rng, float L[3], ref_counters *c)
+void ref_path_sample(const ref_scene *rs, uint32_t x, uint32_t y, uint32_t *rng, float L[3],
+                     ref_counters *c)
 {
     const ref_camera *cam = &rs->cam;
     L[0] = L[1] = L[2] = 0.0f;
@@ -353,7 +358,8 @@ void ref_path_sample(const ref_scene *rs, uint32_t x, uint32_t y, uint32_t *rng,
             float w = 1.0f;
             if (!prev_delta) {
                 float cos_y = fabsf(gi_v3_dot(s.tri->ng, s.wo));
-                float pdf_l = cos_y > 0.0f ? s.tri->light_prob * h.t * h.t / (s.tri->area * cos_y) : 0.0f;
+                float pdf_l =
+                    cos_y > 0.0f ? s.tri->light_prob * h.t * h.t / (s.tri->area * cos_y) : 0.0f;
                 w = bsdf_weight(rs, prev_pdf, pdf_l);
             }
             add_scaled(L, beta, s.mat->emission, w);

@@ -37,7 +37,8 @@ static gi_result embree_fail(ref_scene *rs, const char *what, gi_error *err)
 {
     enum RTCError e = rs->device ? rtcGetDeviceError(rs->device) : RTC_ERROR_UNKNOWN;
     if (e == RTC_ERROR_OUT_OF_MEMORY)
-        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "reference: Embree ran out of memory (%s)", what);
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "reference: Embree ran out of memory (%s)",
+                            what);
     return gi_error_set(err, GI_ERR_IO, "reference: Embree failed: %s (error %d)", what, (int)e);
 }
 
@@ -60,8 +61,8 @@ static gi_result place_vertices(ref_scene *rs, float t, float *vb, gi_error *err
         for (int k = 0; k < 16; k++)
             if (!isfinite(m[o][k])) {
                 res = gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                                   "%s: object %u '%s': transform at t = %g is not finite", s->path, o,
-                                   object_name(s, o), (double)t);
+                                   "%s: object %u '%s': transform at t = %g is not finite", s->path,
+                                   o, object_name(s, o), (double)t);
                 goto done;
             }
         /* Normals by the inverse transpose; a singular transform (scale 0)
@@ -74,17 +75,19 @@ static gi_result place_vertices(ref_scene *rs, float t, float *vb, gi_error *err
     for (uint32_t v = 0; v < s->vertex_count; v++) {
         const gi_vertex *gv = &s->vertices[v];
         uint32_t o = gv->object < s->object_count ? gv->object : 0;
-        gi_vec3 p = s->object_count ? gi_mat4_point(m[o], gi_v3_load(gv->position)) : gi_v3_load(gv->position);
+        gi_vec3 p = s->object_count ? gi_mat4_point(m[o], gi_v3_load(gv->position))
+                                    : gi_v3_load(gv->position);
         if (!coord_ok(p)) {
             res = gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                               "%s: object %u '%s': vertex %u is not finite at t = %g (%g %g %g)", s->path, o,
-                               s->object_count ? object_name(s, o) : "?",
-                               v - (s->object_count ? s->objects[o].first_vertex : 0), (double)t, (double)p.x,
-                               (double)p.y, (double)p.z);
+                               "%s: object %u '%s': vertex %u is not finite at t = %g (%g %g %g)",
+                               s->path, o, s->object_count ? object_name(s, o) : "?",
+                               v - (s->object_count ? s->objects[o].first_vertex : 0), (double)t,
+                               (double)p.x, (double)p.y, (double)p.z);
             goto done;
         }
         gi_v3_store(p, vb + 3 * (size_t)v);
-        gi_vec3 n = s->object_count ? gi_mat4_dir(nm[o], gi_v3_load(gv->normal)) : gi_v3_load(gv->normal);
+        gi_vec3 n =
+            s->object_count ? gi_mat4_dir(nm[o], gi_v3_load(gv->normal)) : gi_v3_load(gv->normal);
         n = gi_v3_normalize(n);
         if (!finite3(n))
             n = gi_v3(0.0f, 0.0f, 0.0f); /* shading falls back to the geometric normal */
@@ -184,8 +187,9 @@ static gi_result place_lights(ref_scene *rs, float t, gi_error *err)
         const gi_light *l = &s->lights[i];
         gi_light_frame f = gi_scene_light_at(s, i, t);
         if (!coord_ok(f.position) || !finite3(f.direction))
-            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: light %u '%s' is not finite at t = %g",
-                                s->path, i, l->name ? l->name : "(unnamed)", (double)t);
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "%s: light %u '%s' is not finite at t = %g", s->path, i,
+                                l->name ? l->name : "(unnamed)", (double)t);
         ref_light *r = &rs->lights[i];
         r->type = l->type;
         r->position = f.position;
@@ -254,8 +258,8 @@ gi_result ref_scene_build(ref_scene *rs, const gi_ref_desc *d, gi_error *err)
         if (!g)
             return embree_fail(rs, "rtcNewGeometry", err);
         rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
-        float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                            s->vertex_count);
+        float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                            3 * sizeof(float), s->vertex_count);
         unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                3 * sizeof(unsigned), s->triangle_count);
         if (!vb || !ib) {

@@ -88,16 +88,17 @@ gi_result gi_ref_create(const gi_ref_desc *d, gi_ref **out, gi_error *err)
     if (!d->scene)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "reference: no scene");
     if (d->width < 1 || d->height < 1 || d->width > 16384 || d->height > 16384)
-        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "reference: size %ux%u is not 1..16384 each",
-                            d->width, d->height);
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "reference: size %ux%u is not 1..16384 each", d->width, d->height);
     if (d->max_bounces < GI_REF_UNLIMITED)
-        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "reference: max_bounces %d is below -1 (unlimited)",
-                            d->max_bounces);
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "reference: max_bounces %d is below -1 (unlimited)", d->max_bounces);
     if ((int)d->strategy < GI_REF_STRATEGY_MIS || (int)d->strategy > GI_REF_STRATEGY_BSDF)
-        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "reference: unknown strategy %d", (int)d->strategy);
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "reference: unknown strategy %d",
+                            (int)d->strategy);
     if (d->threads > MAX_THREADS)
-        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "reference: %u threads exceed %d", d->threads,
-                            MAX_THREADS);
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "reference: %u threads exceed %d",
+                            d->threads, MAX_THREADS);
     double t0 = now_seconds();
     gi_ref *r = calloc(1, sizeof *r);
     if (!r)
@@ -105,8 +106,9 @@ gi_result gi_ref_create(const gi_ref_desc *d, gi_ref **out, gi_error *err)
     r->acc = calloc((size_t)d->width * d->height * ACC_SIZE, sizeof(double));
     if (!r->acc) {
         free(r);
-        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "reference: out of memory (%ux%u accumulation buffer)",
-                            d->width, d->height);
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                            "reference: out of memory (%ux%u accumulation buffer)", d->width,
+                            d->height);
     }
     gi_result res = ref_scene_build(&r->rs, d, err);
     if (res != GI_OK) {
@@ -201,7 +203,8 @@ gi_result gi_ref_render(gi_ref *r, uint32_t spp, gi_error *err)
     if (spp == 0)
         return GI_OK;
     if (r->spp + spp > 0xFFFFFFFFull)
-        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "reference: more than 2^32 - 1 samples per pixel");
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "reference: more than 2^32 - 1 samples per pixel");
     double t0 = now_seconds();
     pass job;
     job.r = r;

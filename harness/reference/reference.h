@@ -68,10 +68,10 @@ typedef enum gi_ref_strategy {
 #define GI_REF_UNLIMITED (-1)
 
 typedef struct gi_ref_desc {
-    const gi_scene *scene; /* required; borrowed */
-    int camera;            /* camera index for gi_scene_camera_at; -1 (or none in the
-                              file) = the default view of the bounds */
-    float time;            /* scene time t: object, light and camera placement */
+    const gi_scene *scene;  /* required; borrowed */
+    int camera;             /* camera index for gi_scene_camera_at; -1 (or none in the
+                               file) = the default view of the bounds */
+    float time;             /* scene time t: object, light and camera placement */
     uint32_t width, height; /* required, 1..16384 each */
     uint32_t seed;
     /* Scattering events a path may have: 0 = emitters and the environment
@@ -119,12 +119,12 @@ gi_image *gi_ref_variance_image(const gi_ref *r);
 double gi_ref_mean_rel_se(const gi_ref *r);
 
 typedef struct gi_ref_stats {
-    uint64_t spp;            /* samples per pixel */
-    uint64_t nonfinite;      /* NaN/Inf samples, discarded (each counted once) */
-    uint64_t rays;           /* closest-hit and shadow rays traced */
-    uint32_t threads;        /* worker threads */
-    double build_seconds;    /* scene validation + BVH build in gi_ref_create */
-    double render_seconds;   /* wall time inside gi_ref_render, summed */
+    uint64_t spp;          /* samples per pixel */
+    uint64_t nonfinite;    /* NaN/Inf samples, discarded (each counted once) */
+    uint64_t rays;         /* closest-hit and shadow rays traced */
+    uint32_t threads;      /* worker threads */
+    double build_seconds;  /* scene validation + BVH build in gi_ref_create */
+    double render_seconds; /* wall time inside gi_ref_render, summed */
 } gi_ref_stats;
 void gi_ref_get_stats(const gi_ref *r, gi_ref_stats *out);
 

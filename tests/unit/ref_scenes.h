@@ -55,7 +55,8 @@ static void tg_bytes(tg_str *s, const void *data, size_t n)
 #if defined(__GNUC__)
 __attribute__((format(printf, 2, 3)))
 #endif
-static void tg_printf(tg_str *s, const char *fmt, ...)
+static void
+tg_printf(tg_str *s, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -81,15 +82,16 @@ static void tg_init(tg_scene *b)
 
 static void tg_free(tg_scene *b)
 {
-    tg_str *all[] = {&b->bin, &b->meshes, &b->accessors, &b->views, &b->nodes,
-                     &b->materials, &b->lights, &b->extras, &b->camera_node, &b->camera};
+    tg_str *all[] = {&b->bin,       &b->meshes, &b->accessors, &b->views,       &b->nodes,
+                     &b->materials, &b->lights, &b->extras,    &b->camera_node, &b->camera};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         free(all[i]->p);
     memset(b, 0, sizeof *b);
 }
 
 /* A material; emission is radiance (split into factor x strength). */
-static int tg_material(tg_scene *b, const float albedo[3], const float emission[3], int double_sided)
+static int tg_material(tg_scene *b, const float albedo[3], const float emission[3],
+                       int double_sided)
 {
     float e = fmaxf(emission[0], fmaxf(emission[1], emission[2]));
     float f[3] = {0, 0, 0};
@@ -100,8 +102,8 @@ static int tg_material(tg_scene *b, const float albedo[3], const float emission[
               "\"emissiveFactor\":[%.9g,%.9g,%.9g],"
               "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":%.9g}},"
               "\"doubleSided\":%s}",
-              b->n_materials ? "," : "", albedo[0], albedo[1], albedo[2], f[0], f[1], f[2], e > 0 ? e : 1.0f,
-              double_sided ? "true" : "false");
+              b->n_materials ? "," : "", albedo[0], albedo[1], albedo[2], f[0], f[1], f[2],
+              e > 0 ? e : 1.0f, double_sided ? "true" : "false");
     return b->n_materials++;
 }
 
@@ -110,8 +112,8 @@ static int tg_view(tg_scene *b, const void *data, size_t size)
 {
     size_t off = b->bin.n;
     tg_bytes(&b->bin, data, size);
-    tg_printf(&b->views, "%s{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}", b->n_views ? "," : "",
-              off, size);
+    tg_printf(&b->views, "%s{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}",
+              b->n_views ? "," : "", off, size);
     return b->n_views++;
 }
 
@@ -133,23 +135,26 @@ static int tg_accessor_vec3(tg_scene *b, const float *v, uint32_t n)
 
 /* One object: a node holding a mesh of one triangle primitive. nrm may be
  * NULL (the loader then computes normals from the faces). */
-static void tg_mesh(tg_scene *b, const float *pos, const float *nrm, uint32_t nverts, const uint32_t *idx,
-                    uint32_t ntris, int material)
+static void tg_mesh(tg_scene *b, const float *pos, const float *nrm, uint32_t nverts,
+                    const uint32_t *idx, uint32_t ntris, int material)
 {
     int ap = tg_accessor_vec3(b, pos, nverts);
     int an = nrm ? tg_accessor_vec3(b, nrm, nverts) : -1;
     int iv = tg_view(b, idx, (size_t)ntris * 3 * sizeof(uint32_t));
-    tg_printf(&b->accessors, ",{\"bufferView\":%d,\"componentType\":5125,\"count\":%u,\"type\":\"SCALAR\"}", iv,
+    tg_printf(&b->accessors,
+              ",{\"bufferView\":%d,\"componentType\":5125,\"count\":%u,\"type\":\"SCALAR\"}", iv,
               ntris * 3);
     int ai = b->n_accessors++;
     if (an >= 0)
-        tg_printf(&b->meshes,
-                  "%s{\"primitives\":[{\"attributes\":{\"POSITION\":%d,\"NORMAL\":%d},\"indices\":%d,"
-                  "\"material\":%d}]}",
-                  b->n_meshes ? "," : "", ap, an, ai, material);
+        tg_printf(
+            &b->meshes,
+            "%s{\"primitives\":[{\"attributes\":{\"POSITION\":%d,\"NORMAL\":%d},\"indices\":%d,"
+            "\"material\":%d}]}",
+            b->n_meshes ? "," : "", ap, an, ai, material);
     else
         tg_printf(&b->meshes,
-                  "%s{\"primitives\":[{\"attributes\":{\"POSITION\":%d},\"indices\":%d,\"material\":%d}]}",
+                  "%s{\"primitives\":[{\"attributes\":{\"POSITION\":%d},\"indices\":%d,"
+                  "\"material\":%d}]}",
                   b->n_meshes ? "," : "", ap, ai, material);
     tg_printf(&b->nodes, "%s{\"mesh\":%d}", b->n_nodes ? "," : "", b->n_meshes);
     b->n_meshes++;
@@ -163,11 +168,13 @@ static void tg_mesh(tg_scene *b, const float *pos, const float *nrm, uint32_t nv
 static void tg_icosphere(tg_scene *b, float r, int level, int smooth, int material)
 {
     const float t = 1.6180339887f;
-    const float ico_v[12][3] = {{-1, t, 0}, {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                                {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
-    const int ico_f[20][3] = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                              {11, 10, 2}, {10, 7, 6}, {7, 1, 8},   {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                              {3, 8, 9},  {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+    const float ico_v[12][3] = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
+                                {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
+                                {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    const int ico_f[20][3] = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                              {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                              {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                              {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
     uint32_t n = 20u << (2 * level);
     float *tri = malloc((size_t)n * 9 * sizeof(float));
     uint32_t count = 0;
@@ -212,7 +219,8 @@ static void tg_icosphere(tg_scene *b, float r, int level, int smooth, int materi
             e1[c] = p[1][c] - p[0][c];
             e2[c] = p[2][c] - p[0][c];
         }
-        float cr[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        float cr[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                       e1[0] * e2[1] - e1[1] * e2[0]};
         if (cr[0] * p[0][0] + cr[1] * p[0][1] + cr[2] * p[0][2] > 0) {
             float tmp[3];
             memcpy(tmp, p[1], sizeof tmp);
@@ -237,7 +245,8 @@ static void tg_icosphere(tg_scene *b, float r, int level, int smooth, int materi
 /* Square of side 2 * half in the plane y = height, front face up (+Y). */
 static void tg_plane(tg_scene *b, float half, float height, int material)
 {
-    const float pos[12] = {-half, height, -half, -half, height, half, half, height, half, half, height, -half};
+    const float pos[12] = {-half, height, -half, -half, height, half,
+                           half,  height, half,  half,  height, -half};
     const float nrm[12] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
     const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
     tg_mesh(b, pos, nrm, 4, idx, 2, material);
@@ -290,13 +299,16 @@ static void tg_look_quat(const float fwd[3], double q[4])
         up[1] = 0;
         up[2] = 1;
     }
-    double rt[3] = {f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2], f[0] * up[1] - f[1] * up[0]};
+    double rt[3] = {f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2],
+                    f[0] * up[1] - f[1] * up[0]};
     double rl = sqrt(rt[0] * rt[0] + rt[1] * rt[1] + rt[2] * rt[2]);
     for (int k = 0; k < 3; k++)
         rt[k] /= rl;
-    double u[3] = {rt[1] * f[2] - rt[2] * f[1], rt[2] * f[0] - rt[0] * f[2], rt[0] * f[1] - rt[1] * f[0]};
+    double u[3] = {rt[1] * f[2] - rt[2] * f[1], rt[2] * f[0] - rt[0] * f[2],
+                   rt[0] * f[1] - rt[1] * f[0]};
     /* Rotation matrix columns: right, up, -forward. */
-    double m[3][3] = {{rt[0], u[0], -f[0]}, {rt[1], u[1], -f[1]}, {rt[2], u[2], -f[2]}}; /* m[row][col] */
+    double m[3][3] = {
+        {rt[0], u[0], -f[0]}, {rt[1], u[1], -f[1]}, {rt[2], u[2], -f[2]}}; /* m[row][col] */
     double tr = m[0][0] + m[1][1] + m[2][2];
     if (tr > 0) {
         double s = sqrt(tr + 1.0) * 2;
@@ -326,15 +338,18 @@ static void tg_look_quat(const float fwd[3], double q[4])
 }
 
 /* A perspective camera at eye looking at target. */
-static void tg_camera(tg_scene *b, const float eye[3], const float target[3], float yfov_deg, float znear)
+static void tg_camera(tg_scene *b, const float eye[3], const float target[3], float yfov_deg,
+                      float znear)
 {
     float f[3] = {target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]};
     double q[4];
     tg_look_quat(f, q);
-    tg_printf(&b->camera_node,
-              "{\"camera\":0,\"translation\":[%.9g,%.9g,%.9g],\"rotation\":[%.12g,%.12g,%.12g,%.12g]}", eye[0],
-              eye[1], eye[2], q[0], q[1], q[2], q[3]);
-    tg_printf(&b->camera, "{\"type\":\"perspective\",\"perspective\":{\"yfov\":%.9g,\"znear\":%.9g}}",
+    tg_printf(
+        &b->camera_node,
+        "{\"camera\":0,\"translation\":[%.9g,%.9g,%.9g],\"rotation\":[%.12g,%.12g,%.12g,%.12g]}",
+        eye[0], eye[1], eye[2], q[0], q[1], q[2], q[3]);
+    tg_printf(&b->camera,
+              "{\"type\":\"perspective\",\"perspective\":{\"yfov\":%.9g,\"znear\":%.9g}}",
               yfov_deg * TG_PI / 180.0, znear);
     b->has_camera = 1;
 }
@@ -377,7 +392,8 @@ static void tg_base64(tg_str *out, const unsigned char *d, size_t n)
     static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     tg_reserve(out, (n + 2) / 3 * 4);
     for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0) | (i + 2 < n ? d[i + 2] : 0);
+        uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0) |
+                     (i + 2 < n ? d[i + 2] : 0);
         char q[4] = {tab[v >> 18 & 63], tab[v >> 12 & 63], i + 1 < n ? tab[v >> 6 & 63] : '=',
                      i + 2 < n ? tab[v & 63] : '='};
         tg_bytes(out, q, 4);
@@ -388,7 +404,9 @@ static void tg_base64(tg_str *out, const unsigned char *d, size_t n)
 static char *tg_json(tg_scene *b)
 {
     tg_str j = {0};
-    tg_printf(&j, "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_materials_emissive_strength\"%s],",
+    tg_printf(&j,
+              "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_materials_emissive_"
+              "strength\"%s],",
               b->n_lights ? ",\"KHR_lights_punctual\"" : "");
     int cam_node = b->has_camera ? b->n_nodes : -1;
     tg_printf(&j, "\"scene\":0,\"scenes\":[{%s\"nodes\":[", b->extras.p ? b->extras.p : "");
@@ -396,7 +414,8 @@ static char *tg_json(tg_scene *b)
         tg_printf(&j, "%s%d", i ? "," : "", i);
     tg_printf(&j, "]}],\"nodes\":[%s", b->nodes.p ? b->nodes.p : "");
     if (b->has_camera)
-        tg_printf(&j, "%s%s],\"cameras\":[%s]", b->n_nodes ? "," : "", b->camera_node.p, b->camera.p);
+        tg_printf(&j, "%s%s],\"cameras\":[%s]", b->n_nodes ? "," : "", b->camera_node.p,
+                  b->camera.p);
     else
         tg_printf(&j, "]");
     tg_printf(&j, ",\"materials\":[%s],\"meshes\":[%s],\"accessors\":[%s],\"bufferViews\":[%s]",
@@ -404,7 +423,9 @@ static char *tg_json(tg_scene *b)
               b->accessors.p ? b->accessors.p : "", b->views.p ? b->views.p : "");
     if (b->n_lights)
         tg_printf(&j, ",\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[%s]}}", b->lights.p);
-    tg_printf(&j, ",\"buffers\":[{\"byteLength\":%zu,\"uri\":\"data:application/octet-stream;base64,", b->bin.n);
+    tg_printf(&j,
+              ",\"buffers\":[{\"byteLength\":%zu,\"uri\":\"data:application/octet-stream;base64,",
+              b->bin.n);
     tg_base64(&j, (const unsigned char *)b->bin.p, b->bin.n);
     tg_printf(&j, "\"}]}");
     return j.p;

@@ -96,12 +96,13 @@ static void check_value(const char *what, const estimate *e, double expected)
 {
     if (expected == 0.0) {
         printf("%-34s %.6f expected 0\n", what, e->mean[1]);
-        CHECK_MSG(e->mean[0] == 0.0 && e->mean[1] == 0.0 && e->mean[2] == 0.0, "%s: %g", what, e->mean[1]);
+        CHECK_MSG(e->mean[0] == 0.0 && e->mean[1] == 0.0 && e->mean[2] == 0.0, "%s: %g", what,
+                  e->mean[1]);
         return;
     }
     double err = fabs(e->mean[1] - expected) / expected;
-    printf("%-34s %.6f expected %.6f: error %.3f%%, standard error %.3f%%, %.2f s\n", what, e->mean[1], expected,
-           100.0 * err, 100.0 * e->se[1] / expected, e->seconds);
+    printf("%-34s %.6f expected %.6f: error %.3f%%, standard error %.3f%%, %.2f s\n", what,
+           e->mean[1], expected, 100.0 * err, 100.0 * e->se[1] / expected, e->seconds);
     CHECK_MSG(err <= TOL, "%s: %.6f vs %.6f (%.3f%%)", what, e->mean[1], expected, 100.0 * err);
     CHECK_MSG(fabs(e->mean[1] - expected) <= 5.0 * e->se[1] + 0.002 * expected,
               "%s: %.6f vs %.6f is %.1f standard errors", what, e->mean[1], expected,
@@ -220,7 +221,8 @@ static void test_plane_under_sky(void)
         estimate e;
         CHECK(render(s, 8, 8, spp[k], strategies[k], &e));
         char what[64];
-        snprintf(what, sizeof what, "plane under uniform sky (%s)", gi_ref_strategy_name(strategies[k]));
+        snprintf(what, sizeof what, "plane under uniform sky (%s)",
+                 gi_ref_strategy_name(strategies[k]));
         check_value(what, &e, rho * L);
         gi_scene_free(s);
     }
@@ -265,7 +267,8 @@ static void test_plane_under_map(void)
         estimate e;
         CHECK(render(s, 8, 8, spp[k], strategies[k], &e));
         char what[64];
-        snprintf(what, sizeof what, "plane under a bright texel (%s)", gi_ref_strategy_name(strategies[k]));
+        snprintf(what, sizeof what, "plane under a bright texel (%s)",
+                 gi_ref_strategy_name(strategies[k]));
         check_value(what, &e, expected);
         gi_scene_free(s);
     }
@@ -273,8 +276,8 @@ static void test_plane_under_map(void)
 
 /* One punctual light over a diffuse plane; a narrow camera looks at
  * `target` on the plane, whose radiance is rho / pi x irradiance. */
-static void punctual_case(const char *what, const char *light_json, const float pos[3], const float dir[3],
-                          const float target[3], double irradiance)
+static void punctual_case(const char *what, const char *light_json, const float pos[3],
+                          const float dir[3], const float target[3], double irradiance)
 {
     const float rho = 0.5f;
     tg_scene b;
@@ -302,18 +305,20 @@ static void test_punctual(void)
     /* Spot: I = 8 at height 2 pointing down, cones 0.3 / 0.5 rad. On the
      * axis E = I / h^2; at 0.4 rad off the axis E = I f cos^3 / h^2 with
      * the ramp f = ((cos 0.4 - cos 0.5) / (cos 0.3 - cos 0.5))^2. */
-    const char *spot = "\"type\":\"spot\",\"intensity\":8,\"spot\":{\"innerConeAngle\":0.3,\"outerConeAngle\":0.5}";
+    const char *spot = "\"type\":\"spot\",\"intensity\":8,\"spot\":{\"innerConeAngle\":0.3,"
+                       "\"outerConeAngle\":0.5}";
     const float top[3] = {0, 2, 0}, down[3] = {0, -1, 0}, foot[3] = {0, 0, 0};
     punctual_case("spot light, on its axis", spot, top, down, foot, 8.0 / 4.0);
     double th = 0.4, t = (cos(th) - cos(0.5)) / (cos(0.3) - cos(0.5));
     const float ramp[3] = {(float)(2.0 * tan(th)), 0, 0};
-    punctual_case("spot light, in its falloff ramp", spot, top, down, ramp, 8.0 * t * t * pow(cos(th), 3) / 4.0);
+    punctual_case("spot light, in its falloff ramp", spot, top, down, ramp,
+                  8.0 * t * t * pow(cos(th), 3) / 4.0);
     const float beyond[3] = {(float)(2.0 * tan(0.55)), 0, 0};
     punctual_case("spot light, outside its cone", spot, top, down, beyond, 0.0);
     /* Directional: E = 3 arriving 30 degrees off the vertical. */
     const float sun_dir[3] = {0.5f, -0.8660254f, 0.0f};
-    punctual_case("directional light at 30 degrees", "\"type\":\"directional\",\"intensity\":3", top, sun_dir,
-                  foot, 3.0 * cos(30.0 * TG_PI / 180.0));
+    punctual_case("directional light at 30 degrees", "\"type\":\"directional\",\"intensity\":3",
+                  top, sun_dir, foot, 3.0 * cos(30.0 * TG_PI / 180.0));
 }
 
 /* Irradiance at the origin (normal +Y) from a unit-radiance polygon, by
@@ -324,9 +329,11 @@ static double polygon_irradiance(const double (*v)[3], int n)
     double sum = 0;
     for (int i = 0; i < n; i++) {
         const double *a = v[i], *b = v[(i + 1) % n];
-        double la = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]), lb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+        double la = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]),
+               lb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
         double c = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / (la * lb);
-        double g[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+        double g[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                       a[0] * b[1] - a[1] * b[0]};
         double gl = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
         sum += acos(fmin(1.0, fmax(-1.0, c))) * g[1] / gl;
     }
@@ -340,7 +347,7 @@ static void test_disk_light(void)
     const float rho = 0.5f, Le = 5.0f, r = 1.0f, h = 2.0f;
     const uint32_t segments = 256;
     double disk = rho * Le * r * r / (h * h + r * r);
-    double (*poly)[3] = malloc(segments * sizeof *poly);
+    double(*poly)[3] = malloc(segments * sizeof *poly);
     for (uint32_t i = 0; i < segments; i++) {
         double a = 2.0 * TG_PI * i / segments;
         poly[i][0] = r * cos(a);
@@ -377,8 +384,8 @@ static void test_disk_light(void)
         char what[64];
         snprintf(what, sizeof what, "disk light on axis (%s)", gi_ref_strategy_name(strategies[k]));
         check_value(what, &e, disk);
-        CHECK_MSG(fabs(e.mean[1] - polygon) <= 5.0 * e.se[1] + 1e-4 * polygon, "%s: %.6f vs polygon %.6f", what,
-                  e.mean[1], polygon);
+        CHECK_MSG(fabs(e.mean[1] - polygon) <= 5.0 * e.se[1] + 1e-4 * polygon,
+                  "%s: %.6f vs polygon %.6f", what, e.mean[1], polygon);
         gi_scene_free(s);
     }
 }

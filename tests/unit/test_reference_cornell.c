@@ -42,8 +42,8 @@ static uint32_t scaled(uint32_t spp)
 }
 
 /* Renders in passes of pass_spp until spp; 0 on failure. */
-static int render(const gi_scene *s, int max_bounces, gi_ref_strategy strategy, uint32_t seed, uint32_t threads,
-                  uint32_t spp, uint32_t pass_spp, render_out *out)
+static int render(const gi_scene *s, int max_bounces, gi_ref_strategy strategy, uint32_t seed,
+                  uint32_t threads, uint32_t spp, uint32_t pass_spp, render_out *out)
 {
     memset(out, 0, sizeof *out);
     gi_ref_desc d;
@@ -63,7 +63,8 @@ static int render(const gi_scene *s, int max_bounces, gi_ref_strategy strategy, 
     }
     int ok = 1;
     while (ok && gi_ref_spp(r) < spp) {
-        uint32_t k = (uint32_t)(spp - gi_ref_spp(r)) < pass_spp ? (uint32_t)(spp - gi_ref_spp(r)) : pass_spp;
+        uint32_t k =
+            (uint32_t)(spp - gi_ref_spp(r)) < pass_spp ? (uint32_t)(spp - gi_ref_spp(r)) : pass_spp;
         ok = gi_ref_render(r, k, &err) == GI_OK;
     }
     out->mean = gi_ref_mean_image(r);
@@ -96,12 +97,14 @@ static void image_mean(const render_out *o, int c, double *mean, double *se)
 static int same_bits(const render_out *a, const render_out *b)
 {
     size_t n = (size_t)NPIX * 4 * sizeof(float);
-    return memcmp(a->mean->rgba, b->mean->rgba, n) == 0 && memcmp(a->var->rgba, b->var->rgba, n) == 0;
+    return memcmp(a->mean->rgba, b->mean->rgba, n) == 0 &&
+           memcmp(a->var->rgba, b->var->rgba, n) == 0;
 }
 
 static void test_strategies(const gi_scene *s)
 {
-    static const gi_ref_strategy st[3] = {GI_REF_STRATEGY_MIS, GI_REF_STRATEGY_LIGHT, GI_REF_STRATEGY_BSDF};
+    static const gi_ref_strategy st[3] = {GI_REF_STRATEGY_MIS, GI_REF_STRATEGY_LIGHT,
+                                          GI_REF_STRATEGY_BSDF};
     /* Direct light (B = 1) and full GI (unlimited). Each strategy has its
      * own seed, so the three estimates are independent. BSDF sampling finds
      * the small light rarely and needs more samples. Much of the standard
@@ -122,8 +125,8 @@ static void test_strategies(const gi_scene *s)
             }
             release(&o);
             if (ok)
-                printf("B=%-2d %-5s luminance %.5f +- %.5f (%.2f%%)\n", bounces[b], gi_ref_strategy_name(st[k]),
-                       m[k][3], e[k][3], 100.0 * e[k][3] / m[k][3]);
+                printf("B=%-2d %-5s luminance %.5f +- %.5f (%.2f%%)\n", bounces[b],
+                       gi_ref_strategy_name(st[k]), m[k][3], e[k][3], 100.0 * e[k][3] / m[k][3]);
         }
         CHECK(ok);
         if (!ok)
@@ -133,13 +136,15 @@ static void test_strategies(const gi_scene *s)
                 for (int c = 0; c < 4; c++) {
                     /* Luminance (c = 3) within 3 combined standard errors,
                      * each of R, G, B within 4. */
-                    double z = fabs(m[k][c] - m[j][c]) / sqrt(e[k][c] * e[k][c] + e[j][c] * e[j][c]);
+                    double z =
+                        fabs(m[k][c] - m[j][c]) / sqrt(e[k][c] * e[k][c] + e[j][c] * e[j][c]);
                     if (c == 3)
                         printf("B=%-2d %s vs %s: %.2f standard errors apart\n", bounces[b],
                                gi_ref_strategy_name(st[k]), gi_ref_strategy_name(st[j]), z);
-                    CHECK_MSG(z < (c == 3 ? 3.0 : 4.0), "B=%d channel %d: %s %.5f vs %s %.5f is %.2f standard errors",
-                              bounces[b], c, gi_ref_strategy_name(st[k]), m[k][c], gi_ref_strategy_name(st[j]),
-                              m[j][c], z);
+                    CHECK_MSG(z < (c == 3 ? 3.0 : 4.0),
+                              "B=%d channel %d: %s %.5f vs %s %.5f is %.2f standard errors",
+                              bounces[b], c, gi_ref_strategy_name(st[k]), m[k][c],
+                              gi_ref_strategy_name(st[j]), m[j][c], z);
                 }
     }
 }
@@ -163,7 +168,8 @@ static void test_bounces(const gi_scene *s)
             for (int i = 0; i < NPIX * 4; i++)
                 nested &= o[b + 1].mean->rgba[i] >= o[b].mean->rgba[i];
             CHECK_MSG(nested, "image(B=%d) is not >= image(B=%d) everywhere", b + 1, b);
-            CHECK_MSG(mean[b + 1] > mean[b], "B=%d mean %.5f, B=%d mean %.5f", b, mean[b], b + 1, mean[b + 1]);
+            CHECK_MSG(mean[b + 1] > mean[b], "B=%d mean %.5f, B=%d mean %.5f", b, mean[b], b + 1,
+                      mean[b + 1]);
         }
         printf("bounce means:");
         for (int b = 0; b < NB; b++)
@@ -177,7 +183,8 @@ static void test_bounces(const gi_scene *s)
             /* The walls reflect 0.05..0.73 per bounce; from the second
              * indirect bounce on the added light shrinks steadily. */
             if (b >= 3)
-                CHECK_MSG(d / prev > 0.2 && d / prev < 0.8, "bounce %d adds %.5f after %.5f", b, d, prev);
+                CHECK_MSG(d / prev > 0.2 && d / prev < 0.8, "bounce %d adds %.5f after %.5f", b, d,
+                          prev);
         }
         printf("\n");
         double m64, mu, e64, eu;
@@ -228,7 +235,8 @@ static void test_determinism(const gi_scene *s)
                 n++;
             }
         double zm = zs / n, zv = zz / n - zm * zm, frac = (double)within / n;
-        printf("seed 3 vs 4: %ld z-scores, mean %.3f, variance %.3f, %.1f%% within 1.96\n", n, zm, zv, 100.0 * frac);
+        printf("seed 3 vs 4: %ld z-scores, mean %.3f, variance %.3f, %.1f%% within 1.96\n", n, zm,
+               zv, 100.0 * frac);
         CHECK(n > NPIX * 2);
         CHECK_MSG(fabs(zm) < 0.1, "mean z %.3f", zm);
         CHECK_MSG(zv > 0.8 && zv < 1.25, "z variance %.3f", zv);
@@ -270,7 +278,8 @@ static void test_rejects(gi_scene *s)
     CHECK(gi_ref_spp(r) == 0 && gi_ref_mean_rel_se(r) == INFINITY);
     CHECK(strncmp(gi_ref_renderer(r), "embree 3.", 9) == 0);
     gi_ref_free(r);
-    CHECK(gi_ref_strategy_parse("bsdf") == GI_REF_STRATEGY_BSDF && gi_ref_strategy_parse("nope") == -1);
+    CHECK(gi_ref_strategy_parse("bsdf") == GI_REF_STRATEGY_BSDF &&
+          gi_ref_strategy_parse("nope") == -1);
 }
 
 int main(void)

@@ -380,8 +380,8 @@ static void test_brdf_chi2(void)
         gi_brdf b;
         double theta_o;
     } cases[] = {
-        {{{0.6f, 0.6f, 0.6f}, {0, 0, 0}, 0, 0}, 0.7},            /* Lambert */
-        {{{0.3f, 0.3f, 0.3f}, {0.5f, 0.5f, 0.5f}, 20, 0}, 0.5},  /* mixture */
+        {{{0.6f, 0.6f, 0.6f}, {0, 0, 0}, 0, 0}, 0.7},           /* Lambert */
+        {{{0.3f, 0.3f, 0.3f}, {0.5f, 0.5f, 0.5f}, 20, 0}, 0.5}, /* mixture */
         {{{0.2f, 0.2f, 0.2f}, {0.6f, 0.6f, 0.6f}, 8, 0}, 1.25}, /* lobe clipped by the surface */
         {{{0, 0, 0}, {0.9f, 0.9f, 0.9f}, 60, 0}, 1.0},          /* Phong only */
     };
@@ -397,7 +397,8 @@ static void test_brdf_chi2(void)
                 double acc = 0;
                 for (int qc = 0; qc < Q; qc++)
                     for (int qp = 0; qp < Q; qp++) {
-                        double cth = (c + (qc + 0.5) / Q) / NC, phi = (p + (qp + 0.5) / Q) * 2 * GI_PI / NP;
+                        double cth = (c + (qc + 0.5) / Q) / NC,
+                               phi = (p + (qp + 0.5) / Q) * 2 * GI_PI / NP;
                         acc += gi_brdf_pdf(b, N, wo, dir_about(N, acos(cth), phi));
                     }
                 prob[c * NP + p] = acc / (Q * Q) * (1.0 / NC) * (2 * GI_PI / NP);
@@ -411,8 +412,8 @@ static void test_brdf_chi2(void)
             gi_vec3 wi;
             float pdf, w[3];
             int delta;
-            gi_brdf_sample(b, N, wo, gi_rng_next_float(&s), gi_rng_next_float(&s), gi_rng_next_float(&s), &wi,
-                           &pdf, w, &delta);
+            gi_brdf_sample(b, N, wo, gi_rng_next_float(&s), gi_rng_next_float(&s),
+                           gi_rng_next_float(&s), &wi, &pdf, w, &delta);
             if (pdf == 0.0f) {
                 count[NC * NP]++;
                 continue;
@@ -426,8 +427,9 @@ static void test_brdf_chi2(void)
         }
         int dof;
         double chi2 = chi2_stat(count, prob, NC * NP + 1, total, &dof);
-        printf("brdf sampler case %zu: chi2 %.1f, dof %d, 0.1%% critical %.1f, failed %.4f (pdf says %.4f)\n", k,
-               chi2, dof, chi2_critical(dof), (double)count[NC * NP] / total, prob[NC * NP]);
+        printf("brdf sampler case %zu: chi2 %.1f, dof %d, 0.1%% critical %.1f, failed %.4f (pdf "
+               "says %.4f)\n",
+               k, chi2, dof, chi2_critical(dof), (double)count[NC * NP] / total, prob[NC * NP]);
         CHECK_MSG(chi2 < chi2_critical(dof), "brdf case %zu chi2 %.1f (dof %d)", k, chi2, dof);
     }
 }
