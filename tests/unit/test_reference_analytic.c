@@ -13,7 +13,8 @@
  *    texel by texel in closed form;
  *  - a spot light (on its axis and inside its falloff ramp) and a
  *    directional light over a diffuse plane: rho / pi times the irradiance
- *    of lights.h.
+ *    of lights.h;
+ *  - a light whose irradiance overflows: every sample discarded and counted.
  * Each must hold within 1% (and within a few standard errors of the
  * estimate). The disk and the sky are also rendered with light-only and
  * BSDF-only sampling, which must agree as well. Under AddressSanitizer the
@@ -390,6 +391,45 @@ static void test_disk_light(void)
     }
 }
 
+/* A point light so strong that the irradiance overflows a float: every
+ * sample is Inf, and each is discarded and counted, never averaged in. */
+static void test_nonfinite_samples(void)
+{
+    tg_scene b;
+    tg_init(&b);
+    float alb[3], em[3];
+    grey(0.5f, alb);
+    grey(0.0f, em);
+    tg_plane(&b, 10.0f, 0.0f, tg_material(&b, alb, em, 0));
+    const float p[3] = {0, 0.01f, 0}, eye[3] = {0, 1, 0}, at[3] = {0, 0, 0};
+    tg_point_light(&b, p, 3e38f);
+    tg_camera(&b, eye, at, 1.0f, 0.01f);
+    gi_error err;
+    gi_scene *s = tg_load(&b, NULL, &err);
+    CHECK_MSG(s != NULL, "%s", err.text);
+    if (!s)
+        return;
+    gi_ref_desc d;
+    gi_ref_desc_init(&d);
+    d.scene = s;
+    d.width = 3;
+    d.height = 2;
+    gi_ref *r;
+    CHECK(gi_ref_create(&d, &r, &err) == GI_OK);
+    CHECK(gi_ref_render(r, 5, &err) == GI_OK);
+    gi_ref_stats st;
+    gi_ref_get_stats(r, &st);
+    printf("overflowing light: %llu of %d samples non-finite\n", (unsigned long long)st.nonfinite,
+           3 * 2 * 5);
+    CHECK(st.nonfinite == 3 * 2 * 5);
+    gi_image *m = gi_ref_mean_image(r);
+    CHECK(m && gi_image_count_nonfinite(m) == 0 && m->rgba[0] == 0.0f);
+    CHECK(gi_ref_mean_rel_se(r) == INFINITY);
+    gi_image_free(m);
+    gi_ref_free(r);
+    gi_scene_free(s);
+}
+
 int main(void)
 {
     test_emitting_sphere();
@@ -398,5 +438,6 @@ int main(void)
     test_plane_under_map();
     test_disk_light();
     test_punctual();
+    test_nonfinite_samples();
     return gi_test_finish();
 }
