@@ -155,11 +155,11 @@ static int parse_opts(int argc, char **argv, ref_opts *o)
 
 typedef struct progress {
     int on;
-    double start;
 } progress;
 
+/* se: the latest --target-se statistic, measured at se_spp samples. */
 static void progress_show(const progress *p, const ref_opts *o, uint64_t spp, double se,
-                          double elapsed)
+                          uint64_t se_spp, double elapsed)
 {
     if (!p->on)
         return;
@@ -168,8 +168,9 @@ static void progress_show(const progress *p, const ref_opts *o, uint64_t spp, do
         frac = fmax(frac, (double)spp / (double)o->spp);
     if (o->time_limit > 0.0)
         frac = fmax(frac, elapsed / o->time_limit);
-    if (o->target_se > 0.0 && isfinite(se) && se > 0.0)
-        frac = fmax(frac, (o->target_se / se) * (o->target_se / se)); /* SE ~ 1/sqrt(spp) */
+    if (o->target_se > 0.0 && isfinite(se) && se > 0.0) /* SE ~ 1/sqrt(spp) */
+        frac =
+            fmax(frac, (double)spp / ((double)se_spp * (se / o->target_se) * (se / o->target_se)));
     frac = fmin(frac, 1.0);
     char bar[31];
     int filled = (int)(frac * 30.0);
@@ -290,9 +291,10 @@ static int run(run_state *r, const ref_opts *o)
     if (res != GI_OK)
         return cli_fail(res == GI_ERR_INVALID_ARGUMENT ? EXIT_USAGE : EXIT_RUN, "%s", err.text);
 
-    progress bar = {isatty(STDERR_FILENO) && gi_log_get_level() >= GI_LOG_WARN, now_seconds()};
+    progress bar = {isatty(STDERR_FILENO) && gi_log_get_level() >= GI_LOG_WARN};
     const double t_render = now_seconds();
     double se = INFINITY, per_spp = 0.0; /* seconds a sample per pixel takes */
+    uint64_t se_spp = 0;
     const char *stop = NULL;
     uint64_t checkpoint = o->target_se > 0.0 ? next_checkpoint(0, se, o->target_se) : o->spp;
     if (o->spp && checkpoint > o->spp)
@@ -327,6 +329,7 @@ static int run(run_state *r, const ref_opts *o)
         }
         if (o->target_se > 0.0 && spp == checkpoint) {
             se = gi_ref_mean_rel_se(r->ref);
+            se_spp = spp;
             if (se <= o->target_se)
                 stop = "target-se";
             else
@@ -340,9 +343,10 @@ static int run(run_state *r, const ref_opts *o)
             stop = "time";
         if (!stop && spp >= 0xFFFFFFFFull)
             stop = "spp";
-        if (bar.on)
-            progress_show(&bar, o, spp, o->target_se > 0.0 ? se : gi_ref_mean_rel_se(r->ref),
-                          elapsed);
+        if (bar.on && o->target_se > 0.0)
+            progress_show(&bar, o, spp, se, se_spp, elapsed);
+        else if (bar.on)
+            progress_show(&bar, o, spp, gi_ref_mean_rel_se(r->ref), spp, elapsed);
     }
     progress_end(&bar);
 
