@@ -71,5 +71,6 @@ int cmd_render(int argc, char **argv);
 int cmd_diff(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
 int cmd_study(int argc, char **argv);
+int cmd_reference(int argc, char **argv);
 
 #endif

@@ -23,6 +23,10 @@ static const char usage[] =
     "                                         methods side by side against the references\n"
     "  study STUDY.json --out DIR [--jobs N] [--resume|--fresh]\n"
     "                                         run a declarative experiment and write its report\n"
+    "  reference --scene S --out FILE [--out FILE2] [--camera C] [--size WxH]\n"
+    "         [--spp N] [--time S] [--target-se E] [--max-bounces B|inf] [--seed N]\n"
+    "         [--threads N] [--time-of-scene T] [--exposure EV] [--stats FILE.json]\n"
+    "                                         Embree path-traced reference (EXR: mean + variance)\n"
     "exit status: 0 success, 1 failure while running, 2 bad usage or bad input\n";
 
 int main(int argc, char **argv)
@@ -61,6 +65,8 @@ int main(int argc, char **argv)
         return cmd_compare(sub_argc, sub_argv);
     if (!strcmp(cmd, "study"))
         return cmd_study(sub_argc, sub_argv);
+    if (!strcmp(cmd, "reference"))
+        return cmd_reference(sub_argc, sub_argv);
     if (!strcmp(cmd, "help")) {
         fputs(usage, stdout);
         return EXIT_OK;
