@@ -439,7 +439,7 @@ static int build_references(study *st, const char *out_dir, gi_plugins *reg)
             snprintf(stats, sizeof stats, "%s.json", img);
             json_object *sj = cli_read_json(stats);
             json_object *m = runner_diff(img, sc->ref_full, NULL, st->exposure, why, sizeof why);
-            double t = rec_num(sj, "wall_s", NULL, NULL), e = rec_num(m, "relmse", NULL, NULL);
+            double t = rec_num(sj, "wall_seconds", NULL, NULL), e = rec_num(m, "relmse", NULL, NULL);
             if (isfinite(t) && isfinite(e) && t > 0 && e > 0 && sc->curve_n < 32) {
                 sc->curve_t[sc->curve_n] = t;
                 sc->curve_e[sc->curve_n] = e;
