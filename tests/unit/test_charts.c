@@ -6,7 +6,8 @@
  * bad arguments and unwritable paths as errors, no temporary files left,
  * the caller's GL context current again afterwards, and the time a chart
  * takes. Registered with the label "charts", not "unit": it runs in the
- * release ctest only (VTK is not built for the ASan preset's checks). */
+ * release ctest only (VTK is not built for the ASan preset's checks). The
+ * PNGs are removed on success; GI_KEEP_CHARTS=1 keeps them for a look. */
 #define _POSIX_C_SOURCE 200809L /* mkdtemp, clock_gettime */
 #include <dirent.h>
 #include <epoxy/egl.h>
@@ -382,6 +383,14 @@ int main(void)
     test_ranges();
     test_errors();
     test_context_restored();
-    printf("charts in %s\n", dir);
+    /* Kept for a look when something failed or GI_KEEP_CHARTS is set. */
+    if (gi_test_failed == 0 && !getenv("GI_KEEP_CHARTS")) {
+        char cmd[700];
+        snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+        if (system(cmd) != 0)
+            fprintf(stderr, "could not remove %s\n", dir);
+    } else {
+        printf("charts in %s\n", dir);
+    }
     return gi_test_finish();
 }
