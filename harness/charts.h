@@ -62,12 +62,14 @@ typedef struct gi_chart_desc {
     uint32_t width, height;                /* pixels; 0 = 900 (width), 600 (height); at most 4096 */
 } gi_chart_desc;
 
-/* Renders the chart and writes it to `path` (which must end in ".png") as an
- * 8-bit RGB PNG of width x height pixels. n may be 0 (empty axes); series
- * may be NULL only then. Errors: GI_ERR_INVALID_ARGUMENT (bad style, size,
- * extension, NULL arrays with count > 0), GI_ERR_IO (the file cannot be
- * created or written), GI_ERR_UNSUPPORTED (no usable EGL/OpenGL 3.2), each
- * with "path: reason" in err. */
+/* Renders the chart and writes it to `path` (which must end in ".png") as
+ * an 8-bit RGB PNG of width x height pixels. desc may be NULL (all
+ * defaults). n may be 0 (empty axes); series may be NULL only then.
+ * Errors, each with "path: reason" in err: GI_ERR_INVALID_ARGUMENT (bad
+ * style, size, extension, NULL arrays with count > 0), GI_ERR_IO (the file
+ * cannot be created or written), GI_ERR_UNSUPPORTED (no EGL context with
+ * OpenGL 3.2), GI_ERR_GL (VTK reported an error while drawing; its text),
+ * GI_ERR_OUT_OF_MEMORY. */
 gi_result gi_chart_write_png(const char *path, const gi_chart_desc *desc,
                              const gi_chart_series *series, uint32_t n, gi_error *err);
 
