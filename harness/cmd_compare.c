@@ -261,6 +261,11 @@ int cmd_compare(int argc, char **argv)
     json_object_object_add(meta, "reference", json_object_new_string(refdesc));
     json_object_object_add(meta, "machine", json_object_new_string(machine));
     json_object_object_add(meta, "date", json_object_new_string(date));
+    if (!o.reference) {
+        char ref_png[64];
+        snprintf(ref_png, sizeof ref_png, "reference_b%u.png", o.ref_bounces);
+        json_object_object_add(meta, "reference_png", json_object_new_string(ref_png));
+    }
     rc = report_write(o.out, runs, meta, why, sizeof why) ? EXIT_OK : cli_fail(EXIT_RUN, "compare: %s", why);
     json_object_put(runs);
     json_object_put(meta);

@@ -403,7 +403,7 @@ static int build_references(study *st, const char *out_dir, gi_plugins *reg)
     char why[1024];
     for (uint32_t si = 0; si < st->scene_count; si++) {
         study_scene *sc = &st->scenes[si];
-        char dir[4096];
+        char dir[2048];
         snprintf(dir, sizeof dir, "%s/references", out_dir);
         cli_mkdirs(dir);
         snprintf(sc->ref_full, sizeof sc->ref_full, "%s/%s_b%u_%uspp.exr", dir, sc->stem, st->ref_bounces, st->ref_spp);

@@ -82,6 +82,9 @@ static void put(text *t, const char *fmt, ...)
 
 static const char *str(json_object *o, const char *key)
 {
+    /* the method's full parameter string (defaults included) when known */
+    if (!strcmp(key, "params") && o && json_object_object_get_ex(o, "params_full", NULL))
+        key = "params_full";
     json_object *v;
     if (o && json_object_object_get_ex(o, key, &v) && json_object_is_type(v, json_type_string))
         return json_object_get_string(v);

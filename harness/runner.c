@@ -340,8 +340,12 @@ int runner_reference(const char *scene, const char *camera, uint32_t width, uint
         args_free(&b);
         return 1;
     }
+    char png[4200];
+    snprintf(png, sizeof png, "%.*s.png", (int)(strlen(out_exr) > 4 ? strlen(out_exr) - 4 : strlen(out_exr)), out_exr);
     arg(&b, "%s", "--out");
     arg(&b, "%s", out_exr);
+    arg(&b, "%s", "--out");
+    arg(&b, "%s", png);
     arg(&b, "%s", "--stats");
     arg(&b, "%s", stats);
     cli_proc_result r;
