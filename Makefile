@@ -27,8 +27,11 @@ test-asan: deps
 	cmake --build --preset asan
 	ctest --preset asan
 
+# The demo study: the Cornell box, every installed method with a small sweep,
+# the path-traced references and convergence curve; report in $(DEMO_OUT)/.
 demo: build
-	bash scripts/demo.sh $(GIBENCH) $(DEMO_OUT)
+	$(GIBENCH) study harness/studies/demo.json --out $(DEMO_OUT)
+	@echo "demo: report in $(DEMO_OUT)/report.md and $(DEMO_OUT)/index.html"
 
 clean:
 	rm -rf build $(DEMO_OUT)

@@ -243,3 +243,42 @@ json_object *cli_timer_json(const gi_timer *t)
     }
     return o;
 }
+
+int cli_caps_cover(const gi_method *m, const gi_scene *s, int animated, char *why, size_t size)
+{
+    uint32_t c = m->caps;
+    int point = 0, directional = 0, mirror = 0, glossy = 0, textured = 0;
+    for (uint32_t i = 0; i < s->light_count; i++) {
+        point |= s->lights[i].type != GI_LIGHT_DIRECTIONAL;
+        directional |= s->lights[i].type == GI_LIGHT_DIRECTIONAL;
+    }
+    for (uint32_t i = 0; i < s->material_count; i++) {
+        const gi_material *mat = &s->materials[i];
+        int spec = mat->ks[0] + mat->ks[1] + mat->ks[2] > 0.0f;
+        mirror |= spec && (mat->mirror || mat->exponent >= GI_MIRROR_EXPONENT);
+        glossy |= spec && !(mat->mirror || mat->exponent >= GI_MIRROR_EXPONENT);
+        textured |= mat->albedo_texture >= 0;
+    }
+    const char *missing = NULL;
+    if (s->emitter_count && !(c & GI_CAP_AREA_LIGHTS))
+        missing = "area lights";
+    else if (point && !(c & GI_CAP_POINT_LIGHTS))
+        missing = "point or spot lights";
+    else if (directional && !(c & GI_CAP_DIRECTIONAL))
+        missing = "directional lights";
+    else if (s->envmap && !(c & GI_CAP_ENVIRONMENT))
+        missing = "environment light";
+    else if (mirror && !(c & GI_CAP_MIRROR))
+        missing = "mirrors";
+    else if (glossy && !(c & GI_CAP_GLOSSY))
+        missing = "glossy materials";
+    else if (textured && !(c & GI_CAP_TEXTURES))
+        missing = "textures";
+    else if (animated && !(c & GI_CAP_RIGID_MOTION))
+        missing = "moving objects";
+    if (missing) {
+        snprintf(why, size, "%s does not handle %s", m->id, missing);
+        return 0;
+    }
+    return 1;
+}

@@ -55,8 +55,22 @@ int cli_write_json(const char *path, json_object *obj, char *why, size_t why_siz
 /* Stage statistics of a timer as a JSON object {stage: {median_ms, ...}}. */
 json_object *cli_timer_json(const gi_timer *t);
 
+/* Do the method's caps cover the scene's lighting and materials (and
+ * motion when animated)? 0 with the reason ("csm does not handle mirrors"). */
+int cli_caps_cover(const gi_method *m, const gi_scene *s, int animated, char *why, size_t size);
+
+/* For reports: "Linux 6.1 x86_64, 2 cores", "2026-11-21 05:00 UTC", and
+ * the command line as typed. */
+void cli_machine_string(char *buf, size_t size);
+void cli_date_string(char *buf, size_t size);
+void cli_command_string(const char *cmd, int argc, char **argv, char *buf, size_t size);
+
 int cmd_methods(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_render(int argc, char **argv);
+int cmd_diff(int argc, char **argv);
+int cmd_compare(int argc, char **argv);
+int cmd_study(int argc, char **argv);
+int cmd_reference(int argc, char **argv);
 
 #endif

@@ -15,6 +15,18 @@ static const char usage[] =
     "         [--param k=v]... [--frames N] [--warmup N] [--time T] [--animate FPS]\n"
     "         [--seed N] [--exposure EV] [--timings FILE.json]\n"
     "                                         render one method (EXR, PFM or PNG output)\n"
+    "  diff TEST REFERENCE [--json] [--heatmap FILE.png] [--flip-map FILE.png]\n"
+    "       [--exposure EV] [--ppd N]         error metrics (RMSE, relMSE, MAE, PSNR, SSIM, FLIP)\n"
+    "  compare --scene S --methods a,b,...|all --out DIR [--size WxH] [--frames N] [--warmup N]\n"
+    "          [--camera C] [--reference FILE.exr] [--ref-spp N] [--ref-bounces B] [--timeout S]\n"
+    "          [--param method.k=v]... [--seed N] [--exposure EV] [--time T] [--fresh]\n"
+    "                                         methods side by side against the references\n"
+    "  study STUDY.json --out DIR [--jobs N] [--resume|--fresh]\n"
+    "                                         run a declarative experiment and write its report\n"
+    "  reference --scene S --out FILE [--out FILE2] [--camera C] [--size WxH]\n"
+    "         [--spp N] [--time S] [--target-se E] [--max-bounces B|inf] [--seed N]\n"
+    "         [--threads N] [--time-of-scene T] [--exposure EV] [--stats FILE.json]\n"
+    "                                         Embree path-traced reference (EXR: mean + variance)\n"
     "exit status: 0 success, 1 failure while running, 2 bad usage or bad input\n";
 
 int main(int argc, char **argv)
@@ -47,6 +59,14 @@ int main(int argc, char **argv)
         return cmd_info(sub_argc, sub_argv);
     if (!strcmp(cmd, "render"))
         return cmd_render(sub_argc, sub_argv);
+    if (!strcmp(cmd, "diff"))
+        return cmd_diff(sub_argc, sub_argv);
+    if (!strcmp(cmd, "compare"))
+        return cmd_compare(sub_argc, sub_argv);
+    if (!strcmp(cmd, "study"))
+        return cmd_study(sub_argc, sub_argv);
+    if (!strcmp(cmd, "reference"))
+        return cmd_reference(sub_argc, sub_argv);
     if (!strcmp(cmd, "help")) {
         fputs(usage, stdout);
         return EXIT_OK;

@@ -11,7 +11,7 @@ pkgs=(
   libembree-dev
   libopenimageio-dev openimageio-tools
   libtinygltf-dev nlohmann-json3-dev libstb-dev
-  libvtk9-dev
+  libvtk9-dev fonts-dejavu-core
   libglfw3-dev libepoxy-dev
   libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libglx-mesa0
   xvfb xauth

@@ -1,8 +1,11 @@
 /* Fake method plugins for the loader tests, one per defect: built several
  * times with one FAKE_* macro defined (tests/CMakeLists.txt). */
+#define _POSIX_C_SOURCE 200809L
 #include "gi/method.h"
 
+#include <signal.h>
 #include <stddef.h>
+#include <unistd.h>
 
 static gi_result fake_create(const gi_host *host, const gi_params *params, void **inst)
 {
@@ -24,6 +27,12 @@ static gi_result fake_update(void *inst, const gi_gpu_scene *s, const gi_changes
 static gi_result fake_render(void *inst, const gi_view *v, const gi_target *t)
 {
     (void)inst, (void)v, (void)t;
+#if defined(FAKE_CRASH)
+    raise(SIGSEGV); /* compare must survive a method that crashes */
+#elif defined(FAKE_HANG)
+    for (;;) /* ... and one that never returns */
+        sleep(1);
+#endif
     return GI_OK;
 }
 static void fake_destroy(void *inst)
@@ -67,7 +76,11 @@ static const gi_method fake_method = {
     .title = "Fake method",
     .citation = "none",
     .version = "0",
+#if defined(FAKE_CRASH) || defined(FAKE_HANG)
+    .caps = GI_CAP_DIRECT | GI_CAP_AREA_LIGHTS,
+#else
     .caps = GI_CAP_DIRECT,
+#endif
     .params = fake_params,
     .create = fake_create,
     .prepare = fake_prepare,

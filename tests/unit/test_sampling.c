@@ -325,9 +325,9 @@ static void test_phong_lobe(void)
 
     /* Chi-square of the sampler against the pdf on a (theta, phi) grid about
      * r; bin probabilities integrated from gi_phong_lobe_pdf. */
-    const float chi_ns[3] = {1, 10, 100};
+    const float chi_ns[4] = {1, 10, 100, 1000};
     enum { NT = 24, NP = 12 };
-    for (int k = 0; k < 3; k++) {
+    for (int k = 0; k < 4; k++) {
         float n = chi_ns[k];
         gi_vec3 r = random_unit(&s);
         /* Most of the lobe lies within a few 1/sqrt(n) of r. */
@@ -365,6 +365,72 @@ static void test_phong_lobe(void)
         printf("phong lobe n=%g: chi2 %.1f, dof %d, 0.1%% critical %.1f\n", n, chi2, dof,
                chi2_critical(dof));
         CHECK_MSG(chi2 < chi2_critical(dof), "phong n=%g chi2 %.1f (dof %d)", n, chi2, dof);
+    }
+}
+
+/* Chi-square of the whole BRDF sampler (lobe choice, both lobes, clipping
+ * at the surface) against gi_brdf_pdf, on a (cos theta, phi) grid about N;
+ * what the reference path tracer draws. Bin probabilities come from a
+ * midpoint rule over each bin (dw = dcos dphi); samples that fail (wi below
+ * the surface) go to one more bin of probability 1 - sum. */
+static void test_brdf_chi2(void)
+{
+    enum { NC = 20, NP = 24, Q = 24 };
+    struct {
+        gi_brdf b;
+        double theta_o;
+    } cases[] = {
+        {{{0.6f, 0.6f, 0.6f}, {0, 0, 0}, 0, 0}, 0.7},           /* Lambert */
+        {{{0.3f, 0.3f, 0.3f}, {0.5f, 0.5f, 0.5f}, 20, 0}, 0.5}, /* mixture */
+        {{{0.2f, 0.2f, 0.2f}, {0.6f, 0.6f, 0.6f}, 8, 0}, 1.25}, /* lobe clipped by the surface */
+        {{{0, 0, 0}, {0.9f, 0.9f, 0.9f}, 60, 0}, 1.0},          /* Phong only */
+    };
+    uint32_t s = gi_rng_init(9, 9, 9);
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        const gi_brdf *b = &cases[k].b;
+        gi_vec3 N = random_unit(&s);
+        gi_vec3 wo = dir_about(N, cases[k].theta_o, 0.4);
+        static double prob[NC * NP + 1];
+        double covered = 0;
+        for (int c = 0; c < NC; c++)
+            for (int p = 0; p < NP; p++) {
+                double acc = 0;
+                for (int qc = 0; qc < Q; qc++)
+                    for (int qp = 0; qp < Q; qp++) {
+                        double cth = (c + (qc + 0.5) / Q) / NC,
+                               phi = (p + (qp + 0.5) / Q) * 2 * GI_PI / NP;
+                        acc += gi_brdf_pdf(b, N, wo, dir_about(N, acos(cth), phi));
+                    }
+                prob[c * NP + p] = acc / (Q * Q) * (1.0 / NC) * (2 * GI_PI / NP);
+                covered += prob[c * NP + p];
+            }
+        prob[NC * NP] = fmax(0.0, 1.0 - covered);
+        const long total = 400000;
+        static long count[NC * NP + 1];
+        memset(count, 0, sizeof count);
+        for (long m = 0; m < total; m++) {
+            gi_vec3 wi;
+            float pdf, w[3];
+            int delta;
+            gi_brdf_sample(b, N, wo, gi_rng_next_float(&s), gi_rng_next_float(&s),
+                           gi_rng_next_float(&s), &wi, &pdf, w, &delta);
+            if (pdf == 0.0f) {
+                count[NC * NP]++;
+                continue;
+            }
+            gi_vec3 l = gi_to_local(wi, N);
+            double phi = atan2(l.y, l.x);
+            phi = phi < 0 ? phi + 2 * GI_PI : phi;
+            int cb = (int)(l.z * NC), pb = (int)(phi / (2 * GI_PI) * NP) % NP;
+            cb = cb < 0 ? 0 : (cb >= NC ? NC - 1 : cb);
+            count[cb * NP + pb]++;
+        }
+        int dof;
+        double chi2 = chi2_stat(count, prob, NC * NP + 1, total, &dof);
+        printf("brdf sampler case %zu: chi2 %.1f, dof %d, 0.1%% critical %.1f, failed %.4f (pdf "
+               "says %.4f)\n",
+               k, chi2, dof, chi2_critical(dof), (double)count[NC * NP] / total, prob[NC * NP]);
+        CHECK_MSG(chi2 < chi2_critical(dof), "brdf case %zu chi2 %.1f (dof %d)", k, chi2, dof);
     }
 }
 
@@ -544,6 +610,7 @@ int main(void)
     test_frames();
     test_phong_lobe();
     test_brdf_sample_consistency();
+    test_brdf_chi2();
     test_furnace();
     return gi_test_finish();
 }

@@ -1,0 +1,279 @@
+/* gibench compare: several methods on one scene, each in its own process
+ * with a time limit, against full-GI and bounce-matched references. */
+#define _POSIX_C_SOURCE 200809L
+#include "cli.h"
+
+#include "report.h"
+#include "runner.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/utsname.h>
+#include <time.h>
+#include <unistd.h>
+
+#define MAX_METHODS 32
+#define MAX_PARAMS 64
+
+typedef struct compare_opts {
+    const char *scene, *methods, *out, *camera, *reference;
+    const char *params[MAX_PARAMS]; /* "method.key=value" */
+    uint32_t param_count;
+    uint32_t width, height, frames, warmup, seed, ref_spp, ref_bounces;
+    double timeout_s;
+    float exposure, time;
+    int fresh;
+} compare_opts;
+
+static int parse(int argc, char **argv, compare_opts *o)
+{
+    memset(o, 0, sizeof *o);
+    o->width = o->height = 128;
+    o->frames = 8;
+    o->warmup = 1;
+    o->seed = 1;
+    o->ref_spp = 256;
+    o->ref_bounces = 64;
+    o->timeout_s = 600;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "--fresh")) {
+            o->fresh = 1;
+            continue;
+        }
+        const char *v = i + 1 < argc ? argv[++i] : NULL;
+        unsigned long u;
+        float f;
+        if (!v && strncmp(a, "--", 2) == 0)
+            return cli_fail(EXIT_USAGE, "compare: %s needs a value", a);
+        if (!strcmp(a, "--scene"))
+            o->scene = v;
+        else if (!strcmp(a, "--methods"))
+            o->methods = v;
+        else if (!strcmp(a, "--out"))
+            o->out = v;
+        else if (!strcmp(a, "--camera"))
+            o->camera = v;
+        else if (!strcmp(a, "--reference"))
+            o->reference = v;
+        else if (!strcmp(a, "--param")) {
+            if (o->param_count == MAX_PARAMS || !strchr(v, '.') || !strchr(v, '='))
+                return cli_fail(EXIT_USAGE, "compare: --param '%s' is not method.name=value", v);
+            o->params[o->param_count++] = v;
+        } else if (!strcmp(a, "--size")) {
+            if (!cli_parse_size(v, &o->width, &o->height))
+                return cli_fail(EXIT_USAGE, "compare: --size '%s' is not WxH", v);
+        } else if (!strcmp(a, "--frames") || !strcmp(a, "--warmup") || !strcmp(a, "--seed") ||
+                   !strcmp(a, "--ref-spp") || !strcmp(a, "--ref-bounces")) {
+            unsigned long lo = !strcmp(a, "--warmup") || !strcmp(a, "--seed") ? 0 : 1;
+            if (!cli_parse_uint(v, lo, 1000000000ul, &u))
+                return cli_fail(EXIT_USAGE, "compare: %s '%s' is not an integer >= %lu", a, v, lo);
+            if (!strcmp(a, "--frames"))
+                o->frames = (uint32_t)u;
+            else if (!strcmp(a, "--warmup"))
+                o->warmup = (uint32_t)u;
+            else if (!strcmp(a, "--seed"))
+                o->seed = (uint32_t)u;
+            else if (!strcmp(a, "--ref-spp"))
+                o->ref_spp = (uint32_t)u;
+            else
+                o->ref_bounces = (uint32_t)u;
+        } else if (!strcmp(a, "--timeout")) {
+            if (!cli_parse_float(v, &f) || f <= 0)
+                return cli_fail(EXIT_USAGE, "compare: --timeout '%s' is not a positive number of seconds", v);
+            o->timeout_s = f;
+        } else if (!strcmp(a, "--exposure")) {
+            if (!cli_parse_float(v, &o->exposure))
+                return cli_fail(EXIT_USAGE, "compare: --exposure '%s' is not a number", v);
+        } else if (!strcmp(a, "--time")) {
+            if (!cli_parse_float(v, &o->time) || o->time < 0)
+                return cli_fail(EXIT_USAGE, "compare: --time '%s' is not a non-negative number", v);
+        } else {
+            return cli_fail(EXIT_USAGE, "compare: unknown argument '%s' (see gibench --help)", a);
+        }
+    }
+    if (!o->scene || !o->methods || !o->out)
+        return cli_fail(EXIT_USAGE, "compare: --scene, --methods and --out are required");
+    if (o->frames > 1 && o->warmup >= o->frames)
+        o->warmup = o->frames - 1;
+    if (o->frames == 1)
+        o->warmup = 0;
+    return EXIT_OK;
+}
+
+/* The machine, for the report: kernel, architecture, cores. */
+void cli_machine_string(char *buf, size_t size)
+{
+    struct utsname u;
+    if (uname(&u) != 0)
+        snprintf(buf, size, "unknown");
+    else
+        snprintf(buf, size, "%s %s %s, %ld cores", u.sysname, u.release, u.machine, sysconf(_SC_NPROCESSORS_ONLN));
+}
+
+void cli_date_string(char *buf, size_t size)
+{
+    time_t t = time(NULL);
+    struct tm tm;
+    gmtime_r(&t, &tm);
+    strftime(buf, size, "%Y-%m-%d %H:%M UTC", &tm);
+}
+
+void cli_command_string(const char *cmd, int argc, char **argv, char *buf, size_t size)
+{
+    snprintf(buf, size, "gibench %s", cmd);
+    for (int i = 0; i < argc; i++) {
+        size_t used = strlen(buf);
+        snprintf(buf + used, size - used, " %s", argv[i]);
+    }
+}
+
+int cmd_compare(int argc, char **argv)
+{
+    compare_opts o;
+    int rc = parse(argc, argv, &o);
+    if (rc != EXIT_OK)
+        return rc;
+    gi_error err;
+    gi_scene *scene = gi_scene_load(o.scene, &err);
+    if (!scene)
+        return cli_fail(EXIT_USAGE, "%s", err.text);
+    if (o.camera && gi_scene_find_camera(scene, o.camera) < 0) {
+        gi_scene_free(scene);
+        return cli_fail(EXIT_USAGE, "compare: %s has no camera '%s'", o.scene, o.camera);
+    }
+    gi_plugins *reg = cli_load_plugins(0);
+    const gi_method *methods[MAX_METHODS];
+    uint32_t n = 0;
+    if (!strcmp(o.methods, "all")) {
+        for (uint32_t i = 0; i < reg->count && n < MAX_METHODS; i++)
+            methods[n++] = reg->items[i].method;
+    } else {
+        char list[1024];
+        snprintf(list, sizeof list, "%s", o.methods);
+        char *save = NULL;
+        for (char *id = strtok_r(list, ",", &save); id; id = strtok_r(NULL, ",", &save)) {
+            const gi_method *m = gi_plugins_find(reg, id);
+            if (!m || n == MAX_METHODS) {
+                gi_plugins_free(reg);
+                gi_scene_free(scene);
+                return cli_fail(EXIT_USAGE, "compare: no method '%s' (see gibench methods)", id);
+            }
+            methods[n++] = m;
+        }
+    }
+    for (uint32_t k = 0; k < o.param_count; k++) {
+        size_t len = (size_t)(strchr(o.params[k], '.') - o.params[k]);
+        int found = 0;
+        for (uint32_t i = 0; i < n; i++)
+            found |= strlen(methods[i]->id) == len && !strncmp(methods[i]->id, o.params[k], len);
+        if (!found) {
+            gi_plugins_free(reg);
+            gi_scene_free(scene);
+            return cli_fail(EXIT_USAGE, "compare: --param '%s' names no method of this comparison", o.params[k]);
+        }
+    }
+    if (!cli_mkdirs(o.out)) {
+        gi_plugins_free(reg);
+        gi_scene_free(scene);
+        return cli_fail(EXIT_RUN, "compare: cannot create %s", o.out);
+    }
+    cli_install_signal_handlers();
+
+    /* References: the full one (given or path traced) and one per bounce
+     * count the methods need. */
+    char ref_full[4096], why[1024];
+    if (o.reference) {
+        snprintf(ref_full, sizeof ref_full, "%s", o.reference);
+    } else {
+        snprintf(ref_full, sizeof ref_full, "%s/reference_b%u.exr", o.out, o.ref_bounces);
+        fprintf(stderr, "compare: reference (%u spp, %u bounces)\n", o.ref_spp, o.ref_bounces);
+        if (!runner_reference(o.scene, o.camera, o.width, o.height, o.ref_spp, o.ref_bounces, o.seed, o.time,
+                              o.timeout_s, ref_full, why, sizeof why)) {
+            gi_plugins_free(reg);
+            gi_scene_free(scene);
+            return cli_fail(EXIT_RUN, "compare: %s", why);
+        }
+    }
+    json_object *runs = json_object_new_array();
+    int failures = 0;
+    char renderer[256] = "";
+    for (uint32_t i = 0; i < n && !cli_interrupted; i++) {
+        const gi_method *m = methods[i];
+        const char *params[MAX_PARAMS];
+        uint32_t np = 0;
+        size_t idlen = strlen(m->id);
+        for (uint32_t k = 0; k < o.param_count; k++)
+            if (!strncmp(o.params[k], m->id, idlen) && o.params[k][idlen] == '.')
+                params[np++] = o.params[k] + idlen + 1;
+        char dir[4096], matched[4096];
+        snprintf(dir, sizeof dir, "%s/%s", o.out, m->id);
+        uint32_t b = m->max_bounces + 1;
+        const char *ref_matched = NULL;
+        run_spec spec = {m->id, o.scene, m->id, o.camera, o.width, o.height, o.frames, o.warmup, o.seed,
+                         o.time, 0.0f, params, np, o.timeout_s, dir, m->id, ref_full, NULL, o.exposure};
+        char reason[256];
+        json_object *rec;
+        if (!cli_caps_cover(m, scene, 0, reason, sizeof reason)) {
+            rec = runner_not_applicable(&spec, reason);
+        } else {
+            if (b < o.ref_bounces) {
+                snprintf(matched, sizeof matched, "%s/reference_b%u.exr", o.out, b);
+                fprintf(stderr, "compare: bounce-matched reference (%u spp, %u bounces)\n", o.ref_spp, b);
+                if (runner_reference(o.scene, o.camera, o.width, o.height, o.ref_spp, b, o.seed, o.time, o.timeout_s,
+                                     matched, why, sizeof why))
+                    ref_matched = matched;
+                else
+                    fprintf(stderr, "gibench: warning: %s\n", why);
+            } else {
+                ref_matched = ref_full; /* the full reference is this method's match */
+            }
+            spec.ref_matched = ref_matched;
+            fprintf(stderr, "compare: %s\n", m->id);
+            rec = runner_execute(&spec, !o.fresh);
+        }
+        json_object *st, *rn;
+        if (json_object_object_get_ex(rec, "status", &st) && !strcmp(json_object_get_string(st), "failed")) {
+            failures++;
+            json_object *r;
+            json_object_object_get_ex(rec, "reason", &r);
+            fprintf(stderr, "gibench: warning: %s failed: %s\n", m->id, json_object_get_string(r));
+        }
+        if (!renderer[0] && json_object_object_get_ex(rec, "renderer", &rn))
+            snprintf(renderer, sizeof renderer, "%s", json_object_get_string(rn));
+        json_object_array_add(runs, rec);
+    }
+    json_object *meta = json_object_new_object();
+    char title[512], cmd[4096], machine[256], date[64], refdesc[512];
+    snprintf(title, sizeof title, "gibench compare: %s at %ux%u", o.scene, o.width, o.height);
+    cli_command_string("compare", argc, argv, cmd, sizeof cmd);
+    cli_machine_string(machine, sizeof machine);
+    cli_date_string(date, sizeof date);
+    if (o.reference)
+        snprintf(refdesc, sizeof refdesc, "%s (given); bounce-matched references %u spp", o.reference, o.ref_spp);
+    else
+        snprintf(refdesc, sizeof refdesc, "path traced (Embree), %u spp, %u bounces; bounce-matched the same spp",
+                 o.ref_spp, o.ref_bounces);
+    json_object_object_add(meta, "title", json_object_new_string(title));
+    json_object_object_add(meta, "command", json_object_new_string(cmd));
+    json_object_object_add(meta, "renderer", json_object_new_string(renderer[0] ? renderer : "(no run finished)"));
+    json_object_object_add(meta, "reference", json_object_new_string(refdesc));
+    json_object_object_add(meta, "machine", json_object_new_string(machine));
+    json_object_object_add(meta, "date", json_object_new_string(date));
+    if (!o.reference) {
+        char ref_png[64];
+        snprintf(ref_png, sizeof ref_png, "reference_b%u.png", o.ref_bounces);
+        json_object_object_add(meta, "reference_png", json_object_new_string(ref_png));
+    }
+    rc = report_write(o.out, runs, meta, why, sizeof why) ? EXIT_OK : cli_fail(EXIT_RUN, "compare: %s", why);
+    json_object_put(runs);
+    json_object_put(meta);
+    gi_plugins_free(reg);
+    gi_scene_free(scene);
+    if (rc == EXIT_OK && cli_interrupted)
+        return cli_fail(EXIT_RUN, "compare: interrupted; rerun the same command to resume");
+    if (rc == EXIT_OK && failures)
+        fprintf(stderr, "gibench: compare: %d of %u methods failed (see %s/report.md)\n", failures, n, o.out);
+    return rc;
+}

@@ -1,0 +1,404 @@
+/* gibench reference: the Embree path tracer (harness/reference/) from the
+ * command line: progressive passes until --spp, --time or --target-se, then
+ * the mean (+ a "variance" layer in EXR) and a stats file. */
+#define _POSIX_C_SOURCE 200809L
+#include "cli.h"
+
+#include "reference.h"
+
+#include "gi/image.h"
+#include "gi/log.h"
+#include "gi/scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#define MAX_OUTS 4
+#define DEFAULT_SPP 256
+/* Passes between progress updates and stop checks last about this long. */
+#define PASS_SECONDS 0.5
+
+typedef struct ref_opts {
+    const char *scene, *camera, *stats;
+    const char *outs[MAX_OUTS];
+    int out_count;
+    uint32_t width, height, seed, threads;
+    uint64_t spp;      /* 0 = no sample limit */
+    double time_limit; /* seconds; 0 = none */
+    double target_se;  /* 0 = none */
+    int max_bounces;
+    float scene_time, exposure;
+    gi_ref_strategy strategy;
+} ref_opts;
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int image_ext_ok(const char *path)
+{
+    const char *dot = strrchr(path, '.');
+    return dot && (!strcmp(dot, ".exr") || !strcmp(dot, ".pfm") || !strcmp(dot, ".png"));
+}
+
+static int is_exr(const char *path)
+{
+    const char *dot = strrchr(path, '.');
+    return dot && !strcmp(dot, ".exr");
+}
+
+static int parse_opts(int argc, char **argv, ref_opts *o)
+{
+    static const char *valued[] = {"--scene",    "--camera",        "--size",        "--spp",
+                                   "--time",     "--target-se",     "--max-bounces", "--seed",
+                                   "--threads",  "--time-of-scene", "--out",         "--stats",
+                                   "--exposure", "--strategy"};
+    memset(o, 0, sizeof *o);
+    o->width = o->height = 256;
+    o->seed = 1;
+    o->max_bounces = GI_REF_UNLIMITED;
+    o->strategy = GI_REF_STRATEGY_MIS;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        int known = 0;
+        for (size_t k = 0; k < sizeof valued / sizeof valued[0]; k++)
+            known |= !strcmp(a, valued[k]);
+        if (!known)
+            return cli_fail(EXIT_USAGE, "reference: unknown argument '%s' (see gibench --help)", a);
+        const char *v = i + 1 < argc ? argv[++i] : NULL;
+        if (!v)
+            return cli_fail(EXIT_USAGE, "reference: %s needs a value", a);
+        unsigned long u;
+        float f;
+        if (!strcmp(a, "--scene"))
+            o->scene = v;
+        else if (!strcmp(a, "--camera"))
+            o->camera = v;
+        else if (!strcmp(a, "--stats"))
+            o->stats = v;
+        else if (!strcmp(a, "--out")) {
+            if (o->out_count == MAX_OUTS)
+                return cli_fail(EXIT_USAGE, "reference: at most %d --out files", MAX_OUTS);
+            if (!image_ext_ok(v))
+                return cli_fail(EXIT_USAGE,
+                                "reference: --out '%s': use a .exr, .pfm or .png file name", v);
+            o->outs[o->out_count++] = v;
+        } else if (!strcmp(a, "--size")) {
+            if (!cli_parse_size(v, &o->width, &o->height))
+                return cli_fail(EXIT_USAGE, "reference: --size '%s' is not WxH with 1..16384 each",
+                                v);
+        } else if (!strcmp(a, "--spp")) {
+            if (!cli_parse_uint(v, 1, 0xFFFFFFFFul, &u))
+                return cli_fail(EXIT_USAGE,
+                                "reference: --spp '%s' is not an integer in 1..4294967295", v);
+            o->spp = u;
+        } else if (!strcmp(a, "--time")) {
+            if (!cli_parse_float(v, &f) || !(f > 0.0f))
+                return cli_fail(EXIT_USAGE,
+                                "reference: --time '%s' is not a positive number of seconds", v);
+            o->time_limit = f;
+        } else if (!strcmp(a, "--target-se")) {
+            if (!cli_parse_float(v, &f) || !(f > 0.0f))
+                return cli_fail(EXIT_USAGE, "reference: --target-se '%s' is not a positive number",
+                                v);
+            o->target_se = f;
+        } else if (!strcmp(a, "--max-bounces")) {
+            if (!strcmp(v, "inf") || !strcmp(v, "unlimited") || !strcmp(v, "-1"))
+                o->max_bounces = GI_REF_UNLIMITED;
+            else if (cli_parse_uint(v, 0, 1000000, &u))
+                o->max_bounces = (int)u;
+            else
+                return cli_fail(EXIT_USAGE,
+                                "reference: --max-bounces '%s' is not 0..1000000 or 'inf'", v);
+        } else if (!strcmp(a, "--seed")) {
+            if (!cli_parse_uint(v, 0, 0xFFFFFFFFul, &u))
+                return cli_fail(EXIT_USAGE,
+                                "reference: --seed '%s' is not a 32-bit unsigned integer", v);
+            o->seed = (uint32_t)u;
+        } else if (!strcmp(a, "--threads")) {
+            if (!cli_parse_uint(v, 0, 1024, &u))
+                return cli_fail(EXIT_USAGE,
+                                "reference: --threads '%s' is not an integer in 0..1024", v);
+            o->threads = (uint32_t)u;
+        } else if (!strcmp(a, "--time-of-scene")) {
+            if (!cli_parse_float(v, &o->scene_time) || o->scene_time < 0.0f)
+                return cli_fail(EXIT_USAGE,
+                                "reference: --time-of-scene '%s' is not a non-negative number", v);
+        } else if (!strcmp(a, "--exposure")) {
+            if (!cli_parse_float(v, &o->exposure))
+                return cli_fail(EXIT_USAGE, "reference: --exposure '%s' is not a number", v);
+        } else if (!strcmp(a, "--strategy")) {
+            int s = gi_ref_strategy_parse(v);
+            if (s < 0)
+                return cli_fail(EXIT_USAGE, "reference: --strategy '%s' is not mis, light or bsdf",
+                                v);
+            o->strategy = (gi_ref_strategy)s;
+        }
+    }
+    if (!o->scene)
+        return cli_fail(EXIT_USAGE, "reference: --scene is required");
+    if (o->out_count == 0)
+        return cli_fail(EXIT_USAGE, "reference: --out is required");
+    if (o->spp == 0 && o->time_limit == 0.0 && o->target_se == 0.0)
+        o->spp = DEFAULT_SPP;
+    return EXIT_OK;
+}
+
+/* ---- progress -------------------------------------------------------- */
+
+typedef struct progress {
+    int on;
+} progress;
+
+/* se: the latest --target-se statistic, measured at se_spp samples. */
+static void progress_show(const progress *p, const ref_opts *o, uint64_t spp, double se,
+                          uint64_t se_spp, double elapsed)
+{
+    if (!p->on)
+        return;
+    double frac = 0.0;
+    if (o->spp)
+        frac = fmax(frac, (double)spp / (double)o->spp);
+    if (o->time_limit > 0.0)
+        frac = fmax(frac, elapsed / o->time_limit);
+    if (o->target_se > 0.0 && isfinite(se) && se > 0.0) /* SE ~ 1/sqrt(spp) */
+        frac =
+            fmax(frac, (double)spp / ((double)se_spp * (se / o->target_se) * (se / o->target_se)));
+    frac = fmin(frac, 1.0);
+    char bar[31];
+    int filled = (int)(frac * 30.0);
+    for (int i = 0; i < 30; i++)
+        bar[i] = i < filled ? '#' : '.';
+    bar[30] = '\0';
+    fprintf(stderr, "\rreference [%s] %3d%%  %llu spp  %.1f s  SE %.4g ", bar, (int)(frac * 100.0),
+            (unsigned long long)spp, elapsed, se);
+    fflush(stderr);
+}
+
+static void progress_end(const progress *p)
+{
+    if (p->on)
+        fputc('\n', stderr);
+}
+
+/* ---- run --------------------------------------------------------------- */
+
+typedef struct run_state {
+    gi_scene *scene;
+    gi_ref *ref;
+    gi_image *mean, *var;
+} run_state;
+
+/* Next sample count at which --target-se is checked: a function of the
+ * image alone (never of timing), so that the stopping point and the image
+ * are reproducible. Aim 10% past the count the 1/sqrt(spp) law predicts,
+ * at most doubling. */
+static uint64_t next_checkpoint(uint64_t spp, double se, double target)
+{
+    if (spp < 4)
+        return 4;
+    double want =
+        isfinite(se) ? 1.1 * (double)spp * (se / target) * (se / target) : 2.0 * (double)spp;
+    uint64_t n = want > 2.0 * (double)spp ? 2 * spp : (uint64_t)ceil(want);
+    return n > spp ? n : spp + 1;
+}
+
+static json_object *stats_json(const run_state *r, const ref_opts *o, int camera, double wall,
+                               const char *stop)
+{
+    gi_ref_stats st;
+    gi_ref_get_stats(r->ref, &st);
+    json_object *j = json_object_new_object();
+    json_object_object_add(j, "renderer", json_object_new_string(gi_ref_renderer(r->ref)));
+    json_object_object_add(j, "scene", json_object_new_string(o->scene));
+    char cam[32];
+    snprintf(cam, sizeof cam, camera < 0 ? "default" : "#%d", camera);
+    json_object_object_add(j, "camera", json_object_new_string(o->camera ? o->camera : cam));
+    json_object_object_add(j, "width", json_object_new_int((int32_t)o->width));
+    json_object_object_add(j, "height", json_object_new_int((int32_t)o->height));
+    json_object_object_add(j, "time_of_scene", json_object_new_double(o->scene_time));
+    json_object_object_add(j, "spp", json_object_new_int64((int64_t)st.spp));
+    json_object_object_add(j, "seed", json_object_new_int64(o->seed));
+    json_object_object_add(j, "max_bounces",
+                           json_object_new_int(o->max_bounces)); /* -1 = unlimited */
+    json_object_object_add(j, "strategy",
+                           json_object_new_string(gi_ref_strategy_name(o->strategy)));
+    json_object_object_add(j, "threads", json_object_new_int((int32_t)st.threads));
+    json_object_object_add(j, "stop", json_object_new_string(stop));
+    json_object_object_add(j, "wall_seconds", json_object_new_double(wall));
+    json_object_object_add(j, "build_seconds", json_object_new_double(st.build_seconds));
+    json_object_object_add(j, "render_seconds", json_object_new_double(st.render_seconds));
+    json_object_object_add(j, "rays", json_object_new_int64((int64_t)st.rays));
+    json_object_object_add(j, "mrays_per_second",
+                           json_object_new_double(st.render_seconds > 0
+                                                      ? 1e-6 * (double)st.rays / st.render_seconds
+                                                      : 0.0));
+    json_object_object_add(j, "nonfinite_samples", json_object_new_int64((int64_t)st.nonfinite));
+    /* Mean over pixels of the standard error of the mean luminance, absolute
+     * and relative (the --target-se statistic, README "Reference path tracer"). */
+    size_t n = (size_t)o->width * o->height;
+    double se_sum = 0.0;
+    for (size_t i = 0; i < n; i++)
+        se_sum += sqrt((double)r->var->rgba[4 * i + 3]);
+    json_object_object_add(j, "mean_se", json_object_new_double(se_sum / (double)n));
+    double rel = gi_ref_mean_rel_se(r->ref);
+    json_object_object_add(j, "mean_rel_se", isfinite(rel) ? json_object_new_double(rel) : NULL);
+    double mean[4];
+    gi_image_mean(r->mean, mean);
+    json_object *mj = json_object_new_array();
+    for (int c = 0; c < 3; c++)
+        json_object_array_add(mj, json_object_new_double(mean[c]));
+    json_object_object_add(j, "mean_rgb", mj);
+    return j;
+}
+
+static int run(run_state *r, const ref_opts *o)
+{
+    double t_start = now_seconds();
+    gi_error err;
+    r->scene = gi_scene_load(o->scene, &err);
+    if (!r->scene)
+        return cli_fail(EXIT_USAGE, "%s", err.text);
+    int camera = 0;
+    if (o->camera) {
+        camera = gi_scene_find_camera(r->scene, o->camera);
+        if (camera < 0)
+            return cli_fail(EXIT_USAGE,
+                            "reference: %s has no camera '%s' (%u cameras; use a name or #k)",
+                            o->scene, o->camera, r->scene->camera_count);
+    } else if (r->scene->camera_count == 0) {
+        camera = -1;
+    }
+    gi_ref_desc d;
+    gi_ref_desc_init(&d);
+    d.scene = r->scene;
+    d.camera = camera;
+    d.time = o->scene_time;
+    d.width = o->width;
+    d.height = o->height;
+    d.seed = o->seed;
+    d.max_bounces = o->max_bounces;
+    d.threads = o->threads;
+    d.strategy = o->strategy;
+    gi_result res = gi_ref_create(&d, &r->ref, &err);
+    if (res != GI_OK)
+        return cli_fail(res == GI_ERR_INVALID_ARGUMENT ? EXIT_USAGE : EXIT_RUN, "%s", err.text);
+
+    progress bar = {isatty(STDERR_FILENO) && gi_log_get_level() >= GI_LOG_WARN};
+    const double t_render = now_seconds();
+    double se = INFINITY, per_spp = 0.0; /* seconds a sample per pixel takes */
+    uint64_t se_spp = 0;
+    const char *stop = NULL;
+    uint64_t checkpoint = o->target_se > 0.0 ? next_checkpoint(0, se, o->target_se) : o->spp;
+    if (o->spp && checkpoint > o->spp)
+        checkpoint = o->spp;
+    while (!stop) {
+        uint64_t spp = gi_ref_spp(r->ref);
+        double elapsed = now_seconds() - t_render;
+        /* Pass size: about PASS_SECONDS of work, never past the checkpoint
+         * or the sample limit, nor (much) past the time budget. */
+        double budget = PASS_SECONDS;
+        if (o->time_limit > 0.0)
+            budget = fmin(budget, o->time_limit - elapsed);
+        uint64_t k = per_spp > 0.0 ? (uint64_t)(budget / per_spp) : 1;
+        k = k < 1 ? 1 : k;
+        if (checkpoint && k > checkpoint - spp)
+            k = checkpoint - spp;
+        if (k > 0xFFFFFFFFull - spp)
+            k = 0xFFFFFFFFull - spp;
+        double t0 = now_seconds();
+        res = gi_ref_render(r->ref, (uint32_t)k, &err);
+        if (res != GI_OK) {
+            progress_end(&bar);
+            return cli_fail(EXIT_RUN, "%s", err.text);
+        }
+        per_spp = (now_seconds() - t0) / (double)k;
+        spp = gi_ref_spp(r->ref);
+        elapsed = now_seconds() - t_render;
+        if (cli_interrupted) {
+            progress_end(&bar);
+            return cli_fail(EXIT_RUN, "reference: interrupted after %llu spp; no image written",
+                            (unsigned long long)spp);
+        }
+        if (o->target_se > 0.0 && spp == checkpoint) {
+            se = gi_ref_mean_rel_se(r->ref);
+            se_spp = spp;
+            if (se <= o->target_se)
+                stop = "target-se";
+            else
+                checkpoint = next_checkpoint(spp, se, o->target_se);
+            if (o->spp && checkpoint > o->spp)
+                checkpoint = o->spp;
+        }
+        if (!stop && o->spp && spp >= o->spp)
+            stop = "spp";
+        if (!stop && o->time_limit > 0.0 && elapsed >= o->time_limit)
+            stop = "time";
+        if (!stop && spp >= 0xFFFFFFFFull)
+            stop = "spp";
+        if (bar.on && o->target_se > 0.0)
+            progress_show(&bar, o, spp, se, se_spp, elapsed);
+        else if (bar.on)
+            progress_show(&bar, o, spp, gi_ref_mean_rel_se(r->ref), spp, elapsed);
+    }
+    progress_end(&bar);
+
+    r->mean = gi_ref_mean_image(r->ref);
+    r->var = gi_ref_variance_image(r->ref);
+    if (!r->mean || !r->var)
+        return cli_fail(EXIT_RUN, "out of memory reading the image");
+    for (int i = 0; i < o->out_count; i++) {
+        if (is_exr(o->outs[i])) {
+            const gi_image *layers[1] = {r->var};
+            const char *names[1] = {"variance"};
+            res = gi_image_write_exr_layers(o->outs[i], r->mean, layers, names, 1, &err);
+        } else {
+            gi_image_write_opts wo = {o->exposure};
+            res = gi_image_write(o->outs[i], r->mean, &wo, &err);
+        }
+        if (res != GI_OK)
+            return cli_fail(EXIT_RUN, "%s", err.text);
+    }
+    gi_ref_stats st;
+    gi_ref_get_stats(r->ref, &st);
+    if (st.nonfinite)
+        gi_log(GI_LOG_WARN, "reference: %llu NaN/Inf samples were discarded",
+               (unsigned long long)st.nonfinite);
+    gi_log(GI_LOG_INFO, "reference: %llu spp in %.2f s (%s), %.2f Mrays/s, mean relative SE %.4g",
+           (unsigned long long)st.spp, st.render_seconds, stop,
+           st.render_seconds > 0 ? 1e-6 * (double)st.rays / st.render_seconds : 0.0,
+           gi_ref_mean_rel_se(r->ref));
+    if (o->stats) {
+        json_object *j = stats_json(r, o, camera, now_seconds() - t_start, stop);
+        char why[GI_ERROR_MAX];
+        int ok = cli_write_json(o->stats, j, why, sizeof why);
+        json_object_put(j);
+        if (!ok)
+            return cli_fail(EXIT_RUN, "%s", why);
+    }
+    return EXIT_OK;
+}
+
+int cmd_reference(int argc, char **argv)
+{
+    ref_opts o;
+    int rc = parse_opts(argc, argv, &o);
+    if (rc != EXIT_OK)
+        return rc;
+    cli_install_signal_handlers();
+    run_state r;
+    memset(&r, 0, sizeof r);
+    rc = run(&r, &o);
+    gi_image_free(r.mean);
+    gi_image_free(r.var);
+    gi_ref_free(r.ref);
+    gi_scene_free(r.scene);
+    return rc;
+}

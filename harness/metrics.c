@@ -1,0 +1,288 @@
+/* Image-error metrics (RMSE, relMSE, MAE, PSNR, SSIM, mean luminance, FLIP)
+ * and per-pixel error maps; definitions in metrics.h. */
+#include "metrics.h"
+
+#include "filter.h"
+#include "flip.h"
+#include "gi/tonemap.h"
+
+#include <assert.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static inline int finite3(const float *p)
+{
+    return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
+}
+
+static inline double lum(const float *p)
+{
+    return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+}
+
+static gi_result check_pair(const gi_image *test, const gi_image *ref, gi_error *err)
+{
+    assert(test && ref && test->rgba && ref->rgba);
+    if (test->width != ref->width || test->height != ref->height)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "image sizes differ: test %ux%u, reference %ux%u", test->width,
+                            test->height, ref->width, ref->height);
+    return GI_OK;
+}
+
+static gi_result check_opts(const gi_metrics_opts *o, gi_error *err)
+{
+    if (!isfinite(o->exposure) || fabsf(o->exposure) > 64.0f)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "exposure %g is not in [-64, 64] stops",
+                            (double)o->exposure);
+    if (o->flip_ppd != 0.0f &&
+        (!(o->flip_ppd > 0.0f) || !isfinite(o->flip_ppd) || o->flip_ppd > 1e4f))
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "FLIP pixels per degree %g is not in (0, 10000]", (double)o->flip_ppd);
+    return GI_OK;
+}
+
+static double ppd_of(const gi_metrics_opts *o)
+{
+    return o->flip_ppd > 0.0f ? (double)o->flip_ppd : GI_FLIP_PPD_DEFAULT;
+}
+
+/* The pixel whose values both images take at an excluded pixel (see
+ * metrics.h): the reference's if finite, else the test's, else NULL (0). */
+static const float *shared_pixel(const float *x, const float *r)
+{
+    return finite3(r) ? r : finite3(x) ? x : NULL;
+}
+
+/* ---- SSIM ---- */
+
+gi_result gi_metrics_ssim_plane(const double *x, const double *y, const uint8_t *mask, uint32_t w,
+                                uint32_t h, double *mean, gi_error *err)
+{
+    size_t n = (size_t)w * h;
+    double k[2 * GI_SSIM_RADIUS + 1], ksum = 0.0;
+    for (int i = -GI_SSIM_RADIUS; i <= GI_SSIM_RADIUS; i++)
+        ksum += k[i + GI_SSIM_RADIUS] =
+            exp(-(double)(i * i) / (2.0 * GI_SSIM_SIGMA * GI_SSIM_SIGMA));
+    for (int i = 0; i < 2 * GI_SSIM_RADIUS + 1; i++)
+        k[i] /= ksum;
+
+    double *mx = malloc(n * sizeof *mx), *my = malloc(n * sizeof *my),
+           *sxx = malloc(n * sizeof *sxx), *syy = malloc(n * sizeof *syy),
+           *sxy = malloc(n * sizeof *sxy), *tmp = malloc(n * sizeof *tmp);
+    gi_result res = GI_OK;
+    if (!mx || !my || !sxx || !syy || !sxy || !tmp) {
+        res =
+            gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "SSIM: out of memory for a %ux%u image", w, h);
+        goto done;
+    }
+#define WINDOW(in, out)                                                                            \
+    gi_filter_separable(in, out, tmp, w, h, k, GI_SSIM_RADIUS, k, GI_SSIM_RADIUS,                  \
+                        GI_BORDER_RENORMALISE)
+    WINDOW(x, mx);
+    WINDOW(y, my);
+    for (size_t i = 0; i < n; i++)
+        sxx[i] = x[i] * x[i];
+    WINDOW(sxx, sxx);
+    for (size_t i = 0; i < n; i++)
+        syy[i] = y[i] * y[i];
+    WINDOW(syy, syy);
+    for (size_t i = 0; i < n; i++)
+        sxy[i] = x[i] * y[i];
+    WINDOW(sxy, sxy);
+#undef WINDOW
+
+    const double c1 = (GI_SSIM_K1 * 1.0) * (GI_SSIM_K1 * 1.0),
+                 c2 = (GI_SSIM_K2 * 1.0) * (GI_SSIM_K2 * 1.0);
+    double sum = 0.0;
+    uint64_t count = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (mask && !mask[i])
+            continue;
+        double vx = sxx[i] - mx[i] * mx[i], vy = syy[i] - my[i] * my[i],
+               cxy = sxy[i] - mx[i] * my[i];
+        double s = ((2.0 * mx[i] * my[i] + c1) * (2.0 * cxy + c2)) /
+                   ((mx[i] * mx[i] + my[i] * my[i] + c1) * (vx + vy + c2));
+        sum += s;
+        count++;
+    }
+    *mean = count ? sum / (double)count : NAN;
+
+done:
+    free(mx);
+    free(my);
+    free(sxx);
+    free(syy);
+    free(sxy);
+    free(tmp);
+    return res;
+}
+
+/* ---- maps ---- */
+
+gi_result gi_metrics_relerr_map(const gi_image *test, const gi_image *ref, float *map,
+                                gi_error *err)
+{
+    gi_result res = check_pair(test, ref, err);
+    if (res)
+        return res;
+    size_t n = (size_t)test->width * test->height;
+    for (size_t i = 0; i < n; i++) {
+        const float *x = test->rgba + i * 4, *r = ref->rgba + i * 4;
+        if (!finite3(x) || !finite3(r)) {
+            map[i] = NAN;
+            continue;
+        }
+        double s = 0.0;
+        for (int c = 0; c < 3; c++)
+            s += fabs((double)x[c] - r[c]) / ((double)r[c] + 0.01);
+        map[i] = (float)(s / 3.0);
+    }
+    return GI_OK;
+}
+
+gi_result gi_metrics_flip_map(const gi_image *test, const gi_image *ref,
+                              const gi_metrics_opts *opts, float *map, double *mean, gi_error *err)
+{
+    gi_metrics_opts defaults = {0};
+    const gi_metrics_opts *o = opts ? opts : &defaults;
+    gi_result res = check_pair(test, ref, err);
+    if (!res)
+        res = check_opts(o, err);
+    if (res)
+        return res;
+    size_t n = (size_t)test->width * test->height;
+    float *ts = malloc(n * 3 * sizeof *ts), *rs = malloc(n * 3 * sizeof *rs);
+    if (!ts || !rs) {
+        free(ts);
+        free(rs);
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "FLIP: out of memory for a %ux%u image",
+                            test->width, test->height);
+    }
+    for (size_t i = 0; i < n; i++) {
+        const float *x = test->rgba + i * 4, *r = ref->rgba + i * 4;
+        if (finite3(x) && finite3(r)) {
+            for (int c = 0; c < 3; c++) {
+                ts[i * 3 + c] = gi_tonemap(x[c], o->exposure);
+                rs[i * 3 + c] = gi_tonemap(r[c], o->exposure);
+            }
+        } else {
+            const float *s = shared_pixel(x, r);
+            for (int c = 0; c < 3; c++)
+                ts[i * 3 + c] = rs[i * 3 + c] = s ? gi_tonemap(s[c], o->exposure) : 0.0f;
+        }
+    }
+    res = gi_flip_map(ts, rs, test->width, test->height, ppd_of(o), map, err);
+    if (!res) {
+        double sum = 0.0;
+        uint64_t count = 0;
+        for (size_t i = 0; i < n; i++) {
+            if (finite3(test->rgba + i * 4) && finite3(ref->rgba + i * 4)) {
+                sum += map[i];
+                count++;
+            } else {
+                map[i] = NAN;
+            }
+        }
+        if (mean)
+            *mean = count ? sum / (double)count : NAN;
+    }
+    free(ts);
+    free(rs);
+    return res;
+}
+
+/* ---- everything ---- */
+
+gi_result gi_metrics_compute(const gi_image *test, const gi_image *ref, const gi_metrics_opts *opts,
+                             gi_metrics *out, gi_error *err)
+{
+    assert(out);
+    gi_metrics_opts defaults = {0};
+    const gi_metrics_opts *o = opts ? opts : &defaults;
+    gi_result res = check_pair(test, ref, err);
+    if (!res)
+        res = check_opts(o, err);
+    if (res)
+        return res;
+
+    memset(out, 0, sizeof *out);
+    out->width = test->width;
+    out->height = test->height;
+    out->exposure = o->exposure;
+    out->flip_ppd = (float)ppd_of(o);
+    size_t n = (size_t)test->width * test->height;
+
+    uint8_t *mask = malloc(n);
+    double *lx = malloc(n * sizeof *lx), *lr = malloc(n * sizeof *lr);
+    float *fmap = o->skip_flip ? NULL : malloc(n * sizeof *fmap);
+    if (!mask || !lx || !lr || (!o->skip_flip && !fmap)) {
+        res = gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "metrics: out of memory for a %ux%u image",
+                           test->width, test->height);
+        goto done;
+    }
+
+    double se = 0.0, rel = 0.0, ae = 0.0, se_t = 0.0, sum_lx = 0.0, sum_lr = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        const float *x = test->rgba + i * 4, *r = ref->rgba + i * 4;
+        int fx = finite3(x), fr = finite3(r);
+        out->nonfinite_test += !fx;
+        out->nonfinite_ref += !fr;
+        mask[i] = (uint8_t)(fx && fr);
+        if (!mask[i]) {
+            out->excluded++;
+            const float *s = shared_pixel(x, r);
+            lx[i] = lr[i] = s ? gi_tonemap((float)lum(s), o->exposure) : 0.0;
+            continue;
+        }
+        for (int c = 0; c < 3; c++) {
+            double d = (double)x[c] - r[c], q = (double)r[c] + 0.01;
+            se += d * d;
+            rel += d * d / (q * q);
+            ae += fabs(d);
+            double dt = (double)gi_tonemap(x[c], o->exposure) - gi_tonemap(r[c], o->exposure);
+            se_t += dt * dt;
+        }
+        sum_lx += lum(x);
+        sum_lr += lum(r);
+        lx[i] = gi_tonemap((float)lum(x), o->exposure);
+        lr[i] = gi_tonemap((float)lum(r), o->exposure);
+    }
+    out->pixels = n - out->excluded;
+
+    if (out->pixels == 0) {
+        out->mse = out->rmse = out->relmse = out->mae = out->psnr = out->ssim = NAN;
+        out->mean_lum_test = out->mean_lum_ref = out->mean_lum_diff_pct = out->flip = NAN;
+        goto done;
+    }
+    double samples = 3.0 * (double)out->pixels;
+    out->mse = se / samples;
+    out->rmse = sqrt(out->mse);
+    out->relmse = rel / samples;
+    out->mae = ae / samples;
+    double mse_t = se_t / samples;
+    out->psnr = mse_t > 0.0 ? 10.0 * log10(1.0 / mse_t) : INFINITY;
+    out->mean_lum_test = sum_lx / (double)out->pixels;
+    out->mean_lum_ref = sum_lr / (double)out->pixels;
+    if (out->mean_lum_ref != 0.0)
+        out->mean_lum_diff_pct =
+            100.0 * (out->mean_lum_test - out->mean_lum_ref) / out->mean_lum_ref;
+    else
+        out->mean_lum_diff_pct = out->mean_lum_test == 0.0 ? 0.0 : NAN;
+
+    res = gi_metrics_ssim_plane(lx, lr, mask, test->width, test->height, &out->ssim, err);
+    if (res)
+        goto done;
+    if (o->skip_flip)
+        out->flip = NAN;
+    else
+        res = gi_metrics_flip_map(test, ref, o, fmap, &out->flip, err);
+
+done:
+    free(mask);
+    free(lx);
+    free(lr);
+    free(fmap);
+    return res;
+}

@@ -1,0 +1,33 @@
+/* Child processes with a time limit: every method run of `compare` and
+ * `study` happens in its own process, so a crash or a hang costs that run
+ * alone. */
+#ifndef GIBENCH_PROC_H
+#define GIBENCH_PROC_H
+
+#include <stddef.h>
+
+typedef struct cli_proc_result {
+    int exit_code;      /* valid when !signaled && !timed_out */
+    int signaled;       /* killed by a signal (crash) */
+    int signal;
+    int timed_out;      /* killed by us at the time limit */
+    double seconds;     /* wall time */
+    char last_line[512]; /* last non-empty line the child printed (stderr + stdout) */
+} cli_proc_result;
+
+/* Runs argv (argv[0] a path) with stdout written to out_path and stderr to
+ * err_path (either may be NULL: discarded; the same path for both merges
+ * them), killing its whole process group after timeout_s seconds (<= 0: no
+ * limit). Returns 0 when the child could be started, -1 otherwise
+ * (result->last_line says why). last_line is taken from err_path. */
+int cli_run(char *const argv[], double timeout_s, const char *out_path, const char *err_path,
+            cli_proc_result *result);
+
+/* One-line description of how a run ended: "ok", "exit 2: <line>",
+ * "crashed (signal 11: Segmentation fault): <line>", "timed out after 30 s". */
+void cli_proc_describe(const cli_proc_result *r, char *buf, size_t size);
+
+/* Absolute path of the running gibench executable. */
+const char *cli_self_exe(void);
+
+#endif

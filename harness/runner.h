@@ -1,0 +1,46 @@
+/* One method run in its own process, then its error against the
+ * references, recorded as a run record (report.h). Shared by `compare`
+ * and `study`. A run whose directory already holds a result for the same
+ * configuration is not run again (resume). */
+#ifndef GIBENCH_RUNNER_H
+#define GIBENCH_RUNNER_H
+
+#include <json-c/json.h>
+#include <stdint.h>
+
+typedef struct run_spec {
+    const char *run_id;   /* name in tables, e.g. "direct" or "direct#3" */
+    const char *scene;
+    const char *method;
+    const char *camera;   /* NULL: the scene's first */
+    uint32_t width, height, frames, warmup, seed;
+    float time;           /* scene time */
+    float animate_fps;    /* > 0: animated frames */
+    const char *const *params; /* "k=v" */
+    uint32_t param_count;
+    double timeout_s;
+    const char *dir;      /* this run's directory (created) */
+    const char *rel;      /* dir relative to the report directory, for links */
+    const char *ref_full;    /* full-GI reference EXR, or NULL */
+    const char *ref_matched; /* bounce-matched reference EXR, or NULL */
+    float exposure;
+} run_spec;
+
+/* Runs (or resumes) a run; never fails as a whole: failures are records
+ * with status "failed" and the child's own message. Caller owns the result. */
+json_object *runner_execute(const run_spec *spec, int resume);
+/* A record for a run that was not attempted ("n/a" with the reason). */
+json_object *runner_not_applicable(const run_spec *spec, const char *reason);
+
+/* Runs `gibench reference` into out_exr unless a file made with the same
+ * settings exists; 1 on success, else 0 with why. */
+int runner_reference(const char *scene, const char *camera, uint32_t width, uint32_t height, uint32_t spp,
+                     uint32_t max_bounces, uint32_t seed, float time, double timeout_s, const char *out_exr,
+                     char *why, size_t why_size);
+
+/* Fills metrics of `image` against `reference` by `gibench diff --json`;
+ * NULL with why on failure. heatmap may be NULL. */
+json_object *runner_diff(const char *image, const char *reference, const char *heatmap, float exposure, char *why,
+                         size_t why_size);
+
+#endif
