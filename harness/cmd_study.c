@@ -24,7 +24,7 @@
 
 typedef struct study_run {
     run_spec spec;
-    char id[128], dir[4096], rel[1024], scene_stem[256];
+    char id[512], dir[4096], rel[1024];
     char *params[MAX_KEYS];
     int scene_index;
     uint32_t bounces; /* the method's max_bounces + 1 */
@@ -403,10 +403,11 @@ static int build_references(study *st, const char *out_dir, gi_plugins *reg)
     char why[1024];
     for (uint32_t si = 0; si < st->scene_count; si++) {
         study_scene *sc = &st->scenes[si];
-        char dir[2048];
+        char dir[2048], stem[256];
+        snprintf(stem, sizeof stem, "%s", sc->stem); /* a copy: -Wrestrict sees sc->stem and the outputs as one object */
         snprintf(dir, sizeof dir, "%s/references", out_dir);
         cli_mkdirs(dir);
-        snprintf(sc->ref_full, sizeof sc->ref_full, "%s/%s_b%u_%uspp.exr", dir, sc->stem, st->ref_bounces, st->ref_spp);
+        snprintf(sc->ref_full, sizeof sc->ref_full, "%s/%s_b%u_%uspp.exr", dir, stem, st->ref_bounces, st->ref_spp);
         fprintf(stderr, "study: reference %s (%u spp, %u bounces)\n", sc->stem, st->ref_spp, st->ref_bounces);
         if (!runner_reference(sc->path, st->camera, st->width, st->height, st->ref_spp, st->ref_bounces, st->seed,
                               st->time, st->timeout_s * 10, sc->ref_full, why, sizeof why))
@@ -420,7 +421,7 @@ static int build_references(study *st, const char *out_dir, gi_plugins *reg)
                 k++;
             if (k == sc->matched_count && k < 8) {
                 sc->matched_bounces[k] = b;
-                snprintf(sc->ref_matched[k], sizeof sc->ref_matched[k], "%s/%s_b%u_%uspp.exr", dir, sc->stem, b,
+                snprintf(sc->ref_matched[k], sizeof sc->ref_matched[k], "%s/%s_b%u_%uspp.exr", dir, stem, b,
                          st->ref_spp);
                 fprintf(stderr, "study: bounce-matched reference %s (%u bounces)\n", sc->stem, b);
                 if (!runner_reference(sc->path, st->camera, st->width, st->height, st->ref_spp, b, st->seed, st->time,
@@ -432,7 +433,7 @@ static int build_references(study *st, const char *out_dir, gi_plugins *reg)
         /* the path tracer's convergence: k-spp images (another seed) against the reference */
         for (uint32_t c = 0; c < st->conv_n; c++) {
             char img[4096], stats[4200];
-            snprintf(img, sizeof img, "%s/%s_conv_%uspp.exr", dir, sc->stem, st->conv_spp[c]);
+            snprintf(img, sizeof img, "%s/%s_conv_%uspp.exr", dir, stem, st->conv_spp[c]);
             if (!runner_reference(sc->path, st->camera, st->width, st->height, st->conv_spp[c], st->ref_bounces,
                                   st->seed + 7919, st->time, st->timeout_s, img, why, sizeof why))
                 return cli_fail(EXIT_RUN, "study: %s", why);
