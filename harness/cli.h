@@ -59,12 +59,6 @@ json_object *cli_timer_json(const gi_timer *t);
  * motion when animated)? 0 with the reason ("csm does not handle mirrors"). */
 int cli_caps_cover(const gi_method *m, const gi_scene *s, int animated, char *why, size_t size);
 
-/* For reports: "Linux 6.1 x86_64, 2 cores", "2026-11-21 05:00 UTC", and
- * the command line as typed. */
-void cli_machine_string(char *buf, size_t size);
-void cli_date_string(char *buf, size_t size);
-void cli_command_string(const char *cmd, int argc, char **argv, char *buf, size_t size);
-
 int cmd_methods(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_render(int argc, char **argv);

@@ -9,8 +9,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/utsname.h>
-#include <time.h>
 #include <unistd.h>
 
 #define MAX_METHODS 32
@@ -100,33 +98,6 @@ static int parse(int argc, char **argv, compare_opts *o)
     if (o->frames == 1)
         o->warmup = 0;
     return EXIT_OK;
-}
-
-/* The machine, for the report: kernel, architecture, cores. */
-void cli_machine_string(char *buf, size_t size)
-{
-    struct utsname u;
-    if (uname(&u) != 0)
-        snprintf(buf, size, "unknown");
-    else
-        snprintf(buf, size, "%s %s %s, %ld cores", u.sysname, u.release, u.machine, sysconf(_SC_NPROCESSORS_ONLN));
-}
-
-void cli_date_string(char *buf, size_t size)
-{
-    time_t t = time(NULL);
-    struct tm tm;
-    gmtime_r(&t, &tm);
-    strftime(buf, size, "%Y-%m-%d %H:%M UTC", &tm);
-}
-
-void cli_command_string(const char *cmd, int argc, char **argv, char *buf, size_t size)
-{
-    snprintf(buf, size, "gibench %s", cmd);
-    for (int i = 0; i < argc; i++) {
-        size_t used = strlen(buf);
-        snprintf(buf + used, size - used, " %s", argv[i]);
-    }
 }
 
 int cmd_compare(int argc, char **argv)
@@ -244,23 +215,14 @@ int cmd_compare(int argc, char **argv)
             snprintf(renderer, sizeof renderer, "%s", json_object_get_string(rn));
         json_object_array_add(runs, rec);
     }
-    json_object *meta = json_object_new_object();
-    char title[512], cmd[4096], machine[256], date[64], refdesc[512];
+    char title[512], refdesc[512];
     snprintf(title, sizeof title, "gibench compare: %s at %ux%u", o.scene, o.width, o.height);
-    cli_command_string("compare", argc, argv, cmd, sizeof cmd);
-    cli_machine_string(machine, sizeof machine);
-    cli_date_string(date, sizeof date);
     if (o.reference)
         snprintf(refdesc, sizeof refdesc, "%s (given); bounce-matched references %u spp", o.reference, o.ref_spp);
     else
         snprintf(refdesc, sizeof refdesc, "path traced (Embree), %u spp, %u bounces; bounce-matched the same spp",
                  o.ref_spp, o.ref_bounces);
-    json_object_object_add(meta, "title", json_object_new_string(title));
-    json_object_object_add(meta, "command", json_object_new_string(cmd));
-    json_object_object_add(meta, "renderer", json_object_new_string(renderer[0] ? renderer : "(no run finished)"));
-    json_object_object_add(meta, "reference", json_object_new_string(refdesc));
-    json_object_object_add(meta, "machine", json_object_new_string(machine));
-    json_object_object_add(meta, "date", json_object_new_string(date));
+    json_object *meta = report_meta_new(title, "compare", argc, argv, renderer, refdesc);
     if (!o.reference) {
         char ref_png[64];
         snprintf(ref_png, sizeof ref_png, "reference_b%u.png", o.ref_bounces);

@@ -662,20 +662,11 @@ int cmd_study(int argc, char **argv)
                 failed++;
             json_object_array_add(runs, json_object_get(st.runs[i].record));
         }
-        json_object *meta = json_object_new_object();
-        char title[512], cmd[4096], machine[256], date[64], refdesc[256];
+        char title[512], refdesc[256];
         snprintf(title, sizeof title, "gibench study: %s (%ux%u, %u frames)", st.name, st.width, st.height, st.frames);
-        cli_command_string("study", argc, argv, cmd, sizeof cmd);
-        cli_machine_string(machine, sizeof machine);
-        cli_date_string(date, sizeof date);
         snprintf(refdesc, sizeof refdesc, "path traced (Embree), %u spp, %u bounces; bounce-matched the same spp",
                  st.ref_spp, st.ref_bounces);
-        json_object_object_add(meta, "title", json_object_new_string(title));
-        json_object_object_add(meta, "command", json_object_new_string(cmd));
-        json_object_object_add(meta, "renderer", json_object_new_string(renderer[0] ? renderer : "(no run finished)"));
-        json_object_object_add(meta, "reference", json_object_new_string(refdesc));
-        json_object_object_add(meta, "machine", json_object_new_string(machine));
-        json_object_object_add(meta, "date", json_object_new_string(date));
+        json_object *meta = report_meta_new(title, "study", argc, argv, renderer, refdesc);
         charts_and_speedups(&st, out, meta, runs);
         char why[1024];
         if (!report_write(out, runs, meta, why, sizeof why))

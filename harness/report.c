@@ -11,6 +11,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/utsname.h>
+#include <time.h>
+#include <unistd.h>
 
 const char *const report_metric_keys[] = {"relmse", "rmse", "mae", "psnr", "ssim", "flip", "mean_lum_diff_pct", NULL};
 
@@ -26,6 +29,50 @@ int cli_mkdirs(const char *path)
             *p = '/';
         }
     return mkdir(buf, 0755) == 0 || errno == EEXIST;
+}
+
+/* The machine, for the report: kernel, architecture, cores. */
+static void machine_string(char *buf, size_t size)
+{
+    struct utsname u;
+    if (uname(&u) != 0)
+        snprintf(buf, size, "unknown");
+    else
+        snprintf(buf, size, "%s %s %s, %ld cores", u.sysname, u.release, u.machine, sysconf(_SC_NPROCESSORS_ONLN));
+}
+
+static void date_string(char *buf, size_t size)
+{
+    time_t t = time(NULL);
+    struct tm tm;
+    gmtime_r(&t, &tm);
+    strftime(buf, size, "%Y-%m-%d %H:%M UTC", &tm);
+}
+
+static void command_string(const char *cmd, int argc, char **argv, char *buf, size_t size)
+{
+    snprintf(buf, size, "gibench %s", cmd);
+    for (int i = 0; i < argc; i++) {
+        size_t used = strlen(buf);
+        snprintf(buf + used, size - used, " %s", argv[i]);
+    }
+}
+
+json_object *report_meta_new(const char *title, const char *command, int argc, char **argv, const char *renderer,
+                             const char *reference)
+{
+    char cmd[4096], machine[256], date[64];
+    command_string(command, argc, argv, cmd, sizeof cmd);
+    machine_string(machine, sizeof machine);
+    date_string(date, sizeof date);
+    json_object *meta = json_object_new_object();
+    json_object_object_add(meta, "title", json_object_new_string(title));
+    json_object_object_add(meta, "command", json_object_new_string(cmd));
+    json_object_object_add(meta, "renderer", json_object_new_string(renderer && *renderer ? renderer : "(no run finished)"));
+    json_object_object_add(meta, "reference", json_object_new_string(reference));
+    json_object_object_add(meta, "machine", json_object_new_string(machine));
+    json_object_object_add(meta, "date", json_object_new_string(date));
+    return meta;
 }
 
 json_object *cli_read_json(const char *path)

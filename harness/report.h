@@ -22,6 +22,11 @@ extern const char *const report_metric_keys[];
  * machine, command). Returns 1 on success, else 0 with why. */
 int report_write(const char *dir, json_object *runs, json_object *meta, char *why, size_t why_size);
 
+/* The report header: title, the command as typed ("gibench <command>
+ * <argv...>"), GL renderer, reference description, machine and date. */
+json_object *report_meta_new(const char *title, const char *command, int argc, char **argv, const char *renderer,
+                             const char *reference);
+
 /* mkdir -p; 1 on success. */
 int cli_mkdirs(const char *path);
 /* Reads a JSON file (NULL if absent or malformed). */

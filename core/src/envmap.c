@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "gi/envmap.h"
+#include "gi/sampling.h"
 
 /* Direction in the map's frame: rotate d by -rotation about +Y. */
 static gi_vec3 to_map_frame(float rotation, gi_vec3 d)
@@ -31,21 +32,6 @@ static gi_vec3 from_map_frame(float rotation, gi_vec3 d)
 {
     float c = cosf(rotation), s = sinf(rotation);
     return gi_v3(c * d.x + s * d.z, d.y, -s * d.x + c * d.z);
-}
-
-/* Largest k in [0, n) with cdf[k] <= x, for cdf[0] = 0 <= x < cdf[n]: the
- * interval [cdf[k], cdf[k+1]) holding x, never an empty one. */
-static uint32_t find_interval(const float *cdf, uint32_t n, float x)
-{
-    uint32_t lo = 0, hi = n;
-    while (hi - lo > 1) {
-        uint32_t mid = (lo + hi) >> 1;
-        if (cdf[mid] <= x)
-            lo = mid;
-        else
-            hi = mid;
-    }
-    return lo;
 }
 
 static float clamp_unit(float x)
@@ -185,11 +171,11 @@ float gi_envmap_sample(const gi_envmap *env, float u1, float u2, gi_vec3 *dir)
         *dir = gi_v3(0.0f, 1.0f, 0.0f);
         return 0.0f;
     }
-    uint32_t j = find_interval(env->marg_cdf, h, u2);
+    uint32_t j = gi_cdf_find_interval(env->marg_cdf, h, u2);
     float m0 = env->marg_cdf[j], m1 = env->marg_cdf[j + 1];
     float dv = (u2 - m0) / (m1 - m0);
     const float *cdf = env->cond_cdf + (size_t)j * (w + 1);
-    uint32_t i = find_interval(cdf, w, u1);
+    uint32_t i = gi_cdf_find_interval(cdf, w, u1);
     float c0 = cdf[i], c1 = cdf[i + 1];
     float du = (u1 - c0) / (c1 - c0);
     /* Stay inside the chosen texel whatever the rounding. */

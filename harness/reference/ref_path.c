@@ -163,20 +163,6 @@ static void make_surface(const ref_scene *rs, const ref_hit *h, gi_vec3 dir, sur
     }
 }
 
-/* Largest k in [0, n) with cdf[k] <= x (cdf[0] = 0 <= x < cdf[n] = 1). */
-static uint32_t find_interval(const float *cdf, uint32_t n, float x)
-{
-    uint32_t lo = 0, hi = n;
-    while (hi - lo > 1) {
-        uint32_t mid = (lo + hi) >> 1;
-        if (cdf[mid] <= x)
-            lo = mid;
-        else
-            hi = mid;
-    }
-    return lo;
-}
-
 static inline void add_scaled(float L[3], const float beta[3], const float a[3], float s)
 {
     for (int k = 0; k < 3; k++)
@@ -216,7 +202,7 @@ static void sample_area_light(const ref_scene *rs, const surface *s, const float
                               uint32_t *rng, float L[3], ref_counters *c)
 {
     float u0 = next(rng), u1 = next(rng), u2 = next(rng);
-    uint32_t t = rs->emitters[find_interval(rs->emitter_cdf, rs->emitter_count, u0)];
+    uint32_t t = rs->emitters[gi_cdf_find_interval(rs->emitter_cdf, rs->emitter_count, u0)];
     const ref_tri *lt = &rs->tris[t];
     if (!(lt->light_prob > 0.0f) || !(lt->area > 0.0f))
         return;

@@ -11,6 +11,7 @@
 #define GI_SAMPLING_H
 
 #include <math.h>
+#include <stdint.h>
 
 #include "gi/vecmath.h"
 
@@ -102,6 +103,23 @@ static inline void gi_sample_uniform_triangle(float u1, float u2, float b[3])
     b[0] = 1.0f - su;
     b[1] = u2 * su;
     b[2] = 1.0f - b[0] - b[1];
+}
+
+/* Sampling a piecewise-constant distribution from its CDF (cdf[0] = 0 <=
+ * x < cdf[n] = 1, n + 1 entries): the largest k in [0, n) with cdf[k] <= x,
+ * i.e. the interval [cdf[k], cdf[k+1]) holding x, never an empty one. Used
+ * by the environment map and the reference's emitter choice. */
+static inline uint32_t gi_cdf_find_interval(const float *cdf, uint32_t n, float x)
+{
+    uint32_t lo = 0, hi = n;
+    while (hi - lo > 1) {
+        uint32_t mid = (lo + hi) >> 1;
+        if (cdf[mid] <= x)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
 }
 
 /* Veach's power heuristic (beta = 2) weight of strategy f, taking nf
