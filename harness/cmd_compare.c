@@ -19,7 +19,7 @@ typedef struct compare_opts {
     const char *params[MAX_PARAMS]; /* "method.key=value" */
     uint32_t param_count;
     uint32_t width, height, frames, warmup, seed, ref_spp, ref_bounces;
-    double timeout_s;
+    double timeout_s, ref_target_se;
     float exposure, time;
     int fresh;
 } compare_opts;
@@ -81,6 +81,10 @@ static int parse(int argc, char **argv, compare_opts *o)
             if (!cli_parse_float(v, &f) || f <= 0)
                 return cli_fail(EXIT_USAGE, "compare: --timeout '%s' is not a positive number of seconds", v);
             o->timeout_s = f;
+        } else if (!strcmp(a, "--ref-target-se")) {
+            if (!cli_parse_float(v, &f) || f <= 0)
+                return cli_fail(EXIT_USAGE, "compare: --ref-target-se '%s' is not a positive number", v);
+            o->ref_target_se = f;
         } else if (!strcmp(a, "--exposure")) {
             if (!cli_parse_float(v, &o->exposure))
                 return cli_fail(EXIT_USAGE, "compare: --exposure '%s' is not a number", v);
@@ -160,7 +164,7 @@ int cmd_compare(int argc, char **argv)
     } else {
         snprintf(ref_full, sizeof ref_full, "%s/reference_b%u.exr", o.out, o.ref_bounces);
         fprintf(stderr, "compare: reference (%u spp, %u bounces)\n", o.ref_spp, o.ref_bounces);
-        if (!runner_reference(o.scene, o.camera, o.width, o.height, o.ref_spp, o.ref_bounces, o.seed, o.time,
+        if (!runner_reference(o.scene, o.camera, o.width, o.height, o.ref_spp, o.ref_target_se, o.ref_bounces, o.seed, o.time,
                               o.timeout_s, ref_full, why, sizeof why)) {
             gi_plugins_free(reg);
             gi_scene_free(scene);
@@ -192,7 +196,7 @@ int cmd_compare(int argc, char **argv)
             if (b < o.ref_bounces) {
                 snprintf(matched, sizeof matched, "%s/reference_b%u.exr", o.out, b);
                 fprintf(stderr, "compare: bounce-matched reference (%u spp, %u bounces)\n", o.ref_spp, b);
-                if (runner_reference(o.scene, o.camera, o.width, o.height, o.ref_spp, b, o.seed, o.time, o.timeout_s,
+                if (runner_reference(o.scene, o.camera, o.width, o.height, o.ref_spp, o.ref_target_se, b, o.seed, o.time, o.timeout_s,
                                      matched, why, sizeof why))
                     ref_matched = matched;
                 else

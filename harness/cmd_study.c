@@ -48,6 +48,7 @@ typedef struct study {
     const char *name;
     uint32_t width, height, frames, warmup, repeats, seed;
     uint32_t ref_spp, ref_bounces;
+    double ref_target_se; /* 0: none */
     uint32_t conv_spp[32], conv_n;
     float time, exposure;
     const char *camera;
@@ -310,7 +311,12 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
         if ((rc = get_uint(ref, "spp", 1, 1u << 24, 256, &st->ref_spp, file)) ||
             (rc = get_uint(ref, "max_bounces", 0, 1024, 64, &st->ref_bounces, file)))
             return rc;
-        json_object *cs;
+        json_object *cs, *tse;
+        if (json_object_object_get_ex(ref, "target_se", &tse) && !json_object_is_type(tse, json_type_null)) {
+            st->ref_target_se = json_object_get_double(tse);
+            if (!(st->ref_target_se > 0))
+                return fail_json(file, "/reference/target_se", "must be a positive relative standard error");
+        }
         if (json_object_object_get_ex(ref, "convergence_spp", &cs)) {
             if (!json_object_is_type(cs, json_type_array) || json_object_array_length(cs) > 32)
                 return fail_json(file, "/reference/convergence_spp", "must be a list of at most 32 sample counts");
@@ -409,7 +415,7 @@ static int build_references(study *st, const char *out_dir, gi_plugins *reg)
         cli_mkdirs(dir);
         snprintf(sc->ref_full, sizeof sc->ref_full, "%s/%s_b%u_%uspp.exr", dir, stem, st->ref_bounces, st->ref_spp);
         fprintf(stderr, "study: reference %s (%u spp, %u bounces)\n", sc->stem, st->ref_spp, st->ref_bounces);
-        if (!runner_reference(sc->path, st->camera, st->width, st->height, st->ref_spp, st->ref_bounces, st->seed,
+        if (!runner_reference(sc->path, st->camera, st->width, st->height, st->ref_spp, st->ref_target_se, st->ref_bounces, st->seed,
                               st->time, st->timeout_s * 10, sc->ref_full, why, sizeof why))
             return cli_fail(EXIT_RUN, "study: %s", why);
         /* bounce-matched references for every method bounce count in use */
@@ -424,7 +430,7 @@ static int build_references(study *st, const char *out_dir, gi_plugins *reg)
                 snprintf(sc->ref_matched[k], sizeof sc->ref_matched[k], "%s/%s_b%u_%uspp.exr", dir, stem, b,
                          st->ref_spp);
                 fprintf(stderr, "study: bounce-matched reference %s (%u bounces)\n", sc->stem, b);
-                if (!runner_reference(sc->path, st->camera, st->width, st->height, st->ref_spp, b, st->seed, st->time,
+                if (!runner_reference(sc->path, st->camera, st->width, st->height, st->ref_spp, st->ref_target_se, b, st->seed, st->time,
                                       st->timeout_s * 10, sc->ref_matched[k], why, sizeof why))
                     return cli_fail(EXIT_RUN, "study: %s", why);
                 sc->matched_count++;
@@ -434,7 +440,7 @@ static int build_references(study *st, const char *out_dir, gi_plugins *reg)
         for (uint32_t c = 0; c < st->conv_n; c++) {
             char img[4096], stats[4200];
             snprintf(img, sizeof img, "%s/%s_conv_%uspp.exr", dir, stem, st->conv_spp[c]);
-            if (!runner_reference(sc->path, st->camera, st->width, st->height, st->conv_spp[c], st->ref_bounces,
+            if (!runner_reference(sc->path, st->camera, st->width, st->height, st->conv_spp[c], 0.0, st->ref_bounces,
                                   st->seed + 7919, st->time, st->timeout_s, img, why, sizeof why))
                 return cli_fail(EXIT_RUN, "study: %s", why);
             snprintf(stats, sizeof stats, "%s.json", img);
@@ -667,6 +673,9 @@ int cmd_study(int argc, char **argv)
         snprintf(refdesc, sizeof refdesc, "path traced (Embree), %u spp, %u bounces; bounce-matched the same spp",
                  st.ref_spp, st.ref_bounces);
         json_object *meta = report_meta_new(title, "study", argc, argv, renderer, refdesc);
+        char ref_png[512];
+        snprintf(ref_png, sizeof ref_png, "references/%s_b%u_%uspp.png", st.scenes[0].stem, st.ref_bounces, st.ref_spp);
+        json_object_object_add(meta, "reference_png", json_object_new_string(ref_png));
         charts_and_speedups(&st, out, meta, runs);
         char why[1024];
         if (!report_write(out, runs, meta, why, sizeof why))

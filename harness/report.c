@@ -203,7 +203,7 @@ static void write_csv(text *t, json_object *runs)
     put(t, "run,scene,method,params,status,reason,renderer,timer,frames,prepare_ms,frame_ms_median,frame_ms_min,"
            "frame_ms_max");
     for (int k = 0; k < ns; k++)
-        put(t, ",stage_%s_ms", stages[k]);
+        put(t, ",stage_%s_ms_median,stage_%s_ms_min,stage_%s_ms_max", stages[k], stages[k], stages[k]);
     for (int r = 0; r < 2; r++)
         for (int m = 0; report_metric_keys[m]; m++)
             put(t, ",%s_%s", report_metric_keys[m], r ? "matched" : "full");
@@ -219,8 +219,11 @@ static void write_csv(text *t, json_object *runs)
         csv_num(t, num(o, "frame_ms", "median", NULL), 0);
         csv_num(t, num(o, "frame_ms", "min", NULL), 0);
         csv_num(t, num(o, "frame_ms", "max", NULL), 0);
-        for (int k = 0; k < ns; k++)
-            csv_num(t, num(o, "stages", stages[k], NULL), 0);
+        for (int k = 0; k < ns; k++) {
+            csv_num(t, num(o, "stages", stages[k], "median"), 0);
+            csv_num(t, num(o, "stages", stages[k], "min"), 0);
+            csv_num(t, num(o, "stages", stages[k], "max"), 0);
+        }
         for (int r = 0; r < 2; r++)
             for (int m = 0; report_metric_keys[m]; m++)
                 csv_num(t, num(o, "metrics", r ? "matched" : "full", report_metric_keys[m]),
@@ -265,6 +268,44 @@ static void write_md(text *t, json_object *runs, json_object *meta)
         md_num(t, num(o, "metrics", "full", "ssim"));
         md_num(t, num(o, "metrics", "full", "mean_lum_diff_pct"));
         put(t, "\n");
+    }
+    const char *stages[32];
+    int ns = stage_names(runs, stages, 32);
+    if (ns > 0) {
+        put(t, "\nStage timings in ms, median (min – max) over the timed frames:\n\n| run |");
+        for (int k = 0; k < ns; k++)
+            put(t, " %s |", stages[k]);
+        put(t, " frame |\n|---|");
+        for (int k = 0; k <= ns; k++)
+            put(t, "---:|");
+        put(t, "\n");
+        for (size_t i = 0; i < count; i++) {
+            json_object *o = json_object_array_get_idx(runs, i);
+            if (strcmp(str(o, "status"), "ok"))
+                continue;
+            put(t, "| %s |", str(o, "run"));
+            for (int k = 0; k <= ns; k++) {
+                const char *k1 = k < ns ? "stages" : "frame_ms", *k2 = k < ns ? stages[k] : NULL;
+                double med = k < ns ? num(o, k1, k2, "median") : num(o, k1, "median", NULL);
+                double mn = k < ns ? num(o, k1, k2, "min") : num(o, k1, "min", NULL);
+                double mx = k < ns ? num(o, k1, k2, "max") : num(o, k1, "max", NULL);
+                if (med == med)
+                    put(t, " %.4g (%.4g – %.4g) |", med, mn, mx);
+                else
+                    put(t, " – |");
+            }
+            put(t, "\n");
+        }
+    }
+    put(t, "\nImages (tonemapped at the report's exposure) and relative error against the full reference "
+           "(log scale, colour bar in each map):\n\n");
+    const char *ref_png = str(meta, "reference_png");
+    if (*ref_png)
+        put(t, "reference: ![reference](%s)\n\n", ref_png);
+    for (size_t i = 0; i < count; i++) {
+        json_object *o = json_object_array_get_idx(runs, i);
+        if (*str(o, "png"))
+            put(t, "%s: ![%s](%s) ![error](%s)\n\n", str(o, "run"), str(o, "run"), str(o, "png"), str(o, "heatmap"));
     }
     json_object *charts;
     if (json_object_object_get_ex(meta, "charts", &charts)) {

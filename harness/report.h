@@ -5,7 +5,7 @@
  *
  * A run record (json object) has: run (id), scene, method, params, status
  * ("ok", "n/a", "failed"), reason, renderer, timer, frames, prepare_ms,
- * frame_ms {median, min, max}, stages {name: median_ms}, stats {...},
+ * frame_ms {median, min, max}, stages {name: {median, min, max}} (ms), stats {...},
  * metrics {"full": {...}, "matched": {...}} (metric name -> value), and
  * the file names image, png, heatmap (relative to the output directory). */
 #ifndef GIBENCH_REPORT_H

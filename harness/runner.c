@@ -168,7 +168,13 @@ static void take_timings(json_object *rec, json_object *t)
                     json_object_object_add(f, "max", json_object_get(mx));
                 json_object_object_add(rec, "frame_ms", f);
             } else {
-                json_object_object_add(stages, name, json_object_get(med));
+                json_object *sj = json_object_new_object();
+                json_object_object_add(sj, "median", json_object_get(med));
+                if (json_object_object_get_ex(st, "min_ms", &mn))
+                    json_object_object_add(sj, "min", json_object_get(mn));
+                if (json_object_object_get_ex(st, "max_ms", &mx))
+                    json_object_object_add(sj, "max", json_object_get(mx));
+                json_object_object_add(stages, name, sj);
             }
         }
     }
@@ -303,8 +309,8 @@ json_object *runner_execute(const run_spec *s, int resume)
 }
 
 int runner_reference(const char *scene, const char *camera, uint32_t width, uint32_t height, uint32_t spp,
-                     uint32_t max_bounces, uint32_t seed, float time, double timeout_s, const char *out_exr,
-                     char *why, size_t why_size)
+                     double target_se, uint32_t max_bounces, uint32_t seed, float time, double timeout_s,
+                     const char *out_exr, char *why, size_t why_size)
 {
     argv_builder b = {0};
     arg(&b, "%s", cli_self_exe());
@@ -321,6 +327,10 @@ int runner_reference(const char *scene, const char *camera, uint32_t width, uint
     arg(&b, "%s", size);
     arg(&b, "%s", "--spp");
     argu(&b, spp);
+    if (target_se > 0) {
+        arg(&b, "%s", "--target-se");
+        argf(&b, target_se);
+    }
     arg(&b, "%s", "--max-bounces");
     argu(&b, max_bounces);
     arg(&b, "%s", "--seed");
