@@ -7,20 +7,7 @@
 set(failures 0)
 set(CB ${SCENES}/cornell_box_coarse.gltf)
 
-# expect(<exit code> <substring of stdout or stderr> <args...>)
-function(expect code text)
-    execute_process(COMMAND ${GIB} ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-    string(STRIP "${err}" err_stripped)
-    string(FIND "${out}${err}" "${text}" pos)
-    string(REGEX MATCHALL "\n" newlines "${err_stripped}")
-    list(LENGTH newlines extra_lines)
-    if(NOT rc EQUAL code OR pos EQUAL -1 OR (NOT code EQUAL 0 AND extra_lines GREATER 0))
-        message(SEND_ERROR "gibench ${ARGN}: expected exit ${code} and '${text}' (one stderr line on failure);\n"
-                           "got exit ${rc}\nstdout: ${out}\nstderr: ${err}")
-        math(EXPR f "${failures} + 1")
-        set(failures ${f} PARENT_SCOPE)
-    endif()
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
 
 # expect_json(<file> <regex>...): the stats file matches every regex.
 function(expect_json file)

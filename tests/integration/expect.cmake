@@ -1,0 +1,19 @@
+# Shared helpers of the command-line tests (include()d by the *_test.cmake
+# and *_cli.cmake scripts). Each failure is reported with SEND_ERROR and
+# counted in the caller's `failures`.
+
+# expect(<exit code> <substring of stdout or stderr> <args...>): runs
+# gibench; on failure (code != 0) stderr must be exactly one line.
+function(expect code text)
+    execute_process(COMMAND ${GIB} ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    string(STRIP "${err}" err_stripped)
+    string(FIND "${out}${err}" "${text}" pos)
+    string(REGEX MATCHALL "\n" newlines "${err_stripped}")
+    list(LENGTH newlines extra_lines)
+    if(NOT rc EQUAL code OR pos EQUAL -1 OR (NOT code EQUAL 0 AND extra_lines GREATER 0))
+        message(SEND_ERROR "gibench ${ARGN}: expected exit ${code} and '${text}' (one stderr line on failure);\n"
+                           "got exit ${rc}\nstdout: ${out}\nstderr: ${err}")
+        math(EXPR f "${failures} + 1")
+        set(failures ${f} PARENT_SCOPE)
+    endif()
+endfunction()
