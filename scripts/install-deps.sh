@@ -14,6 +14,8 @@ pkgs=(
   libvtk9-dev fonts-dejavu-core
   libglfw3-dev libepoxy-dev
   libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libglx-mesa0
+  # An X server for headless tests of the GLFW viewer; the charts do not need it
+  # (VTK draws through EGL, see harness/charts.cpp).
   xvfb xauth
   libjson-c-dev libxxhash-dev
 )
