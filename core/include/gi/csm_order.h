@@ -11,14 +11,14 @@
  *             successive cells are always grid neighbours.
  *   HILBERT   the generalised Hilbert curve "gilbert" (J. Cervený 2019,
  *             github.com/jakubcerveny/gilbert) over the N_a x N_b rectangle,
- *             starting at (0, 0). On 2^k x 2^k squares it is the Hilbert
- *             curve, every step between grid neighbours. On other sizes it
- *             visits every cell exactly once with no skipped cells, and
- *             every step is between neighbours except, when the longer side
- *             is odd and the shorter even (e.g. 4 x 5, 32 x 33), at most one
- *             diagonal step (checked for all sizes up to 40 x 40 by the test).
- * Both directions are O(log(N_a N_b)) (HILBERT: it descends the same
- * recursive split as the generator), with no tables and no state.
+ *             starting at (0, 0). On 2^k x 2^k squares it is the classic
+ *             Hilbert curve (the d2xy of Hacker's Delight; tested). On other
+ *             sizes it visits every cell once with no skipped cells, and
+ *             every step is between grid neighbours except, when the longer
+ *             side is odd and the shorter even (4 x 5, 32 x 33), at most one
+ *             diagonal step (the test checks every size up to 40 x 40).
+ * Both directions are O(log(N_a N_b)) (HILBERT descends the same recursive
+ * split as the generator), with no tables and no state.
  */
 #ifndef GI_CSM_ORDER_H
 #define GI_CSM_ORDER_H
