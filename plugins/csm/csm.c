@@ -29,14 +29,6 @@ extern const gi_shader_source gi_csm_shaders[];
 
 enum { B_OBJECTS = 8, B_OFFSETS = 9, B_ZAVG = 10, B_IEND = 11, B_CELLS = 12, B_PATTERNS = 13 };
 
-/* std430 CsmObject of csm_query.glsl (160 bytes). */
-typedef struct csm_gpu_object {
-    float local_from_world[16];
-    float world_from_local[16];
-    float sphere[4];
-    uint32_t M, offsets_base, segments_base, bias_bits;
-} csm_gpu_object;
-
 typedef struct csm {
     const gi_host *host;
     int N, M, S, z3, filter;

@@ -43,6 +43,14 @@ gi_vec3 csm_project(const float sphere[4], float theta, float phi, gi_vec3 x);
 /* The depth renderer's view (local space) of that map. */
 void csm_map_view(const float sphere[4], float theta, float phi, gi_depth_view *out);
 
+/* std430 CsmObject of shaders/csm_query.glsl (160 bytes). */
+typedef struct csm_gpu_object {
+    float local_from_world[16];
+    float world_from_local[16];
+    float sphere[4];
+    uint32_t M, offsets_base, segments_base, bias_bits; /* bias in local units, as float bits */
+} csm_gpu_object;
+
 typedef struct csm_build_desc {
     uint32_t M;        /* map size */
     uint32_t n_theta, n_phi;

@@ -12,6 +12,7 @@
 // (texels), csm_filter (0 nearest, 1 pcf, 2 rr).
 #ifndef CSM_QUERY_GLSL
 #define CSM_QUERY_GLSL
+#include "rng.glsl"
 #include "csm_geom.glsl"
 
 struct CsmObject {
@@ -59,8 +60,9 @@ float csm_test(CsmObject o, uint a, uint b, ivec2 tex, float depth)
 }
 
 // Visibility of world point x (shading normal n, or vec3(0)) toward world
-// direction w through object k's CSM; u_rr in [0, 1) drives the RR filter.
-float csm_visibility_object(uint k, vec3 x, vec3 n, vec3 w, float u_rr)
+// direction w through object k's CSM with filter `mode` (0 nearest, 1 pcf,
+// 2 rr); u_rr in [0, 1) drives the RR filter.
+float csm_visibility_object(uint k, vec3 x, vec3 n, vec3 w, int mode, float u_rr)
 {
     CsmObject o = csm_objects[k];
     float M = float(o.info.x);
@@ -73,7 +75,7 @@ float csm_visibility_object(uint k, vec3 x, vec3 n, vec3 w, float u_rr)
     }
     vec2 g = csm_grid_coords(wl, csm_n_theta, csm_n_phi);
     int nphi = int(csm_n_phi), nth = int(csm_n_theta);
-    if (csm_filter == 0) {
+    if (mode == 0) {
         uint a = uint(int(floor(g.x + 0.5)) % nphi);
         uint b = uint(clamp(int(floor(g.y + 0.5)), 0, nth - 1));
         vec2 ang = csm_cell_angles(csm_n_theta, csm_n_phi, a, b);
@@ -89,7 +91,7 @@ float csm_visibility_object(uint k, vec3 x, vec3 n, vec3 w, float u_rr)
     int a0 = int(g0.x), b0 = int(g0.y);
     uint as[2] = uint[2](uint(((a0 % nphi) + nphi) % nphi), uint((((a0 + 1) % nphi) + nphi) % nphi));
     uint bs[2] = uint[2](uint(clamp(b0, 0, nth - 1)), uint(clamp(b0 + 1, 0, nth - 1)));
-    if (csm_filter == 2) {
+    if (mode == 2) {
         // Russian roulette: one of the 16 tests with probability = its weight,
         // chosen by four successive binary choices from one random number.
         float r = u_rr;
@@ -131,7 +133,7 @@ float csm_visibility(vec3 x, vec3 n, vec3 w, inout uint rng)
 {
     float v = 1.0;
     for (uint k = 0u; k < csm_object_count && v > 0.0; k++)
-        v *= csm_visibility_object(k, x, n, w, csm_filter == 2 ? gi_rng_next_float(rng) : 0.0);
+        v *= csm_visibility_object(k, x, n, w, csm_filter, csm_filter == 2 ? gi_rng_next_float(rng) : 0.0);
     return v;
 }
 
