@@ -24,7 +24,7 @@
 
 extern const gi_shader_source gi_csm_shaders[];
 
-#define CSM_FORMAT_VERSION 1u
+#define CSM_FORMAT_VERSION 2u
 #define CSM_PATTERNS 256u
 
 enum { B_OBJECTS = 8, B_OFFSETS = 9, B_ZAVG = 10, B_IEND = 11, B_CELLS = 12, B_PATTERNS = 13 };

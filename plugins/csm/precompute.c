@@ -75,10 +75,14 @@ gi_result csm_build_object(const gi_gpu_scene *gs, uint32_t object, const float 
                 goto done;
             }
             timer(host, "compress", 1);
-            const int second = desc->z3 ? 2 : 1;
+            /* z3 option: the third surface where there is one, else the
+             * second (the far side of the last shell), so that receivers of
+             * other objects behind this object stay shadowed (§4.6); a z3
+             * "none" taken as "nothing behind z1" would let the codec put
+             * z_avg far behind the object in runs mixing such texels. */
             for (size_t t = 0; t < (size_t)M * M; t++) {
                 z1[t] = map[4 * t];
-                z2[t] = map[4 * t + (size_t)second];
+                z2[t] = desc->z3 && map[4 * t + 2] < FLT_MAX ? map[4 * t + 2] : map[4 * t + 1];
             }
             free(map);
             r = gi_csm_codec_add_map(enc, first + k, z1, z2, err);
