@@ -1,0 +1,82 @@
+/* CPU side of the csm plugin (csm_cpu.h). */
+#include "csm_cpu.h"
+
+#include <math.h>
+
+void csm_cell_angles(uint32_t n_theta, uint32_t n_phi, uint32_t a, uint32_t b, float *theta, float *phi)
+{
+    *theta = GI_PI * ((float)b + 0.5f) / (float)n_theta;
+    *phi = 2.0f * GI_PI * ((float)a + 0.5f) / (float)n_phi;
+}
+
+gi_vec3 csm_dir(float theta, float phi)
+{
+    float st = sinf(theta);
+    return gi_v3(st * cosf(phi), cosf(theta), st * sinf(phi));
+}
+
+void csm_grid_coords(gi_vec3 w, uint32_t n_theta, uint32_t n_phi, float *u, float *v)
+{
+    float theta = atan2f(sqrtf(w.x * w.x + w.z * w.z), w.y);
+    float phi = atan2f(w.z, w.x);
+    if (phi < 0.0f)
+        phi += 2.0f * GI_PI;
+    *u = phi * (0.5f * GI_INV_PI) * (float)n_phi - 0.5f;
+    *v = theta * GI_INV_PI * (float)n_theta - 0.5f;
+}
+
+void csm_basis(float theta, float phi, gi_vec3 *t, gi_vec3 *b, gi_vec3 *d)
+{
+    *d = csm_dir(theta, phi);
+    *t = gi_v3(-sinf(phi), 0.0f, cosf(phi));
+    *b = gi_v3_cross(*d, *t);
+}
+
+gi_vec3 csm_project(const float sphere[4], float theta, float phi, gi_vec3 x)
+{
+    gi_vec3 t, b, d;
+    csm_basis(theta, phi, &t, &b, &d);
+    gi_vec3 p = gi_v3_sub(x, gi_v3(sphere[0], sphere[1], sphere[2]));
+    float R = sphere[3];
+    return gi_v3(gi_v3_dot(p, t) / R, gi_v3_dot(p, b) / R, CSM_EYE * R - gi_v3_dot(p, d));
+}
+
+void csm_map_view(const float sphere[4], float theta, float phi, gi_depth_view *out)
+{
+    gi_vec3 t, b, d;
+    csm_basis(theta, phi, &t, &b, &d);
+    float R = sphere[3];
+    gi_vec3 eye = gi_v3_add(gi_v3(sphere[0], sphere[1], sphere[2]), gi_v3_scale(d, CSM_EYE * R));
+    memset(out, 0, sizeof *out);
+    float *m = out->view; /* column-major, rows t, b, d */
+    m[0] = t.x, m[4] = t.y, m[8] = t.z, m[12] = -gi_v3_dot(t, eye);
+    m[1] = b.x, m[5] = b.y, m[9] = b.z, m[13] = -gi_v3_dot(b, eye);
+    m[2] = d.x, m[6] = d.y, m[10] = d.z, m[14] = -gi_v3_dot(d, eye);
+    m[15] = 1.0f;
+    /* Everything of the object lies at eye depths in [(EYE-1) R, (EYE+1) R]. */
+    gi_mat4_ortho(out->proj, -R, R, -R, R, 0.5f * (CSM_EYE - 1.0f) * R, (CSM_EYE + 1.5f) * R);
+    out->projection = GI_PROJ_ORTHOGRAPHIC;
+}
+
+int csm_visible_nearest(const gi_csm_data *data, const float sphere[4], uint32_t n_theta, uint32_t n_phi,
+                        gi_csm_order order, gi_vec3 x, gi_vec3 w, float bias)
+{
+    float u, v;
+    csm_grid_coords(w, n_theta, n_phi, &u, &v);
+    uint32_t a = (uint32_t)floorf(u + 0.5f) % n_phi;
+    int bi = (int)floorf(v + 0.5f);
+    uint32_t b = (uint32_t)(bi < 0 ? 0 : bi >= (int)n_theta ? (int)n_theta - 1 : bi);
+    float theta, phi;
+    csm_cell_angles(n_theta, n_phi, a, b, &theta, &phi);
+    gi_vec3 p = csm_project(sphere, theta, phi, x);
+    if (!(fabsf(p.x) < 1.0f && fabsf(p.y) < 1.0f))
+        return 1;
+    uint32_t M = data->M;
+    uint32_t tx = (uint32_t)((p.x * 0.5f + 0.5f) * (float)M), ty = (uint32_t)((p.y * 0.5f + 0.5f) * (float)M);
+    if (tx >= M)
+        tx = M - 1;
+    if (ty >= M)
+        ty = M - 1;
+    uint32_t i = gi_csm_order_index(order, n_phi, n_theta, a, b);
+    return gi_csm_visible(data, ty * M + tx, i, p.z, bias);
+}

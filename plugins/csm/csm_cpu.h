@@ -1,0 +1,74 @@
+/* CPU side of the csm plugin: the direction parameterisation, the map
+ * basis and projection (GLSL twin: shaders/csm_geom.glsl, held equal by
+ * tests/integration/csm_twins.c), the precomputation of one object's
+ * Coherent Shadow Map (precompute.c) and the nearest-filter query on the
+ * decoded data (for tests).
+ *
+ * Directions (§4.1, d = 2, the full sphere), in the object's local frame:
+ *   d(theta, phi) = (sin theta cos phi, cos theta, sin theta sin phi),
+ *   theta in [0, pi] from +Y, phi in [0, 2 pi) from +X toward +Z.
+ * Grid: N_theta x N_phi cells, cell (a, b) (a along phi, b along theta) has
+ * its centre at phi = 2 pi (a + 1/2) / N_phi, theta = pi (b + 1/2) / N_theta.
+ * A direction's continuous grid coordinates are
+ *   u = phi / (2 pi) N_phi - 1/2,  v = theta / pi N_theta - 1/2,
+ * so the nearest cell is (round(u) mod N_phi, clamp(round(v))).
+ * The enumeration (csm_order.h) runs over the N_phi x N_theta grid with
+ * na = N_phi, nb = N_theta.
+ *
+ * Map of cell (theta, phi): orthographic, looking along -d from the eye
+ * c + CSM_EYE R d (sphere centre c, radius R), basis
+ *   t = (-sin phi, 0, cos phi),  b = d x t,  (t, b, d) right-handed,
+ * footprint [-R, R]^2, so a local point x maps to
+ *   sx = (x - c).t / R, sy = (x - c).b / R  (in [-1, 1] inside the map),
+ *   depth = CSM_EYE R - (x - c).d           (the depth renderer's eye z),
+ * texel (floor((sx/2 + 1/2) M), floor((sy/2 + 1/2) M)), row 0 at sy = -1. */
+#ifndef CSM_CPU_H
+#define CSM_CPU_H
+
+#include "gi/csm_codec.h"
+#include "gi/csm_order.h"
+#include "gi/method.h"
+#include "gi/passes.h"
+#include "gi/vecmath.h"
+
+#define CSM_EYE 2.0f
+
+void csm_cell_angles(uint32_t n_theta, uint32_t n_phi, uint32_t a, uint32_t b, float *theta, float *phi);
+gi_vec3 csm_dir(float theta, float phi);
+/* Continuous grid coordinates (u along phi, v along theta) of unit w. */
+void csm_grid_coords(gi_vec3 w, uint32_t n_theta, uint32_t n_phi, float *u, float *v);
+void csm_basis(float theta, float phi, gi_vec3 *t, gi_vec3 *b, gi_vec3 *d);
+/* (sx, sy, depth) of local point x in the map of (theta, phi). */
+gi_vec3 csm_project(const float sphere[4], float theta, float phi, gi_vec3 x);
+/* The depth renderer's view (local space) of that map. */
+void csm_map_view(const float sphere[4], float theta, float phi, gi_depth_view *out);
+
+/* std430 CsmObject of shaders/csm_query.glsl (160 bytes). */
+typedef struct csm_gpu_object {
+    float local_from_world[16];
+    float world_from_local[16];
+    float sphere[4];
+    uint32_t M, offsets_base, segments_base, bias_bits; /* bias in local units, as float bits */
+} csm_gpu_object;
+
+typedef struct csm_build_desc {
+    uint32_t M;        /* map size */
+    uint32_t n_theta, n_phi;
+    gi_csm_order order;
+    int z3;            /* 1: the third surface as the codec's second (§3.1) */
+    uint32_t batch;    /* maps per gi_depth_render call */
+} csm_build_desc;
+
+/* Renders and compresses the N_theta N_phi maps of `object` (local space,
+ * bounding sphere `sphere`). `host` may be NULL (tests); with a host it
+ * reports progress (fraction p0 + p1 * done), stage timers depth_render and
+ * compress, and returns GI_ERR_CANCELLED when host->cancelled(). */
+gi_result csm_build_object(const gi_gpu_scene *gs, uint32_t object, const float sphere[4], const csm_build_desc *desc,
+                           const gi_host *host, float p0, float p1, gi_csm_data *out, gi_error *err);
+
+/* Nearest-filter visibility (1 lit, 0 shadowed) of local point x toward
+ * local unit direction w through one object's CSM; bias in local units. */
+int csm_visible_nearest(const gi_csm_data *data, const float sphere[4], uint32_t n_theta, uint32_t n_phi,
+                        gi_csm_order order, gi_vec3 x, gi_vec3 w, float bias);
+
+#endif

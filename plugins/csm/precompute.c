@@ -1,0 +1,108 @@
+/* Precomputation of one object's Coherent Shadow Map (§3.1, §4.1): the
+ * N_theta x N_phi orthographic dual-depth maps around its bounding sphere,
+ * rendered in batches by the core's depth renderer (object-local, only this
+ * object, eye-z), read back and streamed into the core's codec in the
+ * chosen enumeration order. */
+#include "csm_cpu.h"
+
+#include <float.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+static void timer(const gi_host *host, const char *name, int begin)
+{
+    if (!host)
+        return;
+    if (begin)
+        host->stage_begin(host, name);
+    else
+        host->stage_end(host, name);
+}
+
+gi_result csm_build_object(const gi_gpu_scene *gs, uint32_t object, const float sphere[4], const csm_build_desc *desc,
+                           const gi_host *host, float p0, float p1, gi_csm_data *out, gi_error *err)
+{
+    memset(out, 0, sizeof *out);
+    const uint32_t M = desc->M, N = desc->n_theta * desc->n_phi;
+    const uint32_t batch = desc->batch ? desc->batch : 16;
+    gi_depth_desc dd = {.size = M,
+                        .surfaces = desc->z3 ? 3u : 2u,
+                        .metric = GI_DEPTH_EYE_Z,
+                        .object = (int)object,
+                        .local = 1,
+                        .cull = 0};
+    gi_depth_renderer *dr = gi_depth_renderer_create(&dd, err);
+    if (!dr)
+        return GI_ERR_GL;
+    GLuint tex = gi_depth_texture_create(dr, batch);
+    gi_depth_view *views = calloc(batch, sizeof *views);
+    float *z1 = malloc((size_t)M * M * sizeof *z1), *z2 = malloc((size_t)M * M * sizeof *z2);
+    gi_csm_codec *enc = NULL;
+    gi_result r = GI_ERR_OUT_OF_MEMORY;
+    if (!views || !z1 || !z2) {
+        snprintf(err->text, sizeof err->text, "csm: out of memory for %u x %u maps", M, M);
+        goto done;
+    }
+    r = gi_csm_codec_begin(M, N, &enc, err);
+    if (r != GI_OK)
+        goto done;
+    for (uint32_t first = 0; first < N; first += batch) {
+        if (host && host->cancelled(host)) {
+            r = GI_ERR_CANCELLED;
+            snprintf(err->text, sizeof err->text, "csm: precomputation cancelled");
+            goto done;
+        }
+        uint32_t count = N - first < batch ? N - first : batch;
+        for (uint32_t k = 0; k < count; k++) {
+            uint32_t a, b;
+            float theta, phi;
+            gi_csm_order_cell(desc->order, desc->n_phi, desc->n_theta, first + k, &a, &b);
+            csm_cell_angles(desc->n_theta, desc->n_phi, a, b, &theta, &phi);
+            csm_map_view(sphere, theta, phi, &views[k]);
+        }
+        timer(host, "depth_render", 1);
+        r = gi_depth_render(dr, gs, views, count, tex, 0, err);
+        timer(host, "depth_render", 0);
+        if (r != GI_OK)
+            goto done;
+        for (uint32_t k = 0; k < count; k++) {
+            timer(host, "depth_render", 1);
+            float *map = gi_depth_read_layer(tex, M, k);
+            timer(host, "depth_render", 0);
+            if (!map) {
+                r = GI_ERR_OUT_OF_MEMORY;
+                snprintf(err->text, sizeof err->text, "csm: reading depth map %u failed", first + k);
+                goto done;
+            }
+            timer(host, "compress", 1);
+            /* z3 option: the third surface where there is one, else the
+             * second (the far side of the last shell), so that receivers of
+             * other objects behind this object stay shadowed (§4.6); a z3
+             * "none" taken as "nothing behind z1" would let the codec put
+             * z_avg far behind the object in runs mixing such texels. */
+            for (size_t t = 0; t < (size_t)M * M; t++) {
+                z1[t] = map[4 * t];
+                z2[t] = desc->z3 && map[4 * t + 2] < FLT_MAX ? map[4 * t + 2] : map[4 * t + 1];
+            }
+            free(map);
+            r = gi_csm_codec_add_map(enc, first + k, z1, z2, err);
+            timer(host, "compress", 0);
+            if (r != GI_OK)
+                goto done;
+        }
+        if (host)
+            host->progress(host, "csm: depth maps", p0 + p1 * (float)(first + count) / (float)N);
+    }
+    timer(host, "compress", 1);
+    r = gi_csm_codec_finish(enc, out, err);
+    timer(host, "compress", 0);
+    enc = NULL;
+done:
+    gi_csm_codec_free(enc);
+    free(views);
+    free(z1);
+    free(z2);
+    glDeleteTextures(1, &tex);
+    gi_depth_renderer_free(dr);
+    return r;
+}

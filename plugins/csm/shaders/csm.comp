@@ -1,0 +1,118 @@
+// Coherent Shadow Maps, distant light (environment map), §5: per G-buffer
+// pixel S samples of the environment, visibility from the CSMs of all
+// objects, progressive average over frames (plugins/csm/csm.c).
+#include "scene.glsl"
+#include "brdf.glsl"
+#include "sampling.glsl"
+#include "rng.glsl"
+#include "envmap.glsl"
+#include "csm_query.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(binding = 8) uniform sampler2D g_position;
+layout(binding = 9) uniform sampler2D g_normal;
+layout(binding = 10) uniform sampler2D g_albedo;
+layout(binding = 11) uniform sampler2D g_phong;
+layout(binding = 12) uniform sampler2D g_emission;
+layout(rgba32f, binding = 0) uniform image2D u_accum;
+layout(rgba32f, binding = 1) uniform writeonly image2D u_target;
+
+// 256 stratified patterns of S points in the unit square (§5.1).
+layout(std430, binding = 13) readonly buffer CsmPatterns { vec2 csm_patterns[]; };
+
+uniform vec3 u_eye;
+uniform mat4 u_inv_view_proj;
+uniform ivec2 u_size;
+uniform uint u_frame; // frames already in the average
+uniform uint u_seed;
+uniform int u_S;
+
+// §5.1: diffuse surfaces draw from the environment's radiance CDF, specular
+// ones from the Phong lobe; a surface with both picks the lobe by Russian
+// roulette on lum(k_s) / (lum(k_d) + lum(k_s)). Each lobe is estimated by
+// its own strategy (f_lobe L cos V / (P_lobe pdf)).
+vec3 environment(gi_brdf b, vec3 x, vec3 N, vec3 wo, uint pattern, vec2 cp, inout uint rng)
+{
+    float p_spec = gi_brdf_spec_prob(b);
+    gi_brdf bd = b, bs = b;
+    bd.ks = vec3(0.0);
+    bs.kd = vec3(0.0);
+    vec3 sum = vec3(0.0);
+    for (int s = 0; s < u_S; s++) {
+        vec2 u = fract(csm_patterns[pattern * uint(u_S) + uint(s)] + cp);
+        bool spec = gi_rng_next_float(rng) < p_spec;
+        vec3 w;
+        vec3 c;
+        if (spec) {
+            if (gi_brdf_is_mirror(b)) {
+                w = gi_reflect(wo, N);
+                if (dot(N, w) <= 0.0)
+                    continue;
+                c = b.ks / p_spec;
+            } else {
+                vec3 r = gi_reflect(wo, N);
+                w = gi_phong_lobe_sample(r, b.n, u.x, u.y);
+                float pdf = gi_phong_lobe_pdf(r, b.n, w);
+                float cw = dot(N, w);
+                if (pdf <= 0.0 || cw <= 0.0)
+                    continue;
+                c = gi_brdf_eval(bs, N, wo, w) * cw / (pdf * p_spec);
+            }
+        } else {
+            float pdf = gi_envmap_sample(u.x, u.y, w);
+            float cw = dot(N, w);
+            if (pdf <= 0.0 || cw <= 0.0)
+                continue;
+            c = gi_brdf_eval(bd, N, wo, w) * cw / (pdf * (1.0 - p_spec));
+        }
+        if (all(equal(c, vec3(0.0))))
+            continue;
+        float v = csm_visibility(x, N, w, rng);
+        if (v > 0.0)
+            sum += c * v * gi_envmap_eval(w);
+    }
+    return sum / float(u_S);
+}
+
+void main()
+{
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(px, u_size)))
+        return;
+    vec4 P = texelFetch(g_position, px, 0);
+    vec3 L = vec3(0.0);
+    vec3 wo = normalize(u_eye - P.xyz);
+    if (P.w > 0.0) {
+        vec3 x = P.xyz;
+        vec3 N = normalize(texelFetch(g_normal, px, 0).xyz);
+        vec4 alb = texelFetch(g_albedo, px, 0);
+        vec4 ph = texelFetch(g_phong, px, 0);
+        gi_brdf b;
+        b.kd = alb.rgb;
+        b.ks = ph.rgb;
+        b.n = ph.a;
+        b.mirror = alb.a > 0.5 ? 1 : 0;
+        uint pix = uint(px.y * u_size.x + px.x);
+        uint rng = gi_rng_init(pix, u_frame, u_seed);
+        // Pattern from the pixel and the frame through a hash (§5.1), with a
+        // per-pixel-and-frame Cranley-Patterson shift so that the running
+        // average converges to the integral, not to 256 fixed point sets.
+        uint pattern = gi_pcg_hash(pix ^ gi_pcg_hash(u_frame * 0x9E3779B9u + u_seed)) & 255u;
+        vec2 cp = vec2(gi_rng_next_float(rng), gi_rng_next_float(rng));
+        L = texelFetch(g_emission, px, 0).rgb;
+        if (gi_has_environment())
+            L += environment(b, x, N, wo, pattern, cp, rng);
+    } else if (gi_has_environment()) {
+        vec2 ndc = (vec2(px) + 0.5) / vec2(u_size) * 2.0 - 1.0;
+        vec4 far_point = u_inv_view_proj * vec4(ndc, 1.0, 1.0);
+        L = gi_envmap_eval(normalize(far_point.xyz / far_point.w - u_eye));
+    }
+    vec3 avg = L;
+    if (u_frame > 0u) {
+        vec3 prev = imageLoad(u_accum, px).rgb;
+        avg = prev + (L - prev) / float(u_frame + 1u);
+    }
+    imageStore(u_accum, px, vec4(avg, 1.0));
+    imageStore(u_target, px, vec4(avg, 1.0));
+}
