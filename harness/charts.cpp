@@ -62,6 +62,7 @@
 #include <unistd.h>
 
 #include "charts.h"
+#include "gi/cache.h"
 #include "gi/log.h"
 
 namespace
@@ -668,35 +669,22 @@ gi_result validate(const gi_chart_desc &d, const gi_chart_series *series, uint32
     return GI_OK;
 }
 
-/* Writes to a fresh temporary file beside `path` and renames it into place;
- * the temporary file goes on any failure. */
+/* Writes to a fresh temporary file beside `path` and renames it into place
+ * (core cache.h: gi_atomic_begin/commit); the temporary file goes on any
+ * failure. */
 gi_result write_png(const char *path, const gi_chart_desc &d, const gi_chart_series *series,
                     uint32_t n, gi_error *err)
 {
-    std::string p(path);
-    size_t slash = p.find_last_of('/');
-    std::string dir = slash == std::string::npos ? std::string() : p.substr(0, slash + 1);
-    std::string base = slash == std::string::npos ? p : p.substr(slash + 1);
-    std::string tmpl = dir + "." + base.substr(0, base.size() - 4) + ".tmp-" +
-                       std::to_string(static_cast<long>(getpid())) + "-XXXXXX.png";
-    std::vector<char> tmp(tmpl.begin(), tmpl.end());
-    tmp.push_back('\0');
-    int fd = mkstemps(tmp.data(), 4);
-    if (fd < 0)
-        return gi_error_set(err, GI_ERR_IO, "%s: %s", path, strerror(errno));
-    close(fd);
-    gi_result r = render(d, series, n, tmp.data(), err, path);
-    if (r == GI_OK) {
-        /* mkstemps made it 0600; give it the mode a plain fopen would. */
-        mode_t mask = umask(0);
-        umask(mask);
-        (void)chmod(tmp.data(), 0666 & ~mask);
-        if (rename(tmp.data(), path) != 0)
-            r = gi_error_set(err, GI_ERR_IO, "%s: %s", path, strerror(errno));
-    }
+    gi_atomic_file f;
+    gi_result r = gi_atomic_begin(&f, path, err);
     if (r != GI_OK)
-        unlink(tmp.data());
-    return r;
+        return r;
+    r = render(d, series, n, f.tmp, err, path);
+    if (r != GI_OK) {
+        gi_atomic_commit(&f, 0, nullptr);
+        return r;
+    }
+    return gi_atomic_commit(&f, 1, err);
 }
 
 } // namespace

@@ -5,6 +5,7 @@
  * never sees half an entry and an interrupted study leaves no torn files).
  */
 #define _XOPEN_SOURCE 700
+#define _DEFAULT_SOURCE /* mkstemps */
 
 #include "gi/cache.h"
 
@@ -191,42 +192,68 @@ static void sync_directory_of(const char *path)
     free(dir);
 }
 
+gi_result gi_atomic_begin(gi_atomic_file *f, const char *path, gi_error *err)
+{
+    assert(f && path);
+    if (strlen(path) >= sizeof f->path)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%.200s...: path too long", path);
+    snprintf(f->path, sizeof f->path, "%s", path);
+    const char *slash = strrchr(path, '/');
+    const char *base = slash ? slash + 1 : path;
+    const char *dot = strrchr(base, '.');
+    size_t dir_len = (size_t)(base - path), stem_len = dot && dot != base ? (size_t)(dot - base) : strlen(base);
+    const char *ext = dot && dot != base ? dot : "";
+    snprintf(f->tmp, sizeof f->tmp, "%.*s.%.*s.tmp-%ld-XXXXXX%s", (int)dir_len, path, (int)stem_len, base,
+             (long)getpid(), ext);
+    int fd = mkstemps(f->tmp, (int)strlen(ext));
+    if (fd < 0)
+        return gi_error_set(err, GI_ERR_IO, "%s: cannot create a temporary file: %s", path, strerror(errno));
+    close(fd);
+    return GI_OK;
+}
+
+gi_result gi_atomic_commit(gi_atomic_file *f, int ok, gi_error *err)
+{
+    if (ok) {
+        /* mkstemps made it 0600; results are meant to be shared like any new file. */
+        mode_t mask = umask(0);
+        umask(mask);
+        if (chmod(f->tmp, 0666 & ~mask) == 0 && rename(f->tmp, f->path) == 0) {
+            sync_directory_of(f->path);
+            return GI_OK;
+        }
+        int e = errno;
+        unlink(f->tmp);
+        return gi_error_set(err, GI_ERR_IO, "%s: cannot move the temporary file into place: %s", f->path,
+                            strerror(e));
+    }
+    unlink(f->tmp);
+    return GI_OK;
+}
+
 gi_result gi_file_write_atomic(const char *path, const void *data, size_t size, gi_error *err)
 {
     assert(path && (data || size == 0));
-    char *tmp = malloc(strlen(path) + 16);
-    if (!tmp)
-        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
-    sprintf(tmp, "%s.tmp.XXXXXX", path);
-    int fd = mkstemp(tmp);
-    if (fd < 0) {
-        gi_result r = gi_error_set(err, GI_ERR_IO, "%s: cannot create a temporary file: %s", path,
-                                   strerror(errno));
-        free(tmp);
+    gi_atomic_file f;
+    gi_result r = gi_atomic_begin(&f, path, err);
+    if (r != GI_OK)
         return r;
-    }
     const char *what = NULL;
-    if (fchmod(fd, 0644) != 0)
-        what = "chmod";
+    int fd = open(f.tmp, O_WRONLY | O_TRUNC | O_CLOEXEC);
+    if (fd < 0)
+        what = "open";
     else if (write_all(fd, data, size) != 0)
         what = "write";
     else if (fsync(fd) != 0)
         what = "fsync";
     int e = errno;
-    if (close(fd) != 0 && !what) {
+    if (fd >= 0 && close(fd) != 0 && !what) {
         what = "close";
         e = errno;
     }
-    if (!what && rename(tmp, path) != 0) {
-        what = "rename";
-        e = errno;
-    }
     if (what) {
-        unlink(tmp);
-        free(tmp);
+        gi_atomic_commit(&f, 0, NULL);
         return gi_error_set(err, GI_ERR_IO, "%s: %s failed: %s", path, what, strerror(e));
     }
-    free(tmp);
-    sync_directory_of(path);
-    return GI_OK;
+    return gi_atomic_commit(&f, 1, err);
 }

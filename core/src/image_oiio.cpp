@@ -22,6 +22,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "gi/cache.h"
 #include "gi/image.h"
 #include "gi/tonemap.h"
 
@@ -63,32 +64,20 @@ std::string lower(std::string s)
     return s;
 }
 
-/* Runs `write(tmp_path)` against a fresh temporary file beside `path`, then
- * renames it over `path`. The temporary file is removed on any failure. */
+/* Runs `write(tmp_path)` against a fresh temporary file beside `path`
+ * (core cache.h: gi_atomic_begin/commit), then renames it over `path`. The
+ * temporary file is removed on any failure. */
 template <typename Write>
 gi_result write_atomically(const std::string &path, const std::string &ext, gi_error *err,
                            Write write)
 {
-    size_t slash = path.find_last_of('/');
-    std::string dir = slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
-    std::string base = slash == std::string::npos ? path : path.substr(slash + 1);
-    std::string stem = base.substr(0, base.size() - ext.size());
-    std::string tmpl =
-        dir + "." + stem + ".tmp-" + std::to_string((long)getpid()) + "-XXXXXX" + ext;
-    std::vector<char> name(tmpl.begin(), tmpl.end());
-    name.push_back('\0');
-    int fd = mkstemps(name.data(), (int)ext.size());
-    if (fd < 0)
-        return gi_error_set(err, GI_ERR_IO, "%s: cannot create a temporary file: %s", path.c_str(),
-                            std::strerror(errno));
-    /* mkstemps makes the file 0600; results are meant to be shared. A
-     * failure is not fatal: the file is still right, only less readable. */
-    (void)fchmod(fd, 0644);
-    close(fd);
-    std::string tmp(name.data());
-    gi_result r = GI_ERR_IO;
+    (void)ext; /* gi_atomic_begin keeps the extension last by itself */
+    gi_atomic_file f;
+    gi_result r = gi_atomic_begin(&f, path.c_str(), err);
+    if (r != GI_OK)
+        return r;
     try {
-        r = write(tmp);
+        r = write(std::string(f.tmp));
     } catch (const std::bad_alloc &) {
         r = gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "%s: out of memory", path.c_str());
     } catch (const std::exception &e) {
@@ -96,15 +85,13 @@ gi_result write_atomically(const std::string &path, const std::string &ext, gi_e
     } catch (...) {
         r = gi_error_set(err, GI_ERR_IO, "%s: unknown exception while writing", path.c_str());
     }
-    if (r == GI_OK && std::rename(tmp.c_str(), path.c_str()) != 0)
-        r = gi_error_set(err, GI_ERR_IO, "%s: cannot rename the temporary file into place: %s",
-                         path.c_str(), std::strerror(errno));
-    if (r != GI_OK)
-        std::remove(tmp.c_str());
-    return r;
+    if (r != GI_OK) {
+        gi_atomic_commit(&f, 0, nullptr);
+        return r;
+    }
+    return gi_atomic_commit(&f, 1, err);
 }
 
-/* Writes interleaved float pixels through OIIO (EXR, PNG via uint8). */
 gi_result write_oiio(const std::string &path, const std::string &tmp, const OIIO::ImageSpec &spec,
                      OIIO::TypeDesc data_type, const void *data, gi_error *err)
 {

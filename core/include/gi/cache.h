@@ -28,6 +28,20 @@ char *gi_cache_path(const char *dir, const char *name);
 void *gi_file_read_all(const char *path, size_t *size);
 gi_result gi_file_write_atomic(const char *path, const void *data, size_t size, gi_error *err);
 
+/* Atomic replacement for writers that open the file by name themselves
+ * (OpenImageIO, VTK). gi_atomic_begin creates an empty temporary file beside
+ * `path`, named ".<stem>.tmp-<pid>-XXXXXX<ext>" so that the real extension
+ * (which picks the format) stays last; the caller writes f.tmp; then
+ * gi_atomic_commit(&f, 1, err) gives it a new file's mode (0666 & ~umask)
+ * and renames it over `path`, or gi_atomic_commit(&f, 0, err) removes it.
+ * Every successful begin must be followed by exactly one commit. */
+typedef struct gi_atomic_file {
+    char path[4096];
+    char tmp[4096 + 64];
+} gi_atomic_file;
+gi_result gi_atomic_begin(gi_atomic_file *f, const char *path, gi_error *err);
+gi_result gi_atomic_commit(gi_atomic_file *f, int ok, gi_error *err);
+
 #ifdef __cplusplus
 }
 #endif
