@@ -12,19 +12,8 @@ file(MAKE_DIRECTORY ${cache})
 set(ENV{GIBENCH_CACHE} ${cache})
 set(args render --scene ${SCENES}/bunny_env.glb --method csm --size 48x48 --frames 2 --param N=8 --param M=64)
 
-function(check_json file what)
-    file(READ ${file} j)
-    foreach(pattern ${ARGN})
-        if(NOT j MATCHES "${pattern}")
-            message(SEND_ERROR "${what}: '${pattern}' not in ${file}")
-            math(EXPR f "${failures} + 1")
-            set(failures ${f} PARENT_SCOPE)
-        endif()
-    endforeach()
-endfunction()
-
 expect(0 "" ${args} --out ${OUT}/csm_bunny_1.exr --timings ${OUT}/csm_bunny_1.json)
-check_json(${OUT}/csm_bunny_1.json "first run" "\"nonfinite_pixels\": 0" "\"cache_hit\": 0" "\"segments_per_texel\""
+expect_json(${OUT}/csm_bunny_1.json "\"nonfinite_pixels\": 0" "\"cache_hit\": 0" "\"segments_per_texel\""
            "\"maps\": 128" "\"depth_render\"" "\"compress\"" "\"upload\"")
 file(GLOB cached ${cache}/csm-*.bin)
 list(LENGTH cached n_cached)
@@ -33,23 +22,23 @@ if(NOT n_cached EQUAL 2)
     math(EXPR failures "${failures} + 1")
 endif()
 expect(0 "" ${args} --out ${OUT}/csm_bunny_2.exr --timings ${OUT}/csm_bunny_2.json)
-check_json(${OUT}/csm_bunny_2.json "second run" "\"nonfinite_pixels\": 0" "\"cache_hit\": 1")
+expect_json(${OUT}/csm_bunny_2.json "\"nonfinite_pixels\": 0" "\"cache_hit\": 1")
 
 # A damaged cache file: a warning naming it, recomputed, and rewritten.
 list(GET cached 0 victim)
 file(WRITE ${victim} "GICSMZ this is not a CSM")
 expect(0 "unusable cache file" ${args} --out ${OUT}/csm_bunny_3.exr --timings ${OUT}/csm_bunny_3.json)
-check_json(${OUT}/csm_bunny_3.json "damaged cache" "\"nonfinite_pixels\": 0" "\"cache_hit\": 0")
+expect_json(${OUT}/csm_bunny_3.json "\"nonfinite_pixels\": 0" "\"cache_hit\": 0")
 expect(0 "" ${args} --out ${OUT}/csm_bunny_4.exr --timings ${OUT}/csm_bunny_4.json)
-check_json(${OUT}/csm_bunny_4.json "rewritten cache" "\"cache_hit\": 1")
+expect_json(${OUT}/csm_bunny_4.json "\"cache_hit\": 1")
 
 # Other options run and stay finite.
 expect(0 "" ${args} --param filter=pcf --param depth=z3 --param enumeration=zigzag --param S=5
        --out ${OUT}/csm_bunny_pcf.exr --timings ${OUT}/csm_bunny_pcf.json)
-check_json(${OUT}/csm_bunny_pcf.json "pcf/z3" "\"nonfinite_pixels\": 0")
+expect_json(${OUT}/csm_bunny_pcf.json "\"nonfinite_pixels\": 0")
 expect(0 "" ${args} --param filter=rr --param enumeration=scanline --out ${OUT}/csm_bunny_rr.exr
        --timings ${OUT}/csm_bunny_rr.json)
-check_json(${OUT}/csm_bunny_rr.json "rr" "\"nonfinite_pixels\": 0")
+expect_json(${OUT}/csm_bunny_rr.json "\"nonfinite_pixels\": 0")
 
 # Bad parameters.
 expect(2 "csm: N=1 is outside" ${args} --param N=1 --out ${OUT}/x.exr)

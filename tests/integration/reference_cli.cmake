@@ -9,17 +9,6 @@ set(CB ${SCENES}/cornell_box_coarse.gltf)
 
 include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
 
-# expect_json(<file> <regex>...): the stats file matches every regex.
-function(expect_json file)
-    file(READ ${file} j)
-    foreach(re ${ARGN})
-        if(NOT j MATCHES "${re}")
-            message(SEND_ERROR "${file}: no match for '${re}' in\n${j}")
-            math(EXPR f "${failures} + 1")
-            set(failures ${f} PARENT_SCOPE)
-        endif()
-    endforeach()
-endfunction()
 
 function(expect_same a b)
     execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${a} ${b} RESULT_VARIABLE rc)
