@@ -227,6 +227,14 @@ int cli_write_json(const char *path, json_object *obj, char *why, size_t why_siz
     return ok;
 }
 
+int cli_save_json(const char *path, json_object *obj)
+{
+    char why[GI_ERROR_MAX];
+    int ok = cli_write_json(path, obj, why, sizeof why);
+    json_object_put(obj);
+    return ok ? EXIT_OK : cli_fail(EXIT_RUN, "%s", why);
+}
+
 json_object *cli_timer_json(const gi_timer *t)
 {
     json_object *o = json_object_new_object();

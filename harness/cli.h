@@ -50,6 +50,9 @@ void cli_host_free(cli_host *h);
 extern volatile sig_atomic_t cli_interrupted;
 void cli_install_signal_handlers(void);
 
+/* Writes `obj` to `path` atomically, releases it, and returns EXIT_OK or
+ * EXIT_RUN after printing why (the end of render and reference). */
+int cli_save_json(const char *path, json_object *obj);
 /* Writes a JSON object to a file atomically (pretty-printed). */
 int cli_write_json(const char *path, json_object *obj, char *why, size_t why_size);
 /* Stage statistics of a timer as a JSON object {stage: {median_ms, ...}}. */

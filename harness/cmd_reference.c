@@ -6,6 +6,7 @@
 
 #include "reference.h"
 
+#include "gi/timer.h"
 #include "gi/image.h"
 #include "gi/log.h"
 #include "gi/scene.h"
@@ -34,13 +35,6 @@ typedef struct ref_opts {
     float scene_time, exposure;
     gi_ref_strategy strategy;
 } ref_opts;
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static int image_ext_ok(const char *path)
 {
@@ -261,7 +255,7 @@ static json_object *stats_json(const run_state *r, const ref_opts *o, int camera
 
 static int run(run_state *r, const ref_opts *o)
 {
-    double t_start = now_seconds();
+    double t_start = gi_now();
     gi_error err;
     r->scene = gi_scene_load(o->scene, &err);
     if (!r->scene)
@@ -292,7 +286,7 @@ static int run(run_state *r, const ref_opts *o)
         return cli_fail(res == GI_ERR_INVALID_ARGUMENT ? EXIT_USAGE : EXIT_RUN, "%s", err.text);
 
     progress bar = {isatty(STDERR_FILENO) && gi_log_get_level() >= GI_LOG_WARN};
-    const double t_render = now_seconds();
+    const double t_render = gi_now();
     double se = INFINITY, per_spp = 0.0; /* seconds a sample per pixel takes */
     uint64_t se_spp = 0;
     const char *stop = NULL;
@@ -301,7 +295,7 @@ static int run(run_state *r, const ref_opts *o)
         checkpoint = o->spp;
     while (!stop) {
         uint64_t spp = gi_ref_spp(r->ref);
-        double elapsed = now_seconds() - t_render;
+        double elapsed = gi_now() - t_render;
         /* Pass size: about PASS_SECONDS of work, never past the checkpoint
          * or the sample limit, nor (much) past the time budget. */
         double budget = PASS_SECONDS;
@@ -313,15 +307,15 @@ static int run(run_state *r, const ref_opts *o)
             k = checkpoint - spp;
         if (k > 0xFFFFFFFFull - spp)
             k = 0xFFFFFFFFull - spp;
-        double t0 = now_seconds();
+        double t0 = gi_now();
         res = gi_ref_render(r->ref, (uint32_t)k, &err);
         if (res != GI_OK) {
             progress_end(&bar);
             return cli_fail(EXIT_RUN, "%s", err.text);
         }
-        per_spp = (now_seconds() - t0) / (double)k;
+        per_spp = (gi_now() - t0) / (double)k;
         spp = gi_ref_spp(r->ref);
-        elapsed = now_seconds() - t_render;
+        elapsed = gi_now() - t_render;
         if (cli_interrupted) {
             progress_end(&bar);
             return cli_fail(EXIT_RUN, "reference: interrupted after %llu spp; no image written",
@@ -375,15 +369,7 @@ static int run(run_state *r, const ref_opts *o)
            (unsigned long long)st.spp, st.render_seconds, stop,
            st.render_seconds > 0 ? 1e-6 * (double)st.rays / st.render_seconds : 0.0,
            gi_ref_mean_rel_se(r->ref));
-    if (o->stats) {
-        json_object *j = stats_json(r, o, camera, now_seconds() - t_start, stop);
-        char why[GI_ERROR_MAX];
-        int ok = cli_write_json(o->stats, j, why, sizeof why);
-        json_object_put(j);
-        if (!ok)
-            return cli_fail(EXIT_RUN, "%s", why);
-    }
-    return EXIT_OK;
+    return o->stats ? cli_save_json(o->stats, stats_json(r, o, camera, gi_now() - t_start, stop)) : EXIT_OK;
 }
 
 int cmd_reference(int argc, char **argv)

@@ -305,15 +305,7 @@ static int run(run_state *r, const render_opts *o)
     uint64_t bad = gi_image_count_nonfinite(r->image);
     if (bad)
         gi_log(GI_LOG_WARN, "%s: %llu pixels are NaN or Inf", r->m->id, (unsigned long long)bad);
-    if (o->timings) {
-        json_object *j = timings_json(r, o);
-        char why[GI_ERROR_MAX];
-        int ok = cli_write_json(o->timings, j, why, sizeof why);
-        json_object_put(j);
-        if (!ok)
-            return cli_fail(EXIT_RUN, "%s", why);
-    }
-    return EXIT_OK;
+    return o->timings ? cli_save_json(o->timings, timings_json(r, o)) : EXIT_OK;
 }
 
 int cmd_render(int argc, char **argv)

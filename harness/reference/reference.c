@@ -9,6 +9,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "ref_internal.h"
 
+#include "gi/timer.h"
 #include "gi/rng.h"
 
 #include <assert.h>
@@ -42,13 +43,6 @@ struct gi_ref {
 static inline double lum_d(double r, double g, double b)
 {
     return 0.2126 * r + 0.7152 * g + 0.0722 * b;
-}
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 void gi_ref_desc_init(gi_ref_desc *d)
@@ -99,7 +93,7 @@ gi_result gi_ref_create(const gi_ref_desc *d, gi_ref **out, gi_error *err)
     if (d->threads > MAX_THREADS)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "reference: %u threads exceed %d",
                             d->threads, MAX_THREADS);
-    double t0 = now_seconds();
+    double t0 = gi_now();
     gi_ref *r = calloc(1, sizeof *r);
     if (!r)
         return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "reference: out of memory");
@@ -124,7 +118,7 @@ gi_result gi_ref_create(const gi_ref_desc *d, gi_ref **out, gi_error *err)
              (int)rtcGetDeviceProperty(r->rs.device, RTC_DEVICE_PROPERTY_VERSION_MAJOR),
              (int)rtcGetDeviceProperty(r->rs.device, RTC_DEVICE_PROPERTY_VERSION_MINOR),
              (int)rtcGetDeviceProperty(r->rs.device, RTC_DEVICE_PROPERTY_VERSION_PATCH));
-    r->build_seconds = now_seconds() - t0;
+    r->build_seconds = gi_now() - t0;
     *out = r;
     return GI_OK;
 }
@@ -205,7 +199,7 @@ gi_result gi_ref_render(gi_ref *r, uint32_t spp, gi_error *err)
     if (r->spp + spp > 0xFFFFFFFFull)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
                             "reference: more than 2^32 - 1 samples per pixel");
-    double t0 = now_seconds();
+    double t0 = gi_now();
     pass job;
     job.r = r;
     job.first_sample = (uint32_t)r->spp;
@@ -236,7 +230,7 @@ gi_result gi_ref_render(gi_ref *r, uint32_t spp, gi_error *err)
     }
     free(ws);
     r->spp += spp;
-    r->render_seconds += now_seconds() - t0;
+    r->render_seconds += gi_now() - t0;
     return GI_OK;
 }
 
