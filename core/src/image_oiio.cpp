@@ -68,10 +68,8 @@ std::string lower(std::string s)
  * (core cache.h: gi_atomic_begin/commit), then renames it over `path`. The
  * temporary file is removed on any failure. */
 template <typename Write>
-gi_result write_atomically(const std::string &path, const std::string &ext, gi_error *err,
-                           Write write)
+gi_result write_atomically(const std::string &path, gi_error *err, Write write)
 {
-    (void)ext; /* gi_atomic_begin keeps the extension last by itself */
     gi_atomic_file f;
     gi_result r = gi_atomic_begin(&f, path.c_str(), err);
     if (r != GI_OK)
@@ -309,15 +307,15 @@ gi_result gi_image_write(const char *path, const gi_image *img, const gi_image_w
         if (kind == ".exr") {
             OIIO::ImageSpec spec((int)img->width, (int)img->height, 4, OIIO::TypeDesc::FLOAT);
             spec.attribute("compression", "zip");
-            return write_atomically(p, ext, err, [&](const std::string &tmp) {
+            return write_atomically(p, err, [&](const std::string &tmp) {
                 return write_oiio(p, tmp, spec, OIIO::TypeDesc::FLOAT, img->rgba, err);
             });
         }
         if (kind == ".pfm")
             return write_atomically(
-                p, ext, err, [&](const std::string &tmp) { return write_pfm(p, tmp, img, err); });
+                p, err, [&](const std::string &tmp) { return write_pfm(p, tmp, img, err); });
         if (kind == ".png")
-            return write_atomically(p, ext, err, [&](const std::string &tmp) {
+            return write_atomically(p, err, [&](const std::string &tmp) {
                 return write_png(p, tmp, img, exposure, err);
             });
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
@@ -378,7 +376,7 @@ gi_result gi_image_write_exr_layers(const char *path, const gi_image *rgba,
         spec.channelnames = channel_names;
         spec.alpha_channel = 3;
         spec.attribute("compression", "zip");
-        return write_atomically(p, ext, err, [&](const std::string &tmp) {
+        return write_atomically(p, err, [&](const std::string &tmp) {
             return write_oiio(p, tmp, spec, OIIO::TypeDesc::FLOAT, px.data(), err);
         });
     } catch (const std::bad_alloc &) {
