@@ -422,7 +422,7 @@ static int bench(gi_gpu *gpu, gi_gpu_scene *gs, const gi_scene *s, uint32_t maps
     }
     GLuint arr = gi_depth_texture_create(dr, maps);
     gi_timer *t = gi_timer_create(gi_timer_mode_for(gi_gpu_is_software(gpu)), 1);
-    const int frames = 6;
+    const int frames = 8;
     for (int f = 0; f < frames; f++) {
         gi_timer_frame_begin(t);
         /* alternate the order so neither always runs first */
