@@ -18,8 +18,8 @@
  * scene-global triangle index (the G-buffer's triangle id). World shading
  * normals (inverse transpose, normalised; (0,0,0) where that is not finite)
  * are kept beside the positions for shading code. The BVH is built with
- * quality "high" and RTC_SCENE_FLAG_ROBUST (watertight traversal, no
- * cracks between triangles sharing an edge).
+ * quality "high" and RTC_SCENE_FLAG_ROBUST (Embree avoids the optimisations
+ * that reduce arithmetic accuracy).
  *
  * Validation: a transform or a placed vertex that is not finite, or a
  * coordinate beyond 1e18 (its square overflows float), is an error
