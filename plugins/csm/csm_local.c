@@ -27,34 +27,44 @@ static void fit_rectangle(const gi_scene *s, uint32_t k, float t, csm_light *l)
     gi_vec3 n = gi_v3_length(nsum) > 0.0f ? gi_v3_normalize(nsum) : gi_v3(0, 1, 0);
     gi_vec3 t0, b0;
     gi_onb(n, &t0, &b0);
-    /* principal axes in the plane */
-    double sxx = 0, syy = 0, sxy = 0;
-    for (uint32_t e = 0; e < s->emitter_count; e++) {
+    /* The minimum-area bounding rectangle has a side along an edge of the
+     * convex hull; the triangle edges include those, so try each edge's
+     * direction in the plane (the first 256 triangles') and keep the
+     * smallest rectangle. */
+    float best = FLT_MAX, lo1 = 0, hi1 = 0, lo2 = 0, hi2 = 0;
+    gi_vec3 a1 = t0, a2 = b0;
+    uint32_t tried = 0;
+    for (uint32_t e = 0; e < s->emitter_count && tried < 256; e++) {
         uint32_t tri = s->emitters[e];
         if (s->vertices[s->indices[3 * tri]].object != k)
             continue;
+        tried++;
         gi_vec3 p[3];
         gi_scene_triangle_world(s, tri, t, p);
-        for (int j = 0; j < 3; j++) {
-            gi_vec3 q = gi_v3_sub(p[j], c);
-            double x = gi_v3_dot(q, t0), y = gi_v3_dot(q, b0);
-            sxx += x * x, syy += y * y, sxy += x * y;
-        }
-    }
-    float ang = 0.5f * (float)atan2(2.0 * sxy, sxx - syy);
-    gi_vec3 a1 = gi_v3_add(gi_v3_scale(t0, cosf(ang)), gi_v3_scale(b0, sinf(ang)));
-    gi_vec3 a2 = gi_v3_normalize(gi_v3_cross(n, a1));
-    float lo1 = FLT_MAX, hi1 = -FLT_MAX, lo2 = FLT_MAX, hi2 = -FLT_MAX;
-    for (uint32_t e = 0; e < s->emitter_count; e++) {
-        uint32_t tri = s->emitters[e];
-        if (s->vertices[s->indices[3 * tri]].object != k)
-            continue;
-        gi_vec3 p[3];
-        gi_scene_triangle_world(s, tri, t, p);
-        for (int j = 0; j < 3; j++) {
-            gi_vec3 q = gi_v3_sub(p[j], c);
-            float x = gi_v3_dot(q, a1), y = gi_v3_dot(q, a2);
-            lo1 = fminf(lo1, x), hi1 = fmaxf(hi1, x), lo2 = fminf(lo2, y), hi2 = fmaxf(hi2, y);
+        for (int side = 0; side < 3; side++) {
+            gi_vec3 d = gi_v3_sub(p[(side + 1) % 3], p[side]);
+            d = gi_v3_sub(d, gi_v3_scale(n, gi_v3_dot(d, n)));
+            if (!(gi_v3_length(d) > 0.0f))
+                continue;
+            gi_vec3 c1 = gi_v3_normalize(d), c2 = gi_v3_normalize(gi_v3_cross(n, c1));
+            float l1 = FLT_MAX, h1 = -FLT_MAX, l2 = FLT_MAX, h2 = -FLT_MAX;
+            for (uint32_t f = 0; f < s->emitter_count; f++) {
+                uint32_t tf = s->emitters[f];
+                if (s->vertices[s->indices[3 * tf]].object != k)
+                    continue;
+                gi_vec3 q[3];
+                gi_scene_triangle_world(s, tf, t, q);
+                for (int j = 0; j < 3; j++) {
+                    gi_vec3 r = gi_v3_sub(q[j], c);
+                    float x = gi_v3_dot(r, c1), y = gi_v3_dot(r, c2);
+                    l1 = fminf(l1, x), h1 = fmaxf(h1, x), l2 = fminf(l2, y), h2 = fmaxf(h2, y);
+                }
+            }
+            float area = (h1 - l1) * (h2 - l2);
+            if (area < best * (1.0f - 1e-5f)) {
+                best = area;
+                a1 = c1, a2 = c2, lo1 = l1, hi1 = h1, lo2 = l2, hi2 = h2;
+            }
         }
     }
     if (hi2 - lo2 > hi1 - lo1) { /* e1 is the longer edge */

@@ -6,8 +6,10 @@
  * Lights (csm_lights_collect), in world space at the prepare time:
  *   - area (d = 2): an object with emissive triangles is one light; its
  *     emissive triangles are fitted by their planar bounding rectangle
- *     (normal = area-weighted mean of the triangle normals, in-plane axes
- *     the principal axes of the vertices, extent their bounds): corner o,
+ *     (normal = area-weighted mean of the triangle normals; in the plane
+ *     the smallest-area rectangle with a side along a triangle edge, which
+ *     is the minimum-area rectangle when the first 256 triangles hold the
+ *     convex hull's edges): corner o,
  *     edges e1 (the longer) and e2. The mapping D(x) of §4 is
  *     D(u, v) = o + u e1 + v e2 on [0, 1]^2, discretised at the centres of
  *     an n_u x n_v grid: l(a, b) = o + (a + 1/2)/n_u e1 + (b + 1/2)/n_v e2.
