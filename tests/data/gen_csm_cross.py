@@ -9,6 +9,8 @@ test, Ritschel et al. 2007 §4.6):
   - a point light (KHR_lights_punctual) at (3, 1.5, 0): B shadows the lower
     part of A's +x face;
   - the ground, 8 x 8, 16 x 16 quads, is planar (a receiver-only candidate).
+csm_cross_moved.glb is the same with the point light at (3, 2, 0.5): the
+csm cache must key cube maps on the light's geometry.
 Run: python3 tests/data/gen_csm_cross.py (deterministic output)."""
 import math
 import os
@@ -53,7 +55,7 @@ def box(x0, x1, y0, y1, z0, z1, n=8):
     return m
 
 
-def main():
+def write(name, point_light):
     g = Writer("gibench tests/data/gen_csm_cross.py")
     white = g.material("white", (0.7, 0.7, 0.7))
     grey = g.material("grey", (0.5, 0.5, 0.5))
@@ -74,12 +76,17 @@ def main():
     g.doc["extensions"] = {"KHR_lights_punctual": {"lights": [
         {"name": "point", "type": "point", "color": [1.0, 1.0, 1.0], "intensity": 30.0}]}}
     g.ext_used.add("KHR_lights_punctual")
-    pl = g.node("point_light", translation=(3.0, 1.5, 0.0))
+    pl = g.node("point_light", translation=point_light)
     g.doc["nodes"][pl]["extensions"] = {"KHR_lights_punctual": {"light": 0}}
     nodes.append(pl)
     nodes.append(g.camera_node("camera", (0.5, 4.0, 7.0), (0.0, 0.7, 0.0), 45.0))
     g.scene("csm_cross", nodes)
-    g.write_glb(os.path.join(HERE, "valid", "csm_cross.glb"))
+    g.write_glb(os.path.join(HERE, "valid", name))
+
+
+def main():
+    write("csm_cross.glb", (3.0, 1.5, 0.0))
+    write("csm_cross_moved.glb", (3.0, 2.0, 0.5))
 
 
 if __name__ == "__main__":
