@@ -54,7 +54,7 @@ typedef struct csm {
     const gi_host *host;
     int N, M, S, z3, filter;
     gi_csm_order order;
-    float bias, normal_offset;
+    float bias, normal_offset, normal_offset_local;
     int lights_mode, n_local, m_local, receivers, distant;
     gi_csm_order light_order;
     float linear_aspect;
@@ -85,6 +85,8 @@ static const gi_param_desc csm_params[] = {
     {"bias", GI_PARAM_FLOAT, 0.01, 0, 1, NULL, "bias (Sec. 6)", "depth bias as a fraction of the bounding-sphere radius"},
     {"normal_offset", GI_PARAM_FLOAT, 1, 0, 16, NULL, NULL,
      "receivers move along their normal by this many texels of each object's map (against shadow acne)"},
+    {"normal_offset_local", GI_PARAM_FLOAT, 0.25, 0, 16, NULL, NULL,
+     "for local lights' cube maps: receivers move along their normal by this many texels (2 |x - l| / M_local)"},
     {"lights", GI_PARAM_ENUM, 0, 0, 0, "local|semilocal", "Sec. 4.2, 4.3",
      "point and area lights: fixed local (cube maps at points on the light) or semi-local (orthographic maps, d = l - p)"},
     {"N_local", GI_PARAM_INT, 4, 1, 64, NULL, "N (Sec. 4.2)",
@@ -119,6 +121,7 @@ static gi_result csm_create(const gi_host *host, const gi_params *params, void *
     c->S = gi_params_int(params, "S");
     c->bias = gi_params_float(params, "bias");
     c->normal_offset = gi_params_float(params, "normal_offset");
+    c->normal_offset_local = gi_params_float(params, "normal_offset_local");
     c->lights_mode = gi_params_enum(params, "lights");
     c->n_local = gi_params_int(params, "N_local");
     c->m_local = gi_params_int(params, "M_local");
@@ -672,6 +675,7 @@ static gi_result csm_render(void *inst, const gi_view *view, const gi_target *ta
     glUniform1i(glGetUniformLocation(p, "csm_filter"), c->filter);
     glUniform1ui(glGetUniformLocation(p, "csm_light_count"), c->light_count);
     glUniform1i(glGetUniformLocation(p, "csm_semilocal"), c->lights_mode == LIGHTS_SEMILOCAL);
+    glUniform1f(glGetUniformLocation(p, "csm_normal_offset_local"), c->normal_offset_local);
     glUniform1i(glGetUniformLocation(p, "u_distant"), c->distant);
     glDispatchCompute((view->width + 7) / 8, (view->height + 7) / 8, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |

@@ -315,30 +315,34 @@ static void volume_pairs(const setup *st, gi_vec3 lo, gi_vec3 hi, pair *out, int
     EXPECT(shadowed > pairs / 40, "too few shadowed pairs to mean anything: %d", shadowed);
 }
 
-/* Area of triangle t, 0 for emitters (receivers only). */
-static float w_area_nonemissive(const setup *st, uint32_t t)
+/* Area of triangle t, 0 for emitters (receivers only) and for objects
+ * other than `only` (-1: all). */
+static float w_area_nonemissive(const setup *st, uint32_t t, int only)
 {
     const float *e = gi_scene_triangle_emission(st->s, t);
+    if (only >= 0 && (int)st->s->vertices[st->s->indices[3 * t]].object != only)
+        return 0.0f;
     return e[0] > 0 || e[1] > 0 || e[2] > 0 ? 0.0f : st->w.area[t];
 }
 
 /* Receiver points on the surfaces of csm_cross.glb: per (receiver, caster)
  * the pairs ray casting finds shadowed by that caster, and how many of
  * those and of all pairs the CSM gets right. */
-static void cross_pairs(const setup *st)
+static void surface_pairs(const setup *st, float offset_texels, int cross, int only)
 {
     const gi_scene *s = st->s;
     uint32_t n = s->object_count, rng = gi_rng_init(8, 0, 3);
     int shadowed_by[8][8] = {{0}}, right_by[8][8] = {{0}}, edge_by[8][8] = {{0}}, total = 0, agree = 0;
+    int false_shadow[8] = {0}, lit_total[8] = {0};
     float total_area = 0;
     for (uint32_t t = 0; t < s->triangle_count; t++)
-        total_area += w_area_nonemissive(st, t);
+        total_area += w_area_nonemissive(st, t, only);
     for (int p = 0; p < 6000; p++) {
         /* a triangle by area, a point on it, offset along its normal */
         float r = gi_rng_next_float(&rng) * total_area;
         uint32_t t = 0;
         for (; t + 1 < s->triangle_count; t++)
-            if ((r -= w_area_nonemissive(st, t)) < 0)
+            if ((r -= w_area_nonemissive(st, t, only)) < 0)
                 break;
         float b[3];
         gi_sample_uniform_triangle(gi_rng_next_float(&rng), gi_rng_next_float(&rng), b);
@@ -351,8 +355,8 @@ static void cross_pairs(const setup *st)
         if (gi_v3_dot(ng, gi_v3_sub(y, x)) <= 0 || gi_v3_dot(ng, gi_v3_sub(ys, x)) <= 0)
             continue;
         uint32_t recv = s->vertices[s->indices[3 * t]].object;
-        /* the plugin's default normal offset: one texel at x's distance */
-        gi_vec3 xo = gi_v3_add(x, gi_v3_scale(ng, 2.0f * gi_v3_length(gi_v3_sub(x, ys)) / M_CUBE));
+        /* the normal offset, in texels at x's distance */
+        gi_vec3 xo = gi_v3_add(x, gi_v3_scale(ng, offset_texels * 2.0f * gi_v3_length(gi_v3_sub(x, ys)) / M_CUBE));
         /* receivers covered by another object (the ground under a box) are
          * inside it: no surface the camera could see; left out */
         gi_vec3 xe = gi_v3_add(x, gi_v3_scale(ng, 1e-4f));
@@ -363,6 +367,14 @@ static void cross_pairs(const setup *st)
         int lit = csm_visible(st, j, xo, y, NULL);
         total++;
         agree += lit == exact;
+        if (exact && recv < 8) {
+            lit_total[recv]++;
+            false_shadow[recv] += !lit;
+            if (!lit && getenv("CSM_DEBUG"))
+                printf("    false shadow on %s at (%.3f %.3f %.3f) n (%.2f %.2f %.2f) light point (%.3f %.3f %.3f)\n",
+                       s->objects[recv].name, (double)x.x, (double)x.y, (double)x.z, (double)ng.x, (double)ng.y,
+                       (double)ng.z, (double)ys.x, (double)ys.y, (double)ys.z);
+        }
         if (!exact && by >= 0 && recv < 8 && by < 8) {
             shadowed_by[recv][by]++;
             right_by[recv][by] += !lit;
@@ -377,9 +389,13 @@ static void cross_pairs(const setup *st)
             edge_by[recv][by] += lit && near;
         }
     }
-    printf("  %d surface pairs: %.1f%% agree with ray casting to the snapped light point\n", total,
-           100.0 * agree / total);
+    printf("  %d surface pairs (normal offset %.2f texels): %.1f%% agree with ray casting to the snapped light point\n",
+           total, (double)offset_texels, 100.0 * agree / total);
     EXPECT(agree >= total * 0.95, "%d of %d", agree, total);
+    for (uint32_t rcv = 0; rcv < n && rcv < 8; rcv++)
+        if (lit_total[rcv])
+            printf("  %s: %d lit pairs, CSM shadowed %.1f%% of them\n", s->objects[rcv].name, lit_total[rcv],
+                   100.0 * false_shadow[rcv] / lit_total[rcv]);
     for (uint32_t rcv = 0; rcv < n && rcv < 8; rcv++)
         for (uint32_t c = 0; c < n && c < 8; c++)
             if (shadowed_by[rcv][c])
@@ -388,6 +404,8 @@ static void cross_pairs(const setup *st)
                        s->objects[rcv].name, s->objects[c].name, shadowed_by[rcv][c],
                        100.0 * right_by[rcv][c] / shadowed_by[rcv][c], 100.0 * edge_by[rcv][c] / shadowed_by[rcv][c],
                        100.0 * (shadowed_by[rcv][c] - right_by[rcv][c] - edge_by[rcv][c]) / shadowed_by[rcv][c]);
+    if (!cross)
+        return;
     /* objects 0 ground, 1 box_a, 2 box_b (gen_csm_cross.py) */
     int pairs_needed[][2] = {{2, 1}, {1, 2}, {0, 1}, {0, 2}};
     for (int i = 0; i < 4; i++) {
@@ -564,6 +582,10 @@ int main(void)
         gi_vec3 c = gi_v3_scale(gi_v3_add(lo, hi), 0.5f), h = gi_v3_scale(gi_v3_sub(hi, lo), 1.25f);
         volume_pairs(&st, gi_v3(c.x - h.x, 1e-3f, c.z - h.z), gi_v3(c.x + h.x, 0.5f * hi.y, c.z + h.z), pin, cpu, 0.95);
         gpu_check(&st, pin, cpu, t);
+        /* receivers on the teapot, with the plugin's default normal offset
+         * for local lights (a quarter texel) and with a whole texel */
+        surface_pairs(&st, 0.25f, 0, (int)t);
+        surface_pairs(&st, 1.0f, 0, (int)t);
     }
     free_setup(&st);
 
@@ -580,7 +602,7 @@ int main(void)
         EXPECT(st.light_count == 2 && st.lights[0].kind == CSM_LIGHT_LINEAR && st.lights[0].n_v == 1 &&
                    st.lights[1].kind == CSM_LIGHT_POINT,
                "%u lights", st.light_count);
-        cross_pairs(&st);
+        surface_pairs(&st, 0.25f, 1, -1);
         volume_pairs(&st, gi_v3(-2.5f, 0.01f, -1.5f), gi_v3(2.5f, 2.2f, 1.5f), pin, cpu, 0.95);
         gpu_check(&st, pin, cpu, object_named(st.s, "box_a"));
     }

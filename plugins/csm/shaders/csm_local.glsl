@@ -16,7 +16,7 @@
 //                            (0xFFFFFFFF none); then per light the enumeration
 //                            index of grid cell (a, b) at cells base + b n_u + a
 // Uniforms: csm_light_count, csm_semilocal (1: the orthographic maps with
-// d = l - p, §4.3).
+// d = l - p, §4.3), csm_normal_offset_local.
 #ifndef CSM_LOCAL_GLSL
 #define CSM_LOCAL_GLSL
 #include "csm_query.glsl"
@@ -35,6 +35,7 @@ layout(std430, binding = 16) readonly buffer CsmLightCells { uint csm_light_cell
 
 uniform uint csm_light_count;
 uniform int csm_semilocal;
+uniform float csm_normal_offset_local; // texels of the cube face at x's distance
 
 vec3 csm_light_point(vec3 o, vec3 e1, vec3 e2, uint n_u, uint n_v, uint a, uint b)
 {
@@ -138,12 +139,12 @@ float csm_local_visibility_object(uint j, uint k, vec3 x, vec3 n, vec3 y, int mo
     vec2 g = csm_light_grid(l.o.xyz, l.e1.xyz, l.e2.xyz, l.info.x, l.info.y, y);
     int nu = int(l.info.x), nv = int(l.info.y);
     if (dot(n, n) > 0.0) {
-        // normal offset of csm_normal_offset texels at x's distance
+        // normal offset of csm_normal_offset_local texels at x's distance
         vec3 lc = csm_light_point(p.o.xyz, p.e1.xyz, p.e2.xyz, l.info.x, l.info.y,
                                   uint(clamp(int(floor(g.x + 0.5)), 0, nu - 1)),
                                   uint(clamp(int(floor(g.y + 0.5)), 0, nv - 1)));
         vec3 nl = normalize(n * mat3(ob.world_from_local));
-        xl += nl * (csm_normal_offset * 2.0 * length(xl - lc) / float(p.info.x));
+        xl += nl * (csm_normal_offset_local * 2.0 * length(xl - lc) / float(p.info.x));
     }
     if (mode == 0) {
         uint a = uint(clamp(int(floor(g.x + 0.5)), 0, nu - 1)), b = uint(clamp(int(floor(g.y + 0.5)), 0, nv - 1));
