@@ -55,7 +55,8 @@ typedef struct csm {
     int N, M, S, z3, filter;
     gi_csm_order order;
     float bias, normal_offset, normal_offset_local;
-    int lights_mode, n_local, m_local, receivers, distant;
+    int lights_mode, n_local, m_local, receivers, distant, warned_moved;
+    float *prepare_transforms; /* 16 per object: world_from_local at prepare time */
     gi_csm_order light_order;
     float linear_aspect;
     uint32_t object_count, light_count;
@@ -373,8 +374,12 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
     uint32_t n = s->object_count ? s->object_count : 1u;
     c->objects = calloc(n, sizeof *c->objects);
     c->casts = calloc(n, 1);
+    c->prepare_transforms = malloc((size_t)n * 16 * sizeof(float));
+    if (c->prepare_transforms)
+        for (uint32_t k = 0; k < c->object_count && k < GI_MAX_OBJECTS; k++)
+            memcpy(c->prepare_transforms + 16 * k, gs->world_from_local[k], 16 * sizeof(float));
     gi_csm_data *data = calloc(n, sizeof *data);
-    if (!c->objects || !c->casts || !data) {
+    if (!c->objects || !c->casts || !c->prepare_transforms || !data) {
         free(data);
         return fail(c, GI_ERR_OUT_OF_MEMORY, "csm: out of memory");
     }
@@ -400,7 +405,7 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
         c->casts[k] = !(c->receivers == RECEIVERS_PLANAR && object_is_planar(s, k));
         casters += c->casts[k];
         if (!c->casts[k])
-            host->log(host, GI_LOG_INFO, "csm: object %s is receiver-only (planar)", s->objects[k].name);
+            host->log(host, GI_LOG_INFO, "object %s is receiver-only (planar)", s->objects[k].name);
     }
     /* progress: every build counts as one share */
     uint32_t builds = (c->distant ? casters : 0) + (local ? casters * c->light_count : 0), done = 0;
@@ -446,7 +451,7 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
                 object_world_bounds(gs, k, wb);
                 if (light_in_bounds(l, wb)) {
                     host->log(host, GI_LOG_WARN,
-                              "csm: semi-local light %u lies inside the bounds of object %s, which then casts no "
+                              "semi-local light %u lies inside the bounds of object %s, which then casts no "
                               "shadow of it (semi-local lights are valid outside an object's convex hull only)",
                               j, s->objects[k].name);
                     shadows = 0;
@@ -603,6 +608,27 @@ static gi_result csm_update(void *inst, const gi_gpu_scene *scene, const gi_chan
     c->scene = scene;
     if (changes->flags)
         c->frames = 0;
+    /* §4.2: fixed local lights hold only while lights and objects stay where
+     * they were at prepare time; say so once when something moved. */
+    if (c->lights_mode == LIGHTS_LOCAL && c->light_count > 0 && !c->warned_moved &&
+        (changes->flags & (GI_CHANGED_TRANSFORMS | GI_CHANGED_LIGHTS))) {
+        int moved = 0;
+        for (uint32_t k = 0; k < c->object_count && k < GI_MAX_OBJECTS; k++)
+            moved |= memcmp(c->prepare_transforms + 16 * k, scene->world_from_local[k], 16 * sizeof(float)) != 0;
+        for (uint32_t j = 0; j < c->light_count; j++) {
+            const csm_light *l = &c->lights[j];
+            if (l->punctual >= 0) {
+                gi_light_frame f = gi_scene_light_at(scene->scene, (uint32_t)l->punctual, scene->time);
+                moved |= gi_v3_length(gi_v3_sub(f.position, l->origin)) > 0.0f;
+            }
+        }
+        if (moved) {
+            c->host->log(c->host, GI_LOG_WARN,
+                         "objects or lights moved since the precomputation; fixed local lights' cube maps are "
+                         "not rebuilt (their shadows are those of the first frame's placement); use lights=semilocal");
+            c->warned_moved = 1;
+        }
+    }
     return GI_OK;
 }
 
@@ -705,6 +731,7 @@ static void csm_destroy(void *inst)
         glDeleteProgram(c->program);
     free(c->objects);
     free(c->casts);
+    free(c->prepare_transforms);
     free(c->lights);
     free(c);
 }

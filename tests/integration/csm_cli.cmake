@@ -100,6 +100,11 @@ expect(0 "" ${largs} --param N_local=4 --param linear_aspect=50 --scene ${DATA}/
        --out ${OUT}/csm_cross_area.exr --timings ${OUT}/csm_cross_area.json)
 expect_json(${OUT}/csm_cross_area.json "\"maps_local\": 312")
 
+# an animated scene under fixed local lights: one warning that the cube maps
+# are not rebuilt
+expect(0 "fixed local lights' cube maps are not rebuilt" ${largs} --param N_local=2 --scene ${SCENES}/cornell_moving.gltf
+       --animate 4 --out ${OUT}/csm_moving.exr)
+
 expect(2 "csm: " ${largs} --param N_local=2 --scene ${SCENES}/teapot_area.glb --param lights=distant --out ${OUT}/x.exr)
 expect(2 "csm: N_local=0 is outside" ${largs} --scene ${SCENES}/teapot_area.glb --param N_local=0 --out ${OUT}/x.exr)
 expect(2 "csm: M_local=4 is outside" render --method csm --size 32x32 --scene ${SCENES}/teapot_area.glb --param M_local=4 --out ${OUT}/x.exr)
