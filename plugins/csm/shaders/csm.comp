@@ -83,18 +83,22 @@ vec3 environment(gi_brdf b, vec3 x, vec3 N, vec3 wo, uint pattern, vec2 cp, inou
 
 // §5.1 "Sampling local illumination": area lights by their radiance
 // distribution (an emissive triangle by power from the core's emitter CDF,
-// then a uniform point on it, from the stratified pattern), visibility by
-// the CSM of the light the triangle belongs to.
+// then a uniform point on it, both from one stratified pattern point),
+// visibility by the CSM of the light the triangle belongs to.
 vec3 area_lights(gi_brdf b, vec3 x, vec3 N, vec3 wo, uint own, uint pattern, vec2 cp, inout uint rng)
 {
     vec3 sum = vec3(0.0);
     for (int s = 0; s < u_S; s++) {
         vec2 u = fract(csm_patterns[pattern * uint(u_S) + uint(s)] + cp);
-        uint e = gi_emitter_find(gi_rng_next_float(rng));
+        // u.x picks the triangle and, rescaled within its CDF interval,
+        // the point on it, so the pattern's strata cover the whole light
+        uint e = gi_emitter_find(u.x);
         GiEmitter em = gi_emitters[e];
+        float cdf0 = e > 0u ? gi_emitters[e - 1u].cdf : 0.0;
+        float ux = em.pdf > 0.0 ? clamp((u.x - cdf0) / em.pdf, 0.0, 0.99999994) : 0.0;
         vec3 p0, p1, p2;
         gi_triangle_world(em.triangle, p0, p1, p2);
-        vec3 bc = gi_sample_uniform_triangle(u.x, u.y);
+        vec3 bc = gi_sample_uniform_triangle(ux, u.y);
         vec3 y = bc.x * p0 + bc.y * p1 + bc.z * p2;
         vec3 ng = cross(p1 - p0, p2 - p0);
         float area = 0.5 * length(ng);
