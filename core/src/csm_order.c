@@ -1,5 +1,5 @@
 /* Enumerations of a grid of depth maps for Coherent Shadow Maps, Ritschel et
- * al. 2007 §4.4 (scan-line, zig-zag, Hilbert). The Hilbert order is the
+ * al. 2007 §4.4 (scan-line, zig-zag, Hilbert, diagonal zig-zag). The Hilbert order is the
  * generalised Hilbert curve "gilbert" (Cervený 2019), walked without
  * generating it: both directions descend its recursive split of the
  * rectangle, choosing the sub-rectangle by area (index -> cell) or by
@@ -18,6 +18,8 @@ const char *gi_csm_order_name(gi_csm_order order)
         return "zigzag";
     case GI_CSM_ORDER_HILBERT:
         return "hilbert";
+    case GI_CSM_ORDER_DIAGONAL:
+        return "diagonal";
     }
     return "?";
 }
@@ -25,7 +27,7 @@ const char *gi_csm_order_name(gi_csm_order order)
 int gi_csm_order_parse(const char *name, gi_csm_order *out)
 {
     static const gi_csm_order all[] = {GI_CSM_ORDER_SCANLINE, GI_CSM_ORDER_ZIGZAG,
-                                       GI_CSM_ORDER_HILBERT};
+                                       GI_CSM_ORDER_HILBERT, GI_CSM_ORDER_DIAGONAL};
     for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) {
         if (strcmp(name, gi_csm_order_name(all[k])) == 0) {
             *out = all[k];
@@ -158,6 +160,51 @@ static uint32_t hilbert_index(uint32_t na, uint32_t nb, uint32_t a, uint32_t b)
     return (uint32_t)(k + ((int64_t)a - r.x) * dx + ((int64_t)b - r.y) * dy);
 }
 
+/* Cells before anti-diagonal s (a + b = s) of an na x nb grid: the sum of
+ * the lengths of the diagonals 0 .. s-1, in closed form (the full triangle
+ * minus the two corners that stick out past a = na - 1 and b = nb - 1). */
+static uint64_t diagonal_start(uint64_t na, uint64_t nb, uint64_t s)
+{
+    uint64_t n = s * (s + 1) / 2;
+    if (s > na)
+        n -= (s - na) * (s - na + 1) / 2;
+    if (s > nb)
+        n -= (s - nb) * (s - nb + 1) / 2;
+    return n;
+}
+
+/* First and last a on anti-diagonal s. */
+static void diagonal_range(uint64_t na, uint64_t nb, uint64_t s, uint64_t *lo, uint64_t *hi)
+{
+    *lo = s + 1 > nb ? s + 1 - nb : 0;
+    *hi = s < na - 1 ? s : na - 1;
+}
+
+static void diagonal_cell(uint32_t na, uint32_t nb, uint32_t index, uint32_t *a, uint32_t *b)
+{
+    /* the largest s with diagonal_start(s) <= index, by bisection */
+    uint64_t lo = 0, hi = (uint64_t)na + nb - 1;
+    while (hi - lo > 1) {
+        uint64_t mid = (lo + hi) / 2;
+        if (diagonal_start(na, nb, mid) <= index)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    uint64_t s = lo, k = index - diagonal_start(na, nb, s), alo, ahi;
+    diagonal_range(na, nb, s, &alo, &ahi);
+    uint64_t av = (s & 1) ? ahi - k : alo + k;
+    *a = (uint32_t)av;
+    *b = (uint32_t)(s - av);
+}
+
+static uint32_t diagonal_index(uint32_t na, uint32_t nb, uint32_t a, uint32_t b)
+{
+    uint64_t s = (uint64_t)a + b, alo, ahi;
+    diagonal_range(na, nb, s, &alo, &ahi);
+    return (uint32_t)(diagonal_start(na, nb, s) + ((s & 1) ? ahi - a : a - alo));
+}
+
 void gi_csm_order_cell(gi_csm_order order, uint32_t na, uint32_t nb, uint32_t index, uint32_t *a,
                        uint32_t *b)
 {
@@ -174,6 +221,9 @@ void gi_csm_order_cell(gi_csm_order order, uint32_t na, uint32_t nb, uint32_t in
     case GI_CSM_ORDER_HILBERT:
         hilbert_cell(na, nb, index, a, b);
         return;
+    case GI_CSM_ORDER_DIAGONAL:
+        diagonal_cell(na, nb, index, a, b);
+        return;
     }
     assert(!"unknown order");
 }
@@ -188,6 +238,8 @@ uint32_t gi_csm_order_index(gi_csm_order order, uint32_t na, uint32_t nb, uint32
         return b * na + ((b & 1) ? na - 1 - a : a);
     case GI_CSM_ORDER_HILBERT:
         return hilbert_index(na, nb, a, b);
+    case GI_CSM_ORDER_DIAGONAL:
+        return diagonal_index(na, nb, a, b);
     }
     assert(!"unknown order");
     return 0;

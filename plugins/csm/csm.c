@@ -1,15 +1,26 @@
 /* The `csm` method: Coherent Shadow Maps (Ritschel, Grosch, Kautz, Mueller,
- * EGSR 2007) for distant light from the scene's environment map.
+ * EGSR 2007) for distant light (environment map, directional lights) and
+ * for local lights (emissive objects as area or linear lights, point and
+ * spot lights).
  *
- * prepare(): per object (every object casts; see README.md), N_theta x N_phi
- * orthographic dual-depth maps around its local bounding sphere on a
- * lat-long grid of directions (§4.1), enumerated in scan-line, zig-zag or
- * Hilbert order (§4.4) and compressed losslessly by the core's codec (§3.1);
- * cached on disk by a hash of the mesh and the parameters.
- * render(): G-buffer, then S environment samples per pixel with visibility
- * from all objects' CSMs (§3.2, §4.5 filters, §4.6 rigid motion through the
- * inverse object transform), averaged progressively over frames (§5). */
-#include "csm_cpu.h"
+ * prepare(): per object that casts (every object, or with receivers=planar
+ * every non-planar one, §4.6 "receiver-only objects"):
+ *  - when distant or semi-local light needs them, N_theta x N_phi
+ *    orthographic dual-depth maps around its local bounding sphere on a
+ *    lat-long grid of directions (§4.1), enumerated in scan-line, zig-zag,
+ *    Hilbert or diagonal order (§4.4) and compressed losslessly by the
+ *    core's codec (§3.1);
+ *  - with lights=local, for every light, depth cube maps at the light's
+ *    n_u x n_v grid points (§4.2, §3.3; csm_local.c), sides concatenated as
+ *    k N + i into one codec sequence;
+ *  cached on disk by a hash of the mesh, the parameters and, for cube maps,
+ *  the light's geometry.
+ * render(): G-buffer, then per pixel S environment samples, S area-light
+ * samples and every punctual light, visibility from all objects' CSMs
+ * (§3.2, §4.5 filters, §4.6 rigid motion through the inverse object
+ * transform; for local lights the receiver's own object first), averaged
+ * progressively over frames (§5). */
+#include "csm_local.h"
 
 #include "gi/cache.h"
 #include "gi/log.h"
@@ -25,18 +36,34 @@
 extern const gi_shader_source gi_csm_shaders[];
 
 #define CSM_FORMAT_VERSION 2u
+#define CSM_LOCAL_FORMAT_VERSION 1u
 #define CSM_PATTERNS 256u
 
-enum { B_OBJECTS = 8, B_OFFSETS = 9, B_ZAVG = 10, B_IEND = 11, B_CELLS = 12, B_PATTERNS = 13 };
+enum { B_OBJECTS = 8, B_OFFSETS = 9, B_ZAVG = 10, B_IEND = 11, B_CELLS = 12, B_PATTERNS = 13, B_LIGHTS = 14,
+       B_PAIRS = 15, B_LIGHT_CELLS = 16 };
+enum { LIGHTS_LOCAL = 0, LIGHTS_SEMILOCAL = 1 };
+enum { RECEIVERS_NONE = 0, RECEIVERS_PLANAR = 1 };
+
+/* std430 CsmLight / CsmPair of shaders/csm_local.glsl (64 bytes). */
+typedef struct csm_gpu_rect {
+    float o[4], e1[4], e2[4];
+    uint32_t info[4];
+} csm_gpu_rect;
 
 typedef struct csm {
     const gi_host *host;
     int N, M, S, z3, filter;
     gi_csm_order order;
-    float bias, normal_offset;
-    uint32_t object_count;
+    float bias, normal_offset, normal_offset_local;
+    int lights_mode, n_local, m_local, receivers, distant, warned_moved;
+    float *prepare_transforms; /* 16 per object: world_from_local at prepare time */
+    gi_csm_order light_order;
+    float linear_aspect;
+    uint32_t object_count, light_count;
+    unsigned char *casts; /* per object: 1 if it has CSMs (not receiver-only) */
+    csm_light *lights;
     csm_gpu_object *objects;
-    GLuint ssbo[6]; /* objects, offsets, z_avg, i_end, cells, patterns */
+    GLuint ssbo[9]; /* objects, offsets, z_avg, i_end, cells, patterns, lights, pairs, light cells */
     gi_gbuffer *gbuffer;
     GLuint program, accum;
     uint32_t width, height, frames;
@@ -49,7 +76,8 @@ static const gi_param_desc csm_params[] = {
     {"N", GI_PARAM_INT, 16, 2, 256, NULL, "N (Sec. 4.1)",
      "directions per dimension of the lat-long grid: N_theta = N_phi = N, N^2 maps per object"},
     {"M", GI_PARAM_INT, 128, 8, 1024, NULL, "M (Sec. 3)", "depth map size M x M"},
-    {"enumeration", GI_PARAM_ENUM, 2, 0, 0, "scanline|zigzag|hilbert", "Sec. 4.4", "order of the maps in the codec"},
+    {"enumeration", GI_PARAM_ENUM, 2, 0, 0, "scanline|zigzag|hilbert|diagonal", "Sec. 4.4",
+     "order of the maps in the codec"},
     {"depth", GI_PARAM_ENUM, 0, 0, 0, "z2|z3", "Sec. 3.1",
      "second depth of a segment: z2, or z3 (closed-manifold option)"},
     {"filter", GI_PARAM_ENUM, 0, 0, 0, "nearest|pcf|rr", "Sec. 4.5",
@@ -58,6 +86,19 @@ static const gi_param_desc csm_params[] = {
     {"bias", GI_PARAM_FLOAT, 0.01, 0, 1, NULL, "bias (Sec. 6)", "depth bias as a fraction of the bounding-sphere radius"},
     {"normal_offset", GI_PARAM_FLOAT, 1, 0, 16, NULL, NULL,
      "receivers move along their normal by this many texels of each object's map (against shadow acne)"},
+    {"normal_offset_local", GI_PARAM_FLOAT, 0.25, 0, 16, NULL, NULL,
+     "for local lights' cube maps: receivers move along their normal by this many texels (2 |x - l| / M_local)"},
+    {"lights", GI_PARAM_ENUM, 0, 0, 0, "local|semilocal", "Sec. 4.2, 4.3",
+     "point and area lights: fixed local (cube maps at points on the light) or semi-local (orthographic maps, d = l - p)"},
+    {"N_local", GI_PARAM_INT, 4, 1, 64, NULL, "N (Sec. 4.2)",
+     "points per dimension on an area light (N x N), linear light (N x 1); point lights have 1"},
+    {"M_local", GI_PARAM_INT, 64, 8, 1024, NULL, "M (Sec. 3.3)", "cube face size M x M of local lights' depth cube maps"},
+    {"light_enumeration", GI_PARAM_ENUM, 3, 0, 0, "scanline|zigzag|hilbert|diagonal", "Sec. 4.4",
+     "order of the points on a light in the codec (diagonal: the zig-zag area curve)"},
+    {"linear_aspect", GI_PARAM_FLOAT, 4, 1, 1e6, NULL, "d = 1 (Sec. 4.2)",
+     "an emissive object whose bounding rectangle is longer than this times its width is a linear light"},
+    {"receivers", GI_PARAM_ENUM, 0, 0, 0, "none|planar", "Sec. 4.6",
+     "receiver-only objects without CSMs: none, or every planar object"},
     {0},
 };
 
@@ -81,6 +122,13 @@ static gi_result csm_create(const gi_host *host, const gi_params *params, void *
     c->S = gi_params_int(params, "S");
     c->bias = gi_params_float(params, "bias");
     c->normal_offset = gi_params_float(params, "normal_offset");
+    c->normal_offset_local = gi_params_float(params, "normal_offset_local");
+    c->lights_mode = gi_params_enum(params, "lights");
+    c->n_local = gi_params_int(params, "N_local");
+    c->m_local = gi_params_int(params, "M_local");
+    c->light_order = (gi_csm_order)gi_params_enum(params, "light_enumeration");
+    c->linear_aspect = gi_params_float(params, "linear_aspect");
+    c->receivers = gi_params_enum(params, "receivers");
     gi_shader_register(gi_csm_shaders);
     *out = c;
     return GI_OK;
@@ -98,30 +146,75 @@ static void cache_name(const csm *c, const gi_scene *s, uint32_t k, const float 
     snprintf(name, size, "csm-%016llx.bin", (unsigned long long)h);
 }
 
-static gi_result load_or_build(csm *c, const gi_gpu_scene *gs, uint32_t k, const float sphere[4], gi_csm_data *data,
-                               int *hit)
+/* Cube-map CSMs of one object for one light: the key adds the light's
+ * geometry in the object's local space (rectangle, grid) to the mesh. */
+static void cache_name_local(const csm *c, const gi_scene *s, uint32_t k, const float sphere[4],
+                             const csm_local_desc *d, char *name, size_t size)
+{
+    float key_f[13] = {sphere[0], sphere[1], sphere[2], sphere[3], d->o.x,  d->o.y,  d->o.z,
+                       d->e1.x,   d->e1.y,   d->e1.z,   d->e2.x,   d->e2.y, d->e2.z};
+    uint32_t key_u[6] = {CSM_LOCAL_FORMAT_VERSION, d->M, d->n_u, d->n_v, (uint32_t)d->order, (uint32_t)d->z3};
+    uint64_t h = gi_hash64("gibench-csm-local", 17, gi_scene_object_hash(s, k));
+    h = gi_hash64(key_u, sizeof key_u, h);
+    h = gi_hash64(key_f, sizeof key_f, h);
+    (void)c;
+    snprintf(name, size, "csm-local-%016llx.bin", (unsigned long long)h);
+}
+
+/* Loads cache file `name` into *data if it holds M x M maps, N of them;
+ * a file that does not parse or has other sizes is reported and ignored.
+ * Returns 1 on a hit. *path is the file's path (NULL without a cache). */
+static int cache_load(csm *c, const char *name, uint32_t M, uint32_t N, gi_csm_data *data, char **path)
 {
     const gi_host *host = c->host;
-    char name[64];
-    cache_name(c, gs->scene, k, sphere, name, sizeof name);
-    char *path = host->cache_dir ? gi_cache_path(host->cache_dir, name) : NULL;
+    *path = host->cache_dir ? gi_cache_path(host->cache_dir, name) : NULL;
+    if (!*path)
+        return 0;
+    size_t size = 0;
+    void *bytes = gi_file_read_all(*path, &size);
+    if (!bytes)
+        return 0;
     gi_error err;
-    *hit = 0;
-    if (path) {
-        size_t size = 0;
-        void *bytes = gi_file_read_all(path, &size);
-        if (bytes) {
-            if (gi_csm_data_read(bytes, size, data, &err) == GI_OK && data->M == (uint32_t)c->M &&
-                data->N == (uint32_t)(c->N * c->N))
-                *hit = 1;
-            else {
-                host->log(host, GI_LOG_WARN, "%s: unusable cache file (%s); recomputing", path,
-                          data->M ? "wrong size" : err.text);
-                gi_csm_data_free(data);
-            }
-            free(bytes);
-        }
+    int hit = 0;
+    if (gi_csm_data_read(bytes, size, data, &err) == GI_OK && data->M == M && data->N == N)
+        hit = 1;
+    else {
+        host->log(host, GI_LOG_WARN, "%s: unusable cache file (%s); recomputing", *path,
+                  data->M ? "wrong size" : err.text);
+        gi_csm_data_free(data);
     }
+    free(bytes);
+    return hit;
+}
+
+static void cache_store(csm *c, const char *path, const gi_csm_data *data)
+{
+    if (!path)
+        return;
+    gi_error err;
+    void *bytes = NULL;
+    size_t size = 0;
+    if (gi_csm_data_write(data, &bytes, &size, &err) != GI_OK || gi_file_write_atomic(path, bytes, size, &err) != GI_OK)
+        c->host->log(c->host, GI_LOG_WARN, "csm: not cached: %s", err.text);
+    free(bytes);
+}
+
+/* Maps per gi_depth_render call: 16, or fewer to keep one batch of RGBA32F
+ * layers under 64 MiB. */
+static uint32_t batch_for(int M)
+{
+    uint64_t layer = (uint64_t)M * (uint64_t)M * 16u, batch = 16;
+    if (layer * batch > (64u << 20))
+        batch = (64u << 20) / layer > 0 ? (64u << 20) / layer : 1u;
+    return (uint32_t)batch;
+}
+
+static gi_result load_or_build(csm *c, const gi_gpu_scene *gs, uint32_t k, const float sphere[4], float p0, float p1,
+                               gi_csm_data *data, int *hit)
+{
+    char name[64], *path = NULL;
+    cache_name(c, gs->scene, k, sphere, name, sizeof name);
+    *hit = cache_load(c, name, (uint32_t)c->M, (uint32_t)(c->N * c->N), data, &path);
     if (*hit) {
         free(path);
         return GI_OK;
@@ -131,27 +224,95 @@ static gi_result load_or_build(csm *c, const gi_gpu_scene *gs, uint32_t k, const
                            .n_phi = (uint32_t)c->N,
                            .order = c->order,
                            .z3 = c->z3,
-                           .batch = 16};
-    /* keep one batch of RGBA32F layers under 64 MiB */
-    uint64_t layer = (uint64_t)c->M * (uint64_t)c->M * 16u;
-    if (layer * desc.batch > (64u << 20))
-        desc.batch = (uint32_t)((64u << 20) / layer) > 0 ? (uint32_t)((64u << 20) / layer) : 1u;
-    float p0 = (float)k / (float)c->object_count, p1 = 1.0f / (float)c->object_count;
-    gi_result r = csm_build_object(gs, k, sphere, &desc, host, p0, p1, data, &err);
-    if (r != GI_OK) {
-        free(path);
-        return fail(c, r, err.text);
-    }
-    if (path) {
-        void *bytes = NULL;
-        size_t size = 0;
-        if (gi_csm_data_write(data, &bytes, &size, &err) != GI_OK ||
-            gi_file_write_atomic(path, bytes, size, &err) != GI_OK)
-            host->log(host, GI_LOG_WARN, "csm: not cached: %s", err.text);
-        free(bytes);
-    }
+                           .batch = batch_for(c->M)};
+    gi_error err;
+    gi_result r = csm_build_object(gs, k, sphere, &desc, c->host, p0, p1, data, &err);
+    if (r == GI_OK)
+        cache_store(c, path, data);
     free(path);
-    return GI_OK;
+    return r == GI_OK ? GI_OK : fail(c, r, err.text);
+}
+
+static gi_result load_or_build_local(csm *c, const gi_gpu_scene *gs, uint32_t k, const float sphere[4],
+                                     const csm_local_desc *desc, float p0, float p1, gi_csm_data *data, int *hit)
+{
+    char name[80], *path = NULL;
+    cache_name_local(c, gs->scene, k, sphere, desc, name, sizeof name);
+    *hit = cache_load(c, name, desc->M, 6u * desc->n_u * desc->n_v, data, &path);
+    if (*hit) {
+        free(path);
+        return GI_OK;
+    }
+    gi_error err;
+    gi_result r = csm_build_local(gs, k, sphere, desc, c->host, p0, p1, data, &err);
+    if (r == GI_OK)
+        cache_store(c, path, data);
+    free(path);
+    return r == GI_OK ? GI_OK : fail(c, r, err.text);
+}
+
+/* An object whose vertices all lie in one plane (within 1e-4 of its size):
+ * a receiver-only candidate (§4.6). */
+static int object_is_planar(const gi_scene *s, uint32_t k)
+{
+    const gi_object *o = &s->objects[k];
+    float size = 0.0f;
+    for (int i = 0; i < 3; i++)
+        size = fmaxf(size, o->local_bounds[3 + i] - o->local_bounds[i]);
+    gi_vec3 n = gi_v3(0, 0, 0), p0 = gi_v3(0, 0, 0);
+    for (uint32_t t = o->first_triangle; t < o->first_triangle + o->triangle_count; t++) {
+        gi_vec3 a = gi_v3_load(s->vertices[s->indices[3 * t]].position);
+        gi_vec3 b = gi_v3_load(s->vertices[s->indices[3 * t + 1]].position);
+        gi_vec3 d = gi_v3_load(s->vertices[s->indices[3 * t + 2]].position);
+        gi_vec3 cr = gi_v3_cross(gi_v3_sub(b, a), gi_v3_sub(d, a));
+        if (gi_v3_length(cr) > gi_v3_length(n)) {
+            n = cr;
+            p0 = a;
+        }
+    }
+    if (!(gi_v3_length(n) > 0.0f))
+        return 1;
+    n = gi_v3_normalize(n);
+    for (uint32_t v = o->first_vertex; v < o->first_vertex + o->vertex_count; v++)
+        if (fabsf(gi_v3_dot(gi_v3_sub(gi_v3_load(s->vertices[v].position), p0), n)) > 1e-4f * size)
+            return 0;
+    return 1;
+}
+
+/* Does the world box b (min xyz, max xyz) touch the light's rectangle's
+ * bounding box? Semi-local lights are valid only outside an object's
+ * convex hull (§4.3); the object's box is the conservative stand-in. */
+static int light_in_bounds(const csm_light *l, const float b[6])
+{
+    float lo[3], hi[3];
+    gi_vec3 corners[4] = {l->origin, gi_v3_add(l->origin, l->e1), gi_v3_add(l->origin, l->e2),
+                          gi_v3_add(l->origin, gi_v3_add(l->e1, l->e2))};
+    for (int i = 0; i < 3; i++)
+        lo[i] = FLT_MAX, hi[i] = -FLT_MAX;
+    for (int j = 0; j < 4; j++) {
+        float q[3] = {corners[j].x, corners[j].y, corners[j].z};
+        for (int i = 0; i < 3; i++)
+            lo[i] = fminf(lo[i], q[i]), hi[i] = fmaxf(hi[i], q[i]);
+    }
+    for (int i = 0; i < 3; i++)
+        if (hi[i] < b[i] || lo[i] > b[3 + i])
+            return 0;
+    return 1;
+}
+
+/* World bounds of object k at the transforms in gs. */
+static void object_world_bounds(const gi_gpu_scene *gs, uint32_t k, float out[6])
+{
+    const float *lb = gs->scene->objects[k].local_bounds;
+    for (int i = 0; i < 3; i++)
+        out[i] = FLT_MAX, out[3 + i] = -FLT_MAX;
+    for (int corner = 0; corner < 8; corner++) {
+        gi_vec3 p = gi_v3(lb[(corner & 1) ? 3 : 0], lb[(corner & 2) ? 4 : 1], lb[(corner & 4) ? 5 : 2]);
+        p = gi_mat4_point(gs->world_from_local[k], p);
+        float q[3] = {p.x, p.y, p.z};
+        for (int i = 0; i < 3; i++)
+            out[i] = fminf(out[i], q[i]), out[3 + i] = fmaxf(out[3 + i], q[i]);
+    }
 }
 
 /* §5.1: 256 stratified patterns of S points: jittered strata of a
@@ -194,6 +355,11 @@ static float *make_patterns(int S)
     return p;
 }
 
+static void rect_store(float dst[4], gi_vec3 v, float w)
+{
+    dst[0] = v.x, dst[1] = v.y, dst[2] = v.z, dst[3] = w;
+}
+
 static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
 {
     csm *c = inst;
@@ -207,35 +373,126 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
     c->object_count = s->object_count;
     uint32_t n = s->object_count ? s->object_count : 1u;
     c->objects = calloc(n, sizeof *c->objects);
+    c->casts = calloc(n, 1);
+    c->prepare_transforms = malloc((size_t)n * 16 * sizeof(float));
+    if (c->prepare_transforms)
+        for (uint32_t k = 0; k < c->object_count && k < GI_MAX_OBJECTS; k++)
+            memcpy(c->prepare_transforms + 16 * k, gs->world_from_local[k], 16 * sizeof(float));
     gi_csm_data *data = calloc(n, sizeof *data);
-    if (!c->objects || !data) {
+    if (!c->objects || !c->casts || !c->prepare_transforms || !data) {
         free(data);
         return fail(c, GI_ERR_OUT_OF_MEMORY, "csm: out of memory");
     }
+    /* Lights (§4.2) at the current time; directional lights stay distant. */
+    c->light_count = csm_lights_collect(s, gs->time, (uint32_t)c->n_local, c->linear_aspect, &c->lights);
+    int directional = 0;
+    for (uint32_t i = 0; i < s->light_count; i++)
+        directional |= s->lights[i].type == GI_LIGHT_DIRECTIONAL;
+    int semilocal = c->lights_mode == LIGHTS_SEMILOCAL;
+    c->distant = s->has_environment || directional || (semilocal && c->light_count > 0);
+    int local = !semilocal && c->light_count > 0;
+    uint32_t n_pairs = c->light_count * n;
+    gi_csm_data *ldata = calloc(n_pairs ? n_pairs : 1, sizeof *ldata);
+    csm_gpu_rect *pairs = calloc(n_pairs ? n_pairs : 1, sizeof *pairs);
+    if (!ldata || !pairs) {
+        free(data);
+        free(ldata);
+        free(pairs);
+        return fail(c, GI_ERR_OUT_OF_MEMORY, "csm: out of memory");
+    }
+    uint32_t casters = 0;
+    for (uint32_t k = 0; k < c->object_count; k++) {
+        c->casts[k] = !(c->receivers == RECEIVERS_PLANAR && object_is_planar(s, k));
+        casters += c->casts[k];
+        if (!c->casts[k])
+            host->log(host, GI_LOG_INFO, "object %s is receiver-only (planar)", s->objects[k].name);
+    }
+    /* progress: every build counts as one share */
+    uint32_t builds = (c->distant ? casters : 0) + (local ? casters * c->light_count : 0), done = 0;
+    float share = builds ? 1.0f / (float)builds : 1.0f;
     gi_result r = GI_OK;
-    int hits = 0;
-    uint64_t offsets_total = 0, segments_total = 0, bytes_u = 0, bytes_c = 0;
+    int hits = 0, tries = 0;
+    uint64_t offsets_total = 0, segments_total = 0, bytes_u = 0, bytes_c = 0, maps_local = 0;
+    uint64_t local_segments = 0, local_texels = 0;
     for (uint32_t k = 0; k < c->object_count && r == GI_OK; k++) {
         float sphere[4];
         gi_mesh_object_sphere(s, k, sphere);
         if (!(sphere[3] > 0.0f))
             sphere[3] = 1e-6f; /* a degenerate object: a point; its maps are empty */
+        csm_gpu_object *o = &c->objects[k];
+        memcpy(o->sphere, sphere, sizeof sphere);
+        float b = c->bias * sphere[3];
+        memcpy(&o->bias_bits, &b, sizeof b);
+        if (!c->distant || !c->casts[k])
+            continue; /* M = 0: no orthographic CSM */
         int hit = 0;
-        r = load_or_build(c, gs, k, sphere, &data[k], &hit);
+        r = load_or_build(c, gs, k, sphere, share * (float)done++, share, &data[k], &hit);
         if (r != GI_OK)
             break;
         hits += hit;
-        csm_gpu_object *o = &c->objects[k];
-        memcpy(o->sphere, sphere, sizeof sphere);
+        tries++;
         o->M = (uint32_t)c->M;
         o->offsets_base = (uint32_t)offsets_total;
         o->segments_base = (uint32_t)segments_total;
-        float b = c->bias * sphere[3];
-        memcpy(&o->bias_bits, &b, sizeof b);
         offsets_total += (uint64_t)c->M * (uint64_t)c->M + 1u;
         segments_total += data[k].segment_count;
         bytes_u += data[k].bytes_uncompressed;
         bytes_c += data[k].bytes_compressed;
+    }
+    /* Cube-map CSMs per (light, object) (§4.2, §4.6), or the semi-local
+     * validity flags (§4.3). */
+    for (uint32_t j = 0; j < c->light_count && r == GI_OK; j++) {
+        const csm_light *l = &c->lights[j];
+        for (uint32_t k = 0; k < c->object_count && r == GI_OK; k++) {
+            csm_gpu_rect *pr = &pairs[j * n + k];
+            int shadows = c->casts[k] && l->object != (int)k;
+            if (shadows && semilocal) {
+                float wb[6];
+                object_world_bounds(gs, k, wb);
+                if (light_in_bounds(l, wb)) {
+                    host->log(host, GI_LOG_WARN,
+                              "semi-local light %u lies inside the bounds of object %s, which then casts no "
+                              "shadow of it (semi-local lights are valid outside an object's convex hull only)",
+                              j, s->objects[k].name);
+                    shadows = 0;
+                }
+            }
+            float local_from_world[16];
+            if (!gi_mat4_invert(local_from_world, gs->world_from_local[k]))
+                gi_mat4_identity(local_from_world);
+            csm_local_desc desc = {.M = (uint32_t)c->m_local,
+                                   .o = gi_mat4_point(local_from_world, l->origin),
+                                   .e1 = gi_mat4_dir(local_from_world, l->e1),
+                                   .e2 = gi_mat4_dir(local_from_world, l->e2),
+                                   .n_u = l->n_u,
+                                   .n_v = l->n_v,
+                                   .order = c->light_order,
+                                   .z3 = c->z3,
+                                   .batch = batch_for(c->m_local)};
+            rect_store(pr->o, desc.o, shadows ? 1.0f : 0.0f);
+            rect_store(pr->e1, desc.e1, 0.0f);
+            rect_store(pr->e2, desc.e2, 0.0f);
+            memcpy(&pr->info[3], &c->objects[k].bias_bits, 4);
+            if (!shadows || !local)
+                continue;
+            gi_csm_data *d = &ldata[j * n + k];
+            int hit = 0;
+            r = load_or_build_local(c, gs, k, c->objects[k].sphere, &desc, share * (float)done++, share, d, &hit);
+            if (r != GI_OK)
+                break;
+            hits += hit;
+            tries++;
+            pr->info[0] = desc.M;
+            pr->info[1] = (uint32_t)offsets_total;
+            pr->info[2] = (uint32_t)segments_total;
+            offsets_total += (uint64_t)desc.M * desc.M + 1u;
+            segments_total += d->segment_count;
+            local_segments += d->segment_count;
+            local_texels += (uint64_t)desc.M * desc.M;
+            maps_local += d->N;
+            bytes_u += d->bytes_uncompressed;
+            bytes_c += d->bytes_compressed;
+        }
     }
     if (r == GI_OK && (offsets_total > UINT32_MAX || segments_total > UINT32_MAX))
         r = fail(c, GI_ERR_UNSUPPORTED, "csm: more than 2^32 segments in all");
@@ -247,19 +504,54 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
         uint32_t cells_n = (uint32_t)(c->N * c->N);
         uint32_t *cells = malloc(cells_n * sizeof *cells);
         float *patterns = make_patterns(c->S);
-        if (!offsets || !z || !iend || !cells || !patterns)
+        uint32_t lcells_n = n;
+        for (uint32_t j = 0; j < c->light_count; j++)
+            lcells_n += c->lights[j].n_u * c->lights[j].n_v;
+        uint32_t *lcells = malloc(lcells_n * sizeof *lcells);
+        csm_gpu_rect *lrec = calloc(c->light_count ? c->light_count : 1, sizeof *lrec);
+        if (!offsets || !z || !iend || !cells || !patterns || !lcells || !lrec)
             r = fail(c, GI_ERR_OUT_OF_MEMORY, "csm: out of memory for the upload");
         for (uint32_t k = 0; r == GI_OK && k < c->object_count; k++) {
+            if (!c->objects[k].M)
+                continue;
             size_t m2 = (size_t)c->M * (size_t)c->M + 1u;
             memcpy(offsets + c->objects[k].offsets_base, data[k].offsets, m2 * sizeof *offsets);
             memcpy(z + c->objects[k].segments_base, data[k].z_avg, data[k].segment_count * sizeof *z);
             memcpy(iend + c->objects[k].segments_base, data[k].i_end, data[k].segment_count * sizeof *iend);
         }
+        for (uint32_t q = 0; r == GI_OK && q < n_pairs; q++) {
+            if (!pairs[q].info[0])
+                continue;
+            size_t m2 = (size_t)pairs[q].info[0] * pairs[q].info[0] + 1u;
+            memcpy(offsets + pairs[q].info[1], ldata[q].offsets, m2 * sizeof *offsets);
+            memcpy(z + pairs[q].info[2], ldata[q].z_avg, ldata[q].segment_count * sizeof *z);
+            memcpy(iend + pairs[q].info[2], ldata[q].i_end, ldata[q].segment_count * sizeof *iend);
+        }
         for (uint32_t b = 0; r == GI_OK && b < (uint32_t)c->N; b++)
             for (uint32_t a = 0; a < (uint32_t)c->N; a++)
                 cells[b * (uint32_t)c->N + a] = gi_csm_order_index(c->order, (uint32_t)c->N, (uint32_t)c->N, a, b);
         if (r == GI_OK) {
-            glCreateBuffers(6, c->ssbo);
+            /* object -> light, then each light's grid cells -> enumeration index */
+            for (uint32_t k = 0; k < n; k++)
+                lcells[k] = 0xFFFFFFFFu;
+            uint32_t base = n;
+            for (uint32_t j = 0; j < c->light_count; j++) {
+                const csm_light *l = &c->lights[j];
+                if (l->object >= 0)
+                    lcells[l->object] = j;
+                rect_store(lrec[j].o, l->origin, (float)l->kind);
+                rect_store(lrec[j].e1, l->e1, 0.0f);
+                rect_store(lrec[j].e2, l->e2, 0.0f);
+                lrec[j].info[0] = l->n_u;
+                lrec[j].info[1] = l->n_v;
+                lrec[j].info[2] = base;
+                lrec[j].info[3] = l->object >= 0 ? (uint32_t)l->object : 0x80000000u | (uint32_t)l->punctual;
+                for (uint32_t b = 0; b < l->n_v; b++)
+                    for (uint32_t a = 0; a < l->n_u; a++)
+                        lcells[base + b * l->n_u + a] = gi_csm_order_index(c->light_order, l->n_u, l->n_v, a, b);
+                base += l->n_u * l->n_v;
+            }
+            glCreateBuffers(9, c->ssbo);
             glNamedBufferStorage(c->ssbo[0], (GLsizeiptr)(n * sizeof *c->objects), c->objects,
                                  GL_DYNAMIC_STORAGE_BIT);
             glNamedBufferStorage(c->ssbo[1], (GLsizeiptr)((offsets_total ? offsets_total : 1) * 4), offsets, 0);
@@ -267,6 +559,10 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
             glNamedBufferStorage(c->ssbo[3], (GLsizeiptr)((segments_total ? segments_total : 1) * 4), iend, 0);
             glNamedBufferStorage(c->ssbo[4], (GLsizeiptr)(cells_n * 4), cells, 0);
             glNamedBufferStorage(c->ssbo[5], (GLsizeiptr)(CSM_PATTERNS * (size_t)c->S * 8), patterns, 0);
+            glNamedBufferStorage(c->ssbo[6], (GLsizeiptr)((c->light_count ? c->light_count : 1) * sizeof *lrec), lrec,
+                                 0);
+            glNamedBufferStorage(c->ssbo[7], (GLsizeiptr)((n_pairs ? n_pairs : 1) * sizeof *pairs), pairs, 0);
+            glNamedBufferStorage(c->ssbo[8], (GLsizeiptr)(lcells_n * 4), lcells, 0);
             if (gi_gl_check("csm: upload", &err) != GI_OK)
                 r = fail(c, GI_ERR_GL, err.text);
         }
@@ -275,20 +571,34 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
         free(iend);
         free(cells);
         free(patterns);
+        free(lcells);
+        free(lrec);
         host->stage_end(host, "upload");
     }
     for (uint32_t k = 0; k < c->object_count; k++)
         gi_csm_data_free(&data[k]);
+    for (uint32_t q = 0; q < n_pairs; q++)
+        gi_csm_data_free(&ldata[q]);
     free(data);
+    free(ldata);
+    free(pairs);
     if (r != GI_OK)
         return r;
-    double texels = (double)c->object_count * (double)c->M * (double)c->M;
+    uint32_t distant_objects = 0;
+    for (uint32_t k = 0; k < c->object_count; k++)
+        distant_objects += c->objects[k].M != 0;
+    double texels = (double)distant_objects * (double)c->M * (double)c->M;
+    uint64_t distant_segments = segments_total - local_segments;
     host->stat(host, "bytes_uncompressed", (double)bytes_u);
     host->stat(host, "bytes_compressed", (double)bytes_c);
     host->stat(host, "ratio", bytes_c ? (double)bytes_u / (double)bytes_c : 0.0);
-    host->stat(host, "segments_per_texel", texels > 0 ? (double)segments_total / texels : 0.0);
-    host->stat(host, "maps", (double)c->object_count * c->N * c->N);
-    host->stat(host, "cache_hit", c->object_count > 0 && hits == (int)c->object_count ? 1.0 : 0.0);
+    host->stat(host, "segments_per_texel", texels > 0 ? (double)distant_segments / texels : 0.0);
+    host->stat(host, "maps", (double)distant_objects * c->N * c->N);
+    host->stat(host, "maps_local", (double)maps_local);
+    host->stat(host, "segments_per_texel_local", local_texels ? (double)local_segments / (double)local_texels : 0.0);
+    host->stat(host, "lights", (double)c->light_count);
+    host->stat(host, "receiver_only_objects", (double)(c->object_count - casters));
+    host->stat(host, "cache_hit", tries > 0 && hits == tries ? 1.0 : 0.0);
     return GI_OK;
 }
 
@@ -298,6 +608,27 @@ static gi_result csm_update(void *inst, const gi_gpu_scene *scene, const gi_chan
     c->scene = scene;
     if (changes->flags)
         c->frames = 0;
+    /* §4.2: fixed local lights hold only while lights and objects stay where
+     * they were at prepare time; say so once when something moved. */
+    if (c->lights_mode == LIGHTS_LOCAL && c->light_count > 0 && !c->warned_moved &&
+        (changes->flags & (GI_CHANGED_TRANSFORMS | GI_CHANGED_LIGHTS))) {
+        int moved = 0;
+        for (uint32_t k = 0; k < c->object_count && k < GI_MAX_OBJECTS; k++)
+            moved |= memcmp(c->prepare_transforms + 16 * k, scene->world_from_local[k], 16 * sizeof(float)) != 0;
+        for (uint32_t j = 0; j < c->light_count; j++) {
+            const csm_light *l = &c->lights[j];
+            if (l->punctual >= 0) {
+                gi_light_frame f = gi_scene_light_at(scene->scene, (uint32_t)l->punctual, scene->time);
+                moved |= gi_v3_length(gi_v3_sub(f.position, l->origin)) > 0.0f;
+            }
+        }
+        if (moved) {
+            c->host->log(c->host, GI_LOG_WARN,
+                         "objects or lights moved since the precomputation; fixed local lights' cube maps are "
+                         "not rebuilt (their shadows are those of the first frame's placement); use lights=semilocal");
+            c->warned_moved = 1;
+        }
+    }
     return GI_OK;
 }
 
@@ -351,8 +682,9 @@ static gi_result csm_render(void *inst, const gi_view *view, const gi_target *ta
     glUseProgram(p);
     gi_gpu_scene_bind(c->scene);
     gi_gbuffer_bind(c->gbuffer, GI_BINDING_PLUGIN_FIRST);
-    static const GLuint bindings[6] = {B_OBJECTS, B_OFFSETS, B_ZAVG, B_IEND, B_CELLS, B_PATTERNS};
-    for (int i = 0; i < 6; i++)
+    static const GLuint bindings[9] = {B_OBJECTS, B_OFFSETS, B_ZAVG, B_IEND, B_CELLS, B_PATTERNS, B_LIGHTS, B_PAIRS,
+                                       B_LIGHT_CELLS};
+    for (int i = 0; i < 9; i++)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, bindings[i], c->ssbo[i]);
     glBindImageTexture(0, c->accum, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
     glBindImageTexture(1, target->texture, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
@@ -367,6 +699,10 @@ static gi_result csm_render(void *inst, const gi_view *view, const gi_target *ta
     glUniform1ui(glGetUniformLocation(p, "csm_object_count"), c->object_count);
     glUniform1f(glGetUniformLocation(p, "csm_normal_offset"), c->normal_offset);
     glUniform1i(glGetUniformLocation(p, "csm_filter"), c->filter);
+    glUniform1ui(glGetUniformLocation(p, "csm_light_count"), c->light_count);
+    glUniform1i(glGetUniformLocation(p, "csm_semilocal"), c->lights_mode == LIGHTS_SEMILOCAL);
+    glUniform1f(glGetUniformLocation(p, "csm_normal_offset_local"), c->normal_offset_local);
+    glUniform1i(glGetUniformLocation(p, "u_distant"), c->distant);
     glDispatchCompute((view->width + 7) / 8, (view->height + 7) / 8, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
                     GL_FRAMEBUFFER_BARRIER_BIT);
@@ -374,6 +710,8 @@ static gi_result csm_render(void *inst, const gi_view *view, const gi_target *ta
     c->host->stage_end(c->host, "render");
     c->frames++;
     c->host->stat(c->host, "samples_per_pixel_env", (double)c->frames * c->S);
+    if (c->scene->emitter_count)
+        c->host->stat(c->host, "samples_per_pixel_area", (double)c->frames * c->S);
     if (gi_gl_check("csm: shading pass", &err) != GI_OK)
         return fail(c, GI_ERR_GL, err.text);
     return GI_OK;
@@ -388,10 +726,13 @@ static void csm_destroy(void *inst)
     if (c->accum)
         glDeleteTextures(1, &c->accum);
     if (c->ssbo[0])
-        glDeleteBuffers(6, c->ssbo);
+        glDeleteBuffers(9, c->ssbo);
     if (c->program)
         glDeleteProgram(c->program);
     free(c->objects);
+    free(c->casts);
+    free(c->prepare_transforms);
+    free(c->lights);
     free(c);
 }
 
@@ -404,11 +745,12 @@ static const gi_method csm_method = {
     .struct_size = sizeof(gi_method),
     .abi_version = GI_ABI_VERSION,
     .id = "csm",
-    .title = "Coherent Shadow Maps (distant light)",
+    .title = "Coherent Shadow Maps",
     .citation = "Ritschel, Grosch, Kautz, Mueller. Interactive Illumination with Coherent Shadow Maps. EGSR 2007",
-    .version = "0.1",
-    .caps = GI_CAP_DIRECT | GI_CAP_ENVIRONMENT | GI_CAP_GLOSSY | GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE |
-            GI_CAP_PRECOMPUTE | GI_CAP_RIGID_MOTION | GI_CAP_TEXTURES,
+    .version = "0.2",
+    .caps = GI_CAP_DIRECT | GI_CAP_ENVIRONMENT | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL |
+            GI_CAP_GLOSSY | GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE | GI_CAP_PRECOMPUTE | GI_CAP_RIGID_MOTION |
+            GI_CAP_TEXTURES,
     .max_bounces = 0,
     .params = csm_params,
     .create = csm_create,

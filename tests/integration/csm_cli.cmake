@@ -48,6 +48,71 @@ expect(2 "csm: " ${args} --param enumeration=spiral --out ${OUT}/x.exr)
 expect(2 "csm: S=0 is outside" ${args} --param S=0 --out ${OUT}/x.exr)
 expect(2 "csm: unknown parameter 'K'" ${args} --param K=3 --out ${OUT}/x.exr)
 
+# Local lights (§4.2): the teapot's area light and the cross scene's linear
+# and point lights; cube maps cached per (light, object), keyed on the
+# light's geometry.
+set(lcache ${OUT}/csm_cache_local)
+file(REMOVE_RECURSE ${lcache})
+file(MAKE_DIRECTORY ${lcache})
+set(ENV{GIBENCH_CACHE} ${lcache})
+set(largs render --method csm --size 32x32 --frames 2 --param M_local=32)
+expect(0 "" ${largs} --param N_local=2 --scene ${SCENES}/teapot_area.glb --out ${OUT}/csm_teapot_area.exr
+       --timings ${OUT}/csm_teapot_area.json)
+expect_json(${OUT}/csm_teapot_area.json "\"nonfinite_pixels\": 0" "\"cache_hit\": 0" "\"lights\": 1"
+            "\"maps\": 0" "\"maps_local\": 48" "\"depth_render\"" "\"compress\"" "\"upload\"")
+expect(0 "" ${largs} --param N_local=2 --scene ${SCENES}/teapot_area.glb --out ${OUT}/csm_teapot_area2.exr
+       --timings ${OUT}/csm_teapot_area2.json)
+expect_json(${OUT}/csm_teapot_area2.json "\"cache_hit\": 1")
+# receivers=planar: the ground and the (planar) light get no CSM: 24 cube
+# faces of the teapot only
+expect(0 "receiver-only" -v ${largs} --param N_local=2 --scene ${SCENES}/teapot_area.glb --param receivers=planar
+       --out ${OUT}/csm_teapot_planar.exr --timings ${OUT}/csm_teapot_planar.json)
+expect_json(${OUT}/csm_teapot_planar.json "\"receiver_only_objects\": 2" "\"maps_local\": 24")
+# semi-local: the orthographic maps (teapot, ground, light: 3 x 16), no cube maps
+expect(0 "" ${largs} --param N_local=2 --scene ${SCENES}/teapot_area.glb --param lights=semilocal --param N=4 --param M=32
+       --param filter=pcf --out ${OUT}/csm_teapot_semi.exr --timings ${OUT}/csm_teapot_semi.json)
+expect_json(${OUT}/csm_teapot_semi.json "\"nonfinite_pixels\": 0" "\"maps\": 48" "\"maps_local\": 0")
+# the Cornell box in semi-local mode: the light lies inside the walls' bounds
+expect(0 "inside the bounds of object walls" ${largs} --param N_local=2 --scene ${SCENES}/cornell_box.gltf --param lights=semilocal
+       --param N=4 --param M=32 --out ${OUT}/csm_cornell_semi.exr)
+# linear (4 x 1 points: 24 faces for ground, box_a, box_b) and point light
+# (6 faces for those and the bar); rr filter, hilbert order
+set(DATA ${SCENES}/../tests/data/valid)
+expect(0 "" ${largs} --param N_local=4 --scene ${DATA}/csm_cross.glb --param filter=rr
+       --param light_enumeration=hilbert --out ${OUT}/csm_cross.exr --timings ${OUT}/csm_cross.json)
+expect_json(${OUT}/csm_cross.json "\"nonfinite_pixels\": 0" "\"lights\": 2" "\"maps_local\": 96")
+file(GLOB before ${lcache}/csm-local-*.bin)
+list(LENGTH before n_before)
+# the same meshes with the point light moved: the linear light's maps hit,
+# the point light's 4 are new
+expect(0 "" ${largs} --param N_local=4 --scene ${DATA}/csm_cross_moved.glb --param filter=rr
+       --param light_enumeration=hilbert --out ${OUT}/csm_cross_moved.exr --timings ${OUT}/csm_cross_moved.json)
+expect_json(${OUT}/csm_cross_moved.json "\"cache_hit\": 0")
+file(GLOB after ${lcache}/csm-local-*.bin)
+list(LENGTH after n_after)
+math(EXPR added "${n_after} - ${n_before}")
+if(NOT added EQUAL 4)
+    message(SEND_ERROR "moving the point light should add 4 cube-map cache files, added ${added}")
+    math(EXPR failures "${failures} + 1")
+endif()
+# a linear_aspect above the bar's 30 : 1 makes it an area light (4 x 4)
+expect(0 "" ${largs} --param N_local=4 --param linear_aspect=50 --scene ${DATA}/csm_cross.glb
+       --out ${OUT}/csm_cross_area.exr --timings ${OUT}/csm_cross_area.json)
+expect_json(${OUT}/csm_cross_area.json "\"maps_local\": 312")
+
+# an animated scene under fixed local lights: one warning that the cube maps
+# are not rebuilt
+expect(0 "fixed local lights' cube maps are not rebuilt" ${largs} --param N_local=2 --scene ${SCENES}/cornell_moving.gltf
+       --animate 4 --out ${OUT}/csm_moving.exr)
+
+expect(2 "csm: " ${largs} --param N_local=2 --scene ${SCENES}/teapot_area.glb --param lights=distant --out ${OUT}/x.exr)
+expect(2 "csm: N_local=0 is outside" ${largs} --scene ${SCENES}/teapot_area.glb --param N_local=0 --out ${OUT}/x.exr)
+expect(2 "csm: M_local=4 is outside" render --method csm --size 32x32 --scene ${SCENES}/teapot_area.glb --param M_local=4 --out ${OUT}/x.exr)
+expect(2 "csm: " ${largs} --param N_local=2 --scene ${SCENES}/teapot_area.glb --param light_enumeration=spiral --out ${OUT}/x.exr)
+expect(2 "csm: linear_aspect=0.5 is outside" ${largs} --param N_local=2 --scene ${SCENES}/teapot_area.glb --param linear_aspect=0.5
+       --out ${OUT}/x.exr)
+expect(2 "csm: " ${largs} --param N_local=2 --scene ${SCENES}/teapot_area.glb --param receivers=all --out ${OUT}/x.exr)
+
 if(failures GREATER 0)
     message(FATAL_ERROR "${failures} csm command-line expectation(s) failed")
 endif()

@@ -344,10 +344,11 @@ static void test_orders(void)
 {
     uint32_t sizes[][2] = {{1, 1},  {2, 3},   {3, 2},  {8, 8}, {13, 7},
                            {7, 13}, {32, 32}, {16, 4}, {5, 5}, {64, 64}};
-    gi_csm_order orders[] = {GI_CSM_ORDER_SCANLINE, GI_CSM_ORDER_ZIGZAG, GI_CSM_ORDER_HILBERT};
+    gi_csm_order orders[] = {GI_CSM_ORDER_SCANLINE, GI_CSM_ORDER_ZIGZAG, GI_CSM_ORDER_HILBERT,
+                             GI_CSM_ORDER_DIAGONAL};
     for (size_t s = 0; s < sizeof sizes / sizeof sizes[0]; s++) {
         uint32_t na = sizes[s][0], nb = sizes[s][1], n = na * nb;
-        for (size_t o = 0; o < 3; o++) {
+        for (size_t o = 0; o < 4; o++) {
             unsigned char *seen = calloc(n, 1);
             int bijective = 1;
             uint32_t adjacent = 0, pa = 0, pb = 0;
@@ -378,6 +379,41 @@ static void test_orders(void)
             free(seen);
         }
     }
+    /* The diagonal zig-zag (§4.4, Fig. 8 right): a bijection on every size
+     * up to 40 x 40 whose every step goes to one of the 8 neighbours
+     * (coherent), and on 8 x 8 the JPEG zig-zag scan. */
+    static const uint8_t jpeg[16] = {0, 1, 8, 16, 9, 2, 3, 10, 17, 24, 32, 25, 18, 11, 4, 5};
+    for (uint32_t k = 0; k < 16; k++) {
+        uint32_t a, b;
+        gi_csm_order_cell(GI_CSM_ORDER_DIAGONAL, 8, 8, k, &a, &b);
+        CHECK_MSG(b * 8 + a == jpeg[k], "diagonal 8x8 step %u: (%u, %u)", k, a, b);
+    }
+    int diagonal_ok = 1;
+    for (uint32_t na = 1; na <= 40 && diagonal_ok; na++) {
+        for (uint32_t nb = 1; nb <= 40 && diagonal_ok; nb++) {
+            unsigned char *seen = calloc((size_t)na * nb, 1);
+            uint32_t pa = 0, pb = 0;
+            for (uint32_t k = 0; k < na * nb; k++) {
+                uint32_t a = na, b = nb;
+                gi_csm_order_cell(GI_CSM_ORDER_DIAGONAL, na, nb, k, &a, &b);
+                int da = abs((int)a - (int)pa), db = abs((int)b - (int)pb);
+                if (a >= na || b >= nb || seen[b * na + a] ||
+                    gi_csm_order_index(GI_CSM_ORDER_DIAGONAL, na, nb, a, b) != k ||
+                    (k > 0 && (da > 1 || db > 1 || da + db == 0)) || (k == 0 && (a || b))) {
+                    diagonal_ok = 0;
+                    printf("diagonal %ux%u fails at step %u: (%u, %u)\n", na, nb, k, a, b);
+                    break;
+                }
+                seen[b * na + a] = 1;
+                pa = a;
+                pb = b;
+            }
+            free(seen);
+        }
+    }
+    CHECK(diagonal_ok);
+    gi_csm_order parsed;
+    CHECK(gi_csm_order_parse("diagonal", &parsed) && parsed == GI_CSM_ORDER_DIAGONAL);
     /* Every size up to 40 x 40: Hilbert steps are between neighbours except
      * at most one diagonal step, and only where the longer side is odd and
      * the shorter even. */

@@ -17,8 +17,17 @@
  *             every step is between grid neighbours except, when the longer
  *             side is odd and the shorter even (4 x 5, 32 x 33), at most one
  *             diagonal step (the test checks every size up to 40 x 40).
+ *   DIAGONAL  the zig-zag area curve (JPEG-style): the anti-diagonals
+ *             a + b = s in increasing s, even s with a increasing, odd s
+ *             with a decreasing, starting at (0, 0); every step goes to one
+ *             of the 8 neighbours (a diagonal step inside an anti-diagonal,
+ *             an axis step between two). The paper's Fig. 8 (right) names a
+ *             "zig-zag area curve" for area lights without defining it in
+ *             the text; ZIGZAG (rows) and DIAGONAL (anti-diagonals) are the
+ *             two usual readings, and both are offered.
  * Both directions are O(log(N_a N_b)) (HILBERT descends the same recursive
- * split as the generator), with no tables and no state.
+ * split as the generator; DIAGONAL is closed-form per anti-diagonal), with
+ * no tables and no state.
  */
 #ifndef GI_CSM_ORDER_H
 #define GI_CSM_ORDER_H
@@ -33,9 +42,10 @@ typedef enum gi_csm_order {
     GI_CSM_ORDER_SCANLINE = 0,
     GI_CSM_ORDER_ZIGZAG = 1,
     GI_CSM_ORDER_HILBERT = 2,
+    GI_CSM_ORDER_DIAGONAL = 3,
 } gi_csm_order;
 
-/* "scanline", "zigzag", "hilbert". */
+/* "scanline", "zigzag", "hilbert", "diagonal". */
 const char *gi_csm_order_name(gi_csm_order order);
 /* Parses a name as above; returns 0 if unknown. */
 int gi_csm_order_parse(const char *name, gi_csm_order *out);

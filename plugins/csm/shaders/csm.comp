@@ -1,12 +1,16 @@
-// Coherent Shadow Maps, distant light (environment map), §5: per G-buffer
-// pixel S samples of the environment, visibility from the CSMs of all
-// objects, progressive average over frames (plugins/csm/csm.c).
+// Coherent Shadow Maps, §5: per G-buffer pixel S samples of the environment
+// and S samples of the area lights, every point/spot and directional light
+// once, visibility from the CSMs of all objects (orthographic maps for
+// distant and semi-local light, cube maps for local light), progressive
+// average over frames (plugins/csm/csm.c).
 #include "scene.glsl"
 #include "brdf.glsl"
 #include "sampling.glsl"
 #include "rng.glsl"
 #include "envmap.glsl"
+#include "lights.glsl"
 #include "csm_query.glsl"
+#include "csm_local.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -15,6 +19,7 @@ layout(binding = 9) uniform sampler2D g_normal;
 layout(binding = 10) uniform sampler2D g_albedo;
 layout(binding = 11) uniform sampler2D g_phong;
 layout(binding = 12) uniform sampler2D g_emission;
+layout(binding = 13) uniform usampler2D g_ids;
 layout(rgba32f, binding = 0) uniform image2D u_accum;
 layout(rgba32f, binding = 1) uniform writeonly image2D u_target;
 
@@ -27,6 +32,7 @@ uniform ivec2 u_size;
 uniform uint u_frame; // frames already in the average
 uniform uint u_seed;
 uniform int u_S;
+uniform int u_distant; // 1: the objects have orthographic CSMs
 
 // §5.1: diffuse surfaces draw from the environment's radiance CDF, specular
 // ones from the Phong lobe; a surface with both picks the lobe by Russian
@@ -75,6 +81,84 @@ vec3 environment(gi_brdf b, vec3 x, vec3 N, vec3 wo, uint pattern, vec2 cp, inou
     return sum / float(u_S);
 }
 
+// §5.1 "Sampling local illumination": area lights by their radiance
+// distribution (an emissive triangle by power from the core's emitter CDF,
+// then a uniform point on it, both from one stratified pattern point),
+// visibility by the CSM of the light the triangle belongs to.
+vec3 area_lights(gi_brdf b, vec3 x, vec3 N, vec3 wo, uint own, uint pattern, vec2 cp, inout uint rng)
+{
+    vec3 sum = vec3(0.0);
+    for (int s = 0; s < u_S; s++) {
+        vec2 u = fract(csm_patterns[pattern * uint(u_S) + uint(s)] + cp);
+        // u.x picks the triangle and, rescaled within its CDF interval,
+        // the point on it, so the pattern's strata cover the whole light
+        uint e = gi_emitter_find(u.x);
+        GiEmitter em = gi_emitters[e];
+        float cdf0 = e > 0u ? gi_emitters[e - 1u].cdf : 0.0;
+        float ux = em.pdf > 0.0 ? clamp((u.x - cdf0) / em.pdf, 0.0, 0.99999994) : 0.0;
+        vec3 p0, p1, p2;
+        gi_triangle_world(em.triangle, p0, p1, p2);
+        vec3 bc = gi_sample_uniform_triangle(ux, u.y);
+        vec3 y = bc.x * p0 + bc.y * p1 + bc.z * p2;
+        vec3 ng = cross(p1 - p0, p2 - p0);
+        float area = 0.5 * length(ng);
+        if (area <= 0.0 || em.pdf <= 0.0)
+            continue;
+        vec3 d = y - x;
+        float dist2 = dot(d, d);
+        vec3 w = d * inversesqrt(dist2);
+        float cos_x = dot(N, w);
+        GiMaterial lm = gi_materials[gi_triangle_material(em.triangle)];
+        float cos_y = gi_emitter_cos(ng / (2.0 * area), w, (lm.flags & 2u) != 0u);
+        if (cos_x <= 0.0 || cos_y <= 0.0)
+            continue;
+        uint j = csm_light_cells[gi_vertices[gi_indices[3u * em.triangle]].object];
+        float v = j < csm_light_count ? csm_light_visibility(j, x, N, y, own, rng) : 1.0;
+        if (v > 0.0)
+            sum += gi_brdf_eval(b, N, wo, w) * lm.emission * cos_x * cos_y * v * area / (dist2 * em.pdf);
+    }
+    return sum / float(u_S);
+}
+
+// Point, spot (cube maps at one point, or semi-local) and directional
+// lights (orthographic maps), each once per frame.
+vec3 punctual_lights(gi_brdf b, vec3 x, vec3 N, vec3 wo, uint own, inout uint rng)
+{
+    vec3 sum = vec3(0.0);
+    for (uint i = 0u; i < gi_light_count(); i++) {
+        GiLight l = gi_lights[i];
+        vec3 w, E;
+        if (l.type == GI_LIGHT_DIRECTIONAL) {
+            w = -l.direction;
+            E = l.intensity;
+        } else {
+            vec3 d = l.position - x;
+            float dist = length(d);
+            w = d / dist;
+            E = l.intensity * gi_range_window(dist, l.range) / (dist * dist);
+            if (l.type == GI_LIGHT_SPOT)
+                E *= gi_spot_falloff(dot(-w, l.direction), l.cos_inner, l.cos_outer);
+        }
+        float c = dot(N, w);
+        if (c <= 0.0 || all(equal(E, vec3(0.0))))
+            continue;
+        float v = 1.0;
+        if (l.type == GI_LIGHT_DIRECTIONAL) {
+            if (u_distant != 0)
+                v = csm_visibility(x, N, w, rng);
+        } else {
+            for (uint j = 0u; j < csm_light_count; j++)
+                if (csm_lights[j].info.w == (0x80000000u | i)) {
+                    v = csm_light_visibility(j, x, N, l.position, own, rng);
+                    break;
+                }
+        }
+        if (v > 0.0)
+            sum += gi_brdf_eval(b, N, wo, w) * E * c * v;
+    }
+    return sum;
+}
+
 void main()
 {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
@@ -103,6 +187,10 @@ void main()
         L = texelFetch(g_emission, px, 0).rgb;
         if (gi_has_environment())
             L += environment(b, x, N, wo, pattern, cp, rng);
+        uint own = texelFetch(g_ids, px, 0).x;
+        if (gi_emitter_count() > 0u)
+            L += area_lights(b, x, N, wo, own, (pattern + 97u) & 255u, cp, rng);
+        L += punctual_lights(b, x, N, wo, own, rng);
     } else if (gi_has_environment()) {
         vec2 ndc = (vec2(px) + 0.5) / vec2(u_size) * 2.0 - 1.0;
         vec4 far_point = u_inv_view_proj * vec4(ndc, 1.0, 1.0);

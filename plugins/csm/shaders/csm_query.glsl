@@ -3,7 +3,8 @@
 //   binding 8  CsmObjects  per object: local_from_world and world_from_local
 //                          at the current time (§4.6: queries in local space),
 //                          bounding sphere (local), info = (M, offsets base,
-//                          segments base, bias in local units)
+//                          segments base, bias in local units); M = 0: the
+//                          object has no CSM (receiver-only, §4.6)
 //   binding 9  offsets     all objects' offsets[M^2 + 1], concatenated
 //   binding 10 z_avg       all objects' segments, concatenated
 //   binding 11 i_end
@@ -33,20 +34,26 @@ uniform uint csm_object_count;
 uniform float csm_normal_offset;
 uniform int csm_filter;
 
-// §3.2: the z_avg of the segment of texel (x, y) of object k that holds map i.
-float csm_lookup(CsmObject o, uint M, ivec2 tex, uint i)
+// §3.2: the z_avg of the segment of texel (x, y) that holds map i, in the
+// CSM whose offsets and segments start at offsets_base and segments_base.
+float csm_lookup_at(uint offsets_base, uint segments_base, uint M, ivec2 tex, uint i)
 {
     uint t = uint(tex.y) * M + uint(tex.x);
-    uint lo = csm_offsets[o.info.y + t], hi = csm_offsets[o.info.y + t + 1u];
+    uint lo = csm_offsets[offsets_base + t], hi = csm_offsets[offsets_base + t + 1u];
     // first segment j in [lo, hi) with i_end[j] >= i (the last one has N - 1)
     while (lo < hi) {
         uint mid = (lo + hi) >> 1;
-        if (csm_i_end[o.info.z + mid] < i)
+        if (csm_i_end[segments_base + mid] < i)
             lo = mid + 1u;
         else
             hi = mid;
     }
-    return csm_z_avg[o.info.z + lo];
+    return csm_z_avg[segments_base + lo];
+}
+
+float csm_lookup(CsmObject o, uint M, ivec2 tex, uint i)
+{
+    return csm_lookup_at(o.info.y, o.info.z, M, tex, i);
 }
 
 // One depth test: texel (x, y) of map (a, b); outside the map is lit.
@@ -65,6 +72,8 @@ float csm_test(CsmObject o, uint a, uint b, ivec2 tex, float depth)
 float csm_visibility_object(uint k, vec3 x, vec3 n, vec3 w, int mode, float u_rr)
 {
     CsmObject o = csm_objects[k];
+    if (o.info.x == 0u)
+        return 1.0; // receiver-only object: no CSM
     float M = float(o.info.x);
     vec3 xl = (o.local_from_world * vec4(x, 1.0)).xyz;
     vec3 wl = normalize(mat3(o.local_from_world) * w);

@@ -1,0 +1,616 @@
+/* The csm plugin's local lights (Ritschel et al. 2007 §4.2, §3.3, §4.6)
+ * against exact ray casting, and the GLSL cube-map query against its CPU
+ * twin:
+ *  - teapot_area.glb and cornell_box.gltf: the lights found (one area light
+ *    each), every caster's cube-map CSM (N_local = 4 x 4 points, M = 64,
+ *    diagonal order), random point-light-point pairs (x in a box around
+ *    the casters, points inside closed objects left out, y uniform on the
+ *    light): nearest-filter CSM visibility (product over the objects, §4.6)
+ *    against brute-force ray casting of the segment x-y, and of the segment
+ *    to the snapped grid point (isolating the depth/codec path from the
+ *    discretisation of the light, §4.5); disagreements are classified as
+ *    near a silhouette when moving x by two texels changes the exact answer;
+ *  - tests/data/valid/csm_cross.glb: two boxes and the ground under a
+ *    linear light and a point light; receiver points on every surface; the
+ *    CSM must agree with ray casting where box A shadows box B (linear
+ *    light), where B shadows A (point light), and where the boxes shadow
+ *    the ground; the linear light must be found as linear (d = 1);
+ *  - the GLSL query (shaders/csm_local.glsl) on the same data as the plugin
+ *    uploads it: nearest equals the CPU product, and Russian roulette
+ *    averaged over 256 stratified numbers equals generalised PCF. */
+#include "../../plugins/csm/csm_local.h"
+
+#include "gi/mesh.h"
+#include "gi/rng.h"
+#include "gi/sampling.h"
+#include "gi/shader.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+extern const gi_shader_source gi_csm_local_shaders[];
+
+static int failures;
+#define EXPECT(cond, ...)                                                                                              \
+    do {                                                                                                               \
+        if (!(cond)) {                                                                                                 \
+            failures++;                                                                                                \
+            fprintf(stderr, "%s:%d: failed: %s: ", __FILE__, __LINE__, #cond);                                       \
+            fprintf(stderr, __VA_ARGS__);                                                                              \
+            fputc('\n', stderr);                                                                                       \
+        }                                                                                                              \
+    } while (0)
+
+enum { M_CUBE = 64, NL = 4 };
+
+typedef struct world {
+    const gi_scene *s;
+    gi_vec3 *tri;        /* 3 world corners per triangle at t = 0 */
+    float *area;         /* per triangle */
+} world;
+
+static int seg_hits(const world *w, uint32_t k, gi_vec3 o, gi_vec3 d, float hmax)
+{
+    const gi_object *ob = &w->s->objects[k];
+    int n = 0;
+    for (uint32_t t = ob->first_triangle; t < ob->first_triangle + ob->triangle_count; t++) {
+        gi_vec3 p0 = w->tri[3 * t], e1 = gi_v3_sub(w->tri[3 * t + 1], p0), e2 = gi_v3_sub(w->tri[3 * t + 2], p0);
+        gi_vec3 pv = gi_v3_cross(d, e2);
+        float det = gi_v3_dot(e1, pv);
+        if (fabsf(det) < 1e-14f)
+            continue;
+        gi_vec3 tv = gi_v3_sub(o, p0);
+        float u = gi_v3_dot(tv, pv) / det;
+        gi_vec3 qv = gi_v3_cross(tv, e1);
+        float v = gi_v3_dot(d, qv) / det;
+        float h = gi_v3_dot(e2, qv) / det;
+        n += u >= 0 && v >= 0 && u + v <= 1 && h > 0 && h < hmax;
+    }
+    return n;
+}
+
+/* Is the segment x-y free of every object but `skip`? Sets *by to the
+ * first object found in the way. */
+static int exact_visible(const world *w, gi_vec3 x, gi_vec3 y, int skip, int *by)
+{
+    gi_vec3 d = gi_v3_sub(y, x);
+    for (uint32_t k = 0; k < w->s->object_count; k++)
+        if ((int)k != skip && seg_hits(w, k, x, d, 1.0f - 1e-4f)) {
+            if (by)
+                *by = (int)k;
+            return 0;
+        }
+    return 1;
+}
+
+/* Inside a closed object: an odd number of hits along two lines through x
+ * in both directions (an open object such as the Cornell walls fails one). */
+static int inside_closed(const world *w, gi_vec3 x)
+{
+    const gi_vec3 d1 = gi_v3(0.31f, 0.87f, 0.38f), d2 = gi_v3(0.11f, 0.07f, -0.99f);
+    for (uint32_t k = 0; k < w->s->object_count; k++)
+        if ((seg_hits(w, k, x, d1, FLT_MAX) & 1) && (seg_hits(w, k, x, gi_v3_scale(d1, -1), FLT_MAX) & 1) &&
+            (seg_hits(w, k, x, d2, FLT_MAX) & 1) && (seg_hits(w, k, x, gi_v3_scale(d2, -1), FLT_MAX) & 1))
+            return 1;
+    return 0;
+}
+
+/* A point uniform on light l (its emissive triangles by area), or the point. */
+static gi_vec3 light_sample(const world *w, const csm_light *l, uint32_t *rng)
+{
+    if (l->object < 0)
+        return l->origin;
+    const gi_scene *s = w->s;
+    float total = 0;
+    for (uint32_t e = 0; e < s->emitter_count; e++)
+        if ((int)s->vertices[s->indices[3 * s->emitters[e]]].object == l->object)
+            total += w->area[s->emitters[e]];
+    float r = gi_rng_next_float(rng) * total;
+    uint32_t tri = 0;
+    for (uint32_t e = 0; e < s->emitter_count; e++) {
+        uint32_t t = s->emitters[e];
+        if ((int)s->vertices[s->indices[3 * t]].object != l->object)
+            continue;
+        tri = t;
+        if ((r -= w->area[t]) < 0)
+            break;
+    }
+    float b[3];
+    gi_sample_uniform_triangle(gi_rng_next_float(rng), gi_rng_next_float(rng), b);
+    return gi_v3_add(gi_v3_add(gi_v3_scale(w->tri[3 * tri], b[0]), gi_v3_scale(w->tri[3 * tri + 1], b[1])),
+                     gi_v3_scale(w->tri[3 * tri + 2], b[2]));
+}
+
+/* std430 records as plugins/csm/csm.c uploads them. */
+typedef struct rect {
+    float o[4], e1[4], e2[4];
+    uint32_t info[4];
+} rect;
+
+typedef struct setup {
+    gi_scene *s;
+    gi_gpu_scene *gs;
+    world w;
+    uint32_t light_count;
+    csm_light *lights;
+    gi_csm_data *data;     /* light_count x object_count */
+    csm_local_desc *desc;  /* same */
+    float *bias;           /* per object */
+    float (*local_from_world)[16];
+} setup;
+
+static int setup_scene(gi_gpu *gpu, const char *path, setup *st)
+{
+    gi_error err;
+    memset(st, 0, sizeof *st);
+    st->s = gi_scene_load(path, &err);
+    if (!st->s) {
+        fprintf(stderr, "%s\n", err.text);
+        return 0;
+    }
+    const gi_scene *s = st->s;
+    st->gs = gi_gpu_scene_upload(gpu, s, &err);
+    if (!st->gs) {
+        fprintf(stderr, "%s\n", err.text);
+        return 0;
+    }
+    st->w.s = s;
+    st->w.tri = malloc(sizeof(gi_vec3) * 3 * s->triangle_count);
+    st->w.area = malloc(sizeof(float) * s->triangle_count);
+    for (uint32_t t = 0; t < s->triangle_count; t++) {
+        gi_scene_triangle_world(s, t, 0.0f, &st->w.tri[3 * t]);
+        st->w.area[t] = 0.5f * gi_v3_length(gi_v3_cross(gi_v3_sub(st->w.tri[3 * t + 1], st->w.tri[3 * t]),
+                                                        gi_v3_sub(st->w.tri[3 * t + 2], st->w.tri[3 * t])));
+    }
+    st->light_count = csm_lights_collect(s, 0.0f, NL, 4.0f, &st->lights);
+    uint32_t n = s->object_count;
+    st->data = calloc((size_t)st->light_count * n, sizeof *st->data);
+    st->desc = calloc((size_t)st->light_count * n, sizeof *st->desc);
+    st->bias = calloc(n, sizeof *st->bias);
+    st->local_from_world = calloc(n, sizeof *st->local_from_world);
+    double seg = 0, bu = 0, bc = 0;
+    uint32_t built = 0;
+    for (uint32_t k = 0; k < n; k++) {
+        float sphere[4];
+        gi_mesh_object_sphere(s, k, sphere);
+        st->bias[k] = 0.01f * sphere[3];
+        gi_mat4_invert(st->local_from_world[k], st->gs->world_from_local[k]);
+        for (uint32_t j = 0; j < st->light_count; j++) {
+            const csm_light *l = &st->lights[j];
+            csm_local_desc *d = &st->desc[j * n + k];
+            *d = (csm_local_desc){.M = M_CUBE,
+                                  .o = gi_mat4_point(st->local_from_world[k], l->origin),
+                                  .e1 = gi_mat4_dir(st->local_from_world[k], l->e1),
+                                  .e2 = gi_mat4_dir(st->local_from_world[k], l->e2),
+                                  .n_u = l->n_u,
+                                  .n_v = l->n_v,
+                                  .order = GI_CSM_ORDER_DIAGONAL,
+                                  .z3 = 0,
+                                  .batch = 16};
+            if (l->object == (int)k)
+                continue;
+            gi_csm_data *cd = &st->data[j * n + k];
+            EXPECT(csm_build_local(st->gs, k, sphere, d, NULL, 0, 1, cd, &err) == GI_OK, "%s", err.text);
+            seg += (double)cd->segment_count / (M_CUBE * M_CUBE);
+            bu += (double)cd->bytes_uncompressed;
+            bc += (double)cd->bytes_compressed;
+            built++;
+        }
+    }
+    printf("%s: %u light(s)", path, st->light_count);
+    for (uint32_t j = 0; j < st->light_count; j++)
+        printf(" [%s %ux%u, |e1| %.3f |e2| %.3f]",
+               st->lights[j].kind == CSM_LIGHT_AREA ? "area" : st->lights[j].kind == CSM_LIGHT_LINEAR ? "linear" : "point",
+               st->lights[j].n_u, st->lights[j].n_v, (double)gi_v3_length(st->lights[j].e1),
+               (double)gi_v3_length(st->lights[j].e2));
+    printf("; %u cube-map CSMs of 6 N maps, M = %u: %.2f segments per texel, %.1f : 1\n", built, M_CUBE,
+           built ? seg / built : 0.0, bc > 0 ? bu / bc : 0.0);
+    return 1;
+}
+
+static void free_setup(setup *st)
+{
+    uint32_t n = st->s ? st->s->object_count : 0;
+    for (uint32_t q = 0; q < st->light_count * n; q++)
+        gi_csm_data_free(&st->data[q]);
+    free(st->data);
+    free(st->desc);
+    free(st->bias);
+    free(st->local_from_world);
+    free(st->lights);
+    free(st->w.tri);
+    free(st->w.area);
+    gi_gpu_scene_free(st->gs);
+    gi_scene_free(st->s);
+}
+
+/* CSM visibility of x (world, already offset) toward y on light j: the
+ * product over the objects (§4.6), nearest filter. Sets *by to an object
+ * whose map says shadowed. */
+static int csm_visible(const setup *st, uint32_t j, gi_vec3 x, gi_vec3 y, int *by)
+{
+    const csm_light *l = &st->lights[j];
+    float u, v;
+    csm_light_grid(l->origin, l->e1, l->e2, l->n_u, l->n_v, y, &u, &v);
+    uint32_t n = st->s->object_count;
+    for (uint32_t k = 0; k < n; k++) {
+        if (l->object == (int)k)
+            continue;
+        gi_vec3 xl = gi_mat4_point(st->local_from_world[k], x);
+        if (!csm_local_visible_nearest(&st->data[j * n + k], &st->desc[j * n + k], xl, u, v, st->bias[k])) {
+            if (by)
+                *by = (int)k;
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* The world grid point nearest to y on light j. */
+static gi_vec3 snapped(const csm_light *l, gi_vec3 y)
+{
+    float u, v;
+    csm_light_grid(l->origin, l->e1, l->e2, l->n_u, l->n_v, y, &u, &v);
+    int a = (int)floorf(u + 0.5f), b = (int)floorf(v + 0.5f);
+    a = a < 0 ? 0 : a >= (int)l->n_u ? (int)l->n_u - 1 : a;
+    b = b < 0 ? 0 : b >= (int)l->n_v ? (int)l->n_v - 1 : b;
+    return csm_light_point(l->origin, l->e1, l->e2, l->n_u, l->n_v, (uint32_t)a, (uint32_t)b);
+}
+
+enum { PAIRS = 1500 };
+
+typedef struct pair {
+    float x[4], y[4]; /* x.w = light index */
+} pair;
+
+/* Volume pairs in box [lo, hi] against ray casting; fills pairs for the GPU. */
+static void volume_pairs(const setup *st, gi_vec3 lo, gi_vec3 hi, pair *out, int *cpu_out, double min_agree)
+{
+    uint32_t rng = gi_rng_init(5, 0, 9);
+    int pairs = 0, agree = 0, agree_snapped = 0, shadowed = 0, inside = 0, silhouette = 0, discretised = 0;
+    while (pairs < PAIRS) {
+        gi_vec3 x = gi_v3(lo.x + (hi.x - lo.x) * gi_rng_next_float(&rng), lo.y + (hi.y - lo.y) * gi_rng_next_float(&rng),
+                          lo.z + (hi.z - lo.z) * gi_rng_next_float(&rng));
+        if (inside_closed(&st->w, x)) {
+            inside++;
+            continue;
+        }
+        uint32_t j = gi_rng_next_u32(&rng) % st->light_count;
+        const csm_light *l = &st->lights[j];
+        gi_vec3 y = light_sample(&st->w, l, &rng);
+        int exact = exact_visible(&st->w, x, y, l->object, NULL);
+        int lit = csm_visible(st, j, x, y, NULL);
+        gi_vec3 ys = snapped(l, y);
+        int exact_s = exact_visible(&st->w, x, ys, l->object, NULL);
+        out[pairs] = (pair){{x.x, x.y, x.z, (float)j}, {y.x, y.y, y.z, 0}};
+        cpu_out[pairs] = lit;
+        pairs++;
+        shadowed += !exact;
+        agree += lit == exact;
+        agree_snapped += lit == exact_s;
+        if (lit != exact) {
+            if (exact_s != exact)
+                discretised++;
+            /* near a silhouette: two texels of x's cube map change the answer */
+            float step = 2.0f * 2.0f * gi_v3_length(gi_v3_sub(x, ys)) / M_CUBE;
+            static const float dirs[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+            int near = 0;
+            for (int q = 0; q < 6 && !near; q++)
+                near = exact_visible(&st->w, gi_v3_add(x, gi_v3_scale(gi_v3_load(dirs[q]), step)), ys, l->object,
+                                     NULL) != exact_s;
+            silhouette += near;
+        }
+    }
+    printf("  %d pairs (%d shadowed, %d inside points skipped): %.1f%% agree with the segment to y, %.1f%% with the "
+           "segment to the snapped light point; of the %d disagreements %d are the light's discretisation and %d lie "
+           "within two texels of a silhouette\n",
+           pairs, shadowed, inside, 100.0 * agree / pairs, 100.0 * agree_snapped / pairs, pairs - agree, discretised,
+           silhouette);
+    EXPECT(agree >= pairs * min_agree, "%d of %d", agree, pairs);
+    EXPECT(agree_snapped >= pairs * 0.97, "%d of %d", agree_snapped, pairs);
+    EXPECT(silhouette >= (pairs - agree) * 0.9, "%d of %d disagreements near a silhouette", silhouette, pairs - agree);
+    EXPECT(shadowed > pairs / 40, "too few shadowed pairs to mean anything: %d", shadowed);
+}
+
+/* Area of triangle t, 0 for emitters (receivers only) and for objects
+ * other than `only` (-1: all). */
+static float w_area_nonemissive(const setup *st, uint32_t t, int only)
+{
+    const float *e = gi_scene_triangle_emission(st->s, t);
+    if (only >= 0 && (int)st->s->vertices[st->s->indices[3 * t]].object != only)
+        return 0.0f;
+    return e[0] > 0 || e[1] > 0 || e[2] > 0 ? 0.0f : st->w.area[t];
+}
+
+/* Receiver points on the surfaces of csm_cross.glb: per (receiver, caster)
+ * the pairs ray casting finds shadowed by that caster, and how many of
+ * those and of all pairs the CSM gets right. */
+static void surface_pairs(const setup *st, float offset_texels, int cross, int only)
+{
+    const gi_scene *s = st->s;
+    uint32_t n = s->object_count, rng = gi_rng_init(8, 0, 3);
+    int shadowed_by[8][8] = {{0}}, right_by[8][8] = {{0}}, edge_by[8][8] = {{0}}, total = 0, agree = 0;
+    int false_shadow[8] = {0}, lit_total[8] = {0};
+    float total_area = 0;
+    for (uint32_t t = 0; t < s->triangle_count; t++)
+        total_area += w_area_nonemissive(st, t, only);
+    for (int p = 0; p < 6000; p++) {
+        /* a triangle by area, a point on it, offset along its normal */
+        float r = gi_rng_next_float(&rng) * total_area;
+        uint32_t t = 0;
+        for (; t + 1 < s->triangle_count; t++)
+            if ((r -= w_area_nonemissive(st, t, only)) < 0)
+                break;
+        float b[3];
+        gi_sample_uniform_triangle(gi_rng_next_float(&rng), gi_rng_next_float(&rng), b);
+        const gi_vec3 *q = &st->w.tri[3 * t];
+        gi_vec3 x = gi_v3_add(gi_v3_add(gi_v3_scale(q[0], b[0]), gi_v3_scale(q[1], b[1])), gi_v3_scale(q[2], b[2]));
+        gi_vec3 ng = gi_v3_normalize(gi_v3_cross(gi_v3_sub(q[1], q[0]), gi_v3_sub(q[2], q[0])));
+        uint32_t j = gi_rng_next_u32(&rng) % st->light_count;
+        const csm_light *l = &st->lights[j];
+        gi_vec3 y = light_sample(&st->w, l, &rng), ys = snapped(l, y);
+        if (gi_v3_dot(ng, gi_v3_sub(y, x)) <= 0 || gi_v3_dot(ng, gi_v3_sub(ys, x)) <= 0)
+            continue;
+        uint32_t recv = s->vertices[s->indices[3 * t]].object;
+        /* the normal offset, in texels at x's distance */
+        gi_vec3 xo = gi_v3_add(x, gi_v3_scale(ng, offset_texels * 2.0f * gi_v3_length(gi_v3_sub(x, ys)) / M_CUBE));
+        /* receivers covered by another object (the ground under a box) are
+         * inside it: no surface the camera could see; left out */
+        gi_vec3 xe = gi_v3_add(x, gi_v3_scale(ng, 1e-4f));
+        if (inside_closed(&st->w, xe) || inside_closed(&st->w, xo))
+            continue;
+        int by = -1;
+        int exact = exact_visible(&st->w, xe, ys, l->object, &by);
+        int lit = csm_visible(st, j, xo, y, NULL);
+        total++;
+        agree += lit == exact;
+        if (exact && recv < 8) {
+            lit_total[recv]++;
+            false_shadow[recv] += !lit;
+            if (!lit && getenv("CSM_DEBUG"))
+                printf("    false shadow on %s at (%.3f %.3f %.3f) n (%.2f %.2f %.2f) light point (%.3f %.3f %.3f)\n",
+                       s->objects[recv].name, (double)x.x, (double)x.y, (double)x.z, (double)ng.x, (double)ng.y,
+                       (double)ng.z, (double)ys.x, (double)ys.y, (double)ys.z);
+        }
+        if (!exact && by >= 0 && recv < 8 && by < 8) {
+            shadowed_by[recv][by]++;
+            right_by[recv][by] += !lit;
+            /* a miss within two texels (at x's distance) of the shadow's
+             * edge: the normal offset alone moves x by one texel */
+            float step = 2.0f * 2.0f * gi_v3_length(gi_v3_sub(x, ys)) / M_CUBE;
+            static const float dirs[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+            int near = 0;
+            for (int qd = 0; qd < 6 && lit && !near; qd++)
+                near = exact_visible(&st->w, gi_v3_add(xe, gi_v3_scale(gi_v3_load(dirs[qd]), step)), ys, l->object,
+                                     NULL);
+            edge_by[recv][by] += lit && near;
+        }
+    }
+    printf("  %d surface pairs (normal offset %.2f texels): %.1f%% agree with ray casting to the snapped light point\n",
+           total, (double)offset_texels, 100.0 * agree / total);
+    EXPECT(agree >= total * 0.95, "%d of %d", agree, total);
+    for (uint32_t rcv = 0; rcv < n && rcv < 8; rcv++)
+        if (lit_total[rcv])
+            printf("  %s: %d lit pairs, CSM shadowed %.1f%% of them\n", s->objects[rcv].name, lit_total[rcv],
+                   100.0 * false_shadow[rcv] / lit_total[rcv]);
+    for (uint32_t rcv = 0; rcv < n && rcv < 8; rcv++)
+        for (uint32_t c = 0; c < n && c < 8; c++)
+            if (shadowed_by[rcv][c])
+                printf("  %s shadowed by %s: %d pairs, CSM shadowed %.1f%%, lit within two texels of the shadow's "
+                       "edge %.1f%%, lit elsewhere %.1f%%\n",
+                       s->objects[rcv].name, s->objects[c].name, shadowed_by[rcv][c],
+                       100.0 * right_by[rcv][c] / shadowed_by[rcv][c], 100.0 * edge_by[rcv][c] / shadowed_by[rcv][c],
+                       100.0 * (shadowed_by[rcv][c] - right_by[rcv][c] - edge_by[rcv][c]) / shadowed_by[rcv][c]);
+    if (!cross)
+        return;
+    /* objects 0 ground, 1 box_a, 2 box_b (gen_csm_cross.py) */
+    int pairs_needed[][2] = {{2, 1}, {1, 2}, {0, 1}, {0, 2}};
+    for (int i = 0; i < 4; i++) {
+        int rcv = pairs_needed[i][0], c = pairs_needed[i][1];
+        EXPECT(shadowed_by[rcv][c] >= 20, "%s shadowed by %s only %d times", s->objects[rcv].name, s->objects[c].name,
+               shadowed_by[rcv][c]);
+        EXPECT(right_by[rcv][c] + edge_by[rcv][c] >= shadowed_by[rcv][c] * 0.97 &&
+                   right_by[rcv][c] >= shadowed_by[rcv][c] * 0.7,
+               "%s by %s: %d (+%d at the edge) of %d", s->objects[rcv].name, s->objects[c].name, right_by[rcv][c],
+               edge_by[rcv][c], shadowed_by[rcv][c]);
+    }
+}
+
+static const char *kernel =
+    "#include \"csm_local.glsl\"\n"
+    "layout(local_size_x = 64) in;\n"
+    "layout(std430, binding = 0) readonly buffer In { vec4 pin[]; };\n"
+    "layout(std430, binding = 1) writeonly buffer Out { vec4 pout[]; };\n"
+    "uniform uint u_count;\n"
+    "uniform uint u_obj;\n"
+    "void main() {\n"
+    "    uint c = gl_GlobalInvocationID.x;\n"
+    "    if (c >= u_count) return;\n"
+    "    vec3 x = pin[2u * c].xyz, y = pin[2u * c + 1u].xyz;\n"
+    "    uint j = uint(pin[2u * c].w), rng = 1u;\n"
+    "    float nearest = csm_light_visibility(j, x, vec3(0.0), y, 0xFFFFFFFFu, rng);\n"
+    "    float pcf = csm_local_visibility_object(j, u_obj, x, vec3(0.0), y, 1, 0.0);\n"
+    "    float rr = 0.0;\n"
+    "    for (int i = 0; i < 256; i++)\n"
+    "        rr += csm_local_visibility_object(j, u_obj, x, vec3(0.0), y, 2, (float(i) + 0.5) / 256.0);\n"
+    "    pout[c] = vec4(nearest, pcf, rr / 256.0, 0.0);\n"
+    "}\n";
+
+/* The GLSL query on the plugin's buffer layout (csm.c, csm_local.glsl). */
+static void gpu_check(const setup *st, const pair *pin, const int *cpu, uint32_t obj)
+{
+    const gi_scene *s = st->s;
+    uint32_t n = s->object_count, L = st->light_count;
+    gi_error err;
+    GLuint prog = gi_program_build_compute_text("tests/integration/csm_local_kernel.comp", kernel, NULL, &err);
+    EXPECT(prog != 0, "%s", err.text);
+    if (!prog)
+        return;
+    csm_gpu_object *objs = calloc(n, sizeof *objs);
+    rect *pairs = calloc((size_t)L * n, sizeof *pairs), *lights = calloc(L, sizeof *lights);
+    uint64_t offs = 0, segs = 0, cells_n = n;
+    for (uint32_t j = 0; j < L; j++)
+        cells_n += st->lights[j].n_u * st->lights[j].n_v;
+    for (uint32_t q = 0; q < L * n; q++)
+        if (st->data[q].M)
+            offs += (uint64_t)M_CUBE * M_CUBE + 1, segs += st->data[q].segment_count;
+    uint32_t *offsets = malloc(offs * 4), *iend = malloc(segs * 4), *cells = malloc(cells_n * 4);
+    float *z = malloc(segs * 4);
+    offs = segs = 0;
+    for (uint32_t k = 0; k < n; k++) {
+        memcpy(objs[k].local_from_world, st->local_from_world[k], 64);
+        memcpy(objs[k].world_from_local, st->gs->world_from_local[k], 64);
+        cells[k] = 0xFFFFFFFFu;
+    }
+    uint32_t base = n;
+    for (uint32_t j = 0; j < L; j++) {
+        const csm_light *l = &st->lights[j];
+        if (l->object >= 0)
+            cells[l->object] = j;
+        float lo[4] = {l->origin.x, l->origin.y, l->origin.z, (float)l->kind};
+        float l1[4] = {l->e1.x, l->e1.y, l->e1.z, 0}, l2[4] = {l->e2.x, l->e2.y, l->e2.z, 0};
+        memcpy(lights[j].o, lo, 16), memcpy(lights[j].e1, l1, 16), memcpy(lights[j].e2, l2, 16);
+        lights[j].info[0] = l->n_u, lights[j].info[1] = l->n_v, lights[j].info[2] = base;
+        lights[j].info[3] = l->object >= 0 ? (uint32_t)l->object : 0x80000000u | (uint32_t)l->punctual;
+        for (uint32_t b = 0; b < l->n_v; b++)
+            for (uint32_t a = 0; a < l->n_u; a++)
+                cells[base + b * l->n_u + a] = gi_csm_order_index(GI_CSM_ORDER_DIAGONAL, l->n_u, l->n_v, a, b);
+        base += l->n_u * l->n_v;
+        for (uint32_t k = 0; k < n; k++) {
+            const csm_local_desc *d = &st->desc[j * n + k];
+            const gi_csm_data *cd = &st->data[j * n + k];
+            rect *r = &pairs[j * n + k];
+            float po[4] = {d->o.x, d->o.y, d->o.z, cd->M ? 1.0f : 0.0f};
+            float p1[4] = {d->e1.x, d->e1.y, d->e1.z, 0}, p2[4] = {d->e2.x, d->e2.y, d->e2.z, 0};
+            memcpy(r->o, po, 16), memcpy(r->e1, p1, 16), memcpy(r->e2, p2, 16);
+            memcpy(&r->info[3], &st->bias[k], 4);
+            if (!cd->M)
+                continue;
+            r->info[0] = M_CUBE, r->info[1] = (uint32_t)offs, r->info[2] = (uint32_t)segs;
+            memcpy(offsets + offs, cd->offsets, ((size_t)M_CUBE * M_CUBE + 1) * 4);
+            memcpy(z + segs, cd->z_avg, cd->segment_count * 4);
+            memcpy(iend + segs, cd->i_end, cd->segment_count * 4);
+            offs += (uint64_t)M_CUBE * M_CUBE + 1;
+            segs += cd->segment_count;
+        }
+    }
+    GLuint bufs[9];
+    glCreateBuffers(9, bufs);
+    glNamedBufferStorage(bufs[0], (GLsizeiptr)(sizeof(pair) * PAIRS), pin, 0);
+    glNamedBufferStorage(bufs[1], (GLsizeiptr)(16 * PAIRS), NULL, 0);
+    glNamedBufferStorage(bufs[2], (GLsizeiptr)(n * sizeof *objs), objs, 0);
+    glNamedBufferStorage(bufs[3], (GLsizeiptr)(offs * 4), offsets, 0);
+    glNamedBufferStorage(bufs[4], (GLsizeiptr)(segs * 4), z, 0);
+    glNamedBufferStorage(bufs[5], (GLsizeiptr)(segs * 4), iend, 0);
+    glNamedBufferStorage(bufs[6], (GLsizeiptr)(L * sizeof *lights), lights, 0);
+    glNamedBufferStorage(bufs[7], (GLsizeiptr)((size_t)L * n * sizeof *pairs), pairs, 0);
+    glNamedBufferStorage(bufs[8], (GLsizeiptr)(cells_n * 4), cells, 0);
+    static const GLuint binding[9] = {0, 1, 8, 9, 10, 11, 14, 15, 16};
+    for (int i = 0; i < 9; i++)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding[i], bufs[i]);
+    float *gout = calloc(4 * PAIRS, sizeof(float));
+    glUseProgram(prog);
+    glUniform1ui(glGetUniformLocation(prog, "u_count"), PAIRS);
+    glUniform1ui(glGetUniformLocation(prog, "u_obj"), obj);
+    glUniform1ui(glGetUniformLocation(prog, "csm_object_count"), n);
+    glUniform1ui(glGetUniformLocation(prog, "csm_light_count"), L);
+    glUniform1i(glGetUniformLocation(prog, "csm_filter"), 0);
+    glUniform1i(glGetUniformLocation(prog, "csm_semilocal"), 0);
+    glUniform1f(glGetUniformLocation(prog, "csm_normal_offset"), 0.0f);
+    glDispatchCompute((PAIRS + 63) / 64, 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glGetNamedBufferSubData(bufs[1], 0, (GLsizeiptr)(16 * PAIRS), gout);
+    glUseProgram(0);
+    glDeleteProgram(prog);
+    glDeleteBuffers(9, bufs);
+    int same = 0, partial = 0;
+    double rr_sum = 0, rr_max = 0;
+    for (int p = 0; p < PAIRS; p++) {
+        same += (gout[4 * p] > 0.5f) == (cpu[p] != 0);
+        partial += gout[4 * p + 1] > 0.0f && gout[4 * p + 1] < 1.0f;
+        double e = fabs((double)gout[4 * p + 2] - gout[4 * p + 1]);
+        rr_sum += e;
+        rr_max = e > rr_max ? e : rr_max;
+    }
+    printf("  GLSL cube query: nearest equals the CPU query on %d of %d pairs; %s: PCF strictly between 0 and 1 on %d "
+           "pairs, RR averaged over 256 stratified numbers vs PCF: mean |diff| %.4f, max %.4f\n",
+           same, PAIRS, s->objects[obj].name, partial, rr_sum / PAIRS, rr_max);
+    EXPECT(same >= PAIRS - 2, "%d of %d", same, PAIRS);
+    EXPECT(partial > 0, "PCF never fractional");
+    EXPECT(rr_sum / PAIRS < 0.01 && rr_max <= 16.0 / 256.0 + 1e-3, "mean %g max %g", rr_sum / PAIRS, rr_max);
+    free(gout);
+    free(objs);
+    free(pairs);
+    free(lights);
+    free(offsets);
+    free(z);
+    free(iend);
+    free(cells);
+}
+
+static uint32_t object_named(const gi_scene *s, const char *name)
+{
+    for (uint32_t k = 0; k < s->object_count; k++)
+        if (strcmp(s->objects[k].name, name) == 0)
+            return k;
+    return 0;
+}
+
+int main(void)
+{
+    gi_error err;
+    gi_gpu *gpu = gi_gpu_create(NULL, &err);
+    if (!gpu) {
+        fprintf(stderr, "no GL: %s\n", err.text);
+        return 1;
+    }
+    gi_shader_register(gi_csm_local_shaders);
+    pair *pin = malloc(sizeof *pin * PAIRS);
+    int *cpu = malloc(sizeof *cpu * PAIRS);
+    setup st;
+
+    /* The teapot under its area light: x around the teapot, above the ground. */
+    if (setup_scene(gpu, GI_SOURCE_DIR "/scenes/teapot_area.glb", &st)) {
+        EXPECT(st.light_count == 1 && st.lights[0].kind == CSM_LIGHT_AREA, "%u lights", st.light_count);
+        uint32_t t = object_named(st.s, "teapot");
+        const float *b = st.s->objects[t].local_bounds;
+        gi_vec3 lo = gi_mat4_point(st.gs->world_from_local[t], gi_v3(b[0], b[1], b[2]));
+        gi_vec3 hi = gi_mat4_point(st.gs->world_from_local[t], gi_v3(b[3], b[4], b[5]));
+        gi_vec3 c = gi_v3_scale(gi_v3_add(lo, hi), 0.5f), h = gi_v3_scale(gi_v3_sub(hi, lo), 1.25f);
+        volume_pairs(&st, gi_v3(c.x - h.x, 1e-3f, c.z - h.z), gi_v3(c.x + h.x, 0.5f * hi.y, c.z + h.z), pin, cpu, 0.95);
+        gpu_check(&st, pin, cpu, t);
+        /* receivers on the teapot, with the plugin's default normal offset
+         * for local lights (a quarter texel) and with a whole texel */
+        surface_pairs(&st, 0.25f, 0, (int)t);
+        surface_pairs(&st, 1.0f, 0, (int)t);
+    }
+    free_setup(&st);
+
+    /* The Cornell box: x in the lower third of the box (outside the blocks). */
+    if (setup_scene(gpu, GI_SOURCE_DIR "/scenes/cornell_box.gltf", &st)) {
+        EXPECT(st.light_count == 1 && st.lights[0].kind == CSM_LIGHT_AREA, "%u lights", st.light_count);
+        volume_pairs(&st, gi_v3(0.01f, 0.01f, 0.01f), gi_v3(5.55f, 1.8f, 5.58f), pin, cpu, 0.95);
+        gpu_check(&st, pin, cpu, object_named(st.s, "tall_block"));
+    }
+    free_setup(&st);
+
+    /* Two boxes shadowing each other and the ground (§4.6), a linear and a point light. */
+    if (setup_scene(gpu, GI_SOURCE_DIR "/tests/data/valid/csm_cross.glb", &st)) {
+        EXPECT(st.light_count == 2 && st.lights[0].kind == CSM_LIGHT_LINEAR && st.lights[0].n_v == 1 &&
+                   st.lights[1].kind == CSM_LIGHT_POINT,
+               "%u lights", st.light_count);
+        surface_pairs(&st, 0.25f, 1, -1);
+        volume_pairs(&st, gi_v3(-2.5f, 0.01f, -1.5f), gi_v3(2.5f, 2.2f, 1.5f), pin, cpu, 0.95);
+        gpu_check(&st, pin, cpu, object_named(st.s, "box_a"));
+    }
+    free_setup(&st);
+
+    free(pin);
+    free(cpu);
+    gi_gpu_destroy(gpu);
+    printf("%s\n", failures ? "FAILED" : "ok");
+    return failures ? 1 : 0;
+}
