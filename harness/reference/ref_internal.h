@@ -9,9 +9,8 @@
 
 #include "gi/brdf.h"
 #include "gi/envmap.h"
+#include "gi/raytrace.h"
 #include "gi/vecmath.h"
-
-#include <embree3/rtcore.h>
 
 /* Per triangle, 32 bytes: what shading needs beside the vertices. */
 typedef struct ref_tri {
@@ -46,10 +45,9 @@ typedef struct ref_camera {
 
 typedef struct ref_scene {
     const gi_scene *scene;
-    RTCDevice device;
-    RTCScene rtc;
-    const float *pos; /* world positions, 3 floats a vertex (Embree's vertex buffer) */
-    float *nrm;       /* world shading normals, 3 floats a vertex */
+    gi_rt *rt;        /* the core's BVH over the scene placed at the render time */
+    const float *pos; /* world positions, 3 floats a vertex (gi_rt_positions) */
+    const float *nrm; /* world unit shading normals, 3 floats a vertex (gi_rt_normals) */
     ref_tri *tris;
     ref_material *mats;
     uint32_t emitter_count;

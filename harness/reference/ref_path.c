@@ -55,55 +55,22 @@ static inline float next(uint32_t *rng)
 static inline int trace(const ref_scene *rs, gi_vec3 o, gi_vec3 d, float tnear, float tfar,
                         ref_hit *h, ref_counters *c)
 {
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    struct RTCRayHit rh;
-    rh.ray.org_x = o.x;
-    rh.ray.org_y = o.y;
-    rh.ray.org_z = o.z;
-    rh.ray.tnear = tnear;
-    rh.ray.dir_x = d.x;
-    rh.ray.dir_y = d.y;
-    rh.ray.dir_z = d.z;
-    rh.ray.time = 0.0f;
-    rh.ray.tfar = tfar;
-    rh.ray.mask = ~0u;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(rs->rtc, &ctx, &rh);
+    gi_rt_hit hit;
     c->rays++;
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
+    if (!gi_rt_intersect(rs->rt, o, d, tnear, tfar, &hit))
         return 0;
-    h->t = rh.ray.tfar;
-    h->u = rh.hit.u;
-    h->v = rh.hit.v;
-    h->prim = rh.hit.primID;
+    h->t = hit.t;
+    h->u = hit.u;
+    h->v = hit.v;
+    h->prim = hit.triangle;
     return 1;
 }
 
-/* 1 when something lies on the segment o + t d, 0 < t < tfar. */
+/* 1 when something lies on the segment o + t d, 0 <= t <= tfar. */
 static inline int occluded(const ref_scene *rs, gi_vec3 o, gi_vec3 d, float tfar, ref_counters *c)
 {
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    struct RTCRay r;
-    r.org_x = o.x;
-    r.org_y = o.y;
-    r.org_z = o.z;
-    r.tnear = 0.0f;
-    r.dir_x = d.x;
-    r.dir_y = d.y;
-    r.dir_z = d.z;
-    r.time = 0.0f;
-    r.tfar = tfar;
-    r.mask = ~0u;
-    r.id = 0;
-    r.flags = 0;
-    rtcOccluded1(rs->rtc, &ctx, &r);
     c->rays++;
-    return r.tfar < 0.0f; /* Embree sets -inf on a hit */
+    return gi_rt_occluded(rs->rt, o, d, 0.0f, tfar);
 }
 
 /* Ray origin just off the surface on the side of n, by an offset that

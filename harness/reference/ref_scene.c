@@ -1,12 +1,9 @@
-/* The scene as the reference traces it, at one time t: world-space
- * vertices validated and handed to Embree 3 (one triangle geometry, build
- * quality high), world shading normals, per-triangle geometric normals and
- * areas, materials as gi_brdf, the emitter-selection CDF (area x luminance
- * of the emission), punctual lights and the camera placed at t.
- *
- * Validation comes first because Embree silently drops primitives with
- * NaN/Inf corners: a scene that would render with holes is bad input
- * instead. */
+/* The scene as the reference traces it, at one time t: the core's ray
+ * casting (gi/raytrace.h: world-space vertices validated, world shading
+ * normals, one Embree 3 triangle geometry, build quality high), and beside
+ * it per-triangle geometric normals and areas, materials as gi_brdf, the
+ * emitter-selection CDF (area x luminance of the emission), punctual lights
+ * and the camera placed at t. */
 #include "ref_internal.h"
 
 #include <math.h>
@@ -26,77 +23,6 @@ static int coord_ok(gi_vec3 v)
 {
     return finite3(v) && fabsf(v.x) <= REF_MAX_COORD && fabsf(v.y) <= REF_MAX_COORD &&
            fabsf(v.z) <= REF_MAX_COORD;
-}
-
-static const char *object_name(const gi_scene *s, uint32_t o)
-{
-    return s->objects[o].name ? s->objects[o].name : "(unnamed)";
-}
-
-static gi_result embree_fail(ref_scene *rs, const char *what, gi_error *err)
-{
-    enum RTCError e = rs->device ? rtcGetDeviceError(rs->device) : RTC_ERROR_UNKNOWN;
-    if (e == RTC_ERROR_OUT_OF_MEMORY)
-        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "reference: Embree ran out of memory (%s)",
-                            what);
-    return gi_error_set(err, GI_ERR_IO, "reference: Embree failed: %s (error %d)", what, (int)e);
-}
-
-/* World positions into Embree's vertex buffer, world normals into rs->nrm;
- * rejects non-finite results. Every vertex carries its object, so the loop
- * runs over vertices, not over objects' ranges. */
-static gi_result place_vertices(ref_scene *rs, float t, float *vb, gi_error *err)
-{
-    const gi_scene *s = rs->scene;
-    float(*m)[16] = malloc((size_t)(s->object_count ? s->object_count : 1) * sizeof *m);
-    float(*nm)[16] = malloc((size_t)(s->object_count ? s->object_count : 1) * sizeof *nm);
-    gi_result res = GI_OK;
-    if (!m || !nm) {
-        res = gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "reference: out of memory (transforms)");
-        goto done;
-    }
-    for (uint32_t o = 0; o < s->object_count; o++) {
-        float inv[16];
-        gi_scene_object_transform(s, o, t, m[o]);
-        for (int k = 0; k < 16; k++)
-            if (!isfinite(m[o][k])) {
-                res = gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                                   "%s: object %u '%s': transform at t = %g is not finite", s->path,
-                                   o, object_name(s, o), (double)t);
-                goto done;
-            }
-        /* Normals by the inverse transpose; a singular transform (scale 0)
-         * leaves degenerate triangles that Embree never reports hit. */
-        if (gi_mat4_invert(inv, m[o]))
-            gi_mat4_transpose(nm[o], inv);
-        else
-            memcpy(nm[o], m[o], sizeof nm[o]);
-    }
-    for (uint32_t v = 0; v < s->vertex_count; v++) {
-        const gi_vertex *gv = &s->vertices[v];
-        uint32_t o = gv->object < s->object_count ? gv->object : 0;
-        gi_vec3 p = s->object_count ? gi_mat4_point(m[o], gi_v3_load(gv->position))
-                                    : gi_v3_load(gv->position);
-        if (!coord_ok(p)) {
-            res = gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                               "%s: object %u '%s': vertex %u is not finite at t = %g (%g %g %g)",
-                               s->path, o, s->object_count ? object_name(s, o) : "?",
-                               v - (s->object_count ? s->objects[o].first_vertex : 0), (double)t,
-                               (double)p.x, (double)p.y, (double)p.z);
-            goto done;
-        }
-        gi_v3_store(p, vb + 3 * (size_t)v);
-        gi_vec3 n =
-            s->object_count ? gi_mat4_dir(nm[o], gi_v3_load(gv->normal)) : gi_v3_load(gv->normal);
-        n = gi_v3_normalize(n);
-        if (!finite3(n))
-            n = gi_v3(0.0f, 0.0f, 0.0f); /* shading falls back to the geometric normal */
-        gi_v3_store(n, rs->nrm + 3 * (size_t)v);
-    }
-done:
-    free(m);
-    free(nm);
-    return res;
 }
 
 static void build_materials(ref_scene *rs)
@@ -236,50 +162,16 @@ gi_result ref_scene_build(ref_scene *rs, const gi_ref_desc *d, gi_error *err)
     if (res != GI_OK)
         return res;
 
-    rs->device = rtcNewDevice(NULL);
-    if (!rs->device)
-        return gi_error_set(err, GI_ERR_IO, "reference: cannot create an Embree device (error %d)",
-                            (int)rtcGetDeviceError(NULL));
-    rs->rtc = rtcNewScene(rs->device);
-    if (!rs->rtc)
-        return embree_fail(rs, "rtcNewScene", err);
-    rtcSetSceneBuildQuality(rs->rtc, RTC_BUILD_QUALITY_HIGH);
-    rtcSetSceneFlags(rs->rtc, RTC_SCENE_FLAG_ROBUST);
-
-    rs->nrm = malloc((size_t)(s->vertex_count ? s->vertex_count : 1) * 3 * sizeof(float));
+    res = gi_rt_create(s, d->time, &rs->rt, err);
+    if (res != GI_OK)
+        return res;
+    rs->pos = gi_rt_positions(rs->rt);
+    rs->nrm = gi_rt_normals(rs->rt);
     rs->tris = malloc((size_t)(s->triangle_count ? s->triangle_count : 1) * sizeof *rs->tris);
     rs->mats = calloc(s->material_count ? s->material_count : 1, sizeof *rs->mats);
-    if (!rs->nrm || !rs->tris || !rs->mats)
+    if (!rs->tris || !rs->mats)
         return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "reference: out of memory (%u triangles)",
                             s->triangle_count);
-
-    if (s->triangle_count > 0) {
-        RTCGeometry g = rtcNewGeometry(rs->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        if (!g)
-            return embree_fail(rs, "rtcNewGeometry", err);
-        rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
-        float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                            3 * sizeof(float), s->vertex_count);
-        unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                               3 * sizeof(unsigned), s->triangle_count);
-        if (!vb || !ib) {
-            rtcReleaseGeometry(g);
-            return embree_fail(rs, "vertex and index buffers", err);
-        }
-        res = place_vertices(rs, d->time, vb, err);
-        if (res != GI_OK) {
-            rtcReleaseGeometry(g);
-            return res;
-        }
-        memcpy(ib, s->indices, (size_t)s->triangle_count * 3 * sizeof(unsigned));
-        rs->pos = vb; /* Embree keeps the buffer alive while the geometry is attached */
-        rtcCommitGeometry(g);
-        rtcAttachGeometry(rs->rtc, g);
-        rtcReleaseGeometry(g);
-    }
-    rtcCommitScene(rs->rtc);
-    if (rtcGetDeviceError(rs->device) != RTC_ERROR_NONE)
-        return embree_fail(rs, "BVH build", err);
 
     build_materials(rs);
     build_triangles(rs);
@@ -297,11 +189,7 @@ gi_result ref_scene_build(ref_scene *rs, const gi_ref_desc *d, gi_error *err)
 
 void ref_scene_release(ref_scene *rs)
 {
-    if (rs->rtc)
-        rtcReleaseScene(rs->rtc);
-    if (rs->device)
-        rtcReleaseDevice(rs->device);
-    free(rs->nrm);
+    gi_rt_free(rs->rt);
     free(rs->tris);
     free(rs->mats);
     free(rs->emitters);

@@ -114,10 +114,7 @@ gi_result gi_ref_create(const gi_ref_desc *d, gi_ref **out, gi_error *err)
         long n = sysconf(_SC_NPROCESSORS_ONLN);
         r->threads = n > 0 ? (uint32_t)(n < MAX_THREADS ? n : MAX_THREADS) : 1u;
     }
-    snprintf(r->renderer, sizeof r->renderer, "embree %d.%d.%d cpu",
-             (int)rtcGetDeviceProperty(r->rs.device, RTC_DEVICE_PROPERTY_VERSION_MAJOR),
-             (int)rtcGetDeviceProperty(r->rs.device, RTC_DEVICE_PROPERTY_VERSION_MINOR),
-             (int)rtcGetDeviceProperty(r->rs.device, RTC_DEVICE_PROPERTY_VERSION_PATCH));
+    snprintf(r->renderer, sizeof r->renderer, "%s cpu", gi_rt_version(r->rs.rt));
     r->build_seconds = gi_now() - t0;
     *out = r;
     return GI_OK;

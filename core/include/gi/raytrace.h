@@ -1,0 +1,90 @@
+/* Ray casting on the CPU: the scene's triangles placed at one time t, in an
+ * Embree 3 BVH. The one Embree scene builder of the tree: the reference path
+ * tracer (harness/reference/) and every plugin or test that needs exact
+ * ray queries on the CPU use it.
+ *
+ * Use:
+ *     gi_rt *rt;
+ *     if (gi_rt_create(scene, t, &rt, &err) != GI_OK) { ... err.text ... }
+ *     gi_rt_hit h;
+ *     if (gi_rt_intersect(rt, o, d, 0.0f, INFINITY, &h)) { ... h.t, h.triangle ... }
+ *     gi_rt_set_time(rt, t2, &err);       // moves animated objects
+ *     gi_rt_free(rt);
+ * The scene must outlive the gi_rt (it is read, never copied or changed).
+ *
+ * Placement: every vertex is put in world space by its object's transform at
+ * t (gi_scene_object_transform, the glTF animation sampled as everywhere
+ * else), all triangles in ONE triangle geometry whose primitive index is the
+ * scene-global triangle index (the G-buffer's triangle id). World shading
+ * normals (inverse transpose, normalised; (0,0,0) where that is not finite)
+ * are kept beside the positions for shading code. The BVH is built with
+ * quality "high" and RTC_SCENE_FLAG_ROBUST (watertight traversal, no
+ * cracks between triangles sharing an edge).
+ *
+ * Validation: a transform or a placed vertex that is not finite, or a
+ * coordinate beyond 1e18 (its square overflows float), is an error
+ * (GI_ERR_INVALID_ARGUMENT, "scene: object k 'name': vertex i is not finite
+ * at t = ..."), because Embree silently drops such triangles and the scene
+ * would show holes instead of failing.
+ *
+ * Queries: gi_rt_intersect and gi_rt_occluded only read the committed BVH,
+ * so any number of threads may query one gi_rt at once. gi_rt_set_time
+ * rewrites the BVH and must not run while queries are in flight. The ray
+ * interval is Embree's closed one: hits with tmin <= t <= tmax count
+ * (tmin >= 0); d need not be unit length, t is in units of |d|. With no
+ * moving object gi_rt_set_time only records the time; otherwise it
+ * re-places every vertex and rebuilds the BVH (a rebuild, not a refit: the
+ * rigid motions of glTF animations can move objects far, and a refitted
+ * BVH degrades with the distance moved).
+ */
+#ifndef GI_RAYTRACE_H
+#define GI_RAYTRACE_H
+
+#include "gi/common.h"
+#include "gi/scene.h"
+#include "gi/vecmath.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct gi_rt gi_rt; /* the scene's triangles placed at one time t, in a BVH */
+
+typedef struct gi_rt_hit {
+    float t;           /* ray parameter of the hit */
+    uint32_t object;   /* scene object index (as in the G-buffer ids) */
+    uint32_t triangle; /* scene-global triangle index (as in the G-buffer ids) */
+    float u, v;        /* barycentrics of vertices 1 and 2 */
+    gi_vec3 position;  /* world hit point, from the barycentrics */
+    gi_vec3 ng;        /* unit geometric normal cross(p1 - p0, p2 - p0), front face = CCW;
+                          (0, 0, 1) for a degenerate triangle */
+} gi_rt_hit;
+
+/* Places `scene` at `time` and builds the BVH. On success *out owns it
+ * (gi_rt_free). NULL scene or out, or a non-finite time, is
+ * GI_ERR_INVALID_ARGUMENT; see the manual above for what else fails. */
+gi_result gi_rt_create(const gi_scene *scene, float time, gi_rt **out, gi_error *err);
+/* Re-places the moving objects at `time` and rebuilds the BVH. On failure
+ * the gi_rt is unchanged (still placed at its previous time). */
+gi_result gi_rt_set_time(gi_rt *rt, float time, gi_error *err);
+void gi_rt_free(gi_rt *rt);
+
+/* Closest hit of o + t d with tmin <= t <= tmax: 1 and *hit filled, or 0. */
+int gi_rt_intersect(const gi_rt *rt, gi_vec3 o, gi_vec3 d, float tmin, float tmax, gi_rt_hit *hit);
+/* 1 when any triangle lies on o + t d, tmin <= t <= tmax. */
+int gi_rt_occluded(const gi_rt *rt, gi_vec3 o, gi_vec3 d, float tmin, float tmax);
+
+/* The placement at the current time, for shading code (valid until the
+ * next gi_rt_set_time or gi_rt_free): world positions and world unit
+ * shading normals, 3 floats a vertex in scene vertex order. */
+const float *gi_rt_positions(const gi_rt *rt);
+const float *gi_rt_normals(const gi_rt *rt);
+float gi_rt_time(const gi_rt *rt);
+const gi_scene *gi_rt_scene(const gi_rt *rt);
+/* "embree 3.13.5": the library version, for reports. */
+const char *gi_rt_version(const gi_rt *rt);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,330 @@
+/* Ray casting on the CPU (gi/raytrace.h): the scene placed at time t in one
+ * Embree 3 triangle geometry. Placement and validation come first, because
+ * Embree silently drops primitives with NaN/Inf corners. */
+#include "gi/raytrace.h"
+
+#include <embree3/rtcore.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Coordinates beyond this overflow squared distances in float. */
+#define RT_MAX_COORD 1e18f
+
+struct gi_rt {
+    const gi_scene *scene;
+    RTCDevice device;
+    RTCScene rtc;
+    RTCGeometry geom; /* NULL for a scene without triangles */
+    float *pos;       /* Embree's vertex buffer: world positions, 3 floats a vertex */
+    float *nrm;       /* world unit shading normals, 3 floats a vertex */
+    float time;
+    int moving; /* some object is animated */
+    char version[32];
+};
+
+static int finite3(gi_vec3 v)
+{
+    return isfinite(v.x) && isfinite(v.y) && isfinite(v.z);
+}
+
+static int coord_ok(gi_vec3 v)
+{
+    return finite3(v) && fabsf(v.x) <= RT_MAX_COORD && fabsf(v.y) <= RT_MAX_COORD &&
+           fabsf(v.z) <= RT_MAX_COORD;
+}
+
+static const char *object_name(const gi_scene *s, uint32_t o)
+{
+    return s->objects[o].name ? s->objects[o].name : "(unnamed)";
+}
+
+static gi_result embree_fail(const gi_rt *rt, const char *what, gi_error *err)
+{
+    enum RTCError e = rt->device ? rtcGetDeviceError(rt->device) : RTC_ERROR_UNKNOWN;
+    if (e == RTC_ERROR_OUT_OF_MEMORY)
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "raytrace: Embree ran out of memory (%s)",
+                            what);
+    return gi_error_set(err, GI_ERR_IO, "raytrace: Embree failed: %s (error %d)", what, (int)e);
+}
+
+/* World positions into pos, world shading normals into nrm (3 floats a
+ * vertex each); rejects non-finite results. Every vertex carries its
+ * object, so the loop runs over vertices, not over objects' ranges. */
+static gi_result place_vertices(const gi_scene *s, float t, float *pos, float *nrm, gi_error *err)
+{
+    float(*m)[16] = malloc((size_t)(s->object_count ? s->object_count : 1) * sizeof *m);
+    float(*nm)[16] = malloc((size_t)(s->object_count ? s->object_count : 1) * sizeof *nm);
+    gi_result res = GI_OK;
+    if (!m || !nm) {
+        res = gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "raytrace: out of memory (transforms)");
+        goto done;
+    }
+    for (uint32_t o = 0; o < s->object_count; o++) {
+        float inv[16];
+        gi_scene_object_transform(s, o, t, m[o]);
+        for (int k = 0; k < 16; k++)
+            if (!isfinite(m[o][k])) {
+                res = gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                   "%s: object %u '%s': transform at t = %g is not finite", s->path,
+                                   o, object_name(s, o), (double)t);
+                goto done;
+            }
+        /* Normals by the inverse transpose; a singular transform (scale 0)
+         * leaves degenerate triangles that Embree never reports hit. */
+        if (gi_mat4_invert(inv, m[o]))
+            gi_mat4_transpose(nm[o], inv);
+        else
+            memcpy(nm[o], m[o], sizeof nm[o]);
+    }
+    for (uint32_t v = 0; v < s->vertex_count; v++) {
+        const gi_vertex *gv = &s->vertices[v];
+        uint32_t o = gv->object < s->object_count ? gv->object : 0;
+        gi_vec3 p = s->object_count ? gi_mat4_point(m[o], gi_v3_load(gv->position))
+                                    : gi_v3_load(gv->position);
+        if (!coord_ok(p)) {
+            res = gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                               "%s: object %u '%s': vertex %u is not finite at t = %g (%g %g %g)",
+                               s->path, o, s->object_count ? object_name(s, o) : "?",
+                               v - (s->object_count ? s->objects[o].first_vertex : 0), (double)t,
+                               (double)p.x, (double)p.y, (double)p.z);
+            goto done;
+        }
+        gi_v3_store(p, pos + 3 * (size_t)v);
+        gi_vec3 n =
+            s->object_count ? gi_mat4_dir(nm[o], gi_v3_load(gv->normal)) : gi_v3_load(gv->normal);
+        n = gi_v3_normalize(n);
+        if (!finite3(n))
+            n = gi_v3(0.0f, 0.0f, 0.0f); /* shading falls back to the geometric normal */
+        gi_v3_store(n, nrm + 3 * (size_t)v);
+    }
+done:
+    free(m);
+    free(nm);
+    return res;
+}
+
+static gi_result commit(gi_rt *rt, gi_error *err)
+{
+    if (rt->geom)
+        rtcCommitGeometry(rt->geom);
+    rtcCommitScene(rt->rtc);
+    if (rtcGetDeviceError(rt->device) != RTC_ERROR_NONE)
+        return embree_fail(rt, "BVH build", err);
+    return GI_OK;
+}
+
+gi_result gi_rt_create(const gi_scene *s, float time, gi_rt **out, gi_error *err)
+{
+    if (out)
+        *out = NULL;
+    if (!s || !out)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "raytrace: %s is NULL",
+                            !s ? "the scene" : "the output pointer");
+    if (!isfinite(time))
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "raytrace: time %g is not finite",
+                            (double)time);
+    gi_rt *rt = calloc(1, sizeof *rt);
+    if (!rt)
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "raytrace: out of memory");
+    rt->scene = s;
+    rt->time = time;
+    for (uint32_t o = 0; o < s->object_count; o++)
+        rt->moving |= s->objects[o].animated != 0;
+    gi_result res = GI_OK;
+    rt->device = rtcNewDevice(NULL);
+    if (!rt->device) {
+        res = gi_error_set(err, GI_ERR_IO, "raytrace: cannot create an Embree device (error %d)",
+                           (int)rtcGetDeviceError(NULL));
+        goto fail;
+    }
+    snprintf(rt->version, sizeof rt->version, "embree %d.%d.%d",
+             (int)rtcGetDeviceProperty(rt->device, RTC_DEVICE_PROPERTY_VERSION_MAJOR),
+             (int)rtcGetDeviceProperty(rt->device, RTC_DEVICE_PROPERTY_VERSION_MINOR),
+             (int)rtcGetDeviceProperty(rt->device, RTC_DEVICE_PROPERTY_VERSION_PATCH));
+    rt->rtc = rtcNewScene(rt->device);
+    if (!rt->rtc) {
+        res = embree_fail(rt, "rtcNewScene", err);
+        goto fail;
+    }
+    rtcSetSceneBuildQuality(rt->rtc, RTC_BUILD_QUALITY_HIGH);
+    rtcSetSceneFlags(rt->rtc, RTC_SCENE_FLAG_ROBUST);
+    rt->nrm = malloc((size_t)(s->vertex_count ? s->vertex_count : 1) * 3 * sizeof(float));
+    if (!rt->nrm) {
+        res = gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "raytrace: out of memory (%u vertices)",
+                           s->vertex_count);
+        goto fail;
+    }
+    if (s->triangle_count > 0) {
+        rt->geom = rtcNewGeometry(rt->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        if (!rt->geom) {
+            res = embree_fail(rt, "rtcNewGeometry", err);
+            goto fail;
+        }
+        rtcSetGeometryBuildQuality(rt->geom, RTC_BUILD_QUALITY_HIGH);
+        /* Embree owns both buffers; they live as long as the geometry. */
+        rt->pos = rtcSetNewGeometryBuffer(rt->geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                          3 * sizeof(float), s->vertex_count);
+        unsigned *ib = rtcSetNewGeometryBuffer(rt->geom, RTC_BUFFER_TYPE_INDEX, 0,
+                                               RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
+                                               s->triangle_count);
+        if (!rt->pos || !ib) {
+            res = embree_fail(rt, "vertex and index buffers", err);
+            goto fail;
+        }
+        res = place_vertices(s, time, rt->pos, rt->nrm, err);
+        if (res != GI_OK)
+            goto fail;
+        memcpy(ib, s->indices, (size_t)s->triangle_count * 3 * sizeof(unsigned));
+        rtcAttachGeometryByID(rt->rtc, rt->geom, 0);
+    }
+    res = commit(rt, err);
+    if (res != GI_OK)
+        goto fail;
+    *out = rt;
+    return GI_OK;
+fail:
+    gi_rt_free(rt);
+    return res;
+}
+
+gi_result gi_rt_set_time(gi_rt *rt, float time, gi_error *err)
+{
+    if (!rt)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "raytrace: the gi_rt is NULL");
+    if (!isfinite(time))
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "raytrace: time %g is not finite",
+                            (double)time);
+    if (!rt->moving || !rt->geom || time == rt->time) {
+        rt->time = time;
+        return GI_OK;
+    }
+    /* Placed into scratch first so that a failure leaves the old placement. */
+    const gi_scene *s = rt->scene;
+    size_t n = (size_t)s->vertex_count * 3;
+    float *pos = malloc(n * sizeof *pos), *nrm = malloc(n * sizeof *nrm);
+    gi_result res = GI_OK;
+    if (!pos || !nrm)
+        res = gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "raytrace: out of memory (%u vertices)",
+                           s->vertex_count);
+    else
+        res = place_vertices(s, time, pos, nrm, err);
+    if (res == GI_OK) {
+        memcpy(rt->pos, pos, n * sizeof *pos);
+        memcpy(rt->nrm, nrm, n * sizeof *nrm);
+        rtcUpdateGeometryBuffer(rt->geom, RTC_BUFFER_TYPE_VERTEX, 0);
+        res = commit(rt, err);
+        if (res == GI_OK)
+            rt->time = time;
+    }
+    free(pos);
+    free(nrm);
+    return res;
+}
+
+void gi_rt_free(gi_rt *rt)
+{
+    if (!rt)
+        return;
+    if (rt->geom)
+        rtcReleaseGeometry(rt->geom);
+    if (rt->rtc)
+        rtcReleaseScene(rt->rtc);
+    if (rt->device)
+        rtcReleaseDevice(rt->device);
+    free(rt->nrm);
+    free(rt);
+}
+
+static inline gi_vec3 vertex(const gi_rt *rt, uint32_t v)
+{
+    return gi_v3_load(rt->pos + 3 * (size_t)v);
+}
+
+int gi_rt_intersect(const gi_rt *rt, gi_vec3 o, gi_vec3 d, float tmin, float tmax, gi_rt_hit *hit)
+{
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRayHit rh;
+    rh.ray.org_x = o.x;
+    rh.ray.org_y = o.y;
+    rh.ray.org_z = o.z;
+    rh.ray.tnear = tmin;
+    rh.ray.dir_x = d.x;
+    rh.ray.dir_y = d.y;
+    rh.ray.dir_z = d.z;
+    rh.ray.time = 0.0f;
+    rh.ray.tfar = tmax;
+    rh.ray.mask = ~0u;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(rt->rtc, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
+        return 0;
+    const gi_scene *s = rt->scene;
+    uint32_t tri = rh.hit.primID;
+    const uint32_t *idx = s->indices + 3 * (size_t)tri;
+    gi_vec3 p0 = vertex(rt, idx[0]), p1 = vertex(rt, idx[1]), p2 = vertex(rt, idx[2]);
+    float b0 = 1.0f - rh.hit.u - rh.hit.v;
+    gi_vec3 c = gi_v3_cross(gi_v3_sub(p1, p0), gi_v3_sub(p2, p0));
+    float len = gi_v3_length(c);
+    hit->t = rh.ray.tfar;
+    hit->object = s->vertices[idx[0]].object;
+    hit->triangle = tri;
+    hit->u = rh.hit.u;
+    hit->v = rh.hit.v;
+    hit->position =
+        gi_v3_add(gi_v3_add(gi_v3_scale(p0, b0), gi_v3_scale(p1, rh.hit.u)), gi_v3_scale(p2, rh.hit.v));
+    hit->ng = len > 0.0f && isfinite(len) ? gi_v3_scale(c, 1.0f / len) : gi_v3(0.0f, 0.0f, 1.0f);
+    return 1;
+}
+
+int gi_rt_occluded(const gi_rt *rt, gi_vec3 o, gi_vec3 d, float tmin, float tmax)
+{
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRay r;
+    r.org_x = o.x;
+    r.org_y = o.y;
+    r.org_z = o.z;
+    r.tnear = tmin;
+    r.dir_x = d.x;
+    r.dir_y = d.y;
+    r.dir_z = d.z;
+    r.time = 0.0f;
+    r.tfar = tmax;
+    r.mask = ~0u;
+    r.id = 0;
+    r.flags = 0;
+    rtcOccluded1(rt->rtc, &ctx, &r);
+    return r.tfar < 0.0f; /* Embree sets -inf on a hit */
+}
+
+const float *gi_rt_positions(const gi_rt *rt)
+{
+    return rt->pos;
+}
+
+const float *gi_rt_normals(const gi_rt *rt)
+{
+    return rt->nrm;
+}
+
+float gi_rt_time(const gi_rt *rt)
+{
+    return rt->time;
+}
+
+const gi_scene *gi_rt_scene(const gi_rt *rt)
+{
+    return rt->scene;
+}
+
+const char *gi_rt_version(const gi_rt *rt)
+{
+    return rt->version;
+}
