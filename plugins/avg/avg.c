@@ -35,6 +35,8 @@ static const gi_param_desc avg_params[] = {
     {"filter", GI_PARAM_BOOL, 1, 0, 1, NULL, "Sec. III-C", "discontinuity-aware mx x mx box filter"},
     {"voxeliser", GI_PARAM_ENUM, 0, 0, 0, "conservative|paper", "Sec. III-A",
      "exact triangle-box voxels, or the paper's epsilon shift and stand-in triangles"},
+    {"tracing", GI_PARAM_ENUM, 0, 0, 0, "avg|exact", "Fig. 6",
+     "VPL paths marched through the AVG on the GPU, or the same paths traced exactly by Embree on the CPU"},
     {"offset", GI_PARAM_FLOAT, 1.5, 0.0, 8.0, NULL, NULL,
      "ray origins leave a surface this many voxel edges along its normal"},
     {0},
@@ -60,6 +62,7 @@ static gi_result avg_create(const gi_host *host, const gi_params *params, void *
     a->filter = gi_params_bool(params, "filter");
     a->voxeliser = gi_params_enum(params, "voxeliser");
     a->offset = gi_params_float(params, "offset");
+    a->tracing = gi_params_enum(params, "tracing");
     a->mx = (int)lround(sqrt((double)a->M));
     if (a->mx * a->mx != a->M) {
         host->log(host, GI_LOG_ERROR, "avg: M=%d is not a square number (1, 4, 9, 16, 25, 36, 49, 64)", a->M);
@@ -103,6 +106,11 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
         return fail(a, GI_ERR_GL, err.text);
     if (build_programs(a, &err) != GI_OK)
         return fail(a, GI_ERR_GL, err.text);
+    if (a->tracing == 1) {
+        a->exact = avg_exact_create(scene, &err);
+        if (!a->exact)
+            return fail(a, GI_ERR_INVALID_ARGUMENT, err.text);
+    }
     a->cpu_slots = calloc(a->slots, sizeof *a->cpu_slots);
     a->cpu_vpls = calloc(a->slots, sizeof *a->cpu_vpls);
     if (!a->cpu_slots || !a->cpu_vpls)
@@ -318,6 +326,8 @@ static gi_result avg_render(void *inst, const gi_view *view, const gi_target *ta
     if (r != GI_OK)
         return r;
 
+    /* The grid is built with exact tracing too: it places the grid and sets
+     * the clamping distance, so that both tracings shade alike. */
     host->stage_begin(host, "vox");
     avg_grid_place(a->grid, a->scene->bounds);
     r = avg_grid_voxelise(a->grid, a->scene, (avg_vox_mode)a->voxeliser, &err);
@@ -328,7 +338,12 @@ static gi_result avg_render(void *inst, const gi_view *view, const gi_target *ta
     host->stage_begin(host, "tra");
     avg_light_table lt;
     avg_light_table_build(a->scene, &lt);
-    r = trace_avg(a, &lt, &err);
+    if (a->exact) {
+        avg_trace_desc td = {a->paths, (uint32_t)a->bounces, a->offset};
+        r = avg_exact_trace(a->exact, a->scene, &lt, &td, a->cpu_slots, &err);
+    } else {
+        r = trace_avg(a, &lt, &err);
+    }
     if (r == GI_OK)
         compact(a);
     host->stage_end(host, "tra");
@@ -354,6 +369,7 @@ static void avg_destroy(void *inst)
         return;
     free_size_dependent(a);
     avg_grid_free(a->grid);
+    avg_exact_free(a->exact);
     GLuint progs[5] = {a->prog_trace, a->prog_split, a->prog_shade, a->prog_assemble, a->prog_final};
     for (int i = 0; i < 5; i++)
         if (progs[i])

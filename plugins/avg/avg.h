@@ -52,7 +52,7 @@ float *avg_grid_read(const avg_grid *g, int colour);
  * u_grid_origin / u_grid_h / u_grid_n uniforms of `program`. */
 void avg_grid_bind(const avg_grid *g, GLuint program, GLuint unit_normal, GLuint unit_colour);
 
-/* A VPL, std430 (48 bytes), mirrored in shaders/avg_vpl.glsl. */
+/* A VPL, std430 (64 bytes), mirrored in shaders/avg_vpl.glsl. */
 enum { AVG_VPL_DIFFUSE = 0, AVG_VPL_POINT = 1, AVG_VPL_SPOT = 2 };
 typedef struct avg_vpl {
     float position[3];
@@ -61,6 +61,8 @@ typedef struct avg_vpl {
     float cos_inner;
     float power[3];     /* diffuse: flux, radiant intensity = power cos / pi; point/spot: intensity */
     float cos_outer;
+    float spot_dir[3];  /* spot lights: the cone's axis */
+    float range;        /* punctual lights: glTF range (0 = none) */
 } avg_vpl;
 
 /* Tracing settings shared by the GPU and CPU tracers. */
@@ -83,6 +85,23 @@ typedef struct avg_light_table {
  * power at the current time). Directional lights get no share (not supported). */
 void avg_light_table_build(const gi_gpu_scene *gs, avg_light_table *t);
 
+/* Quasi-random pair `pair` of light path i (C twin of avg_vpl.glsl's avg_qr). */
+void avg_qr(uint32_t i, uint32_t pair, uint32_t mask, float out[2]);
+
+/* Exact tracing on the CPU with Embree (avg_trace_cpu.c): the same paths,
+ * the same slots. avg_exact_trace re-places the scene at gs->time when it
+ * changed and reads the emitter and light records back from the GPU. */
+typedef struct avg_exact avg_exact;
+avg_exact *avg_exact_create(const gi_gpu_scene *gs, gi_error *err);
+void avg_exact_free(avg_exact *x);
+gi_result avg_exact_trace(avg_exact *x, const gi_gpu_scene *gs, const avg_light_table *lt, const avg_trace_desc *d,
+                          avg_vpl *slots, gi_error *err);
+
+/* C twin of avg_vpl.glsl's avg_vpl_contribution (for tests): what VPL v
+ * sends to a receiver at x with unit normal n without visibility, S such
+ * that the Lambert receiver reflects (albedo / pi) S. */
+void avg_vpl_contribution(const avg_vpl *v, const float x[3], const float n[3], float dmin2, float out[3]);
+
 /* The method instance (avg.c). */
 typedef struct avg {
     const gi_host *host;
@@ -102,7 +121,7 @@ typedef struct avg {
     avg_vpl *cpu_slots;         /* readback of the slots */
     avg_vpl *cpu_vpls;          /* compacted live VPLs, in slot order */
     uint32_t vpl_count;
-    void *exact;                /* the CPU tracer's state (avg_trace_cpu.c), NULL for avg tracing */
+    avg_exact *exact;           /* the CPU tracer (avg_trace_cpu.c), NULL for avg tracing */
     void *atlas;                /* gi_depth_atlas when visibility is on */
     char error[GI_ERROR_MAX];
 } avg;
