@@ -42,7 +42,7 @@ typedef struct avg_grid {
 avg_grid *avg_grid_create(uint32_t n, gi_error *err);
 void avg_grid_free(avg_grid *g);
 /* Places the grid around `bounds` (min xyz, max xyz): a cube of the largest
- * extent plus a margin of one voxel on every side. */
+ * extent plus a margin of 1.5 voxels on every side. */
 void avg_grid_place(avg_grid *g, const float bounds[6]);
 /* Clears and voxelises the scene at its current time (§III-A). */
 gi_result avg_grid_voxelise(avg_grid *g, const gi_gpu_scene *gs, avg_vox_mode mode, gi_error *err);

@@ -86,8 +86,10 @@ void avg_grid_place(avg_grid *g, const float bounds[6])
         ext = fmaxf(ext, bounds[3 + a] - bounds[a]);
     if (!(ext > 0.0f))
         ext = 1.0f;
-    /* n - 2 voxels span the scene, one voxel of margin on each side. */
-    g->h = ext / (float)(g->n > 2 ? g->n - 2 : g->n);
+    /* n - 3 voxels span the scene's largest extent, centred: 1.5 voxels of
+     * margin, so that walls at the bounds lie in the middle of a voxel
+     * layer rather than on the faces between two (which would fill both). */
+    g->h = ext / (float)(g->n > 3 ? g->n - 3 : g->n);
     for (int a = 0; a < 3; a++)
         g->origin[a] = 0.5f * (bounds[a] + bounds[3 + a]) - 0.5f * g->h * (float)g->n;
 }
