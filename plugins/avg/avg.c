@@ -64,11 +64,6 @@ static gi_result avg_create(const gi_host *host, const gi_params *params, void *
     a->offset = gi_params_float(params, "offset");
     a->tracing = gi_params_enum(params, "tracing");
     a->mx = (int)lround(sqrt((double)a->M));
-    if (a->mx * a->mx != a->M) {
-        host->log(host, GI_LOG_ERROR, "avg: M=%d is not a square number (1, 4, 9, 16, 25, 36, 49, 64)", a->M);
-        free(a);
-        return GI_ERR_INVALID_ARGUMENT;
-    }
     a->paths = ((uint32_t)a->vpls + (uint32_t)a->bounces) / ((uint32_t)a->bounces + 1u);
     if (a->paths == 0)
         a->paths = 1;
@@ -101,6 +96,12 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
     avg *a = inst;
     gi_error err;
     a->scene = scene;
+    /* Checked here rather than in create(), where the host has no instance
+     * to ask for the message. */
+    if (a->mx * a->mx != a->M) {
+        snprintf(a->error, sizeof a->error, "M=%d is not a square number (1, 4, 9, 16, 25, 36, 49 or 64)", a->M);
+        return GI_ERR_INVALID_ARGUMENT;
+    }
     a->grid = avg_grid_create((uint32_t)a->grid_n, &err);
     if (!a->grid)
         return fail(a, GI_ERR_GL, err.text);
