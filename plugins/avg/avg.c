@@ -6,7 +6,8 @@
  *   tra  light paths traced through the AVG, a VPL on the light and at every
  *        hit (§III-B, shaders/avg_trace.comp), read back and compacted in
  *        slot order (deterministic);
- *   sha  one low-resolution shadow map per VPL in one atlas (§III-C);
+ *   sha  one low-resolution shadow map per VPL in the core's depth atlas,
+ *        one instanced draw (§III-C);
  *   ill  G-buffer, the swizzle into M sub-images, each sub-image shaded by
  *        its N_VPL / M VPLs, reassembly, the discontinuity-aware box
  *        filter, times albedo (§III-C, Fig. 4).
@@ -22,6 +23,8 @@
 #include <string.h>
 
 enum { B_SLOTS = 8, B_VPLS = 9 };
+#define AVG_BIAS_VOXELS 0.5f /* receiver offset and constant depth bias, in voxel edges */
+#define AVG_BIAS_TEXELS 1.0f /* depth bias per unit of distance and slope, in texels of the map */
 
 static const gi_param_desc avg_params[] = {
     {"grid", GI_PARAM_INT, 64, 4, 512, NULL, "AVG resolution (Sec. III-A, 64^3)", "voxels per axis of the grid"},
@@ -32,6 +35,12 @@ static const gi_param_desc avg_params[] = {
      "interleaved-sampling subsets, a square number (mx x mx pixel pattern)"},
     {"clamp", GI_PARAM_FLOAT, 1.0, 0.0, 100.0, NULL, "G clamping",
      "the geometry term's distance is clamped below at this many voxel edges"},
+    {"visibility", GI_PARAM_BOOL, 1, 0, 1, NULL, "Table I FPS (V) / (NV)",
+     "VPL visibility from shadow maps; off: every VPL reaches every point it faces"},
+    {"shadow_size", GI_PARAM_INT, 32, 4, 512, NULL, "Sec. III-C (low resolution)", "each VPL's shadow map is this many texels square"},
+    {"projection", GI_PARAM_ENUM, 0, 0, 0, "auto|paraboloid|perspective", "Sec. IV",
+     "shadow-map projection; auto: paraboloid for scenes of small triangles, perspective for large ones (as the paper)"},
+    {"fov", GI_PARAM_FLOAT, 120.0, 10.0, 170.0, NULL, "Sec. IV", "field of view of perspective shadow maps, degrees"},
     {"filter", GI_PARAM_BOOL, 1, 0, 1, NULL, "Sec. III-C", "discontinuity-aware mx x mx box filter"},
     {"voxeliser", GI_PARAM_ENUM, 0, 0, 0, "conservative|paper", "Sec. III-A",
      "exact triangle-box voxels, or the paper's epsilon shift and stand-in triangles"},
@@ -63,6 +72,10 @@ static gi_result avg_create(const gi_host *host, const gi_params *params, void *
     a->voxeliser = gi_params_enum(params, "voxeliser");
     a->offset = gi_params_float(params, "offset");
     a->tracing = gi_params_enum(params, "tracing");
+    a->visibility = gi_params_bool(params, "visibility");
+    a->tile = gi_params_int(params, "shadow_size");
+    a->projection = gi_params_enum(params, "projection");
+    a->fov = gi_params_float(params, "fov");
     a->mx = (int)lround(sqrt((double)a->M));
     a->paths = ((uint32_t)a->vpls + (uint32_t)a->bounces) / ((uint32_t)a->bounces + 1u);
     if (a->paths == 0)
@@ -91,6 +104,52 @@ static gi_result build_programs(avg *a, gi_error *err)
     return GI_OK;
 }
 
+/* The paper's rule (Sec. IV): paraboloid maps for scenes of small
+ * triangles, perspective maps for scenes of large ones, whose straight
+ * edges the paraboloid warp would bend. Small: mean edge below 1/16 of the
+ * scene's extent. */
+static gi_projection choose_projection(avg *a, const gi_scene *s)
+{
+    if (a->projection == 1)
+        return GI_PROJ_PARABOLOID;
+    if (a->projection == 2)
+        return GI_PROJ_PERSPECTIVE;
+    double sum = 0.0;
+    for (uint32_t t = 0; t < s->triangle_count; t++) {
+        gi_vec3 p[3];
+        gi_scene_triangle_world(s, t, 0.0f, p);
+        for (int e = 0; e < 3; e++)
+            sum += gi_v3_length(gi_v3_sub(p[(e + 1) % 3], p[e]));
+    }
+    float ext = 0.0f;
+    for (int i = 0; i < 3; i++)
+        ext = fmaxf(ext, s->bounds[3 + i] - s->bounds[i]);
+    double mean = s->triangle_count ? sum / (3.0 * s->triangle_count) : 0.0;
+    return mean < ext / 16.0 ? GI_PROJ_PARABOLOID : GI_PROJ_PERSPECTIVE;
+}
+
+/* §III-C: one shadow map per live VPL, from its position along its normal,
+ * all in the atlas in one instanced draw. */
+static gi_result shadow_maps(avg *a, gi_error *err)
+{
+    const gi_depth_atlas_desc *d = gi_depth_atlas_get_desc(a->atlas);
+    const float *b = a->scene->bounds;
+    float diag = sqrtf((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) + (b[5] - b[2]) * (b[5] - b[2]));
+    float zfar = 2.0f * diag + 1e-6f, znear = 1e-3f * a->grid->h;
+    for (uint32_t j = 0; j < a->vpl_count; j++) {
+        const avg_vpl *v = &a->cpu_vpls[j];
+        gi_vec3 eye = gi_v3_load(v->position), n = gi_v3_load(v->normal);
+        gi_vec3 up = fabsf(n.y) < 0.9f ? gi_v3(0, 1, 0) : gi_v3(1, 0, 0);
+        gi_depth_view *dv = &a->views[j];
+        gi_mat4_look_at(dv->view, eye, gi_v3_add(eye, n), up);
+        gi_mat4_perspective(dv->proj, a->fov * GI_PI / 180.0f, 1.0f, znear, zfar);
+        dv->projection = d->projection;
+        dv->znear = 0.0f;
+        dv->zfar = zfar;
+    }
+    return gi_depth_atlas_render(a->atlas, a->scene, a->views, a->vpl_count, err);
+}
+
 static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
 {
     avg *a = inst;
@@ -107,6 +166,15 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
         return fail(a, GI_ERR_GL, err.text);
     if (build_programs(a, &err) != GI_OK)
         return fail(a, GI_ERR_GL, err.text);
+    if (a->visibility) {
+        gi_depth_atlas_desc d = {(uint32_t)a->tile, a->slots, choose_projection(a, scene->scene), GI_DEPTH_RADIAL, 1};
+        a->atlas = gi_depth_atlas_create(&d, &err);
+        if (!a->atlas)
+            return fail(a, GI_ERR_INVALID_ARGUMENT, err.text);
+        a->views = calloc(a->slots, sizeof *a->views);
+        if (!a->views)
+            return fail(a, GI_ERR_OUT_OF_MEMORY, "avg: out of memory for the shadow-map views");
+    }
     if (a->tracing == 1) {
         a->exact = avg_exact_create(scene, &err);
         if (!a->exact)
@@ -285,6 +353,16 @@ static gi_result illuminate(avg *a, const gi_view *view, const gi_target *target
     glUniform1ui(glGetUniformLocation(p, "u_count"), a->vpl_count);
     float dmin = a->clamp * a->grid->h;
     glUniform1f(glGetUniformLocation(p, "u_dmin2"), dmin * dmin);
+    glUniform1i(glGetUniformLocation(p, "u_visibility"), a->atlas != NULL);
+    if (a->atlas) {
+        glBindTextureUnit(13, gi_depth_atlas_texture(a->atlas));
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, gi_depth_atlas_views_buffer(a->atlas));
+        /* Depth bias for maps of `tile` texels: half a voxel plus a share
+         * of the distance that grows as the maps get coarser (and with the
+         * slope, in the shader). */
+        glUniform1f(glGetUniformLocation(p, "u_bias_abs"), AVG_BIAS_VOXELS * a->grid->h);
+        glUniform1f(glGetUniformLocation(p, "u_bias_rel"), AVG_BIAS_TEXELS / (float)a->tile);
+    }
     glDispatchCompute((sw + 7) / 8, (sh + 7) / 8, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
 
@@ -351,6 +429,14 @@ static gi_result avg_render(void *inst, const gi_view *view, const gi_target *ta
     if (r != GI_OK)
         return fail(a, r, err.text);
 
+    if (a->atlas) {
+        host->stage_begin(host, "sha");
+        r = shadow_maps(a, &err);
+        host->stage_end(host, "sha");
+        if (r != GI_OK)
+            return fail(a, r, err.text);
+    }
+
     host->stage_begin(host, "ill");
     r = illuminate(a, view, target, &err);
     host->stage_end(host, "ill");
@@ -371,6 +457,8 @@ static void avg_destroy(void *inst)
     free_size_dependent(a);
     avg_grid_free(a->grid);
     avg_exact_free(a->exact);
+    gi_depth_atlas_free(a->atlas);
+    free(a->views);
     GLuint progs[5] = {a->prog_trace, a->prog_split, a->prog_shade, a->prog_assemble, a->prog_final};
     for (int i = 0; i < 5; i++)
         if (progs[i])

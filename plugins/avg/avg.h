@@ -107,7 +107,7 @@ typedef struct avg {
     const gi_host *host;
     /* parameters */
     int grid_n, vpls, bounces, M, tile, projection, filter, visibility, tracing, voxeliser;
-    float clamp, offset;
+    float clamp, offset, fov;
     int mx;                     /* sqrt(M): M = mx x mx subsets */
     /* resources */
     const gi_gpu_scene *scene;
@@ -122,7 +122,8 @@ typedef struct avg {
     avg_vpl *cpu_vpls;          /* compacted live VPLs, in slot order */
     uint32_t vpl_count;
     avg_exact *exact;           /* the CPU tracer (avg_trace_cpu.c), NULL for avg tracing */
-    void *atlas;                /* gi_depth_atlas when visibility is on */
+    gi_depth_atlas *atlas;      /* the VPLs' shadow maps when visibility is on */
+    gi_depth_view *views;       /* one per VPL slot */
     char error[GI_ERROR_MAX];
 } avg;
 

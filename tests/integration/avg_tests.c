@@ -13,6 +13,11 @@
  *                     identical; it changes when the scene moves and comes
  *                     back when the scene does; the light VPLs of AVG and
  *                     exact tracing agree (same quasi-random numbers);
+ *   avg_tests visibility  the light VPLs' shadow maps (core depth atlas,
+ *                     paraboloid and perspective) against Embree shadow
+ *                     rays for every receiver pixel (the VPLs at hits lie
+ *                     inside voxels, behind their surface, by design, and
+ *                     are not comparable with exact rays);
  *   avg_tests shade   interleaved shading with M = 1 equals the plain sum
  *                     over all VPLs computed on the CPU from the G-buffer
  *                     (no visibility), and M = 16 without the filter equals
@@ -418,9 +423,6 @@ static void march_case(gi_gpu *gpu, const char *scene_path, uint32_t n, uint32_t
             if (!near_surface) /* probes can pass beside an edge: measure exactly */
                 near_surface = scene_distance(s, p) <= 2.0f * sqrtf(3.0f) * g->h;
             phantom += !near_surface;
-            if (!near_surface && getenv("AVG_DEBUG"))
-                printf("phantom: p %g %g %g cell %g %g %g t_in %g embree %d t %g\n", p.x, p.y, p.z, hit[4 * i],
-                       hit[4 * i + 1], hit[4 * i + 2], hit[4 * i + 3], eh, eh ? h.t : -1.0f);
         }
         if (eh && ah) {
             both++;
@@ -569,8 +571,8 @@ static void shade_case(gi_gpu *gpu, int M, int filter)
     char m_kv[16], f_kv[16];
     snprintf(m_kv, sizeof m_kv, "M=%d", M);
     snprintf(f_kv, sizeof f_kv, "filter=%d", filter);
-    const char *kv[] = {"vpls=256", "grid=32", m_kv, f_kv};
-    avg *a = make_avg(&host, gs, kv, 4);
+    const char *kv[] = {"vpls=256", "grid=32", m_kv, f_kv, "visibility=false"};
+    avg *a = make_avg(&host, gs, kv, 5);
     if (!a) {
         EXPECT(0, "cannot make the avg instance");
         return;
@@ -629,10 +631,102 @@ static void shade_case(gi_gpu *gpu, int M, int filter)
     gi_scene_free(s);
 }
 
+/* ---- visibility: the VPL shadow maps against Embree ---- */
+
+/* The shadow-map test of avg_visibility.glsl on the CPU (same offsets and
+ * biases as avg.c), given the atlas tiles read back: 1 visible, 0 shadowed. */
+static int map_visible(const avg *a, const float *tiles, uint32_t j, gi_vec3 x, gi_vec3 n, float bias_abs,
+                       float bias_rel)
+{
+    const gi_depth_atlas_desc *d = gi_depth_atlas_get_desc(a->atlas);
+    uint32_t tx, ty;
+    float zp;
+    gi_vec3 xo = gi_v3_add(x, gi_v3_scale(n, bias_abs));
+    if (!gi_depth_atlas_texel(&a->views[j], d->projection, d->metric, d->tile, xo, &tx, &ty, &zp))
+        return 1;
+    float zmap = tiles[(size_t)j * d->tile * d->tile + (size_t)ty * d->tile + tx];
+    gi_vec3 w = gi_v3_normalize(gi_v3_sub(gi_v3_load(a->cpu_vpls[j].position), x));
+    float c = fminf(fmaxf(gi_v3_dot(n, w), 0.05f), 1.0f);
+    float slope = fminf(sqrtf(1.0f - c * c) / c, 10.0f);
+    return zp <= zmap + bias_abs + bias_rel * (1.0f + slope) * zp;
+}
+
+static void visibility_case(gi_gpu *gpu, const char *projection)
+{
+    gi_error err;
+    gi_scene *s = gi_scene_load(GI_SOURCE_DIR "/scenes/cornell_box.gltf", &err);
+    if (!s) {
+        EXPECT(0, "%s", err.text);
+        return;
+    }
+    gi_gpu_scene *gs = gi_gpu_scene_upload(gpu, s, &err);
+    gi_gpu_scene_set_time(gs, 0.0f);
+    gi_host host = make_host(gs);
+    char pkv[64];
+    snprintf(pkv, sizeof pkv, "projection=%s", projection);
+    const char *kv[] = {"vpls=256", "grid=32", pkv};
+    avg *a = make_avg(&host, gs, kv, 3);
+    gi_rt *rt = NULL;
+    if (!a || gi_rt_create(s, 0.0f, &rt, &err) != GI_OK) {
+        EXPECT(0, "cannot make the avg instance or the ray caster");
+        return;
+    }
+    uint32_t w = 32, h = 32;
+    target t = make_target(w, h);
+    gi_view v;
+    make_view(s, 0.0f, w, h, &v);
+    EXPECT(render(a, &v, &t), "render");
+    const gi_depth_atlas_desc *d = gi_depth_atlas_get_desc(a->atlas);
+    float *tiles = malloc((size_t)a->vpl_count * d->tile * d->tile * sizeof *tiles);
+    for (uint32_t j = 0; j < a->vpl_count; j++) {
+        float *tile = gi_depth_atlas_read_tile(a->atlas, j);
+        memcpy(tiles + (size_t)j * d->tile * d->tile, tile, (size_t)d->tile * d->tile * sizeof *tiles);
+        free(tile);
+    }
+    gi_image *pos = gi_gpu_read_texture(a->gbuffer->tex_position, w, h);
+    gi_image *nrm = gi_gpu_read_texture(a->gbuffer->tex_normal, w, h);
+    uint32_t pairs = 0, agree = 0, false_shadow = 0, false_light = 0;
+    float bias_abs = 0.5f * a->grid->h, bias_rel = 1.0f / (float)a->tile; /* AVG_BIAS_* in avg.c */
+    for (size_t i = 0; i < (size_t)w * h; i++) {
+        if (pos->rgba[4 * i + 3] <= 0.0f)
+            continue;
+        gi_vec3 x = gi_v3_load(&pos->rgba[4 * i]), n = gi_v3_normalize(gi_v3_load(&nrm->rgba[4 * i]));
+        for (uint32_t j = 0; j < a->vpl_count; j++) {
+            float c3[3];
+            avg_vpl_contribution(&a->cpu_vpls[j], &pos->rgba[4 * i], &nrm->rgba[4 * i], 0.0f, c3);
+            if (c3[0] + c3[1] + c3[2] <= 0.0f || (a->cpu_vpls[j].kind >> 8 & 0xFFu) != 0)
+                continue;
+            gi_vec3 y = gi_v3_load(a->cpu_vpls[j].position);
+            gi_vec3 dir = gi_v3_sub(y, x);
+            float dist = gi_v3_length(dir);
+            /* Ray from just off the receiver to just short of the VPL. */
+            int blocked = gi_rt_occluded(rt, gi_v3_add(x, gi_v3_scale(n, 1e-3f)), gi_v3_scale(dir, 1.0f / dist),
+                                         0.0f, dist - 1e-2f);
+            int vis = map_visible(a, tiles, j, x, n, bias_abs, bias_rel);
+            pairs++;
+            agree += vis == !blocked;
+            false_shadow += !vis && !blocked;
+            false_light += vis && blocked;
+        }
+    }
+    printf("visibility %s: %u receiver-VPL pairs, shadow maps agree with Embree on %.2f %% (%u falsely shadowed, %u "
+           "falsely lit)\n",
+           projection, pairs, 100.0 * agree / (pairs ? pairs : 1), false_shadow, false_light);
+    EXPECT(agree >= pairs - pairs / 20, "shadow maps agree with ray casting on only %u of %u pairs", agree, pairs);
+    EXPECT(pairs > 10000, "too few pairs (%u)", pairs);
+    free(tiles);
+    gi_image_free(pos);
+    gi_image_free(nrm);
+    gi_rt_free(rt);
+    gi_method_entry(GI_ABI_VERSION)->destroy(a);
+    gi_gpu_scene_free(gs);
+    gi_scene_free(s);
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
-        fprintf(stderr, "usage: avg_tests voxel|march|vpls|shade\n");
+        fprintf(stderr, "usage: avg_tests voxel|march|vpls|shade|visibility\n");
         return 2;
     }
     gi_error err;
@@ -654,6 +748,9 @@ int main(int argc, char **argv)
         shade_case(gpu, 1, 1);
         shade_case(gpu, 16, 0);
         shade_case(gpu, 9, 0);
+    } else if (!strcmp(argv[1], "visibility")) {
+        visibility_case(gpu, "paraboloid");
+        visibility_case(gpu, "perspective");
     } else {
         fprintf(stderr, "unknown test '%s'\n", argv[1]);
         return 2;

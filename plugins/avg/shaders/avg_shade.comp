@@ -1,10 +1,11 @@
 // Shading (§III-C, Fig. 4): every texel of the split G-buffer gathers the
 // N_VPL / M VPLs of its subset m (VPLs m, m + M, m + 2M, ...): the VPL's
 // emission times the clamped geometry term, times the VPL's visibility from
-// its shadow map when visibility is on. The result S is irradiance-like:
+// its shadow map when visibility is on (avg_visibility.glsl). The result S is irradiance-like:
 // the Lambert receiver reflects (albedo / pi) S (applied after the filter).
 #define AVG_NO_GRID_SAMPLERS
 #include "avg_vpl.glsl"
+#include "avg_visibility.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -17,6 +18,7 @@ uniform ivec2 u_sub;   // sw, sh
 uniform int u_mx;
 uniform uint u_count;  // live VPLs
 uniform float u_dmin2; // clamping distance squared
+uniform bool u_visibility;
 
 void main()
 {
@@ -36,6 +38,8 @@ void main()
             vec3 c = avg_vpl_contribution(v, x, n, u_dmin2);
             if (c == vec3(0.0))
                 continue;
+            if (u_visibility)
+                c *= avg_visible(j, x, n, normalize(v.position - x));
             S += c;
         }
     }
