@@ -37,6 +37,8 @@ typedef struct avg_grid {
     GLuint tex_normal;  /* RGBA32F 3D: sum of triangle normals, count in w */
     GLuint tex_colour;  /* RGBA32F 3D: sum of albedos, count in w */
     GLuint fbo, program[2]; /* layered FBO; programs per avg_vox_mode */
+    GLuint ssbo_colours;    /* per material: albedo x mean texture colour */
+    const gi_scene *colour_scene; /* the scene ssbo_colours was made for */
 } avg_grid;
 
 avg_grid *avg_grid_create(uint32_t n, gi_error *err);

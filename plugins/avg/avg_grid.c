@@ -73,6 +73,8 @@ void avg_grid_free(avg_grid *g)
         glDeleteTextures(1, &g->tex_normal);
     if (g->tex_colour)
         glDeleteTextures(1, &g->tex_colour);
+    if (g->ssbo_colours)
+        glDeleteBuffers(1, &g->ssbo_colours);
     for (int i = 0; i < 2; i++)
         if (g->program[i])
             glDeleteProgram(g->program[i]);
@@ -94,8 +96,44 @@ void avg_grid_place(avg_grid *g, const float bounds[6])
         g->origin[a] = 0.5f * (bounds[a] + bounds[3 + a]) - 0.5f * g->h * (float)g->n;
 }
 
+/* Per material, the colour a voxel takes from it: the albedo times the
+ * texture's mean colour, which is what the paper's "lowest mip-map level"
+ * holds (the core keeps one level only, so the mean is computed here). */
+static gi_result upload_material_colours(avg_grid *g, const gi_scene *s, gi_error *err)
+{
+    uint32_t n = s->material_count ? s->material_count : 1;
+    float *c = calloc((size_t)n * 4, sizeof *c);
+    if (!c)
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "avg: out of memory");
+    for (uint32_t m = 0; m < s->material_count; m++) {
+        const gi_material *mat = &s->materials[m];
+        double mean[3] = {1, 1, 1};
+        if (mat->albedo_texture >= 0) {
+            const gi_texture *t = &s->textures[mat->albedo_texture];
+            size_t texels = (size_t)t->width * t->height;
+            mean[0] = mean[1] = mean[2] = 0.0;
+            for (size_t i = 0; i < texels; i++)
+                for (int k = 0; k < 3; k++)
+                    mean[k] += t->rgba[4 * i + k];
+            for (int k = 0; k < 3; k++)
+                mean[k] = texels ? mean[k] / (double)texels : 1.0;
+        }
+        for (int k = 0; k < 3; k++)
+            c[4 * m + k] = (float)(mat->albedo[k] * mean[k]);
+    }
+    if (g->ssbo_colours)
+        glDeleteBuffers(1, &g->ssbo_colours);
+    glCreateBuffers(1, &g->ssbo_colours);
+    glNamedBufferStorage(g->ssbo_colours, (GLsizeiptr)((size_t)n * 4 * sizeof *c), c, 0);
+    free(c);
+    g->colour_scene = s;
+    return GI_OK;
+}
+
 gi_result avg_grid_voxelise(avg_grid *g, const gi_gpu_scene *gs, avg_vox_mode mode, gi_error *err)
 {
+    if (g->colour_scene != gs->scene && upload_material_colours(g, gs->scene, err) != GI_OK)
+        return GI_ERR_OUT_OF_MEMORY;
     const float zero[4] = {0, 0, 0, 0};
     glClearTexImage(g->tex_normal, 0, GL_RGBA, GL_FLOAT, zero);
     glClearTexImage(g->tex_colour, 0, GL_RGBA, GL_FLOAT, zero);
@@ -114,6 +152,7 @@ gi_result avg_grid_voxelise(avg_grid *g, const gi_gpu_scene *gs, avg_vox_mode mo
     glUniform1i(glGetUniformLocation(p, "u_mode"), (GLint)mode);
     glUniform1f(glGetUniformLocation(p, "u_epsilon"), 0.5f);
     gi_gpu_scene_bind(gs);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, g->ssbo_colours);
     gi_gpu_scene_draw(gs, -1, (GLsizei)g->n);
     glUseProgram(0);
     glDisable(GL_BLEND);

@@ -19,8 +19,9 @@ layout(triangle_strip, max_vertices = 5) out;
 
 in vec3 v_grid[];
 flat in uint v_material[];
-in vec2 v_uv[];
 flat in int v_slice[];
+
+layout(std430, binding = 8) readonly buffer AvgColours { vec4 avg_material_colour[]; };
 
 uniform int u_grid_n;
 uniform int u_mode;
@@ -84,16 +85,10 @@ void main()
     if (zmax < k || zmin > k + 1.0)
         return;
 
-    uint m = v_material[0];
-    GiMaterial mat = gi_materials[m];
-    vec3 colour = mat.albedo;
-    if (mat.texture_layer >= 0) {
-        // The lowest mip level (the texture's average), as the paper does.
-        vec2 uv = (v_uv[0] + v_uv[1] + v_uv[2]) / 3.0;
-        colour *= textureLod(gi_albedo_textures, vec3(uv, float(mat.texture_layer)), 1000.0).rgb;
-    }
     g_normal = n; // the stored normal is the triangle's own, before any shift
-    g_colour = colour;
+    // The material's albedo times its texture's mean colour: the paper's
+    // "lowest mip-map level", so texture detail does not fill whole voxels.
+    g_colour = avg_material_colour[v_material[0]].rgb;
     g_p0 = a;
     g_p1 = b;
     g_p2 = c;

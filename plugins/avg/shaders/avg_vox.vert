@@ -7,21 +7,18 @@
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in uint a_object;
 layout(location = 3) in uint a_material;
-layout(location = 4) in vec2 a_uv;
 
 uniform vec3 u_grid_origin;
 uniform float u_grid_h;
 
 out vec3 v_grid;
 flat out uint v_material;
-out vec2 v_uv;
 flat out int v_slice;
 
 void main()
 {
     v_grid = (gi_object_point(a_object, a_position) - u_grid_origin) / u_grid_h;
     v_material = a_material;
-    v_uv = a_uv;
     v_slice = gl_InstanceID;
     gl_Position = vec4(0.0, 0.0, 0.0, 1.0);
 }
