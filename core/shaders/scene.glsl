@@ -1,5 +1,8 @@
 // The scene on the GPU: buffer layouts and fetch helpers (mirrors gpu.h).
 // Bindings are fixed; plugins use binding points >= 8 for their own data.
+// SSBOs: 0 vertices, 1 indices, 2 materials, 3 lights, 4 emitters (here),
+// 5 depth-atlas views (depth_atlas.glsl); UBOs: 0 objects, 1 scene info;
+// textures: 0-2 environment (envmap.glsl), 3 albedo textures.
 #ifndef GI_SCENE_GLSL
 #define GI_SCENE_GLSL
 #include "common.glsl"

@@ -55,6 +55,7 @@ enum {
     GI_SSBO_MATERIALS = 2,
     GI_SSBO_LIGHTS = 3,
     GI_SSBO_EMITTERS = 4,
+    GI_SSBO_DEPTH_ATLAS = 5, /* views of a gi_depth_atlas (passes.h, depth_atlas.glsl) */
     GI_UBO_OBJECTS = 0,
     GI_UBO_FRAME = 1,
     GI_TEX_ENV = 0,       /* sampler2D: RGBA32F radiance, intensity applied */

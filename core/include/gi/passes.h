@@ -27,6 +27,31 @@
  * paraboloid maps the hemisphere around the view's -Z (Brabec et al.).
  * Cube maps are six perspective views (gi_mat4_cube_face_view) into six
  * consecutive layers in GL face order +X, -X, +Y, -Y, +Z, -Z.
+ *
+ * Depth atlas (gi_depth_atlas_*): many small first-surface depth maps (e.g.
+ * 1024 maps of 32 x 32) in ONE R32F 2D texture, all drawn by ONE instanced
+ * draw: instance i renders view i (gl_InstanceID indexes an SSBO of views)
+ * into tile i, clipped to its tile by four gl_ClipDistance planes (viewport
+ * arrays would allow only 16 views). Tile i is column i % columns, row
+ * i / columns, row 0 at the bottom (GL); columns = ceil(sqrt(capacity)),
+ * rows = ceil(capacity / columns). Depth is linear (the desc's metric),
+ * written as colour with a depth test on a depth buffer of the atlas' size,
+ * so each texel holds the first surface exactly as gi_depth_render with
+ * surfaces = 1 would (tests/unit/test_depth_atlas.c holds the two equal).
+ * Texels of tiles not rendered, and texels where nothing was hit, hold
+ * FLT_MAX. All objects are drawn, placed by the transforms last set on the
+ * gi_gpu_scene. Projections: perspective (the view's proj matrix) or
+ * paraboloid (hemisphere around the view's -Z, Brabec et al. 2002; the back
+ * hemisphere is clipped away); one projection per atlas.
+ *   gi_depth_atlas_desc d = {.tile = 32, .capacity = 1024,
+ *                            .projection = GI_PROJ_PARABOLOID, .metric = GI_DEPTH_RADIAL};
+ *   gi_depth_atlas *a = gi_depth_atlas_create(&d, &err);
+ *   gi_depth_atlas_render(a, gs, views, n, &err);     // n <= capacity
+ *   glBindTextureUnit(unit, gi_depth_atlas_texture(a));
+ *   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, GI_SSBO_DEPTH_ATLAS,
+ *                    gi_depth_atlas_views_buffer(a));
+ * GLSL side: core/shaders/depth_atlas.glsl (gi_atlas_depth looks a world
+ * point up in view i's tile); gi_depth_atlas_texel is its C twin.
  */
 #ifndef GI_PASSES_H
 #define GI_PASSES_H
@@ -98,6 +123,46 @@ void gi_depth_cube_views(gi_vec3 eye, float znear, float zfar, gi_depth_view out
 /* Reads layer `layer` of a depth array back (size*size*4 floats, row 0 at
  * the bottom), for tests and CPU-side compression. Caller frees. */
 float *gi_depth_read_layer(GLuint array_tex, uint32_t size, uint32_t layer);
+
+/* ---- depth atlas (see the manual above) ---- */
+typedef struct gi_depth_atlas_desc {
+    uint32_t tile;            /* each map is tile x tile texels (1..4096) */
+    uint32_t capacity;        /* max maps; columns = ceil(sqrt(capacity)) */
+    gi_projection projection; /* GI_PROJ_PERSPECTIVE or GI_PROJ_PARABOLOID */
+    gi_depth_metric metric;   /* GI_DEPTH_EYE_Z or GI_DEPTH_RADIAL */
+    int cull;                 /* 0 none, 1 back faces, 2 front faces */
+} gi_depth_atlas_desc;
+
+typedef struct gi_depth_atlas gi_depth_atlas;
+
+/* NULL with a message when the desc is invalid or the atlas (columns x
+ * tile by rows x tile) exceeds GL_MAX_TEXTURE_SIZE. Needs a current GL
+ * context. */
+gi_depth_atlas *gi_depth_atlas_create(const gi_depth_atlas_desc *d, gi_error *err);
+void gi_depth_atlas_free(gi_depth_atlas *a);
+/* Renders views[0..count) into tiles 0..count-1 with one instanced draw
+ * and clears every other tile to FLT_MAX. count > capacity, a view whose
+ * projection differs from the atlas', or (paraboloid) a view without
+ * 0 <= znear < zfar is GI_ERR_INVALID_ARGUMENT and draws nothing.
+ * Leaves the views SSBO bound at GI_SSBO_DEPTH_ATLAS. */
+gi_result gi_depth_atlas_render(gi_depth_atlas *a, const gi_gpu_scene *gs, const gi_depth_view *views,
+                                uint32_t count, gi_error *err);
+GLuint gi_depth_atlas_texture(const gi_depth_atlas *a);      /* R32F, linear depth, FLT_MAX where empty */
+GLuint gi_depth_atlas_views_buffer(const gi_depth_atlas *a); /* SSBO read by depth_atlas.glsl */
+uint32_t gi_depth_atlas_columns(const gi_depth_atlas *a);
+uint32_t gi_depth_atlas_rows(const gi_depth_atlas *a);
+uint32_t gi_depth_atlas_count(const gi_depth_atlas *a); /* views drawn by the last render */
+const gi_depth_atlas_desc *gi_depth_atlas_get_desc(const gi_depth_atlas *a);
+/* Tile `tile` read back: tile x tile floats, row 0 at the bottom; NULL when
+ * tile >= capacity. For tests and CPU-side use. Caller frees. */
+float *gi_depth_atlas_read_tile(const gi_depth_atlas *a, uint32_t tile);
+/* C twin of gi_atlas_texel (depth_atlas.glsl): the texel (within its tile)
+ * that world point p falls into in view v, and p's own depth in `metric`.
+ * Returns 0 when p is outside the view's footprint (behind a perspective
+ * eye, outside its frustum's sides, or in a paraboloid's back hemisphere);
+ * *point_depth is set either way. */
+int gi_depth_atlas_texel(const gi_depth_view *v, gi_projection projection, gi_depth_metric metric,
+                         uint32_t tile, gi_vec3 p, uint32_t *tx, uint32_t *ty, float *point_depth);
 
 #ifdef __cplusplus
 }

@@ -1,0 +1,12 @@
+// Depth atlas, fragment stage: the linear depth of the nearest surface
+// (the depth test keeps it) as colour, in the atlas' metric.
+uniform int u_metric; // 0 eye z, 1 radial
+
+in vec3 v_eye;
+
+layout(location = 0) out float o_depth;
+
+void main()
+{
+    o_depth = u_metric == 1 ? length(v_eye) : -v_eye.z;
+}
