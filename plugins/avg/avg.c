@@ -161,6 +161,16 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
         snprintf(a->error, sizeof a->error, "M=%d is not a square number (1, 4, 9, 16, 25, 36, 49 or 64)", a->M);
         return GI_ERR_INVALID_ARGUMENT;
     }
+    uint32_t directional = 0;
+    for (uint32_t l = 0; l < scene->scene->light_count; l++)
+        directional += scene->scene->lights[l].type == GI_LIGHT_DIRECTIONAL;
+    if (directional)
+        a->host->log(a->host, GI_LOG_WARN, "%u directional light(s) ignored: not supported (caps)", directional);
+    if (scene->light_count > AVG_MAX_PUNCTUAL)
+        a->host->log(a->host, GI_LOG_WARN, "only the first %d of %u punctual lights emit VPLs", AVG_MAX_PUNCTUAL,
+                     scene->light_count);
+    if (scene->scene->has_environment)
+        a->host->log(a->host, GI_LOG_WARN, "the environment map is ignored: not supported (caps)");
     a->grid = avg_grid_create((uint32_t)a->grid_n, &err);
     if (!a->grid)
         return fail(a, GI_ERR_GL, err.text);
