@@ -25,6 +25,7 @@
 #include "../../plugins/avg/avg.h"
 
 #include "gi/image.h"
+#include "gi/lights.h"
 #include "gi/raytrace.h"
 #include "gi/rng.h"
 #include "gi/sampling.h"
@@ -192,8 +193,10 @@ static int tri_box_clip(const gi_vec3 p[3], gi_vec3 lo, gi_vec3 hi)
     return n > 0;
 }
 
-/* CPU counts of triangles overlapping each voxel, boxes grown by `grow`. */
-static uint32_t *cpu_voxelise(const gi_scene *s, float t, const avg_grid *g, float grow)
+/* CPU counts of triangles overlapping each voxel, boxes grown by `grow`;
+ * with `colour`, also the sum of the overlapping triangles' material
+ * albedos (the test scenes have no textures). */
+static uint32_t *cpu_voxelise(const gi_scene *s, float t, const avg_grid *g, float grow, float *colour)
 {
     uint32_t n = g->n;
     uint32_t *count = calloc((size_t)n * n * n, sizeof *count);
@@ -221,8 +224,13 @@ static uint32_t *cpu_voxelise(const gi_scene *s, float t, const avg_grid *g, flo
                 for (int x = i0[0]; x <= i1[0]; x++) {
                     gi_vec3 blo = gi_v3((float)x - grow, (float)y - grow, (float)z - grow);
                     gi_vec3 bhi = gi_v3((float)x + 1 + grow, (float)y + 1 + grow, (float)z + 1 + grow);
-                    if (tri_box_clip(p, blo, bhi))
-                        count[((size_t)z * n + y) * n + x]++;
+                    if (tri_box_clip(p, blo, bhi)) {
+                        size_t v = ((size_t)z * n + y) * n + x;
+                        count[v]++;
+                        if (colour)
+                            for (int c = 0; c < 3; c++)
+                                colour[3 * v + c] += s->materials[s->vertices[s->indices[3 * tri]].material].albedo[c];
+                    }
                 }
     }
     return count;
@@ -244,8 +252,9 @@ static void voxel_case(gi_gpu *gpu, const char *scene_path, float t, uint32_t n)
         return;
     }
     avg_grid_place(g, gs->bounds);
-    uint32_t *inner = cpu_voxelise(s, t, g, -1e-3f), *exact = cpu_voxelise(s, t, g, 0.0f),
-             *outer = cpu_voxelise(s, t, g, 1e-3f);
+    float *colour = calloc((size_t)n * n * n * 3, sizeof *colour);
+    uint32_t *inner = cpu_voxelise(s, t, g, -1e-3f, NULL), *exact = cpu_voxelise(s, t, g, 0.0f, colour),
+             *outer = cpu_voxelise(s, t, g, 1e-3f, NULL);
     size_t total = (size_t)n * n * n, filled_cpu = 0;
     for (size_t i = 0; i < total; i++)
         filled_cpu += exact[i] > 0;
@@ -261,12 +270,17 @@ static void voxel_case(gi_gpu *gpu, const char *scene_path, float t, uint32_t n)
             count_equal += (uint32_t)c >= inner[i] && (uint32_t)c <= outer[i];
             if (c > 0.0f && fabsf(col[4 * i + 3] - c) > 0.0f)
                 colour_bad++;
+            /* Where the overlap is unambiguous, the colour sums agree too. */
+            if (mode == AVG_VOX_CONSERVATIVE && inner[i] == outer[i] && (uint32_t)c == exact[i])
+                for (int k = 0; k < 3; k++)
+                    if (fabsf(col[4 * i + k] - colour[3 * i + k]) > 1e-4f * (1.0f + c))
+                        colour_bad++;
         }
         printf("voxel %s t=%.2f n=%u %-12s: %zu filled (CPU %zu), %zu missed, %zu false positives (%.3f %%), "
                "triangle count within the CPU's bounds in %.3f %% of voxels\n",
                strrchr(scene_path, '/') + 1, t, n, mode ? "paper" : "conservative", filled, filled_cpu, misses, fp,
                100.0 * (double)fp / (double)(filled ? filled : 1), 100.0 * (double)count_equal / (double)total);
-        EXPECT(colour_bad == 0, "%zu voxels with different normal and colour counts", colour_bad);
+        EXPECT(colour_bad == 0, "%zu voxels with different counts or colour sums", colour_bad);
         if (mode == AVG_VOX_CONSERVATIVE) {
             EXPECT(misses == 0, "conservative voxeliser missed %zu overlapped voxels", misses);
             EXPECT(fp == 0, "conservative voxeliser filled %zu voxels no triangle overlaps", fp);
@@ -282,6 +296,7 @@ static void voxel_case(gi_gpu *gpu, const char *scene_path, float t, uint32_t n)
     free(inner);
     free(exact);
     free(outer);
+    free(colour);
     avg_grid_free(g);
     gi_gpu_scene_free(gs);
     gi_scene_free(s);
@@ -723,10 +738,109 @@ static void visibility_case(gi_gpu *gpu, const char *projection)
     gi_scene_free(s);
 }
 
+/* ---- punctual: point and spot lights through their VPLs ---- */
+
+/* tests/data/valid/lights.gltf (an emissive quad, a point, a spot and a
+ * directional light over a floor) with direct light only, no visibility,
+ * M = 1: the image must equal emission + albedo/pi x (the area-light VPLs'
+ * sum + the exact point and spot light irradiance). The point light's VPLs
+ * each cover one hemisphere at twice the intensity and the paths are split
+ * among the lights by power, so this holds the split and the hemispheres
+ * to the closed form (up to the rounding of path counts: 4096 paths). The
+ * directional light is ignored by the method and by this sum. */
+static void punctual_case(gi_gpu *gpu)
+{
+    gi_error err;
+    gi_scene *s = gi_scene_load(GI_SOURCE_DIR "/tests/data/valid/lights.gltf", &err);
+    if (!s) {
+        EXPECT(0, "%s", err.text);
+        return;
+    }
+    gi_gpu_scene *gs = gi_gpu_scene_upload(gpu, s, &err);
+    gi_gpu_scene_set_time(gs, 0.0f);
+    gi_host host = make_host(gs);
+    const char *kv[] = {"vpls=4096", "bounces=0", "grid=16", "M=1", "filter=false", "visibility=false"};
+    avg *a = make_avg(&host, gs, kv, 6);
+    if (!a) {
+        EXPECT(0, "cannot make the avg instance");
+        return;
+    }
+    uint32_t w = 48, h = 48;
+    target t = make_target(w, h);
+    gi_view v;
+    make_view(s, 0.0f, w, h, &v);
+    EXPECT(render(a, &v, &t), "render");
+    gi_image *img = gi_gpu_read_texture(t.tex, w, h);
+    gi_image *pos = gi_gpu_read_texture(a->gbuffer->tex_position, w, h);
+    gi_image *nrm = gi_gpu_read_texture(a->gbuffer->tex_normal, w, h);
+    gi_image *alb = gi_gpu_read_texture(a->gbuffer->tex_albedo, w, h);
+    gi_image *emi = gi_gpu_read_texture(a->gbuffer->tex_emission, w, h);
+    float dmin2 = a->clamp * a->grid->h * a->clamp * a->grid->h;
+    double worst = 0.0, sum_got = 0.0, sum_expect = 0.0, punctual_share = 0.0;
+    uint32_t lit = 0;
+    for (size_t i = 0; i < (size_t)w * h; i++) {
+        /* Receivers only: the lamp seen directly is exact either way. */
+        if (pos->rgba[4 * i + 3] <= 0.0f || emi->rgba[4 * i] + emi->rgba[4 * i + 1] + emi->rgba[4 * i + 2] > 0.0f)
+            continue;
+        gi_vec3 x = gi_v3_load(&pos->rgba[4 * i]), n = gi_v3_normalize(gi_v3_load(&nrm->rgba[4 * i]));
+        double S[3] = {0, 0, 0}, P[3] = {0, 0, 0};
+        for (uint32_t j = 0; j < a->vpl_count; j++) {
+            if ((a->cpu_vpls[j].kind & 0xFFu) != AVG_VPL_DIFFUSE)
+                continue;
+            float c3[3], nn[3] = {n.x, n.y, n.z};
+            avg_vpl_contribution(&a->cpu_vpls[j], &pos->rgba[4 * i], nn, dmin2, c3);
+            for (int c = 0; c < 3; c++)
+                S[c] += c3[c];
+        }
+        for (uint32_t l = 0; l < s->light_count; l++) {
+            const gi_light *L = &s->lights[l];
+            if (L->type == GI_LIGHT_DIRECTIONAL)
+                continue;
+            gi_light_frame f = gi_scene_light_at(s, l, 0.0f);
+            gi_vec3 d = gi_v3_sub(f.position, x);
+            float d2 = gi_v3_dot(d, d), dist = sqrtf(d2);
+            gi_vec3 wl = gi_v3_scale(d, 1.0f / dist);
+            float cx = gi_v3_dot(n, wl);
+            if (cx <= 0.0f)
+                continue;
+            float g = cx / fmaxf(d2, dmin2) * gi_range_window(dist, L->range);
+            if (L->type == GI_LIGHT_SPOT)
+                g *= gi_spot_falloff(-gi_v3_dot(wl, f.direction), cosf(L->inner_cone), cosf(L->outer_cone));
+            for (int c = 0; c < 3; c++)
+                P[c] += L->intensity[c] * g;
+        }
+        for (int c = 0; c < 3; c++) {
+            double expect = emi->rgba[4 * i + c] + alb->rgba[4 * i + c] / GI_PI * (S[c] + P[c]);
+            double got = img->rgba[4 * i + c];
+            sum_got += got;
+            sum_expect += expect;
+            punctual_share += alb->rgba[4 * i + c] / GI_PI * P[c];
+            double rel = fabs(got - expect) / (fabs(expect) + 1e-3);
+            worst = rel > worst ? rel : worst;
+        }
+        lit++;
+    }
+    printf("punctual: %u receiver pixels, %u VPLs, point and spot lights %.0f %% of their light; image sum %.5g against the "
+           "closed form %.5g (%+.3f %%), largest pixel difference %.2f %%\n",
+           lit, a->vpl_count, 100.0 * punctual_share / sum_expect, sum_got, sum_expect,
+           100.0 * (sum_got - sum_expect) / sum_expect, 100.0 * worst);
+    EXPECT(punctual_share > 0.2 * sum_expect, "the punctual lights carry too little of the light to test them");
+    EXPECT(fabs(sum_got - sum_expect) < 0.01 * sum_expect, "image sum off by more than 1 %%");
+    EXPECT(worst < 0.03, "a pixel differs by %.3g (relative)", worst);
+    gi_image_free(img);
+    gi_image_free(pos);
+    gi_image_free(nrm);
+    gi_image_free(alb);
+    gi_image_free(emi);
+    gi_method_entry(GI_ABI_VERSION)->destroy(a);
+    gi_gpu_scene_free(gs);
+    gi_scene_free(s);
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
-        fprintf(stderr, "usage: avg_tests voxel|march|vpls|shade|visibility\n");
+        fprintf(stderr, "usage: avg_tests voxel|march|vpls|shade|visibility|punctual\n");
         return 2;
     }
     gi_error err;
@@ -748,6 +862,8 @@ int main(int argc, char **argv)
         shade_case(gpu, 1, 1);
         shade_case(gpu, 16, 0);
         shade_case(gpu, 9, 0);
+    } else if (!strcmp(argv[1], "punctual")) {
+        punctual_case(gpu);
     } else if (!strcmp(argv[1], "visibility")) {
         visibility_case(gpu, "paraboloid");
         visibility_case(gpu, "perspective");
