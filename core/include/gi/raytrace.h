@@ -18,13 +18,13 @@
  * scene-global triangle index (the G-buffer's triangle id). World shading
  * normals (inverse transpose, normalised; (0,0,0) where that is not finite)
  * are kept beside the positions for shading code. The BVH is built with
- * quality "high" and RTC_SCENE_FLAG_ROBUST (watertight traversal, no
- * cracks between triangles sharing an edge).
+ * quality "high" and RTC_SCENE_FLAG_ROBUST (Embree avoids the optimisations
+ * that reduce arithmetic accuracy).
  *
  * Validation: a transform or a placed vertex that is not finite, or a
  * coordinate beyond 1e18 (its square overflows float), is an error
- * (GI_ERR_INVALID_ARGUMENT, "scene: object k 'name': vertex i is not finite
- * at t = ..."), because Embree silently drops such triangles and the scene
+ * (GI_ERR_INVALID_ARGUMENT, "<scene file>: object k 'name': vertex i is not
+ * finite at t = ..."), because Embree silently drops such triangles and the scene
  * would show holes instead of failing.
  *
  * Queries: gi_rt_intersect and gi_rt_occluded only read the committed BVH,
@@ -69,7 +69,8 @@ gi_result gi_rt_create(const gi_scene *scene, float time, gi_rt **out, gi_error 
 gi_result gi_rt_set_time(gi_rt *rt, float time, gi_error *err);
 void gi_rt_free(gi_rt *rt);
 
-/* Closest hit of o + t d with tmin <= t <= tmax: 1 and *hit filled, or 0. */
+/* Closest hit of o + t d with tmin <= t <= tmax: 1 and *hit filled, or 0.
+ * rt and hit must not be NULL (asserted). */
 int gi_rt_intersect(const gi_rt *rt, gi_vec3 o, gi_vec3 d, float tmin, float tmax, gi_rt_hit *hit);
 /* 1 when any triangle lies on o + t d, tmin <= t <= tmax. */
 int gi_rt_occluded(const gi_rt *rt, gi_vec3 o, gi_vec3 d, float tmin, float tmax);
