@@ -1,0 +1,514 @@
+/* The `avg` method: Approximate Visibility Grids for interactive indirect
+ * illumination (Bashford-Rogers, Debattista, Harvey, Chalmers).
+ *
+ * Every frame, nothing precomputed (§III):
+ *   vox  the scene voxelised into the AVG by the rasteriser (§III-A, avg_grid.c);
+ *   tra  light paths traced through the AVG, a VPL on the light and at every
+ *        hit (§III-B, shaders/avg_trace.comp), read back and compacted in
+ *        slot order (deterministic);
+ *   sha  one low-resolution shadow map per VPL in the core's depth atlas,
+ *        one instanced draw (§III-C);
+ *   ill  G-buffer, the swizzle into M sub-images, each sub-image shaded by
+ *        its N_VPL / M VPLs, reassembly, the discontinuity-aware box
+ *        filter, times albedo (§III-C, Fig. 4).
+ * The VPLs on the lights carry the direct light (Keller's instant
+ * radiosity, which the paper builds on), the others the indirect bounces. */
+#include "avg.h"
+
+#include "gi/log.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { B_SLOTS = 8, B_VPLS = 9 };
+#define AVG_BIAS_VOXELS 0.5f /* receiver offset and constant depth bias, in voxel edges */
+#define AVG_BIAS_TEXELS 1.0f /* depth bias per unit of distance and slope, in texels of the map */
+
+static const gi_param_desc avg_params[] = {
+    {"grid", GI_PARAM_INT, 64, 4, 512, NULL, "AVG resolution (Sec. III-A, 64^3)", "voxels per axis of the grid"},
+    {"vpls", GI_PARAM_INT, 1024, 1, 65536, NULL, "N_VPL (Sec. IV, 1024)",
+     "VPL slots: N_VPL / (B + 1) light paths, each with a VPL on the light and at up to B hits"},
+    {"bounces", GI_PARAM_INT, 3, 0, 3, NULL, "bounces (Sec. IV, 3)", "indirect bounces B (VPLs at hits 1..B)"},
+    {"M", GI_PARAM_INT, 16, 1, 64, NULL, "M (Sec. III-C, 16)",
+     "interleaved-sampling subsets, a square number (mx x mx pixel pattern)"},
+    {"clamp", GI_PARAM_FLOAT, 1.0, 0.0, 100.0, NULL, "G clamping",
+     "the geometry term's distance is clamped below at this many voxel edges"},
+    {"visibility", GI_PARAM_BOOL, 1, 0, 1, NULL, "Table I FPS (V) / (NV)",
+     "VPL visibility from shadow maps; off: every VPL reaches every point it faces"},
+    {"shadow_size", GI_PARAM_INT, 32, 4, 512, NULL, "Sec. III-C (low resolution)", "each VPL's shadow map is this many texels square"},
+    {"projection", GI_PARAM_ENUM, 0, 0, 0, "auto|paraboloid|perspective", "Sec. IV",
+     "shadow-map projection; auto: paraboloid for scenes of small triangles, perspective for large ones (as the paper)"},
+    {"fov", GI_PARAM_FLOAT, 120.0, 10.0, 170.0, NULL, "Sec. IV", "field of view of perspective shadow maps, degrees"},
+    {"filter", GI_PARAM_BOOL, 1, 0, 1, NULL, "Sec. III-C", "discontinuity-aware mx x mx box filter"},
+    {"voxeliser", GI_PARAM_ENUM, 0, 0, 0, "conservative|paper", "Sec. III-A",
+     "exact triangle-box voxels, or the paper's epsilon shift and stand-in triangles"},
+    {"tracing", GI_PARAM_ENUM, 0, 0, 0, "avg|exact", "Fig. 6",
+     "VPL paths marched through the AVG on the GPU, or the same paths traced exactly by Embree on the CPU"},
+    {"offset", GI_PARAM_FLOAT, 1.5, 0.0, 8.0, NULL, NULL,
+     "ray origins leave a surface this many voxel edges along its normal"},
+    {0},
+};
+
+static gi_result fail(avg *a, gi_result r, const char *msg)
+{
+    snprintf(a->error, sizeof a->error, "%s", msg);
+    return r;
+}
+
+static gi_result avg_create(const gi_host *host, const gi_params *params, void **out)
+{
+    avg *a = calloc(1, sizeof *a);
+    if (!a)
+        return GI_ERR_OUT_OF_MEMORY;
+    a->host = host;
+    a->grid_n = gi_params_int(params, "grid");
+    a->vpls = gi_params_int(params, "vpls");
+    a->bounces = gi_params_int(params, "bounces");
+    a->M = gi_params_int(params, "M");
+    a->clamp = gi_params_float(params, "clamp");
+    a->filter = gi_params_bool(params, "filter");
+    a->voxeliser = gi_params_enum(params, "voxeliser");
+    a->offset = gi_params_float(params, "offset");
+    a->tracing = gi_params_enum(params, "tracing");
+    a->visibility = gi_params_bool(params, "visibility");
+    a->tile = gi_params_int(params, "shadow_size");
+    a->projection = gi_params_enum(params, "projection");
+    a->fov = gi_params_float(params, "fov");
+    a->mx = (int)lround(sqrt((double)a->M));
+    a->paths = ((uint32_t)a->vpls + (uint32_t)a->bounces) / ((uint32_t)a->bounces + 1u);
+    if (a->paths == 0)
+        a->paths = 1;
+    a->slots = a->paths * ((uint32_t)a->bounces + 1u);
+    gi_shader_register(gi_avg_shaders);
+    *out = a;
+    return GI_OK;
+}
+
+static gi_result build_programs(avg *a, gi_error *err)
+{
+    struct {
+        GLuint *p;
+        const char *name;
+    } list[] = {{&a->prog_trace, "avg_trace.comp"},
+                {&a->prog_split, "avg_split.comp"},
+                {&a->prog_shade, "avg_shade.comp"},
+                {&a->prog_assemble, "avg_assemble.comp"},
+                {&a->prog_final, "avg_final.comp"}};
+    for (size_t i = 0; i < sizeof list / sizeof list[0]; i++) {
+        *list[i].p = gi_program_build_compute(list[i].name, NULL, err);
+        if (!*list[i].p)
+            return GI_ERR_GL;
+    }
+    return GI_OK;
+}
+
+/* The paper's rule (Sec. IV): paraboloid maps for scenes of small
+ * triangles, perspective maps for scenes of large ones, whose straight
+ * edges the paraboloid warp would bend. Small: mean edge below 1/16 of the
+ * scene's extent. */
+static gi_projection choose_projection(avg *a, const gi_scene *s)
+{
+    if (a->projection == 1)
+        return GI_PROJ_PARABOLOID;
+    if (a->projection == 2)
+        return GI_PROJ_PERSPECTIVE;
+    double sum = 0.0;
+    for (uint32_t t = 0; t < s->triangle_count; t++) {
+        gi_vec3 p[3];
+        gi_scene_triangle_world(s, t, 0.0f, p);
+        for (int e = 0; e < 3; e++)
+            sum += gi_v3_length(gi_v3_sub(p[(e + 1) % 3], p[e]));
+    }
+    float ext = 0.0f;
+    for (int i = 0; i < 3; i++)
+        ext = fmaxf(ext, s->bounds[3 + i] - s->bounds[i]);
+    double mean = s->triangle_count ? sum / (3.0 * s->triangle_count) : 0.0;
+    return mean < ext / 16.0 ? GI_PROJ_PARABOLOID : GI_PROJ_PERSPECTIVE;
+}
+
+/* §III-C: one shadow map per live VPL, from its position along its normal,
+ * all in the atlas in one instanced draw. */
+static gi_result shadow_maps(avg *a, gi_error *err)
+{
+    const gi_depth_atlas_desc *d = gi_depth_atlas_get_desc(a->atlas);
+    const float *b = a->scene->bounds;
+    float diag = sqrtf((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) + (b[5] - b[2]) * (b[5] - b[2]));
+    float zfar = 2.0f * diag + 1e-6f, znear = 1e-3f * a->grid->h;
+    for (uint32_t j = 0; j < a->vpl_count; j++) {
+        const avg_vpl *v = &a->cpu_vpls[j];
+        gi_vec3 eye = gi_v3_load(v->position), n = gi_v3_load(v->normal);
+        gi_vec3 up = fabsf(n.y) < 0.9f ? gi_v3(0, 1, 0) : gi_v3(1, 0, 0);
+        gi_depth_view *dv = &a->views[j];
+        gi_mat4_look_at(dv->view, eye, gi_v3_add(eye, n), up);
+        gi_mat4_perspective(dv->proj, a->fov * GI_PI / 180.0f, 1.0f, znear, zfar);
+        dv->projection = d->projection;
+        dv->znear = 0.0f;
+        dv->zfar = zfar;
+    }
+    return gi_depth_atlas_render(a->atlas, a->scene, a->views, a->vpl_count, err);
+}
+
+static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
+{
+    avg *a = inst;
+    gi_error err;
+    a->scene = scene;
+    /* Checked here rather than in create(), where the host has no instance
+     * to ask for the message. */
+    if (a->mx * a->mx != a->M) {
+        snprintf(a->error, sizeof a->error, "M=%d is not a square number (1, 4, 9, 16, 25, 36, 49 or 64)", a->M);
+        return GI_ERR_INVALID_ARGUMENT;
+    }
+    uint32_t directional = 0;
+    for (uint32_t l = 0; l < scene->scene->light_count; l++)
+        directional += scene->scene->lights[l].type == GI_LIGHT_DIRECTIONAL;
+    if (directional)
+        a->host->log(a->host, GI_LOG_WARN, "%u directional light(s) ignored: not supported (caps)", directional);
+    if (scene->light_count > AVG_MAX_PUNCTUAL)
+        a->host->log(a->host, GI_LOG_WARN, "only the first %d of %u punctual lights emit VPLs", AVG_MAX_PUNCTUAL,
+                     scene->light_count);
+    if (scene->scene->has_environment)
+        a->host->log(a->host, GI_LOG_WARN, "the environment map is ignored: not supported (caps)");
+    a->grid = avg_grid_create((uint32_t)a->grid_n, &err);
+    if (!a->grid)
+        return fail(a, GI_ERR_GL, err.text);
+    if (build_programs(a, &err) != GI_OK)
+        return fail(a, GI_ERR_GL, err.text);
+    if (a->visibility) {
+        gi_depth_atlas_desc d = {(uint32_t)a->tile, a->slots, choose_projection(a, scene->scene), GI_DEPTH_RADIAL, 1};
+        a->atlas = gi_depth_atlas_create(&d, &err);
+        if (!a->atlas)
+            return fail(a, GI_ERR_INVALID_ARGUMENT, err.text);
+        a->views = calloc(a->slots, sizeof *a->views);
+        if (!a->views)
+            return fail(a, GI_ERR_OUT_OF_MEMORY, "avg: out of memory for the shadow-map views");
+    }
+    if (a->tracing == 1) {
+        a->exact = avg_exact_create(scene, &err);
+        if (!a->exact)
+            return fail(a, GI_ERR_INVALID_ARGUMENT, err.text);
+    }
+    a->cpu_slots = calloc(a->slots, sizeof *a->cpu_slots);
+    a->cpu_vpls = calloc(a->slots, sizeof *a->cpu_vpls);
+    if (!a->cpu_slots || !a->cpu_vpls)
+        return fail(a, GI_ERR_OUT_OF_MEMORY, "avg: out of memory for the VPL slots");
+    glCreateBuffers(1, &a->ssbo_slots);
+    glNamedBufferStorage(a->ssbo_slots, (GLsizeiptr)(a->slots * sizeof(avg_vpl)), NULL, GL_DYNAMIC_STORAGE_BIT);
+    glCreateBuffers(1, &a->ssbo_vpls);
+    glNamedBufferStorage(a->ssbo_vpls, (GLsizeiptr)(a->slots * sizeof(avg_vpl)), NULL, GL_DYNAMIC_STORAGE_BIT);
+    if (gi_gl_check("avg: prepare", &err) != GI_OK)
+        return fail(a, GI_ERR_GL, err.text);
+    return GI_OK;
+}
+
+static gi_result avg_update(void *inst, const gi_gpu_scene *scene, const gi_changes *changes)
+{
+    (void)changes; /* everything is rebuilt every frame (§III): nothing to invalidate */
+    ((avg *)inst)->scene = scene;
+    return GI_OK;
+}
+
+void avg_light_table_build(const gi_gpu_scene *gs, avg_light_table *t)
+{
+    memset(t, 0, sizeof *t);
+    double power[1 + AVG_MAX_PUNCTUAL];
+    uint32_t np = gs->light_count < AVG_MAX_PUNCTUAL ? gs->light_count : AVG_MAX_PUNCTUAL;
+    power[0] = gs->emitter_count > 0 ? gs->emitter_power : 0.0;
+    if (np > 0) {
+        gi_gpu_light lights[AVG_MAX_PUNCTUAL];
+        glGetNamedBufferSubData(gs->ssbo_lights, 0, (GLsizeiptr)(np * sizeof(gi_gpu_light)), lights);
+        for (uint32_t l = 0; l < np; l++) {
+            double lum = gi_luminance(lights[l].intensity);
+            double p = 0.0;
+            if (lights[l].type == GI_LIGHT_POINT)
+                p = 4.0 * GI_PI * lum;
+            else if (lights[l].type == GI_LIGHT_SPOT) /* cone solid angle to the ramp's middle */
+                p = 2.0 * GI_PI * (1.0 - 0.5 * (lights[l].cos_inner + lights[l].cos_outer)) * lum;
+            power[1 + l] = p > 0.0 ? p : 0.0;
+        }
+    }
+    double total = 0.0;
+    for (uint32_t l = 0; l <= np; l++)
+        total += power[l];
+    if (!(total > 0.0))
+        return;
+    t->count = 1 + np;
+    double run = 0.0;
+    for (uint32_t l = 0; l <= np; l++) {
+        run += power[l];
+        t->pdf[l] = (float)(power[l] / total);
+        t->cdf[l] = (float)(run / total);
+    }
+    t->cdf[np] = 1.0f;
+}
+
+static uint32_t pow2_mask(uint32_t n)
+{
+    uint32_t m = 1;
+    while (m < n)
+        m <<= 1;
+    return m - 1;
+}
+
+/* §III-B on the GPU: one invocation per path through the AVG. */
+static gi_result trace_avg(avg *a, const avg_light_table *lt, gi_error *err)
+{
+    GLuint p = a->prog_trace;
+    glUseProgram(p);
+    gi_gpu_scene_bind(a->scene);
+    avg_grid_bind(a->grid, p, 8, 9);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, B_SLOTS, a->ssbo_slots);
+    glUniform1ui(glGetUniformLocation(p, "u_paths"), a->paths);
+    glUniform1ui(glGetUniformLocation(p, "u_bounces"), (GLuint)a->bounces);
+    glUniform1ui(glGetUniformLocation(p, "u_qr_mask"), pow2_mask(a->paths));
+    glUniform1f(glGetUniformLocation(p, "u_offset"), a->offset);
+    glUniform1i(glGetUniformLocation(p, "u_light_count"), (GLint)lt->count);
+    glUniform1fv(glGetUniformLocation(p, "u_light_cdf"), 65, lt->cdf);
+    glUniform1fv(glGetUniformLocation(p, "u_light_pdf"), 65, lt->pdf);
+    glDispatchCompute((a->paths + 63) / 64, 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    glUseProgram(0);
+    glGetNamedBufferSubData(a->ssbo_slots, 0, (GLsizeiptr)(a->slots * sizeof(avg_vpl)), a->cpu_slots);
+    return gi_gl_check("avg: VPL tracing", err);
+}
+
+/* Live VPLs (non-zero power) in slot order: the same list every frame for
+ * the same scene. */
+static void compact(avg *a)
+{
+    a->vpl_count = 0;
+    for (uint32_t s = 0; s < a->slots; s++) {
+        const float *pw = a->cpu_slots[s].power;
+        if (pw[0] > 0.0f || pw[1] > 0.0f || pw[2] > 0.0f)
+            a->cpu_vpls[a->vpl_count++] = a->cpu_slots[s];
+    }
+    if (a->vpl_count)
+        glNamedBufferSubData(a->ssbo_vpls, 0, (GLsizeiptr)(a->vpl_count * sizeof(avg_vpl)), a->cpu_vpls);
+}
+
+static GLuint make_tex2d(GLenum format, uint32_t w, uint32_t h)
+{
+    GLuint t;
+    glCreateTextures(GL_TEXTURE_2D, 1, &t);
+    glTextureStorage2D(t, 1, format, (GLsizei)w, (GLsizei)h);
+    glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    return t;
+}
+
+static void free_size_dependent(avg *a)
+{
+    gi_gbuffer_free(a->gbuffer);
+    a->gbuffer = NULL;
+    GLuint t[4] = {a->tex_split_pos, a->tex_split_nrm, a->tex_split_out, a->tex_indirect};
+    for (int i = 0; i < 4; i++)
+        if (t[i])
+            glDeleteTextures(1, &t[i]);
+    a->tex_split_pos = a->tex_split_nrm = a->tex_split_out = a->tex_indirect = 0;
+}
+
+static gi_result ensure_size(avg *a, uint32_t w, uint32_t h)
+{
+    if (a->gbuffer && a->width == w && a->height == h)
+        return GI_OK;
+    free_size_dependent(a);
+    gi_error err;
+    a->gbuffer = gi_gbuffer_create(w, h, &err);
+    if (!a->gbuffer)
+        return fail(a, GI_ERR_GL, err.text);
+    uint32_t mx = (uint32_t)a->mx;
+    a->split_w = (w + mx - 1) / mx;
+    a->split_h = (h + mx - 1) / mx;
+    a->tex_split_pos = make_tex2d(GL_RGBA32F, a->split_w * mx, a->split_h * mx);
+    a->tex_split_nrm = make_tex2d(GL_RGBA32F, a->split_w * mx, a->split_h * mx);
+    a->tex_split_out = make_tex2d(GL_RGBA32F, a->split_w * mx, a->split_h * mx);
+    a->tex_indirect = make_tex2d(GL_RGBA32F, w, h);
+    a->width = w;
+    a->height = h;
+    return GI_OK;
+}
+
+/* §III-C: split, shade per subset, reassemble, filter, albedo. */
+static gi_result illuminate(avg *a, const gi_view *view, const gi_target *target, gi_error *err)
+{
+    gi_result r = gi_gbuffer_render(a->gbuffer, a->scene, view->view, view->proj, err);
+    if (r != GI_OK)
+        return r;
+    GLint size[2] = {(GLint)a->width, (GLint)a->height};
+    GLint sub[2] = {(GLint)a->split_w, (GLint)a->split_h};
+    GLuint sw = a->split_w * (GLuint)a->mx, sh = a->split_h * (GLuint)a->mx;
+
+    GLuint p = a->prog_split;
+    glUseProgram(p);
+    glBindTextureUnit(8, a->gbuffer->tex_position);
+    glBindTextureUnit(9, a->gbuffer->tex_normal);
+    glBindImageTexture(0, a->tex_split_pos, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(1, a->tex_split_nrm, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glUniform2iv(glGetUniformLocation(p, "u_size"), 1, size);
+    glUniform2iv(glGetUniformLocation(p, "u_sub"), 1, sub);
+    glUniform1i(glGetUniformLocation(p, "u_mx"), a->mx);
+    glDispatchCompute((sw + 7) / 8, (sh + 7) / 8, 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+
+    p = a->prog_shade;
+    glUseProgram(p);
+    glBindTextureUnit(8, a->tex_split_pos);
+    glBindTextureUnit(9, a->tex_split_nrm);
+    glBindImageTexture(0, a->tex_split_out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, B_VPLS, a->ssbo_vpls);
+    glUniform2iv(glGetUniformLocation(p, "u_sub"), 1, sub);
+    glUniform1i(glGetUniformLocation(p, "u_mx"), a->mx);
+    glUniform1ui(glGetUniformLocation(p, "u_count"), a->vpl_count);
+    float dmin = a->clamp * a->grid->h;
+    glUniform1f(glGetUniformLocation(p, "u_dmin2"), dmin * dmin);
+    glUniform1i(glGetUniformLocation(p, "u_visibility"), a->atlas != NULL);
+    if (a->atlas) {
+        glBindTextureUnit(13, gi_depth_atlas_texture(a->atlas));
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, gi_depth_atlas_views_buffer(a->atlas));
+        /* Depth bias for maps of `tile` texels: half a voxel plus a share
+         * of the distance that grows as the maps get coarser (and with the
+         * slope, in the shader). */
+        glUniform1f(glGetUniformLocation(p, "u_bias_abs"), AVG_BIAS_VOXELS * a->grid->h);
+        glUniform1f(glGetUniformLocation(p, "u_bias_rel"), AVG_BIAS_TEXELS / (float)a->tile);
+    }
+    glDispatchCompute((sw + 7) / 8, (sh + 7) / 8, 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+
+    p = a->prog_assemble;
+    glUseProgram(p);
+    glBindTextureUnit(8, a->tex_split_out);
+    glBindImageTexture(0, a->tex_indirect, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glUniform2iv(glGetUniformLocation(p, "u_size"), 1, size);
+    glUniform2iv(glGetUniformLocation(p, "u_sub"), 1, sub);
+    glUniform1i(glGetUniformLocation(p, "u_mx"), a->mx);
+    glDispatchCompute((a->width + 7) / 8, (a->height + 7) / 8, 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+
+    p = a->prog_final;
+    glUseProgram(p);
+    gi_gbuffer_bind(a->gbuffer, 8);
+    glBindTextureUnit(14, a->tex_indirect);
+    glBindImageTexture(1, target->texture, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glUniform2iv(glGetUniformLocation(p, "u_size"), 1, size);
+    glUniform1i(glGetUniformLocation(p, "u_mx"), a->mx);
+    glUniform1i(glGetUniformLocation(p, "u_filter"), a->filter);
+    glUniform1f(glGetUniformLocation(p, "u_normal_dot"), 0.9f);
+    /* A neighbour counts while it is within twice the window's width on a
+     * surface facing the camera at the pixel's depth. */
+    float footprint = 2.0f * tanf(0.5f * view->yfov) / (float)a->height;
+    glUniform1f(glGetUniformLocation(p, "u_max_dist"), 2.0f * (float)a->mx * footprint);
+    glDispatchCompute((a->width + 7) / 8, (a->height + 7) / 8, 1);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
+                    GL_FRAMEBUFFER_BARRIER_BIT);
+    glUseProgram(0);
+    return gi_gl_check("avg: shading", err);
+}
+
+static gi_result avg_render(void *inst, const gi_view *view, const gi_target *target)
+{
+    avg *a = inst;
+    const gi_host *host = a->host;
+    gi_error err;
+    gi_result r = ensure_size(a, view->width, view->height);
+    if (r != GI_OK)
+        return r;
+
+    /* The grid is built with exact tracing too: it places the grid and sets
+     * the clamping distance, so that both tracings shade alike. */
+    host->stage_begin(host, "vox");
+    avg_grid_place(a->grid, a->scene->bounds);
+    r = avg_grid_voxelise(a->grid, a->scene, (avg_vox_mode)a->voxeliser, &err);
+    host->stage_end(host, "vox");
+    if (r != GI_OK)
+        return fail(a, r, err.text);
+
+    host->stage_begin(host, "tra");
+    avg_light_table lt;
+    avg_light_table_build(a->scene, &lt);
+    if (a->exact) {
+        avg_trace_desc td = {a->paths, (uint32_t)a->bounces, a->offset};
+        r = avg_exact_trace(a->exact, a->scene, &lt, &td, a->cpu_slots, &err);
+    } else {
+        r = trace_avg(a, &lt, &err);
+    }
+    if (r == GI_OK)
+        compact(a);
+    host->stage_end(host, "tra");
+    if (r != GI_OK)
+        return fail(a, r, err.text);
+
+    if (a->atlas) {
+        host->stage_begin(host, "sha");
+        r = shadow_maps(a, &err);
+        host->stage_end(host, "sha");
+        if (r != GI_OK)
+            return fail(a, r, err.text);
+    }
+
+    host->stage_begin(host, "ill");
+    r = illuminate(a, view, target, &err);
+    host->stage_end(host, "ill");
+    if (r != GI_OK)
+        return fail(a, r, err.text);
+
+    host->stat(host, "vpls_live", (double)a->vpl_count);
+    host->stat(host, "light_paths", (double)a->paths);
+    host->stat(host, "voxel_size", (double)a->grid->h);
+    return GI_OK;
+}
+
+static void avg_destroy(void *inst)
+{
+    avg *a = inst;
+    if (!a)
+        return;
+    free_size_dependent(a);
+    avg_grid_free(a->grid);
+    avg_exact_free(a->exact);
+    gi_depth_atlas_free(a->atlas);
+    free(a->views);
+    GLuint progs[5] = {a->prog_trace, a->prog_split, a->prog_shade, a->prog_assemble, a->prog_final};
+    for (int i = 0; i < 5; i++)
+        if (progs[i])
+            glDeleteProgram(progs[i]);
+    if (a->ssbo_slots)
+        glDeleteBuffers(1, &a->ssbo_slots);
+    if (a->ssbo_vpls)
+        glDeleteBuffers(1, &a->ssbo_vpls);
+    free(a->cpu_slots);
+    free(a->cpu_vpls);
+    free(a);
+}
+
+static const char *avg_last_error(void *inst)
+{
+    return inst ? ((avg *)inst)->error : "";
+}
+
+static const gi_method avg_method = {
+    .struct_size = sizeof(gi_method),
+    .abi_version = GI_ABI_VERSION,
+    .id = "avg",
+    .title = "Approximate Visibility Grids for Interactive Indirect Illumination",
+    .citation = "Bashford-Rogers, Debattista, Harvey, Chalmers. VS-Games 2011",
+    .version = "0.1",
+    .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_RIGID_MOTION |
+            GI_CAP_DEFORMATION | GI_CAP_TEXTURES,
+    .max_bounces = 3,
+    .params = avg_params,
+    .create = avg_create,
+    .prepare = avg_prepare,
+    .update = avg_update,
+    .render = avg_render,
+    .destroy = avg_destroy,
+    .last_error = avg_last_error,
+};
+
+GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)
+{
+    if (GI_ABI_VERSION_MAJOR(host_abi_version) != GI_ABI_MAJOR)
+        return NULL;
+    return &avg_method;
+}

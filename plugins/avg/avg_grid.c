@@ -1,0 +1,182 @@
+/* The Approximate Visibility Grid, §III-A (Fig. 2): the scene voxelised by
+ * the rasteriser into two 3D textures every frame.
+ *
+ * The paper draws each triangle once per Z slice it spans, one pass per
+ * slice, from a geometry shader. Here the passes are one instanced draw
+ * (instance k = slice k) into a layered framebuffer that holds both 3D
+ * textures as layers (gl_Layer = k): the same work, one draw call, no
+ * image stores (so additive blending does the summing exactly as in the
+ * paper, and the result does not depend on the order of fragments). */
+#include "avg.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static GLuint make_tex3d(uint32_t n)
+{
+    GLuint t;
+    glCreateTextures(GL_TEXTURE_3D, 1, &t);
+    glTextureStorage3D(t, 1, GL_RGBA32F, (GLsizei)n, (GLsizei)n, (GLsizei)n);
+    glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTextureParameteri(t, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(t, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(t, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+    return t;
+}
+
+avg_grid *avg_grid_create(uint32_t n, gi_error *err)
+{
+    avg_grid *g = calloc(1, sizeof *g);
+    if (!g) {
+        gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "avg: out of memory");
+        return NULL;
+    }
+    g->n = n;
+    g->h = 1.0f;
+    gi_shader_register(gi_avg_shaders);
+    for (int mode = 0; mode < 2; mode++) {
+        g->program[mode] = gi_program_build("avg_vox.vert", "avg_vox.geom", "avg_vox.frag", NULL, err);
+        if (!g->program[mode]) {
+            avg_grid_free(g);
+            return NULL;
+        }
+    }
+    g->tex_normal = make_tex3d(n);
+    g->tex_colour = make_tex3d(n);
+    glCreateFramebuffers(1, &g->fbo);
+    glNamedFramebufferTexture(g->fbo, GL_COLOR_ATTACHMENT0, g->tex_normal, 0);
+    glNamedFramebufferTexture(g->fbo, GL_COLOR_ATTACHMENT1, g->tex_colour, 0);
+    const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glNamedFramebufferDrawBuffers(g->fbo, 2, bufs);
+    GLenum status = glCheckNamedFramebufferStatus(g->fbo, GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE) {
+        gi_error_set(err, GI_ERR_GL, "avg: layered grid framebuffer incomplete (0x%x)", status);
+        avg_grid_free(g);
+        return NULL;
+    }
+    if (gi_gl_check("avg: grid creation", err) != GI_OK) {
+        avg_grid_free(g);
+        return NULL;
+    }
+    return g;
+}
+
+void avg_grid_free(avg_grid *g)
+{
+    if (!g)
+        return;
+    if (g->fbo)
+        glDeleteFramebuffers(1, &g->fbo);
+    if (g->tex_normal)
+        glDeleteTextures(1, &g->tex_normal);
+    if (g->tex_colour)
+        glDeleteTextures(1, &g->tex_colour);
+    if (g->ssbo_colours)
+        glDeleteBuffers(1, &g->ssbo_colours);
+    for (int i = 0; i < 2; i++)
+        if (g->program[i])
+            glDeleteProgram(g->program[i]);
+    free(g);
+}
+
+void avg_grid_place(avg_grid *g, const float bounds[6])
+{
+    float ext = 0.0f;
+    for (int a = 0; a < 3; a++)
+        ext = fmaxf(ext, bounds[3 + a] - bounds[a]);
+    if (!(ext > 0.0f))
+        ext = 1.0f;
+    /* n - 3 voxels span the scene's largest extent, centred: 1.5 voxels of
+     * margin, so that walls at the bounds lie in the middle of a voxel
+     * layer rather than on the faces between two (which would fill both). */
+    g->h = ext / (float)(g->n > 3 ? g->n - 3 : g->n);
+    for (int a = 0; a < 3; a++)
+        g->origin[a] = 0.5f * (bounds[a] + bounds[3 + a]) - 0.5f * g->h * (float)g->n;
+}
+
+/* Per material, the colour a voxel takes from it: the albedo times the
+ * texture's mean colour, which is what the paper's "lowest mip-map level"
+ * holds (the core keeps one level only, so the mean is computed here). */
+static gi_result upload_material_colours(avg_grid *g, const gi_scene *s, gi_error *err)
+{
+    uint32_t n = s->material_count ? s->material_count : 1;
+    float *c = calloc((size_t)n * 4, sizeof *c);
+    if (!c)
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "avg: out of memory");
+    for (uint32_t m = 0; m < s->material_count; m++) {
+        const gi_material *mat = &s->materials[m];
+        double mean[3] = {1, 1, 1};
+        if (mat->albedo_texture >= 0) {
+            const gi_texture *t = &s->textures[mat->albedo_texture];
+            size_t texels = (size_t)t->width * t->height;
+            mean[0] = mean[1] = mean[2] = 0.0;
+            for (size_t i = 0; i < texels; i++)
+                for (int k = 0; k < 3; k++)
+                    mean[k] += t->rgba[4 * i + k];
+            for (int k = 0; k < 3; k++)
+                mean[k] = texels ? mean[k] / (double)texels : 1.0;
+        }
+        for (int k = 0; k < 3; k++)
+            c[4 * m + k] = (float)(mat->albedo[k] * mean[k]);
+    }
+    if (g->ssbo_colours)
+        glDeleteBuffers(1, &g->ssbo_colours);
+    glCreateBuffers(1, &g->ssbo_colours);
+    glNamedBufferStorage(g->ssbo_colours, (GLsizeiptr)((size_t)n * 4 * sizeof *c), c, 0);
+    free(c);
+    g->colour_scene = s;
+    return GI_OK;
+}
+
+gi_result avg_grid_voxelise(avg_grid *g, const gi_gpu_scene *gs, avg_vox_mode mode, gi_error *err)
+{
+    if (g->colour_scene != gs->scene && upload_material_colours(g, gs->scene, err) != GI_OK)
+        return GI_ERR_OUT_OF_MEMORY;
+    const float zero[4] = {0, 0, 0, 0};
+    glClearTexImage(g->tex_normal, 0, GL_RGBA, GL_FLOAT, zero);
+    glClearTexImage(g->tex_colour, 0, GL_RGBA, GL_FLOAT, zero);
+    GLuint p = g->program[mode];
+    glBindFramebuffer(GL_FRAMEBUFFER, g->fbo);
+    glViewport(0, 0, (GLsizei)g->n, (GLsizei)g->n);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glUseProgram(p);
+    glUniform3f(glGetUniformLocation(p, "u_grid_origin"), g->origin[0], g->origin[1], g->origin[2]);
+    glUniform1f(glGetUniformLocation(p, "u_grid_h"), g->h);
+    glUniform1i(glGetUniformLocation(p, "u_grid_n"), (GLint)g->n);
+    glUniform1i(glGetUniformLocation(p, "u_mode"), (GLint)mode);
+    glUniform1f(glGetUniformLocation(p, "u_epsilon"), 0.5f);
+    gi_gpu_scene_bind(gs);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, g->ssbo_colours);
+    gi_gpu_scene_draw(gs, -1, (GLsizei)g->n);
+    glUseProgram(0);
+    glDisable(GL_BLEND);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    return gi_gl_check("avg: voxelisation", err);
+}
+
+float *avg_grid_read(const avg_grid *g, int colour)
+{
+    size_t count = (size_t)g->n * g->n * g->n * 4;
+    float *out = malloc(count * sizeof *out);
+    if (!out)
+        return NULL;
+    glGetTextureImage(colour ? g->tex_colour : g->tex_normal, 0, GL_RGBA, GL_FLOAT, (GLsizei)(count * sizeof *out),
+                      out);
+    return out;
+}
+
+void avg_grid_bind(const avg_grid *g, GLuint program, GLuint unit_normal, GLuint unit_colour)
+{
+    glBindTextureUnit(unit_normal, g->tex_normal);
+    glBindTextureUnit(unit_colour, g->tex_colour);
+    glUniform3f(glGetUniformLocation(program, "u_grid_origin"), g->origin[0], g->origin[1], g->origin[2]);
+    glUniform1f(glGetUniformLocation(program, "u_grid_h"), g->h);
+    glUniform1i(glGetUniformLocation(program, "u_grid_n"), (GLint)g->n);
+}

@@ -1,0 +1,64 @@
+// Virtual point lights (§III-B/C): the record the tracer writes and the
+// shading pass reads (avg.h's avg_vpl), the fixed quasi-random numbers of the
+// light paths, and a VPL's unshadowed contribution to a receiver.
+#ifndef AVG_VPL_GLSL
+#define AVG_VPL_GLSL
+#include "common.glsl"
+#include "rng.glsl"
+#include "sequences.glsl"
+#include "lights.glsl"
+
+const uint AVG_VPL_DIFFUSE = 0u;
+const uint AVG_VPL_POINT = 1u;
+const uint AVG_VPL_SPOT = 2u;
+
+struct AvgVpl {
+    vec3 position; uint kind;   // kind | bounce << 8 | double-sided << 16
+    vec3 normal; float cos_inner; // surface normal, or the hemisphere a light VPL covers
+    vec3 power; float cos_outer;  // diffuse: flux (intensity = power cos / pi); point/spot: intensity
+    vec3 spot_dir; float range;
+};
+
+// Quasi-random pair `pair` of light path i: the Sobol (0,2) point of an
+// index permuted per pair by a fixed XOR (Kollig-Keller style padding of
+// the dimensions), mask = 2^k - 1 >= paths - 1. Fixed across frames, so a
+// static scene gets the same VPLs every frame (§III-B). C twin: avg_qr in
+// avg_trace_cpu.c.
+vec2 avg_qr(uint i, uint pair, uint mask)
+{
+    uint j = i ^ (gi_pcg_hash(pair * 0x9E3779B9u + 0x632BE5ABu) & mask);
+    return vec2(gi_radical_inverse2(j), gi_sobol2(j));
+}
+
+// What VPL v sends to a receiver at x with unit normal n, without
+// visibility: the irradiance-like S such that the reflected radiance is
+// (albedo / pi) S. The squared distance is clamped below by dmin2 (the
+// geometry term's clamping of instant radiosity).
+vec3 avg_vpl_contribution(AvgVpl v, vec3 x, vec3 n, float dmin2)
+{
+    vec3 d = v.position - x;
+    float d2 = dot(d, d);
+    if (!(d2 > 0.0))
+        return vec3(0.0);
+    vec3 w = d * inversesqrt(d2);
+    float cos_x = dot(n, w);
+    float cos_v = dot(v.normal, -w);
+    if (cos_x <= 0.0)
+        return vec3(0.0);
+    uint kind = v.kind & 0xFFu;
+    if (kind == AVG_VPL_DIFFUSE) {
+        if ((v.kind & 0x10000u) != 0u)
+            cos_v = abs(cos_v);
+        if (cos_v <= 0.0)
+            return vec3(0.0);
+        return v.power * (cos_v * GI_INV_PI * cos_x / max(d2, dmin2));
+    }
+    // A punctual light's VPL covers one hemisphere about `normal`.
+    if (cos_v <= 0.0)
+        return vec3(0.0);
+    float f = cos_x / max(d2, dmin2) * gi_range_window(sqrt(d2), v.range);
+    if (kind == AVG_VPL_SPOT)
+        f *= gi_spot_falloff(dot(-w, v.spot_dir), v.cos_inner, v.cos_outer);
+    return v.power * f;
+}
+#endif
