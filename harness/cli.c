@@ -284,6 +284,8 @@ int cli_caps_cover(const gi_method *m, const gi_scene *s, int animated, char *wh
         missing = "textures";
     else if (animated && !(c & GI_CAP_RIGID_MOTION))
         missing = "moving objects";
+    else if (gi_scene_deforms(s) && !(c & GI_CAP_DEFORMATION))
+        missing = "deforming meshes"; /* even for a still frame: the CPU copy holds the rest pose */
     if (missing) {
         snprintf(why, size, "%s does not handle %s", m->id, missing);
         return 0;

@@ -278,7 +278,8 @@ static int run(run_state *r, const render_opts *o)
         float t = o->time + (o->animate_fps > 0 ? (float)f / o->animate_fps : 0.0f);
         if (f > 0 && o->animate_fps > 0) {
             gi_gpu_scene_set_time(r->gs, t);
-            gi_changes ch = {GI_CHANGED_TRANSFORMS | GI_CHANGED_LIGHTS, t, ~0ull};
+            gi_changes ch = {GI_CHANGED_TRANSFORMS | GI_CHANGED_LIGHTS | (r->gs->deforming ? GI_CHANGED_VERTICES : 0u),
+                             t, ~0ull};
             res = r->m->update(r->inst, r->gs, &ch);
             if (res != GI_OK)
                 return method_fail(r, "update", res);

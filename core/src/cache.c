@@ -25,7 +25,7 @@ uint64_t gi_hash64(const void *data, size_t size, uint64_t seed)
 }
 
 /* Positions, normals and uvs of every vertex, then the indices relative to
- * the object's first vertex: the same mesh hashes the same wherever it sits
+ * the object's first vertex, then any morph targets with their weights: the same mesh hashes the same wherever it sits
  * in the scene, and any change to what a method precomputes from it changes
  * the hash. The object's transform and material are not part of it. */
 uint64_t gi_scene_object_hash(const gi_scene *s, uint32_t object)
@@ -48,6 +48,19 @@ uint64_t gi_scene_object_hash(const gi_scene *s, uint32_t object)
          k < ((size_t)o->first_triangle + o->triangle_count) * 3; k++) {
         uint32_t rel = s->indices[k] - o->first_vertex;
         XXH64_update(st, &rel, sizeof rel);
+    }
+    if (o->morph_count) { /* the morph targets and their weights shape it too */
+        size_t n = (size_t)o->morph_count * o->vertex_count * 3;
+        XXH64_update(st, &o->morph_count, sizeof o->morph_count);
+        XXH64_update(st, o->morph_positions, n * sizeof(float));
+        if (o->morph_normals)
+            XXH64_update(st, o->morph_normals, n * sizeof(float));
+        XXH64_update(st, o->morph_weights, o->morph_count * sizeof(float));
+        if (o->morph_track.count) {
+            XXH64_update(st, o->morph_track.times, o->morph_track.count * sizeof(float));
+            XXH64_update(st, o->morph_track.values, (size_t)o->morph_track.count * o->morph_count * sizeof(float));
+            XXH64_update(st, &o->morph_track.step, sizeof o->morph_track.step);
+        }
     }
     uint64_t h = XXH64_digest(st);
     XXH64_freeState(st);

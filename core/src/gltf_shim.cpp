@@ -737,6 +737,17 @@ struct Reader {
 struct MeshData {
     std::vector<gi_vertex> vertices; /* object index not yet set */
     std::vector<uint32_t> indices;   /* relative to vertices */
+    /* Morph targets: per target, 3 floats a vertex (zeros where a primitive's
+     * target lacks the attribute). */
+    size_t morph_count = 0;
+    bool morph_normals = false;
+    std::vector<std::vector<float>> tpos, tnrm;
+    std::vector<float> weights; /* mesh.weights, or zeros */
+};
+
+/* An object's morph data, moved into the gi_object by build(). */
+struct ObjectMorph {
+    std::vector<float> pos, nrm, weights; /* target-major; nrm empty if none */
 };
 
 struct Track {
@@ -747,6 +758,7 @@ struct Track {
 struct NodeInfo {
     float t[3] = {0, 0, 0}, r[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
     Track anim[3]; /* translation, rotation, scale */
+    Track weights; /* morph weights, one key = the mesh's target count floats */
 };
 
 struct TextureData {
@@ -800,6 +812,7 @@ class Converter
     std::vector<uint32_t> indices;
     std::vector<gi_object> objects;
     std::vector<std::string> object_names;
+    std::vector<ObjectMorph> object_morphs;
     std::vector<gi_light> lights;
     std::vector<std::string> light_names;
     std::vector<gi_camera> cameras;
@@ -832,6 +845,9 @@ class Converter
     void read_positions(const std::string &pp, int acc, std::vector<gi_vertex> *v);
     void read_normals(const std::string &pp, int acc, std::vector<gi_vertex> *v);
     void read_uvs(const std::string &pp, int acc, std::vector<gi_vertex> *v);
+    void read_targets(const std::string &pp, const tinygltf::Primitive &prim, size_t nv,
+                      bool first_prim, MeshData *out);
+    void morph_bounds(gi_object *o, const ObjectMorph &om, const Track &tr) const;
     void read_indices(const std::string &pp, const tinygltf::Primitive &prim, size_t nv,
                       std::vector<uint32_t> *out);
     void instantiate();
@@ -1401,6 +1417,16 @@ const MeshData &Converter::mesh(int index)
             fail(fmt("/meshes/%zu/primitives", mi), "mesh has no primitives");
         for (size_t k = 0; k < ms.primitives.size(); k++)
             convert_primitive(mi, k, &meshes[mi]);
+        MeshData &md = meshes[mi];
+        if (!ms.weights.empty() && ms.weights.size() != md.morph_count)
+            fail(fmt("/meshes/%zu/weights", mi), fmt("has %zu weights but the mesh has %zu morph targets",
+                                                     ms.weights.size(), md.morph_count));
+        md.weights.assign(md.morph_count, 0.0f);
+        for (size_t k = 0; k < ms.weights.size(); k++) {
+            if (!finite_float(ms.weights[k]))
+                fail(fmt("/meshes/%zu/weights/%zu", mi, k), "weight is not finite");
+            md.weights[k] = static_cast<float>(ms.weights[k]);
+        }
         mesh_done[mi] = true;
     }
     return meshes[mi];
@@ -1549,6 +1575,62 @@ void Converter::read_indices(const std::string &pp, const tinygltf::Primitive &p
     }
 }
 
+/* Morph targets of one primitive (glTF 2.0 §3.7.2.2): POSITION and NORMAL
+ * displacements, float VEC3, one per vertex; TANGENT is ignored (there are
+ * no normal maps). Every primitive of a mesh must have as many targets. */
+void Converter::read_targets(const std::string &pp, const tinygltf::Primitive &prim, size_t nv,
+                             bool first_prim, MeshData *out)
+{
+    size_t first_vertex = out->vertices.size(); /* this primitive's vertices are appended after */
+    if (first_prim) {
+        out->morph_count = prim.targets.size();
+        out->tpos.assign(out->morph_count, std::vector<float>());
+        out->tnrm.assign(out->morph_count, std::vector<float>());
+    } else if (prim.targets.size() != out->morph_count) {
+        fail(pp + "/targets", fmt("has %zu morph targets but the mesh's first primitive has %zu",
+                                  prim.targets.size(), out->morph_count));
+    }
+    if (prim.targets.size() > 255)
+        fail(pp + "/targets", fmt("%zu morph targets exceed the limit of 255", prim.targets.size()));
+    for (size_t k = 0; k < prim.targets.size(); k++) {
+        std::string pt = fmt("%s/targets/%zu", pp.c_str(), k);
+        std::vector<float> *dst[2] = {&out->tpos[k], &out->tnrm[k]};
+        const char *names[2] = {"POSITION", "NORMAL"};
+        for (const auto &attr : prim.targets[k])
+            if (attr.first != "POSITION" && attr.first != "NORMAL" && attr.first != "TANGENT")
+                fail(pt + "/" + attr.first,
+                     "morph target attribute " + shown(attr.first) +
+                         " is not supported (POSITION, NORMAL, TANGENT)");
+        for (int j = 0; j < 2; j++) {
+            dst[j]->resize((first_vertex + nv) * 3, 0.0f);
+            auto it = prim.targets[k].find(names[j]);
+            if (it == prim.targets[k].end())
+                continue;
+            int acc = it->second;
+            if (acc < 0 || static_cast<size_t>(acc) >= m.accessors.size())
+                fail(pt + "/" + names[j], out_of_range("accessor", acc, m.accessors.size(), "accessors"));
+            const tinygltf::Accessor &a = m.accessors[static_cast<size_t>(acc)];
+            check_accessor_kind(acc, j == 0 ? "morph target POSITION" : "morph target NORMAL",
+                                a.type == TINYGLTF_TYPE_VEC3 &&
+                                    a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT);
+            if (a.count != nv)
+                fail(pt + "/" + names[j],
+                     fmt("accessor %d has %zu elements but POSITION has %zu", acc, a.count, nv));
+            if (j == 1)
+                out->morph_normals = true;
+            Reader r = reader(acc);
+            for (size_t e = 0; e < nv; e++)
+                for (int ax = 0; ax < 3; ax++) {
+                    double x = r.get(e, static_cast<uint64_t>(ax));
+                    if (!finite_float(x))
+                        fail(fmt("/accessors/%d", acc),
+                             fmt("morph target %s element %zu is not finite", names[j], e));
+                    (*dst[j])[(first_vertex + e) * 3 + static_cast<size_t>(ax)] = static_cast<float>(x);
+                }
+        }
+    }
+}
+
 void Converter::convert_primitive(size_t mi, size_t k, MeshData *out)
 {
     const tinygltf::Primitive &prim = m.meshes[mi].primitives[k];
@@ -1595,6 +1677,7 @@ void Converter::convert_primitive(size_t mi, size_t k, MeshData *out)
         read_uvs(pp, tex, &v);
     read_indices(pp, prim, v.size(), &idx);
     smooth_normals(&v, idx, need);
+    read_targets(pp, prim, v.size(), k == 0, out);
 
     if (out->vertices.size() + v.size() > GI_MAX_VERTICES)
         fail(pp, fmt("mesh exceeds the limit of %u vertices", GI_MAX_VERTICES));
@@ -1713,7 +1796,25 @@ void Converter::add_object(int node)
     }
     for (uint32_t i : md.indices)
         indices.push_back(o.first_vertex + i);
+    ObjectMorph om;
+    o.morph_count = static_cast<uint32_t>(md.morph_count);
+    std::string pw = fmt("/nodes/%d/weights", node);
+    if (!nd.weights.empty() && nd.weights.size() != md.morph_count)
+        fail(pw, fmt("has %zu weights but mesh %d has %zu morph targets", nd.weights.size(), nd.mesh,
+                     md.morph_count));
+    om.weights = md.weights;
+    for (size_t k = 0; k < nd.weights.size(); k++) {
+        if (!finite_float(nd.weights[k]))
+            fail(fmt("%s/%zu", pw.c_str(), k), "weight is not finite");
+        om.weights[k] = static_cast<float>(nd.weights[k]);
+    }
+    for (size_t k = 0; k < md.morph_count; k++) {
+        om.pos.insert(om.pos.end(), md.tpos[k].begin(), md.tpos[k].end());
+        if (md.morph_normals)
+            om.nrm.insert(om.nrm.end(), md.tnrm[k].begin(), md.tnrm[k].end());
+    }
     objects.push_back(o);
+    object_morphs.push_back(std::move(om));
     const std::string &mesh_name = m.meshes[static_cast<size_t>(nd.mesh)].name;
     object_names.push_back(!nd.name.empty()     ? nd.name
                            : !mesh_name.empty() ? mesh_name
@@ -1733,6 +1834,43 @@ void Converter::convert_animations()
                 if (!t.times.empty())
                     o.animated = 1;
     }
+    for (size_t i = 0; i < objects.size(); i++)
+        if (objects[i].morph_count)
+            morph_bounds(&objects[i], object_morphs[i], nodes[static_cast<size_t>(objects[i].node)].weights);
+}
+
+/* Local bounds of a morphing object over every weight it takes: a LINEAR
+ * or STEP track stays within its keys' range (held outside them), so per
+ * target k the weight lies in [lo_k, hi_k] and per vertex and axis the box
+ * of base + sum_k w_k d_k is base + sum_k min/max(lo_k d_k, hi_k d_k). */
+void Converter::morph_bounds(gi_object *o, const ObjectMorph &om, const Track &tr) const
+{
+    size_t n = o->morph_count, nv = o->vertex_count;
+    std::vector<float> lo(om.weights), hi(om.weights);
+    if (!tr.times.empty()) {
+        lo.assign(n, INFINITY);
+        hi.assign(n, -INFINITY);
+        for (size_t e = 0; e < tr.times.size(); e++)
+            for (size_t k = 0; k < n; k++) {
+                lo[k] = std::min(lo[k], tr.values[e * n + k]);
+                hi[k] = std::max(hi[k], tr.values[e * n + k]);
+            }
+    }
+    for (int k = 0; k < 3; k++) {
+        o->local_bounds[k] = INFINITY;
+        o->local_bounds[k + 3] = -INFINITY;
+    }
+    for (size_t i = 0; i < nv; i++)
+        for (int ax = 0; ax < 3; ax++) {
+            double a = vertices[o->first_vertex + i].position[ax], b = a;
+            for (size_t k = 0; k < n; k++) {
+                double d = om.pos[(k * nv + i) * 3 + static_cast<size_t>(ax)];
+                a += std::min(lo[k] * d, hi[k] * d);
+                b += std::max(lo[k] * d, hi[k] * d);
+            }
+            o->local_bounds[ax] = std::min(o->local_bounds[ax], static_cast<float>(a));
+            o->local_bounds[ax + 3] = std::max(o->local_bounds[ax + 3], static_cast<float>(b));
+        }
 }
 
 void Converter::convert_channel(size_t a, size_t k)
@@ -1750,8 +1888,17 @@ void Converter::convert_channel(size_t a, size_t k)
                : ch.target_path == "rotation"  ? 1
                : ch.target_path == "scale"     ? 2
                                                : -1;
-    if (ch.target_path == "weights")
-        return; /* morph targets are not supported; their weights do not move geometry here */
+    size_t width = path == 1 ? 4 : 3;
+    if (ch.target_path == "weights") {
+        int mesh_index = m.nodes[static_cast<size_t>(ch.target_node)].mesh;
+        if (mesh_index < 0)
+            fail(pc + "/target/node", fmt("node %d animates morph weights but has no mesh", ch.target_node));
+        width = mesh(mesh_index).morph_count;
+        if (width == 0)
+            fail(pc + "/target/node",
+                 fmt("node %d animates morph weights but mesh %d has no morph targets", ch.target_node, mesh_index));
+        path = 3;
+    }
     if (path < 0)
         fail(pc + "/target/path", "path " + shown(ch.target_path) + " is not supported");
     const tinygltf::AnimationSampler &s = an.samplers[static_cast<size_t>(ch.sampler)];
@@ -1772,21 +1919,29 @@ void Converter::convert_channel(size_t a, size_t k)
                         in.type == TINYGLTF_TYPE_SCALAR &&
                             in.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT);
     bool float_out = out.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT;
-    bool ok = path == 1
-                  ? out.type == TINYGLTF_TYPE_VEC4 &&
-                        (float_out || (out.normalized &&
-                                       out.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
-                  : out.type == TINYGLTF_TYPE_VEC3 && float_out;
-    check_accessor_kind(s.output, path == 1 ? "rotation output" : "translation/scale output", ok);
-    if (out.count != in.count)
+    bool norm_out = out.normalized && out.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+    bool ok = path == 1   ? out.type == TINYGLTF_TYPE_VEC4 && (float_out || norm_out)
+              : path == 3 ? out.type == TINYGLTF_TYPE_SCALAR && (float_out || norm_out)
+                          : out.type == TINYGLTF_TYPE_VEC3 && float_out;
+    check_accessor_kind(s.output,
+                        path == 1   ? "rotation output"
+                        : path == 3 ? "weights output"
+                                    : "translation/scale output",
+                        ok);
+    if (path == 3) { /* one scalar per target per key (§3.11) */
+        if (out.count != in.count * width)
+            fail(ps + "/output", fmt("weights output has %zu values but %zu keys x %zu morph targets = %zu",
+                                     out.count, in.count, width, in.count * width));
+    } else if (out.count != in.count) {
         fail(ps + "/output", fmt("output has %zu keys but input has %zu", out.count, in.count));
-    Track &t = nodes[static_cast<size_t>(ch.target_node)].anim[path];
+    }
+    NodeInfo &ni = nodes[static_cast<size_t>(ch.target_node)];
+    Track &t = path == 3 ? ni.weights : ni.anim[path];
     if (!t.times.empty())
         fail(pc, fmt("node %d %s is already animated by another channel", ch.target_node,
                      ch.target_path.c_str()));
     Reader ri = reader(s.input), ro = reader(s.output);
     std::string pi = fmt("/accessors/%d", s.input), po = fmt("/accessors/%d", s.output);
-    uint64_t width = path == 1 ? 4 : 3;
     t.step = s.interpolation == "STEP";
     for (size_t e = 0; e < in.count; e++) {
         float time = static_cast<float>(ri.get(e, 0));
@@ -1797,8 +1952,9 @@ void Converter::convert_channel(size_t a, size_t k)
                          static_cast<double>(time), static_cast<double>(t.times.back())));
         t.times.push_back(time);
         double l2 = 0.0;
-        for (uint64_t j = 0; j < width; j++) {
-            double x = ro.get(e, j);
+        for (size_t j = 0; j < width; j++) {
+            /* weights: scalar accessor, element e * width + j */
+            double x = path == 3 ? ro.get(e * width + j, 0) : ro.get(e, j);
             if (!finite_float(x))
                 fail(po, fmt("animation value %zu is not finite", e));
             t.values.push_back(static_cast<float>(x));
@@ -1938,6 +2094,17 @@ gi_scene *Converter::build() const
             s->objects[i] = objects[i];
             s->objects[i].name = nullptr;
             s->objects[i].name = copy_string(object_names[i]);
+            s->objects[i].morph_positions = nullptr;
+            s->objects[i].morph_normals = nullptr;
+            s->objects[i].morph_weights = nullptr;
+            s->objects[i].morph_track = gi_track();
+            if (objects[i].morph_count) {
+                const ObjectMorph &om = object_morphs[i];
+                s->objects[i].morph_positions = copy_array(om.pos);
+                s->objects[i].morph_normals = copy_array(om.nrm);
+                s->objects[i].morph_weights = copy_array(om.weights);
+                fill_track(&s->objects[i].morph_track, nodes[static_cast<size_t>(objects[i].node)].weights);
+            }
         }
         s->lights = static_cast<gi_light *>(calloc(lights.size() + 1, sizeof(gi_light)));
         if (!s->lights)

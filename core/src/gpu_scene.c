@@ -1,10 +1,12 @@
-/* The scene on the GPU, uploaded once; transforms refreshed per frame. */
+/* The scene on the GPU, uploaded once; transforms, lights, emitters and the
+ * vertices of morphing objects refreshed per frame. */
 #include "gi/envmap.h"
 #include "gi/gpu.h"
 #include "gi/image.h"
 #include "gi/log.h"
 
 #include <float.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -134,7 +136,9 @@ gi_gpu_scene *gi_gpu_scene_upload(gi_gpu *gpu, const gi_scene *s, gi_error *err)
     gs->light_count = s->light_count;
     gs->emitter_count = s->emitter_count;
 
-    gs->vbo = make_buffer(s->vertices, (size_t)s->vertex_count * sizeof(gi_vertex), 0);
+    /* Updatable: morph targets (set_time) and gi_gpu_scene_update_vertices. */
+    gs->vbo = make_buffer(s->vertices, (size_t)s->vertex_count * sizeof(gi_vertex), GL_DYNAMIC_STORAGE_BIT);
+    gs->deforming = gi_scene_deforms(s);
     gs->ibo = make_buffer(s->indices, (size_t)s->triangle_count * 3 * sizeof(uint32_t), 0);
     glCreateVertexArrays(1, &gs->vao);
     glVertexArrayVertexBuffer(gs->vao, 0, gs->vbo, 0, sizeof(gi_vertex));
@@ -207,6 +211,31 @@ void gi_gpu_scene_set_time(gi_gpu_scene *gs, float t)
     }
     glNamedBufferSubData(gs->ubo_objects, 0, (GLsizeiptr)(s->object_count * 32 * sizeof(float)), ubo);
 
+    /* Morphing objects: their vertices at t into the vertex buffer (one
+     * upload per object; the rest of the buffer is untouched). */
+    if (gs->deforming) {
+        gi_vertex *v = NULL;
+        size_t cap = 0;
+        for (uint32_t o = 0; o < s->object_count; o++) {
+            const gi_object *obj = &s->objects[o];
+            if (!obj->morph_count || !obj->vertex_count)
+                continue;
+            if (obj->vertex_count > cap) {
+                free(v);
+                cap = obj->vertex_count;
+                v = malloc(cap * sizeof *v);
+                if (!v) {
+                    gi_log(GI_LOG_ERROR, "gpu scene: out of memory morphing object %u", o);
+                    break;
+                }
+            }
+            gi_scene_object_vertices(s, o, t, v);
+            glNamedBufferSubData(gs->vbo, (GLintptr)((size_t)obj->first_vertex * sizeof *v),
+                                 (GLsizeiptr)((size_t)obj->vertex_count * sizeof *v), v);
+        }
+        free(v);
+    }
+
     if (s->light_count) {
         gi_gpu_light *lights = calloc(s->light_count, sizeof *lights);
         for (uint32_t i = 0; lights && i < s->light_count; i++) {
@@ -262,6 +291,34 @@ void gi_gpu_scene_set_time(gi_gpu_scene *gs, float t)
         gs->ubo_info = make_buffer(NULL, sizeof info, GL_DYNAMIC_STORAGE_BIT);
     glNamedBufferSubData(gs->ubo_info, 0, sizeof info, &info);
     gs->time = t;
+}
+
+gi_result gi_gpu_scene_update_vertices(gi_gpu_scene *gs, uint32_t first_vertex, uint32_t count,
+                                       const gi_vertex *v, gi_error *err)
+{
+    if (!gs || (!v && count))
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "gpu scene: update_vertices: %s is NULL",
+                            !gs ? "the scene" : "the vertex array");
+    if (first_vertex > gs->vertex_count || count > gs->vertex_count - first_vertex)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "gpu scene: update_vertices: vertices %u..%u+%u past the %u of the scene", first_vertex,
+                            first_vertex, count, gs->vertex_count);
+    const gi_scene *s = gs->scene;
+    for (uint32_t i = 0; i < count; i++) {
+        const gi_vertex *x = &v[i], *old = &s->vertices[first_vertex + i];
+        if (x->object != old->object || x->material != old->material)
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "gpu scene: update_vertices: vertex %u changes its object or material (%u/%u -> %u/%u)",
+                                first_vertex + i, old->object, old->material, x->object, x->material);
+        for (int k = 0; k < 3; k++)
+            if (!isfinite(x->position[k]) || !isfinite(x->normal[k]))
+                return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                    "gpu scene: update_vertices: vertex %u is not finite", first_vertex + i);
+    }
+    if (count)
+        glNamedBufferSubData(gs->vbo, (GLintptr)((size_t)first_vertex * sizeof *v), (GLsizeiptr)((size_t)count * sizeof *v),
+                             v);
+    return gi_gl_check("gpu scene: update_vertices", err);
 }
 
 void gi_gpu_scene_bind(const gi_gpu_scene *gs)

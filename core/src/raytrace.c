@@ -22,7 +22,7 @@ struct gi_rt {
     float *pos;       /* Embree's vertex buffer: world positions, 3 floats a vertex */
     float *nrm;       /* world unit shading normals, 3 floats a vertex */
     float time;
-    int moving; /* some object is animated */
+    int moving; /* some object is animated or has morph targets */
     char version[32];
 };
 
@@ -58,6 +58,7 @@ static gi_result place_vertices(const gi_scene *s, float t, float *pos, float *n
 {
     float(*m)[16] = malloc((size_t)(s->object_count ? s->object_count : 1) * sizeof *m);
     float(*nm)[16] = malloc((size_t)(s->object_count ? s->object_count : 1) * sizeof *nm);
+    gi_vertex *morphed = NULL;
     gi_result res = GI_OK;
     if (!m || !nm) {
         res = gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "raytrace: out of memory (transforms)");
@@ -80,9 +81,27 @@ static gi_result place_vertices(const gi_scene *s, float t, float *pos, float *n
         else
             memcpy(nm[o], m[o], sizeof nm[o]);
     }
+    /* Morphing objects: their vertices at t (gi_scene_object_vertices), one
+     * object at a time, so that normals are blended as the GPU has them. */
+    size_t morph_max = 0;
+    for (uint32_t o = 0; o < s->object_count; o++)
+        if (s->objects[o].morph_count && s->objects[o].vertex_count > morph_max)
+            morph_max = s->objects[o].vertex_count;
+    if (morph_max && !(morphed = malloc(morph_max * sizeof *morphed))) {
+        res = gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "raytrace: out of memory (morph targets)");
+        goto done;
+    }
+    uint32_t morphed_object = UINT32_MAX;
     for (uint32_t v = 0; v < s->vertex_count; v++) {
         const gi_vertex *gv = &s->vertices[v];
         uint32_t o = gv->object < s->object_count ? gv->object : 0;
+        if (s->object_count && s->objects[o].morph_count) {
+            if (morphed_object != o) {
+                gi_scene_object_vertices(s, o, t, morphed);
+                morphed_object = o;
+            }
+            gv = &morphed[v - s->objects[o].first_vertex];
+        }
         gi_vec3 p = s->object_count ? gi_mat4_point(m[o], gi_v3_load(gv->position))
                                     : gi_v3_load(gv->position);
         if (!coord_ok(p)) {
@@ -104,6 +123,7 @@ static gi_result place_vertices(const gi_scene *s, float t, float *pos, float *n
 done:
     free(m);
     free(nm);
+    free(morphed);
     return res;
 }
 
@@ -133,7 +153,7 @@ gi_result gi_rt_create(const gi_scene *s, float time, gi_rt **out, gi_error *err
     rt->scene = s;
     rt->time = time;
     for (uint32_t o = 0; o < s->object_count; o++)
-        rt->moving |= s->objects[o].animated != 0;
+        rt->moving |= s->objects[o].animated != 0 || s->objects[o].morph_count != 0;
     gi_result res = GI_OK;
     rt->device = rtcNewDevice(NULL);
     if (!rt->device) {
@@ -191,14 +211,16 @@ fail:
     return res;
 }
 
-gi_result gi_rt_set_time(gi_rt *rt, float time, gi_error *err)
+/* Re-places every vertex at `time` and rebuilds; `force` even when
+ * nothing moves (the caller changed the scene's vertices). */
+static gi_result replace(gi_rt *rt, float time, int force, gi_error *err)
 {
     if (!rt)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "raytrace: the gi_rt is NULL");
     if (!isfinite(time))
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "raytrace: time %g is not finite",
                             (double)time);
-    if (!rt->moving || !rt->geom || time == rt->time) {
+    if (!rt->geom || (!force && (!rt->moving || time == rt->time))) {
         rt->time = time;
         return GI_OK;
     }
@@ -223,6 +245,16 @@ gi_result gi_rt_set_time(gi_rt *rt, float time, gi_error *err)
     free(pos);
     free(nrm);
     return res;
+}
+
+gi_result gi_rt_set_time(gi_rt *rt, float time, gi_error *err)
+{
+    return replace(rt, time, 0, err);
+}
+
+gi_result gi_rt_refresh(gi_rt *rt, gi_error *err)
+{
+    return replace(rt, rt ? rt->time : 0.0f, 1, err);
 }
 
 void gi_rt_free(gi_rt *rt)

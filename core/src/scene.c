@@ -173,8 +173,13 @@ void gi_scene_free(gi_scene *s)
         free_track(&s->nodes[i].anim_s);
     }
     free(s->nodes);
-    for (uint32_t i = 0; s->objects && i < s->object_count; i++)
+    for (uint32_t i = 0; s->objects && i < s->object_count; i++) {
         free(s->objects[i].name);
+        free(s->objects[i].morph_positions);
+        free(s->objects[i].morph_normals);
+        free(s->objects[i].morph_weights);
+        free_track(&s->objects[i].morph_track);
+    }
     free(s->objects);
     for (uint32_t i = 0; s->lights && i < s->light_count; i++)
         free(s->lights[i].name);
@@ -191,10 +196,10 @@ void gi_scene_free(gi_scene *s)
 
 /* ---- animation and transforms ------------------------------------------ */
 
-/* Value of a track at t (width 3 or 4): held before the first and after the
- * last key; STEP holds each key until the next; LINEAR interpolates, with
- * slerp along the shorter arc for rotations. */
-static void sample_track(const gi_track *tr, int width, float t, float *out)
+/* Value of a track at t (`width` floats a key): held before the first and
+ * after the last key; STEP holds each key until the next; LINEAR
+ * interpolates, with slerp along the shorter arc when `slerp` (rotations). */
+static void sample_track_any(const gi_track *tr, int width, int slerp, float t, float *out)
 {
     uint32_t n = tr->count;
     if (!(t > tr->times[0]) || n == 1) { /* NaN lands here too */
@@ -219,7 +224,7 @@ static void sample_track(const gi_track *tr, int width, float t, float *out)
         return;
     }
     float u = (t - tr->times[lo]) / (tr->times[hi] - tr->times[lo]);
-    if (width == 4) {
+    if (slerp) {
         float d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
         float bb[4] = {b[0], b[1], b[2], b[3]};
         if (d < 0.0f)
@@ -230,6 +235,12 @@ static void sample_track(const gi_track *tr, int width, float t, float *out)
     }
     for (int k = 0; k < width; k++)
         out[k] = a[k] + (b[k] - a[k]) * u;
+}
+
+/* Translation/scale (width 3) and rotation (width 4) tracks. */
+static void sample_track(const gi_track *tr, int width, float t, float *out)
+{
+    sample_track_any(tr, width, width == 4, t, out);
 }
 
 /* Node transform relative to its parent at t. */
@@ -377,6 +388,90 @@ int gi_scene_find_camera(const gi_scene *s, const char *name)
 
 /* ---- geometry ----------------------------------------------------------- */
 
+int gi_scene_deforms(const gi_scene *s)
+{
+    assert(s);
+    for (uint32_t o = 0; o < s->object_count; o++)
+        if (s->objects[o].morph_count)
+            return 1;
+    return 0;
+}
+
+void gi_scene_morph_weights(const gi_scene *s, uint32_t object, float t, float *out)
+{
+    assert(s && object < s->object_count);
+    const gi_object *o = &s->objects[object];
+    if (!o->morph_count)
+        return;
+    if (o->morph_track.count)
+        sample_track_any(&o->morph_track, (int)o->morph_count, 0, t, out);
+    else
+        memcpy(out, o->morph_weights, (size_t)o->morph_count * sizeof *out);
+}
+
+/* Morph targets hold at most GI_MAX_VERTICES x 3 floats in all; weights on
+ * the stack up to this many targets, on the heap beyond. */
+#define MORPH_STACK 16
+
+gi_vec3 gi_scene_vertex_position(const gi_scene *s, uint32_t vertex, float t)
+{
+    assert(s && vertex < s->vertex_count);
+    const gi_vertex *v = &s->vertices[vertex];
+    const gi_object *o = v->object < s->object_count ? &s->objects[v->object] : NULL;
+    if (!o || !o->morph_count)
+        return gi_v3_load(v->position);
+    float wbuf[MORPH_STACK], *w = o->morph_count <= MORPH_STACK ? wbuf : malloc(o->morph_count * sizeof *w);
+    if (!w)
+        return gi_v3_load(v->position);
+    gi_scene_morph_weights(s, v->object, t, w);
+    size_t i = vertex - o->first_vertex, nv = o->vertex_count;
+    double p[3] = {v->position[0], v->position[1], v->position[2]};
+    for (uint32_t k = 0; k < o->morph_count; k++)
+        for (int c = 0; c < 3; c++)
+            p[c] += (double)w[k] * o->morph_positions[((size_t)k * nv + i) * 3 + (size_t)c];
+    if (w != wbuf)
+        free(w);
+    return gi_v3((float)p[0], (float)p[1], (float)p[2]);
+}
+
+void gi_scene_object_vertices(const gi_scene *s, uint32_t object, float t, gi_vertex *out)
+{
+    assert(s && object < s->object_count && out);
+    const gi_object *o = &s->objects[object];
+    size_t nv = o->vertex_count;
+    memcpy(out, s->vertices + o->first_vertex, nv * sizeof *out);
+    if (!o->morph_count)
+        return;
+    float wbuf[MORPH_STACK], *w = o->morph_count <= MORPH_STACK ? wbuf : malloc(o->morph_count * sizeof *w);
+    if (!w)
+        return;
+    gi_scene_morph_weights(s, object, t, w);
+    for (size_t i = 0; i < nv; i++) {
+        double p[3] = {out[i].position[0], out[i].position[1], out[i].position[2]};
+        double n[3] = {out[i].normal[0], out[i].normal[1], out[i].normal[2]};
+        for (uint32_t k = 0; k < o->morph_count; k++) {
+            const float *dp = o->morph_positions + ((size_t)k * nv + i) * 3;
+            for (int c = 0; c < 3; c++)
+                p[c] += (double)w[k] * dp[c];
+            if (o->morph_normals) {
+                const float *dn = o->morph_normals + ((size_t)k * nv + i) * 3;
+                for (int c = 0; c < 3; c++)
+                    n[c] += (double)w[k] * dn[c];
+            }
+        }
+        for (int c = 0; c < 3; c++)
+            out[i].position[c] = (float)p[c];
+        if (o->morph_normals) {
+            double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            if (l > 0.0 && isfinite(l)) /* else the rest normal stays */
+                for (int c = 0; c < 3; c++)
+                    out[i].normal[c] = (float)(n[c] / l);
+        }
+    }
+    if (w != wbuf)
+        free(w);
+}
+
 void gi_scene_triangle_world(const gi_scene *s, uint32_t tri, float t, gi_vec3 p[3])
 {
     assert(s && tri < s->triangle_count);
@@ -384,7 +479,7 @@ void gi_scene_triangle_world(const gi_scene *s, uint32_t tri, float t, gi_vec3 p
     float m[16];
     gi_scene_object_transform(s, s->vertices[idx[0]].object, t, m);
     for (int k = 0; k < 3; k++)
-        p[k] = gi_mat4_point(m, gi_v3_load(s->vertices[idx[k]].position));
+        p[k] = gi_mat4_point(m, gi_scene_vertex_position(s, idx[k], t));
 }
 
 /* Each object's local box, transformed at t (conservative under rotation). */

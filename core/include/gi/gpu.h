@@ -1,5 +1,5 @@
 /* The GPU: a headless OpenGL 4.5 core context through EGL, and the scene
- * uploaded once.
+ * uploaded once (the vertices of morphing objects rewritten per frame).
  *
  * Use:
  *     gi_error err;
@@ -114,13 +114,27 @@ typedef struct gi_gpu_scene {
     float time;           /* time the transforms were last set for */
     float world_from_local[GI_MAX_OBJECTS][16]; /* CPU copy of the UBO */
     float bounds[6];      /* world bounds at `time` */
+    int deforming;        /* the scene has morph targets: set_time rewrites their vertices */
 } gi_gpu_scene;
 
 gi_gpu_scene *gi_gpu_scene_upload(gi_gpu *gpu, const gi_scene *scene, gi_error *err);
 void gi_gpu_scene_free(gi_gpu_scene *gs);
 /* Recomputes object transforms, light frames and emitter areas at time t
- * and refreshes the UBO/SSBOs. Cheap; call once per frame of an animation. */
+ * and refreshes the UBO/SSBOs; for objects with morph targets it also
+ * writes their vertices at t (gi_scene_object_vertices) into `vbo` (which
+ * is also the GI_SSBO_VERTICES buffer). Cheap for rigid scenes; call once
+ * per frame of an animation. */
 void gi_gpu_scene_set_time(gi_gpu_scene *gs, float t);
+/* Overwrites vertices first_vertex .. first_vertex + count - 1 of the
+ * vertex buffer (object-local, gi_vertex layout): deformation driven by
+ * the caller (procedural or simulated) rather than by glTF morph targets.
+ * A vertex must keep its object and material, and be finite; a range past
+ * the scene is an error. The caller keeps its CPU copy (scene->vertices,
+ * gi_rt_refresh) and the objects' local_bounds in step, tells methods
+ * through gi_changes (GI_CHANGED_VERTICES), and must not also have morph
+ * targets on those objects (set_time would overwrite them). */
+gi_result gi_gpu_scene_update_vertices(gi_gpu_scene *gs, uint32_t first_vertex, uint32_t count,
+                                       const gi_vertex *v, gi_error *err);
 /* Binds every scene resource to its fixed binding point. */
 void gi_gpu_scene_bind(const gi_gpu_scene *gs);
 /* Draws all triangles (or only object `object` when >= 0) with the scene

@@ -77,6 +77,8 @@ enum {
     GI_CHANGED_LIGHTS = 1u << 1,     /* light placement or power */
     GI_CHANGED_MATERIALS = 1u << 2,
     GI_CHANGED_CAMERA = 1u << 3,
+    GI_CHANGED_VERTICES = 1u << 4,   /* vertex positions/normals (deformation: morph targets at the new
+                                        time, or gi_gpu_scene_update_vertices); needs GI_CAP_DEFORMATION */
 };
 
 typedef struct gi_changes {

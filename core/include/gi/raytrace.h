@@ -32,7 +32,8 @@
  * rewrites the BVH and must not run while queries are in flight. The ray
  * interval is Embree's closed one: hits with tmin <= t <= tmax count
  * (tmin >= 0); d need not be unit length, t is in units of |d|. With no
- * moving object gi_rt_set_time only records the time; otherwise it
+ * moving object (no animated transform, no morph target) gi_rt_set_time
+ * only records the time; otherwise it
  * re-places every vertex and rebuilds the BVH (a rebuild, not a refit: the
  * rigid motions of glTF animations can move objects far, and a refitted
  * BVH degrades with the distance moved).
@@ -65,8 +66,14 @@ typedef struct gi_rt_hit {
  * GI_ERR_INVALID_ARGUMENT; see the manual above for what else fails. */
 gi_result gi_rt_create(const gi_scene *scene, float time, gi_rt **out, gi_error *err);
 /* Re-places the moving objects at `time` and rebuilds the BVH. On failure
- * the gi_rt is unchanged (still placed at its previous time). */
+ * the gi_rt is unchanged (still placed at its previous time). Moving:
+ * animated transforms and morph targets (gi_scene_object_vertices). */
 gi_result gi_rt_set_time(gi_rt *rt, float time, gi_error *err);
+/* Re-places every vertex at the current time and rebuilds, for a caller
+ * that owns its gi_scene and changed scene->vertices in place (a
+ * procedural deformation; the glTF way, morph targets, needs only
+ * gi_rt_set_time). Same failure rule as gi_rt_set_time. */
+gi_result gi_rt_refresh(gi_rt *rt, gi_error *err);
 void gi_rt_free(gi_rt *rt);
 
 /* Closest hit of o + t d with tmin <= t <= tmax: 1 and *hit filled, or 0.

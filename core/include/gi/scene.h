@@ -97,8 +97,20 @@ typedef struct gi_object {
     int node; /* gi_scene.nodes index */
     uint32_t first_triangle, triangle_count;
     uint32_t first_vertex, vertex_count;
-    float local_bounds[6]; /* min xyz, max xyz in object-local space */
-    int animated;          /* this node or an ancestor is animated */
+    float local_bounds[6]; /* min xyz, max xyz in object-local space; with morph
+                              targets, over every weight the animation reaches */
+    int animated;          /* this node or an ancestor is animated (rigid motion) */
+    /* Morph targets (glTF mesh.primitives[].targets): the deforming object's
+     * vertex i at weights w is position[i] + sum_k w[k] morph_positions[k][i],
+     * normal normalize(normal[i] + sum_k w[k] morph_normals[k][i]). 0 targets
+     * = a rigid object. Weights: node.weights, else mesh.weights, else 0,
+     * animated by a "weights" channel (morph_track, morph_count floats a key,
+     * LINEAR or STEP). See gi_scene_object_vertices. */
+    uint32_t morph_count;
+    float *morph_positions; /* morph_count x vertex_count x 3, object-local displacements */
+    float *morph_normals;   /* same layout; NULL when no target has NORMAL (normals not displaced) */
+    float *morph_weights;   /* morph_count default weights */
+    gi_track morph_track;   /* count 0 when the weights are not animated */
 } gi_object;
 
 typedef enum gi_light_type {
@@ -170,7 +182,7 @@ typedef struct gi_scene {
     int has_environment;
     gi_environment environment;
     struct gi_envmap *envmap; /* loaded map with its sampling CDF, or NULL */
-    float animation_length;   /* seconds; 0 for a static scene */
+    float animation_length;   /* seconds; 0 for a static scene (includes weight animations) */
     float bounds[6];          /* world bounds at t = 0 */
 } gi_scene;
 
@@ -194,9 +206,25 @@ gi_light_frame gi_scene_light_at(const gi_scene *s, uint32_t light, float t);
 gi_camera_frame gi_scene_camera_at(const gi_scene *s, int camera, float t);
 /* Index of the camera named `name`, or of "#k", or -1 when none matches. */
 int gi_scene_find_camera(const gi_scene *s, const char *name);
-/* World-space corners of triangle `tri` at time t. */
+/* 1 when some object has morph targets (its vertices are a function of
+ * time, or at least differ from the stored rest pose): methods must claim
+ * GI_CAP_DEFORMATION for it (harness cli_caps_cover). */
+int gi_scene_deforms(const gi_scene *s);
+/* Morph weights of object o at time t (morph_count floats; nothing for a
+ * rigid object). */
+void gi_scene_morph_weights(const gi_scene *s, uint32_t object, float t, float *out);
+/* The object's vertices at time t in object-local space (vertex_count
+ * records, copies of scene->vertices[first_vertex ...] with morph targets
+ * applied: positions blended, normals blended and renormalised). For a
+ * rigid object a plain copy. This is what the GPU's vertex buffer holds
+ * after gi_gpu_scene_set_time(t) and what gi_rt places at t. */
+void gi_scene_object_vertices(const gi_scene *s, uint32_t object, float t, gi_vertex *out);
+/* Object-local position of scene vertex v at time t (morphs applied). */
+gi_vec3 gi_scene_vertex_position(const gi_scene *s, uint32_t vertex, float t);
+/* World-space corners of triangle `tri` at time t (morphs applied). */
 void gi_scene_triangle_world(const gi_scene *s, uint32_t tri, float t, gi_vec3 p[3]);
-/* World bounds at time t. */
+/* World bounds at time t (from the objects' local_bounds: conservative
+ * under rotation and for morphing objects). */
 void gi_scene_bounds_at(const gi_scene *s, float t, float out[6]);
 /* Emitted radiance of a triangle (its material's emission). */
 const float *gi_scene_triangle_emission(const gi_scene *s, uint32_t tri);
