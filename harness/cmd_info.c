@@ -37,6 +37,8 @@ static json_object *scene_json(const gi_scene *s)
         json_object_object_add(x, "name", json_object_new_string(s->objects[i].name ? s->objects[i].name : ""));
         json_object_object_add(x, "triangles", json_object_new_int64(s->objects[i].triangle_count));
         json_object_object_add(x, "animated", json_object_new_boolean(s->objects[i].animated));
+        json_object_object_add(x, "morph_targets", json_object_new_int64(s->objects[i].morph_count));
+        json_object_object_add(x, "morph_animated", json_object_new_boolean(s->objects[i].morph_track.count > 0));
         json_object_array_add(objs, x);
     }
     json_object_object_add(o, "objects", objs);
@@ -92,9 +94,14 @@ static void print_scene(const gi_scene *s)
            s->has_environment ? ", environment " : "", s->has_environment ? s->environment.uri : "");
     if (s->animation_length > 0)
         printf("  animation: %g s\n", s->animation_length);
-    for (uint32_t i = 0; i < s->object_count; i++)
-        printf("  object %u %-20s %7u triangles%s\n", i, s->objects[i].name ? s->objects[i].name : "",
+    for (uint32_t i = 0; i < s->object_count; i++) {
+        printf("  object %u %-20s %7u triangles%s", i, s->objects[i].name ? s->objects[i].name : "",
                s->objects[i].triangle_count, s->objects[i].animated ? " (animated)" : "");
+        if (s->objects[i].morph_count)
+            printf(", %u morph targets%s", s->objects[i].morph_count,
+                   s->objects[i].morph_track.count ? " (weights animated)" : "");
+        printf("\n");
+    }
     for (uint32_t i = 0; i < s->material_count; i++) {
         const gi_material *m = &s->materials[i];
         printf("  material %u %-18s albedo (%.3g %.3g %.3g)%s", i, m->name ? m->name : "", m->albedo[0], m->albedo[1],

@@ -158,18 +158,29 @@ class Gltf:
         texs.append({"sampler": len(samplers) - 1, "source": len(imgs) - 1})
         return len(texs) - 1
 
-    def mesh(self, name, parts):
-        """parts: list of (Mesh, material index)."""
+    def mesh(self, name, parts, weights=None):
+        """parts: list of (Mesh, material index). A Mesh with .targets (a list
+        of {"POSITION": flat displacements, "NORMAL": flat displacements})
+        gets glTF morph targets; `weights` are the mesh's default weights."""
         prims = []
         for m, mat in parts:
             attrs = {"POSITION": self.float_accessor(m.pos, "VEC3", minmax=True),
                      "NORMAL": self.float_accessor(m.nrm, "VEC3")}
             if m.uv is not None:
                 attrs["TEXCOORD_0"] = self.float_accessor(m.uv, "VEC2")
-            prims.append({"attributes": attrs, "indices": self.index_accessor(m.idx, m.nverts),
-                          "material": mat, "mode": 4})
+            prim = {"attributes": attrs, "indices": self.index_accessor(m.idx, m.nverts),
+                    "material": mat, "mode": 4}
+            targets = getattr(m, "targets", None)
+            if targets:
+                prim["targets"] = [
+                    {k: self.float_accessor(t[k], "VEC3", minmax=(k == "POSITION"))
+                     for k in ("POSITION", "NORMAL") if k in t} for t in targets]
+            prims.append(prim)
         meshes = self._list("meshes")
-        meshes.append({"name": name, "primitives": prims})
+        mesh = {"name": name, "primitives": prims}
+        if weights is not None:
+            mesh["weights"] = [float(w) for w in weights]
+        meshes.append(mesh)
         return len(meshes) - 1
 
     def node(self, name, mesh=None, camera=None, translation=None, rotation=None,
@@ -206,7 +217,7 @@ class Gltf:
             key = tuple(times)
             if key not in time_acc:
                 time_acc[key] = self.float_accessor(times, "SCALAR", target=None, minmax=True)
-            typ = "VEC4" if path == "rotation" else "VEC3"
+            typ = {"rotation": "VEC4", "weights": "SCALAR"}.get(path, "VEC3")
             out = self.float_accessor(values, typ, target=None)
             samplers.append({"input": time_acc[key], "interpolation": "LINEAR", "output": out})
             chans.append({"sampler": len(samplers) - 1, "target": {"node": node, "path": path}})

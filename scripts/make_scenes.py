@@ -315,7 +315,8 @@ def cornell_materials(g):
     return m
 
 
-def build_cornell(cb, out_path, tessellate=True, glossy=False, bunny=None, anim=None):
+def build_cornell(cb, out_path, tessellate=True, glossy=False, bunny=None, anim=None,
+                  deform=False):
     title = os.path.splitext(os.path.basename(out_path))[0]
     cr = CORNELL_COPYRIGHT + ("; " + BUNNY_COPYRIGHT if bunny else "")
     g = Gltf(GENERATOR, cr)
@@ -335,8 +336,14 @@ def build_cornell(cb, out_path, tessellate=True, glossy=False, bunny=None, anim=
     if bunny is None:
         m = cb.block_mesh("short_block", cell)
         stats["tris"] += m.ntris
-        nodes.append(g.node("short_block", mesh=g.mesh("short_block", [(m, short_mat)]),
-                            translation=cb.blocks["short_block"]["origin"]))
+        if deform:
+            m.targets, times, weights = short_block_morph(cb, m)
+        sb = g.node("short_block", mesh=g.mesh("short_block", [(m, short_mat)],
+                                               weights=[0.0, 0.0] if deform else None),
+                    translation=cb.blocks["short_block"]["origin"])
+        nodes.append(sb)
+        if deform:
+            g.animation("short_block_morph", [(sb, "weights", times, weights)])
     m = cb.block_mesh("tall_block", cell)
     stats["tris"] += m.ntris
     nodes.append(g.node("tall_block", mesh=g.mesh("tall_block", [(m, tall_mat)]),
@@ -359,6 +366,53 @@ def build_cornell(cb, out_path, tessellate=True, glossy=False, bunny=None, anim=
     g.scene(title, nodes)
     g.write_gltf(out_path, title + ".bin")
     return stats
+
+
+# ------------------------------------------------------ deforming block ----
+MORPH_STRETCH = 0.5   # target 0: heights grow by this fraction
+MORPH_BULGE = 0.2     # target 1: sides bow out by this fraction of their offset at mid-height
+
+
+def mesh_vertex_normals(pos, idx):
+    """Area-weighted vertex normals over the mesh's own index sharing (no welding)."""
+    cells = [idx[i:i + 3] for i in range(0, len(idx), 3)]
+    return smooth_normals(pos, cells, weld=False)
+
+
+def short_block_morph(cb, m):
+    """Two morph targets of the short block, each a function of the rest
+    position alone (so coincident vertices of adjacent faces move together and
+    the block stays closed): 'stretch' d = (0, s y, 0) and 'bulge'
+    d = b sin(pi y / h) (x, 0, z) in block-local coordinates (origin at the
+    centre of the footprint). NORMAL targets are the area-weighted vertex
+    normals of the fully displaced mesh minus the rest normals.  Weights
+    (stretch, bulge) animate LINEAR over 0..4 s: (0,0) (1,0) (1,1) (0,1) (0,0)."""
+    pos = [tuple(m.pos[3 * i:3 * i + 3]) for i in range(m.nverts)]
+    h = max(p[1] for p in pos)
+    fns = [lambda p: (0.0, MORPH_STRETCH * p[1], 0.0),
+           lambda p: (MORPH_BULGE * math.sin(math.pi * p[1] / h) * p[0], 0.0,
+                      MORPH_BULGE * math.sin(math.pi * p[1] / h) * p[2])]
+    rest_n = mesh_vertex_normals(pos, m.idx)
+    targets = []
+    for fn in fns:
+        d = [fn(p) for p in pos]
+        moved = [add(p, q) for p, q in zip(pos, d)]
+        n1 = mesh_vertex_normals(moved, m.idx)
+        targets.append({"POSITION": [c for q in d for c in q],
+                        "NORMAL": [c for a, b in zip(n1, rest_n) for c in sub(a, b)]})
+    # Clearance: the fully displaced block (both weights 1) stays inside the
+    # room and off the tall block's footprint.
+    o = cb.blocks["short_block"]["origin"]
+    both = [add(add(p, fns[0](p)), fns[1](p)) for p in pos]
+    world = [add(p, o) for p in both]
+    lo, hi = cb.bounds
+    assert all(lo[k] < p[k] < hi[k] for p in world for k in (0, 2)), "short block leaves the room"
+    assert max(p[1] for p in world) < hi[1] - 1.0, "short block reaches the light"
+    tall = cb.blocks["tall_block"]["footprint"]
+    assert not any(point_in_poly_xz(p, tall) for p in world), "short block enters the tall block"
+    times = [0.0, 1.0, 2.0, 3.0, 4.0]
+    weights = [0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0, 0.0, 0.0]
+    return targets, times, weights
 
 
 # --------------------------------------------------------- moving bunny ----
@@ -553,17 +607,24 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--cornell-obj", required=True)
-    ap.add_argument("--meshes-json", required=True)
+    ap.add_argument("--meshes-json")
+    ap.add_argument("--only", help="write only this scene (cornell_deform.gltf needs no meshes)")
     ap.add_argument("--env-name", default="forest")
     ap.add_argument("--out", required=True)
     a = ap.parse_args()
-    with open(a.meshes_json) as f:
-        meshes = json.load(f)
     out = a.out
     cb = Cornell(a.cornell_obj)
     for n in cb.notes:
         print("note:", n)
     stats = {}
+    stats["cornell_deform.gltf"] = build_cornell(
+        cb, os.path.join(out, "cornell_deform.gltf"), deform=True)
+    if a.only == "cornell_deform.gltf":
+        return
+    if a.only or not a.meshes_json:
+        raise SystemExit("--meshes-json is required (--only knows cornell_deform.gltf)")
+    with open(a.meshes_json) as f:
+        meshes = json.load(f)
     stats["cornell_box.gltf"] = build_cornell(cb, os.path.join(out, "cornell_box.gltf"))
     stats["cornell_box_coarse.gltf"] = build_cornell(
         cb, os.path.join(out, "cornell_box_coarse.gltf"), tessellate=False)
