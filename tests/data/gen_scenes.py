@@ -224,6 +224,75 @@ def valid_animated():
     return b.finish()
 
 
+def valid_morph():
+    """Morph targets. Mesh 0 'quad' (QUAD, normals +Z) has two targets:
+    target 0 POSITION (0, 0, 1) on every vertex with NORMAL (0, 0.5, 0) on
+    every vertex; target 1 POSITION (1, 0, 0) on vertex 2 only, no NORMAL.
+    mesh.weights [0.25, 0]. Node 0 'morphing' animates its weights LINEAR
+    (t 0: [0, 0], t 2: [1, 2]); node 1 'posed' (translation 0,0,-3) uses the
+    same mesh with node.weights [0, 1] and no animation; node 2 'rigid'
+    (translation 0,-3,0) the plain quad mesh 1 without targets."""
+    b = base()
+    doc = b.doc
+    nrm = b.accessor(floats([0, 0, 1] * 4), 4, "VEC3")
+    t0p = b.positions([(0, 0, 1)] * 4)
+    t0n = b.accessor(floats([0, 0.5, 0] * 4), 4, "VEC3")
+    t1p = b.positions([(0, 0, 0), (0, 0, 0), (1, 0, 0), (0, 0, 0)])
+    p = prim(doc)
+    p["attributes"]["NORMAL"] = nrm
+    p["targets"] = [{"POSITION": t0p, "NORMAL": t0n}, {"POSITION": t1p}]
+    doc["meshes"][0]["weights"] = [0.25, 0]
+    pos2 = b.positions(QUAD)
+    idx2 = b.indices(QUAD_IDX)
+    doc["meshes"].append({"name": "plain", "primitives": [
+        {"attributes": {"POSITION": pos2}, "indices": idx2, "material": 0}]})
+    t_w = b.accessor(floats([0, 2]), 2, "SCALAR", min=[0], max=[2])
+    v_w = b.accessor(floats([0, 0, 1, 2]), 4, "SCALAR")
+    doc["nodes"] = [{"name": "morphing", "mesh": 0},
+                    {"name": "posed", "mesh": 0, "weights": [0, 1], "translation": [0, 0, -3]},
+                    {"name": "rigid", "mesh": 1, "translation": [0, -3, 0]}]
+    doc["scenes"] = [{"nodes": [0, 1, 2]}]
+    doc["animations"] = [{"name": "breathe", "samplers": [
+        {"input": t_w, "output": v_w, "interpolation": "LINEAR"}],
+        "channels": [{"sampler": 0, "target": {"node": 0, "path": "weights"}}]}]
+    return b.finish()
+
+
+def with_morph(targets, mesh_weights=None, node_weights=None, second_prim_targets=None):
+    """targets: list of {attribute: (flat floats, count, type)} for the quad."""
+    def fn(doc, b):
+        def make(ts):
+            out = []
+            for t in ts:
+                out.append({k: b.accessor(floats(v[0]), v[1], v[2]) for k, v in t.items()})
+            return out
+        prim(doc)["targets"] = make(targets)
+        if mesh_weights is not None:
+            doc["meshes"][0]["weights"] = mesh_weights
+        if node_weights is not None:
+            doc["nodes"][0]["weights"] = node_weights
+        if second_prim_targets is not None:
+            p2 = dict(prim(doc))
+            p2["targets"] = make(second_prim_targets)
+            doc["meshes"][0]["primitives"].append(p2)
+    return fn
+
+
+def with_morph_animation(target_count, out_values, out_count, out_type):
+    """The quad with `target_count` zero targets and a weights channel."""
+    def fn(doc, b):
+        if target_count:
+            with_morph([{"POSITION": ([0] * 12, 4, "VEC3")}] * target_count)(doc, b)
+        t = b.accessor(floats([0, 1]), 2, "SCALAR")
+        v = b.accessor(floats(out_values), out_count, out_type)
+        doc["animations"] = [{"samplers": [{"input": t, "output": v}],
+                              "channels": [{"sampler": 0, "target": {"node": 0, "path": "weights"}}]}]
+    return fn
+
+
+MORPH_ZERO = {"POSITION": ([0] * 12, 4, "VEC3")}
+
+
 def valid_textured():
     """A quad with float uvs and a 2x2 sRGB texture; Phong and mirror extras;
     a second quad with normalised UNSIGNED_SHORT uvs and given normals."""
@@ -769,6 +838,34 @@ CORPUS = [
     ("anim-duplicate.gltf",
      "/animations/0/channels/1: node 0 translation is already animated by another channel",
      rebuilt(duplicate_channel)),
+    # morph targets
+    ("morph-attribute.gltf",
+     "/meshes/0/primitives/0/targets/0/TEXCOORD_0: morph target attribute 'TEXCOORD_0' is not supported",
+     rebuilt(with_morph([{"POSITION": ([0] * 12, 4, "VEC3"), "TEXCOORD_0": ([0] * 8, 4, "VEC2")}]))),
+    ("morph-type.gltf", "/accessors/2: morph target POSITION cannot be VEC2 of FLOAT",
+     rebuilt(with_morph([{"POSITION": ([0] * 8, 4, "VEC2")}]))),
+    ("morph-count.gltf",
+     "/meshes/0/primitives/0/targets/0/NORMAL: accessor 2 has 3 elements but POSITION has 4",
+     rebuilt(with_morph([{"NORMAL": ([0] * 9, 3, "VEC3")}]))),
+    ("morph-nan.gltf", "/accessors/2: morph target POSITION element 1 is not finite",
+     rebuilt(with_morph([{"POSITION": ([0, 0, 0, 0, NAN, 0] + [0] * 6, 4, "VEC3")}]))),
+    ("morph-primitives.gltf",
+     "/meshes/0/primitives/1/targets: has 2 morph targets but the mesh's first primitive has 1",
+     rebuilt(with_morph([MORPH_ZERO], second_prim_targets=[MORPH_ZERO, MORPH_ZERO]))),
+    ("morph-mesh-weights.gltf", "/meshes/0/weights: has 2 weights but the mesh has 1 morph targets",
+     rebuilt(with_morph([MORPH_ZERO], mesh_weights=[0.5, 0.5]))),
+    ("morph-node-weights.gltf", "/nodes/0/weights: has 1 weights but mesh 0 has 0 morph targets",
+     mutate(set_path(["nodes", 0, "weights"], [1.0]))),
+    ("morph-anim-no-targets.gltf",
+     "/animations/0/channels/0/target/node: node 0 animates morph weights but mesh 0 has no morph targets",
+     rebuilt(with_morph_animation(0, [0, 1], 2, "SCALAR"))),
+    ("morph-anim-count.gltf",
+     "/animations/0/samplers/0/output: weights output has 3 values but 2 keys x 2 morph targets = 4",
+     rebuilt(with_morph_animation(2, [0, 1, 0], 3, "SCALAR"))),
+    ("morph-anim-type.gltf", "weights output cannot be VEC2 of FLOAT",
+     rebuilt(with_morph_animation(1, [0, 1, 0, 1], 2, "VEC2"))),
+    ("morph-anim-nan.gltf", "animation value 1 is not finite",
+     rebuilt(with_morph_animation(1, [0, INF], 2, "SCALAR"))),
     # environment
     ("env-parent.gltf",
      "/scenes/0/extras/gibench/environment/uri: URI '../sky.pfm' leaves the scene directory",
@@ -804,7 +901,7 @@ CORPUS = [
 def write_all():
     os.makedirs(os.path.join(VALID, "env"), exist_ok=True)
     os.makedirs(MALFORMED, exist_ok=True)
-    for name, make in [("quad", valid_quad), ("animated", valid_animated),
+    for name, make in [("quad", valid_quad), ("animated", valid_animated), ("morph", valid_morph),
                        ("textured", valid_textured), ("lights", valid_lights),
                        ("texture16", valid_texture16)]:
         doc = make()
