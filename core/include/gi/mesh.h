@@ -2,6 +2,9 @@
  * CDF, bounding spheres, welded vertices with vertex-triangle adjacency and
  * per-vertex areas (implicit visibility surfels, Dong et al. Sec. 4.1).
  * Everything in world space at a given time unless said otherwise.
+ * Morph targets: the triangle areas follow them (time t); the sphere and
+ * the welded vertices are of the rest pose (scene->vertices), as are the
+ * precomputations that use them (such methods lack GI_CAP_DEFORMATION).
  */
 #ifndef GI_MESH_H
 #define GI_MESH_H
@@ -12,9 +15,11 @@
 extern "C" {
 #endif
 
-/* Area of each triangle at time t; out has triangle_count floats. */
+/* Area of each triangle at time t (transforms and morph targets); out has
+ * triangle_count floats. */
 void gi_mesh_triangle_areas(const gi_scene *s, float t, float *out);
-/* Bounding sphere (Ritter) of one object in its local space: centre xyz, radius. */
+/* Bounding sphere (Ritter) of one object's rest pose in its local space:
+ * centre xyz, radius. */
 void gi_mesh_object_sphere(const gi_scene *s, uint32_t object, float out[4]);
 
 /* Vertices merged where positions are equal (within eps x scene size),
