@@ -35,6 +35,25 @@ match("${csv}" "\ndirect,[^\n]*,ok," "direct did not run ok:\n${csv}")
 match("${csv}" "fake_crash,[^\n]*failed,\"?crashed \\(signal" "the crash was not isolated and reported:\n${csv}")
 match("${csv}" "fake_hang,[^\n]*failed,timed out after" "the hang was not cut off:\n${csv}")
 match("${csv}" "fake_narrow,[^\n]*n/a,fake_narrow does not handle area lights" "n/a cell missing:\n${csv}")
+# render --animate tells update() that vertices changed on a deforming
+# scene, and not on a scene that only moves rigidly.
+foreach(sc cornell_deform cornell_moving)
+    run(0 render --scene scenes/${sc}.gltf --method fake_changes --size 8x8 --time 0 --animate 2 --frames 3
+           --out ${OUT}/fake_changes_${sc}.exr --timings ${OUT}/fake_changes_${sc}.json)
+    file(READ ${OUT}/fake_changes_${sc}.json fj)
+    string(JSON upd GET "${fj}" stats updates)
+    string(JSON cv GET "${fj}" stats changed_vertices)
+    string(JSON ct GET "${fj}" stats changed_transforms)
+    if(sc STREQUAL "cornell_deform")
+        set(want 1)
+    else()
+        set(want 0)
+    endif()
+    if(NOT upd EQUAL 2 OR NOT cv EQUAL want OR NOT ct EQUAL 1)
+        fail("${sc}: update() saw ${upd} updates, changed_vertices ${cv} (want ${want}), transforms ${ct}")
+    endif()
+endforeach()
+
 # A deforming scene (morph targets): methods without GI_CAP_DEFORMATION are
 # n/a even for a still frame (their CPU copy of the mesh is the rest pose);
 # avg, which claims it, runs.

@@ -7,9 +7,17 @@
 #include <stddef.h>
 #include <unistd.h>
 
+#if defined(FAKE_CHANGES)
+static const gi_host *fake_host;
+static uint32_t fake_flags_seen, fake_updates;
+#endif
+
 static gi_result fake_create(const gi_host *host, const gi_params *params, void **inst)
 {
     (void)host, (void)params;
+#if defined(FAKE_CHANGES)
+    fake_host = host;
+#endif
     static int dummy;
     *inst = &dummy;
     return GI_OK;
@@ -22,6 +30,13 @@ static gi_result fake_prepare(void *inst, const gi_gpu_scene *s)
 static gi_result fake_update(void *inst, const gi_gpu_scene *s, const gi_changes *c)
 {
     (void)inst, (void)s, (void)c;
+#if defined(FAKE_CHANGES) /* reports what the harness passed (stats in --timings) */
+    fake_flags_seen |= c->flags;
+    fake_updates++;
+    fake_host->stat(fake_host, "updates", fake_updates);
+    fake_host->stat(fake_host, "changed_vertices", (fake_flags_seen & GI_CHANGED_VERTICES) ? 1 : 0);
+    fake_host->stat(fake_host, "changed_transforms", (fake_flags_seen & GI_CHANGED_TRANSFORMS) ? 1 : 0);
+#endif
     return GI_OK;
 }
 static gi_result fake_render(void *inst, const gi_view *v, const gi_target *t)
