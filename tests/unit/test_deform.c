@@ -10,6 +10,7 @@
 #include "check.h"
 
 #include "gi/gpu.h"
+#include "gi/mesh.h"
 #include "gi/raytrace.h"
 #include "gi/scene.h"
 
@@ -85,6 +86,13 @@ static void test_vertices(const gi_scene *s)
     gi_scene_triangle_world(s, s->objects[1].first_triangle, 5.0f, p);
     CHECK_NEAR(p[2].x, 2.0f, 1e-6);
     CHECK_NEAR(p[2].z, -3.0f, 1e-6);
+    /* Triangle areas follow the morph: 'posed' triangle 0 = (-1,-1) (1,-1) (2,1): area 2. */
+    float areas[6];
+    gi_mesh_triangle_areas(s, 1.0f, areas);
+    CHECK_NEAR(areas[s->objects[1].first_triangle], 2.0f, 1e-6);
+    CHECK_NEAR(areas[s->objects[2].first_triangle], 2.0f, 1e-6);
+    CHECK_NEAR(areas[s->objects[2].first_triangle + 1], 2.0f, 1e-6);
+    CHECK_NEAR(areas[s->objects[1].first_triangle + 1], 3.0f, 1e-6); /* (-1,-1) (2,1) (-1,1) */
     /* Bounds over the weights reached: x up to 1 + 2, z 0 .. 1 (morphing). */
     const float *lb = s->objects[0].local_bounds;
     CHECK(lb[0] == -1.0f && lb[3] == 3.0f && lb[2] == 0.0f && lb[5] == 1.0f);
