@@ -1592,10 +1592,17 @@ void Converter::read_targets(const std::string &pp, const tinygltf::Primitive &p
     }
     if (prim.targets.size() > 255)
         fail(pp + "/targets", fmt("%zu morph targets exceed the limit of 255", prim.targets.size()));
+    /* Displacements are stored per target for every vertex of the mesh: as
+     * many as GI_MAX_VERTICES vertices at most, like the vertices. */
+    if (prim.targets.size() && (first_vertex + nv) * prim.targets.size() > GI_MAX_VERTICES)
+        fail(pp + "/targets", fmt("%zu morph targets x %zu vertices exceed the limit of %u", prim.targets.size(),
+                                  first_vertex + nv, GI_MAX_VERTICES));
     for (size_t k = 0; k < prim.targets.size(); k++) {
         std::string pt = fmt("%s/targets/%zu", pp.c_str(), k);
         std::vector<float> *dst[2] = {&out->tpos[k], &out->tnrm[k]};
         const char *names[2] = {"POSITION", "NORMAL"};
+        if (prim.targets[k].empty())
+            fail(pt, "morph target has no attribute");
         for (const auto &attr : prim.targets[k])
             if (attr.first != "POSITION" && attr.first != "NORMAL" && attr.first != "TANGENT")
                 fail(pt + "/" + attr.first,

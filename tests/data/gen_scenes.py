@@ -842,6 +842,8 @@ CORPUS = [
     ("morph-attribute.gltf",
      "/meshes/0/primitives/0/targets/0/TEXCOORD_0: morph target attribute 'TEXCOORD_0' is not supported",
      rebuilt(with_morph([{"POSITION": ([0] * 12, 4, "VEC3"), "TEXCOORD_0": ([0] * 8, 4, "VEC2")}]))),
+    ("morph-empty.gltf", "/meshes/0/primitives/0/targets/0: morph target has no attribute",
+     rebuilt(with_morph([{}]))),
     ("morph-type.gltf", "/accessors/2: morph target POSITION cannot be VEC2 of FLOAT",
      rebuilt(with_morph([{"POSITION": ([0] * 8, 4, "VEC2")}]))),
     ("morph-count.gltf",
