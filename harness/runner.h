@@ -24,6 +24,8 @@ typedef struct run_spec {
     const char *ref_full;    /* full-GI reference EXR, or NULL */
     const char *ref_matched; /* bounce-matched reference EXR, or NULL */
     float exposure;
+    int no_cache;         /* render --no-cache: precompute afresh (timing of precomputation) */
+    const char *label;    /* the study entry's label, or NULL */
 } run_spec;
 
 /* Runs (or resumes) a run; never fails as a whole: failures are records
