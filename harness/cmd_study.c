@@ -30,6 +30,7 @@ typedef struct run_settings {
     int scenes[MAX_SCENES]; /* indices into study.scenes */
     uint32_t scene_n;
     uint32_t width, height, frames, warmup;
+    uint32_t repeats; /* each with seed + r; an entry's repeats are interleaved */
     float time, animate_fps;
     int cache;   /* 0: render --no-cache (precomputation timed afresh) */
     int compare; /* 0: no references, no metrics (timing-only runs) */
@@ -69,9 +70,10 @@ typedef struct study_ref {
 typedef struct study {
     json_object *root;
     const char *name;
-    uint32_t repeats, seed;
+    uint32_t seed;
     uint32_t ref_spp, ref_bounces;
     double ref_target_se; /* 0: none */
+    int ref_pixel_center; /* "pixel": "center": references sample pixel centres */
     uint32_t conv_spp[32], conv_n;
     float exposure;
     const char *camera;
@@ -295,7 +297,8 @@ static int parse_settings(study *st, json_object *o, const char *prefix, const c
     }
     int rc;
     if ((rc = get_uint(o, prefix, "frames", 1, 100000, rs->frames, &rs->frames, file)) ||
-        (rc = get_uint(o, prefix, "warmup", 0, 1000, rs->warmup, &rs->warmup, file)))
+        (rc = get_uint(o, prefix, "warmup", 0, 1000, rs->warmup, &rs->warmup, file)) ||
+        (rc = get_uint(o, prefix, "repeats", 1, 100, rs->repeats, &rs->repeats, file)))
         return rc;
     if (rs->warmup >= rs->frames)
         rs->warmup = rs->frames > 1 ? rs->frames - 1 : 0;
@@ -414,21 +417,23 @@ static int expand_method(study *st, const char *file, const char *out_dir, const
             nk++;
         }
     }
-    int idx[MAX_KEYS] = {0};
-    for (;;) {
-        char combo[MAX_KEYS][128];
-        for (int k = 0; k < nk; k++)
-            snprintf(combo[k], 128, "%s", values[k][idx[k]]);
-        for (uint32_t rep = 0; rep < st->repeats; rep++) {
+    /* repeats outermost: the entry's whole sweep once per repeat, so that
+     * slow spells of a shared machine spread over all variants alike */
+    for (uint32_t rep = 0; rep < rs->repeats; rep++) {
+        int idx[MAX_KEYS] = {0};
+        for (;;) {
+            char combo[MAX_KEYS][128];
+            for (int k = 0; k < nk; k++)
+                snprintf(combo[k], 128, "%s", values[k][idx[k]]);
             int rc = add_run(st, file, out_dir, m, combo, nk, rep, rs);
             if (rc != EXIT_OK)
                 return rc;
+            int k = 0;
+            while (k < nk && ++idx[k] == counts[k])
+                idx[k++] = 0;
+            if (k == nk)
+                break;
         }
-        int k = 0;
-        while (k < nk && ++idx[k] == counts[k])
-            idx[k++] = 0;
-        if (k == nk)
-            break;
     }
     return EXIT_OK;
 }
@@ -488,12 +493,12 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
     b->width = b->height = 128;
     b->frames = 8;
     b->warmup = 1;
+    b->repeats = 1;
     b->cache = 1;
     b->compare = 1;
     if ((rc = parse_settings(st, o, "", file, b)))
         return rc;
-    if ((rc = get_uint(o, "", "repeats", 1, 100, 1, &st->repeats, file)) ||
-        (rc = get_uint(o, "", "seed", 0, 0x7FFFFFFF, 1, &st->seed, file)))
+    if ((rc = get_uint(o, "", "seed", 0, 0x7FFFFFFF, 1, &st->seed, file)))
         return rc;
     st->camera = json_object_object_get_ex(o, "camera", &v) && !json_object_is_type(v, json_type_null)
                      ? json_object_get_string(v)
@@ -515,7 +520,16 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
         if ((rc = get_uint(ref, "/reference", "spp", 1, 1u << 24, 256, &st->ref_spp, file)) ||
             (rc = get_uint(ref, "/reference", "max_bounces", 0, 1024, 64, &st->ref_bounces, file)))
             return rc;
-        json_object *cs, *tse;
+        json_object *cs, *tse, *px;
+        static const char *ref_keys[] = {"spp", "target_se", "max_bounces", "convergence_spp", "pixel", NULL};
+        if ((rc = check_keys(ref, ref_keys, "/reference", file)))
+            return rc;
+        if (json_object_object_get_ex(ref, "pixel", &px)) {
+            const char *pv = json_object_get_string(px);
+            if (!json_object_is_type(px, json_type_string) || (strcmp(pv, "box") && strcmp(pv, "center")))
+                return fail_json(file, "/reference/pixel", "must be \"box\" (the pixel's average) or \"center\"");
+            st->ref_pixel_center = !strcmp(pv, "center");
+        }
         if (json_object_object_get_ex(ref, "target_se", &tse) && !json_object_is_type(tse, json_type_null)) {
             st->ref_target_se = json_object_get_double(tse);
             if (!(st->ref_target_se > 0))
@@ -547,7 +561,7 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
     if (!json_object_is_type(v, json_type_array))
         return fail_json(file, "/methods", "must be \"all\" or a list of {\"method\": id, \"params\": {...}}");
     static const char *entry_keys[] = {"method", "params", "label", "scenes", "size", "frames", "warmup",
-                                       "time", "animate", "cache", "compare", NULL};
+                                       "repeats", "time", "animate", "cache", "compare", NULL};
     for (size_t i = 0; i < json_object_array_length(v); i++) {
         json_object *e = json_object_array_get_idx(v, i), *id, *params = NULL;
         char mpath[64];
@@ -627,11 +641,16 @@ static int build_references(study *st, const char *out_dir)
         snprintf(stem, sizeof stem, "%s", sc->name); /* a copy: -Wrestrict sees sc->name and the outputs as one object */
         snprintf(dir, sizeof dir, "%s/references", out_dir);
         cli_mkdirs(dir);
-        snprintf(sc->ref_full, sizeof sc->ref_full, "%s/%s_b%u_%uspp.exr", dir, stem, st->ref_bounces, st->ref_spp);
+        /* the file name carries every setting that changes the image, so that
+         * runs compared with an older reference are not taken as done */
+        const char *px = st->ref_pixel_center ? "_center" : "";
+        snprintf(sc->ref_full, sizeof sc->ref_full, "%s/%s_b%u_%uspp%s.exr", dir, stem, st->ref_bounces, st->ref_spp,
+                 px);
         fprintf(stderr, "study: reference %s (%ux%u, %u spp, %u bounces)\n", stem, sc->width, sc->height, st->ref_spp,
                 st->ref_bounces);
         if (!runner_reference(path, st->camera, sc->width, sc->height, st->ref_spp, st->ref_target_se, st->ref_bounces,
-                              st->seed, sc->time, st->timeout_s * 10, sc->ref_full, why, sizeof why))
+                              st->seed, sc->time, st->ref_pixel_center, st->timeout_s * 10, sc->ref_full, why,
+                              sizeof why))
             return cli_fail(EXIT_RUN, "study: %s", why);
         /* bounce-matched references for every method bounce count in use */
         for (uint32_t r = 0; r < st->run_count; r++) {
@@ -642,11 +661,12 @@ static int build_references(study *st, const char *out_dir)
                 k++;
             if (k == sc->matched_count && k < 8) {
                 sc->matched_bounces[k] = b;
-                snprintf(sc->ref_matched[k], sizeof sc->ref_matched[k], "%s/%s_b%u_%uspp.exr", dir, stem, b,
-                         st->ref_spp);
+                snprintf(sc->ref_matched[k], sizeof sc->ref_matched[k], "%s/%s_b%u_%uspp%s.exr", dir, stem, b,
+                         st->ref_spp, px);
                 fprintf(stderr, "study: bounce-matched reference %s (%u bounces)\n", stem, b);
                 if (!runner_reference(path, st->camera, sc->width, sc->height, st->ref_spp, st->ref_target_se, b,
-                                      st->seed, sc->time, st->timeout_s * 10, sc->ref_matched[k], why, sizeof why))
+                                      st->seed, sc->time, st->ref_pixel_center, st->timeout_s * 10,
+                                      sc->ref_matched[k], why, sizeof why))
                     return cli_fail(EXIT_RUN, "study: %s", why);
                 sc->matched_count++;
             }
@@ -654,9 +674,10 @@ static int build_references(study *st, const char *out_dir)
         /* the path tracer's convergence: k-spp images (another seed) against the reference */
         for (uint32_t c = 0; c < st->conv_n; c++) {
             char img[4096], stats[4200];
-            snprintf(img, sizeof img, "%s/%s_conv_%uspp.exr", dir, stem, st->conv_spp[c]);
+            snprintf(img, sizeof img, "%s/%s_conv_%uspp%s.exr", dir, stem, st->conv_spp[c], px);
             if (!runner_reference(path, st->camera, sc->width, sc->height, st->conv_spp[c], 0.0, st->ref_bounces,
-                                  st->seed + 7919, sc->time, st->timeout_s, img, why, sizeof why))
+                                  st->seed + 7919, sc->time, st->ref_pixel_center, st->timeout_s, img, why,
+                                  sizeof why))
                 return cli_fail(EXIT_RUN, "study: %s", why);
             snprintf(stats, sizeof stats, "%s.json", img);
             json_object *sj = cli_read_json(stats);
@@ -1086,13 +1107,13 @@ int cmd_study(int argc, char **argv)
         char title[512], refdesc[256];
         snprintf(title, sizeof title, "gibench study: %s (%ux%u, %u frames)", st.name, st.base.width, st.base.height,
                  st.base.frames);
-        snprintf(refdesc, sizeof refdesc, "path traced (Embree), %u spp, %u bounces; bounce-matched the same spp",
-                 st.ref_spp, st.ref_bounces);
+        snprintf(refdesc, sizeof refdesc, "path traced (Embree), %u spp, %u bounces; bounce-matched the same spp%s",
+                 st.ref_spp, st.ref_bounces, st.ref_pixel_center ? "; camera rays through pixel centres" : "");
         json_object *meta = report_meta_new(title, "study", argc, argv, renderer, refdesc);
         if (st.ref_count) {
             char ref_png[512];
-            snprintf(ref_png, sizeof ref_png, "references/%s_b%u_%uspp.png", st.refs[0].name, st.ref_bounces,
-                     st.ref_spp);
+            snprintf(ref_png, sizeof ref_png, "references/%s_b%u_%uspp%s.png", st.refs[0].name, st.ref_bounces,
+                     st.ref_spp, st.ref_pixel_center ? "_center" : "");
             json_object_object_add(meta, "reference_png", json_object_new_string(ref_png));
         }
         json_object *chart_list = json_object_new_array();

@@ -325,8 +325,8 @@ json_object *runner_execute(const run_spec *s, int resume)
 }
 
 int runner_reference(const char *scene, const char *camera, uint32_t width, uint32_t height, uint32_t spp,
-                     double target_se, uint32_t max_bounces, uint32_t seed, float time, double timeout_s,
-                     const char *out_exr, char *why, size_t why_size)
+                     double target_se, uint32_t max_bounces, uint32_t seed, float time, int pixel_center,
+                     double timeout_s, const char *out_exr, char *why, size_t why_size)
 {
     argv_builder b = {0};
     arg(&b, "%s", cli_self_exe());
@@ -353,6 +353,10 @@ int runner_reference(const char *scene, const char *camera, uint32_t width, uint
     argu(&b, seed);
     arg(&b, "%s", "--time-of-scene");
     argf(&b, time);
+    if (pixel_center) {
+        arg(&b, "%s", "--pixel");
+        arg(&b, "%s", "center");
+    }
     char config[8192], cfg_path[4200], log[4200], stats[4200];
     join(&b, config, sizeof config);
     snprintf(cfg_path, sizeof cfg_path, "%s.config", out_exr);
