@@ -84,6 +84,7 @@ typedef struct study {
     study_ref refs[MAX_REFS];
     uint32_t ref_count;
     json_object *charts; /* the "charts" list, or NULL */
+    const char *timer;   /* "timer": GIBENCH_TIMER for the runs, or NULL */
     study_run *runs;
     uint32_t run_count;
 } study;
@@ -482,7 +483,7 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
         return fail_json(file, "/", "a study is a JSON object");
     static const char *known[] = {"name", "description", "scenes", "size", "frames", "warmup", "repeats", "seed",
                                   "camera", "time", "animate", "cache", "compare", "exposure", "timeout",
-                                  "methods", "reference", "charts", NULL};
+                                  "methods", "reference", "charts", "timer", NULL};
     int rc = check_keys(o, known, "", file);
     if (rc != EXIT_OK)
         return rc;
@@ -507,6 +508,14 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
     st->timeout_s = json_object_object_get_ex(o, "timeout", &v) ? json_object_get_double(v) : 600.0;
     if (!(st->timeout_s > 0))
         return fail_json(file, "/timeout", "must be a positive number of seconds");
+    if (json_object_object_get_ex(o, "timer", &v)) {
+        /* the stage timers of every run (GIBENCH_TIMER, inherited by the children) */
+        const char *tv = json_object_get_string(v);
+        if (!json_object_is_type(v, json_type_string) ||
+            (strcmp(tv, "query") && strcmp(tv, "finish") && strcmp(tv, "cputime")))
+            return fail_json(file, "/timer", "must be \"finish\", \"query\" or \"cputime\"");
+        st->timer = tv;
+    }
     if (json_object_object_get_ex(o, "charts", &v)) {
         if ((rc = check_charts(v, file)))
             return rc;
@@ -1084,6 +1093,8 @@ int cmd_study(int argc, char **argv)
         print_plan(&st);
     if (rc == EXIT_OK && !dry && !cli_mkdirs(out))
         rc = cli_fail(EXIT_RUN, "study: cannot create %s", out);
+    if (rc == EXIT_OK && !dry && st.timer)
+        setenv("GIBENCH_TIMER", st.timer, 1);
     if (rc == EXIT_OK && !dry) {
         cli_install_signal_handlers();
         fprintf(stderr, "study: %s: %u runs on %u scenes\n", st.name, st.run_count, st.scene_count);

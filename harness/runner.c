@@ -249,8 +249,9 @@ json_object *runner_execute(const run_spec *s, int resume)
     join(&b, config, sizeof config);
     /* The references are part of what the result depends on. */
     size_t used = strlen(config);
-    snprintf(config + used, sizeof config - used, " | full=%s | matched=%s", s->ref_full ? s->ref_full : "-",
-             s->ref_matched ? s->ref_matched : "-");
+    const char *timer = getenv("GIBENCH_TIMER"); /* the timer mode changes every timing */
+    snprintf(config + used, sizeof config - used, " | full=%s | matched=%s%s%s", s->ref_full ? s->ref_full : "-",
+             s->ref_matched ? s->ref_matched : "-", timer ? " | timer=" : "", timer ? timer : "");
     arg(&b, "%s", "--out");
     arg(&b, "%s", exr);
     arg(&b, "%s", "--out");

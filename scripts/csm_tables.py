@@ -23,6 +23,7 @@ PAPER_T1 = {1024: ("32.0 MB", "3.9 MB", "4 s", 8.2),
             16384: ("512.0 MB", "19.9 MB", "50 s", 25.4),
             262144: ("8.0 GB", "242.8 MB", "844 s", 86.2)}
 PAPER_T1_TIME_S = {1024: 4.0, 16384: 50.0, 262144: 844.0}
+PAPER_T1_COMPRESSED_MIB = {1024: 3.9, 16384: 19.9, 262144: 242.8}
 # Paper, Table 2, Buddha, 1024x768, N = 128^2, M = 128: S -> M samples/s.
 PAPER_T2 = {"shade": {16: 66.2, 64: 69.9, 625: 81.9},
             "random": {16: 85.0, 625: 132.5},
@@ -94,9 +95,14 @@ def main():
     # ---- Table 1
     t1 = sorted(by.get("table1", []), key=lambda r: (params(r)["enumeration"], int(params(r)["N"])))
     w("### Table 1: bunny alone, distant lat-long light, M = 128\n")
+    w("Ours: compressed = 4 B per texel (offsets) + 6 B per segment (float z_avg, uint16 i_end); "
+      "'ratio at 4 B/seg.' counts 4 B per segment (16-bit z_avg and i_end, as a 2-byte depth suggests) for "
+      "comparison with the paper, whose format is not stated; 'paper seg./texel' is the paper's compressed size "
+      "read back with that 4 B-per-segment assumption.\n")
     w("| N | maps | enumeration | uncompressed | compressed | segments / texel | precompute (s) "
-      "(depth maps + compression) | ratio | paper: uncompressed | compressed | time | ratio |")
-    w("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+      "(depth maps + compression) | ratio | ratio at 4 B/seg. | paper: uncompressed | compressed | time "
+      "| ratio | paper seg./texel |")
+    w("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     fits = {}
     times = {}
     for r in t1:
@@ -105,12 +111,15 @@ def main():
         maps = int(num(r, "stat_maps"))
         t = (num(r, "prepare_depth_render_ms") + num(r, "prepare_compress_ms")) / 1000.0
         pap = PAPER_T1.get(maps, ("–", "–", "–", None))
-        w("| %d×%d | %d | %s | %s | %s | %.2f | %.1f (%.1f + %.1f) | %.1f : 1 | %s | %s | %s | %s |" % (
+        m2 = int(p["M"]) ** 2
+        ratio4 = num(r, "stat_bytes_uncompressed") / (4 * (m2 + 1) + 4 * num(r, "stat_segments_per_texel") * m2)
+        pseg = ((PAPER_T1_COMPRESSED_MIB[maps] * 2 ** 20 / m2) - 4) / 4 if maps in PAPER_T1_COMPRESSED_MIB else None
+        w("| %d×%d | %d | %s | %s | %s | %.1f | %.1f (%.1f + %.1f) | %.1f : 1 | %.1f : 1 | %s | %s | %s | %s | %s |" % (
             n, n, maps, p["enumeration"], mb(num(r, "stat_bytes_uncompressed")),
             mb(num(r, "stat_bytes_compressed")), num(r, "stat_segments_per_texel"), t,
             num(r, "prepare_depth_render_ms") / 1000.0, num(r, "prepare_compress_ms") / 1000.0,
-            num(r, "stat_ratio"), pap[0], pap[1], pap[2],
-            "%.1f : 1" % pap[3] if pap[3] else "–"))
+            num(r, "stat_ratio"), ratio4, pap[0], pap[1], pap[2],
+            "%.1f : 1" % pap[3] if pap[3] else "–", "%.0f" % pseg if pseg else "–"))
         fits.setdefault(p["enumeration"], []).append((maps, num(r, "stat_ratio")))
         times.setdefault(p["enumeration"], {})[maps] = t
     w("")

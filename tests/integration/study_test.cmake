@@ -60,6 +60,8 @@ match("${csv}" "^run,[^\n]*,label,width,height,prepare_depth_render_ms,prepare_c
 match("${csv}" "\nbunny_alone_env-csm-[^\n]*N=4,M=16,enumeration=hilbert[^\n]*,ok,[^\n]*,table,8,8,[0-9.e+-]+,[0-9.e+-]+"
       "the N = 4 Hilbert table row is missing or lacks its precompute timings:\n${csv}")
 match("${csv}" "\nbunny_env-csm-[^\n]*,ok,[^\n]*,error,16,16" "the compared row is missing:\n${csv}")
+match("${csv}" "\nbunny_env-csm-[^\n]*,ok,[^\n]*,process-cpu-time-around-glFinish,"
+      "\"timer\": \"cputime\" did not reach the runs:\n${csv}")
 file(READ ${S}/frames.csv frames)
 string(REGEX MATCHALL "\nbunny_teapot_moving-csm-[^,]*,moving,[0-9]+," moving_rows "${frames}")
 list(LENGTH moving_rows nmoving)
