@@ -741,7 +741,6 @@ static void csm_destroy(void *inst)
         glDeleteTextures(1, &c->accum);
     if (c->ssbo[0])
         glDeleteBuffers(9, c->ssbo);
-        glDeleteBuffers(6, c->ssbo);
     if (c->count)
         glDeleteBuffers(1, &c->count);
     if (c->program)
