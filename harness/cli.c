@@ -247,6 +247,13 @@ json_object *cli_timer_json(const gi_timer *t)
         json_object_object_add(s, "max_ms", json_object_new_double(st[i].max_ms));
         json_object_object_add(s, "mean_ms", json_object_new_double(st[i].mean_ms));
         json_object_object_add(s, "samples", json_object_new_int((int32_t)st[i].samples));
+        /* every timed frame's value, in order (per-frame time of animations) */
+        uint32_t n_ms = 0;
+        const double *ms = gi_timer_samples(t, st[i].name, &n_ms);
+        json_object *arr = json_object_new_array();
+        for (uint32_t k = 0; ms && k < n_ms; k++)
+            json_object_array_add(arr, json_object_new_double(ms[k]));
+        json_object_object_add(s, "samples_ms", arr);
         json_object_object_add(o, st[i].name, s);
     }
     return o;

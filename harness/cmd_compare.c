@@ -164,7 +164,7 @@ int cmd_compare(int argc, char **argv)
     } else {
         snprintf(ref_full, sizeof ref_full, "%s/reference_b%u.exr", o.out, o.ref_bounces);
         fprintf(stderr, "compare: reference (%u spp, %u bounces)\n", o.ref_spp, o.ref_bounces);
-        if (!runner_reference(o.scene, o.camera, o.width, o.height, o.ref_spp, o.ref_target_se, o.ref_bounces, o.seed, o.time,
+        if (!runner_reference(o.scene, o.camera, o.width, o.height, o.ref_spp, o.ref_target_se, o.ref_bounces, o.seed, o.time, 0,
                               o.timeout_s, ref_full, why, sizeof why)) {
             gi_plugins_free(reg);
             gi_scene_free(scene);
@@ -187,7 +187,7 @@ int cmd_compare(int argc, char **argv)
         uint32_t b = m->max_bounces + 1;
         const char *ref_matched = NULL;
         run_spec spec = {m->id, o.scene, m->id, o.camera, o.width, o.height, o.frames, o.warmup, o.seed,
-                         o.time, 0.0f, params, np, o.timeout_s, dir, m->id, ref_full, NULL, o.exposure};
+                         o.time, 0.0f, params, np, o.timeout_s, dir, m->id, ref_full, NULL, o.exposure, 0, NULL};
         char reason[256];
         json_object *rec;
         if (!cli_caps_cover(m, scene, 0, reason, sizeof reason)) {
@@ -196,7 +196,7 @@ int cmd_compare(int argc, char **argv)
             if (b < o.ref_bounces) {
                 snprintf(matched, sizeof matched, "%s/reference_b%u.exr", o.out, b);
                 fprintf(stderr, "compare: bounce-matched reference (%u spp, %u bounces)\n", o.ref_spp, b);
-                if (runner_reference(o.scene, o.camera, o.width, o.height, o.ref_spp, o.ref_target_se, b, o.seed, o.time, o.timeout_s,
+                if (runner_reference(o.scene, o.camera, o.width, o.height, o.ref_spp, o.ref_target_se, b, o.seed, o.time, 0, o.timeout_s,
                                      matched, why, sizeof why))
                     ref_matched = matched;
                 else

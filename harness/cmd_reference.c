@@ -34,6 +34,7 @@ typedef struct ref_opts {
     int max_bounces;
     float scene_time, exposure;
     gi_ref_strategy strategy;
+    int pixel_center;
 } ref_opts;
 
 static int image_ext_ok(const char *path)
@@ -53,7 +54,7 @@ static int parse_opts(int argc, char **argv, ref_opts *o)
     static const char *valued[] = {"--scene",    "--camera",        "--size",        "--spp",
                                    "--time",     "--target-se",     "--max-bounces", "--seed",
                                    "--threads",  "--time-of-scene", "--out",         "--stats",
-                                   "--exposure", "--strategy"};
+                                   "--exposure", "--strategy",      "--pixel"};
     memset(o, 0, sizeof *o);
     o->width = o->height = 256;
     o->seed = 1;
@@ -134,6 +135,10 @@ static int parse_opts(int argc, char **argv, ref_opts *o)
                 return cli_fail(EXIT_USAGE, "reference: --strategy '%s' is not mis, light or bsdf",
                                 v);
             o->strategy = (gi_ref_strategy)s;
+        } else if (!strcmp(a, "--pixel")) {
+            if (strcmp(v, "box") && strcmp(v, "center"))
+                return cli_fail(EXIT_USAGE, "reference: --pixel '%s' is not box or center", v);
+            o->pixel_center = !strcmp(v, "center");
         }
     }
     if (!o->scene)
@@ -224,6 +229,7 @@ static json_object *stats_json(const run_state *r, const ref_opts *o, int camera
                            json_object_new_int(o->max_bounces)); /* -1 = unlimited */
     json_object_object_add(j, "strategy",
                            json_object_new_string(gi_ref_strategy_name(o->strategy)));
+    json_object_object_add(j, "pixel", json_object_new_string(o->pixel_center ? "center" : "box"));
     json_object_object_add(j, "threads", json_object_new_int((int32_t)st.threads));
     json_object_object_add(j, "stop", json_object_new_string(stop));
     json_object_object_add(j, "wall_seconds", json_object_new_double(wall));
@@ -281,6 +287,7 @@ static int run(run_state *r, const ref_opts *o)
     d.max_bounces = o->max_bounces;
     d.threads = o->threads;
     d.strategy = o->strategy;
+    d.pixel_center = o->pixel_center;
     gi_result res = gi_ref_create(&d, &r->ref, &err);
     if (res != GI_OK)
         return cli_fail(res == GI_ERR_INVALID_ARGUMENT ? EXIT_USAGE : EXIT_RUN, "%s", err.text);

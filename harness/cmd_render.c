@@ -21,6 +21,7 @@ typedef struct render_opts {
     uint32_t param_count;
     uint32_t width, height, frames, warmup, seed;
     float time, animate_fps, exposure;
+    int no_cache; /* --no-cache: precompute afresh and keep nothing (timing studies) */
 } render_opts;
 
 static int image_ext_ok(const char *path)
@@ -39,6 +40,10 @@ static int parse_opts(int argc, char **argv, render_opts *o)
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
         unsigned long u;
+        if (!strcmp(a, "--no-cache")) {
+            o->no_cache = 1;
+            continue;
+        }
         if (!strcmp(a, "--scene") || !strcmp(a, "--method") || !strcmp(a, "--camera") || !strcmp(a, "--out") ||
             !strcmp(a, "--size") || !strcmp(a, "--param") || !strcmp(a, "--frames") || !strcmp(a, "--warmup") ||
             !strcmp(a, "--time") || !strcmp(a, "--animate") || !strcmp(a, "--seed") || !strcmp(a, "--exposure") ||
@@ -186,6 +191,8 @@ static json_object *timings_json(const run_state *r, const render_opts *o)
     json_object_object_add(j, "warmup", json_object_new_int((int32_t)o->warmup));
     json_object_object_add(j, "seed", json_object_new_int64(o->seed));
     json_object_object_add(j, "time", json_object_new_double(o->time));
+    json_object_object_add(j, "animate_fps", json_object_new_double(o->animate_fps));
+    json_object_object_add(j, "cache", json_object_new_boolean(!o->no_cache));
     json_object_object_add(j, "gl_renderer", json_object_new_string(gi_gpu_renderer(r->gpu)));
     json_object_object_add(j, "gl_version", json_object_new_string(gi_gpu_version(r->gpu)));
     json_object_object_add(j, "egl_platform", json_object_new_string(gi_gpu_platform(r->gpu)));
@@ -233,9 +240,11 @@ static int run(run_state *r, const render_opts *o)
     } else if (r->scene->camera_count == 0) {
         camera = -1;
     }
-    r->cache_dir = gi_cache_dir(&err);
-    if (!r->cache_dir)
-        return cli_fail(EXIT_RUN, "%s", err.text);
+    if (!o->no_cache) {
+        r->cache_dir = gi_cache_dir(&err);
+        if (!r->cache_dir)
+            return cli_fail(EXIT_RUN, "%s", err.text);
+    }
     r->gpu = gi_gpu_create(NULL, &err);
     if (!r->gpu)
         return cli_fail(EXIT_RUN, "%s", err.text);

@@ -21,12 +21,28 @@
 #define MAX_RUNS 4096
 #define MAX_SWEEP 64
 #define MAX_KEYS 16
+#define MAX_SCENES 16
+#define MAX_REFS 32
+
+/* What a run is made with: the study's top-level values, overridden per
+ * method entry (README.md, "Studies"). */
+typedef struct run_settings {
+    int scenes[MAX_SCENES]; /* indices into study.scenes */
+    uint32_t scene_n;
+    uint32_t width, height, frames, warmup;
+    uint32_t repeats; /* each with seed + r; an entry's repeats are interleaved */
+    float time, animate_fps;
+    int cache;   /* 0: render --no-cache (precomputation timed afresh) */
+    int compare; /* 0: no references, no metrics (timing-only runs) */
+    const char *label;
+} run_settings;
 
 typedef struct study_run {
     run_spec spec;
     char id[512], dir[4096], rel[1024];
     char *params[MAX_KEYS];
     int scene_index;
+    int ref_index; /* -1: not compared */
     uint32_t bounces; /* the method's max_bounces + 1 */
     json_object *record;
 } study_run;
@@ -34,6 +50,14 @@ typedef struct study_run {
 typedef struct study_scene {
     const char *path;
     char stem[256];
+} study_scene;
+
+/* The references of one scene at one size and scene time. */
+typedef struct study_ref {
+    int scene_index;
+    uint32_t width, height;
+    float time;
+    char name[320]; /* the scene's stem, plus size and time where a scene has several */
     char ref_full[4096];
     char ref_matched[8][4096];
     uint32_t matched_bounces[8];
@@ -41,20 +65,26 @@ typedef struct study_scene {
     /* convergence curve of the path tracer: time (s) and relMSE */
     double curve_t[32], curve_e[32];
     uint32_t curve_n;
-} study_scene;
+} study_ref;
 
 typedef struct study {
     json_object *root;
     const char *name;
-    uint32_t width, height, frames, warmup, repeats, seed;
+    uint32_t seed;
     uint32_t ref_spp, ref_bounces;
     double ref_target_se; /* 0: none */
+    int ref_pixel_center; /* "pixel": "center": references sample pixel centres */
     uint32_t conv_spp[32], conv_n;
-    float time, exposure;
+    float exposure;
     const char *camera;
     double timeout_s;
-    study_scene scenes[16];
+    run_settings base;
+    study_scene scenes[MAX_SCENES];
     uint32_t scene_count;
+    study_ref refs[MAX_REFS];
+    uint32_t ref_count;
+    json_object *charts; /* the "charts" list, or NULL */
+    const char *timer;   /* "timer": GIBENCH_TIMER for the runs, or NULL */
     study_run *runs;
     uint32_t run_count;
 } study;
@@ -64,8 +94,10 @@ static int fail_json(const char *file, const char *path, const char *what)
     return cli_fail(EXIT_USAGE, "%s: %s: %s", file, path, what);
 }
 
-static int get_uint(json_object *o, const char *key, uint32_t min, uint32_t max, uint32_t def, uint32_t *out,
-                    const char *file)
+/* o[key] as an integer in [min, max] (absent or null: def); `prefix` is the
+ * JSON path of o for messages. */
+static int get_uint(json_object *o, const char *prefix, const char *key, uint32_t min, uint32_t max, uint32_t def,
+                    uint32_t *out, const char *file)
 {
     json_object *v;
     *out = def;
@@ -74,14 +106,31 @@ static int get_uint(json_object *o, const char *key, uint32_t min, uint32_t max,
     if (!json_object_is_type(v, json_type_int) || json_object_get_int64(v) < min || json_object_get_int64(v) > max) {
         char msg[128];
         snprintf(msg, sizeof msg, "must be an integer in [%u, %u]", min, max);
-        char path[64];
-        snprintf(path, sizeof path, "/%s", key);
+        char path[160];
+        snprintf(path, sizeof path, "%s/%s", prefix, key);
         return fail_json(file, path, msg);
     }
     *out = (uint32_t)json_object_get_int64(v);
     return EXIT_OK;
 }
 
+/* Rejects keys of o that are not in `known` (NULL-terminated). */
+static int check_keys(json_object *o, const char *const *known, const char *prefix, const char *file)
+{
+    json_object_object_foreach(o, key, val)
+    {
+        (void)val;
+        int ok = 0;
+        for (int i = 0; known[i]; i++)
+            ok |= !strcmp(known[i], key);
+        if (!ok) {
+            char path[256];
+            snprintf(path, sizeof path, "%s/%s", prefix, key);
+            return fail_json(file, path, "unknown key");
+        }
+    }
+    return EXIT_OK;
+}
 /* Values of one parameter: a scalar, a list, or a range
  * {"from": a, "to": b, "step": s} / {"from": a, "to": b, "count": n, "scale": "log"}.
  * Written as text "name=value". */
@@ -153,38 +202,185 @@ static void stem_of(const char *path, char *out, size_t size)
         *dot = '\0';
 }
 
-static int add_run(study *st, const char *file, const char *out_dir, const gi_method *m, char combo[][128], int nk,
-                   uint32_t repeat)
+/* The scene's index in the study, loading (and so validating) it once. */
+static int scene_index(study *st, const char *file, const char *jpath, const char *path, int *out)
 {
-    for (uint32_t si = 0; si < st->scene_count; si++) {
+    for (uint32_t i = 0; i < st->scene_count; i++)
+        if (!strcmp(st->scenes[i].path, path)) {
+            *out = (int)i;
+            return EXIT_OK;
+        }
+    if (st->scene_count == MAX_SCENES)
+        return fail_json(file, jpath, "more than 16 scenes in one study");
+    gi_error err;
+    gi_scene *s = gi_scene_load(path, &err);
+    if (!s)
+        return cli_fail(EXIT_USAGE, "%s: %s: %s", file, jpath, err.text);
+    gi_scene_free(s);
+    study_scene *sc = &st->scenes[st->scene_count];
+    sc->path = path;
+    stem_of(path, sc->stem, sizeof sc->stem);
+    *out = (int)st->scene_count++;
+    return EXIT_OK;
+}
+
+/* The references a compared run needs: one set per scene, size and time. */
+static int ref_index(study *st, int scene, uint32_t w, uint32_t h, float time)
+{
+    for (uint32_t i = 0; i < st->ref_count; i++) {
+        study_ref *r = &st->refs[i];
+        if (r->scene_index == scene && r->width == w && r->height == h && r->time == time)
+            return (int)i;
+    }
+    if (st->ref_count == MAX_REFS)
+        return -1;
+    study_ref *r = &st->refs[st->ref_count];
+    memset(r, 0, sizeof *r);
+    r->scene_index = scene;
+    r->width = w;
+    r->height = h;
+    r->time = time;
+    return (int)st->ref_count++;
+}
+
+/* Names the reference sets: the scene's stem, with size and time added
+ * where one scene has several. */
+static void name_refs(study *st)
+{
+    for (uint32_t i = 0; i < st->ref_count; i++) {
+        study_ref *r = &st->refs[i];
+        int shared = 0;
+        for (uint32_t k = 0; k < st->ref_count; k++)
+            shared |= k != i && st->refs[k].scene_index == r->scene_index;
+        const char *stem = st->scenes[r->scene_index].stem;
+        if (!shared)
+            snprintf(r->name, sizeof r->name, "%s", stem);
+        else if (r->time == 0.0f)
+            snprintf(r->name, sizeof r->name, "%s_%ux%u", stem, r->width, r->height);
+        else
+            snprintf(r->name, sizeof r->name, "%s_%ux%u_t%g", stem, r->width, r->height, (double)r->time);
+    }
+}
+
+/* Reads the run settings that a method entry (or the top level) may give:
+ * scenes, size, frames, warmup, time, animate, cache, compare, label. */
+static int parse_settings(study *st, json_object *o, const char *prefix, const char *file, run_settings *rs)
+{
+    json_object *v;
+    char path[160];
+    if (json_object_object_get_ex(o, "scenes", &v)) {
+        snprintf(path, sizeof path, "%s/scenes", prefix);
+        if (!json_object_is_type(v, json_type_array) || json_object_array_length(v) == 0 ||
+            json_object_array_length(v) > MAX_SCENES)
+            return fail_json(file, path, "a list of 1 to 16 scene files is required");
+        rs->scene_n = 0;
+        for (size_t i = 0; i < json_object_array_length(v); i++) {
+            json_object *e = json_object_array_get_idx(v, i);
+            char ep[200];
+            snprintf(ep, sizeof ep, "%s/%zu", path, i);
+            if (!json_object_is_type(e, json_type_string))
+                return fail_json(file, ep, "a scene is a file name");
+            int rc = scene_index(st, file, ep, json_object_get_string(e), &rs->scenes[rs->scene_n]);
+            if (rc != EXIT_OK)
+                return rc;
+            rs->scene_n++;
+        }
+    }
+    if (json_object_object_get_ex(o, "size", &v)) {
+        snprintf(path, sizeof path, "%s/size", prefix);
+        if (!json_object_is_type(v, json_type_array) || json_object_array_length(v) != 2)
+            return fail_json(file, path, "must be [width, height]");
+        int w = json_object_get_int(json_object_array_get_idx(v, 0)), h = json_object_get_int(json_object_array_get_idx(v, 1));
+        if (w < 1 || h < 1 || w > 16384 || h > 16384)
+            return fail_json(file, path, "width and height must be 1..16384");
+        rs->width = (uint32_t)w;
+        rs->height = (uint32_t)h;
+    }
+    int rc;
+    if ((rc = get_uint(o, prefix, "frames", 1, 100000, rs->frames, &rs->frames, file)) ||
+        (rc = get_uint(o, prefix, "warmup", 0, 1000, rs->warmup, &rs->warmup, file)) ||
+        (rc = get_uint(o, prefix, "repeats", 1, 100, rs->repeats, &rs->repeats, file)))
+        return rc;
+    if (rs->warmup >= rs->frames)
+        rs->warmup = rs->frames > 1 ? rs->frames - 1 : 0;
+    if (json_object_object_get_ex(o, "time", &v)) {
+        rs->time = (float)json_object_get_double(v);
+        if (!(rs->time >= 0.0f) || (!json_object_is_type(v, json_type_double) && !json_object_is_type(v, json_type_int))) {
+            snprintf(path, sizeof path, "%s/time", prefix);
+            return fail_json(file, path, "must be a non-negative number of seconds");
+        }
+    }
+    if (json_object_object_get_ex(o, "animate", &v) && !json_object_is_type(v, json_type_null)) {
+        rs->animate_fps = (float)json_object_get_double(v);
+        if (!(rs->animate_fps > 0.0f)) {
+            snprintf(path, sizeof path, "%s/animate", prefix);
+            return fail_json(file, path, "must be a positive frame rate (frames per second of scene time)");
+        }
+    }
+    const char *flags[2] = {"cache", "compare"};
+    int *dest[2] = {&rs->cache, &rs->compare};
+    for (int k = 0; k < 2; k++)
+        if (json_object_object_get_ex(o, flags[k], &v)) {
+            if (!json_object_is_type(v, json_type_boolean)) {
+                snprintf(path, sizeof path, "%s/%s", prefix, flags[k]);
+                return fail_json(file, path, "must be true or false");
+            }
+            *dest[k] = json_object_get_boolean(v);
+        }
+    if (json_object_object_get_ex(o, "label", &v)) {
+        if (!json_object_is_type(v, json_type_string)) {
+            snprintf(path, sizeof path, "%s/label", prefix);
+            return fail_json(file, path, "must be a string");
+        }
+        rs->label = json_object_get_string(v);
+    }
+    return EXIT_OK;
+}
+
+static int add_run(study *st, const char *file, const char *out_dir, const gi_method *m, char combo[][128], int nk,
+                   uint32_t repeat, const run_settings *rs)
+{
+    for (uint32_t k = 0; k < rs->scene_n; k++) {
+        int si = rs->scenes[k];
         if (st->run_count == MAX_RUNS)
             return cli_fail(EXIT_USAGE, "%s: more than %d runs", file, MAX_RUNS);
         study_run *r = &st->runs[st->run_count];
         memset(r, 0, sizeof *r);
         char key[4096];
-        snprintf(key, sizeof key, "%s|%s|%u", st->scenes[si].path, m->id, repeat);
-        for (int k = 0; k < nk; k++) {
-            r->params[k] = strdup(combo[k]);
+        snprintf(key, sizeof key, "%s|%s|%u|%ux%u|%u/%u|%g|%g|%d|%d", st->scenes[si].path, m->id, repeat, rs->width,
+                 rs->height, rs->frames, rs->warmup, (double)rs->time, (double)rs->animate_fps, rs->cache,
+                 rs->compare);
+        for (int p = 0; p < nk; p++) {
+            r->params[p] = strdup(combo[p]);
             size_t used = strlen(key);
-            snprintf(key + used, sizeof key - used, "|%s", combo[k]);
+            snprintf(key + used, sizeof key - used, "|%s", combo[p]);
         }
         uint64_t h = gi_hash64(key, strlen(key), 0);
         snprintf(r->id, sizeof r->id, "%s-%s-%08x", st->scenes[si].stem, m->id, (unsigned)(h & 0xFFFFFFFFu));
         snprintf(r->rel, sizeof r->rel, "runs/%s", r->id);
         snprintf(r->dir, sizeof r->dir, "%s/%s", out_dir, r->rel);
-        r->scene_index = (int)si;
+        r->scene_index = si;
         r->bounces = m->max_bounces + 1;
+        r->ref_index = -1;
+        if (rs->compare) {
+            r->ref_index = ref_index(st, si, rs->width, rs->height, rs->time);
+            if (r->ref_index < 0)
+                return cli_fail(EXIT_USAGE, "%s: more than %d (scene, size, time) reference sets", file, MAX_REFS);
+        }
         run_spec *s = &r->spec;
         s->run_id = r->id;
         s->scene = st->scenes[si].path;
         s->method = m->id;
         s->camera = st->camera;
-        s->width = st->width;
-        s->height = st->height;
-        s->frames = st->frames;
-        s->warmup = st->warmup;
+        s->width = rs->width;
+        s->height = rs->height;
+        s->frames = rs->frames;
+        s->warmup = rs->warmup;
         s->seed = st->seed + repeat;
-        s->time = st->time;
+        s->time = rs->time;
+        s->animate_fps = rs->animate_fps;
+        s->no_cache = !rs->cache;
+        s->label = rs->label;
         s->params = (const char *const *)r->params;
         s->param_count = (uint32_t)nk;
         s->timeout_s = st->timeout_s;
@@ -198,7 +394,7 @@ static int add_run(study *st, const char *file, const char *out_dir, const gi_me
 
 /* Expands one method entry: the Cartesian product of its sweeps. */
 static int expand_method(study *st, const char *file, const char *out_dir, const gi_method *m, json_object *params,
-                         const char *mpath)
+                         const char *mpath, const run_settings *rs)
 {
     static char values[MAX_KEYS][MAX_SWEEP][128];
     int counts[MAX_KEYS], nk = 0;
@@ -222,21 +418,56 @@ static int expand_method(study *st, const char *file, const char *out_dir, const
             nk++;
         }
     }
-    int idx[MAX_KEYS] = {0};
-    for (;;) {
-        char combo[MAX_KEYS][128];
-        for (int k = 0; k < nk; k++)
-            snprintf(combo[k], 128, "%s", values[k][idx[k]]);
-        for (uint32_t rep = 0; rep < st->repeats; rep++) {
-            int rc = add_run(st, file, out_dir, m, combo, nk, rep);
+    /* repeats outermost: the entry's whole sweep once per repeat, so that
+     * slow spells of a shared machine spread over all variants alike */
+    for (uint32_t rep = 0; rep < rs->repeats; rep++) {
+        int idx[MAX_KEYS] = {0};
+        for (;;) {
+            char combo[MAX_KEYS][128];
+            for (int k = 0; k < nk; k++)
+                snprintf(combo[k], 128, "%s", values[k][idx[k]]);
+            int rc = add_run(st, file, out_dir, m, combo, nk, rep, rs);
             if (rc != EXIT_OK)
                 return rc;
+            int k = 0;
+            while (k < nk && ++idx[k] == counts[k])
+                idx[k++] = 0;
+            if (k == nk)
+                break;
         }
-        int k = 0;
-        while (k < nk && ++idx[k] == counts[k])
-            idx[k++] = 0;
-        if (k == nk)
-            break;
+    }
+    return EXIT_OK;
+}
+
+/* Checks the "charts" list (each chart is drawn after the runs). */
+static int check_charts(json_object *charts, const char *file)
+{
+    if (!json_object_is_type(charts, json_type_array) || json_object_array_length(charts) > 32)
+        return fail_json(file, "/charts", "must be a list of at most 32 charts");
+    static const char *known[] = {"file", "title", "where", "x", "y", "series", "log_x", "log_y", "x_label",
+                                  "y_label", NULL};
+    for (size_t i = 0; i < json_object_array_length(charts); i++) {
+        json_object *c = json_object_array_get_idx(charts, i), *v;
+        char path[64];
+        snprintf(path, sizeof path, "/charts/%zu", i);
+        if (!json_object_is_type(c, json_type_object))
+            return fail_json(file, path, "a chart is an object");
+        int rc = check_keys(c, known, path, file);
+        if (rc != EXIT_OK)
+            return rc;
+        const char *need[3] = {"file", "x", "y"};
+        for (int k = 0; k < 3; k++)
+            if (!json_object_object_get_ex(c, need[k], &v) || !json_object_is_type(v, json_type_string) ||
+                !*json_object_get_string(v))
+                return fail_json(file, path, "a chart needs \"file\", \"x\" and \"y\" (strings)");
+        const char *f = json_object_get_string(json_object_object_get(c, "file"));
+        size_t n = strlen(f);
+        if (n < 5 || strcmp(f + n - 4, ".png") || strchr(f, '/'))
+            return fail_json(file, path, "\"file\" must be a plain file name ending in .png");
+        if (json_object_object_get_ex(c, "where", &v) && !json_object_is_type(v, json_type_object))
+            return fail_json(file, path, "\"where\" must be an object {field: value}");
+        if (json_object_object_get_ex(c, "series", &v) && !json_object_is_type(v, json_type_string))
+            return fail_json(file, path, "\"series\" must be a field name");
     }
     return EXIT_OK;
 }
@@ -250,68 +481,64 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
     json_object *o = st->root, *v;
     if (!json_object_is_type(o, json_type_object))
         return fail_json(file, "/", "a study is a JSON object");
-    json_object_object_foreach(o, key, val)
-    {
-        (void)val;
-        static const char *known[] = {"name", "description", "scenes", "size", "frames", "warmup", "repeats",
-                                      "seed", "camera", "time", "exposure", "timeout", "methods", "reference",
-                                      NULL};
-        int ok = 0;
-        for (int i = 0; known[i]; i++)
-            ok |= !strcmp(known[i], key);
-        if (!ok) {
-            char path[128];
-            snprintf(path, sizeof path, "/%s", key);
-            return fail_json(file, path, "unknown key");
-        }
-    }
-    st->name = json_object_object_get_ex(o, "name", &v) ? json_object_get_string(v) : "study";
-    if (!json_object_object_get_ex(o, "scenes", &v) || !json_object_is_type(v, json_type_array) ||
-        json_object_array_length(v) == 0 || json_object_array_length(v) > 16)
-        return fail_json(file, "/scenes", "a list of 1 to 16 scene files is required");
-    for (size_t i = 0; i < json_object_array_length(v); i++) {
-        study_scene *sc = &st->scenes[st->scene_count++];
-        sc->path = json_object_get_string(json_object_array_get_idx(v, i));
-        gi_error err;
-        gi_scene *s = gi_scene_load(sc->path, &err);
-        if (!s)
-            return cli_fail(EXIT_USAGE, "%s: /scenes/%zu: %s", file, i, err.text);
-        gi_scene_free(s);
-        stem_of(sc->path, sc->stem, sizeof sc->stem);
-    }
-    st->width = st->height = 128;
-    if (json_object_object_get_ex(o, "size", &v)) {
-        if (!json_object_is_type(v, json_type_array) || json_object_array_length(v) != 2)
-            return fail_json(file, "/size", "must be [width, height]");
-        int w = json_object_get_int(json_object_array_get_idx(v, 0)), h = json_object_get_int(json_object_array_get_idx(v, 1));
-        if (w < 1 || h < 1 || w > 16384 || h > 16384)
-            return fail_json(file, "/size", "width and height must be 1..16384");
-        st->width = (uint32_t)w;
-        st->height = (uint32_t)h;
-    }
-    int rc;
-    if ((rc = get_uint(o, "frames", 1, 100000, 8, &st->frames, file)) || (rc = get_uint(o, "warmup", 0, 1000, 1, &st->warmup, file)) ||
-        (rc = get_uint(o, "repeats", 1, 100, 1, &st->repeats, file)) || (rc = get_uint(o, "seed", 0, 0x7FFFFFFF, 1, &st->seed, file)))
+    static const char *known[] = {"name", "description", "scenes", "size", "frames", "warmup", "repeats", "seed",
+                                  "camera", "time", "animate", "cache", "compare", "exposure", "timeout",
+                                  "methods", "reference", "charts", "timer", NULL};
+    int rc = check_keys(o, known, "", file);
+    if (rc != EXIT_OK)
         return rc;
-    if (st->warmup >= st->frames)
-        st->warmup = st->frames > 1 ? st->frames - 1 : 0;
+    st->name = json_object_object_get_ex(o, "name", &v) ? json_object_get_string(v) : "study";
+    if (!json_object_object_get_ex(o, "scenes", &v))
+        return fail_json(file, "/scenes", "a list of 1 to 16 scene files is required");
+    run_settings *b = &st->base;
+    b->width = b->height = 128;
+    b->frames = 8;
+    b->warmup = 1;
+    b->repeats = 1;
+    b->cache = 1;
+    b->compare = 1;
+    if ((rc = parse_settings(st, o, "", file, b)))
+        return rc;
+    if ((rc = get_uint(o, "", "seed", 0, 0x7FFFFFFF, 1, &st->seed, file)))
+        return rc;
     st->camera = json_object_object_get_ex(o, "camera", &v) && !json_object_is_type(v, json_type_null)
                      ? json_object_get_string(v)
                      : NULL;
-    st->time = json_object_object_get_ex(o, "time", &v) ? (float)json_object_get_double(v) : 0.0f;
     st->exposure = json_object_object_get_ex(o, "exposure", &v) ? (float)json_object_get_double(v) : 0.0f;
     st->timeout_s = json_object_object_get_ex(o, "timeout", &v) ? json_object_get_double(v) : 600.0;
     if (!(st->timeout_s > 0))
         return fail_json(file, "/timeout", "must be a positive number of seconds");
+    if (json_object_object_get_ex(o, "timer", &v)) {
+        /* the stage timers of every run (GIBENCH_TIMER, inherited by the children) */
+        const char *tv = json_object_get_string(v);
+        if (!json_object_is_type(v, json_type_string) ||
+            (strcmp(tv, "query") && strcmp(tv, "finish") && strcmp(tv, "cputime")))
+            return fail_json(file, "/timer", "must be \"finish\", \"query\" or \"cputime\"");
+        st->timer = tv;
+    }
+    if (json_object_object_get_ex(o, "charts", &v)) {
+        if ((rc = check_charts(v, file)))
+            return rc;
+        st->charts = v;
+    }
 
     json_object *ref;
     st->ref_spp = 256;
     st->ref_bounces = 64;
     if (json_object_object_get_ex(o, "reference", &ref)) {
-        if ((rc = get_uint(ref, "spp", 1, 1u << 24, 256, &st->ref_spp, file)) ||
-            (rc = get_uint(ref, "max_bounces", 0, 1024, 64, &st->ref_bounces, file)))
+        if ((rc = get_uint(ref, "/reference", "spp", 1, 1u << 24, 256, &st->ref_spp, file)) ||
+            (rc = get_uint(ref, "/reference", "max_bounces", 0, 1024, 64, &st->ref_bounces, file)))
             return rc;
-        json_object *cs, *tse;
+        json_object *cs, *tse, *px;
+        static const char *ref_keys[] = {"spp", "target_se", "max_bounces", "convergence_spp", "pixel", NULL};
+        if ((rc = check_keys(ref, ref_keys, "/reference", file)))
+            return rc;
+        if (json_object_object_get_ex(ref, "pixel", &px)) {
+            const char *pv = json_object_get_string(px);
+            if (!json_object_is_type(px, json_type_string) || (strcmp(pv, "box") && strcmp(pv, "center")))
+                return fail_json(file, "/reference/pixel", "must be \"box\" (the pixel's average) or \"center\"");
+            st->ref_pixel_center = !strcmp(pv, "center");
+        }
         if (json_object_object_get_ex(ref, "target_se", &tse) && !json_object_is_type(tse, json_type_null)) {
             st->ref_target_se = json_object_get_double(tse);
             if (!(st->ref_target_se > 0))
@@ -335,25 +562,33 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
         return cli_fail(EXIT_RUN, "out of memory");
     if (json_object_is_type(v, json_type_string) && !strcmp(json_object_get_string(v), "all")) {
         for (uint32_t i = 0; i < reg->count; i++)
-            if ((rc = expand_method(st, file, out_dir, reg->items[i].method, NULL, "/methods")))
+            if ((rc = expand_method(st, file, out_dir, reg->items[i].method, NULL, "/methods", b)))
                 return rc;
+        name_refs(st);
         return EXIT_OK;
     }
     if (!json_object_is_type(v, json_type_array))
         return fail_json(file, "/methods", "must be \"all\" or a list of {\"method\": id, \"params\": {...}}");
+    static const char *entry_keys[] = {"method", "params", "label", "scenes", "size", "frames", "warmup",
+                                       "repeats", "time", "animate", "cache", "compare", NULL};
     for (size_t i = 0; i < json_object_array_length(v); i++) {
         json_object *e = json_object_array_get_idx(v, i), *id, *params = NULL;
         char mpath[64];
         snprintf(mpath, sizeof mpath, "/methods/%zu", i);
         if (!json_object_is_type(e, json_type_object) || !json_object_object_get_ex(e, "method", &id))
             return fail_json(file, mpath, "needs \"method\"");
+        if ((rc = check_keys(e, entry_keys, mpath, file)))
+            return rc;
+        run_settings rs = *b;
+        if ((rc = parse_settings(st, e, mpath, file, &rs)))
+            return rc;
         json_object_object_get_ex(e, "params", &params);
         if (params && !json_object_is_type(params, json_type_object))
             return fail_json(file, mpath, "\"params\" must be an object");
         const char *mid = json_object_get_string(id);
         if (!strcmp(mid, "all")) {
             for (uint32_t k = 0; k < reg->count; k++)
-                if ((rc = expand_method(st, file, out_dir, reg->items[k].method, NULL, mpath)))
+                if ((rc = expand_method(st, file, out_dir, reg->items[k].method, NULL, mpath, &rs)))
                     return rc;
             continue;
         }
@@ -363,16 +598,17 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
             snprintf(msg, sizeof msg, "no method '%s' is installed (see gibench methods)", mid);
             return fail_json(file, mpath, msg);
         }
-        if ((rc = expand_method(st, file, out_dir, m, params, mpath)))
+        if ((rc = expand_method(st, file, out_dir, m, params, mpath, &rs)))
             return rc;
     }
+    name_refs(st);
     return EXIT_OK;
 }
 
 /* Log-log interpolation of the path tracer's time at error e; extrapolates
  * with slope -1 (relMSE ~ 1/time for an unbiased estimator). *extrapolated
  * is set when e lies outside the curve. */
-static double pt_time_at(const study_scene *sc, double e, int *extrapolated)
+static double pt_time_at(const study_ref *sc, double e, int *extrapolated)
 {
     *extrapolated = 0;
     if (sc->curve_n == 0 || !(e > 0))
@@ -404,34 +640,42 @@ static double rec_num(json_object *o, const char *k1, const char *k2, const char
     return json_object_get_double(o);
 }
 
-static int build_references(study *st, const char *out_dir, gi_plugins *reg)
+static int build_references(study *st, const char *out_dir)
 {
     char why[1024];
-    for (uint32_t si = 0; si < st->scene_count; si++) {
-        study_scene *sc = &st->scenes[si];
-        char dir[2048], stem[256];
-        snprintf(stem, sizeof stem, "%s", sc->stem); /* a copy: -Wrestrict sees sc->stem and the outputs as one object */
+    for (uint32_t ri = 0; ri < st->ref_count; ri++) {
+        study_ref *sc = &st->refs[ri];
+        const char *path = st->scenes[sc->scene_index].path;
+        char dir[2048], stem[320];
+        snprintf(stem, sizeof stem, "%s", sc->name); /* a copy: -Wrestrict sees sc->name and the outputs as one object */
         snprintf(dir, sizeof dir, "%s/references", out_dir);
         cli_mkdirs(dir);
-        snprintf(sc->ref_full, sizeof sc->ref_full, "%s/%s_b%u_%uspp.exr", dir, stem, st->ref_bounces, st->ref_spp);
-        fprintf(stderr, "study: reference %s (%u spp, %u bounces)\n", sc->stem, st->ref_spp, st->ref_bounces);
-        if (!runner_reference(sc->path, st->camera, st->width, st->height, st->ref_spp, st->ref_target_se, st->ref_bounces, st->seed,
-                              st->time, st->timeout_s * 10, sc->ref_full, why, sizeof why))
+        /* the file name carries every setting that changes the image, so that
+         * runs compared with an older reference are not taken as done */
+        const char *px = st->ref_pixel_center ? "_center" : "";
+        snprintf(sc->ref_full, sizeof sc->ref_full, "%s/%s_b%u_%uspp%s.exr", dir, stem, st->ref_bounces, st->ref_spp,
+                 px);
+        fprintf(stderr, "study: reference %s (%ux%u, %u spp, %u bounces)\n", stem, sc->width, sc->height, st->ref_spp,
+                st->ref_bounces);
+        if (!runner_reference(path, st->camera, sc->width, sc->height, st->ref_spp, st->ref_target_se, st->ref_bounces,
+                              st->seed, sc->time, st->ref_pixel_center, st->timeout_s * 10, sc->ref_full, why,
+                              sizeof why))
             return cli_fail(EXIT_RUN, "study: %s", why);
         /* bounce-matched references for every method bounce count in use */
         for (uint32_t r = 0; r < st->run_count; r++) {
-            if (st->runs[r].scene_index != (int)si || st->runs[r].bounces >= st->ref_bounces)
+            if (st->runs[r].ref_index != (int)ri || st->runs[r].bounces >= st->ref_bounces)
                 continue;
             uint32_t b = st->runs[r].bounces, k = 0;
             while (k < sc->matched_count && sc->matched_bounces[k] != b)
                 k++;
             if (k == sc->matched_count && k < 8) {
                 sc->matched_bounces[k] = b;
-                snprintf(sc->ref_matched[k], sizeof sc->ref_matched[k], "%s/%s_b%u_%uspp.exr", dir, stem, b,
-                         st->ref_spp);
-                fprintf(stderr, "study: bounce-matched reference %s (%u bounces)\n", sc->stem, b);
-                if (!runner_reference(sc->path, st->camera, st->width, st->height, st->ref_spp, st->ref_target_se, b, st->seed, st->time,
-                                      st->timeout_s * 10, sc->ref_matched[k], why, sizeof why))
+                snprintf(sc->ref_matched[k], sizeof sc->ref_matched[k], "%s/%s_b%u_%uspp%s.exr", dir, stem, b,
+                         st->ref_spp, px);
+                fprintf(stderr, "study: bounce-matched reference %s (%u bounces)\n", stem, b);
+                if (!runner_reference(path, st->camera, sc->width, sc->height, st->ref_spp, st->ref_target_se, b,
+                                      st->seed, sc->time, st->ref_pixel_center, st->timeout_s * 10,
+                                      sc->ref_matched[k], why, sizeof why))
                     return cli_fail(EXIT_RUN, "study: %s", why);
                 sc->matched_count++;
             }
@@ -439,9 +683,10 @@ static int build_references(study *st, const char *out_dir, gi_plugins *reg)
         /* the path tracer's convergence: k-spp images (another seed) against the reference */
         for (uint32_t c = 0; c < st->conv_n; c++) {
             char img[4096], stats[4200];
-            snprintf(img, sizeof img, "%s/%s_conv_%uspp.exr", dir, stem, st->conv_spp[c]);
-            if (!runner_reference(sc->path, st->camera, st->width, st->height, st->conv_spp[c], 0.0, st->ref_bounces,
-                                  st->seed + 7919, st->time, st->timeout_s, img, why, sizeof why))
+            snprintf(img, sizeof img, "%s/%s_conv_%uspp%s.exr", dir, stem, st->conv_spp[c], px);
+            if (!runner_reference(path, st->camera, sc->width, sc->height, st->conv_spp[c], 0.0, st->ref_bounces,
+                                  st->seed + 7919, sc->time, st->ref_pixel_center, st->timeout_s, img, why,
+                                  sizeof why))
                 return cli_fail(EXIT_RUN, "study: %s", why);
             snprintf(stats, sizeof stats, "%s.json", img);
             json_object *sj = cli_read_json(stats);
@@ -456,13 +701,15 @@ static int build_references(study *st, const char *out_dir, gi_plugins *reg)
             json_object_put(m);
         }
     }
-    (void)reg;
     return EXIT_OK;
 }
 
 static void attach_refs(study *st, study_run *r)
 {
-    study_scene *sc = &st->scenes[r->scene_index];
+    r->spec.ref_full = r->spec.ref_matched = NULL;
+    if (r->ref_index < 0)
+        return;
+    study_ref *sc = &st->refs[r->ref_index];
     r->spec.ref_full = sc->ref_full;
     r->spec.ref_matched = sc->ref_full;
     for (uint32_t k = 0; k < sc->matched_count; k++)
@@ -470,25 +717,32 @@ static void attach_refs(study *st, study_run *r)
             r->spec.ref_matched = sc->ref_matched[k];
 }
 
+/* A record for a run, or "n/a" when the method's caps do not cover its scene. */
+static json_object *run_or_skip(study_run *r, gi_plugins *reg, int resume)
+{
+    gi_error err;
+    gi_scene *s = gi_scene_load(r->spec.scene, &err);
+    char why[256];
+    const gi_method *m = gi_plugins_find(reg, r->spec.method);
+    json_object *rec;
+    if (s && m && !cli_caps_cover(m, s, r->spec.animate_fps > 0, why, sizeof why))
+        rec = runner_not_applicable(&r->spec, why);
+    else
+        rec = runner_execute(&r->spec, resume);
+    gi_scene_free(s);
+    return rec;
+}
+
 /* Runs every run not yet done: `jobs` worker processes, each taking runs
  * i, i+jobs, ...; results land in each run's result.json. */
 static void execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg)
 {
-    gi_error err;
     for (uint32_t i = 0; i < st->run_count; i++)
         attach_refs(st, &st->runs[i]);
     if (jobs <= 1) {
         for (uint32_t i = 0; i < st->run_count && !cli_interrupted; i++) {
-            study_run *r = &st->runs[i];
-            fprintf(stderr, "study: run %u/%u %s\n", i + 1, st->run_count, r->id);
-            gi_scene *s = gi_scene_load(r->spec.scene, &err);
-            char why[256];
-            const gi_method *m = gi_plugins_find(reg, r->spec.method);
-            if (s && m && !cli_caps_cover(m, s, r->spec.animate_fps > 0, why, sizeof why))
-                r->record = runner_not_applicable(&r->spec, why);
-            else
-                r->record = runner_execute(&r->spec, !fresh);
-            gi_scene_free(s);
+            fprintf(stderr, "study: run %u/%u %s\n", i + 1, st->run_count, st->runs[i].id);
+            st->runs[i].record = run_or_skip(&st->runs[i], reg, !fresh);
         }
         return;
     }
@@ -498,7 +752,7 @@ static void execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg)
         if (pid == 0) {
             for (uint32_t i = j; i < st->run_count && !cli_interrupted; i += jobs) {
                 fprintf(stderr, "study: [worker %u] run %u/%u %s\n", j, i + 1, st->run_count, st->runs[i].id);
-                json_object_put(runner_execute(&st->runs[i].spec, !fresh));
+                json_object_put(run_or_skip(&st->runs[i], reg, !fresh));
             }
             _exit(0);
         }
@@ -509,31 +763,22 @@ static void execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg)
             waitpid(pids[j], NULL, 0);
     free(pids);
     /* collect: every worker wrote result.json; resume picks them up */
-    for (uint32_t i = 0; i < st->run_count; i++) {
-        study_run *r = &st->runs[i];
-        gi_scene *s = gi_scene_load(r->spec.scene, &err);
-        char why[256];
-        const gi_method *m = gi_plugins_find(reg, r->spec.method);
-        if (s && m && !cli_caps_cover(m, s, 0, why, sizeof why))
-            r->record = runner_not_applicable(&r->spec, why);
-        else
-            r->record = runner_execute(&r->spec, 1);
-        gi_scene_free(s);
-    }
+    for (uint32_t i = 0; i < st->run_count; i++)
+        st->runs[i].record = run_or_skip(&st->runs[i], reg, 1);
 }
 
-/* Error-against-time charts per scene and the equal-error speed-up column. */
-static void charts_and_speedups(study *st, const char *out_dir, json_object *meta, json_object *runs)
+/* Error-against-time charts per reference set and the equal-error speed-up column. */
+static void charts_and_speedups(study *st, const char *out_dir, json_object *meta, json_object *chart_list,
+                                json_object *runs)
 {
-    json_object *chart_list = json_object_new_array();
     char md[8192] = "";
-    for (uint32_t si = 0; si < st->scene_count; si++) {
-        study_scene *sc = &st->scenes[si];
+    for (uint32_t ri = 0; ri < st->ref_count; ri++) {
+        study_ref *sc = &st->refs[ri];
         /* group runs by method */
         const char *methods[32];
         uint32_t nm = 0;
         for (uint32_t i = 0; i < st->run_count; i++) {
-            if (st->runs[i].scene_index != (int)si)
+            if (st->runs[i].ref_index != (int)ri)
                 continue;
             int seen = 0;
             for (uint32_t k = 0; k < nm; k++)
@@ -549,7 +794,7 @@ static void charts_and_speedups(study *st, const char *out_dir, json_object *met
             uint32_t c = 0;
             for (uint32_t i = 0; i < st->run_count; i++) {
                 study_run *r = &st->runs[i];
-                if (r->scene_index != (int)si || strcmp(r->spec.method, methods[k]))
+                if (r->ref_index != (int)ri || strcmp(r->spec.method, methods[k]))
                     continue;
                 double fm = rec_num(r->record, "frame_ms", "median", NULL);
                 double e = rec_num(r->record, "metrics", "full", "relmse");
@@ -573,9 +818,9 @@ static void charts_and_speedups(study *st, const char *out_dir, json_object *met
         if (sc->curve_n)
             series[ns++] = (gi_chart_series){"path tracer (Embree, CPU)", sc->curve_t, sc->curve_e, sc->curve_n, 2};
         char name[512], path[4700], title[512];
-        snprintf(name, sizeof name, "chart_%s_error_vs_time.png", sc->stem);
+        snprintf(name, sizeof name, "chart_%s_error_vs_time.png", sc->name);
         snprintf(path, sizeof path, "%s/%s", out_dir, name);
-        snprintf(title, sizeof title, "%s: relMSE against time (full-GI reference)", sc->stem);
+        snprintf(title, sizeof title, "%s: relMSE against time (full-GI reference)", sc->name);
         gi_chart_desc desc = {title, "time to image (s): frames x median frame time", "relMSE", 1, 1, 0, 0};
         gi_error err;
         if (gi_chart_write_png(path, &desc, series, ns, &err) == GI_OK)
@@ -586,7 +831,7 @@ static void charts_and_speedups(study *st, const char *out_dir, json_object *met
         free(ys);
         size_t used = strlen(md);
         snprintf(md + used, sizeof md - used,
-                 "Path tracer convergence on %s (relMSE against the %u-spp reference, another seed):", sc->stem,
+                 "Path tracer convergence on %s (relMSE against the %u-spp reference, another seed):", sc->name,
                  st->ref_spp);
         for (uint32_t c = 0; c < sc->curve_n; c++) {
             used = strlen(md);
@@ -614,15 +859,208 @@ static void charts_and_speedups(study *st, const char *out_dir, json_object *met
                  rec_num(o, "metrics", "full", "relmse"), rec_num(o, "pt_time_at_equal_error_s", NULL, NULL), sp,
                  ex ? " (extrapolated)" : "");
     }
-    json_object_object_add(meta, "charts", chart_list);
     json_object_object_add(meta, "markdown", json_object_new_string(md));
+}
+
+/* A field of a run record by name: a top-level key ("label", "run",
+ * "prepare_ms", "frame_samples_ms"), a dotted path ("stats.ratio",
+ * "metrics.matched.relmse", "stages.render.median", "prepare_stages.compress")
+ * or "params.K", the value of parameter K in the full parameter string.
+ * Returns a new reference (json_object_put it) or NULL. */
+static json_object *record_field(json_object *rec, const char *name)
+{
+    json_object *v;
+    if (!strncmp(name, "params.", 7)) {
+        const char *ps = json_object_object_get_ex(rec, "params_full", &v) || json_object_object_get_ex(rec, "params", &v)
+                             ? json_object_get_string(v)
+                             : "";
+        size_t kl = strlen(name + 7);
+        for (const char *p = ps; p && *p; p = strchr(p, ',') ? strchr(p, ',') + 1 : NULL) {
+            if (!strncmp(p, name + 7, kl) && p[kl] == '=') {
+                const char *val = p + kl + 1, *end = strchr(val, ',');
+                size_t n = end ? (size_t)(end - val) : strlen(val);
+                return json_object_new_string_len(val, (int)n);
+            }
+        }
+        return NULL;
+    }
+    char buf[256];
+    snprintf(buf, sizeof buf, "%s", name);
+    json_object *o = rec;
+    for (char *save = NULL, *tok = strtok_r(buf, ".", &save); tok; tok = strtok_r(NULL, ".", &save)) {
+        if (!o || !json_object_object_get_ex(o, tok, &o))
+            return NULL;
+    }
+    return json_object_get(o);
+}
+
+/* The number a field holds (a number, or text that is one); NaN otherwise. */
+static double field_num(json_object *f)
+{
+    if (!f)
+        return NAN;
+    if (json_object_is_type(f, json_type_double) || json_object_is_type(f, json_type_int))
+        return json_object_get_double(f);
+    if (json_object_is_type(f, json_type_string)) {
+        char *end;
+        const char *s = json_object_get_string(f);
+        double d = strtod(s, &end);
+        return end != s && *end == '\0' ? d : NAN;
+    }
+    return NAN;
+}
+
+/* Whether a record's field equals a "where" value (numerically when both are numbers). */
+static int field_equals(json_object *rec, const char *name, json_object *want)
+{
+    json_object *f = record_field(rec, name);
+    int eq = 0;
+    if (f) {
+        double a = field_num(f), b = field_num(want);
+        eq = isfinite(a) && isfinite(b) ? a == b : !strcmp(json_object_get_string(f), json_object_get_string(want));
+    }
+    json_object_put(f);
+    return eq;
+}
+
+static int cmp_point(const void *a, const void *b)
+{
+    const double *p = a, *q = b;
+    return (p[0] > q[0]) - (p[0] < q[0]);
+}
+
+/* The study's own charts ("charts" in the study file): y against x over the
+ * finished runs that match "where", one series per value of "series". A y
+ * that is a list (e.g. frame_samples_ms) gives one series per run, against
+ * its position in the list. */
+static void user_charts(study *st, const char *out_dir, json_object *runs, json_object *chart_list)
+{
+    if (!st->charts)
+        return;
+    size_t nr = json_object_array_length(runs);
+    for (size_t ci = 0; ci < json_object_array_length(st->charts); ci++) {
+        json_object *c = json_object_array_get_idx(st->charts, ci), *v, *where = NULL;
+        const char *file = json_object_get_string(json_object_object_get(c, "file"));
+        const char *xf = json_object_get_string(json_object_object_get(c, "x"));
+        const char *yf = json_object_get_string(json_object_object_get(c, "y"));
+        const char *sf = json_object_object_get_ex(c, "series", &v) ? json_object_get_string(v) : NULL;
+        json_object_object_get_ex(c, "where", &where);
+        char *labels[32] = {0};
+        double *pts[32] = {0}; /* (x, y) pairs */
+        uint32_t counts[32] = {0}, ns = 0;
+        for (size_t i = 0; i < nr; i++) {
+            json_object *rec = json_object_array_get_idx(runs, i);
+            if (!json_object_object_get_ex(rec, "status", &v) || strcmp(json_object_get_string(v), "ok"))
+                continue;
+            int match = 1;
+            if (where) {
+                json_object_object_foreach(where, k, want) match &= field_equals(rec, k, want);
+            }
+            if (!match)
+                continue;
+            json_object *y = record_field(rec, yf);
+            int is_list = y && json_object_is_type(y, json_type_array);
+            char label[256];
+            if (is_list && !sf)
+                snprintf(label, sizeof label, "%s", json_object_get_string(json_object_object_get(rec, "run")));
+            else if (sf) {
+                json_object *s = record_field(rec, sf);
+                const char *leaf = strrchr(sf, '.') ? strrchr(sf, '.') + 1 : sf;
+                snprintf(label, sizeof label, "%s=%s", leaf, s ? json_object_get_string(s) : "?");
+                json_object_put(s);
+            } else
+                snprintf(label, sizeof label, "%s", yf);
+            uint32_t k = 0;
+            while (k < ns && strcmp(labels[k], label))
+                k++;
+            if (k == ns) {
+                if (ns == 32) {
+                    json_object_put(y);
+                    continue;
+                }
+                labels[ns] = strdup(label);
+                pts[ns] = calloc((size_t)2 * MAX_RUNS, sizeof(double));
+                ns++;
+            }
+            if (is_list) {
+                for (size_t j = 0; j < json_object_array_length(y) && counts[k] < MAX_RUNS && pts[k]; j++) {
+                    pts[k][2 * counts[k]] = (double)(j + 1);
+                    pts[k][2 * counts[k] + 1] = json_object_get_double(json_object_array_get_idx(y, j));
+                    counts[k]++;
+                }
+            } else if (pts[k] && counts[k] < MAX_RUNS) {
+                json_object *x = record_field(rec, xf);
+                pts[k][2 * counts[k]] = field_num(x);
+                pts[k][2 * counts[k] + 1] = field_num(y);
+                counts[k]++;
+                json_object_put(x);
+            }
+            json_object_put(y);
+        }
+        gi_chart_series series[32];
+        double *xy[32][2] = {{0}};
+        for (uint32_t k = 0; k < ns; k++) {
+            if (pts[k])
+                qsort(pts[k], counts[k], 2 * sizeof(double), cmp_point);
+            xy[k][0] = malloc((counts[k] + 1) * sizeof(double));
+            xy[k][1] = malloc((counts[k] + 1) * sizeof(double));
+            for (uint32_t j = 0; j < counts[k] && xy[k][0] && xy[k][1]; j++) {
+                xy[k][0][j] = pts[k][2 * j];
+                xy[k][1][j] = pts[k][2 * j + 1];
+            }
+            series[k] = (gi_chart_series){labels[k], xy[k][0], xy[k][1], xy[k][0] && xy[k][1] ? counts[k] : 0, 0};
+        }
+        const char *title = json_object_object_get_ex(c, "title", &v) ? json_object_get_string(v) : file;
+        const char *xl = json_object_object_get_ex(c, "x_label", &v) ? json_object_get_string(v) : xf;
+        const char *yl = json_object_object_get_ex(c, "y_label", &v) ? json_object_get_string(v) : yf;
+        int lx = json_object_object_get_ex(c, "log_x", &v) && json_object_get_boolean(v);
+        int ly = json_object_object_get_ex(c, "log_y", &v) && json_object_get_boolean(v);
+        gi_chart_desc desc = {title, xl, yl, lx, ly, 0, 0};
+        char path[4700];
+        snprintf(path, sizeof path, "%s/%s", out_dir, file);
+        gi_error err;
+        if (ns == 0)
+            fprintf(stderr, "gibench: warning: chart %s: no finished run matches\n", file);
+        else if (gi_chart_write_png(path, &desc, series, ns, &err) == GI_OK)
+            json_object_array_add(chart_list, json_object_new_string(file));
+        else
+            fprintf(stderr, "gibench: warning: chart %s not written: %s\n", file, err.text);
+        for (uint32_t k = 0; k < ns; k++) {
+            free(labels[k]);
+            free(pts[k]);
+            free(xy[k][0]);
+            free(xy[k][1]);
+        }
+    }
+}
+
+/* --dry-run: what the study would do, without doing it. */
+static void print_plan(const study *st)
+{
+    printf("study %s: %u runs, %u scenes, %u reference sets\n", st->name, st->run_count, st->scene_count,
+           st->ref_count);
+    for (uint32_t i = 0; i < st->ref_count; i++)
+        printf("reference %s: %s %ux%u time %g\n", st->refs[i].name, st->scenes[st->refs[i].scene_index].path,
+               st->refs[i].width, st->refs[i].height, (double)st->refs[i].time);
+    for (uint32_t i = 0; i < st->run_count; i++) {
+        const study_run *r = &st->runs[i];
+        const run_spec *s = &r->spec;
+        printf("run %s: %s %s %ux%u frames %u warmup %u%s%s%s%s", r->id, s->scene, s->method, s->width, s->height,
+               s->frames, s->warmup, s->animate_fps > 0 ? " animate" : "", s->no_cache ? " no-cache" : "",
+               r->ref_index < 0 ? " not-compared" : "", s->label ? " label=" : "");
+        if (s->label)
+            printf("%s", s->label);
+        for (uint32_t k = 0; k < s->param_count; k++)
+            printf(" %s", s->params[k]);
+        printf("\n");
+    }
 }
 
 int cmd_study(int argc, char **argv)
 {
     const char *file = NULL, *out = NULL;
     unsigned long jobs = 1;
-    int fresh = 0;
+    int fresh = 0, dry = 0;
     for (int i = 0; i < argc; i++) {
         if (!strcmp(argv[i], "--out") && i + 1 < argc)
             out = argv[++i];
@@ -633,6 +1071,8 @@ int cmd_study(int argc, char **argv)
             fresh = 0;
         else if (!strcmp(argv[i], "--fresh"))
             fresh = 1;
+        else if (!strcmp(argv[i], "--dry-run"))
+            dry = 1;
         else if (argv[i][0] == '-')
             return cli_fail(EXIT_USAGE, "study: unknown or incomplete option '%s'", argv[i]);
         else if (!file)
@@ -640,20 +1080,27 @@ int cmd_study(int argc, char **argv)
         else
             return cli_fail(EXIT_USAGE, "study: one study file at a time");
     }
-    if (!file || !out)
-        return cli_fail(EXIT_USAGE, "study: usage: gibench study STUDY.json --out DIR [--jobs N] [--resume|--fresh]");
+    if (!file || (!out && !dry))
+        return cli_fail(EXIT_USAGE,
+                        "study: usage: gibench study STUDY.json --out DIR [--jobs N] [--resume|--fresh] [--dry-run]");
+    if (!out)
+        out = ".";
     gi_plugins *reg = cli_load_plugins(0);
     study st;
     memset(&st, 0, sizeof st);
     int rc = load_study(&st, file, out, reg);
-    if (rc == EXIT_OK && !cli_mkdirs(out))
+    if (rc == EXIT_OK && dry)
+        print_plan(&st);
+    if (rc == EXIT_OK && !dry && !cli_mkdirs(out))
         rc = cli_fail(EXIT_RUN, "study: cannot create %s", out);
-    if (rc == EXIT_OK) {
+    if (rc == EXIT_OK && !dry && st.timer)
+        setenv("GIBENCH_TIMER", st.timer, 1);
+    if (rc == EXIT_OK && !dry) {
         cli_install_signal_handlers();
         fprintf(stderr, "study: %s: %u runs on %u scenes\n", st.name, st.run_count, st.scene_count);
-        rc = build_references(&st, out, reg);
+        rc = build_references(&st, out);
     }
-    if (rc == EXIT_OK) {
+    if (rc == EXIT_OK && !dry) {
         execute_runs(&st, (uint32_t)jobs, fresh, reg);
         json_object *runs = json_object_new_array();
         char renderer[256] = "";
@@ -669,19 +1116,27 @@ int cmd_study(int argc, char **argv)
             json_object_array_add(runs, json_object_get(st.runs[i].record));
         }
         char title[512], refdesc[256];
-        snprintf(title, sizeof title, "gibench study: %s (%ux%u, %u frames)", st.name, st.width, st.height, st.frames);
-        snprintf(refdesc, sizeof refdesc, "path traced (Embree), %u spp, %u bounces; bounce-matched the same spp",
-                 st.ref_spp, st.ref_bounces);
+        snprintf(title, sizeof title, "gibench study: %s (%ux%u, %u frames)", st.name, st.base.width, st.base.height,
+                 st.base.frames);
+        snprintf(refdesc, sizeof refdesc, "path traced (Embree), %u spp, %u bounces; bounce-matched the same spp%s",
+                 st.ref_spp, st.ref_bounces, st.ref_pixel_center ? "; camera rays through pixel centres" : "");
         json_object *meta = report_meta_new(title, "study", argc, argv, renderer, refdesc);
-        char ref_png[512];
-        snprintf(ref_png, sizeof ref_png, "references/%s_b%u_%uspp.png", st.scenes[0].stem, st.ref_bounces, st.ref_spp);
-        json_object_object_add(meta, "reference_png", json_object_new_string(ref_png));
-        charts_and_speedups(&st, out, meta, runs);
+        if (st.ref_count) {
+            char ref_png[512];
+            snprintf(ref_png, sizeof ref_png, "references/%s_b%u_%uspp%s.png", st.refs[0].name, st.ref_bounces,
+                     st.ref_spp, st.ref_pixel_center ? "_center" : "");
+            json_object_object_add(meta, "reference_png", json_object_new_string(ref_png));
+        }
+        json_object *chart_list = json_object_new_array();
+        charts_and_speedups(&st, out, meta, chart_list, runs);
+        user_charts(&st, out, runs, chart_list);
+        json_object_object_add(meta, "charts", chart_list);
         char why[1024];
         if (!report_write(out, runs, meta, why, sizeof why))
             rc = cli_fail(EXIT_RUN, "study: %s", why);
         else
-            fprintf(stderr, "study: wrote %s/report.md, index.html, runs.csv (%d failed runs)\n", out, failed);
+            fprintf(stderr, "study: wrote %s/report.md, index.html, runs.csv, frames.csv (%d failed runs)\n", out,
+                    failed);
         if (rc == EXIT_OK && cli_interrupted)
             rc = cli_fail(EXIT_RUN, "study: interrupted; rerun the same command to resume");
         json_object_put(runs);

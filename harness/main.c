@@ -13,7 +13,7 @@ static const char usage[] =
     "  info SCENE [--json]                    describe a scene file\n"
     "  render --scene S --method M --out FILE [--out FILE2] [--camera C] [--size WxH]\n"
     "         [--param k=v]... [--frames N] [--warmup N] [--time T] [--animate FPS]\n"
-    "         [--seed N] [--exposure EV] [--timings FILE.json]\n"
+    "         [--seed N] [--exposure EV] [--timings FILE.json] [--no-cache]\n"
     "                                         render one method (EXR, PFM or PNG output)\n"
     "  diff TEST REFERENCE [--json] [--heatmap FILE.png] [--flip-map FILE.png]\n"
     "       [--exposure EV] [--ppd N]         error metrics (RMSE, relMSE, MAE, PSNR, SSIM, FLIP)\n"
@@ -21,11 +21,12 @@ static const char usage[] =
     "          [--camera C] [--reference FILE.exr] [--ref-spp N] [--ref-target-se E] [--ref-bounces B]\n"
     "          [--timeout S] [--param method.k=v]... [--seed N] [--exposure EV] [--time T] [--fresh]\n"
     "                                         methods side by side against the references\n"
-    "  study STUDY.json --out DIR [--jobs N] [--resume|--fresh]\n"
+    "  study STUDY.json --out DIR [--jobs N] [--resume|--fresh] [--dry-run]\n"
     "                                         run a declarative experiment and write its report\n"
     "  reference --scene S --out FILE [--out FILE2] [--camera C] [--size WxH]\n"
     "         [--spp N] [--time S] [--target-se E] [--max-bounces B|inf] [--seed N]\n"
     "         [--threads N] [--time-of-scene T] [--exposure EV] [--stats FILE.json]\n"
+    "         [--pixel box|center]\n"
     "                                         Embree path-traced reference (EXR: mean + variance)\n"
     "exit status: 0 success, 1 failure while running, 2 bad usage or bad input\n";
 

@@ -174,14 +174,16 @@ static void csv_num(text *t, double v, int last)
     put(t, last ? "\n" : ",");
 }
 
-/* The union of stage names over all runs, first-seen order. */
-static int stage_names(json_object *runs, const char **names, int max)
+/* The union over all runs of the keys of object `field` ("stages",
+ * "prepare_stages", "stats"), first-seen order. */
+static int key_names(json_object *runs, const char *field, const char **names, int max)
 {
     int n = 0;
     size_t count = json_object_array_length(runs);
     for (size_t i = 0; i < count; i++) {
         json_object *stages;
-        if (!json_object_object_get_ex(json_object_array_get_idx(runs, i), "stages", &stages))
+        if (!json_object_object_get_ex(json_object_array_get_idx(runs, i), field, &stages) ||
+            !json_object_is_type(stages, json_type_object))
             continue;
         json_object_object_foreach(stages, key, val)
         {
@@ -196,10 +198,17 @@ static int stage_names(json_object *runs, const char **names, int max)
     return n;
 }
 
+static int stage_names(json_object *runs, const char **names, int max)
+{
+    return key_names(runs, "stages", names, max);
+}
+
 static void write_csv(text *t, json_object *runs)
 {
-    const char *stages[32];
+    const char *stages[32], *pstages[32], *stats[64];
     int ns = stage_names(runs, stages, 32);
+    int np = key_names(runs, "prepare_stages", pstages, 32);
+    int nst = key_names(runs, "stats", stats, 64);
     put(t, "run,scene,method,params,status,reason,renderer,timer,frames,prepare_ms,frame_ms_median,frame_ms_min,"
            "frame_ms_max");
     for (int k = 0; k < ns; k++)
@@ -207,6 +216,11 @@ static void write_csv(text *t, json_object *runs)
     for (int r = 0; r < 2; r++)
         for (int m = 0; report_metric_keys[m]; m++)
             put(t, ",%s_%s", report_metric_keys[m], r ? "matched" : "full");
+    put(t, ",label,width,height");
+    for (int k = 0; k < np; k++)
+        put(t, ",prepare_%s_ms", pstages[k]);
+    for (int k = 0; k < nst; k++)
+        put(t, ",stat_%s", stats[k]);
     put(t, "\n");
     size_t count = json_object_array_length(runs);
     for (size_t i = 0; i < count; i++) {
@@ -226,8 +240,32 @@ static void write_csv(text *t, json_object *runs)
         }
         for (int r = 0; r < 2; r++)
             for (int m = 0; report_metric_keys[m]; m++)
-                csv_num(t, num(o, "metrics", r ? "matched" : "full", report_metric_keys[m]),
-                        r == 1 && !report_metric_keys[m + 1]);
+                csv_num(t, num(o, "metrics", r ? "matched" : "full", report_metric_keys[m]), 0);
+        csv_field(t, str(o, "label"), 0);
+        csv_num(t, num(o, "width", NULL, NULL), 0);
+        csv_num(t, num(o, "height", NULL, NULL), np + nst == 0);
+        for (int k = 0; k < np; k++)
+            csv_num(t, num(o, "prepare_stages", pstages[k], NULL), k == np - 1 && nst == 0);
+        for (int k = 0; k < nst; k++)
+            csv_num(t, num(o, "stats", stats[k], NULL), k == nst - 1);
+    }
+}
+
+/* frames.csv: every timed frame of every run (per-frame time of animations). */
+static void write_frames_csv(text *t, json_object *runs)
+{
+    put(t, "run,label,frame,frame_ms\n");
+    size_t count = json_object_array_length(runs);
+    for (size_t i = 0; i < count; i++) {
+        json_object *o = json_object_array_get_idx(runs, i), *f;
+        if (!json_object_object_get_ex(o, "frame_samples_ms", &f) || !json_object_is_type(f, json_type_array))
+            continue;
+        for (size_t k = 0; k < json_object_array_length(f); k++) {
+            csv_field(t, str(o, "run"), 0);
+            csv_field(t, str(o, "label"), 0);
+            put(t, "%zu,", k + 1);
+            csv_num(t, json_object_get_double(json_object_array_get_idx(f, k)), 1);
+        }
     }
 }
 
@@ -412,6 +450,9 @@ int report_write(const char *dir, json_object *runs, json_object *meta, char *wh
     text t = {0};
     write_csv(&t, runs);
     if (!write_text(dir, "runs.csv", &t, why, why_size))
+        return 0;
+    write_frames_csv(&t, runs);
+    if (!write_text(dir, "frames.csv", &t, why, why_size))
         return 0;
     write_md(&t, runs, meta);
     if (!write_text(dir, "report.md", &t, why, why_size))

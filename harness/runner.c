@@ -84,6 +84,8 @@ static json_object *base_record(const run_spec *s)
     json_object_object_add(o, "frames", json_object_new_int((int32_t)s->frames));
     json_object_object_add(o, "width", json_object_new_int((int32_t)s->width));
     json_object_object_add(o, "height", json_object_new_int((int32_t)s->height));
+    if (s->label)
+        json_object_object_add(o, "label", json_object_new_string(s->label));
     return o;
 }
 
@@ -147,10 +149,20 @@ static void take_timings(json_object *rec, json_object *t)
         json_object_object_add(rec, "params_full", json_object_get(v));
     if (json_object_object_get_ex(t, "stats", &v))
         json_object_object_add(rec, "stats", json_object_get(v));
-    if (json_object_object_get_ex(t, "prepare", &prepare) && json_object_object_get_ex(prepare, "frame", &v)) {
-        json_object *med;
-        if (json_object_object_get_ex(v, "median_ms", &med))
-            json_object_object_add(rec, "prepare_ms", json_object_get(med));
+    if (json_object_object_get_ex(t, "prepare", &prepare)) {
+        /* the whole of prepare, and its stages (precomputation timings) */
+        json_object *pst = json_object_new_object();
+        json_object_object_foreach(prepare, name, st)
+        {
+            json_object *med;
+            if (!json_object_object_get_ex(st, "median_ms", &med))
+                continue;
+            if (!strcmp(name, "frame"))
+                json_object_object_add(rec, "prepare_ms", json_object_get(med));
+            else
+                json_object_object_add(pst, name, json_object_get(med));
+        }
+        json_object_object_add(rec, "prepare_stages", pst);
     }
     json_object *stages = json_object_new_object();
     if (json_object_object_get_ex(t, "render", &render)) {
@@ -160,7 +172,9 @@ static void take_timings(json_object *rec, json_object *t)
             if (!json_object_object_get_ex(st, "median_ms", &med))
                 continue;
             if (strcmp(name, "frame") == 0) {
-                json_object *f = json_object_new_object();
+                json_object *f = json_object_new_object(), *samples;
+                if (json_object_object_get_ex(st, "samples_ms", &samples))
+                    json_object_object_add(rec, "frame_samples_ms", json_object_get(samples));
                 json_object_object_add(f, "median", json_object_get(med));
                 if (json_object_object_get_ex(st, "min_ms", &mn))
                     json_object_object_add(f, "min", json_object_get(mn));
@@ -223,6 +237,8 @@ json_object *runner_execute(const run_spec *s, int resume)
         arg(&b, "%s", "--animate");
         argf(&b, s->animate_fps);
     }
+    if (s->no_cache)
+        arg(&b, "%s", "--no-cache");
     arg(&b, "%s", "--exposure");
     argf(&b, s->exposure);
     for (uint32_t i = 0; i < s->param_count; i++) {
@@ -233,8 +249,9 @@ json_object *runner_execute(const run_spec *s, int resume)
     join(&b, config, sizeof config);
     /* The references are part of what the result depends on. */
     size_t used = strlen(config);
-    snprintf(config + used, sizeof config - used, " | full=%s | matched=%s", s->ref_full ? s->ref_full : "-",
-             s->ref_matched ? s->ref_matched : "-");
+    const char *timer = getenv("GIBENCH_TIMER"); /* the timer mode changes every timing */
+    snprintf(config + used, sizeof config - used, " | full=%s | matched=%s%s%s", s->ref_full ? s->ref_full : "-",
+             s->ref_matched ? s->ref_matched : "-", timer ? " | timer=" : "", timer ? timer : "");
     arg(&b, "%s", "--out");
     arg(&b, "%s", exr);
     arg(&b, "%s", "--out");
@@ -309,8 +326,8 @@ json_object *runner_execute(const run_spec *s, int resume)
 }
 
 int runner_reference(const char *scene, const char *camera, uint32_t width, uint32_t height, uint32_t spp,
-                     double target_se, uint32_t max_bounces, uint32_t seed, float time, double timeout_s,
-                     const char *out_exr, char *why, size_t why_size)
+                     double target_se, uint32_t max_bounces, uint32_t seed, float time, int pixel_center,
+                     double timeout_s, const char *out_exr, char *why, size_t why_size)
 {
     argv_builder b = {0};
     arg(&b, "%s", cli_self_exe());
@@ -337,6 +354,10 @@ int runner_reference(const char *scene, const char *camera, uint32_t width, uint
     argu(&b, seed);
     arg(&b, "%s", "--time-of-scene");
     argf(&b, time);
+    if (pixel_center) {
+        arg(&b, "%s", "--pixel");
+        arg(&b, "%s", "center");
+    }
     char config[8192], cfg_path[4200], log[4200], stats[4200];
     join(&b, config, sizeof config);
     snprintf(cfg_path, sizeof cfg_path, "%s.config", out_exr);

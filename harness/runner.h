@@ -24,6 +24,8 @@ typedef struct run_spec {
     const char *ref_full;    /* full-GI reference EXR, or NULL */
     const char *ref_matched; /* bounce-matched reference EXR, or NULL */
     float exposure;
+    int no_cache;         /* render --no-cache: precompute afresh (timing of precomputation) */
+    const char *label;    /* the study entry's label, or NULL */
 } run_spec;
 
 /* Runs (or resumes) a run; never fails as a whole: failures are records
@@ -34,10 +36,11 @@ json_object *runner_not_applicable(const run_spec *spec, const char *reason);
 
 /* Runs `gibench reference` into out_exr unless a file made with the same
  * settings exists; stops at `spp` samples or, when target_se > 0, as soon
- * as the relative standard error reaches it. 1 on success, else 0 with why. */
+ * as the relative standard error reaches it; pixel_center: --pixel center.
+ * 1 on success, else 0 with why. */
 int runner_reference(const char *scene, const char *camera, uint32_t width, uint32_t height, uint32_t spp,
-                     double target_se, uint32_t max_bounces, uint32_t seed, float time, double timeout_s,
-                     const char *out_exr, char *why, size_t why_size);
+                     double target_se, uint32_t max_bounces, uint32_t seed, float time, int pixel_center,
+                     double timeout_s, const char *out_exr, char *why, size_t why_size);
 
 /* Fills metrics of `image` against `reference` by `gibench diff --json`;
  * NULL with why on failure. heatmap may be NULL. */

@@ -504,6 +504,81 @@ def build_bunny_env(meshes, env_name, out_path):
     return {"tris": bunny.ntris + ground.ntris, "emissive_tris": 0}
 
 
+def build_bunny_alone_env(meshes, env_name, out_path):
+    """The bunny of bunny_env.glb without the ground: the object alone, as in
+    the CSM paper's Table 1 (compression of one object's maps)."""
+    g = Gltf(GENERATOR, BUNNY_COPYRIGHT + "; environment map: Blender studiolight "
+             + env_name + ".exr (CC0, Greg Zaal, HDRI Haven)")
+    pos, cells = npm_mesh(meshes["bunny"], 1.0)
+    bunny = smooth_mesh(pos, cells, weld=False)
+    mb = g.material("bunny", WHITE)
+    cam = g.camera_node("camera", (-2.4, 1.0, -2.1), (0.0, 0.45, 0.0), 30.0)
+    n1 = g.node("bunny", mesh=g.mesh("bunny", [(bunny, mb)]))
+    g.scene("bunny_alone_env", [cam, n1], extras=env_extras(env_name))
+    g.write_glb(out_path)
+    return {"tris": bunny.ntris, "emissive_tris": 0}
+
+
+def moving_bunny_path(bunny_pos, teapot_pos):
+    """A 4 s LINEAR loop of the bunny behind the teapot (between it and the
+    map's brightest region) with one full turn about +Y; its footprint is
+    checked to stay clear of the teapot's at 401 times."""
+    times = [0.0, 1.0, 2.0, 3.0, 4.0]
+    path = [(-1.7, 0.0, -1.4), (0.0, 0.0, -1.7), (1.7, 0.0, -1.4), (0.0, 0.0, -2.4),
+            (-1.7, 0.0, -1.4)]
+    rots = [quat_axis_angle((0, 1, 0), math.radians(90.0 * k)) for k in range(5)]
+    for a, b in zip(rots, rots[1:]):
+        assert sum(x * y for x, y in zip(a, b)) > 0
+    teapot_hull = convex_hull_xz([(p[0], p[2]) for p in teapot_pos])
+    hull = [(p[0], p[2]) for p in bunny_pos]
+    min_clear = 1e9
+    for s in range(401):
+        t = 4.0 * s / 400
+        k = min(int(t), 3)
+        tr = lerp(path[k], path[k + 1], t - k)
+        q = quat_axis_angle((0, 1, 0), math.radians(90.0 * t))
+        for p in hull[::3]:
+            w = quat_rotate(q, (p[0], 0.0, p[1]))
+            x, z = w[0] + tr[0], w[2] + tr[2]
+            assert not point_in_poly_xz((x, 0, z), teapot_hull), "bunny enters the teapot"
+            d = min(math.sqrt(seg_dist2((x, z), (teapot_hull[i][0], teapot_hull[i][2]),
+                                        (teapot_hull[(i + 1) % len(teapot_hull)][0],
+                                         teapot_hull[(i + 1) % len(teapot_hull)][2])))
+                    for i in range(len(teapot_hull)))
+            min_clear = min(min_clear, d)
+    assert min_clear > 0.1, "bunny path too close to the teapot: %.3f" % min_clear
+    return {"times": times, "translation": path, "rotation": rots, "clearance": min_clear}
+
+
+def build_bunny_teapot_moving(meshes, env_name, out_path):
+    """Two objects under the environment map, one animated: the teapot stands
+    still at the origin, the bunny loops behind it on the ground (4 s)."""
+    g = Gltf(GENERATOR, BUNNY_COPYRIGHT + "; " + TEAPOT_COPYRIGHT
+             + "; environment map: Blender studiolight " + env_name
+             + ".exr (CC0, Greg Zaal, HDRI Haven)")
+    bpos, bcells = npm_mesh(meshes["bunny"], 1.0)
+    bunny = smooth_mesh(bpos, bcells, weld=False)
+    tpos, tcells = npm_mesh(meshes["teapot"], 1.0)
+    teapot = smooth_mesh(tpos, tcells, weld=True)
+    ground = ground_grid(10.0, 64)
+    anim = moving_bunny_path(bpos, tpos)
+    mb = g.material("bunny", WHITE)
+    mt = g.material("teapot", (0.75, 0.55, 0.3), double_sided=True)
+    mg = g.material("ground", (0.5, 0.5, 0.5))
+    cam = g.camera_node("camera", (0.0, 2.2, 3.6), (0.0, 0.3, -0.9), 50.0)
+    bn = g.node("bunny", mesh=g.mesh("bunny", [(bunny, mb)]),
+                translation=anim["translation"][0], rotation=anim["rotation"][0])
+    nodes = [cam, g.node("teapot", mesh=g.mesh("teapot", [(teapot, mt)])), bn,
+             g.node("ground", mesh=g.mesh("ground", [(ground, mg)]))]
+    g.animation("bunny_path", [
+        (bn, "translation", anim["times"], [c for t in anim["translation"] for c in t]),
+        (bn, "rotation", anim["times"], [c for q in anim["rotation"] for c in q])])
+    g.scene("bunny_teapot_moving", nodes, extras=env_extras(env_name))
+    g.write_glb(out_path)
+    print("note: bunny_teapot_moving clearance %.3f" % anim["clearance"])
+    return {"tris": bunny.ntris + teapot.ntris + ground.ntris, "emissive_tris": 0}
+
+
 def build_teapot(meshes, env_name, out_path, area_light):
     cr = TEAPOT_COPYRIGHT
     if not area_light:
@@ -637,6 +712,10 @@ def main():
     stats["teapot_area.glb"] = build_teapot(meshes, a.env_name,
                                             os.path.join(out, "teapot_area.glb"), True)
     stats["u_room.gltf"] = build_u_room(os.path.join(out, "u_room.gltf"))
+    stats["bunny_alone_env.glb"] = build_bunny_alone_env(
+        meshes, a.env_name, os.path.join(out, "bunny_alone_env.glb"))
+    stats["bunny_teapot_moving.glb"] = build_bunny_teapot_moving(
+        meshes, a.env_name, os.path.join(out, "bunny_teapot_moving.glb"))
     pos, cells = npm_mesh(meshes["bunny"], 1.2)
     bunny = smooth_mesh(pos, cells, weld=False)
     anim = bunny_animation(cb, pos)

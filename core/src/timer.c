@@ -72,6 +72,8 @@ const char *gi_timer_mode_name(gi_timer_mode mode)
         return "cpu-wall-clock-around-glFinish";
     case GI_TIMER_CPU_ONLY:
         return "cpu-wall-clock";
+    case GI_TIMER_CPU_TIME:
+        return "process-cpu-time-around-glFinish";
     }
     return "?";
 }
@@ -83,6 +85,8 @@ gi_timer_mode gi_timer_mode_for(int gl_is_software)
         return GI_TIMER_GL_QUERY;
     if (env && strcmp(env, "finish") == 0)
         return GI_TIMER_CPU_FINISH;
+    if (env && strcmp(env, "cputime") == 0)
+        return GI_TIMER_CPU_TIME;
     return gl_is_software ? GI_TIMER_CPU_FINISH : GI_TIMER_GL_QUERY;
 }
 
@@ -133,8 +137,13 @@ static int find_stage(gi_timer *t, const char *name, int create)
 
 static double cpu_mark(const gi_timer *t)
 {
-    if (t->mode == GI_TIMER_CPU_FINISH)
+    if (t->mode == GI_TIMER_CPU_FINISH || t->mode == GI_TIMER_CPU_TIME)
         glFinish();
+    if (t->mode == GI_TIMER_CPU_TIME) {
+        struct timespec ts;
+        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+        return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+    }
     return gi_now();
 }
 

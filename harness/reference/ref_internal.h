@@ -61,6 +61,7 @@ typedef struct ref_scene {
     uint32_t width, height, seed;
     int max_bounces; /* < 0: unlimited */
     gi_ref_strategy strategy;
+    int pixel_center; /* camera rays through pixel centres (gi_ref_desc) */
 } ref_scene;
 
 /* Builds everything above from the desc (validates first). */

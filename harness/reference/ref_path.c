@@ -278,8 +278,12 @@ void ref_path_sample(const ref_scene *rs, uint32_t x, uint32_t y, uint32_t *rng,
     L[0] = L[1] = L[2] = 0.0f;
     float beta[3] = {1.0f, 1.0f, 1.0f};
 
-    /* Box filter: a uniform point in the pixel; row 0 is the top. */
+    /* Box filter: a uniform point in the pixel; row 0 is the top. With
+     * pixel_center the point is the centre (the numbers are still drawn, so
+     * that the rest of the path uses the same stream). */
     float jx = next(rng), jy = next(rng);
+    if (rs->pixel_center)
+        jx = jy = 0.5f;
     float sx = (((float)x + jx) / (float)rs->width * 2.0f - 1.0f) * cam->tan_half_y * cam->aspect;
     float sy = (1.0f - ((float)y + jy) / (float)rs->height * 2.0f) * cam->tan_half_y;
     gi_vec3 d = gi_v3_normalize(

@@ -158,6 +158,7 @@ gi_result ref_scene_build(ref_scene *rs, const gi_ref_desc *d, gi_error *err)
     rs->seed = d->seed;
     rs->max_bounces = d->max_bounces;
     rs->strategy = d->strategy;
+    rs->pixel_center = d->pixel_center;
     gi_result res = place_camera(rs, d, err);
     if (res != GI_OK)
         return res;

@@ -81,6 +81,11 @@ typedef struct gi_ref_desc {
     int max_bounces;
     uint32_t threads; /* worker threads; 0 = the number of online CPUs */
     gi_ref_strategy strategy;
+    /* 0: each camera sample uniform in its pixel (box filter, the pixel's
+     * exact average); 1: every sample through the pixel's centre, as the
+     * GPU methods' G-buffers sample it (so that a comparison measures
+     * shading, not anti-aliasing). */
+    int pixel_center;
 } gi_ref_desc;
 
 /* Defaults: scene NULL, camera 0, time 0, size 0 (must be set), seed 1,

@@ -40,7 +40,7 @@ extern const gi_shader_source gi_csm_shaders[];
 #define CSM_PATTERNS 256u
 
 enum { B_OBJECTS = 8, B_OFFSETS = 9, B_ZAVG = 10, B_IEND = 11, B_CELLS = 12, B_PATTERNS = 13, B_LIGHTS = 14,
-       B_PAIRS = 15, B_LIGHT_CELLS = 16 };
+       B_PAIRS = 15, B_LIGHT_CELLS = 16, B_COUNT = 17 };
 enum { LIGHTS_LOCAL = 0, LIGHTS_SEMILOCAL = 1 };
 enum { RECEIVERS_NONE = 0, RECEIVERS_PLANAR = 1 };
 
@@ -52,7 +52,7 @@ typedef struct csm_gpu_rect {
 
 typedef struct csm {
     const gi_host *host;
-    int N, M, S, z3, filter;
+    int N, M, S, z3, filter, mode;
     gi_csm_order order;
     float bias, normal_offset, normal_offset_local;
     int lights_mode, n_local, m_local, receivers, distant, warned_moved;
@@ -65,7 +65,7 @@ typedef struct csm {
     csm_gpu_object *objects;
     GLuint ssbo[9]; /* objects, offsets, z_avg, i_end, cells, patterns, lights, pairs, light cells */
     gi_gbuffer *gbuffer;
-    GLuint program, accum;
+    GLuint program, accum, count; /* count: samples taken this frame */
     uint32_t width, height, frames;
     float last_view_proj[16];
     const gi_gpu_scene *scene;
@@ -99,6 +99,9 @@ static const gi_param_desc csm_params[] = {
      "an emissive object whose bounding rectangle is longer than this times its width is a linear light"},
     {"receivers", GI_PARAM_ENUM, 0, 0, 0, "none|planar", "Sec. 4.6",
      "receiver-only objects without CSMs: none, or every planar object"},
+    {"mode", GI_PARAM_ENUM, 0, 0, 0, "shade|random|coherent", "Table 2",
+     "shade: the image; random/coherent: Table 2's benchmark, S shadow tests per pixel in uniform directions, "
+     "per-pixel patterns (random) or one direction per sample for all pixels (coherent); image = visible fraction"},
     {0},
 };
 
@@ -129,6 +132,7 @@ static gi_result csm_create(const gi_host *host, const gi_params *params, void *
     c->light_order = (gi_csm_order)gi_params_enum(params, "light_enumeration");
     c->linear_aspect = gi_params_float(params, "linear_aspect");
     c->receivers = gi_params_enum(params, "receivers");
+    c->mode = gi_params_enum(params, "mode");
     gi_shader_register(gi_csm_shaders);
     *out = c;
     return GI_OK;
@@ -552,6 +556,8 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
                 base += l->n_u * l->n_v;
             }
             glCreateBuffers(9, c->ssbo);
+            glCreateBuffers(1, &c->count);
+            glNamedBufferStorage(c->count, 4, NULL, GL_DYNAMIC_STORAGE_BIT);
             glNamedBufferStorage(c->ssbo[0], (GLsizeiptr)(n * sizeof *c->objects), c->objects,
                                  GL_DYNAMIC_STORAGE_BIT);
             glNamedBufferStorage(c->ssbo[1], (GLsizeiptr)((offsets_total ? offsets_total : 1) * 4), offsets, 0);
@@ -694,6 +700,10 @@ static gi_result csm_render(void *inst, const gi_view *view, const gi_target *ta
     glUniform1ui(glGetUniformLocation(p, "u_frame"), c->frames);
     glUniform1ui(glGetUniformLocation(p, "u_seed"), view->seed);
     glUniform1i(glGetUniformLocation(p, "u_S"), c->S);
+    glUniform1i(glGetUniformLocation(p, "u_mode"), c->mode);
+    const GLuint zero = 0;
+    glNamedBufferSubData(c->count, 0, 4, &zero);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, B_COUNT, c->count);
     glUniform1ui(glGetUniformLocation(p, "csm_n_theta"), (GLuint)c->N);
     glUniform1ui(glGetUniformLocation(p, "csm_n_phi"), (GLuint)c->N);
     glUniform1ui(glGetUniformLocation(p, "csm_object_count"), c->object_count);
@@ -705,13 +715,17 @@ static gi_result csm_render(void *inst, const gi_view *view, const gi_target *ta
     glUniform1i(glGetUniformLocation(p, "u_distant"), c->distant);
     glDispatchCompute((view->width + 7) / 8, (view->height + 7) / 8, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
-                    GL_FRAMEBUFFER_BARRIER_BIT);
+                    GL_FRAMEBUFFER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     glUseProgram(0);
     c->host->stage_end(c->host, "render");
     c->frames++;
     c->host->stat(c->host, "samples_per_pixel_env", (double)c->frames * c->S);
     if (c->scene->emitter_count)
         c->host->stat(c->host, "samples_per_pixel_area", (double)c->frames * c->S);
+    /* read after the timed stage: S per surface pixel (Table 2's "samples") */
+    GLuint taken = 0;
+    glGetNamedBufferSubData(c->count, 0, 4, &taken);
+    c->host->stat(c->host, "samples_per_frame", (double)taken);
     if (gi_gl_check("csm: shading pass", &err) != GI_OK)
         return fail(c, GI_ERR_GL, err.text);
     return GI_OK;
@@ -727,6 +741,8 @@ static void csm_destroy(void *inst)
         glDeleteTextures(1, &c->accum);
     if (c->ssbo[0])
         glDeleteBuffers(9, c->ssbo);
+    if (c->count)
+        glDeleteBuffers(1, &c->count);
     if (c->program)
         glDeleteProgram(c->program);
     free(c->objects);

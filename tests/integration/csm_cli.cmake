@@ -40,6 +40,49 @@ expect(0 "" ${args} --param filter=rr --param enumeration=scanline --out ${OUT}/
        --timings ${OUT}/csm_bunny_rr.json)
 expect_json(${OUT}/csm_bunny_rr.json "\"nonfinite_pixels\": 0")
 
+# Table 2's visibility benchmark (mode=random|coherent) on the bunny alone:
+# every mode counts S samples per surface pixel (the same pixels), and
+# random and coherent directions estimate the same average visibility (the
+# image is the visible fraction on the bunny) from different directions.
+# --no-cache leaves no file behind.
+function(milli json key out) # first channel of a JSON number list, in thousandths
+    file(READ ${json} j)
+    string(JSON v GET "${j}" ${key} 0)
+    if(NOT v MATCHES "^([0-9]+)(\\.([0-9]*))?")
+        message(FATAL_ERROR "${json}: ${key} = '${v}' is not a number >= 0")
+    endif()
+    string(SUBSTRING "${CMAKE_MATCH_3}000" 0 3 frac)
+    math(EXPR m "${CMAKE_MATCH_1} * 1000 + 1${frac} - 1000")
+    set(${out} ${m} PARENT_SCOPE)
+endfunction()
+file(GLOB before ${cache}/csm-*.bin)
+set(vis render --scene ${SCENES}/bunny_alone_env.glb --method csm --size 24x24 --param N=8 --param M=32
+    --param S=256 --no-cache)
+foreach(mode shade random coherent)
+    expect(0 "" ${vis} --param mode=${mode} --out ${OUT}/csm_vis_${mode}.exr --timings ${OUT}/csm_vis_${mode}.json)
+    expect_json(${OUT}/csm_vis_${mode}.json "\"nonfinite_pixels\": 0" "\"cache_hit\": 0" "\"cache\": false")
+    file(READ ${OUT}/csm_vis_${mode}.json j)
+    string(JSON spf_${mode} GET "${j}" stats samples_per_frame)
+endforeach()
+if(NOT spf_shade GREATER 0 OR NOT spf_random EQUAL spf_shade OR NOT spf_coherent EQUAL spf_shade)
+    message(SEND_ERROR "samples_per_frame differs between modes or is 0: ${spf_shade} ${spf_random} ${spf_coherent}")
+    math(EXPR failures "${failures} + 1")
+endif()
+milli(${OUT}/csm_vis_random.json mean_rgb v_random)
+milli(${OUT}/csm_vis_coherent.json mean_rgb v_coherent)
+math(EXPR d "${v_random} - ${v_coherent}")
+if(d LESS -30 OR d GREATER 30 OR v_random EQUAL v_coherent)
+    message(SEND_ERROR "image means (the background shows the map in both): random ${v_random}, coherent "
+                       "${v_coherent} (thousandths): expected within 0.03 of each other but not equal")
+    math(EXPR failures "${failures} + 1")
+endif()
+file(GLOB after ${cache}/csm-*.bin)
+if(NOT before STREQUAL after)
+    message(SEND_ERROR "--no-cache wrote cache files: ${after}")
+    math(EXPR failures "${failures} + 1")
+endif()
+expect(2 "csm: " ${args} --param mode=fast --out ${OUT}/x.exr)
+
 # Bad parameters.
 expect(2 "csm: N=1 is outside" ${args} --param N=1 --out ${OUT}/x.exr)
 expect(2 "csm: M=2000 is outside" ${args} --param M=2000 --out ${OUT}/x.exr)

@@ -72,6 +72,15 @@ expect_same(${OUT}/ref_se1.pfm ${OUT}/ref_se2.pfm)
 expect(0 "" reference --scene ${CB} --size 16x16 --target-se 0.0001 --spp 5 --out ${OUT}/ref_cap.pfm
        --stats ${OUT}/ref_cap.json)
 expect_json(${OUT}/ref_cap.json "\"stop\": \"spp\"" "\"spp\": 5,")
+# --pixel center: every camera sample through the pixel centre, so with
+# emitters only (0 bounces) all samples of a pixel agree: no variance.
+expect(2 "reference: --pixel 'gauss'" reference --scene ${CB} --pixel gauss --out ${OUT}/r.exr)
+expect(0 "" reference --scene ${CB} --size 16x16 --spp 4 --max-bounces 0 --pixel center --out ${OUT}/ref_pc.pfm
+       --stats ${OUT}/ref_pc.json)
+expect_json(${OUT}/ref_pc.json "\"pixel\": \"center\"" "\"mean_se\": 0(\\.0*)?,")
+expect(0 "" reference --scene ${CB} --size 16x16 --spp 4 --max-bounces 0 --out ${OUT}/ref_box.pfm
+       --stats ${OUT}/ref_box.json)
+expect_json(${OUT}/ref_box.json "\"pixel\": \"box\"" "\"mean_se\": [0-9.]*[1-9]")
 # --time stops on time.
 expect(0 "" reference --scene ${CB} --size 16x16 --time 0.3 --out ${OUT}/ref_time.pfm --stats ${OUT}/ref_time.json)
 expect_json(${OUT}/ref_time.json "\"stop\": \"time\"")

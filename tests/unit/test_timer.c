@@ -15,6 +15,13 @@ static void sleep_ms(double ms)
     nanosleep(&ts, NULL);
 }
 
+static double cpu_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
 static const gi_stage_stats *find(const gi_stage_stats *st, uint32_t n, const char *name)
 {
     for (uint32_t i = 0; i < n; i++)
@@ -86,6 +93,24 @@ int main(void)
             gi_timer_free(t);
         }
         glDeleteBuffers(1, &buf);
+        /* CPU-time mode: a sleep costs (almost) nothing, busy work does. */
+        t = gi_timer_create(GI_TIMER_CPU_TIME, 0);
+        gi_timer_frame_begin(t);
+        gi_timer_begin(t, "sleep");
+        sleep_ms(50);
+        gi_timer_end(t, "sleep");
+        gi_timer_begin(t, "busy");
+        volatile double acc = 0.0; /* spin until this process has used 30 ms of CPU */
+        for (double c0 = cpu_seconds(); cpu_seconds() - c0 < 0.03;)
+            acc += 1.0;
+        gi_timer_end(t, "busy");
+        gi_timer_frame_end(t);
+        n = gi_timer_stats(t, st, 8);
+        const gi_stage_stats *sl = find(st, n, "sleep"), *bu = find(st, n, "busy");
+        CHECK_MSG(sl && sl->median_ms < 10.0, "a 50 ms sleep cost %.2f ms of CPU time", sl ? sl->median_ms : -1.0);
+        CHECK_MSG(bu && bu->median_ms > 25.0, "30 ms of busy work cost %.2f ms of CPU time", bu ? bu->median_ms : -1.0);
+        CHECK(strcmp(gi_timer_mode_name(GI_TIMER_CPU_TIME), "process-cpu-time-around-glFinish") == 0);
+        gi_timer_free(t);
         CHECK(gi_gl_check("timer", &err) == GI_OK);
         gi_gpu_destroy(gpu);
     }

@@ -25,6 +25,11 @@ typedef enum gi_timer_mode {
     GI_TIMER_GL_QUERY = 0,
     GI_TIMER_CPU_FINISH = 1, /* glFinish + wall clock */
     GI_TIMER_CPU_ONLY = 2,   /* wall clock, no GL (CPU-only work, tests) */
+    /* glFinish + the process's CPU time (all its threads, llvmpipe's
+     * workers included): the work done rather than the time waited, so
+     * that ratios hold on a shared, oversubscribed machine. Software
+     * renderers only (a GPU's work is not the process's CPU time). */
+    GI_TIMER_CPU_TIME = 3,
 } gi_timer_mode;
 
 typedef struct gi_timer gi_timer;
@@ -43,7 +48,7 @@ void gi_timer_free(gi_timer *t);
 gi_timer_mode gi_timer_get_mode(const gi_timer *t);
 const char *gi_timer_mode_name(gi_timer_mode mode);
 /* Picks GI_TIMER_CPU_FINISH for software renderers, GL queries otherwise;
- * GIBENCH_TIMER=query|finish overrides. */
+ * GIBENCH_TIMER=query|finish|cputime overrides. */
 gi_timer_mode gi_timer_mode_for(int gl_is_software);
 
 void gi_timer_frame_begin(gi_timer *t);

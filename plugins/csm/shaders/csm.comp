@@ -33,6 +33,26 @@ uniform uint u_frame; // frames already in the average
 uniform uint u_seed;
 uniform int u_S;
 uniform int u_distant; // 1: the objects have orthographic CSMs
+uniform int u_mode; // 0 shade; Table 2 visibility benchmarks: 1 random, 2 coherent
+
+// Monte Carlo samples taken this frame (S per surface pixel), for the
+// samples-per-second figure of Table 2.
+layout(std430, binding = 17) buffer CsmCount { uint csm_sample_count; };
+
+// Table 2's visibility benchmarks: S shadow tests in uniform directions on
+// the sphere, returning the visible fraction. "random": each pixel its own
+// stratified pattern with its own shift (as shading uses); "coherent": every
+// pixel of the frame the same pattern and no shift, so that sample s tests
+// the same direction at every pixel.
+float visibility_test(vec3 x, vec3 N, uint pattern, vec2 cp, inout uint rng)
+{
+    float sum = 0.0;
+    for (int s = 0; s < u_S; s++) {
+        vec2 u = fract(csm_patterns[pattern * uint(u_S) + uint(s)] + cp);
+        sum += csm_visibility(x, N, gi_sample_uniform_sphere(u.x, u.y), rng);
+    }
+    return sum / float(u_S);
+}
 
 // §5.1: diffuse surfaces draw from the environment's radiance CDF, specular
 // ones from the Phong lobe; a surface with both picks the lobe by Russian
@@ -184,13 +204,22 @@ void main()
         // average converges to the integral, not to 256 fixed point sets.
         uint pattern = gi_pcg_hash(pix ^ gi_pcg_hash(u_frame * 0x9E3779B9u + u_seed)) & 255u;
         vec2 cp = vec2(gi_rng_next_float(rng), gi_rng_next_float(rng));
+        atomicAdd(csm_sample_count, uint(u_S));
+        if (u_mode == 2) {
+            pattern = gi_pcg_hash(u_frame * 0x9E3779B9u + u_seed) & 255u;
+            cp = vec2(0.0);
+        }
         L = texelFetch(g_emission, px, 0).rgb;
-        if (gi_has_environment())
+        if (u_mode != 0)
+            L = vec3(visibility_test(x, N, pattern, cp, rng));
+        else if (gi_has_environment())
             L += environment(b, x, N, wo, pattern, cp, rng);
         uint own = texelFetch(g_ids, px, 0).x;
-        if (gi_emitter_count() > 0u)
-            L += area_lights(b, x, N, wo, own, (pattern + 97u) & 255u, cp, rng);
-        L += punctual_lights(b, x, N, wo, own, rng);
+        if (u_mode == 0) {
+            if (gi_emitter_count() > 0u)
+                L += area_lights(b, x, N, wo, own, (pattern + 97u) & 255u, cp, rng);
+            L += punctual_lights(b, x, N, wo, own, rng);
+        }
     } else if (gi_has_environment()) {
         vec2 ndc = (vec2(px) + 0.5) / vec2(u_size) * 2.0 - 1.0;
         vec4 far_point = u_inv_view_proj * vec4(ndc, 1.0, 1.0);

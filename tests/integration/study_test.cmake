@@ -1,0 +1,88 @@
+# Study files: every file in harness/studies/ loads and expands (--dry-run),
+# malformed entries and charts are refused, and a tiny study with the
+# features of harness/studies/csm.json runs end to end.
+# cmake -DGIB=... -DROOT=... -DOUT=... -P study_test.cmake
+set(failures 0)
+function(fail msg)
+    message(SEND_ERROR "${msg}")
+    math(EXPR f "${failures} + 1")
+    set(failures ${f} PARENT_SCOPE)
+endfunction()
+function(match text regex msg)
+    if(NOT text MATCHES "${regex}")
+        message(SEND_ERROR "${msg}")
+        math(EXPR f "${failures} + 1")
+        set(failures ${f} PARENT_SCOPE)
+    endif()
+endfunction()
+function(run code)
+    execute_process(COMMAND ${GIB} ${ARGN} WORKING_DIRECTORY ${ROOT} RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                    ERROR_VARIABLE err)
+    set(last_out "${out}" PARENT_SCOPE)
+    set(last_err "${err}" PARENT_SCOPE)
+    if(NOT rc EQUAL code)
+        message(SEND_ERROR "gibench ${ARGN}: exit ${rc}, expected ${code}\n${out}\n${err}")
+        math(EXPR f "${failures} + 1")
+        set(failures ${f} PARENT_SCOPE)
+    endif()
+endfunction()
+
+# Every shipped study file is valid: scenes load, methods and parameter
+# values exist, charts are well formed.
+file(GLOB studies ${ROOT}/harness/studies/*.json)
+foreach(s ${studies})
+    run(0 study ${s} --dry-run)
+    match("${last_out}" "^study [^\n]*: [1-9][0-9]* runs" "${s}: --dry-run printed no plan:\n${last_out}")
+endforeach()
+run(0 study harness/studies/csm.json --dry-run)
+match("${last_out}" "label=table1 N=128 M=128 enumeration=hilbert" "csm.json: no Table 1 run at N = 128, Hilbert")
+match("${last_out}" "no-cache not-compared label=table1" "csm.json: Table 1 runs must skip the cache and the references")
+match("${last_out}" "animate not-compared label=moving" "csm.json: no animated run")
+
+run(2 study tests/data/studies/bad_entry_key.json --dry-run)
+match("${last_err}" "/methods/0/frame: unknown key" "an unknown method-entry key was not named:\n${last_err}")
+run(2 study tests/data/studies/bad_chart.json --dry-run)
+match("${last_err}" "/charts/0: \"file\" must be a plain file name" "a chart escaping the output was accepted:\n${last_err}")
+
+# The tiny csm study end to end.
+set(S ${OUT}/study_csm_tiny)
+file(REMOVE_RECURSE ${S})
+run(0 study tests/data/studies/csm_tiny.json --out ${S})
+file(READ ${S}/runs.csv csv)
+string(REGEX MATCHALL "\n[^\n]+" rows "${csv}")
+list(LENGTH rows nrows)
+if(NOT nrows EQUAL 6)
+    fail("csm_tiny: expected 6 runs, got ${nrows}:\n${csv}")
+endif()
+match("${csv}" "^run,[^\n]*,label,width,height,prepare_depth_render_ms,prepare_compress_ms[^\n]*,stat_ratio,"
+      "runs.csv lacks the label, prepare-stage or stats columns:\n${csv}")
+# Table-style rows: 8x8, not compared (no metrics), fresh precomputation.
+match("${csv}" "\nbunny_alone_env-csm-[^\n]*N=4,M=16,enumeration=hilbert[^\n]*,ok,[^\n]*,table,8,8,[0-9.e+-]+,[0-9.e+-]+"
+      "the N = 4 Hilbert table row is missing or lacks its precompute timings:\n${csv}")
+match("${csv}" "\nbunny_env-csm-[^\n]*,ok,[^\n]*,error,16,16" "the compared row is missing:\n${csv}")
+match("${csv}" "\nbunny_env-csm-[^\n]*,ok,[^\n]*,process-cpu-time-around-glFinish,"
+      "\"timer\": \"cputime\" did not reach the runs:\n${csv}")
+file(READ ${S}/frames.csv frames)
+string(REGEX MATCHALL "\nbunny_teapot_moving-csm-[^,]*,moving,[0-9]+," moving_rows "${frames}")
+list(LENGTH moving_rows nmoving)
+if(NOT nmoving EQUAL 3)
+    fail("frames.csv: expected 3 timed frames of the moving run, got ${nmoving}:\n${frames}")
+endif()
+foreach(f chart_ratio.png chart_frames.png chart_bunny_env_error_vs_time.png report.md)
+    if(NOT EXISTS ${S}/${f})
+        fail("csm_tiny did not write ${f}")
+    endif()
+endforeach()
+file(GLOB refs ${S}/references/*.exr)
+foreach(r ${refs})
+    if(r MATCHES "bunny_alone|moving")
+        fail("a reference was rendered for a run with \"compare\": false: ${r}")
+    endif()
+endforeach()
+file(READ ${S}/report.md md)
+match("${md}" "chart_ratio.png" "report.md does not show the study's own chart")
+
+if(failures GREATER 0)
+    message(FATAL_ERROR "${failures} study expectation(s) failed")
+endif()
+message(STATUS "study files and features behave")
