@@ -30,9 +30,9 @@ def main(argv):
     if len(argv) < 2:
         sys.stderr.write("usage: avg_vpl_regions.py FILE.csv...\n")
         return 2
-    print("| file | live VPLs | near arm | corridor (x > 4) | far arm | far-arm VPLs by bounce 1/2/3 "
-          "| power share: far arm | corridor x > 4 |")
-    print("|---|---:|---:|---:|---:|---|---:|---:|")
+    print("| file | live VPLs | near arm | corridor (x > 4) | corridor VPLs by bounce 1/2/3 | far arm "
+          "| far-arm VPLs by bounce 1/2/3 | power share: corridor | corridor x > 4 | far arm |")
+    print("|---|---:|---:|---:|---|---:|---|---:|---:|---:|")
     for path in argv[1:]:
         try:
             with open(path, newline="") as f:
@@ -43,6 +43,7 @@ def main(argv):
         count = {"near": 0, "corridor": 0, "corridor_far": 0, "far": 0}
         power = dict.fromkeys(count, 0.0)
         far_bounce = [0, 0, 0, 0]
+        cor_bounce = [0, 0, 0, 0]
         for r in rows:
             reg = region(float(r["x"]), float(r["z"]))
             lum = 0.2126 * float(r["r"]) + 0.7152 * float(r["g"]) + 0.0722 * float(r["b"])
@@ -50,11 +51,14 @@ def main(argv):
             power[reg] += lum
             if reg == "far":
                 far_bounce[min(int(r["bounce"]), 3)] += 1
+            elif reg.startswith("corridor"):
+                cor_bounce[min(int(r["bounce"]), 3)] += 1
         total = sum(power.values())
         share = {k: 100.0 * v / total if total else 0.0 for k, v in power.items()}
-        print("| %s | %d | %d | %d (%d) | %d | %d / %d / %d | %.2f %% | %.2f %% |" % (
+        print("| %s | %d | %d | %d (%d) | %d / %d / %d | %d | %d / %d / %d | %.2f %% | %.2f %% | %.2f %% |" % (
             path, len(rows), count["near"], count["corridor"] + count["corridor_far"], count["corridor_far"],
-            count["far"], far_bounce[1], far_bounce[2], far_bounce[3], share["far"], share["corridor_far"]))
+            cor_bounce[1], cor_bounce[2], cor_bounce[3], count["far"], far_bounce[1], far_bounce[2], far_bounce[3],
+            share["corridor"] + share["corridor_far"], share["corridor_far"], share["far"]))
     return 0
 
 
