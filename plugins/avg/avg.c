@@ -288,6 +288,32 @@ static void compact(avg *a)
         glNamedBufferSubData(a->ssbo_vpls, 0, (GLsizeiptr)(a->vpl_count * sizeof(avg_vpl)), a->cpu_vpls);
 }
 
+/* Diagnostics: with GIBENCH_AVG_VPLS=FILE every frame (re)writes FILE as
+ * CSV, one live VPL a line (position, normal, power, bounce: 0 on the
+ * light), so that where the VPLs land can be counted
+ * (scripts/avg_vpl_regions.py). A file that cannot be written is reported
+ * once per frame as a warning and does not stop the render. */
+static void dump_vpls(const avg *a)
+{
+    const char *path = getenv("GIBENCH_AVG_VPLS");
+    if (!path || !*path)
+        return;
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        gi_log(GI_LOG_WARN, "avg: cannot write GIBENCH_AVG_VPLS file '%s'", path);
+        return;
+    }
+    fprintf(f, "x,y,z,nx,ny,nz,r,g,b,bounce\n");
+    for (uint32_t i = 0; i < a->vpl_count; i++) {
+        const avg_vpl *v = &a->cpu_vpls[i];
+        fprintf(f, "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%u\n", v->position[0], v->position[1],
+                v->position[2], v->normal[0], v->normal[1], v->normal[2], v->power[0], v->power[1], v->power[2],
+                (v->kind >> 8) & 0xffu);
+    }
+    if (fclose(f) != 0)
+        gi_log(GI_LOG_WARN, "avg: cannot write GIBENCH_AVG_VPLS file '%s'", path);
+}
+
 static GLuint make_tex2d(GLenum format, uint32_t w, uint32_t h)
 {
     GLuint t;
@@ -433,8 +459,10 @@ static gi_result avg_render(void *inst, const gi_view *view, const gi_target *ta
     } else {
         r = trace_avg(a, &lt, &err);
     }
-    if (r == GI_OK)
+    if (r == GI_OK) {
         compact(a);
+        dump_vpls(a);
+    }
     host->stage_end(host, "tra");
     if (r != GI_OK)
         return fail(a, r, err.text);

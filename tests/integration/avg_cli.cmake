@@ -93,6 +93,50 @@ if(NOT d_relmse_anim_still EQUAL 0 OR d_relmse_anim_ref_t2 GREATER 0.3 OR d_lum_
     math(EXPR failures "${failures} + 1")
 endif()
 
+# GIBENCH_AVG_VPLS: the live VPLs as CSV, one a line; as many as the
+# vpls_live stat, one VPL on the light per light path (bounce 0), hits at
+# bounces 1..3; an unwritable file is a warning, not a failure.
+execute_process(COMMAND ${CMAKE_COMMAND} -E env GIBENCH_AVG_VPLS=${OUT}/avg_vpls.csv
+                ${GIB} -q render --scene ${SCENES}/u_room.gltf --method avg ${small} --out ${OUT}/avg_dump.exr
+                --timings ${OUT}/avg_dump.json RESULT_VARIABLE rc)
+file(READ ${OUT}/avg_dump.json tj)
+string(JSON live GET "${tj}" stats vpls_live)
+string(JSON paths GET "${tj}" stats light_paths)
+file(STRINGS ${OUT}/avg_vpls.csv lines)
+list(LENGTH lines n)
+list(GET lines 0 header)
+set(counts 0 0 0 0)
+set(bad 0)
+foreach(l IN LISTS lines)
+    if(l MATCHES ",([0-9]+)$")
+        if(CMAKE_MATCH_1 GREATER 3)
+            math(EXPR bad "${bad} + 1")
+        else()
+            list(GET counts ${CMAKE_MATCH_1} c)
+            math(EXPR c "${c} + 1")
+            list(REMOVE_AT counts ${CMAKE_MATCH_1})
+            list(INSERT counts ${CMAKE_MATCH_1} ${c})
+        endif()
+    endif()
+endforeach()
+list(GET counts 0 on_light)
+math(EXPR rows "${n} - 1")
+if(NOT rc EQUAL 0 OR NOT header STREQUAL "x,y,z,nx,ny,nz,r,g,b,bounce" OR NOT rows EQUAL live
+   OR NOT on_light EQUAL paths OR NOT bad EQUAL 0)
+    message(SEND_ERROR "GIBENCH_AVG_VPLS: exit ${rc}, header '${header}', ${rows} rows for ${live} live VPLs, "
+                       "bounce counts ${counts} for ${paths} paths, ${bad} bad bounces")
+    math(EXPR failures "${failures} + 1")
+else()
+    message(STATUS "GIBENCH_AVG_VPLS: ${rows} VPLs, by bounce ${counts}")
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} -E env GIBENCH_AVG_VPLS=${OUT}/no/such/dir/v.csv
+                ${GIB} render --scene ${SCENES}/u_room.gltf --method avg ${small} --out ${OUT}/avg_dump.exr
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT err MATCHES "cannot write GIBENCH_AVG_VPLS file")
+    message(SEND_ERROR "unwritable GIBENCH_AVG_VPLS: exit ${rc}, stderr '${err}'")
+    math(EXPR failures "${failures} + 1")
+endif()
+
 set(args render --scene ${SCENES}/cornell_box.gltf --method avg --size 32x32 --out ${OUT}/x.exr)
 expect(2 "M=5 is not a square number" ${args} --param M=5)
 expect(2 "avg: grid=2 is outside" ${args} --param grid=2)
