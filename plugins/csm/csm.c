@@ -52,9 +52,9 @@ typedef struct csm_gpu_rect {
 
 typedef struct csm {
     const gi_host *host;
-    int N, M, S, z3, filter, mode;
+    int N, M, S, z3, filter, mode, open_surfaces;
     gi_csm_order order;
-    float bias, normal_offset, normal_offset_local;
+    float bias, normal_offset, normal_offset_local, shell_thickness;
     int lights_mode, n_local, m_local, receivers, distant, warned_moved;
     float *prepare_transforms; /* 16 per object: world_from_local at prepare time */
     gi_csm_order light_order;
@@ -80,6 +80,11 @@ static const gi_param_desc csm_params[] = {
      "order of the maps in the codec"},
     {"depth", GI_PARAM_ENUM, 0, 0, 0, "z2|z3", "Sec. 3.1",
      "second depth of a segment: z2, or z3 (closed-manifold option)"},
+    {"open_surfaces", GI_PARAM_ENUM, 0, 0, 0, "shell|open", NULL,
+     "a texel with a first surface and no second (open or single-sided mesh, e.g. a ground plane): shell: second "
+     "depth z1 + shell_thickness, so that what lies behind stays shadowed; open: none (the codec may light it)"},
+    {"shell_thickness", GI_PARAM_FLOAT, 1e-3, 1e-6, 1, NULL, NULL,
+     "thickness of that shell as a fraction of the object's bounding-sphere radius"},
     {"filter", GI_PARAM_ENUM, 0, 0, 0, "nearest|pcf|rr", "Sec. 4.5",
      "nearest map and texel; generalised PCF (4 maps x 4 texels); Russian roulette over those 16"},
     {"S", GI_PARAM_INT, 16, 1, 1024, NULL, "S (Sec. 5.1)", "environment samples per pixel and frame"},
@@ -121,6 +126,8 @@ static gi_result csm_create(const gi_host *host, const gi_params *params, void *
     c->M = gi_params_int(params, "M");
     c->order = (gi_csm_order)gi_params_enum(params, "enumeration");
     c->z3 = gi_params_enum(params, "depth");
+    c->open_surfaces = gi_params_enum(params, "open_surfaces");
+    c->shell_thickness = gi_params_float(params, "shell_thickness");
     c->filter = gi_params_enum(params, "filter");
     c->S = gi_params_int(params, "S");
     c->bias = gi_params_float(params, "bias");
@@ -138,13 +145,24 @@ static gi_result csm_create(const gi_host *host, const gi_params *params, void *
     return GI_OK;
 }
 
+/* Thin-shell depth behind a lone first surface in the local units of an
+ * object of bounding-sphere radius R: shell_thickness R, or 0 with
+ * open_surfaces=open (csm_texel_depths). */
+static float shell_depth(const csm *c, float R)
+{
+    return c->open_surfaces == 0 ? c->shell_thickness * R : 0.0f;
+}
+
 /* Cache file name: hash of the format version, the object's mesh, its
- * sphere and every parameter that changes the data. */
+ * sphere and every parameter that changes the data (the shell depth is 0
+ * for open surfaces, so shell_thickness only counts with shell). */
 static void cache_name(const csm *c, const gi_scene *s, uint32_t k, const float sphere[4], char *name, size_t size)
 {
     uint32_t key[12] = {CSM_FORMAT_VERSION, (uint32_t)c->M, (uint32_t)c->N, (uint32_t)c->N, (uint32_t)c->order,
                         (uint32_t)c->z3, 0, 0, 0, 0, 0, 0};
     memcpy(&key[6], sphere, 4 * sizeof(float));
+    float shell = shell_depth(c, sphere[3]);
+    memcpy(&key[10], &shell, sizeof shell);
     uint64_t h = gi_hash64("gibench-csm", 11, gi_scene_object_hash(s, k));
     h = gi_hash64(key, sizeof key, h);
     snprintf(name, size, "csm-%016llx.bin", (unsigned long long)h);
@@ -155,8 +173,8 @@ static void cache_name(const csm *c, const gi_scene *s, uint32_t k, const float 
 static void cache_name_local(const csm *c, const gi_scene *s, uint32_t k, const float sphere[4],
                              const csm_local_desc *d, char *name, size_t size)
 {
-    float key_f[13] = {sphere[0], sphere[1], sphere[2], sphere[3], d->o.x,  d->o.y,  d->o.z,
-                       d->e1.x,   d->e1.y,   d->e1.z,   d->e2.x,   d->e2.y, d->e2.z};
+    float key_f[14] = {sphere[0], sphere[1], sphere[2], sphere[3], d->o.x, d->o.y,  d->o.z,
+                       d->e1.x,   d->e1.y,   d->e1.z,   d->e2.x,   d->e2.y, d->e2.z, d->shell};
     uint32_t key_u[6] = {CSM_LOCAL_FORMAT_VERSION, d->M, d->n_u, d->n_v, (uint32_t)d->order, (uint32_t)d->z3};
     uint64_t h = gi_hash64("gibench-csm-local", 17, gi_scene_object_hash(s, k));
     h = gi_hash64(key_u, sizeof key_u, h);
@@ -228,6 +246,7 @@ static gi_result load_or_build(csm *c, const gi_gpu_scene *gs, uint32_t k, const
                            .n_phi = (uint32_t)c->N,
                            .order = c->order,
                            .z3 = c->z3,
+                           .shell = shell_depth(c, sphere[3]),
                            .batch = batch_for(c->M)};
     gi_error err;
     gi_result r = csm_build_object(gs, k, sphere, &desc, c->host, p0, p1, data, &err);
@@ -472,6 +491,7 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
                                    .n_v = l->n_v,
                                    .order = c->light_order,
                                    .z3 = c->z3,
+                                   .shell = shell_depth(c, c->objects[k].sphere[3]),
                                    .batch = batch_for(c->m_local)};
             rect_store(pr->o, desc.o, shadows ? 1.0f : 0.0f);
             rect_store(pr->e1, desc.e1, 0.0f);

@@ -1,6 +1,7 @@
 /* CPU side of the csm plugin (csm_cpu.h). */
 #include "csm_cpu.h"
 
+#include <float.h>
 #include <math.h>
 
 void csm_cell_angles(uint32_t n_theta, uint32_t n_phi, uint32_t a, uint32_t b, float *theta, float *phi)
@@ -79,4 +80,15 @@ int csm_visible_nearest(const gi_csm_data *data, const float sphere[4], uint32_t
         ty = M - 1;
     uint32_t i = gi_csm_order_index(order, n_phi, n_theta, a, b);
     return gi_csm_visible(data, ty * M + tx, i, p.z, bias);
+}
+
+void csm_texel_depths(const float *map, size_t texels, int z3, float shell, float *z1, float *z2)
+{
+    for (size_t t = 0; t < texels; t++) {
+        float a = map[4 * t], b = z3 && map[4 * t + 2] < FLT_MAX ? map[4 * t + 2] : map[4 * t + 1];
+        if (shell > 0.0f && a < FLT_MAX && b >= FLT_MAX)
+            b = a + shell;
+        z1[t] = a;
+        z2[t] = b;
+    }
 }

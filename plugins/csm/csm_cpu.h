@@ -56,8 +56,26 @@ typedef struct csm_build_desc {
     uint32_t n_theta, n_phi;
     gi_csm_order order;
     int z3;            /* 1: the third surface as the codec's second (§3.1) */
+    float shell;       /* > 0: thin-shell depth (local units) behind a lone first surface; 0: open */
     uint32_t batch;    /* maps per gi_depth_render call */
 } csm_build_desc;
+
+/* The codec's depths of the M x M texels of one map from the depth
+ * renderer's read-back layer `map` (4 floats a texel: z1, z2, z3, -; none
+ * >= FLT_MAX): z1 as it is; the second depth is z2, or with `z3` the third
+ * surface where the texel has one and else z2 (the far side of the last
+ * shell, §3.1's closed-manifold option). A texel with a first surface and no
+ * second one (an open or single-sided surface: a ground plane, a quad, the
+ * silhouette of a mesh with holes) gets z1 + shell when shell > 0: the
+ * surface is taken as a shell of that thickness, so the codec's z_avg stays
+ * within [z1, z1 + shell) and points of other objects behind the surface
+ * stay shadowed. With shell = 0 (open_surfaces=open) the second depth stays
+ * "none", which tells the codec that nothing lies behind z1: it may then put
+ * z_avg at the largest z1 of a whole run of maps (or FLT_MAX), so points
+ * behind the surface test lit. z1 + shell may round to z1 when shell is
+ * below the float spacing at z1; the codec then stores z1 (a classic
+ * shadow-map texel), still shadowing what lies behind. */
+void csm_texel_depths(const float *map, size_t texels, int z3, float shell, float *z1, float *z2);
 
 /* Renders and compresses the N_theta N_phi maps of `object` (local space,
  * bounding sphere `sphere`). `host` may be NULL (tests); with a host it

@@ -246,11 +246,8 @@ gi_result csm_build_local(const gi_gpu_scene *gs, uint32_t object, const float s
                 goto done;
             }
             timer(host, "compress", 1);
-            /* z3 option as for the distant maps (precompute.c) */
-            for (size_t t = 0; t < (size_t)M * M; t++) {
-                z1[t] = map[4 * t];
-                z2[t] = desc->z3 && map[4 * t + 2] < FLT_MAX ? map[4 * t + 2] : map[4 * t + 1];
-            }
+            /* z3 option and open surfaces as for the distant maps (csm_texel_depths) */
+            csm_texel_depths(map, (size_t)M * M, desc->z3, desc->shell, z1, z2);
             free(map);
             r = gi_csm_codec_add_map(enc, first + k, z1, z2, err);
             timer(host, "compress", 0);

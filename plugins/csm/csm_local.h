@@ -74,6 +74,7 @@ typedef struct csm_local_desc {
     uint32_t n_u, n_v;
     gi_csm_order order;
     int z3;
+    float shell; /* thin-shell depth behind a lone first surface (csm_texel_depths); 0: open */
     uint32_t batch;
 } csm_local_desc;
 

@@ -5,7 +5,6 @@
  * chosen enumeration order. */
 #include "csm_cpu.h"
 
-#include <float.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -75,15 +74,8 @@ gi_result csm_build_object(const gi_gpu_scene *gs, uint32_t object, const float 
                 goto done;
             }
             timer(host, "compress", 1);
-            /* z3 option: the third surface where there is one, else the
-             * second (the far side of the last shell), so that receivers of
-             * other objects behind this object stay shadowed (§4.6); a z3
-             * "none" taken as "nothing behind z1" would let the codec put
-             * z_avg far behind the object in runs mixing such texels. */
-            for (size_t t = 0; t < (size_t)M * M; t++) {
-                z1[t] = map[4 * t];
-                z2[t] = desc->z3 && map[4 * t + 2] < FLT_MAX ? map[4 * t + 2] : map[4 * t + 1];
-            }
+            /* z3 option and open surfaces: csm_texel_depths (csm_cpu.h) */
+            csm_texel_depths(map, (size_t)M * M, desc->z3, desc->shell, z1, z2);
             free(map);
             r = gi_csm_codec_add_map(enc, first + k, z1, z2, err);
             timer(host, "compress", 0);

@@ -40,6 +40,22 @@ expect(0 "" ${args} --param filter=rr --param enumeration=scanline --out ${OUT}/
        --timings ${OUT}/csm_bunny_rr.json)
 expect_json(${OUT}/csm_bunny_rr.json "\"nonfinite_pixels\": 0")
 
+# open_surfaces and shell_thickness are in the cache key: each makes new
+# files for both objects (bunny, ground).
+file(GLOB cached ${cache}/csm-*.bin)
+list(LENGTH cached n_before)
+expect(0 "" ${args} --param open_surfaces=open --out ${OUT}/csm_bunny_open.exr --timings ${OUT}/csm_bunny_open.json)
+expect_json(${OUT}/csm_bunny_open.json "\"nonfinite_pixels\": 0" "\"cache_hit\": 0")
+expect(0 "" ${args} --param shell_thickness=0.01 --out ${OUT}/csm_bunny_shell.exr --timings ${OUT}/csm_bunny_shell.json)
+expect_json(${OUT}/csm_bunny_shell.json "\"nonfinite_pixels\": 0" "\"cache_hit\": 0")
+file(GLOB cached ${cache}/csm-*.bin)
+list(LENGTH cached n_after)
+math(EXPR n_new "${n_after} - ${n_before}")
+if(NOT n_new EQUAL 4)
+    message(SEND_ERROR "open_surfaces=open and shell_thickness=0.01: expected 4 new cache files, found ${n_new}")
+    math(EXPR failures "${failures} + 1")
+endif()
+
 # Table 2's visibility benchmark (mode=random|coherent) on the bunny alone:
 # every mode counts S samples per surface pixel (the same pixels), and
 # random and coherent directions estimate the same average visibility (the
@@ -89,6 +105,8 @@ expect(2 "csm: M=2000 is outside" ${args} --param M=2000 --out ${OUT}/x.exr)
 expect(2 "csm: " ${args} --param filter=box --out ${OUT}/x.exr)
 expect(2 "csm: " ${args} --param enumeration=spiral --out ${OUT}/x.exr)
 expect(2 "csm: S=0 is outside" ${args} --param S=0 --out ${OUT}/x.exr)
+expect(2 "csm: " ${args} --param open_surfaces=closed --out ${OUT}/x.exr)
+expect(2 "csm: shell_thickness=0 is outside" ${args} --param shell_thickness=0 --out ${OUT}/x.exr)
 expect(2 "csm: unknown parameter 'K'" ${args} --param K=3 --out ${OUT}/x.exr)
 
 # Local lights (§4.2): the teapot's area light and the cross scene's linear

@@ -189,6 +189,7 @@ static int setup_scene(gi_gpu *gpu, const char *path, setup *st)
                                   .n_v = l->n_v,
                                   .order = GI_CSM_ORDER_DIAGONAL,
                                   .z3 = 0,
+                                  .shell = 1e-3f * sphere[3], /* the plugin's default */
                                   .batch = 16};
             if (l->object == (int)k)
                 continue;

@@ -12,10 +12,21 @@
  *    rigid transform of the object (§4.6), and the same data uploaded as
  *    the plugin does: nearest equals the CPU query, and
  *    the Russian-roulette filter averaged over 256 stratified random
- *    numbers equals the generalised PCF value (§4.5). */
+ *    numbers equals the generalised PCF value (§4.5);
+ *  - open surfaces (plugins/csm/README.md "Open and single-sided
+ *    surfaces"): the ground plane of bunny_env.glb has one surface per
+ *    texel. Points on the bunny's underside and points just above the
+ *    ground, toward directions below the horizon: the product of both
+ *    objects' CSMs (N = 8 x 8, M = 64, nearest) against exact ray casting
+ *    (gi_rt_occluded on the whole scene) with the default thin shell
+ *    (open_surfaces=shell, z2 and z3 options) and without it (open), which
+ *    lets the light through the ground; and the same for a local point
+ *    light below the ground (cube-map CSM of the ground, §3.3). */
 #include "../../plugins/csm/csm_cpu.h"
+#include "../../plugins/csm/csm_local.h"
 
 #include "gi/mesh.h"
+#include "gi/raytrace.h"
 #include "gi/rng.h"
 #include "gi/sampling.h"
 #include "gi/shader.h"
@@ -63,6 +74,215 @@ static int hits(const gi_scene *s, uint32_t k, gi_vec3 o, gi_vec3 d)
     return n;
 }
 
+/* The plugin's default shell_thickness (fraction of R). */
+#define SHELL 1e-3f
+
+/* Visibility of world point x toward world unit w through the CSMs of
+ * objects ks[0..n) (nearest filter, bias 0.01 R each): the product of §4.6. */
+static int csm_lit(const gi_gpu_scene *gs, const uint32_t *ks, const gi_csm_data *const *data, float (*spheres)[4],
+                   int n, uint32_t N, gi_vec3 x, gi_vec3 w)
+{
+    for (int i = 0; i < n; i++) {
+        float inv[16];
+        gi_mat4_invert(inv, gs->world_from_local[ks[i]]);
+        gi_vec3 xl = gi_mat4_point(inv, x), wl = gi_v3_normalize(gi_mat4_dir(inv, w));
+        if (!csm_visible_nearest(data[i], spheres[i], N, N, GI_CSM_ORDER_HILBERT, xl, wl, 0.01f * spheres[i][3]))
+            return 0;
+    }
+    return 1;
+}
+
+/* Part 2: open surfaces. Returns the number of failed checks. */
+static int open_surfaces(const gi_scene *s, const gi_gpu_scene *gs, uint32_t kb)
+{
+    int fails = 0;
+    gi_error err;
+    uint32_t kg = 0;
+    while (kg < s->object_count && strcmp(s->objects[kg].name, "ground") != 0)
+        kg++;
+    gi_rt *rt = NULL;
+    if (kg == s->object_count || gi_rt_create(s, 0.0f, &rt, &err) != GI_OK) {
+        fprintf(stderr, "no ground object / ray casting failed\n");
+        return 1;
+    }
+    const uint32_t N = 8, M = 64;
+    uint32_t ks[2] = {kb, kg};
+    float spheres[2][4];
+    gi_mesh_object_sphere(s, kb, spheres[0]);
+    gi_mesh_object_sphere(s, kg, spheres[1]);
+    /* variants: 0 shell (z2), 1 open (z2), 2 shell (z3) */
+    enum { VARIANTS = 3 };
+    static const char *names[VARIANTS] = {"shell, z2", "open, z2", "shell, z3"};
+    gi_csm_data data[VARIANTS][2];
+    memset(data, 0, sizeof data);
+    for (int v = 0; v < VARIANTS; v++)
+        for (int i = 0; i < 2; i++) {
+            csm_build_desc d = {.M = M,
+                                .n_theta = N,
+                                .n_phi = N,
+                                .order = GI_CSM_ORDER_HILBERT,
+                                .z3 = v == 2,
+                                .shell = v == 1 ? 0.0f : SHELL * spheres[i][3],
+                                .batch = 16};
+            if (csm_build_object(gs, ks[i], spheres[i], &d, NULL, 0, 1, &data[v][i], &err) != GI_OK) {
+                fprintf(stderr, "%s\n", err.text);
+                fails++;
+            }
+        }
+    if (fails)
+        return fails;
+    printf("ground: R = %.3f, %u maps of %u^2: %.2f segments per texel with the shell, %.2f open\n",
+           (double)spheres[1][3], N * N, M, (double)data[0][1].segment_count / (M * M),
+           (double)data[1][1].segment_count / (M * M));
+
+    /* Pairs: A, points on the bunny's underside (triangles whose world
+     * geometric normal points down), offset one texel of the bunny's map
+     * along it, at least 0.1 above the ground, directions below the horizon
+     * on the normal's side; B,
+     * points 0.1..0.4 above the ground (outside the bunny) near it,
+     * directions below the horizon. The ground's bias (0.01 R = 0.07) is a
+     * band of about that height in which even a correct CSM lights points
+     * behind the plane, hence the heights. */
+    const gi_object *ob = &s->objects[kb];
+    const float *m = gs->world_from_local[kb];
+    float *cdf = malloc(sizeof(float) * ob->triangle_count);
+    gi_vec3 *tp = malloc(sizeof(gi_vec3) * 3 * ob->triangle_count);
+    float total = 0;
+    for (uint32_t t = 0; t < ob->triangle_count; t++) {
+        for (int j = 0; j < 3; j++) {
+            const float *q = s->vertices[s->indices[3 * (ob->first_triangle + t) + (uint32_t)j]].position;
+            tp[3 * t + (uint32_t)j] = gi_mat4_point(m, gi_v3(q[0], q[1], q[2]));
+        }
+        gi_vec3 n = gi_v3_cross(gi_v3_sub(tp[3 * t + 1], tp[3 * t]), gi_v3_sub(tp[3 * t + 2], tp[3 * t]));
+        float len = gi_v3_length(n);
+        total += len > 0 && n.y < -0.3f * len ? len : 0.0f;
+        cdf[t] = total;
+    }
+    uint32_t rng = gi_rng_init(11, 0, 1);
+    const float texel = 2.0f * spheres[0][3] / (float)M;
+    enum { PAIRS = 1500 };
+    int occluded[2] = {0, 0}, agree[VARIANTS][2], agree_occ[VARIANTS][2];
+    memset(agree, 0, sizeof agree);
+    memset(agree_occ, 0, sizeof agree_occ);
+    for (int kind = 0; kind < 2; kind++)
+        for (int p = 0; p < PAIRS;) {
+            gi_vec3 x, w, n = gi_v3(0, 1, 0);
+            if (kind == 0) {
+                float r = gi_rng_next_float(&rng) * total;
+                uint32_t lo = 0, hi = ob->triangle_count - 1;
+                while (lo < hi) {
+                    uint32_t mid = (lo + hi) / 2;
+                    if (cdf[mid] > r)
+                        hi = mid;
+                    else
+                        lo = mid + 1;
+                }
+                float b[3];
+                gi_sample_uniform_triangle(gi_rng_next_float(&rng), gi_rng_next_float(&rng), b);
+                const gi_vec3 *q = &tp[3 * lo];
+                n = gi_v3_normalize(gi_v3_cross(gi_v3_sub(q[1], q[0]), gi_v3_sub(q[2], q[0])));
+                x = gi_v3_add(gi_v3_add(gi_v3_scale(q[0], b[0]), gi_v3_scale(q[1], b[1])), gi_v3_scale(q[2], b[2]));
+                x = gi_v3_add(x, gi_v3_scale(n, texel));
+                if (x.y < 0.1f) /* within the ground's bias band */
+                    continue;
+            } else {
+                x = gi_v3(1.2f * (2.0f * gi_rng_next_float(&rng) - 1.0f), 0.1f + 0.3f * gi_rng_next_float(&rng),
+                          1.2f * (2.0f * gi_rng_next_float(&rng) - 1.0f));
+                /* leave out points inside the bunny (odd hits both ways) */
+                gi_rt_hit h1, h2;
+                if (gi_rt_intersect(rt, x, gi_v3(0, 1, 0), 0, INFINITY, &h1) && h1.object == kb &&
+                    gi_rt_intersect(rt, x, gi_v3(0, -1, 0), 0, INFINITY, &h2) && h2.object == kb &&
+                    gi_v3_dot(h1.ng, gi_v3(0, 1, 0)) > 0)
+                    continue;
+            }
+            w = gi_sample_uniform_sphere(gi_rng_next_float(&rng), gi_rng_next_float(&rng));
+            if (w.y > -0.1f || (kind == 0 && gi_v3_dot(w, n) < 0.1f))
+                continue;
+            int exact = !gi_rt_occluded(rt, x, w, 1e-4f, INFINITY);
+            occluded[kind] += !exact;
+            for (int v = 0; v < VARIANTS; v++) {
+                const gi_csm_data *dv[2] = {&data[v][0], &data[v][1]};
+                int lit = csm_lit(gs, ks, dv, spheres, 2, N, x, w);
+                agree[v][kind] += lit == exact;
+                agree_occ[v][kind] += !exact && !lit;
+            }
+            p++;
+        }
+    static const char *kinds[2] = {"bunny underside", "above the ground"};
+    for (int kind = 0; kind < 2; kind++)
+        for (int v = 0; v < VARIANTS; v++)
+            printf("open surfaces, %s, %s: %d pairs (%d occluded): %.1f%% agree with ray casting, "
+                   "%.1f%% of the occluded ones shadowed\n",
+                   kinds[kind], names[v], PAIRS, occluded[kind], 100.0 * agree[v][kind] / PAIRS,
+                   100.0 * agree_occ[v][kind] / (occluded[kind] ? occluded[kind] : 1));
+    for (int kind = 0; kind < 2; kind++) {
+        if (occluded[kind] < PAIRS / 2) {
+            fprintf(stderr, "%s: only %d occluded pairs\n", kinds[kind], occluded[kind]);
+            fails++;
+        }
+        for (int v = 0; v < VARIANTS; v += 2)
+            if (agree[v][kind] < PAIRS * 95 / 100) {
+                fprintf(stderr, "%s, %s: %d of %d agree\n", kinds[kind], names[v], agree[v][kind], PAIRS);
+                fails++;
+            }
+        if (agree_occ[1][kind] > occluded[kind] / 2) {
+            fprintf(stderr, "%s, open: %d of %d occluded pairs shadowed: the leak is gone?\n", kinds[kind],
+                    agree_occ[1][kind], occluded[kind]);
+            fails++;
+        }
+    }
+    free(cdf);
+    free(tp);
+
+    /* A point light 1 below the ground's centre: the ground's cube-map CSM
+     * (radial depth) for points 0.1..0.4 above the ground within 2 of the
+     * centre, all occluded by the ground. */
+    float gs_[4];
+    memcpy(gs_, spheres[1], sizeof gs_);
+    float inv[16];
+    gi_mat4_invert(inv, gs->world_from_local[kg]);
+    gi_vec3 light = gi_v3(0.0f, -1.0f, 0.0f);
+    int cube_shadowed[2] = {0, 0}, cube_occluded = 0;
+    for (int v = 0; v < 2; v++) {
+        csm_local_desc d = {.M = M,
+                            .o = gi_mat4_point(inv, light),
+                            .n_u = 1,
+                            .n_v = 1,
+                            .order = GI_CSM_ORDER_SCANLINE,
+                            .shell = v == 0 ? SHELL * gs_[3] : 0.0f,
+                            .batch = 6};
+        gi_csm_data cd;
+        if (csm_build_local(gs, kg, gs_, &d, NULL, 0, 1, &cd, &err) != GI_OK) {
+            fprintf(stderr, "%s\n", err.text);
+            fails++;
+            continue;
+        }
+        uint32_t r2 = gi_rng_init(12, 0, 1);
+        for (int p = 0; p < 500; p++) {
+            gi_vec3 x = gi_v3(2.0f * (2.0f * gi_rng_next_float(&r2) - 1.0f), 0.1f + 0.3f * gi_rng_next_float(&r2),
+                              2.0f * (2.0f * gi_rng_next_float(&r2) - 1.0f));
+            gi_vec3 to = gi_v3_sub(light, x);
+            if (v == 0)
+                cube_occluded += gi_rt_occluded(rt, x, to, 1e-4f, 1.0f - 1e-4f);
+            cube_shadowed[v] += !csm_local_visible_nearest(&cd, &d, gi_mat4_point(inv, x), 0, 0, 0.01f * gs_[3]);
+        }
+        gi_csm_data_free(&cd);
+    }
+    printf("open surfaces, point light below the ground (cube map): %d of 500 pairs occluded; shadowed: shell %d, "
+           "open %d\n",
+           cube_occluded, cube_shadowed[0], cube_shadowed[1]);
+    if (cube_shadowed[0] < cube_occluded * 95 / 100 || cube_shadowed[1] > cube_occluded / 2) {
+        fprintf(stderr, "cube map: shell %d, open %d of %d occluded\n", cube_shadowed[0], cube_shadowed[1],
+                cube_occluded);
+        fails++;
+    }
+    for (int v = 0; v < VARIANTS; v++)
+        for (int i = 0; i < 2; i++)
+            gi_csm_data_free(&data[v][i]);
+    gi_rt_free(rt);
+    return fails;
+}
+
 int main(void)
 {
     gi_error err;
@@ -87,7 +307,8 @@ int main(void)
     float sphere[4];
     gi_mesh_object_sphere(s, k, sphere);
     const uint32_t N = 8, M = 64;
-    csm_build_desc desc = {.M = M, .n_theta = N, .n_phi = N, .order = GI_CSM_ORDER_HILBERT, .z3 = 0, .batch = 16};
+    csm_build_desc desc = {
+        .M = M, .n_theta = N, .n_phi = N, .order = GI_CSM_ORDER_HILBERT, .z3 = 0, .shell = SHELL * sphere[3], .batch = 16};
     gi_csm_data data;
     EXPECT(csm_build_object(gs, k, sphere, &desc, NULL, 0, 1, &data, &err) == GI_OK, "%s", err.text);
     printf("bunny: R = %.4f, %u maps of %u^2: %.2f segments per texel, %.2f : 1\n", (double)sphere[3], N * N, M,
@@ -252,6 +473,8 @@ int main(void)
     free(pin);
     free(cpu_lit);
     free(exact_lit);
+
+    failures += open_surfaces(s, gs, k);
 
     gi_csm_data_free(&data);
     gi_gpu_scene_free(gs);
