@@ -77,6 +77,29 @@ typedef struct csm_build_desc {
  * shadow-map texel), still shadowing what lies behind. */
 void csm_texel_depths(const float *map, size_t texels, int z3, float shell, float *z1, float *z2);
 
+/* What csm_encode_maps renders: `count` maps of `object` (object-local,
+ * only that object), map q's view given by view(ctx, q, &v), rendered in
+ * batches of `batch` (0: 16), read back and streamed into the codec as map
+ * q, the depths taken by csm_texel_depths(z3, shell). `what` names the maps
+ * in progress and error messages ("depth maps", "cube faces"). */
+typedef struct csm_encode_desc {
+    uint32_t object;
+    uint32_t M, count;
+    gi_depth_metric metric;
+    int z3;
+    float shell;
+    uint32_t batch;
+    void (*view)(void *ctx, uint32_t q, gi_depth_view *out);
+    void *ctx;
+    const char *what;
+} csm_encode_desc;
+
+/* The precomputation loop shared by the distant maps and the local lights'
+ * cube maps: render, read back, compress (§3.1). Progress, stage timers
+ * (depth_render, compress) and cancellation as csm_build_object. */
+gi_result csm_encode_maps(const gi_gpu_scene *gs, const csm_encode_desc *desc, const gi_host *host, float p0, float p1,
+                          gi_csm_data *out, gi_error *err);
+
 /* Renders and compresses the N_theta N_phi maps of `object` (local space,
  * bounding sphere `sphere`). `host` may be NULL (tests); with a host it
  * reports progress (fraction p0 + p1 * done), stage timers depth_render and

@@ -172,103 +172,48 @@ void csm_cube_project(int face, gi_vec3 d, float *sx, float *sy)
     *sy = gi_v3_dot(t, d) / z;
 }
 
-static void timer(const gi_host *host, const char *name, int begin)
+/* Map q of one (light, object) pair: cube face q / NP at light point
+ * q % NP of the light's enumeration order, faces concatenated as kN + i
+ * (§3.3, §4.2). */
+typedef struct local_views {
+    const csm_local_desc *desc;
+    gi_vec3 c;
+    float R;
+} local_views;
+
+static void local_view(void *ctx, uint32_t q, gi_depth_view *out)
 {
-    if (!host)
-        return;
-    if (begin)
-        host->stage_begin(host, name);
-    else
-        host->stage_end(host, name);
+    const local_views *lv = ctx;
+    const csm_local_desc *desc = lv->desc;
+    const uint32_t NP = desc->n_u * desc->n_v;
+    uint32_t face = q / NP, i = q % NP, a, b;
+    gi_csm_order_cell(desc->order, desc->n_u, desc->n_v, i, &a, &b);
+    gi_vec3 eye = csm_light_point(desc->o, desc->e1, desc->e2, desc->n_u, desc->n_v, a, b);
+    /* everything of the object lies within |eye - c| + R */
+    float dist = gi_v3_length(gi_v3_sub(eye, lv->c));
+    float zfar = 1.05f * (dist + lv->R) + 1e-6f, znear = 1e-4f * (dist + lv->R);
+    gi_mat4_cube_face_view(out->view, eye, (int)face);
+    gi_mat4_perspective(out->proj, GI_PI * 0.5f, 1.0f, znear, zfar);
+    out->projection = GI_PROJ_PERSPECTIVE;
+    out->znear = znear;
+    out->zfar = zfar;
 }
 
 gi_result csm_build_local(const gi_gpu_scene *gs, uint32_t object, const float sphere[4], const csm_local_desc *desc,
                           const gi_host *host, float p0, float p1, gi_csm_data *out, gi_error *err)
 {
-    memset(out, 0, sizeof *out);
-    const uint32_t M = desc->M, NP = desc->n_u * desc->n_v, N = 6 * NP;
-    const uint32_t batch = desc->batch ? desc->batch : 16;
-    gi_depth_desc dd = {.size = M,
-                        .surfaces = desc->z3 ? 3u : 2u,
-                        .metric = GI_DEPTH_RADIAL,
-                        .object = (int)object,
-                        .local = 1,
-                        .cull = 0};
-    gi_depth_renderer *dr = gi_depth_renderer_create(&dd, err);
-    if (!dr)
-        return GI_ERR_GL;
-    GLuint tex = gi_depth_texture_create(dr, batch);
-    gi_depth_view *views = calloc(batch, sizeof *views);
-    float *z1 = malloc((size_t)M * M * sizeof *z1), *z2 = malloc((size_t)M * M * sizeof *z2);
-    gi_csm_codec *enc = NULL;
-    gi_result r = GI_ERR_OUT_OF_MEMORY;
-    gi_vec3 c = gi_v3(sphere[0], sphere[1], sphere[2]);
-    float R = sphere[3];
-    if (!views || !z1 || !z2) {
-        snprintf(err->text, sizeof err->text, "csm: out of memory for %u x %u cube faces", M, M);
-        goto done;
-    }
-    r = gi_csm_codec_begin(M, N, &enc, err);
-    if (r != GI_OK)
-        goto done;
-    for (uint32_t first = 0; first < N; first += batch) {
-        if (host && host->cancelled(host)) {
-            r = GI_ERR_CANCELLED;
-            snprintf(err->text, sizeof err->text, "csm: precomputation cancelled");
-            goto done;
-        }
-        uint32_t count = N - first < batch ? N - first : batch;
-        for (uint32_t k = 0; k < count; k++) {
-            uint32_t q = first + k, face = q / NP, i = q % NP, a, b;
-            gi_csm_order_cell(desc->order, desc->n_u, desc->n_v, i, &a, &b);
-            gi_vec3 eye = csm_light_point(desc->o, desc->e1, desc->e2, desc->n_u, desc->n_v, a, b);
-            /* everything of the object lies within |eye - c| + R */
-            float dist = gi_v3_length(gi_v3_sub(eye, c));
-            float zfar = 1.05f * (dist + R) + 1e-6f, znear = 1e-4f * (dist + R);
-            gi_mat4_cube_face_view(views[k].view, eye, (int)face);
-            gi_mat4_perspective(views[k].proj, GI_PI * 0.5f, 1.0f, znear, zfar);
-            views[k].projection = GI_PROJ_PERSPECTIVE;
-            views[k].znear = znear;
-            views[k].zfar = zfar;
-        }
-        timer(host, "depth_render", 1);
-        r = gi_depth_render(dr, gs, views, count, tex, 0, err);
-        timer(host, "depth_render", 0);
-        if (r != GI_OK)
-            goto done;
-        for (uint32_t k = 0; k < count; k++) {
-            timer(host, "depth_render", 1);
-            float *map = gi_depth_read_layer(tex, M, k);
-            timer(host, "depth_render", 0);
-            if (!map) {
-                r = GI_ERR_OUT_OF_MEMORY;
-                snprintf(err->text, sizeof err->text, "csm: reading cube face %u failed", first + k);
-                goto done;
-            }
-            timer(host, "compress", 1);
-            /* z3 option and open surfaces as for the distant maps (csm_texel_depths) */
-            csm_texel_depths(map, (size_t)M * M, desc->z3, desc->shell, z1, z2);
-            free(map);
-            r = gi_csm_codec_add_map(enc, first + k, z1, z2, err);
-            timer(host, "compress", 0);
-            if (r != GI_OK)
-                goto done;
-        }
-        if (host)
-            host->progress(host, "csm: cube maps", p0 + p1 * (float)(first + count) / (float)N);
-    }
-    timer(host, "compress", 1);
-    r = gi_csm_codec_finish(enc, out, err);
-    timer(host, "compress", 0);
-    enc = NULL;
-done:
-    gi_csm_codec_free(enc);
-    free(views);
-    free(z1);
-    free(z2);
-    glDeleteTextures(1, &tex);
-    gi_depth_renderer_free(dr);
-    return r;
+    local_views lv = {desc, gi_v3(sphere[0], sphere[1], sphere[2]), sphere[3]};
+    csm_encode_desc e = {.object = object,
+                         .M = desc->M,
+                         .count = 6 * desc->n_u * desc->n_v,
+                         .metric = GI_DEPTH_RADIAL,
+                         .z3 = desc->z3,
+                         .shell = desc->shell,
+                         .batch = desc->batch,
+                         .view = local_view,
+                         .ctx = &lv,
+                         .what = "cube faces"};
+    return csm_encode_maps(gs, &e, host, p0, p1, out, err);
 }
 
 int csm_local_visible_nearest(const gi_csm_data *data, const csm_local_desc *desc, gi_vec3 x, float u, float v,

@@ -7,6 +7,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 static void timer(const gi_host *host, const char *name, int begin)
 {
@@ -18,16 +19,16 @@ static void timer(const gi_host *host, const char *name, int begin)
         host->stage_end(host, name);
 }
 
-gi_result csm_build_object(const gi_gpu_scene *gs, uint32_t object, const float sphere[4], const csm_build_desc *desc,
-                           const gi_host *host, float p0, float p1, gi_csm_data *out, gi_error *err)
+gi_result csm_encode_maps(const gi_gpu_scene *gs, const csm_encode_desc *desc, const gi_host *host, float p0, float p1,
+                          gi_csm_data *out, gi_error *err)
 {
     memset(out, 0, sizeof *out);
-    const uint32_t M = desc->M, N = desc->n_theta * desc->n_phi;
+    const uint32_t M = desc->M, N = desc->count;
     const uint32_t batch = desc->batch ? desc->batch : 16;
     gi_depth_desc dd = {.size = M,
                         .surfaces = desc->z3 ? 3u : 2u,
-                        .metric = GI_DEPTH_EYE_Z,
-                        .object = (int)object,
+                        .metric = desc->metric,
+                        .object = (int)desc->object,
                         .local = 1,
                         .cull = 0};
     gi_depth_renderer *dr = gi_depth_renderer_create(&dd, err);
@@ -39,7 +40,7 @@ gi_result csm_build_object(const gi_gpu_scene *gs, uint32_t object, const float 
     gi_csm_codec *enc = NULL;
     gi_result r = GI_ERR_OUT_OF_MEMORY;
     if (!views || !z1 || !z2) {
-        snprintf(err->text, sizeof err->text, "csm: out of memory for %u x %u maps", M, M);
+        snprintf(err->text, sizeof err->text, "csm: out of memory for %u x %u %s", M, M, desc->what);
         goto done;
     }
     r = gi_csm_codec_begin(M, N, &enc, err);
@@ -52,13 +53,8 @@ gi_result csm_build_object(const gi_gpu_scene *gs, uint32_t object, const float 
             goto done;
         }
         uint32_t count = N - first < batch ? N - first : batch;
-        for (uint32_t k = 0; k < count; k++) {
-            uint32_t a, b;
-            float theta, phi;
-            gi_csm_order_cell(desc->order, desc->n_phi, desc->n_theta, first + k, &a, &b);
-            csm_cell_angles(desc->n_theta, desc->n_phi, a, b, &theta, &phi);
-            csm_map_view(sphere, theta, phi, &views[k]);
-        }
+        for (uint32_t k = 0; k < count; k++)
+            desc->view(desc->ctx, first + k, &views[k]);
         timer(host, "depth_render", 1);
         r = gi_depth_render(dr, gs, views, count, tex, 0, err);
         timer(host, "depth_render", 0);
@@ -70,7 +66,7 @@ gi_result csm_build_object(const gi_gpu_scene *gs, uint32_t object, const float 
             timer(host, "depth_render", 0);
             if (!map) {
                 r = GI_ERR_OUT_OF_MEMORY;
-                snprintf(err->text, sizeof err->text, "csm: reading depth map %u failed", first + k);
+                snprintf(err->text, sizeof err->text, "csm: reading %s %u failed", desc->what, first + k);
                 goto done;
             }
             timer(host, "compress", 1);
@@ -82,8 +78,11 @@ gi_result csm_build_object(const gi_gpu_scene *gs, uint32_t object, const float 
             if (r != GI_OK)
                 goto done;
         }
-        if (host)
-            host->progress(host, "csm: depth maps", p0 + p1 * (float)(first + count) / (float)N);
+        if (host) {
+            char label[96];
+            snprintf(label, sizeof label, "csm: %s", desc->what);
+            host->progress(host, label, p0 + p1 * (float)(first + count) / (float)N);
+        }
     }
     timer(host, "compress", 1);
     r = gi_csm_codec_finish(enc, out, err);
@@ -97,4 +96,38 @@ done:
     glDeleteTextures(1, &tex);
     gi_depth_renderer_free(dr);
     return r;
+}
+
+/* Map q of an object's distant-light CSM: the q-th cell of the enumeration
+ * order on the lat-long grid (§4.1, §4.4). */
+typedef struct distant_views {
+    const csm_build_desc *desc;
+    const float *sphere;
+} distant_views;
+
+static void distant_view(void *ctx, uint32_t q, gi_depth_view *out)
+{
+    const distant_views *dv = ctx;
+    uint32_t a, b;
+    float theta, phi;
+    gi_csm_order_cell(dv->desc->order, dv->desc->n_phi, dv->desc->n_theta, q, &a, &b);
+    csm_cell_angles(dv->desc->n_theta, dv->desc->n_phi, a, b, &theta, &phi);
+    csm_map_view(dv->sphere, theta, phi, out);
+}
+
+gi_result csm_build_object(const gi_gpu_scene *gs, uint32_t object, const float sphere[4], const csm_build_desc *desc,
+                           const gi_host *host, float p0, float p1, gi_csm_data *out, gi_error *err)
+{
+    distant_views dv = {desc, sphere};
+    csm_encode_desc e = {.object = object,
+                         .M = desc->M,
+                         .count = desc->n_theta * desc->n_phi,
+                         .metric = GI_DEPTH_EYE_Z,
+                         .z3 = desc->z3,
+                         .shell = desc->shell,
+                         .batch = desc->batch,
+                         .view = distant_view,
+                         .ctx = &dv,
+                         .what = "depth maps"};
+    return csm_encode_maps(gs, &e, host, p0, p1, out, err);
 }
