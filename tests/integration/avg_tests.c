@@ -37,16 +37,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int failures;
-#define EXPECT(cond, ...)                                                                                              \
-    do {                                                                                                               \
-        if (!(cond)) {                                                                                                 \
-            failures++;                                                                                                \
-            fprintf(stderr, "%s:%d: failed: %s: ", __FILE__, __LINE__, #cond);                                       \
-            fprintf(stderr, __VA_ARGS__);                                                                              \
-            fputc('\n', stderr);                                                                                       \
-        }                                                                                                              \
-    } while (0)
+/* EXPECT(cond, fmt, ...): CHECK_MSG of the unit tests' check.h, which
+ * counts failures in gi_test_failed. */
+#include "../unit/check.h"
+#define EXPECT CHECK_MSG
 
 /* ---- a minimal host for driving the method in-process ---- */
 
@@ -911,7 +905,7 @@ int main(int argc, char **argv)
         return 2;
     }
     gi_gpu_destroy(gpu);
-    if (failures)
-        fprintf(stderr, "%d failure(s)\n", failures);
-    return failures ? 1 : 0;
+    if (gi_test_failed)
+        fprintf(stderr, "%d failure(s)\n", gi_test_failed);
+    return gi_test_failed ? 1 : 0;
 }

@@ -33,16 +33,10 @@
 
 extern const gi_shader_source gi_csm_local_shaders[];
 
-static int failures;
-#define EXPECT(cond, ...)                                                                                              \
-    do {                                                                                                               \
-        if (!(cond)) {                                                                                                 \
-            failures++;                                                                                                \
-            fprintf(stderr, "%s:%d: failed: %s: ", __FILE__, __LINE__, #cond);                                       \
-            fprintf(stderr, __VA_ARGS__);                                                                              \
-            fputc('\n', stderr);                                                                                       \
-        }                                                                                                              \
-    } while (0)
+/* EXPECT(cond, fmt, ...): CHECK_MSG of the unit tests' check.h, which
+ * counts failures in gi_test_failed. */
+#include "../unit/check.h"
+#define EXPECT CHECK_MSG
 
 enum { M_CUBE = 64, NL = 4 };
 
@@ -612,6 +606,6 @@ int main(void)
     free(pin);
     free(cpu);
     gi_gpu_destroy(gpu);
-    printf("%s\n", failures ? "FAILED" : "ok");
-    return failures ? 1 : 0;
+    printf("%s\n", gi_test_failed ? "FAILED" : "ok");
+    return gi_test_failed ? 1 : 0;
 }

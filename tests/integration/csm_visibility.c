@@ -39,16 +39,10 @@
 
 extern const gi_shader_source gi_csm_query_shaders[];
 
-static int failures;
-#define EXPECT(cond, ...)                                                                                              \
-    do {                                                                                                               \
-        if (!(cond)) {                                                                                                 \
-            failures++;                                                                                                \
-            fprintf(stderr, "%s:%d: failed: %s: ", __FILE__, __LINE__, #cond);                                       \
-            fprintf(stderr, __VA_ARGS__);                                                                              \
-            fputc('\n', stderr);                                                                                       \
-        }                                                                                                              \
-    } while (0)
+/* EXPECT(cond, fmt, ...): CHECK_MSG of the unit tests' check.h, which
+ * counts failures in gi_test_failed. */
+#include "../unit/check.h"
+#define EXPECT CHECK_MSG
 
 /* Number of hits of the ray o + h d, h > 0, with object k (local space). */
 static int hits(const gi_scene *s, uint32_t k, gi_vec3 o, gi_vec3 d)
@@ -474,12 +468,12 @@ int main(void)
     free(cpu_lit);
     free(exact_lit);
 
-    failures += open_surfaces(s, gs, k);
+    gi_test_failed += open_surfaces(s, gs, k);
 
     gi_csm_data_free(&data);
     gi_gpu_scene_free(gs);
     gi_scene_free(s);
     gi_gpu_destroy(gpu);
-    printf("%s\n", failures ? "FAILED" : "ok");
-    return failures ? 1 : 0;
+    printf("%s\n", gi_test_failed ? "FAILED" : "ok");
+    return gi_test_failed ? 1 : 0;
 }
