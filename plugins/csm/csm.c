@@ -78,8 +78,9 @@ static const gi_param_desc csm_params[] = {
     {"M", GI_PARAM_INT, 128, 8, 1024, NULL, "M (Sec. 3)", "depth map size M x M"},
     {"enumeration", GI_PARAM_ENUM, 2, 0, 0, "scanline|zigzag|hilbert|diagonal", "Sec. 4.4",
      "order of the maps in the codec"},
-    {"depth", GI_PARAM_ENUM, 0, 0, 0, "z2|z3", "Sec. 3.1",
-     "second depth of a segment: z2, or z3 (closed-manifold option)"},
+    {"depth", GI_PARAM_ENUM, 0, 0, 0, "z2|z3|sphere", "Sec. 3.1",
+     "second depth of a segment: z2; z3 (closed-manifold option), z2 where there is no third surface; sphere: z3, the "
+     "spherical far plane (exit from the bounding sphere) where there is no third surface"},
     {"open_surfaces", GI_PARAM_ENUM, 0, 0, 0, "shell|open", NULL,
      "a texel with a first surface and no second (open or single-sided mesh, e.g. a ground plane): shell: second "
      "depth z1 + shell_thickness, so that what lies behind stays shadowed; open: none (the codec may light it)"},

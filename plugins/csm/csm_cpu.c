@@ -82,13 +82,49 @@ int csm_visible_nearest(const gi_csm_data *data, const float sphere[4], uint32_t
     return gi_csm_visible(data, ty * M + tx, i, p.z, bias);
 }
 
-void csm_texel_depths(const float *map, size_t texels, int z3, float shell, float *z1, float *z2)
+void csm_texel_depths(const float *map, size_t texels, int mode, float shell, const float *far, float *z1,
+                      float *z2)
 {
     for (size_t t = 0; t < texels; t++) {
-        float a = map[4 * t], b = z3 && map[4 * t + 2] < FLT_MAX ? map[4 * t + 2] : map[4 * t + 1];
+        float a = map[4 * t], b = map[4 * t + 1];
+        if (mode != CSM_DEPTH_Z2 && b < FLT_MAX) {
+            if (map[4 * t + 2] < FLT_MAX)
+                b = map[4 * t + 2];
+            else if (mode == CSM_DEPTH_SPHERE && far[t] > b && far[t] < FLT_MAX)
+                b = far[t];
+        }
         if (shell > 0.0f && a < FLT_MAX && b >= FLT_MAX)
             b = a + shell;
         z1[t] = a;
         z2[t] = b;
     }
+}
+
+void csm_sphere_far(const gi_depth_view *v, gi_depth_metric metric, const float sphere[4], uint32_t M, float *far)
+{
+    float vp[16], inv[16];
+    gi_mat4_mul(vp, v->proj, v->view);
+    if (!gi_mat4_invert(inv, vp)) {
+        for (size_t t = 0; t < (size_t)M * M; t++)
+            far[t] = FLT_MAX;
+        return;
+    }
+    const gi_vec3 c = gi_v3(sphere[0], sphere[1], sphere[2]);
+    const double R = sphere[3];
+    for (uint32_t j = 0; j < M; j++)
+        for (uint32_t i = 0; i < M; i++) {
+            float x = ((float)i + 0.5f) / (float)M * 2.0f - 1.0f, y = ((float)j + 0.5f) / (float)M * 2.0f - 1.0f;
+            /* the texel's ray: from its point on the near plane (clip z 0) toward the far plane (z 1) */
+            gi_vec3 p0 = gi_mat4_point(inv, gi_v3(x, y, 0.0f)), p1 = gi_mat4_point(inv, gi_v3(x, y, 1.0f));
+            gi_vec3 d = gi_v3_normalize(gi_v3_sub(p1, p0)), oc = gi_v3_sub(p0, c);
+            double b = gi_v3_dot(oc, d), disc = b * b - ((double)gi_v3_dot(oc, oc) - R * R);
+            float *out = &far[(size_t)j * M + i];
+            if (disc < 0.0) {
+                *out = FLT_MAX;
+                continue;
+            }
+            gi_vec3 exit_point = gi_v3_add(p0, gi_v3_scale(d, (float)(-b + sqrt(disc))));
+            gi_vec3 e = gi_mat4_point(v->view, exit_point);
+            *out = metric == GI_DEPTH_EYE_Z ? -e.z : gi_v3_length(e);
+        }
 }

@@ -55,16 +55,25 @@ typedef struct csm_build_desc {
     uint32_t M;        /* map size */
     uint32_t n_theta, n_phi;
     gi_csm_order order;
-    int z3;            /* 1: the third surface as the codec's second (§3.1) */
+    int z3;            /* CSM_DEPTH_*: 0 z2; 1 z3, else z2; 2 z3, else the spherical far plane (§3.1) */
     float shell;       /* > 0: thin-shell depth (local units) behind a lone first surface; 0: open */
     uint32_t batch;    /* maps per gi_depth_render call */
 } csm_build_desc;
 
+/* Second-depth options of §3.1 ("Details on depth values"), the `depth`
+ * parameter: the second surface; the third surface (closed two-manifolds:
+ * the back of an object needs no correct shadow) falling back to the second
+ * where a texel has no third; or the third falling back to the spherical
+ * far plane, the depth at which the texel's ray leaves the object's
+ * bounding sphere. */
+enum { CSM_DEPTH_Z2 = 0, CSM_DEPTH_Z3 = 1, CSM_DEPTH_SPHERE = 2 };
+
 /* The codec's depths of the M x M texels of one map from the depth
  * renderer's read-back layer `map` (4 floats a texel: z1, z2, z3, -; none
- * >= FLT_MAX): z1 as it is; the second depth is z2, or with `z3` the third
- * surface where the texel has one and else z2 (the far side of the last
- * shell, §3.1's closed-manifold option). A texel with a first surface and no
+ * >= FLT_MAX): z1 as it is; the second depth is z2 (mode CSM_DEPTH_Z2), or
+ * the third surface where the texel has one and else z2 (CSM_DEPTH_Z3: the
+ * far side of the last shell) or else far[t] (CSM_DEPTH_SPHERE: the
+ * spherical far plane, csm_sphere_far; `far` is only read in that mode). A texel with a first surface and no
  * second one (an open or single-sided surface: a ground plane, a quad, the
  * silhouette of a mesh with holes) gets z1 + shell when shell > 0: the
  * surface is taken as a shell of that thickness, so the codec's z_avg stays
@@ -75,7 +84,15 @@ typedef struct csm_build_desc {
  * behind the surface test lit. z1 + shell may round to z1 when shell is
  * below the float spacing at z1; the codec then stores z1 (a classic
  * shadow-map texel), still shadowing what lies behind. */
-void csm_texel_depths(const float *map, size_t texels, int z3, float shell, float *z1, float *z2);
+void csm_texel_depths(const float *map, size_t texels, int mode, float shell, const float *far, float *z1,
+                      float *z2);
+
+/* The spherical far plane of one M x M map: for each texel the depth, in
+ * the map's metric, at which the ray through the texel's centre leaves the
+ * sphere (centre sphere[0..2], radius sphere[3], the map's own space);
+ * FLT_MAX where the ray misses it. `v` is the map's view (orthographic or
+ * perspective, core clip depth [0, 1]). */
+void csm_sphere_far(const gi_depth_view *v, gi_depth_metric metric, const float sphere[4], uint32_t M, float *far);
 
 /* What csm_encode_maps renders: `count` maps of `object` (object-local,
  * only that object), map q's view given by view(ctx, q, &v), rendered in
@@ -86,7 +103,8 @@ typedef struct csm_encode_desc {
     uint32_t object;
     uint32_t M, count;
     gi_depth_metric metric;
-    int z3;
+    int z3;              /* CSM_DEPTH_* */
+    const float *sphere; /* the object's bounding sphere (CSM_DEPTH_SPHERE) */
     float shell;
     uint32_t batch;
     void (*view)(void *ctx, uint32_t q, gi_depth_view *out);

@@ -208,6 +208,7 @@ gi_result csm_build_local(const gi_gpu_scene *gs, uint32_t object, const float s
                          .count = 6 * desc->n_u * desc->n_v,
                          .metric = GI_DEPTH_RADIAL,
                          .z3 = desc->z3,
+                         .sphere = sphere,
                          .shell = desc->shell,
                          .batch = desc->batch,
                          .view = local_view,

@@ -73,7 +73,7 @@ typedef struct csm_local_desc {
     gi_vec3 o, e1, e2;
     uint32_t n_u, n_v;
     gi_csm_order order;
-    int z3;
+    int z3; /* CSM_DEPTH_* (csm_cpu.h) */
     float shell; /* thin-shell depth behind a lone first surface (csm_texel_depths); 0: open */
     uint32_t batch;
 } csm_local_desc;

@@ -37,9 +37,10 @@ gi_result csm_encode_maps(const gi_gpu_scene *gs, const csm_encode_desc *desc, c
     GLuint tex = gi_depth_texture_create(dr, batch);
     gi_depth_view *views = calloc(batch, sizeof *views);
     float *z1 = malloc((size_t)M * M * sizeof *z1), *z2 = malloc((size_t)M * M * sizeof *z2);
+    float *far = desc->z3 == CSM_DEPTH_SPHERE ? malloc((size_t)M * M * sizeof *far) : NULL;
     gi_csm_codec *enc = NULL;
     gi_result r = GI_ERR_OUT_OF_MEMORY;
-    if (!views || !z1 || !z2) {
+    if (!views || !z1 || !z2 || (desc->z3 == CSM_DEPTH_SPHERE && (!far || !desc->sphere))) {
         snprintf(err->text, sizeof err->text, "csm: out of memory for %u x %u %s", M, M, desc->what);
         goto done;
     }
@@ -70,8 +71,10 @@ gi_result csm_encode_maps(const gi_gpu_scene *gs, const csm_encode_desc *desc, c
                 goto done;
             }
             timer(host, "compress", 1);
-            /* z3 option and open surfaces: csm_texel_depths (csm_cpu.h) */
-            csm_texel_depths(map, (size_t)M * M, desc->z3, desc->shell, z1, z2);
+            /* depth option and open surfaces: csm_texel_depths (csm_cpu.h) */
+            if (far)
+                csm_sphere_far(&views[k], desc->metric, desc->sphere, M, far);
+            csm_texel_depths(map, (size_t)M * M, desc->z3, desc->shell, far, z1, z2);
             free(map);
             r = gi_csm_codec_add_map(enc, first + k, z1, z2, err);
             timer(host, "compress", 0);
@@ -93,6 +96,7 @@ done:
     free(views);
     free(z1);
     free(z2);
+    free(far);
     glDeleteTextures(1, &tex);
     gi_depth_renderer_free(dr);
     return r;
@@ -124,6 +128,7 @@ gi_result csm_build_object(const gi_gpu_scene *gs, uint32_t object, const float 
                          .count = desc->n_theta * desc->n_phi,
                          .metric = GI_DEPTH_EYE_Z,
                          .z3 = desc->z3,
+                         .sphere = sphere,
                          .shell = desc->shell,
                          .batch = desc->batch,
                          .view = distant_view,

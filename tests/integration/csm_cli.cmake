@@ -36,6 +36,9 @@ expect_json(${OUT}/csm_bunny_4.json "\"cache_hit\": 1")
 expect(0 "" ${args} --param filter=pcf --param depth=z3 --param enumeration=zigzag --param S=5
        --out ${OUT}/csm_bunny_pcf.exr --timings ${OUT}/csm_bunny_pcf.json)
 expect_json(${OUT}/csm_bunny_pcf.json "\"nonfinite_pixels\": 0")
+expect(0 "" ${args} --param depth=sphere --param enumeration=diagonal --out ${OUT}/csm_bunny_sphere.exr
+       --timings ${OUT}/csm_bunny_sphere.json)
+expect_json(${OUT}/csm_bunny_sphere.json "\"nonfinite_pixels\": 0" "\"cache_hit\": 0")
 expect(0 "" ${args} --param filter=rr --param enumeration=scanline --out ${OUT}/csm_bunny_rr.exr
        --timings ${OUT}/csm_bunny_rr.json)
 expect_json(${OUT}/csm_bunny_rr.json "\"nonfinite_pixels\": 0")
