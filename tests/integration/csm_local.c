@@ -25,6 +25,8 @@
 #include "gi/sampling.h"
 #include "gi/shader.h"
 
+#include "csm_test_util.h"
+
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -50,19 +52,8 @@ static int seg_hits(const world *w, uint32_t k, gi_vec3 o, gi_vec3 d, float hmax
 {
     const gi_object *ob = &w->s->objects[k];
     int n = 0;
-    for (uint32_t t = ob->first_triangle; t < ob->first_triangle + ob->triangle_count; t++) {
-        gi_vec3 p0 = w->tri[3 * t], e1 = gi_v3_sub(w->tri[3 * t + 1], p0), e2 = gi_v3_sub(w->tri[3 * t + 2], p0);
-        gi_vec3 pv = gi_v3_cross(d, e2);
-        float det = gi_v3_dot(e1, pv);
-        if (fabsf(det) < 1e-14f)
-            continue;
-        gi_vec3 tv = gi_v3_sub(o, p0);
-        float u = gi_v3_dot(tv, pv) / det;
-        gi_vec3 qv = gi_v3_cross(tv, e1);
-        float v = gi_v3_dot(d, qv) / det;
-        float h = gi_v3_dot(e2, qv) / det;
-        n += u >= 0 && v >= 0 && u + v <= 1 && h > 0 && h < hmax;
-    }
+    for (uint32_t t = ob->first_triangle; t < ob->first_triangle + ob->triangle_count; t++)
+        n += csm_test_ray_hits_triangle(w->tri[3 * t], w->tri[3 * t + 1], w->tri[3 * t + 2], o, d, hmax);
     return n;
 }
 
@@ -556,13 +547,9 @@ static uint32_t object_named(const gi_scene *s, const char *name)
 
 int main(void)
 {
-    gi_error err;
-    gi_gpu *gpu = gi_gpu_create(NULL, &err);
-    if (!gpu) {
-        fprintf(stderr, "no GL: %s\n", err.text);
+    gi_gpu *gpu = csm_test_gpu(gi_csm_local_shaders);
+    if (!gpu)
         return 1;
-    }
-    gi_shader_register(gi_csm_local_shaders);
     pair *pin = malloc(sizeof *pin * PAIRS);
     int *cpu = malloc(sizeof *cpu * PAIRS);
     setup st;

@@ -12,6 +12,8 @@
 #include "gi/sampling.h"
 #include "gi/shader.h"
 
+#include "csm_test_util.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -47,13 +49,10 @@ static const char *kernel =
 
 int main(void)
 {
-    gi_error err;
-    gi_gpu *gpu = gi_gpu_create(NULL, &err);
-    if (!gpu) {
-        fprintf(stderr, "no GL: %s\n", err.text);
+    gi_gpu *gpu = csm_test_gpu(gi_csm_twin_shaders);
+    if (!gpu)
         return 1;
-    }
-    gi_shader_register(gi_csm_twin_shaders);
+    gi_error err;
     GLuint prog = gi_program_build_compute_text("tests/integration/csm_twins.comp", kernel, NULL, &err);
     if (!prog) {
         fprintf(stderr, "%s\n", err.text);

@@ -31,6 +31,8 @@
 #include "gi/sampling.h"
 #include "gi/shader.h"
 
+#include "csm_test_util.h"
+
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -52,18 +54,8 @@ static int hits(const gi_scene *s, uint32_t k, gi_vec3 o, gi_vec3 d)
     for (uint32_t t = ob->first_triangle; t < ob->first_triangle + ob->triangle_count; t++) {
         const float *q0 = s->vertices[s->indices[3 * t]].position, *q1 = s->vertices[s->indices[3 * t + 1]].position,
                     *q2 = s->vertices[s->indices[3 * t + 2]].position;
-        gi_vec3 p0 = gi_v3(q0[0], q0[1], q0[2]);
-        gi_vec3 e1 = gi_v3_sub(gi_v3(q1[0], q1[1], q1[2]), p0), e2 = gi_v3_sub(gi_v3(q2[0], q2[1], q2[2]), p0);
-        gi_vec3 pv = gi_v3_cross(d, e2);
-        float det = gi_v3_dot(e1, pv);
-        if (fabsf(det) < 1e-14f)
-            continue;
-        gi_vec3 tv = gi_v3_sub(o, p0);
-        float u = gi_v3_dot(tv, pv) / det;
-        gi_vec3 qv = gi_v3_cross(tv, e1);
-        float v = gi_v3_dot(d, qv) / det;
-        float h = gi_v3_dot(e2, qv) / det;
-        n += u >= 0 && v >= 0 && u + v <= 1 && h > 0;
+        n += csm_test_ray_hits_triangle(gi_v3(q0[0], q0[1], q0[2]), gi_v3(q1[0], q1[1], q1[2]),
+                                        gi_v3(q2[0], q2[1], q2[2]), o, d, INFINITY);
     }
     return n;
 }
@@ -279,12 +271,10 @@ static int open_surfaces(const gi_scene *s, const gi_gpu_scene *gs, uint32_t kb)
 
 int main(void)
 {
-    gi_error err;
-    gi_gpu *gpu = gi_gpu_create(NULL, &err);
-    if (!gpu) {
-        fprintf(stderr, "no GL: %s\n", err.text);
+    gi_gpu *gpu = csm_test_gpu(NULL);
+    if (!gpu)
         return 1;
-    }
+    gi_error err;
     gi_scene *s = gi_scene_load(GI_SOURCE_DIR "/scenes/bunny_env.glb", &err);
     if (!s) {
         fprintf(stderr, "%s\n", err.text);
