@@ -3,29 +3,7 @@
 # features of harness/studies/csm.json runs end to end.
 # cmake -DGIB=... -DROOT=... -DOUT=... -P study_test.cmake
 set(failures 0)
-function(fail msg)
-    message(SEND_ERROR "${msg}")
-    math(EXPR f "${failures} + 1")
-    set(failures ${f} PARENT_SCOPE)
-endfunction()
-function(match text regex msg)
-    if(NOT text MATCHES "${regex}")
-        message(SEND_ERROR "${msg}")
-        math(EXPR f "${failures} + 1")
-        set(failures ${f} PARENT_SCOPE)
-    endif()
-endfunction()
-function(run code)
-    execute_process(COMMAND ${GIB} ${ARGN} WORKING_DIRECTORY ${ROOT} RESULT_VARIABLE rc OUTPUT_VARIABLE out
-                    ERROR_VARIABLE err)
-    set(last_out "${out}" PARENT_SCOPE)
-    set(last_err "${err}" PARENT_SCOPE)
-    if(NOT rc EQUAL code)
-        message(SEND_ERROR "gibench ${ARGN}: exit ${rc}, expected ${code}\n${out}\n${err}")
-        math(EXPR f "${failures} + 1")
-        set(failures ${f} PARENT_SCOPE)
-    endif()
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
 
 # Every shipped study file is valid: scenes load, methods and parameter
 # values exist, charts are well formed.
