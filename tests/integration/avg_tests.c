@@ -91,18 +91,7 @@ static gi_host make_host(const gi_gpu_scene *gs)
 static void make_view(const gi_scene *s, float t, uint32_t w, uint32_t h, gi_view *v)
 {
     gi_camera_frame cf = gi_scene_camera_at(s, s->camera_count ? 0 : -1, t);
-    memset(v, 0, sizeof *v);
-    v->width = w;
-    v->height = h;
-    gi_mat4_invert(v->view, cf.world_from_camera);
-    gi_mat4_perspective(v->proj, cf.yfov, (float)w / (float)h, cf.znear, cf.zfar);
-    gi_mat4_mul(v->view_proj, v->proj, v->view);
-    gi_mat4_invert(v->inv_view_proj, v->view_proj);
-    v->eye = cf.eye;
-    v->yfov = cf.yfov;
-    v->znear = cf.znear;
-    v->zfar = cf.zfar;
-    v->time = t;
+    gi_view_from_camera(&cf, w, h, t, v);
     v->seed = 1;
 }
 
