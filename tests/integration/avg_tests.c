@@ -285,12 +285,11 @@ static uint32_t *cpu_voxelise(const gi_scene *s, float t, const avg_grid *g, flo
 static void voxel_case(gi_gpu *gpu, const char *scene_path, const float *ts, int nt, uint32_t n)
 {
     gi_error err;
-    gi_scene *s = gi_scene_load(scene_path, &err);
-    if (!s) {
-        EXPECT(0, "%s", err.text);
+    fixture fx;
+    if (!load_fixture(gpu, scene_path, &fx))
         return;
-    }
-    gi_gpu_scene *gs = gi_gpu_scene_upload(gpu, s, &err);
+    const gi_scene *s = fx.s;
+    gi_gpu_scene *gs = fx.gs;
     avg_grid *g = avg_grid_create(n, &err);
     if (!g) {
         EXPECT(0, "%s", err.text);
@@ -347,8 +346,7 @@ static void voxel_case(gi_gpu *gpu, const char *scene_path, const float *ts, int
         free(colour);
     }
     avg_grid_free(g);
-    gi_gpu_scene_free(gs);
-    gi_scene_free(s);
+    free_fixture(&fx);
 }
 
 /* ---- deform: the grid follows morph targets ---- */
@@ -442,13 +440,11 @@ static const char *march_src = "#define AVG_UNIT_NORMAL 8\n"
 static void march_case(gi_gpu *gpu, const char *scene_path, uint32_t n, uint32_t rays)
 {
     gi_error err;
-    gi_scene *s = gi_scene_load(scene_path, &err);
-    if (!s) {
-        EXPECT(0, "%s", err.text);
+    fixture fx;
+    if (!load_fixture(gpu, scene_path, &fx))
         return;
-    }
-    gi_gpu_scene *gs = gi_gpu_scene_upload(gpu, s, &err);
-    gi_gpu_scene_set_time(gs, 0.0f);
+    const gi_scene *s = fx.s;
+    gi_gpu_scene *gs = fx.gs;
     avg_grid *g = avg_grid_create(n, &err);
     gi_rt *rt = NULL;
     if (!g || gi_rt_create(s, 0.0f, &rt, &err) != GI_OK) {
@@ -563,8 +559,7 @@ static void march_case(gi_gpu *gpu, const char *scene_path, uint32_t n, uint32_t
     free(grid);
     gi_rt_free(rt);
     avg_grid_free(g);
-    gi_gpu_scene_free(gs);
-    gi_scene_free(s);
+    free_fixture(&fx);
 }
 
 /* ---- vpls: determinism and the two tracers ---- */
