@@ -46,6 +46,18 @@ function(match text regex msg)
     endif()
 endfunction()
 
+# match_count(<text> <regex> <count> <what>): regex matches text exactly
+# count times (e.g. "\n[^\n]+": the data rows of a CSV file).
+function(match_count text regex count what)
+    string(REGEX MATCHALL "${regex}" found "${text}")
+    list(LENGTH found n)
+    if(NOT n EQUAL count)
+        message(SEND_ERROR "${what}: expected ${count}, got ${n}:\n${text}")
+        math(EXPR f "${failures} + 1")
+        set(failures ${f} PARENT_SCOPE)
+    endif()
+endfunction()
+
 # run(<exit code> <args...>): runs gibench in ${ROOT}, which must exit with
 # code; its stdout and stderr are left in last_out and last_err.
 function(run code)
