@@ -28,6 +28,29 @@ static inline int csm_test_ray_hits_triangle(gi_vec3 p0, gi_vec3 p1, gi_vec3 p2,
     return u >= 0 && v >= 0 && u + v <= 1 && h > 0 && h < hmax;
 }
 
+/* Runs the bound compute program (64 invocations per group) over `count`
+ * invocations and reads the first `bytes` of buffer `out` into dst. */
+static inline void csm_test_dispatch_read(uint32_t count, GLuint out, GLsizeiptr bytes, void *dst)
+{
+    glDispatchCompute((count + 63) / 64, 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glGetNamedBufferSubData(out, 0, bytes, dst);
+}
+
+/* The GLSL queries' results, 4 floats per pair (nearest, PCF, RR averaged
+ * over 256 stratified numbers, 0): mean and largest |RR - PCF|. */
+static inline void csm_test_rr_error(const float *gout, int pairs, double *mean, double *max)
+{
+    double sum = 0, worst = 0;
+    for (int p = 0; p < pairs; p++) {
+        double e = fabs((double)gout[4 * p + 2] - gout[4 * p + 1]);
+        sum += e;
+        worst = e > worst ? e : worst;
+    }
+    *mean = sum / pairs;
+    *max = worst;
+}
+
 /* The GL context (EGL surfaceless) with the test's embedded shaders
  * registered; NULL after a one-line error when there is no GL. */
 static inline gi_gpu *csm_test_gpu(const gi_shader_source *shaders)

@@ -101,9 +101,7 @@ int main(void)
     for (GLuint i = 0; i < 3; i++)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, i, bufs[i]);
     glUseProgram(prog);
-    glDispatchCompute(CASES / 64, 1, 1);
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    glGetNamedBufferSubData(bufs[2], 0, (GLsizeiptr)(sizeof(float) * CASES * OUT_F), gpu_out);
+    csm_test_dispatch_read(CASES, bufs[2], (GLsizeiptr)(sizeof(float) * CASES * OUT_F), gpu_out);
     static const char *names[OUT_F] = {"cell theta", "cell phi", "dir.x", "dir.y", "dir.z", "grid u", "grid v",
                                        "t.x", "t.y", "t.z", "b.x", "b.y", "b.z", "d.x", "d.y", "d.z",
                                        "project sx", "project sy", "project depth"};
