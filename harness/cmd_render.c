@@ -112,18 +112,7 @@ static int parse_opts(int argc, char **argv, render_opts *o)
 static void make_view(const gi_scene *s, int camera, const render_opts *o, float t, uint32_t frame, gi_view *v)
 {
     gi_camera_frame cf = gi_scene_camera_at(s, camera, t);
-    memset(v, 0, sizeof *v);
-    v->width = o->width;
-    v->height = o->height;
-    gi_mat4_invert(v->view, cf.world_from_camera);
-    gi_mat4_perspective(v->proj, cf.yfov, (float)o->width / (float)o->height, cf.znear, cf.zfar);
-    gi_mat4_mul(v->view_proj, v->proj, v->view);
-    gi_mat4_invert(v->inv_view_proj, v->view_proj);
-    v->eye = cf.eye;
-    v->yfov = cf.yfov;
-    v->znear = cf.znear;
-    v->zfar = cf.zfar;
-    v->time = t;
+    gi_view_from_camera(&cf, o->width, o->height, t, v);
     v->frame_index = frame;
     v->seed = o->seed;
     v->exposure = o->exposure;

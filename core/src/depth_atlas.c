@@ -94,12 +94,7 @@ gi_depth_atlas *gi_depth_atlas_create(const gi_depth_atlas_desc *d, gi_error *er
     a->loc_views = glGetUniformLocation(a->program, "u_views");
     a->loc_projection = glGetUniformLocation(a->program, "u_projection");
     a->loc_metric = glGetUniformLocation(a->program, "u_metric");
-    glCreateTextures(GL_TEXTURE_2D, 1, &a->tex);
-    glTextureStorage2D(a->tex, 1, GL_R32F, (GLsizei)a->width, (GLsizei)a->height);
-    glTextureParameteri(a->tex, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTextureParameteri(a->tex, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTextureParameteri(a->tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTextureParameteri(a->tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    a->tex = gi_gpu_texture_2d(GL_R32F, a->width, a->height);
     glCreateRenderbuffers(1, &a->depth_rb);
     glNamedRenderbufferStorage(a->depth_rb, GL_DEPTH_COMPONENT32F, (GLsizei)a->width, (GLsizei)a->height);
     glCreateFramebuffers(1, &a->fbo);

@@ -32,16 +32,22 @@ static GLuint make_buffer(const void *data, size_t size, GLbitfield flags)
     return b;
 }
 
-static GLuint make_texture_2d(GLenum format, uint32_t w, uint32_t h, GLenum data_format, const float *data)
+GLuint gi_gpu_texture_2d(GLenum format, uint32_t width, uint32_t height)
 {
     GLuint t;
     glCreateTextures(GL_TEXTURE_2D, 1, &t);
-    glTextureStorage2D(t, 1, format, (GLsizei)w, (GLsizei)h);
-    glTextureSubImage2D(t, 0, 0, 0, (GLsizei)w, (GLsizei)h, data_format, GL_FLOAT, data);
+    glTextureStorage2D(t, 1, format, (GLsizei)width, (GLsizei)height);
     glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glTextureParameteri(t, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTextureParameteri(t, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return t;
+}
+
+static GLuint make_texture_2d(GLenum format, uint32_t w, uint32_t h, GLenum data_format, const float *data)
+{
+    GLuint t = gi_gpu_texture_2d(format, w, h);
+    glTextureSubImage2D(t, 0, 0, 0, (GLsizei)w, (GLsizei)h, data_format, GL_FLOAT, data);
     return t;
 }
 

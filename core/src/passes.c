@@ -6,18 +6,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static GLuint make_tex(GLenum format, uint32_t w, uint32_t h)
-{
-    GLuint t;
-    glCreateTextures(GL_TEXTURE_2D, 1, &t);
-    glTextureStorage2D(t, 1, format, (GLsizei)w, (GLsizei)h);
-    glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTextureParameteri(t, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTextureParameteri(t, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    return t;
-}
-
 gi_gbuffer *gi_gbuffer_create(uint32_t width, uint32_t height, gi_error *err)
 {
     if (width == 0 || height == 0 || width > 16384 || height > 16384) {
@@ -36,13 +24,13 @@ gi_gbuffer *gi_gbuffer_create(uint32_t width, uint32_t height, gi_error *err)
         free(gb);
         return NULL;
     }
-    gb->tex_position = make_tex(GL_RGBA32F, width, height);
-    gb->tex_normal = make_tex(GL_RGBA16F, width, height);
-    gb->tex_albedo = make_tex(GL_RGBA16F, width, height);
-    gb->tex_phong = make_tex(GL_RGBA16F, width, height);
-    gb->tex_emission = make_tex(GL_RGBA16F, width, height);
-    gb->tex_ids = make_tex(GL_RGBA32UI, width, height);
-    gb->tex_depth = make_tex(GL_DEPTH_COMPONENT32F, width, height);
+    gb->tex_position = gi_gpu_texture_2d(GL_RGBA32F, width, height);
+    gb->tex_normal = gi_gpu_texture_2d(GL_RGBA16F, width, height);
+    gb->tex_albedo = gi_gpu_texture_2d(GL_RGBA16F, width, height);
+    gb->tex_phong = gi_gpu_texture_2d(GL_RGBA16F, width, height);
+    gb->tex_emission = gi_gpu_texture_2d(GL_RGBA16F, width, height);
+    gb->tex_ids = gi_gpu_texture_2d(GL_RGBA32UI, width, height);
+    gb->tex_depth = gi_gpu_texture_2d(GL_DEPTH_COMPONENT32F, width, height);
     glCreateFramebuffers(1, &gb->fbo);
     GLuint color[6] = {gb->tex_position, gb->tex_normal, gb->tex_albedo, gb->tex_phong, gb->tex_emission, gb->tex_ids};
     GLenum bufs[6];
@@ -138,8 +126,8 @@ gi_depth_renderer *gi_depth_renderer_create(const gi_depth_desc *desc, gi_error 
     glCreateRenderbuffers(1, &r->depth_rb);
     glNamedRenderbufferStorage(r->depth_rb, GL_DEPTH_COMPONENT32F, (GLsizei)desc->size, (GLsizei)desc->size);
     glNamedFramebufferRenderbuffer(r->fbo, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, r->depth_rb);
-    r->peel[0] = make_tex(GL_R32F, desc->size, desc->size);
-    r->peel[1] = make_tex(GL_R32F, desc->size, desc->size);
+    r->peel[0] = gi_gpu_texture_2d(GL_R32F, desc->size, desc->size);
+    r->peel[1] = gi_gpu_texture_2d(GL_R32F, desc->size, desc->size);
     return r;
 }
 

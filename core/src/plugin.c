@@ -228,3 +228,19 @@ void gi_plugins_free(gi_plugins *reg)
     free(reg->errors);
     free(reg);
 }
+
+void gi_view_from_camera(const gi_camera_frame *cf, uint32_t width, uint32_t height, float t, gi_view *v)
+{
+    memset(v, 0, sizeof *v);
+    v->width = width;
+    v->height = height;
+    gi_mat4_invert(v->view, cf->world_from_camera);
+    gi_mat4_perspective(v->proj, cf->yfov, (float)width / (float)height, cf->znear, cf->zfar);
+    gi_mat4_mul(v->view_proj, v->proj, v->view);
+    gi_mat4_invert(v->inv_view_proj, v->view_proj);
+    v->eye = cf->eye;
+    v->yfov = cf->yfov;
+    v->znear = cf->znear;
+    v->zfar = cf->zfar;
+    v->time = t;
+}

@@ -314,16 +314,6 @@ static void dump_vpls(const avg *a)
         gi_log(GI_LOG_WARN, "avg: cannot write GIBENCH_AVG_VPLS file '%s'", path);
 }
 
-static GLuint make_tex2d(GLenum format, uint32_t w, uint32_t h)
-{
-    GLuint t;
-    glCreateTextures(GL_TEXTURE_2D, 1, &t);
-    glTextureStorage2D(t, 1, format, (GLsizei)w, (GLsizei)h);
-    glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    return t;
-}
-
 static void free_size_dependent(avg *a)
 {
     gi_gbuffer_free(a->gbuffer);
@@ -347,10 +337,10 @@ static gi_result ensure_size(avg *a, uint32_t w, uint32_t h)
     uint32_t mx = (uint32_t)a->mx;
     a->split_w = (w + mx - 1) / mx;
     a->split_h = (h + mx - 1) / mx;
-    a->tex_split_pos = make_tex2d(GL_RGBA32F, a->split_w * mx, a->split_h * mx);
-    a->tex_split_nrm = make_tex2d(GL_RGBA32F, a->split_w * mx, a->split_h * mx);
-    a->tex_split_out = make_tex2d(GL_RGBA32F, a->split_w * mx, a->split_h * mx);
-    a->tex_indirect = make_tex2d(GL_RGBA32F, w, h);
+    a->tex_split_pos = gi_gpu_texture_2d(GL_RGBA32F, a->split_w * mx, a->split_h * mx);
+    a->tex_split_nrm = gi_gpu_texture_2d(GL_RGBA32F, a->split_w * mx, a->split_h * mx);
+    a->tex_split_out = gi_gpu_texture_2d(GL_RGBA32F, a->split_w * mx, a->split_h * mx);
+    a->tex_indirect = gi_gpu_texture_2d(GL_RGBA32F, w, h);
     a->width = w;
     a->height = h;
     return GI_OK;

@@ -91,18 +91,7 @@ static gi_host make_host(const gi_gpu_scene *gs)
 static void make_view(const gi_scene *s, float t, uint32_t w, uint32_t h, gi_view *v)
 {
     gi_camera_frame cf = gi_scene_camera_at(s, s->camera_count ? 0 : -1, t);
-    memset(v, 0, sizeof *v);
-    v->width = w;
-    v->height = h;
-    gi_mat4_invert(v->view, cf.world_from_camera);
-    gi_mat4_perspective(v->proj, cf.yfov, (float)w / (float)h, cf.znear, cf.zfar);
-    gi_mat4_mul(v->view_proj, v->proj, v->view);
-    gi_mat4_invert(v->inv_view_proj, v->view_proj);
-    v->eye = cf.eye;
-    v->yfov = cf.yfov;
-    v->znear = cf.znear;
-    v->zfar = cf.zfar;
-    v->time = t;
+    gi_view_from_camera(&cf, w, h, t, v);
     v->seed = 1;
 }
 
@@ -153,6 +142,65 @@ static int render(avg *a, const gi_view *v, const target *t)
         return 0;
     }
     return 1;
+}
+
+/* A scene loaded and uploaded at t = 0, with a host around it. */
+typedef struct fixture {
+    gi_scene *s;
+    gi_gpu_scene *gs;
+    gi_host host;
+} fixture;
+
+static int load_fixture(gi_gpu *gpu, const char *scene_path, fixture *f)
+{
+    gi_error err;
+    f->s = gi_scene_load(scene_path, &err);
+    if (!f->s) {
+        EXPECT(0, "%s", err.text);
+        return 0;
+    }
+    f->gs = gi_gpu_scene_upload(gpu, f->s, &err);
+    gi_gpu_scene_set_time(f->gs, 0.0f);
+    f->host = make_host(f->gs);
+    return 1;
+}
+
+static void free_fixture(fixture *f)
+{
+    gi_gpu_scene_free(f->gs);
+    gi_scene_free(f->s);
+}
+
+/* Renders one w x h frame of `a` at t = 0 into a new target. */
+static target render_frame(avg *a, const gi_scene *s, uint32_t w, uint32_t h)
+{
+    target t = make_target(w, h);
+    gi_view v;
+    make_view(s, 0.0f, w, h, &v);
+    EXPECT(render(a, &v, &t), "render");
+    return t;
+}
+
+/* The G-buffer of the last frame of `a`, read back. */
+typedef struct gbuffer_images {
+    gi_image *pos, *nrm, *alb, *emi;
+} gbuffer_images;
+
+static gbuffer_images read_gbuffer(const avg *a, uint32_t w, uint32_t h)
+{
+    gbuffer_images g = {gi_gpu_read_texture(a->gbuffer->tex_position, w, h),
+                        gi_gpu_read_texture(a->gbuffer->tex_normal, w, h),
+                        gi_gpu_read_texture(a->gbuffer->tex_albedo, w, h),
+                        gi_gpu_read_texture(a->gbuffer->tex_emission, w, h)};
+    return g;
+}
+
+static void free_gbuffer_images(gbuffer_images *g)
+{
+    gi_image_free(g->pos);
+    gi_image_free(g->nrm);
+    gi_image_free(g->alb);
+    gi_image_free(g->emi);
 }
 
 /* ---- voxel: CPU triangle-box overlap by clipping ---- */
@@ -237,12 +285,11 @@ static uint32_t *cpu_voxelise(const gi_scene *s, float t, const avg_grid *g, flo
 static void voxel_case(gi_gpu *gpu, const char *scene_path, const float *ts, int nt, uint32_t n)
 {
     gi_error err;
-    gi_scene *s = gi_scene_load(scene_path, &err);
-    if (!s) {
-        EXPECT(0, "%s", err.text);
+    fixture fx;
+    if (!load_fixture(gpu, scene_path, &fx))
         return;
-    }
-    gi_gpu_scene *gs = gi_gpu_scene_upload(gpu, s, &err);
+    const gi_scene *s = fx.s;
+    gi_gpu_scene *gs = fx.gs;
     avg_grid *g = avg_grid_create(n, &err);
     if (!g) {
         EXPECT(0, "%s", err.text);
@@ -299,8 +346,7 @@ static void voxel_case(gi_gpu *gpu, const char *scene_path, const float *ts, int
         free(colour);
     }
     avg_grid_free(g);
-    gi_gpu_scene_free(gs);
-    gi_scene_free(s);
+    free_fixture(&fx);
 }
 
 /* ---- deform: the grid follows morph targets ---- */
@@ -394,13 +440,11 @@ static const char *march_src = "#define AVG_UNIT_NORMAL 8\n"
 static void march_case(gi_gpu *gpu, const char *scene_path, uint32_t n, uint32_t rays)
 {
     gi_error err;
-    gi_scene *s = gi_scene_load(scene_path, &err);
-    if (!s) {
-        EXPECT(0, "%s", err.text);
+    fixture fx;
+    if (!load_fixture(gpu, scene_path, &fx))
         return;
-    }
-    gi_gpu_scene *gs = gi_gpu_scene_upload(gpu, s, &err);
-    gi_gpu_scene_set_time(gs, 0.0f);
+    const gi_scene *s = fx.s;
+    gi_gpu_scene *gs = fx.gs;
     avg_grid *g = avg_grid_create(n, &err);
     gi_rt *rt = NULL;
     if (!g || gi_rt_create(s, 0.0f, &rt, &err) != GI_OK) {
@@ -515,27 +559,22 @@ static void march_case(gi_gpu *gpu, const char *scene_path, uint32_t n, uint32_t
     free(grid);
     gi_rt_free(rt);
     avg_grid_free(g);
-    gi_gpu_scene_free(gs);
-    gi_scene_free(s);
+    free_fixture(&fx);
 }
 
 /* ---- vpls: determinism and the two tracers ---- */
 
 static void vpls_case(gi_gpu *gpu)
 {
-    gi_error err;
-    gi_scene *s = gi_scene_load(GI_SOURCE_DIR "/scenes/cornell_moving.gltf", &err);
-    if (!s) {
-        EXPECT(0, "%s", err.text);
+    fixture fx;
+    if (!load_fixture(gpu, GI_SOURCE_DIR "/scenes/cornell_moving.gltf", &fx))
         return;
-    }
-    gi_gpu_scene *gs = gi_gpu_scene_upload(gpu, s, &err);
-    gi_gpu_scene_set_time(gs, 0.0f);
-    gi_host host = make_host(gs);
+    const gi_scene *s = fx.s;
+    gi_gpu_scene *gs = fx.gs;
     const char *kv[] = {"vpls=512", "grid=32", "M=4"};
-    avg *a = make_avg(&host, gs, kv, 3);
+    avg *a = make_avg(&fx.host, gs, kv, 3);
     const char *kx[] = {"vpls=512", "grid=32", "M=4", "tracing=exact"};
-    avg *x = make_avg(&host, gs, kx, 4);
+    avg *x = make_avg(&fx.host, gs, kx, 4);
     if (!a || !x) {
         EXPECT(0, "cannot make the avg instances");
         return;
@@ -595,42 +634,32 @@ static void vpls_case(gi_gpu *gpu)
     m->destroy(x);
     free(first);
     free(moved);
-    gi_gpu_scene_free(gs);
-    gi_scene_free(s);
+    free_fixture(&fx);
 }
 
 /* ---- shade: interleaved shading against the plain sum ---- */
 
 static void shade_case(gi_gpu *gpu, int M, int filter)
 {
-    gi_error err;
-    gi_scene *s = gi_scene_load(GI_SOURCE_DIR "/scenes/cornell_box.gltf", &err);
-    if (!s) {
-        EXPECT(0, "%s", err.text);
+    fixture fx;
+    if (!load_fixture(gpu, GI_SOURCE_DIR "/scenes/cornell_box.gltf", &fx))
         return;
-    }
-    gi_gpu_scene *gs = gi_gpu_scene_upload(gpu, s, &err);
-    gi_gpu_scene_set_time(gs, 0.0f);
-    gi_host host = make_host(gs);
+    const gi_scene *s = fx.s;
+    gi_gpu_scene *gs = fx.gs;
     char m_kv[16], f_kv[16];
     snprintf(m_kv, sizeof m_kv, "M=%d", M);
     snprintf(f_kv, sizeof f_kv, "filter=%d", filter);
     const char *kv[] = {"vpls=256", "grid=32", m_kv, f_kv, "visibility=false"};
-    avg *a = make_avg(&host, gs, kv, 5);
+    avg *a = make_avg(&fx.host, gs, kv, 5);
     if (!a) {
         EXPECT(0, "cannot make the avg instance");
         return;
     }
     uint32_t w = 30, h = 26; /* not multiples of 4: partial sub-images */
-    target t = make_target(w, h);
-    gi_view v;
-    make_view(s, 0.0f, w, h, &v);
-    EXPECT(render(a, &v, &t), "render");
+    target t = render_frame(a, s, w, h);
     gi_image *img = gi_gpu_read_texture(t.tex, w, h);
-    gi_image *pos = gi_gpu_read_texture(a->gbuffer->tex_position, w, h);
-    gi_image *nrm = gi_gpu_read_texture(a->gbuffer->tex_normal, w, h);
-    gi_image *alb = gi_gpu_read_texture(a->gbuffer->tex_albedo, w, h);
-    gi_image *emi = gi_gpu_read_texture(a->gbuffer->tex_emission, w, h);
+    gbuffer_images gb = read_gbuffer(a, w, h);
+    const gi_image *pos = gb.pos, *nrm = gb.nrm, *alb = gb.alb, *emi = gb.emi;
     float dmin = a->clamp * a->grid->h;
     double worst = 0.0;
     uint32_t lit = 0;
@@ -666,13 +695,9 @@ static void shade_case(gi_gpu *gpu, int M, int filter)
     EXPECT(lit > w * h / 2, "only %u pixels hit the scene", lit);
     EXPECT(worst < 1e-3, "GPU shading differs from the CPU sum by %.3g (relative)", worst);
     gi_image_free(img);
-    gi_image_free(pos);
-    gi_image_free(nrm);
-    gi_image_free(alb);
-    gi_image_free(emi);
+    free_gbuffer_images(&gb);
     gi_method_entry(GI_ABI_VERSION)->destroy(a);
-    gi_gpu_scene_free(gs);
-    gi_scene_free(s);
+    free_fixture(&fx);
 }
 
 /* ---- visibility: the VPL shadow maps against Embree ---- */
@@ -698,28 +723,22 @@ static int map_visible(const avg *a, const float *tiles, uint32_t j, gi_vec3 x, 
 static void visibility_case(gi_gpu *gpu, const char *projection)
 {
     gi_error err;
-    gi_scene *s = gi_scene_load(GI_SOURCE_DIR "/scenes/cornell_box.gltf", &err);
-    if (!s) {
-        EXPECT(0, "%s", err.text);
+    fixture fx;
+    if (!load_fixture(gpu, GI_SOURCE_DIR "/scenes/cornell_box.gltf", &fx))
         return;
-    }
-    gi_gpu_scene *gs = gi_gpu_scene_upload(gpu, s, &err);
-    gi_gpu_scene_set_time(gs, 0.0f);
-    gi_host host = make_host(gs);
+    const gi_scene *s = fx.s;
+    gi_gpu_scene *gs = fx.gs;
     char pkv[64];
     snprintf(pkv, sizeof pkv, "projection=%s", projection);
     const char *kv[] = {"vpls=256", "grid=32", pkv};
-    avg *a = make_avg(&host, gs, kv, 3);
+    avg *a = make_avg(&fx.host, gs, kv, 3);
     gi_rt *rt = NULL;
     if (!a || gi_rt_create(s, 0.0f, &rt, &err) != GI_OK) {
         EXPECT(0, "cannot make the avg instance or the ray caster");
         return;
     }
     uint32_t w = 32, h = 32;
-    target t = make_target(w, h);
-    gi_view v;
-    make_view(s, 0.0f, w, h, &v);
-    EXPECT(render(a, &v, &t), "render");
+    render_frame(a, s, w, h);
     const gi_depth_atlas_desc *d = gi_depth_atlas_get_desc(a->atlas);
     float *tiles = malloc((size_t)a->vpl_count * d->tile * d->tile * sizeof *tiles);
     for (uint32_t j = 0; j < a->vpl_count; j++) {
@@ -727,8 +746,8 @@ static void visibility_case(gi_gpu *gpu, const char *projection)
         memcpy(tiles + (size_t)j * d->tile * d->tile, tile, (size_t)d->tile * d->tile * sizeof *tiles);
         free(tile);
     }
-    gi_image *pos = gi_gpu_read_texture(a->gbuffer->tex_position, w, h);
-    gi_image *nrm = gi_gpu_read_texture(a->gbuffer->tex_normal, w, h);
+    gbuffer_images gb = read_gbuffer(a, w, h);
+    const gi_image *pos = gb.pos, *nrm = gb.nrm;
     uint32_t pairs = 0, agree = 0, false_shadow = 0, false_light = 0;
     float bias_abs = 0.5f * a->grid->h, bias_rel = 1.0f / (float)a->tile; /* AVG_BIAS_* in avg.c */
     for (size_t i = 0; i < (size_t)w * h; i++) {
@@ -759,12 +778,10 @@ static void visibility_case(gi_gpu *gpu, const char *projection)
     EXPECT(agree >= pairs - pairs / 20, "shadow maps agree with ray casting on only %u of %u pairs", agree, pairs);
     EXPECT(pairs > 10000, "too few pairs (%u)", pairs);
     free(tiles);
-    gi_image_free(pos);
-    gi_image_free(nrm);
+    free_gbuffer_images(&gb);
     gi_rt_free(rt);
     gi_method_entry(GI_ABI_VERSION)->destroy(a);
-    gi_gpu_scene_free(gs);
-    gi_scene_free(s);
+    free_fixture(&fx);
 }
 
 /* ---- punctual: point and spot lights through their VPLs ---- */
@@ -779,31 +796,22 @@ static void visibility_case(gi_gpu *gpu, const char *projection)
  * directional light is ignored by the method and by this sum. */
 static void punctual_case(gi_gpu *gpu)
 {
-    gi_error err;
-    gi_scene *s = gi_scene_load(GI_SOURCE_DIR "/tests/data/valid/lights.gltf", &err);
-    if (!s) {
-        EXPECT(0, "%s", err.text);
+    fixture fx;
+    if (!load_fixture(gpu, GI_SOURCE_DIR "/tests/data/valid/lights.gltf", &fx))
         return;
-    }
-    gi_gpu_scene *gs = gi_gpu_scene_upload(gpu, s, &err);
-    gi_gpu_scene_set_time(gs, 0.0f);
-    gi_host host = make_host(gs);
+    const gi_scene *s = fx.s;
+    gi_gpu_scene *gs = fx.gs;
     const char *kv[] = {"vpls=4096", "bounces=0", "grid=16", "M=1", "filter=false", "visibility=false"};
-    avg *a = make_avg(&host, gs, kv, 6);
+    avg *a = make_avg(&fx.host, gs, kv, 6);
     if (!a) {
         EXPECT(0, "cannot make the avg instance");
         return;
     }
     uint32_t w = 48, h = 48;
-    target t = make_target(w, h);
-    gi_view v;
-    make_view(s, 0.0f, w, h, &v);
-    EXPECT(render(a, &v, &t), "render");
+    target t = render_frame(a, s, w, h);
     gi_image *img = gi_gpu_read_texture(t.tex, w, h);
-    gi_image *pos = gi_gpu_read_texture(a->gbuffer->tex_position, w, h);
-    gi_image *nrm = gi_gpu_read_texture(a->gbuffer->tex_normal, w, h);
-    gi_image *alb = gi_gpu_read_texture(a->gbuffer->tex_albedo, w, h);
-    gi_image *emi = gi_gpu_read_texture(a->gbuffer->tex_emission, w, h);
+    gbuffer_images gb = read_gbuffer(a, w, h);
+    const gi_image *pos = gb.pos, *nrm = gb.nrm, *alb = gb.alb, *emi = gb.emi;
     float dmin2 = a->clamp * a->grid->h * a->clamp * a->grid->h;
     double worst = 0.0, sum_got = 0.0, sum_expect = 0.0, punctual_share = 0.0;
     uint32_t lit = 0;
@@ -857,13 +865,9 @@ static void punctual_case(gi_gpu *gpu)
     EXPECT(fabs(sum_got - sum_expect) < 0.01 * sum_expect, "image sum off by more than 1 %%");
     EXPECT(worst < 0.03, "a pixel differs by %.3g (relative)", worst);
     gi_image_free(img);
-    gi_image_free(pos);
-    gi_image_free(nrm);
-    gi_image_free(alb);
-    gi_image_free(emi);
+    free_gbuffer_images(&gb);
     gi_method_entry(GI_ABI_VERSION)->destroy(a);
-    gi_gpu_scene_free(gs);
-    gi_scene_free(s);
+    free_fixture(&fx);
 }
 
 int main(int argc, char **argv)

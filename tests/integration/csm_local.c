@@ -25,6 +25,8 @@
 #include "gi/sampling.h"
 #include "gi/shader.h"
 
+#include "csm_test_util.h"
+
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -50,19 +52,8 @@ static int seg_hits(const world *w, uint32_t k, gi_vec3 o, gi_vec3 d, float hmax
 {
     const gi_object *ob = &w->s->objects[k];
     int n = 0;
-    for (uint32_t t = ob->first_triangle; t < ob->first_triangle + ob->triangle_count; t++) {
-        gi_vec3 p0 = w->tri[3 * t], e1 = gi_v3_sub(w->tri[3 * t + 1], p0), e2 = gi_v3_sub(w->tri[3 * t + 2], p0);
-        gi_vec3 pv = gi_v3_cross(d, e2);
-        float det = gi_v3_dot(e1, pv);
-        if (fabsf(det) < 1e-14f)
-            continue;
-        gi_vec3 tv = gi_v3_sub(o, p0);
-        float u = gi_v3_dot(tv, pv) / det;
-        gi_vec3 qv = gi_v3_cross(tv, e1);
-        float v = gi_v3_dot(d, qv) / det;
-        float h = gi_v3_dot(e2, qv) / det;
-        n += u >= 0 && v >= 0 && u + v <= 1 && h > 0 && h < hmax;
-    }
+    for (uint32_t t = ob->first_triangle; t < ob->first_triangle + ob->triangle_count; t++)
+        n += csm_test_ray_hits_triangle(w->tri[3 * t], w->tri[3 * t + 1], w->tri[3 * t + 2], o, d, hmax);
     return n;
 }
 
@@ -515,27 +506,23 @@ static void gpu_check(const setup *st, const pair *pin, const int *cpu, uint32_t
     glUniform1i(glGetUniformLocation(prog, "csm_filter"), 0);
     glUniform1i(glGetUniformLocation(prog, "csm_semilocal"), 0);
     glUniform1f(glGetUniformLocation(prog, "csm_normal_offset"), 0.0f);
-    glDispatchCompute((PAIRS + 63) / 64, 1, 1);
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    glGetNamedBufferSubData(bufs[1], 0, (GLsizeiptr)(16 * PAIRS), gout);
+    csm_test_dispatch_read(PAIRS, bufs[1], (GLsizeiptr)(16 * PAIRS), gout);
     glUseProgram(0);
     glDeleteProgram(prog);
     glDeleteBuffers(9, bufs);
     int same = 0, partial = 0;
-    double rr_sum = 0, rr_max = 0;
     for (int p = 0; p < PAIRS; p++) {
         same += (gout[4 * p] > 0.5f) == (cpu[p] != 0);
         partial += gout[4 * p + 1] > 0.0f && gout[4 * p + 1] < 1.0f;
-        double e = fabs((double)gout[4 * p + 2] - gout[4 * p + 1]);
-        rr_sum += e;
-        rr_max = e > rr_max ? e : rr_max;
     }
+    double rr_mean, rr_max;
+    csm_test_rr_error(gout, PAIRS, &rr_mean, &rr_max);
     printf("  GLSL cube query: nearest equals the CPU query on %d of %d pairs; %s: PCF strictly between 0 and 1 on %d "
            "pairs, RR averaged over 256 stratified numbers vs PCF: mean |diff| %.4f, max %.4f\n",
-           same, PAIRS, s->objects[obj].name, partial, rr_sum / PAIRS, rr_max);
+           same, PAIRS, s->objects[obj].name, partial, rr_mean, rr_max);
     EXPECT(same >= PAIRS - 2, "%d of %d", same, PAIRS);
     EXPECT(partial > 0, "PCF never fractional");
-    EXPECT(rr_sum / PAIRS < 0.01 && rr_max <= 16.0 / 256.0 + 1e-3, "mean %g max %g", rr_sum / PAIRS, rr_max);
+    EXPECT(rr_mean < 0.01 && rr_max <= 16.0 / 256.0 + 1e-3, "mean %g max %g", rr_mean, rr_max);
     free(gout);
     free(objs);
     free(pairs);
@@ -556,13 +543,9 @@ static uint32_t object_named(const gi_scene *s, const char *name)
 
 int main(void)
 {
-    gi_error err;
-    gi_gpu *gpu = gi_gpu_create(NULL, &err);
-    if (!gpu) {
-        fprintf(stderr, "no GL: %s\n", err.text);
+    gi_gpu *gpu = csm_test_gpu(gi_csm_local_shaders);
+    if (!gpu)
         return 1;
-    }
-    gi_shader_register(gi_csm_local_shaders);
     pair *pin = malloc(sizeof *pin * PAIRS);
     int *cpu = malloc(sizeof *cpu * PAIRS);
     setup st;

@@ -12,6 +12,8 @@
 #include "gi/sampling.h"
 #include "gi/shader.h"
 
+#include "csm_test_util.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -47,13 +49,10 @@ static const char *kernel =
 
 int main(void)
 {
-    gi_error err;
-    gi_gpu *gpu = gi_gpu_create(NULL, &err);
-    if (!gpu) {
-        fprintf(stderr, "no GL: %s\n", err.text);
+    gi_gpu *gpu = csm_test_gpu(gi_csm_twin_shaders);
+    if (!gpu)
         return 1;
-    }
-    gi_shader_register(gi_csm_twin_shaders);
+    gi_error err;
     GLuint prog = gi_program_build_compute_text("tests/integration/csm_twins.comp", kernel, NULL, &err);
     if (!prog) {
         fprintf(stderr, "%s\n", err.text);
@@ -102,9 +101,7 @@ int main(void)
     for (GLuint i = 0; i < 3; i++)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, i, bufs[i]);
     glUseProgram(prog);
-    glDispatchCompute(CASES / 64, 1, 1);
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    glGetNamedBufferSubData(bufs[2], 0, (GLsizeiptr)(sizeof(float) * CASES * OUT_F), gpu_out);
+    csm_test_dispatch_read(CASES, bufs[2], (GLsizeiptr)(sizeof(float) * CASES * OUT_F), gpu_out);
     static const char *names[OUT_F] = {"cell theta", "cell phi", "dir.x", "dir.y", "dir.z", "grid u", "grid v",
                                        "t.x", "t.y", "t.z", "b.x", "b.y", "b.z", "d.x", "d.y", "d.z",
                                        "project sx", "project sy", "project depth"};

@@ -29,3 +29,45 @@ function(expect_json file)
         endif()
     endforeach()
 endfunction()
+
+# fail(<message>): one failed expectation.
+function(fail msg)
+    message(SEND_ERROR "${msg}")
+    math(EXPR f "${failures} + 1")
+    set(failures ${f} PARENT_SCOPE)
+endfunction()
+
+# match(<text> <regex> <message>): text must match regex.
+function(match text regex msg)
+    if(NOT text MATCHES "${regex}")
+        message(SEND_ERROR "${msg}")
+        math(EXPR f "${failures} + 1")
+        set(failures ${f} PARENT_SCOPE)
+    endif()
+endfunction()
+
+# match_count(<text> <regex> <count> <what>): regex matches text exactly
+# count times (e.g. "\n[^\n]+": the data rows of a CSV file).
+function(match_count text regex count what)
+    string(REGEX MATCHALL "${regex}" found "${text}")
+    list(LENGTH found n)
+    if(NOT n EQUAL count)
+        message(SEND_ERROR "${what}: expected ${count}, got ${n}:\n${text}")
+        math(EXPR f "${failures} + 1")
+        set(failures ${f} PARENT_SCOPE)
+    endif()
+endfunction()
+
+# run(<exit code> <args...>): runs gibench in ${ROOT}, which must exit with
+# code; its stdout and stderr are left in last_out and last_err.
+function(run code)
+    execute_process(COMMAND ${GIB} ${ARGN} WORKING_DIRECTORY ${ROOT} RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                    ERROR_VARIABLE err)
+    set(last_out "${out}" PARENT_SCOPE)
+    set(last_err "${err}" PARENT_SCOPE)
+    if(NOT rc EQUAL code)
+        message(SEND_ERROR "gibench ${ARGN}: exit ${rc}, expected ${code}\n${out}\n${err}")
+        math(EXPR f "${failures} + 1")
+        set(failures ${f} PARENT_SCOPE)
+    endif()
+endfunction()

@@ -3,29 +3,7 @@
 # features of harness/studies/csm.json runs end to end.
 # cmake -DGIB=... -DROOT=... -DOUT=... -P study_test.cmake
 set(failures 0)
-function(fail msg)
-    message(SEND_ERROR "${msg}")
-    math(EXPR f "${failures} + 1")
-    set(failures ${f} PARENT_SCOPE)
-endfunction()
-function(match text regex msg)
-    if(NOT text MATCHES "${regex}")
-        message(SEND_ERROR "${msg}")
-        math(EXPR f "${failures} + 1")
-        set(failures ${f} PARENT_SCOPE)
-    endif()
-endfunction()
-function(run code)
-    execute_process(COMMAND ${GIB} ${ARGN} WORKING_DIRECTORY ${ROOT} RESULT_VARIABLE rc OUTPUT_VARIABLE out
-                    ERROR_VARIABLE err)
-    set(last_out "${out}" PARENT_SCOPE)
-    set(last_err "${err}" PARENT_SCOPE)
-    if(NOT rc EQUAL code)
-        message(SEND_ERROR "gibench ${ARGN}: exit ${rc}, expected ${code}\n${out}\n${err}")
-        math(EXPR f "${failures} + 1")
-        set(failures ${f} PARENT_SCOPE)
-    endif()
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
 
 # Every shipped study file is valid: scenes load, methods and parameter
 # values exist, charts are well formed.
@@ -49,11 +27,7 @@ set(S ${OUT}/study_csm_tiny)
 file(REMOVE_RECURSE ${S})
 run(0 study tests/data/studies/csm_tiny.json --out ${S})
 file(READ ${S}/runs.csv csv)
-string(REGEX MATCHALL "\n[^\n]+" rows "${csv}")
-list(LENGTH rows nrows)
-if(NOT nrows EQUAL 6)
-    fail("csm_tiny: expected 6 runs, got ${nrows}:\n${csv}")
-endif()
+match_count("${csv}" "\n[^\n]+" 6 "csm_tiny: runs")
 match("${csv}" "^run,[^\n]*,label,width,height,prepare_depth_render_ms,prepare_compress_ms[^\n]*,stat_ratio,"
       "runs.csv lacks the label, prepare-stage or stats columns:\n${csv}")
 # Table-style rows: 8x8, not compared (no metrics), fresh precomputation.
@@ -63,11 +37,7 @@ match("${csv}" "\nbunny_env-csm-[^\n]*,ok,[^\n]*,error,16,16" "the compared row 
 match("${csv}" "\nbunny_env-csm-[^\n]*,ok,[^\n]*,process-cpu-time-around-glFinish,"
       "\"timer\": \"cputime\" did not reach the runs:\n${csv}")
 file(READ ${S}/frames.csv frames)
-string(REGEX MATCHALL "\nbunny_teapot_moving-csm-[^,]*,moving,[0-9]+," moving_rows "${frames}")
-list(LENGTH moving_rows nmoving)
-if(NOT nmoving EQUAL 3)
-    fail("frames.csv: expected 3 timed frames of the moving run, got ${nmoving}:\n${frames}")
-endif()
+match_count("${frames}" "\nbunny_teapot_moving-csm-[^,]*,moving,[0-9]+," 3 "frames.csv: timed frames of the moving run")
 foreach(f chart_ratio.png chart_frames.png chart_bunny_env_error_vs_time.png report.md)
     if(NOT EXISTS ${S}/${f})
         fail("csm_tiny did not write ${f}")

@@ -21,6 +21,7 @@
  * instanced into the atlas against the same views drawn one by one with
  * gi_depth_render, side by side in one run with the core timer. */
 #include "check.h"
+#include "gpu_fixture.h"
 
 #include "gi/gpu.h"
 #include "gi/passes.h"
@@ -464,15 +465,10 @@ static int bench(gi_gpu *gpu, gi_gpu_scene *gs, const gi_scene *s, uint32_t maps
 int main(int argc, char **argv)
 {
     gi_error err;
-    gi_gpu *gpu = gi_gpu_create(NULL, &err);
-    CHECK_MSG(gpu != NULL, "%s", err.text);
-    gi_scene *s = gi_scene_load(GI_SOURCE_DIR "/scenes/cornell_box.gltf", &err);
-    CHECK_MSG(s != NULL, "%s", err.text);
-    if (!gpu || !s)
-        return gi_test_finish();
-    gi_gpu_scene *gs = gi_gpu_scene_upload(gpu, s, &err);
-    CHECK_MSG(gs != NULL, "%s", err.text);
-    if (!gs)
+    gi_gpu *gpu;
+    gi_scene *s;
+    gi_gpu_scene *gs;
+    if (!gpu_fixture_load(GI_SOURCE_DIR "/scenes/cornell_box.gltf", &gpu, &s, &gs) || !gs)
         return gi_test_finish();
     if (argc > 1 && strcmp(argv[1], "--bench") == 0) {
         uint32_t maps = argc > 2 ? (uint32_t)strtoul(argv[2], NULL, 10) : 1024;

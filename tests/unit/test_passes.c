@@ -2,6 +2,7 @@
  * (ids, depth, normal, albedo) and peeled depth maps (orthographic,
  * perspective cube faces, paraboloid; first, second and third surface). */
 #include "check.h"
+#include "gpu_fixture.h"
 #include "gi/gpu.h"
 #include "gi/passes.h"
 
@@ -104,14 +105,11 @@ static float compare_map(const gi_scene *s, const float *map, uint32_t size, int
 int main(void)
 {
     gi_error err;
-    gi_gpu *gpu = gi_gpu_create(NULL, &err);
-    CHECK_MSG(gpu != NULL, "%s", err.text);
-    gi_scene *s = gi_scene_load(GI_SOURCE_DIR "/scenes/cornell_box.gltf", &err);
-    CHECK_MSG(s != NULL, "%s", err.text);
-    if (!gpu || !s)
+    gi_gpu *gpu;
+    gi_scene *s;
+    gi_gpu_scene *gs;
+    if (!gpu_fixture_load(GI_SOURCE_DIR "/scenes/cornell_box.gltf", &gpu, &s, &gs))
         return gi_test_finish();
-    gi_gpu_scene *gs = gi_gpu_scene_upload(gpu, s, &err);
-    CHECK_MSG(gs != NULL, "%s", err.text);
 
     /* ---- G-buffer from the scene camera ---- */
     const uint32_t W = 48, H = 48;

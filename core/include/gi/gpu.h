@@ -141,6 +141,11 @@ void gi_gpu_scene_bind(const gi_gpu_scene *gs);
  * VAO; the caller has a program bound. `instances` > 1 draws instanced. */
 void gi_gpu_scene_draw(const gi_gpu_scene *gs, int object, GLsizei instances);
 
+/* A new width x height 2D texture of `format` (one level, contents
+ * undefined) with nearest filtering and clamp-to-edge wrapping: the render
+ * targets, image outputs and lookup tables of the passes and plugins. */
+GLuint gi_gpu_texture_2d(GLenum format, uint32_t width, uint32_t height);
+
 /* Reads an RGBA32F texture (level 0) into a new image, top row first. */
 struct gi_image *gi_gpu_read_texture(GLuint tex, uint32_t width, uint32_t height);
 

@@ -102,6 +102,12 @@ typedef struct gi_view {
     float exposure;          /* display exposure (stops) the report will use */
 } gi_view;
 
+/* For hosts: the view of camera frame cf on a width x height image at scene
+ * time t (view, perspective projection with aspect width / height, their
+ * product and its inverse, eye, yfov, znear, zfar); frame_index, seed and
+ * exposure are 0, for the caller to set. */
+void gi_view_from_camera(const gi_camera_frame *cf, uint32_t width, uint32_t height, float t, gi_view *v);
+
 /* Where render() writes: linear RGB radiance (alpha ignored) into an
  * RGBA32F 2D texture of view->width x view->height owned by the host.
  * Write it with an FBO attachment (`fbo` has it attached as colour 0) or

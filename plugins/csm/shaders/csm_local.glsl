@@ -105,9 +105,8 @@ float csm_cube_test(CsmPair p, CsmLight l, uint a, uint b, vec3 x, int mode, flo
     ivec2 i0 = ivec2(t0);
     if (mode == 2) {
         float r = rr;
-        int ix = r < ft.x ? 1 : 0;
-        r = ix == 1 ? r / ft.x : (r - ft.x) / (1.0 - ft.x);
-        int iy = r < ft.y ? 1 : 0;
+        int ix = csm_rr_choose(r, ft.x);
+        int iy = csm_rr_choose(r, ft.y);
         ivec2 tex = clamp(i0 + ivec2(ix, iy), ivec2(0), ivec2(last));
         return depth <= csm_lookup_at(p.info.y, p.info.z, M, tex, i) + z_bias ? 1.0 : 0.0;
     }
@@ -155,10 +154,8 @@ float csm_local_visibility_object(uint j, uint k, vec3 x, vec3 n, vec3 y, int mo
     uint bs[2] = uint[2](uint(clamp(int(g0.y), 0, nv - 1)), uint(clamp(int(g0.y) + 1, 0, nv - 1)));
     if (mode == 2) {
         float r = u_rr;
-        int ia = r < fg.x ? 1 : 0;
-        r = ia == 1 ? r / fg.x : (r - fg.x) / (1.0 - fg.x);
-        int ib = r < fg.y ? 1 : 0;
-        r = ib == 1 ? r / fg.y : (r - fg.y) / (1.0 - fg.y);
+        int ia = csm_rr_choose(r, fg.x);
+        int ib = csm_rr_choose(r, fg.y);
         return csm_cube_test(p, l, as[ia], bs[ib], xl, 2, r);
     }
     float v = 0.0;

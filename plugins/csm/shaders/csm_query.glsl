@@ -57,6 +57,16 @@ float csm_lookup(CsmObject o, uint M, ivec2 tex, uint i)
 }
 
 // One depth test: texel (x, y) of map (a, b); outside the map is lit.
+// One binary choice of the Russian-roulette filter (§4.5): 1 with
+// probability f (when r < f), and r rescaled to [0, 1) within the chosen
+// part for the next choice.
+int csm_rr_choose(inout float r, float f)
+{
+    int i = r < f ? 1 : 0;
+    r = i == 1 ? r / f : (r - f) / (1.0 - f);
+    return i;
+}
+
 float csm_test(CsmObject o, uint a, uint b, ivec2 tex, float depth)
 {
     uint M = o.info.x;
@@ -104,17 +114,14 @@ float csm_visibility_object(uint k, vec3 x, vec3 n, vec3 w, int mode, float u_rr
         // Russian roulette: one of the 16 tests with probability = its weight,
         // chosen by four successive binary choices from one random number.
         float r = u_rr;
-        int ia = r < fg.x ? 1 : 0;
-        r = ia == 1 ? r / fg.x : (r - fg.x) / (1.0 - fg.x);
-        int ib = r < fg.y ? 1 : 0;
-        r = ib == 1 ? r / fg.y : (r - fg.y) / (1.0 - fg.y);
+        int ia = csm_rr_choose(r, fg.x);
+        int ib = csm_rr_choose(r, fg.y);
         vec2 ang = csm_cell_angles(csm_n_theta, csm_n_phi, as[ia], bs[ib]);
         vec3 p = csm_project(o.sphere, ang.x, ang.y, xl);
         vec2 tc = (p.xy * 0.5 + 0.5) * M - 0.5;
         vec2 t0 = floor(tc), ft = tc - t0;
-        int ix = r < ft.x ? 1 : 0;
-        r = ix == 1 ? r / ft.x : (r - ft.x) / (1.0 - ft.x);
-        int iy = r < ft.y ? 1 : 0;
+        int ix = csm_rr_choose(r, ft.x);
+        int iy = csm_rr_choose(r, ft.y);
         return csm_test(o, as[ia], bs[ib], ivec2(t0) + ivec2(ix, iy), p.z);
     }
     float v = 0.0;
