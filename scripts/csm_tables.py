@@ -24,6 +24,11 @@ PAPER_T1 = {1024: ("32.0 MB", "3.9 MB", "4 s", 8.2),
             262144: ("8.0 GB", "242.8 MB", "844 s", 86.2)}
 PAPER_T1_TIME_S = {1024: 4.0, 16384: 50.0, 262144: 844.0}
 PAPER_T1_COMPRESSED_MIB = {1024: 3.9, 16384: 19.9, 262144: 242.8}
+# Paper, Table 1, local lights (6 N maps, M = 128): (object, light points,
+# enumeration, total maps, uncompressed, compressed, time, ratio) as printed.
+PAPER_T1_LOCAL = [("Dragon", "8×8", "scanline", 384, "12.0 MB", "2.3 MB", "3 s", 5.2),
+                  ("Dragon", "8×8", "hilbert", 384, "12.0 MB", "1.9 MB", "3 s", 6.3),
+                  ("Plant", "32×32", "hilbert", 6144, "192 MB", "4.5 MB", "13 s", 42.0)]
 # Paper, Table 2, Buddha, 1024x768, N = 128^2, M = 128: S -> M samples/s.
 PAPER_T2 = {"shade": {16: 66.2, 64: 69.9, 625: 81.9},
             "random": {16: 85.0, 625: 132.5},
@@ -99,6 +104,39 @@ def main():
     out = []
     w = out.append
     w("GL renderer: %s. Timings are software-rasterised; only ratios within this run mean anything.\n" % renderer)
+
+    # ---- Table 1, local lights (harness/studies/csm_local.json)
+    tl = sorted(by.get("table1_local", []),
+                key=lambda r: (params(r)["light_enumeration"], int(params(r)["N_local"])))
+    if tl:
+        w("### Table 1, local lights: the teapot's depth cube maps at N × N points on the area light of teapot_area.glb, "
+          "M = 128\n")
+        w("Ground and light receiver-only (`receivers=planar`), so only the teapot's maps are built; storage as in "
+          "the distant table. The paper's local rows are other objects (Dragon, Plant) and are listed after ours.\n")
+        w("| light points | maps (6 N) | enumeration | uncompressed | compressed | segments / texel | precompute (s) "
+          "| ratio |")
+        w("|---|---:|---|---:|---:|---:|---:|---:|")
+        lfits = {}
+        for r in tl:
+            p = params(r)
+            n = int(p["N_local"])
+            maps = int(num(r, "stat_maps_local"))
+            t = (num(r, "prepare_depth_render_ms") + num(r, "prepare_compress_ms")) / 1000.0
+            w("| %d×%d | %d | %s | %s | %s | %.1f | %.1f | %.1f : 1 |" % (
+                n, n, maps, p["light_enumeration"], mb(num(r, "stat_bytes_uncompressed")),
+                mb(num(r, "stat_bytes_compressed")), num(r, "stat_segments_per_texel_local"), t,
+                num(r, "stat_ratio")))
+            lfits.setdefault(p["light_enumeration"], []).append((maps, num(r, "stat_ratio")))
+        w("\nPaper (other objects):\n")
+        w("| object | light points | enumeration | maps | uncompressed | compressed | time | ratio |")
+        w("|---|---|---|---:|---:|---:|---:|---:|")
+        for o, lp, e, m, u, c, t, ratio in PAPER_T1_LOCAL:
+            w("| %s | %s | %s | %d | %s | %s | %s | %.1f : 1 |" % (o, lp, e, m, u, c, t, ratio))
+        w("\nGrowth with the number of maps (ratio ∝ N^e): " + "; ".join(
+            "%s e = %.3f" % (e, fit_exponent(pts)) for e, pts in sorted(lfits.items()) if len(pts) >= 2) + ".")
+        if "table1" not in by:
+            print("\n".join(out))
+            return
 
     # ---- Table 1
     t1 = sorted(by.get("table1", []), key=lambda r: (params(r)["enumeration"], int(params(r)["N"])))
