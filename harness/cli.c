@@ -67,6 +67,17 @@ int cli_parse_float(const char *s, float *out)
     return 1;
 }
 
+int cli_add_out(const char *cmd, const char **outs, int *count, int max, const char *path)
+{
+    const char *dot = strrchr(path, '.');
+    if (*count == max)
+        return cli_fail(EXIT_USAGE, "%s: at most %d --out files", cmd, max);
+    if (!dot || (strcmp(dot, ".exr") && strcmp(dot, ".pfm") && strcmp(dot, ".png")))
+        return cli_fail(EXIT_USAGE, "%s: --out '%s': use a .exr, .pfm or .png file name", cmd, path);
+    outs[(*count)++] = path;
+    return 0;
+}
+
 int cli_parse_size(const char *s, uint32_t *w, uint32_t *h)
 {
     const char *x = s ? strchr(s, 'x') : NULL;

@@ -25,6 +25,10 @@ int cli_parse_size(const char *s, uint32_t *w, uint32_t *h);
 /* Parses an unsigned integer in [min, max]; 0 on failure. */
 int cli_parse_uint(const char *s, unsigned long min, unsigned long max, unsigned long *out);
 int cli_parse_float(const char *s, float *out);
+/* Appends an --out file name to outs[0..*count) for command `cmd`
+ * ("render", "reference"): at most `max`, and only .exr, .pfm or .png
+ * names. Returns 0, or EXIT_USAGE after printing the reason. */
+int cli_add_out(const char *cmd, const char **outs, int *count, int max, const char *path);
 
 /* The plugin registry of this build plus $GIBENCH_PLUGIN_PATH; loader
  * refusals are printed as warnings. */

@@ -37,12 +37,6 @@ typedef struct ref_opts {
     int pixel_center;
 } ref_opts;
 
-static int image_ext_ok(const char *path)
-{
-    const char *dot = strrchr(path, '.');
-    return dot && (!strcmp(dot, ".exr") || !strcmp(dot, ".pfm") || !strcmp(dot, ".png"));
-}
-
 static int is_exr(const char *path)
 {
     const char *dot = strrchr(path, '.');
@@ -79,12 +73,8 @@ static int parse_opts(int argc, char **argv, ref_opts *o)
         else if (!strcmp(a, "--stats"))
             o->stats = v;
         else if (!strcmp(a, "--out")) {
-            if (o->out_count == MAX_OUTS)
-                return cli_fail(EXIT_USAGE, "reference: at most %d --out files", MAX_OUTS);
-            if (!image_ext_ok(v))
-                return cli_fail(EXIT_USAGE,
-                                "reference: --out '%s': use a .exr, .pfm or .png file name", v);
-            o->outs[o->out_count++] = v;
+            if (cli_add_out("reference", o->outs, &o->out_count, MAX_OUTS, v))
+                return EXIT_USAGE;
         } else if (!strcmp(a, "--size")) {
             if (!cli_parse_size(v, &o->width, &o->height))
                 return cli_fail(EXIT_USAGE, "reference: --size '%s' is not WxH with 1..16384 each",

@@ -24,12 +24,6 @@ typedef struct render_opts {
     int no_cache; /* --no-cache: precompute afresh and keep nothing (timing studies) */
 } render_opts;
 
-static int image_ext_ok(const char *path)
-{
-    const char *dot = strrchr(path, '.');
-    return dot && (!strcmp(dot, ".exr") || !strcmp(dot, ".pfm") || !strcmp(dot, ".png"));
-}
-
 static int parse_opts(int argc, char **argv, render_opts *o)
 {
     memset(o, 0, sizeof *o);
@@ -63,11 +57,8 @@ static int parse_opts(int argc, char **argv, render_opts *o)
         else if (!strcmp(a, "--timings"))
             o->timings = v;
         else if (!strcmp(a, "--out")) {
-            if (o->out_count == MAX_OUTS)
-                return cli_fail(EXIT_USAGE, "render: at most %d --out files", MAX_OUTS);
-            if (!image_ext_ok(v))
-                return cli_fail(EXIT_USAGE, "render: --out '%s': use a .exr, .pfm or .png file name", v);
-            o->outs[o->out_count++] = v;
+            if (cli_add_out("render", o->outs, &o->out_count, MAX_OUTS, v))
+                return EXIT_USAGE;
         } else if (!strcmp(a, "--size")) {
             if (!cli_parse_size(v, &o->width, &o->height))
                 return cli_fail(EXIT_USAGE, "render: --size '%s' is not WxH with 1..16384 each", v);
