@@ -192,18 +192,15 @@ static int write_sky(const char *path, float L, uint32_t w, uint32_t h)
     return ok;
 }
 
-/* Plane under a uniform sky: irradiance pi L, radiance rho L. The camera
- * looks straight down and sees only the plane. */
-static void test_plane_under_sky(void)
+/* A diffuse plane (albedo rho) under the environment map `env` (scale,
+ * rotation about +Y in degrees), seen straight down from above (eye_x,
+ * eye_z), rendered with each of the three direct-light strategies at its
+ * own sample count and held against the expected radiance. */
+static void plane_under_env(const char *name, float rho, float eye_x, float eye_z, const char *env, float scale,
+                            float rotation, const uint32_t spp[3], double expected)
 {
-    const float rho = 0.6f, L = 1.5f;
-    const char *dir = GI_BINARY_DIR "/tests";
-    CHECK(write_sky(GI_BINARY_DIR "/tests/reference_sky_const.exr", 1.0f, 8, 4));
     static const gi_ref_strategy strategies[3] = {GI_REF_STRATEGY_MIS, GI_REF_STRATEGY_LIGHT,
                                                   GI_REF_STRATEGY_BSDF};
-    /* Cosine-weighted BSDF sampling of a constant sky has no variance;
-     * light sampling (uniform over the sphere) needs many samples. */
-    static const uint32_t spp[3] = {1024, 16384, 64};
     for (int k = 0; k < 3; k++) {
         tg_scene b;
         tg_init(&b);
@@ -211,22 +208,32 @@ static void test_plane_under_sky(void)
         grey(rho, alb);
         grey(0.0f, em);
         tg_plane(&b, 100.0f, 0.0f, tg_material(&b, alb, em, 0));
-        const float eye[3] = {0.3f, 1.0f, -0.2f}, at[3] = {0.3f, 0.0f, -0.2f};
+        const float eye[3] = {eye_x, 1.0f, eye_z}, at[3] = {eye_x, 0.0f, eye_z};
         tg_camera(&b, eye, at, 60.0f, 0.01f);
-        tg_environment(&b, "reference_sky_const.exr", L, 0.0f);
+        tg_environment(&b, env, scale, rotation);
         gi_error err;
-        gi_scene *s = tg_load(&b, dir, &err);
+        gi_scene *s = tg_load(&b, GI_BINARY_DIR "/tests", &err);
         CHECK_MSG(s != NULL, "%s", err.text);
         if (!s)
             return;
         estimate e;
         CHECK(render(s, 8, 8, spp[k], strategies[k], &e));
-        char what[64];
-        snprintf(what, sizeof what, "plane under uniform sky (%s)",
-                 gi_ref_strategy_name(strategies[k]));
-        check_value(what, &e, rho * L);
+        char what[96];
+        snprintf(what, sizeof what, "%s (%s)", name, gi_ref_strategy_name(strategies[k]));
+        check_value(what, &e, expected);
         gi_scene_free(s);
     }
+}
+
+/* Plane under a uniform sky: irradiance pi L, radiance rho L. */
+static void test_plane_under_sky(void)
+{
+    const float rho = 0.6f, L = 1.5f;
+    CHECK(write_sky(GI_BINARY_DIR "/tests/reference_sky_const.exr", 1.0f, 8, 4));
+    /* Cosine-weighted BSDF sampling of a constant sky has no variance;
+     * light sampling (uniform over the sphere) needs many samples. */
+    static const uint32_t spp[3] = {1024, 16384, 64};
+    plane_under_env("plane under uniform sky", rho, 0.3f, -0.2f, "reference_sky_const.exr", L, 0.0f, spp, rho * L);
 }
 
 /* Plane under a 16x8 map with a gradient and one very bright texel,
@@ -246,33 +253,9 @@ static void test_plane_under_map(void)
             double s0 = sin(TG_PI * j / h), s1 = sin(TG_PI * (j + 1) / h);
             sum += map_texel(i, j) * (1.0 / w) * (s1 * s1 - s0 * s0);
         }
-    double expected = rho * sum;
-    static const gi_ref_strategy strategies[3] = {GI_REF_STRATEGY_MIS, GI_REF_STRATEGY_LIGHT,
-                                                  GI_REF_STRATEGY_BSDF};
     static const uint32_t spp[3] = {4096, 4096, 32768};
-    for (int k = 0; k < 3; k++) {
-        tg_scene b;
-        tg_init(&b);
-        float alb[3], em[3];
-        grey(rho, alb);
-        grey(0.0f, em);
-        tg_plane(&b, 100.0f, 0.0f, tg_material(&b, alb, em, 0));
-        const float eye[3] = {-0.4f, 1.0f, 0.1f}, at[3] = {-0.4f, 0.0f, 0.1f};
-        tg_camera(&b, eye, at, 60.0f, 0.01f);
-        tg_environment(&b, "reference_sky_map.exr", 1.0f, 30.0f);
-        gi_error err;
-        gi_scene *s = tg_load(&b, GI_BINARY_DIR "/tests", &err);
-        CHECK_MSG(s != NULL, "%s", err.text);
-        if (!s)
-            return;
-        estimate e;
-        CHECK(render(s, 8, 8, spp[k], strategies[k], &e));
-        char what[64];
-        snprintf(what, sizeof what, "plane under a bright texel (%s)",
-                 gi_ref_strategy_name(strategies[k]));
-        check_value(what, &e, expected);
-        gi_scene_free(s);
-    }
+    plane_under_env("plane under a bright texel", rho, -0.4f, 0.1f, "reference_sky_map.exr", 1.0f, 30.0f, spp,
+                    rho * sum);
 }
 
 /* One punctual light over a diffuse plane; a narrow camera looks at
