@@ -1,7 +1,7 @@
 // Depth atlas (passes.h, gi_depth_atlas_*): the views SSBO and the lookup
 // of a world point in view i's tile. A plugin binds the atlas texture to a
 // sampler2D of its own and the SSBO of gi_depth_atlas_views_buffer() at
-// binding GI_DEPTH_ATLAS_BINDING (default 5 = GI_SSBO_DEPTH_ATLAS; define
+// binding GI_DEPTH_ATLAS_BINDING (default GI_SSBO_DEPTH_ATLAS; define
 // it before the #include to use another binding), then:
 //     float zp;
 //     float zmap = gi_atlas_depth(u_atlas, i, world_point, zp);
@@ -10,8 +10,9 @@
 #ifndef GI_DEPTH_ATLAS_GLSL
 #define GI_DEPTH_ATLAS_GLSL
 
+#include "glsl_shared.h"
 #ifndef GI_DEPTH_ATLAS_BINDING
-#define GI_DEPTH_ATLAS_BINDING 5
+#define GI_DEPTH_ATLAS_BINDING GI_SSBO_DEPTH_ATLAS
 #endif
 
 struct GiAtlasView {

@@ -13,10 +13,11 @@
 #ifndef GI_ENVMAP_GLSL
 #define GI_ENVMAP_GLSL
 #include "common.glsl"
+#include "glsl_shared.h"
 
-layout(binding = 0) uniform sampler2D gi_env_radiance; // GI_TEX_ENV
-layout(binding = 1) uniform sampler2D gi_env_cond_cdf; // GI_TEX_ENV_COND
-layout(binding = 2) uniform sampler2D gi_env_marg_cdf; // GI_TEX_ENV_MARG
+layout(binding = GI_TEX_ENV) uniform sampler2D gi_env_radiance;
+layout(binding = GI_TEX_ENV_COND) uniform sampler2D gi_env_cond_cdf;
+layout(binding = GI_TEX_ENV_MARG) uniform sampler2D gi_env_marg_cdf;
 
 #ifndef GI_ENV_ROTATION
 uniform float gi_env_rotation;

@@ -26,7 +26,7 @@ void main()
         n = -n;
     bool mirror = (m.flags & GI_MATERIAL_MIRROR) != 0u;
     // Emitters radiate from their front face (CCW), both faces if double-sided.
-    bool emits = gl_FrontFacing || (m.flags & 2u) != 0u;
+    bool emits = gl_FrontFacing || (m.flags & GI_MATERIAL_DOUBLE_SIDED) != 0u;
     o_position = vec4(v_world, v_eye_depth);
     o_normal = vec4(n, 0.0);
     o_albedo = vec4(gi_material_albedo(v_material, v_uv), mirror ? 1.0 : 0.0);

@@ -1,11 +1,9 @@
 // The scene on the GPU: buffer layouts and fetch helpers (mirrors gpu.h).
-// Bindings are fixed; plugins use binding points >= 8 for their own data.
-// SSBOs: 0 vertices, 1 indices, 2 materials, 3 lights, 4 emitters (here),
-// 5 depth-atlas views (depth_atlas.glsl); UBOs: 0 objects, 1 scene info;
-// textures: 0-2 environment (envmap.glsl), 3 albedo textures.
+// Binding points come from glsl_shared.h, the header the C side includes too.
 #ifndef GI_SCENE_GLSL
 #define GI_SCENE_GLSL
 #include "common.glsl"
+#include "glsl_shared.h"
 
 struct GiVertex {
     vec3 position; uint object;
@@ -15,7 +13,7 @@ struct GiVertex {
 struct GiMaterial {
     vec3 albedo; int texture_layer;
     vec3 ks; float exponent;
-    vec3 emission; uint flags; // bit 0 mirror, bit 1 double-sided
+    vec3 emission; uint flags; // GI_MATERIAL_FLAG_MIRROR | GI_MATERIAL_FLAG_DOUBLE_SIDED
 };
 struct GiLight {
     vec3 position; uint type;  // 0 point, 1 spot, 2 directional
@@ -31,27 +29,27 @@ struct GiObject {
     mat4 normal_matrix;
 };
 
-layout(std430, binding = 0) readonly buffer GiVertices { GiVertex gi_vertices[]; };
-layout(std430, binding = 1) readonly buffer GiIndices { uint gi_indices[]; };
-layout(std430, binding = 2) readonly buffer GiMaterials { GiMaterial gi_materials[]; };
-layout(std430, binding = 3) readonly buffer GiLights { GiLight gi_lights[]; };
-layout(std430, binding = 4) readonly buffer GiEmitters { GiEmitter gi_emitters[]; };
-layout(std140, binding = 0) uniform GiObjects { GiObject gi_objects[256]; };
-layout(std140, binding = 1) uniform GiSceneInfo {
+layout(std430, binding = GI_SSBO_VERTICES) readonly buffer GiVertices { GiVertex gi_vertices[]; };
+layout(std430, binding = GI_SSBO_INDICES) readonly buffer GiIndices { uint gi_indices[]; };
+layout(std430, binding = GI_SSBO_MATERIALS) readonly buffer GiMaterials { GiMaterial gi_materials[]; };
+layout(std430, binding = GI_SSBO_LIGHTS) readonly buffer GiLights { GiLight gi_lights[]; };
+layout(std430, binding = GI_SSBO_EMITTERS) readonly buffer GiEmitters { GiEmitter gi_emitters[]; };
+layout(std140, binding = GI_UBO_OBJECTS) uniform GiObjects { GiObject gi_objects[GI_MAX_OBJECTS]; };
+layout(std140, binding = GI_UBO_FRAME) uniform GiSceneInfo {
     uvec4 gi_counts;        // triangles, punctual lights, emitters, has environment
     vec4 gi_scene_params;   // area-light power, environment power estimate, time, env rotation (rad)
     vec4 gi_bounds_min;     // world bounds at the current time
     vec4 gi_bounds_max;
 };
-layout(binding = 3) uniform sampler2DArray gi_albedo_textures;
+layout(binding = GI_TEX_ALBEDO) uniform sampler2DArray gi_albedo_textures;
 // envmap.glsl reads the map's rotation from here.
 #define GI_ENV_ROTATION gi_scene_params.w
 
-const uint GI_LIGHT_POINT = 0u;
-const uint GI_LIGHT_SPOT = 1u;
-const uint GI_LIGHT_DIRECTIONAL = 2u;
-const uint GI_MATERIAL_MIRROR = 1u;
-const uint GI_NO_ID = 0xFFFFFFFFu;
+const uint GI_LIGHT_POINT = GI_LIGHT_TYPE_POINT;
+const uint GI_LIGHT_SPOT = GI_LIGHT_TYPE_SPOT;
+const uint GI_LIGHT_DIRECTIONAL = GI_LIGHT_TYPE_DIRECTIONAL;
+const uint GI_MATERIAL_MIRROR = GI_MATERIAL_FLAG_MIRROR;
+const uint GI_MATERIAL_DOUBLE_SIDED = GI_MATERIAL_FLAG_DOUBLE_SIDED;
 
 uint gi_triangle_count() { return gi_counts.x; }
 uint gi_light_count() { return gi_counts.y; }
@@ -70,6 +68,9 @@ void gi_triangle_world(uint tri, out vec3 p0, out vec3 p1, out vec3 p2)
     p1 = gi_object_point(o, gi_vertices[i1].position);
     p2 = gi_object_point(o, gi_vertices[i2].position);
 }
+
+// Does material m emit from both sides (glTF doubleSided)?
+bool gi_material_double_sided(uint m) { return (gi_materials[m].flags & GI_MATERIAL_DOUBLE_SIDED) != 0u; }
 
 uint gi_triangle_material(uint tri) { return gi_vertices[gi_indices[3u * tri]].material; }
 

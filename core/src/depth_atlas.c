@@ -9,7 +9,7 @@
 #include <string.h>
 
 #define ATLAS_MAX_TILE 4096u
-#define ATLAS_VIEWS_UNIT 14 /* texture unit of the views' texture buffer while drawing */
+#define ATLAS_VIEWS_UNIT GI_TEX_CORE_ATLAS_VIEWS /* the views' texture buffer while drawing */
 
 /* std430 layout of depth_atlas.glsl's GiDepthAtlasViews. */
 typedef struct atlas_view_gpu {

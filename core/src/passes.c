@@ -185,7 +185,7 @@ gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi
     }
     glUniform1i(glGetUniformLocation(p, "u_metric"), (GLint)d->metric);
     glUniform1i(glGetUniformLocation(p, "u_local"), d->local);
-    glUniform1i(glGetUniformLocation(p, "u_prev"), 15);
+    glUniform1i(glGetUniformLocation(p, "u_prev"), GI_TEX_CORE_DEPTH_PEEL);
     GLint loc_view = glGetUniformLocation(p, "u_view"), loc_proj = glGetUniformLocation(p, "u_proj");
     GLint loc_projection = glGetUniformLocation(p, "u_projection"), loc_range = glGetUniformLocation(p, "u_range");
     GLint loc_peel = glGetUniformLocation(p, "u_peel");
@@ -214,7 +214,7 @@ gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi
             glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
             glClearBufferfv(GL_COLOR, 1, far_value);
             glClear(GL_DEPTH_BUFFER_BIT);
-            glBindTextureUnit(15, prev);
+            glBindTextureUnit(GI_TEX_CORE_DEPTH_PEEL, prev);
             glUniform1i(loc_peel, (GLint)k);
             gi_gpu_scene_draw(gs, d->object, 1);
         }
@@ -222,7 +222,7 @@ gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi
     glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDisable(GL_CLIP_DISTANCE0);
     glDisable(GL_CULL_FACE);
-    glBindTextureUnit(15, 0);
+    glBindTextureUnit(GI_TEX_CORE_DEPTH_PEEL, 0);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glUseProgram(0);
     return gi_gl_check("depth-map pass", err);

@@ -22,27 +22,81 @@ extern const gi_shader_source gi_core_shaders[];
 static const gi_shader_source *g_tables[MAX_TABLES];
 static int g_table_count;
 
-void gi_shader_register(const gi_shader_source *table)
+/* Names are looked up in three places, in order: the core's shaders; the
+ * table of the file that includes (so a plugin's own helpers win over
+ * another plugin's of the same name); then every registered table, where
+ * a name two tables define is ambiguous and an error, never a silent
+ * choice. A name may also be a source's full path ("plugins/x/shaders/y.comp"),
+ * which is unique. A table may not reuse a core shader's name: the core's
+ * would be found first and the plugin's silently ignored. */
+
+static const gi_shader_source *find_in(const gi_shader_source *table, const char *name)
+{
+    for (const gi_shader_source *s = table; s && s->name; s++)
+        if (strcmp(s->name, name) == 0 || strcmp(s->path, name) == 0)
+            return s;
+    return NULL;
+}
+
+/* The registered table that holds `src`, or NULL (the core's, or none). */
+static const gi_shader_source *table_of(const gi_shader_source *src)
+{
+    for (int t = 0; t < g_table_count; t++)
+        for (const gi_shader_source *s = g_tables[t]; s->name; s++)
+            if (s == src)
+                return g_tables[t];
+    return NULL;
+}
+
+gi_result gi_shader_register(const gi_shader_source *table, gi_error *err)
 {
     for (int i = 0; i < g_table_count; i++)
         if (g_tables[i] == table)
-            return;
-    if (g_table_count < MAX_TABLES)
-        g_tables[g_table_count++] = table;
-    else
-        gi_log(GI_LOG_ERROR, "too many shader tables registered");
+            return GI_OK;
+    for (const gi_shader_source *s = table; s->name; s++) {
+        const gi_shader_source *core = find_in(gi_core_shaders, s->name);
+        if (core)
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "%s: named like the core's %s, which #include and the builders find first; "
+                                "rename it",
+                                s->path, core->path);
+    }
+    if (g_table_count >= MAX_TABLES)
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "more than %d shader tables registered", MAX_TABLES);
+    g_tables[g_table_count++] = table;
+    return GI_OK;
+}
+
+/* Looks `name` up as described above, `from` being the including file's
+ * table (NULL at the top level). */
+static const gi_shader_source *lookup(const char *name, const gi_shader_source *from, gi_error *err)
+{
+    const gi_shader_source *s = find_in(gi_core_shaders, name);
+    if (s)
+        return s;
+    if (from && (s = find_in(from, name)) != NULL)
+        return s;
+    const gi_shader_source *found = NULL;
+    for (int t = 0; t < g_table_count; t++) {
+        s = find_in(g_tables[t], name);
+        if (!s)
+            continue;
+        if (found) {
+            gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                         "shader name '%s' is ambiguous: %s and %s; name it by its path", name, found->path, s->path);
+            return NULL;
+        }
+        found = s;
+    }
+    if (!found)
+        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "no shader source named '%s'", name);
+    return found;
 }
 
 const gi_shader_source *gi_shader_find(const char *name)
 {
-    for (const gi_shader_source *s = gi_core_shaders; s->name; s++)
-        if (strcmp(s->name, name) == 0)
-            return s;
-    for (int t = 0; t < g_table_count; t++)
-        for (const gi_shader_source *s = g_tables[t]; s->name; s++)
-            if (strcmp(s->name, name) == 0)
-                return s;
-    return NULL;
+    gi_error err;
+    return lookup(name, NULL, &err);
 }
 
 typedef struct buf {
@@ -124,10 +178,11 @@ static int expand_into(buf *out, expansion *ex, const gi_shader_source *src, gi_
             return 0;
         }
         if (inc > 0) {
-            const gi_shader_source *child = gi_shader_find(name);
+            gi_error why;
+            const gi_shader_source *child = lookup(name, table_of(src), &why);
             if (!child) {
-                gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s:%d: #include \"%s\": no such shader source",
-                             src->path, line, name);
+                gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s:%d: #include \"%s\": %s", src->path, line, name,
+                             why.text);
                 return 0;
             }
             int seen = 0;
@@ -168,11 +223,9 @@ static char *expand(const gi_shader_source *src, const char *stage_define, const
 
 char *gi_shader_expand(const char *name, const char *defines, gi_error *err)
 {
-    const gi_shader_source *src = gi_shader_find(name);
-    if (!src) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "no shader source named '%s'", name);
+    const gi_shader_source *src = lookup(name, NULL, err);
+    if (!src)
         return NULL;
-    }
     expansion ex = {0};
     return expand(src, NULL, defines, &ex, err);
 }
@@ -234,11 +287,9 @@ static GLuint compile_text(GLenum type, const char *text, const expansion *ex, c
 
 static GLuint compile_named(GLenum type, const char *name, const char *defines, gi_error *err)
 {
-    const gi_shader_source *src = gi_shader_find(name);
-    if (!src) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "no shader source named '%s'", name);
+    const gi_shader_source *src = lookup(name, NULL, err);
+    if (!src)
         return 0;
-    }
     expansion ex = {0};
     const char *stage = type == GL_VERTEX_SHADER     ? "#define GI_VERTEX_SHADER 1\n"
                         : type == GL_FRAGMENT_SHADER ? "#define GI_FRAGMENT_SHADER 1\n"

@@ -14,6 +14,7 @@
  * The VPLs on the lights carry the direct light (Keller's instant
  * radiosity, which the paper builds on), the others the indirect bounces. */
 #include "avg.h"
+#include "shaders/avg_bindings.h"
 
 #include "gi/log.h"
 
@@ -22,7 +23,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { B_SLOTS = 8, B_VPLS = 9 };
 #define AVG_BIAS_VOXELS 0.5f /* receiver offset and constant depth bias, in voxel edges */
 #define AVG_BIAS_TEXELS 1.0f /* depth bias per unit of distance and slope, in texels of the map */
 
@@ -51,18 +51,15 @@ static const gi_param_desc avg_params[] = {
     {0},
 };
 
-static gi_result fail(avg *a, gi_result r, const char *msg)
-{
-    snprintf(a->error, sizeof a->error, "%s", msg);
-    return r;
-}
-
 static gi_result avg_create(const gi_host *host, const gi_params *params, void **out)
 {
     avg *a = calloc(1, sizeof *a);
     if (!a)
         return GI_ERR_OUT_OF_MEMORY;
-    a->host = host;
+    if (gi_kit_init(&a->kit, host, gi_avg_shaders) != GI_OK) {
+        free(a);
+        return GI_ERR_INVALID_ARGUMENT;
+    }
     a->grid_n = gi_params_int(params, "grid");
     a->vpls = gi_params_int(params, "vpls");
     a->bounces = gi_params_int(params, "bounces");
@@ -81,7 +78,6 @@ static gi_result avg_create(const gi_host *host, const gi_params *params, void *
     if (a->paths == 0)
         a->paths = 1;
     a->slots = a->paths * ((uint32_t)a->bounces + 1u);
-    gi_shader_register(gi_avg_shaders);
     *out = a;
     return GI_OK;
 }
@@ -133,7 +129,7 @@ static gi_projection choose_projection(avg *a, const gi_scene *s)
 static gi_result shadow_maps(avg *a, gi_error *err)
 {
     const gi_depth_atlas_desc *d = gi_depth_atlas_get_desc(a->atlas);
-    const float *b = a->scene->bounds;
+    const float *b = a->kit.scene->bounds;
     float diag = sqrtf((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) + (b[5] - b[2]) * (b[5] - b[2]));
     float zfar = 2.0f * diag + 1e-6f, znear = 1e-3f * a->grid->h;
     for (uint32_t j = 0; j < a->vpl_count; j++) {
@@ -147,66 +143,94 @@ static gi_result shadow_maps(avg *a, gi_error *err)
         dv->znear = 0.0f;
         dv->zfar = zfar;
     }
-    return gi_depth_atlas_render(a->atlas, a->scene, a->views, a->vpl_count, err);
+    return gi_depth_atlas_render(a->atlas, a->kit.scene, a->views, a->vpl_count, err);
+}
+
+/* Everything prepare() makes, released before a second prepare() and by destroy(). */
+static void release_prepared(avg *a)
+{
+    avg_grid_free(a->grid);
+    avg_exact_free(a->exact);
+    gi_depth_atlas_free(a->atlas);
+    free(a->views);
+    GLuint progs[5] = {a->prog_trace, a->prog_split, a->prog_shade, a->prog_assemble, a->prog_final};
+    for (int i = 0; i < 5; i++)
+        if (progs[i])
+            glDeleteProgram(progs[i]);
+    if (a->ssbo_slots)
+        glDeleteBuffers(1, &a->ssbo_slots);
+    if (a->ssbo_vpls)
+        glDeleteBuffers(1, &a->ssbo_vpls);
+    free(a->cpu_slots);
+    free(a->cpu_vpls);
+    a->grid = NULL;
+    a->exact = NULL;
+    a->atlas = NULL;
+    a->views = NULL;
+    a->prog_trace = a->prog_split = a->prog_shade = a->prog_assemble = a->prog_final = 0;
+    a->ssbo_slots = a->ssbo_vpls = 0;
+    a->cpu_slots = a->cpu_vpls = NULL;
+    a->vpl_count = 0;
 }
 
 static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
 {
     avg *a = inst;
     gi_error err;
-    a->scene = scene;
+    release_prepared(a);
+    gi_kit_prepare(&a->kit, scene);
     /* Checked here rather than in create(), where the host has no instance
      * to ask for the message. */
     if (a->mx * a->mx != a->M) {
-        snprintf(a->error, sizeof a->error, "M=%d is not a square number (1, 4, 9, 16, 25, 36, 49 or 64)", a->M);
-        return GI_ERR_INVALID_ARGUMENT;
+        return gi_kit_fail(&a->kit, GI_ERR_INVALID_ARGUMENT,
+                           "M=%d is not a square number (1, 4, 9, 16, 25, 36, 49 or 64)", a->M);
     }
     uint32_t directional = 0;
     for (uint32_t l = 0; l < scene->scene->light_count; l++)
         directional += scene->scene->lights[l].type == GI_LIGHT_DIRECTIONAL;
     if (directional)
-        a->host->log(a->host, GI_LOG_WARN, "%u directional light(s) ignored: not supported (caps)", directional);
+        a->kit.host->log(a->kit.host, GI_LOG_WARN, "%u directional light(s) ignored: not supported (caps)", directional);
     if (scene->light_count > AVG_MAX_PUNCTUAL)
-        a->host->log(a->host, GI_LOG_WARN, "only the first %d of %u punctual lights emit VPLs", AVG_MAX_PUNCTUAL,
+        a->kit.host->log(a->kit.host, GI_LOG_WARN, "only the first %d of %u punctual lights emit VPLs", AVG_MAX_PUNCTUAL,
                      scene->light_count);
     if (scene->scene->has_environment)
-        a->host->log(a->host, GI_LOG_WARN, "the environment map is ignored: not supported (caps)");
+        a->kit.host->log(a->kit.host, GI_LOG_WARN, "the environment map is ignored: not supported (caps)");
     a->grid = avg_grid_create((uint32_t)a->grid_n, &err);
     if (!a->grid)
-        return fail(a, GI_ERR_GL, err.text);
+        return gi_kit_fail_with(&a->kit, GI_ERR_GL, &err);
     if (build_programs(a, &err) != GI_OK)
-        return fail(a, GI_ERR_GL, err.text);
+        return gi_kit_fail_with(&a->kit, GI_ERR_GL, &err);
     if (a->visibility) {
         gi_depth_atlas_desc d = {(uint32_t)a->tile, a->slots, choose_projection(a, scene->scene), GI_DEPTH_RADIAL, 1};
         a->atlas = gi_depth_atlas_create(&d, &err);
         if (!a->atlas)
-            return fail(a, GI_ERR_INVALID_ARGUMENT, err.text);
+            return gi_kit_fail_with(&a->kit, GI_ERR_INVALID_ARGUMENT, &err);
         a->views = calloc(a->slots, sizeof *a->views);
         if (!a->views)
-            return fail(a, GI_ERR_OUT_OF_MEMORY, "avg: out of memory for the shadow-map views");
+            return gi_kit_fail(&a->kit, GI_ERR_OUT_OF_MEMORY, "avg: out of memory for the shadow-map views");
     }
     if (a->tracing == 1) {
         a->exact = avg_exact_create(scene, &err);
         if (!a->exact)
-            return fail(a, GI_ERR_INVALID_ARGUMENT, err.text);
+            return gi_kit_fail_with(&a->kit, GI_ERR_INVALID_ARGUMENT, &err);
     }
     a->cpu_slots = calloc(a->slots, sizeof *a->cpu_slots);
     a->cpu_vpls = calloc(a->slots, sizeof *a->cpu_vpls);
     if (!a->cpu_slots || !a->cpu_vpls)
-        return fail(a, GI_ERR_OUT_OF_MEMORY, "avg: out of memory for the VPL slots");
+        return gi_kit_fail(&a->kit, GI_ERR_OUT_OF_MEMORY, "avg: out of memory for the VPL slots");
     glCreateBuffers(1, &a->ssbo_slots);
     glNamedBufferStorage(a->ssbo_slots, (GLsizeiptr)(a->slots * sizeof(avg_vpl)), NULL, GL_DYNAMIC_STORAGE_BIT);
     glCreateBuffers(1, &a->ssbo_vpls);
     glNamedBufferStorage(a->ssbo_vpls, (GLsizeiptr)(a->slots * sizeof(avg_vpl)), NULL, GL_DYNAMIC_STORAGE_BIT);
     if (gi_gl_check("avg: prepare", &err) != GI_OK)
-        return fail(a, GI_ERR_GL, err.text);
+        return gi_kit_fail_with(&a->kit, GI_ERR_GL, &err);
     return GI_OK;
 }
 
 static gi_result avg_update(void *inst, const gi_gpu_scene *scene, const gi_changes *changes)
 {
-    (void)changes; /* everything is rebuilt every frame (§III): nothing to invalidate */
-    ((avg *)inst)->scene = scene;
+    /* everything is rebuilt every frame (§III): nothing to invalidate */
+    gi_kit_update(&((avg *)inst)->kit, scene, changes);
     return GI_OK;
 }
 
@@ -257,9 +281,9 @@ static gi_result trace_avg(avg *a, const avg_light_table *lt, gi_error *err)
 {
     GLuint p = a->prog_trace;
     glUseProgram(p);
-    gi_gpu_scene_bind(a->scene);
-    avg_grid_bind(a->grid, p, 8, 9);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, B_SLOTS, a->ssbo_slots);
+    gi_gpu_scene_bind(a->kit.scene);
+    avg_grid_bind(a->grid, p, AVG_TEX_GRID_NORMAL, AVG_TEX_GRID_COLOUR);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, AVG_SSBO_SLOTS, a->ssbo_slots);
     glUniform1ui(glGetUniformLocation(p, "u_paths"), a->paths);
     glUniform1ui(glGetUniformLocation(p, "u_bounces"), (GLuint)a->bounces);
     glUniform1ui(glGetUniformLocation(p, "u_qr_mask"), pow2_mask(a->paths));
@@ -314,52 +338,32 @@ static void dump_vpls(const avg *a)
         gi_log(GI_LOG_WARN, "avg: cannot write GIBENCH_AVG_VPLS file '%s'", path);
 }
 
-static void free_size_dependent(avg *a)
+/* The split images (M sub-images of ceil(w / mx) x ceil(h / mx)) and the
+ * indirect image, as the kit's scratch textures. */
+static void size_scratch(avg *a, uint32_t w, uint32_t h)
 {
-    gi_gbuffer_free(a->gbuffer);
-    a->gbuffer = NULL;
-    GLuint t[4] = {a->tex_split_pos, a->tex_split_nrm, a->tex_split_out, a->tex_indirect};
-    for (int i = 0; i < 4; i++)
-        if (t[i])
-            glDeleteTextures(1, &t[i]);
-    a->tex_split_pos = a->tex_split_nrm = a->tex_split_out = a->tex_indirect = 0;
-}
-
-static gi_result ensure_size(avg *a, uint32_t w, uint32_t h)
-{
-    if (a->gbuffer && a->width == w && a->height == h)
-        return GI_OK;
-    free_size_dependent(a);
-    gi_error err;
-    a->gbuffer = gi_gbuffer_create(w, h, &err);
-    if (!a->gbuffer)
-        return fail(a, GI_ERR_GL, err.text);
     uint32_t mx = (uint32_t)a->mx;
     a->split_w = (w + mx - 1) / mx;
     a->split_h = (h + mx - 1) / mx;
-    a->tex_split_pos = gi_gpu_texture_2d(GL_RGBA32F, a->split_w * mx, a->split_h * mx);
-    a->tex_split_nrm = gi_gpu_texture_2d(GL_RGBA32F, a->split_w * mx, a->split_h * mx);
-    a->tex_split_out = gi_gpu_texture_2d(GL_RGBA32F, a->split_w * mx, a->split_h * mx);
-    a->tex_indirect = gi_gpu_texture_2d(GL_RGBA32F, w, h);
-    a->width = w;
-    a->height = h;
-    return GI_OK;
+    a->tex_split_pos = gi_kit_scratch_texture(&a->kit, 0, GL_RGBA32F, a->split_w * mx, a->split_h * mx);
+    a->tex_split_nrm = gi_kit_scratch_texture(&a->kit, 1, GL_RGBA32F, a->split_w * mx, a->split_h * mx);
+    a->tex_split_out = gi_kit_scratch_texture(&a->kit, 2, GL_RGBA32F, a->split_w * mx, a->split_h * mx);
+    a->tex_indirect = gi_kit_scratch_texture(&a->kit, 3, GL_RGBA32F, w, h);
 }
 
 /* §III-C: split, shade per subset, reassemble, filter, albedo. */
 static gi_result illuminate(avg *a, const gi_view *view, const gi_target *target, gi_error *err)
 {
-    gi_result r = gi_gbuffer_render(a->gbuffer, a->scene, view->view, view->proj, err);
+    gi_result r = gi_gbuffer_render(a->kit.gbuffer, a->kit.scene, view->view, view->proj, err);
     if (r != GI_OK)
         return r;
-    GLint size[2] = {(GLint)a->width, (GLint)a->height};
+    GLint size[2] = {(GLint)view->width, (GLint)view->height};
     GLint sub[2] = {(GLint)a->split_w, (GLint)a->split_h};
     GLuint sw = a->split_w * (GLuint)a->mx, sh = a->split_h * (GLuint)a->mx;
 
     GLuint p = a->prog_split;
     glUseProgram(p);
-    glBindTextureUnit(8, a->gbuffer->tex_position);
-    glBindTextureUnit(9, a->gbuffer->tex_normal);
+    gi_gbuffer_bind(a->kit.gbuffer, GI_TEX_GBUFFER_POSITION);
     glBindImageTexture(0, a->tex_split_pos, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glBindImageTexture(1, a->tex_split_nrm, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glUniform2iv(glGetUniformLocation(p, "u_size"), 1, size);
@@ -370,10 +374,10 @@ static gi_result illuminate(avg *a, const gi_view *view, const gi_target *target
 
     p = a->prog_shade;
     glUseProgram(p);
-    glBindTextureUnit(8, a->tex_split_pos);
-    glBindTextureUnit(9, a->tex_split_nrm);
+    glBindTextureUnit(AVG_TEX_SPLIT_POS, a->tex_split_pos);
+    glBindTextureUnit(AVG_TEX_SPLIT_NRM, a->tex_split_nrm);
     glBindImageTexture(0, a->tex_split_out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, B_VPLS, a->ssbo_vpls);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, AVG_SSBO_VPLS, a->ssbo_vpls);
     glUniform2iv(glGetUniformLocation(p, "u_sub"), 1, sub);
     glUniform1i(glGetUniformLocation(p, "u_mx"), a->mx);
     glUniform1ui(glGetUniformLocation(p, "u_count"), a->vpl_count);
@@ -381,8 +385,8 @@ static gi_result illuminate(avg *a, const gi_view *view, const gi_target *target
     glUniform1f(glGetUniformLocation(p, "u_dmin2"), dmin * dmin);
     glUniform1i(glGetUniformLocation(p, "u_visibility"), a->atlas != NULL);
     if (a->atlas) {
-        glBindTextureUnit(13, gi_depth_atlas_texture(a->atlas));
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, gi_depth_atlas_views_buffer(a->atlas));
+        glBindTextureUnit(AVG_TEX_ATLAS, gi_depth_atlas_texture(a->atlas));
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, AVG_SSBO_ATLAS_VIEWS, gi_depth_atlas_views_buffer(a->atlas));
         /* Depth bias for maps of `tile` texels: half a voxel plus a share
          * of the distance that grows as the maps get coarser (and with the
          * slope, in the shader). */
@@ -394,18 +398,18 @@ static gi_result illuminate(avg *a, const gi_view *view, const gi_target *target
 
     p = a->prog_assemble;
     glUseProgram(p);
-    glBindTextureUnit(8, a->tex_split_out);
+    glBindTextureUnit(AVG_TEX_SPLIT_OUT, a->tex_split_out);
     glBindImageTexture(0, a->tex_indirect, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glUniform2iv(glGetUniformLocation(p, "u_size"), 1, size);
     glUniform2iv(glGetUniformLocation(p, "u_sub"), 1, sub);
     glUniform1i(glGetUniformLocation(p, "u_mx"), a->mx);
-    glDispatchCompute((a->width + 7) / 8, (a->height + 7) / 8, 1);
+    glDispatchCompute((view->width + 7) / 8, (view->height + 7) / 8, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
 
     p = a->prog_final;
     glUseProgram(p);
-    gi_gbuffer_bind(a->gbuffer, 8);
-    glBindTextureUnit(14, a->tex_indirect);
+    gi_gbuffer_bind(a->kit.gbuffer, GI_TEX_GBUFFER_POSITION);
+    glBindTextureUnit(AVG_TEX_INDIRECT, a->tex_indirect);
     glBindImageTexture(1, target->texture, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glUniform2iv(glGetUniformLocation(p, "u_size"), 1, size);
     glUniform1i(glGetUniformLocation(p, "u_mx"), a->mx);
@@ -413,9 +417,9 @@ static gi_result illuminate(avg *a, const gi_view *view, const gi_target *target
     glUniform1f(glGetUniformLocation(p, "u_normal_dot"), 0.9f);
     /* A neighbour counts while it is within twice the window's width on a
      * surface facing the camera at the pixel's depth. */
-    float footprint = 2.0f * tanf(0.5f * view->yfov) / (float)a->height;
+    float footprint = 2.0f * tanf(0.5f * view->yfov) / (float)view->height;
     glUniform1f(glGetUniformLocation(p, "u_max_dist"), 2.0f * (float)a->mx * footprint);
-    glDispatchCompute((a->width + 7) / 8, (a->height + 7) / 8, 1);
+    glDispatchCompute((view->width + 7) / 8, (view->height + 7) / 8, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
                     GL_FRAMEBUFFER_BARRIER_BIT);
     glUseProgram(0);
@@ -425,27 +429,28 @@ static gi_result illuminate(avg *a, const gi_view *view, const gi_target *target
 static gi_result avg_render(void *inst, const gi_view *view, const gi_target *target)
 {
     avg *a = inst;
-    const gi_host *host = a->host;
+    const gi_host *host = a->kit.host;
     gi_error err;
-    gi_result r = ensure_size(a, view->width, view->height);
+    gi_result r = gi_kit_frame_begin(&a->kit, view, GI_KIT_GBUFFER);
     if (r != GI_OK)
         return r;
+    size_scratch(a, view->width, view->height);
 
     /* The grid is built with exact tracing too: it places the grid and sets
      * the clamping distance, so that both tracings shade alike. */
     host->stage_begin(host, "vox");
-    avg_grid_place(a->grid, a->scene->bounds);
-    r = avg_grid_voxelise(a->grid, a->scene, (avg_vox_mode)a->voxeliser, &err);
+    avg_grid_place(a->grid, a->kit.scene->bounds);
+    r = avg_grid_voxelise(a->grid, a->kit.scene, (avg_vox_mode)a->voxeliser, &err);
     host->stage_end(host, "vox");
     if (r != GI_OK)
-        return fail(a, r, err.text);
+        return gi_kit_fail_with(&a->kit, r, &err);
 
     host->stage_begin(host, "tra");
     avg_light_table lt;
-    avg_light_table_build(a->scene, &lt);
+    avg_light_table_build(a->kit.scene, &lt);
     if (a->exact) {
         avg_trace_desc td = {a->paths, (uint32_t)a->bounces, a->offset};
-        r = avg_exact_trace(a->exact, a->scene, &lt, &td, a->cpu_slots, &err);
+        r = avg_exact_trace(a->exact, a->kit.scene, &lt, &td, a->cpu_slots, &err);
     } else {
         r = trace_avg(a, &lt, &err);
     }
@@ -455,21 +460,21 @@ static gi_result avg_render(void *inst, const gi_view *view, const gi_target *ta
     }
     host->stage_end(host, "tra");
     if (r != GI_OK)
-        return fail(a, r, err.text);
+        return gi_kit_fail_with(&a->kit, r, &err);
 
     if (a->atlas) {
         host->stage_begin(host, "sha");
         r = shadow_maps(a, &err);
         host->stage_end(host, "sha");
         if (r != GI_OK)
-            return fail(a, r, err.text);
+            return gi_kit_fail_with(&a->kit, r, &err);
     }
 
     host->stage_begin(host, "ill");
     r = illuminate(a, view, target, &err);
     host->stage_end(host, "ill");
     if (r != GI_OK)
-        return fail(a, r, err.text);
+        return gi_kit_fail_with(&a->kit, r, &err);
 
     host->stat(host, "vpls_live", (double)a->vpl_count);
     host->stat(host, "light_paths", (double)a->paths);
@@ -482,27 +487,14 @@ static void avg_destroy(void *inst)
     avg *a = inst;
     if (!a)
         return;
-    free_size_dependent(a);
-    avg_grid_free(a->grid);
-    avg_exact_free(a->exact);
-    gi_depth_atlas_free(a->atlas);
-    free(a->views);
-    GLuint progs[5] = {a->prog_trace, a->prog_split, a->prog_shade, a->prog_assemble, a->prog_final};
-    for (int i = 0; i < 5; i++)
-        if (progs[i])
-            glDeleteProgram(progs[i]);
-    if (a->ssbo_slots)
-        glDeleteBuffers(1, &a->ssbo_slots);
-    if (a->ssbo_vpls)
-        glDeleteBuffers(1, &a->ssbo_vpls);
-    free(a->cpu_slots);
-    free(a->cpu_vpls);
+    gi_kit_free(&a->kit);
+    release_prepared(a);
     free(a);
 }
 
 static const char *avg_last_error(void *inst)
 {
-    return inst ? ((avg *)inst)->error : "";
+    return inst ? gi_kit_last_error(&((avg *)inst)->kit) : "";
 }
 
 static const gi_method avg_method = {

@@ -13,8 +13,7 @@
 #ifndef AVG_H
 #define AVG_H
 
-#include "gi/method.h"
-#include "gi/passes.h"
+#include "gi/kit.h"
 
 #include <stdint.h>
 
@@ -106,19 +105,17 @@ void avg_vpl_contribution(const avg_vpl *v, const float x[3], const float n[3], 
 
 /* The method instance (avg.c). */
 typedef struct avg {
-    const gi_host *host;
+    gi_kit kit;                 /* host, scene, G-buffer, scratch textures, error text */
     /* parameters */
     int grid_n, vpls, bounces, M, tile, projection, filter, visibility, tracing, voxeliser;
     float clamp, offset, fov;
     int mx;                     /* sqrt(M): M = mx x mx subsets */
     /* resources */
-    const gi_gpu_scene *scene;
     avg_grid *grid;
-    gi_gbuffer *gbuffer;
     GLuint prog_trace, prog_split, prog_shade, prog_assemble, prog_final;
     GLuint ssbo_slots, ssbo_vpls, ubo_lights;
-    GLuint tex_split_pos, tex_split_nrm, tex_split_out, tex_indirect;
-    uint32_t width, height, split_w, split_h;
+    GLuint tex_split_pos, tex_split_nrm, tex_split_out, tex_indirect; /* the kit's scratch textures 0-3 */
+    uint32_t split_w, split_h;
     uint32_t slots, paths;
     avg_vpl *cpu_slots;         /* readback of the slots */
     avg_vpl *cpu_vpls;          /* compacted live VPLs, in slot order */
@@ -126,7 +123,6 @@ typedef struct avg {
     avg_exact *exact;           /* the CPU tracer (avg_trace_cpu.c), NULL for avg tracing */
     gi_depth_atlas *atlas;      /* the VPLs' shadow maps when visibility is on */
     gi_depth_view *views;       /* one per VPL slot */
-    char error[GI_ERROR_MAX];
 } avg;
 
 #ifdef __cplusplus

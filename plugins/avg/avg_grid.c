@@ -8,6 +8,7 @@
  * image stores (so additive blending does the summing exactly as in the
  * paper, and the result does not depend on the order of fragments). */
 #include "avg.h"
+#include "shaders/avg_bindings.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -35,7 +36,10 @@ avg_grid *avg_grid_create(uint32_t n, gi_error *err)
     }
     g->n = n;
     g->h = 1.0f;
-    gi_shader_register(gi_avg_shaders);
+    if (gi_shader_register(gi_avg_shaders, err) != GI_OK) {
+        avg_grid_free(g);
+        return NULL;
+    }
     for (int mode = 0; mode < 2; mode++) {
         g->program[mode] = gi_program_build("avg_vox.vert", "avg_vox.geom", "avg_vox.frag", NULL, err);
         if (!g->program[mode]) {
@@ -152,7 +156,7 @@ gi_result avg_grid_voxelise(avg_grid *g, const gi_gpu_scene *gs, avg_vox_mode mo
     glUniform1i(glGetUniformLocation(p, "u_mode"), (GLint)mode);
     glUniform1f(glGetUniformLocation(p, "u_epsilon"), 0.5f);
     gi_gpu_scene_bind(gs);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, g->ssbo_colours);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, AVG_SSBO_COLOURS, g->ssbo_colours);
     gi_gpu_scene_draw(gs, -1, (GLsizei)g->n);
     glUseProgram(0);
     glDisable(GL_BLEND);

@@ -23,6 +23,7 @@
 #include "csm_local.h"
 
 #include "gi/cache.h"
+#include "gi/kit.h"
 #include "gi/log.h"
 #include "gi/mesh.h"
 #include "gi/rng.h"
@@ -51,7 +52,7 @@ typedef struct csm_gpu_rect {
 } csm_gpu_rect;
 
 typedef struct csm {
-    const gi_host *host;
+    gi_kit kit; /* host, scene, G-buffer, accumulation, error text */
     int N, M, S, z3, filter, mode, open_surfaces;
     gi_csm_order order;
     float bias, normal_offset, normal_offset_local, shell_thickness;
@@ -64,12 +65,7 @@ typedef struct csm {
     csm_light *lights;
     csm_gpu_object *objects;
     GLuint ssbo[9]; /* objects, offsets, z_avg, i_end, cells, patterns, lights, pairs, light cells */
-    gi_gbuffer *gbuffer;
-    GLuint program, accum, count; /* count: samples taken this frame */
-    uint32_t width, height, frames;
-    float last_view_proj[16];
-    const gi_gpu_scene *scene;
-    char error[GI_ERROR_MAX];
+    GLuint program, count; /* count: samples taken this frame */
 } csm;
 
 static const gi_param_desc csm_params[] = {
@@ -111,18 +107,15 @@ static const gi_param_desc csm_params[] = {
     {0},
 };
 
-static gi_result fail(csm *c, gi_result r, const char *msg)
-{
-    snprintf(c->error, sizeof c->error, "%s", msg);
-    return r;
-}
-
 static gi_result csm_create(const gi_host *host, const gi_params *params, void **out)
 {
     csm *c = calloc(1, sizeof *c);
     if (!c)
         return GI_ERR_OUT_OF_MEMORY;
-    c->host = host;
+    if (gi_kit_init(&c->kit, host, gi_csm_shaders) != GI_OK) {
+        free(c);
+        return GI_ERR_INVALID_ARGUMENT;
+    }
     c->N = gi_params_int(params, "N");
     c->M = gi_params_int(params, "M");
     c->order = (gi_csm_order)gi_params_enum(params, "enumeration");
@@ -141,7 +134,6 @@ static gi_result csm_create(const gi_host *host, const gi_params *params, void *
     c->linear_aspect = gi_params_float(params, "linear_aspect");
     c->receivers = gi_params_enum(params, "receivers");
     c->mode = gi_params_enum(params, "mode");
-    gi_shader_register(gi_csm_shaders);
     *out = c;
     return GI_OK;
 }
@@ -189,7 +181,7 @@ static void cache_name_local(const csm *c, const gi_scene *s, uint32_t k, const 
  * Returns 1 on a hit. *path is the file's path (NULL without a cache). */
 static int cache_load(csm *c, const char *name, uint32_t M, uint32_t N, gi_csm_data *data, char **path)
 {
-    const gi_host *host = c->host;
+    const gi_host *host = c->kit.host;
     *path = host->cache_dir ? gi_cache_path(host->cache_dir, name) : NULL;
     if (!*path)
         return 0;
@@ -218,7 +210,7 @@ static void cache_store(csm *c, const char *path, const gi_csm_data *data)
     void *bytes = NULL;
     size_t size = 0;
     if (gi_csm_data_write(data, &bytes, &size, &err) != GI_OK || gi_file_write_atomic(path, bytes, size, &err) != GI_OK)
-        c->host->log(c->host, GI_LOG_WARN, "csm: not cached: %s", err.text);
+        c->kit.host->log(c->kit.host, GI_LOG_WARN, "csm: not cached: %s", err.text);
     free(bytes);
 }
 
@@ -250,11 +242,11 @@ static gi_result load_or_build(csm *c, const gi_gpu_scene *gs, uint32_t k, const
                            .shell = shell_depth(c, sphere[3]),
                            .batch = batch_for(c->M)};
     gi_error err;
-    gi_result r = csm_build_object(gs, k, sphere, &desc, c->host, p0, p1, data, &err);
+    gi_result r = csm_build_object(gs, k, sphere, &desc, c->kit.host, p0, p1, data, &err);
     if (r == GI_OK)
         cache_store(c, path, data);
     free(path);
-    return r == GI_OK ? GI_OK : fail(c, r, err.text);
+    return r == GI_OK ? GI_OK : gi_kit_fail_with(&c->kit, r, &err);
 }
 
 static gi_result load_or_build_local(csm *c, const gi_gpu_scene *gs, uint32_t k, const float sphere[4],
@@ -268,11 +260,11 @@ static gi_result load_or_build_local(csm *c, const gi_gpu_scene *gs, uint32_t k,
         return GI_OK;
     }
     gi_error err;
-    gi_result r = csm_build_local(gs, k, sphere, desc, c->host, p0, p1, data, &err);
+    gi_result r = csm_build_local(gs, k, sphere, desc, c->kit.host, p0, p1, data, &err);
     if (r == GI_OK)
         cache_store(c, path, data);
     free(path);
-    return r == GI_OK ? GI_OK : fail(c, r, err.text);
+    return r == GI_OK ? GI_OK : gi_kit_fail_with(&c->kit, r, &err);
 }
 
 /* An object whose vertices all lie in one plane (within 1e-4 of its size):
@@ -384,16 +376,40 @@ static void rect_store(float dst[4], gi_vec3 v, float w)
     dst[0] = v.x, dst[1] = v.y, dst[2] = v.z, dst[3] = w;
 }
 
+/* Everything prepare() makes, released before a second prepare() and by destroy(). */
+static void release_prepared(csm *c)
+{
+    if (c->ssbo[0])
+        glDeleteBuffers(9, c->ssbo);
+    if (c->count)
+        glDeleteBuffers(1, &c->count);
+    if (c->program)
+        glDeleteProgram(c->program);
+    memset(c->ssbo, 0, sizeof c->ssbo);
+    c->count = c->program = 0;
+    free(c->objects);
+    free(c->casts);
+    free(c->prepare_transforms);
+    free(c->lights);
+    c->objects = NULL;
+    c->casts = NULL;
+    c->prepare_transforms = NULL;
+    c->lights = NULL;
+    c->object_count = c->light_count = 0;
+    c->warned_moved = 0;
+}
+
 static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
 {
     csm *c = inst;
-    const gi_host *host = c->host;
+    release_prepared(c);
+    const gi_host *host = c->kit.host;
     const gi_scene *s = gs->scene;
     gi_error err;
-    c->scene = gs;
+    gi_kit_prepare(&c->kit, gs);
     c->program = gi_program_build_compute("csm.comp", NULL, &err);
     if (!c->program)
-        return fail(c, GI_ERR_GL, err.text);
+        return gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
     c->object_count = s->object_count;
     uint32_t n = s->object_count ? s->object_count : 1u;
     c->objects = calloc(n, sizeof *c->objects);
@@ -405,7 +421,7 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
     gi_csm_data *data = calloc(n, sizeof *data);
     if (!c->objects || !c->casts || !c->prepare_transforms || !data) {
         free(data);
-        return fail(c, GI_ERR_OUT_OF_MEMORY, "csm: out of memory");
+        return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "csm: out of memory");
     }
     /* Lights (§4.2) at the current time; directional lights stay distant. */
     c->light_count = csm_lights_collect(s, gs->time, (uint32_t)c->n_local, c->linear_aspect, &c->lights);
@@ -422,7 +438,7 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
         free(data);
         free(ldata);
         free(pairs);
-        return fail(c, GI_ERR_OUT_OF_MEMORY, "csm: out of memory");
+        return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "csm: out of memory");
     }
     uint32_t casters = 0;
     for (uint32_t k = 0; k < c->object_count; k++) {
@@ -520,7 +536,7 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
         }
     }
     if (r == GI_OK && (offsets_total > UINT32_MAX || segments_total > UINT32_MAX))
-        r = fail(c, GI_ERR_UNSUPPORTED, "csm: more than 2^32 segments in all");
+        r = gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED, "csm: more than 2^32 segments in all");
     if (r == GI_OK) {
         host->stage_begin(host, "upload");
         uint32_t *offsets = malloc((offsets_total ? offsets_total : 1) * sizeof *offsets);
@@ -535,7 +551,7 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
         uint32_t *lcells = malloc(lcells_n * sizeof *lcells);
         csm_gpu_rect *lrec = calloc(c->light_count ? c->light_count : 1, sizeof *lrec);
         if (!offsets || !z || !iend || !cells || !patterns || !lcells || !lrec)
-            r = fail(c, GI_ERR_OUT_OF_MEMORY, "csm: out of memory for the upload");
+            r = gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "csm: out of memory for the upload");
         for (uint32_t k = 0; r == GI_OK && k < c->object_count; k++) {
             if (!c->objects[k].M)
                 continue;
@@ -591,7 +607,7 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
             glNamedBufferStorage(c->ssbo[7], (GLsizeiptr)((n_pairs ? n_pairs : 1) * sizeof *pairs), pairs, 0);
             glNamedBufferStorage(c->ssbo[8], (GLsizeiptr)(lcells_n * 4), lcells, 0);
             if (gi_gl_check("csm: upload", &err) != GI_OK)
-                r = fail(c, GI_ERR_GL, err.text);
+                r = gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
         }
         free(offsets);
         free(z);
@@ -632,9 +648,7 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
 static gi_result csm_update(void *inst, const gi_gpu_scene *scene, const gi_changes *changes)
 {
     csm *c = inst;
-    c->scene = scene;
-    if (changes->flags)
-        c->frames = 0;
+    gi_kit_update(&c->kit, scene, changes);
     /* §4.2: fixed local lights hold only while lights and objects stay where
      * they were at prepare time; say so once when something moved. */
     if (c->lights_mode == LIGHTS_LOCAL && c->light_count > 0 && !c->warned_moved &&
@@ -650,7 +664,7 @@ static gi_result csm_update(void *inst, const gi_gpu_scene *scene, const gi_chan
             }
         }
         if (moved) {
-            c->host->log(c->host, GI_LOG_WARN,
+            c->kit.host->log(c->kit.host, GI_LOG_WARN,
                          "objects or lights moved since the precomputation; fixed local lights' cube maps are "
                          "not rebuilt (their shadows are those of the first frame's placement); use lights=semilocal");
             c->warned_moved = 1;
@@ -659,67 +673,38 @@ static gi_result csm_update(void *inst, const gi_gpu_scene *scene, const gi_chan
     return GI_OK;
 }
 
-static gi_result ensure_size(csm *c, uint32_t w, uint32_t h)
-{
-    if (c->gbuffer && c->width == w && c->height == h)
-        return GI_OK;
-    gi_gbuffer_free(c->gbuffer);
-    glDeleteTextures(1, &c->accum);
-    gi_error err;
-    c->gbuffer = gi_gbuffer_create(w, h, &err);
-    if (!c->gbuffer)
-        return fail(c, GI_ERR_GL, err.text);
-    glCreateTextures(GL_TEXTURE_2D, 1, &c->accum);
-    glTextureStorage2D(c->accum, 1, GL_RGBA32F, (GLsizei)w, (GLsizei)h);
-    c->width = w;
-    c->height = h;
-    c->frames = 0;
-    return GI_OK;
-}
-
 static gi_result csm_render(void *inst, const gi_view *view, const gi_target *target)
 {
     csm *c = inst;
+    gi_kit *kit = &c->kit;
+    const gi_host *host = kit->host;
     gi_error err;
-    gi_result r = ensure_size(c, view->width, view->height);
+    gi_result r = gi_kit_frame_begin(kit, view, GI_KIT_GBUFFER | GI_KIT_ACCUMULATE);
     if (r != GI_OK)
         return r;
-    if (view->frame_index == 0 || memcmp(c->last_view_proj, view->view_proj, sizeof c->last_view_proj))
-        c->frames = 0;
-    memcpy(c->last_view_proj, view->view_proj, sizeof c->last_view_proj);
 
     /* §4.6: queries in object-local space through the inverse transform. */
     for (uint32_t k = 0; k < c->object_count; k++) {
         csm_gpu_object *o = &c->objects[k];
-        memcpy(o->world_from_local, c->scene->world_from_local[k], sizeof o->world_from_local);
+        memcpy(o->world_from_local, kit->scene->world_from_local[k], sizeof o->world_from_local);
         if (!gi_mat4_invert(o->local_from_world, o->world_from_local))
             gi_mat4_identity(o->local_from_world);
     }
     if (c->object_count)
         glNamedBufferSubData(c->ssbo[0], 0, (GLsizeiptr)(c->object_count * sizeof *c->objects), c->objects);
 
-    c->host->stage_begin(c->host, "gbuffer");
-    r = gi_gbuffer_render(c->gbuffer, c->scene, view->view, view->proj, &err);
-    c->host->stage_end(c->host, "gbuffer");
+    r = gi_kit_render_gbuffer(kit, view, "gbuffer");
     if (r != GI_OK)
-        return fail(c, r, err.text);
+        return r;
 
-    c->host->stage_begin(c->host, "render");
+    host->stage_begin(host, "render");
     GLuint p = c->program;
     glUseProgram(p);
-    gi_gpu_scene_bind(c->scene);
-    gi_gbuffer_bind(c->gbuffer, GI_BINDING_PLUGIN_FIRST);
+    gi_kit_bind(kit, p, view, target);
     static const GLuint bindings[9] = {B_OBJECTS, B_OFFSETS, B_ZAVG, B_IEND, B_CELLS, B_PATTERNS, B_LIGHTS, B_PAIRS,
                                        B_LIGHT_CELLS};
     for (int i = 0; i < 9; i++)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, bindings[i], c->ssbo[i]);
-    glBindImageTexture(0, c->accum, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-    glBindImageTexture(1, target->texture, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glUniform3f(glGetUniformLocation(p, "u_eye"), view->eye.x, view->eye.y, view->eye.z);
-    glUniformMatrix4fv(glGetUniformLocation(p, "u_inv_view_proj"), 1, GL_FALSE, view->inv_view_proj);
-    glUniform2i(glGetUniformLocation(p, "u_size"), (GLint)view->width, (GLint)view->height);
-    glUniform1ui(glGetUniformLocation(p, "u_frame"), c->frames);
-    glUniform1ui(glGetUniformLocation(p, "u_seed"), view->seed);
     glUniform1i(glGetUniformLocation(p, "u_S"), c->S);
     glUniform1i(glGetUniformLocation(p, "u_mode"), c->mode);
     const GLuint zero = 0;
@@ -734,21 +719,19 @@ static gi_result csm_render(void *inst, const gi_view *view, const gi_target *ta
     glUniform1i(glGetUniformLocation(p, "csm_semilocal"), c->lights_mode == LIGHTS_SEMILOCAL);
     glUniform1f(glGetUniformLocation(p, "csm_normal_offset_local"), c->normal_offset_local);
     glUniform1i(glGetUniformLocation(p, "u_distant"), c->distant);
-    glDispatchCompute((view->width + 7) / 8, (view->height + 7) / 8, 1);
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
-                    GL_FRAMEBUFFER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    gi_kit_dispatch_8x8(view->width, view->height);
     glUseProgram(0);
-    c->host->stage_end(c->host, "render");
-    c->frames++;
-    c->host->stat(c->host, "samples_per_pixel_env", (double)c->frames * c->S);
-    if (c->scene->emitter_count)
-        c->host->stat(c->host, "samples_per_pixel_area", (double)c->frames * c->S);
+    host->stage_end(host, "render");
+    gi_kit_frame_end(kit);
+    host->stat(host, "samples_per_pixel_env", (double)kit->frames * c->S);
+    if (kit->scene->emitter_count)
+        host->stat(host, "samples_per_pixel_area", (double)kit->frames * c->S);
     /* read after the timed stage: S per surface pixel (Table 2's "samples") */
     GLuint taken = 0;
     glGetNamedBufferSubData(c->count, 0, 4, &taken);
-    c->host->stat(c->host, "samples_per_frame", (double)taken);
+    host->stat(host, "samples_per_frame", (double)taken);
     if (gi_gl_check("csm: shading pass", &err) != GI_OK)
-        return fail(c, GI_ERR_GL, err.text);
+        return gi_kit_fail_with(kit, GI_ERR_GL, &err);
     return GI_OK;
 }
 
@@ -757,25 +740,14 @@ static void csm_destroy(void *inst)
     csm *c = inst;
     if (!c)
         return;
-    gi_gbuffer_free(c->gbuffer);
-    if (c->accum)
-        glDeleteTextures(1, &c->accum);
-    if (c->ssbo[0])
-        glDeleteBuffers(9, c->ssbo);
-    if (c->count)
-        glDeleteBuffers(1, &c->count);
-    if (c->program)
-        glDeleteProgram(c->program);
-    free(c->objects);
-    free(c->casts);
-    free(c->prepare_transforms);
-    free(c->lights);
+    gi_kit_free(&c->kit);
+    release_prepared(c);
     free(c);
 }
 
 static const char *csm_last_error(void *inst)
 {
-    return inst ? ((csm *)inst)->error : "";
+    return inst ? gi_kit_last_error(&((csm *)inst)->kit) : "";
 }
 
 static const gi_method csm_method = {

@@ -13,8 +13,7 @@
  * Area lights are not seen through mirrors (that needs a ray query).
  * Frames of a still view average progressively; a moved camera or scene
  * restarts the average. */
-#include "gi/method.h"
-#include "gi/passes.h"
+#include "gi/kit.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,15 +22,9 @@
 extern const gi_shader_source gi_direct_shaders[];
 
 typedef struct direct {
-    const gi_host *host;
+    gi_kit kit;
     int light_samples, env_samples, mis, accumulate;
-    gi_gbuffer *gbuffer;
-    GLuint program, accum;
-    uint32_t width, height;
-    uint32_t frames; /* frames in the running average */
-    float last_view_proj[16];
-    const gi_gpu_scene *scene;
-    char error[GI_ERROR_MAX];
+    GLuint program;
 } direct;
 
 static const gi_param_desc direct_params[] = {
@@ -44,23 +37,19 @@ static const gi_param_desc direct_params[] = {
     {0},
 };
 
-static gi_result fail(direct *d, gi_result r, const char *msg)
-{
-    snprintf(d->error, sizeof d->error, "%s", msg);
-    return r;
-}
-
 static gi_result direct_create(const gi_host *host, const gi_params *params, void **out)
 {
     direct *d = calloc(1, sizeof *d);
     if (!d)
         return GI_ERR_OUT_OF_MEMORY;
-    d->host = host;
+    if (gi_kit_init(&d->kit, host, gi_direct_shaders) != GI_OK) {
+        free(d);
+        return GI_ERR_INVALID_ARGUMENT;
+    }
     d->light_samples = gi_params_int(params, "light_samples");
     d->env_samples = gi_params_int(params, "env_samples");
     d->mis = gi_params_bool(params, "mis");
     d->accumulate = gi_params_bool(params, "accumulate");
-    gi_shader_register(gi_direct_shaders);
     *out = d;
     return GI_OK;
 }
@@ -68,83 +57,49 @@ static gi_result direct_create(const gi_host *host, const gi_params *params, voi
 static gi_result direct_prepare(void *inst, const gi_gpu_scene *scene)
 {
     direct *d = inst;
-    gi_error err;
-    d->scene = scene;
-    d->program = gi_program_build_compute("direct.comp", NULL, &err);
-    if (!d->program)
-        return fail(d, GI_ERR_GL, err.text);
+    gi_kit_prepare(&d->kit, scene);
+    if (!d->program) {
+        gi_error err;
+        d->program = gi_program_build_compute("direct.comp", NULL, &err);
+        if (!d->program)
+            return gi_kit_fail_with(&d->kit, GI_ERR_GL, &err);
+    }
     return GI_OK;
 }
 
 static gi_result direct_update(void *inst, const gi_gpu_scene *scene, const gi_changes *changes)
 {
-    direct *d = inst;
-    d->scene = scene;
-    if (changes->flags)
-        d->frames = 0;
-    return GI_OK;
-}
-
-static gi_result ensure_size(direct *d, uint32_t w, uint32_t h)
-{
-    if (d->gbuffer && d->width == w && d->height == h)
-        return GI_OK;
-    gi_gbuffer_free(d->gbuffer);
-    glDeleteTextures(1, &d->accum);
-    gi_error err;
-    d->gbuffer = gi_gbuffer_create(w, h, &err);
-    if (!d->gbuffer)
-        return fail(d, GI_ERR_GL, err.text);
-    glCreateTextures(GL_TEXTURE_2D, 1, &d->accum);
-    glTextureStorage2D(d->accum, 1, GL_RGBA32F, (GLsizei)w, (GLsizei)h);
-    d->width = w;
-    d->height = h;
-    d->frames = 0;
+    gi_kit_update(&((direct *)inst)->kit, scene, changes);
     return GI_OK;
 }
 
 static gi_result direct_render(void *inst, const gi_view *view, const gi_target *target)
 {
     direct *d = inst;
-    gi_error err;
-    gi_result r = ensure_size(d, view->width, view->height);
+    gi_kit *k = &d->kit;
+    const gi_host *host = k->host;
+    gi_result r = gi_kit_frame_begin(k, view, GI_KIT_GBUFFER | GI_KIT_ACCUMULATE | (d->accumulate ? 0 : GI_KIT_NO_AVERAGE));
+    if (r == GI_OK)
+        r = gi_kit_render_gbuffer(k, view, "gbuffer");
     if (r != GI_OK)
         return r;
-    if (!d->accumulate || view->frame_index == 0 || memcmp(d->last_view_proj, view->view_proj, sizeof d->last_view_proj))
-        d->frames = 0;
-    memcpy(d->last_view_proj, view->view_proj, sizeof d->last_view_proj);
 
-    d->host->stage_begin(d->host, "gbuffer");
-    r = gi_gbuffer_render(d->gbuffer, d->scene, view->view, view->proj, &err);
-    d->host->stage_end(d->host, "gbuffer");
-    if (r != GI_OK)
-        return fail(d, r, err.text);
-
-    d->host->stage_begin(d->host, "shade");
+    host->stage_begin(host, "shade");
     GLuint p = d->program;
     glUseProgram(p);
-    gi_gpu_scene_bind(d->scene);
-    gi_gbuffer_bind(d->gbuffer, GI_BINDING_PLUGIN_FIRST);
-    glBindImageTexture(0, d->accum, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-    glBindImageTexture(1, target->texture, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glUniform3f(glGetUniformLocation(p, "u_eye"), view->eye.x, view->eye.y, view->eye.z);
-    glUniformMatrix4fv(glGetUniformLocation(p, "u_inv_view_proj"), 1, GL_FALSE, view->inv_view_proj);
-    glUniform2i(glGetUniformLocation(p, "u_size"), (GLint)view->width, (GLint)view->height);
-    glUniform1ui(glGetUniformLocation(p, "u_frame"), d->frames);
-    glUniform1ui(glGetUniformLocation(p, "u_seed"), view->seed);
+    gi_kit_bind(k, p, view, target);
     glUniform1i(glGetUniformLocation(p, "u_light_samples"), d->light_samples);
     glUniform1i(glGetUniformLocation(p, "u_env_samples"), d->env_samples);
     glUniform1i(glGetUniformLocation(p, "u_mis"), d->mis);
-    glDispatchCompute((view->width + 7) / 8, (view->height + 7) / 8, 1);
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
-                    GL_FRAMEBUFFER_BARRIER_BIT);
+    gi_kit_dispatch_8x8(view->width, view->height);
     glUseProgram(0);
-    d->host->stage_end(d->host, "shade");
-    d->frames++;
-    d->host->stat(d->host, "samples_per_pixel_area", (double)d->frames * d->light_samples);
-    d->host->stat(d->host, "samples_per_pixel_env", (double)d->frames * d->env_samples);
+    host->stage_end(host, "shade");
+    gi_kit_frame_end(k);
+    host->stat(host, "samples_per_pixel_area", (double)k->frames * d->light_samples);
+    host->stat(host, "samples_per_pixel_env", (double)k->frames * d->env_samples);
+    gi_error err;
     if (gi_gl_check("direct: shading pass", &err) != GI_OK)
-        return fail(d, GI_ERR_GL, err.text);
+        return gi_kit_fail_with(k, GI_ERR_GL, &err);
     return GI_OK;
 }
 
@@ -153,9 +108,7 @@ static void direct_destroy(void *inst)
     direct *d = inst;
     if (!d)
         return;
-    gi_gbuffer_free(d->gbuffer);
-    if (d->accum)
-        glDeleteTextures(1, &d->accum);
+    gi_kit_free(&d->kit);
     if (d->program)
         glDeleteProgram(d->program);
     free(d);
@@ -163,7 +116,7 @@ static void direct_destroy(void *inst)
 
 static const char *direct_last_error(void *inst)
 {
-    return inst ? ((direct *)inst)->error : "";
+    return inst ? gi_kit_last_error(&((direct *)inst)->kit) : "";
 }
 
 static const gi_method direct_method = {

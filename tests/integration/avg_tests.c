@@ -188,10 +188,10 @@ typedef struct gbuffer_images {
 
 static gbuffer_images read_gbuffer(const avg *a, uint32_t w, uint32_t h)
 {
-    gbuffer_images g = {gi_gpu_read_texture(a->gbuffer->tex_position, w, h),
-                        gi_gpu_read_texture(a->gbuffer->tex_normal, w, h),
-                        gi_gpu_read_texture(a->gbuffer->tex_albedo, w, h),
-                        gi_gpu_read_texture(a->gbuffer->tex_emission, w, h)};
+    gbuffer_images g = {gi_gpu_read_texture(a->kit.gbuffer->tex_position, w, h),
+                        gi_gpu_read_texture(a->kit.gbuffer->tex_normal, w, h),
+                        gi_gpu_read_texture(a->kit.gbuffer->tex_albedo, w, h),
+                        gi_gpu_read_texture(a->kit.gbuffer->tex_emission, w, h)};
     return g;
 }
 
@@ -882,7 +882,10 @@ int main(int argc, char **argv)
         fprintf(stderr, "no GL: %s\n", err.text);
         return 1;
     }
-    gi_shader_register(gi_avg_shaders);
+    if (gi_shader_register(gi_avg_shaders, &err) != GI_OK) {
+        fprintf(stderr, "shaders: %s\n", err.text);
+        return 1;
+    }
     if (!strcmp(argv[1], "voxel")) {
         voxel_case(gpu, GI_SOURCE_DIR "/scenes/cornell_box.gltf", (const float[]){0.0f}, 1, 32);
         voxel_case(gpu, GI_SOURCE_DIR "/scenes/cornell_moving.gltf", (const float[]){1.3f}, 1, 40);

@@ -61,8 +61,11 @@ static inline gi_gpu *csm_test_gpu(const gi_shader_source *shaders)
         fprintf(stderr, "no GL: %s\n", err.text);
         return NULL;
     }
-    if (shaders)
-        gi_shader_register(shaders);
+    if (shaders && gi_shader_register(shaders, &err) != GI_OK) {
+        fprintf(stderr, "shaders: %s\n", err.text);
+        gi_gpu_destroy(gpu);
+        return NULL;
+    }
     return gpu;
 }
 

@@ -423,7 +423,7 @@ int main(void)
     EXPECT(shadowed > pairs / 20, "too few shadowed pairs to mean anything: %d", shadowed);
 
     /* The GLSL query on the same pairs. */
-    gi_shader_register(gi_csm_query_shaders);
+    EXPECT(gi_shader_register(gi_csm_query_shaders, NULL) == GI_OK, "shader table refused");
     static const char *kernel =
         "#include \"csm_query.glsl\"\n"
         "layout(local_size_x = 64) in;\n"

@@ -15,6 +15,66 @@ static const gi_shader_source test_sources[] = {
     {0, 0, 0},
 };
 
+/* Two more tables: one reuses a core shader's name (refused), two define the
+ * same helper name (each file sees its own; a top-level lookup is ambiguous). */
+static const gi_shader_source clash_core[] = {
+    {"brdf.glsl", "plugins/clash/shaders/brdf.glsl", "float nothing() { return 0.0; }\n"},
+    {0, 0, 0},
+};
+static const gi_shader_source plugin_a[] = {
+    {"helper.glsl", "plugins/a/shaders/helper.glsl", "float helper() { return 1.0; }\n"},
+    {"a.comp", "plugins/a/shaders/a.comp",
+     "#include \"helper.glsl\"\nlayout(local_size_x = 1) in;\nlayout(std430, binding = 8) buffer O { float v; };\n"
+     "void main() { v = helper(); }\n"},
+    {0, 0, 0},
+};
+static const gi_shader_source plugin_b[] = {
+    {"helper.glsl", "plugins/b/shaders/helper.glsl", "float helper() { return 2.0; }\n"},
+    {"b.comp", "plugins/b/shaders/b.comp",
+     "#include \"helper.glsl\"\nlayout(local_size_x = 1) in;\nlayout(std430, binding = 8) buffer O { float v; };\n"
+     "void main() { v = helper(); }\n"},
+    {0, 0, 0},
+};
+
+/* Runs a one-invocation program writing one float; returns it. */
+static float run_one(GLuint prog)
+{
+    GLuint buf;
+    float v = -1.0f;
+    glCreateBuffers(1, &buf);
+    glNamedBufferStorage(buf, sizeof v, &v, 0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, buf);
+    glUseProgram(prog);
+    glDispatchCompute(1, 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glGetNamedBufferSubData(buf, 0, sizeof v, &v);
+    glUseProgram(0);
+    glDeleteBuffers(1, &buf);
+    return v;
+}
+
+static void check_namespaces(void)
+{
+    gi_error err;
+    CHECK(gi_shader_register(clash_core, &err) == GI_ERR_INVALID_ARGUMENT);
+    CHECK_MSG(strstr(err.text, "plugins/clash/shaders/brdf.glsl: named like the core's core/shaders/brdf.glsl"),
+              "'%s'", err.text);
+    CHECK(gi_shader_find("brdf.glsl") && strcmp(gi_shader_find("brdf.glsl")->path, "core/shaders/brdf.glsl") == 0);
+    CHECK(gi_shader_register(plugin_a, &err) == GI_OK && gi_shader_register(plugin_b, NULL) == GI_OK);
+    GLuint pa = gi_program_build_compute("a.comp", NULL, &err);
+    CHECK_MSG(pa != 0, "%s", err.text);
+    GLuint pb = gi_program_build_compute("b.comp", NULL, &err);
+    CHECK_MSG(pb != 0, "%s", err.text);
+    CHECK(pa && run_one(pa) == 1.0f);
+    CHECK(pb && run_one(pb) == 2.0f);
+    glDeleteProgram(pa);
+    glDeleteProgram(pb);
+    CHECK(gi_shader_expand("helper.glsl", NULL, &err) == NULL);
+    CHECK_MSG(strstr(err.text, "'helper.glsl' is ambiguous: plugins/a/shaders/helper.glsl and plugins/b/shaders/helper.glsl"),
+              "'%s'", err.text);
+    CHECK(gi_shader_find("plugins/b/shaders/helper.glsl") == &plugin_b[0]);
+}
+
 int main(void)
 {
     gi_error err;
@@ -31,7 +91,7 @@ int main(void)
     glGetIntegerv(GL_CONTEXT_PROFILE_MASK, &profile);
     CHECK(profile & GL_CONTEXT_CORE_PROFILE_BIT);
 
-    gi_shader_register(test_sources);
+    CHECK(gi_shader_register(test_sources, &err) == GI_OK);
     /* A compute shader that uses an included function and writes an SSBO. */
     const char *text = "#include \"smoke_lib.glsl\"\n"
                        "layout(local_size_x = 64) in;\n"
@@ -63,8 +123,10 @@ int main(void)
     CHECK(gi_shader_expand("nope.glsl", NULL, &err) == NULL && strstr(err.text, "no shader source named 'nope.glsl'"));
     const char *missing = "#include \"missing.glsl\"\nvoid main() {}\n";
     CHECK(gi_program_build_compute_text("tests/missing.comp", missing, NULL, &err) == 0);
-    CHECK_MSG(strcmp(err.text, "tests/missing.comp:1: #include \"missing.glsl\": no such shader source") == 0, "'%s'",
-              err.text);
+    CHECK_MSG(strcmp(err.text, "tests/missing.comp:1: #include \"missing.glsl\": no shader source named 'missing.glsl'") ==
+                  0,
+              "'%s'", err.text);
+    check_namespaces();
     /* Every core shader compiles on this driver. */
     const char *programs[][2] = {{"gbuffer.vert", "gbuffer.frag"}, {"depth.vert", "depth.frag"}};
     for (int i = 0; i < 2; i++) {

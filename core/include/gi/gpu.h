@@ -22,6 +22,7 @@
 #include <epoxy/gl.h>
 
 #include "gi/common.h"
+#include "gi/glsl_shared.h"
 #include "gi/scene.h"
 
 #ifdef __cplusplus
@@ -47,23 +48,8 @@ int gi_gpu_is_software(const gi_gpu *gpu);
 /* Checks glGetError; on error writes "what: GL_INVALID_..." into err. */
 gi_result gi_gl_check(const char *what, gi_error *err);
 
-/* Fixed bindings of the scene resources, mirrored in core/shaders/scene.glsl.
- * Plugins use binding points >= GI_BINDING_PLUGIN_FIRST for their own. */
-enum {
-    GI_SSBO_VERTICES = 0,
-    GI_SSBO_INDICES = 1,
-    GI_SSBO_MATERIALS = 2,
-    GI_SSBO_LIGHTS = 3,
-    GI_SSBO_EMITTERS = 4,
-    GI_SSBO_DEPTH_ATLAS = 5, /* views of a gi_depth_atlas (passes.h, depth_atlas.glsl) */
-    GI_UBO_OBJECTS = 0,
-    GI_UBO_FRAME = 1,
-    GI_TEX_ENV = 0,       /* sampler2D: RGBA32F radiance, intensity applied */
-    GI_TEX_ENV_COND = 1,  /* sampler2D: R32F, (width+1) x height conditional CDF */
-    GI_TEX_ENV_MARG = 2,  /* sampler2D: R32F, (height+1) x 1 marginal CDF */
-    GI_TEX_ALBEDO = 3,    /* sampler2DArray: material textures, one layer each */
-    GI_BINDING_PLUGIN_FIRST = 8,
-};
+/* The scene's binding points, the G-buffer's texture units and the first
+ * points left to plugins are in gi/glsl_shared.h (shared with GLSL). */
 
 /* std430 material record (64 bytes), see scene.glsl. */
 typedef struct gi_gpu_material {
@@ -72,7 +58,7 @@ typedef struct gi_gpu_material {
     float ks[3];
     float exponent;
     float emission[3];
-    uint32_t flags; /* bit 0 mirror, bit 1 double-sided */
+    uint32_t flags; /* GI_MATERIAL_FLAG_MIRROR | GI_MATERIAL_FLAG_DOUBLE_SIDED */
 } gi_gpu_material;
 
 /* std430 punctual light record (64 bytes), world space at the current time. */

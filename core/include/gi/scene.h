@@ -41,7 +41,7 @@ extern "C" {
 
 #define GI_MIRROR_EXPONENT 10000.0f
 /* Limits that validation enforces ("absurd counts or sizes"). */
-#define GI_MAX_OBJECTS 256 /* the object-transform UBO holds this many */
+#include "gi/glsl_shared.h" /* GI_MAX_OBJECTS: the object-transform UBO holds this many */
 #define GI_MAX_TRIANGLES (16u * 1024u * 1024u)
 #define GI_MAX_VERTICES (48u * 1024u * 1024u)
 #define GI_MAX_MATERIALS 4096
@@ -114,9 +114,9 @@ typedef struct gi_object {
 } gi_object;
 
 typedef enum gi_light_type {
-    GI_LIGHT_POINT = 0,
-    GI_LIGHT_SPOT = 1,
-    GI_LIGHT_DIRECTIONAL = 2,
+    GI_LIGHT_POINT = GI_LIGHT_TYPE_POINT,
+    GI_LIGHT_SPOT = GI_LIGHT_TYPE_SPOT,
+    GI_LIGHT_DIRECTIONAL = GI_LIGHT_TYPE_DIRECTIONAL,
 } gi_light_type;
 
 /* A KHR_lights_punctual light as placed by its node. */

@@ -3,8 +3,11 @@
  * Every .glsl/.vert/.frag/.geom/.comp file under core/shaders/ and under
  * plugins/<name>/shaders/ is compiled into the binary (core: the gicore
  * library; plugins: their own table, registered with gi_shader_register).
- * A source may `#include "name.glsl"`: the name is looked up among the
- * registered sources, core/shaders first. Lines are tagged with #line so
+ * A source may `#include "name.glsl"`: the name is looked up in the core's
+ * sources, then in the including file's own table, then in every registered
+ * table (a name two plugins' tables share is then an error: name it by its
+ * path). A table that reuses a core shader's name is refused when it is
+ * registered, never silently shadowed. Lines are tagged with #line so
  * that a compile error reads "core/shaders/brdf.glsl:42: message".
  * The `#version 450 core` line is added by the builder; sources must not
  * contain one.
@@ -27,10 +30,13 @@ typedef struct gi_shader_source {
 } gi_shader_source;
 
 /* Adds a table of sources (static storage, NULL-name terminated) to the
- * lookup. Plugins register theirs in create(); registering the same table
- * twice is harmless. */
-void gi_shader_register(const gi_shader_source *table);
-/* Finds a registered source by name; NULL when unknown. */
+ * lookup. Plugins register theirs in create() (gi_kit_init does).
+ * Registering the same table twice is harmless. GI_ERR_INVALID_ARGUMENT
+ * with the reason in err (may be NULL) when one of its names is a core
+ * shader's. */
+gi_result gi_shader_register(const gi_shader_source *table, gi_error *err);
+/* Finds a source by name (or path) as #include does from the top level;
+ * NULL when unknown or ambiguous. */
 const gi_shader_source *gi_shader_find(const char *name);
 
 /* Expands #include directives of `name`, prefixes #version and `defines`

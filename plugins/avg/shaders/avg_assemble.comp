@@ -2,7 +2,9 @@
 // interleaved image (the inverse of avg_split.comp).
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = 8) uniform sampler2D u_split_out;
+#include "avg_bindings.h"
+
+layout(binding = AVG_TEX_SPLIT_OUT) uniform sampler2D u_split_out;
 layout(rgba32f, binding = 0) uniform writeonly image2D u_indirect;
 
 uniform ivec2 u_size;

@@ -7,16 +7,13 @@
 // remaining weights are renormalised. Then
 // times albedo / pi (Lambert), plus the emission seen directly.
 #include "common.glsl"
+#include "gbuffer_read.glsl"
+#include "avg_bindings.h"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = 8) uniform sampler2D g_position;
-layout(binding = 9) uniform sampler2D g_normal;
-layout(binding = 10) uniform sampler2D g_albedo;
-layout(binding = 11) uniform sampler2D g_phong;
-layout(binding = 12) uniform sampler2D g_emission;
-layout(binding = 14) uniform sampler2D u_indirect;
-layout(rgba32f, binding = 1) uniform writeonly image2D u_target;
+layout(binding = AVG_TEX_INDIRECT) uniform sampler2D u_indirect;
+layout(rgba32f, binding = GI_IMAGE_TARGET) uniform writeonly image2D u_target;
 
 uniform ivec2 u_size;
 uniform int u_mx;
@@ -29,12 +26,12 @@ void main()
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(p, u_size)))
         return;
-    vec4 P = texelFetch(g_position, p, 0);
+    vec4 P = texelFetch(gi_gbuffer_position, p, 0);
     vec3 L = vec3(0.0);
     if (P.w > 0.0) {
         vec3 S = texelFetch(u_indirect, p, 0).rgb;
         if (u_filter && u_mx > 1) {
-            vec3 n = texelFetch(g_normal, p, 0).xyz;
+            vec3 n = texelFetch(gi_gbuffer_normal, p, 0).xyz;
             vec3 sum = vec3(0.0);
             float wsum = 0.0;
             int lo = -(u_mx / 2);
@@ -43,10 +40,10 @@ void main()
                     ivec2 q = p + ivec2(dx, dy);
                     if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, u_size)))
                         continue;
-                    vec4 Q = texelFetch(g_position, q, 0);
+                    vec4 Q = texelFetch(gi_gbuffer_position, q, 0);
                     if (Q.w <= 0.0)
                         continue;
-                    if (dot(n, texelFetch(g_normal, q, 0).xyz) < u_normal_dot)
+                    if (dot(n, texelFetch(gi_gbuffer_normal, q, 0).xyz) < u_normal_dot)
                         continue;
                     if (distance(P.xyz, Q.xyz) > u_max_dist * P.w)
                         continue;
@@ -56,7 +53,7 @@ void main()
             }
             S = wsum > 0.0 ? sum / wsum : S; // the pixel itself always passes
         }
-        L = texelFetch(g_emission, p, 0).rgb + texelFetch(g_albedo, p, 0).rgb * GI_INV_PI * S;
+        L = texelFetch(gi_gbuffer_emission, p, 0).rgb + texelFetch(gi_gbuffer_albedo, p, 0).rgb * GI_INV_PI * S;
     }
     imageStore(u_target, p, vec4(L, 1.0));
 }

@@ -4,15 +4,16 @@
 // its shadow map when visibility is on (avg_visibility.glsl). The result S is irradiance-like:
 // the Lambert receiver reflects (albedo / pi) S (applied after the filter).
 #define AVG_NO_GRID_SAMPLERS
+#include "avg_bindings.h"
 #include "avg_vpl.glsl"
 #include "avg_visibility.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = 8) uniform sampler2D u_split_pos;
-layout(binding = 9) uniform sampler2D u_split_nrm;
+layout(binding = AVG_TEX_SPLIT_POS) uniform sampler2D u_split_pos;
+layout(binding = AVG_TEX_SPLIT_NRM) uniform sampler2D u_split_nrm;
 layout(rgba32f, binding = 0) uniform writeonly image2D u_split_out;
-layout(std430, binding = 9) readonly buffer AvgVpls { AvgVpl vpls[]; };
+layout(std430, binding = AVG_SSBO_VPLS) readonly buffer AvgVpls { AvgVpl vpls[]; };
 
 uniform ivec2 u_sub;   // sw, sh
 uniform int u_mx;

@@ -3,10 +3,10 @@
 // sub-images in one swizzle pass. Pixel p belongs to subset
 // (p.x mod mx, p.y mod mx); the sub-image of subset (a, b) is the block at
 // (a sw, b sh) of the split texture, sw x sh = ceil(W / mx) x ceil(H / mx).
+#include "gbuffer_read.glsl"
+
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = 8) uniform sampler2D g_position;
-layout(binding = 9) uniform sampler2D g_normal;
 layout(rgba32f, binding = 0) uniform writeonly image2D u_split_pos;
 layout(rgba32f, binding = 1) uniform writeonly image2D u_split_nrm;
 
@@ -23,8 +23,8 @@ void main()
     ivec2 p = (s - ab * u_sub) * u_mx + ab;
     vec4 P = vec4(0.0), N = vec4(0.0);
     if (all(lessThan(p, u_size))) {
-        P = texelFetch(g_position, p, 0);
-        N = texelFetch(g_normal, p, 0);
+        P = texelFetch(gi_gbuffer_position, p, 0);
+        N = texelFetch(gi_gbuffer_normal, p, 0);
     }
     imageStore(u_split_pos, s, P);
     imageStore(u_split_nrm, s, N);

@@ -13,8 +13,9 @@
 //    into the voxel along the ray (pair 2k+1 .x);
 //  - next bounce: cosine sampling about that normal (pair 2k), Russian
 //    roulette with survival max(colour) (pair 2k+1 .y), up to B hits.
-#define AVG_UNIT_NORMAL 8
-#define AVG_UNIT_COLOUR 9
+#include "avg_bindings.h"
+#define AVG_UNIT_NORMAL AVG_TEX_GRID_NORMAL
+#define AVG_UNIT_COLOUR AVG_TEX_GRID_COLOUR
 #include "scene.glsl"
 #include "sampling.glsl"
 #include "avg_grid.glsl"
@@ -22,7 +23,7 @@
 
 layout(local_size_x = 64) in;
 
-layout(std430, binding = 8) writeonly buffer AvgSlots { AvgVpl slots[]; };
+layout(std430, binding = AVG_SSBO_SLOTS) writeonly buffer AvgSlots { AvgVpl slots[]; };
 
 uniform uint u_paths;
 uniform uint u_bounces;
@@ -73,7 +74,7 @@ void main()
         axis = ng / (2.0 * area);
         float pdf_area = pl * em.pdf / area;
         v.position = bc.x * p0 + bc.y * p1 + bc.z * p2;
-        v.kind = AVG_VPL_DIFFUSE | (((lm.flags & 2u) != 0u) ? 0x10000u : 0u);
+        v.kind = AVG_VPL_DIFFUSE | (((lm.flags & GI_MATERIAL_DOUBLE_SIDED) != 0u) ? 0x10000u : 0u);
         v.normal = axis;
         v.power = lm.emission * GI_PI / (pdf_area * N);
         flux = v.power;

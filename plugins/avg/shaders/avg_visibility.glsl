@@ -6,10 +6,11 @@
 // the artifact at the edges of perspective maps).
 #ifndef AVG_VISIBILITY_GLSL
 #define AVG_VISIBILITY_GLSL
-#define GI_DEPTH_ATLAS_BINDING 10
+#include "avg_bindings.h"
+#define GI_DEPTH_ATLAS_BINDING AVG_SSBO_ATLAS_VIEWS
 #include "depth_atlas.glsl"
 
-layout(binding = 13) uniform sampler2D u_atlas;
+layout(binding = AVG_TEX_ATLAS) uniform sampler2D u_atlas;
 uniform float u_bias_abs; // world units
 uniform float u_bias_rel; // fraction of the receiver's distance per unit of slope
 

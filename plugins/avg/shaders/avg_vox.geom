@@ -12,6 +12,7 @@
 // and where its projected area is below one voxel face a stand-in covering
 // its pixel bounding box is drawn instead (the paper's "larger triangle that
 // is guaranteed to be rasterised"; one quad covers every voxel it overlaps).
+#include "avg_bindings.h"
 #include "scene.glsl"
 
 layout(triangles) in;
@@ -21,7 +22,7 @@ in vec3 v_grid[];
 flat in uint v_material[];
 flat in int v_slice[];
 
-layout(std430, binding = 8) readonly buffer AvgColours { vec4 avg_material_colour[]; };
+layout(std430, binding = AVG_SSBO_COLOURS) readonly buffer AvgColours { vec4 avg_material_colour[]; };
 
 uniform int u_grid_n;
 uniform int u_mode;

@@ -11,26 +11,14 @@
 #include "lights.glsl"
 #include "csm_query.glsl"
 #include "csm_local.glsl"
+#include "gbuffer_read.glsl"
+#include "accumulate.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-
-layout(binding = 8) uniform sampler2D g_position;
-layout(binding = 9) uniform sampler2D g_normal;
-layout(binding = 10) uniform sampler2D g_albedo;
-layout(binding = 11) uniform sampler2D g_phong;
-layout(binding = 12) uniform sampler2D g_emission;
-layout(binding = 13) uniform usampler2D g_ids;
-layout(rgba32f, binding = 0) uniform image2D u_accum;
-layout(rgba32f, binding = 1) uniform writeonly image2D u_target;
 
 // 256 stratified patterns of S points in the unit square (§5.1).
 layout(std430, binding = 13) readonly buffer CsmPatterns { vec2 csm_patterns[]; };
 
-uniform vec3 u_eye;
-uniform mat4 u_inv_view_proj;
-uniform ivec2 u_size;
-uniform uint u_frame; // frames already in the average
-uniform uint u_seed;
 uniform int u_S;
 uniform int u_distant; // 1: the objects have orthographic CSMs
 uniform int u_mode; // 0 shade; Table 2 visibility benchmarks: 1 random, 2 coherent
@@ -129,7 +117,7 @@ vec3 area_lights(gi_brdf b, vec3 x, vec3 N, vec3 wo, uint own, uint pattern, vec
         vec3 w = d * inversesqrt(dist2);
         float cos_x = dot(N, w);
         GiMaterial lm = gi_materials[gi_triangle_material(em.triangle)];
-        float cos_y = gi_emitter_cos(ng / (2.0 * area), w, (lm.flags & 2u) != 0u);
+        float cos_y = gi_emitter_cos(ng / (2.0 * area), w, (lm.flags & GI_MATERIAL_DOUBLE_SIDED) != 0u);
         if (cos_x <= 0.0 || cos_y <= 0.0)
             continue;
         uint j = csm_light_cells[gi_vertices[gi_indices[3u * em.triangle]].object];
@@ -184,19 +172,12 @@ void main()
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(px, u_size)))
         return;
-    vec4 P = texelFetch(g_position, px, 0);
-    vec3 L = vec3(0.0);
-    vec3 wo = normalize(u_eye - P.xyz);
-    if (P.w > 0.0) {
-        vec3 x = P.xyz;
-        vec3 N = normalize(texelFetch(g_normal, px, 0).xyz);
-        vec4 alb = texelFetch(g_albedo, px, 0);
-        vec4 ph = texelFetch(g_phong, px, 0);
-        gi_brdf b;
-        b.kd = alb.rgb;
-        b.ks = ph.rgb;
-        b.n = ph.a;
-        b.mirror = alb.a > 0.5 ? 1 : 0;
+    GiSurface sf = gi_gbuffer_surface(px);
+    vec3 L = gi_background(px);
+    if (sf.hit) {
+        vec3 x = sf.position, N = sf.normal;
+        vec3 wo = normalize(u_eye - x);
+        gi_brdf b = sf.brdf;
         uint pix = uint(px.y * u_size.x + px.x);
         uint rng = gi_rng_init(pix, u_frame, u_seed);
         // Pattern from the pixel and the frame through a hash (§5.1), with a
@@ -209,27 +190,17 @@ void main()
             pattern = gi_pcg_hash(u_frame * 0x9E3779B9u + u_seed) & 255u;
             cp = vec2(0.0);
         }
-        L = texelFetch(g_emission, px, 0).rgb;
+        L = sf.emission;
         if (u_mode != 0)
             L = vec3(visibility_test(x, N, pattern, cp, rng));
         else if (gi_has_environment())
             L += environment(b, x, N, wo, pattern, cp, rng);
-        uint own = texelFetch(g_ids, px, 0).x;
+        uint own = gi_gbuffer_ids_at(px).x;
         if (u_mode == 0) {
             if (gi_emitter_count() > 0u)
                 L += area_lights(b, x, N, wo, own, (pattern + 97u) & 255u, cp, rng);
             L += punctual_lights(b, x, N, wo, own, rng);
         }
-    } else if (gi_has_environment()) {
-        vec2 ndc = (vec2(px) + 0.5) / vec2(u_size) * 2.0 - 1.0;
-        vec4 far_point = u_inv_view_proj * vec4(ndc, 1.0, 1.0);
-        L = gi_envmap_eval(normalize(far_point.xyz / far_point.w - u_eye));
     }
-    vec3 avg = L;
-    if (u_frame > 0u) {
-        vec3 prev = imageLoad(u_accum, px).rgb;
-        avg = prev + (L - prev) / float(u_frame + 1u);
-    }
-    imageStore(u_accum, px, vec4(avg, 1.0));
-    imageStore(u_target, px, vec4(avg, 1.0));
+    gi_accumulate_store(px, L);
 }

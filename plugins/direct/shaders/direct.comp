@@ -5,22 +5,11 @@
 #include "rng.glsl"
 #include "envmap.glsl"
 #include "lights.glsl"
+#include "gbuffer_read.glsl"
+#include "accumulate.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = 8) uniform sampler2D g_position;
-layout(binding = 9) uniform sampler2D g_normal;
-layout(binding = 10) uniform sampler2D g_albedo;
-layout(binding = 11) uniform sampler2D g_phong;
-layout(binding = 12) uniform sampler2D g_emission;
-layout(rgba32f, binding = 0) uniform image2D u_accum;
-layout(rgba32f, binding = 1) uniform writeonly image2D u_target;
-
-uniform vec3 u_eye;
-uniform mat4 u_inv_view_proj;
-uniform ivec2 u_size;
-uniform uint u_frame;   // frames already in the average
-uniform uint u_seed;
 uniform int u_light_samples;
 uniform int u_env_samples;
 uniform bool u_mis;
@@ -44,12 +33,12 @@ vec3 area_lights(gi_brdf b, vec3 x, vec3 N, vec3 wo, inout uint rng)
         float dist2 = dot(d, d);
         vec3 w = d * inversesqrt(dist2);
         float cos_x = dot(N, w);
-        GiMaterial lm = gi_materials[gi_triangle_material(em.triangle)];
-        float cos_y = gi_emitter_cos(ng / (2.0 * area), w, (lm.flags & 2u) != 0u);
+        uint lmi = gi_triangle_material(em.triangle);
+        float cos_y = gi_emitter_cos(ng / (2.0 * area), w, gi_material_double_sided(lmi));
         if (cos_x <= 0.0 || cos_y <= 0.0)
             continue;
         float pdf_area = em.pdf / area;
-        sum += gi_brdf_eval(b, N, wo, w) * lm.emission * cos_x * cos_y / (dist2 * pdf_area);
+        sum += gi_brdf_eval(b, N, wo, w) * gi_materials[lmi].emission * cos_x * cos_y / (dist2 * pdf_area);
     }
     return sum / float(u_light_samples);
 }
@@ -115,37 +104,18 @@ void main()
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(px, u_size)))
         return;
-    vec4 P = texelFetch(g_position, px, 0);
-    vec3 L = vec3(0.0);
-    vec3 wo = normalize(u_eye - P.xyz);
-    if (P.w > 0.0) {
-        vec3 x = P.xyz;
-        vec3 N = normalize(texelFetch(g_normal, px, 0).xyz);
-        vec4 alb = texelFetch(g_albedo, px, 0);
-        vec4 ph = texelFetch(g_phong, px, 0);
-        gi_brdf b;
-        b.kd = alb.rgb;
-        b.ks = ph.rgb;
-        b.n = ph.a;
-        b.mirror = alb.a > 0.5 ? 1 : 0;
+    GiSurface sf = gi_gbuffer_surface(px);
+    vec3 L = gi_background(px);
+    if (sf.hit) {
+        vec3 x = sf.position, N = sf.normal;
+        vec3 wo = normalize(u_eye - x);
         uint rng = gi_rng_init(uint(px.y * u_size.x + px.x), u_frame, u_seed);
-        L = texelFetch(g_emission, px, 0).rgb;
+        L = sf.emission;
         if (gi_emitter_count() > 0u)
-            L += area_lights(b, x, N, wo, rng);
-        L += punctual_lights(b, x, N, wo);
+            L += area_lights(sf.brdf, x, N, wo, rng);
+        L += punctual_lights(sf.brdf, x, N, wo);
         if (gi_has_environment())
-            L += environment(b, N, wo, rng);
-    } else if (gi_has_environment()) {
-        // Background: the map seen directly along the pixel's view ray.
-        vec2 ndc = (vec2(px) + 0.5) / vec2(u_size) * 2.0 - 1.0;
-        vec4 far_point = u_inv_view_proj * vec4(ndc, 1.0, 1.0);
-        L = gi_envmap_eval(normalize(far_point.xyz / far_point.w - u_eye));
+            L += environment(sf.brdf, N, wo, rng);
     }
-    vec3 avg = L;
-    if (u_frame > 0u) {
-        vec3 prev = imageLoad(u_accum, px).rgb;
-        avg = prev + (L - prev) / float(u_frame + 1u);
-    }
-    imageStore(u_accum, px, vec4(avg, 1.0));
-    imageStore(u_target, px, vec4(avg, 1.0));
+    gi_accumulate_store(px, L);
 }
