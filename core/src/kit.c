@@ -4,6 +4,7 @@
 #include "gi/log.h"
 
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -147,6 +148,38 @@ gi_result gi_kit_fail_with(gi_kit *k, gi_result r, const gi_error *err)
 const char *gi_kit_last_error(const gi_kit *k)
 {
     return k ? k->error.text : "";
+}
+
+gi_result gi_abi_layout_check(const gi_abi_layout *plugin, gi_error *err)
+{
+    static const gi_abi_layout host = GI_ABI_LAYOUT;
+#define FIELD(f, type) {offsetof(gi_abi_layout, f), #type}
+    static const struct {
+        size_t offset;
+        const char *name;
+    } fields[] = {FIELD(host, gi_host), FIELD(view, gi_view), FIELD(target, gi_target), FIELD(changes, gi_changes),
+                  FIELD(gpu_scene, gi_gpu_scene), FIELD(gpu_material, gi_gpu_material),
+                  FIELD(gpu_light, gi_gpu_light), FIELD(gpu_emitter, gi_gpu_emitter), FIELD(scene, gi_scene),
+                  FIELD(object, gi_object), FIELD(material, gi_material), FIELD(light, gi_light),
+                  FIELD(camera, gi_camera), FIELD(vertex, gi_vertex), FIELD(param_desc, gi_param_desc),
+                  FIELD(gbuffer, gi_gbuffer), FIELD(depth_view, gi_depth_view), FIELD(depth_desc, gi_depth_desc),
+                  FIELD(depth_atlas_desc, gi_depth_atlas_desc), FIELD(kit, gi_kit)};
+#undef FIELD
+    _Static_assert(sizeof fields / sizeof fields[0] * sizeof(uint32_t) + sizeof(uint32_t) == sizeof(gi_abi_layout),
+                   "every gi_abi_layout field is checked");
+    if (plugin->revision != host.revision)
+        return gi_error_set(err, GI_ERR_UNSUPPORTED, "built against data layout revision %u, this gibench has %u",
+                            plugin->revision, host.revision);
+    for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++) {
+        uint32_t p, h;
+        memcpy(&p, (const char *)plugin + fields[i].offset, sizeof p);
+        memcpy(&h, (const char *)&host + fields[i].offset, sizeof h);
+        if (p != h)
+            return gi_error_set(err, GI_ERR_UNSUPPORTED,
+                                "built against %s of %u bytes, this gibench has %u: rebuild the plugin",
+                                fields[i].name, p, h);
+    }
+    return GI_OK;
 }
 
 void gi_kit_dispatch_8x8(uint32_t width, uint32_t height)

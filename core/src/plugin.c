@@ -1,6 +1,7 @@
 /* The plugin loader (plugin.h): dlopen, entry, descriptor checks. */
 #define _POSIX_C_SOURCE 200809L
 #include "gi/plugin.h"
+#include "gi/kit.h"
 #include "gi/log.h"
 
 #include <dirent.h>
@@ -90,6 +91,14 @@ gi_result gi_method_validate(const gi_method *m, gi_error *err)
         if (fns[i].end > m->struct_size || !fns[i].present)
             return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "method '%s' lacks the required function %s()", m->id,
                                 fns[i].name);
+    if (m->struct_size < offsetof(gi_method, layout) + sizeof m->layout)
+        return gi_error_set(err, GI_ERR_UNSUPPORTED,
+                            "method '%s' has no data layout (built for ABI 1.0); rebuild it against this gibench "
+                            "(ABI %u.%u)",
+                            m->id, GI_ABI_MAJOR, GI_ABI_MINOR);
+    gi_error lerr;
+    if (gi_abi_layout_check(&m->layout, &lerr) != GI_OK)
+        return gi_error_set(err, GI_ERR_UNSUPPORTED, "method '%s' %s", m->id, lerr.text);
     gi_error perr;
     if (validate_params(m, &perr) != GI_OK)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "method '%s': %s", m->id, perr.text);

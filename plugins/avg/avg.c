@@ -514,6 +514,7 @@ static const gi_method avg_method = {
     .render = avg_render,
     .destroy = avg_destroy,
     .last_error = avg_last_error,
+    .layout = GI_ABI_LAYOUT,
 };
 
 GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)

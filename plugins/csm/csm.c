@@ -768,6 +768,7 @@ static const gi_method csm_method = {
     .render = csm_render,
     .destroy = csm_destroy,
     .last_error = csm_last_error,
+    .layout = GI_ABI_LAYOUT,
 };
 
 GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)

@@ -137,6 +137,7 @@ static const gi_method direct_method = {
     .render = direct_render,
     .destroy = direct_destroy,
     .last_error = direct_last_error,
+    .layout = GI_ABI_LAYOUT,
 };
 
 GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)

@@ -1,7 +1,7 @@
 /* Fake method plugins for the loader tests, one per defect: built several
  * times with one FAKE_* macro defined (tests/CMakeLists.txt). */
 #define _POSIX_C_SOURCE 200809L
-#include "gi/method.h"
+#include "gi/kit.h" /* GI_ABI_LAYOUT */
 
 #include <signal.h>
 #include <stddef.h>
@@ -105,6 +105,7 @@ static const gi_method fake_method = {
 #endif
     .destroy = fake_destroy,
     .last_error = fake_last_error,
+    .layout = GI_ABI_LAYOUT,
 };
 
 GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)
@@ -115,6 +116,21 @@ GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)
 #else
     if (GI_ABI_VERSION_MAJOR(host_abi_version) != GI_ABI_MAJOR)
         return NULL;
+#if defined(FAKE_LAYOUT_OLD) || defined(FAKE_LAYOUT_NEW) || defined(FAKE_LAYOUT_REVISION)
+    /* Built against other headers: a copy of the descriptor with the layout
+     * such a build would have recorded. */
+    static gi_method other;
+    other = fake_method;
+#if defined(FAKE_LAYOUT_OLD) /* an older gi_view, 16 bytes shorter */
+    other.layout.view -= 16;
+#elif defined(FAKE_LAYOUT_NEW) /* a newer gi_scene, 8 bytes longer */
+    other.layout.scene += 8;
+#else /* same sizes, a struct reordered */
+    other.layout.revision += 1;
+#endif
+    return &other;
+#else
     return &fake_method;
+#endif
 #endif
 }

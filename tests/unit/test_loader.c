@@ -1,9 +1,12 @@
 /* The plugin loader refuses broken plugins with clear messages: wrong ABI,
  * missing function, duplicate id, bad id, NULL entry, short descriptor, bad
- * parameter table; and loads a good one. */
+ * parameter table, a build against another data layout (older, newer, or
+ * reordered); and loads a good one. */
 #include "check.h"
+#include "gi/kit.h"
 #include "gi/plugin.h"
 
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -20,12 +23,23 @@ static void expect_refused(const char *kind, const char *substring)
 
 int main(void)
 {
-    expect_refused("wrong_abi", "built for plugin ABI 2.0, this gibench speaks 1.0");
+    expect_refused("wrong_abi", "built for plugin ABI 2.0, this gibench speaks 1.1");
     expect_refused("missing_fn", "lacks the required function render()");
     expect_refused("bad_id", "method id 'Bad Id!' is not [a-z0-9_]{1,31}");
     expect_refused("null_entry", "gi_method_entry returned NULL");
     expect_refused("small_struct", "descriptor is");
     expect_refused("bad_param", "parameter 'n' default 100 outside [0, 10]");
+    /* Built against other data layouts: refused with the struct named. */
+    char msg[160];
+    snprintf(msg, sizeof msg, "built against gi_view of %zu bytes, this gibench has %zu: rebuild the plugin",
+             sizeof(gi_view) - 16, sizeof(gi_view));
+    expect_refused("layout_old", msg);
+    snprintf(msg, sizeof msg, "built against gi_scene of %zu bytes, this gibench has %zu", sizeof(gi_scene) + 8,
+             sizeof(gi_scene));
+    expect_refused("layout_new", msg);
+    snprintf(msg, sizeof msg, "built against data layout revision %u, this gibench has %u", GI_LAYOUT_REVISION + 1u,
+             GI_LAYOUT_REVISION);
+    expect_refused("layout_revision", msg);
 
     gi_error err;
     CHECK(gi_plugins_add(NULL, FAKE_DIR "/does_not_exist.so", &err) == GI_ERR_IO);
@@ -41,7 +55,7 @@ int main(void)
     for (uint32_t i = 0; i < reg->error_count; i++)
         dup += strstr(reg->errors[i], "duplicate method id 'fake_good'") != NULL;
     CHECK(dup == 1);
-    CHECK(reg->error_count == 7);
+    CHECK(reg->error_count == 10);
     const gi_method *m = gi_plugins_find(reg, "fake_good");
     CHECK(m && m->params && strcmp(m->params[1].choices, "a|b|c") == 0);
     gi_plugins_free(reg);
@@ -53,5 +67,12 @@ int main(void)
     bad = *m;
     bad.destroy = NULL;
     CHECK(gi_method_validate(&bad, &err) != GI_OK && strstr(err.text, "destroy()"));
+    /* A 1.0 descriptor (ends at last_error) has no layout: refused. */
+    bad = *m;
+    bad.struct_size = (uint32_t)offsetof(gi_method, layout);
+    CHECK(gi_method_validate(&bad, &err) == GI_ERR_UNSUPPORTED && strstr(err.text, "has no data layout"));
+    /* A plugin built against the current headers passes the check. */
+    static const gi_abi_layout current = GI_ABI_LAYOUT;
+    CHECK(gi_abi_layout_check(&current, &err) == GI_OK);
     return gi_test_finish();
 }

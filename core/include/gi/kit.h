@@ -104,6 +104,23 @@ gi_result gi_kit_fail(gi_kit *k, gi_result r, const char *fmt, ...)
 gi_result gi_kit_fail_with(gi_kit *k, gi_result r, const gi_error *err);
 const char *gi_kit_last_error(const gi_kit *k);
 
+/* The data layout this build sees (gi_method.layout; method.h "Data
+ * layout"). Bump GI_LAYOUT_REVISION on a same-size change of one of them. */
+#define GI_LAYOUT_REVISION 1u
+#define GI_ABI_LAYOUT                                                                                                 \
+    {                                                                                                                 \
+        GI_LAYOUT_REVISION, sizeof(gi_host), sizeof(gi_view), sizeof(gi_target), sizeof(gi_changes),                 \
+            sizeof(gi_gpu_scene), sizeof(gi_gpu_material), sizeof(gi_gpu_light), sizeof(gi_gpu_emitter),              \
+            sizeof(gi_scene), sizeof(gi_object), sizeof(gi_material), sizeof(gi_light), sizeof(gi_camera),            \
+            sizeof(gi_vertex), sizeof(gi_param_desc), sizeof(gi_gbuffer), sizeof(gi_depth_view), sizeof(gi_depth_desc), \
+            sizeof(gi_depth_atlas_desc), sizeof(gi_kit)                                                               \
+    }
+
+/* GI_OK when `plugin` (a descriptor's layout) equals the core's; else
+ * GI_ERR_UNSUPPORTED and "built against <struct> of N bytes, this gibench
+ * has M" (or the revisions) in err. */
+gi_result gi_abi_layout_check(const gi_abi_layout *plugin, gi_error *err);
+
 /* A compute dispatch covering width x height with 8 x 8 work groups
  * (the kit's shaders' local size), then a barrier for images, texture
  * fetches and buffers written by it. */

@@ -21,6 +21,15 @@
  * before touching it (GI_HAS_FIELD). A change that reorders or removes a
  * field bumps GI_ABI_MAJOR; a change that appends bumps GI_ABI_MINOR.
  *
+ * Data layout: a plugin also reads structs the host fills (gi_view,
+ * gi_gpu_scene, gi_scene and its arrays, gi_gbuffer, ...) and embeds the
+ * core's gi_kit. Their sizes as the plugin's build saw them travel in
+ * gi_method.layout (GI_ABI_LAYOUT); the loader refuses a plugin whose
+ * sizes or GI_LAYOUT_REVISION differ from its own, naming the first
+ * struct that differs. Whoever changes one of these structs without
+ * changing its size (a reorder, a type of the same width) bumps
+ * GI_LAYOUT_REVISION by hand.
+ *
  * Ownership: plugins own and free every GL object they create; they read
  * the scene's GPU buffers (gi_gpu_scene) but never delete or resize them;
  * the target texture belongs to the host.
@@ -38,7 +47,7 @@ extern "C" {
 #endif
 
 #define GI_ABI_MAJOR 1u
-#define GI_ABI_MINOR 0u
+#define GI_ABI_MINOR 1u /* 1.1: gi_method.layout */
 #define GI_ABI_VERSION ((GI_ABI_MAJOR << 16) | GI_ABI_MINOR)
 #define GI_ABI_VERSION_MAJOR(v) ((v) >> 16)
 
@@ -119,6 +128,7 @@ typedef struct gi_target {
 } gi_target;
 
 typedef struct gi_host gi_host;
+typedef struct gi_abi_layout gi_abi_layout;
 struct gi_host {
     uint32_t struct_size;
     uint32_t abi_version;
@@ -153,6 +163,16 @@ struct gi_host {
     int gl_is_software;
 };
 
+/* Sizes of the data structs a plugin reads or embeds, as its build saw
+ * them (GI_ABI_LAYOUT fills it). */
+struct gi_abi_layout {
+    uint32_t revision; /* GI_LAYOUT_REVISION */
+    uint32_t host, view, target, changes, gpu_scene, gpu_material, gpu_light, gpu_emitter;
+    uint32_t scene, object, material, light, camera, vertex, param_desc;
+    uint32_t gbuffer, depth_view, depth_desc, depth_atlas_desc, kit;
+};
+
+
 typedef struct gi_method {
     uint32_t struct_size;  /* sizeof(gi_method) the plugin was built with */
     uint32_t abi_version;  /* GI_ABI_VERSION the plugin was built with */
@@ -170,9 +190,14 @@ typedef struct gi_method {
     gi_result (*render)(void *instance, const gi_view *view, const gi_target *target);
     void (*destroy)(void *instance);
     const char *(*last_error)(void *instance);
+    /* ABI 1.1: the data layout the plugin was built against; set it to
+     * GI_ABI_LAYOUT (gi/kit.h, which a plugin includes). Required. */
+    gi_abi_layout layout;
 } gi_method;
 
 typedef const gi_method *(*gi_method_entry_fn)(uint32_t host_abi_version);
+
+
 
 /* The one symbol a plugin defines and exports (declared here so that the
  * definition is checked against it). */
