@@ -285,28 +285,30 @@ int cli_caps_cover(const gi_method *m, const gi_scene *s, int animated, char *wh
         glossy |= spec && !(mat->mirror || mat->exponent >= GI_MIRROR_EXPONENT);
         textured |= mat->albedo_texture >= 0;
     }
-    const char *missing = NULL;
+    const char *missing[9];
+    int n = 0;
     if (s->emitter_count && !(c & GI_CAP_AREA_LIGHTS))
-        missing = "area lights";
-    else if (point && !(c & GI_CAP_POINT_LIGHTS))
-        missing = "point or spot lights";
-    else if (directional && !(c & GI_CAP_DIRECTIONAL))
-        missing = "directional lights";
-    else if (s->envmap && !(c & GI_CAP_ENVIRONMENT))
-        missing = "environment light";
-    else if (mirror && !(c & GI_CAP_MIRROR))
-        missing = "mirrors";
-    else if (glossy && !(c & GI_CAP_GLOSSY))
-        missing = "glossy materials";
-    else if (textured && !(c & GI_CAP_TEXTURES))
-        missing = "textures";
-    else if (animated && !(c & GI_CAP_RIGID_MOTION))
-        missing = "moving objects";
-    else if (gi_scene_deforms(s) && !(c & GI_CAP_DEFORMATION))
-        missing = "deforming meshes"; /* even for a still frame: the CPU copy holds the rest pose */
-    if (missing) {
-        snprintf(why, size, "%s does not handle %s", m->id, missing);
-        return 0;
-    }
-    return 1;
+        missing[n++] = "area lights";
+    if (point && !(c & GI_CAP_POINT_LIGHTS))
+        missing[n++] = "point or spot lights";
+    if (directional && !(c & GI_CAP_DIRECTIONAL))
+        missing[n++] = "directional lights";
+    if (s->envmap && !(c & GI_CAP_ENVIRONMENT))
+        missing[n++] = "environment light";
+    if (mirror && !(c & GI_CAP_MIRROR))
+        missing[n++] = "mirrors";
+    if (glossy && !(c & GI_CAP_GLOSSY))
+        missing[n++] = "glossy materials";
+    if (textured && !(c & GI_CAP_TEXTURES))
+        missing[n++] = "textures";
+    if (animated && !(c & GI_CAP_RIGID_MOTION))
+        missing[n++] = "moving objects";
+    if (gi_scene_deforms(s) && !(c & GI_CAP_DEFORMATION))
+        missing[n++] = "deforming meshes"; /* even for a still frame: the CPU copy holds the rest pose */
+    if (n == 0)
+        return 1;
+    int used = snprintf(why, size, "%s does not handle %s", m->id, missing[0]);
+    for (int i = 1; i < n && used >= 0 && (size_t)used < size; i++)
+        used += snprintf(why + used, size - (size_t)used, "%s%s", i == n - 1 ? " or " : ", ", missing[i]);
+    return 0;
 }

@@ -63,7 +63,8 @@ int cli_write_json(const char *path, json_object *obj, char *why, size_t why_siz
 json_object *cli_timer_json(const gi_timer *t);
 
 /* Do the method's caps cover the scene's lighting and materials (and
- * motion when animated)? 0 with the reason ("csm does not handle mirrors"). */
+ * motion when animated)? 0 with the reason naming everything not covered
+ * ("avg does not handle directional lights or environment light"). */
 int cli_caps_cover(const gi_method *m, const gi_scene *s, int animated, char *why, size_t size);
 
 int cmd_methods(int argc, char **argv);

@@ -211,6 +211,12 @@ static int run(run_state *r, const render_opts *o)
     r->scene = gi_scene_load(o->scene, &err);
     if (!r->scene)
         return cli_fail(EXIT_USAGE, "%s", err.text);
+    /* A study marks such a cell n/a; a single render runs it but says what
+     * the image leaves out. */
+    char why[256];
+    if (!cli_caps_cover(r->m, r->scene, o->animate_fps > 0, why, sizeof why))
+        gi_log(GI_LOG_WARN, "render: %s in %s: the image leaves that out (a study marks this cell n/a)", why,
+               o->scene);
     int camera = 0;
     if (o->camera) {
         camera = gi_scene_find_camera(r->scene, o->camera);

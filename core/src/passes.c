@@ -106,9 +106,12 @@ struct gi_depth_renderer {
 
 gi_depth_renderer *gi_depth_renderer_create(const gi_depth_desc *desc, gi_error *err)
 {
-    if (desc->size == 0 || desc->size > 16384 || desc->surfaces < 1 || desc->surfaces > 4) {
+    gi_depth_desc d = *desc;
+    if (d.surfaces == 0)
+        d.surfaces = 1;
+    if (d.size == 0 || d.size > 16384 || d.surfaces > 4) {
         gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth maps: size %u (1..16384) or surfaces %u (1..4) invalid",
-                     desc->size, desc->surfaces);
+                     d.size, d.surfaces);
         return NULL;
     }
     gi_depth_renderer *r = calloc(1, sizeof *r);
@@ -116,7 +119,7 @@ gi_depth_renderer *gi_depth_renderer_create(const gi_depth_desc *desc, gi_error 
         gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory");
         return NULL;
     }
-    r->desc = *desc;
+    r->desc = d;
     r->program = gi_program_build("depth.vert", NULL, "depth.frag", NULL, err);
     if (!r->program) {
         free(r);
@@ -216,7 +219,7 @@ gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi
             glClear(GL_DEPTH_BUFFER_BIT);
             glBindTextureUnit(GI_TEX_CORE_DEPTH_PEEL, prev);
             glUniform1i(loc_peel, (GLint)k);
-            gi_gpu_scene_draw(gs, d->object, 1);
+            gi_gpu_scene_draw(gs, d->only_object ? (int)d->only_object - 1 : -1, 1);
         }
     }
     glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);

@@ -28,7 +28,7 @@ gi_result csm_encode_maps(const gi_gpu_scene *gs, const csm_encode_desc *desc, c
     gi_depth_desc dd = {.size = M,
                         .surfaces = desc->z3 ? 3u : 2u,
                         .metric = desc->metric,
-                        .object = (int)desc->object,
+                        .only_object = desc->object + 1u,
                         .local = 1,
                         .cull = 0};
     gi_depth_renderer *dr = gi_depth_renderer_create(&dd, err);

@@ -38,6 +38,9 @@ foreach(scene cornell_box_coarse.gltf cornell_glossy.gltf bunny_env.glb teapot_p
         math(EXPR failures "${failures} + 1")
     endif()
 endforeach()
+# A render on a scene its caps do not cover runs, warning with what is left out.
+expect(0 "warning: render: avg does not handle environment light in " render --scene ${SCENES}/bunny_env.glb --method avg --size 16x16 --param vpls=16 --out ${OUT}/avg_env.exr)
+expect(0 "warning: render: csm does not handle deforming meshes" render --scene ${SCENES}/cornell_deform.gltf --method csm --size 16x16 --param N=2 --param M=8 --param M_local=8 --param N_local=1 --out ${OUT}/csm_deform.exr)
 # An animated render advances time and calls update.
 expect(0 "" render --scene ${SCENES}/cornell_moving.gltf --method direct --size 32x32 --frames 3 --animate 2 --out ${OUT}/moving.png)
 

@@ -352,7 +352,7 @@ int main(void)
            (double)data.segment_count / (M * M), (double)data.bytes_uncompressed / (double)data.bytes_compressed);
 
     /* Lossless on real maps. */
-    gi_depth_desc dd = {.size = M, .surfaces = 2, .metric = GI_DEPTH_EYE_Z, .object = (int)k, .local = 1};
+    gi_depth_desc dd = {.size = M, .surfaces = 2, .metric = GI_DEPTH_EYE_Z, .only_object = k + 1u, .local = 1};
     gi_depth_renderer *dr = gi_depth_renderer_create(&dd, &err);
     GLuint tex = gi_depth_texture_create(dr, 1);
     uint64_t bad = 0, checked = 0, degenerate = 0;

@@ -97,7 +97,7 @@ static void compare_with_per_view(gi_gpu_scene *gs, const gi_scene *s, const cha
     gi_depth_atlas_desc ad = {.tile = tile, .capacity = nviews + 3, .projection = proj, .metric = metric, .cull = cull};
     gi_depth_atlas *a = gi_depth_atlas_create(&ad, &err);
     CHECK_MSG(a != NULL, "%s", err.text);
-    gi_depth_desc dd = {.size = tile, .surfaces = 1, .metric = metric, .object = -1, .cull = cull};
+    gi_depth_desc dd = {.size = tile, .surfaces = 1, .metric = metric, .cull = cull};
     gi_depth_renderer *dr = gi_depth_renderer_create(&dd, &err);
     CHECK_MSG(dr != NULL, "%s", err.text);
     if (!a || !dr) {
@@ -415,7 +415,7 @@ static int bench(gi_gpu *gpu, gi_gpu_scene *gs, const gi_scene *s, uint32_t maps
     gi_depth_metric metric = proj == GI_PROJ_PARABOLOID ? GI_DEPTH_RADIAL : GI_DEPTH_EYE_Z;
     gi_depth_atlas_desc ad = {.tile = tile, .capacity = maps, .projection = proj, .metric = metric};
     gi_depth_atlas *a = gi_depth_atlas_create(&ad, &err);
-    gi_depth_desc dd = {.size = tile, .surfaces = 1, .metric = metric, .object = -1};
+    gi_depth_desc dd = {.size = tile, .surfaces = 1, .metric = metric};
     gi_depth_renderer *dr = gi_depth_renderer_create(&dd, &err);
     if (!a || !dr) {
         fprintf(stderr, "%s\n", err.text);

@@ -165,7 +165,7 @@ int main(void)
     const uint32_t S = 64;
     float cx = 0.5f * (s->bounds[0] + s->bounds[3]), cz = 0.5f * (s->bounds[2] + s->bounds[5]);
     float top = s->bounds[4] + 1.0f, half = 0.55f * (s->bounds[3] - s->bounds[0]);
-    gi_depth_desc desc = {.size = S, .surfaces = 3, .metric = GI_DEPTH_EYE_Z, .object = -1};
+    gi_depth_desc desc = {.size = S, .surfaces = 3, .metric = GI_DEPTH_EYE_Z};
     gi_depth_renderer *dr = gi_depth_renderer_create(&desc, &err);
     CHECK_MSG(dr != NULL, "%s", err.text);
     GLuint tex = gi_depth_texture_create(dr, 8);

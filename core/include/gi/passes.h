@@ -91,7 +91,8 @@ typedef enum gi_depth_metric {
     GI_DEPTH_RADIAL = 1,
 } gi_depth_metric;
 
-/* One depth map to render. */
+/* One depth map to render. (Desc structs here follow the zero-means-default
+ * rule: a field left 0 asks for the default the comment names.) */
 typedef struct gi_depth_view {
     float view[16];         /* world (or object-local, see `local`) -> eye */
     float proj[16];         /* ignored for paraboloid */
@@ -101,10 +102,10 @@ typedef struct gi_depth_view {
 
 typedef struct gi_depth_desc {
     uint32_t size;          /* maps are size x size */
-    uint32_t surfaces;      /* 1..4 peeled layers (2 = dual depth, 3 = z3) */
-    gi_depth_metric metric;
-    int object;             /* render only this object, -1 = all */
-    int local;              /* 1: ignore object transforms (object-local maps) */
+    uint32_t surfaces;      /* 1..4 peeled layers (2 = dual depth, 3 = z3); 0 = 1 */
+    gi_depth_metric metric; /* 0 = GI_DEPTH_EYE_Z */
+    uint32_t only_object;   /* 0 = all objects; k + 1 = object k alone */
+    int local;              /* 1: ignore object transforms (object-local maps); 0 = world */
     int cull;               /* 0 none, 1 back faces, 2 front faces */
 } gi_depth_desc;
 
