@@ -18,7 +18,7 @@
  *  - the GLSL query (shaders/csm_local.glsl) on the same data as the plugin
  *    uploads it: nearest equals the CPU product, and Russian roulette
  *    averaged over 256 stratified numbers equals generalised PCF. */
-#include "../../plugins/csm/csm_local.h"
+#include "csm_local.h"
 
 #include "gi/mesh.h"
 #include "gi/rng.h"
@@ -37,7 +37,7 @@ extern const gi_shader_source gi_csm_local_shaders[];
 
 /* EXPECT(cond, fmt, ...): CHECK_MSG of the unit tests' check.h, which
  * counts failures in gi_test_failed. */
-#include "../unit/check.h"
+#include "check.h"
 #define EXPECT CHECK_MSG
 
 enum { M_CUBE = 64, NL = 4 };
@@ -431,7 +431,7 @@ static void gpu_check(const setup *st, const pair *pin, const int *cpu, uint32_t
     const gi_scene *s = st->s;
     uint32_t n = s->object_count, L = st->light_count;
     gi_error err;
-    GLuint prog = gi_program_build_compute_text("tests/integration/csm_local_kernel.comp", kernel, NULL, &err);
+    GLuint prog = gi_program_build_compute_text("plugins/csm/tests/csm_local_kernel.comp", kernel, NULL, &err);
     EXPECT(prog != 0, "%s", err.text);
     if (!prog)
         return;

@@ -22,8 +22,8 @@
  *    (open_surfaces=shell, z2 and z3 options) and without it (open), which
  *    lets the light through the ground; and the same for a local point
  *    light below the ground (cube-map CSM of the ground, §3.3). */
-#include "../../plugins/csm/csm_cpu.h"
-#include "../../plugins/csm/csm_local.h"
+#include "csm_cpu.h"
+#include "csm_local.h"
 
 #include "gi/mesh.h"
 #include "gi/raytrace.h"
@@ -43,7 +43,7 @@ extern const gi_shader_source gi_csm_query_shaders[];
 
 /* EXPECT(cond, fmt, ...): CHECK_MSG of the unit tests' check.h, which
  * counts failures in gi_test_failed. */
-#include "../unit/check.h"
+#include "check.h"
 #define EXPECT CHECK_MSG
 
 /* Number of hits of the ray o + h d, h > 0, with object k (local space). */
@@ -439,7 +439,7 @@ int main(void)
         "    pout[c] = vec4(csm_visibility_object(0u, x, vec3(0.0), w, 0, 0.0),\n"
         "                   csm_visibility_object(0u, x, vec3(0.0), w, 1, 0.0), rr / 256.0, 0.0);\n"
         "}\n";
-    GLuint prog = gi_program_build_compute_text("tests/integration/csm_query_kernel.comp", kernel, NULL, &err);
+    GLuint prog = gi_program_build_compute_text("plugins/csm/tests/csm_query_kernel.comp", kernel, NULL, &err);
     EXPECT(prog != 0, "%s", err.text);
     csm_gpu_object obj;
     memset(&obj, 0, sizeof obj);

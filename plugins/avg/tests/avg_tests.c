@@ -22,7 +22,7 @@
  *                     over all VPLs computed on the CPU from the G-buffer
  *                     (no visibility), and M = 16 without the filter equals
  *                     M times the sum over each pixel's own subset. */
-#include "../../plugins/avg/avg.h"
+#include "avg.h"
 
 #include "gi/image.h"
 #include "gi/lights.h"
@@ -39,7 +39,7 @@
 
 /* EXPECT(cond, fmt, ...): CHECK_MSG of the unit tests' check.h, which
  * counts failures in gi_test_failed. */
-#include "../unit/check.h"
+#include "check.h"
 #define EXPECT CHECK_MSG
 
 /* ---- a minimal host for driving the method in-process ---- */
