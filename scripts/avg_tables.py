@@ -6,14 +6,23 @@ Reads DIR/runs.csv and DIR/frames.csv written by
 and prints Markdown (Table I, Table II, Fig. 6 with the direct AVG-against-
 exact image difference, Fig. 7, the 64^3 against 128^3 grid, the U room's
 VPL sweep, the references) to stdout. The paper's numbers are those printed
-in Bashford-Rogers et al. (Table I, Table II, the text of §IV). The image
-differences and the triangle counts come from `gibench diff` and
-`gibench info` (GIBENCH, default build/release/bin/gibench); the Fig. 6
-heat maps are written to DIR/fig6_<scene>_avg_vs_exact.png. Stdlib only.
+in Bashford-Rogers et al. (Table I, Table II, the text of §IV). The triangle
+counts come from `gibench info` (GIBENCH, default build/release/bin/gibench).
 
-Usage: scripts/avg_tables.py DIR [GIBENCH] > DIR/tables.md
+The numbers that need the study's EXR images (which are not committed: the
+Fig. 6 difference between the AVG-traced and the exactly traced image, and
+the references' statistics) are measured with `--measure`, right after the
+study: `gibench diff` on the EXRs, the references' JSON statistics, the Fig. 6
+heat maps written to DIR/fig6_<scene>_avg_vs_exact.png, and all of it kept in
+DIR/image_stats.csv, which is committed. Without `--measure` the tables are
+made from the committed files alone (runs.csv, frames.csv, image_stats.csv),
+so they can be regenerated, and checked, on a checkout without the EXRs.
+Stdlib only.
+
+Usage: scripts/avg_tables.py DIR [GIBENCH] [--measure] > DIR/tables.md
 """
 
+import argparse
 import csv
 import json
 import os
@@ -63,15 +72,63 @@ def gibench_json(exe, args):
     return json.loads(out)
 
 
+IMAGE_STATS_FIELDS = ["kind", "scene", "bounces", "relmse", "mean_lum_diff_pct", "flip", "ssim", "mean_rel_se",
+                      "wall_seconds"]
+
+
+def measure_image_stats(d, exe, runs):
+    """The statistics that need the EXR images: Fig. 6's AVG-against-exact
+    difference per scene and the references' statistics; writes the heat
+    maps and returns the rows of image_stats.csv."""
+    rows = []
+    for _, scene in SCENES:
+        a, e = find(runs, "still", scene, visibility="true"), find(runs, "fig6", scene)
+        if not a or not e:
+            continue
+        stem = os.path.splitext(os.path.basename(scene))[0]
+        m = gibench_json(exe, ["diff", os.path.join(d, "runs", a["run"], "image.exr"),
+                               os.path.join(d, "runs", e["run"], "image.exr"),
+                               "--heatmap", os.path.join(d, "fig6_%s_avg_vs_exact.png" % stem)])
+        rows.append({"kind": "fig6", "scene": scene,
+                     **{k: "" if m.get(k) is None else repr(m[k])
+                        for k in ("relmse", "mean_lum_diff_pct", "flip", "ssim")}})
+    for _, scene in SCENES:
+        stem = os.path.splitext(os.path.basename(scene))[0]
+        full = os.path.join(d, "references", "%s_b64_512spp_center.exr" % stem)
+        for b in (4, 64):
+            p = os.path.join(d, "references", "%s_b%d_512spp_center.exr" % (stem, b))
+            if not os.path.exists(p + ".json"):
+                continue
+            with open(p + ".json") as fh:
+                st = json.load(fh)
+            diff = gibench_json(exe, ["diff", p, full])["mean_lum_diff_pct"] if b == 4 else None
+            rows.append({"kind": "reference", "scene": scene, "bounces": str(b),
+                         "mean_lum_diff_pct": "" if diff is None else repr(diff),
+                         "mean_rel_se": repr(st["mean_rel_se"]), "wall_seconds": repr(st["wall_seconds"])})
+    return rows
+
+
 def main():
-    if len(sys.argv) not in (2, 3):
-        sys.exit("usage: avg_tables.py DIR [GIBENCH] (DIR: the study's --out directory)")
-    d = sys.argv[1]
-    exe = sys.argv[2] if len(sys.argv) == 3 else "build/release/bin/gibench"
+    ap = argparse.ArgumentParser(description="Tables of the avg study (DIR: the study's --out directory)")
+    ap.add_argument("dir")
+    ap.add_argument("gibench", nargs="?", default="build/release/bin/gibench")
+    ap.add_argument("--measure", action="store_true",
+                    help="measure DIR/image_stats.csv from the study's EXR images first")
+    args = ap.parse_args()
+    d, exe = args.dir, args.gibench
     with open(os.path.join(d, "runs.csv"), newline="") as fh:
         runs = [r for r in csv.DictReader(fh) if r["status"] == "ok"]
     with open(os.path.join(d, "frames.csv"), newline="") as fh:
         frames = list(csv.DictReader(fh))
+    stats_path = os.path.join(d, "image_stats.csv")
+    if args.measure:
+        stats = measure_image_stats(d, exe, runs)
+        with open(stats_path, "w", newline="") as fh:
+            wr = csv.DictWriter(fh, fieldnames=IMAGE_STATS_FIELDS, restval="", lineterminator="\n")
+            wr.writeheader()
+            wr.writerows(stats)
+    with open(stats_path, newline="") as fh:
+        stats = list(csv.DictReader(fh))
     renderer = runs[0]["renderer"] if runs else "?"
     timer = runs[0]["timer"] if runs else "?"
     out = []
@@ -168,16 +225,11 @@ def main():
     w("| scene | relMSE | image mean (AVG vs exact) | FLIP | SSIM |")
     w("|---|---:|---:|---:|---:|")
     for sname, scene in SCENES:
-        a, e = find(runs, "still", scene, visibility="true"), find(runs, "fig6", scene)
-        if not a or not e:
-            continue
-        stem = os.path.splitext(os.path.basename(scene))[0]
-        m = gibench_json(exe, ["diff", os.path.join(d, "runs", a["run"], "image.exr"),
-                               os.path.join(d, "runs", e["run"], "image.exr"),
-                               "--heatmap", os.path.join(d, "fig6_%s_avg_vs_exact.png" % stem)])
-        g = {k: float("nan") if m.get(k) is None else m[k] for k in ("relmse", "mean_lum_diff_pct", "flip", "ssim")}
-        w("| %s | %s | %s | %s | %s |" % (sname, f(g["relmse"]), pct(g["mean_lum_diff_pct"]), f(g["flip"]),
-                                          f(g["ssim"])))
+        for r in stats:
+            if r["kind"] == "fig6" and r["scene"] == scene:
+                g = {k: num(r, k) for k in ("relmse", "mean_lum_diff_pct", "flip", "ssim")}
+                w("| %s | %s | %s | %s | %s |" % (sname, f(g["relmse"]), pct(g["mean_lum_diff_pct"]), f(g["flip"]),
+                                                  f(g["ssim"])))
     w("")
 
     # ---- U room VPL sweep
@@ -198,17 +250,11 @@ def main():
     w("| scene | bounces | mean relative standard error | wall s | matched against full: image mean |")
     w("|---|---:|---:|---:|---:|")
     for sname, scene in SCENES:
-        stem = os.path.splitext(os.path.basename(scene))[0]
-        full = os.path.join(d, "references", "%s_b64_512spp_center.exr" % stem)
-        for b in (4, 64):
-            p = os.path.join(d, "references", "%s_b%d_512spp_center.exr" % (stem, b))
-            if not os.path.exists(p + ".json"):
-                continue
-            with open(p + ".json") as fh:
-                s = json.load(fh)
-            diff = gibench_json(exe, ["diff", p, full])["mean_lum_diff_pct"] if b == 4 else None
-            w("| %s | %d | %.1f %% | %.0f | %s |" % (sname, b, 100 * s["mean_rel_se"], s["wall_seconds"],
-                                                  pct(diff) if diff is not None else "–"))
+        for r in stats:
+            if r["kind"] == "reference" and r["scene"] == scene:
+                diff = num(r, "mean_lum_diff_pct")
+                w("| %s | %s | %.1f %% | %.0f | %s |" % (sname, r["bounces"], 100 * num(r, "mean_rel_se"),
+                                                      num(r, "wall_seconds"), pct(diff) if diff == diff else "–"))
     print("\n".join(out))
     return 0
 

@@ -18,6 +18,8 @@ pkgs=(
   # (VTK draws through EGL, see harness/charts.cpp).
   xvfb xauth
   libjson-c-dev libxxhash-dev
+  # scripts/*.py (the results tables, their test integration.results_tables)
+  python3
 )
 if [ "${1:-}" = "--sources" ]; then
   pkgs+=(embree-tools blender-data)

@@ -1,6 +1,6 @@
 /* Approximate Visibility Grids (Bashford-Rogers, Debattista, Harvey,
  * Chalmers): the plugin's internal interface, shared by avg.c and the tests
- * (tests/integration/avg_*.c compile the plugin's sources in).
+ * (tests/avg_tests.c compiles the plugin's sources in).
  *
  *   avg_grid   the AVG itself (§III-A): two 3D textures (summed normals and
  *              summed colours, a count in alpha), rebuilt by the rasteriser

@@ -1,6 +1,6 @@
 /* CPU side of the csm plugin: the direction parameterisation, the map
  * basis and projection (GLSL twin: shaders/csm_geom.glsl, held equal by
- * tests/integration/csm_twins.c), the precomputation of one object's
+ * tests/csm_twins.c), the precomputation of one object's
  * Coherent Shadow Map (precompute.c) and the nearest-filter query on the
  * decoded data (for tests).
  *

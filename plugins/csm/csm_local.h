@@ -1,7 +1,7 @@
 /* Local lights of the csm plugin (Ritschel et al. 2007 §4.2, §3.3, §4.4):
  * the scene's lights as parameterised shapes, depth cube maps at N points
  * on each, and the query on them. GLSL twin: shaders/csm_local.glsl (held
- * equal by tests/integration/csm_local.c).
+ * equal by tests/csm_local.c).
  *
  * Lights (csm_lights_collect), in world space at the prepare time:
  *   - area (d = 2): an object with emissive triangles is one light; its

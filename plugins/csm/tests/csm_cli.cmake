@@ -1,10 +1,10 @@
 # The csm plugin through the gibench command: a finite render of the bunny,
 # the on-disk cache (a second run hits it; a damaged file is recomputed with
 # a warning), and bad parameters exit 2.
-# Run by ctest as: cmake -DGIB=... -DSCENES=... -DOUT=... -P csm_cli.cmake
+# Run by ctest as: cmake -DGIB=... -DSCENES=... -DOUT=... -DEXPECT=.../expect.cmake -P csm_cli.cmake
 
 set(failures 0)
-include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
+include(${EXPECT})
 
 set(cache ${OUT}/csm_cache)
 file(REMOVE_RECURSE ${cache})

@@ -2,10 +2,10 @@
 # moving, a deforming and an indirectly lit scene and of point/spot lights, every
 # variant (exact tracing, the paper's voxeliser, M = 1 without filter),
 # the stage timers of Table I, and bad parameters exiting 2.
-# Run by ctest as: cmake -DGIB=... -DSCENES=... -DDATA=... -DOUT=... -P avg_cli.cmake
+# Run by ctest as: cmake -DGIB=... -DSCENES=... -DDATA=... -DOUT=... -DEXPECT=.../expect.cmake -P avg_cli.cmake
 
 set(failures 0)
-include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
+include(${EXPECT})
 
 set(small --size 32x32 --param grid=32 --param vpls=256)
 

@@ -6,7 +6,7 @@
  * about 35 here). Directions are kept 1e-3 away
  * from the phi = 0 seam and the poles, where a 1-ulp difference may
  * legitimately wrap phi by 2 pi. */
-#include "../../plugins/csm/csm_cpu.h"
+#include "csm_cpu.h"
 
 #include "gi/rng.h"
 #include "gi/sampling.h"
@@ -53,7 +53,7 @@ int main(void)
     if (!gpu)
         return 1;
     gi_error err;
-    GLuint prog = gi_program_build_compute_text("tests/integration/csm_twins.comp", kernel, NULL, &err);
+    GLuint prog = gi_program_build_compute_text("plugins/csm/tests/csm_twins.comp", kernel, NULL, &err);
     if (!prog) {
         fprintf(stderr, "%s\n", err.text);
         return 1;

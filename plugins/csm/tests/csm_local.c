@@ -18,7 +18,7 @@
  *  - the GLSL query (shaders/csm_local.glsl) on the same data as the plugin
  *    uploads it: nearest equals the CPU product, and Russian roulette
  *    averaged over 256 stratified numbers equals generalised PCF. */
-#include "../../plugins/csm/csm_local.h"
+#include "csm_local.h"
 
 #include "gi/mesh.h"
 #include "gi/rng.h"
@@ -37,8 +37,10 @@ extern const gi_shader_source gi_csm_local_shaders[];
 
 /* EXPECT(cond, fmt, ...): CHECK_MSG of the unit tests' check.h, which
  * counts failures in gi_test_failed. */
-#include "../unit/check.h"
+#include "check.h"
 #define EXPECT CHECK_MSG
+#include "vis_score.h"
+#include "csm_cpu.h"
 
 enum { M_CUBE = 64, NL = 4 };
 
@@ -127,19 +129,22 @@ typedef struct setup {
     float (*local_from_world)[16];
 } setup;
 
-static int setup_scene(gi_gpu *gpu, const char *path, setup *st)
+/* Loads the scene and finds its lights; with `cube_maps`, builds every
+ * caster's cube-map CSMs too. Returns 0 after a message when any of it
+ * fails (the caller then fails the test). */
+static int setup_scene(gi_gpu *gpu, const char *path, setup *st, int cube_maps)
 {
     gi_error err;
     memset(st, 0, sizeof *st);
     st->s = gi_scene_load(path, &err);
     if (!st->s) {
-        fprintf(stderr, "%s\n", err.text);
+        fprintf(stderr, "set-up failed: %s: %s\n", path, err.text);
         return 0;
     }
     const gi_scene *s = st->s;
     st->gs = gi_gpu_scene_upload(gpu, s, &err);
     if (!st->gs) {
-        fprintf(stderr, "%s\n", err.text);
+        fprintf(stderr, "set-up failed: %s: upload: %s\n", path, err.text);
         return 0;
     }
     st->w.s = s;
@@ -176,10 +181,13 @@ static int setup_scene(gi_gpu *gpu, const char *path, setup *st)
                                   .z3 = 0,
                                   .shell = 1e-3f * sphere[3], /* the plugin's default */
                                   .batch = 16};
-            if (l->object == (int)k)
+            if (l->object == (int)k || !cube_maps)
                 continue;
             gi_csm_data *cd = &st->data[j * n + k];
-            EXPECT(csm_build_local(st->gs, k, sphere, d, NULL, 0, 1, cd, &err) == GI_OK, "%s", err.text);
+            if (csm_build_local(st->gs, k, sphere, d, NULL, 0, 1, cd, &err) != GI_OK) {
+                fprintf(stderr, "set-up failed: %s: cube maps of object %u for light %u: %s\n", path, k, j, err.text);
+                return 0;
+            }
             seg += (double)cd->segment_count / (M_CUBE * M_CUBE);
             bu += (double)cd->bytes_uncompressed;
             bc += (double)cd->bytes_compressed;
@@ -192,8 +200,14 @@ static int setup_scene(gi_gpu *gpu, const char *path, setup *st)
                st->lights[j].kind == CSM_LIGHT_AREA ? "area" : st->lights[j].kind == CSM_LIGHT_LINEAR ? "linear" : "point",
                st->lights[j].n_u, st->lights[j].n_v, (double)gi_v3_length(st->lights[j].e1),
                (double)gi_v3_length(st->lights[j].e2));
-    printf("; %u cube-map CSMs of 6 N maps, M = %u: %.2f segments per texel, %.1f : 1\n", built, M_CUBE,
-           built ? seg / built : 0.0, bc > 0 ? bu / bc : 0.0);
+    if (cube_maps)
+        printf("; %u cube-map CSMs of 6 N maps, M = %u: %.2f segments per texel, %.1f : 1", built, M_CUBE,
+               built ? seg / built : 0.0, bc > 0 ? bu / bc : 0.0);
+    printf("\n");
+    if (st->light_count == 0) {
+        fprintf(stderr, "set-up failed: %s: no light found\n", path);
+        return 0;
+    }
     return 1;
 }
 
@@ -253,10 +267,12 @@ typedef struct pair {
 } pair;
 
 /* Volume pairs in box [lo, hi] against ray casting; fills pairs for the GPU. */
-static void volume_pairs(const setup *st, gi_vec3 lo, gi_vec3 hi, pair *out, int *cpu_out, double min_agree)
+static void volume_pairs(const setup *st, const char *name, gi_vec3 lo, gi_vec3 hi, pair *out, int *cpu_out,
+                         double min_agree)
 {
     uint32_t rng = gi_rng_init(5, 0, 9);
     int pairs = 0, agree = 0, agree_snapped = 0, shadowed = 0, inside = 0, silhouette = 0, discretised = 0;
+    vis_score score = {0}, score_snapped = {0};
     while (pairs < PAIRS) {
         gi_vec3 x = gi_v3(lo.x + (hi.x - lo.x) * gi_rng_next_float(&rng), lo.y + (hi.y - lo.y) * gi_rng_next_float(&rng),
                           lo.z + (hi.z - lo.z) * gi_rng_next_float(&rng));
@@ -277,6 +293,8 @@ static void volume_pairs(const setup *st, gi_vec3 lo, gi_vec3 hi, pair *out, int
         shadowed += !exact;
         agree += lit == exact;
         agree_snapped += lit == exact_s;
+        vis_add(&score, exact, lit);
+        vis_add(&score_snapped, exact_s, lit);
         if (lit != exact) {
             if (exact_s != exact)
                 discretised++;
@@ -298,7 +316,11 @@ static void volume_pairs(const setup *st, gi_vec3 lo, gi_vec3 hi, pair *out, int
     EXPECT(agree >= pairs * min_agree, "%d of %d", agree, pairs);
     EXPECT(agree_snapped >= pairs * 0.97, "%d of %d", agree_snapped, pairs);
     EXPECT(silhouette >= (pairs - agree) * 0.9, "%d of %d disagreements near a silhouette", silhouette, pairs - agree);
-    EXPECT(shadowed > pairs / 40, "too few shadowed pairs to mean anything: %d", shadowed);
+    char what[160];
+    snprintf(what, sizeof what, "  %s, volume pairs, cube-map CSM vs the segment x-y", name);
+    gi_test_failed += vis_check(&score, what, VIS_MARGIN, 50);
+    snprintf(what, sizeof what, "  %s, volume pairs, cube-map CSM vs the segment to the snapped light point", name);
+    gi_test_failed += vis_check(&score_snapped, what, VIS_MARGIN, 50);
 }
 
 /* Area of triangle t, 0 for emitters (receivers only) and for objects
@@ -314,12 +336,13 @@ static float w_area_nonemissive(const setup *st, uint32_t t, int only)
 /* Receiver points on the surfaces of csm_cross.glb: per (receiver, caster)
  * the pairs ray casting finds shadowed by that caster, and how many of
  * those and of all pairs the CSM gets right. */
-static void surface_pairs(const setup *st, float offset_texels, int cross, int only)
+static void surface_pairs(const setup *st, const char *name, float offset_texels, int cross, int only, double margin)
 {
     const gi_scene *s = st->s;
     uint32_t n = s->object_count, rng = gi_rng_init(8, 0, 3);
     int shadowed_by[8][8] = {{0}}, right_by[8][8] = {{0}}, edge_by[8][8] = {{0}}, total = 0, agree = 0;
     int false_shadow[8] = {0}, lit_total[8] = {0};
+    vis_score score = {0};
     float total_area = 0;
     for (uint32_t t = 0; t < s->triangle_count; t++)
         total_area += w_area_nonemissive(st, t, only);
@@ -353,6 +376,7 @@ static void surface_pairs(const setup *st, float offset_texels, int cross, int o
         int lit = csm_visible(st, j, xo, y, NULL);
         total++;
         agree += lit == exact;
+        vis_add(&score, exact, lit);
         if (exact && recv < 8) {
             lit_total[recv]++;
             false_shadow[recv] += !lit;
@@ -378,6 +402,10 @@ static void surface_pairs(const setup *st, float offset_texels, int cross, int o
     printf("  %d surface pairs (normal offset %.2f texels): %.1f%% agree with ray casting to the snapped light point\n",
            total, (double)offset_texels, 100.0 * agree / total);
     EXPECT(agree >= total * 0.95, "%d of %d", agree, total);
+    char what[160];
+    snprintf(what, sizeof what, "  %s, surface pairs (offset %.2f texels), cube-map CSM vs ray casting", name,
+             (double)offset_texels);
+    gi_test_failed += vis_check(&score, what, margin, 50);
     for (uint32_t rcv = 0; rcv < n && rcv < 8; rcv++)
         if (lit_total[rcv])
             printf("  %s: %d lit pairs, CSM shadowed %.1f%% of them\n", s->objects[rcv].name, lit_total[rcv],
@@ -431,7 +459,7 @@ static void gpu_check(const setup *st, const pair *pin, const int *cpu, uint32_t
     const gi_scene *s = st->s;
     uint32_t n = s->object_count, L = st->light_count;
     gi_error err;
-    GLuint prog = gi_program_build_compute_text("tests/integration/csm_local_kernel.comp", kernel, NULL, &err);
+    GLuint prog = gi_program_build_compute_text("plugins/csm/tests/csm_local_kernel.comp", kernel, NULL, &err);
     EXPECT(prog != 0, "%s", err.text);
     if (!prog)
         return;
@@ -533,12 +561,170 @@ static void gpu_check(const setup *st, const pair *pin, const int *cpu, uint32_t
     free(cells);
 }
 
+/* The object called `name`; a scene without it fails the test. */
 static uint32_t object_named(const gi_scene *s, const char *name)
 {
     for (uint32_t k = 0; k < s->object_count; k++)
         if (strcmp(s->objects[k].name, name) == 0)
             return k;
+    EXPECT(0, "set-up failed: no object named %s", name);
     return 0;
+}
+
+/* ---- semi-local lights (§4.3, lights=semilocal) ----
+ * No cube maps: the orthographic maps of the distant case serve every
+ * light, queried toward d = y - x. The plugin's defaults: N = 16 x 16
+ * directions, M = 128, Hilbert order, z2, thin shell, bias 0.01 R,
+ * nearest filter. An object whose world box touches the light's
+ * rectangle's box casts no shadow of that light (the plugin's validity
+ * rule, csm.c light_in_bounds, restated here), nor does the light's own
+ * emitter. */
+enum { N_SEMI = 16, M_SEMI = 128 };
+
+typedef struct semi {
+    gi_csm_data *data;      /* per object */
+    float (*sphere)[4];     /* per object */
+    unsigned char *shadows; /* per (light, object): the object casts a shadow of the light */
+} semi;
+
+static int light_box_touches(const setup *st, const csm_light *l, uint32_t k)
+{
+    const float *lb = st->s->objects[k].local_bounds;
+    float b[6] = {FLT_MAX, FLT_MAX, FLT_MAX, -FLT_MAX, -FLT_MAX, -FLT_MAX};
+    for (int corner = 0; corner < 8; corner++) {
+        gi_vec3 p = gi_mat4_point(st->gs->world_from_local[k],
+                                  gi_v3(lb[(corner & 1) ? 3 : 0], lb[(corner & 2) ? 4 : 1], lb[(corner & 4) ? 5 : 2]));
+        for (int i = 0; i < 3; i++)
+            b[i] = fminf(b[i], (&p.x)[i]), b[3 + i] = fmaxf(b[3 + i], (&p.x)[i]);
+    }
+    gi_vec3 c[4] = {l->origin, gi_v3_add(l->origin, l->e1), gi_v3_add(l->origin, l->e2),
+                    gi_v3_add(l->origin, gi_v3_add(l->e1, l->e2))};
+    for (int i = 0; i < 3; i++) {
+        float lo = FLT_MAX, hi = -FLT_MAX;
+        for (int q = 0; q < 4; q++)
+            lo = fminf(lo, (&c[q].x)[i]), hi = fmaxf(hi, (&c[q].x)[i]);
+        if (hi < b[i] || lo > b[3 + i])
+            return 0;
+    }
+    return 1;
+}
+
+/* Builds every object's orthographic CSM; 0 after a message on failure. */
+static int semi_build(const setup *st, semi *sm)
+{
+    uint32_t n = st->s->object_count;
+    gi_error err;
+    sm->data = calloc(n, sizeof *sm->data);
+    sm->sphere = calloc(n, sizeof *sm->sphere);
+    sm->shadows = calloc((size_t)st->light_count * n, 1);
+    for (uint32_t k = 0; k < n; k++) {
+        gi_mesh_object_sphere(st->s, k, sm->sphere[k]);
+        csm_build_desc d = {.M = M_SEMI,
+                            .n_theta = N_SEMI,
+                            .n_phi = N_SEMI,
+                            .order = GI_CSM_ORDER_HILBERT,
+                            .z3 = CSM_DEPTH_Z2,
+                            .shell = 1e-3f * sm->sphere[k][3],
+                            .batch = 16};
+        if (csm_build_object(st->gs, k, sm->sphere[k], &d, NULL, 0, 1, &sm->data[k], &err) != GI_OK) {
+            fprintf(stderr, "set-up failed: orthographic CSM of object %u: %s\n", k, err.text);
+            return 0;
+        }
+        for (uint32_t j = 0; j < st->light_count; j++) {
+            int shadows = st->lights[j].object != (int)k && !light_box_touches(st, &st->lights[j], k);
+            sm->shadows[j * n + k] = (unsigned char)shadows;
+            if (st->lights[j].object != (int)k && !shadows)
+                printf("  semi-local: light %u lies inside the bounds of %s, which casts no shadow of it\n", j,
+                       st->s->objects[k].name);
+        }
+    }
+    return 1;
+}
+
+static void semi_free(const setup *st, semi *sm)
+{
+    for (uint32_t k = 0; sm->data && k < st->s->object_count; k++)
+        gi_csm_data_free(&sm->data[k]);
+    free(sm->data);
+    free(sm->sphere);
+    free(sm->shadows);
+}
+
+/* Semi-local visibility of x toward y on light j (nearest filter): the
+ * product over the objects that shadow it; with `snapped`, instead ray
+ * casting along each object's nearest map direction (the whole line, as
+ * the orthographic map sees it), which isolates the depth and codec path
+ * from the angular discretisation of the N x N directions. */
+static int semi_visible(const setup *st, const semi *sm, uint32_t j, gi_vec3 x, gi_vec3 y, int snapped)
+{
+    uint32_t n = st->s->object_count;
+    for (uint32_t k = 0; k < n; k++) {
+        if (!sm->shadows[j * n + k])
+            continue;
+        gi_vec3 xl = gi_mat4_point(st->local_from_world[k], x);
+        gi_vec3 wl = gi_v3_normalize(gi_mat4_dir(st->local_from_world[k], gi_v3_sub(y, x)));
+        if (!snapped) {
+            if (!csm_visible_nearest(&sm->data[k], sm->sphere[k], N_SEMI, N_SEMI, GI_CSM_ORDER_HILBERT, xl, wl,
+                                     0.01f * sm->sphere[k][3]))
+                return 0;
+            continue;
+        }
+        float u, v, theta, phi;
+        csm_grid_coords(wl, N_SEMI, N_SEMI, &u, &v);
+        int b = (int)floorf(v + 0.5f);
+        b = b < 0 ? 0 : b >= N_SEMI ? N_SEMI - 1 : b;
+        csm_cell_angles(N_SEMI, N_SEMI, (uint32_t)floorf(u + 0.5f) % N_SEMI, (uint32_t)b, &theta, &phi);
+        gi_vec3 d = csm_dir(theta, phi);
+        const gi_object *ob = &st->s->objects[k];
+        for (uint32_t t = ob->first_triangle; t < ob->first_triangle + ob->triangle_count; t++) {
+            const float *q0 = st->s->vertices[st->s->indices[3 * t]].position,
+                        *q1 = st->s->vertices[st->s->indices[3 * t + 1]].position,
+                        *q2 = st->s->vertices[st->s->indices[3 * t + 2]].position;
+            if (csm_test_ray_hits_triangle(gi_v3(q0[0], q0[1], q0[2]), gi_v3(q1[0], q1[1], q1[2]),
+                                           gi_v3(q2[0], q2[1], q2[2]), xl, d, INFINITY))
+                return 0;
+        }
+    }
+    return 1;
+}
+
+/* Random pairs as in volume_pairs (x in the box [lo, hi] outside closed
+ * objects, y uniform on a random light): semi-local CSM visibility against
+ * ray casting of the segment x-y, and against rays along the snapped map
+ * directions, each scored with the trivial answers. */
+static void semilocal_pairs(const setup *st, const char *name, gi_vec3 lo, gi_vec3 hi)
+{
+    semi sm = {0};
+    if (!semi_build(st, &sm)) {
+        gi_test_failed++;
+        semi_free(st, &sm);
+        return;
+    }
+    uint32_t rng = gi_rng_init(6, 0, 9);
+    vis_score score = {0}, score_snapped = {0};
+    int inside = 0;
+    while (score.pairs < PAIRS) {
+        gi_vec3 x = gi_v3(lo.x + (hi.x - lo.x) * gi_rng_next_float(&rng), lo.y + (hi.y - lo.y) * gi_rng_next_float(&rng),
+                          lo.z + (hi.z - lo.z) * gi_rng_next_float(&rng));
+        if (inside_closed(&st->w, x)) {
+            inside++;
+            continue;
+        }
+        uint32_t j = gi_rng_next_u32(&rng) % st->light_count;
+        const csm_light *l = &st->lights[j];
+        gi_vec3 y = light_sample(&st->w, l, &rng);
+        int lit = semi_visible(st, &sm, j, x, y, 0);
+        vis_add(&score, exact_visible(&st->w, x, y, l->object, NULL), lit);
+        vis_add(&score_snapped, semi_visible(st, &sm, j, x, y, 1), lit);
+    }
+    char what[160];
+    printf("  %s, semi-local (N = %u x %u, M = %u): %d inside points skipped\n", name, N_SEMI, N_SEMI, M_SEMI,
+           inside);
+    snprintf(what, sizeof what, "  %s, volume pairs, semi-local CSM vs the segment x-y", name);
+    gi_test_failed += vis_check(&score, what, VIS_MARGIN, 50);
+    snprintf(what, sizeof what, "  %s, volume pairs, semi-local CSM vs rays along the snapped map directions", name);
+    gi_test_failed += vis_check(&score_snapped, what, VIS_MARGIN, 50);
+    semi_free(st, &sm);
 }
 
 int main(void)
@@ -551,38 +737,57 @@ int main(void)
     setup st;
 
     /* The teapot under its area light: x around the teapot, above the ground. */
-    if (setup_scene(gpu, GI_SOURCE_DIR "/scenes/teapot_area.glb", &st)) {
+    if (setup_scene(gpu, GI_SOURCE_DIR "/scenes/teapot_area.glb", &st, 1)) {
         EXPECT(st.light_count == 1 && st.lights[0].kind == CSM_LIGHT_AREA, "%u lights", st.light_count);
         uint32_t t = object_named(st.s, "teapot");
         const float *b = st.s->objects[t].local_bounds;
         gi_vec3 lo = gi_mat4_point(st.gs->world_from_local[t], gi_v3(b[0], b[1], b[2]));
         gi_vec3 hi = gi_mat4_point(st.gs->world_from_local[t], gi_v3(b[3], b[4], b[5]));
         gi_vec3 c = gi_v3_scale(gi_v3_add(lo, hi), 0.5f), h = gi_v3_scale(gi_v3_sub(hi, lo), 1.25f);
-        volume_pairs(&st, gi_v3(c.x - h.x, 1e-3f, c.z - h.z), gi_v3(c.x + h.x, 0.5f * hi.y, c.z + h.z), pin, cpu, 0.95);
+        gi_vec3 box_lo = gi_v3(c.x - h.x, 1e-3f, c.z - h.z), box_hi = gi_v3(c.x + h.x, 0.5f * hi.y, c.z + h.z);
+        volume_pairs(&st, "teapot", box_lo, box_hi, pin, cpu, 0.95);
         gpu_check(&st, pin, cpu, t);
-        /* receivers on the teapot, with the plugin's default normal offset
-         * for local lights (a quarter texel) and with a whole texel */
-        surface_pairs(&st, 0.25f, 0, (int)t);
-        surface_pairs(&st, 1.0f, 0, (int)t);
+        /* Receivers on the teapot, with the plugin's default normal offset
+         * for local lights (a quarter texel) and with a whole texel. Here
+         * the method does NOT meet the margin of the other cases
+         * (VIS_MARGIN, one half): it removes 44 % (quarter texel) and 42 %
+         * (whole texel) of the always-lit answer's disagreements. The
+         * teapot's shadows on itself (spout, handle and lid on the body)
+         * are a few cube-map texels across, so the band around their edges
+         * where a 64^2 cube map errs holds about half of them (26 % of the
+         * shadowed pairs are lit within two texels of the edge) and acne
+         * near grazing light takes as many lit pairs. This is reported as a
+         * gap (plugins/csm/README.md), not tuned away: the check here is
+         * only that the CSM beats "no shadows" at all (margin 0). */
+        surface_pairs(&st, "teapot", 0.25f, 0, (int)t, 0.0);
+        surface_pairs(&st, "teapot", 1.0f, 0, (int)t, 0.0);
+        semilocal_pairs(&st, "teapot", box_lo, box_hi);
+    } else {
+        gi_test_failed++;
     }
     free_setup(&st);
 
     /* The Cornell box: x in the lower third of the box (outside the blocks). */
-    if (setup_scene(gpu, GI_SOURCE_DIR "/scenes/cornell_box.gltf", &st)) {
+    if (setup_scene(gpu, GI_SOURCE_DIR "/scenes/cornell_box.gltf", &st, 1)) {
         EXPECT(st.light_count == 1 && st.lights[0].kind == CSM_LIGHT_AREA, "%u lights", st.light_count);
-        volume_pairs(&st, gi_v3(0.01f, 0.01f, 0.01f), gi_v3(5.55f, 1.8f, 5.58f), pin, cpu, 0.95);
+        volume_pairs(&st, "Cornell box", gi_v3(0.01f, 0.01f, 0.01f), gi_v3(5.55f, 1.8f, 5.58f), pin, cpu, 0.95);
         gpu_check(&st, pin, cpu, object_named(st.s, "tall_block"));
+    } else {
+        gi_test_failed++;
     }
     free_setup(&st);
 
     /* Two boxes shadowing each other and the ground (§4.6), a linear and a point light. */
-    if (setup_scene(gpu, GI_SOURCE_DIR "/tests/data/valid/csm_cross.glb", &st)) {
+    if (setup_scene(gpu, GI_SOURCE_DIR "/tests/data/valid/csm_cross.glb", &st, 1)) {
         EXPECT(st.light_count == 2 && st.lights[0].kind == CSM_LIGHT_LINEAR && st.lights[0].n_v == 1 &&
                    st.lights[1].kind == CSM_LIGHT_POINT,
                "%u lights", st.light_count);
-        surface_pairs(&st, 0.25f, 1, -1);
-        volume_pairs(&st, gi_v3(-2.5f, 0.01f, -1.5f), gi_v3(2.5f, 2.2f, 1.5f), pin, cpu, 0.95);
+        surface_pairs(&st, "cross", 0.25f, 1, -1, VIS_MARGIN);
+        volume_pairs(&st, "cross", gi_v3(-2.5f, 0.01f, -1.5f), gi_v3(2.5f, 2.2f, 1.5f), pin, cpu, 0.95);
         gpu_check(&st, pin, cpu, object_named(st.s, "box_a"));
+        semilocal_pairs(&st, "cross", gi_v3(-2.5f, 0.01f, -1.5f), gi_v3(2.5f, 2.2f, 1.5f));
+    } else {
+        gi_test_failed++;
     }
     free_setup(&st);
 

@@ -1,0 +1,39 @@
+# The results' tables regenerate from what is committed: each tables script
+# runs on its committed study folder (runs.csv, frames.csv and the small
+# files beside them; no EXR images, which are not committed) and must print
+# exactly the committed tables.md.
+# Run by ctest as: cmake -DPYTHON=... -DGIB=... -DROOT=... -DOUT=... -P tables_test.cmake
+
+set(failures 0)
+# study folder, script, extra arguments
+set(cases "avg|avg_tables.py|${GIB}" "csm|csm_tables.py|" "csm_local|csm_tables.py|")
+foreach(c ${cases})
+    string(REPLACE "|" ";" parts "${c}")
+    list(GET parts 0 study)
+    list(GET parts 1 script)
+    list(LENGTH parts n)
+    set(extra "")
+    if(n GREATER 2)
+        list(GET parts 2 extra)
+    endif()
+    set(got ${OUT}/tables_${study}.md)
+    execute_process(COMMAND ${PYTHON} ${ROOT}/scripts/${script} ${ROOT}/results/${study} ${extra}
+        WORKING_DIRECTORY ${ROOT} RESULT_VARIABLE rc OUTPUT_FILE ${got} ERROR_VARIABLE err)
+    if(NOT rc EQUAL 0)
+        message(SEND_ERROR "scripts/${script} results/${study}: exit ${rc}\n${err}")
+        math(EXPR failures "${failures} + 1")
+        continue()
+    endif()
+    execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${got} ${ROOT}/results/${study}/tables.md
+        RESULT_VARIABLE same)
+    if(NOT same EQUAL 0)
+        execute_process(COMMAND diff -u ${ROOT}/results/${study}/tables.md ${got} OUTPUT_VARIABLE d)
+        message(SEND_ERROR "scripts/${script} results/${study} differs from results/${study}/tables.md:\n${d}")
+        math(EXPR failures "${failures} + 1")
+    else()
+        message(STATUS "results/${study}/tables.md: regenerated identically by scripts/${script}")
+    endif()
+endforeach()
+if(failures GREATER 0)
+    message(FATAL_ERROR "${failures} table(s) do not regenerate")
+endif()
