@@ -12,8 +12,9 @@
  *   tex_ids       RGBA32UI object, material, triangle (scene-global index),
  *                          0xFFFFFFFF for all three where nothing was hit
  *   tex_depth     DEPTH32F hardware depth
- * Plugins sample them with texelFetch; the core also provides
- * core/shaders/gbuffer_read.glsl with the decoding helpers.
+ * Methods read them through the kit: gi_kit_bind (kit.h) binds them at the
+ * units GI_TEX_GBUFFER_* of glsl_shared.h, and core/shaders/gbuffer_read.glsl
+ * declares the samplers there and decodes a pixel (gi_gbuffer_surface).
  *
  * Depth maps (gi_depth_*): LINEAR depth written to RGBA32F layers of a 2D
  * array texture: channel k holds the (k+1)-th surface along each ray
@@ -77,7 +78,8 @@ void gi_gbuffer_free(gi_gbuffer *gb);
 gi_result gi_gbuffer_render(gi_gbuffer *gb, const gi_gpu_scene *gs, const float view[16],
                             const float proj[16], gi_error *err);
 /* Binds the G-buffer textures to units first_unit .. first_unit+5 in the
- * order position, normal, albedo, phong, emission, ids. */
+ * order position, normal, albedo, phong, emission, ids (gbuffer_read.glsl
+ * expects first_unit = GI_TEX_GBUFFER_POSITION). */
 void gi_gbuffer_bind(const gi_gbuffer *gb, GLuint first_unit);
 
 typedef enum gi_projection {
