@@ -117,6 +117,8 @@ static int get_uint(json_object *o, const char *prefix, const char *key, uint32_
 /* Rejects keys of o that are not in `known` (NULL-terminated). */
 static int check_keys(json_object *o, const char *const *known, const char *prefix, const char *file)
 {
+    if (!json_object_is_type(o, json_type_object))
+        return fail_json(file, *prefix ? prefix : "/", "must be an object {key: value}");
     json_object_object_foreach(o, key, val)
     {
         (void)val;
@@ -131,64 +133,156 @@ static int check_keys(json_object *o, const char *const *known, const char *pref
     }
     return EXIT_OK;
 }
+/* The text of one sweep value: numbers as JSON wrote them, booleans and
+ * strings as they are. 0 when the value has no such text (null, list, object). */
+static int scalar_text(json_object *e, const char **out)
+{
+    if (!json_object_is_type(e, json_type_int) && !json_object_is_type(e, json_type_double) &&
+        !json_object_is_type(e, json_type_boolean) && !json_object_is_type(e, json_type_string))
+        return 0;
+    *out = json_object_get_string(e);
+    return *out != NULL;
+}
+
+/* Appends "name=value" to out[0..*n), refusing a value the range already
+ * holds (a step or a count finer than the values can resolve). */
+static int push_value(const char *file, const char *path, const char *name, const char *value, char out[][128],
+                      int *n)
+{
+    char kv[128];
+    if (snprintf(kv, sizeof kv, "%s=%s", name, value) >= (int)sizeof kv)
+        return fail_json(file, path, "the value is too long");
+    for (int i = 0; i < *n; i++)
+        if (!strcmp(out[i], kv))
+            return fail_json(file, path, "the range gives the same value twice (its step is lost to rounding)");
+    memcpy(out[(*n)++], kv, sizeof kv);
+    return EXIT_OK;
+}
+
+/* The values of a range object. Their number is computed and bounded
+ * (at most MAX_SWEEP) before any is written, and integer ranges are
+ * stepped in integers, so that no rounding can stretch the loop. */
+static int range_values(const char *file, const char *path, const char *name, json_object *v, char out[][128],
+                        int *n)
+{
+    static const char *const keys[] = {"from", "to", "step", "count", "scale", NULL};
+    json_object_object_foreach(v, key, val)
+    {
+        (void)val;
+        int ok = 0;
+        for (int i = 0; keys[i]; i++)
+            ok |= !strcmp(keys[i], key);
+        if (!ok)
+            return fail_json(file, path, "a range has only \"from\", \"to\", \"step\" or \"count\", and \"scale\"");
+    }
+    json_object *from, *to, *step = NULL, *count = NULL, *scale = NULL;
+    if (!json_object_object_get_ex(v, "from", &from) || !json_object_object_get_ex(v, "to", &to))
+        return fail_json(file, path, "a range needs \"from\" and \"to\"");
+    int has_step = json_object_object_get_ex(v, "step", &step), has_count = json_object_object_get_ex(v, "count", &count);
+    if (has_step == has_count)
+        return fail_json(file, path, "a range needs \"step\" or \"count\" (one of them)");
+    json_object *nums[3] = {from, to, has_step ? step : NULL};
+    for (int k = 0; k < 3; k++)
+        if (nums[k] && ((!json_object_is_type(nums[k], json_type_int) &&
+                         !json_object_is_type(nums[k], json_type_double)) ||
+                        !isfinite(json_object_get_double(nums[k]))))
+            return fail_json(file, path, "\"from\", \"to\" and \"step\" must be finite numbers");
+    int log_scale = 0;
+    if (json_object_object_get_ex(v, "scale", &scale)) {
+        const char *sv = json_object_is_type(scale, json_type_string) ? json_object_get_string(scale) : "";
+        if (has_step || (strcmp(sv, "lin") && strcmp(sv, "log")))
+            return fail_json(file, path, "\"scale\" is \"lin\" or \"log\", with \"count\"");
+        log_scale = !strcmp(sv, "log");
+    }
+    int is_int = json_object_is_type(from, json_type_int) && json_object_is_type(to, json_type_int);
+    double a = json_object_get_double(from), b = json_object_get_double(to);
+    char text[64];
+    *n = 0;
+    if (has_count) {
+        if (!json_object_is_type(count, json_type_int) || json_object_get_int64(count) < 1 ||
+            json_object_get_int64(count) > MAX_SWEEP)
+            return fail_json(file, path, "\"count\" must be an integer in 1..64");
+        if (log_scale && !(a > 0 && b > 0))
+            return fail_json(file, path, "a log range needs positive \"from\" and \"to\"");
+        int c = (int)json_object_get_int64(count);
+        for (int i = 0; i < c; i++) {
+            double t = c == 1 ? 0.0 : (double)i / (c - 1);
+            double x = log_scale ? exp(log(a) + t * (log(b) - log(a))) : a + t * (b - a);
+            if (is_int)
+                snprintf(text, sizeof text, "%lld", (long long)llround(x));
+            else
+                snprintf(text, sizeof text, "%.9g", x);
+            int rc = push_value(file, path, name, text, out, n);
+            if (rc != EXIT_OK)
+                return rc;
+        }
+        return EXIT_OK;
+    }
+    if (is_int && json_object_is_type(step, json_type_int)) {
+        int64_t ia = json_object_get_int64(from), ib = json_object_get_int64(to), is = json_object_get_int64(step);
+        if (is <= 0)
+            return fail_json(file, path, "\"step\" must be positive");
+        if (ib < ia)
+            return fail_json(file, path, "the range is empty (\"to\" is below \"from\")");
+        uint64_t steps = ((uint64_t)ib - (uint64_t)ia) / (uint64_t)is; /* exact: ib >= ia */
+        if (steps > MAX_SWEEP - 1)
+            return fail_json(file, path, "the range gives more than 64 values");
+        for (uint64_t i = 0; i <= steps; i++) {
+            snprintf(text, sizeof text, "%lld", (long long)(ia + (int64_t)i * is));
+            int rc = push_value(file, path, name, text, out, n);
+            if (rc != EXIT_OK)
+                return rc;
+        }
+        return EXIT_OK;
+    }
+    double s = json_object_get_double(step);
+    if (!(s > 0))
+        return fail_json(file, path, "\"step\" must be positive");
+    if (b < a)
+        return fail_json(file, path, "the range is empty (\"to\" is below \"from\")");
+    double span = (b - a) / s;
+    if (!(span <= MAX_SWEEP - 1 + 1e-9))
+        return fail_json(file, path, "the range gives more than 64 values");
+    int steps = (int)floor(span + 1e-9);
+    for (int i = 0; i <= steps; i++) {
+        snprintf(text, sizeof text, "%.9g", a + i * s);
+        int rc = push_value(file, path, name, text, out, n);
+        if (rc != EXIT_OK)
+            return rc;
+    }
+    return EXIT_OK;
+}
+
 /* Values of one parameter: a scalar, a list, or a range
  * {"from": a, "to": b, "step": s} / {"from": a, "to": b, "count": n, "scale": "log"}.
- * Written as text "name=value". */
+ * Written as text "name=value", at most MAX_SWEEP of them. */
 static int sweep_values(const char *file, const char *mpath, const char *name, json_object *v, char out[][128],
                         int *n)
 {
     char path[512];
     snprintf(path, sizeof path, "%s/params/%s", mpath, name);
     *n = 0;
+    const char *text;
     if (json_object_is_type(v, json_type_array)) {
         size_t len = json_object_array_length(v);
         if (len == 0 || len > MAX_SWEEP)
             return fail_json(file, path, "a sweep needs 1 to 64 values");
         for (size_t i = 0; i < len; i++) {
-            json_object *e = json_object_array_get_idx(v, i);
-            if (json_object_is_type(e, json_type_array) || json_object_is_type(e, json_type_object))
+            if (!scalar_text(json_object_array_get_idx(v, i), &text))
                 return fail_json(file, path, "sweep values must be numbers, booleans or strings");
-            snprintf(out[(*n)++], 128, "%s=%s", name, json_object_get_string(e));
+            if (snprintf(out[*n], 128, "%s=%s", name, text) >= 128)
+                return fail_json(file, path, "the value is too long");
+            (*n)++;
         }
         return EXIT_OK;
     }
-    if (json_object_is_type(v, json_type_object)) {
-        json_object *from, *to, *step, *count, *scale;
-        if (!json_object_object_get_ex(v, "from", &from) || !json_object_object_get_ex(v, "to", &to))
-            return fail_json(file, path, "a range needs \"from\" and \"to\"");
-        double a = json_object_get_double(from), b = json_object_get_double(to);
-        int is_int = json_object_is_type(from, json_type_int) && json_object_is_type(to, json_type_int);
-        int log_scale = json_object_object_get_ex(v, "scale", &scale) && !strcmp(json_object_get_string(scale), "log");
-        if (json_object_object_get_ex(v, "count", &count)) {
-            int c = json_object_get_int(count);
-            if (c < 1 || c > MAX_SWEEP || (log_scale && (a <= 0 || b <= 0)))
-                return fail_json(file, path, "count must be 1..64 (and a log range positive)");
-            for (int i = 0; i < c; i++) {
-                double t = c == 1 ? 0.0 : (double)i / (c - 1);
-                double x = log_scale ? exp(log(a) + t * (log(b) - log(a))) : a + t * (b - a);
-                if (is_int)
-                    snprintf(out[(*n)++], 128, "%s=%lld", name, (long long)llround(x));
-                else
-                    snprintf(out[(*n)++], 128, "%s=%.9g", name, x);
-            }
-        } else if (json_object_object_get_ex(v, "step", &step)) {
-            double s = json_object_get_double(step);
-            if (!(s > 0) || (b - a) / s > MAX_SWEEP - 1)
-                return fail_json(file, path, "step must be positive and give at most 64 values");
-            for (double x = a; x <= b + 1e-9 * fabs(s); x += s) {
-                if (is_int && json_object_is_type(step, json_type_int))
-                    snprintf(out[(*n)++], 128, "%s=%lld", name, (long long)llround(x));
-                else
-                    snprintf(out[(*n)++], 128, "%s=%.9g", name, x);
-            }
-        } else {
-            return fail_json(file, path, "a range needs \"step\" or \"count\"");
-        }
-        if (*n == 0)
-            return fail_json(file, path, "the range is empty");
-        return EXIT_OK;
-    }
-    snprintf(out[(*n)++], 128, "%s=%s", name, json_object_get_string(v));
+    if (json_object_is_type(v, json_type_object))
+        return range_values(file, path, name, v, out, n);
+    if (!scalar_text(v, &text))
+        return fail_json(file, path, "a value is a number, a boolean, a string, a list or a range");
+    if (snprintf(out[0], 128, "%s=%s", name, text) >= 128)
+        return fail_json(file, path, "the value is too long");
+    *n = 1;
     return EXIT_OK;
 }
 
@@ -418,6 +512,15 @@ static int expand_method(study *st, const char *file, const char *out_dir, const
             nk++;
         }
     }
+    /* the number of runs the entry makes, bounded before any is made */
+    uint64_t cells = (uint64_t)rs->repeats * rs->scene_n;
+    for (int k = 0; k < nk && cells <= MAX_RUNS; k++)
+        cells *= (uint64_t)counts[k];
+    if (cells > MAX_RUNS - st->run_count) {
+        char msg[128];
+        snprintf(msg, sizeof msg, "the study makes more than %d runs", MAX_RUNS);
+        return fail_json(file, mpath, msg);
+    }
     /* repeats outermost: the entry's whole sweep once per repeat, so that
      * slow spells of a shared machine spread over all variants alike */
     for (uint32_t rep = 0; rep < rs->repeats; rep++) {
@@ -526,6 +629,8 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
     st->ref_spp = 256;
     st->ref_bounces = 64;
     if (json_object_object_get_ex(o, "reference", &ref)) {
+        if (!json_object_is_type(ref, json_type_object))
+            return fail_json(file, "/reference", "must be an object {\"spp\": ..., ...}");
         if ((rc = get_uint(ref, "/reference", "spp", 1, 1u << 24, 256, &st->ref_spp, file)) ||
             (rc = get_uint(ref, "/reference", "max_bounces", 0, 1024, 64, &st->ref_bounces, file)))
             return rc;
@@ -577,6 +682,8 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
         snprintf(mpath, sizeof mpath, "/methods/%zu", i);
         if (!json_object_is_type(e, json_type_object) || !json_object_object_get_ex(e, "method", &id))
             return fail_json(file, mpath, "needs \"method\"");
+        if (!json_object_is_type(id, json_type_string))
+            return fail_json(file, mpath, "\"method\" must be a method id (a string) or \"all\"");
         if ((rc = check_keys(e, entry_keys, mpath, file)))
             return rc;
         run_settings rs = *b;

@@ -1,0 +1,59 @@
+# Malformed study files are refused before anything runs: exit 2, one line
+# on stderr naming the JSON path, never a crash or a hang. Each case is
+# written to ${OUT}/study_strict/ and loaded with --dry-run (the asan preset
+# runs this script too, so an out-of-bounds write shows as a failure).
+# cmake -DGIB=... -DROOT=... -DOUT=... -P study_strict.cmake
+set(failures 0)
+include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
+set(D ${OUT}/study_strict)
+file(REMOVE_RECURSE ${D})
+file(MAKE_DIRECTORY ${D})
+set(SCENE "\"scenes\": [\"scenes/cornell_box_coarse.gltf\"]")
+
+# refuse(<name> <study text> <regex of the message>)
+function(refuse name text regex)
+    file(WRITE ${D}/${name}.json "${text}")
+    execute_process(COMMAND ${GIB} study ${D}/${name}.json --dry-run WORKING_DIRECTORY ${ROOT} TIMEOUT 60
+                    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    string(STRIP "${err}" err)
+    string(REGEX MATCHALL "\n" lines "${err}")
+    list(LENGTH lines extra)
+    if(NOT rc STREQUAL "2" OR extra GREATER 0 OR NOT err MATCHES "${regex}")
+        message(SEND_ERROR "${name}: expected exit 2 and one line matching '${regex}'; got exit ${rc}\n${err}")
+        math(EXPR f "${failures} + 1")
+        set(failures ${f} PARENT_SCOPE)
+    endif()
+endfunction()
+
+# Memory safety: values of the wrong type where the reader used to assume one.
+refuse(method_null "{${SCENE}, \"methods\": [{\"method\": null}]}" "/methods/0: \"method\" must be")
+refuse(method_number "{${SCENE}, \"methods\": [{\"method\": 5}]}" "/methods/0: \"method\" must be")
+refuse(reference_number "{${SCENE}, \"methods\": \"all\", \"reference\": 5}" "/reference: must be an object")
+refuse(param_null "{${SCENE}, \"methods\": [{\"method\": \"direct\", \"params\": {\"mis\": null}}]}"
+       "/methods/0/params/mis: a value is")
+# A range whose step is lost to rounding (1e17 + 1 == 1e17 in double) used
+# to loop for ever, writing past the table of values.
+refuse(range_rounding_float
+       "{${SCENE}, \"methods\": [{\"method\": \"direct\", \"params\": {\"light_samples\": {\"from\": 1e17, \"to\": 1.00000000000000016e17, \"step\": 1}}}]}"
+       "/methods/0/params/light_samples: the range gives the same value twice")
+refuse(range_rounding_int
+       "{${SCENE}, \"methods\": [{\"method\": \"direct\", \"params\": {\"light_samples\": {\"from\": 100000000000000000, \"to\": 100000000000000016, \"step\": 1}}}]}"
+       "light_samples=100000000000000000 is outside")
+refuse(range_too_long
+       "{${SCENE}, \"methods\": [{\"method\": \"direct\", \"params\": {\"light_samples\": {\"from\": 1, \"to\": 1000, \"step\": 1}}}]}"
+       "the range gives more than 64 values")
+refuse(range_huge_span
+       "{${SCENE}, \"methods\": [{\"method\": \"direct\", \"params\": {\"light_samples\": {\"from\": -9000000000000000000, \"to\": 9000000000000000000, \"step\": 1}}}]}"
+       "the range gives more than 64 values")
+refuse(range_count_rounding
+       "{${SCENE}, \"methods\": [{\"method\": \"direct\", \"params\": {\"light_samples\": {\"from\": 1, \"to\": 2, \"count\": 5}}}]}"
+       "the range gives the same value twice")
+# Too many runs is refused before the first is made.
+refuse(too_many_runs
+       "{${SCENE}, \"methods\": [{\"method\": \"direct\", \"params\": {\"light_samples\": {\"from\": 1, \"to\": 64, \"step\": 1}, \"env_samples\": {\"from\": 0, \"to\": 63, \"step\": 1}, \"mis\": [true, false]}}]}"
+       "/methods/0: the study makes more than 4096 runs")
+
+if(failures GREATER 0)
+    message(FATAL_ERROR "${failures} malformed study file(s) not refused properly")
+endif()
+message(STATUS "malformed study files are refused")
