@@ -114,6 +114,76 @@ static int get_uint(json_object *o, const char *prefix, const char *key, uint32_
     return EXIT_OK;
 }
 
+/* o[key] as a number in [min, max] (absent or null: def). */
+static int get_number(json_object *o, const char *prefix, const char *key, double min, double max, double def,
+                      double *out, const char *file)
+{
+    json_object *v;
+    *out = def;
+    if (!json_object_object_get_ex(o, key, &v) || json_object_is_type(v, json_type_null))
+        return EXIT_OK;
+    double d = json_object_get_double(v);
+    if ((!json_object_is_type(v, json_type_int) && !json_object_is_type(v, json_type_double)) || !(d >= min) ||
+        !(d <= max)) {
+        char msg[128], path[160];
+        snprintf(msg, sizeof msg, "must be a number in [%g, %g]", min, max);
+        snprintf(path, sizeof path, "%s/%s", prefix, key);
+        return fail_json(file, path, msg);
+    }
+    *out = d;
+    return EXIT_OK;
+}
+
+/* o[key] as a string (absent: def; null too when null_ok). */
+static int get_string(json_object *o, const char *prefix, const char *key, int null_ok, const char *def,
+                      const char **out, const char *file)
+{
+    json_object *v;
+    *out = def;
+    if (!json_object_object_get_ex(o, key, &v) || (null_ok && json_object_is_type(v, json_type_null)))
+        return EXIT_OK;
+    if (!json_object_is_type(v, json_type_string)) {
+        char path[160];
+        snprintf(path, sizeof path, "%s/%s", prefix, key);
+        return fail_json(file, path, null_ok ? "must be a string or null" : "must be a string");
+    }
+    *out = json_object_get_string(v);
+    return EXIT_OK;
+}
+
+/* The study file as strict JSON (no trailing commas, no comments, nothing
+ * after the top-level value); NULL after printing where it goes wrong. */
+static json_object *read_strict_json(const char *file)
+{
+    size_t n = 0;
+    char *text = gi_file_read_all(file, &n);
+    if (!text) {
+        cli_fail(EXIT_USAGE, "%s: cannot read the study file", file);
+        return NULL;
+    }
+    json_tokener *tok = json_tokener_new();
+    json_object *o = NULL;
+    if (tok) {
+        json_tokener_set_flags(tok, JSON_TOKENER_STRICT);
+        o = json_tokener_parse_ex(tok, text, (int)n);
+        enum json_tokener_error e = json_tokener_get_error(tok);
+        size_t end = json_tokener_get_parse_end(tok);
+        if (e == json_tokener_continue)
+            e = json_tokener_error_parse_eof;
+        if (e != json_tokener_success || !o) {
+            size_t line = 1;
+            for (size_t i = 0; i < end && i < n; i++)
+                line += text[i] == '\n';
+            cli_fail(EXIT_USAGE, "%s: line %zu: not valid JSON: %s", file, line, json_tokener_error_desc(e));
+            json_object_put(o);
+            o = NULL;
+        }
+        json_tokener_free(tok);
+    }
+    free(text);
+    return o;
+}
+
 /* Rejects keys of o that are not in `known` (NULL-terminated). */
 static int check_keys(json_object *o, const char *const *known, const char *prefix, const char *file)
 {
@@ -310,7 +380,10 @@ static int scene_index(study *st, const char *file, const char *jpath, const cha
     gi_scene *s = gi_scene_load(path, &err);
     if (!s)
         return cli_fail(EXIT_USAGE, "%s: %s: %s", file, jpath, err.text);
+    int has_camera = !st->camera || gi_scene_find_camera(s, st->camera) >= 0;
     gi_scene_free(s);
+    if (!has_camera)
+        return cli_fail(EXIT_USAGE, "%s: /camera: %s has no camera '%s'", file, path, st->camera);
     study_scene *sc = &st->scenes[st->scene_count];
     sc->path = path;
     stem_of(path, sc->stem, sizeof sc->stem);
@@ -384,9 +457,11 @@ static int parse_settings(study *st, json_object *o, const char *prefix, const c
         snprintf(path, sizeof path, "%s/size", prefix);
         if (!json_object_is_type(v, json_type_array) || json_object_array_length(v) != 2)
             return fail_json(file, path, "must be [width, height]");
-        int w = json_object_get_int(json_object_array_get_idx(v, 0)), h = json_object_get_int(json_object_array_get_idx(v, 1));
-        if (w < 1 || h < 1 || w > 16384 || h > 16384)
-            return fail_json(file, path, "width and height must be 1..16384");
+        json_object *jw = json_object_array_get_idx(v, 0), *jh = json_object_array_get_idx(v, 1);
+        int64_t w = json_object_get_int64(jw), h = json_object_get_int64(jh);
+        if (!json_object_is_type(jw, json_type_int) || !json_object_is_type(jh, json_type_int) || w < 1 || h < 1 ||
+            w > 16384 || h > 16384)
+            return fail_json(file, path, "width and height must be integers in 1..16384");
         rs->width = (uint32_t)w;
         rs->height = (uint32_t)h;
     }
@@ -397,19 +472,18 @@ static int parse_settings(study *st, json_object *o, const char *prefix, const c
         return rc;
     if (rs->warmup >= rs->frames)
         rs->warmup = rs->frames > 1 ? rs->frames - 1 : 0;
-    if (json_object_object_get_ex(o, "time", &v)) {
-        rs->time = (float)json_object_get_double(v);
-        if (!(rs->time >= 0.0f) || (!json_object_is_type(v, json_type_double) && !json_object_is_type(v, json_type_int))) {
-            snprintf(path, sizeof path, "%s/time", prefix);
-            return fail_json(file, path, "must be a non-negative number of seconds");
-        }
-    }
+    double d;
+    if ((rc = get_number(o, prefix, "time", 0.0, 1e6, rs->time, &d, file)))
+        return rc;
+    rs->time = (float)d;
     if (json_object_object_get_ex(o, "animate", &v) && !json_object_is_type(v, json_type_null)) {
-        rs->animate_fps = (float)json_object_get_double(v);
-        if (!(rs->animate_fps > 0.0f)) {
+        d = json_object_get_double(v);
+        if ((!json_object_is_type(v, json_type_int) && !json_object_is_type(v, json_type_double)) || !(d > 0) ||
+            !(d <= 1e4)) {
             snprintf(path, sizeof path, "%s/animate", prefix);
-            return fail_json(file, path, "must be a positive frame rate (frames per second of scene time)");
+            return fail_json(file, path, "must be a positive frame rate (frames per second of scene time, at most 1e4)");
         }
+        rs->animate_fps = (float)d;
     }
     const char *flags[2] = {"cache", "compare"};
     int *dest[2] = {&rs->cache, &rs->compare};
@@ -571,16 +645,22 @@ static int check_charts(json_object *charts, const char *file)
             return fail_json(file, path, "\"where\" must be an object {field: value}");
         if (json_object_object_get_ex(c, "series", &v) && !json_object_is_type(v, json_type_string))
             return fail_json(file, path, "\"series\" must be a field name");
+        const char *texts[3] = {"title", "x_label", "y_label"}, *flags[2] = {"log_x", "log_y"};
+        for (int k = 0; k < 3; k++)
+            if (json_object_object_get_ex(c, texts[k], &v) && !json_object_is_type(v, json_type_string))
+                return fail_json(file, path, "\"title\", \"x_label\" and \"y_label\" must be strings");
+        for (int k = 0; k < 2; k++)
+            if (json_object_object_get_ex(c, flags[k], &v) && !json_object_is_type(v, json_type_boolean))
+                return fail_json(file, path, "\"log_x\" and \"log_y\" must be true or false");
     }
     return EXIT_OK;
 }
 
 static int load_study(study *st, const char *file, const char *out_dir, gi_plugins *reg)
 {
-    st->root = cli_read_json(file);
+    st->root = read_strict_json(file);
     if (!st->root)
-        return access(file, R_OK) ? cli_fail(EXIT_USAGE, "%s: cannot read the study file", file)
-                                  : cli_fail(EXIT_USAGE, "%s: not valid JSON", file);
+        return EXIT_USAGE;
     json_object *o = st->root, *v;
     if (!json_object_is_type(o, json_type_object))
         return fail_json(file, "/", "a study is a JSON object");
@@ -590,7 +670,11 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
     int rc = check_keys(o, known, "", file);
     if (rc != EXIT_OK)
         return rc;
-    st->name = json_object_object_get_ex(o, "name", &v) ? json_object_get_string(v) : "study";
+    const char *desc;
+    if ((rc = get_string(o, "", "name", 0, "study", &st->name, file)) ||
+        (rc = get_string(o, "", "description", 0, NULL, &desc, file)) ||
+        (rc = get_string(o, "", "camera", 1, NULL, &st->camera, file)))
+        return rc;
     if (!json_object_object_get_ex(o, "scenes", &v))
         return fail_json(file, "/scenes", "a list of 1 to 16 scene files is required");
     run_settings *b = &st->base;
@@ -604,11 +688,11 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
         return rc;
     if ((rc = get_uint(o, "", "seed", 0, 0x7FFFFFFF, 1, &st->seed, file)))
         return rc;
-    st->camera = json_object_object_get_ex(o, "camera", &v) && !json_object_is_type(v, json_type_null)
-                     ? json_object_get_string(v)
-                     : NULL;
-    st->exposure = json_object_object_get_ex(o, "exposure", &v) ? (float)json_object_get_double(v) : 0.0f;
-    st->timeout_s = json_object_object_get_ex(o, "timeout", &v) ? json_object_get_double(v) : 600.0;
+    double exposure;
+    if ((rc = get_number(o, "", "exposure", -64.0, 64.0, 0.0, &exposure, file)) ||
+        (rc = get_number(o, "", "timeout", 0.0, 1e6, 600.0, &st->timeout_s, file)))
+        return rc;
+    st->exposure = (float)exposure;
     if (!(st->timeout_s > 0))
         return fail_json(file, "/timeout", "must be a positive number of seconds");
     if (json_object_object_get_ex(o, "timer", &v)) {
@@ -653,8 +737,9 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
             if (!json_object_is_type(cs, json_type_array) || json_object_array_length(cs) > 32)
                 return fail_json(file, "/reference/convergence_spp", "must be a list of at most 32 sample counts");
             for (size_t i = 0; i < json_object_array_length(cs); i++) {
-                int k = json_object_get_int(json_object_array_get_idx(cs, i));
-                if (k < 1 || (uint32_t)k >= st->ref_spp)
+                json_object *kj = json_object_array_get_idx(cs, i);
+                int64_t k = json_object_get_int64(kj);
+                if (!json_object_is_type(kj, json_type_int) || k < 1 || (uint64_t)k >= st->ref_spp)
                     return fail_json(file, "/reference/convergence_spp", "each count must be 1 .. spp-1");
                 st->conv_spp[st->conv_n++] = (uint32_t)k;
             }
@@ -672,8 +757,8 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
         name_refs(st);
         return EXIT_OK;
     }
-    if (!json_object_is_type(v, json_type_array))
-        return fail_json(file, "/methods", "must be \"all\" or a list of {\"method\": id, \"params\": {...}}");
+    if (!json_object_is_type(v, json_type_array) || json_object_array_length(v) == 0)
+        return fail_json(file, "/methods", "must be \"all\" or a non-empty list of {\"method\": id, \"params\": {...}}");
     static const char *entry_keys[] = {"method", "params", "label", "scenes", "size", "frames", "warmup",
                                        "repeats", "time", "animate", "cache", "compare", NULL};
     for (size_t i = 0; i < json_object_array_length(v); i++) {
@@ -694,6 +779,8 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
             return fail_json(file, mpath, "\"params\" must be an object");
         const char *mid = json_object_get_string(id);
         if (!strcmp(mid, "all")) {
+            if (params)
+                return fail_json(file, mpath, "\"all\" runs every method with its defaults: no \"params\"");
             for (uint32_t k = 0; k < reg->count; k++)
                 if ((rc = expand_method(st, file, out_dir, reg->items[k].method, NULL, mpath, &rs)))
                     return rc;

@@ -53,6 +53,39 @@ refuse(too_many_runs
        "{${SCENE}, \"methods\": [{\"method\": \"direct\", \"params\": {\"light_samples\": {\"from\": 1, \"to\": 64, \"step\": 1}, \"env_samples\": {\"from\": 0, \"to\": 63, \"step\": 1}, \"mis\": [true, false]}}]}"
        "/methods/0: the study makes more than 4096 runs")
 
+# Sloppy input that used to be taken: one strict reader, types, ranges and
+# unknown keys checked before anything runs.
+refuse(trailing_comma "{${SCENE}, \"methods\": \"all\",}" "line 1: not valid JSON")
+refuse(trailing_text "{${SCENE}, \"methods\": \"all\"} x" "not valid JSON")
+refuse(size_strings "{${SCENE}, \"size\": [\"32\", \"32\"], \"methods\": \"all\"}"
+       "/size: width and height must be integers")
+refuse(size_fraction "{${SCENE}, \"size\": [32.9, 32], \"methods\": \"all\"}" "/size: width and height must be integers")
+refuse(exposure_text "{${SCENE}, \"exposure\": \"abc\", \"methods\": \"all\"}" "/exposure: must be a number in")
+refuse(exposure_huge "{${SCENE}, \"exposure\": 1e39, \"methods\": \"all\"}" "/exposure: must be a number in")
+refuse(timeout_text "{${SCENE}, \"timeout\": \"10\", \"methods\": \"all\"}" "/timeout: must be a number in")
+refuse(time_text "{${SCENE}, \"time\": \"1\", \"methods\": \"all\"}" "/time: must be a number in")
+refuse(animate_text "{${SCENE}, \"animate\": \"30\", \"methods\": \"all\"}" "/animate: must be a positive frame rate")
+refuse(name_null "{${SCENE}, \"name\": null, \"methods\": \"all\"}" "/name: must be a string")
+refuse(methods_empty "{${SCENE}, \"methods\": []}" "/methods: must be \"all\" or a non-empty list")
+refuse(all_with_params "{${SCENE}, \"methods\": [{\"method\": \"all\", \"params\": {\"mis\": false}}]}"
+       "/methods/0: \"all\" runs every method with its defaults: no \"params\"")
+refuse(camera_unknown "{${SCENE}, \"camera\": \"nope\", \"methods\": \"all\"}" "/camera: [^ ]+ has no camera 'nope'")
+refuse(camera_number "{${SCENE}, \"camera\": 3, \"methods\": \"all\"}" "/camera: must be a string or null")
+refuse(convergence_fraction "{${SCENE}, \"methods\": \"all\", \"reference\": {\"spp\": 64, \"convergence_spp\": [4.5]}}"
+       "/reference/convergence_spp: each count")
+refuse(range_unknown_key
+       "{${SCENE}, \"methods\": [{\"method\": \"direct\", \"params\": {\"light_samples\": {\"from\": 1, \"to\": 4, \"stepp\": 1}}}]}"
+       "a range has only")
+refuse(range_count_fraction
+       "{${SCENE}, \"methods\": [{\"method\": \"direct\", \"params\": {\"light_samples\": {\"from\": 1, \"to\": 4, \"count\": 2.5}}}]}"
+       "\"count\" must be an integer")
+refuse(range_scale_unknown
+       "{${SCENE}, \"methods\": [{\"method\": \"direct\", \"params\": {\"light_samples\": {\"from\": 1, \"to\": 4, \"count\": 2, \"scale\": \"lg\"}}}]}"
+       "\"scale\" is \"lin\" or \"log\"")
+refuse(chart_log_text
+       "{${SCENE}, \"methods\": \"all\", \"charts\": [{\"file\": \"a.png\", \"x\": \"run\", \"y\": \"prepare_ms\", \"log_x\": \"yes\"}]}"
+       "\"log_x\" and \"log_y\" must be true or false")
+
 if(failures GREATER 0)
     message(FATAL_ERROR "${failures} malformed study file(s) not refused properly")
 endif()
