@@ -87,8 +87,8 @@ static int parse(int argc, char **argv, compare_opts *o)
                 return cli_fail(EXIT_USAGE, "compare: --ref-target-se '%s' is not a positive number", v);
             o->ref_target_se = f;
         } else if (!strcmp(a, "--exposure")) {
-            if (!cli_parse_float(v, &o->exposure))
-                return cli_fail(EXIT_USAGE, "compare: --exposure '%s' is not a number", v);
+            if (!cli_parse_exposure(v, &o->exposure))
+                return cli_fail(EXIT_USAGE, "compare: --exposure '%s' is not a number of stops in -64..64", v);
         } else if (!strcmp(a, "--time")) {
             if (!cli_parse_float(v, &o->time) || o->time < 0)
                 return cli_fail(EXIT_USAGE, "compare: --time '%s' is not a non-negative number", v);
