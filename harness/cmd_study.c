@@ -20,7 +20,7 @@
 
 #define MAX_RUNS 4096
 #define MAX_SWEEP 64
-#define MAX_KEYS 16
+#define MAX_KEYS 64 /* parameters of one entry: as many as render takes (--param) */
 #define MAX_SCENES 16
 #define MAX_REFS 32
 
@@ -514,7 +514,7 @@ static int add_run(study *st, const char *file, const char *out_dir, const gi_me
             return cli_fail(EXIT_USAGE, "%s: more than %d runs", file, MAX_RUNS);
         study_run *r = &st->runs[st->run_count];
         memset(r, 0, sizeof *r);
-        char key[4096];
+        char key[MAX_KEYS * 128 + 4096]; /* every parameter's text: a cut key would merge two runs */
         snprintf(key, sizeof key, "%s|%s|%u|%ux%u|%u/%u|%g|%g|%d|%d", st->scenes[si].path, m->id, repeat, rs->width,
                  rs->height, rs->frames, rs->warmup, (double)rs->time, (double)rs->animate_fps, rs->cache,
                  rs->compare);
@@ -570,7 +570,7 @@ static int expand_method(study *st, const char *file, const char *out_dir, const
         json_object_object_foreach(params, name, v)
         {
             if (nk == MAX_KEYS)
-                return fail_json(file, mpath, "too many parameters");
+                return fail_json(file, mpath, "more than 64 parameters");
             int rc = sweep_values(file, mpath, name, v, values[nk], &counts[nk]);
             if (rc != EXIT_OK)
                 return rc;

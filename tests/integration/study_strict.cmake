@@ -86,6 +86,28 @@ refuse(chart_log_text
        "{${SCENE}, \"methods\": \"all\", \"charts\": [{\"file\": \"a.png\", \"x\": \"run\", \"y\": \"prepare_ms\", \"log_x\": \"yes\"}]}"
        "\"log_x\" and \"log_y\" must be true or false")
 
+# A method may be given every parameter it declares (csm declares 18; the
+# reader used to stop at 16).
+set(ALL "\"N\": 4, \"M\": 16, \"enumeration\": \"hilbert\", \"depth\": \"z2\", \"open_surfaces\": \"shell\",
+\"shell_thickness\": 0.001, \"filter\": \"nearest\", \"bias\": 0.01, \"normal_offset\": 1,
+\"normal_offset_local\": 0.25, \"lights\": \"local\", \"N_local\": 2, \"M_local\": 16,
+\"light_enumeration\": \"diagonal\", \"linear_aspect\": 4, \"receivers\": \"none\", \"mode\": \"shade\"")
+file(WRITE ${D}/csm_all_params.json
+     "{${SCENE}, \"methods\": [{\"method\": \"csm\", \"params\": {${ALL}, \"S\": [4, 8]}}]}")
+execute_process(COMMAND ${GIB} study ${D}/csm_all_params.json --dry-run WORKING_DIRECTORY ${ROOT} TIMEOUT 60
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+string(REGEX MATCHALL "\nrun [^\n]*" runs "\n${out}")
+list(LENGTH runs nruns)
+set(first "")
+if(nruns GREATER 0)
+    list(GET runs 0 first)
+endif()
+string(REGEX MATCHALL " [A-Za-z_]+=" given "${first}")
+list(LENGTH given ngiven)
+if(NOT rc EQUAL 0 OR NOT nruns EQUAL 2 OR NOT ngiven EQUAL 18)
+    fail("csm with all its parameters: expected exit 0, 2 runs of 18 parameters; got exit ${rc}, ${nruns} runs, ${ngiven} parameters\n${out}${err}")
+endif()
+
 if(failures GREATER 0)
     message(FATAL_ERROR "${failures} malformed study file(s) not refused properly")
 endif()
