@@ -44,6 +44,7 @@
 #include <vtkStringArray.h>
 #include <vtkTable.h>
 #include <vtkTextProperty.h>
+#include <vtkUnsignedCharArray.h>
 #include <vtkWindowToImageFilter.h>
 
 #include <algorithm>
@@ -540,7 +541,7 @@ void set_axis(vtkAxis *axis, const char *title, int log, const double range[2], 
 /* Draws the chart and, when `file` is not NULL, writes it there as PNG.
  * `what` starts every error message (the destination path). */
 gi_result render(const gi_chart_desc &d, const gi_chart_series *series, uint32_t n,
-                 const char *file, gi_error *err, const char *what)
+                 std::vector<unsigned char> *png, gi_error *err, const char *what)
 {
     uint32_t w = d.width ? d.width : default_width;
     uint32_t h = d.height ? d.height : default_height;
@@ -616,23 +617,25 @@ gi_result render(const gi_chart_desc &d, const gi_chart_series *series, uint32_t
     if (dims[0] != static_cast<int>(w) || dims[1] != static_cast<int>(h))
         return gi_error_set(err, GI_ERR_GL, "%s: VTK drew %dx%d pixels instead of %ux%u", what,
                             dims[0], dims[1], w, h);
-    if (!file)
+    if (!png)
         return GI_OK;
 
+    /* Encoded in memory: the file itself is written by the core's atomic
+     * writer, which checks every write (VTK's does not see a full disk). */
     vtkNew<vtkPNGWriter> writer;
-    writer->SetFileName(file);
+    writer->WriteToMemoryOn();
     writer->SetInputConnection(grab->GetOutputPort());
-    errno = 0;
     writer->Write();
-    if (writer->GetErrorCode() != vtkErrorCode::NoError || !out.capture->first_error.empty()) {
-        int e = errno;
-        return gi_error_set(err, GI_ERR_IO, "%s: %s", what,
-                            e ? strerror(e)
-                              : (!out.capture->first_error.empty()
-                                     ? out.capture->first_error.c_str()
-                                     : vtkErrorCode::GetStringFromErrorCode(
-                                           static_cast<unsigned long>(writer->GetErrorCode()))));
-    }
+    vtkUnsignedCharArray *result = writer->GetResult();
+    if (writer->GetErrorCode() != vtkErrorCode::NoError || !out.capture->first_error.empty() || !result ||
+        result->GetNumberOfValues() <= 0)
+        return gi_error_set(err, GI_ERR_IO, "%s: PNG encoding failed: %s", what,
+                            !out.capture->first_error.empty()
+                                ? out.capture->first_error.c_str()
+                                : vtkErrorCode::GetStringFromErrorCode(
+                                      static_cast<unsigned long>(writer->GetErrorCode())));
+    const unsigned char *bytes = result->GetPointer(0);
+    png->assign(bytes, bytes + result->GetNumberOfValues());
     return GI_OK;
 }
 
@@ -669,22 +672,17 @@ gi_result validate(const gi_chart_desc &d, const gi_chart_series *series, uint32
     return GI_OK;
 }
 
-/* Writes to a fresh temporary file beside `path` and renames it into place
- * (core cache.h: gi_atomic_begin/commit); the temporary file goes on any
- * failure. */
+/* Encodes the chart in memory, then writes it with the core's one atomic
+ * writer (cache.h: gi_file_write_atomic: temporary file, checked writes,
+ * fsync, rename), so that a failed write never leaves a file. */
 gi_result write_png(const char *path, const gi_chart_desc &d, const gi_chart_series *series,
                     uint32_t n, gi_error *err)
 {
-    gi_atomic_file f;
-    gi_result r = gi_atomic_begin(&f, path, err);
+    std::vector<unsigned char> png;
+    gi_result r = render(d, series, n, &png, err, path);
     if (r != GI_OK)
         return r;
-    r = render(d, series, n, f.tmp, err, path);
-    if (r != GI_OK) {
-        gi_atomic_commit(&f, 0, nullptr);
-        return r;
-    }
-    return gi_atomic_commit(&f, 1, err);
+    return gi_file_write_atomic(path, png.data(), png.size(), err);
 }
 
 } // namespace

@@ -5,7 +5,9 @@
 #include "gi/cache.h"
 #include "gi/log.h"
 
+#include <ctype.h>
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -61,9 +63,19 @@ int cli_parse_float(const char *s, float *out)
     char *end;
     errno = 0;
     double v = strtod(s, &end);
-    if (errno || *end || !isfinite(v))
+    /* a float's range, not a double's: 1e39 would become inf */
+    if (errno || *end || !isfinite(v) || fabs(v) > FLT_MAX || isspace((unsigned char)s[0]))
         return 0;
     *out = (float)v;
+    return 1;
+}
+
+int cli_parse_exposure(const char *s, float *out)
+{
+    float v;
+    if (!cli_parse_float(s, &v) || fabsf(v) > 64.0f)
+        return 0;
+    *out = v;
     return 1;
 }
 

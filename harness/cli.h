@@ -24,7 +24,10 @@ int cli_fail(int code, const char *fmt, ...)
 int cli_parse_size(const char *s, uint32_t *w, uint32_t *h);
 /* Parses an unsigned integer in [min, max]; 0 on failure. */
 int cli_parse_uint(const char *s, unsigned long min, unsigned long max, unsigned long *out);
+/* Parses a finite number that a float holds; 0 on failure. */
 int cli_parse_float(const char *s, float *out);
+/* Parses an exposure in stops, -64..64 (beyond, every pixel is black or white). */
+int cli_parse_exposure(const char *s, float *out);
 /* Appends an --out file name to outs[0..*count) for command `cmd`
  * ("render", "reference"): at most `max`, and only .exr, .pfm or .png
  * names. Returns 0, or EXIT_USAGE after printing the reason. */

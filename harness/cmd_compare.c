@@ -3,6 +3,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
 
+#include "gi/image.h"
 #include "report.h"
 #include "runner.h"
 
@@ -86,8 +87,8 @@ static int parse(int argc, char **argv, compare_opts *o)
                 return cli_fail(EXIT_USAGE, "compare: --ref-target-se '%s' is not a positive number", v);
             o->ref_target_se = f;
         } else if (!strcmp(a, "--exposure")) {
-            if (!cli_parse_float(v, &o->exposure))
-                return cli_fail(EXIT_USAGE, "compare: --exposure '%s' is not a number", v);
+            if (!cli_parse_exposure(v, &o->exposure))
+                return cli_fail(EXIT_USAGE, "compare: --exposure '%s' is not a number of stops in -64..64", v);
         } else if (!strcmp(a, "--time")) {
             if (!cli_parse_float(v, &o->time) || o->time < 0)
                 return cli_fail(EXIT_USAGE, "compare: --time '%s' is not a non-negative number", v);
@@ -125,18 +126,39 @@ int cmd_compare(int argc, char **argv)
         for (uint32_t i = 0; i < reg->count && n < MAX_METHODS; i++)
             methods[n++] = reg->items[i].method;
     } else {
+        /* a comma-separated list of installed ids, none empty, none twice */
         char list[1024];
-        snprintf(list, sizeof list, "%s", o.methods);
-        char *save = NULL;
-        for (char *id = strtok_r(list, ",", &save); id; id = strtok_r(NULL, ",", &save)) {
-            const gi_method *m = gi_plugins_find(reg, id);
-            if (!m || n == MAX_METHODS) {
+        if (snprintf(list, sizeof list, "%s", o.methods) >= (int)sizeof list) {
+            gi_plugins_free(reg);
+            gi_scene_free(scene);
+            return cli_fail(EXIT_USAGE, "compare: --methods is too long");
+        }
+        for (char *id = list, *next; id; id = next) {
+            next = strchr(id, ',');
+            if (next)
+                *next++ = '\0';
+            const gi_method *m = *id ? gi_plugins_find(reg, id) : NULL;
+            int twice = 0;
+            for (uint32_t k = 0; m && k < n; k++)
+                twice |= methods[k] == m;
+            if (!m || twice || n == MAX_METHODS) {
                 gi_plugins_free(reg);
                 gi_scene_free(scene);
+                if (!*id)
+                    return cli_fail(EXIT_USAGE, "compare: --methods '%s' has an empty method name", o.methods);
+                if (twice)
+                    return cli_fail(EXIT_USAGE, "compare: --methods names '%s' twice", id);
+                if (m)
+                    return cli_fail(EXIT_USAGE, "compare: --methods names more than %d methods", MAX_METHODS);
                 return cli_fail(EXIT_USAGE, "compare: no method '%s' (see gibench methods)", id);
             }
             methods[n++] = m;
         }
+    }
+    if (n == 0) {
+        gi_plugins_free(reg);
+        gi_scene_free(scene);
+        return cli_fail(EXIT_USAGE, "compare: no method is installed (see gibench methods)");
     }
     for (uint32_t k = 0; k < o.param_count; k++) {
         size_t len = (size_t)(strchr(o.params[k], '.') - o.params[k]);
@@ -147,6 +169,38 @@ int cmd_compare(int argc, char **argv)
             gi_plugins_free(reg);
             gi_scene_free(scene);
             return cli_fail(EXIT_USAGE, "compare: --param '%s' names no method of this comparison", o.params[k]);
+        }
+    }
+    /* Each method's parameters against its table, now rather than in a
+     * child process after the references have rendered. */
+    for (uint32_t i = 0; i < n; i++) {
+        const char *kv[MAX_PARAMS];
+        uint32_t np = 0;
+        size_t idlen = strlen(methods[i]->id);
+        for (uint32_t k = 0; k < o.param_count; k++)
+            if (!strncmp(o.params[k], methods[i]->id, idlen) && o.params[k][idlen] == '.')
+                kv[np++] = o.params[k] + idlen + 1;
+        gi_params *p = gi_params_parse(methods[i]->id, methods[i]->params, kv, np, &err);
+        if (!p) {
+            gi_plugins_free(reg);
+            gi_scene_free(scene);
+            return cli_fail(EXIT_USAGE, "compare: --param %s", err.text);
+        }
+        gi_params_free(p);
+    }
+    /* A given reference must be an image of the comparison's size. */
+    if (o.reference) {
+        gi_image *ref = gi_image_read(o.reference, &err);
+        int fits = ref && ref->width == o.width && ref->height == o.height;
+        uint32_t rw = ref ? ref->width : 0, rh = ref ? ref->height : 0;
+        gi_image_free(ref);
+        if (!fits) {
+            gi_plugins_free(reg);
+            gi_scene_free(scene);
+            if (!rw)
+                return cli_fail(EXIT_USAGE, "compare: --reference %s", err.text);
+            return cli_fail(EXIT_USAGE, "compare: --reference %s is %ux%u, the comparison is %ux%u (--size)",
+                            o.reference, rw, rh, o.width, o.height);
         }
     }
     if (!cli_mkdirs(o.out)) {

@@ -62,7 +62,7 @@ static int parse_opts(int argc, char **argv, diff_opts *o)
                 return cli_fail(EXIT_USAGE, "diff: %s '%s': use a .png file name", a, v);
             *(!strcmp(a, "--heatmap") ? &o->heatmap : &o->flip_map) = v;
         } else if (!strcmp(a, "--exposure")) {
-            if (!cli_parse_float(v, &o->m.exposure) || fabsf(o->m.exposure) > 64.0f)
+            if (!cli_parse_exposure(v, &o->m.exposure))
                 return cli_fail(EXIT_USAGE,
                                 "diff: --exposure '%s' is not a number of stops in [-64, 64]", v);
         } else {

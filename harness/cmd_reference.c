@@ -117,8 +117,8 @@ static int parse_opts(int argc, char **argv, ref_opts *o)
                 return cli_fail(EXIT_USAGE,
                                 "reference: --time-of-scene '%s' is not a non-negative number", v);
         } else if (!strcmp(a, "--exposure")) {
-            if (!cli_parse_float(v, &o->exposure))
-                return cli_fail(EXIT_USAGE, "reference: --exposure '%s' is not a number", v);
+            if (!cli_parse_exposure(v, &o->exposure))
+                return cli_fail(EXIT_USAGE, "reference: --exposure '%s' is not a number of stops in -64..64", v);
         } else if (!strcmp(a, "--strategy")) {
             int s = gi_ref_strategy_parse(v);
             if (s < 0)

@@ -85,8 +85,8 @@ static int parse_opts(int argc, char **argv, render_opts *o)
             if (!cli_parse_float(v, &o->animate_fps) || o->animate_fps <= 0)
                 return cli_fail(EXIT_USAGE, "render: --animate '%s' is not a positive frame rate", v);
         } else if (!strcmp(a, "--exposure")) {
-            if (!cli_parse_float(v, &o->exposure))
-                return cli_fail(EXIT_USAGE, "render: --exposure '%s' is not a number", v);
+            if (!cli_parse_exposure(v, &o->exposure))
+                return cli_fail(EXIT_USAGE, "render: --exposure '%s' is not a number of stops in -64..64", v);
         }
     }
     if (!o->scene)

@@ -20,7 +20,7 @@
 
 #define MAX_RUNS 4096
 #define MAX_SWEEP 64
-#define MAX_KEYS 16
+#define MAX_KEYS 64 /* parameters of one entry: as many as render takes (--param) */
 #define MAX_SCENES 16
 #define MAX_REFS 32
 
@@ -114,9 +114,81 @@ static int get_uint(json_object *o, const char *prefix, const char *key, uint32_
     return EXIT_OK;
 }
 
+/* o[key] as a number in [min, max] (absent or null: def). */
+static int get_number(json_object *o, const char *prefix, const char *key, double min, double max, double def,
+                      double *out, const char *file)
+{
+    json_object *v;
+    *out = def;
+    if (!json_object_object_get_ex(o, key, &v) || json_object_is_type(v, json_type_null))
+        return EXIT_OK;
+    double d = json_object_get_double(v);
+    if ((!json_object_is_type(v, json_type_int) && !json_object_is_type(v, json_type_double)) || !(d >= min) ||
+        !(d <= max)) {
+        char msg[128], path[160];
+        snprintf(msg, sizeof msg, "must be a number in [%g, %g]", min, max);
+        snprintf(path, sizeof path, "%s/%s", prefix, key);
+        return fail_json(file, path, msg);
+    }
+    *out = d;
+    return EXIT_OK;
+}
+
+/* o[key] as a string (absent: def; null too when null_ok). */
+static int get_string(json_object *o, const char *prefix, const char *key, int null_ok, const char *def,
+                      const char **out, const char *file)
+{
+    json_object *v;
+    *out = def;
+    if (!json_object_object_get_ex(o, key, &v) || (null_ok && json_object_is_type(v, json_type_null)))
+        return EXIT_OK;
+    if (!json_object_is_type(v, json_type_string)) {
+        char path[160];
+        snprintf(path, sizeof path, "%s/%s", prefix, key);
+        return fail_json(file, path, null_ok ? "must be a string or null" : "must be a string");
+    }
+    *out = json_object_get_string(v);
+    return EXIT_OK;
+}
+
+/* The study file as strict JSON (no trailing commas, no comments, nothing
+ * after the top-level value); NULL after printing where it goes wrong. */
+static json_object *read_strict_json(const char *file)
+{
+    size_t n = 0;
+    char *text = gi_file_read_all(file, &n);
+    if (!text) {
+        cli_fail(EXIT_USAGE, "%s: cannot read the study file", file);
+        return NULL;
+    }
+    json_tokener *tok = json_tokener_new();
+    json_object *o = NULL;
+    if (tok) {
+        json_tokener_set_flags(tok, JSON_TOKENER_STRICT);
+        o = json_tokener_parse_ex(tok, text, (int)n);
+        enum json_tokener_error e = json_tokener_get_error(tok);
+        size_t end = json_tokener_get_parse_end(tok);
+        if (e == json_tokener_continue)
+            e = json_tokener_error_parse_eof;
+        if (e != json_tokener_success || !o) {
+            size_t line = 1;
+            for (size_t i = 0; i < end && i < n; i++)
+                line += text[i] == '\n';
+            cli_fail(EXIT_USAGE, "%s: line %zu: not valid JSON: %s", file, line, json_tokener_error_desc(e));
+            json_object_put(o);
+            o = NULL;
+        }
+        json_tokener_free(tok);
+    }
+    free(text);
+    return o;
+}
+
 /* Rejects keys of o that are not in `known` (NULL-terminated). */
 static int check_keys(json_object *o, const char *const *known, const char *prefix, const char *file)
 {
+    if (!json_object_is_type(o, json_type_object))
+        return fail_json(file, *prefix ? prefix : "/", "must be an object {key: value}");
     json_object_object_foreach(o, key, val)
     {
         (void)val;
@@ -131,64 +203,156 @@ static int check_keys(json_object *o, const char *const *known, const char *pref
     }
     return EXIT_OK;
 }
+/* The text of one sweep value: numbers as JSON wrote them, booleans and
+ * strings as they are. 0 when the value has no such text (null, list, object). */
+static int scalar_text(json_object *e, const char **out)
+{
+    if (!json_object_is_type(e, json_type_int) && !json_object_is_type(e, json_type_double) &&
+        !json_object_is_type(e, json_type_boolean) && !json_object_is_type(e, json_type_string))
+        return 0;
+    *out = json_object_get_string(e);
+    return *out != NULL;
+}
+
+/* Appends "name=value" to out[0..*n), refusing a value the range already
+ * holds (a step or a count finer than the values can resolve). */
+static int push_value(const char *file, const char *path, const char *name, const char *value, char out[][128],
+                      int *n)
+{
+    char kv[128];
+    if (snprintf(kv, sizeof kv, "%s=%s", name, value) >= (int)sizeof kv)
+        return fail_json(file, path, "the value is too long");
+    for (int i = 0; i < *n; i++)
+        if (!strcmp(out[i], kv))
+            return fail_json(file, path, "the range gives the same value twice (its step is lost to rounding)");
+    memcpy(out[(*n)++], kv, sizeof kv);
+    return EXIT_OK;
+}
+
+/* The values of a range object. Their number is computed and bounded
+ * (at most MAX_SWEEP) before any is written, and integer ranges are
+ * stepped in integers, so that no rounding can stretch the loop. */
+static int range_values(const char *file, const char *path, const char *name, json_object *v, char out[][128],
+                        int *n)
+{
+    static const char *const keys[] = {"from", "to", "step", "count", "scale", NULL};
+    json_object_object_foreach(v, key, val)
+    {
+        (void)val;
+        int ok = 0;
+        for (int i = 0; keys[i]; i++)
+            ok |= !strcmp(keys[i], key);
+        if (!ok)
+            return fail_json(file, path, "a range has only \"from\", \"to\", \"step\" or \"count\", and \"scale\"");
+    }
+    json_object *from, *to, *step = NULL, *count = NULL, *scale = NULL;
+    if (!json_object_object_get_ex(v, "from", &from) || !json_object_object_get_ex(v, "to", &to))
+        return fail_json(file, path, "a range needs \"from\" and \"to\"");
+    int has_step = json_object_object_get_ex(v, "step", &step), has_count = json_object_object_get_ex(v, "count", &count);
+    if (has_step == has_count)
+        return fail_json(file, path, "a range needs \"step\" or \"count\" (one of them)");
+    json_object *nums[3] = {from, to, has_step ? step : NULL};
+    for (int k = 0; k < 3; k++)
+        if (nums[k] && ((!json_object_is_type(nums[k], json_type_int) &&
+                         !json_object_is_type(nums[k], json_type_double)) ||
+                        !isfinite(json_object_get_double(nums[k]))))
+            return fail_json(file, path, "\"from\", \"to\" and \"step\" must be finite numbers");
+    int log_scale = 0;
+    if (json_object_object_get_ex(v, "scale", &scale)) {
+        const char *sv = json_object_is_type(scale, json_type_string) ? json_object_get_string(scale) : "";
+        if (has_step || (strcmp(sv, "lin") && strcmp(sv, "log")))
+            return fail_json(file, path, "\"scale\" is \"lin\" or \"log\", with \"count\"");
+        log_scale = !strcmp(sv, "log");
+    }
+    int is_int = json_object_is_type(from, json_type_int) && json_object_is_type(to, json_type_int);
+    double a = json_object_get_double(from), b = json_object_get_double(to);
+    char text[64];
+    *n = 0;
+    if (has_count) {
+        if (!json_object_is_type(count, json_type_int) || json_object_get_int64(count) < 1 ||
+            json_object_get_int64(count) > MAX_SWEEP)
+            return fail_json(file, path, "\"count\" must be an integer in 1..64");
+        if (log_scale && !(a > 0 && b > 0))
+            return fail_json(file, path, "a log range needs positive \"from\" and \"to\"");
+        int c = (int)json_object_get_int64(count);
+        for (int i = 0; i < c; i++) {
+            double t = c == 1 ? 0.0 : (double)i / (c - 1);
+            double x = log_scale ? exp(log(a) + t * (log(b) - log(a))) : a + t * (b - a);
+            if (is_int)
+                snprintf(text, sizeof text, "%lld", (long long)llround(x));
+            else
+                snprintf(text, sizeof text, "%.9g", x);
+            int rc = push_value(file, path, name, text, out, n);
+            if (rc != EXIT_OK)
+                return rc;
+        }
+        return EXIT_OK;
+    }
+    if (is_int && json_object_is_type(step, json_type_int)) {
+        int64_t ia = json_object_get_int64(from), ib = json_object_get_int64(to), is = json_object_get_int64(step);
+        if (is <= 0)
+            return fail_json(file, path, "\"step\" must be positive");
+        if (ib < ia)
+            return fail_json(file, path, "the range is empty (\"to\" is below \"from\")");
+        uint64_t steps = ((uint64_t)ib - (uint64_t)ia) / (uint64_t)is; /* exact: ib >= ia */
+        if (steps > MAX_SWEEP - 1)
+            return fail_json(file, path, "the range gives more than 64 values");
+        for (uint64_t i = 0; i <= steps; i++) {
+            snprintf(text, sizeof text, "%lld", (long long)(ia + (int64_t)i * is));
+            int rc = push_value(file, path, name, text, out, n);
+            if (rc != EXIT_OK)
+                return rc;
+        }
+        return EXIT_OK;
+    }
+    double s = json_object_get_double(step);
+    if (!(s > 0))
+        return fail_json(file, path, "\"step\" must be positive");
+    if (b < a)
+        return fail_json(file, path, "the range is empty (\"to\" is below \"from\")");
+    double span = (b - a) / s;
+    if (!(span <= MAX_SWEEP - 1 + 1e-9))
+        return fail_json(file, path, "the range gives more than 64 values");
+    int steps = (int)floor(span + 1e-9);
+    for (int i = 0; i <= steps; i++) {
+        snprintf(text, sizeof text, "%.9g", a + i * s);
+        int rc = push_value(file, path, name, text, out, n);
+        if (rc != EXIT_OK)
+            return rc;
+    }
+    return EXIT_OK;
+}
+
 /* Values of one parameter: a scalar, a list, or a range
  * {"from": a, "to": b, "step": s} / {"from": a, "to": b, "count": n, "scale": "log"}.
- * Written as text "name=value". */
+ * Written as text "name=value", at most MAX_SWEEP of them. */
 static int sweep_values(const char *file, const char *mpath, const char *name, json_object *v, char out[][128],
                         int *n)
 {
     char path[512];
     snprintf(path, sizeof path, "%s/params/%s", mpath, name);
     *n = 0;
+    const char *text;
     if (json_object_is_type(v, json_type_array)) {
         size_t len = json_object_array_length(v);
         if (len == 0 || len > MAX_SWEEP)
             return fail_json(file, path, "a sweep needs 1 to 64 values");
         for (size_t i = 0; i < len; i++) {
-            json_object *e = json_object_array_get_idx(v, i);
-            if (json_object_is_type(e, json_type_array) || json_object_is_type(e, json_type_object))
+            if (!scalar_text(json_object_array_get_idx(v, i), &text))
                 return fail_json(file, path, "sweep values must be numbers, booleans or strings");
-            snprintf(out[(*n)++], 128, "%s=%s", name, json_object_get_string(e));
+            if (snprintf(out[*n], 128, "%s=%s", name, text) >= 128)
+                return fail_json(file, path, "the value is too long");
+            (*n)++;
         }
         return EXIT_OK;
     }
-    if (json_object_is_type(v, json_type_object)) {
-        json_object *from, *to, *step, *count, *scale;
-        if (!json_object_object_get_ex(v, "from", &from) || !json_object_object_get_ex(v, "to", &to))
-            return fail_json(file, path, "a range needs \"from\" and \"to\"");
-        double a = json_object_get_double(from), b = json_object_get_double(to);
-        int is_int = json_object_is_type(from, json_type_int) && json_object_is_type(to, json_type_int);
-        int log_scale = json_object_object_get_ex(v, "scale", &scale) && !strcmp(json_object_get_string(scale), "log");
-        if (json_object_object_get_ex(v, "count", &count)) {
-            int c = json_object_get_int(count);
-            if (c < 1 || c > MAX_SWEEP || (log_scale && (a <= 0 || b <= 0)))
-                return fail_json(file, path, "count must be 1..64 (and a log range positive)");
-            for (int i = 0; i < c; i++) {
-                double t = c == 1 ? 0.0 : (double)i / (c - 1);
-                double x = log_scale ? exp(log(a) + t * (log(b) - log(a))) : a + t * (b - a);
-                if (is_int)
-                    snprintf(out[(*n)++], 128, "%s=%lld", name, (long long)llround(x));
-                else
-                    snprintf(out[(*n)++], 128, "%s=%.9g", name, x);
-            }
-        } else if (json_object_object_get_ex(v, "step", &step)) {
-            double s = json_object_get_double(step);
-            if (!(s > 0) || (b - a) / s > MAX_SWEEP - 1)
-                return fail_json(file, path, "step must be positive and give at most 64 values");
-            for (double x = a; x <= b + 1e-9 * fabs(s); x += s) {
-                if (is_int && json_object_is_type(step, json_type_int))
-                    snprintf(out[(*n)++], 128, "%s=%lld", name, (long long)llround(x));
-                else
-                    snprintf(out[(*n)++], 128, "%s=%.9g", name, x);
-            }
-        } else {
-            return fail_json(file, path, "a range needs \"step\" or \"count\"");
-        }
-        if (*n == 0)
-            return fail_json(file, path, "the range is empty");
-        return EXIT_OK;
-    }
-    snprintf(out[(*n)++], 128, "%s=%s", name, json_object_get_string(v));
+    if (json_object_is_type(v, json_type_object))
+        return range_values(file, path, name, v, out, n);
+    if (!scalar_text(v, &text))
+        return fail_json(file, path, "a value is a number, a boolean, a string, a list or a range");
+    if (snprintf(out[0], 128, "%s=%s", name, text) >= 128)
+        return fail_json(file, path, "the value is too long");
+    *n = 1;
     return EXIT_OK;
 }
 
@@ -216,7 +380,10 @@ static int scene_index(study *st, const char *file, const char *jpath, const cha
     gi_scene *s = gi_scene_load(path, &err);
     if (!s)
         return cli_fail(EXIT_USAGE, "%s: %s: %s", file, jpath, err.text);
+    int has_camera = !st->camera || gi_scene_find_camera(s, st->camera) >= 0;
     gi_scene_free(s);
+    if (!has_camera)
+        return cli_fail(EXIT_USAGE, "%s: /camera: %s has no camera '%s'", file, path, st->camera);
     study_scene *sc = &st->scenes[st->scene_count];
     sc->path = path;
     stem_of(path, sc->stem, sizeof sc->stem);
@@ -290,9 +457,11 @@ static int parse_settings(study *st, json_object *o, const char *prefix, const c
         snprintf(path, sizeof path, "%s/size", prefix);
         if (!json_object_is_type(v, json_type_array) || json_object_array_length(v) != 2)
             return fail_json(file, path, "must be [width, height]");
-        int w = json_object_get_int(json_object_array_get_idx(v, 0)), h = json_object_get_int(json_object_array_get_idx(v, 1));
-        if (w < 1 || h < 1 || w > 16384 || h > 16384)
-            return fail_json(file, path, "width and height must be 1..16384");
+        json_object *jw = json_object_array_get_idx(v, 0), *jh = json_object_array_get_idx(v, 1);
+        int64_t w = json_object_get_int64(jw), h = json_object_get_int64(jh);
+        if (!json_object_is_type(jw, json_type_int) || !json_object_is_type(jh, json_type_int) || w < 1 || h < 1 ||
+            w > 16384 || h > 16384)
+            return fail_json(file, path, "width and height must be integers in 1..16384");
         rs->width = (uint32_t)w;
         rs->height = (uint32_t)h;
     }
@@ -303,19 +472,18 @@ static int parse_settings(study *st, json_object *o, const char *prefix, const c
         return rc;
     if (rs->warmup >= rs->frames)
         rs->warmup = rs->frames > 1 ? rs->frames - 1 : 0;
-    if (json_object_object_get_ex(o, "time", &v)) {
-        rs->time = (float)json_object_get_double(v);
-        if (!(rs->time >= 0.0f) || (!json_object_is_type(v, json_type_double) && !json_object_is_type(v, json_type_int))) {
-            snprintf(path, sizeof path, "%s/time", prefix);
-            return fail_json(file, path, "must be a non-negative number of seconds");
-        }
-    }
+    double d;
+    if ((rc = get_number(o, prefix, "time", 0.0, 1e6, rs->time, &d, file)))
+        return rc;
+    rs->time = (float)d;
     if (json_object_object_get_ex(o, "animate", &v) && !json_object_is_type(v, json_type_null)) {
-        rs->animate_fps = (float)json_object_get_double(v);
-        if (!(rs->animate_fps > 0.0f)) {
+        d = json_object_get_double(v);
+        if ((!json_object_is_type(v, json_type_int) && !json_object_is_type(v, json_type_double)) || !(d > 0) ||
+            !(d <= 1e4)) {
             snprintf(path, sizeof path, "%s/animate", prefix);
-            return fail_json(file, path, "must be a positive frame rate (frames per second of scene time)");
+            return fail_json(file, path, "must be a positive frame rate (frames per second of scene time, at most 1e4)");
         }
+        rs->animate_fps = (float)d;
     }
     const char *flags[2] = {"cache", "compare"};
     int *dest[2] = {&rs->cache, &rs->compare};
@@ -346,7 +514,7 @@ static int add_run(study *st, const char *file, const char *out_dir, const gi_me
             return cli_fail(EXIT_USAGE, "%s: more than %d runs", file, MAX_RUNS);
         study_run *r = &st->runs[st->run_count];
         memset(r, 0, sizeof *r);
-        char key[4096];
+        char key[MAX_KEYS * 128 + 4096]; /* every parameter's text: a cut key would merge two runs */
         snprintf(key, sizeof key, "%s|%s|%u|%ux%u|%u/%u|%g|%g|%d|%d", st->scenes[si].path, m->id, repeat, rs->width,
                  rs->height, rs->frames, rs->warmup, (double)rs->time, (double)rs->animate_fps, rs->cache,
                  rs->compare);
@@ -402,7 +570,7 @@ static int expand_method(study *st, const char *file, const char *out_dir, const
         json_object_object_foreach(params, name, v)
         {
             if (nk == MAX_KEYS)
-                return fail_json(file, mpath, "too many parameters");
+                return fail_json(file, mpath, "more than 64 parameters");
             int rc = sweep_values(file, mpath, name, v, values[nk], &counts[nk]);
             if (rc != EXIT_OK)
                 return rc;
@@ -417,6 +585,15 @@ static int expand_method(study *st, const char *file, const char *out_dir, const
             }
             nk++;
         }
+    }
+    /* the number of runs the entry makes, bounded before any is made */
+    uint64_t cells = (uint64_t)rs->repeats * rs->scene_n;
+    for (int k = 0; k < nk && cells <= MAX_RUNS; k++)
+        cells *= (uint64_t)counts[k];
+    if (cells > MAX_RUNS - st->run_count) {
+        char msg[128];
+        snprintf(msg, sizeof msg, "the study makes more than %d runs", MAX_RUNS);
+        return fail_json(file, mpath, msg);
     }
     /* repeats outermost: the entry's whole sweep once per repeat, so that
      * slow spells of a shared machine spread over all variants alike */
@@ -468,16 +645,22 @@ static int check_charts(json_object *charts, const char *file)
             return fail_json(file, path, "\"where\" must be an object {field: value}");
         if (json_object_object_get_ex(c, "series", &v) && !json_object_is_type(v, json_type_string))
             return fail_json(file, path, "\"series\" must be a field name");
+        const char *texts[3] = {"title", "x_label", "y_label"}, *flags[2] = {"log_x", "log_y"};
+        for (int k = 0; k < 3; k++)
+            if (json_object_object_get_ex(c, texts[k], &v) && !json_object_is_type(v, json_type_string))
+                return fail_json(file, path, "\"title\", \"x_label\" and \"y_label\" must be strings");
+        for (int k = 0; k < 2; k++)
+            if (json_object_object_get_ex(c, flags[k], &v) && !json_object_is_type(v, json_type_boolean))
+                return fail_json(file, path, "\"log_x\" and \"log_y\" must be true or false");
     }
     return EXIT_OK;
 }
 
 static int load_study(study *st, const char *file, const char *out_dir, gi_plugins *reg)
 {
-    st->root = cli_read_json(file);
+    st->root = read_strict_json(file);
     if (!st->root)
-        return access(file, R_OK) ? cli_fail(EXIT_USAGE, "%s: cannot read the study file", file)
-                                  : cli_fail(EXIT_USAGE, "%s: not valid JSON", file);
+        return EXIT_USAGE;
     json_object *o = st->root, *v;
     if (!json_object_is_type(o, json_type_object))
         return fail_json(file, "/", "a study is a JSON object");
@@ -487,7 +670,11 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
     int rc = check_keys(o, known, "", file);
     if (rc != EXIT_OK)
         return rc;
-    st->name = json_object_object_get_ex(o, "name", &v) ? json_object_get_string(v) : "study";
+    const char *desc;
+    if ((rc = get_string(o, "", "name", 0, "study", &st->name, file)) ||
+        (rc = get_string(o, "", "description", 0, NULL, &desc, file)) ||
+        (rc = get_string(o, "", "camera", 1, NULL, &st->camera, file)))
+        return rc;
     if (!json_object_object_get_ex(o, "scenes", &v))
         return fail_json(file, "/scenes", "a list of 1 to 16 scene files is required");
     run_settings *b = &st->base;
@@ -501,11 +688,11 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
         return rc;
     if ((rc = get_uint(o, "", "seed", 0, 0x7FFFFFFF, 1, &st->seed, file)))
         return rc;
-    st->camera = json_object_object_get_ex(o, "camera", &v) && !json_object_is_type(v, json_type_null)
-                     ? json_object_get_string(v)
-                     : NULL;
-    st->exposure = json_object_object_get_ex(o, "exposure", &v) ? (float)json_object_get_double(v) : 0.0f;
-    st->timeout_s = json_object_object_get_ex(o, "timeout", &v) ? json_object_get_double(v) : 600.0;
+    double exposure;
+    if ((rc = get_number(o, "", "exposure", -64.0, 64.0, 0.0, &exposure, file)) ||
+        (rc = get_number(o, "", "timeout", 0.0, 1e6, 600.0, &st->timeout_s, file)))
+        return rc;
+    st->exposure = (float)exposure;
     if (!(st->timeout_s > 0))
         return fail_json(file, "/timeout", "must be a positive number of seconds");
     if (json_object_object_get_ex(o, "timer", &v)) {
@@ -526,6 +713,8 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
     st->ref_spp = 256;
     st->ref_bounces = 64;
     if (json_object_object_get_ex(o, "reference", &ref)) {
+        if (!json_object_is_type(ref, json_type_object))
+            return fail_json(file, "/reference", "must be an object {\"spp\": ..., ...}");
         if ((rc = get_uint(ref, "/reference", "spp", 1, 1u << 24, 256, &st->ref_spp, file)) ||
             (rc = get_uint(ref, "/reference", "max_bounces", 0, 1024, 64, &st->ref_bounces, file)))
             return rc;
@@ -548,8 +737,9 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
             if (!json_object_is_type(cs, json_type_array) || json_object_array_length(cs) > 32)
                 return fail_json(file, "/reference/convergence_spp", "must be a list of at most 32 sample counts");
             for (size_t i = 0; i < json_object_array_length(cs); i++) {
-                int k = json_object_get_int(json_object_array_get_idx(cs, i));
-                if (k < 1 || (uint32_t)k >= st->ref_spp)
+                json_object *kj = json_object_array_get_idx(cs, i);
+                int64_t k = json_object_get_int64(kj);
+                if (!json_object_is_type(kj, json_type_int) || k < 1 || (uint64_t)k >= st->ref_spp)
                     return fail_json(file, "/reference/convergence_spp", "each count must be 1 .. spp-1");
                 st->conv_spp[st->conv_n++] = (uint32_t)k;
             }
@@ -567,8 +757,8 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
         name_refs(st);
         return EXIT_OK;
     }
-    if (!json_object_is_type(v, json_type_array))
-        return fail_json(file, "/methods", "must be \"all\" or a list of {\"method\": id, \"params\": {...}}");
+    if (!json_object_is_type(v, json_type_array) || json_object_array_length(v) == 0)
+        return fail_json(file, "/methods", "must be \"all\" or a non-empty list of {\"method\": id, \"params\": {...}}");
     static const char *entry_keys[] = {"method", "params", "label", "scenes", "size", "frames", "warmup",
                                        "repeats", "time", "animate", "cache", "compare", NULL};
     for (size_t i = 0; i < json_object_array_length(v); i++) {
@@ -577,6 +767,8 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
         snprintf(mpath, sizeof mpath, "/methods/%zu", i);
         if (!json_object_is_type(e, json_type_object) || !json_object_object_get_ex(e, "method", &id))
             return fail_json(file, mpath, "needs \"method\"");
+        if (!json_object_is_type(id, json_type_string))
+            return fail_json(file, mpath, "\"method\" must be a method id (a string) or \"all\"");
         if ((rc = check_keys(e, entry_keys, mpath, file)))
             return rc;
         run_settings rs = *b;
@@ -587,6 +779,8 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
             return fail_json(file, mpath, "\"params\" must be an object");
         const char *mid = json_object_get_string(id);
         if (!strcmp(mid, "all")) {
+            if (params)
+                return fail_json(file, mpath, "\"all\" runs every method with its defaults: no \"params\"");
             for (uint32_t k = 0; k < reg->count; k++)
                 if ((rc = expand_method(st, file, out_dir, reg->items[k].method, NULL, mpath, &rs)))
                     return rc;

@@ -13,7 +13,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#define MAX_ARGS 96
+#define MAX_ARGS 256 /* 40 of the run's own, 2 per parameter (up to 64), with room to spare */
 
 typedef struct argv_builder {
     char *argv[MAX_ARGS + 1];
@@ -72,7 +72,7 @@ static void path_in(char *out, size_t size, const char *dir, const char *name)
 static json_object *base_record(const run_spec *s)
 {
     json_object *o = json_object_new_object();
-    char params[2048] = "";
+    char params[64 * 130] = ""; /* up to 64 "k=v" of up to 128 characters */
     for (uint32_t i = 0; i < s->param_count; i++) {
         size_t used = strlen(params);
         snprintf(params + used, sizeof params - used, "%s%s", i ? "," : "", s->params[i]);
@@ -245,7 +245,7 @@ json_object *runner_execute(const run_spec *s, int resume)
         arg(&b, "%s", "--param");
         arg(&b, "%s", s->params[i]);
     }
-    char config[8192];
+    char config[16384]; /* the whole command line: a cut one could match another run's */
     join(&b, config, sizeof config);
     /* The references are part of what the result depends on. */
     size_t used = strlen(config);

@@ -3,10 +3,12 @@
  *
  * Writes: .exr float32 RGBA (+ "<layer>.R/G/B/A" channels), .pfm float32 RGB
  * (written here by hand: this OIIO build has no PFM writer), .png 8-bit sRGB
- * after gi_tonemap. Every write goes to a unique temporary file in the
- * destination directory (".<name>.tmp-<pid>-XXXXXX<ext>", the real extension
- * last) and is renamed into place, so readers never see a partial file.
+ * after gi_tonemap. Every file is encoded in memory and written by the
+ * core's one atomic writer (gi_file_write_atomic: a temporary file in the
+ * destination directory, every write, fsync and close checked, renamed into
+ * place), so readers never see a partial file and a full disk is an error.
  * Reads: anything OIIO reads, channels chosen by name, row 0 = top. */
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <cerrno>
@@ -64,18 +66,19 @@ std::string lower(std::string s)
     return s;
 }
 
-/* Runs `write(tmp_path)` against a fresh temporary file beside `path`
- * (core cache.h: gi_atomic_begin/commit), then renames it over `path`. The
- * temporary file is removed on any failure. */
-template <typename Write>
-gi_result write_atomically(const std::string &path, gi_error *err, Write write)
+/* Encodes the file in memory with `encode(bytes)`, then hands the bytes to
+ * the core's one atomic writer (cache.h: gi_file_write_atomic: a temporary
+ * file beside `path`, every write, fsync and close checked, then renamed
+ * into place). Encoders do not check the results of their own writes (a
+ * full disk gave a 0-byte PNG under its final name); here nothing reaches
+ * the disk but through a writer that does. */
+template <typename Encode>
+gi_result write_atomically(const std::string &path, gi_error *err, Encode encode)
 {
-    gi_atomic_file f;
-    gi_result r = gi_atomic_begin(&f, path.c_str(), err);
-    if (r != GI_OK)
-        return r;
+    std::vector<unsigned char> bytes;
+    gi_result r;
     try {
-        r = write(std::string(f.tmp));
+        r = encode(bytes);
     } catch (const std::bad_alloc &) {
         r = gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "%s: out of memory", path.c_str());
     } catch (const std::exception &e) {
@@ -83,21 +86,27 @@ gi_result write_atomically(const std::string &path, gi_error *err, Write write)
     } catch (...) {
         r = gi_error_set(err, GI_ERR_IO, "%s: unknown exception while writing", path.c_str());
     }
-    if (r != GI_OK) {
-        gi_atomic_commit(&f, 0, nullptr);
+    if (r != GI_OK)
         return r;
-    }
-    return gi_atomic_commit(&f, 1, err);
+    return gi_file_write_atomic(path.c_str(), bytes.data(), bytes.size(), err);
 }
 
-gi_result write_oiio(const std::string &path, const std::string &tmp, const OIIO::ImageSpec &spec,
-                     OIIO::TypeDesc data_type, const void *data, gi_error *err)
+/* The file OIIO would write at `path` (its format chosen by the extension),
+ * in memory. */
+gi_result encode_oiio(const std::string &path, const OIIO::ImageSpec &spec, OIIO::TypeDesc data_type,
+                      const void *data, std::vector<unsigned char> &bytes, gi_error *err)
 {
-    std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(tmp);
+    std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(path);
     if (!out)
         return gi_error_set(err, GI_ERR_IO, "%s: %s", path.c_str(),
                             one_line(OIIO::geterror()).c_str());
-    if (!out->open(tmp, spec) || !out->write_image(data_type, data) || !out->close())
+    if (!out->supports("ioproxy"))
+        return gi_error_set(err, GI_ERR_UNSUPPORTED,
+                            "%s: this OpenImageIO cannot encode %s in memory", path.c_str(),
+                            out->format_name());
+    OIIO::Filesystem::IOVecOutput vec(bytes);
+    if (!out->set_ioproxy(&vec) || !out->open(path, spec) || !out->write_image(data_type, data) ||
+        !out->close())
         return gi_error_set(err, GI_ERR_IO, "%s: %s", path.c_str(),
                             one_line(out->geterror()).c_str());
     return GI_OK;
@@ -106,40 +115,32 @@ gi_result write_oiio(const std::string &path, const std::string &tmp, const OIIO
 /* PFM (Debevec's portable float map): "PF\n<w> <h>\n<scale>\n", then rows
  * from the BOTTOM of the picture up, RGB float32 each; a negative scale
  * means little-endian samples. */
-gi_result write_pfm(const std::string &path, const std::string &tmp, const gi_image *img,
-                    gi_error *err)
+gi_result encode_pfm(const gi_image *img, std::vector<unsigned char> &bytes)
 {
     const uint32_t one = 1;
     unsigned char first_byte;
     std::memcpy(&first_byte, &one, 1);
     const bool little_endian = first_byte == 1;
 
-    FILE *f = std::fopen(tmp.c_str(), "wb");
-    if (!f)
-        return gi_error_set(err, GI_ERR_IO, "%s: %s", path.c_str(), std::strerror(errno));
-    bool ok = std::fprintf(f, "PF\n%u %u\n%s\n", img->width, img->height,
-                           little_endian ? "-1.0" : "1.0") > 0;
+    char header[64];
+    int hn = std::snprintf(header, sizeof header, "PF\n%u %u\n%s\n", img->width, img->height,
+                           little_endian ? "-1.0" : "1.0");
+    size_t row_bytes = (size_t)img->width * 3 * sizeof(float);
+    bytes.resize((size_t)hn + row_bytes * img->height);
+    std::memcpy(bytes.data(), header, (size_t)hn);
     std::vector<float> row((size_t)img->width * 3);
-    for (uint32_t k = 0; ok && k < img->height; k++) {
+    for (uint32_t k = 0; k < img->height; k++) {
         const float *src = img->rgba + (size_t)(img->height - 1 - k) * img->width * 4;
         for (uint32_t x = 0; x < img->width; x++)
             for (int c = 0; c < 3; c++)
                 row[(size_t)x * 3 + c] = src[(size_t)x * 4 + c];
-        ok = std::fwrite(row.data(), sizeof(float), row.size(), f) == row.size();
+        std::memcpy(bytes.data() + hn + row_bytes * k, row.data(), row_bytes);
     }
-    int saved = errno;
-    if (std::fclose(f) != 0 && ok) {
-        ok = false;
-        saved = errno;
-    }
-    if (!ok)
-        return gi_error_set(err, GI_ERR_IO, "%s: write failed: %s", path.c_str(),
-                            std::strerror(saved));
     return GI_OK;
 }
 
-gi_result write_png(const std::string &path, const std::string &tmp, const gi_image *img,
-                    float exposure, gi_error *err)
+gi_result encode_png(const std::string &path, const gi_image *img, float exposure,
+                     std::vector<unsigned char> &bytes, gi_error *err)
 {
     size_t n = (size_t)img->width * img->height;
     std::vector<unsigned char> px(n * 3);
@@ -150,7 +151,7 @@ gi_result write_png(const std::string &path, const std::string &tmp, const gi_im
         }
     OIIO::ImageSpec spec((int)img->width, (int)img->height, 3, OIIO::TypeDesc::UINT8);
     spec.attribute("oiio:ColorSpace", "sRGB");
-    return write_oiio(path, tmp, spec, OIIO::TypeDesc::UINT8, px.data(), err);
+    return encode_oiio(path, spec, OIIO::TypeDesc::UINT8, px.data(), bytes, err);
 }
 
 bool image_ok(const gi_image *img)
@@ -307,16 +308,16 @@ gi_result gi_image_write(const char *path, const gi_image *img, const gi_image_w
         if (kind == ".exr") {
             OIIO::ImageSpec spec((int)img->width, (int)img->height, 4, OIIO::TypeDesc::FLOAT);
             spec.attribute("compression", "zip");
-            return write_atomically(p, err, [&](const std::string &tmp) {
-                return write_oiio(p, tmp, spec, OIIO::TypeDesc::FLOAT, img->rgba, err);
+            return write_atomically(p, err, [&](std::vector<unsigned char> &bytes) {
+                return encode_oiio(p, spec, OIIO::TypeDesc::FLOAT, img->rgba, bytes, err);
             });
         }
         if (kind == ".pfm")
             return write_atomically(
-                p, err, [&](const std::string &tmp) { return write_pfm(p, tmp, img, err); });
+                p, err, [&](std::vector<unsigned char> &bytes) { return encode_pfm(img, bytes); });
         if (kind == ".png")
-            return write_atomically(p, err, [&](const std::string &tmp) {
-                return write_png(p, tmp, img, exposure, err);
+            return write_atomically(p, err, [&](std::vector<unsigned char> &bytes) {
+                return encode_png(p, img, exposure, bytes, err);
             });
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
                             "%s: unsupported image format '%s' (use .exr, .pfm or .png)", path,
@@ -376,8 +377,8 @@ gi_result gi_image_write_exr_layers(const char *path, const gi_image *rgba,
         spec.channelnames = channel_names;
         spec.alpha_channel = 3;
         spec.attribute("compression", "zip");
-        return write_atomically(p, err, [&](const std::string &tmp) {
-            return write_oiio(p, tmp, spec, OIIO::TypeDesc::FLOAT, px.data(), err);
+        return write_atomically(p, err, [&](std::vector<unsigned char> &bytes) {
+            return encode_oiio(p, spec, OIIO::TypeDesc::FLOAT, px.data(), bytes, err);
         });
     } catch (const std::bad_alloc &) {
         return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "%s: out of memory", path);

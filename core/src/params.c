@@ -2,6 +2,7 @@
 #include "gi/params.h"
 
 #include <assert.h>
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -51,6 +52,9 @@ static int parse_value(const gi_param_desc *d, const char *v, double *out)
 {
     char *end = NULL;
     errno = 0;
+    /* the value is exactly its text: strtoll and strtod would skip blanks */
+    if (!*v || isspace((unsigned char)v[0]))
+        return 0;
     switch (d->type) {
     case GI_PARAM_INT: {
         long long x = strtoll(v, &end, 10);

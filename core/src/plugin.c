@@ -182,8 +182,10 @@ static void scan_dir(gi_plugins *reg, const char *dir)
             n++;
     }
     closedir(d);
-    /* Sorted, so that which duplicate wins does not depend on readdir order. */
-    qsort(names, n, sizeof *names, cmp_str);
+    /* Sorted, so that which duplicate wins does not depend on readdir order
+     * (a folder without plugins has no list to sort: qsort wants a pointer). */
+    if (n > 1)
+        qsort(names, n, sizeof *names, cmp_str);
     for (size_t i = 0; i < n; i++) {
         size_t len = strlen(dir) + strlen(names[i]) + 2;
         char *path = malloc(len);

@@ -1,14 +1,18 @@
 /* The plugin loader refuses broken plugins with clear messages: wrong ABI,
  * missing function, duplicate id, bad id, NULL entry, short descriptor, bad
  * parameter table, a build against another data layout (older, newer, or
- * reordered); and loads a good one. */
+ * reordered); and loads a good one. A folder without plugins is an empty
+ * registry (no sort of an empty list: undefined behaviour under UBSan). */
+#define _POSIX_C_SOURCE 200809L
 #include "check.h"
 #include "gi/kit.h"
 #include "gi/plugin.h"
 
 #include <stddef.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #define FAKE_DIR GI_BINARY_DIR "/tests/fake_plugins"
 
@@ -59,6 +63,18 @@ int main(void)
     const gi_method *m = gi_plugins_find(reg, "fake_good");
     CHECK(m && m->params && strcmp(m->params[1].choices, "a|b|c") == 0);
     gi_plugins_free(reg);
+
+    /* A folder holding no plugin, and one that does not exist: empty registries. */
+    char empty[] = "/tmp/gibench_no_plugins_XXXXXX";
+    CHECK(mkdtemp(empty) != NULL);
+    unsetenv("GIBENCH_PLUGIN_PATH");
+    gi_plugins *none = gi_plugins_scan(empty);
+    CHECK(none && none->count == 0 && none->error_count == 0);
+    gi_plugins_free(none);
+    none = gi_plugins_scan("/tmp/gibench_no_such_folder_for_plugins");
+    CHECK(none && none->count == 0 && none->error_count == 0);
+    gi_plugins_free(none);
+    rmdir(empty);
 
     /* Validation of a descriptor without a library. */
     gi_method bad = *m;

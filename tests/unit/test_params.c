@@ -65,5 +65,16 @@ int main(void)
     p = parse("N=4", "N=5", &err);
     CHECK(p == NULL && strstr(err.text, "given twice"));
     CHECK(gi_param_desc_count(desc) == 4);
+    /* A value is exactly its text: no blanks around it, not empty (strtol
+     * and strtod would skip leading blanks and take " 5" as 5). */
+    const char *blank[] = {"N= 5", "N=5 ", "N=\t5", "N=", "bias= 0.5", "bias=0.5\n", "bias="};
+    for (size_t i = 0; i < sizeof blank / sizeof blank[0]; i++) {
+        p = parse(blank[i], NULL, &err);
+        CHECK_MSG(p == NULL && strstr(err.text, "is not"), "'%s' was taken", blank[i]);
+        gi_params_free(p);
+    }
+    p = parse("N=5", "bias=0.5", &err);
+    CHECK(p && gi_params_int(p, "N") == 5);
+    gi_params_free(p);
     return gi_test_finish();
 }
