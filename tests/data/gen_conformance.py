@@ -17,6 +17,10 @@ Writes tests/data/conformance/:
                       the same lit by one light of one type only
   all.gltf            the same lit by every type (the parameter sweep scene)
   area_point.gltf     area + point light (for methods without distant light)
+  one_object_all.gltf, one_object_area_point.gltf
+                      the same as one object (one node, one mesh): the
+                      parameter sweep's scenes, cheapest for per-object
+                      precomputation
   moving.gltf         area.gltf with the box moving over 2 s (rigid motion)
   light_moving.gltf   point.gltf with the point light moving over 2 s
   env/uniform.pfm     a constant white environment map
@@ -122,14 +126,24 @@ def box(h):
     return m
 
 
-def room(name, lights, box_track=None, light_track=None):
-    """lights: subset of area, point, spot, directional, environment."""
+def room(name, lights, box_track=None, light_track=None, one_object=False):
+    """lights: subset of area, point, spot, directional, environment.
+    one_object: floor, box and lamp are primitives of one mesh on one node
+    (one object: what per-object precomputation costs least on)."""
     g = Writer(GEN)
     m_floor = g.material("floor", (0.6, 0.6, 0.6))
     m_box = g.material("box", (0.7, 0.5, 0.3))
-    nodes = [g.node("floor", mesh=g.mesh("floor", [(quad(0, 0, 0, 2.0, 2.0), m_floor)]))]
-    nb = g.node("box", mesh=g.mesh("box", [(box(0.3), m_box)]), translation=(0.0, 0.3, 0.0))
-    nodes.append(nb)
+    if one_object:
+        parts = [(quad(0, 0, 0, 2.0, 2.0), m_floor), (box(0.3).transformed(lambda p: (p[0], p[1] + 0.3, p[2])), m_box)]
+        if "area" in lights:
+            m_lamp = g.material("lamp", (0.0, 0.0, 0.0), emission=(1.0, 1.0, 1.0), emission_strength=8.0)
+            parts.append((quad(0, 2.0, 0, 0.4, 0.4, down=True), m_lamp))
+        nodes = [g.node("everything", mesh=g.mesh("everything", parts))]
+        lights = [k for k in lights if k != "area"]
+    else:
+        nodes = [g.node("floor", mesh=g.mesh("floor", [(quad(0, 0, 0, 2.0, 2.0), m_floor)]))]
+        nb = g.node("box", mesh=g.mesh("box", [(box(0.3), m_box)]), translation=(0.0, 0.3, 0.0))
+        nodes.append(nb)
     if "area" in lights:
         m_lamp = g.material("lamp", (0.0, 0.0, 0.0), emission=(1.0, 1.0, 1.0), emission_strength=8.0)
         nodes.append(g.node("lamp", mesh=g.mesh("lamp", [(quad(0, 2.0, 0, 0.4, 0.4, down=True), m_lamp)])))
@@ -183,6 +197,8 @@ def main():
         room(kind, [kind])
     room("all", ["area", "point", "spot", "directional", "environment"])
     room("area_point", ["area", "point"])
+    room("one_object_all", ["area", "point", "spot", "directional", "environment"], one_object=True)
+    room("one_object_area_point", ["area", "point"], one_object=True)
     room("moving", ["area"], box_track=True)
     room("light_moving", ["point"], light_track=True)
 
