@@ -77,5 +77,6 @@ int cmd_diff(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
 int cmd_study(int argc, char **argv);
 int cmd_reference(int argc, char **argv);
+int cmd_conformance(int argc, char **argv);
 
 #endif

@@ -28,6 +28,8 @@ static const char usage[] =
     "         [--threads N] [--time-of-scene T] [--exposure EV] [--stats FILE.json]\n"
     "         [--pixel box|center]\n"
     "                                         Embree path-traced reference (EXR: mean + variance)\n"
+    "  conformance [--method M] [--json] [--size N] [--item-timeout S]\n"
+    "                                         the conformance suite: every check on every method (or M)\n"
     "exit status: 0 success, 1 failure while running, 2 bad usage or bad input\n";
 
 int main(int argc, char **argv)
@@ -68,6 +70,8 @@ int main(int argc, char **argv)
         return cmd_study(sub_argc, sub_argv);
     if (!strcmp(cmd, "reference"))
         return cmd_reference(sub_argc, sub_argv);
+    if (!strcmp(cmd, "conformance"))
+        return cmd_conformance(sub_argc, sub_argv);
     if (!strcmp(cmd, "help")) {
         fputs(usage, stdout);
         return EXIT_OK;

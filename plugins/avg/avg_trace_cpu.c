@@ -26,9 +26,35 @@ struct avg_exact {
     uint32_t light_count;
 };
 
+/* Kensler's hash permutation of [0, mask] (mask = 2^k - 1): twin of
+ * avg_vpl.glsl's avg_permute, which says why it replaced an XOR. */
+static uint32_t avg_permute(uint32_t i, uint32_t mask, uint32_t p)
+{
+    uint32_t w = mask;
+    i ^= p;
+    i *= 0xe170893du;
+    i ^= p >> 16;
+    i ^= (i & w) >> 4;
+    i ^= p >> 8;
+    i *= 0x0929eb3fu;
+    i ^= p >> 23;
+    i ^= (i & w) >> 1;
+    i *= 1u | (p >> 27);
+    i *= 0x6935fa69u;
+    i ^= (i & w) >> 11;
+    i *= 0x74dcb303u;
+    i ^= (i & w) >> 2;
+    i *= 0x9e501cc3u;
+    i ^= (i & w) >> 2;
+    i *= 0xc860a3dfu;
+    i &= w;
+    i ^= i >> 5;
+    return (i + p) & w;
+}
+
 void avg_qr(uint32_t i, uint32_t pair, uint32_t mask, float out[2])
 {
-    uint32_t j = i ^ (gi_pcg_hash(pair * 0x9E3779B9u + 0x632BE5ABu) & mask);
+    uint32_t j = avg_permute(i, mask, gi_pcg_hash(pair * 0x9E3779B9u + 0x632BE5ABu));
     out[0] = gi_radical_inverse2(j);
     out[1] = gi_sobol2(j);
 }

@@ -1,8 +1,11 @@
 /* Fake method plugins for the loader tests, one per defect: built several
- * times with one FAKE_* macro defined (tests/CMakeLists.txt). */
+ * times with one FAKE_* macro defined (tests/CMakeLists.txt). The FAKE_CONF_*
+ * kinds render something (a constant per pixel) for the conformance suite's
+ * own tests: each breaks one rule the suite must catch. */
 #define _POSIX_C_SOURCE 200809L
 #include "gi/kit.h" /* GI_ABI_LAYOUT */
 
+#include <math.h>
 #include <signal.h>
 #include <stddef.h>
 #include <unistd.h>
@@ -39,10 +42,28 @@ static gi_result fake_update(void *inst, const gi_gpu_scene *s, const gi_changes
 #endif
     return GI_OK;
 }
+#if defined(FAKE_CONF_WRONG) || defined(FAKE_CONF_NAN) || defined(FAKE_CONF_NONDET) || defined(FAKE_CONF_LIAR)
+#define FAKE_CONF 1
+static uint32_t fake_renders; /* renders so far in this process */
+#endif
+
 static gi_result fake_render(void *inst, const gi_view *v, const gi_target *t)
 {
     (void)inst, (void)v, (void)t;
-#if defined(FAKE_CRASH)
+#if defined(FAKE_CONF)
+    float c[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+#if defined(FAKE_CONF_WRONG) /* the emission alone: no bounce at all in the furnace */
+    c[0] = c[1] = c[2] = 1.0f;
+#elif defined(FAKE_CONF_NAN)
+    c[0] = c[1] = c[2] = NAN;
+#elif defined(FAKE_CONF_NONDET) /* a different image on every call */
+    c[0] = c[1] = c[2] = 0.5f + 0.01f * (float)(fake_renders % 64u);
+#elif defined(FAKE_CONF_LIAR) /* claims every light, renders none */
+    c[0] = c[1] = c[2] = 0.0f;
+#endif
+    fake_renders++;
+    glClearNamedFramebufferfv(t->fbo, GL_COLOR, 0, c);
+#elif defined(FAKE_CRASH)
     raise(SIGSEGV); /* compare must survive a method that crashes */
 #elif defined(FAKE_HANG)
     for (;;) /* ... and one that never returns */
@@ -91,8 +112,11 @@ static const gi_method fake_method = {
     .title = "Fake method",
     .citation = "none",
     .version = "0",
-#if defined(FAKE_CRASH) || defined(FAKE_HANG)
+#if defined(FAKE_CRASH) || defined(FAKE_HANG) || defined(FAKE_CONF_WRONG) || defined(FAKE_CONF_NAN) || \
+    defined(FAKE_CONF_NONDET)
     .caps = GI_CAP_DIRECT | GI_CAP_AREA_LIGHTS,
+#elif defined(FAKE_CONF_LIAR)
+    .caps = GI_CAP_DIRECT | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT,
 #else
     .caps = GI_CAP_DIRECT,
 #endif

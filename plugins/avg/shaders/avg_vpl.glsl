@@ -19,14 +19,41 @@ struct AvgVpl {
     vec3 spot_dir; float range;
 };
 
-// Quasi-random pair `pair` of light path i: the Sobol (0,2) point of an
-// index permuted per pair by a fixed XOR (Kollig-Keller style padding of
-// the dimensions), mask = 2^k - 1 >= paths - 1. Fixed across frames, so a
+// A bijection of [0, mask] chosen by the seed p: Kensler's hash
+// permutation ("Correlated Multi-Jittered Sampling", 2013) on a power of
+// two, so no cycle walking is needed. Unlike an XOR with a constant it is
+// not linear in the bits of i. C twin: avg_permute in avg_trace_cpu.c.
+uint avg_permute(uint i, uint mask, uint p)
+{
+    uint w = mask;
+    i ^= p; i *= 0xe170893du;
+    i ^= p >> 16;
+    i ^= (i & w) >> 4;
+    i ^= p >> 8; i *= 0x0929eb3fu;
+    i ^= p >> 23;
+    i ^= (i & w) >> 1; i *= 1u | (p >> 27);
+    i *= 0x6935fa69u;
+    i ^= (i & w) >> 11; i *= 0x74dcb303u;
+    i ^= (i & w) >> 2; i *= 0x9e501cc3u;
+    i ^= (i & w) >> 2; i *= 0xc860a3dfu;
+    i &= w;
+    i ^= i >> 5;
+    return (i + p) & w;
+}
+
+// Quasi-random pair `pair` of light path i: the Sobol (0,2) point of the
+// path's index permuted per pair (Kollig-Keller padding of the dimensions),
+// mask = 2^k - 1 >= paths - 1. Each pair's points over all paths are the
+// whole (0,2)-net when the path count is a power of two. The permutation
+// must not be linear in the bits of i: with the former XOR by a constant,
+// pair 2k+1's Russian-roulette number was a fixed bit flip of pair 2k-1's,
+// so at albedo 1/2 every path that survived one roulette died at the next
+// and the third bounce's VPLs never existed. Fixed across frames, so a
 // static scene gets the same VPLs every frame (§III-B). C twin: avg_qr in
 // avg_trace_cpu.c.
 vec2 avg_qr(uint i, uint pair, uint mask)
 {
-    uint j = i ^ (gi_pcg_hash(pair * 0x9E3779B9u + 0x632BE5ABu) & mask);
+    uint j = avg_permute(i, mask, gi_pcg_hash(pair * 0x9E3779B9u + 0x632BE5ABu));
     return vec2(gi_radical_inverse2(j), gi_sobol2(j));
 }
 
