@@ -618,7 +618,8 @@ static conf_status check_resize(session *S, const conf_opts *o, result *r)
 
 /* An update between frames: the image after update() must be closer to a
  * fresh instance's image of the new state than the old image is (at most
- * a quarter of that distance), and the new state must look different. */
+ * a tenth of that distance: what the method did not take in shows), and
+ * the new state must look different. */
 static conf_status check_update(session *S, const conf_opts *o, const char *which, result *r)
 {
     char path[512] = "", why[256];
@@ -687,10 +688,10 @@ static conf_status check_update(session *S, const conf_opts *o, const char *whic
         return set(r, R_FAIL, "after update: %s", why);
     if (!(old_d > 0.01))
         return set(r, R_FAIL, "%s: the change does not show (difference %.2g); the check cannot judge", base, old_d);
-    if (!(new_d <= 0.25 * old_d))
+    if (!(new_d <= 0.1 * old_d))
         return set(r, R_FAIL,
                    "%s: after update() the image is %.3g from a fresh instance's of the new state (the old image: %.3g); "
-                   "limit a quarter",
+                   "limit a tenth",
                    base, new_d, old_d);
     return set(r, R_PASS, "%s: after update() %.3g from a fresh instance (the old image %.3g)", base, new_d, old_d);
 }
