@@ -272,7 +272,7 @@ static uint32_t pow2_mask(uint32_t n)
 }
 
 /* §III-B on the GPU: one invocation per path through the AVG. */
-static gi_result trace_avg(avg *a, const avg_light_table *lt, gi_error *err)
+static gi_result trace_avg(avg *a, const avg_light_table *lt, uint32_t seed, gi_error *err)
 {
     GLuint p = a->prog_trace;
     glUseProgram(p);
@@ -282,6 +282,7 @@ static gi_result trace_avg(avg *a, const avg_light_table *lt, gi_error *err)
     glUniform1ui(glGetUniformLocation(p, "u_paths"), a->paths);
     glUniform1ui(glGetUniformLocation(p, "u_bounces"), (GLuint)a->bounces);
     glUniform1ui(glGetUniformLocation(p, "u_qr_mask"), pow2_mask(a->paths));
+    glUniform1ui(glGetUniformLocation(p, "u_seed"), seed);
     glUniform1f(glGetUniformLocation(p, "u_offset"), a->offset);
     glUniform1i(glGetUniformLocation(p, "u_light_count"), (GLint)lt->count);
     glUniform1fv(glGetUniformLocation(p, "u_light_cdf"), 65, lt->cdf);
@@ -444,10 +445,10 @@ static gi_result avg_render(void *inst, const gi_view *view, const gi_target *ta
     avg_light_table lt;
     avg_light_table_build(a->kit.scene, &lt);
     if (a->exact) {
-        avg_trace_desc td = {a->paths, (uint32_t)a->bounces, a->offset};
+        avg_trace_desc td = {a->paths, (uint32_t)a->bounces, a->offset, view->seed};
         r = avg_exact_trace(a->exact, a->kit.scene, &lt, &td, a->cpu_slots, &err);
     } else {
-        r = trace_avg(a, &lt, &err);
+        r = trace_avg(a, &lt, view->seed, &err);
     }
     if (r == GI_OK) {
         compact(a);

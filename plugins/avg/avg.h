@@ -71,6 +71,7 @@ typedef struct avg_trace_desc {
     uint32_t paths;     /* light paths; each owns bounces + 1 VPL slots */
     uint32_t bounces;   /* indirect bounces B: VPLs at hits 1..B */
     float offset;       /* ray origins move this many voxels along the normal */
+    uint32_t seed;      /* the run's seed (gi_view.seed); 1, the default, gives the sequence of earlier versions */
 } avg_trace_desc;
 
 /* Light choice of the tracers: the area lights as one group (emitter CDF
@@ -86,8 +87,9 @@ typedef struct avg_light_table {
  * power at the current time). Directional lights get no share (not supported). */
 void avg_light_table_build(const gi_gpu_scene *gs, avg_light_table *t);
 
-/* Quasi-random pair `pair` of light path i (C twin of avg_vpl.glsl's avg_qr). */
-void avg_qr(uint32_t i, uint32_t pair, uint32_t mask, float out[2]);
+/* Quasi-random pair `pair` of light path i for the run's seed (C twin of
+ * avg_vpl.glsl's avg_qr). */
+void avg_qr(uint32_t i, uint32_t pair, uint32_t mask, uint32_t seed, float out[2]);
 
 /* Exact tracing on the CPU with Embree (avg_trace_cpu.c): the same paths,
  * the same slots. avg_exact_trace re-places the scene at gs->time when it

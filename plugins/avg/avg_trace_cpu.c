@@ -52,9 +52,9 @@ static uint32_t avg_permute(uint32_t i, uint32_t mask, uint32_t p)
     return (i + p) & w;
 }
 
-void avg_qr(uint32_t i, uint32_t pair, uint32_t mask, float out[2])
+void avg_qr(uint32_t i, uint32_t pair, uint32_t mask, uint32_t seed, float out[2])
 {
-    uint32_t j = avg_permute(i, mask, gi_pcg_hash(pair * 0x9E3779B9u + 0x632BE5ABu));
+    uint32_t j = avg_permute(i, mask, gi_pcg_hash(pair * 0x9E3779B9u + 0x632BE5ABu) ^ gi_pcg_hash(seed) ^ gi_pcg_hash(1u));
     out[0] = gi_radical_inverse2(j);
     out[1] = gi_sobol2(j);
 }
@@ -142,8 +142,8 @@ static void trace_path(const avg_exact *x, const gi_scene *s, const avg_light_ta
         return;
     float lo = l > 0 ? lt->cdf[l - 1] : 0.0f;
     float q0[2], q1[2];
-    avg_qr(i, 0, mask, q0);
-    avg_qr(i, 1, mask, q1);
+    avg_qr(i, 0, mask, d->seed, q0);
+    avg_qr(i, 1, mask, d->seed, q1);
     avg_vpl v;
     memset(&v, 0, sizeof v);
     gi_vec3 origin, dir, flux;
@@ -207,7 +207,7 @@ static void trace_path(const avg_exact *x, const gi_scene *s, const avg_light_ta
         if (!gi_rt_intersect(x->rt, origin, dir, 0.0f, INFINITY, &hit))
             return;
         float qp[2];
-        avg_qr(i, 2 * k + 1, mask, qp);
+        avg_qr(i, 2 * k + 1, mask, d->seed, qp);
         gi_vec3 c = material_albedo(s, hit.triangle, hit.u, hit.v);
         gi_vec3 n = hit.ng;
         if (gi_v3_dot(n, dir) > 0.0f)
@@ -226,7 +226,7 @@ static void trace_path(const avg_exact *x, const gi_scene *s, const avg_light_ta
             return;
         flux = gi_v3_scale(gi_v3_mul(flux, c), 1.0f / q);
         float qd[2];
-        avg_qr(i, 2 * k, mask, qd);
+        avg_qr(i, 2 * k, mask, d->seed, qd);
         dir = gi_to_world(gi_sample_cosine_hemisphere(qd[0], qd[1]), n);
         origin = gi_v3_add(hit.position, gi_v3_scale(n, eps));
     }

@@ -56,7 +56,8 @@ typedef struct csm {
     int N, M, S, z3, filter, mode, open_surfaces;
     gi_csm_order order;
     float bias, normal_offset, normal_offset_local, shell_thickness;
-    int lights_mode, n_local, m_local, receivers, distant, warned_moved;
+    int lights_mode, n_local, m_local, receivers, distant, warned_moved, local_motion;
+    uint32_t rebuilds; /* local-light precomputations redone in update() (local_motion=rebuild) */
     float *prepare_transforms; /* 16 per object: world_from_local at prepare time */
     gi_csm_order light_order;
     float linear_aspect;
@@ -99,6 +100,9 @@ static const gi_param_desc csm_params[] = {
      "order of the points on a light in the codec (diagonal: the zig-zag area curve)"},
     {"linear_aspect", GI_PARAM_FLOAT, 4, 1, 1e6, NULL, "d = 1 (Sec. 4.2)",
      "an emissive object whose bounding rectangle is longer than this times its width is a linear light"},
+    {"local_motion", GI_PARAM_ENUM, 0, 0, 0, "rebuild|keep", "Sec. 4.2",
+     "fixed local lights when a light or an object moves: rebuild their cube maps (a precomputation in that frame's "
+     "update, stage 'rebuild'), or keep the first placement's (the paper's fixed lights; shadows then stale)"},
     {"receivers", GI_PARAM_ENUM, 0, 0, 0, "none|planar", "Sec. 4.6",
      "receiver-only objects without CSMs: none, or every planar object"},
     {"mode", GI_PARAM_ENUM, 0, 0, 0, "shade|random|coherent", "Table 2",
@@ -134,6 +138,7 @@ static gi_result csm_create(const gi_host *host, const gi_params *params, void *
     c->linear_aspect = gi_params_float(params, "linear_aspect");
     c->receivers = gi_params_enum(params, "receivers");
     c->mode = gi_params_enum(params, "mode");
+    c->local_motion = gi_params_enum(params, "local_motion");
     *out = c;
     return GI_OK;
 }
@@ -663,10 +668,22 @@ static gi_result csm_update(void *inst, const gi_gpu_scene *scene, const gi_chan
                 moved |= gi_v3_length(gi_v3_sub(f.position, l->origin)) > 0.0f;
             }
         }
+        if (moved && c->local_motion == 0) {
+            /* Fixed local lights hold for one placement: precompute again
+             * for this one (the distant maps come from the cache when
+             * there is one; they are object-local and did not change). */
+            const gi_host *host = c->kit.host;
+            host->stage_begin(host, "rebuild");
+            gi_result r = csm_prepare(c, scene);
+            host->stage_end(host, "rebuild");
+            c->rebuilds++;
+            host->stat(host, "local_rebuilds", (double)c->rebuilds);
+            return r;
+        }
         if (moved) {
             c->kit.host->log(c->kit.host, GI_LOG_WARN,
-                         "objects or lights moved since the precomputation; fixed local lights' cube maps are "
-                         "not rebuilt (their shadows are those of the first frame's placement); use lights=semilocal");
+                         "objects or lights moved since the precomputation; with local_motion=keep fixed local "
+                         "lights' cube maps are not rebuilt (their shadows are those of the first frame's placement)");
             c->warned_moved = 1;
         }
     }

@@ -28,6 +28,7 @@ layout(std430, binding = AVG_SSBO_SLOTS) writeonly buffer AvgSlots { AvgVpl slot
 uniform uint u_paths;
 uniform uint u_bounces;
 uniform uint u_qr_mask;
+uniform uint u_seed; // the run's seed: other seeds, other (equally fixed) VPLs
 uniform float u_offset;          // ray origins move this many voxels along the normal
 uniform int u_light_count;       // entries: 0 = all area lights, 1 + l = punctual light l
 uniform float u_light_cdf[65];
@@ -59,7 +60,7 @@ void main()
 
     AvgVpl v = none;
     vec3 origin, dir, flux, axis;
-    vec2 q0 = avg_qr(i, 0u, u_qr_mask), q1 = avg_qr(i, 1u, u_qr_mask);
+    vec2 q0 = avg_qr(i, 0u, u_qr_mask, u_seed), q1 = avg_qr(i, 1u, u_qr_mask, u_seed);
     if (l == 0) {
         uint e = gi_emitter_find(clamp((u - lo) / pl, 0.0, GI_ONE_MINUS_EPSILON));
         GiEmitter em = gi_emitters[e];
@@ -119,7 +120,7 @@ void main()
         float t_in, t_out;
         if (!avg_march(origin, dir, cell, t_in, t_out))
             return;
-        vec2 qp = avg_qr(i, 2u * k + 1u, u_qr_mask);
+        vec2 qp = avg_qr(i, 2u * k + 1u, u_qr_mask, u_seed);
         vec3 x = origin + dir * mix(t_in, t_out, qp.x); // pushed into the voxel
         vec3 c = avg_colour(cell);
         vec3 n = avg_normal(cell);
@@ -139,7 +140,7 @@ void main()
         if (!(qp.y < q))
             return;
         flux *= c / q;
-        vec2 qd = avg_qr(i, 2u * k, u_qr_mask);
+        vec2 qd = avg_qr(i, 2u * k, u_qr_mask, u_seed);
         dir = gi_to_world(gi_sample_cosine_hemisphere(qd.x, qd.y), n);
         origin = x + n * u_offset;
     }

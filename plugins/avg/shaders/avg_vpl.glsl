@@ -51,9 +51,10 @@ uint avg_permute(uint i, uint mask, uint p)
 // and the third bounce's VPLs never existed. Fixed across frames, so a
 // static scene gets the same VPLs every frame (§III-B). C twin: avg_qr in
 // avg_trace_cpu.c.
-vec2 avg_qr(uint i, uint pair, uint mask)
+vec2 avg_qr(uint i, uint pair, uint mask, uint seed)
 {
-    uint j = avg_permute(i, mask, gi_pcg_hash(pair * 0x9E3779B9u + 0x632BE5ABu));
+    // seed 1 (the default run seed) leaves the permutation of earlier versions
+    uint j = avg_permute(i, mask, gi_pcg_hash(pair * 0x9E3779B9u + 0x632BE5ABu) ^ gi_pcg_hash(seed) ^ gi_pcg_hash(1u));
     return vec2(gi_radical_inverse2(j), gi_sobol2(j));
 }
 

@@ -137,6 +137,31 @@ if(NOT rc EQUAL 0 OR NOT err MATCHES "cannot write GIBENCH_AVG_VPLS file")
     math(EXPR failures "${failures} + 1")
 endif()
 
+# --seed chooses the light paths: the same seed gives the same image, another
+# seed other VPLs (and so another image), for both tracers.
+foreach(tracing avg exact)
+    foreach(run a:1 b:1 c:2)
+        string(REPLACE ":" ";" rs ${run})
+        list(GET rs 0 tag)
+        list(GET rs 1 seed)
+        expect(0 "" render --scene ${SCENES}/cornell_box_coarse.gltf --method avg --size 24x24 --param vpls=64
+               --param tracing=${tracing} --seed ${seed} --out ${OUT}/avg_seed_${tracing}_${tag}.exr)
+    endforeach()
+    foreach(pair a:b a:c)
+        string(REPLACE ":" ";" ps ${pair})
+        list(GET ps 0 x)
+        list(GET ps 1 y)
+        execute_process(COMMAND ${GIB} diff ${OUT}/avg_seed_${tracing}_${x}.exr ${OUT}/avg_seed_${tracing}_${y}.exr --json
+                        OUTPUT_VARIABLE j RESULT_VARIABLE rc)
+        string(JSON rmse_${x}${y} GET "${j}" rmse)
+    endforeach()
+    message(STATUS "avg ${tracing}: seed 1 twice rmse ${rmse_ab}, seeds 1 and 2 rmse ${rmse_ac}")
+    if(NOT rmse_ab EQUAL 0 OR NOT rmse_ac GREATER 0)
+        message(SEND_ERROR "avg ${tracing} --seed: same seed rmse ${rmse_ab} (must be 0), other seed ${rmse_ac} (must be > 0)")
+        math(EXPR failures "${failures} + 1")
+    endif()
+endforeach()
+
 set(args render --scene ${SCENES}/cornell_box.gltf --method avg --size 32x32 --out ${OUT}/x.exr)
 expect(2 "M=5 is not a square number" ${args} --param M=5)
 expect(2 "avg: grid=2 is outside" ${args} --param grid=2)
