@@ -271,17 +271,22 @@ static int run(run_state *r, const render_opts *o)
         if (cli_interrupted)
             return cli_fail(EXIT_RUN, "render: interrupted after %u of %u frames; no image written", f, o->frames);
         float t = o->time + (o->animate_fps > 0 ? (float)f / o->animate_fps : 0.0f);
+        /* A frame of an animation is update() and render(): what an
+         * interactive program pays per frame (a method that rebuilds data
+         * in update() is charged for it; its stages count in the frame). */
+        gi_timer_frame_begin(r->render_timer);
         if (f > 0 && o->animate_fps > 0) {
             gi_gpu_scene_set_time(r->gs, t);
             gi_changes ch = {GI_CHANGED_TRANSFORMS | GI_CHANGED_LIGHTS | (r->gs->deforming ? GI_CHANGED_VERTICES : 0u),
                              t, ~0ull};
             res = r->m->update(r->inst, r->gs, &ch);
-            if (res != GI_OK)
+            if (res != GI_OK) {
+                gi_timer_frame_end(r->render_timer);
                 return method_fail(r, "update", res);
+            }
         }
         gi_view view;
         make_view(r->scene, camera, o, t, o->animate_fps > 0 ? 0 : f, &view);
-        gi_timer_frame_begin(r->render_timer);
         res = r->m->render(r->inst, &view, &target);
         gi_timer_frame_end(r->render_timer);
         if (res != GI_OK)

@@ -164,10 +164,14 @@ expect(0 "" ${largs} --param N_local=4 --param linear_aspect=50 --scene ${DATA}/
        --out ${OUT}/csm_cross_area.exr --timings ${OUT}/csm_cross_area.json)
 expect_json(${OUT}/csm_cross_area.json "\"maps_local\": 312")
 
-# an animated scene under fixed local lights: one warning that the cube maps
-# are not rebuilt
-expect(0 "fixed local lights' cube maps are not rebuilt" ${largs} --param N_local=2 --scene ${SCENES}/cornell_moving.gltf
-       --animate 4 --out ${OUT}/csm_moving.exr)
+# an animated scene under fixed local lights: by default the cube maps are
+# precomputed again in each frame whose objects moved (stage "rebuild", stat
+# local_rebuilds); with local_motion=keep they stay, with one warning
+expect(0 "" ${largs} --param N_local=2 --scene ${SCENES}/cornell_moving.gltf
+       --animate 4 --out ${OUT}/csm_moving.exr --timings ${OUT}/csm_moving.json)
+expect_json(${OUT}/csm_moving.json "\"local_rebuilds\": [1-9]" "\"rebuild\": {")
+expect(0 "fixed local lights' cube maps are not rebuilt" ${largs} --param N_local=2 --param local_motion=keep
+       --scene ${SCENES}/cornell_moving.gltf --animate 4 --out ${OUT}/csm_moving_keep.exr)
 
 expect(2 "csm: " ${largs} --param N_local=2 --scene ${SCENES}/teapot_area.glb --param lights=distant --out ${OUT}/x.exr)
 expect(2 "csm: N_local=0 is outside" ${largs} --scene ${SCENES}/teapot_area.glb --param N_local=0 --out ${OUT}/x.exr)
