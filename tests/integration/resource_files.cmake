@@ -50,6 +50,43 @@ file(WRITE ${D}/scene/cornell_box_coarse.gltf "${gltf}")
 execute_process(COMMAND mkfifo ${D}/scene/env.exr)
 refused(env_fifo "environment map 'env.exr'.*not a regular file" info ${D}/scene/cornell_box_coarse.gltf)
 
+# Symbolic links in a scene's folder may not lead out of it: a buffer, an
+# environment map or a folder linked to a file outside is refused; a link
+# that stays inside is fine.
+file(MAKE_DIRECTORY ${D}/outside ${D}/links)
+file(COPY ${ROOT}/scenes/cornell_box_coarse.bin DESTINATION ${D}/outside)
+file(COPY ${ROOT}/scenes/env/forest.exr DESTINATION ${D}/outside)
+file(WRITE ${D}/links/plain.gltf "${gltf}")
+string(JSON plain SET "${gltf}" scenes 0 extras "{}")
+file(CREATE_LINK ${D}/outside/cornell_box_coarse.bin ${D}/links/cornell_box_coarse.bin SYMBOLIC)
+file(WRITE ${D}/links/buffer.gltf "${plain}")
+refused(buffer_symlink "/buffers/0/uri: URI 'cornell_box_coarse.bin' leaves the scene directory through a symbolic link"
+        info ${D}/links/buffer.gltf)
+file(MAKE_DIRECTORY ${D}/links_env)
+file(COPY ${ROOT}/scenes/cornell_box_coarse.bin DESTINATION ${D}/links_env)
+file(CREATE_LINK ${D}/outside/forest.exr ${D}/links_env/env.exr SYMBOLIC)
+file(WRITE ${D}/links_env/env.gltf "${gltf}")
+refused(env_symlink "environment/uri: URI 'env.exr' leaves the scene directory through a symbolic link"
+        info ${D}/links_env/env.gltf)
+file(MAKE_DIRECTORY ${D}/links_dir)
+file(CREATE_LINK ${D}/outside ${D}/links_dir/sub SYMBOLIC)
+string(JSON subdir SET "${plain}" buffers 0 uri "\"sub/cornell_box_coarse.bin\"")
+file(WRITE ${D}/links_dir/dir.gltf "${subdir}")
+refused(dir_symlink "URI 'sub/cornell_box_coarse.bin' leaves the scene directory through a symbolic link"
+        info ${D}/links_dir/dir.gltf)
+# a link that stays inside the folder, reached through a linked scene folder
+file(MAKE_DIRECTORY ${D}/inside/data)
+file(COPY ${ROOT}/scenes/cornell_box_coarse.bin DESTINATION ${D}/inside/data)
+file(CREATE_LINK ${D}/inside/data/cornell_box_coarse.bin ${D}/inside/cornell_box_coarse.bin SYMBOLIC)
+file(WRITE ${D}/inside/ok.gltf "${plain}")
+file(CREATE_LINK ${D}/inside ${D}/inside_link SYMBOLIC)
+foreach(scene ${D}/inside/ok.gltf ${D}/inside_link/ok.gltf)
+    execute_process(COMMAND ${GIB} info ${scene} TIMEOUT 10 RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
+    if(NOT rc STREQUAL "0")
+        fail("${scene}: a link inside the scene folder was refused: exit ${rc}: ${err}")
+    endif()
+endforeach()
+
 if(failures GREATER 0)
     message(FATAL_ERROR "${failures} special file(s) not refused properly")
 endif()
