@@ -11,7 +11,9 @@
 #include "report.h"
 #include "runner.h"
 
+#include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -934,9 +936,12 @@ static void execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg)
     for (uint32_t i = 0; i < st->run_count; i++)
         attach_refs(st, &st->runs[i]);
     if (jobs <= 1) {
-        for (uint32_t i = 0; i < st->run_count && !cli_interrupted; i++) {
-            fprintf(stderr, "study: run %u/%u %s\n", i + 1, st->run_count, st->runs[i].id);
-            st->runs[i].record = run_or_skip(&st->runs[i], reg, !fresh);
+        /* once interrupted, the runs left are not started: they are
+         * reported as interrupted (or as done, when a result is cached) */
+        for (uint32_t i = 0; i < st->run_count; i++) {
+            if (!cli_interrupted)
+                fprintf(stderr, "study: run %u/%u %s\n", i + 1, st->run_count, st->runs[i].id);
+            st->runs[i].record = run_or_skip(&st->runs[i], reg, !fresh || cli_interrupted);
         }
         return;
     }
@@ -952,9 +957,20 @@ static void execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg)
         }
         pids[j] = pid;
     }
-    for (uint32_t j = 0; j < jobs && pids; j++)
-        if (pids[j] > 0)
-            waitpid(pids[j], NULL, 0);
+    /* An interrupted study passes SIGTERM on to its workers (a SIGTERM sent
+     * to the study alone does not reach them), which stop their runs'
+     * process groups (cli_run) and start no more. */
+    int forwarded = 0;
+    for (uint32_t j = 0; j < jobs && pids; j++) {
+        while (pids[j] > 0 && waitpid(pids[j], NULL, 0) < 0 && errno == EINTR) {
+            if (cli_interrupted && !forwarded) {
+                for (uint32_t k = 0; k < jobs; k++)
+                    if (pids[k] > 0)
+                        kill(pids[k], SIGTERM);
+                forwarded = 1;
+            }
+        }
+    }
     free(pids);
     /* collect: every worker wrote result.json; resume picks them up */
     for (uint32_t i = 0; i < st->run_count; i++)
@@ -1298,7 +1314,7 @@ int cmd_study(int argc, char **argv)
         execute_runs(&st, (uint32_t)jobs, fresh, reg);
         json_object *runs = json_object_new_array();
         char renderer[256] = "";
-        int failed = 0;
+        int failed = 0, interrupted = 0;
         for (uint32_t i = 0; i < st.run_count; i++) {
             json_object *v;
             if (!st.runs[i].record)
@@ -1307,6 +1323,9 @@ int cmd_study(int argc, char **argv)
                 snprintf(renderer, sizeof renderer, "%s", json_object_get_string(v));
             if (json_object_object_get_ex(st.runs[i].record, "status", &v) && !strcmp(json_object_get_string(v), "failed"))
                 failed++;
+            if (json_object_object_get_ex(st.runs[i].record, "status", &v) &&
+                !strcmp(json_object_get_string(v), "interrupted"))
+                interrupted++;
             json_object_array_add(runs, json_object_get(st.runs[i].record));
         }
         char title[512], refdesc[256];
@@ -1332,7 +1351,8 @@ int cmd_study(int argc, char **argv)
             fprintf(stderr, "study: wrote %s/report.md, index.html, runs.csv, frames.csv (%d failed runs)\n", out,
                     failed);
         if (rc == EXIT_OK && cli_interrupted)
-            rc = cli_fail(EXIT_RUN, "study: interrupted; rerun the same command to resume");
+            rc = cli_fail(EXIT_RUN, "study: interrupted (%d runs to redo); rerun the same command to resume",
+                          interrupted);
         json_object_put(runs);
         json_object_put(meta);
     }
