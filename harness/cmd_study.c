@@ -11,7 +11,9 @@
 #include "report.h"
 #include "runner.h"
 
+#include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -50,6 +52,7 @@ typedef struct study_run {
 typedef struct study_scene {
     const char *path;
     char stem[256];
+    uint64_t hash; /* its content: the file, every object's geometry, the environment map */
 } study_scene;
 
 /* The references of one scene at one size and scene time. */
@@ -381,11 +384,27 @@ static int scene_index(study *st, const char *file, const char *jpath, const cha
     if (!s)
         return cli_fail(EXIT_USAGE, "%s: %s: %s", file, jpath, err.text);
     int has_camera = !st->camera || gi_scene_find_camera(s, st->camera) >= 0;
+    /* the scene by its content, not its name: the file, each object's
+     * geometry (its buffers) and the environment map's bytes */
+    size_t n = 0;
+    char *bytes = gi_file_read_all(path, &n);
+    uint64_t hash = gi_hash64(bytes ? bytes : "", n, 0x5CE7E);
+    free(bytes);
+    for (uint32_t k = 0; k < s->object_count; k++) {
+        uint64_t oh = gi_scene_object_hash(s, k);
+        hash = gi_hash64(&oh, sizeof oh, hash);
+    }
+    if (s->has_environment && s->environment.path) {
+        bytes = gi_file_read_all(s->environment.path, &n);
+        hash = gi_hash64(bytes ? bytes : "", n, hash);
+        free(bytes);
+    }
     gi_scene_free(s);
     if (!has_camera)
         return cli_fail(EXIT_USAGE, "%s: /camera: %s has no camera '%s'", file, path, st->camera);
     study_scene *sc = &st->scenes[st->scene_count];
     sc->path = path;
+    sc->hash = hash;
     stem_of(path, sc->stem, sizeof sc->stem);
     *out = (int)st->scene_count++;
     return EXIT_OK;
@@ -419,7 +438,16 @@ static void name_refs(study *st)
         int shared = 0;
         for (uint32_t k = 0; k < st->ref_count; k++)
             shared |= k != i && st->refs[k].scene_index == r->scene_index;
-        const char *stem = st->scenes[r->scene_index].stem;
+        /* two scenes of one name (in different folders) get apart by content */
+        char stem[300];
+        const study_scene *sc = &st->scenes[r->scene_index];
+        int same_name = 0;
+        for (uint32_t k = 0; k < st->scene_count; k++)
+            same_name |= (int)k != r->scene_index && !strcmp(st->scenes[k].stem, sc->stem);
+        if (same_name)
+            snprintf(stem, sizeof stem, "%s-%08x", sc->stem, (unsigned)(sc->hash & 0xFFFFFFFFu));
+        else
+            snprintf(stem, sizeof stem, "%s", sc->stem);
         if (!shared)
             snprintf(r->name, sizeof r->name, "%s", stem);
         else if (r->time == 0.0f)
@@ -515,8 +543,13 @@ static int add_run(study *st, const char *file, const char *out_dir, const gi_me
         study_run *r = &st->runs[st->run_count];
         memset(r, 0, sizeof *r);
         char key[MAX_KEYS * 128 + 4096]; /* every parameter's text: a cut key would merge two runs */
-        snprintf(key, sizeof key, "%s|%s|%u|%ux%u|%u/%u|%g|%g|%d|%d", st->scenes[si].path, m->id, repeat, rs->width,
-                 rs->height, rs->frames, rs->warmup, (double)rs->time, (double)rs->animate_fps, rs->cache,
+        /* every input that changes the result: the scene by its content, the
+         * method, seed, camera, size, frames, times, exposure, timer mode,
+         * cache and comparison, and each parameter */
+        snprintf(key, sizeof key, "%016llx|%s|seed=%u|camera=%s|%ux%u|%u/%u|%.9g|%.9g|ev=%.9g|timer=%s|%d|%d",
+                 (unsigned long long)st->scenes[si].hash, m->id, st->seed + repeat,
+                 st->camera ? st->camera : "-", rs->width, rs->height, rs->frames, rs->warmup, (double)rs->time,
+                 (double)rs->animate_fps, (double)st->exposure, st->timer ? st->timer : "-", rs->cache,
                  rs->compare);
         for (int p = 0; p < nk; p++) {
             r->params[p] = strdup(combo[p]);
@@ -934,9 +967,12 @@ static void execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg)
     for (uint32_t i = 0; i < st->run_count; i++)
         attach_refs(st, &st->runs[i]);
     if (jobs <= 1) {
-        for (uint32_t i = 0; i < st->run_count && !cli_interrupted; i++) {
-            fprintf(stderr, "study: run %u/%u %s\n", i + 1, st->run_count, st->runs[i].id);
-            st->runs[i].record = run_or_skip(&st->runs[i], reg, !fresh);
+        /* once interrupted, the runs left are not started: they are
+         * reported as interrupted (or as done, when a result is cached) */
+        for (uint32_t i = 0; i < st->run_count; i++) {
+            if (!cli_interrupted)
+                fprintf(stderr, "study: run %u/%u %s\n", i + 1, st->run_count, st->runs[i].id);
+            st->runs[i].record = run_or_skip(&st->runs[i], reg, !fresh || cli_interrupted);
         }
         return;
     }
@@ -952,9 +988,20 @@ static void execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg)
         }
         pids[j] = pid;
     }
-    for (uint32_t j = 0; j < jobs && pids; j++)
-        if (pids[j] > 0)
-            waitpid(pids[j], NULL, 0);
+    /* An interrupted study passes SIGTERM on to its workers (a SIGTERM sent
+     * to the study alone does not reach them), which stop their runs'
+     * process groups (cli_run) and start no more. */
+    int forwarded = 0;
+    for (uint32_t j = 0; j < jobs && pids; j++) {
+        while (pids[j] > 0 && waitpid(pids[j], NULL, 0) < 0 && errno == EINTR) {
+            if (cli_interrupted && !forwarded) {
+                for (uint32_t k = 0; k < jobs; k++)
+                    if (pids[k] > 0)
+                        kill(pids[k], SIGTERM);
+                forwarded = 1;
+            }
+        }
+    }
     free(pids);
     /* collect: every worker wrote result.json; resume picks them up */
     for (uint32_t i = 0; i < st->run_count; i++)
@@ -1298,7 +1345,7 @@ int cmd_study(int argc, char **argv)
         execute_runs(&st, (uint32_t)jobs, fresh, reg);
         json_object *runs = json_object_new_array();
         char renderer[256] = "";
-        int failed = 0;
+        int failed = 0, interrupted = 0;
         for (uint32_t i = 0; i < st.run_count; i++) {
             json_object *v;
             if (!st.runs[i].record)
@@ -1307,6 +1354,9 @@ int cmd_study(int argc, char **argv)
                 snprintf(renderer, sizeof renderer, "%s", json_object_get_string(v));
             if (json_object_object_get_ex(st.runs[i].record, "status", &v) && !strcmp(json_object_get_string(v), "failed"))
                 failed++;
+            if (json_object_object_get_ex(st.runs[i].record, "status", &v) &&
+                !strcmp(json_object_get_string(v), "interrupted"))
+                interrupted++;
             json_object_array_add(runs, json_object_get(st.runs[i].record));
         }
         char title[512], refdesc[256];
@@ -1332,7 +1382,8 @@ int cmd_study(int argc, char **argv)
             fprintf(stderr, "study: wrote %s/report.md, index.html, runs.csv, frames.csv (%d failed runs)\n", out,
                     failed);
         if (rc == EXIT_OK && cli_interrupted)
-            rc = cli_fail(EXIT_RUN, "study: interrupted; rerun the same command to resume");
+            rc = cli_fail(EXIT_RUN, "study: interrupted (%d runs to redo); rerun the same command to resume",
+                          interrupted);
         json_object_put(runs);
         json_object_put(meta);
     }

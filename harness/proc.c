@@ -12,6 +12,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
+#ifdef __linux__
+#include <sys/prctl.h>
+#endif
 #include <time.h>
 #include <unistd.h>
 
@@ -59,7 +62,13 @@ static void read_last_line(const char *log_path, char *out, size_t size)
 int cli_run(char *const argv[], double timeout_s, const char *out_path, const char *err_path, cli_proc_result *r)
 {
     memset(r, 0, sizeof *r);
+    if (cli_interrupted) { /* nothing new starts once gibench is interrupted */
+        r->interrupted = 1;
+        snprintf(r->last_line, sizeof r->last_line, "not started: interrupted");
+        return 0;
+    }
     double t0 = gi_now();
+    pid_t parent = getpid();
     pid_t pid = fork();
     if (pid < 0) {
         snprintf(r->last_line, sizeof r->last_line, "fork failed: %s", strerror(errno));
@@ -67,6 +76,14 @@ int cli_run(char *const argv[], double timeout_s, const char *out_path, const ch
     }
     if (pid == 0) {
         setpgid(0, 0); /* so that a time-out kills the child's children too */
+#ifdef __linux__
+        /* gibench killed outright (SIGKILL) takes its child along */
+        prctl(PR_SET_PDEATHSIG, SIGKILL);
+        if (getppid() != parent)
+            _exit(127);
+#else
+        (void)parent;
+#endif
         int fo = open(out_path ? out_path : "/dev/null", O_WRONLY | O_CREAT | O_TRUNC, 0644);
         int fe = err_path && out_path && !strcmp(err_path, out_path)
                      ? dup(fo)
@@ -90,6 +107,7 @@ int cli_run(char *const argv[], double timeout_s, const char *out_path, const ch
     }
     setpgid(pid, pid);
     int status = 0;
+    double term_sent = 0.0;
     for (;;) {
         pid_t w = waitpid(pid, &status, WNOHANG);
         if (w == pid)
@@ -105,13 +123,22 @@ int cli_run(char *const argv[], double timeout_s, const char *out_path, const ch
             break;
         }
         if (cli_interrupted) {
-            kill(-pid, SIGTERM);
+            /* SIGTERM to the whole group, SIGKILL after the grace period */
+            if (!term_sent) {
+                kill(-pid, SIGTERM);
+                term_sent = gi_now();
+            } else if (gi_now() - term_sent > CLI_KILL_GRACE_S) {
+                kill(-pid, SIGKILL);
+            }
         }
         struct timespec ts = {0, 5 * 1000 * 1000};
         nanosleep(&ts, NULL);
     }
     r->seconds = gi_now() - t0;
-    if (!r->timed_out) {
+    if (term_sent > 0.0 && !r->timed_out && !(WIFEXITED(status) && WEXITSTATUS(status) == 0)) {
+        kill(-pid, SIGKILL); /* whatever of the group is left */
+        r->interrupted = 1;
+    } else if (!r->timed_out) {
         if (WIFSIGNALED(status)) {
             r->signaled = 1;
             r->signal = WTERMSIG(status);
@@ -125,7 +152,9 @@ int cli_run(char *const argv[], double timeout_s, const char *out_path, const ch
 
 void cli_proc_describe(const cli_proc_result *r, char *buf, size_t size)
 {
-    if (r->timed_out)
+    if (r->interrupted)
+        snprintf(buf, size, "interrupted");
+    else if (r->timed_out)
         snprintf(buf, size, "timed out after %.0f s", r->seconds);
     else if (r->signaled)
         snprintf(buf, size, "crashed (signal %d: %s)%s%s", r->signal, strsignal(r->signal),

@@ -11,9 +11,14 @@ typedef struct cli_proc_result {
     int signaled;       /* killed by a signal (crash) */
     int signal;
     int timed_out;      /* killed by us at the time limit */
+    int interrupted;    /* stopped (or never started) because gibench was interrupted */
     double seconds;     /* wall time */
     char last_line[512]; /* last non-empty line the child printed (stderr + stdout) */
 } cli_proc_result;
+
+/* Seconds between the SIGTERM that an interrupted gibench sends to a
+ * child's process group and the SIGKILL that follows when it is still there. */
+#define CLI_KILL_GRACE_S 5.0
 
 /* Runs argv (argv[0] a path) with stdout written to out_path and stderr to
  * err_path (either may be NULL: discarded; the same path for both merges
@@ -23,8 +28,15 @@ typedef struct cli_proc_result {
 int cli_run(char *const argv[], double timeout_s, const char *out_path, const char *err_path,
             cli_proc_result *result);
 
-/* One-line description of how a run ended: "ok", "exit 2: <line>",
- * "crashed (signal 11: Segmentation fault): <line>", "timed out after 30 s". */
+/* When gibench itself is interrupted (SIGINT/SIGTERM: cli_interrupted), a
+ * child not yet started is not started, and a running child's process group
+ * gets SIGTERM, then SIGKILL after CLI_KILL_GRACE_S; unless it still exits 0,
+ * the result says interrupted (a run to redo, not a failed one). A child
+ * also gets SIGKILL when gibench dies (PR_SET_PDEATHSIG, Linux).
+ *
+ * One-line description of how a run ended: "ok", "exit 2: <line>",
+ * "crashed (signal 11: Segmentation fault): <line>", "timed out after 30 s",
+ * "interrupted". */
 void cli_proc_describe(const cli_proc_result *r, char *buf, size_t size);
 
 /* Absolute path of the running gibench executable. */

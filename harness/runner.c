@@ -262,7 +262,9 @@ json_object *runner_execute(const run_spec *s, int resume)
     if (resume) {
         json_object *old = cli_read_json(result);
         json_object *c;
-        if (old && json_object_object_get_ex(old, "config", &c) && strcmp(json_object_get_string(c), config) == 0) {
+        json_object *st;
+        if (old && json_object_object_get_ex(old, "config", &c) && strcmp(json_object_get_string(c), config) == 0 &&
+            !(json_object_object_get_ex(old, "status", &st) && !strcmp(json_object_get_string(st), "interrupted"))) {
             json_object_put(rec);
             args_free(&b);
             return old;
@@ -318,6 +320,16 @@ json_object *runner_execute(const run_spec *s, int resume)
                 json_object_object_add(rec, "heatmap", json_object_new_string(p));
             }
         }
+    }
+    /* A run that did not finish while gibench was being interrupted is
+     * "interrupted": reported, but not recorded, so that resuming redoes it
+     * (a failure recorded here would be kept for good). */
+    json_object *status;
+    if (cli_interrupted && !(json_object_object_get_ex(rec, "status", &status) &&
+                             !strcmp(json_object_get_string(status), "ok"))) {
+        json_object_object_add(rec, "status", json_object_new_string("interrupted"));
+        json_object_object_add(rec, "reason", json_object_new_string("interrupted: resuming the study redoes it"));
+        return rec;
     }
     char why[GI_ERROR_MAX];
     if (!cli_write_json(result, rec, why, sizeof why))

@@ -121,6 +121,7 @@ struct Context {
     bool has_base = false;
     std::string base;   /* scene directory as given, without trailing '/' */
     std::string prefix; /* base + '/' */
+    std::string real_prefix; /* realpath(base) + '/': where a resolved file must lie */
     /* First refusal by a callback that tinygltf calls (its own text would not
      * say which JSON element it was). */
     std::string refused_pointer, refused;
@@ -224,6 +225,21 @@ bool relative_path_ok(const std::string &path, const char **why)
     return true;
 }
 
+/* Whether `path`, with every symbolic link resolved, lies below the scene
+ * directory (also resolved). A file that does not exist passes: reading it
+ * fails later with its own error. */
+bool resolves_inside(const Context &c, const std::string &path)
+{
+    if (c.real_prefix.empty())
+        return true;
+    char *real = realpath(path.c_str(), nullptr);
+    if (!real)
+        return true;
+    std::string r(real);
+    free(real);
+    return r.size() > c.real_prefix.size() && r.compare(0, c.real_prefix.size(), c.real_prefix) == 0;
+}
+
 /* The file a relative URI names, or a Failure at `pointer`. */
 std::string resolve_uri(const Context &c, const std::string &pointer, const std::string &uri)
 {
@@ -237,6 +253,9 @@ std::string resolve_uri(const Context &c, const std::string &pointer, const std:
              "external URI " + shown(uri) + " needs a base directory (loaded from memory)");
     if (!decode_uri(uri, &path, &why) || !relative_path_ok(path, &why))
         fail(pointer, "URI " + shown(uri) + " " + why);
+    if (!resolves_inside(c, c.prefix + path))
+        fail(pointer, "URI " + shown(uri) +
+                          " leaves the scene directory through a symbolic link");
     return c.prefix + path;
 }
 
@@ -261,7 +280,7 @@ bool path_allowed(const Context &c, const std::string &path)
     const char *why = nullptr;
     return c.has_base && path.size() > c.prefix.size() &&
            path.compare(0, c.prefix.size(), c.prefix) == 0 &&
-           relative_path_ok(path.substr(c.prefix.size()), &why);
+           relative_path_ok(path.substr(c.prefix.size()), &why) && resolves_inside(c, path);
 }
 
 bool read_file(const std::string &path, std::vector<unsigned char> *out, std::string *why)
@@ -2231,6 +2250,10 @@ void set_context(Context *c, const gi_gltf_source *src)
         while (c->base.size() > 1 && c->base.back() == '/')
             c->base.pop_back();
         c->prefix = c->base == "/" ? c->base : c->base + "/";
+        if (char *real = realpath(c->base.c_str(), nullptr)) {
+            c->real_prefix = std::string(real) == "/" ? std::string("/") : std::string(real) + "/";
+            free(real);
+        }
     }
 }
 

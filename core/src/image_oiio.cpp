@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -172,13 +173,24 @@ struct channels {
 /* Reads subimage 0 of `path` as float, placed in its display window. */
 bool read_all(const char *path, channels *ch, gi_error *err)
 {
-    struct stat st;
-    if (stat(path, &st) != 0) {
+    /* Every image read comes here: only a regular file is opened by the
+     * decoder. A FIFO would block it and a device (/dev/zero) never ends;
+     * O_NONBLOCK keeps the probe itself from blocking on a FIFO. */
+    int fd = open(path, O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+    if (fd < 0) {
         gi_error_set(err, GI_ERR_IO, "%s: %s", path, std::strerror(errno));
         return false;
     }
-    if (S_ISDIR(st.st_mode)) {
-        gi_error_set(err, GI_ERR_IO, "%s: is a directory", path);
+    struct stat st;
+    int st_rc = fstat(fd, &st);
+    close(fd);
+    if (st_rc != 0 || !S_ISREG(st.st_mode)) {
+        const char *kind = st_rc != 0              ? ""
+                           : S_ISDIR(st.st_mode)  ? " (a directory)"
+                           : S_ISFIFO(st.st_mode) ? " (a FIFO)"
+                           : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? " (a device)"
+                                                                        : "";
+        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: not a regular file%s", path, kind);
         return false;
     }
     /* Keep PNG/TIFF alpha as stored; OIIO would premultiply by default. */

@@ -1,0 +1,60 @@
+# SIGTERM to a running study (as Ctrl-C would be): each run in progress is
+# stopped with its process group (SIGTERM, SIGKILL after the grace period),
+# no run is left behind or started, the report lists the runs as
+# "interrupted", never "failed", and resuming redoes them.
+# cmake -DGIB=... -DROOT=... -DOUT=... -DFAKE_RUN=... -P study_interrupt.cmake
+set(failures 0)
+include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
+set(ENV{GIBENCH_PLUGIN_PATH} "${FAKE_RUN}")
+set(D ${OUT}/study_interrupt)
+file(REMOVE_RECURSE ${D})
+file(MAKE_DIRECTORY ${D})
+# two hanging runs and one that is never reached before the signal
+function(study_file timeout)
+    file(WRITE ${D}/hang.json "{\"name\": \"hang\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
+  \"size\": [8, 8], \"frames\": 1, \"warmup\": 0, \"compare\": false, \"timeout\": ${timeout},
+  \"methods\": [{\"method\": \"fake_hang\", \"params\": {}}, {\"method\": \"fake_hang\", \"label\": \"second\"},
+               {\"method\": \"direct\"}]}")
+endfunction()
+
+foreach(jobs 1 2)
+    set(S ${D}/out${jobs})
+    study_file(600)
+    # start the study, wait for its first run's log, SIGTERM the study alone
+    execute_process(COMMAND sh -c "\"$0\" study \"$3\" --out \"$1\" --jobs $2 >\"$1.log\" 2>&1 & p=$!
+                                   i=0; while ! ls \"$1\"/runs/*/render.log >/dev/null 2>&1 && [ $i -lt 600 ]; do sleep 0.1; i=$((i+1)); done
+                                   sleep 1; kill -TERM $p; wait $p; echo $?"
+                            ${GIB} ${S} ${jobs} ${D}/hang.json
+                    WORKING_DIRECTORY ${ROOT} TIMEOUT 120 RESULT_VARIABLE rc OUTPUT_VARIABLE code)
+    string(STRIP "${code}" code)
+    file(READ ${S}.log log)
+    if(NOT rc EQUAL 0 OR NOT code STREQUAL "1")
+        fail("--jobs ${jobs}: the interrupted study exited ${code} (expected 1):\n${log}")
+    endif()
+    match("${log}" "study: interrupted \\(3 runs to redo\\)" "--jobs ${jobs}: no 'interrupted' line:\n${log}")
+    # no render of this study is left running
+    execute_process(COMMAND sh -c "ps -eo args | grep -F \"$0/runs/\" | grep -v grep" ${S} OUTPUT_VARIABLE left)
+    if(NOT left STREQUAL "")
+        fail("--jobs ${jobs}: runs left running after the study was interrupted:\n${left}")
+    endif()
+    file(READ ${S}/runs.csv csv)
+    match_count("${csv}" ",interrupted," 3 "--jobs ${jobs}: interrupted runs in runs.csv")
+    match_count("${csv}" ",failed," 0 "--jobs ${jobs}: failed runs in runs.csv")
+    file(GLOB results ${S}/runs/*/result.json)
+    if(results)
+        fail("--jobs ${jobs}: an interrupted run left a result: ${results}")
+    endif()
+    # resuming redoes every run: the hangs time out now, direct finishes
+    study_file(2)
+    execute_process(COMMAND ${GIB} study ${D}/hang.json --out ${S} --jobs ${jobs} WORKING_DIRECTORY ${ROOT}
+                    TIMEOUT 120 RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
+    file(READ ${S}/runs.csv csv)
+    match_count("${csv}" ",failed,\"?timed out after" 2 "--jobs ${jobs}: the hangs were not redone on resume:\n${csv}")
+    match_count("${csv}" ",ok," 1 "--jobs ${jobs}: the run never started was not run on resume:\n${csv}")
+    match_count("${csv}" ",interrupted," 0 "--jobs ${jobs}: interrupted runs after resuming")
+endforeach()
+
+if(failures GREATER 0)
+    message(FATAL_ERROR "${failures} interrupt expectation(s) failed")
+endif()
+message(STATUS "an interrupted study stops its runs and redoes them on resume")
