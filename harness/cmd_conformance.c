@@ -311,6 +311,13 @@ static gi_image *render_frames(session *S, const scene_ref *sc, float t, uint32_
     return img;
 }
 
+/* A fresh instance on sc, `frames` frames at t = 0 of size x size with
+ * `seed`: the image, or NULL with the reason kept in S. */
+static gi_image *fresh_render(session *S, const scene_ref *sc, uint32_t size, uint32_t frames, uint32_t seed)
+{
+    return instance_new(S, NULL, 0, sc) ? render_frames(S, sc, 0.0f, size, size, frames, 0, 0.0f, seed) : NULL;
+}
+
 static int update(session *S, scene_ref *sc, uint32_t flags, float t)
 {
     gi_gpu_scene_set_time(sc->gs, t);
@@ -458,9 +465,7 @@ static conf_status check_furnace(session *S, const conf_opts *o, const char *arg
     double expect = 0.0;
     for (uint32_t k = 0; k <= B; k++)
         expect += Le * pow(rho, (double)k);
-    gi_image *img = NULL;
-    if (instance_new(S, NULL, 0, &sc))
-        img = render_frames(S, &sc, 0.0f, o->size, o->size, frames_for(S->m, 4), 0, 0.0f, 1);
+    gi_image *img = fresh_render(S, &sc, o->size, frames_for(S->m, 4), 1);
     scene_free(&sc);
     if (!img)
         return fail_why(r, S);
@@ -494,9 +499,7 @@ static conf_status check_scene(session *S, const conf_opts *o, const char *path,
         scene_free(&sc);
         return set(r, R_NA, "%s", why);
     }
-    gi_image *img = NULL;
-    if (instance_new(S, NULL, 0, &sc))
-        img = render_frames(S, &sc, 0.0f, o->size, o->size, 1, 0, 0.0f, 1);
+    gi_image *img = fresh_render(S, &sc, o->size, 1, 1);
     scene_free(&sc);
     if (!img)
         return fail_why(r, S);
@@ -513,11 +516,8 @@ static conf_status check_determinism(session *S, const conf_opts *o, result *r)
     if (!pick_scene(S, path, sizeof path, &sc, r))
         return r->status;
     uint32_t frames = frames_for(S->m, 2);
-    gi_image *a = NULL, *b = NULL;
-    if (instance_new(S, NULL, 0, &sc))
-        a = render_frames(S, &sc, 0.0f, o->size, o->size, frames, 0, 0.0f, 7);
-    if (a && instance_new(S, NULL, 0, &sc))
-        b = render_frames(S, &sc, 0.0f, o->size, o->size, frames, 0, 0.0f, 7);
+    gi_image *a = fresh_render(S, &sc, o->size, frames, 7);
+    gi_image *b = a ? fresh_render(S, &sc, o->size, frames, 7) : NULL;
     scene_free(&sc);
     if (!a || !b) {
         gi_image_free(a);
@@ -594,8 +594,8 @@ static conf_status check_resize(session *S, const conf_opts *o, result *r)
         method_error(S, "second prepare", res);
     else
         d = render_frames(S, &sc2, 0.0f, o->size, o->size, frames, 0, 0.0f, 3);
-    if (d && instance_new(S, NULL, 0, &sc2))
-        e = render_frames(S, &sc2, 0.0f, o->size, o->size, frames, 0, 0.0f, 3);
+    if (d)
+        e = fresh_render(S, &sc2, o->size, frames, 3);
     instance_free(S);
     scene_free(&sc);
     scene_free(&sc2);
@@ -766,11 +766,8 @@ static conf_status check_light(session *S, const conf_opts *o, const char *kind,
         return fail_why(r, S);
     }
     uint32_t frames = frames_for(S->m, 2);
-    gi_image *lit = NULL, *unlit = NULL;
-    if (instance_new(S, NULL, 0, &sc))
-        lit = render_frames(S, &sc, 0.0f, o->size, o->size, frames, 0, 0.0f, 1);
-    if (lit && instance_new(S, NULL, 0, &sd))
-        unlit = render_frames(S, &sd, 0.0f, o->size, o->size, frames, 0, 0.0f, 1);
+    gi_image *lit = fresh_render(S, &sc, o->size, frames, 1);
+    gi_image *unlit = lit ? fresh_render(S, &sd, o->size, frames, 1) : NULL;
     instance_free(S);
     scene_free(&sc);
     scene_free(&sd);
