@@ -12,11 +12,13 @@
 #include "runner.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -1297,6 +1299,48 @@ static void print_plan(const study *st)
     }
 }
 
+/* One study at a time per --out: an exclusive flock() on DIR/.gibench-study.lock,
+ * taken before anything (references included) is built and held until the
+ * study exits; the kernel releases it when the process dies, crashed or not.
+ * The file holds the holder's pid and is left in place (unlinking it would
+ * let a third study lock a new file while a second waits on the old one).
+ * The descriptor is close-on-exec, so runs started by the study do not hold
+ * it. Returns the descriptor, or -1 after printing why (*rc set). */
+static int lock_out_dir(const char *out, int *rc)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/.gibench-study.lock", out);
+    int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+    if (fd < 0) {
+        *rc = cli_fail(EXIT_RUN, "study: cannot open the lock %s: %s", path, strerror(errno));
+        return -1;
+    }
+    while (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        if (errno == EINTR)
+            continue;
+        if (errno == EWOULDBLOCK) {
+            char pid[32] = "";
+            ssize_t n = pread(fd, pid, sizeof pid - 1, 0);
+            pid[n > 0 ? n : 0] = '\0';
+            pid[strcspn(pid, "\n")] = '\0';
+            *rc = cli_fail(EXIT_USAGE, "study: %s is in use by another study (pid %s holds %s)", out,
+                           pid[0] ? pid : "unknown", path);
+        } else {
+            *rc = cli_fail(EXIT_RUN, "study: cannot lock %s: %s", path, strerror(errno));
+        }
+        close(fd);
+        return -1;
+    }
+    char pid[32];
+    int len = snprintf(pid, sizeof pid, "%ld\n", (long)getpid());
+    if (ftruncate(fd, 0) != 0 || pwrite(fd, pid, (size_t)len, 0) != len) {
+        *rc = cli_fail(EXIT_RUN, "study: cannot write the lock %s: %s", path, strerror(errno));
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
 int cmd_study(int argc, char **argv)
 {
     const char *file = NULL, *out = NULL;
@@ -1334,6 +1378,9 @@ int cmd_study(int argc, char **argv)
         print_plan(&st);
     if (rc == EXIT_OK && !dry && !cli_mkdirs(out))
         rc = cli_fail(EXIT_RUN, "study: cannot create %s", out);
+    int lock_fd = -1;
+    if (rc == EXIT_OK && !dry)
+        lock_fd = lock_out_dir(out, &rc);
     if (rc == EXIT_OK && !dry && st.timer)
         setenv("GIBENCH_TIMER", st.timer, 1);
     if (rc == EXIT_OK && !dry) {
@@ -1395,5 +1442,7 @@ int cmd_study(int argc, char **argv)
     free(st.runs);
     json_object_put(st.root);
     gi_plugins_free(reg);
+    if (lock_fd >= 0)
+        close(lock_fd); /* releases the lock */
     return rc;
 }
