@@ -1405,6 +1405,29 @@ static void print_plan(const study *st)
     }
 }
 
+static void study_free(study *st)
+{
+    for (uint32_t i = 0; st->runs && i < st->run_count; i++) {
+        json_object_put(st->runs[i].record);
+        for (int k = 0; k < MAX_KEYS; k++)
+            free(st->runs[i].params[k]);
+    }
+    free(st->runs);
+    json_object_put(st->root);
+    memset(st, 0, sizeof *st);
+}
+
+int study_check(const char *file, gi_plugins *reg)
+{
+    study *st = calloc(1, sizeof *st); /* over a megabyte: not on the stack */
+    if (!st)
+        return cli_fail(EXIT_RUN, "study: out of memory");
+    int rc = load_study(st, file, ".", reg);
+    study_free(st);
+    free(st);
+    return rc;
+}
+
 /* One study at a time per --out: an exclusive flock() on DIR/.gibench-study.lock,
  * taken before anything (references included) is built and held until the
  * study exits; the kernel releases it when the process dies, crashed or not.
@@ -1540,13 +1563,7 @@ int cmd_study(int argc, char **argv)
         json_object_put(runs);
         json_object_put(meta);
     }
-    for (uint32_t i = 0; st.runs && i < st.run_count; i++) {
-        json_object_put(st.runs[i].record);
-        for (int k = 0; k < MAX_KEYS; k++)
-            free(st.runs[i].params[k]);
-    }
-    free(st.runs);
-    json_object_put(st.root);
+    study_free(&st);
     gi_plugins_free(reg);
     if (lock_fd >= 0)
         close(lock_fd); /* releases the lock */
