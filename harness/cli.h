@@ -76,6 +76,9 @@ int cmd_render(int argc, char **argv);
 int cmd_diff(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
 int cmd_study(int argc, char **argv);
+/* The study reader alone (what --dry-run checks, without the plan): EXIT_OK,
+ * or EXIT_USAGE after printing one line; for tests/fuzz/fuzz_study.c. */
+int study_check(const char *file, gi_plugins *reg);
 int cmd_reference(int argc, char **argv);
 int cmd_conformance(int argc, char **argv);
 

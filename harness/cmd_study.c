@@ -12,11 +12,13 @@
 #include "runner.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -154,6 +156,108 @@ static int get_string(json_object *o, const char *prefix, const char *key, int n
     return EXIT_OK;
 }
 
+/* json-c keeps the last of two equal keys in an object and drops the
+ * first without a word; a study file that gives "params" (or "spp", ...)
+ * twice is refused instead, naming the key's JSON path and its line. The
+ * text has already parsed as strict JSON, so a small scanner suffices:
+ * strings, the brackets and commas around them. Keys compare as written
+ * (escapes are not decoded). Returns EXIT_OK or EXIT_USAGE after printing. */
+typedef struct key_frame {
+    int is_object, want_key;
+    size_t index; /* arrays: the element being read */
+    const char *key; /* objects: the key being read */
+    size_t key_len;
+    const char **keys; /* objects: keys seen (into the text) */
+    size_t *lens, count, cap;
+} key_frame;
+
+static int check_duplicate_keys(const char *file, const char *text, size_t n)
+{
+    enum { MAX_DEPTH = 64 }; /* json-c stops at 32 */
+    key_frame st[MAX_DEPTH];
+    int top = -1, rc = EXIT_OK;
+    size_t line = 1;
+    for (size_t i = 0; i < n && rc == EXIT_OK; i++) {
+        char c = text[i];
+        if (c == '\n') {
+            line++;
+        } else if (c == '"') {
+            size_t j = i + 1;
+            while (j < n && text[j] != '"')
+                j += text[j] == '\\' ? 2 : 1;
+            if (j > n)
+                j = n;
+            key_frame *f = top >= 0 ? &st[top] : NULL;
+            if (f && f->is_object && f->want_key) {
+                const char *k = text + i + 1;
+                size_t kl = j - i - 1;
+                for (size_t q = 0; q < f->count; q++)
+                    if (f->lens[q] == kl && !memcmp(f->keys[q], k, kl)) {
+                        char path[512];
+                        size_t used = 0;
+                        for (int d = 0; d < top && used < sizeof path; d++) {
+                            int w = st[d].is_object
+                                        ? snprintf(path + used, sizeof path - used, "/%.*s", (int)st[d].key_len,
+                                                   st[d].key)
+                                        : snprintf(path + used, sizeof path - used, "/%zu", st[d].index);
+                            used += w > 0 ? (size_t)w : 0;
+                        }
+                        if (used < sizeof path)
+                            snprintf(path + used, sizeof path - used, "/%.*s", (int)kl, k);
+                        char what[64];
+                        snprintf(what, sizeof what, "key given twice (line %zu)", line);
+                        rc = fail_json(file, path, what);
+                        break;
+                    }
+                if (rc == EXIT_OK && f->count == f->cap) {
+                    size_t cap = f->cap ? 2 * f->cap : 8;
+                    const char **keys = realloc(f->keys, cap * sizeof *keys);
+                    if (keys)
+                        f->keys = keys;
+                    size_t *lens = keys ? realloc(f->lens, cap * sizeof *lens) : NULL;
+                    if (lens)
+                        f->lens = lens;
+                    if (!keys || !lens)
+                        rc = cli_fail(EXIT_RUN, "%s: out of memory", file);
+                    else
+                        f->cap = cap;
+                }
+                if (rc == EXIT_OK) {
+                    f->keys[f->count] = k;
+                    f->lens[f->count++] = kl;
+                    f->key = k;
+                    f->key_len = kl;
+                    f->want_key = 0;
+                }
+            }
+            for (size_t q = i + 1; q < j; q++)
+                line += text[q] == '\n';
+            i = j;
+        } else if (c == '{' || c == '[') {
+            if (top + 1 >= MAX_DEPTH)
+                break; /* deeper than json-c reads: it refused the file already */
+            key_frame *f = &st[++top];
+            memset(f, 0, sizeof *f);
+            f->is_object = c == '{';
+            f->want_key = f->is_object;
+        } else if ((c == '}' || c == ']') && top >= 0) {
+            free(st[top].keys);
+            free(st[top].lens);
+            top--;
+        } else if (c == ',' && top >= 0) {
+            if (st[top].is_object)
+                st[top].want_key = 1;
+            else
+                st[top].index++;
+        }
+    }
+    for (; top >= 0; top--) {
+        free(st[top].keys);
+        free(st[top].lens);
+    }
+    return rc;
+}
+
 /* The study file as strict JSON (no trailing commas, no comments, nothing
  * after the top-level value); NULL after printing where it goes wrong. */
 static json_object *read_strict_json(const char *file)
@@ -182,6 +286,10 @@ static json_object *read_strict_json(const char *file)
             o = NULL;
         }
         json_tokener_free(tok);
+    }
+    if (o && check_duplicate_keys(file, text, n) != EXIT_OK) {
+        json_object_put(o);
+        o = NULL;
     }
     free(text);
     return o;
@@ -1297,6 +1405,71 @@ static void print_plan(const study *st)
     }
 }
 
+static void study_free(study *st)
+{
+    for (uint32_t i = 0; st->runs && i < st->run_count; i++) {
+        json_object_put(st->runs[i].record);
+        for (int k = 0; k < MAX_KEYS; k++)
+            free(st->runs[i].params[k]);
+    }
+    free(st->runs);
+    json_object_put(st->root);
+    memset(st, 0, sizeof *st);
+}
+
+int study_check(const char *file, gi_plugins *reg)
+{
+    study *st = calloc(1, sizeof *st); /* over a megabyte: not on the stack */
+    if (!st)
+        return cli_fail(EXIT_RUN, "study: out of memory");
+    int rc = load_study(st, file, ".", reg);
+    study_free(st);
+    free(st);
+    return rc;
+}
+
+/* One study at a time per --out: an exclusive flock() on DIR/.gibench-study.lock,
+ * taken before anything (references included) is built and held until the
+ * study exits; the kernel releases it when the process dies, crashed or not.
+ * The file holds the holder's pid and is left in place (unlinking it would
+ * let a third study lock a new file while a second waits on the old one).
+ * The descriptor is close-on-exec, so runs started by the study do not hold
+ * it. Returns the descriptor, or -1 after printing why (*rc set). */
+static int lock_out_dir(const char *out, int *rc)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/.gibench-study.lock", out);
+    int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+    if (fd < 0) {
+        *rc = cli_fail(EXIT_RUN, "study: cannot open the lock %s: %s", path, strerror(errno));
+        return -1;
+    }
+    while (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        if (errno == EINTR)
+            continue;
+        if (errno == EWOULDBLOCK) {
+            char pid[32] = "";
+            ssize_t n = pread(fd, pid, sizeof pid - 1, 0);
+            pid[n > 0 ? n : 0] = '\0';
+            pid[strcspn(pid, "\n")] = '\0';
+            *rc = cli_fail(EXIT_USAGE, "study: %s is in use by another study (pid %s holds %s)", out,
+                           pid[0] ? pid : "unknown", path);
+        } else {
+            *rc = cli_fail(EXIT_RUN, "study: cannot lock %s: %s", path, strerror(errno));
+        }
+        close(fd);
+        return -1;
+    }
+    char pid[32];
+    int len = snprintf(pid, sizeof pid, "%ld\n", (long)getpid());
+    if (ftruncate(fd, 0) != 0 || pwrite(fd, pid, (size_t)len, 0) != len) {
+        *rc = cli_fail(EXIT_RUN, "study: cannot write the lock %s: %s", path, strerror(errno));
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
 int cmd_study(int argc, char **argv)
 {
     const char *file = NULL, *out = NULL;
@@ -1334,6 +1507,9 @@ int cmd_study(int argc, char **argv)
         print_plan(&st);
     if (rc == EXIT_OK && !dry && !cli_mkdirs(out))
         rc = cli_fail(EXIT_RUN, "study: cannot create %s", out);
+    int lock_fd = -1;
+    if (rc == EXIT_OK && !dry)
+        lock_fd = lock_out_dir(out, &rc);
     if (rc == EXIT_OK && !dry && st.timer)
         setenv("GIBENCH_TIMER", st.timer, 1);
     if (rc == EXIT_OK && !dry) {
@@ -1387,13 +1563,9 @@ int cmd_study(int argc, char **argv)
         json_object_put(runs);
         json_object_put(meta);
     }
-    for (uint32_t i = 0; st.runs && i < st.run_count; i++) {
-        json_object_put(st.runs[i].record);
-        for (int k = 0; k < MAX_KEYS; k++)
-            free(st.runs[i].params[k]);
-    }
-    free(st.runs);
-    json_object_put(st.root);
+    study_free(&st);
     gi_plugins_free(reg);
+    if (lock_fd >= 0)
+        close(lock_fd); /* releases the lock */
     return rc;
 }

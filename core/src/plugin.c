@@ -6,9 +6,19 @@
 
 #include <dirent.h>
 #include <dlfcn.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+/* How long a plugin may take to load in the probe (constructors included). */
+#define GI_PROBE_SECONDS 30
 
 /* The size of gi_method in ABI 1.0: everything up to last_error. */
 #define GI_METHOD_SIZE_1_0 (offsetof(gi_method, last_error) + sizeof(void *))
@@ -117,7 +127,8 @@ static int push_error(gi_plugins *reg, const char *text)
     return 1;
 }
 
-gi_result gi_plugins_add(gi_plugins *reg, const char *path, gi_error *err)
+/* dlopen, entry and validation, with the descriptor returned (no registry). */
+static gi_result open_and_check(const char *path, const gi_method **out, gi_error *err)
 {
     /* Never dlclose: see plugin.h. A refused library stays mapped too; it is
      * rare and closing it would run its destructors. */
@@ -140,6 +151,171 @@ gi_result gi_plugins_add(gi_plugins *reg, const char *path, gi_error *err)
     gi_error verr;
     if (gi_method_validate(m, &verr) != GI_OK)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: %s", path, verr.text);
+    *out = m;
+    return GI_OK;
+}
+
+/* Plugins are loaded in a forked child first (dlopen with its
+ * constructors, gi_method_entry, validation), so that a plugin that
+ * crashes, exits or hangs while loading is refused with one line instead of
+ * taking the command down; the parent then maps only the plugins the child
+ * found valid. One child checks a whole batch in order and reports a line
+ * "<index> <code> <message>" per plugin through a pipe; when it dies, the
+ * first plugin it did not report is the culprit, and a new child goes on
+ * with the next. The child leaves with _exit (no atexit handlers, no stdio
+ * flush, no destructors). One child per batch, not per plugin: a fork of
+ * gibench, and the first dlopen in it (copy-on-write faults all over the
+ * loader's data), are the cost, not the plugins after it. */
+typedef struct probe_result {
+    gi_result code; /* GI_OK: load it in the parent */
+    gi_error err;   /* the refusal, "path: reason" */
+} probe_result;
+
+static void probe_child(char *const *paths, size_t from, size_t n, int fd)
+{
+    /* a crash here must end the child, whatever handlers the host set */
+    signal(SIGSEGV, SIG_DFL);
+    signal(SIGBUS, SIG_DFL);
+    signal(SIGILL, SIG_DFL);
+    signal(SIGFPE, SIG_DFL);
+    signal(SIGABRT, SIG_DFL);
+    signal(SIGPIPE, SIG_DFL);
+    for (size_t i = from; i < n; i++) {
+        gi_error cerr = {{0}};
+        const gi_method *m = NULL;
+        gi_result r = open_and_check(paths[i], &m, &cerr);
+        for (char *c = cerr.text; *c; c++)
+            if (*c == '\n' || *c == '\r')
+                *c = ' ';
+        char line[sizeof cerr.text + 48];
+        int len = snprintf(line, sizeof line, "%zu %d %s\n", i, (int)r, r == GI_OK ? "" : cerr.text);
+        if (len < 0 || (size_t)len >= sizeof line) {
+            len = (int)sizeof line - 1;
+            line[len - 1] = '\n';
+        }
+        for (int done = 0; done < len;) {
+            ssize_t w = write(fd, line + done, (size_t)(len - done));
+            if (w < 0 && errno == EINTR)
+                continue;
+            if (w <= 0)
+                _exit(3);
+            done += (int)w;
+        }
+    }
+    _exit(0);
+}
+
+static long elapsed_ms(const struct timespec *since)
+{
+    struct timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    return (now.tv_sec - since->tv_sec) * 1000L + (now.tv_nsec - since->tv_nsec) / 1000000L;
+}
+
+/* Runs one child from `from`; fills out[] for what it reported, and for the
+ * plugin it died on. Returns the index to go on from (n when done). */
+static size_t probe_from(char *const *paths, size_t from, size_t n, probe_result *out)
+{
+    int fds[2];
+    pid_t pid = -1;
+    if (pipe(fds) == 0) {
+        fflush(NULL); /* nothing buffered is written twice */
+        pid = fork();
+        if (pid == 0) {
+            close(fds[0]);
+            probe_child(paths, from, n, fds[1]);
+        }
+        close(fds[1]);
+        if (pid < 0)
+            close(fds[0]);
+    }
+    if (pid < 0) {
+        gi_error_set(&out[from].err, GI_ERR_IO, "%s: cannot probe the plugin: %s", paths[from], strerror(errno));
+        out[from].code = GI_ERR_IO;
+        return from + 1;
+    }
+    size_t next = from; /* the first plugin not reported yet */
+    char buf[2 * sizeof(gi_error) + 64];
+    size_t got = 0;
+    int hung = 0;
+    struct timespec since;
+    clock_gettime(CLOCK_MONOTONIC, &since);
+    for (;;) {
+        long left_ms = GI_PROBE_SECONDS * 1000L - elapsed_ms(&since);
+        if (left_ms <= 0) {
+            hung = 1;
+            break;
+        }
+        struct pollfd pfd = {.fd = fds[0], .events = POLLIN};
+        int pr = poll(&pfd, 1, (int)left_ms);
+        if (pr < 0 && errno == EINTR)
+            continue;
+        if (pr == 0) {
+            hung = 1;
+            break;
+        }
+        if (pr < 0)
+            break;
+        ssize_t r = read(fds[0], buf + got, sizeof buf - 1 - got);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r <= 0)
+            break; /* EOF: the child is gone */
+        got += (size_t)r;
+        buf[got] = '\0';
+        char *nl;
+        while ((nl = memchr(buf, '\n', got)) != NULL) {
+            *nl = '\0';
+            char *rest = NULL;
+            unsigned long long idx = strtoull(buf, &rest, 10);
+            long code = rest && *rest == ' ' ? strtol(rest + 1, &rest, 10) : -1;
+            if (idx == next && idx < n && code >= 0) {
+                out[idx].code = code <= GI_ERR_IO ? (gi_result)code : GI_ERR_INVALID_ARGUMENT;
+                if (out[idx].code != GI_OK)
+                    snprintf(out[idx].err.text, sizeof out[idx].err.text, "%s", *rest == ' ' ? rest + 1 : rest);
+                next++;
+                clock_gettime(CLOCK_MONOTONIC, &since); /* the time limit is per plugin */
+            }
+            size_t used = (size_t)(nl - buf) + 1;
+            memmove(buf, nl + 1, got - used);
+            got -= used;
+        }
+        if (got == sizeof buf - 1)
+            got = 0; /* a line too long to be ours: dropped */
+    }
+    close(fds[0]);
+    if (hung)
+        kill(pid, SIGKILL);
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
+        ;
+    if (next >= n)
+        return n;
+    probe_result *bad = &out[next];
+    bad->code = GI_ERR_UNSUPPORTED;
+    if (hung)
+        gi_error_set(&bad->err, bad->code, "%s: still loading after %d s (killed)", paths[next], GI_PROBE_SECONDS);
+    else if (WIFSIGNALED(status))
+        gi_error_set(&bad->err, bad->code, "%s: crashed while loading (signal %d)", paths[next], WTERMSIG(status));
+    else
+        gi_error_set(&bad->err, bad->code, "%s: exited while loading (status %d)", paths[next],
+                     WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+    return next + 1;
+}
+
+static void probe_all(char *const *paths, size_t n, probe_result *out)
+{
+    for (size_t i = 0; i < n;)
+        i = probe_from(paths, i, n, out);
+}
+
+/* Maps a plugin the probe found valid and registers it. */
+static gi_result add_probed(gi_plugins *reg, const char *path, gi_error *err)
+{
+    const gi_method *m = NULL;
+    gi_result r = open_and_check(path, &m, err);
+    if (r != GI_OK)
+        return r;
     if (!reg)
         return GI_OK;
     for (uint32_t i = 0; i < reg->count; i++)
@@ -156,12 +332,30 @@ gi_result gi_plugins_add(gi_plugins *reg, const char *path, gi_error *err)
     return GI_OK;
 }
 
+gi_result gi_plugins_add(gi_plugins *reg, const char *path, gi_error *err)
+{
+    probe_result pr = {GI_OK, {{0}}};
+    char *paths[1] = {(char *)path};
+    probe_all(paths, 1, &pr);
+    if (pr.code != GI_OK) {
+        gi_error_set(err, pr.code, "%s", pr.err.text);
+        return pr.code;
+    }
+    return add_probed(reg, path, err);
+}
+
 static int cmp_str(const void *a, const void *b)
 {
     return strcmp(*(char *const *)a, *(char *const *)b);
 }
 
-static void scan_dir(gi_plugins *reg, const char *dir)
+typedef struct path_list {
+    char **v;
+    size_t n;
+} path_list;
+
+/* Appends the folder's plugin files to `list`, sorted by name. */
+static void scan_dir(path_list *list, const char *dir)
 {
     DIR *d = opendir(dir);
     if (!d)
@@ -189,11 +383,12 @@ static void scan_dir(gi_plugins *reg, const char *dir)
     for (size_t i = 0; i < n; i++) {
         size_t len = strlen(dir) + strlen(names[i]) + 2;
         char *path = malloc(len);
-        if (path) {
+        char **grown = path ? realloc(list->v, (list->n + 1) * sizeof *list->v) : NULL;
+        if (grown) {
             snprintf(path, len, "%s/%s", dir, names[i]);
-            gi_error err;
-            if (gi_plugins_add(reg, path, &err) != GI_OK)
-                push_error(reg, err.text);
+            list->v = grown;
+            list->v[list->n++] = path;
+        } else {
             free(path);
         }
         free(names[i]);
@@ -206,16 +401,34 @@ gi_plugins *gi_plugins_scan(const char *build_dir)
     gi_plugins *reg = calloc(1, sizeof *reg);
     if (!reg)
         return NULL;
+    path_list list = {NULL, 0};
     if (build_dir)
-        scan_dir(reg, build_dir);
+        scan_dir(&list, build_dir);
     const char *env = getenv("GIBENCH_PLUGIN_PATH");
     if (env) {
         char *copy = dup_str(env), *save = NULL;
         for (char *tok = copy ? strtok_r(copy, ":", &save) : NULL; tok; tok = strtok_r(NULL, ":", &save))
             if (*tok && (!build_dir || strcmp(tok, build_dir) != 0))
-                scan_dir(reg, tok);
+                scan_dir(&list, tok);
         free(copy);
     }
+    /* every plugin is tried in a child first; only those it found valid
+     * are mapped here, in the order found */
+    probe_result *probed = list.n ? calloc(list.n, sizeof *probed) : NULL;
+    if (probed)
+        probe_all(list.v, list.n, probed);
+    for (size_t i = 0; i < list.n; i++) {
+        gi_error err;
+        if (!probed)
+            push_error(reg, "out of memory while probing plugins");
+        else if (probed[i].code != GI_OK)
+            push_error(reg, probed[i].err.text);
+        else if (add_probed(reg, list.v[i], &err) != GI_OK)
+            push_error(reg, err.text);
+        free(list.v[i]);
+    }
+    free(probed);
+    free(list.v);
     return reg;
 }
 

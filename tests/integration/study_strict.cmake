@@ -85,6 +85,16 @@ refuse(range_scale_unknown
 refuse(chart_log_text
        "{${SCENE}, \"methods\": \"all\", \"charts\": [{\"file\": \"a.png\", \"x\": \"run\", \"y\": \"prepare_ms\", \"log_x\": \"yes\"}]}"
        "\"log_x\" and \"log_y\" must be true or false")
+# Two equal keys in one object: json-c keeps the last silently; refused,
+# with the key's JSON path and line, at any depth.
+refuse(duplicate_top "{${SCENE}, \"size\": [8, 8],\n\"methods\": \"all\", \"size\": [16, 16]}"
+       "/size: key given twice \\(line 2\\)")
+refuse(duplicate_params
+       "{${SCENE}, \"methods\": [{\"method\": \"direct\"}, {\"method\": \"direct\", \"params\": {\"light_samples\": 4, \"light_samples\": 8}}]}"
+       "/methods/1/params/light_samples: key given twice \\(line 1\\)")
+refuse(duplicate_reference
+       "{${SCENE}, \"methods\": \"all\", \"reference\": {\"spp\": 4, \"pixel\": \"box\", \"spp\": 64}}"
+       "/reference/spp: key given twice")
 
 # A method may be given every parameter it declares (csm declares 18; the
 # reader used to stop at 16).

@@ -1,7 +1,8 @@
 /* Fake method plugins for the loader tests, one per defect: built several
  * times with one FAKE_* macro defined (tests/CMakeLists.txt). The FAKE_CONF_*
  * kinds render something (a constant per pixel) for the conformance suite's
- * own tests: each breaks one rule the suite must catch. */
+ * own tests: each breaks one rule the suite must catch. FAKE_ENTRY_CRASH and
+ * FAKE_CTOR_CRASH crash while loading (in gi_method_entry, in a constructor). */
 #define _POSIX_C_SOURCE 200809L
 #include "gi/kit.h" /* GI_ABI_LAYOUT */
 
@@ -132,8 +133,18 @@ static const gi_method fake_method = {
     .layout = GI_ABI_LAYOUT,
 };
 
+#if defined(FAKE_CTOR_CRASH) /* crashes as it is mapped, before any symbol is looked up */
+__attribute__((constructor)) static void fake_ctor(void)
+{
+    raise(SIGSEGV);
+}
+#endif
+
 GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)
 {
+#if defined(FAKE_ENTRY_CRASH) /* the loader must survive a plugin that crashes in its entry */
+    raise(SIGSEGV);
+#endif
 #if defined(FAKE_NULL_ENTRY)
     (void)host_abi_version;
     return NULL;

@@ -1,0 +1,27 @@
+# A plugin that crashes while loading (in gi_method_entry or a constructor)
+# is refused with one warning naming it; every command goes on with the
+# other plugins (it used to die with signal 11 and no message).
+# cmake -DGIB=... -DFAKE_PLUGINS=... -DOUT=... -P plugin_crash.cmake
+set(failures 0)
+include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
+foreach(kind entry_crash ctor_crash)
+    set(D ${OUT}/plugin_crash_${kind})
+    file(REMOVE_RECURSE ${D})
+    file(MAKE_DIRECTORY ${D})
+    file(COPY ${FAKE_PLUGINS}/gimethod_fake_${kind}.so ${FAKE_PLUGINS}/gimethod_fake_good.so DESTINATION ${D})
+    set(ENV{GIBENCH_PLUGIN_PATH} "${D}")
+    execute_process(COMMAND ${GIB} methods TIMEOUT 120 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    if(NOT rc EQUAL 0)
+        fail("${kind}: gibench methods exited ${rc}:\n${out}${err}")
+    endif()
+    foreach(id direct fake_good)
+        match("${out}" "${id}" "${kind}: method ${id} not listed:\n${out}")
+    endforeach()
+    match("${err}" "^gibench: warning: plugin refused: ${D}/gimethod_fake_${kind}\\.so: crashed while loading \\(signal 11\\)\n$"
+          "${kind}: not exactly one warning naming the plugin and its signal:\n${err}")
+endforeach()
+unset(ENV{GIBENCH_PLUGIN_PATH})
+if(failures GREATER 0)
+    message(FATAL_ERROR "${failures} plugin crash expectation(s) failed")
+endif()
+message(STATUS "a plugin that crashes while loading is refused with one warning")
