@@ -282,6 +282,29 @@ json_object *cli_timer_json(const gi_timer *t)
     return o;
 }
 
+uint64_t cli_scene_content_hash(const gi_scene *s, const char *path)
+{
+    size_t n = 0;
+    char *bytes = gi_file_read_all(path, &n);
+    uint64_t hash = gi_hash64(bytes ? bytes : "", n, 0x5CE7E);
+    free(bytes);
+    for (uint32_t k = 0; k < s->object_count; k++) {
+        uint64_t oh = gi_scene_object_hash(s, k);
+        hash = gi_hash64(&oh, sizeof oh, hash);
+    }
+    for (uint32_t t = 0; t < s->texture_count; t++) {
+        const gi_texture *tx = &s->textures[t];
+        if (tx->rgba)
+            hash = gi_hash64(tx->rgba, (size_t)tx->width * tx->height * 4 * sizeof(float), hash);
+    }
+    if (s->has_environment && s->environment.path) {
+        bytes = gi_file_read_all(s->environment.path, &n);
+        hash = gi_hash64(bytes ? bytes : "", n, hash);
+        free(bytes);
+    }
+    return hash;
+}
+
 int cli_caps_cover(const gi_method *m, const gi_scene *s, int animated, char *why, size_t size)
 {
     uint32_t c = m->caps;

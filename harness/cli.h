@@ -65,6 +65,11 @@ int cli_write_json(const char *path, json_object *obj, char *why, size_t why_siz
 /* Stage statistics of a timer as a JSON object {stage: {median_ms, ...}}. */
 json_object *cli_timer_json(const gi_timer *t);
 
+/* The scene by its content, not its name: the file's bytes, every object's
+ * geometry (gi_scene_object_hash), every texture's decoded texels and the
+ * environment map's bytes. What run ids and references are keyed on. */
+uint64_t cli_scene_content_hash(const gi_scene *s, const char *path);
+
 /* Do the method's caps cover the scene's lighting and materials (and
  * motion when animated)? 0 with the reason naming everything not covered
  * ("avg does not handle directional lights or environment light"). */

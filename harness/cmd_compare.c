@@ -113,6 +113,7 @@ int cmd_compare(int argc, char **argv)
         return rc;
     gi_error err;
     gi_scene *scene = gi_scene_load(o.scene, &err);
+    uint64_t scene_hash = scene ? cli_scene_content_hash(scene, o.scene) : 0;
     if (!scene)
         return cli_fail(EXIT_USAGE, "%s", err.text);
     if (o.camera && gi_scene_find_camera(scene, o.camera) < 0) {
@@ -218,7 +219,7 @@ int cmd_compare(int argc, char **argv)
     } else {
         snprintf(ref_full, sizeof ref_full, "%s/reference_b%u.exr", o.out, o.ref_bounces);
         fprintf(stderr, "compare: reference (%u spp, %u bounces)\n", o.ref_spp, o.ref_bounces);
-        if (!runner_reference(o.scene, o.camera, o.width, o.height, o.ref_spp, o.ref_target_se, o.ref_bounces, o.seed, o.time, 0,
+        if (!runner_reference(o.scene, scene_hash, o.camera, o.width, o.height, o.ref_spp, o.ref_target_se, o.ref_bounces, o.seed, o.time, 0,
                               o.timeout_s, ref_full, why, sizeof why)) {
             gi_plugins_free(reg);
             gi_scene_free(scene);
@@ -250,7 +251,7 @@ int cmd_compare(int argc, char **argv)
             if (b < o.ref_bounces) {
                 snprintf(matched, sizeof matched, "%s/reference_b%u.exr", o.out, b);
                 fprintf(stderr, "compare: bounce-matched reference (%u spp, %u bounces)\n", o.ref_spp, b);
-                if (runner_reference(o.scene, o.camera, o.width, o.height, o.ref_spp, o.ref_target_se, b, o.seed, o.time, 0, o.timeout_s,
+                if (runner_reference(o.scene, scene_hash, o.camera, o.width, o.height, o.ref_spp, o.ref_target_se, b, o.seed, o.time, 0, o.timeout_s,
                                      matched, why, sizeof why))
                     ref_matched = matched;
                 else

@@ -492,21 +492,8 @@ static int scene_index(study *st, const char *file, const char *jpath, const cha
     if (!s)
         return cli_fail(EXIT_USAGE, "%s: %s: %s", file, jpath, err.text);
     int has_camera = !st->camera || gi_scene_find_camera(s, st->camera) >= 0;
-    /* the scene by its content, not its name: the file, each object's
-     * geometry (its buffers) and the environment map's bytes */
-    size_t n = 0;
-    char *bytes = gi_file_read_all(path, &n);
-    uint64_t hash = gi_hash64(bytes ? bytes : "", n, 0x5CE7E);
-    free(bytes);
-    for (uint32_t k = 0; k < s->object_count; k++) {
-        uint64_t oh = gi_scene_object_hash(s, k);
-        hash = gi_hash64(&oh, sizeof oh, hash);
-    }
-    if (s->has_environment && s->environment.path) {
-        bytes = gi_file_read_all(s->environment.path, &n);
-        hash = gi_hash64(bytes ? bytes : "", n, hash);
-        free(bytes);
-    }
+    /* the scene by its content, not its name */
+    uint64_t hash = cli_scene_content_hash(s, path);
     gi_scene_free(s);
     if (!has_camera)
         return cli_fail(EXIT_USAGE, "%s: /camera: %s has no camera '%s'", file, path, st->camera);
@@ -992,7 +979,7 @@ static int build_references(study *st, const char *out_dir)
                  px);
         fprintf(stderr, "study: reference %s (%ux%u, %u spp, %u bounces)\n", stem, sc->width, sc->height, st->ref_spp,
                 st->ref_bounces);
-        if (!runner_reference(path, st->camera, sc->width, sc->height, st->ref_spp, st->ref_target_se, st->ref_bounces,
+        if (!runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width, sc->height, st->ref_spp, st->ref_target_se, st->ref_bounces,
                               st->seed, sc->time, st->ref_pixel_center, st->timeout_s * 10, sc->ref_full, why,
                               sizeof why))
             return cli_fail(EXIT_RUN, "study: %s", why);
@@ -1008,7 +995,7 @@ static int build_references(study *st, const char *out_dir)
                 snprintf(sc->ref_matched[k], sizeof sc->ref_matched[k], "%s/%s_b%u_%uspp%s.exr", dir, stem, b,
                          st->ref_spp, px);
                 fprintf(stderr, "study: bounce-matched reference %s (%u bounces)\n", stem, b);
-                if (!runner_reference(path, st->camera, sc->width, sc->height, st->ref_spp, st->ref_target_se, b,
+                if (!runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width, sc->height, st->ref_spp, st->ref_target_se, b,
                                       st->seed, sc->time, st->ref_pixel_center, st->timeout_s * 10,
                                       sc->ref_matched[k], why, sizeof why))
                     return cli_fail(EXIT_RUN, "study: %s", why);
@@ -1019,7 +1006,7 @@ static int build_references(study *st, const char *out_dir)
         for (uint32_t c = 0; c < st->conv_n; c++) {
             char img[4096], stats[4200];
             snprintf(img, sizeof img, "%s/%s_conv_%uspp%s.exr", dir, stem, st->conv_spp[c], px);
-            if (!runner_reference(path, st->camera, sc->width, sc->height, st->conv_spp[c], 0.0, st->ref_bounces,
+            if (!runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width, sc->height, st->conv_spp[c], 0.0, st->ref_bounces,
                                   st->seed + 7919, sc->time, st->ref_pixel_center, st->timeout_s, img, why,
                                   sizeof why))
                 return cli_fail(EXIT_RUN, "study: %s", why);

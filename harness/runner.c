@@ -337,9 +337,9 @@ json_object *runner_execute(const run_spec *s, int resume)
     return rec;
 }
 
-int runner_reference(const char *scene, const char *camera, uint32_t width, uint32_t height, uint32_t spp,
-                     double target_se, uint32_t max_bounces, uint32_t seed, float time, int pixel_center,
-                     double timeout_s, const char *out_exr, char *why, size_t why_size)
+int runner_reference(const char *scene, uint64_t scene_hash, const char *camera, uint32_t width, uint32_t height,
+                     uint32_t spp, double target_se, uint32_t max_bounces, uint32_t seed, float time,
+                     int pixel_center, double timeout_s, const char *out_exr, char *why, size_t why_size)
 {
     argv_builder b = {0};
     arg(&b, "%s", cli_self_exe());
@@ -372,6 +372,10 @@ int runner_reference(const char *scene, const char *camera, uint32_t width, uint
     }
     char config[8192], cfg_path[4200], log[4200], stats[4200];
     join(&b, config, sizeof config);
+    /* The scene's content joins the command line in the key: an edited
+     * scene under the same name is rendered again, never reused. */
+    size_t used = strlen(config);
+    snprintf(config + used, sizeof config - used, "\nscene-content %016llx", (unsigned long long)scene_hash);
     snprintf(cfg_path, sizeof cfg_path, "%s.config", out_exr);
     snprintf(log, sizeof log, "%s.log", out_exr);
     snprintf(stats, sizeof stats, "%s.json", out_exr);

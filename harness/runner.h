@@ -38,9 +38,9 @@ json_object *runner_not_applicable(const run_spec *spec, const char *reason);
  * settings exists; stops at `spp` samples or, when target_se > 0, as soon
  * as the relative standard error reaches it; pixel_center: --pixel center.
  * 1 on success, else 0 with why. */
-int runner_reference(const char *scene, const char *camera, uint32_t width, uint32_t height, uint32_t spp,
-                     double target_se, uint32_t max_bounces, uint32_t seed, float time, int pixel_center,
-                     double timeout_s, const char *out_exr, char *why, size_t why_size);
+int runner_reference(const char *scene, uint64_t scene_hash, const char *camera, uint32_t width, uint32_t height,
+                     uint32_t spp, double target_se, uint32_t max_bounces, uint32_t seed, float time,
+                     int pixel_center, double timeout_s, const char *out_exr, char *why, size_t why_size);
 
 /* Fills metrics of `image` against `reference` by `gibench diff --json`;
  * NULL with why on failure. heatmap may be NULL. */
