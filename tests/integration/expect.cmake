@@ -71,3 +71,16 @@ function(run code)
         set(failures ${f} PARENT_SCOPE)
     endif()
 endfunction()
+
+# expect_refusal(<name> <regex> <rc> <stderr>): a command's result must be
+# exit 2 with one stderr line matching regex (study_strict, resource_files).
+function(expect_refusal name regex rc err)
+    string(STRIP "${err}" err)
+    string(REGEX MATCHALL "\n" lines "${err}")
+    list(LENGTH lines extra)
+    if(NOT rc STREQUAL "2" OR extra GREATER 0 OR NOT err MATCHES "${regex}")
+        message(SEND_ERROR "${name}: expected exit 2 and one line matching '${regex}'; got exit ${rc}\n${err}")
+        math(EXPR f "${failures} + 1")
+        set(failures ${f} PARENT_SCOPE)
+    endif()
+endfunction()

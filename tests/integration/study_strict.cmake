@@ -15,14 +15,8 @@ function(refuse name text regex)
     file(WRITE ${D}/${name}.json "${text}")
     execute_process(COMMAND ${GIB} study ${D}/${name}.json --dry-run WORKING_DIRECTORY ${ROOT} TIMEOUT 60
                     RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-    string(STRIP "${err}" err)
-    string(REGEX MATCHALL "\n" lines "${err}")
-    list(LENGTH lines extra)
-    if(NOT rc STREQUAL "2" OR extra GREATER 0 OR NOT err MATCHES "${regex}")
-        message(SEND_ERROR "${name}: expected exit 2 and one line matching '${regex}'; got exit ${rc}\n${err}")
-        math(EXPR f "${failures} + 1")
-        set(failures ${f} PARENT_SCOPE)
-    endif()
+    expect_refusal(${name} "${regex}" "${rc}" "${err}")
+    set(failures ${failures} PARENT_SCOPE)
 endfunction()
 
 # Memory safety: values of the wrong type where the reader used to assume one.
