@@ -427,14 +427,20 @@ void add_series(vtkChartXY *chart, const gi_chart_desc &d, const gi_chart_series
     chart->AddPlot(plot);
     plot->SetInputData(table, 0, 1);
     plot->SetLabel(label_of(s, k));
-    const unsigned char *c = palette[k % palette_size];
-    plot->SetColor(c[0], c[1], c[2], 255);
-    plot->SetWidth(2.0f);
-    if (s.style == GI_CHART_DASHED) {
+    /* colour and marker by position, or by the series' own colour index */
+    uint32_t look = s.color > 0 ? (uint32_t)s.color - 1 : k;
+    const unsigned char *c = palette[look % palette_size];
+    plot->SetColor(c[0], c[1], c[2], s.style == GI_CHART_THIN ? 150 : 255);
+    plot->SetWidth(s.style == GI_CHART_THIN ? 1.0f : 2.0f);
+    if (s.style == GI_CHART_THIN) {
+        plot->SetLegendVisibility(false);
+        plot->SetMarkerStyle(markers[look % marker_count]);
+        plot->SetMarkerSize(4.0f);
+    } else if (s.style == GI_CHART_DASHED) {
         plot->GetPen()->SetLineType(vtkPen::DASH_LINE);
         plot->SetMarkerStyle(vtkPlotPoints::NONE);
     } else {
-        plot->SetMarkerStyle(markers[k % marker_count]);
+        plot->SetMarkerStyle(markers[look % marker_count]);
         plot->SetMarkerSize(s.style == GI_CHART_MARKERS ? 9.0f : 7.0f);
     }
 }
@@ -660,10 +666,13 @@ gi_result validate(const gi_chart_desc &d, const gi_chart_series *series, uint32
     for (uint32_t k = 0; k < n; k++) {
         const gi_chart_series &s = series[k];
         if (s.style != GI_CHART_LINE_MARKERS && s.style != GI_CHART_MARKERS &&
-            s.style != GI_CHART_DASHED)
+            s.style != GI_CHART_DASHED && s.style != GI_CHART_THIN)
             return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
                                 "%s: series %u ('%s'): unknown style %d", what, k + 1,
                                 label_of(s, k).c_str(), s.style);
+        if (s.color < 0)
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: series %u ('%s'): colour index %d < 0",
+                                what, k + 1, label_of(s, k).c_str(), s.color);
         if (s.count > 0 && (!s.x || !s.y))
             return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
                                 "%s: series %u ('%s'): %u points but no x or y array", what, k + 1,
@@ -715,7 +724,7 @@ extern "C" gi_result gi_chart_write_png(const char *path, const gi_chart_desc *d
 extern "C" gi_result gi_chart_available(gi_error *err)
 {
     static const double x[] = {1.0, 10.0}, y[] = {1.0, 0.1};
-    gi_chart_series s = {"probe", x, y, 2, GI_CHART_LINE_MARKERS};
+    gi_chart_series s = {"probe", x, y, 2, GI_CHART_LINE_MARKERS, 0};
     gi_chart_desc d = {"probe", "x", "y", 1, 1, 64, 48};
     try {
         std::lock_guard<std::mutex> lock(chart_mutex);

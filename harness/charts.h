@@ -45,6 +45,8 @@ enum {
     GI_CHART_LINE_MARKERS = 0, /* solid line through the points, a marker at each */
     GI_CHART_MARKERS = 1,      /* markers only */
     GI_CHART_DASHED = 2,       /* dashed line, no markers (reference curves) */
+    GI_CHART_THIN = 3,         /* thin, faint line with small markers and no legend entry
+                                  (the many runs behind a series that carries the legend) */
 };
 
 typedef struct gi_chart_series {
@@ -53,6 +55,8 @@ typedef struct gi_chart_series {
     const double *y;
     uint32_t count;
     int style; /* GI_CHART_* */
+    int color; /* 0: colour and marker by position in the array; k > 0: those of position k - 1
+                  (so that a method's runs and its front share a look) */
 } gi_chart_series;
 
 /* Zero means default in every field. */

@@ -5,13 +5,17 @@
 #include "gi/image.h"
 #include "gi/log.h"
 #include "gi/passes.h"
+#include "metrics.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #define MAX_PARAMS 64
 #define MAX_OUTS 4
+#define MAX_CURVE_REFS 4
+#define MAX_CURVE_POINTS 64
 
 typedef struct render_opts {
     const char *scene, *method, *camera, *timings;
@@ -22,6 +26,10 @@ typedef struct render_opts {
     uint32_t width, height, frames, warmup, seed;
     float time, animate_fps, exposure;
     int no_cache; /* --no-cache: precompute afresh and keep nothing (timing studies) */
+    /* --curve-ref NAME=PATH: the image's error against PATH after frames
+     * 1, 2, 4, 8, ... (every frame up to 16), in the timings as "curve" */
+    const char *curve_name[MAX_CURVE_REFS], *curve_path[MAX_CURVE_REFS];
+    int curve_ref_count;
 } render_opts;
 
 static int parse_opts(int argc, char **argv, render_opts *o)
@@ -41,7 +49,7 @@ static int parse_opts(int argc, char **argv, render_opts *o)
         if (!strcmp(a, "--scene") || !strcmp(a, "--method") || !strcmp(a, "--camera") || !strcmp(a, "--out") ||
             !strcmp(a, "--size") || !strcmp(a, "--param") || !strcmp(a, "--frames") || !strcmp(a, "--warmup") ||
             !strcmp(a, "--time") || !strcmp(a, "--animate") || !strcmp(a, "--seed") || !strcmp(a, "--exposure") ||
-            !strcmp(a, "--timings")) {
+            !strcmp(a, "--timings") || !strcmp(a, "--curve-ref")) {
             if (!v)
                 return cli_fail(EXIT_USAGE, "render: %s needs a value", a);
             i++;
@@ -56,7 +64,15 @@ static int parse_opts(int argc, char **argv, render_opts *o)
             o->camera = v;
         else if (!strcmp(a, "--timings"))
             o->timings = v;
-        else if (!strcmp(a, "--out")) {
+        else if (!strcmp(a, "--curve-ref")) {
+            const char *eq = strchr(v, '=');
+            if (!eq || eq == v || !eq[1] || eq - v > 31)
+                return cli_fail(EXIT_USAGE, "render: --curve-ref '%s' is not NAME=IMAGE (a name of 1..31 characters)", v);
+            if (o->curve_ref_count == MAX_CURVE_REFS)
+                return cli_fail(EXIT_USAGE, "render: at most %d --curve-ref", MAX_CURVE_REFS);
+            o->curve_name[o->curve_ref_count] = v;
+            o->curve_path[o->curve_ref_count++] = eq + 1;
+        } else if (!strcmp(a, "--out")) {
             if (cli_add_out("render", o->outs, &o->out_count, MAX_OUTS, v))
                 return EXIT_USAGE;
         } else if (!strcmp(a, "--size")) {
@@ -123,6 +139,10 @@ typedef struct run_state {
     gi_timer *prep_timer, *render_timer;
     GLuint target_tex, target_fbo;
     gi_image *image;
+    gi_image *curve_ref[MAX_CURVE_REFS];
+    uint32_t curve_frame[MAX_CURVE_POINTS]; /* 1-based frame after which the error was taken */
+    gi_metrics curve_m[MAX_CURVE_POINTS][MAX_CURVE_REFS];
+    uint32_t curve_n;
 } run_state;
 
 static void cleanup(run_state *r)
@@ -141,6 +161,8 @@ static void cleanup(run_state *r)
     gi_params_free(r->params);
     gi_plugins_free(r->reg);
     gi_image_free(r->image);
+    for (int i = 0; i < MAX_CURVE_REFS; i++)
+        gi_image_free(r->curve_ref[i]);
     if (r->host_ready)
         cli_host_free(&r->host);
     free(r->cache_dir);
@@ -153,6 +175,78 @@ static int method_fail(run_state *r, const char *what, gi_result res)
     return cli_fail(res == GI_ERR_INVALID_ARGUMENT || res == GI_ERR_UNSUPPORTED ? EXIT_USAGE : EXIT_RUN,
                     "%s: %s failed (%s)%s%s", r->m->id, what, gi_result_name(res), msg && *msg ? ": " : "",
                     msg ? msg : "");
+}
+
+/* Whether the error is recorded after 1-based frame k of n: every frame of
+ * short runs, else 1, 2, 4, 8, ... and the last. */
+static int curve_frame_wanted(uint32_t k, uint32_t n)
+{
+    return n <= 16 || (k & (k - 1)) == 0 || k == n;
+}
+
+/* The convergence curve: per recorded frame, the time to that image (the
+ * sum of the frame times so far; a warm-up frame, whose time is not kept,
+ * is charged the median of the timed frames) and the error against each
+ * --curve-ref. */
+static json_object *curve_json(const run_state *r, const render_opts *o)
+{
+    uint32_t n_ms = 0;
+    const double *ms = gi_timer_samples(r->render_timer, "frame", &n_ms);
+    gi_stage_stats st[GI_TIMER_MAX_STAGES + 1];
+    uint32_t ns = gi_timer_stats(r->render_timer, st, GI_TIMER_MAX_STAGES + 1);
+    double median = NAN;
+    for (uint32_t i = 0; i < ns; i++)
+        if (!strcmp(st[i].name, "frame"))
+            median = st[i].median_ms;
+    json_object *arr = json_object_new_array();
+    double total = 0;
+    uint32_t next = 0;
+    for (uint32_t k = 1; k <= o->frames && next < r->curve_n; k++) {
+        uint32_t timed = k > o->warmup ? k - o->warmup - 1 : UINT32_MAX;
+        total += timed < n_ms && ms ? ms[timed] : median;
+        if (r->curve_frame[next] != k)
+            continue;
+        json_object *p = json_object_new_object();
+        json_object_object_add(p, "frame", json_object_new_int((int32_t)k));
+        json_object_object_add(p, "time_ms", json_object_new_double(total));
+        for (int c = 0; c < o->curve_ref_count; c++) {
+            const gi_metrics *m = &r->curve_m[next][c];
+            json_object *mj = json_object_new_object();
+            json_object_object_add(mj, "relmse", json_object_new_double(m->relmse));
+            json_object_object_add(mj, "rmse", json_object_new_double(m->rmse));
+            json_object_object_add(mj, "mae", json_object_new_double(m->mae));
+            json_object_object_add(mj, "mean_lum_diff_pct", json_object_new_double(m->mean_lum_diff_pct));
+            char name[32];
+            snprintf(name, sizeof name, "%.*s", (int)(strchr(o->curve_name[c], '=') - o->curve_name[c]),
+                     o->curve_name[c]);
+            json_object_object_add(p, name, mj);
+        }
+        json_object_array_add(arr, p);
+        next++;
+    }
+    return arr;
+}
+
+/* Reads the image back after 1-based frame k and records its error
+ * against every --curve-ref (outside the timed frame). */
+static int record_curve_point(run_state *r, const render_opts *o, uint32_t k)
+{
+    if (o->curve_ref_count == 0 || !curve_frame_wanted(k, o->frames) || r->curve_n == MAX_CURVE_POINTS)
+        return EXIT_OK;
+    gi_image *img = gi_gpu_read_texture(r->target_tex, o->width, o->height);
+    if (!img)
+        return cli_fail(EXIT_RUN, "out of memory reading the image back");
+    gi_metrics_opts mo = {o->exposure, 0, 1};
+    for (int c = 0; c < o->curve_ref_count; c++) {
+        gi_error err;
+        if (gi_metrics_compute(img, r->curve_ref[c], &mo, &r->curve_m[r->curve_n][c], &err) != GI_OK) {
+            gi_image_free(img);
+            return cli_fail(EXIT_RUN, "render: error against %s: %s", o->curve_path[c], err.text);
+        }
+    }
+    gi_image_free(img);
+    r->curve_frame[r->curve_n++] = k;
+    return EXIT_OK;
 }
 
 static json_object *timings_json(const run_state *r, const render_opts *o)
@@ -187,6 +281,8 @@ static json_object *timings_json(const run_state *r, const render_opts *o)
         json_object_array_add(mj, json_object_new_double(mean[c]));
     json_object_object_add(j, "mean_rgb", mj);
     json_object_object_add(j, "nonfinite_pixels", json_object_new_int64((int64_t)gi_image_count_nonfinite(r->image)));
+    if (o->curve_ref_count)
+        json_object_object_add(j, "curve", curve_json(r, o));
     return j;
 }
 
@@ -217,6 +313,15 @@ static int run(run_state *r, const render_opts *o)
     if (!cli_caps_cover(r->m, r->scene, o->animate_fps > 0, why, sizeof why))
         gi_log(GI_LOG_WARN, "render: %s in %s: the image leaves that out (a study marks this cell n/a)", why,
                o->scene);
+    /* references of the convergence curve: read before anything is timed */
+    for (int c = 0; c < o->curve_ref_count; c++) {
+        r->curve_ref[c] = gi_image_read(o->curve_path[c], &err);
+        if (!r->curve_ref[c])
+            return cli_fail(EXIT_USAGE, "render: --curve-ref: %s", err.text);
+        if (r->curve_ref[c]->width != o->width || r->curve_ref[c]->height != o->height)
+            return cli_fail(EXIT_USAGE, "render: --curve-ref %s is %ux%u, the render %ux%u", o->curve_path[c],
+                            r->curve_ref[c]->width, r->curve_ref[c]->height, o->width, o->height);
+    }
     int camera = 0;
     if (o->camera) {
         camera = gi_scene_find_camera(r->scene, o->camera);
@@ -293,6 +398,9 @@ static int run(run_state *r, const render_opts *o)
             return method_fail(r, "render", res);
         if (gi_gl_check("after render", &err) != GI_OK)
             return cli_fail(EXIT_RUN, "%s: %s", r->m->id, err.text);
+        int rc = record_curve_point(r, o, f + 1);
+        if (rc != EXIT_OK)
+            return rc;
     }
     r->image = gi_gpu_read_texture(r->target_tex, o->width, o->height);
     if (!r->image)

@@ -10,6 +10,7 @@
 #include "gi/cache.h"
 #include "report.h"
 #include "runner.h"
+#include "tradeoff.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -48,6 +49,7 @@ typedef struct study_run {
     int scene_index;
     int ref_index; /* -1: not compared */
     uint32_t bounces; /* the method's max_bounces + 1 */
+    uint64_t setting; /* every input but the seed: runs of one setting are repeats */
     json_object *record;
 } study_run;
 
@@ -67,9 +69,8 @@ typedef struct study_ref {
     char ref_matched[8][4096];
     uint32_t matched_bounces[8];
     uint32_t matched_count;
-    /* convergence curve of the path tracer: time (s) and relMSE */
-    double curve_t[32], curve_e[32];
-    uint32_t curve_n;
+    /* the path tracer's convergence: full GI, and for each matched bounce count */
+    tradeoff_pt_curve pt_full, pt_matched[8];
 } study_ref;
 
 typedef struct study {
@@ -652,6 +653,14 @@ static int add_run(study *st, const char *file, const char *out_dir, const gi_me
             snprintf(key + used, sizeof key - used, "|%s", combo[p]);
         }
         uint64_t h = gi_hash64(key, strlen(key), 0);
+        /* the same key with the repeat's seed left out */
+        char *seed_at = strstr(key, "|seed=");
+        if (seed_at) {
+            char *end = strchr(seed_at + 1, '|');
+            if (end)
+                memmove(seed_at, end, strlen(end) + 1);
+        }
+        r->setting = gi_hash64(key, strlen(key), 0);
         snprintf(r->id, sizeof r->id, "%s-%s-%08x", st->scenes[si].stem, m->id, (unsigned)(h & 0xFFFFFFFFu));
         snprintf(r->rel, sizeof r->rel, "runs/%s", r->id);
         snprintf(r->dir, sizeof r->dir, "%s/%s", out_dir, r->rel);
@@ -927,29 +936,6 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
     return EXIT_OK;
 }
 
-/* Log-log interpolation of the path tracer's time at error e; extrapolates
- * with slope -1 (relMSE ~ 1/time for an unbiased estimator). *extrapolated
- * is set when e lies outside the curve. */
-static double pt_time_at(const study_ref *sc, double e, int *extrapolated)
-{
-    *extrapolated = 0;
-    if (sc->curve_n == 0 || !(e > 0))
-        return NAN;
-    /* curve sorted by time, error decreasing */
-    for (uint32_t i = 0; i + 1 < sc->curve_n; i++) {
-        double e0 = sc->curve_e[i], e1 = sc->curve_e[i + 1];
-        if ((e <= e0 && e >= e1) || (e >= e0 && e <= e1)) {
-            double t = (log(e) - log(e0)) / (log(e1) - log(e0));
-            if (!isfinite(t))
-                t = 0;
-            return exp(log(sc->curve_t[i]) + t * (log(sc->curve_t[i + 1]) - log(sc->curve_t[i])));
-        }
-    }
-    *extrapolated = 1;
-    uint32_t k = e > sc->curve_e[0] ? 0 : sc->curve_n - 1;
-    return sc->curve_t[k] * sc->curve_e[k] / e;
-}
-
 static double rec_num(json_object *o, const char *k1, const char *k2, const char *k3)
 {
     const char *keys[3] = {k1, k2, k3};
@@ -960,6 +946,41 @@ static double rec_num(json_object *o, const char *k1, const char *k2, const char
         o = v;
     }
     return json_object_get_double(o);
+}
+
+/* The path tracer's convergence curve at one bounce limit: an image of
+ * each convergence_spp count (another seed) against `reference`. The
+ * full-GI images keep their old names (references made before per-bounce
+ * curves are reused). */
+static int pt_convergence(study *st, const char *out_dir, const study_ref *sc, const char *scene, uint32_t bounces,
+                          const char *reference, tradeoff_pt_curve *curve, char *why, size_t why_size)
+{
+    const char *px = st->ref_pixel_center ? "_center" : "";
+    curve->n = 0;
+    for (uint32_t c = 0; c < st->conv_n; c++) {
+        char img[4096], stats[4200], b[32] = "";
+        if (bounces != st->ref_bounces)
+            snprintf(b, sizeof b, "b%u_", bounces);
+        char stem[320];
+        snprintf(stem, sizeof stem, "%s", sc->name);
+        snprintf(img, sizeof img, "%s/references/%s_conv_%s%uspp%s.exr", out_dir, stem, b, st->conv_spp[c], px);
+        if (!runner_reference(scene, st->scenes[sc->scene_index].hash, st->camera, sc->width, sc->height,
+                              st->conv_spp[c], 0.0, bounces, st->seed + 7919, sc->time, st->ref_pixel_center,
+                              st->timeout_s, img, why, why_size))
+            return 0;
+        snprintf(stats, sizeof stats, "%s.json", img);
+        json_object *sj = cli_read_json(stats);
+        json_object *m = runner_diff(img, reference, NULL, st->exposure, why, why_size);
+        double t = rec_num(sj, "wall_seconds", NULL, NULL), e = rec_num(m, "relmse", NULL, NULL);
+        if (isfinite(t) && isfinite(e) && t > 0 && e > 0 && curve->n < TRADEOFF_PT_POINTS) {
+            curve->t[curve->n] = t;
+            curve->e[curve->n] = e;
+            curve->n++;
+        }
+        json_object_put(sj);
+        json_object_put(m);
+    }
+    return 1;
 }
 
 static int build_references(study *st, const char *out_dir)
@@ -1002,25 +1023,17 @@ static int build_references(study *st, const char *out_dir)
                 sc->matched_count++;
             }
         }
-        /* the path tracer's convergence: k-spp images (another seed) against the reference */
-        for (uint32_t c = 0; c < st->conv_n; c++) {
-            char img[4096], stats[4200];
-            snprintf(img, sizeof img, "%s/%s_conv_%uspp%s.exr", dir, stem, st->conv_spp[c], px);
-            if (!runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width, sc->height, st->conv_spp[c], 0.0, st->ref_bounces,
-                                  st->seed + 7919, sc->time, st->ref_pixel_center, st->timeout_s, img, why,
-                                  sizeof why))
+        /* the path tracer's convergence, for full GI and for each bounce
+         * count in use: k-spp images (another seed) against the reference
+         * of the same bounce count */
+        sc->pt_full.bounces = st->ref_bounces;
+        if (!pt_convergence(st, out_dir, sc, path, st->ref_bounces, sc->ref_full, &sc->pt_full, why, sizeof why))
+            return cli_fail(EXIT_RUN, "study: %s", why);
+        for (uint32_t k = 0; k < sc->matched_count; k++) {
+            sc->pt_matched[k].bounces = sc->matched_bounces[k];
+            if (!pt_convergence(st, out_dir, sc, path, sc->matched_bounces[k], sc->ref_matched[k], &sc->pt_matched[k], why,
+                                sizeof why))
                 return cli_fail(EXIT_RUN, "study: %s", why);
-            snprintf(stats, sizeof stats, "%s.json", img);
-            json_object *sj = cli_read_json(stats);
-            json_object *m = runner_diff(img, sc->ref_full, NULL, st->exposure, why, sizeof why);
-            double t = rec_num(sj, "wall_seconds", NULL, NULL), e = rec_num(m, "relmse", NULL, NULL);
-            if (isfinite(t) && isfinite(e) && t > 0 && e > 0 && sc->curve_n < 32) {
-                sc->curve_t[sc->curve_n] = t;
-                sc->curve_e[sc->curve_n] = e;
-                sc->curve_n++;
-            }
-            json_object_put(sj);
-            json_object_put(m);
         }
     }
     return EXIT_OK;
@@ -1103,99 +1116,24 @@ static void execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg)
         st->runs[i].record = run_or_skip(&st->runs[i], reg, 1);
 }
 
-/* Error-against-time charts per reference set and the equal-error speed-up column. */
-static void charts_and_speedups(study *st, const char *out_dir, json_object *meta, json_object *chart_list,
-                                json_object *runs)
+/* Per reference set: the error-against-time charts with every run's
+ * convergence curve, the Pareto fronts and the path tracer's curves, and
+ * the equal-error and equal-time tables (tradeoff.h). */
+static void charts_and_speedups(study *st, const char *out_dir, json_object *meta, json_object *chart_list)
 {
-    char md[8192] = "";
-    for (uint32_t ri = 0; ri < st->ref_count; ri++) {
+    tradeoff_text md = {0};
+    tradeoff_run *tr = calloc(st->run_count + 1, sizeof *tr);
+    for (uint32_t ri = 0; ri < st->ref_count && tr; ri++) {
         study_ref *sc = &st->refs[ri];
-        /* group runs by method */
-        const char *methods[32];
-        uint32_t nm = 0;
-        for (uint32_t i = 0; i < st->run_count; i++) {
-            if (st->runs[i].ref_index != (int)ri)
-                continue;
-            int seen = 0;
-            for (uint32_t k = 0; k < nm; k++)
-                seen |= !strcmp(methods[k], st->runs[i].spec.method);
-            if (!seen && nm < 32)
-                methods[nm++] = st->runs[i].spec.method;
-        }
-        gi_chart_series series[33];
-        double *xs = calloc((size_t)(nm + 1) * MAX_RUNS, sizeof *xs), *ys = calloc((size_t)(nm + 1) * MAX_RUNS, sizeof *ys);
-        uint32_t ns = 0;
-        for (uint32_t k = 0; k < nm && xs && ys; k++) {
-            double *x = xs + (size_t)ns * MAX_RUNS, *y = ys + (size_t)ns * MAX_RUNS;
-            uint32_t c = 0;
-            for (uint32_t i = 0; i < st->run_count; i++) {
-                study_run *r = &st->runs[i];
-                if (r->ref_index != (int)ri || strcmp(r->spec.method, methods[k]))
-                    continue;
-                double fm = rec_num(r->record, "frame_ms", "median", NULL);
-                double e = rec_num(r->record, "metrics", "full", "relmse");
-                if (!(fm > 0) || !(e > 0))
-                    continue;
-                double t = fm * r->spec.frames / 1000.0;
-                x[c] = t;
-                y[c] = e;
-                c++;
-                int extrapolated;
-                double tpt = pt_time_at(sc, e, &extrapolated);
-                if (isfinite(tpt)) {
-                    json_object_object_add(r->record, "pt_time_at_equal_error_s", json_object_new_double(tpt));
-                    json_object_object_add(r->record, "speedup_vs_pt", json_object_new_double(tpt / t));
-                    json_object_object_add(r->record, "speedup_extrapolated", json_object_new_boolean(extrapolated));
-                }
-            }
-            series[ns] = (gi_chart_series){methods[k], x, y, c, 0};
-            ns++;
-        }
-        if (sc->curve_n)
-            series[ns++] = (gi_chart_series){"path tracer (Embree, CPU)", sc->curve_t, sc->curve_e, sc->curve_n, 2};
-        char name[512], path[4700], title[512];
-        snprintf(name, sizeof name, "chart_%s_error_vs_time.png", sc->name);
-        snprintf(path, sizeof path, "%s/%s", out_dir, name);
-        snprintf(title, sizeof title, "%s: relMSE against time (full-GI reference)", sc->name);
-        gi_chart_desc desc = {title, "time to image (s): frames x median frame time", "relMSE", 1, 1, 0, 0};
-        gi_error err;
-        if (gi_chart_write_png(path, &desc, series, ns, &err) == GI_OK)
-            json_object_array_add(chart_list, json_object_new_string(name));
-        else
-            fprintf(stderr, "gibench: warning: chart %s not written: %s\n", name, err.text);
-        free(xs);
-        free(ys);
-        size_t used = strlen(md);
-        snprintf(md + used, sizeof md - used,
-                 "Path tracer convergence on %s (relMSE against the %u-spp reference, another seed):", sc->name,
-                 st->ref_spp);
-        for (uint32_t c = 0; c < sc->curve_n; c++) {
-            used = strlen(md);
-            snprintf(md + used, sizeof md - used, " %.3g s → %.3g;", sc->curve_t[c], sc->curve_e[c]);
-        }
-        used = strlen(md);
-        snprintf(md + used, sizeof md - used, "\n\n");
+        uint32_t n = 0;
+        for (uint32_t i = 0; i < st->run_count; i++)
+            if (st->runs[i].ref_index == (int)ri && st->runs[i].record)
+                tr[n++] = (tradeoff_run){st->runs[i].record, st->runs[i].bounces, st->runs[i].setting};
+        tradeoff_report(out_dir, sc->name, &sc->pt_full, sc->pt_matched, sc->matched_count, tr, n, chart_list, &md);
     }
-    size_t used = strlen(md);
-    snprintf(md + used, sizeof md - used,
-             "| run | method | params | time to image (s) | relMSE full | path tracer time at equal error (s) | "
-             "speed-up |\n|---|---|---|---:|---:|---:|---:|\n");
-    for (size_t i = 0; i < json_object_array_length(runs); i++) {
-        json_object *o = json_object_array_get_idx(runs, i), *v;
-        double sp = rec_num(o, "speedup_vs_pt", NULL, NULL);
-        if (!isfinite(sp))
-            continue;
-        int ex = json_object_object_get_ex(o, "speedup_extrapolated", &v) && json_object_get_boolean(v);
-        used = strlen(md);
-        snprintf(md + used, sizeof md - used, "| %s | %s | `%s` | %.4g | %.4g | %.4g | %.3g%s |\n",
-                 json_object_get_string(json_object_object_get(o, "run")),
-                 json_object_get_string(json_object_object_get(o, "method")),
-                 json_object_get_string(json_object_object_get(o, "params")),
-                 rec_num(o, "frame_ms", "median", NULL) * rec_num(o, "frames", NULL, NULL) / 1000.0,
-                 rec_num(o, "metrics", "full", "relmse"), rec_num(o, "pt_time_at_equal_error_s", NULL, NULL), sp,
-                 ex ? " (extrapolated)" : "");
-    }
-    json_object_object_add(meta, "markdown", json_object_new_string(md));
+    free(tr);
+    json_object_object_add(meta, "markdown", json_object_new_string(md.s ? md.s : ""));
+    free(md.s);
 }
 
 /* A field of a run record by name: a top-level key ("label", "run",
@@ -1344,7 +1282,7 @@ static void user_charts(study *st, const char *out_dir, json_object *runs, json_
                 xy[k][0][j] = pts[k][2 * j];
                 xy[k][1][j] = pts[k][2 * j + 1];
             }
-            series[k] = (gi_chart_series){labels[k], xy[k][0], xy[k][1], xy[k][0] && xy[k][1] ? counts[k] : 0, 0};
+            series[k] = (gi_chart_series){labels[k], xy[k][0], xy[k][1], xy[k][0] && xy[k][1] ? counts[k] : 0, 0, 0};
         }
         const char *title = json_object_object_get_ex(c, "title", &v) ? json_object_get_string(v) : file;
         const char *xl = json_object_object_get_ex(c, "x_label", &v) ? json_object_get_string(v) : xf;
@@ -1535,14 +1473,14 @@ int cmd_study(int argc, char **argv)
             json_object_object_add(meta, "reference_png", json_object_new_string(ref_png));
         }
         json_object *chart_list = json_object_new_array();
-        charts_and_speedups(&st, out, meta, chart_list, runs);
+        charts_and_speedups(&st, out, meta, chart_list);
         user_charts(&st, out, runs, chart_list);
         json_object_object_add(meta, "charts", chart_list);
         char why[1024];
         if (!report_write(out, runs, meta, why, sizeof why))
             rc = cli_fail(EXIT_RUN, "study: %s", why);
         else
-            fprintf(stderr, "study: wrote %s/report.md, index.html, runs.csv, frames.csv (%d failed runs)\n", out,
+            fprintf(stderr, "study: wrote %s/report.md, index.html, runs.csv, frames.csv, curves.csv (%d failed runs)\n", out,
                     failed);
         if (rc == EXIT_OK && cli_interrupted)
             rc = cli_fail(EXIT_RUN, "study: interrupted (%d runs to redo); rerun the same command to resume",

@@ -269,6 +269,31 @@ static void write_frames_csv(text *t, json_object *runs)
     }
 }
 
+/* curves.csv: every run's convergence curve (render --curve-ref): the
+ * time to the image after each recorded frame and its error. */
+static void write_curves_csv(text *t, json_object *runs)
+{
+    put(t, "run,method,params,label,seed,frame,time_s,relmse_full,relmse_matched\n");
+    size_t count = json_object_array_length(runs);
+    for (size_t i = 0; i < count; i++) {
+        json_object *o = json_object_array_get_idx(runs, i), *c;
+        if (!json_object_object_get_ex(o, "curve", &c) || !json_object_is_type(c, json_type_array))
+            continue;
+        for (size_t k = 0; k < json_object_array_length(c); k++) {
+            json_object *p = json_object_array_get_idx(c, k);
+            csv_field(t, str(o, "run"), 0);
+            csv_field(t, str(o, "method"), 0);
+            csv_field(t, str(o, "params"), 0);
+            csv_field(t, str(o, "label"), 0);
+            csv_num(t, num(o, "seed", NULL, NULL), 0);
+            csv_num(t, num(p, "frame", NULL, NULL), 0);
+            csv_num(t, num(p, "time_ms", NULL, NULL) / 1000.0, 0);
+            csv_num(t, num(p, "full", "relmse", NULL), 0);
+            csv_num(t, num(p, "matched", "relmse", NULL), 1);
+        }
+    }
+}
+
 static void md_num(text *t, double v)
 {
     if (v == v)
@@ -453,6 +478,9 @@ int report_write(const char *dir, json_object *runs, json_object *meta, char *wh
         return 0;
     write_frames_csv(&t, runs);
     if (!write_text(dir, "frames.csv", &t, why, why_size))
+        return 0;
+    write_curves_csv(&t, runs);
+    if (!write_text(dir, "curves.csv", &t, why, why_size))
         return 0;
     write_md(&t, runs, meta);
     if (!write_text(dir, "report.md", &t, why, why_size))

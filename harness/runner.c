@@ -82,6 +82,7 @@ static json_object *base_record(const run_spec *s)
     json_object_object_add(o, "method", json_object_new_string(s->method));
     json_object_object_add(o, "params", json_object_new_string(params));
     json_object_object_add(o, "frames", json_object_new_int((int32_t)s->frames));
+    json_object_object_add(o, "seed", json_object_new_int64(s->seed));
     json_object_object_add(o, "width", json_object_new_int((int32_t)s->width));
     json_object_object_add(o, "height", json_object_new_int((int32_t)s->height));
     if (s->label)
@@ -149,6 +150,8 @@ static void take_timings(json_object *rec, json_object *t)
         json_object_object_add(rec, "params_full", json_object_get(v));
     if (json_object_object_get_ex(t, "stats", &v))
         json_object_object_add(rec, "stats", json_object_get(v));
+    if (json_object_object_get_ex(t, "curve", &v))
+        json_object_object_add(rec, "curve", json_object_get(v));
     if (json_object_object_get_ex(t, "prepare", &prepare)) {
         /* the whole of prepare, and its stages (precomputation timings) */
         json_object *pst = json_object_new_object();
@@ -250,8 +253,20 @@ json_object *runner_execute(const run_spec *s, int resume)
     /* The references are part of what the result depends on. */
     size_t used = strlen(config);
     const char *timer = getenv("GIBENCH_TIMER"); /* the timer mode changes every timing */
-    snprintf(config + used, sizeof config - used, " | full=%s | matched=%s%s%s", s->ref_full ? s->ref_full : "-",
+    /* "curve": results made before render recorded convergence curves are not reused */
+    snprintf(config + used, sizeof config - used, " | full=%s | matched=%s | curve%s%s", s->ref_full ? s->ref_full : "-",
              s->ref_matched ? s->ref_matched : "-", timer ? " | timer=" : "", timer ? timer : "");
+    /* the convergence curve against the same references (they are in the
+     * config already) */
+    const char *crefs[2] = {s->ref_full, s->ref_matched};
+    const char *cnames[2] = {"full", "matched"};
+    for (int k = 0; k < 2; k++)
+        if (crefs[k]) {
+            arg(&b, "%s", "--curve-ref");
+            char kv[4200];
+            snprintf(kv, sizeof kv, "%s=%s", cnames[k], crefs[k]);
+            arg(&b, "%s", kv);
+        }
     arg(&b, "%s", "--out");
     arg(&b, "%s", exr);
     arg(&b, "%s", "--out");

@@ -137,9 +137,9 @@ static void test_log_log_chart(void)
         e_pt[i] = 2.0 * pow(t[i], -0.5); /* Monte Carlo: 1/sqrt(time) */
     }
     gi_chart_series s[3] = {
-        {"method A (unbiased)", t, e_a, N, GI_CHART_LINE_MARKERS},
-        {"method B (biased)", t, e_b, N, GI_CHART_MARKERS},
-        {"path tracer", t_pt, e_pt, N, GI_CHART_DASHED},
+        {"method A (unbiased)", t, e_a, N, GI_CHART_LINE_MARKERS, 0},
+        {"method B (biased)", t, e_b, N, GI_CHART_MARKERS, 0},
+        {"path tracer", t_pt, e_pt, N, GI_CHART_DASHED, 0},
     };
     gi_chart_desc d = {"Cornell box: RMSE against time", "time [ms]", "RMSE", 1, 1, 1000, 640};
     char path[600];
@@ -222,7 +222,7 @@ static void test_points_kept(void)
 {
     double x[] = {1, 0, -1, NAN, 2, INFINITY, 3};
     double y[] = {1, 1, 1, 1, -2, 1, 0.5};
-    gi_chart_series s = {"s", x, y, 7, GI_CHART_LINE_MARKERS};
+    gi_chart_series s = {"s", x, y, 7, GI_CHART_LINE_MARKERS, 0};
     gi_chart_desc lin = {0}, logx = {0}, loglog = {0};
     logx.log_x = 1;
     loglog.log_x = loglog.log_y = 1;
@@ -230,11 +230,11 @@ static void test_points_kept(void)
     CHECK(gi_chart_points_kept(NULL, &s) == 5);
     CHECK(gi_chart_points_kept(&logx, &s) == 3);   /* also x = 0, x = -1 */
     CHECK(gi_chart_points_kept(&loglog, &s) == 2); /* also y = -2 */
-    gi_chart_series empty = {"e", NULL, NULL, 0, GI_CHART_DASHED};
+    gi_chart_series empty = {"e", NULL, NULL, 0, GI_CHART_DASHED, 0};
     CHECK(gi_chart_points_kept(&loglog, &empty) == 0);
 
     /* Such a series still draws (with a warning), as do empty ones. */
-    gi_chart_series both[3] = {s, empty, {NULL, x, y, 1, GI_CHART_MARKERS}};
+    gi_chart_series both[3] = {s, empty, {NULL, x, y, 1, GI_CHART_MARKERS, 0}};
     char path[600];
     snprintf(path, sizeof path, "%s/dropped.png", dir);
     gi_error err = {{0}};
@@ -272,13 +272,13 @@ static void test_ranges(void)
     } cases[] = {
         {"wide.png",
          {"seven decades", "samples per pixel", "relMSE", 1, 1, 700, 500},
-         {"1/spp", x, y, N, GI_CHART_LINE_MARKERS}},
+         {"1/spp", x, y, N, GI_CHART_LINE_MARKERS, 0}},
         {"single.png",
          {"one point", "x", "y", 1, 1, 400, 300},
-         {"only", &one_x, &one_y, 1, GI_CHART_LINE_MARKERS}},
+         {"only", &one_x, &one_y, 1, GI_CHART_LINE_MARKERS, 0}},
         {"linear.png",
          {"linear axes", "frame", "signed error", 0, 0, 600, 400},
-         {"parabola", lx, ly, N, GI_CHART_LINE_MARKERS}},
+         {"parabola", lx, ly, N, GI_CHART_LINE_MARKERS, 0}},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         char path[600];
@@ -302,10 +302,46 @@ static void test_ranges(void)
     }
 }
 
+/* A series' own colour index: colour and marker of that position, so that
+ * a method's runs (thin, no legend entry) and its front share a look. */
+static void test_colour_index(void)
+{
+    enum { N = 8 };
+    double x[N], y[N], y2[N];
+    for (int i = 0; i < N; i++) {
+        x[i] = i;
+        y[i] = i * 0.5;
+        y2[i] = i * 0.25;
+    }
+    gi_chart_series s[2] = {
+        {NULL, x, y2, N, GI_CHART_THIN, 2},
+        {"front", x, y, N, GI_CHART_LINE_MARKERS, 2},
+    };
+    gi_chart_desc d = {"colour index", "x", "y", 0, 0, 500, 400};
+    char path[600];
+    snprintf(path, sizeof path, "%s/colour_index.png", dir);
+    gi_error err = {{0}};
+    CHECK_MSG(gi_chart_write_png(path, &d, s, 2, &err) == GI_OK, "%s", err.text);
+    gi_image *img = gi_image_read(path, &err);
+    CHECK_MSG(img != NULL, "%s", err.text);
+    static const int blue[3] = {0, 114, 178}, vermillion[3] = {213, 94, 0};
+    size_t blue_px = 0, verm_px = 0;
+    for (uint32_t yy = 0; img && yy < img->height; yy++)
+        for (uint32_t xx = 0; xx < img->width; xx++) {
+            int rgb[3];
+            px(img, xx, yy, rgb);
+            blue_px += near_colour(rgb, blue, 24);
+            verm_px += near_colour(rgb, vermillion, 24);
+        }
+    /* both series in the second palette colour; the first (blue) unused */
+    CHECK_MSG(verm_px > 20 && blue_px == 0, "%zu vermillion, %zu blue pixels", verm_px, blue_px);
+    gi_image_free(img);
+}
+
 static void test_errors(void)
 {
     double x[] = {1, 2}, y[] = {1, 2};
-    gi_chart_series s = {"s", x, y, 2, GI_CHART_LINE_MARKERS};
+    gi_chart_series s = {"s", x, y, 2, GI_CHART_LINE_MARKERS, 0};
     gi_chart_desc d = {0};
     gi_error err = {{0}};
     char path[600];
@@ -328,10 +364,13 @@ static void test_errors(void)
     CHECK(gi_chart_write_png("", &d, &s, 1, &err) == GI_ERR_INVALID_ARGUMENT);
 
     snprintf(path, sizeof path, "%s/c.png", dir);
-    gi_chart_series bad_style = {"s", x, y, 2, 7};
+    gi_chart_series bad_style = {"s", x, y, 2, 7, 0};
     CHECK(gi_chart_write_png(path, &d, &bad_style, 1, &err) == GI_ERR_INVALID_ARGUMENT);
     CHECK_MSG(strstr(err.text, "style") != NULL, "%s", err.text);
-    gi_chart_series no_data = {"s", NULL, y, 2, GI_CHART_MARKERS};
+    gi_chart_series bad_colour = {"s", x, y, 2, GI_CHART_THIN, -1};
+    CHECK(gi_chart_write_png(path, &d, &bad_colour, 1, &err) == GI_ERR_INVALID_ARGUMENT);
+    CHECK_MSG(strstr(err.text, "colour") != NULL, "%s", err.text);
+    gi_chart_series no_data = {"s", NULL, y, 2, GI_CHART_MARKERS, 0};
     CHECK(gi_chart_write_png(path, &d, &no_data, 1, &err) == GI_ERR_INVALID_ARGUMENT);
     CHECK(gi_chart_write_png(path, &d, NULL, 2, &err) == GI_ERR_INVALID_ARGUMENT);
     gi_chart_desc huge = {0};
@@ -355,7 +394,7 @@ static void test_context_restored(void)
     glBindBuffer(GL_ARRAY_BUFFER, buf);
     glBindBuffer(GL_ARRAY_BUFFER, 0);
     double x[] = {1, 10}, y[] = {1, 0.1};
-    gi_chart_series s = {"s", x, y, 2, GI_CHART_LINE_MARKERS};
+    gi_chart_series s = {"s", x, y, 2, GI_CHART_LINE_MARKERS, 0};
     gi_chart_desc d = {"with the core's context", NULL, NULL, 1, 1, 400, 300};
     char path[600];
     snprintf(path, sizeof path, "%s/ctx.png", dir);
@@ -381,6 +420,7 @@ int main(void)
         return gi_test_finish();
     test_points_kept();
     test_ranges();
+    test_colour_index();
     test_errors();
     test_context_restored();
     /* Kept for a look when something failed or GI_KEEP_CHARTS is set. */

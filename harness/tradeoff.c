@@ -1,0 +1,510 @@
+/* Speed against accuracy for one reference set (tradeoff.h). */
+#include "tradeoff.h"
+
+#include "charts.h"
+#include "gi/log.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_POINTS 64 /* render records at most this many curve points */
+
+void tradeoff_put(tradeoff_text *t, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(NULL, 0, fmt, ap);
+    va_end(ap);
+    if (n < 0)
+        return;
+    if (t->len + (size_t)n + 1 > t->cap) {
+        size_t cap = t->cap ? t->cap : 4096;
+        while (cap < t->len + (size_t)n + 1)
+            cap *= 2;
+        char *s = realloc(t->s, cap);
+        if (!s)
+            return;
+        t->s = s;
+        t->cap = cap;
+    }
+    va_start(ap, fmt);
+    vsnprintf(t->s + t->len, t->cap - t->len, fmt, ap);
+    va_end(ap);
+    t->len += (size_t)n;
+}
+
+double tradeoff_pt_time_at(const tradeoff_pt_curve *c, double e, int *extrapolated)
+{
+    *extrapolated = 0;
+    if (!c || c->n == 0 || !(e > 0))
+        return NAN;
+    for (uint32_t i = 0; i + 1 < c->n; i++) {
+        double e0 = c->e[i], e1 = c->e[i + 1];
+        if ((e <= e0 && e >= e1) || (e >= e0 && e <= e1)) {
+            double s = (log(e) - log(e0)) / (log(e1) - log(e0));
+            if (!isfinite(s))
+                s = 0;
+            return exp(log(c->t[i]) + s * (log(c->t[i + 1]) - log(c->t[i])));
+        }
+    }
+    *extrapolated = 1;
+    /* the end nearest in error, extended with slope -1 */
+    uint32_t lo = 0, hi = 0;
+    for (uint32_t i = 1; i < c->n; i++) {
+        if (c->e[i] < c->e[lo])
+            lo = i;
+        if (c->e[i] > c->e[hi])
+            hi = i;
+    }
+    uint32_t k = e > c->e[hi] ? hi : lo;
+    return c->t[k] * c->e[k] / e;
+}
+
+static double num(json_object *o, const char *k1, const char *k2, const char *k3)
+{
+    const char *keys[3] = {k1, k2, k3};
+    for (int i = 0; i < 3 && keys[i]; i++) {
+        json_object *v;
+        if (!o || !json_object_object_get_ex(o, keys[i], &v) || !v)
+            return NAN;
+        o = v;
+    }
+    return json_object_get_double(o);
+}
+
+static const char *str(json_object *o, const char *key)
+{
+    json_object *v;
+    return o && json_object_object_get_ex(o, key, &v) && v ? json_object_get_string(v) : "";
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median_of(double *v, uint32_t n)
+{
+    if (n == 0)
+        return NAN;
+    qsort(v, n, sizeof *v, cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* One run's curve: time (s), relMSE full and matched after each recorded
+ * frame. A record without a curve (made before render recorded them)
+ * gives its final image only, at frames x median frame time. */
+static uint32_t run_curve(json_object *rec, double *t, double *ef, double *em, uint32_t *frame)
+{
+    json_object *c;
+    if (json_object_object_get_ex(rec, "curve", &c) && json_object_is_type(c, json_type_array) &&
+        json_object_array_length(c) > 0) {
+        uint32_t n = 0;
+        for (size_t k = 0; k < json_object_array_length(c) && n < MAX_POINTS; k++) {
+            json_object *p = json_object_array_get_idx(c, k);
+            t[n] = num(p, "time_ms", NULL, NULL) / 1000.0;
+            ef[n] = num(p, "full", "relmse", NULL);
+            em[n] = num(p, "matched", "relmse", NULL);
+            frame[n] = (uint32_t)num(p, "frame", NULL, NULL);
+            if (!isfinite(em[n]))
+                em[n] = ef[n];
+            n++;
+        }
+        return n;
+    }
+    t[0] = num(rec, "frame_ms", "median", NULL) * num(rec, "frames", NULL, NULL) / 1000.0;
+    ef[0] = num(rec, "metrics", "full", "relmse");
+    em[0] = num(rec, "metrics", "matched", "relmse");
+    frame[0] = (uint32_t)num(rec, "frames", NULL, NULL);
+    if (!isfinite(em[0]))
+        em[0] = ef[0];
+    return 1;
+}
+
+/* The repeats of one setting pooled: medians, and the spread of relMSE. */
+typedef struct setting {
+    uint64_t key;
+    json_object *first;
+    const char *method;
+    uint32_t bounces, repeats, method_index;
+    uint32_t n;
+    double t[MAX_POINTS], ef[MAX_POINTS], ef_lo[MAX_POINTS], ef_hi[MAX_POINTS], em[MAX_POINTS];
+    uint32_t frame[MAX_POINTS];
+    double prep_s;
+} setting;
+
+typedef struct front_point {
+    uint32_t s, k; /* setting and point */
+} front_point;
+
+static const tradeoff_pt_curve *curve_for(const tradeoff_pt_curve *full, const tradeoff_pt_curve *matched,
+                                          uint32_t matched_n, uint32_t bounces)
+{
+    for (uint32_t i = 0; i < matched_n; i++)
+        if (matched[i].bounces == bounces && bounces < full->bounces)
+            return &matched[i];
+    return full;
+}
+
+/* Pools the runs of each setting. Returns the number of settings. */
+static uint32_t pool_settings(const tradeoff_run *runs, uint32_t run_n, setting *set, const char **methods,
+                              uint32_t *nm)
+{
+    uint32_t ns = 0;
+    *nm = 0;
+    for (uint32_t i = 0; i < run_n; i++) {
+        if (strcmp(str(runs[i].record, "status"), "ok"))
+            continue;
+        uint32_t s = 0;
+        while (s < ns && set[s].key != runs[i].setting)
+            s++;
+        if (s < ns)
+            continue;
+        setting *g = &set[ns++];
+        memset(g, 0, sizeof *g);
+        g->key = runs[i].setting;
+        g->first = runs[i].record;
+        g->method = str(runs[i].record, "method");
+        g->bounces = runs[i].bounces;
+        uint32_t m = 0;
+        while (m < *nm && strcmp(methods[m], g->method))
+            m++;
+        if (m == *nm)
+            methods[(*nm)++] = g->method;
+        g->method_index = m;
+        /* every repeat of this setting */
+        static double t[MAX_POINTS][64], ef[MAX_POINTS][64], em[MAX_POINTS][64];
+        double prep[64];
+        uint32_t n = MAX_POINTS, rep = 0;
+        for (uint32_t j = i; j < run_n && rep < 64; j++) {
+            if (runs[j].setting != g->key || strcmp(str(runs[j].record, "status"), "ok"))
+                continue;
+            double rt[MAX_POINTS], ref[MAX_POINTS], rem[MAX_POINTS];
+            uint32_t frame[MAX_POINTS];
+            uint32_t rn = run_curve(runs[j].record, rt, ref, rem, frame);
+            if (rn < n)
+                n = rn;
+            for (uint32_t k = 0; k < rn; k++) {
+                t[k][rep] = rt[k];
+                ef[k][rep] = ref[k];
+                em[k][rep] = rem[k];
+                if (rep == 0)
+                    g->frame[k] = frame[k];
+            }
+            prep[rep] = num(runs[j].record, "prepare_ms", NULL, NULL) / 1000.0;
+            rep++;
+        }
+        g->repeats = rep;
+        g->n = rep ? n : 0;
+        for (uint32_t k = 0; k < g->n; k++) {
+            g->t[k] = median_of(t[k], rep);
+            g->em[k] = median_of(em[k], rep);
+            g->ef[k] = median_of(ef[k], rep); /* sorted: the ends are the spread */
+            g->ef_lo[k] = ef[k][0];
+            g->ef_hi[k] = ef[k][rep - 1];
+        }
+        g->prep_s = median_of(prep, rep);
+    }
+    return ns;
+}
+
+/* Each method's Pareto front over all its settings' points (time, error):
+ * no other point of the method is both faster and more accurate. */
+static uint32_t pareto(const setting *set, uint32_t ns, uint32_t method, int matched, front_point *out)
+{
+    uint32_t n = 0;
+    for (uint32_t s = 0; s < ns; s++) {
+        if (set[s].method_index != method)
+            continue;
+        for (uint32_t k = 0; k < set[s].n; k++) {
+            double t = set[s].t[k], e = matched ? set[s].em[k] : set[s].ef[k];
+            if (!(t > 0) || !(e > 0))
+                continue;
+            int dominated = 0;
+            for (uint32_t s2 = 0; s2 < ns && !dominated; s2++) {
+                if (set[s2].method_index != method)
+                    continue;
+                for (uint32_t k2 = 0; k2 < set[s2].n && !dominated; k2++) {
+                    double t2 = set[s2].t[k2], e2 = matched ? set[s2].em[k2] : set[s2].ef[k2];
+                    dominated = t2 <= t && e2 <= e && (t2 < t || e2 < e);
+                }
+            }
+            /* of equal points, the first one stands */
+            for (uint32_t i = 0; i < n && !dominated; i++) {
+                const setting *o = &set[out[i].s];
+                dominated = o->t[out[i].k] == t && (matched ? o->em[out[i].k] : o->ef[out[i].k]) == e;
+            }
+            if (!dominated)
+                out[n++] = (front_point){s, k};
+        }
+    }
+    /* by time */
+    for (uint32_t i = 1; i < n; i++)
+        for (uint32_t j = i; j > 0 && set[out[j].s].t[out[j].k] < set[out[j - 1].s].t[out[j - 1].k]; j--) {
+            front_point tmp = out[j];
+            out[j] = out[j - 1];
+            out[j - 1] = tmp;
+        }
+    return n;
+}
+
+static void chart(const char *out_dir, const char *name, int matched, const tradeoff_pt_curve *full,
+                  const tradeoff_pt_curve *mcurves, uint32_t matched_n, const setting *set, uint32_t ns,
+                  const char **methods, uint32_t nm, json_object *chart_list)
+{
+    uint32_t cap = ns + 2 * nm + matched_n + 2;
+    gi_chart_series *series = calloc(cap, sizeof *series);
+    double *fx = calloc((size_t)nm * ns * MAX_POINTS * 2 + 1, sizeof *fx);
+    double *fy = calloc((size_t)nm * ns * MAX_POINTS * 2 + 1, sizeof *fy);
+    front_point *fp = calloc((size_t)ns * MAX_POINTS + 1, sizeof *fp);
+    char(*labels)[160] = calloc(nm + matched_n + 1, sizeof *labels);
+    if (!series || !fx || !fy || !fp || !labels) {
+        free(series), free(fx), free(fy), free(fp), free(labels);
+        return;
+    }
+    uint32_t n = 0;
+    for (uint32_t m = 0; m < nm; m++) {
+        for (uint32_t s = 0; s < ns; s++)
+            if (set[s].method_index == m && set[s].n > 1)
+                series[n++] = (gi_chart_series){NULL, set[s].t, matched ? set[s].em : set[s].ef, set[s].n,
+                                                GI_CHART_THIN, (int)m + 1};
+        uint32_t k = pareto(set, ns, m, matched, fp);
+        double *x = fx + (size_t)m * ns * MAX_POINTS * 2, *y = fy + (size_t)m * ns * MAX_POINTS * 2;
+        /* a staircase: between two settings on the front nothing better is
+         * known than the slower one's error, reached at its own time */
+        uint32_t c = 0;
+        for (uint32_t i = 0; i < k; i++) {
+            double t = set[fp[i].s].t[fp[i].k], e = matched ? set[fp[i].s].em[fp[i].k] : set[fp[i].s].ef[fp[i].k];
+            if (i > 0) {
+                x[c] = t;
+                y[c] = y[c - 1];
+                c++;
+            }
+            x[c] = t;
+            y[c++] = e;
+        }
+        snprintf(labels[m], sizeof labels[m], "%s (Pareto front)", methods[m]);
+        series[n++] = (gi_chart_series){labels[m], x, y, c, GI_CHART_LINE_MARKERS, (int)m + 1};
+    }
+    int colour = (int)nm + 1;
+    if (!matched) {
+        series[n++] = (gi_chart_series){"path tracer (Embree, CPU), full GI", full->t, full->e, full->n,
+                                        GI_CHART_DASHED, colour};
+    } else {
+        for (uint32_t i = 0; i < matched_n; i++) {
+            snprintf(labels[nm + i], sizeof labels[nm + i], "path tracer, max_bounces %u", mcurves[i].bounces);
+            series[n++] = (gi_chart_series){labels[nm + i], mcurves[i].t, mcurves[i].e, mcurves[i].n,
+                                            GI_CHART_DASHED, colour + (int)i};
+        }
+        series[n++] = (gi_chart_series){"path tracer, full GI", full->t, full->e, full->n, GI_CHART_DASHED,
+                                        colour + (int)matched_n};
+    }
+    char file[512], path[4700], title[512];
+    snprintf(file, sizeof file, "chart_%s_error_vs_time%s.png", name, matched ? "_matched" : "");
+    snprintf(path, sizeof path, "%s/%s", out_dir, file);
+    snprintf(title, sizeof title, "%s: relMSE against time (%s)", name,
+             matched ? "bounce-matched references" : "full-GI reference");
+    gi_chart_desc desc = {title, "time to image (s): sum of frame times so far", "relMSE", 1, 1, 0, 0};
+    gi_error err;
+    if (gi_chart_write_png(path, &desc, series, n, &err) == GI_OK)
+        json_object_array_add(chart_list, json_object_new_string(file));
+    else
+        gi_log(GI_LOG_WARN, "chart %s not written: %s", file, err.text);
+    free(series), free(fx), free(fy), free(fp), free(labels);
+}
+
+/* relMSE as "median" or "median [min–max]" over repeats. */
+static void put_error(tradeoff_text *md, const setting *g, uint32_t k)
+{
+    if (g->repeats > 1 && g->ef_hi[k] > g->ef_lo[k])
+        tradeoff_put(md, " %.4g [%.4g–%.4g] |", g->ef[k], g->ef_lo[k], g->ef_hi[k]);
+    else
+        tradeoff_put(md, " %.4g |", g->ef[k]);
+}
+
+static void params_cell(tradeoff_text *md, json_object *rec)
+{
+    const char *p = str(rec, "params");
+    tradeoff_put(md, " `%s` |", *p ? p : "(defaults)");
+}
+
+/* Per record: the earliest recorded frame whose error is within 1 % of the
+ * final image's (a method with an error floor is charged only the frames it
+ * needs), and its speed-ups there. */
+static void annotate_records(const tradeoff_run *runs, uint32_t run_n, const tradeoff_pt_curve *full,
+                             const tradeoff_pt_curve *matched, uint32_t matched_n)
+{
+    for (uint32_t i = 0; i < run_n; i++) {
+        json_object *rec = runs[i].record;
+        if (strcmp(str(rec, "status"), "ok"))
+            continue;
+        double t[MAX_POINTS], ef[MAX_POINTS], em[MAX_POINTS];
+        uint32_t frame[MAX_POINTS];
+        uint32_t n = run_curve(rec, t, ef, em, frame);
+        if (n == 0 || !(ef[n - 1] > 0))
+            continue;
+        uint32_t k = 0;
+        while (k + 1 < n && !(ef[k] <= ef[n - 1] * 1.01))
+            k++;
+        json_object_object_add(rec, "time_to_final_error_s", json_object_new_double(t[k]));
+        json_object_object_add(rec, "frames_to_final_error", json_object_new_int((int32_t)frame[k]));
+        int ex = 0, exm = 0;
+        double tpt = tradeoff_pt_time_at(full, ef[n - 1], &ex);
+        const tradeoff_pt_curve *mc = curve_for(full, matched, matched_n, runs[i].bounces);
+        double tptm = tradeoff_pt_time_at(mc, em[n - 1], &exm);
+        if (isfinite(tpt) && t[k] > 0) {
+            json_object_object_add(rec, "pt_time_at_equal_error_s", json_object_new_double(tpt));
+            json_object_object_add(rec, "speedup_vs_pt", json_object_new_double(tpt / t[k]));
+        }
+        if (isfinite(tptm) && t[k] > 0)
+            json_object_object_add(rec, "speedup_vs_pt_matched", json_object_new_double(tptm / t[k]));
+        json_object_object_add(rec, "speedup_extrapolated", json_object_new_boolean(ex || exm));
+    }
+}
+
+static void equal_error_table(tradeoff_text *md, const char *name, const tradeoff_pt_curve *full,
+                              const tradeoff_pt_curve *matched, uint32_t matched_n, const setting *set, uint32_t ns,
+                              const char **methods, uint32_t nm, front_point *fp)
+{
+    tradeoff_put(md,
+                 "#### %s: equal error (each method's Pareto front against the full-GI reference)\n\n"
+                 "Speed-up = the path tracer's time to the same relMSE ÷ the method's time to its image; "
+                 "\"matched\" compares the method's error against the reference of its own bounce count with "
+                 "the path tracer limited to that count. Precomputation is not in the time to image: it has "
+                 "its own column, and the last three add it amortised over 1, 100 and 10,000 images. "
+                 "\"*\": the path tracer's time is extrapolated beyond its measured curve (slope −1). "
+                 "relMSE over repeats: median [min–max].\n\n",
+                 name);
+    tradeoff_put(md, "| method | params | frames | time to image (s) | relMSE full | path tracer, same error (s) | "
+                     "speed-up | relMSE matched | matched path tracer (s) | speed-up matched | precompute (s) | "
+                     "amortised ×1 (s) | ×100 (s) | ×10⁴ (s) |\n"
+                     "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (uint32_t m = 0; m < nm; m++) {
+        uint32_t k = pareto(set, ns, m, 0, fp);
+        for (uint32_t i = 0; i < k; i++) {
+            const setting *g = &set[fp[i].s];
+            uint32_t p = fp[i].k;
+            int ex = 0, exm = 0;
+            double tpt = tradeoff_pt_time_at(full, g->ef[p], &ex);
+            const tradeoff_pt_curve *mc = curve_for(full, matched, matched_n, g->bounces);
+            double tptm = tradeoff_pt_time_at(mc, g->em[p], &exm);
+            double prep = isfinite(g->prep_s) ? g->prep_s : 0.0;
+            tradeoff_put(md, "| %s |", methods[m]);
+            params_cell(md, g->first);
+            tradeoff_put(md, " %u | %.4g |", g->frame[p], g->t[p]);
+            put_error(md, g, p);
+            tradeoff_put(md, " %.4g%s | %.3g%s | %.4g | %.4g%s | %.3g%s | %.4g | %.4g | %.4g | %.4g |\n", tpt,
+                         ex ? "*" : "", tpt / g->t[p], ex ? "*" : "", g->em[p], tptm, exm ? "*" : "",
+                         tptm / g->t[p], exm ? "*" : "", prep, g->t[p] + prep, g->t[p] + prep / 100.0,
+                         g->t[p] + prep / 1e4);
+        }
+    }
+    tradeoff_put(md, "\n");
+}
+
+/* The method's best error among its points reached by time T (NaN if none). */
+static double best_error_by(const setting *set, uint32_t ns, uint32_t m, int matched, double T, const setting **at,
+                            uint32_t *at_k)
+{
+    double best = NAN;
+    for (uint32_t s = 0; s < ns; s++) {
+        if (set[s].method_index != m)
+            continue;
+        for (uint32_t k = 0; k < set[s].n; k++) {
+            double e = matched ? set[s].em[k] : set[s].ef[k];
+            if (set[s].t[k] <= T && e > 0 && !(e >= best)) {
+                best = e;
+                *at = &set[s];
+                *at_k = k;
+            }
+        }
+    }
+    return best;
+}
+
+static void equal_time_table(tradeoff_text *md, const char *name, const tradeoff_pt_curve *full,
+                             const tradeoff_pt_curve *matched, uint32_t matched_n, const setting *set, uint32_t ns,
+                             const char **methods, uint32_t nm)
+{
+    if (full->n == 0)
+        return;
+    tradeoff_put(md,
+                 "#### %s: equal time (each method's best relMSE within the time the path tracer needs for its "
+                 "error levels)\n\n"
+                 "A column per image of the path tracer's convergence run (time, its relMSE). A cell: the "
+                 "method's lowest relMSE among its settings and frames whose time to image is within that time "
+                 "(precomputation not counted), and its ratio to the path tracer's error; \"–\": no setting is "
+                 "that fast. \"matched\" rows: against the reference of the method's bounce count, the path "
+                 "tracer limited to it (its own time and error at that image).\n\n",
+                 name);
+    tradeoff_put(md, "| method |");
+    for (uint32_t i = 0; i < full->n; i++)
+        tradeoff_put(md, " %.3g s (PT %.3g) |", full->t[i], full->e[i]);
+    tradeoff_put(md, "\n|---|");
+    for (uint32_t i = 0; i < full->n; i++)
+        tradeoff_put(md, "---:|");
+    tradeoff_put(md, "\n");
+    for (uint32_t m = 0; m < nm; m++) {
+        for (int matched_row = 0; matched_row < 2; matched_row++) {
+            uint32_t b = 0;
+            for (uint32_t s = 0; s < ns; s++)
+                if (set[s].method_index == m)
+                    b = set[s].bounces;
+            const tradeoff_pt_curve *c = matched_row ? curve_for(full, matched, matched_n, b) : full;
+            if (matched_row && c == full)
+                continue; /* the method is full GI: the row above says it */
+            tradeoff_put(md, "| %s%s |", methods[m], matched_row ? " (matched)" : "");
+            for (uint32_t i = 0; i < full->n; i++) {
+                double T = i < c->n ? c->t[i] : NAN, ept = i < c->n ? c->e[i] : NAN;
+                const setting *at = NULL;
+                uint32_t at_k = 0;
+                double e = isfinite(T) ? best_error_by(set, ns, m, matched_row, T, &at, &at_k) : NAN;
+                if (isfinite(e))
+                    tradeoff_put(md, " %.4g (×%.3g) |", e, e / ept);
+                else
+                    tradeoff_put(md, " – |");
+            }
+            tradeoff_put(md, "\n");
+        }
+    }
+    tradeoff_put(md, "\n");
+}
+
+void tradeoff_report(const char *out_dir, const char *name, const tradeoff_pt_curve *full,
+                     const tradeoff_pt_curve *matched, uint32_t matched_n, const tradeoff_run *runs,
+                     uint32_t run_n, json_object *chart_list, tradeoff_text *md)
+{
+    setting *set = calloc(run_n + 1, sizeof *set);
+    const char **methods = calloc(run_n + 1, sizeof *methods);
+    front_point *fp = calloc((size_t)(run_n + 1) * MAX_POINTS, sizeof *fp);
+    if (!set || !methods || !fp) {
+        free(set), free(methods), free(fp);
+        return;
+    }
+    annotate_records(runs, run_n, full, matched, matched_n);
+    uint32_t nm = 0, ns = pool_settings(runs, run_n, set, methods, &nm);
+    int any_matched = 0;
+    for (uint32_t s = 0; s < ns; s++)
+        any_matched |= set[s].bounces < full->bounces;
+    chart(out_dir, name, 0, full, matched, matched_n, set, ns, methods, nm, chart_list);
+    if (any_matched)
+        chart(out_dir, name, 1, full, matched, matched_n, set, ns, methods, nm, chart_list);
+    tradeoff_put(md, "Path tracer convergence on %s (relMSE against the reference, another seed):", name);
+    const tradeoff_pt_curve *curves[9] = {full};
+    uint32_t nc = 1;
+    for (uint32_t i = 0; i < matched_n && nc < 9; i++)
+        curves[nc++] = &matched[i];
+    for (uint32_t c = 0; c < nc; c++) {
+        tradeoff_put(md, "%s max_bounces %u:", c ? ";" : "", curves[c]->bounces);
+        for (uint32_t i = 0; i < curves[c]->n; i++)
+            tradeoff_put(md, " %.3g s → %.3g%s", curves[c]->t[i], curves[c]->e[i], i + 1 < curves[c]->n ? "," : "");
+    }
+    tradeoff_put(md, ".\n\n");
+    equal_error_table(md, name, full, matched, matched_n, set, ns, methods, nm, fp);
+    equal_time_table(md, name, full, matched, matched_n, set, ns, methods, nm);
+    free(set), free(methods), free(fp);
+}
