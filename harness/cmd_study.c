@@ -1129,7 +1129,8 @@ static void charts_and_speedups(study *st, const char *out_dir, json_object *met
         for (uint32_t i = 0; i < st->run_count; i++)
             if (st->runs[i].ref_index == (int)ri && st->runs[i].record)
                 tr[n++] = (tradeoff_run){st->runs[i].record, st->runs[i].bounces, st->runs[i].setting};
-        tradeoff_report(out_dir, sc->name, &sc->pt_full, sc->pt_matched, sc->matched_count, tr, n, chart_list, &md);
+        tradeoff_report(out_dir, sc->name, &sc->pt_full, sc->pt_matched, sc->matched_count, tr, n, gi_chart_write_png,
+                        chart_list, &md);
     }
     free(tr);
     json_object_object_add(meta, "markdown", json_object_new_string(md.s ? md.s : ""));

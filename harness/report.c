@@ -203,6 +203,11 @@ static int stage_names(json_object *runs, const char **names, int max)
     return key_names(runs, "stages", names, max);
 }
 
+/* The last columns of runs.csv: the seed, and what the study's speed
+ * against accuracy found for the run (tradeoff.h). */
+static const char *const tradeoff_keys[] = {"seed", "time_to_final_error_s", "frames_to_final_error",
+                                             "speedup_vs_pt", "speedup_vs_pt_matched", NULL};
+
 static void write_csv(text *t, json_object *runs)
 {
     const char *stages[32], *pstages[32], *stats[64];
@@ -221,6 +226,8 @@ static void write_csv(text *t, json_object *runs)
         put(t, ",prepare_%s_ms", pstages[k]);
     for (int k = 0; k < nst; k++)
         put(t, ",stat_%s", stats[k]);
+    for (int k = 0; tradeoff_keys[k]; k++)
+        put(t, ",%s", tradeoff_keys[k]);
     put(t, "\n");
     size_t count = json_object_array_length(runs);
     for (size_t i = 0; i < count; i++) {
@@ -243,11 +250,13 @@ static void write_csv(text *t, json_object *runs)
                 csv_num(t, num(o, "metrics", r ? "matched" : "full", report_metric_keys[m]), 0);
         csv_field(t, str(o, "label"), 0);
         csv_num(t, num(o, "width", NULL, NULL), 0);
-        csv_num(t, num(o, "height", NULL, NULL), np + nst == 0);
+        csv_num(t, num(o, "height", NULL, NULL), 0);
         for (int k = 0; k < np; k++)
-            csv_num(t, num(o, "prepare_stages", pstages[k], NULL), k == np - 1 && nst == 0);
+            csv_num(t, num(o, "prepare_stages", pstages[k], NULL), 0);
         for (int k = 0; k < nst; k++)
-            csv_num(t, num(o, "stats", stats[k], NULL), k == nst - 1);
+            csv_num(t, num(o, "stats", stats[k], NULL), 0);
+        for (int k = 0; tradeoff_keys[k]; k++)
+            csv_num(t, num(o, tradeoff_keys[k], NULL, NULL), !tradeoff_keys[k + 1]);
     }
 }
 

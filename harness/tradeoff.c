@@ -252,7 +252,7 @@ static uint32_t pareto(const setting *set, uint32_t ns, uint32_t method, int mat
     return n;
 }
 
-static void chart(const char *out_dir, const char *name, int matched, const tradeoff_pt_curve *full,
+static void chart(tradeoff_chart_fn write_chart, const char *out_dir, const char *name, int matched, const tradeoff_pt_curve *full,
                   const tradeoff_pt_curve *mcurves, uint32_t matched_n, const setting *set, uint32_t ns,
                   const char **methods, uint32_t nm, json_object *chart_list)
 {
@@ -310,7 +310,7 @@ static void chart(const char *out_dir, const char *name, int matched, const trad
              matched ? "bounce-matched references" : "full-GI reference");
     gi_chart_desc desc = {title, "time to image (s): sum of frame times so far", "relMSE", 1, 1, 0, 0};
     gi_error err;
-    if (gi_chart_write_png(path, &desc, series, n, &err) == GI_OK)
+    if (write_chart(path, &desc, series, n, &err) == GI_OK)
         json_object_array_add(chart_list, json_object_new_string(file));
     else
         gi_log(GI_LOG_WARN, "chart %s not written: %s", file, err.text);
@@ -476,7 +476,7 @@ static void equal_time_table(tradeoff_text *md, const char *name, const tradeoff
 
 void tradeoff_report(const char *out_dir, const char *name, const tradeoff_pt_curve *full,
                      const tradeoff_pt_curve *matched, uint32_t matched_n, const tradeoff_run *runs,
-                     uint32_t run_n, json_object *chart_list, tradeoff_text *md)
+                     uint32_t run_n, tradeoff_chart_fn write_chart, json_object *chart_list, tradeoff_text *md)
 {
     setting *set = calloc(run_n + 1, sizeof *set);
     const char **methods = calloc(run_n + 1, sizeof *methods);
@@ -490,9 +490,10 @@ void tradeoff_report(const char *out_dir, const char *name, const tradeoff_pt_cu
     int any_matched = 0;
     for (uint32_t s = 0; s < ns; s++)
         any_matched |= set[s].bounces < full->bounces;
-    chart(out_dir, name, 0, full, matched, matched_n, set, ns, methods, nm, chart_list);
-    if (any_matched)
-        chart(out_dir, name, 1, full, matched, matched_n, set, ns, methods, nm, chart_list);
+    if (write_chart)
+        chart(write_chart, out_dir, name, 0, full, matched, matched_n, set, ns, methods, nm, chart_list);
+    if (write_chart && any_matched)
+        chart(write_chart, out_dir, name, 1, full, matched, matched_n, set, ns, methods, nm, chart_list);
     tradeoff_put(md, "Path tracer convergence on %s (relMSE against the reference, another seed):", name);
     const tradeoff_pt_curve *curves[9] = {full};
     uint32_t nc = 1;
