@@ -11,6 +11,7 @@
 #include <string.h>
 
 #define MAX_POINTS 64 /* render records at most this many curve points */
+#define FRONT_MIN_GAIN 0.01 /* a front point must lower the error by this share */
 
 void tradeoff_put(tradeoff_text *t, const char *fmt, ...)
 {
@@ -213,7 +214,8 @@ static uint32_t pool_settings(const tradeoff_run *runs, uint32_t run_n, setting 
 }
 
 /* Each method's Pareto front over all its settings' points (time, error):
- * no other point of the method is both faster and more accurate. */
+ * no other point of the method is both faster and more accurate, and each
+ * point is at least 1 % more accurate than the faster one before it. */
 static uint32_t pareto(const setting *set, uint32_t ns, uint32_t method, int matched, front_point *out)
 {
     uint32_t n = 0;
@@ -249,7 +251,21 @@ static uint32_t pareto(const setting *set, uint32_t ns, uint32_t method, int mat
             out[j] = out[j - 1];
             out[j - 1] = tmp;
         }
-    return n;
+    /* a point that lowers the error by less than 1 % against the last one
+     * kept is not worth its extra time: such points (an error floor
+     * approached frame by frame) are dropped */
+    uint32_t kept = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        double e = matched ? set[out[i].s].em[out[i].k] : set[out[i].s].ef[out[i].k];
+        if (kept > 0) {
+            const setting *l = &set[out[kept - 1].s];
+            double el = matched ? l->em[out[kept - 1].k] : l->ef[out[kept - 1].k];
+            if (!(e < el * (1.0 - FRONT_MIN_GAIN)))
+                continue;
+        }
+        out[kept++] = out[i];
+    }
+    return kept;
 }
 
 static void chart(tradeoff_chart_fn write_chart, const char *out_dir, const char *name, int matched, const tradeoff_pt_curve *full,
