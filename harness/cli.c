@@ -4,6 +4,7 @@
 
 #include "gi/cache.h"
 #include "gi/log.h"
+#include "gi/timer.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -163,13 +164,86 @@ static void host_log(const gi_host *h, int level, const char *fmt, ...)
     gi_log((gi_log_level)(level < 0 ? 0 : level > 3 ? 3 : level), "%s: %s", self(h)->method_id, msg);
 }
 
+void cli_format_duration(double seconds, char *out, size_t size)
+{
+    if (!isfinite(seconds) || seconds < 0) {
+        snprintf(out, size, "?");
+        return;
+    }
+    unsigned long s = (unsigned long)(seconds + 0.5);
+    if (s >= 3600)
+        snprintf(out, size, "%lu:%02lu:%02lu", s / 3600, s / 60 % 60, s % 60);
+    else
+        snprintf(out, size, "%lu:%02lu", s / 60, s % 60);
+}
+
+void cli_progress_start(cli_progress *p, const char *label)
+{
+    p->on = isatty(STDERR_FILENO) && gi_log_get_level() >= GI_LOG_WARN;
+    p->open = 0;
+    p->start = gi_now();
+    snprintf(p->label, sizeof p->label, "%s", label);
+}
+
+void cli_progress_show(cli_progress *p, double fraction, uint64_t done, uint64_t total, const char *note)
+{
+    if (!p->on)
+        return;
+    if (!(fraction >= 0))
+        fraction = 0;
+    if (fraction > 1)
+        fraction = 1;
+    double elapsed = gi_now() - p->start;
+    char bar[21], el[32], eta[32] = "?", count[48] = "";
+    int filled = (int)(fraction * 20.0);
+    for (int i = 0; i < 20; i++)
+        bar[i] = i < filled ? '#' : '.';
+    bar[20] = '\0';
+    cli_format_duration(elapsed, el, sizeof el);
+    if (fraction > 0)
+        cli_format_duration(elapsed * (1.0 - fraction) / fraction, eta, sizeof eta);
+    if (total > 0)
+        snprintf(count, sizeof count, "  %llu/%llu", (unsigned long long)done, (unsigned long long)total);
+    /* \033[K clears what a longer line left behind */
+    fprintf(stderr, "\r%s [%s] %3d%%%s  %s elapsed, ETA %s%s%s\033[K", p->label, bar, (int)(fraction * 100.0),
+            count, el, eta, note ? "  " : "", note ? note : "");
+    fflush(stderr);
+    p->open = 1;
+}
+
+void cli_progress_end(cli_progress *p)
+{
+    if (p->on && p->open)
+        fputc('\n', stderr);
+    p->open = 0;
+}
+
+/* A plugin's precomputation progress. The task names what is being done
+ * (a plugin may name itself in it: no second prefix then); a new task
+ * starts a new line and its own clock. */
 static void host_progress(const gi_host *h, const char *task, float fraction)
 {
-    if (!self(h)->show_progress)
+    cli_host *c = self(h);
+    if (!c->show_progress)
         return;
-    int pct = (int)(fraction * 100.0f + 0.5f);
-    fprintf(stderr, "\r%s: %s %3d%%%s", self(h)->method_id, task, pct, fraction >= 1.0f ? "\n" : "");
-    fflush(stderr);
+    size_t idl = strlen(c->method_id);
+    int named = !strncmp(task, c->method_id, idl) && (task[idl] == ':' || task[idl] == ' ');
+    char label[64];
+    snprintf(label, sizeof label, "%s%s%s", named ? "" : c->method_id, named ? "" : ": ", task);
+    if (!c->bar.open || strcmp(c->bar.label, label)) {
+        cli_progress_end(&c->bar);
+        cli_progress_start(&c->bar, label);
+    }
+    cli_progress_show(&c->bar, fraction, 0, 0, NULL);
+    if (fraction >= 1.0f)
+        cli_progress_end(&c->bar);
+}
+
+void cli_host_progress_end(cli_host *h)
+{
+    if (h->bar.open)
+        cli_progress_show(&h->bar, 1.0, 0, 0, NULL);
+    cli_progress_end(&h->bar);
 }
 
 static void host_stage_begin(const gi_host *h, const char *name)
@@ -207,7 +281,7 @@ void cli_host_init(cli_host *h, const char *method_id, const char *cache_dir, co
     memset(h, 0, sizeof *h);
     h->method_id = method_id;
     h->stats = json_object_new_object();
-    h->show_progress = isatty(STDERR_FILENO);
+    h->show_progress = isatty(STDERR_FILENO) && gi_log_get_level() >= GI_LOG_WARN;
     gi_host *g = &h->host;
     g->struct_size = sizeof *g;
     g->abi_version = GI_ABI_VERSION;

@@ -9,6 +9,7 @@
 
 #include <json-c/json.h>
 #include <signal.h>
+#include <stdio.h>
 
 /* Exit codes (ARCHITECTURE.md): 0 ok, 1 failure while running, 2 bad usage or input. */
 enum { EXIT_OK = 0, EXIT_RUN = 1, EXIT_USAGE = 2 };
@@ -40,6 +41,22 @@ gi_plugins *cli_load_plugins(int quiet);
 void cli_caps_string(uint32_t caps, char *buf, size_t size);
 const char *cli_param_type_name(gi_param_type t);
 
+/* A progress line on a terminal: "\rLABEL [#####.....]  45%  k/N  0:12 elapsed, ETA 0:15  NOTE".
+ * Off (nothing printed) when stderr is not a terminal or under -q, so that
+ * logs stay clean. The ETA is the elapsed time scaled by the share left. */
+typedef struct cli_progress {
+    int on, open;
+    double start;
+    char label[64];
+} cli_progress;
+void cli_progress_start(cli_progress *p, const char *label);
+/* fraction in [0, 1]; done/total are shown when total > 0; note may be NULL. */
+void cli_progress_show(cli_progress *p, double fraction, uint64_t done, uint64_t total, const char *note);
+/* Ends an open line (a newline); nothing when none is open. */
+void cli_progress_end(cli_progress *p);
+/* "m:ss" or "h:mm:ss" of a duration in seconds. */
+void cli_format_duration(double seconds, char *out, size_t size);
+
 /* Host services for one method instance. */
 typedef struct cli_host {
     gi_host host;
@@ -47,11 +64,15 @@ typedef struct cli_host {
     gi_timer *timer;   /* where stage timers go now (prepare or render timer) */
     json_object *stats;
     int show_progress;
+    cli_progress bar; /* the precomputation's progress line */
 } cli_host;
 
 void cli_host_init(cli_host *h, const char *method_id, const char *cache_dir, const gi_gpu_scene *gs,
                    const char *renderer, int software);
 void cli_host_free(cli_host *h);
+/* Completes and ends a precomputation progress line left open (a plugin
+ * whose last report was below 100 %). */
+void cli_host_progress_end(cli_host *h);
 
 /* Set by SIGINT/SIGTERM; the host reports it through cancelled(). */
 extern volatile sig_atomic_t cli_interrupted;
@@ -74,6 +95,9 @@ uint64_t cli_scene_content_hash(const gi_scene *s, const char *path);
  * motion when animated)? 0 with the reason naming everything not covered
  * ("avg does not handle directional lights or environment light"). */
 int cli_caps_cover(const gi_method *m, const gi_scene *s, int animated, char *why, size_t size);
+
+/* The help of one command (gibench help CMD, CMD --help): 0 when known. */
+int cli_command_help(const char *cmd, FILE *to);
 
 int cmd_methods(int argc, char **argv);
 int cmd_info(int argc, char **argv);

@@ -260,8 +260,12 @@ int cmd_compare(int argc, char **argv)
                 ref_matched = ref_full; /* the full reference is this method's match */
             }
             spec.ref_matched = ref_matched;
-            fprintf(stderr, "compare: %s\n", m->id);
+            double t0 = gi_now();
             rec = runner_execute(&spec, !o.fresh);
+            json_object *c;
+            int cached = json_object_object_get_ex(rec, "cached", &c) && json_object_get_boolean(c);
+            json_object_object_del(rec, "cached");
+            fprintf(stderr, "compare: %s %s (%.1f s)\n", m->id, cached ? "cached" : "ran", gi_now() - t0);
         }
         json_object *st, *rn;
         if (json_object_object_get_ex(rec, "status", &st) && !strcmp(json_object_get_string(st), "failed")) {

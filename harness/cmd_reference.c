@@ -166,8 +166,12 @@ static void progress_show(const progress *p, const ref_opts *o, uint64_t spp, do
     for (int i = 0; i < 30; i++)
         bar[i] = i < filled ? '#' : '.';
     bar[30] = '\0';
-    fprintf(stderr, "\rreference [%s] %3d%%  %llu spp  %.1f s  SE %.4g ", bar, (int)(frac * 100.0),
-            (unsigned long long)spp, elapsed, se);
+    char el[32], eta[32] = "?";
+    cli_format_duration(elapsed, el, sizeof el);
+    if (frac > 0)
+        cli_format_duration(elapsed * (1.0 - frac) / frac, eta, sizeof eta);
+    fprintf(stderr, "\rreference [%s] %3d%%  %llu spp  %s elapsed, ETA %s  SE %.4g\033[K", bar, (int)(frac * 100.0),
+            (unsigned long long)spp, el, eta, se);
     fflush(stderr);
 }
 

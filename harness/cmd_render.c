@@ -171,6 +171,8 @@ static void cleanup(run_state *r)
 /* Reports a method failure with its own message. */
 static int method_fail(run_state *r, const char *what, gi_result res)
 {
+    if (r->host_ready)
+        cli_host_progress_end(&r->host);
     const char *msg = r->m->last_error(r->inst);
     return cli_fail(res == GI_ERR_INVALID_ARGUMENT || res == GI_ERR_UNSUPPORTED ? EXIT_USAGE : EXIT_RUN,
                     "%s: %s failed (%s)%s%s", r->m->id, what, gi_result_name(res), msg && *msg ? ": " : "",
@@ -286,6 +288,31 @@ static json_object *timings_json(const run_state *r, const render_opts *o)
     return j;
 }
 
+/* One line at the end (unless -q): the method, frames, frame time and files. */
+static void print_summary(const run_state *r, const render_opts *o)
+{
+    if (gi_log_get_level() < GI_LOG_WARN)
+        return;
+    gi_stage_stats st[GI_TIMER_MAX_STAGES + 1];
+    uint32_t n = gi_timer_stats(r->render_timer, st, GI_TIMER_MAX_STAGES + 1);
+    double median = NAN, prep = NAN;
+    for (uint32_t i = 0; i < n; i++)
+        if (!strcmp(st[i].name, "frame"))
+            median = st[i].median_ms;
+    n = gi_timer_stats(r->prep_timer, st, GI_TIMER_MAX_STAGES + 1);
+    for (uint32_t i = 0; i < n; i++)
+        if (!strcmp(st[i].name, "frame"))
+            prep = st[i].median_ms;
+    char files[1024] = "";
+    for (int i = 0; i < o->out_count; i++) {
+        size_t used = strlen(files);
+        snprintf(files + used, sizeof files - used, "%s%s", i ? ", " : "", o->outs[i]);
+    }
+    printf("render: %s, %ux%u, %u frame%s (%u warm-up), median %.3g ms/frame, prepare %.3g ms (%s); wrote %s%s%s\n",
+           r->m->id, o->width, o->height, o->frames, o->frames == 1 ? "" : "s", o->warmup, median, prep,
+           gi_gpu_renderer(r->gpu), files, o->timings ? ", " : "", o->timings ? o->timings : "");
+}
+
 static int run(run_state *r, const render_opts *o)
 {
     gi_error err;
@@ -368,13 +395,22 @@ static int run(run_state *r, const render_opts *o)
     gi_timer_frame_begin(r->prep_timer);
     res = r->m->prepare(r->inst, r->gs);
     gi_timer_frame_end(r->prep_timer);
+    cli_host_progress_end(&r->host);
     if (res != GI_OK)
         return method_fail(r, "prepare", res);
 
     r->host.timer = r->render_timer;
+    cli_progress bar;
+    char label[64];
+    snprintf(label, sizeof label, "render %s", r->m->id);
+    cli_progress_start(&bar, label);
     for (uint32_t f = 0; f < o->frames; f++) {
-        if (cli_interrupted)
+        if (f > 0 && o->frames > 1)
+            cli_progress_show(&bar, (double)f / o->frames, f, o->frames, "frames");
+        if (cli_interrupted) {
+            cli_progress_end(&bar);
             return cli_fail(EXIT_RUN, "render: interrupted after %u of %u frames; no image written", f, o->frames);
+        }
         float t = o->time + (o->animate_fps > 0 ? (float)f / o->animate_fps : 0.0f);
         /* A frame of an animation is update() and render(): what an
          * interactive program pays per frame (a method that rebuilds data
@@ -399,9 +435,14 @@ static int run(run_state *r, const render_opts *o)
         if (gi_gl_check("after render", &err) != GI_OK)
             return cli_fail(EXIT_RUN, "%s: %s", r->m->id, err.text);
         int rc = record_curve_point(r, o, f + 1);
-        if (rc != EXIT_OK)
+        if (rc != EXIT_OK) {
+            cli_progress_end(&bar);
             return rc;
+        }
     }
+    if (o->frames > 1)
+        cli_progress_show(&bar, 1.0, o->frames, o->frames, "frames");
+    cli_progress_end(&bar);
     r->image = gi_gpu_read_texture(r->target_tex, o->width, o->height);
     if (!r->image)
         return cli_fail(EXIT_RUN, "out of memory reading the image back");
@@ -414,7 +455,10 @@ static int run(run_state *r, const render_opts *o)
     uint64_t bad = gi_image_count_nonfinite(r->image);
     if (bad)
         gi_log(GI_LOG_WARN, "%s: %llu pixels are NaN or Inf", r->m->id, (unsigned long long)bad);
-    return o->timings ? cli_save_json(o->timings, timings_json(r, o)) : EXIT_OK;
+    int rc = o->timings ? cli_save_json(o->timings, timings_json(r, o)) : EXIT_OK;
+    if (rc == EXIT_OK)
+        print_summary(r, o);
+    return rc;
 }
 
 int cmd_render(int argc, char **argv)

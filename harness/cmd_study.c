@@ -1068,6 +1068,42 @@ static json_object *run_or_skip(study_run *r, gi_plugins *reg, int resume)
     return rec;
 }
 
+/* Progress of one worker's share of the runs: one line per run, saying
+ * whether it ran or came from a earlier result, with elapsed time and an
+ * ETA from the runs executed so far. */
+typedef struct run_progress {
+    double start, ran_seconds;
+    uint32_t ran, left;
+} run_progress;
+
+static void report_run(run_progress *p, const study *st, uint32_t i, json_object *rec, double seconds,
+                       const char *who)
+{
+    json_object *v;
+    const char *status = json_object_object_get_ex(rec, "status", &v) ? json_object_get_string(v) : "?";
+    int cached = json_object_object_get_ex(rec, "cached", &v) && json_object_get_boolean(v);
+    json_object_object_del(rec, "cached"); /* what the runner told us, not part of the record */
+    const char *what = !strcmp(status, "ok") ? (cached ? "cached" : "ran") : status;
+    if (!strcmp(what, "ran") || !strcmp(what, "failed")) {
+        p->ran++;
+        p->ran_seconds += seconds;
+    }
+    if (p->left)
+        p->left--;
+    char el[32], eta[32] = "?";
+    cli_format_duration(gi_now() - p->start, el, sizeof el);
+    if (p->ran)
+        cli_format_duration(p->ran_seconds / p->ran * p->left, eta, sizeof eta);
+    const run_spec *s = &st->runs[i].spec;
+    char params[256] = "";
+    for (uint32_t k = 0; k < s->param_count; k++) {
+        size_t used = strlen(params);
+        snprintf(params + used, sizeof params - used, "%s%s", k ? "," : " ", s->params[k]);
+    }
+    fprintf(stderr, "study: %s[%u/%u] %s %s (%s%s) %.1f s; elapsed %s, ETA %s\n", who, i + 1, st->run_count, what,
+            st->runs[i].id, s->method, params, seconds, el, p->left ? eta : "0:00");
+}
+
 /* Runs every run not yet done: `jobs` worker processes, each taking runs
  * i, i+jobs, ...; results land in each run's result.json. */
 static void execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg)
@@ -1077,10 +1113,14 @@ static void execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg)
     if (jobs <= 1) {
         /* once interrupted, the runs left are not started: they are
          * reported as interrupted (or as done, when a result is cached) */
+        run_progress p = {gi_now(), 0, 0, st->run_count};
         for (uint32_t i = 0; i < st->run_count; i++) {
-            if (!cli_interrupted)
-                fprintf(stderr, "study: run %u/%u %s\n", i + 1, st->run_count, st->runs[i].id);
+            double t0 = gi_now();
             st->runs[i].record = run_or_skip(&st->runs[i], reg, !fresh || cli_interrupted);
+            if (!cli_interrupted)
+                report_run(&p, st, i, st->runs[i].record, gi_now() - t0, "");
+            else
+                json_object_object_del(st->runs[i].record, "cached");
         }
         return;
     }
@@ -1088,9 +1128,15 @@ static void execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg)
     for (uint32_t j = 0; j < jobs && pids; j++) {
         pid_t pid = fork();
         if (pid == 0) {
+            run_progress p = {gi_now(), 0, 0, (st->run_count - j + jobs - 1) / jobs};
+            char who[32];
+            snprintf(who, sizeof who, "worker %u ", j);
             for (uint32_t i = j; i < st->run_count && !cli_interrupted; i += jobs) {
-                fprintf(stderr, "study: [worker %u] run %u/%u %s\n", j, i + 1, st->run_count, st->runs[i].id);
-                json_object_put(run_or_skip(&st->runs[i], reg, !fresh));
+                double t0 = gi_now();
+                json_object *rec = run_or_skip(&st->runs[i], reg, !fresh);
+                if (!cli_interrupted)
+                    report_run(&p, st, i, rec, gi_now() - t0, who);
+                json_object_put(rec);
             }
             _exit(0);
         }
@@ -1112,8 +1158,10 @@ static void execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg)
     }
     free(pids);
     /* collect: every worker wrote result.json; resume picks them up */
-    for (uint32_t i = 0; i < st->run_count; i++)
+    for (uint32_t i = 0; i < st->run_count; i++) {
         st->runs[i].record = run_or_skip(&st->runs[i], reg, 1);
+        json_object_object_del(st->runs[i].record, "cached");
+    }
 }
 
 /* Per reference set: the error-against-time charts with every run's

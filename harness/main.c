@@ -1,19 +1,22 @@
 /* gibench: the command-line front door (ARCHITECTURE.md "Command line"). */
 #include "cli.h"
 
+#include "gi/gpu.h"
 #include "gi/log.h"
+#include "gibench_version.h"
 
 #include <stdio.h>
 #include <string.h>
 
 static const char usage[] =
-    "usage: gibench [-v|-q] COMMAND ...\n"
+    "usage: gibench [-v|-vv|-q] COMMAND ...   (gibench help COMMAND, gibench COMMAND --help)\n"
+    "       gibench --version [-v]\n"
     "commands:\n"
     "  methods [--json]                       list method plugins and their parameters\n"
     "  info SCENE [--json]                    describe a scene file\n"
     "  render --scene S --method M --out FILE [--out FILE2] [--camera C] [--size WxH]\n"
     "         [--param k=v]... [--frames N] [--warmup N] [--time T] [--animate FPS]\n"
-    "         [--seed N] [--exposure EV] [--timings FILE.json] [--no-cache]\n"
+    "         [--seed N] [--exposure EV] [--timings FILE.json] [--no-cache] [--curve-ref NAME=IMG]\n"
     "                                         render one method (EXR, PFM or PNG output)\n"
     "  diff TEST REFERENCE [--json] [--heatmap FILE.png] [--flip-map FILE.png]\n"
     "       [--exposure EV] [--ppd N]         error metrics (RMSE, relMSE, MAE, PSNR, SSIM, FLIP)\n"
@@ -32,9 +35,35 @@ static const char usage[] =
     "                                         the conformance suite: every check on every method (or M)\n"
     "exit status: 0 success, 1 failure while running, 2 bad usage or bad input\n";
 
+/* gibench --version: the version and commit; with -v also the GL renderer
+ * this machine gives (a context is made for it). */
+static int print_version(void)
+{
+    printf("gibench %s (commit %s)\n", GIBENCH_VERSION, GIBENCH_COMMIT);
+    if (gi_log_get_level() >= GI_LOG_INFO) {
+        gi_error err;
+        gi_gpu *gpu = gi_gpu_create(NULL, &err);
+        if (!gpu)
+            return cli_fail(EXIT_RUN, "no GL context: %s", err.text);
+        printf("GL renderer: %s\nGL version: %s\nEGL platform: %s\n", gi_gpu_renderer(gpu), gi_gpu_version(gpu),
+               gi_gpu_platform(gpu));
+        gi_gpu_destroy(gpu);
+    }
+    return EXIT_OK;
+}
+
+/* Is this command's help asked for ("--help" or "-h" among its arguments)? */
+static int wants_help(int argc, char **argv)
+{
+    for (int i = 0; i < argc; i++)
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h"))
+            return 1;
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
-    int i = 1;
+    int i = 1, version = 0;
     gi_log_set_level(GI_LOG_WARN);
     for (; i < argc && argv[i][0] == '-'; i++) {
         if (!strcmp(argv[i], "-v"))
@@ -46,9 +75,13 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
             fputs(usage, stdout);
             return EXIT_OK;
-        } else
+        } else if (!strcmp(argv[i], "--version"))
+            version = 1;
+        else
             return cli_fail(EXIT_USAGE, "unknown option '%s' (see gibench --help)", argv[i]);
     }
+    if (version)
+        return i < argc ? cli_fail(EXIT_USAGE, "--version takes no command") : print_version();
     if (i >= argc) {
         fputs(usage, stderr);
         return EXIT_USAGE;
@@ -56,6 +89,23 @@ int main(int argc, char **argv)
     const char *cmd = argv[i];
     int sub_argc = argc - i - 1;
     char **sub_argv = argv + i + 1;
+    if (!strcmp(cmd, "help")) {
+        if (sub_argc == 0) {
+            fputs(usage, stdout);
+            return EXIT_OK;
+        }
+        if (sub_argc > 1)
+            return cli_fail(EXIT_USAGE, "help: one command at a time (gibench help COMMAND)");
+        const char *which = wants_help(1, sub_argv) ? "help" : sub_argv[0];
+        if (!cli_command_help(which, stdout))
+            return cli_fail(EXIT_USAGE, "help: unknown command '%s' (see gibench --help)", sub_argv[0]);
+        return EXIT_OK;
+    }
+    if (wants_help(sub_argc, sub_argv)) {
+        if (!cli_command_help(cmd, stdout))
+            return cli_fail(EXIT_USAGE, "unknown command '%s' (see gibench --help)", cmd);
+        return EXIT_OK;
+    }
     if (!strcmp(cmd, "methods"))
         return cmd_methods(sub_argc, sub_argv);
     if (!strcmp(cmd, "info"))
@@ -72,9 +122,5 @@ int main(int argc, char **argv)
         return cmd_reference(sub_argc, sub_argv);
     if (!strcmp(cmd, "conformance"))
         return cmd_conformance(sub_argc, sub_argv);
-    if (!strcmp(cmd, "help")) {
-        fputs(usage, stdout);
-        return EXIT_OK;
-    }
     return cli_fail(EXIT_USAGE, "unknown command '%s' (see gibench --help)", cmd);
 }

@@ -282,6 +282,8 @@ json_object *runner_execute(const run_spec *s, int resume)
             !(json_object_object_get_ex(old, "status", &st) && !strcmp(json_object_get_string(st), "interrupted"))) {
             json_object_put(rec);
             args_free(&b);
+            /* for the caller's progress line only; it removes the key */
+            json_object_object_add(old, "cached", json_object_new_boolean(1));
             return old;
         }
         json_object_put(old);

@@ -1,0 +1,97 @@
+/* The help of every command: `gibench help CMD` and `gibench CMD --help`
+ * (README.md, "Command line", says the same at length). */
+#include "cli.h"
+
+#include <string.h>
+
+typedef struct command_help {
+    const char *name, *text;
+} command_help;
+
+static const command_help helps[] = {
+    {"methods",
+     "usage: gibench methods [--json]\n"
+     "List the method plugins found (the build's plugins/ and GIBENCH_PLUGIN_PATH): id, paper,\n"
+     "caps, bounce count and every parameter with its type, default, range and meaning.\n"
+     "  --json   the same as JSON (what bash completion and scripts read)\n"},
+    {"info",
+     "usage: gibench info SCENE [--json]\n"
+     "Describe a glTF scene: objects, triangles, materials, lights, cameras, animation, bounds.\n"
+     "  --json   as JSON\n"},
+    {"render",
+     "usage: gibench render --scene S --method M --out FILE [--out FILE]... [options]\n"
+     "Render one method on one scene and camera; write the image and, with --timings, its timings.\n"
+     "  --scene S              glTF scene (.gltf/.glb)\n"
+     "  --method M             method id (gibench methods)\n"
+     "  --out FILE             .exr (linear float), .pfm or .png (tonemapped); up to 4\n"
+     "  --camera NAME|#k       the scene's camera (default: its first)\n"
+     "  --size WxH             image size (default 256x256)\n"
+     "  --param k=v            a method parameter (repeatable; gibench methods lists them)\n"
+     "  --frames N             frames of a still view (progressive methods converge); default 1\n"
+     "  --warmup N             frames left out of the timing statistics\n"
+     "  --time T               scene time in seconds (animation)\n"
+     "  --animate FPS          advance the scene's animation 1/FPS per frame (update() + render())\n"
+     "  --seed N               random seed (default 1)\n"
+     "  --exposure EV          stops applied before tonemapping (PNG)\n"
+     "  --timings FILE.json    method, parameters, GL renderer, timer mode, per-stage times, stats\n"
+     "  --no-cache             precompute afresh and keep nothing (timing of precomputation)\n"
+     "  --curve-ref NAME=IMAGE record the error against IMAGE after frames 1, 2, 4, ... (up to 4)\n"
+     "Prints a progress bar on a terminal and a one-line summary at the end (-q: none).\n"},
+    {"reference",
+     "usage: gibench reference --scene S --out FILE.exr [--out FILE.png] [options]\n"
+     "Embree path-traced reference, progressive passes until a stopping rule; EXR with mean and variance.\n"
+     "  --camera NAME|#k   --size WxH   --seed N   --exposure EV   --threads N\n"
+     "  --spp N                 stop at N samples per pixel\n"
+     "  --time S                stop after S seconds of rendering\n"
+     "  --target-se E           stop when the mean relative standard error reaches E\n"
+     "  --max-bounces B|inf     path length limit (B = 1: direct light only)\n"
+     "  --time-of-scene T       scene time (animation)\n"
+     "  --pixel box|center      camera rays spread over the pixel (box) or through its centre\n"
+     "  --stats FILE.json       samples, rays, time, standard error\n"},
+    {"diff",
+     "usage: gibench diff TEST REFERENCE [--json] [--heatmap FILE.png] [--flip-map FILE.png]\n"
+     "                    [--exposure EV] [--ppd N]\n"
+     "Error metrics of TEST against REFERENCE: RMSE, relMSE, MAE, PSNR, SSIM, FLIP, mean luminance.\n"
+     "  --json             as JSON\n"
+     "  --heatmap FILE     relative error map with its colour bar (log scale)\n"
+     "  --flip-map FILE    FLIP map\n"
+     "  --exposure EV      stops before tonemapping (PSNR, SSIM, FLIP)\n"
+     "  --ppd N            FLIP pixels per degree (default 67.02)\n"},
+    {"compare",
+     "usage: gibench compare --scene S --methods a,b,...|all --out DIR [options]\n"
+     "Methods side by side against the path-traced references (full GI and bounce-matched);\n"
+     "writes DIR/report.md, index.html and runs.csv. Options as render (--size, --frames,\n"
+     "--warmup, --camera, --seed, --exposure, --time) and:\n"
+     "  --param method.k=v     a parameter of one method (repeatable)\n"
+     "  --reference FILE.exr   use this full-GI reference instead of rendering one\n"
+     "  --ref-spp N  --ref-target-se E  --ref-bounces B   how the references are rendered\n"
+     "  --timeout S            seconds per method run\n"
+     "  --fresh                rerun methods even when a result for the same configuration exists\n"},
+    {"study",
+     "usage: gibench study STUDY.json --out DIR [--jobs N] [--resume|--fresh] [--dry-run]\n"
+     "Run a declarative experiment (README.md, \"Studies\"): every method setting x scene x repeat in\n"
+     "its own process, against the references, with convergence curves, Pareto fronts and the\n"
+     "equal-error and equal-time tables; cached runs are not run again.\n"
+     "  --out DIR     output folder (locked while a study runs in it)\n"
+     "  --jobs N      worker processes\n"
+     "  --resume      keep earlier results of the same configuration (the default)\n"
+     "  --fresh       run everything again\n"
+     "  --dry-run     check the file and print the plan; run nothing\n"},
+    {"conformance",
+     "usage: gibench conformance [--method M] [--json] [--size N] [--item-timeout S]\n"
+     "The conformance suite on every method (or M): closed emitting sphere = Le * sum rho^k for its\n"
+     "bounce count, finiteness, determinism, caps honesty, parameter checks.\n"
+     "  --json   as JSON   --size N   image size   --item-timeout S   seconds per check\n"},
+    {"help", "usage: gibench help [COMMAND]\nThe list of commands, or the help of one.\n"},
+};
+
+int cli_command_help(const char *cmd, FILE *to)
+{
+    for (size_t i = 0; i < sizeof helps / sizeof helps[0]; i++)
+        if (!strcmp(helps[i].name, cmd)) {
+            fputs(helps[i].text, to);
+            fputs("exit status: 0 success, 1 failure while running, 2 bad usage or bad input\n", to);
+            return 1;
+        }
+    return 0;
+}
