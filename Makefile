@@ -12,9 +12,15 @@ all: build
 deps:
 	@bash scripts/install-deps.sh
 
+# Bash completion of commands, methods and parameters, generated from the
+# build's own `gibench methods --json` into the user's completion folder.
+COMPLETION_DIR ?= $(or $(XDG_DATA_HOME),$(HOME)/.local/share)/bash-completion/completions
+
 build: deps
 	cmake --preset release >/dev/null
 	cmake --build --preset release
+	@mkdir -p $(COMPLETION_DIR) && python3 scripts/gen-completion.py $(GIBENCH) $(COMPLETION_DIR)/gibench \
+	  || echo "make: bash completion not installed (scripts/gen-completion.py failed)"
 
 test: test-release test-asan
 

@@ -18,8 +18,9 @@ pkgs=(
   # (VTK draws through EGL, see harness/charts.cpp).
   xvfb xauth
   libjson-c-dev libxxhash-dev
-  # scripts/*.py (the results tables, their test integration.results_tables)
-  python3
+  # scripts/*.py (the results tables, their test integration.results_tables;
+  # the bash completion, scripts/gen-completion.py, which `make` installs)
+  python3 bash-completion
 )
 if [ "${1:-}" = "--sources" ]; then
   pkgs+=(embree-tools blender-data)
