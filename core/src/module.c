@@ -63,6 +63,10 @@ void *gi_module_symbol(const char *file, const char *symbol, const char *what, g
         if (!handle) {
             char reason[1024];
             const char *e = dlerror();
+            /* dlerror() begins with the path, which the message names already. */
+            size_t pn = strlen(path);
+            if (e && !strncmp(e, path, pn) && !strncmp(e + pn, ": ", 2))
+                e += pn + 2;
             snprintf(reason, sizeof reason, "%s", e ? e : "unknown dlopen error");
             one_line(reason);
             pthread_mutex_unlock(&lock);
