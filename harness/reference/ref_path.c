@@ -55,15 +55,8 @@ static inline float next(uint32_t *rng)
 static inline int trace(const ref_scene *rs, gi_vec3 o, gi_vec3 d, float tnear, float tfar,
                         ref_hit *h, ref_counters *c)
 {
-    gi_rt_hit hit;
     c->rays++;
-    if (!gi_rt_intersect(rs->rt, o, d, tnear, tfar, &hit))
-        return 0;
-    h->t = hit.t;
-    h->u = hit.u;
-    h->v = hit.v;
-    h->prim = hit.triangle;
-    return 1;
+    return gi_rt_intersect_tuv(rs->rt, o, d, tnear, tfar, &h->t, &h->u, &h->v, &h->prim);
 }
 
 /* 1 when something lies on the segment o + t d, 0 <= t <= tfar. */
