@@ -5,11 +5,18 @@
 # paired and interleaved runs (issue 14).
 #
 #   scripts/ref-vs-embree.sh [--rounds N] [--spp S] [--size N] [--length L]
-#                            [GIBENCH [LABEL]]...
+#                            [--scene point|area] [GIBENCH]...
 #
-# Scenes: Embree's models/cornell_box.obj with its cornell_box.ecs (camera,
-# point light) and our scenes/cornell_box_coarse.gltf, the same 36 triangles
-# divided by 100 (scenes/README.md), lit by its emissive ceiling quad. Path
+# The shared scene: Embree's models/cornell_box.obj with its cornell_box.ecs
+# (camera, fov 37, point light at (213, 300, 227), intensity 1e5), and for
+# us scenes/cornell_box_coarse.gltf, the same 36 triangles divided by 100
+# (scenes/README.md), turned here into the same set-up: its ceiling quad no
+# longer emits (Embree's obj has it as plain geometry too), a
+# KHR_lights_punctual point light at (2.13, 3.00, 2.27) of intensity
+# 1e5 / 100^2 and the camera's yfov 37 degrees. So both trace the same rays
+# against the same triangles: one shadow ray to the point light and one
+# continuation ray per vertex (--scene area keeps our emissive quad instead,
+# for reference: one shadow ray to a point sampled on it). Path
 # length L: Embree's --max-path-length L (1 = primary ray + shadow ray) and
 # our --max-bounces L (1 = direct light) trace the same rays per path.
 # Each round runs, in a random order, every program at S spp and at 1 spp;
@@ -22,7 +29,7 @@
 # Needs: embree-tools (scripts/install-deps.sh --sources), python3.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-rounds=15 spp=64 size=128 length=3
+rounds=15 spp=64 size=128 length=3 scene=point
 builds=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -30,6 +37,7 @@ while [ $# -gt 0 ]; do
     --spp) spp=$2; shift 2 ;;
     --size) size=$2; shift 2 ;;
     --length) length=$2; shift 2 ;;
+    --scene) scene=$2; shift 2 ;;
     -*) echo "ref-vs-embree: unknown option '$1'" >&2; exit 2 ;;
     *) builds+=("$1"); shift ;;
   esac
@@ -44,12 +52,38 @@ done
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 cp "$models"/cornell_box.obj "$models"/cornell_box.mtl "$models"/cornell_box.ecs "$tmp"/
+cp scenes/cornell_box_coarse.gltf scenes/cornell_box_coarse.bin "$tmp"/
+case "$scene" in
+  area) ours_scene=$tmp/cornell_box_coarse.gltf ;;
+  point)
+    ours_scene=$tmp/cornell_box_point.gltf
+    python3 - "$tmp" <<'EOF'
+import json, math, sys
+d = sys.argv[1]
+g = json.load(open(d + "/cornell_box_coarse.gltf"))
+for m in g["materials"]:
+    if m.get("name") == "light":
+        m.pop("emissiveFactor", None)
+        m.pop("extensions", None)
+g["extensionsUsed"] = [e for e in g["extensionsUsed"] if e != "KHR_materials_emissive_strength"] + ["KHR_lights_punctual"]
+g.setdefault("extensions", {})["KHR_lights_punctual"] = {
+    "lights": [{"name": "ecs_point", "type": "point", "color": [1.0, 1.0, 1.0], "intensity": 10.0}]}
+g["nodes"].append({"name": "ecs_point", "translation": [2.13, 3.00, 2.27],
+                   "extensions": {"KHR_lights_punctual": {"light": 0}}})
+g["scenes"][0]["nodes"].append(len(g["nodes"]) - 1)
+g["cameras"][0]["perspective"]["yfov"] = math.radians(37.0)
+json.dump(g, open(d + "/cornell_box_point.gltf", "w"), indent=1)
+EOF
+    ;;
+  *) echo "ref-vs-embree: --scene '$scene' is not point or area" >&2; exit 2 ;;
+esac
 
-python3 - "$tmp" "$rounds" "$spp" "$size" "$length" "${builds[@]}" <<'EOF'
+python3 - "$tmp" "$rounds" "$spp" "$size" "$length" "$ours_scene" "${builds[@]}" <<'EOF'
 import json, os, random, resource, statistics, subprocess, sys, time
 
 tmp, rounds, spp, size, length = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4]), int(sys.argv[5])
-builds = sys.argv[6:]
+ours_scene = sys.argv[6]
+builds = sys.argv[7:]
 
 def run(argv, cwd=None):
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -66,7 +100,7 @@ def embree(s):
              "--spp", str(s), "--max-path-length", str(length), "-o", os.path.join(tmp, "embree.tga")], tmp)
 
 def ours(b, s, traversal, tag):
-    argv = [b, "reference", "--scene", "scenes/cornell_box_coarse.gltf", "--size", "%dx%d" % (size, size),
+    argv = [b, "reference", "--scene", ours_scene, "--size", "%dx%d" % (size, size),
             "--spp", str(s), "--max-bounces", str(length), "--threads", "1",
             "--out", os.path.join(tmp, tag + ".exr"), "--stats", os.path.join(tmp, tag + ".json")]
     if traversal:
@@ -106,7 +140,7 @@ for _ in range(rounds):
             render_s[k].append(st["render_seconds"])
 
 samples = (spp - 1) * size * size
-print("%dx%d, %d vs 1 spp, path length %d, 1 thread, %d interleaved rounds (medians)" % (size, size, spp, length, rounds))
+print("%dx%d, %d vs 1 spp, path length %d, 1 thread, %d interleaved rounds (medians); ours: %s" % (size, size, spp, length, rounds, os.path.basename(ours_scene)))
 for i, b in enumerate(builds):
     print("  gibench[%d] = %s" % (i, b))
 print("%-26s %14s %14s %14s" % ("program", "Msamples/s cpu", "Msamples/s wall", "ratio cpu (wall)"))

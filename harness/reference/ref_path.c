@@ -325,6 +325,13 @@ void ref_path_sample(const ref_scene *rs, uint32_t x, uint32_t y, uint32_t *rng,
         if (rs->light_count > 0)
             punctual_lights(rs, &s, beta, L, c);
 
+        /* The vertex a continuation would find could add only emission
+         * (depth + 1 = max_bounces); a scene without emitters and without
+         * an environment has none to add, so the ray is not traced (the
+         * image is the same bits, the path ends here either way). */
+        if (depth + 1 == rs->max_bounces && rs->emitter_count == 0 && !rs->env)
+            break;
+
         /* BSDF sampling continues the path. */
         float u1 = next(rng), u2 = next(rng), u3 = next(rng);
         gi_vec3 wi;
