@@ -35,6 +35,7 @@ typedef struct ref_opts {
     float scene_time, exposure;
     gi_ref_strategy strategy;
     int pixel_center;
+    int robust_traversal;
 } ref_opts;
 
 static int is_exr(const char *path)
@@ -48,7 +49,8 @@ static int parse_opts(int argc, char **argv, ref_opts *o)
     static const char *valued[] = {"--scene",    "--camera",        "--size",        "--spp",
                                    "--time",     "--target-se",     "--max-bounces", "--seed",
                                    "--threads",  "--time-of-scene", "--out",         "--stats",
-                                   "--exposure", "--strategy",      "--pixel"};
+                                   "--exposure", "--strategy",      "--pixel",
+                                   "--traversal"};
     memset(o, 0, sizeof *o);
     o->width = o->height = 256;
     o->seed = 1;
@@ -129,6 +131,10 @@ static int parse_opts(int argc, char **argv, ref_opts *o)
             if (strcmp(v, "box") && strcmp(v, "center"))
                 return cli_fail(EXIT_USAGE, "reference: --pixel '%s' is not box or center", v);
             o->pixel_center = !strcmp(v, "center");
+        } else if (!strcmp(a, "--traversal")) {
+            if (strcmp(v, "fast") && strcmp(v, "robust"))
+                return cli_fail(EXIT_USAGE, "reference: --traversal '%s' is not fast or robust", v);
+            o->robust_traversal = !strcmp(v, "robust");
         }
     }
     if (!o->scene)
@@ -224,6 +230,8 @@ static json_object *stats_json(const run_state *r, const ref_opts *o, int camera
     json_object_object_add(j, "strategy",
                            json_object_new_string(gi_ref_strategy_name(o->strategy)));
     json_object_object_add(j, "pixel", json_object_new_string(o->pixel_center ? "center" : "box"));
+    json_object_object_add(j, "traversal",
+                           json_object_new_string(o->robust_traversal ? "robust" : "fast"));
     json_object_object_add(j, "threads", json_object_new_int((int32_t)st.threads));
     json_object_object_add(j, "stop", json_object_new_string(stop));
     json_object_object_add(j, "wall_seconds", json_object_new_double(wall));
@@ -282,6 +290,7 @@ static int run(run_state *r, const ref_opts *o)
     d.threads = o->threads;
     d.strategy = o->strategy;
     d.pixel_center = o->pixel_center;
+    d.robust_traversal = o->robust_traversal;
     gi_result res = gi_ref_create(&d, &r->ref, &err);
     if (res != GI_OK)
         return cli_fail(res == GI_ERR_INVALID_ARGUMENT ? EXIT_USAGE : EXIT_RUN, "%s", err.text);

@@ -29,7 +29,7 @@ static const char usage[] =
     "  reference --scene S --out FILE [--out FILE2] [--camera C] [--size WxH]\n"
     "         [--spp N] [--time S] [--target-se E] [--max-bounces B|inf] [--seed N]\n"
     "         [--threads N] [--time-of-scene T] [--exposure EV] [--stats FILE.json]\n"
-    "         [--pixel box|center]\n"
+    "         [--pixel box|center] [--traversal fast|robust]\n"
     "                                         Embree path-traced reference (EXR: mean + variance)\n"
     "  conformance [--method M] [--json] [--size N] [--item-timeout S]\n"
     "                                         the conformance suite: every check on every method (or M)\n"

@@ -4,11 +4,16 @@
 #   scripts/install-deps.sh            build, test and run dependencies
 #   scripts/install-deps.sh --sources  also the packages the scene-conversion
 #                                      scripts read (embree-tools, blender-data, npm)
+#                                      and scripts/ref-vs-embree.sh runs (embree-tools)
+#                                      and scripts/startup-time.sh runs (hyperfine)
 set -eu
 
 pkgs=(
   build-essential cmake ninja-build pkg-config clang libclang-rt-14-dev
   libembree-dev
+  # EXR (OpenEXR) and PNG writing (libpng) in the core; every other image
+  # format through the OpenImageIO module, loaded only when needed
+  libopenexr-dev libpng-dev
   libopenimageio-dev openimageio-tools
   libtinygltf-dev nlohmann-json3-dev libstb-dev
   libvtk9-dev fonts-dejavu-core
@@ -23,7 +28,7 @@ pkgs=(
   python3 bash-completion
 )
 if [ "${1:-}" = "--sources" ]; then
-  pkgs+=(embree-tools blender-data)
+  pkgs+=(embree-tools blender-data hyperfine)
   # npm runs the glTF validator and fetches the bunny and teapot meshes; a
   # machine that already has a Node.js with npm (not from Debian) keeps it.
   command -v npm >/dev/null 2>&1 || pkgs+=(nodejs npm)

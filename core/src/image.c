@@ -1,5 +1,5 @@
 /* Linear RGBA32F images in memory: allocation and the small whole-image
- * statistics the harness and the tests use. File I/O is in image_oiio.cpp. */
+ * statistics the harness and the tests use. File I/O is in image_io.c. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

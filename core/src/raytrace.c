@@ -139,8 +139,17 @@ static gi_result commit(gi_rt *rt, gi_error *err)
 
 gi_result gi_rt_create(const gi_scene *s, float time, gi_rt **out, gi_error *err)
 {
+    return gi_rt_create_ex(s, time, 0u, out, err);
+}
+
+gi_result gi_rt_create_ex(const gi_scene *s, float time, unsigned flags, gi_rt **out,
+                          gi_error *err)
+{
     if (out)
         *out = NULL;
+    if (flags & ~(unsigned)GI_RT_FAST_TRAVERSAL)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "raytrace: unknown option bits 0x%x",
+                            flags & ~(unsigned)GI_RT_FAST_TRAVERSAL);
     if (!s || !out)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "raytrace: %s is NULL",
                             !s ? "the scene" : "the output pointer");
@@ -171,7 +180,8 @@ gi_result gi_rt_create(const gi_scene *s, float time, gi_rt **out, gi_error *err
         goto fail;
     }
     rtcSetSceneBuildQuality(rt->rtc, RTC_BUILD_QUALITY_HIGH);
-    rtcSetSceneFlags(rt->rtc, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneFlags(rt->rtc,
+                     flags & GI_RT_FAST_TRAVERSAL ? RTC_SCENE_FLAG_NONE : RTC_SCENE_FLAG_ROBUST);
     rt->nrm = malloc((size_t)(s->vertex_count ? s->vertex_count : 1) * 3 * sizeof(float));
     if (!rt->nrm) {
         res = gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "raytrace: out of memory (%u vertices)",
@@ -276,28 +286,49 @@ static inline gi_vec3 vertex(const gi_rt *rt, uint32_t v)
     return gi_v3_load(rt->pos + 3 * (size_t)v);
 }
 
+/* rtcIntersect1 on one ray; 1 on a hit. */
+static inline int intersect1(const gi_rt *rt, gi_vec3 o, gi_vec3 d, float tmin, float tmax,
+                             struct RTCRayHit *rh)
+{
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    rh->ray.org_x = o.x;
+    rh->ray.org_y = o.y;
+    rh->ray.org_z = o.z;
+    rh->ray.tnear = tmin;
+    rh->ray.dir_x = d.x;
+    rh->ray.dir_y = d.y;
+    rh->ray.dir_z = d.z;
+    rh->ray.time = 0.0f;
+    rh->ray.tfar = tmax;
+    rh->ray.mask = ~0u;
+    rh->ray.id = 0;
+    rh->ray.flags = 0;
+    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(rt->rtc, &ctx, rh);
+    return rh->hit.geomID != RTC_INVALID_GEOMETRY_ID;
+}
+
+int gi_rt_intersect_tuv(const gi_rt *rt, gi_vec3 o, gi_vec3 d, float tmin, float tmax, float *t,
+                        float *u, float *v, uint32_t *triangle)
+{
+    assert(rt && t && u && v && triangle);
+    struct RTCRayHit rh;
+    if (!intersect1(rt, o, d, tmin, tmax, &rh))
+        return 0;
+    *t = rh.ray.tfar;
+    *u = rh.hit.u;
+    *v = rh.hit.v;
+    *triangle = rh.hit.primID;
+    return 1;
+}
+
 int gi_rt_intersect(const gi_rt *rt, gi_vec3 o, gi_vec3 d, float tmin, float tmax, gi_rt_hit *hit)
 {
     assert(rt && hit);
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
     struct RTCRayHit rh;
-    rh.ray.org_x = o.x;
-    rh.ray.org_y = o.y;
-    rh.ray.org_z = o.z;
-    rh.ray.tnear = tmin;
-    rh.ray.dir_x = d.x;
-    rh.ray.dir_y = d.y;
-    rh.ray.dir_z = d.z;
-    rh.ray.time = 0.0f;
-    rh.ray.tfar = tmax;
-    rh.ray.mask = ~0u;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(rt->rtc, &ctx, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
+    if (!intersect1(rt, o, d, tmin, tmax, &rh))
         return 0;
     const gi_scene *s = rt->scene;
     uint32_t tri = rh.hit.primID;

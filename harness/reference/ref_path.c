@@ -55,15 +55,8 @@ static inline float next(uint32_t *rng)
 static inline int trace(const ref_scene *rs, gi_vec3 o, gi_vec3 d, float tnear, float tfar,
                         ref_hit *h, ref_counters *c)
 {
-    gi_rt_hit hit;
     c->rays++;
-    if (!gi_rt_intersect(rs->rt, o, d, tnear, tfar, &hit))
-        return 0;
-    h->t = hit.t;
-    h->u = hit.u;
-    h->v = hit.v;
-    h->prim = hit.triangle;
-    return 1;
+    return gi_rt_intersect_tuv(rs->rt, o, d, tnear, tfar, &h->t, &h->u, &h->v, &h->prim);
 }
 
 /* 1 when something lies on the segment o + t d, 0 <= t <= tfar. */
@@ -331,6 +324,13 @@ void ref_path_sample(const ref_scene *rs, uint32_t x, uint32_t y, uint32_t *rng,
             sample_environment(rs, &s, beta, rng, L, c);
         if (rs->light_count > 0)
             punctual_lights(rs, &s, beta, L, c);
+
+        /* The vertex a continuation would find could add only emission
+         * (depth + 1 = max_bounces); a scene without emitters and without
+         * an environment has none to add, so the ray is not traced (the
+         * image is the same bits, the path ends here either way). */
+        if (depth + 1 == rs->max_bounces && rs->emitter_count == 0 && !rs->env)
+            break;
 
         /* BSDF sampling continues the path. */
         float u1 = next(rng), u2 = next(rng), u3 = next(rng);

@@ -163,7 +163,8 @@ gi_result ref_scene_build(ref_scene *rs, const gi_ref_desc *d, gi_error *err)
     if (res != GI_OK)
         return res;
 
-    res = gi_rt_create(s, d->time, &rs->rt, err);
+    res = gi_rt_create_ex(s, d->time, d->robust_traversal ? 0u : (unsigned)GI_RT_FAST_TRAVERSAL,
+                          &rs->rt, err);
     if (res != GI_OK)
         return res;
     rs->pos = gi_rt_positions(rs->rt);

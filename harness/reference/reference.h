@@ -86,10 +86,16 @@ typedef struct gi_ref_desc {
      * GPU methods' G-buffers sample it (so that a comparison measures
      * shading, not anti-aliasing). */
     int pixel_center;
+    /* 0: Embree's default traversal (GI_RT_FAST_TRAVERSAL, what Embree's
+     * own path tracer uses); 1: RTC_SCENE_FLAG_ROBUST, slower, never lets
+     * a ray through the shared edge of two triangles. The two agree to
+     * float rounding except for such rare rays (statistically the same
+     * image; `gibench reference --traversal`). */
+    int robust_traversal;
 } gi_ref_desc;
 
 /* Defaults: scene NULL, camera 0, time 0, size 0 (must be set), seed 1,
- * unlimited bounces, all CPUs, MIS. */
+ * unlimited bounces, all CPUs, MIS, fast traversal. */
 void gi_ref_desc_init(gi_ref_desc *d);
 
 typedef struct gi_ref gi_ref;

@@ -86,7 +86,9 @@ static inline void gi_brdf_eval(const gi_brdf *b, gi_vec3 N, gi_vec3 wo, gi_vec3
     if (gi_v3_dot(N, wo) <= 0.0f || gi_v3_dot(N, wi) <= 0.0f)
         return;
     float spec = 0.0f;
-    if (!gi_brdf_is_mirror(b)) {
+    /* A purely diffuse material skips the lobe (and its powf): ks * spec
+     * would add exactly 0. */
+    if (!gi_brdf_is_mirror(b) && (b->ks[0] != 0.0f || b->ks[1] != 0.0f || b->ks[2] != 0.0f)) {
         float c = gi_v3_dot(gi_reflect(wo, N), wi);
         if (c > 0.0f)
             spec = (b->n + 2.0f) * (0.5f * GI_INV_PI) * powf(c, b->n);
