@@ -4,6 +4,7 @@
 #include "vlf_core.h"
 
 #include <float.h>
+#include <stdint.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -250,13 +251,14 @@ static int frag_push(frag_buf *b, uint32_t cell, float depth, uint32_t elem)
  * the projected triangle). Calls emit for each covered cell. */
 typedef int (*cell_fn)(void *user, uint32_t cx, uint32_t cy, float depth);
 
-static int raster_tri(const vlf_field *f, uint32_t i, const gi_vec3 *p, cell_fn emit, void *user)
+static int raster_tri(const vlf_field *f, const vlf_psf *fr, const gi_vec3 *p, cell_fn emit, void *user)
 {
     float x[3], y[3], z[3];
-    float S = (float)f->prm.S;
+    float NS = (float)(f->prm.N * f->prm.S);
     for (int k = 0; k < 3; k++) {
-        vlf_psf_project(f, i, p[k], &x[k], &y[k], &z[k]);
-        x[k] *= S, y[k] *= S;
+        x[k] = (gi_v3_dot(p[k], fr->u) + 1.0f) * 0.5f * NS;
+        y[k] = (gi_v3_dot(p[k], fr->v) + 1.0f) * 0.5f * NS;
+        z[k] = gi_v3_dot(p[k], fr->n);
     }
     float area2 = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
     if (fabsf(area2) < 1e-9f)
@@ -349,7 +351,7 @@ static int build_psf(vlf_field *f, uint32_t i, frag_buf *buf, vlf_rect *rects)
     for (uint32_t ti = 0; ti < f->tri_count; ti++) {
         uint32_t fi = f->tri_face[ti];
         sort_ctx c = {buf, f, p, &f->faces[fi], N, bbox + 4 * fi};
-        if (!raster_tri(f, i, f->tri_p + 3 * (size_t)ti, emit_frag, &c)) {
+        if (!raster_tri(f, p, f->tri_p + 3 * (size_t)ti, emit_frag, &c)) {
             free(bbox);
             return 0;
         }
@@ -668,6 +670,125 @@ oom:
 
 /* ---- Propagation (§3.2-§3.4) --------------------------------------------- */
 
+/* Fragments of all faces along a perturbed direction (frame fr), sorted
+ * per ray front to back; kept with their depths (§3.5: perturbed
+ * directions are sorted like fixed ones, used for transport, discarded). */
+static int perturbed_list(vlf_field *f, const vlf_psf *fr, frag_buf *buf)
+{
+    int32_t bb[4];
+    buf->n = 0;
+    for (uint32_t ti = 0; ti < f->tri_count; ti++) {
+        bb[0] = bb[1] = INT32_MAX;
+        bb[2] = bb[3] = -1;
+        sort_ctx c = {buf, f, fr, &f->faces[f->tri_face[ti]], f->prm.N * f->prm.S, bb};
+        if (!raster_tri(f, fr, f->tri_p + 3 * (size_t)ti, emit_frag, &c))
+            return 0;
+    }
+    qsort(buf->v, buf->n, sizeof *buf->v, frag_cmp);
+    return 1;
+}
+
+/* The tile slot of non-diffuse face fc in fixed subfield i holding VLF
+ * point q, or SIZE_MAX where q's cell is outside the face there. */
+static size_t slot_at(const vlf_field *f, const vlf_face *fc, uint32_t i, gi_vec3 q)
+{
+    float x, y, z;
+    vlf_psf_project(f, i, q, &x, &y, &z);
+    const vlf_rect *r = &f->rects[(size_t)fc->nd * f->prm.l + i];
+    int cx = (int)floorf(x) - r->x0, cy = (int)floorf(y) - r->y0;
+    if (cx < 0 || cy < 0 || cx >= (int)r->w || cy >= (int)r->h)
+        return SIZE_MAX;
+    size_t slot = r->offset + (size_t)cy * r->w + (size_t)cx;
+    return f->nd_cover[slot] ? slot : SIZE_MAX;
+}
+
+/* A sweep along a perturbed direction fr->n (sign: +n or -n) standing in
+ * for fixed direction i with weight dW: as sweep() below, but non-diffuse
+ * faces read and write the tiles of fixed subfield i at each fragment's
+ * point. */
+static void sweep_perturbed(vlf_field *f, uint32_t i, const vlf_psf *fr, const frag_buf *buf, int sign, float dW,
+                            int first_iteration)
+{
+    uint32_t S = f->prm.S, N = f->prm.N * S;
+    float inv_s2 = 1.0f / (float)(S * S);
+    gi_vec3 t = gi_v3_scale(fr->n, (float)sign);
+    float cell_area = (2.0f / (float)N) * (2.0f / (float)N);
+    float min_area = 1.0f / (64.0f * f->prm.density * f->prm.density);
+    float sky[3] = {0, 0, 0};
+    if (first_iteration && f->env)
+        gi_envmap_eval(f->env, gi_v3_scale(t, -1.0f), sky);
+    double shot = 0, recv = 0, back = 0, esc = 0;
+    size_t a = 0;
+    while (a < buf->n) {
+        size_t e = a;
+        while (e < buf->n && buf->v[e].cell == buf->v[a].cell)
+            e++;
+        uint32_t c = buf->v[a].cell;
+        float U = ((float)(c % N) + 0.5f) / (float)N * 2.0f - 1.0f, V = ((float)(c / N) + 0.5f) / (float)N * 2.0f - 1.0f;
+        gi_vec3 o = gi_v3_add(gi_v3_scale(fr->u, U), gi_v3_scale(fr->v, V));
+        float L[3] = {sky[0], sky[1], sky[2]};
+        for (size_t j = 0; j < e - a; j++) {
+            const frag_tmp *fg = &buf->v[sign > 0 ? a + j : e - 1 - j];
+            uint32_t el = fg->elem;
+            const vlf_face *fc = &f->faces[f->elem_face[el]];
+            float cs = gi_v3_dot(fc->n, t);
+            float lum = L[0] + L[1] + L[2];
+            size_t slot = SIZE_MAX;
+            if (fc->nd >= 0 && cs != 0.0f)
+                slot = slot_at(f, fc, i, gi_v3_add(o, gi_v3_scale(fr->n, fg->depth)));
+            if (cs < 0.0f) {
+                float s = cell_area * dW / fmaxf(f->elem_area[el], min_area);
+                for (int q = 0; q < 3; q++)
+                    f->E_next[3 * (size_t)el + q] += L[q] * s;
+                if (slot != SIZE_MAX)
+                    for (int q = 0; q < 3; q++)
+                        f->in[3 * slot + q] += L[q] * inv_s2 / (float)f->prm.perturbed;
+                recv += lum;
+                L[0] = L[1] = L[2] = 0.0f;
+            } else if (cs > 0.0f) {
+                back += lum;
+                for (int q = 0; q < 3; q++)
+                    L[q] = f->L_cur[3 * (size_t)el + q] * fc->send_scale;
+                if (slot != SIZE_MAX)
+                    for (int q = 0; q < 3; q++)
+                        L[q] += f->out_cur[3 * slot + q];
+                shot += L[0] + L[1] + L[2];
+            }
+            f->st.samples++;
+        }
+        esc += L[0] + L[1] + L[2];
+        a = e;
+    }
+    double w = (double)cell_area * dW / 3.0;
+    f->st.flux_shot += shot * w;
+    f->st.flux_received += recv * w;
+    f->st.flux_back += back * w;
+    f->st.flux_escaped += esc * w;
+}
+
+/* Perturbed direction k of fixed direction i: uniform in the cap of solid
+ * angle dOmega_i around w_i (the paper's samples spread over the solid
+ * angle each fixed direction stands for), from a hash of (seed, i, k). */
+static gi_vec3 perturbed_dir(const vlf_field *f, uint32_t i, uint32_t k)
+{
+    uint32_t h = f->prm.seed * 0x9E3779B9u ^ (i * 0x85EBCA6Bu) ^ (k * 0xC2B2AE35u);
+    float u[2];
+    for (int j = 0; j < 2; j++) {
+        h ^= h >> 16;
+        h *= 0x7FEB352Du;
+        h ^= h >> 15;
+        h *= 0x846CA68Bu;
+        h ^= h >> 16;
+        u[j] = (float)(h >> 8) / 16777216.0f;
+    }
+    float cos_max = 1.0f - f->dirs.solid_angle[i] / (2.0f * GI_PI);
+    float cz = 1.0f - u[0] * (1.0f - cos_max), sz = sqrtf(fmaxf(0.0f, 1.0f - cz * cz));
+    float phi = 2.0f * GI_PI * u[1];
+    const vlf_psf *p = &f->psf[i];
+    return gi_v3_normalize(gi_v3_add(gi_v3_scale(p->n, cz),
+                                     gi_v3_add(gi_v3_scale(p->u, sz * cosf(phi)), gi_v3_scale(p->v, sz * sinf(phi)))));
+}
+
 /* One sweep of subfield i along travel direction t = sign * w_i, front to
  * back along t through every ray's fragments with the radiance interface:
  * receivers (front side facing against t) take the interface's radiance,
@@ -878,17 +999,35 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
     }
     f->st.flux_shot = f->st.flux_received = f->st.flux_back = f->st.flux_escaped = 0;
     f->st.samples = 0;
+    frag_buf pbuf = {0};
     for (uint32_t it = 0; it < f->prm.iterations; it++) {
         for (uint32_t i = 0; i < l; i++) {
-            if (cancelled && cancelled(user))
+            if (cancelled && cancelled(user)) {
+                free(pbuf.v);
                 return -1;
+            }
             for (uint32_t fi = 0; fi < f->face_count; fi++)
                 if (f->faces[fi].nd >= 0) {
                     const vlf_rect *r = &f->rects[(size_t)f->faces[fi].nd * l + i];
                     memset(f->in + 3 * (size_t)r->offset, 0, (size_t)r->w * r->h * 3 * sizeof(float));
                 }
-            sweep(f, i, +1, it == 0);
-            sweep(f, i, -1, it == 0);
+            if (f->prm.perturbed == 0) {
+                sweep(f, i, +1, it == 0);
+                sweep(f, i, -1, it == 0);
+            } else {
+                for (uint32_t k = 0; k < f->prm.perturbed; k++) {
+                    vlf_psf fr;
+                    fr.n = perturbed_dir(f, i, k);
+                    gi_onb(fr.n, &fr.u, &fr.v);
+                    if (!perturbed_list(f, &fr, &pbuf)) {
+                        free(pbuf.v);
+                        return -1;
+                    }
+                    /* each sign's solid angle: the fixed direction's, shared */
+                    sweep_perturbed(f, i, &fr, &pbuf, +1, f->dirs.solid_angle[i] / (float)f->prm.perturbed, it == 0);
+                    sweep_perturbed(f, i, &fr, &pbuf, -1, f->dirs.solid_angle[i + l] / (float)f->prm.perturbed, it == 0);
+                }
+            }
             if (f->nd_count)
                 scatter(f, i);
         }
@@ -904,6 +1043,7 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
             f->out_next[k] = 0.0f;
         }
     }
+    free(pbuf.v);
     f->st.propagate_s = now_s() - t0;
     return 0;
 }

@@ -41,6 +41,7 @@ typedef struct vlf_params {
     uint32_t S;          /* radiance interface cells per subfield cell and side (its super-sampling, §3.3) */
     float density;       /* diffuse elements per unit length (scene scaled into the unit sphere) */
     uint32_t iterations; /* shooting iterations */
+    uint32_t perturbed;  /* perturbed virtual directions per fixed direction for transport (0: the fixed one, §3.5) */
     uint32_t seed;
 } vlf_params;
 

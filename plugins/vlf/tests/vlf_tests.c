@@ -286,6 +286,18 @@ static void test_energy(void)
     EXPECT(fabs(absorbed / st->flux_received - 1.0) < 0.02, "irradiance x area %.5g vs received %.5g", absorbed,
            st->flux_received);
     vlf_field_free(&f);
+    /* the same with 3 perturbed directions per fixed one (§3.5) */
+    p.perturbed = 3;
+    EXPECT(vlf_field_build(&f, s, 0.0f, &p, err, sizeof err) == 0, "%s", err);
+    vlf_field_propagate(&f, NULL, NULL);
+    printf("energy, 3 perturbed directions: emitted %.6f shot %.6f received %.6f back %.6f escaped %.6f\n",
+           st->flux_emitted, st->flux_shot, st->flux_received, st->flux_back, st->flux_escaped);
+    CHECK_NEAR(st->flux_shot, st->flux_received + st->flux_back + st->flux_escaped, 1e-4 * st->flux_shot);
+    EXPECT(st->flux_escaped < 1e-3 * st->flux_shot && st->flux_back < 1e-3 * st->flux_shot,
+           "perturbed: light escaped (%.4g) or met back faces (%.4g)", st->flux_escaped, st->flux_back);
+    EXPECT(fabs(st->flux_shot / st->flux_emitted - 1.0) < 0.02, "perturbed: shot %.5g vs emitted %.5g", st->flux_shot,
+           st->flux_emitted);
+    vlf_field_free(&f);
     gi_scene_free(s);
 }
 
