@@ -40,7 +40,7 @@ static const gi_param_desc vlf_params_desc[] = {
      "diffuse elements per unit length, the scene scaled into the unit sphere (faces get k x k elements, k <= 64)"},
     {"iterations", GI_PARAM_INT, 8, 1, 64, NULL, "iterations (Sec. 6)",
      "shooting iterations; k iterations carry k bounces (max_bounces = 7 describes the default 8)"},
-    {"perturbed", GI_PARAM_INT, 0, 0, 64, NULL, "perturbed samples (Sec. 3.5)",
+    {"perturbed", GI_PARAM_INT, 0, 0, 36, NULL, "perturbed samples (Sec. 3.5)",
      "perturbed virtual directions per fixed direction, used only for transport (0: the fixed direction itself; "
      "the paper's high quality uses 36)"},
     {"seed", GI_PARAM_INT, 1, 0, 1000000, NULL, NULL, "seed of the perturbed directions"},
