@@ -340,6 +340,116 @@ static void test_furnace(void)
     }
 }
 
+/* Two quads: an emitter of radiance 1 at height 1 facing down, and below
+ * it a mirror (ks 0.8) tilted so that the emitter's light leaves it
+ * toward +x. */
+static void add_quad(gi_scene *s, uint32_t q, gi_vec3 a, gi_vec3 b, gi_vec3 c, gi_vec3 d, uint32_t material)
+{
+    gi_vec3 v[4] = {a, b, c, d};
+    for (int k = 0; k < 4; k++) {
+        gi_vertex *x = &s->vertices[4 * q + (uint32_t)k];
+        x->position[0] = v[k].x, x->position[1] = v[k].y, x->position[2] = v[k].z;
+        x->normal[2] = 1.0f;
+        x->material = material;
+    }
+    uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    for (int k = 0; k < 6; k++)
+        s->indices[6 * q + (uint32_t)k] = 4 * q + idx[k];
+}
+
+static void test_mirror(void)
+{
+    gi_scene *s = calloc(1, sizeof *s);
+    s->triangle_count = 4;
+    s->vertex_count = 8;
+    s->vertices = calloc(8, sizeof *s->vertices);
+    s->indices = calloc(12, sizeof *s->indices);
+    s->material_count = 2;
+    s->materials = calloc(2, sizeof *s->materials);
+    s->materials[0].emission[0] = s->materials[0].emission[1] = s->materials[0].emission[2] = 1.0f;
+    s->materials[0].albedo_texture = s->materials[1].albedo_texture = -1;
+    s->materials[1].ks[0] = s->materials[1].ks[1] = s->materials[1].ks[2] = 0.8f;
+    s->materials[1].mirror = 1;
+    s->materials[1].exponent = GI_MIRROR_EXPONENT;
+    s->node_count = 1;
+    s->nodes = calloc(1, sizeof *s->nodes);
+    s->nodes[0].parent = -1;
+    s->nodes[0].rotation[3] = 1.0f;
+    s->nodes[0].scale[0] = s->nodes[0].scale[1] = s->nodes[0].scale[2] = 1.0f;
+    s->object_count = 1;
+    s->objects = calloc(1, sizeof *s->objects);
+    s->objects[0].triangle_count = 4;
+    s->objects[0].vertex_count = 8;
+    /* emitter at z = 1, normal -z (clockwise seen from above) */
+    add_quad(s, 0, gi_v3(-0.3f, -0.3f, 1.0f), gi_v3(-0.3f, 0.3f, 1.0f), gi_v3(0.3f, 0.3f, 1.0f), gi_v3(0.3f, -0.3f, 1.0f), 0);
+    /* mirror around the origin, normal (sin 22.5, 0, cos 22.5): light coming
+     * down (-z) leaves along (sin 45, 0, cos 45) */
+    float c = cosf(GI_PI / 8), sn = sinf(GI_PI / 8);
+    gi_vec3 tx = gi_v3(c, 0, -sn), ty = gi_v3(0, 1, 0);
+    gi_vec3 P[4];
+    float uv[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    for (int k = 0; k < 4; k++)
+        P[k] = gi_v3_add(gi_v3_scale(tx, 0.3f * uv[k][0]), gi_v3_scale(ty, 0.3f * uv[k][1]));
+    add_quad(s, 1, P[0], P[1], P[2], P[3], 1);
+    float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+    for (uint32_t v = 0; v < 8; v++)
+        for (int a = 0; a < 3; a++)
+            lo[a] = fminf(lo[a], s->vertices[v].position[a]), hi[a] = fmaxf(hi[a], s->vertices[v].position[a]);
+    for (int a = 0; a < 3; a++)
+        s->objects[0].local_bounds[a] = lo[a], s->objects[0].local_bounds[3 + a] = hi[a];
+    vlf_params p = defaults();
+    p.iterations = 2;
+    vlf_field f;
+    char err[256];
+    int rc = vlf_field_build(&f, s, 0.0f, &p, err, sizeof err);
+    EXPECT(rc == 0, "%s", err);
+    if (rc == 0) {
+        vlf_field_propagate(&f, NULL, NULL);
+        int mf = -1;
+        for (uint32_t fi = 0; fi < f.face_count; fi++)
+            if (f.faces[fi].nd >= 0)
+                mf = (int)fi;
+        EXPECT(mf >= 0, "no non-diffuse face");
+        gi_vec3 refl = gi_v3_normalize(gi_v3(1, 0, 1));
+        /* mean stored radiance of the mirror along each signed direction */
+        double best_hit = 0.0, far = 0.0;
+        float best_ang = 10.0f;
+        for (uint32_t sd = 0; mf >= 0 && sd < 2 * p.l; sd++) {
+            gi_vec3 w = f.dirs.signed_dirs[sd];
+            uint32_t i = sd % p.l;
+            if (gi_v3_dot(w, f.faces[mf].n) <= 0.0f)
+                continue;
+            const vlf_rect *r = &f.rects[(size_t)f.faces[mf].nd * p.l + i];
+            double sum = 0.0;
+            uint32_t n = 0;
+            for (uint32_t k = 0; k < r->w * r->h; k++)
+                if (f.nd_cover[r->offset + k])
+                    sum += f.out_tot[3 * (size_t)(r->offset + k)], n++;
+            double mean = n ? sum / n : 0.0;
+            float ang = acosf(fminf(1.0f, gi_v3_dot(w, refl)));
+            if (ang < best_ang)
+                best_ang = ang, best_hit = mean;
+            if (ang > 1.0f)
+                far = fmax(far, mean);
+        }
+        /* the mirror's radiance toward the reflected direction shows the
+         * emitter through it: most of ks Le = 0.8 at the direction nearest
+         * the reflection (barycentric weights and the emitter's edges take
+         * some), and nothing far from it */
+        printf("mirror: stored radiance %.3f at the direction nearest the reflection (%.3f rad from it; ks Le = 0.8), "
+               "at most %.4f beyond 1 rad from it (the emitter subtends up to 0.54 rad seen from the mirror)\n", best_hit, best_ang, far);
+        EXPECT(best_hit > 0.3 && best_hit < 0.85, "mirror radiance toward the reflection %.3f", best_hit);
+        EXPECT(far < 0.01, "mirror radiance away from the reflection %.4f", far);
+        vlf_field_free(&f);
+    }
+    free(s->vertices);
+    free(s->indices);
+    free(s->materials);
+    free(s->objects);
+    free(s->nodes);
+    free(s);
+}
+
 int main(int argc, char **argv)
 {
     const char *part = argc > 1 ? argv[1] : "all";
@@ -352,8 +462,10 @@ int main(int argc, char **argv)
         test_energy(), any = 1;
     if (all || strcmp(part, "furnace") == 0)
         test_furnace(), any = 1;
+    if (all || strcmp(part, "mirror") == 0)
+        test_mirror(), any = 1;
     if (!any) {
-        fprintf(stderr, "vlf_tests: unknown part '%s' (dirs, order, energy, furnace)\n", part);
+        fprintf(stderr, "vlf_tests: unknown part '%s' (dirs, order, energy, furnace, mirror)\n", part);
         return 2;
     }
     return gi_test_finish();
