@@ -557,6 +557,12 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
         snprintf(err, err_size, "vlf: N = %u must be a multiple of the tile size m = %u", p->N, p->m);
         return -1;
     }
+    double ray_bytes = (double)p->l * (double)(p->N * p->S) * (double)(p->N * p->S) * sizeof(uint32_t);
+    if (ray_bytes > 2.0 * 1024 * 1024 * 1024) {
+        snprintf(err, err_size, "vlf: l (N S)^2 = %.3g rays need %.1f GB of depth lists alone; lower l, N or S",
+                 ray_bytes / sizeof(uint32_t), ray_bytes / (1024.0 * 1024 * 1024));
+        return -1;
+    }
     if (vlf_dirs_build(&f->dirs, p->l, err, err_size) != 0)
         return -1;
     if (s->triangle_count == 0) {
