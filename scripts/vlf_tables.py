@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """Tables of the vlf study next to the paper's numbers.
 
-Reads DIR/runs/*/result.json and DIR/references/*.exr.json written by
+Reads DIR/runs.csv written by
     gibench study harness/studies/vlf.json --out DIR
-(both are not committed: run this right after the study) and prints
-Markdown to stdout: Table 1 (faces, elements, sort / GPU init /
+and DIR/reference_rays.csv (the Embree references' rays per second; made
+from DIR/references/*.exr.json, which are not committed, when they are
+there) and prints Markdown to stdout: Table 1 (faces, elements, sort / GPU init /
 propagation, memory, render time per frame) beside the paper's Table 1,
 Fig. 8 (the glossy Cornell box against the path-traced reference, MSE and
 relMSE, low and high quality), the direction and resolution sweeps, and
@@ -14,6 +15,7 @@ reference's rays per second measured in the same study. Stdlib only.
 Usage: scripts/vlf_tables.py DIR > DIR/tables.md
 """
 
+import csv
 import glob
 import json
 import os
@@ -28,19 +30,58 @@ PAPER_T1 = [
 ]
 
 
+def num(x):
+    try:
+        return float(x)
+    except (TypeError, ValueError):
+        return None
+
+
 def load_runs(d):
+    """runs.csv rows as the dicts the tables read."""
     runs = []
-    for f in sorted(glob.glob(os.path.join(d, "runs", "*", "result.json"))):
-        with open(f) as fh:
-            r = json.load(fh)
-        if r.get("status") == "ok":
+    with open(os.path.join(d, "runs.csv"), newline="") as fh:
+        for row in csv.DictReader(fh):
+            if row["status"] != "ok":
+                continue
+            r = {"method": row["method"], "scene": row["scene"], "label": row["label"], "params_full": row["params"],
+                 "renderer": row["renderer"], "timer": row["timer"],
+                 "prepare_stages": {k: num(row.get("prepare_" + k + "_ms")) or 0.0 for k in ("sort", "propagate", "gpu_init")},
+                 "stages": {k: {"median": num(row.get("stage_" + k + "_ms_median"))} for k in ("render", "shade")
+                            if num(row.get("stage_" + k + "_ms_median")) is not None},
+                 "stats": {k[5:]: num(v) for k, v in row.items() if k.startswith("stat_") and num(v) is not None},
+                 "metrics": {w: {m: num(row.get(m + "_" + w)) for m in ("rmse", "relmse", "mean_lum_diff_pct")}
+                             for w in ("full", "matched")}}
             runs.append(r)
     return runs
 
 
+def reference_rays(d):
+    """scene name -> Mrays/s of its 64-bounce reference; refreshes
+    DIR/reference_rays.csv from the references' JSON when they exist."""
+    path = os.path.join(d, "reference_rays.csv")
+    found = {}
+    for f in sorted(glob.glob(os.path.join(d, "references", "*_b64_*spp_center.exr.json"))):
+        with open(f) as fh:
+            j = json.load(fh)
+        name = os.path.basename(f).split("_b64_")[0]
+        found[name] = (j.get("mrays_per_second"), j.get("threads"), j.get("rays"))
+    if found:
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh, lineterminator="\n")
+            w.writerow(["scene", "mrays_per_second", "threads", "rays"])
+            for k in sorted(found):
+                w.writerow([k] + list(found[k]))
+    out = {}
+    if os.path.exists(path):
+        with open(path, newline="") as fh:
+            for row in csv.DictReader(fh):
+                out[row["scene"]] = num(row["mrays_per_second"])
+    return out
+
+
 def p(r, key, default=""):
-    full = r.get("params_full") or ""
-    for kv in full.split(","):
+    for kv in (r.get("params_full") or "").split(","):
         if "=" in kv:
             k, v = kv.split("=", 1)
             if k == key:
@@ -49,8 +90,7 @@ def p(r, key, default=""):
 
 
 def metric(r, which, key):
-    m = (r.get("metrics") or {}).get(which) or {}
-    return m.get(key)
+    return ((r.get("metrics") or {}).get(which) or {}).get(key)
 
 
 def fmt(x, nd=3):
@@ -65,11 +105,12 @@ def main():
     d = sys.argv[1] if len(sys.argv) > 1 else "results/vlf"
     runs = load_runs(d)
     vlf = [r for r in runs if r["method"] == "vlf"]
+    rays = reference_rays(d)
     renderer = runs[0]["renderer"] if runs else "?"
     timer = runs[0]["timer"] if runs else "?"
     out = []
     out.append("# vlf study tables\n")
-    out.append(f"Made by `scripts/vlf_tables.py {d}` from the study's run files. GL renderer: {renderer}; "
+    out.append(f"Made by `scripts/vlf_tables.py results/vlf` from runs.csv and reference_rays.csv. GL renderer: {renderer}; "
                f"timer: {timer} (CPU time of the process, llvmpipe's threads included). Times are only "
                "comparable as ratios within this study.\n")
 
@@ -87,7 +128,7 @@ def main():
             os.path.basename(r["scene"]), int(st.get("faces", 0)), int(st.get("diffuse_elements", 0)),
             int(st.get("nondiffuse_elements", 0)), int(st.get("tiles", 0)), ps.get("sort", 0), ps.get("gpu_init", 0),
             ps.get("propagate", 0), tot, st.get("bytes_propagate", 0) / 2**20, st.get("bytes_render", 0) / 2**20,
-            r["stages"]["render"]["median"], p(r, "l"), p(r, "N"), p(r, "S"), p(r, "iterations")))
+            r["stages"]["render"]["median"] or 0.0, p(r, "l"), p(r, "N"), p(r, "S"), p(r, "iterations")))
     out.append("\nPaper, Table 1 (GeForce 8800 GTX, 512 directions, 3 iterations, 1024×768):\n")
     out.append("| scene | faces | diffuse el. | non-diffuse el. | sort (s) | GPU init (s) | propagation (s) | memory propagate (MB) | memory render (MB) | fps |")
     out.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
@@ -109,7 +150,7 @@ def main():
             fmt(rm * rm if rm is not None else None), fmt(rmm * rmm if rmm is not None else None),
             fmt(metric(r, "matched", "relmse")), fmt(metric(r, "matched", "mean_lum_diff_pct"), 2),
             "{:.0f}".format((r.get("prepare_stages") or {}).get("propagate", 0.0)),
-            "{:.1f}".format(r["stages"].get("render", r["stages"].get("shade", {})).get("median", 0.0))))
+            "{:.1f}".format(r["stages"].get("render", r["stages"].get("shade", {})).get("median") or 0.0)))
 
     out.append("\n## Cornell box against the path tracer\n")
     out.append("| scene | method | MSE full | MSE matched | relMSE matched | mean diff matched (%) |")
@@ -133,11 +174,7 @@ def main():
         if r["label"] != "table1":
             continue
         name = os.path.splitext(os.path.basename(r["scene"]))[0]
-        ref = glob.glob(os.path.join(d, "references", f"{name}_b64_*spp_center.exr.json"))
-        mr = None
-        if ref:
-            with open(ref[0]) as fh:
-                mr = json.load(fh).get("mrays_per_second")
+        mr = rays.get(name)
         sps = r["stats"].get("samples_per_s", 0) / 1e6
         cpu_ms = (r.get("prepare_stages") or {}).get("propagate", 0.0)
         spc = r["stats"].get("samples_transported", 0) / (cpu_ms * 1e3) if cpu_ms > 0 else 0.0
