@@ -23,6 +23,8 @@ pkgs=(
   # (VTK draws through EGL, see harness/charts.cpp).
   xvfb xauth
   libjson-c-dev libxxhash-dev
+  # plugins/vlf: the spherical triangulation of the direction set
+  libqhull-dev
   # scripts/*.py (the results tables, their test integration.results_tables;
   # the bash completion, scripts/gen-completion.py, which `make` installs)
   python3 bash-completion

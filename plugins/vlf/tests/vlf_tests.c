@@ -1,0 +1,472 @@
+/* The vlf plugin's parts against independent computations (the plugin's
+ * CPU sources are compiled in; see plugins/vlf/README.md "Tests"):
+ *
+ *   vlf_tests dirs     the direction set covers the sphere evenly (largest
+ *                      angular gap to the nearest direction bounded), the
+ *                      triangulation is a closed sphere (Euler, solid angles
+ *                      sum to 4 pi, every direction in at least 3 triangles,
+ *                      each triangle counter-clockwise), barycentric weights
+ *                      of random directions are non-negative, sum to 1 and
+ *                      reproduce the direction; a node gets weight 1 itself;
+ *   vlf_tests order    the per-ray depth order on random non-intersecting
+ *                      triangles: the first surface of every ray of every
+ *                      subfield equals the Embree hit along the ray;
+ *   vlf_tests energy   closed box: per iteration everything shot is received
+ *                      (nothing escapes, nothing lands on a back face), and
+ *                      the emitted flux equals the first iteration's shot;
+ *   vlf_tests furnace  the closed emitting sphere (conformance scene):
+ *                      the mean irradiance of the propagated field converges
+ *                      to Le (1/(1 - rho) - 1) pi within 2 % as iterations grow;
+ *   vlf_tests mirror   a mirror facing an emitter: the mirror's stored
+ *                      radiance in the subfields around the reflected
+ *                      direction shows the emitter (ks Le), and nothing where
+ *                      the reflection misses it. */
+#include "vlf_core.h"
+
+#include "gi/raytrace.h"
+#include "gi/rng.h"
+#include "gi/scene.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#define EXPECT CHECK_MSG
+
+static gi_scene *load(const char *rel)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", GI_SOURCE_DIR, rel);
+    gi_error err;
+    gi_scene *s = gi_scene_load(path, &err);
+    EXPECT(s != NULL, "loading %s: %s", path, err.text);
+    return s;
+}
+
+static vlf_params defaults(void)
+{
+    return (vlf_params){.l = 128, .N = 64, .m = 8, .S = 2, .density = 12, .iterations = 8, .seed = 1};
+}
+
+static float frand(uint32_t *s)
+{
+    *s = *s * 1664525u + 1013904223u;
+    return (float)(*s >> 8) / 16777216.0f;
+}
+
+static gi_vec3 rand_dir(uint32_t *s)
+{
+    float z = 2.0f * frand(s) - 1.0f, phi = 2.0f * GI_PI * frand(s);
+    float r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+    return gi_v3(r * cosf(phi), r * sinf(phi), z);
+}
+
+static void test_dirs(void)
+{
+    uint32_t ls[] = {8, 32, 128, 512};
+    for (size_t li = 0; li < sizeof ls / sizeof ls[0]; li++) {
+        vlf_dirs d;
+        char err[256];
+        uint32_t l = ls[li];
+        EXPECT(vlf_dirs_build(&d, l, err, sizeof err) == 0, "%s", err);
+        uint32_t n = 2 * l;
+        /* closed triangulated sphere: V - E + F = 2 with E = 3F/2 */
+        EXPECT(d.tri_count == 2 * n - 4, "l=%u: %u triangles for %u nodes", l, d.tri_count, n);
+        double sum = 0.0;
+        for (uint32_t k = 0; k < n; k++)
+            sum += d.solid_angle[k];
+        CHECK_NEAR(sum, 4.0 * GI_PI, 1e-3);
+        /* solid angles of the nodes within a factor of 2 of the mean */
+        float mean = (float)(4.0 * GI_PI / n), lo = FLT_MAX, hi = 0;
+        for (uint32_t k = 0; k < n; k++)
+            lo = fminf(lo, d.solid_angle[k]), hi = fmaxf(hi, d.solid_angle[k]);
+        EXPECT(lo > 0.5f * mean && hi < 2.0f * mean, "l=%u: solid angles %.4g..%.4g, mean %.4g", l, lo, hi, mean);
+        uint32_t *deg = calloc(n, sizeof *deg);
+        int ccw = 1;
+        for (uint32_t t = 0; t < d.tri_count; t++) {
+            gi_vec3 a = d.signed_dirs[d.tris[3 * t]], b = d.signed_dirs[d.tris[3 * t + 1]], c = d.signed_dirs[d.tris[3 * t + 2]];
+            if (gi_v3_dot(gi_v3_cross(gi_v3_sub(b, a), gi_v3_sub(c, a)), a) <= 0.0f)
+                ccw = 0;
+            for (int j = 0; j < 3; j++)
+                deg[d.tris[3 * t + j]]++;
+        }
+        EXPECT(ccw, "l=%u: a triangle is not counter-clockwise seen from outside", l);
+        uint32_t mindeg = UINT32_MAX;
+        for (uint32_t k = 0; k < n; k++)
+            mindeg = deg[k] < mindeg ? deg[k] : mindeg;
+        EXPECT(mindeg >= 3, "l=%u: a direction lies in %u triangles", l, mindeg);
+        free(deg);
+        /* coverage: largest angle from a random direction to its nearest node,
+         * against the cap radius of an even spread (acos(1 - 2/n)) times 1.6 */
+        uint32_t seed = 12345u;
+        float worst = 0.0f, bad_sum = 0.0f, worst_rec = 0.0f;
+        for (int q = 0; q < 20000; q++) {
+            gi_vec3 w = rand_dir(&seed);
+            float best = -2.0f;
+            for (uint32_t k = 0; k < n; k++)
+                best = fmaxf(best, gi_v3_dot(w, d.signed_dirs[k]));
+            worst = fmaxf(worst, acosf(fminf(1.0f, best)));
+            uint32_t node[3];
+            float al[3];
+            vlf_dirs_locate(&d, w, node, al);
+            float s = al[0] + al[1] + al[2];
+            bad_sum = fmaxf(bad_sum, fabsf(s - 1.0f));
+            EXPECT(al[0] >= 0 && al[1] >= 0 && al[2] >= 0, "negative weight");
+            /* the weights reproduce the direction up to its length */
+            gi_vec3 r = gi_v3_add(gi_v3_add(gi_v3_scale(d.signed_dirs[node[0]], al[0]), gi_v3_scale(d.signed_dirs[node[1]], al[1])),
+                                  gi_v3_scale(d.signed_dirs[node[2]], al[2]));
+            worst_rec = fmaxf(worst_rec, acosf(fminf(1.0f, gi_v3_dot(gi_v3_normalize(r), w))));
+        }
+        float cap = acosf(1.0f - 2.0f / (float)n);
+        printf("dirs l=%u: %u triangles, largest gap %.2f deg (even-spread cap %.2f deg), solid angles %.4f..%.4f sr\n", l,
+               d.tri_count, worst * 180 / GI_PI, cap * 180 / GI_PI, lo, hi);
+        EXPECT(worst < 1.6f * cap, "l=%u: gap %.3g rad > 1.6 x %.3g", l, worst, cap);
+        EXPECT(bad_sum < 1e-5f, "l=%u: weights sum off by %.3g", l, bad_sum);
+        EXPECT(worst_rec < 1e-3f, "l=%u: interpolated direction off by %.3g rad", l, worst_rec);
+        /* a node itself: weight 1 on it */
+        int node_ok = 1;
+        for (uint32_t k = 0; k < n; k++) {
+            uint32_t node[3];
+            float al[3];
+            vlf_dirs_locate(&d, d.signed_dirs[k], node, al);
+            float wk = 0.0f;
+            for (int j = 0; j < 3; j++)
+                if (node[j] == k)
+                    wk += al[j];
+            if (wk < 0.999f)
+                node_ok = 0;
+        }
+        EXPECT(node_ok, "l=%u: a node does not get weight 1 at itself", l);
+        vlf_dirs_free(&d);
+    }
+}
+
+/* A scene of random non-intersecting triangles: one small triangle in each
+ * cell of a 4 x 4 x 4 grid, random orientation. */
+static gi_scene *random_triangles(uint32_t count, uint32_t seed)
+{
+    gi_scene *s = calloc(1, sizeof *s);
+    s->triangle_count = count;
+    s->vertex_count = 3 * count;
+    s->vertices = calloc(s->vertex_count, sizeof *s->vertices);
+    s->indices = calloc(3 * count, sizeof *s->indices);
+    s->material_count = 1;
+    s->materials = calloc(1, sizeof *s->materials);
+    s->materials[0].albedo[0] = s->materials[0].albedo[1] = s->materials[0].albedo[2] = 0.5f;
+    s->materials[0].albedo_texture = -1;
+    s->object_count = 1;
+    s->objects = calloc(1, sizeof *s->objects);
+    s->node_count = 1;
+    s->nodes = calloc(1, sizeof *s->nodes);
+    s->nodes[0].parent = -1;
+    s->nodes[0].rotation[3] = 1.0f;
+    s->nodes[0].scale[0] = s->nodes[0].scale[1] = s->nodes[0].scale[2] = 1.0f;
+    s->objects[0].node = 0;
+    s->objects[0].triangle_count = count;
+    s->objects[0].vertex_count = 3 * count;
+    float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+    for (uint32_t t = 0; t < count; t++) {
+        uint32_t cx = t % 4, cy = (t / 4) % 4, cz = t / 16;
+        gi_vec3 c = gi_v3((float)cx + 0.5f, (float)cy + 0.5f, (float)cz + 0.5f);
+        for (int k = 0; k < 3; k++) {
+            gi_vec3 r = gi_v3_scale(rand_dir(&seed), 0.45f);
+            gi_vec3 p = gi_v3_add(c, r);
+            gi_vertex *v = &s->vertices[3 * t + (uint32_t)k];
+            v->position[0] = p.x, v->position[1] = p.y, v->position[2] = p.z;
+            v->normal[2] = 1.0f;
+            s->indices[3 * t + (uint32_t)k] = 3 * t + (uint32_t)k;
+            for (int a = 0; a < 3; a++)
+                lo[a] = fminf(lo[a], v->position[a]), hi[a] = fmaxf(hi[a], v->position[a]);
+        }
+    }
+    for (int a = 0; a < 3; a++)
+        s->objects[0].local_bounds[a] = lo[a], s->objects[0].local_bounds[3 + a] = hi[a];
+    return s;
+}
+
+static void free_random(gi_scene *s)
+{
+    free(s->vertices);
+    free(s->indices);
+    free(s->materials);
+    free(s->objects);
+    free(s->nodes);
+    free(s);
+}
+
+static void test_order(void)
+{
+    gi_scene *s = random_triangles(64, 777u);
+    vlf_params p = defaults();
+    p.l = 16;
+    p.N = 48;
+    p.density = 8;
+    vlf_field f;
+    char err[256];
+    int rc = vlf_field_build(&f, s, 0.0f, &p, err, sizeof err);
+    EXPECT(rc == 0, "%s", err);
+    gi_rt *rt = NULL;
+    gi_error e;
+    EXPECT(gi_rt_create(s, 0.0f, &rt, &e) == GI_OK, "embree: %s", e.text);
+    if (rc != 0 || !rt) {
+        free_random(s);
+        return;
+    }
+    uint32_t rays = 0, agree = 0, hits = 0;
+    for (uint32_t i = 0; i < p.l; i++) {
+        const vlf_psf *ps = &f.psf[i];
+        uint32_t NS = p.N * p.S;
+        for (uint32_t c = 0; c < NS * NS; c++) {
+            float U = ((float)(c % NS) + 0.5f) / (float)NS * 2.0f - 1.0f;
+            float V = ((float)(c / NS) + 0.5f) / (float)NS * 2.0f - 1.0f;
+            for (int sign = -1; sign <= 1; sign += 2) {
+                /* a world ray entering along sign * n from outside the unit sphere */
+                gi_vec3 q = gi_v3_add(gi_v3_add(gi_v3_scale(ps->u, U), gi_v3_scale(ps->v, V)), gi_v3_scale(ps->n, -1.5f * (float)sign));
+                gi_vec3 o = gi_v3_add(f.centre, gi_v3_scale(q, f.radius));
+                gi_vec3 d = gi_v3_scale(ps->n, (float)sign);
+                gi_rt_hit h;
+                int hit = gi_rt_intersect(rt, o, d, 0.0f, FLT_MAX, &h);
+                uint32_t a = ps->cell_start[c], b = ps->cell_start[c + 1];
+                int has = b > a;
+                uint32_t first = has ? (sign > 0 ? ps->frag[a] : ps->frag[b - 1]) : UINT32_MAX;
+                rays++;
+                if (!hit) {
+                    agree += !has;
+                    continue;
+                }
+                hits++;
+                if (has && f.tri_face[h.triangle] == f.elem_face[first])
+                    agree++;
+            }
+        }
+    }
+    printf("order: %u rays (%u hit), first surface agrees with Embree on %u (%.3f %%)\n", rays, hits, agree,
+           100.0 * agree / rays);
+    /* cell centres on a triangle's edge may go either way: allow 0.5 % */
+    EXPECT(agree >= rays - rays / 200, "depth order disagrees with Embree on %u of %u rays", rays - agree, rays);
+    EXPECT(hits > rays / 20, "too few rays hit (%u of %u): the test set-up is wrong", hits, rays);
+    gi_rt_free(rt);
+    vlf_field_free(&f);
+    free_random(s);
+}
+
+static void test_energy(void)
+{
+    gi_scene *s = load("tests/data/conformance/furnace_050.gltf");
+    if (!s)
+        return;
+    vlf_params p = defaults();
+    p.l = 64;
+    p.N = 48;
+    p.density = 6;
+    p.iterations = 1;
+    if (getenv("VLF_N"))
+        p.N = (uint32_t)atoi(getenv("VLF_N"));
+    vlf_field f;
+    char err[256];
+    EXPECT(vlf_field_build(&f, s, 0.0f, &p, err, sizeof err) == 0, "%s", err);
+    vlf_field_propagate(&f, NULL, NULL);
+    const vlf_stats *st = &f.st;
+    printf("energy (closed sphere, 1 iteration): emitted %.6f shot %.6f received %.6f back %.6f escaped %.6f\n",
+           st->flux_emitted, st->flux_shot, st->flux_received, st->flux_back, st->flux_escaped);
+    CHECK_NEAR(st->flux_shot, st->flux_received + st->flux_back + st->flux_escaped, 1e-4 * st->flux_shot);
+    EXPECT(st->flux_escaped < 1e-3 * st->flux_shot, "light escaped a closed sphere: %.4g of %.4g", st->flux_escaped,
+           st->flux_shot);
+    EXPECT(st->flux_back < 1e-3 * st->flux_shot, "light met back faces in a closed sphere: %.4g", st->flux_back);
+    /* what is shot in the first iteration is the emission, within the
+     * aliasing of the faces' projections onto the rays */
+    EXPECT(fabs(st->flux_shot / st->flux_emitted - 1.0) < 0.02, "shot %.5g vs emitted %.5g", st->flux_shot, st->flux_emitted);
+    /* received = sum of E * area over elements */
+    double absorbed = 0.0;
+    for (uint32_t e = 0; e < f.elem_count; e++)
+        absorbed += (f.E_tot[3 * e] + f.E_tot[3 * e + 1] + f.E_tot[3 * e + 2]) / 3.0 * f.elem_area[e];
+    EXPECT(fabs(absorbed / st->flux_received - 1.0) < 0.02, "irradiance x area %.5g vs received %.5g", absorbed,
+           st->flux_received);
+    vlf_field_free(&f);
+    /* the same with 3 perturbed directions per fixed one (§3.5) */
+    p.perturbed = 3;
+    EXPECT(vlf_field_build(&f, s, 0.0f, &p, err, sizeof err) == 0, "%s", err);
+    vlf_field_propagate(&f, NULL, NULL);
+    printf("energy, 3 perturbed directions: emitted %.6f shot %.6f received %.6f back %.6f escaped %.6f\n",
+           st->flux_emitted, st->flux_shot, st->flux_received, st->flux_back, st->flux_escaped);
+    CHECK_NEAR(st->flux_shot, st->flux_received + st->flux_back + st->flux_escaped, 1e-4 * st->flux_shot);
+    EXPECT(st->flux_escaped < 1e-3 * st->flux_shot && st->flux_back < 1e-3 * st->flux_shot,
+           "perturbed: light escaped (%.4g) or met back faces (%.4g)", st->flux_escaped, st->flux_back);
+    EXPECT(fabs(st->flux_shot / st->flux_emitted - 1.0) < 0.02, "perturbed: shot %.5g vs emitted %.5g", st->flux_shot,
+           st->flux_emitted);
+    vlf_field_free(&f);
+    gi_scene_free(s);
+}
+
+static void test_furnace(void)
+{
+    const char *files[] = {"tests/data/conformance/furnace_050.gltf", "tests/data/conformance/furnace_080.gltf"};
+    const double rho[] = {0.5, 0.8};
+    for (int k = 0; k < 2; k++) {
+        gi_scene *s = load(files[k]);
+        if (!s)
+            return;
+        uint32_t its[] = {1, 8, 16};
+        for (int q = 0; q < 3; q++) {
+            vlf_params p = defaults();
+            if (!getenv("VLF_FULL"))
+                p.l = 64, p.N = 48, p.density = 6;
+            p.iterations = its[q];
+            vlf_field f;
+            char err[256];
+            EXPECT(vlf_field_build(&f, s, 0.0f, &p, err, sizeof err) == 0, "%s", err);
+            vlf_field_propagate(&f, NULL, NULL);
+            /* radiance of the surface = Le + rho E / pi, area-weighted mean */
+            double num = 0.0, den = 0.0;
+            for (uint32_t e = 0; e < f.elem_count; e++) {
+                const vlf_face *fc = &f.faces[f.elem_face[e]];
+                double L = fc->emission[0] + fc->kd[0] * f.E_tot[3 * e] / GI_PI;
+                num += L * f.elem_area[e];
+                den += f.elem_area[e];
+            }
+            double got = num / den, Le = f.faces[0].emission[0];
+            double want = 0.0;
+            for (uint32_t b = 0; b <= its[q]; b++)
+                want += Le * pow(rho[k], b);
+            printf("furnace rho=%.1f iterations %2u: mean radiance %.5f, due Le sum_{k<=%u} rho^k = %.5f (limit %.5f)\n",
+                   rho[k], its[q], got, its[q], want, Le / (1.0 - rho[k]));
+            EXPECT(fabs(got / want - 1.0) < 0.02, "furnace %.4f vs %.4f", got, want);
+            vlf_field_free(&f);
+        }
+        gi_scene_free(s);
+    }
+}
+
+/* Two quads: an emitter of radiance 1 at height 1 facing down, and below
+ * it a mirror (ks 0.8) tilted so that the emitter's light leaves it
+ * toward +x. */
+static void add_quad(gi_scene *s, uint32_t q, gi_vec3 a, gi_vec3 b, gi_vec3 c, gi_vec3 d, uint32_t material)
+{
+    gi_vec3 v[4] = {a, b, c, d};
+    for (int k = 0; k < 4; k++) {
+        gi_vertex *x = &s->vertices[4 * q + (uint32_t)k];
+        x->position[0] = v[k].x, x->position[1] = v[k].y, x->position[2] = v[k].z;
+        x->normal[2] = 1.0f;
+        x->material = material;
+    }
+    uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    for (int k = 0; k < 6; k++)
+        s->indices[6 * q + (uint32_t)k] = 4 * q + idx[k];
+}
+
+static void test_mirror(void)
+{
+    gi_scene *s = calloc(1, sizeof *s);
+    s->triangle_count = 4;
+    s->vertex_count = 8;
+    s->vertices = calloc(8, sizeof *s->vertices);
+    s->indices = calloc(12, sizeof *s->indices);
+    s->material_count = 2;
+    s->materials = calloc(2, sizeof *s->materials);
+    s->materials[0].emission[0] = s->materials[0].emission[1] = s->materials[0].emission[2] = 1.0f;
+    s->materials[0].albedo_texture = s->materials[1].albedo_texture = -1;
+    s->materials[1].ks[0] = s->materials[1].ks[1] = s->materials[1].ks[2] = 0.8f;
+    s->materials[1].mirror = 1;
+    s->materials[1].exponent = GI_MIRROR_EXPONENT;
+    s->node_count = 1;
+    s->nodes = calloc(1, sizeof *s->nodes);
+    s->nodes[0].parent = -1;
+    s->nodes[0].rotation[3] = 1.0f;
+    s->nodes[0].scale[0] = s->nodes[0].scale[1] = s->nodes[0].scale[2] = 1.0f;
+    s->object_count = 1;
+    s->objects = calloc(1, sizeof *s->objects);
+    s->objects[0].triangle_count = 4;
+    s->objects[0].vertex_count = 8;
+    /* emitter at z = 1, normal -z (clockwise seen from above) */
+    add_quad(s, 0, gi_v3(-0.3f, -0.3f, 1.0f), gi_v3(-0.3f, 0.3f, 1.0f), gi_v3(0.3f, 0.3f, 1.0f), gi_v3(0.3f, -0.3f, 1.0f), 0);
+    /* mirror around the origin, normal (sin 22.5, 0, cos 22.5): light coming
+     * down (-z) leaves along (sin 45, 0, cos 45) */
+    float c = cosf(GI_PI / 8), sn = sinf(GI_PI / 8);
+    gi_vec3 tx = gi_v3(c, 0, -sn), ty = gi_v3(0, 1, 0);
+    gi_vec3 P[4];
+    float uv[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    for (int k = 0; k < 4; k++)
+        P[k] = gi_v3_add(gi_v3_scale(tx, 0.3f * uv[k][0]), gi_v3_scale(ty, 0.3f * uv[k][1]));
+    add_quad(s, 1, P[0], P[1], P[2], P[3], 1);
+    float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+    for (uint32_t v = 0; v < 8; v++)
+        for (int a = 0; a < 3; a++)
+            lo[a] = fminf(lo[a], s->vertices[v].position[a]), hi[a] = fmaxf(hi[a], s->vertices[v].position[a]);
+    for (int a = 0; a < 3; a++)
+        s->objects[0].local_bounds[a] = lo[a], s->objects[0].local_bounds[3 + a] = hi[a];
+    vlf_params p = defaults();
+    p.iterations = 2;
+    vlf_field f;
+    char err[256];
+    int rc = vlf_field_build(&f, s, 0.0f, &p, err, sizeof err);
+    EXPECT(rc == 0, "%s", err);
+    if (rc == 0) {
+        vlf_field_propagate(&f, NULL, NULL);
+        int mf = -1;
+        for (uint32_t fi = 0; fi < f.face_count; fi++)
+            if (f.faces[fi].nd >= 0)
+                mf = (int)fi;
+        EXPECT(mf >= 0, "no non-diffuse face");
+        gi_vec3 refl = gi_v3_normalize(gi_v3(1, 0, 1));
+        /* mean stored radiance of the mirror along each signed direction */
+        double best_hit = 0.0, far = 0.0;
+        float best_ang = 10.0f;
+        for (uint32_t sd = 0; mf >= 0 && sd < 2 * p.l; sd++) {
+            gi_vec3 w = f.dirs.signed_dirs[sd];
+            uint32_t i = sd % p.l;
+            if (gi_v3_dot(w, f.faces[mf].n) <= 0.0f)
+                continue;
+            const vlf_rect *r = &f.rects[(size_t)f.faces[mf].nd * p.l + i];
+            double sum = 0.0;
+            uint32_t n = 0;
+            for (uint32_t k = 0; k < r->w * r->h; k++)
+                if (f.nd_cover[r->offset + k])
+                    sum += f.out_tot[3 * (size_t)(r->offset + k)], n++;
+            double mean = n ? sum / n : 0.0;
+            float ang = acosf(fminf(1.0f, gi_v3_dot(w, refl)));
+            if (ang < best_ang)
+                best_ang = ang, best_hit = mean;
+            if (ang > 1.0f)
+                far = fmax(far, mean);
+        }
+        /* the mirror's radiance toward the reflected direction shows the
+         * emitter through it: most of ks Le = 0.8 at the direction nearest
+         * the reflection (barycentric weights and the emitter's edges take
+         * some), and nothing far from it */
+        printf("mirror: stored radiance %.3f at the direction nearest the reflection (%.3f rad from it; ks Le = 0.8), "
+               "at most %.4f beyond 1 rad from it (the emitter subtends up to 0.54 rad seen from the mirror)\n", best_hit, best_ang, far);
+        EXPECT(best_hit > 0.3 && best_hit < 0.85, "mirror radiance toward the reflection %.3f", best_hit);
+        EXPECT(far < 0.01, "mirror radiance away from the reflection %.4f", far);
+        vlf_field_free(&f);
+    }
+    free(s->vertices);
+    free(s->indices);
+    free(s->materials);
+    free(s->objects);
+    free(s->nodes);
+    free(s);
+}
+
+int main(int argc, char **argv)
+{
+    const char *part = argc > 1 ? argv[1] : "all";
+    int all = strcmp(part, "all") == 0, any = 0;
+    if (all || strcmp(part, "dirs") == 0)
+        test_dirs(), any = 1;
+    if (all || strcmp(part, "order") == 0)
+        test_order(), any = 1;
+    if (all || strcmp(part, "energy") == 0)
+        test_energy(), any = 1;
+    if (all || strcmp(part, "furnace") == 0)
+        test_furnace(), any = 1;
+    if (all || strcmp(part, "mirror") == 0)
+        test_mirror(), any = 1;
+    if (!any) {
+        fprintf(stderr, "vlf_tests: unknown part '%s' (dirs, order, energy, furnace, mirror)\n", part);
+        return 2;
+    }
+    return gi_test_finish();
+}

@@ -1,0 +1,325 @@
+/* The `vlf` method: Light Field Propagation and Rendering on the GPU
+ * (Mortensen, Khanna, Slater, Afrigraph 2007), the GPU Virtual Light Field.
+ *
+ * prepare(): the light field is built and propagated on the CPU
+ * (vlf_core.c: stages `sort` and `propagate`), then uploaded (`gpu_init`);
+ * render(): the G-buffer and one compute pass reading the irradiance atlas
+ * and the non-diffuse tiles (shaders/vlf_render.comp, stage `render`).
+ * See plugins/vlf/README.md for what follows the paper and what does not. */
+#include "gi/kit.h"
+#include "gi/log.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "vlf_core.h"
+
+extern const gi_shader_source gi_vlf_shaders[];
+
+enum { VLF_LOOKUP_W = 512, VLF_LOOKUP_H = 256, VLF_BUFFERS = 7 };
+
+typedef struct vlf {
+    gi_kit kit;
+    vlf_params prm;
+    vlf_field field;
+    int have_field;
+    GLuint program;
+    GLuint buf[VLF_BUFFERS];
+    GLuint lookup;
+} vlf;
+
+static const gi_param_desc vlf_params_desc[] = {
+    {"l", GI_PARAM_INT, 128, 8, 1024, NULL, "l (Sec. 2.1)", "bi-directional directions spread over the hemisphere"},
+    {"N", GI_PARAM_INT, 64, 8, 256, NULL, "N (Sec. 2.1)", "rays per side of each parallel subfield (N x N)"},
+    {"m", GI_PARAM_INT, 8, 1, 64, NULL, "m (Sec. 2.1)", "cells per side of a tile of non-diffuse storage; N must be a multiple"},
+    {"S", GI_PARAM_INT, 2, 1, 8, NULL, "RI super-sampling (Sec. 3.3)",
+     "radiance interface cells per subfield cell and side: transport on (N S)^2 rays"},
+    {"density", GI_PARAM_FLOAT, 12, 1, 64, NULL, "texel density",
+     "diffuse elements per unit length, the scene scaled into the unit sphere (faces get k x k elements, k <= 64)"},
+    {"iterations", GI_PARAM_INT, 8, 1, 64, NULL, "iterations (Sec. 6)",
+     "shooting iterations; k iterations carry k bounces (max_bounces = 7 describes the default 8)"},
+    {"perturbed", GI_PARAM_INT, 0, 0, 36, NULL, "perturbed samples (Sec. 3.5)",
+     "perturbed virtual directions per fixed direction, used only for transport (0: the fixed direction itself; "
+     "the paper's high quality uses 36)"},
+    {"seed", GI_PARAM_INT, 1, 0, 1000000, NULL, NULL, "seed of the perturbed directions"},
+    {0},
+};
+
+static gi_result vlf_create(const gi_host *host, const gi_params *params, void **out)
+{
+    vlf *v = calloc(1, sizeof *v);
+    if (!v)
+        return GI_ERR_OUT_OF_MEMORY;
+    if (gi_kit_init(&v->kit, host, gi_vlf_shaders) != GI_OK) {
+        free(v);
+        return GI_ERR_INVALID_ARGUMENT;
+    }
+    v->prm.l = (uint32_t)gi_params_int(params, "l");
+    v->prm.N = (uint32_t)gi_params_int(params, "N");
+    v->prm.m = (uint32_t)gi_params_int(params, "m");
+    v->prm.S = (uint32_t)gi_params_int(params, "S");
+    v->prm.perturbed = (uint32_t)gi_params_int(params, "perturbed");
+    v->prm.seed = (uint32_t)gi_params_int(params, "seed");
+    v->prm.density = gi_params_float(params, "density");
+    v->prm.iterations = (uint32_t)gi_params_int(params, "iterations");
+    if (v->prm.N % v->prm.m != 0) {
+        host->log(host, GI_LOG_ERROR, "vlf: N = %u is not a multiple of the tile size m = %u", v->prm.N, v->prm.m);
+        gi_kit_free(&v->kit);
+        free(v);
+        return GI_ERR_INVALID_ARGUMENT;
+    }
+    *out = v;
+    return GI_OK;
+}
+
+static int vlf_cancelled(void *user)
+{
+    const gi_host *h = user;
+    return h->cancelled && h->cancelled(h);
+}
+
+static void upload(GLuint b, const void *data, size_t bytes)
+{
+    static const float zero[4] = {0, 0, 0, 0};
+    glNamedBufferData(b, (GLsizeiptr)(bytes ? bytes : sizeof zero), bytes ? data : zero, GL_STATIC_DRAW);
+}
+
+/* Uploads the propagated field: faces, irradiance atlas, tiles, their
+ * index, the subfield frames (the WC -> PSF matrices' rows) and the
+ * triangulation with its lat-long lookup ("gpu_init"). */
+static gi_result vlf_upload(vlf *v)
+{
+    vlf_field *f = &v->field;
+    uint32_t l = f->prm.l, T = f->dirs.tri_count;
+    if (!v->buf[0])
+        glCreateBuffers(VLF_BUFFERS, v->buf);
+    float *faces = calloc((size_t)f->face_count * 16, sizeof *faces);
+    float *irr = calloc((size_t)f->elem_count * 4 + 4, sizeof *irr);
+    float *dirs = calloc(((size_t)3 * l + 3 * T + 2 * l) * 4, sizeof *dirs);
+    int32_t *rects = calloc((size_t)f->nd_count * l * 8 + 8, sizeof *rects);
+    uint32_t *tris = calloc((size_t)T * 4, sizeof *tris);
+    uint32_t *lut = calloc((size_t)VLF_LOOKUP_W * VLF_LOOKUP_H, sizeof *lut);
+    if (!faces || !irr || !dirs || !rects || !tris || !lut) {
+        free(faces), free(irr), free(dirs), free(rects), free(tris), free(lut);
+        return gi_kit_fail(&v->kit, GI_ERR_OUT_OF_MEMORY, "vlf: out of memory uploading the light field");
+    }
+    /* faces: chart origin, axes scaled to texels, then W, H, first element, nd */
+    for (uint32_t i = 0; i < f->face_count; i++) {
+        const vlf_face *fc = &f->faces[i];
+        gi_vec3 o = gi_v3_add(f->centre, gi_v3_scale(fc->origin, f->radius));
+        gi_vec3 t = gi_v3_scale(fc->t, f->prm.density / f->radius), b = gi_v3_scale(fc->b, f->prm.density / f->radius);
+        float *F = faces + 16 * (size_t)i;
+        memcpy(F, &o, 3 * sizeof(float));
+        memcpy(F + 4, &t, 3 * sizeof(float));
+        memcpy(F + 8, &b, 3 * sizeof(float));
+        uint32_t info[4] = {fc->W, fc->H, fc->first_elem, (uint32_t)fc->nd};
+        memcpy(F + 12, info, sizeof info);
+    }
+    /* the irradiance atlas; w: the part of the texel that lies on its face
+     * (the filter's weight, so that slivers at a face's border, hit by few
+     * rays, count little) */
+    float texel = 1.0f / (f->prm.density * f->prm.density);
+    for (uint32_t e = 0; e < f->elem_count; e++) {
+        memcpy(irr + 4 * (size_t)e, f->E_tot + 3 * (size_t)e, 3 * sizeof(float));
+        irr[4 * (size_t)e + 3] = fminf(1.0f, f->elem_area[e] / texel);
+    }
+    for (uint32_t i = 0; i < l; i++) {
+        const vlf_psf *p = &f->psf[i];
+        gi_vec3 fr[3] = {p->u, p->v, p->n};
+        for (int k = 0; k < 3; k++)
+            memcpy(dirs + 4 * (3 * i + (uint32_t)k), &fr[k], 3 * sizeof(float));
+    }
+    for (uint32_t t = 0; t < T; t++) {
+        for (int k = 0; k < 3; k++)
+            memcpy(dirs + 4 * (3 * l + 3 * t + (uint32_t)k), f->dirs.tri_inv + 9 * t + 3 * k, 3 * sizeof(float));
+        memcpy(tris + 4 * t, f->dirs.tris + 3 * t, 3 * sizeof(uint32_t));
+    }
+    for (uint32_t s = 0; s < 2 * l; s++)
+        memcpy(dirs + 4 * (3 * l + 3 * T + s), &f->dirs.signed_dirs[s], 3 * sizeof(float));
+    for (size_t r = 0; r < (size_t)f->nd_count * l; r++) {
+        const vlf_rect *R = &f->rects[r];
+        rects[8 * r] = R->x0;
+        rects[8 * r + 1] = R->y0;
+        rects[8 * r + 2] = (int32_t)R->w;
+        rects[8 * r + 3] = (int32_t)R->h;
+        rects[8 * r + 4] = (int32_t)R->offset;
+    }
+    for (uint32_t y = 0; y < VLF_LOOKUP_H; y++)
+        for (uint32_t x = 0; x < VLF_LOOKUP_W; x++) {
+            float phi = ((float)x + 0.5f) / VLF_LOOKUP_W * 2.0f * GI_PI - GI_PI;
+            float theta = ((float)y + 0.5f) / VLF_LOOKUP_H * GI_PI;
+            gi_vec3 w = gi_v3(sinf(theta) * cosf(phi), sinf(theta) * sinf(phi), cosf(theta));
+            uint32_t node[3];
+            float al[3];
+            lut[y * VLF_LOOKUP_W + x] = vlf_dirs_locate(&f->dirs, w, node, al);
+        }
+    upload(v->buf[0], faces, (size_t)f->face_count * 16 * sizeof *faces);
+    upload(v->buf[1], irr, (size_t)f->elem_count * 4 * sizeof *irr);
+    upload(v->buf[6], f->tri_face, (size_t)f->tri_count * sizeof *f->tri_face);
+    upload(v->buf[2], f->out_tot, (size_t)f->nd_cells * 3 * sizeof(float));
+    upload(v->buf[3], rects, (size_t)f->nd_count * l * 8 * sizeof *rects);
+    upload(v->buf[4], dirs, ((size_t)3 * l + 3 * T + 2 * l) * 4 * sizeof *dirs);
+    upload(v->buf[5], tris, (size_t)T * 4 * sizeof *tris);
+    if (!v->lookup)
+        v->lookup = gi_gpu_texture_2d(GL_R32UI, VLF_LOOKUP_W, VLF_LOOKUP_H);
+    glTextureSubImage2D(v->lookup, 0, 0, 0, VLF_LOOKUP_W, VLF_LOOKUP_H, GL_RED_INTEGER, GL_UNSIGNED_INT, lut);
+    free(faces), free(irr), free(dirs), free(rects), free(tris), free(lut);
+    gi_error err;
+    if (gi_gl_check("vlf: upload", &err) != GI_OK)
+        return gi_kit_fail_with(&v->kit, GI_ERR_GL, &err);
+    return GI_OK;
+}
+
+/* Builds, propagates and uploads the light field of the scene at its
+ * current time. */
+static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
+{
+    const gi_host *host = v->kit.host;
+    if (v->have_field)
+        vlf_field_free(&v->field);
+    v->have_field = 0;
+    char err[256];
+    host->stage_begin(host, "sort");
+    int rc = vlf_field_build(&v->field, gs->scene, gs->time, &v->prm, err, sizeof err);
+    host->stage_end(host, "sort");
+    if (rc != 0) {
+        vlf_field_free(&v->field);
+        return gi_kit_fail(&v->kit, GI_ERR_INVALID_ARGUMENT, "%s", err);
+    }
+    v->have_field = 1;
+    host->stage_begin(host, "propagate");
+    rc = vlf_field_propagate(&v->field, vlf_cancelled, (void *)host);
+    host->stage_end(host, "propagate");
+    if (rc != 0)
+        return gi_kit_fail(&v->kit, GI_ERR_CANCELLED, "vlf: propagation cancelled");
+    host->stage_begin(host, "gpu_init");
+    gi_result r = vlf_upload(v);
+    glFinish();
+    host->stage_end(host, "gpu_init");
+    const vlf_stats *s = &v->field.st;
+    host->stat(host, "faces", v->field.face_count);
+    host->stat(host, "diffuse_elements", s->diffuse_elements);
+    host->stat(host, "nondiffuse_elements", s->nondiffuse_elements);
+    host->stat(host, "tiles", s->tiles);
+    host->stat(host, "bytes_propagate", (double)s->bytes_propagate);
+    host->stat(host, "bytes_render", (double)s->bytes_render);
+    host->stat(host, "samples_transported", (double)s->samples);
+    host->stat(host, "samples_per_s", s->propagate_s > 0 ? (double)s->samples / s->propagate_s : 0.0);
+    host->stat(host, "flux_emitted", s->flux_emitted);
+    host->stat(host, "flux_received", s->flux_received);
+    host->stat(host, "flux_escaped", s->flux_escaped);
+    return r;
+}
+
+static gi_result vlf_prepare(void *inst, const gi_gpu_scene *gs)
+{
+    vlf *v = inst;
+    gi_kit_prepare(&v->kit, gs);
+    if (!v->program) {
+        gi_error err;
+        v->program = gi_program_build_compute("vlf_render.comp", NULL, &err);
+        if (!v->program)
+            return gi_kit_fail_with(&v->kit, GI_ERR_GL, &err);
+    }
+    return vlf_build(v, gs);
+}
+
+/* A static method: any change of the scene propagates the field again;
+ * a moved camera needs nothing. */
+static gi_result vlf_update(void *inst, const gi_gpu_scene *gs, const gi_changes *changes)
+{
+    vlf *v = inst;
+    gi_kit_update(&v->kit, gs, changes);
+    if (changes->flags & ~(uint32_t)GI_CHANGED_CAMERA)
+        return vlf_build(v, gs);
+    return GI_OK;
+}
+
+static gi_result vlf_render(void *inst, const gi_view *view, const gi_target *target)
+{
+    vlf *v = inst;
+    gi_kit *k = &v->kit;
+    const gi_host *host = k->host;
+    if (!v->have_field)
+        return gi_kit_fail(k, GI_ERR_INVALID_ARGUMENT, "vlf: render before prepare");
+    host->stage_begin(host, "render");
+    gi_result r = gi_kit_frame_begin(k, view, GI_KIT_GBUFFER);
+    if (r == GI_OK)
+        r = gi_kit_render_gbuffer(k, view, NULL);
+    if (r != GI_OK) {
+        host->stage_end(host, "render");
+        return r;
+    }
+    GLuint p = v->program;
+    glUseProgram(p);
+    gi_kit_bind(k, p, view, target);
+    for (int b = 0; b < VLF_BUFFERS; b++)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, GI_SSBO_PLUGIN_FIRST + (GLuint)b, v->buf[b]);
+    glBindTextureUnit(GI_TEX_PLUGIN_FIRST, v->lookup);
+    glBindImageTexture(GI_IMAGE_TARGET, target->texture, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    const vlf_field *f = &v->field;
+    glUniform3f(glGetUniformLocation(p, "u_centre"), f->centre.x, f->centre.y, f->centre.z);
+    glUniform1f(glGetUniformLocation(p, "u_radius"), f->radius);
+    glUniform1ui(glGetUniformLocation(p, "u_l"), f->prm.l);
+    glUniform1ui(glGetUniformLocation(p, "u_N"), f->prm.N);
+    glUniform1ui(glGetUniformLocation(p, "u_tri_count"), f->dirs.tri_count);
+    gi_kit_dispatch_8x8(view->width, view->height);
+    glUseProgram(0);
+    host->stage_end(host, "render");
+    gi_kit_frame_end(k);
+    gi_error err;
+    if (gi_gl_check("vlf: render pass", &err) != GI_OK)
+        return gi_kit_fail_with(k, GI_ERR_GL, &err);
+    return GI_OK;
+}
+
+static void vlf_destroy(void *inst)
+{
+    vlf *v = inst;
+    if (!v)
+        return;
+    gi_kit_free(&v->kit);
+    if (v->have_field)
+        vlf_field_free(&v->field);
+    if (v->program)
+        glDeleteProgram(v->program);
+    if (v->buf[0])
+        glDeleteBuffers(VLF_BUFFERS, v->buf);
+    if (v->lookup)
+        glDeleteTextures(1, &v->lookup);
+    free(v);
+}
+
+static const char *vlf_last_error(void *inst)
+{
+    return inst ? gi_kit_last_error(&((vlf *)inst)->kit) : "";
+}
+
+static const gi_method vlf_method = {
+    .struct_size = sizeof(gi_method),
+    .abi_version = GI_ABI_VERSION,
+    .id = "vlf",
+    .title = "Light Field Propagation and Rendering on the GPU (GPU Virtual Light Field)",
+    .citation = "Mortensen, Khanna, Slater. Afrigraph 2007",
+    .version = "0.1",
+    .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_GLOSSY | GI_CAP_MIRROR | GI_CAP_AREA_LIGHTS |
+            GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION | GI_CAP_PRECOMPUTE | GI_CAP_VISIBILITY,
+    .max_bounces = 7,
+    .params = vlf_params_desc,
+    .create = vlf_create,
+    .prepare = vlf_prepare,
+    .update = vlf_update,
+    .render = vlf_render,
+    .destroy = vlf_destroy,
+    .last_error = vlf_last_error,
+    .layout = GI_ABI_LAYOUT,
+};
+
+GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)
+{
+    if (GI_ABI_VERSION_MAJOR(host_abi_version) != GI_ABI_MAJOR)
+        return NULL;
+    return &vlf_method;
+}

@@ -1,0 +1,1081 @@
+/* The CPU side of the vlf method: directions, subfields, depth order,
+ * storage and propagation (see vlf_core.h and plugins/vlf/README.md). */
+#define _POSIX_C_SOURCE 200809L
+#include "vlf_core.h"
+
+#include <float.h>
+#include <stdint.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <libqhull_r/qhull_ra.h>
+
+#include "gi/envmap.h"
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---- Directions (§2.1) ---------------------------------------------------- */
+
+static int inv3(const float m[9], float out[9])
+{
+    float a = m[0], b = m[1], c = m[2], d = m[3], e = m[4], f = m[5], g = m[6], h = m[7], i = m[8];
+    float A = e * i - f * h, B = -(d * i - f * g), C = d * h - e * g;
+    float det = a * A + b * B + c * C;
+    if (fabsf(det) < 1e-12f)
+        return 0;
+    float s = 1.0f / det;
+    out[0] = A * s;
+    out[1] = -(b * i - c * h) * s;
+    out[2] = (b * f - c * e) * s;
+    out[3] = B * s;
+    out[4] = (a * i - c * g) * s;
+    out[5] = -(a * f - c * d) * s;
+    out[6] = C * s;
+    out[7] = -(a * h - b * g) * s;
+    out[8] = (a * e - b * d) * s;
+    return 1;
+}
+
+/* Area of the spherical triangle a, b, c (van Oosterom and Strackee). */
+static float spherical_area(gi_vec3 a, gi_vec3 b, gi_vec3 c)
+{
+    float num = gi_v3_dot(a, gi_v3_cross(b, c));
+    float den = 1.0f + gi_v3_dot(a, b) + gi_v3_dot(b, c) + gi_v3_dot(c, a);
+    return 2.0f * fabsf(atan2f(num, den));
+}
+
+int vlf_dirs_build(vlf_dirs *d, uint32_t l, char *err, size_t err_size)
+{
+    memset(d, 0, sizeof *d);
+    if (l < 4) {
+        snprintf(err, err_size, "vlf: l = %u directions, at least 4 needed", l);
+        return -1;
+    }
+    d->l = l;
+    uint32_t n = 2 * l;
+    d->signed_dirs = calloc(n, sizeof *d->signed_dirs);
+    d->solid_angle = calloc(n, sizeof *d->solid_angle);
+    coordT *pts = calloc((size_t)n * 3, sizeof *pts);
+    if (!d->signed_dirs || !d->solid_angle || !pts) {
+        free(pts);
+        vlf_dirs_free(d);
+        snprintf(err, err_size, "vlf: out of memory for %u directions", l);
+        return -1;
+    }
+    /* Spherical Fibonacci points on the upper hemisphere: equal-area bands in
+     * z, golden-angle steps in phi. */
+    const double golden = GI_PI * (3.0 - sqrt(5.0));
+    for (uint32_t k = 0; k < l; k++) {
+        double z = 1.0 - ((double)k + 0.5) / (double)l;
+        double r = sqrt(fmax(0.0, 1.0 - z * z));
+        double phi = golden * (double)k;
+        gi_vec3 w = gi_v3((float)(r * cos(phi)), (float)(r * sin(phi)), (float)z);
+        d->signed_dirs[k] = w;
+        d->signed_dirs[k + l] = gi_v3_scale(w, -1.0f);
+    }
+    for (uint32_t k = 0; k < n; k++) {
+        pts[3 * k + 0] = d->signed_dirs[k].x;
+        pts[3 * k + 1] = d->signed_dirs[k].y;
+        pts[3 * k + 2] = d->signed_dirs[k].z;
+    }
+    /* The convex hull of points on the sphere is their spherical Delaunay
+     * triangulation; Qt triangulates any non-simplicial facet. */
+    qhT qh_qh;
+    qhT *qh = &qh_qh;
+    qh_zero(qh, stderr);
+    char flags[] = "qhull Qt";
+    int rc = qh_new_qhull(qh, 3, (int)n, pts, False, flags, NULL, NULL);
+    int ok = rc == 0;
+    if (ok) {
+        facetT *facet;
+        uint32_t count = 0;
+        FORALLfacets count++;
+        d->tris = calloc((size_t)count * 3, sizeof *d->tris);
+        d->tri_inv = calloc((size_t)count * 9, sizeof *d->tri_inv);
+        ok = d->tris && d->tri_inv;
+        uint32_t t = 0;
+        FORALLfacets
+        {
+            if (!ok)
+                break;
+            vertexT *vertex, **vertexp;
+            uint32_t v[3], nv = 0;
+            FOREACHvertex_(facet->vertices)
+            {
+                if (nv < 3)
+                    v[nv] = (uint32_t)qh_pointid(qh, vertex->point);
+                nv++;
+            }
+            if (nv != 3) {
+                ok = 0;
+                break;
+            }
+            gi_vec3 a = d->signed_dirs[v[0]], b = d->signed_dirs[v[1]], c = d->signed_dirs[v[2]];
+            gi_vec3 nrm = gi_v3_cross(gi_v3_sub(b, a), gi_v3_sub(c, a));
+            if (gi_v3_dot(nrm, gi_v3_add(a, gi_v3_add(b, c))) < 0.0f) {
+                uint32_t tmp = v[1];
+                v[1] = v[2];
+                v[2] = tmp;
+                gi_vec3 tv = b;
+                b = c;
+                c = tv;
+            }
+            float m[9] = {a.x, b.x, c.x, a.y, b.y, c.y, a.z, b.z, c.z};
+            if (!inv3(m, d->tri_inv + 9 * t)) {
+                ok = 0;
+                break;
+            }
+            memcpy(d->tris + 3 * t, v, sizeof v);
+            float area = spherical_area(a, b, c);
+            for (int j = 0; j < 3; j++)
+                d->solid_angle[v[j]] += area / 3.0f;
+            t++;
+        }
+        d->tri_count = t;
+    }
+    int curlong, totlong;
+    qh_freeqhull(qh, !qh_ALL);
+    qh_memfreeshort(qh, &curlong, &totlong);
+    free(pts);
+    if (!ok) {
+        vlf_dirs_free(d);
+        snprintf(err, err_size, "vlf: qhull could not triangulate %u directions (code %d)", l, rc);
+        return -1;
+    }
+    return 0;
+}
+
+void vlf_dirs_free(vlf_dirs *d)
+{
+    free(d->signed_dirs);
+    free(d->solid_angle);
+    free(d->tris);
+    free(d->tri_inv);
+    memset(d, 0, sizeof *d);
+}
+
+uint32_t vlf_dirs_locate(const vlf_dirs *d, gi_vec3 w, uint32_t node[3], float alpha[3])
+{
+    uint32_t best = 0;
+    float best_min = -FLT_MAX;
+    float bx[3] = {0, 0, 0};
+    for (uint32_t t = 0; t < d->tri_count; t++) {
+        const float *m = d->tri_inv + 9 * t;
+        float x = m[0] * w.x + m[1] * w.y + m[2] * w.z;
+        float y = m[3] * w.x + m[4] * w.y + m[5] * w.z;
+        float z = m[6] * w.x + m[7] * w.y + m[8] * w.z;
+        float mn = fminf(x, fminf(y, z));
+        if (mn > best_min) {
+            best_min = mn;
+            best = t;
+            bx[0] = x;
+            bx[1] = y;
+            bx[2] = z;
+            if (mn >= 0.0f)
+                break;
+        }
+    }
+    float s = 0.0f;
+    for (int j = 0; j < 3; j++) {
+        bx[j] = fmaxf(bx[j], 0.0f);
+        s += bx[j];
+    }
+    for (int j = 0; j < 3; j++) {
+        node[j] = d->tris[3 * best + j];
+        alpha[j] = s > 0.0f ? bx[j] / s : 1.0f / 3.0f;
+    }
+    return best;
+}
+
+/* ---- Subfields ------------------------------------------------------------ */
+
+gi_vec3 vlf_to_vlf(const vlf_field *f, gi_vec3 world)
+{
+    return gi_v3_scale(gi_v3_sub(world, f->centre), 1.0f / f->radius);
+}
+
+void vlf_psf_project(const vlf_field *f, uint32_t i, gi_vec3 q, float *x, float *y, float *depth)
+{
+    const vlf_psf *p = &f->psf[i];
+    float N = (float)f->prm.N;
+    *x = (gi_v3_dot(q, p->u) + 1.0f) * 0.5f * N;
+    *y = (gi_v3_dot(q, p->v) + 1.0f) * 0.5f * N;
+    *depth = gi_v3_dot(q, p->n);
+}
+
+/* Elements: texels of the face's chart, density per unit length. */
+uint32_t vlf_element_at(const vlf_field *f, const vlf_face *fc, gi_vec3 q)
+{
+    gi_vec3 d = gi_v3_sub(q, fc->origin);
+    float x = gi_v3_dot(d, fc->t) * f->prm.density, y = gi_v3_dot(d, fc->b) * f->prm.density;
+    int ix = (int)floorf(x), iy = (int)floorf(y);
+    ix = ix < 0 ? 0 : ix >= (int)fc->W ? (int)fc->W - 1 : ix;
+    iy = iy < 0 ? 0 : iy >= (int)fc->H ? (int)fc->H - 1 : iy;
+    return fc->first_elem + (uint32_t)iy * fc->W + (uint32_t)ix;
+}
+
+typedef struct frag_tmp {
+    uint32_t cell;
+    float depth;
+    uint32_t elem;
+} frag_tmp;
+
+typedef struct frag_buf {
+    frag_tmp *v;
+    size_t n, cap;
+} frag_buf;
+
+static int frag_push(frag_buf *b, uint32_t cell, float depth, uint32_t elem)
+{
+    if (b->n == b->cap) {
+        size_t cap = b->cap ? b->cap * 2 : 4096;
+        frag_tmp *v = realloc(b->v, cap * sizeof *v);
+        if (!v)
+            return 0;
+        b->v = v;
+        b->cap = cap;
+    }
+    b->v[b->n++] = (frag_tmp){cell, depth, elem};
+    return 1;
+}
+
+/* Rasterises face fi orthographically into subfield i (cell centres inside
+ * the projected triangle). Calls emit for each covered cell. */
+typedef int (*cell_fn)(void *user, uint32_t cx, uint32_t cy, float depth);
+
+static int raster_tri(const vlf_field *f, const vlf_psf *fr, const gi_vec3 *p, cell_fn emit, void *user)
+{
+    float x[3], y[3], z[3];
+    float NS = (float)(f->prm.N * f->prm.S);
+    for (int k = 0; k < 3; k++) {
+        x[k] = (gi_v3_dot(p[k], fr->u) + 1.0f) * 0.5f * NS;
+        y[k] = (gi_v3_dot(p[k], fr->v) + 1.0f) * 0.5f * NS;
+        z[k] = gi_v3_dot(p[k], fr->n);
+    }
+    float area2 = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+    if (fabsf(area2) < 1e-9f)
+        return 1;
+    int N = (int)(f->prm.N * f->prm.S);
+    int x0 = (int)floorf(fminf(x[0], fminf(x[1], x[2])) - 0.5f), x1 = (int)ceilf(fmaxf(x[0], fmaxf(x[1], x[2])));
+    int y0 = (int)floorf(fminf(y[0], fminf(y[1], y[2])) - 0.5f), y1 = (int)ceilf(fmaxf(y[0], fmaxf(y[1], y[2])));
+    if (x0 < 0)
+        x0 = 0;
+    if (y0 < 0)
+        y0 = 0;
+    if (x1 > N - 1)
+        x1 = N - 1;
+    if (y1 > N - 1)
+        y1 = N - 1;
+    float inv = 1.0f / area2;
+    for (int cy = y0; cy <= y1; cy++) {
+        float py = (float)cy + 0.5f;
+        for (int cx = x0; cx <= x1; cx++) {
+            float px = (float)cx + 0.5f;
+            float w1 = ((px - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (py - y[0])) * inv;
+            float w2 = ((x[1] - x[0]) * (py - y[0]) - (px - x[0]) * (y[1] - y[0])) * inv;
+            float w0 = 1.0f - w1 - w2;
+            if (w0 < 0.0f || w1 < 0.0f || w2 < 0.0f)
+                continue;
+            float depth = w0 * z[0] + w1 * z[1] + w2 * z[2];
+            if (!emit(user, (uint32_t)cx, (uint32_t)cy, depth))
+                return 0;
+        }
+    }
+    return 1;
+}
+
+typedef struct sort_ctx {
+    frag_buf *buf;
+    const vlf_field *f;
+    const vlf_psf *psf;
+    const vlf_face *face;
+    uint32_t N;
+    int32_t *bbox; /* minx, miny, maxx, maxy of the face in this subfield */
+} sort_ctx;
+
+static int emit_frag(void *user, uint32_t cx, uint32_t cy, float depth)
+{
+    sort_ctx *c = user;
+    int32_t *bb = c->bbox;
+    int32_t X = (int32_t)(cx / c->f->prm.S), Y = (int32_t)(cy / c->f->prm.S); /* the subfield's cell */
+    if (X < bb[0])
+        bb[0] = X;
+    if (Y < bb[1])
+        bb[1] = Y;
+    if (X > bb[2])
+        bb[2] = X;
+    if (Y > bb[3])
+        bb[3] = Y;
+    float U = ((float)cx + 0.5f) / (float)c->N * 2.0f - 1.0f, V = ((float)cy + 0.5f) / (float)c->N * 2.0f - 1.0f;
+    gi_vec3 q = gi_v3_add(gi_v3_add(gi_v3_scale(c->psf->u, U), gi_v3_scale(c->psf->v, V)), gi_v3_scale(c->psf->n, depth));
+    uint32_t e = vlf_element_at(c->f, c->face, q);
+    return frag_push(c->buf, cy * c->N + cx, depth, e);
+}
+
+static int frag_cmp(const void *a, const void *b)
+{
+    const frag_tmp *x = a, *y = b;
+    if (x->cell != y->cell)
+        return x->cell < y->cell ? -1 : 1;
+    if (x->depth != y->depth)
+        return x->depth < y->depth ? -1 : 1;
+    return x->elem < y->elem ? -1 : (x->elem > y->elem);
+}
+
+/* Per-ray depth order of subfield i (the "sort" stage, §3.2): every face
+ * rasterised into the N x N rays, the fragments of each ray sorted front to
+ * back; the tile rectangles of non-diffuse faces recorded on the way. */
+static int build_psf(vlf_field *f, uint32_t i, frag_buf *buf, vlf_rect *rects)
+{
+    vlf_psf *p = &f->psf[i];
+    gi_vec3 w = f->dirs.signed_dirs[i];
+    p->n = w;
+    gi_onb(w, &p->u, &p->v);
+    uint32_t N = f->prm.N * f->prm.S, m = f->prm.m;
+    buf->n = 0;
+    int32_t *bbox = malloc(((size_t)f->face_count * 4 + 4) * sizeof *bbox);
+    if (!bbox)
+        return 0;
+    for (uint32_t fi = 0; fi < f->face_count; fi++) {
+        bbox[4 * fi] = bbox[4 * fi + 1] = INT32_MAX;
+        bbox[4 * fi + 2] = bbox[4 * fi + 3] = -1;
+    }
+    for (uint32_t ti = 0; ti < f->tri_count; ti++) {
+        uint32_t fi = f->tri_face[ti];
+        sort_ctx c = {buf, f, p, &f->faces[fi], N, bbox + 4 * fi};
+        if (!raster_tri(f, p, f->tri_p + 3 * (size_t)ti, emit_frag, &c)) {
+            free(bbox);
+            return 0;
+        }
+    }
+    for (uint32_t fi = 0; fi < f->face_count; fi++) {
+        if (f->faces[fi].nd < 0)
+            continue;
+        vlf_rect *r = &rects[(size_t)f->faces[fi].nd * f->prm.l + i];
+        const int32_t *bb = bbox + 4 * fi;
+        if (bb[2] < 0) {
+            *r = (vlf_rect){0, 0, 0, 0, 0};
+        } else {
+            int32_t tx0 = bb[0] / (int32_t)m, ty0 = bb[1] / (int32_t)m;
+            int32_t tx1 = bb[2] / (int32_t)m, ty1 = bb[3] / (int32_t)m;
+            *r = (vlf_rect){tx0 * (int32_t)m, ty0 * (int32_t)m, (uint32_t)(tx1 - tx0 + 1) * m,
+                            (uint32_t)(ty1 - ty0 + 1) * m, 0};
+        }
+    }
+    free(bbox);
+    qsort(buf->v, buf->n, sizeof *buf->v, frag_cmp);
+    p->cell_start = calloc((size_t)N * N + 1, sizeof *p->cell_start);
+    p->frag = malloc((buf->n ? buf->n : 1) * sizeof *p->frag);
+    if (!p->cell_start || !p->frag)
+        return 0;
+    p->frag_count = (uint32_t)buf->n;
+    for (size_t k = 0; k < buf->n; k++) {
+        p->cell_start[buf->v[k].cell + 1]++;
+        p->frag[k] = buf->v[k].elem;
+    }
+    for (uint32_t c = 0; c < N * N; c++)
+        p->cell_start[c + 1] += p->cell_start[c];
+    return 1;
+}
+
+static size_t rect_slot(const vlf_rect *r, uint32_t cx, uint32_t cy)
+{
+    return r->offset + (size_t)((int32_t)cy - r->y0) * r->w + (size_t)((int32_t)cx - r->x0);
+}
+
+typedef struct tri_key {
+    uint32_t tri, material;
+    int32_t nx, ny, nz, d;
+} tri_key;
+
+static int key_cmp(const void *a, const void *b)
+{
+    const tri_key *x = a, *y = b;
+    const int32_t kx[5] = {(int32_t)x->material, x->nx, x->ny, x->nz, x->d};
+    const int32_t ky[5] = {(int32_t)y->material, y->nx, y->ny, y->nz, y->d};
+    for (int k = 0; k < 5; k++)
+        if (kx[k] != ky[k])
+            return kx[k] < ky[k] ? -1 : 1;
+    return x->tri < y->tri ? -1 : (x->tri > y->tri);
+}
+
+/* Faces: the scene's triangles grouped by material and plane (normal and
+ * offset to 1e-3), each group one face with a chart of density texels per
+ * unit length over its bounding rectangle in the plane (§3.1: one
+ * irradiance texture per face; the charts are the atlas). */
+static int group_faces(vlf_field *f, const gi_scene *s, float t)
+{
+    uint32_t T = s->triangle_count;
+    f->tri_count = T;
+    f->tri_face = malloc((size_t)T * sizeof *f->tri_face);
+    f->tri_p = malloc((size_t)T * 3 * sizeof *f->tri_p);
+    tri_key *keys = malloc((size_t)T * sizeof *keys);
+    gi_vec3 *nrm = malloc((size_t)T * sizeof *nrm);
+    f->faces = calloc((size_t)T, sizeof *f->faces);
+    if (!f->tri_face || !f->tri_p || !keys || !nrm || !f->faces) {
+        free(keys);
+        free(nrm);
+        return 0;
+    }
+    for (uint32_t ti = 0; ti < T; ti++) {
+        gi_vec3 w[3];
+        gi_scene_triangle_world(s, ti, t, w);
+        gi_vec3 *p = f->tri_p + 3 * (size_t)ti;
+        for (int k = 0; k < 3; k++)
+            p[k] = vlf_to_vlf(f, w[k]);
+        gi_vec3 n = gi_v3_normalize(gi_v3_cross(gi_v3_sub(p[1], p[0]), gi_v3_sub(p[2], p[0])));
+        nrm[ti] = n;
+        keys[ti] = (tri_key){ti, s->vertices[s->indices[3 * ti]].material, (int32_t)lrintf(n.x * 1000.0f),
+                             (int32_t)lrintf(n.y * 1000.0f), (int32_t)lrintf(n.z * 1000.0f),
+                             (int32_t)lrintf(gi_v3_dot(n, p[0]) * 1000.0f)};
+    }
+    qsort(keys, T, sizeof *keys, key_cmp);
+    uint32_t nf = 0;
+    for (uint32_t a = 0; a < T;) {
+        uint32_t b = a + 1;
+        while (b < T && key_cmp(&(tri_key){0, keys[a].material, keys[a].nx, keys[a].ny, keys[a].nz, keys[a].d},
+                                &(tri_key){0, keys[b].material, keys[b].nx, keys[b].ny, keys[b].nz, keys[b].d}) == 0)
+            b++;
+        vlf_face *fc = &f->faces[nf];
+        uint32_t t0 = keys[a].tri;
+        gi_vec3 n = gi_v3(0, 0, 0);
+        for (uint32_t k = a; k < b; k++) {
+            const gi_vec3 *p = f->tri_p + 3 * (size_t)keys[k].tri;
+            gi_vec3 c = gi_v3_cross(gi_v3_sub(p[1], p[0]), gi_v3_sub(p[2], p[0]));
+            n = gi_v3_add(n, c);
+            fc->area += 0.5f * gi_v3_length(c);
+            f->tri_face[keys[k].tri] = nf;
+        }
+        fc->n = gi_v3_length(n) > 0.0f ? gi_v3_normalize(n) : nrm[t0];
+        gi_onb(fc->n, &fc->t, &fc->b);
+        float lo[2] = {FLT_MAX, FLT_MAX}, hi[2] = {-FLT_MAX, -FLT_MAX};
+        gi_vec3 p0 = f->tri_p[3 * (size_t)t0];
+        for (uint32_t k = a; k < b; k++)
+            for (int c = 0; c < 3; c++) {
+                gi_vec3 d = gi_v3_sub(f->tri_p[3 * (size_t)keys[k].tri + (size_t)c], p0);
+                float x = gi_v3_dot(d, fc->t), y = gi_v3_dot(d, fc->b);
+                lo[0] = fminf(lo[0], x), lo[1] = fminf(lo[1], y);
+                hi[0] = fmaxf(hi[0], x), hi[1] = fmaxf(hi[1], y);
+            }
+        fc->origin = gi_v3_add(p0, gi_v3_add(gi_v3_scale(fc->t, lo[0]), gi_v3_scale(fc->b, lo[1])));
+        float W = ceilf((hi[0] - lo[0]) * f->prm.density), H = ceilf((hi[1] - lo[1]) * f->prm.density);
+        fc->W = W < 1.0f ? 1u : W > 1024.0f ? 1024u : (uint32_t)W;
+        fc->H = H < 1.0f ? 1u : H > 1024.0f ? 1024u : (uint32_t)H;
+        const gi_material *mt = &s->materials[keys[a].material];
+        memcpy(fc->kd, mt->albedo, sizeof fc->kd);
+        memcpy(fc->ks, mt->ks, sizeof fc->ks);
+        fc->exponent = mt->exponent;
+        fc->mirror = mt->mirror || mt->exponent >= GI_MIRROR_EXPONENT;
+        const float *le = gi_scene_triangle_emission(s, t0);
+        for (int k = 0; k < 3; k++)
+            fc->emission[k] = le ? le[k] : 0.0f;
+        nf++;
+        a = b;
+    }
+    f->face_count = nf;
+    free(keys);
+    free(nrm);
+    return 1;
+}
+
+/* Clips polygon (x, y)[n] to the half-plane s * (coord k) <= c; returns
+ * the new count (Sutherland-Hodgman). */
+static int clip_poly(float *x, float *y, int n, int k, float s, float c)
+{
+    float ox[16], oy[16];
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        int j = (i + 1) % n;
+        float vi = s * (k ? y[i] : x[i]) - c, vj = s * (k ? y[j] : x[j]) - c;
+        if (vi <= 0.0f && m < 16)
+            ox[m] = x[i], oy[m] = y[i], m++;
+        if ((vi < 0.0f && vj > 0.0f) || (vi > 0.0f && vj < 0.0f)) {
+            float t = vi / (vi - vj);
+            if (m < 16)
+                ox[m] = x[i] + t * (x[j] - x[i]), oy[m] = y[i] + t * (y[j] - y[i]), m++;
+        }
+    }
+    memcpy(x, ox, (size_t)m * sizeof *x);
+    memcpy(y, oy, (size_t)m * sizeof *y);
+    return m;
+}
+
+/* Area of each element inside its face: every triangle clipped exactly
+ * against the texels of its bounding box. */
+static void element_areas(vlf_field *f)
+{
+    float texel = 1.0f / (f->prm.density * f->prm.density);
+    for (uint32_t ti = 0; ti < f->tri_count; ti++) {
+        const vlf_face *fc = &f->faces[f->tri_face[ti]];
+        const gi_vec3 *p = f->tri_p + 3 * (size_t)ti;
+        float x[3], y[3];
+        for (int k = 0; k < 3; k++) {
+            gi_vec3 d = gi_v3_sub(p[k], fc->origin);
+            x[k] = gi_v3_dot(d, fc->t) * f->prm.density;
+            y[k] = gi_v3_dot(d, fc->b) * f->prm.density;
+        }
+        int x0 = (int)floorf(fminf(x[0], fminf(x[1], x[2]))), x1 = (int)floorf(fmaxf(x[0], fmaxf(x[1], x[2])));
+        int y0 = (int)floorf(fminf(y[0], fminf(y[1], y[2]))), y1 = (int)floorf(fmaxf(y[0], fmaxf(y[1], y[2])));
+        for (int ty = y0; ty <= y1; ty++)
+            for (int tx = x0; tx <= x1; tx++) {
+                float px[16] = {x[0], x[1], x[2]}, py[16] = {y[0], y[1], y[2]};
+                int n = 3;
+                n = clip_poly(px, py, n, 0, 1.0f, (float)tx + 1.0f);
+                n = clip_poly(px, py, n, 0, -1.0f, -(float)tx);
+                n = clip_poly(px, py, n, 1, 1.0f, (float)ty + 1.0f);
+                n = clip_poly(px, py, n, 1, -1.0f, -(float)ty);
+                float a = 0.0f;
+                for (int i = 0; i < n; i++) {
+                    int j = (i + 1) % n;
+                    a += px[i] * py[j] - px[j] * py[i];
+                }
+                int cx = tx < 0 ? 0 : tx >= (int)fc->W ? (int)fc->W - 1 : tx;
+                int cy = ty < 0 ? 0 : ty >= (int)fc->H ? (int)fc->H - 1 : ty;
+                f->elem_area[fc->first_elem + (uint32_t)cy * fc->W + (uint32_t)cx] += 0.5f * fabsf(a) * texel;
+            }
+    }
+}
+
+int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *p, char *err, size_t err_size)
+{
+    memset(f, 0, sizeof *f);
+    f->prm = *p;
+    double t0 = now_s();
+    if (p->S < 1 || p->S > 8) {
+        snprintf(err, err_size, "vlf: supersampling S = %u outside 1..8", p->S);
+        return -1;
+    }
+    if (p->N < 4 || p->m < 1 || p->N % p->m != 0) {
+        snprintf(err, err_size, "vlf: N = %u must be a multiple of the tile size m = %u", p->N, p->m);
+        return -1;
+    }
+    double ray_bytes = (double)p->l * (double)(p->N * p->S) * (double)(p->N * p->S) * sizeof(uint32_t);
+    if (ray_bytes > 2.0 * 1024 * 1024 * 1024) {
+        snprintf(err, err_size, "vlf: l (N S)^2 = %.3g rays need %.1f GB of depth lists alone; lower l, N or S",
+                 ray_bytes / sizeof(uint32_t), ray_bytes / (1024.0 * 1024 * 1024));
+        return -1;
+    }
+    if (vlf_dirs_build(&f->dirs, p->l, err, err_size) != 0)
+        return -1;
+    if (s->triangle_count == 0) {
+        snprintf(err, err_size, "vlf: the scene has no triangles");
+        return -1;
+    }
+    float b[6];
+    gi_scene_bounds_at(s, t, b);
+    f->centre = gi_v3(0.5f * (b[0] + b[3]), 0.5f * (b[1] + b[4]), 0.5f * (b[2] + b[5]));
+    f->radius = 0.5f * sqrtf((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) + (b[5] - b[2]) * (b[5] - b[2]));
+    f->radius *= 1.001f;
+    if (!(f->radius > 0.0f) || !isfinite(f->radius)) {
+        snprintf(err, err_size, "vlf: the scene's bounds are empty or not finite");
+        return -1;
+    }
+    f->env = s->envmap;
+    if (!group_faces(f, s, t))
+        goto oom;
+    uint32_t elems = 0;
+    for (uint32_t fi = 0; fi < f->face_count; fi++) {
+        vlf_face *fc = &f->faces[fi];
+        fc->first_elem = elems;
+        elems += fc->W * fc->H;
+        fc->nd = (fc->ks[0] > 0.0f || fc->ks[1] > 0.0f || fc->ks[2] > 0.0f) ? (int32_t)f->nd_count++ : -1;
+        /* Diffuse emission normalised so that the discrete directions carry
+         * exactly pi L per unit area out of the face. */
+        double sum = 0.0;
+        for (uint32_t sd = 0; sd < 2 * p->l; sd++) {
+            float c2 = gi_v3_dot(fc->n, f->dirs.signed_dirs[sd]);
+            if (c2 > 0.0f)
+                sum += c2 * f->dirs.solid_angle[sd];
+        }
+        fc->send_scale = sum > 0.0 ? (float)(GI_PI / sum) : 1.0f;
+    }
+    f->elem_count = elems;
+    f->elem_face = malloc((size_t)elems * sizeof *f->elem_face);
+    f->elem_area = calloc((size_t)elems, sizeof *f->elem_area);
+    f->E_tot = calloc((size_t)elems * 3, sizeof(float));
+    f->E_next = calloc((size_t)elems * 3, sizeof(float));
+    f->L_cur = calloc((size_t)elems * 3, sizeof(float));
+    f->psf = calloc(p->l, sizeof *f->psf);
+    f->rects = calloc((size_t)f->nd_count * p->l + 1, sizeof *f->rects);
+    if (!f->elem_face || !f->elem_area || !f->E_tot || !f->E_next || !f->L_cur || !f->psf || !f->rects)
+        goto oom;
+    for (uint32_t fi = 0; fi < f->face_count; fi++) {
+        vlf_face *fc = &f->faces[fi];
+        for (uint32_t e = 0; e < fc->W * fc->H; e++)
+            f->elem_face[fc->first_elem + e] = fi;
+    }
+    element_areas(f);
+    frag_buf buf = {0};
+    for (uint32_t i = 0; i < p->l; i++) {
+        if (!build_psf(f, i, &buf, f->rects)) {
+            free(buf.v);
+            goto oom;
+        }
+    }
+    free(buf.v);
+    /* Tile storage offsets, then coverage of each stored cell. */
+    size_t cells = 0;
+    uint32_t tiles = 0;
+    for (size_t r = 0; r < (size_t)f->nd_count * p->l; r++) {
+        f->rects[r].offset = (uint32_t)cells;
+        cells += (size_t)f->rects[r].w * f->rects[r].h;
+        tiles += f->rects[r].w * f->rects[r].h / (p->m * p->m);
+    }
+    if (cells > 0x7fffffffu) {
+        snprintf(err, err_size, "vlf: %zu non-diffuse cells do not fit (lower N or l)", cells);
+        return -1;
+    }
+    f->nd_cells = (uint32_t)cells;
+    size_t nc = cells ? cells : 1;
+    f->nd_cover = calloc(nc, 1);
+    f->out_cur = calloc(nc * 3, sizeof(float));
+    f->out_next = calloc(nc * 3, sizeof(float));
+    f->out_tot = calloc(nc * 3, sizeof(float));
+    f->in = calloc(nc * 3, sizeof(float));
+    if (!f->nd_cover || !f->out_cur || !f->out_next || !f->out_tot || !f->in)
+        goto oom;
+    size_t frags = 0;
+    for (uint32_t i = 0; i < p->l; i++) {
+        const vlf_psf *ps = &f->psf[i];
+        frags += ps->frag_count;
+        uint32_t NS = p->N * p->S;
+        for (uint32_t c = 0; c < NS * NS; c++)
+            for (uint32_t k = ps->cell_start[c]; k < ps->cell_start[c + 1]; k++) {
+                const vlf_face *fc = &f->faces[f->elem_face[ps->frag[k]]];
+                if (fc->nd >= 0)
+                    f->nd_cover[rect_slot(&f->rects[(size_t)fc->nd * p->l + i], (c % NS) / p->S, (c / NS) / p->S)] = 1;
+            }
+    }
+    uint32_t ndel = 0;
+    for (size_t c = 0; c < cells; c++)
+        ndel += f->nd_cover[c];
+    f->st.diffuse_elements = elems;
+    f->st.nondiffuse_elements = ndel;
+    f->st.tiles = tiles;
+    /* Memory as the paper counts it: current, next and total ir/radiance
+     * (RGB float) for both kinds, plus the depth order; rendering keeps the
+     * totals only. */
+    f->st.bytes_propagate = (size_t)elems * 3 * sizeof(float) * 3 + cells * 3 * sizeof(float) * 4 + cells +
+                            frags * sizeof(uint32_t) + (size_t)p->l * ((size_t)p->N * p->S * p->N * p->S + 1) * sizeof(uint32_t);
+    f->st.bytes_render = (size_t)elems * 3 * sizeof(float) + cells * 3 * sizeof(float) +
+                         (size_t)f->nd_count * p->l * sizeof(vlf_rect);
+    f->st.sort_s = now_s() - t0;
+    return 0;
+oom:
+    snprintf(err, err_size, "vlf: out of memory building the light field (N = %u, l = %u)", p->N, p->l);
+    return -1;
+}
+
+/* ---- Propagation (§3.2-§3.4) --------------------------------------------- */
+
+/* Fragments of all faces along a perturbed direction (frame fr), sorted
+ * per ray front to back; kept with their depths (§3.5: perturbed
+ * directions are sorted like fixed ones, used for transport, discarded). */
+static int perturbed_list(vlf_field *f, const vlf_psf *fr, frag_buf *buf)
+{
+    int32_t bb[4];
+    buf->n = 0;
+    for (uint32_t ti = 0; ti < f->tri_count; ti++) {
+        bb[0] = bb[1] = INT32_MAX;
+        bb[2] = bb[3] = -1;
+        sort_ctx c = {buf, f, fr, &f->faces[f->tri_face[ti]], f->prm.N * f->prm.S, bb};
+        if (!raster_tri(f, fr, f->tri_p + 3 * (size_t)ti, emit_frag, &c))
+            return 0;
+    }
+    qsort(buf->v, buf->n, sizeof *buf->v, frag_cmp);
+    return 1;
+}
+
+/* The tile slot of non-diffuse face fc in fixed subfield i holding VLF
+ * point q, or SIZE_MAX where q's cell is outside the face there. */
+static size_t slot_at(const vlf_field *f, const vlf_face *fc, uint32_t i, gi_vec3 q)
+{
+    float x, y, z;
+    vlf_psf_project(f, i, q, &x, &y, &z);
+    const vlf_rect *r = &f->rects[(size_t)fc->nd * f->prm.l + i];
+    int cx = (int)floorf(x) - r->x0, cy = (int)floorf(y) - r->y0;
+    if (cx < 0 || cy < 0 || cx >= (int)r->w || cy >= (int)r->h)
+        return SIZE_MAX;
+    size_t slot = r->offset + (size_t)cy * r->w + (size_t)cx;
+    return f->nd_cover[slot] ? slot : SIZE_MAX;
+}
+
+/* A sweep along a perturbed direction fr->n (sign: +n or -n) standing in
+ * for fixed direction i with weight dW: as sweep() below, but non-diffuse
+ * faces read and write the tiles of fixed subfield i at each fragment's
+ * point. */
+static void sweep_perturbed(vlf_field *f, uint32_t i, const vlf_psf *fr, const frag_buf *buf, int sign, float dW,
+                            int first_iteration)
+{
+    uint32_t S = f->prm.S, N = f->prm.N * S;
+    float inv_s2 = 1.0f / (float)(S * S);
+    gi_vec3 t = gi_v3_scale(fr->n, (float)sign);
+    float cell_area = (2.0f / (float)N) * (2.0f / (float)N);
+    float min_area = 1.0f / (64.0f * f->prm.density * f->prm.density);
+    float sky[3] = {0, 0, 0};
+    if (first_iteration && f->env)
+        gi_envmap_eval(f->env, gi_v3_scale(t, -1.0f), sky);
+    double shot = 0, recv = 0, back = 0, esc = 0;
+    size_t a = 0;
+    while (a < buf->n) {
+        size_t e = a;
+        while (e < buf->n && buf->v[e].cell == buf->v[a].cell)
+            e++;
+        uint32_t c = buf->v[a].cell;
+        float U = ((float)(c % N) + 0.5f) / (float)N * 2.0f - 1.0f, V = ((float)(c / N) + 0.5f) / (float)N * 2.0f - 1.0f;
+        gi_vec3 o = gi_v3_add(gi_v3_scale(fr->u, U), gi_v3_scale(fr->v, V));
+        float L[3] = {sky[0], sky[1], sky[2]};
+        for (size_t j = 0; j < e - a; j++) {
+            const frag_tmp *fg = &buf->v[sign > 0 ? a + j : e - 1 - j];
+            uint32_t el = fg->elem;
+            const vlf_face *fc = &f->faces[f->elem_face[el]];
+            float cs = gi_v3_dot(fc->n, t);
+            float lum = L[0] + L[1] + L[2];
+            size_t slot = SIZE_MAX;
+            if (fc->nd >= 0 && cs != 0.0f)
+                slot = slot_at(f, fc, i, gi_v3_add(o, gi_v3_scale(fr->n, fg->depth)));
+            if (cs < 0.0f) {
+                float s = cell_area * dW / fmaxf(f->elem_area[el], min_area);
+                for (int q = 0; q < 3; q++)
+                    f->E_next[3 * (size_t)el + q] += L[q] * s;
+                if (slot != SIZE_MAX)
+                    for (int q = 0; q < 3; q++)
+                        f->in[3 * slot + q] += L[q] * inv_s2 / (float)f->prm.perturbed;
+                recv += lum;
+                L[0] = L[1] = L[2] = 0.0f;
+            } else if (cs > 0.0f) {
+                back += lum;
+                for (int q = 0; q < 3; q++)
+                    L[q] = f->L_cur[3 * (size_t)el + q] * fc->send_scale;
+                if (slot != SIZE_MAX)
+                    for (int q = 0; q < 3; q++)
+                        L[q] += f->out_cur[3 * slot + q];
+                shot += L[0] + L[1] + L[2];
+            }
+            f->st.samples++;
+        }
+        esc += L[0] + L[1] + L[2];
+        a = e;
+    }
+    double w = (double)cell_area * dW / 3.0;
+    f->st.flux_shot += shot * w;
+    f->st.flux_received += recv * w;
+    f->st.flux_back += back * w;
+    f->st.flux_escaped += esc * w;
+}
+
+/* Perturbed direction k of fixed direction i: uniform in the cap of solid
+ * angle dOmega_i around w_i (the paper's samples spread over the solid
+ * angle each fixed direction stands for), from a hash of (seed, i, k). */
+static gi_vec3 perturbed_dir(const vlf_field *f, uint32_t i, uint32_t k)
+{
+    uint32_t h = f->prm.seed * 0x9E3779B9u ^ (i * 0x85EBCA6Bu) ^ (k * 0xC2B2AE35u);
+    float u[2];
+    for (int j = 0; j < 2; j++) {
+        h ^= h >> 16;
+        h *= 0x7FEB352Du;
+        h ^= h >> 15;
+        h *= 0x846CA68Bu;
+        h ^= h >> 16;
+        u[j] = (float)(h >> 8) / 16777216.0f;
+    }
+    float cos_max = 1.0f - f->dirs.solid_angle[i] / (2.0f * GI_PI);
+    float cz = 1.0f - u[0] * (1.0f - cos_max), sz = sqrtf(fmaxf(0.0f, 1.0f - cz * cz));
+    float phi = 2.0f * GI_PI * u[1];
+    const vlf_psf *p = &f->psf[i];
+    return gi_v3_normalize(gi_v3_add(gi_v3_scale(p->n, cz),
+                                     gi_v3_add(gi_v3_scale(p->u, sz * cosf(phi)), gi_v3_scale(p->v, sz * sinf(phi)))));
+}
+
+/* One sweep of subfield i along travel direction t = sign * w_i, front to
+ * back along t through every ray's fragments with the radiance interface:
+ * receivers (front side facing against t) take the interface's radiance,
+ * senders (front side along t) overwrite it with their unshot radiance. */
+static void sweep(vlf_field *f, uint32_t i, int sign, int first_iteration)
+{
+    const vlf_psf *p = &f->psf[i];
+    uint32_t S = f->prm.S, N = f->prm.N * S, l = f->prm.l;
+    float inv_s2 = 1.0f / (float)(S * S);
+    uint32_t sd = sign > 0 ? i : i + l;
+    gi_vec3 t = f->dirs.signed_dirs[sd];
+    float dW = f->dirs.solid_angle[sd];
+    float cell_area = (2.0f / (float)N) * (2.0f / (float)N);
+    float sky[3] = {0, 0, 0};
+    if (first_iteration && f->env)
+        gi_envmap_eval(f->env, gi_v3_scale(t, -1.0f), sky);
+    double shot = 0, recv = 0, back = 0, esc = 0;
+    float min_area = 1.0f / (64.0f * f->prm.density * f->prm.density);
+    for (uint32_t c = 0; c < N * N; c++) {
+        uint32_t a = p->cell_start[c], e = p->cell_start[c + 1];
+        float L[3] = {sky[0], sky[1], sky[2]};
+        int32_t step = sign > 0 ? 1 : -1;
+        int32_t k = sign > 0 ? (int32_t)a : (int32_t)e - 1, end = sign > 0 ? (int32_t)e : (int32_t)a - 1;
+        uint32_t cx = (c % N) / S, cy = (c / N) / S; /* the subfield's cell of this interface cell */
+        for (; k != end; k += step) {
+            uint32_t el = p->frag[k];
+            const vlf_face *fc = &f->faces[f->elem_face[el]];
+            float cs = gi_v3_dot(fc->n, t);
+            float lum = L[0] + L[1] + L[2];
+            if (cs < 0.0f) {
+                /* receiver */
+                float s = cell_area * dW / fmaxf(f->elem_area[el], min_area);
+                for (int q = 0; q < 3; q++)
+                    f->E_next[3 * (size_t)el + q] += L[q] * s;
+                if (fc->nd >= 0) {
+                    size_t slot = rect_slot(&f->rects[(size_t)fc->nd * l + i], cx, cy);
+                    for (int q = 0; q < 3; q++)
+                        f->in[3 * slot + q] += L[q] * inv_s2;
+                }
+                recv += lum;
+                L[0] = L[1] = L[2] = 0.0f;
+            } else if (cs > 0.0f) {
+                /* sender: what arrived on its back side is absorbed */
+                back += lum;
+                for (int q = 0; q < 3; q++)
+                    L[q] = f->L_cur[3 * (size_t)el + q] * fc->send_scale;
+                if (fc->nd >= 0) {
+                    size_t slot = rect_slot(&f->rects[(size_t)fc->nd * l + i], cx, cy);
+                    for (int q = 0; q < 3; q++)
+                        L[q] += f->out_cur[3 * slot + q];
+                }
+                shot += L[0] + L[1] + L[2];
+            }
+            f->st.samples++;
+        }
+        esc += L[0] + L[1] + L[2];
+    }
+    double w = (double)cell_area * dW / 3.0;
+    f->st.flux_shot += shot * w;
+    f->st.flux_received += recv * w;
+    f->st.flux_back += back * w;
+    f->st.flux_escaped += esc * w;
+}
+
+/* Bilinear read of face nd's incoming radiance in subfield i at continuous
+ * cell position (x, y), over covered cells only. */
+static int read_in(const vlf_field *f, const vlf_rect *r, float x, float y, float out[3])
+{
+    float fx = x - 0.5f - (float)r->x0, fy = y - 0.5f - (float)r->y0;
+    int ix = (int)floorf(fx), iy = (int)floorf(fy);
+    float ax = fx - (float)ix, ay = fy - (float)iy;
+    float wsum = 0.0f;
+    out[0] = out[1] = out[2] = 0.0f;
+    for (int dy = 0; dy < 2; dy++)
+        for (int dx = 0; dx < 2; dx++) {
+            int X = ix + dx, Y = iy + dy;
+            if (X < 0 || Y < 0 || X >= (int)r->w || Y >= (int)r->h)
+                continue;
+            size_t slot = r->offset + (size_t)Y * r->w + (size_t)X;
+            if (!f->nd_cover[slot])
+                continue;
+            float wt = (dx ? ax : 1.0f - ax) * (dy ? ay : 1.0f - ay) + 1e-6f;
+            for (int q = 0; q < 3; q++)
+                out[q] += wt * f->in[3 * slot + q];
+            wsum += wt;
+        }
+    if (wsum <= 0.0f)
+        return 0;
+    for (int q = 0; q < 3; q++)
+        out[q] /= wsum;
+    return 1;
+}
+
+/* Non-diffuse scattering (§3.4): the radiance that subfield i brought to
+ * each non-diffuse face is reflected into the subfields around the
+ * reflected direction (mirrors and lobes narrower than the direction set:
+ * the three nearest, barycentric weights; wider Phong lobes: every
+ * direction of the lobe, weighted by it), by backward mapping of each
+ * target cell through the face's plane into subfield i. */
+static void scatter(vlf_field *f, uint32_t i)
+{
+    uint32_t l = f->prm.l, n2 = 2 * l;
+    float *g = malloc(n2 * sizeof *g);
+    if (!g)
+        return;
+    for (uint32_t fi = 0; fi < f->face_count; fi++) {
+        const vlf_face *fc = &f->faces[fi];
+        if (fc->nd < 0)
+            continue;
+        const vlf_rect *ri = &f->rects[(size_t)fc->nd * l + i];
+        float ci = gi_v3_dot(fc->n, f->dirs.signed_dirs[i]);
+        if (ri->w == 0 || ci == 0.0f)
+            continue;
+        uint32_t sd_in = ci < 0.0f ? i : i + l; /* travel direction of the incoming light */
+        gi_vec3 t = f->dirs.signed_dirs[sd_in];
+        float cos_in = fabsf(ci);
+        gi_vec3 r = gi_v3_sub(t, gi_v3_scale(fc->n, 2.0f * gi_v3_dot(t, fc->n)));
+        memset(g, 0, n2 * sizeof *g);
+        int lobe = 0;
+        if (!fc->mirror) {
+            double s1 = 0, s2 = 0;
+            for (uint32_t j = 0; j < n2; j++) {
+                float cj = gi_v3_dot(f->dirs.signed_dirs[j], r);
+                if (cj > 0.0f && gi_v3_dot(f->dirs.signed_dirs[j], fc->n) > 0.0f) {
+                    g[j] = powf(cj, fc->exponent);
+                    if (g[j] < 1e-3f)
+                        g[j] = 0.0f;
+                    s1 += g[j];
+                    s2 += (double)g[j] * g[j];
+                }
+            }
+            lobe = s2 > 0.0 && s1 * s1 / s2 >= 3.0; /* at least ~3 directions in the lobe */
+            if (!lobe)
+                memset(g, 0, n2 * sizeof *g);
+        }
+        if (!lobe) {
+            uint32_t node[3];
+            float al[3];
+            vlf_dirs_locate(&f->dirs, r, node, al);
+            for (int j = 0; j < 3; j++)
+                g[node[j]] += al[j];
+        }
+        /* Normalise: the face reflects ks of the flux that arrives from this direction. */
+        double norm = 0.0;
+        for (uint32_t j = 0; j < n2; j++) {
+            float cj = gi_v3_dot(f->dirs.signed_dirs[j], fc->n);
+            if (g[j] > 0.0f && cj > 0.0f)
+                norm += g[j] * cj * f->dirs.solid_angle[j];
+            else
+                g[j] = 0.0f;
+        }
+        if (norm <= 0.0)
+            continue;
+        float scale = (float)((double)cos_in * f->dirs.solid_angle[sd_in] / norm);
+        for (uint32_t j = 0; j < n2; j++) {
+            if (g[j] <= 0.0f)
+                continue;
+            uint32_t pj = j % l;
+            const vlf_rect *rj = &f->rects[(size_t)fc->nd * l + pj];
+            const vlf_psf *P = &f->psf[pj];
+            float c[3];
+            for (int q = 0; q < 3; q++)
+                c[q] = fc->ks[q] * g[j] * scale;
+            float dn = gi_v3_dot(P->n, fc->n);
+            if (fabsf(dn) < 1e-6f)
+                continue;
+            for (uint32_t yy = 0; yy < rj->h; yy++)
+                for (uint32_t xx = 0; xx < rj->w; xx++) {
+                    size_t slot = rj->offset + (size_t)yy * rj->w + xx;
+                    if (!f->nd_cover[slot])
+                        continue;
+                    /* the cell's ray meets the face's plane at q */
+                    float U = ((float)(rj->x0 + (int32_t)xx) + 0.5f) / (float)f->prm.N * 2.0f - 1.0f;
+                    float V = ((float)(rj->y0 + (int32_t)yy) + 0.5f) / (float)f->prm.N * 2.0f - 1.0f;
+                    gi_vec3 o = gi_v3_add(gi_v3_scale(P->u, U), gi_v3_scale(P->v, V));
+                    float tt = gi_v3_dot(fc->n, gi_v3_sub(fc->origin, o)) / dn;
+                    gi_vec3 q = gi_v3_add(o, gi_v3_scale(P->n, tt));
+                    float x, y, z;
+                    vlf_psf_project(f, i, q, &x, &y, &z);
+                    float Lin[3];
+                    if (!read_in(f, ri, x, y, Lin))
+                        continue;
+                    for (int k = 0; k < 3; k++)
+                        f->out_next[3 * slot + k] += c[k] * Lin[k];
+                }
+        }
+    }
+    free(g);
+}
+
+int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
+{
+    double t0 = now_s();
+    uint32_t l = f->prm.l;
+    size_t ne = (size_t)f->elem_count * 3, nc = (size_t)f->nd_cells * 3;
+    memset(f->E_tot, 0, ne * sizeof(float));
+    memset(f->out_tot, 0, nc * sizeof(float));
+    memset(f->out_cur, 0, nc * sizeof(float));
+    memset(f->out_next, 0, nc * sizeof(float));
+    memset(f->E_next, 0, ne * sizeof(float));
+    f->st.flux_emitted = 0;
+    for (uint32_t e = 0; e < f->elem_count; e++) {
+        const vlf_face *fc = &f->faces[f->elem_face[e]];
+        for (int q = 0; q < 3; q++) {
+            f->L_cur[3 * e + q] = fc->emission[q];
+            f->st.flux_emitted += GI_PI * fc->emission[q] * f->elem_area[e] / 3.0;
+        }
+    }
+    f->st.flux_shot = f->st.flux_received = f->st.flux_back = f->st.flux_escaped = 0;
+    f->st.samples = 0;
+    frag_buf pbuf = {0};
+    for (uint32_t it = 0; it < f->prm.iterations; it++) {
+        for (uint32_t i = 0; i < l; i++) {
+            if (cancelled && cancelled(user)) {
+                free(pbuf.v);
+                return -1;
+            }
+            for (uint32_t fi = 0; fi < f->face_count; fi++)
+                if (f->faces[fi].nd >= 0) {
+                    const vlf_rect *r = &f->rects[(size_t)f->faces[fi].nd * l + i];
+                    memset(f->in + 3 * (size_t)r->offset, 0, (size_t)r->w * r->h * 3 * sizeof(float));
+                }
+            if (f->prm.perturbed == 0) {
+                sweep(f, i, +1, it == 0);
+                sweep(f, i, -1, it == 0);
+            } else {
+                for (uint32_t k = 0; k < f->prm.perturbed; k++) {
+                    vlf_psf fr;
+                    fr.n = perturbed_dir(f, i, k);
+                    gi_onb(fr.n, &fr.u, &fr.v);
+                    if (!perturbed_list(f, &fr, &pbuf)) {
+                        free(pbuf.v);
+                        return -1;
+                    }
+                    /* each sign's solid angle: the fixed direction's, shared */
+                    sweep_perturbed(f, i, &fr, &pbuf, +1, f->dirs.solid_angle[i] / (float)f->prm.perturbed, it == 0);
+                    sweep_perturbed(f, i, &fr, &pbuf, -1, f->dirs.solid_angle[i + l] / (float)f->prm.perturbed, it == 0);
+                }
+            }
+            if (f->nd_count)
+                scatter(f, i);
+        }
+        for (size_t k = 0; k < ne; k++) {
+            f->E_tot[k] += f->E_next[k];
+            const vlf_face *fc = &f->faces[f->elem_face[k / 3]];
+            f->L_cur[k] = fc->kd[k % 3] * (float)GI_INV_PI * f->E_next[k];
+            f->E_next[k] = 0.0f;
+        }
+        for (size_t k = 0; k < nc; k++) {
+            f->out_tot[k] += f->out_next[k];
+            f->out_cur[k] = f->out_next[k];
+            f->out_next[k] = 0.0f;
+        }
+    }
+    free(pbuf.v);
+    f->st.propagate_s = now_s() - t0;
+    return 0;
+}
+
+void vlf_field_free(vlf_field *f)
+{
+    if (f->psf)
+        for (uint32_t i = 0; i < f->prm.l; i++) {
+            free(f->psf[i].cell_start);
+            free(f->psf[i].frag);
+        }
+    free(f->psf);
+    vlf_dirs_free(&f->dirs);
+    free(f->faces);
+    free(f->tri_face);
+    free(f->tri_p);
+    free(f->elem_face);
+    free(f->elem_area);
+    free(f->rects);
+    free(f->nd_cover);
+    free(f->E_tot);
+    free(f->E_next);
+    free(f->L_cur);
+    free(f->out_cur);
+    free(f->out_next);
+    free(f->out_tot);
+    free(f->in);
+    memset(f, 0, sizeof *f);
+}

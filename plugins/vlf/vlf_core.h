@@ -1,0 +1,128 @@
+/* The CPU side of the vlf method (Mortensen, Khanna, Slater, Afrigraph 2007):
+ * the direction set with its spherical triangulation (§2.1), the parallel
+ * subfields and their per-ray depth order (§3.2), the storage of diffuse
+ * elements and sparse non-diffuse tiles (§3.1), and the propagation of
+ * unshot radiance through radiance interfaces (§3.2-§3.4). No GL here: the
+ * plugin (vlf.c) uploads the result for rendering (§4), and the tests drive
+ * these functions directly. */
+#ifndef VLF_CORE_H
+#define VLF_CORE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "gi/scene.h"
+#include "gi/vecmath.h"
+
+/* l bi-directional directions on the upper hemisphere and the spherical
+ * triangulation of the 2l signed directions (s < l: +w_s, s >= l: -w_{s-l}). */
+typedef struct vlf_dirs {
+    uint32_t l;
+    gi_vec3 *signed_dirs;  /* 2l unit vectors */
+    float *solid_angle;    /* 2l: a third of the areas of the triangles at each node (sum 4 pi) */
+    uint32_t tri_count;
+    uint32_t *tris;        /* 3 per spherical triangle, counter-clockwise seen from outside */
+    float *tri_inv;        /* 9 per triangle: inverse of the matrix with columns a, b, c (row-major) */
+} vlf_dirs;
+
+/* Builds the set with qhull. 0 on success, else -1 with a message in err. */
+int vlf_dirs_build(vlf_dirs *d, uint32_t l, char *err, size_t err_size);
+void vlf_dirs_free(vlf_dirs *d);
+/* The spherical triangle holding unit direction w and its barycentric
+ * weights (non-negative, summing to 1) of its three nodes; returns the
+ * triangle index. */
+uint32_t vlf_dirs_locate(const vlf_dirs *d, gi_vec3 w, uint32_t node[3], float alpha[3]);
+
+/* Parameters (names of the paper where it has them). */
+typedef struct vlf_params {
+    uint32_t l;          /* bi-directional directions */
+    uint32_t N;          /* cells per side of a parallel subfield */
+    uint32_t m;          /* cells per side of a tile of non-diffuse storage */
+    uint32_t S;          /* radiance interface cells per subfield cell and side (its super-sampling, §3.3) */
+    float density;       /* diffuse elements per unit length (scene scaled into the unit sphere) */
+    uint32_t iterations; /* shooting iterations */
+    uint32_t perturbed;  /* perturbed virtual directions per fixed direction for transport (0: the fixed one, §3.5) */
+    uint32_t seed;
+} vlf_params;
+
+/* A rectangle of tiles of one non-diffuse face in one subfield. */
+typedef struct vlf_rect {
+    int32_t x0, y0;
+    uint32_t w, h;
+    uint32_t offset; /* first cell in the tile storage */
+} vlf_rect;
+
+/* A face: the coplanar triangles of one material (the paper's planar
+ * polygons), with a W x H chart of diffuse elements in its plane. */
+typedef struct vlf_face {
+    gi_vec3 origin;     /* a point of the plane, the chart's corner (VLF coordinates) */
+    gi_vec3 n;          /* unit normal */
+    gi_vec3 t, b;       /* chart axes in the plane, unit */
+    float area;         /* VLF units */
+    uint32_t W, H;      /* chart texels */
+    uint32_t first_elem;
+    float kd[3], ks[3], exponent, emission[3];
+    int mirror;
+    int32_t nd;         /* index among non-diffuse faces, -1 for diffuse */
+    float send_scale;   /* pi / sum over directions of |cos| dOmega (diffuse emission normalisation) */
+} vlf_face;
+
+/* Fragment lists of one subfield: the faces each ray meets, front to back
+ * along +w, on the radiance interface's (N S)^2 rays (cell c's list is
+ * frag[cell_start[c] .. cell_start[c+1])). */
+typedef struct vlf_psf {
+    gi_vec3 u, v, n;
+    uint32_t *cell_start; /* N*N + 1 */
+    uint32_t *frag;       /* element index of each fragment */
+    uint32_t frag_count;
+} vlf_psf;
+
+typedef struct vlf_stats {
+    double sort_s, propagate_s;
+    double flux_emitted, flux_shot, flux_received, flux_back, flux_escaped; /* sums over iterations */
+    uint64_t samples;        /* fragments visited in propagation (the paper's "ray intersections") */
+    size_t bytes_propagate;  /* storage while propagating */
+    size_t bytes_render;     /* storage kept for rendering */
+    uint32_t diffuse_elements, nondiffuse_elements, tiles;
+} vlf_stats;
+
+typedef struct vlf_field {
+    vlf_params prm;
+    vlf_dirs dirs;
+    gi_vec3 centre;
+    float radius;            /* world = centre + radius * vlf */
+    uint32_t face_count, elem_count, nd_count;
+    vlf_face *faces;
+    uint32_t tri_count;
+    uint32_t *tri_face;      /* face of each scene triangle */
+    gi_vec3 *tri_p;          /* 3 corners per triangle, VLF coordinates */
+    uint32_t *elem_face;
+    float *elem_area;
+    vlf_psf *psf;            /* l (fixed directions) */
+    vlf_rect *rects;         /* nd_count * l */
+    uint32_t nd_cells;
+    uint8_t *nd_cover;       /* nd_cells: the face covers this cell */
+    /* radiance storage (RGB) */
+    float *E_tot, *E_next, *L_cur;       /* elem_count * 3: irradiance, unshot diffuse radiance */
+    float *out_cur, *out_next, *out_tot, *in; /* nd_cells * 3 */
+    const struct gi_envmap *env;
+    vlf_stats st;
+} vlf_field;
+
+/* Builds the field for scene s at time t: faces, elements, directions and
+ * the per-ray depth order of every subfield ("sort"). 0 or -1 with err. */
+int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *p, char *err, size_t err_size);
+/* Shoots unshot radiance for p->iterations iterations ("propagate").
+ * `cancelled` (may be NULL) is polled between directions; returns -1 then. */
+int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user);
+void vlf_field_free(vlf_field *f);
+
+/* Subfield frame of fixed direction i: cell coordinates (x, y) in [0, N)
+ * and depth of VLF point q. */
+void vlf_psf_project(const vlf_field *f, uint32_t i, gi_vec3 q, float *x, float *y, float *depth);
+/* Element (chart texel, global index) of face fc holding VLF point q. */
+uint32_t vlf_element_at(const vlf_field *f, const vlf_face *fc, gi_vec3 q);
+/* World point to VLF coordinates. */
+gi_vec3 vlf_to_vlf(const vlf_field *f, gi_vec3 world);
+
+#endif
