@@ -42,6 +42,12 @@ static const gi_param_desc iv_params[] = {
      "a node is subdivided while its solid angle seen from the other end exceeds this many bins' solid angle"},
     {"links", GI_PARAM_ENUM, 0, 0, 0, "hierarchical|brute", "Sec. 4.2 / 3.1 (Fig. 10 b, c)",
      "hierarchical links, or every leaf against every leaf"},
+    {"remesh", GI_PARAM_FLOAT, 0.0, 0.0, 1.0, NULL, "Sec. 5.1 (re-meshing)",
+     "target edge length as a fraction of the scene's largest extent: longer triangles are subdivided; 0 = the model's own vertices"},
+    {"bilinear", GI_PARAM_BOOL, 0, 0, 1, NULL, "Sec. 4.2.2 (deviation)",
+     "a link goes into the four bins around its direction, each with its share of the node's solid angle (README \"Deviations\")"},
+    {"coverage", GI_PARAM_FLOAT, 0.0, 0.0, 1.0, NULL, "Eq. 4 / Eq. 5 (deviation)",
+     "a bin whose links' solid angles sum to less than this share of it passes light through that share only; 0: Eq. 5 (the nearest covers the bin)"},
     {"splat", GI_PARAM_BOOL, 1, 0, 1, NULL, "Sec. 3 (an element covers its bin)",
      "a disc nearer than its size covers every bin it spans, not only its centre's (README \"Deviations\")"},
     {0},
@@ -49,13 +55,13 @@ static const gi_param_desc iv_params[] = {
 
 typedef struct implicit_vis {
     gi_kit kit;
-    int N, bounces, brute, splat;
-    float subdiv;
+    int N, bounces, brute, splat, bilinear;
+    float subdiv, remesh, coverage;
     iv_hier *hier;
     iv_links *links;
     float *irr;          /* 6 per element */
-    float *vertex_light; /* 12 per scene vertex: e_front, e_back, normal (vec4 each) */
-    GLuint ssbo_light;
+    float *elem_light; /* 12 per element: e_front, e_back, normal (vec4 each) */
+    GLuint ssbo_light, ssbo_tri, ssbo_grid;
     GLuint prog_display;
 } implicit_vis;
 
@@ -71,8 +77,11 @@ static gi_result iv_create(const gi_host *host, const gi_params *params, void **
     m->N = gi_params_int(params, "N");
     m->bounces = gi_params_int(params, "bounces");
     m->subdiv = gi_params_float(params, "subdiv");
+    m->remesh = gi_params_float(params, "remesh");
     m->brute = gi_params_enum(params, "links") == 1;
     m->splat = gi_params_bool(params, "splat");
+    m->bilinear = gi_params_bool(params, "bilinear");
+    m->coverage = gi_params_float(params, "coverage");
     *out = m;
     return GI_OK;
 }
@@ -82,15 +91,17 @@ static void release_prepared(implicit_vis *m)
     iv_links_free(m->links);
     iv_hier_free(m->hier);
     free(m->irr);
-    free(m->vertex_light);
-    if (m->ssbo_light)
-        glDeleteBuffers(1, &m->ssbo_light);
+    free(m->elem_light);
+    GLuint bufs[3] = {m->ssbo_light, m->ssbo_tri, m->ssbo_grid};
+    for (int i = 0; i < 3; i++)
+        if (bufs[i])
+            glDeleteBuffers(1, &bufs[i]);
     if (m->prog_display)
         glDeleteProgram(m->prog_display);
     m->links = NULL;
     m->hier = NULL;
-    m->irr = m->vertex_light = NULL;
-    m->ssbo_light = m->prog_display = 0;
+    m->irr = m->elem_light = NULL;
+    m->ssbo_light = m->ssbo_tri = m->ssbo_grid = m->prog_display = 0;
 }
 
 static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
@@ -102,7 +113,10 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
     const gi_scene *s = gs->scene;
     const gi_host *host = m->kit.host;
     host->stage_begin(host, "hierarchy");
-    m->hier = iv_hier_create(s, &err);
+    float ext = 0.0f;
+    for (int c = 0; c < 3; c++)
+        ext = fmaxf(ext, s->bounds[3 + c] - s->bounds[c]);
+    m->hier = iv_hier_create(s, m->remesh * ext, &err);
     host->stage_end(host, "hierarchy");
     if (!m->hier)
         return gi_kit_fail_with(&m->kit, GI_ERR_INVALID_ARGUMENT, &err);
@@ -116,13 +130,31 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
                            "implicit_vis: links=brute compares every two of %u elements (limit %u): use links=hierarchical",
                            m->hier->elem_count, IV_MAX_BRUTE_ELEMENTS);
     m->links = iv_links_create(m->hier, (uint32_t)m->N);
+    if (m->links) {
+        m->links->bilinear = m->bilinear;
+        m->links->coverage = m->coverage;
+    }
     m->irr = calloc((size_t)m->hier->elem_count * 6, sizeof(float));
-    m->vertex_light = calloc((size_t)s->vertex_count * 12, sizeof(float));
-    if (!m->links || !m->irr || !m->vertex_light)
+    m->elem_light = calloc((size_t)m->hier->elem_count * 12, sizeof(float));
+    uint32_t *tri = malloc(((size_t)s->triangle_count * 2 + 1) * sizeof(uint32_t));
+    if (!m->links || !m->irr || !m->elem_light || !tri) {
+        free(tri);
         return gi_kit_fail(&m->kit, GI_ERR_OUT_OF_MEMORY, "implicit_vis: out of memory for the links of %u nodes",
                            m->hier->node_count);
+    }
+    /* the display's look-up: triangle -> (k, first grid point), grid point -> element */
+    for (uint32_t t = 0; t < s->triangle_count; t++) {
+        tri[2 * t] = m->hier->tri_k[t];
+        tri[2 * t + 1] = m->hier->tri_grid[t];
+    }
+    glCreateBuffers(1, &m->ssbo_tri);
+    glNamedBufferStorage(m->ssbo_tri, (GLsizeiptr)((size_t)s->triangle_count * 2 * sizeof(uint32_t)), tri, 0);
+    free(tri);
+    glCreateBuffers(1, &m->ssbo_grid);
+    glNamedBufferStorage(m->ssbo_grid, (GLsizeiptr)((size_t)m->hier->sample_count * sizeof(uint32_t)),
+                         m->hier->samp_elem, 0);
     glCreateBuffers(1, &m->ssbo_light);
-    glNamedBufferStorage(m->ssbo_light, (GLsizeiptr)((size_t)s->vertex_count * 12 * sizeof(float)), NULL,
+    glNamedBufferStorage(m->ssbo_light, (GLsizeiptr)((size_t)m->hier->elem_count * 12 * sizeof(float)), NULL,
                          GL_DYNAMIC_STORAGE_BIT);
     m->prog_display = gi_program_build_compute("iv_display.comp", NULL, &err);
     if (!m->prog_display)
@@ -130,6 +162,7 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
     host->stat(host, "elements", (double)m->hier->elem_count);
     host->stat(host, "nodes", (double)m->hier->node_count);
     host->stat(host, "segments", (double)m->hier->segment_count);
+    host->stat(host, "surface_points", (double)m->hier->sample_count);
     if (gi_gl_check("implicit_vis: prepare", &err) != GI_OK)
         return gi_kit_fail_with(&m->kit, GI_ERR_GL, &err);
     return GI_OK;
@@ -142,20 +175,18 @@ static gi_result iv_update(void *inst, const gi_gpu_scene *gs, const gi_changes 
     return GI_OK;
 }
 
-/* Each scene vertex gets its element's irradiance and normal. */
-static void upload_vertex_light(implicit_vis *m, const gi_scene *s)
+/* Each element's irradiance (both sides) and normal, for the display. */
+static void upload_elem_light(implicit_vis *m)
 {
     const iv_hier *h = m->hier;
-    for (uint32_t v = 0; v < s->vertex_count; v++) {
-        uint32_t e = h->vert_elem[v];
-        float *o = &m->vertex_light[12 * (size_t)v];
+    for (uint32_t e = 0; e < h->elem_count; e++) {
+        float *o = &m->elem_light[12 * (size_t)e];
         memcpy(o, &m->irr[6 * e], 3 * sizeof(float));
         memcpy(o + 4, &m->irr[6 * e + 3], 3 * sizeof(float));
         memcpy(o + 8, &h->nrm[3 * h->elem_node[e]], 3 * sizeof(float));
         o[3] = o[7] = o[11] = 0.0f;
     }
-    glNamedBufferSubData(m->ssbo_light, 0, (GLsizeiptr)((size_t)s->vertex_count * 12 * sizeof(float)),
-                         m->vertex_light);
+    glNamedBufferSubData(m->ssbo_light, 0, (GLsizeiptr)((size_t)h->elem_count * 12 * sizeof(float)), m->elem_light);
 }
 
 static gi_result iv_render(void *inst, const gi_view *view, const gi_target *target)
@@ -184,7 +215,7 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
     host->stage_begin(host, "illumination");
     iv_lights li = {s, gs->time, s->envmap};
     iv_illuminate(m->links, m->hier, &li, (uint32_t)m->bounces, m->irr);
-    upload_vertex_light(m, s);
+    upload_elem_light(m);
     host->stage_end(host, "illumination");
 
     host->stage_begin(host, "display");
@@ -193,7 +224,9 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
         GLuint p = m->prog_display;
         glUseProgram(p);
         gi_kit_bind(&m->kit, p, view, target);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_VERTEX_LIGHT, m->ssbo_light);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_ELEM_LIGHT, m->ssbo_light);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_TRI, m->ssbo_tri);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_GRID, m->ssbo_grid);
         GLint size[2] = {(GLint)view->width, (GLint)view->height};
         glUniform2iv(glGetUniformLocation(p, "u_size"), 1, size);
         gi_kit_dispatch_8x8(view->width, view->height);

@@ -5,7 +5,7 @@
  * stage on its own.
  *
  * Use (Algorithm 1):
- *     iv_hier *h = iv_hier_create(scene, &err);      // CreateSurfels + CreateGeometricHierarchy
+ *     iv_hier *h = iv_hier_create(scene, edge, &err);      // CreateSurfels + CreateGeometricHierarchy
  *     iv_links *l = iv_links_create(h, N);
  *     per frame:
  *         iv_hier_update(h, scene, t);               // UpdateElements (Sec. 4.2.1)
@@ -33,13 +33,35 @@ float iv_bin_solid_angle(uint32_t b, uint32_t n);
 
 /* ---- surface elements and the geometric hierarchy (Sec. 4.1) ---- */
 
+/* Re-meshing limits: subdivisions of one triangle, surface points in all. */
+#define IV_MAX_K 64u
+#define IV_MAX_SAMPLES (8u * 1024u * 1024u)
+
+/* Grid point (i, j) of a triangle subdivided k times (i + j <= k; the
+ * point's barycentric weights of corners 1 and 2 are i / k and j / k):
+ * rows of constant j, k + 1 - j points each. */
+static inline uint32_t iv_grid_index(uint32_t k, uint32_t i, uint32_t j)
+{
+    return j * (k + 1) - j * (j - 1) / 2 + i;
+}
+
 typedef struct iv_hier {
-    /* Elements: one oriented disc per model vertex (scene vertices equal in
+    /* Surface points: the corners of every triangle, or with re-meshing
+     * every point of its k x k subdivision grid (Sec. 4.1 and 5.1, the
+     * optional re-meshing to a target edge length). */
+    uint32_t *tri_k;    /* per triangle: subdivisions (1 = none) */
+    uint32_t *tri_grid; /* per triangle + 1: its first point */
+    uint32_t sample_count;
+    uint32_t *samp_tri;  /* triangle of each point */
+    float *samp_b;       /* 2 per point: barycentric weights of corners 1 and 2 */
+    float *samp_share;   /* per point: its share of the triangle's area (1/3 per sub-triangle around it / k^2) */
+    uint32_t *samp_elem; /* point -> element */
+    float *rest;         /* 3 per point: object-local rest position */
+    /* Elements: one oriented disc per distinct point (points equal in
      * position and normal merged). */
     uint32_t elem_count;
-    uint32_t *vert_elem; /* scene vertex -> element */
-    uint32_t *elem_rep;  /* element -> one of its scene vertices */
-    float *elem_albedo;  /* 3 per element: mean albedo of its vertices */
+    uint32_t *elem_rep;  /* element -> one of its points */
+    float *elem_albedo;  /* 3 per element: mean albedo of its points */
     float *elem_emit;    /* 3 per element: emitted radiance */
     uint8_t *elem_two_sided_emit;
     uint32_t segment_count; /* connected parts of each object: the roots */
@@ -59,9 +81,12 @@ typedef struct iv_hier {
     float *area; /* per node: sum of the children */
     float *tri_area; /* scratch: triangle areas at t */
     gi_vertex *verts; /* scratch: an object's vertices at t */
+    float *wpos, *wnrm; /* scratch: the model's vertices at t, world space */
 } iv_hier;
 
-iv_hier *iv_hier_create(const gi_scene *s, gi_error *err);
+/* target_edge > 0: each triangle subdivided k times, k its longest edge
+ * over target_edge rounded up (at most IV_MAX_K); 0: the model as it is. */
+iv_hier *iv_hier_create(const gi_scene *s, float target_edge, gi_error *err);
 void iv_hier_free(iv_hier *h);
 /* Positions, normals and areas of the elements at time t (rigid motion and
  * morph targets), then every node from its children (Sec. 4.2.1). */
@@ -76,6 +101,11 @@ typedef struct iv_links {
     uint32_t nodes;
     int32_t *other;    /* nodes x bins: the linked node, -1 empty */
     float *dist;       /* nodes x bins: its distance */
+    int bilinear;      /* links written into the four bins around their direction (README "Deviations") */
+    float coverage;    /* > 0: a bin whose links' solid angles sum to less than this share of it is lit
+                          through that part only (README "Deviations"); 0: Eq. 5, the nearest covers all */
+    float *cover;      /* nodes x bins: solid angle of every node linked in the bin (Eq. 4's sum); after
+                          refinement summed down each leaf's path */
     float *bin_dir;    /* 3 per bin: centre direction */
     float *bin_omega;  /* per bin: solid angle */
     /* After iv_links_refine_push: the receiving links of each leaf

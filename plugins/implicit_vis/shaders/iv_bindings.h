@@ -2,5 +2,8 @@
  * shader alike (only #define lines). SSBOs from GI_SSBO_PLUGIN_FIRST (8). */
 #ifndef IV_BINDINGS_H
 #define IV_BINDINGS_H
-#define IV_SSBO_VERTEX_LIGHT 8 /* iv_display.comp: per scene vertex, its element's irradiance (both sides) and normal */
+/* iv_display.comp */
+#define IV_SSBO_ELEM_LIGHT 8 /* per element: irradiance on both sides, normal */
+#define IV_SSBO_TRI 9        /* per triangle: subdivisions k, its first grid point */
+#define IV_SSBO_GRID 10      /* per grid point: its element */
 #endif
