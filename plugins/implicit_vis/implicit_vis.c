@@ -26,7 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Bins x nodes x 8 bytes above this are refused with a message. */
+/* Bins x nodes x 12 bytes (link, distance, coverage) above this are refused with a message. */
 #define IV_MAX_LINK_BYTES (3ull << 30)
 /* Brute force compares every two leaves: refused above this many. */
 #define IV_MAX_BRUTE_ELEMENTS 40000u
@@ -120,7 +120,7 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
     host->stage_end(host, "hierarchy");
     if (!m->hier)
         return gi_kit_fail_with(&m->kit, GI_ERR_INVALID_ARGUMENT, &err);
-    unsigned long long bytes = 6ull * (unsigned long long)m->N * (unsigned long long)m->N * m->hier->node_count * 8ull;
+    unsigned long long bytes = 6ull * (unsigned long long)m->N * (unsigned long long)m->N * m->hier->node_count * 12ull;
     if (bytes > IV_MAX_LINK_BYTES)
         return gi_kit_fail(&m->kit, GI_ERR_UNSUPPORTED,
                            "implicit_vis: %u nodes x 6 x %d x %d bins need %.1f GiB of links (limit 3 GiB): lower N",
