@@ -1,0 +1,289 @@
+/* The `implicit_vis` method: Interactive Global Illumination Using Implicit
+ * Visibility (Dong, Kautz, Theobalt, Seidel, PG 2007).
+ *
+ * prepare(): surface elements and the geometric hierarchy (Algorithm 1,
+ * lines 1-2; iv_core.c). Every frame (lines 3-11), each a stage timer named
+ * as the paper's Table 1:
+ *   update_elements  positions, normals, areas at the frame's time, bottom-up;
+ *   create_links     the hierarchical links in world-aligned 6 x N x N bins,
+ *                    the shortest per bin (implicit visibility);
+ *   refine_push      refinement and push-down to unidirectional leaf links;
+ *   illumination     direct light along the light links, the environment
+ *                    through empty bins, punctual lights through their bin,
+ *                    then `bounces` gathers and pull-ups;
+ *   display          the G-buffer and the per-vertex irradiance
+ *                    interpolated per pixel (shaders/iv_display.comp).
+ * The hierarchy, links and gathering run on the CPU (one thread); only the
+ * display runs on the GPU (README "Not yet implemented"). */
+#include "iv.h"
+#include "shaders/iv_bindings.h"
+
+#include "gi/kit.h"
+#include "gi/shader.h"
+#include "gi/log.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Bins x nodes x 12 bytes (link, distance, coverage) above this are refused with a message. */
+#define IV_MAX_LINK_BYTES (3ull << 30)
+/* Brute force compares every two leaves: refused above this many. */
+#define IV_MAX_BRUTE_ELEMENTS 40000u
+
+extern const gi_shader_source gi_implicit_vis_shaders[];
+
+static const gi_param_desc iv_params[] = {
+    {"N", GI_PARAM_INT, 12, 1, 32, NULL, "N (Sec. 4.2.2, 6 x N x N bins; Table 1: 8, 12, 16)",
+     "bins per cube-map side of every node"},
+    {"bounces", GI_PARAM_INT, 3, 0, 3, NULL, "light bounces (Algorithm 1, line 8)",
+     "indirect bounces after the direct light (Table 1: 1)"},
+    {"subdiv", GI_PARAM_FLOAT, 1.0, 0.01, 100.0, NULL, "Sec. 4.2.2",
+     "a node is subdivided while its solid angle seen from the other end exceeds this many bins' solid angle"},
+    {"links", GI_PARAM_ENUM, 0, 0, 0, "hierarchical|brute", "Sec. 4.2 / 3.1 (Fig. 10 b, c)",
+     "hierarchical links, or every leaf against every leaf"},
+    {"remesh", GI_PARAM_FLOAT, 0.0, 0.0, 1.0, NULL, "Sec. 5.1 (re-meshing)",
+     "target edge length as a fraction of the scene's largest extent: longer triangles are subdivided; 0 = the model's own vertices"},
+    {"bilinear", GI_PARAM_BOOL, 0, 0, 1, NULL, "Sec. 4.2.2 (deviation)",
+     "a link goes into the four bins around its direction, each with its share of the node's solid angle (README \"Deviations\")"},
+    {"coverage", GI_PARAM_FLOAT, 0.0, 0.0, 1.0, NULL, "Eq. 4 / Eq. 5 (deviation)",
+     "a bin whose links' solid angles sum to less than this share of it passes light through that share only; 0: Eq. 5 (the nearest covers the bin)"},
+    {"splat", GI_PARAM_BOOL, 1, 0, 1, NULL, "Sec. 3 (an element covers its bin)",
+     "a disc nearer than its size covers every bin it spans, not only its centre's (README \"Deviations\")"},
+    {0},
+};
+
+typedef struct implicit_vis {
+    gi_kit kit;
+    int N, bounces, brute, splat, bilinear;
+    float subdiv, remesh, coverage;
+    iv_hier *hier;
+    iv_links *links;
+    float *irr;          /* 6 per element */
+    float *elem_light; /* 12 per element: e_front, e_back, normal (vec4 each) */
+    GLuint ssbo_light, ssbo_tri, ssbo_grid;
+    GLuint prog_display;
+} implicit_vis;
+
+static gi_result iv_create(const gi_host *host, const gi_params *params, void **out)
+{
+    implicit_vis *m = calloc(1, sizeof *m);
+    if (!m)
+        return GI_ERR_OUT_OF_MEMORY;
+    if (gi_kit_init(&m->kit, host, gi_implicit_vis_shaders) != GI_OK) {
+        free(m);
+        return GI_ERR_INVALID_ARGUMENT;
+    }
+    m->N = gi_params_int(params, "N");
+    m->bounces = gi_params_int(params, "bounces");
+    m->subdiv = gi_params_float(params, "subdiv");
+    m->remesh = gi_params_float(params, "remesh");
+    m->brute = gi_params_enum(params, "links") == 1;
+    m->splat = gi_params_bool(params, "splat");
+    m->bilinear = gi_params_bool(params, "bilinear");
+    m->coverage = gi_params_float(params, "coverage");
+    *out = m;
+    return GI_OK;
+}
+
+static void release_prepared(implicit_vis *m)
+{
+    iv_links_free(m->links);
+    iv_hier_free(m->hier);
+    free(m->irr);
+    free(m->elem_light);
+    GLuint bufs[3] = {m->ssbo_light, m->ssbo_tri, m->ssbo_grid};
+    for (int i = 0; i < 3; i++)
+        if (bufs[i])
+            glDeleteBuffers(1, &bufs[i]);
+    if (m->prog_display)
+        glDeleteProgram(m->prog_display);
+    m->links = NULL;
+    m->hier = NULL;
+    m->irr = m->elem_light = NULL;
+    m->ssbo_light = m->ssbo_tri = m->ssbo_grid = m->prog_display = 0;
+}
+
+static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
+{
+    implicit_vis *m = inst;
+    gi_error err;
+    release_prepared(m);
+    gi_kit_prepare(&m->kit, gs);
+    const gi_scene *s = gs->scene;
+    const gi_host *host = m->kit.host;
+    host->stage_begin(host, "hierarchy");
+    float ext = 0.0f;
+    for (int c = 0; c < 3; c++)
+        ext = fmaxf(ext, s->bounds[3 + c] - s->bounds[c]);
+    m->hier = iv_hier_create(s, m->remesh * ext, &err);
+    host->stage_end(host, "hierarchy");
+    if (!m->hier)
+        return gi_kit_fail_with(&m->kit, GI_ERR_INVALID_ARGUMENT, &err);
+    unsigned long long bytes = 6ull * (unsigned long long)m->N * (unsigned long long)m->N * m->hier->node_count * 12ull;
+    if (bytes > IV_MAX_LINK_BYTES)
+        return gi_kit_fail(&m->kit, GI_ERR_UNSUPPORTED,
+                           "implicit_vis: %u nodes x 6 x %d x %d bins need %.1f GiB of links (limit 3 GiB): lower N",
+                           m->hier->node_count, m->N, m->N, (double)bytes / (1u << 30));
+    if (m->brute && m->hier->elem_count > IV_MAX_BRUTE_ELEMENTS)
+        return gi_kit_fail(&m->kit, GI_ERR_UNSUPPORTED,
+                           "implicit_vis: links=brute compares every two of %u elements (limit %u): use links=hierarchical",
+                           m->hier->elem_count, IV_MAX_BRUTE_ELEMENTS);
+    m->links = iv_links_create(m->hier, (uint32_t)m->N);
+    if (m->links) {
+        m->links->bilinear = m->bilinear;
+        m->links->coverage = m->coverage;
+    }
+    m->irr = calloc((size_t)m->hier->elem_count * 6, sizeof(float));
+    m->elem_light = calloc((size_t)m->hier->elem_count * 12, sizeof(float));
+    uint32_t *tri = malloc(((size_t)s->triangle_count * 2 + 1) * sizeof(uint32_t));
+    if (!m->links || !m->irr || !m->elem_light || !tri) {
+        free(tri);
+        return gi_kit_fail(&m->kit, GI_ERR_OUT_OF_MEMORY, "implicit_vis: out of memory for the links of %u nodes",
+                           m->hier->node_count);
+    }
+    /* the display's look-up: triangle -> (k, first grid point), grid point -> element */
+    for (uint32_t t = 0; t < s->triangle_count; t++) {
+        tri[2 * t] = m->hier->tri_k[t];
+        tri[2 * t + 1] = m->hier->tri_grid[t];
+    }
+    glCreateBuffers(1, &m->ssbo_tri);
+    glNamedBufferStorage(m->ssbo_tri, (GLsizeiptr)((size_t)s->triangle_count * 2 * sizeof(uint32_t)), tri, 0);
+    free(tri);
+    glCreateBuffers(1, &m->ssbo_grid);
+    glNamedBufferStorage(m->ssbo_grid, (GLsizeiptr)((size_t)m->hier->sample_count * sizeof(uint32_t)),
+                         m->hier->samp_elem, 0);
+    glCreateBuffers(1, &m->ssbo_light);
+    glNamedBufferStorage(m->ssbo_light, (GLsizeiptr)((size_t)m->hier->elem_count * 12 * sizeof(float)), NULL,
+                         GL_DYNAMIC_STORAGE_BIT);
+    m->prog_display = gi_program_build_compute("iv_display.comp", NULL, &err);
+    if (!m->prog_display)
+        return gi_kit_fail_with(&m->kit, GI_ERR_GL, &err);
+    host->stat(host, "elements", (double)m->hier->elem_count);
+    host->stat(host, "nodes", (double)m->hier->node_count);
+    host->stat(host, "segments", (double)m->hier->segment_count);
+    host->stat(host, "surface_points", (double)m->hier->sample_count);
+    if (gi_gl_check("implicit_vis: prepare", &err) != GI_OK)
+        return gi_kit_fail_with(&m->kit, GI_ERR_GL, &err);
+    return GI_OK;
+}
+
+static gi_result iv_update(void *inst, const gi_gpu_scene *gs, const gi_changes *changes)
+{
+    /* everything but the hierarchy is rebuilt every frame (Algorithm 1) */
+    gi_kit_update(&((implicit_vis *)inst)->kit, gs, changes);
+    return GI_OK;
+}
+
+/* Each element's irradiance (both sides) and normal, for the display. */
+static void upload_elem_light(implicit_vis *m)
+{
+    const iv_hier *h = m->hier;
+    for (uint32_t e = 0; e < h->elem_count; e++) {
+        float *o = &m->elem_light[12 * (size_t)e];
+        memcpy(o, &m->irr[6 * e], 3 * sizeof(float));
+        memcpy(o + 4, &m->irr[6 * e + 3], 3 * sizeof(float));
+        memcpy(o + 8, &h->nrm[3 * h->elem_node[e]], 3 * sizeof(float));
+        o[3] = o[7] = o[11] = 0.0f;
+    }
+    glNamedBufferSubData(m->ssbo_light, 0, (GLsizeiptr)((size_t)h->elem_count * 12 * sizeof(float)), m->elem_light);
+}
+
+static gi_result iv_render(void *inst, const gi_view *view, const gi_target *target)
+{
+    implicit_vis *m = inst;
+    const gi_host *host = m->kit.host;
+    const gi_gpu_scene *gs = m->kit.scene;
+    const gi_scene *s = gs->scene;
+    gi_error err;
+    gi_result r = gi_kit_frame_begin(&m->kit, view, GI_KIT_GBUFFER);
+    if (r != GI_OK)
+        return r;
+
+    host->stage_begin(host, "update_elements");
+    iv_hier_update(m->hier, s, gs->time);
+    host->stage_end(host, "update_elements");
+
+    host->stage_begin(host, "create_links");
+    iv_links_build(m->links, m->hier, m->subdiv, m->brute, m->splat);
+    host->stage_end(host, "create_links");
+
+    host->stage_begin(host, "refine_push");
+    iv_links_refine_push(m->links, m->hier);
+    host->stage_end(host, "refine_push");
+
+    host->stage_begin(host, "illumination");
+    iv_lights li = {s, gs->time, s->envmap};
+    iv_illuminate(m->links, m->hier, &li, (uint32_t)m->bounces, m->irr);
+    upload_elem_light(m);
+    host->stage_end(host, "illumination");
+
+    host->stage_begin(host, "display");
+    r = gi_kit_render_gbuffer(&m->kit, view, NULL);
+    if (r == GI_OK) {
+        GLuint p = m->prog_display;
+        glUseProgram(p);
+        gi_kit_bind(&m->kit, p, view, target);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_ELEM_LIGHT, m->ssbo_light);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_TRI, m->ssbo_tri);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_GRID, m->ssbo_grid);
+        GLint size[2] = {(GLint)view->width, (GLint)view->height};
+        glUniform2iv(glGetUniformLocation(p, "u_size"), 1, size);
+        gi_kit_dispatch_8x8(view->width, view->height);
+        glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
+        glUseProgram(0);
+        r = gi_gl_check("implicit_vis: display", &err);
+    }
+    host->stage_end(host, "display");
+    if (r != GI_OK)
+        return gi_kit_fail_with(&m->kit, r, &err);
+    gi_kit_frame_end(&m->kit);
+
+    host->stat(host, "link_tries", (double)m->links->tries);
+    host->stat(host, "links_created", (double)m->links->created);
+    host->stat(host, "leaf_links", (double)m->links->receiving);
+    host->stat(host, "light_links", (double)m->links->light_off[m->hier->elem_count]);
+    return GI_OK;
+}
+
+static void iv_destroy(void *inst)
+{
+    implicit_vis *m = inst;
+    if (!m)
+        return;
+    gi_kit_free(&m->kit);
+    release_prepared(m);
+    free(m);
+}
+
+static const char *iv_last_error(void *inst)
+{
+    return inst ? gi_kit_last_error(&((implicit_vis *)inst)->kit) : "";
+}
+
+static const gi_method iv_method = {
+    .struct_size = sizeof(gi_method),
+    .abi_version = GI_ABI_VERSION,
+    .id = "implicit_vis",
+    .title = "Interactive Global Illumination Using Implicit Visibility",
+    .citation = "Dong, Kautz, Theobalt, Seidel. Pacific Graphics 2007",
+    .version = "0.1",
+    .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL |
+            GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION | GI_CAP_DEFORMATION | GI_CAP_VISIBILITY | GI_CAP_TEXTURES,
+    .max_bounces = 3,
+    .params = iv_params,
+    .create = iv_create,
+    .prepare = iv_prepare,
+    .update = iv_update,
+    .render = iv_render,
+    .destroy = iv_destroy,
+    .last_error = iv_last_error,
+    .layout = GI_ABI_LAYOUT,
+};
+
+GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)
+{
+    if (GI_ABI_VERSION_MAJOR(host_abi_version) != GI_ABI_MAJOR)
+        return NULL;
+    return &iv_method;
+}

@@ -1,0 +1,157 @@
+/* The implicit_vis method's CPU side (Dong, Kautz, Theobalt, Seidel, PG 2007):
+ * surface elements, the geometric hierarchy, the cube-map bins, the
+ * hierarchical link structure with implicit visibility and the gathering
+ * of light along its links. No GL here, so that the tests can drive every
+ * stage on its own.
+ *
+ * Use (Algorithm 1):
+ *     iv_hier *h = iv_hier_create(scene, edge, &err);      // CreateSurfels + CreateGeometricHierarchy
+ *     iv_links *l = iv_links_create(h, N);
+ *     per frame:
+ *         iv_hier_update(h, scene, t);               // UpdateElements (Sec. 4.2.1)
+ *         iv_links_build(l, h, subdiv, brute, splat);        // CreateHierarchicalLinks (Sec. 4.2.2)
+ *         iv_links_refine_push(l, h);                 // Refine + PushDownLinks (Sec. 4.2.3-4.2.4)
+ *         iv_illuminate(l, h, &lights, bounces, E);   // ComputeIlluminate + PullupEnergy (Sec. 4.3)
+ */
+#ifndef IV_H
+#define IV_H
+
+#include "gi/envmap.h"
+#include "gi/scene.h"
+
+#include <stdint.h>
+
+/* ---- cube-map bins (Sec. 4.2.2 "Discretization") ---- */
+
+/* Bin of direction d (any length > 0) in a 6 x n x n world-aligned cube map:
+ * face * n * n + row * n + column. Faces +X -X +Y -Y +Z -Z. */
+uint32_t iv_bin_of(gi_vec3 d, uint32_t n);
+/* Unit direction through the centre of bin b. */
+gi_vec3 iv_bin_centre(uint32_t b, uint32_t n);
+/* Solid angle of bin b (exact for a cube-map texel). */
+float iv_bin_solid_angle(uint32_t b, uint32_t n);
+
+/* ---- surface elements and the geometric hierarchy (Sec. 4.1) ---- */
+
+/* Re-meshing limits: subdivisions of one triangle, surface points in all. */
+#define IV_MAX_K 64u
+#define IV_MAX_SAMPLES (8u * 1024u * 1024u)
+
+/* Grid point (i, j) of a triangle subdivided k times (i + j <= k; the
+ * point's barycentric weights of corners 1 and 2 are i / k and j / k):
+ * rows of constant j, k + 1 - j points each. */
+static inline uint32_t iv_grid_index(uint32_t k, uint32_t i, uint32_t j)
+{
+    return j * (k + 1) - j * (j - 1) / 2 + i;
+}
+
+typedef struct iv_hier {
+    /* Surface points: the corners of every triangle, or with re-meshing
+     * every point of its k x k subdivision grid (Sec. 4.1 and 5.1, the
+     * optional re-meshing to a target edge length). */
+    uint32_t *tri_k;    /* per triangle: subdivisions (1 = none) */
+    uint32_t *tri_grid; /* per triangle + 1: its first point */
+    uint32_t sample_count;
+    uint32_t *samp_tri;  /* triangle of each point */
+    float *samp_b;       /* 2 per point: barycentric weights of corners 1 and 2 */
+    float *samp_share;   /* per point: its share of the triangle's area (1/3 per sub-triangle around it / k^2) */
+    uint32_t *samp_elem; /* point -> element */
+    float *rest;         /* 3 per point: object-local rest position */
+    /* Elements: one oriented disc per distinct point (points equal in
+     * position and normal merged). */
+    uint32_t elem_count;
+    uint32_t *elem_rep;  /* element -> one of its points */
+    float *elem_albedo;  /* 3 per element: mean albedo of its points */
+    float *elem_emit;    /* 3 per element: emitted radiance */
+    uint8_t *elem_two_sided_emit;
+    uint32_t segment_count; /* connected parts of each object: the roots */
+    /* Nodes in breadth-first order: the roots first, children contiguous
+     * and after their parent, so bottom-up is a backward sweep. */
+    uint32_t node_count;
+    uint32_t root_count;
+    uint32_t *first_child;
+    uint8_t *child_count; /* 0 for a leaf */
+    int32_t *parent;      /* -1 for a root */
+    int32_t *node_elem;   /* element of a leaf, -1 otherwise */
+    uint32_t *elem_node;  /* element -> its leaf */
+    uint32_t depth;       /* levels of the deepest tree */
+    /* Per frame (iv_hier_update), world space. */
+    float *pos;  /* 3 per node: area-weighted mean of the children */
+    float *nrm;  /* 3 per node: area-weighted mean normal (unit for a leaf; shorter where children disagree) */
+    float *area; /* per node: sum of the children */
+    float *tri_area; /* scratch: triangle areas at t */
+    gi_vertex *verts; /* scratch: an object's vertices at t */
+    float *wpos, *wnrm; /* scratch: the model's vertices at t, world space */
+} iv_hier;
+
+/* target_edge > 0: each triangle subdivided k times, k its longest edge
+ * over target_edge rounded up (at most IV_MAX_K); 0: the model as it is. */
+iv_hier *iv_hier_create(const gi_scene *s, float target_edge, gi_error *err);
+void iv_hier_free(iv_hier *h);
+/* Positions, normals and areas of the elements at time t (rigid motion and
+ * morph targets), then every node from its children (Sec. 4.2.1). */
+void iv_hier_update(iv_hier *h, const gi_scene *s, float t);
+static inline int iv_is_leaf(const iv_hier *h, uint32_t node) { return h->child_count[node] == 0; }
+
+/* ---- the hierarchical link structure (Sec. 4.2) ---- */
+
+typedef struct iv_links {
+    uint32_t n;        /* bins per cube side (the paper's N) */
+    uint32_t bins;     /* 6 n n */
+    uint32_t nodes;
+    int32_t *other;    /* nodes x bins: the linked node, -1 empty */
+    float *dist;       /* nodes x bins: its distance */
+    int bilinear;      /* links written into the four bins around their direction (README "Deviations") */
+    float coverage;    /* > 0: a bin whose links' solid angles sum to less than this share of it is lit
+                          through that part only (README "Deviations"); 0: Eq. 5, the nearest covers all */
+    float *cover;      /* nodes x bins: solid angle of every node linked in the bin (Eq. 4's sum); after
+                          refinement summed down each leaf's path */
+    float *bin_dir;    /* 3 per bin: centre direction */
+    float *bin_omega;  /* per bin: solid angle */
+    /* After iv_links_refine_push: the receiving links of each leaf
+     * (unidirectional), and the light links among them (Sec. 4.3.1 "Speedup"). */
+    uint32_t *leaf_off;   /* elements + 1 */
+    uint32_t *leaf_bin;   /* bin of each receiving link */
+    uint32_t *leaf_src;   /* node at its other end */
+    uint32_t *light_off;  /* elements + 1 */
+    uint32_t *light_bin, *light_src;
+    size_t leaf_cap, light_cap;
+    /* Counters of the last build. */
+    uint64_t tries;       /* node pairs considered */
+    uint64_t created;     /* bin entries written (a shorter link replacing one counts) */
+    uint64_t receiving;   /* leaf links after refinement and push-down */
+} iv_links;
+
+iv_links *iv_links_create(const iv_hier *h, uint32_t n);
+void iv_links_free(iv_links *l);
+/* Sec. 4.2.2: links from the top-level pairs down, a node subdivided while
+ * its solid angle seen from the other exceeds `subdiv` times the bin's;
+ * each bin keeps its shortest link. brute != 0: every leaf against every
+ * leaf instead (the non-hierarchical version, Sec. 3.1). splat != 0: a
+ * leaf disc that covers several bins of the other end is written into all
+ * of them (README "Deviations"), else into the bin of its centre only. */
+void iv_links_build(iv_links *l, const iv_hier *h, float subdiv, int brute, int splat);
+/* Sec. 4.2.3 and 4.2.4 in one breadth-first pass: each node's bin keeps
+ * the shorter of its own link and its parent's (a parent's link moves to
+ * the children that hold no shorter one), so that a leaf ends with the
+ * shortest link found on its path to the root; then the leaves' links are
+ * listed as receiving links, and those from emitting nodes as light links. */
+void iv_links_refine_push(iv_links *l, const iv_hier *h);
+
+/* ---- illumination (Sec. 4.3, 4.4) ---- */
+
+typedef struct iv_lights {
+    const gi_scene *scene;
+    float t;                  /* punctual lights placed at this time */
+    const gi_envmap *env;     /* NULL: black */
+} iv_lights;
+
+/* Gathers the direct light (light links, punctual lights through their bin,
+ * the environment through empty bins) and `bounces` indirect bounces at the
+ * leaves with Eq. 5 (each linked node covering its bin), pulling the
+ * reflected radiance up after each gather. Out: per element the irradiance
+ * on both sides of its disc, e_out[6 e + 0..2] on the normal's side,
+ * [6 e + 3..5] on the other. */
+void iv_illuminate(const iv_links *l, iv_hier *h, const iv_lights *lights, uint32_t bounces, float *e_out);
+
+#endif
