@@ -18,6 +18,8 @@ pkgs=(
   # (VTK draws through EGL, see harness/charts.cpp).
   xvfb xauth
   libjson-c-dev libxxhash-dev
+  # gi/simplify.h: lower-detail geometry (avg's VPL shadow maps)
+  libmeshoptimizer-dev
   # scripts/*.py (the results tables, their test integration.results_tables)
   python3
 )
