@@ -1,11 +1,14 @@
 /* The avg plugin's parts against independent computations (the plugin's
  * sources are compiled in; see plugins/avg/README.md "Tests"):
  *
- *   avg_tests voxel   the GPU voxelisation (both voxelisers) against a CPU
- *                     triangle-box overlap voxelisation of the same scene
- *                     (Cornell box at t = 0, Cornell moving at t = 1.3):
- *                     every overlapped voxel filled, false positives and
- *                     per-voxel triangle counts reported;
+ *   avg_tests voxel   the GPU voxelisation (all three voxelisers) against a
+ *                     CPU triangle-box overlap voxelisation of the same
+ *                     scene (Cornell box at t = 0, Cornell moving at
+ *                     t = 1.3): every overlapped voxel filled, false
+ *                     positives and per-voxel triangle counts reported; the
+ *                     single-pass voxeliser also against the per-slice
+ *                     conservative one: equal counts in every voxel, sums
+ *                     within its fixed-point rounding;
  *   avg_tests march   rays marched through the grid on the GPU against
  *                     Embree rays (gi/raytrace.h) in the same scene: the AVG
  *                     hit voxel lies within one voxel of the real hit;
@@ -23,6 +26,7 @@
  *                     (no visibility), and M = 16 without the filter equals
  *                     M times the sum over each pixel's own subset. */
 #include "avg.h"
+#include "shaders/avg_bindings.h"
 
 #include "gi/image.h"
 #include "gi/lights.h"
@@ -311,7 +315,9 @@ static void voxel_case(gi_gpu *gpu, const char *scene_path, const float *ts, int
         size_t total = (size_t)n * n * n, filled_cpu = 0;
         for (size_t i = 0; i < total; i++)
             filled_cpu += exact[i] > 0;
-        for (int mode = 0; mode < 2; mode++) {
+        float *slices_nrm = NULL, *slices_col = NULL;
+        static const char *mode_names[] = {"conservative", "paper", "single"};
+        for (int mode = 0; mode < 3; mode++) {
             EXPECT(avg_grid_voxelise(g, gs, (avg_vox_mode)mode, &err) == GI_OK, "%s", err.text);
             float *nrm = avg_grid_read(g, 0), *col = avg_grid_read(g, 1);
             size_t misses = 0, fp = 0, filled = 0, count_equal = 0, colour_bad = 0, ambiguous = 0;
@@ -327,7 +333,7 @@ static void voxel_case(gi_gpu *gpu, const char *scene_path, const float *ts, int
                 if (c > 0.0f && fabsf(col[4 * i + 3] - c) > 0.0f)
                     colour_bad++;
                 /* Where the overlap is unambiguous, the colour sums agree too. */
-                if (mode == AVG_VOX_CONSERVATIVE && inner[i] == outer[i] && (uint32_t)c == exact[i])
+                if (mode != AVG_VOX_PAPER && inner[i] == outer[i] && (uint32_t)c == exact[i])
                     for (int k = 0; k < 3; k++)
                         if (fabsf(col[4 * i + k] - colour[3 * i + k]) > 1e-4f * (1.0f + c))
                             colour_bad++;
@@ -335,21 +341,54 @@ static void voxel_case(gi_gpu *gpu, const char *scene_path, const float *ts, int
             printf("voxel %s t=%.2f n=%u %-12s: %zu filled (CPU %zu), %zu missed, %zu false positives (%.3f %%), "
                    "triangle count different from the CPU's in %zu of %zu voxels (%zu voxels with a triangle within "
                    "1e-3 of a face, counted either way)\n",
-                   strrchr(scene_path, '/') + 1, t, n, mode ? "paper" : "conservative", filled, filled_cpu, misses, fp,
+                   strrchr(scene_path, '/') + 1, t, n, mode_names[mode], filled, filled_cpu, misses, fp,
                    100.0 * (double)fp / (double)(filled ? filled : 1), total - count_equal, total, ambiguous);
             EXPECT(colour_bad == 0, "%zu voxels with different counts or colour sums", colour_bad);
-            if (mode == AVG_VOX_CONSERVATIVE) {
-                EXPECT(misses == 0, "conservative voxeliser missed %zu overlapped voxels", misses);
-                EXPECT(fp == 0, "conservative voxeliser filled %zu voxels no triangle overlaps", fp);
+            if (mode != AVG_VOX_PAPER) {
+                EXPECT(misses == 0, "%s voxeliser missed %zu overlapped voxels", mode_names[mode], misses);
+                EXPECT(fp == 0, "%s voxeliser filled %zu voxels no triangle overlaps", mode_names[mode], fp);
                 EXPECT(count_equal == total, "triangle counts differ in %zu voxels", total - count_equal);
-            } else {
+            }
+            if (mode == AVG_VOX_SINGLE && slices_nrm) {
+                /* The single pass against the per-slice conservative pass:
+                 * the same count in every voxel, the sums within the fixed
+                 * point's rounding (count / (2 AVG_VOX_FIXED) per component)
+                 * plus float summation error. */
+                size_t count_diff = 0, sum_bad = 0;
+                double worst = 0.0;
+                for (size_t i = 0; i < total; i++) {
+                    float c = slices_nrm[4 * i + 3];
+                    count_diff += nrm[4 * i + 3] != c;
+                    double bound = c / (2.0 * AVG_VOX_FIXED) + 1e-6 * (1.0 + c);
+                    for (int k = 0; k < 3; k++) {
+                        double dn = fabs(nrm[4 * i + k] - slices_nrm[4 * i + k]);
+                        double dc = fabs(col[4 * i + k] - slices_col[4 * i + k]);
+                        worst = fmax(worst, fmax(dn, dc));
+                        sum_bad += dn > bound || dc > bound;
+                    }
+                }
+                printf("voxel %s t=%.2f n=%u single vs conservative: counts differ in %zu of %zu voxels, largest sum "
+                       "difference %.3g (bound per voxel count / %.0f)\n",
+                       strrchr(scene_path, '/') + 1, t, n, count_diff, total, worst, 2.0 * AVG_VOX_FIXED);
+                EXPECT(count_diff == 0, "single-pass counts differ from the per-slice ones in %zu voxels",
+                       count_diff);
+                EXPECT(sum_bad == 0, "%zu sums beyond the fixed-point bound", sum_bad);
+            }
+            if (mode == AVG_VOX_PAPER) {
                 /* The paper's voxeliser is not conservative at partly covered
                  * voxels; it must still fill most of the surface voxels. */
                 EXPECT(misses * 10 < filled_cpu, "paper voxeliser missed %zu of %zu voxels", misses, filled_cpu);
             }
-            free(nrm);
-            free(col);
+            if (mode == AVG_VOX_CONSERVATIVE) {
+                slices_nrm = nrm;
+                slices_col = col;
+            } else {
+                free(nrm);
+                free(col);
+            }
         }
+        free(slices_nrm);
+        free(slices_col);
         free(inner);
         free(exact);
         free(outer);
