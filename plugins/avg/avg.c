@@ -242,6 +242,11 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
         if (r != GI_OK)
             return gi_kit_fail_with(&a->kit, r, &err);
         gi_depth_atlas_desc d = {(uint32_t)a->tile, a->slots, choose_projection(a, scene->scene), GI_DEPTH_RADIAL, 1};
+        if (a->lod && a->projection == 1)
+            a->kit.host->log(a->kit.host, GI_LOG_WARN,
+                             "shadow_lod=%g with projection=paraboloid: the warp bends the simplified copy's long "
+                             "edges (projection=auto or perspective avoids it)",
+                             (double)a->shadow_lod);
         a->atlas = gi_depth_atlas_create(&d, &err);
         if (!a->atlas)
             return gi_kit_fail_with(&a->kit, GI_ERR_INVALID_ARGUMENT, &err);
@@ -532,6 +537,8 @@ static gi_result avg_render(void *inst, const gi_view *view, const gi_target *ta
     host->stat(host, "vpls_live", (double)a->vpl_count);
     host->stat(host, "light_paths", (double)a->paths);
     host->stat(host, "voxel_size", (double)a->grid->h);
+    if (a->atlas)
+        host->stat(host, "shadow_paraboloid", (double)(gi_depth_atlas_get_desc(a->atlas)->projection == GI_PROJ_PARABOLOID));
     if (a->atlas)
         host->stat(host, "shadow_triangles", (double)(a->lod ? a->lod->triangle_count : a->kit.scene->triangle_count));
     return GI_OK;

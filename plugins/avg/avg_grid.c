@@ -161,6 +161,13 @@ static gi_result voxelise_single(avg_grid *g, const gi_gpu_scene *gs, gi_error *
 {
     size_t bytes = (size_t)g->n * g->n * g->n * 8 * sizeof(int32_t);
     if (!g->ssbo_sums) {
+        GLint64 limit = 0;
+        glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &limit);
+        if ((GLint64)bytes > limit)
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "avg: voxeliser=single needs %zu MiB of sums at grid=%u, more than this GL's "
+                                "largest storage buffer (%lld MiB); use a smaller grid or voxeliser=conservative",
+                                bytes >> 20, g->n, (long long)(limit >> 20));
         glCreateBuffers(1, &g->ssbo_sums);
         glNamedBufferStorage(g->ssbo_sums, (GLsizeiptr)bytes, NULL, GL_DYNAMIC_STORAGE_BIT);
         if (gi_gl_check("avg: single-pass voxel sums", err) != GI_OK)

@@ -17,8 +17,10 @@
  *                     back when the scene does; the light VPLs of AVG and
  *                     exact tracing agree (same quasi-random numbers);
  *   avg_tests visibility  the light VPLs' shadow maps (core depth atlas,
- *                     paraboloid and perspective) against Embree shadow
- *                     rays for every receiver pixel (the VPLs at hits lie
+ *                     paraboloid and perspective; and the maps of the
+ *                     shadow_lod=0.1 copy on the Cornell box and Cornell
+ *                     moving) against Embree shadow rays through the full
+ *                     scene for every receiver pixel (the VPLs at hits lie
  *                     inside voxels, behind their surface, by design, and
  *                     are not comparable with exact rays);
  *   avg_tests shade   interleaved shading with M = 1 equals the plain sum
@@ -33,6 +35,7 @@
 #include "gi/raytrace.h"
 #include "gi/rng.h"
 #include "gi/sampling.h"
+#include "gi/simplify.h"
 
 #include <float.h>
 #include <math.h>
@@ -769,18 +772,19 @@ static int map_visible(const avg *a, const float *tiles, uint32_t j, gi_vec3 x, 
     return zp <= zmap + bias_abs + bias_rel * (1.0f + slope) * zp;
 }
 
-static void visibility_case(gi_gpu *gpu, const char *projection)
+static void visibility_case(gi_gpu *gpu, const char *scene, const char *projection, const char *lod)
 {
     gi_error err;
     fixture fx;
-    if (!load_fixture(gpu, GI_SOURCE_DIR "/scenes/cornell_box.gltf", &fx))
+    if (!load_fixture(gpu, scene, &fx))
         return;
     const gi_scene *s = fx.s;
     gi_gpu_scene *gs = fx.gs;
-    char pkv[64];
+    char pkv[64], lkv[64];
     snprintf(pkv, sizeof pkv, "projection=%s", projection);
-    const char *kv[] = {"vpls=256", "grid=32", pkv};
-    avg *a = make_avg(&fx.host, gs, kv, 3);
+    snprintf(lkv, sizeof lkv, "shadow_lod=%s", lod);
+    const char *kv[] = {"vpls=256", "grid=32", pkv, lkv};
+    avg *a = make_avg(&fx.host, gs, kv, 4);
     gi_rt *rt = NULL;
     if (!a || gi_rt_create(s, 0.0f, &rt, &err) != GI_OK) {
         EXPECT(0, "cannot make the avg instance or the ray caster");
@@ -823,13 +827,15 @@ static void visibility_case(gi_gpu *gpu, const char *projection)
             false_light += vis && blocked;
         }
     }
-    printf("visibility %s: %u receiver-VPL pairs, shadow maps agree with Embree on %.2f %% (%u falsely shadowed, %u "
-           "falsely lit)\n",
-           projection, pairs, 100.0 * agree / (pairs ? pairs : 1), false_shadow, false_light);
+    const char *used = gi_depth_atlas_get_desc(a->atlas)->projection == GI_PROJ_PARABOLOID ? "paraboloid" : "perspective";
+    printf("visibility %s %s (%s maps) shadow_lod=%s (%u triangles a map): %u receiver-VPL pairs, shadow maps agree "
+           "with Embree on %.2f %% (%u falsely shadowed, %u falsely lit)\n",
+           strrchr(scene, '/') + 1, projection, used, lod, a->lod ? a->lod->triangle_count : s->triangle_count, pairs,
+           100.0 * agree / (pairs ? pairs : 1), false_shadow, false_light);
     EXPECT(agree >= pairs - pairs / 20, "shadow maps agree with ray casting on only %u of %u pairs", agree, pairs);
     EXPECT(pairs > 10000, "too few pairs (%u)", pairs);
     char what[96];
-    snprintf(what, sizeof what, "visibility %s, light-VPL shadow maps vs Embree", projection);
+    snprintf(what, sizeof what, "visibility %s shadow_lod=%s, light-VPL shadow maps vs Embree", projection, lod);
     gi_test_failed += vis_check(&score, what, VIS_MARGIN, 1000);
     free(tiles);
     free_gbuffer_images(&gb);
@@ -959,8 +965,12 @@ int main(int argc, char **argv)
     } else if (!strcmp(argv[1], "punctual")) {
         punctual_case(gpu);
     } else if (!strcmp(argv[1], "visibility")) {
-        visibility_case(gpu, "paraboloid");
-        visibility_case(gpu, "perspective");
+        visibility_case(gpu, GI_SOURCE_DIR "/scenes/cornell_box.gltf", "paraboloid", "1");
+        visibility_case(gpu, GI_SOURCE_DIR "/scenes/cornell_box.gltf", "perspective", "1");
+        /* Maps of the lower-detail copy (the auto rule then picks
+         * perspective maps) against rays through the full scene. */
+        visibility_case(gpu, GI_SOURCE_DIR "/scenes/cornell_box.gltf", "auto", "0.1");
+        visibility_case(gpu, GI_SOURCE_DIR "/scenes/cornell_moving.gltf", "auto", "0.1");
     } else {
         fprintf(stderr, "unknown test '%s'\n", argv[1]);
         return 2;
