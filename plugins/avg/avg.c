@@ -232,6 +232,9 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
     if (scene->light_count > AVG_MAX_PUNCTUAL)
         a->kit.host->log(a->kit.host, GI_LOG_WARN, "only the first %d of %u punctual lights emit VPLs", AVG_MAX_PUNCTUAL,
                      scene->light_count);
+    /* Before the grid's textures are made: at grid=512 they are 4 GiB. */
+    if (a->voxeliser == AVG_VOX_SINGLE && avg_grid_check_single((uint32_t)a->grid_n, &err) != GI_OK)
+        return gi_kit_fail_with(&a->kit, GI_ERR_INVALID_ARGUMENT, &err);
     a->grid = avg_grid_create((uint32_t)a->grid_n, &err);
     if (!a->grid)
         return gi_kit_fail_with(&a->kit, GI_ERR_GL, &err);

@@ -51,6 +51,9 @@ void avg_grid_free(avg_grid *g);
 void avg_grid_place(avg_grid *g, const float bounds[6]);
 /* Clears and voxelises the scene at its current time (§III-A). */
 gi_result avg_grid_voxelise(avg_grid *g, const gi_gpu_scene *gs, avg_vox_mode mode, gi_error *err);
+/* GI_OK when this GL can hold the single-pass voxeliser's sums for an
+ * n^3 grid (8 ints a voxel in one storage buffer), else a message. */
+gi_result avg_grid_check_single(uint32_t n, gi_error *err);
 /* Reads the normal (or colour) texture back: n^3 x 4 floats, x fastest. */
 float *avg_grid_read(const avg_grid *g, int colour);
 /* Binds both textures as sampler3D units (normal, colour) and sets the

@@ -155,19 +155,27 @@ static gi_result upload_material_colours(avg_grid *g, const gi_scene *s, gi_erro
     return GI_OK;
 }
 
+gi_result avg_grid_check_single(uint32_t n, gi_error *err)
+{
+    size_t bytes = (size_t)n * n * n * 8 * sizeof(int32_t);
+    GLint64 limit = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &limit);
+    if ((GLint64)bytes > limit)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "avg: voxeliser=single needs %zu MiB of sums at grid=%u, more than this GL's "
+                            "largest storage buffer (%lld MiB); use a smaller grid or voxeliser=conservative",
+                            bytes >> 20, n, (long long)(limit >> 20));
+    return GI_OK;
+}
+
 /* One draw of the scene into the fixed-point sums, then the resolve
  * into the textures (AVG_VOX_SINGLE). */
 static gi_result voxelise_single(avg_grid *g, const gi_gpu_scene *gs, gi_error *err)
 {
     size_t bytes = (size_t)g->n * g->n * g->n * 8 * sizeof(int32_t);
     if (!g->ssbo_sums) {
-        GLint64 limit = 0;
-        glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &limit);
-        if ((GLint64)bytes > limit)
-            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                                "avg: voxeliser=single needs %zu MiB of sums at grid=%u, more than this GL's "
-                                "largest storage buffer (%lld MiB); use a smaller grid or voxeliser=conservative",
-                                bytes >> 20, g->n, (long long)(limit >> 20));
+        if (avg_grid_check_single(g->n, err) != GI_OK)
+            return GI_ERR_INVALID_ARGUMENT;
         glCreateBuffers(1, &g->ssbo_sums);
         glNamedBufferStorage(g->ssbo_sums, (GLsizeiptr)bytes, NULL, GL_DYNAMIC_STORAGE_BIT);
         if (gi_gl_check("avg: single-pass voxel sums", err) != GI_OK)
