@@ -25,6 +25,8 @@ pkgs=(
   libjson-c-dev libxxhash-dev
   # plugins/vlf: the spherical triangulation of the direction set
   libqhull-dev
+  # gi/simplify.h: lower-detail geometry (avg's VPL shadow maps)
+  libmeshoptimizer-dev
   # scripts/*.py (the results tables, their test integration.results_tables;
   # the bash completion, scripts/gen-completion.py, which `make` installs)
   python3 bash-completion

@@ -2,6 +2,7 @@
  * texture, drawn with one instanced draw (depth_atlas.vert/.frag), and the
  * C twin of the GLSL lookup (depth_atlas.glsl). */
 #include "gi/passes.h"
+#include "gi/simplify.h"
 
 #include <float.h>
 #include <math.h>
@@ -28,6 +29,7 @@ struct gi_depth_atlas {
     GLuint program, fbo, tex, depth_rb, ssbo, ssbo_tex;
     GLint loc_grid, loc_views, loc_projection, loc_metric;
     atlas_view_gpu *staging; /* capacity entries */
+    const gi_simplified *geometry; /* drawn instead of the scene's triangles when set */
 };
 
 gi_depth_atlas *gi_depth_atlas_create(const gi_depth_atlas_desc *d, gi_error *err)
@@ -196,7 +198,10 @@ gi_result gi_depth_atlas_render(gi_depth_atlas *a, const gi_gpu_scene *gs, const
         glUniform1i(a->loc_projection, (GLint)d->projection);
         glUniform1i(a->loc_metric, (GLint)d->metric);
         glBindTextureUnit(ATLAS_VIEWS_UNIT, a->ssbo_tex);
-        gi_gpu_scene_draw(gs, -1, (GLsizei)count);
+        if (a->geometry)
+            gi_simplified_draw(a->geometry, gs, (GLsizei)count);
+        else
+            gi_gpu_scene_draw(gs, -1, (GLsizei)count);
         for (GLenum k = 0; k < 5; k++)
             glDisable(GL_CLIP_DISTANCE0 + k);
         glDisable(GL_CULL_FACE);
@@ -206,6 +211,11 @@ gi_result gi_depth_atlas_render(gi_depth_atlas *a, const gi_gpu_scene *gs, const
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     a->count = count;
     return gi_gl_check("depth atlas: render", err);
+}
+
+void gi_depth_atlas_set_geometry(gi_depth_atlas *a, const gi_simplified *m)
+{
+    a->geometry = m;
 }
 
 GLuint gi_depth_atlas_texture(const gi_depth_atlas *a)

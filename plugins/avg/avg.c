@@ -17,6 +17,7 @@
 #include "shaders/avg_bindings.h"
 
 #include "gi/log.h"
+#include "gi/simplify.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -25,6 +26,11 @@
 
 #define AVG_BIAS_VOXELS 0.5f /* receiver offset and constant depth bias, in voxel edges */
 #define AVG_BIAS_TEXELS 1.0f /* depth bias per unit of distance and slope, in texels of the map */
+/* Largest surface move the shadow maps' lower-detail copy may make, as a
+ * share of each object's extent (meshopt's relative error): half a texel
+ * of a 32^2 map seen from one extent away with the 120 degree field of
+ * view is about 5 % of it, so the copy stays well inside a texel. */
+#define AVG_LOD_ERROR 0.02f
 
 static const gi_param_desc avg_params[] = {
     {"grid", GI_PARAM_INT, 64, 4, 512, NULL, "AVG resolution (Sec. III-A, 64^3)", "voxels per axis of the grid"},
@@ -41,9 +47,14 @@ static const gi_param_desc avg_params[] = {
     {"projection", GI_PARAM_ENUM, 0, 0, 0, "auto|paraboloid|perspective", "Sec. IV",
      "shadow-map projection; auto: paraboloid for scenes of small triangles, perspective for large ones (as the paper)"},
     {"fov", GI_PARAM_FLOAT, 120.0, 10.0, 170.0, NULL, "Sec. IV", "field of view of perspective shadow maps, degrees"},
+    {"shadow_lod", GI_PARAM_FLOAT, 1.0, 0.01, 1.0, NULL, "Sec. V (lower-detail geometry for the maps)",
+     "the VPL shadow maps draw a simplified copy of each object with this share of its triangles "
+     "(meshoptimizer, surface moved by at most 2 % of the object's size); 1: the scene itself"},
     {"filter", GI_PARAM_BOOL, 1, 0, 1, NULL, "Sec. III-C", "discontinuity-aware mx x mx box filter"},
-    {"voxeliser", GI_PARAM_ENUM, 0, 0, 0, "conservative|paper", "Sec. III-A",
-     "exact triangle-box voxels, or the paper's epsilon shift and stand-in triangles"},
+    {"voxeliser", GI_PARAM_ENUM, 0, 0, 0, "conservative|paper|single", "Sec. III-A",
+     "exact triangle-box voxels drawn slice by slice (one instance per Z slice), the paper's epsilon shift and "
+     "stand-in triangles (slice by slice), or the exact voxels in a single pass (dominant-axis projection, "
+     "integer atomics)"},
     {"tracing", GI_PARAM_ENUM, 0, 0, 0, "avg|exact", "Fig. 6",
      "VPL paths marched through the AVG on the GPU, or the same paths traced exactly by Embree on the CPU"},
     {"offset", GI_PARAM_FLOAT, 1.5, 0.0, 8.0, NULL, NULL,
@@ -73,6 +84,7 @@ static gi_result avg_create(const gi_host *host, const gi_params *params, void *
     a->tile = gi_params_int(params, "shadow_size");
     a->projection = gi_params_enum(params, "projection");
     a->fov = gi_params_float(params, "fov");
+    a->shadow_lod = gi_params_float(params, "shadow_lod");
     a->mx = (int)lround(sqrt((double)a->M));
     a->paths = ((uint32_t)a->vpls + (uint32_t)a->bounces) / ((uint32_t)a->bounces + 1u);
     if (a->paths == 0)
@@ -103,25 +115,53 @@ static gi_result build_programs(avg *a, gi_error *err)
 /* The paper's rule (Sec. IV): paraboloid maps for scenes of small
  * triangles, perspective maps for scenes of large ones, whose straight
  * edges the paraboloid warp would bend. Small: mean edge below 1/16 of the
- * scene's extent. */
+ * scene's extent. The triangles measured are those the maps draw: the
+ * lower-detail copy when there is one (its long edges would be bent). */
 static gi_projection choose_projection(avg *a, const gi_scene *s)
 {
     if (a->projection == 1)
         return GI_PROJ_PARABOLOID;
     if (a->projection == 2)
         return GI_PROJ_PERSPECTIVE;
+    const uint32_t *idx = a->lod ? a->lod->indices : s->indices;
+    uint32_t count = a->lod ? a->lod->triangle_count : s->triangle_count;
     double sum = 0.0;
-    for (uint32_t t = 0; t < s->triangle_count; t++) {
+    float m[16];
+    uint32_t m_object = UINT32_MAX;
+    for (uint32_t t = 0; t < count; t++) {
         gi_vec3 p[3];
-        gi_scene_triangle_world(s, t, 0.0f, p);
+        for (int k = 0; k < 3; k++) {
+            const gi_vertex *v = &s->vertices[idx[3 * (size_t)t + k]];
+            if (v->object != m_object) {
+                gi_scene_object_transform(s, v->object, 0.0f, m);
+                m_object = v->object;
+            }
+            p[k] = gi_mat4_point(m, gi_v3_load(v->position));
+        }
         for (int e = 0; e < 3; e++)
             sum += gi_v3_length(gi_v3_sub(p[(e + 1) % 3], p[e]));
     }
     float ext = 0.0f;
     for (int i = 0; i < 3; i++)
         ext = fmaxf(ext, s->bounds[3 + i] - s->bounds[i]);
-    double mean = s->triangle_count ? sum / (3.0 * s->triangle_count) : 0.0;
+    double mean = count ? sum / (3.0 * count) : 0.0;
     return mean < ext / 16.0 ? GI_PROJ_PARABOLOID : GI_PROJ_PERSPECTIVE;
+}
+
+/* The shadow maps' lower-detail copy (param shadow_lod < 1): indices into
+ * the scene's own vertices, so rigid motion (object transforms) and morph
+ * targets (the vertex buffer rewritten per frame) move it as they move the
+ * scene; built again when the caller moves vertices itself. */
+static gi_result build_lod(avg *a, const gi_scene *s, gi_error *err)
+{
+    gi_simplified_free(a->lod);
+    a->lod = NULL;
+    if (a->shadow_lod >= 1.0f)
+        return GI_OK;
+    a->lod = gi_simplify_scene(s, a->shadow_lod, AVG_LOD_ERROR, err);
+    if (!a->lod) /* the parameter's range leaves only out of memory */
+        return GI_ERR_OUT_OF_MEMORY;
+    return gi_simplified_upload(a->lod, err);
 }
 
 /* §III-C: one shadow map per live VPL, from its position along its normal,
@@ -152,6 +192,8 @@ static void release_prepared(avg *a)
     avg_grid_free(a->grid);
     avg_exact_free(a->exact);
     gi_depth_atlas_free(a->atlas);
+    gi_simplified_free(a->lod);
+    a->lod = NULL;
     free(a->views);
     GLuint progs[5] = {a->prog_trace, a->prog_split, a->prog_shade, a->prog_assemble, a->prog_final};
     for (int i = 0; i < 5; i++)
@@ -190,16 +232,28 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
     if (scene->light_count > AVG_MAX_PUNCTUAL)
         a->kit.host->log(a->kit.host, GI_LOG_WARN, "only the first %d of %u punctual lights emit VPLs", AVG_MAX_PUNCTUAL,
                      scene->light_count);
+    /* Before the grid's textures are made: at grid=512 they are 4 GiB. */
+    if (a->voxeliser == AVG_VOX_SINGLE && avg_grid_check_single((uint32_t)a->grid_n, &err) != GI_OK)
+        return gi_kit_fail_with(&a->kit, GI_ERR_INVALID_ARGUMENT, &err);
     a->grid = avg_grid_create((uint32_t)a->grid_n, &err);
     if (!a->grid)
         return gi_kit_fail_with(&a->kit, GI_ERR_GL, &err);
     if (build_programs(a, &err) != GI_OK)
         return gi_kit_fail_with(&a->kit, GI_ERR_GL, &err);
     if (a->visibility) {
+        gi_result r = build_lod(a, scene->scene, &err);
+        if (r != GI_OK)
+            return gi_kit_fail_with(&a->kit, r, &err);
         gi_depth_atlas_desc d = {(uint32_t)a->tile, a->slots, choose_projection(a, scene->scene), GI_DEPTH_RADIAL, 1};
+        if (a->lod && a->projection == 1)
+            a->kit.host->log(a->kit.host, GI_LOG_WARN,
+                             "shadow_lod=%g with projection=paraboloid: the warp bends the simplified copy's long "
+                             "edges (projection=auto or perspective avoids it)",
+                             (double)a->shadow_lod);
         a->atlas = gi_depth_atlas_create(&d, &err);
         if (!a->atlas)
             return gi_kit_fail_with(&a->kit, GI_ERR_INVALID_ARGUMENT, &err);
+        gi_depth_atlas_set_geometry(a->atlas, a->lod);
         a->views = calloc(a->slots, sizeof *a->views);
         if (!a->views)
             return gi_kit_fail(&a->kit, GI_ERR_OUT_OF_MEMORY, "avg: out of memory for the shadow-map views");
@@ -224,8 +278,19 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
 
 static gi_result avg_update(void *inst, const gi_gpu_scene *scene, const gi_changes *changes)
 {
-    /* everything is rebuilt every frame (§III): nothing to invalidate */
-    gi_kit_update(&((avg *)inst)->kit, scene, changes);
+    /* Everything is rebuilt every frame (§III). The shadow maps'
+     * lower-detail copy follows transforms and morph targets by itself;
+     * vertices the caller moved (a scene without morph targets that
+     * reports new vertices) change the copy's shape, so it is made again. */
+    avg *a = inst;
+    gi_kit_update(&a->kit, scene, changes);
+    if (a->lod && (changes->flags & GI_CHANGED_VERTICES) && !gi_scene_deforms(scene->scene)) {
+        gi_error err;
+        gi_result r = build_lod(a, scene->scene, &err);
+        if (r != GI_OK)
+            return gi_kit_fail_with(&a->kit, r, &err);
+        gi_depth_atlas_set_geometry(a->atlas, a->lod);
+    }
     return GI_OK;
 }
 
@@ -475,6 +540,10 @@ static gi_result avg_render(void *inst, const gi_view *view, const gi_target *ta
     host->stat(host, "vpls_live", (double)a->vpl_count);
     host->stat(host, "light_paths", (double)a->paths);
     host->stat(host, "voxel_size", (double)a->grid->h);
+    if (a->atlas)
+        host->stat(host, "shadow_paraboloid", (double)(gi_depth_atlas_get_desc(a->atlas)->projection == GI_PROJ_PARABOLOID));
+    if (a->atlas)
+        host->stat(host, "shadow_triangles", (double)(a->lod ? a->lod->triangle_count : a->kit.scene->triangle_count));
     return GI_OK;
 }
 

@@ -27,6 +27,7 @@ extern const gi_shader_source gi_avg_shaders[];
 typedef enum avg_vox_mode {
     AVG_VOX_CONSERVATIVE = 0, /* bounding quad per slice + exact triangle-box test per fragment */
     AVG_VOX_PAPER = 1,        /* the paper's: slice part of the triangle, epsilon shift, stand-ins */
+    AVG_VOX_SINGLE = 2,       /* one draw, dominant-axis projection, the conservative test per column voxel */
 } avg_vox_mode;
 
 typedef struct avg_grid {
@@ -35,7 +36,10 @@ typedef struct avg_grid {
     float h;            /* voxel edge length (voxels are cubes) */
     GLuint tex_normal;  /* RGBA32F 3D: sum of triangle normals, count in w */
     GLuint tex_colour;  /* RGBA32F 3D: sum of albedos, count in w */
-    GLuint fbo, program[2]; /* layered FBO; programs per avg_vox_mode */
+    GLuint fbo, program[3]; /* layered FBO; programs per avg_vox_mode */
+    GLuint fbo_single;      /* the single pass: no attachments, n x n */
+    GLuint prog_resolve;    /* the single pass: fixed-point sums -> textures */
+    GLuint ssbo_sums;       /* the single pass: 8 ints a voxel (avg_vox1.frag) */
     GLuint ssbo_colours;    /* per material: albedo x mean texture colour */
     const gi_scene *colour_scene; /* the scene ssbo_colours was made for */
 } avg_grid;
@@ -47,6 +51,9 @@ void avg_grid_free(avg_grid *g);
 void avg_grid_place(avg_grid *g, const float bounds[6]);
 /* Clears and voxelises the scene at its current time (§III-A). */
 gi_result avg_grid_voxelise(avg_grid *g, const gi_gpu_scene *gs, avg_vox_mode mode, gi_error *err);
+/* GI_OK when this GL can hold the single-pass voxeliser's sums for an
+ * n^3 grid (8 ints a voxel in one storage buffer), else a message. */
+gi_result avg_grid_check_single(uint32_t n, gi_error *err);
 /* Reads the normal (or colour) texture back: n^3 x 4 floats, x fastest. */
 float *avg_grid_read(const avg_grid *g, int colour);
 /* Binds both textures as sampler3D units (normal, colour) and sets the
@@ -110,7 +117,7 @@ typedef struct avg {
     gi_kit kit;                 /* host, scene, G-buffer, scratch textures, error text */
     /* parameters */
     int grid_n, vpls, bounces, M, tile, projection, filter, visibility, tracing, voxeliser;
-    float clamp, offset, fov;
+    float clamp, offset, fov, shadow_lod;
     int mx;                     /* sqrt(M): M = mx x mx subsets */
     /* resources */
     avg_grid *grid;
@@ -125,6 +132,7 @@ typedef struct avg {
     avg_exact *exact;           /* the CPU tracer (avg_trace_cpu.c), NULL for avg tracing */
     gi_depth_atlas *atlas;      /* the VPLs' shadow maps when visibility is on */
     gi_depth_view *views;       /* one per VPL slot */
+    struct gi_simplified *lod;  /* the shadow maps' lower-detail copy (shadow_lod < 1), else NULL */
 } avg;
 
 #ifdef __cplusplus

@@ -6,7 +6,13 @@
  * (instance k = slice k) into a layered framebuffer that holds both 3D
  * textures as layers (gl_Layer = k): the same work, one draw call, no
  * image stores (so additive blending does the summing exactly as in the
- * paper, and the result does not depend on the order of fragments). */
+ * paper, and the result does not depend on the order of fragments).
+ *
+ * The single-pass voxeliser (AVG_VOX_SINGLE, beside the paper's) draws the
+ * scene once: each triangle projected along its dominant axis, each pixel
+ * a column of voxels tested against the triangle, sums by integer atomics
+ * into a buffer that a compute pass turns into the two textures
+ * (shaders/avg_vox1.*, avg_vox_resolve.comp). */
 #include "avg.h"
 #include "shaders/avg_bindings.h"
 
@@ -47,6 +53,15 @@ avg_grid *avg_grid_create(uint32_t n, gi_error *err)
             return NULL;
         }
     }
+    g->program[AVG_VOX_SINGLE] = gi_program_build("avg_vox.vert", "avg_vox1.geom", "avg_vox1.frag", NULL, err);
+    g->prog_resolve = g->program[AVG_VOX_SINGLE] ? gi_program_build_compute("avg_vox_resolve.comp", NULL, err) : 0;
+    if (!g->prog_resolve) {
+        avg_grid_free(g);
+        return NULL;
+    }
+    glCreateFramebuffers(1, &g->fbo_single);
+    glNamedFramebufferParameteri(g->fbo_single, GL_FRAMEBUFFER_DEFAULT_WIDTH, (GLint)n);
+    glNamedFramebufferParameteri(g->fbo_single, GL_FRAMEBUFFER_DEFAULT_HEIGHT, (GLint)n);
     g->tex_normal = make_tex3d(n);
     g->tex_colour = make_tex3d(n);
     glCreateFramebuffers(1, &g->fbo);
@@ -79,9 +94,15 @@ void avg_grid_free(avg_grid *g)
         glDeleteTextures(1, &g->tex_colour);
     if (g->ssbo_colours)
         glDeleteBuffers(1, &g->ssbo_colours);
-    for (int i = 0; i < 2; i++)
+    if (g->ssbo_sums)
+        glDeleteBuffers(1, &g->ssbo_sums);
+    if (g->fbo_single)
+        glDeleteFramebuffers(1, &g->fbo_single);
+    for (int i = 0; i < 3; i++)
         if (g->program[i])
             glDeleteProgram(g->program[i]);
+    if (g->prog_resolve)
+        glDeleteProgram(g->prog_resolve);
     free(g);
 }
 
@@ -134,10 +155,68 @@ static gi_result upload_material_colours(avg_grid *g, const gi_scene *s, gi_erro
     return GI_OK;
 }
 
+gi_result avg_grid_check_single(uint32_t n, gi_error *err)
+{
+    size_t bytes = (size_t)n * n * n * 8 * sizeof(int32_t);
+    GLint64 limit = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &limit);
+    if ((GLint64)bytes > limit)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "avg: voxeliser=single needs %zu MiB of sums at grid=%u, more than this GL's "
+                            "largest storage buffer (%lld MiB); use a smaller grid or voxeliser=conservative",
+                            bytes >> 20, n, (long long)(limit >> 20));
+    return GI_OK;
+}
+
+/* One draw of the scene into the fixed-point sums, then the resolve
+ * into the textures (AVG_VOX_SINGLE). */
+static gi_result voxelise_single(avg_grid *g, const gi_gpu_scene *gs, gi_error *err)
+{
+    size_t bytes = (size_t)g->n * g->n * g->n * 8 * sizeof(int32_t);
+    if (!g->ssbo_sums) {
+        if (avg_grid_check_single(g->n, err) != GI_OK)
+            return GI_ERR_INVALID_ARGUMENT;
+        glCreateBuffers(1, &g->ssbo_sums);
+        glNamedBufferStorage(g->ssbo_sums, (GLsizeiptr)bytes, NULL, GL_DYNAMIC_STORAGE_BIT);
+        if (gi_gl_check("avg: single-pass voxel sums", err) != GI_OK)
+            return GI_ERR_GL;
+    }
+    const int32_t zero = 0;
+    glClearNamedBufferData(g->ssbo_sums, GL_R32I, GL_RED_INTEGER, GL_INT, &zero);
+    GLuint p = g->program[AVG_VOX_SINGLE];
+    glBindFramebuffer(GL_FRAMEBUFFER, g->fbo_single);
+    glViewport(0, 0, (GLsizei)g->n, (GLsizei)g->n);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    glUseProgram(p);
+    glUniform3f(glGetUniformLocation(p, "u_grid_origin"), g->origin[0], g->origin[1], g->origin[2]);
+    glUniform1f(glGetUniformLocation(p, "u_grid_h"), g->h);
+    glUniform1i(glGetUniformLocation(p, "u_grid_n"), (GLint)g->n);
+    gi_gpu_scene_bind(gs);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, AVG_SSBO_COLOURS, g->ssbo_colours);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, AVG_SSBO_VOX_SUMS, g->ssbo_sums);
+    gi_gpu_scene_draw(gs, -1, 1);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    p = g->prog_resolve;
+    glUseProgram(p);
+    glUniform1i(glGetUniformLocation(p, "u_grid_n"), (GLint)g->n);
+    glBindImageTexture(0, g->tex_normal, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(1, g->tex_colour, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    GLuint groups = (g->n + 3) / 4;
+    glDispatchCompute(groups, groups, groups);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+    glUseProgram(0);
+    return gi_gl_check("avg: single-pass voxelisation", err);
+}
+
 gi_result avg_grid_voxelise(avg_grid *g, const gi_gpu_scene *gs, avg_vox_mode mode, gi_error *err)
 {
     if (g->colour_scene != gs->scene && upload_material_colours(g, gs->scene, err) != GI_OK)
         return GI_ERR_OUT_OF_MEMORY;
+    if (mode == AVG_VOX_SINGLE)
+        return voxelise_single(g, gs, err);
     const float zero[4] = {0, 0, 0, 0};
     glClearTexImage(g->tex_normal, 0, GL_RGBA, GL_FLOAT, zero);
     glClearTexImage(g->tex_colour, 0, GL_RGBA, GL_FLOAT, zero);

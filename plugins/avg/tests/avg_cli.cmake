@@ -1,6 +1,7 @@
 # The avg plugin through the gibench command: finite renders of a still, a
 # moving, a deforming and an indirectly lit scene and of point/spot lights, every
-# variant (exact tracing, the paper's voxeliser, M = 1 without filter),
+# variant (exact tracing, the paper's and the single-pass voxeliser, the
+# shadow maps' lower-detail copy, M = 1 without filter),
 # the stage timers of Table I, and bad parameters exiting 2.
 # Run by ctest as: cmake -DGIB=... -DSCENES=... -DDATA=... -DOUT=... -DEXPECT=.../expect.cmake -P avg_cli.cmake
 
@@ -22,8 +23,8 @@ expect_json(${OUT}/avg_uroom.json "\"nonfinite_pixels\": 0")
 expect(0 "" render --scene ${DATA}/valid/lights.gltf --method avg ${small} --out ${OUT}/avg_lights.exr
        --timings ${OUT}/avg_lights.json)
 expect_json(${OUT}/avg_lights.json "\"nonfinite_pixels\": 0")
-foreach(variant "tracing=exact" "voxeliser=paper" "M=1;--param;filter=false" "visibility=false"
-        "projection=perspective" "projection=paraboloid;--param;bounces=0")
+foreach(variant "tracing=exact" "voxeliser=paper" "voxeliser=single" "shadow_lod=0.1" "M=1;--param;filter=false"
+        "visibility=false" "projection=perspective" "projection=paraboloid;--param;bounces=0")
     string(MAKE_C_IDENTIFIER "${variant}" tag)
     expect(0 "" render --scene ${SCENES}/cornell_box.gltf --method avg ${small} --param ${variant}
            --out ${OUT}/avg_${tag}.exr --timings ${OUT}/avg_${tag}.json)
@@ -170,6 +171,11 @@ expect(2 "avg: bounces=4 is outside" ${args} --param bounces=4)
 expect(2 "avg: " ${args} --param tracing=photon)
 expect(2 "avg: " ${args} --param projection=cube)
 expect(2 "avg: unknown parameter 'K'" ${args} --param K=3)
+expect(2 "avg: shadow_lod=0 is outside" ${args} --param shadow_lod=0)
+# The single-pass voxeliser's sums (8 ints a voxel) beyond the GL's largest
+# storage buffer: refused with one line (llvmpipe allows 128 MiB; 512^3
+# voxels need 4 GiB, more than any GL allows).
+expect(2 "voxeliser=single needs" ${args} --param grid=512 --param voxeliser=single)
 
 if(failures GREATER 0)
     message(FATAL_ERROR "${failures} avg command-line expectation(s) failed")

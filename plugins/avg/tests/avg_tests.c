@@ -1,11 +1,14 @@
 /* The avg plugin's parts against independent computations (the plugin's
  * sources are compiled in; see plugins/avg/README.md "Tests"):
  *
- *   avg_tests voxel   the GPU voxelisation (both voxelisers) against a CPU
- *                     triangle-box overlap voxelisation of the same scene
- *                     (Cornell box at t = 0, Cornell moving at t = 1.3):
- *                     every overlapped voxel filled, false positives and
- *                     per-voxel triangle counts reported;
+ *   avg_tests voxel   the GPU voxelisation (all three voxelisers) against a
+ *                     CPU triangle-box overlap voxelisation of the same
+ *                     scene (Cornell box at t = 0, Cornell moving at
+ *                     t = 1.3): every overlapped voxel filled, false
+ *                     positives and per-voxel triangle counts reported; the
+ *                     single-pass voxeliser also against the per-slice
+ *                     conservative one: equal counts in every voxel, sums
+ *                     within its fixed-point rounding;
  *   avg_tests march   rays marched through the grid on the GPU against
  *                     Embree rays (gi/raytrace.h) in the same scene: the AVG
  *                     hit voxel lies within one voxel of the real hit;
@@ -14,8 +17,10 @@
  *                     back when the scene does; the light VPLs of AVG and
  *                     exact tracing agree (same quasi-random numbers);
  *   avg_tests visibility  the light VPLs' shadow maps (core depth atlas,
- *                     paraboloid and perspective) against Embree shadow
- *                     rays for every receiver pixel (the VPLs at hits lie
+ *                     paraboloid and perspective; and the maps of the
+ *                     shadow_lod=0.1 copy on the Cornell box and Cornell
+ *                     moving) against Embree shadow rays through the full
+ *                     scene for every receiver pixel (the VPLs at hits lie
  *                     inside voxels, behind their surface, by design, and
  *                     are not comparable with exact rays);
  *   avg_tests shade   interleaved shading with M = 1 equals the plain sum
@@ -23,12 +28,14 @@
  *                     (no visibility), and M = 16 without the filter equals
  *                     M times the sum over each pixel's own subset. */
 #include "avg.h"
+#include "shaders/avg_bindings.h"
 
 #include "gi/image.h"
 #include "gi/lights.h"
 #include "gi/raytrace.h"
 #include "gi/rng.h"
 #include "gi/sampling.h"
+#include "gi/simplify.h"
 
 #include <float.h>
 #include <math.h>
@@ -311,7 +318,9 @@ static void voxel_case(gi_gpu *gpu, const char *scene_path, const float *ts, int
         size_t total = (size_t)n * n * n, filled_cpu = 0;
         for (size_t i = 0; i < total; i++)
             filled_cpu += exact[i] > 0;
-        for (int mode = 0; mode < 2; mode++) {
+        float *slices_nrm = NULL, *slices_col = NULL;
+        static const char *mode_names[] = {"conservative", "paper", "single"};
+        for (int mode = 0; mode < 3; mode++) {
             EXPECT(avg_grid_voxelise(g, gs, (avg_vox_mode)mode, &err) == GI_OK, "%s", err.text);
             float *nrm = avg_grid_read(g, 0), *col = avg_grid_read(g, 1);
             size_t misses = 0, fp = 0, filled = 0, count_equal = 0, colour_bad = 0, ambiguous = 0;
@@ -327,7 +336,7 @@ static void voxel_case(gi_gpu *gpu, const char *scene_path, const float *ts, int
                 if (c > 0.0f && fabsf(col[4 * i + 3] - c) > 0.0f)
                     colour_bad++;
                 /* Where the overlap is unambiguous, the colour sums agree too. */
-                if (mode == AVG_VOX_CONSERVATIVE && inner[i] == outer[i] && (uint32_t)c == exact[i])
+                if (mode != AVG_VOX_PAPER && inner[i] == outer[i] && (uint32_t)c == exact[i])
                     for (int k = 0; k < 3; k++)
                         if (fabsf(col[4 * i + k] - colour[3 * i + k]) > 1e-4f * (1.0f + c))
                             colour_bad++;
@@ -335,21 +344,54 @@ static void voxel_case(gi_gpu *gpu, const char *scene_path, const float *ts, int
             printf("voxel %s t=%.2f n=%u %-12s: %zu filled (CPU %zu), %zu missed, %zu false positives (%.3f %%), "
                    "triangle count different from the CPU's in %zu of %zu voxels (%zu voxels with a triangle within "
                    "1e-3 of a face, counted either way)\n",
-                   strrchr(scene_path, '/') + 1, t, n, mode ? "paper" : "conservative", filled, filled_cpu, misses, fp,
+                   strrchr(scene_path, '/') + 1, t, n, mode_names[mode], filled, filled_cpu, misses, fp,
                    100.0 * (double)fp / (double)(filled ? filled : 1), total - count_equal, total, ambiguous);
             EXPECT(colour_bad == 0, "%zu voxels with different counts or colour sums", colour_bad);
-            if (mode == AVG_VOX_CONSERVATIVE) {
-                EXPECT(misses == 0, "conservative voxeliser missed %zu overlapped voxels", misses);
-                EXPECT(fp == 0, "conservative voxeliser filled %zu voxels no triangle overlaps", fp);
+            if (mode != AVG_VOX_PAPER) {
+                EXPECT(misses == 0, "%s voxeliser missed %zu overlapped voxels", mode_names[mode], misses);
+                EXPECT(fp == 0, "%s voxeliser filled %zu voxels no triangle overlaps", mode_names[mode], fp);
                 EXPECT(count_equal == total, "triangle counts differ in %zu voxels", total - count_equal);
-            } else {
+            }
+            if (mode == AVG_VOX_SINGLE && slices_nrm) {
+                /* The single pass against the per-slice conservative pass:
+                 * the same count in every voxel, the sums within the fixed
+                 * point's rounding (count / (2 AVG_VOX_FIXED) per component)
+                 * plus float summation error. */
+                size_t count_diff = 0, sum_bad = 0;
+                double worst = 0.0;
+                for (size_t i = 0; i < total; i++) {
+                    float c = slices_nrm[4 * i + 3];
+                    count_diff += nrm[4 * i + 3] != c;
+                    double bound = c / (2.0 * AVG_VOX_FIXED) + 1e-6 * (1.0 + c);
+                    for (int k = 0; k < 3; k++) {
+                        double dn = fabs(nrm[4 * i + k] - slices_nrm[4 * i + k]);
+                        double dc = fabs(col[4 * i + k] - slices_col[4 * i + k]);
+                        worst = fmax(worst, fmax(dn, dc));
+                        sum_bad += dn > bound || dc > bound;
+                    }
+                }
+                printf("voxel %s t=%.2f n=%u single vs conservative: counts differ in %zu of %zu voxels, largest sum "
+                       "difference %.3g (bound per voxel count / %.0f)\n",
+                       strrchr(scene_path, '/') + 1, t, n, count_diff, total, worst, 2.0 * AVG_VOX_FIXED);
+                EXPECT(count_diff == 0, "single-pass counts differ from the per-slice ones in %zu voxels",
+                       count_diff);
+                EXPECT(sum_bad == 0, "%zu sums beyond the fixed-point bound", sum_bad);
+            }
+            if (mode == AVG_VOX_PAPER) {
                 /* The paper's voxeliser is not conservative at partly covered
                  * voxels; it must still fill most of the surface voxels. */
                 EXPECT(misses * 10 < filled_cpu, "paper voxeliser missed %zu of %zu voxels", misses, filled_cpu);
             }
-            free(nrm);
-            free(col);
+            if (mode == AVG_VOX_CONSERVATIVE) {
+                slices_nrm = nrm;
+                slices_col = col;
+            } else {
+                free(nrm);
+                free(col);
+            }
         }
+        free(slices_nrm);
+        free(slices_col);
         free(inner);
         free(exact);
         free(outer);
@@ -730,18 +772,19 @@ static int map_visible(const avg *a, const float *tiles, uint32_t j, gi_vec3 x, 
     return zp <= zmap + bias_abs + bias_rel * (1.0f + slope) * zp;
 }
 
-static void visibility_case(gi_gpu *gpu, const char *projection)
+static void visibility_case(gi_gpu *gpu, const char *scene, const char *projection, const char *lod)
 {
     gi_error err;
     fixture fx;
-    if (!load_fixture(gpu, GI_SOURCE_DIR "/scenes/cornell_box.gltf", &fx))
+    if (!load_fixture(gpu, scene, &fx))
         return;
     const gi_scene *s = fx.s;
     gi_gpu_scene *gs = fx.gs;
-    char pkv[64];
+    char pkv[64], lkv[64];
     snprintf(pkv, sizeof pkv, "projection=%s", projection);
-    const char *kv[] = {"vpls=256", "grid=32", pkv};
-    avg *a = make_avg(&fx.host, gs, kv, 3);
+    snprintf(lkv, sizeof lkv, "shadow_lod=%s", lod);
+    const char *kv[] = {"vpls=256", "grid=32", pkv, lkv};
+    avg *a = make_avg(&fx.host, gs, kv, 4);
     gi_rt *rt = NULL;
     if (!a || gi_rt_create(s, 0.0f, &rt, &err) != GI_OK) {
         EXPECT(0, "cannot make the avg instance or the ray caster");
@@ -784,13 +827,15 @@ static void visibility_case(gi_gpu *gpu, const char *projection)
             false_light += vis && blocked;
         }
     }
-    printf("visibility %s: %u receiver-VPL pairs, shadow maps agree with Embree on %.2f %% (%u falsely shadowed, %u "
-           "falsely lit)\n",
-           projection, pairs, 100.0 * agree / (pairs ? pairs : 1), false_shadow, false_light);
+    const char *used = gi_depth_atlas_get_desc(a->atlas)->projection == GI_PROJ_PARABOLOID ? "paraboloid" : "perspective";
+    printf("visibility %s %s (%s maps) shadow_lod=%s (%u triangles a map): %u receiver-VPL pairs, shadow maps agree "
+           "with Embree on %.2f %% (%u falsely shadowed, %u falsely lit)\n",
+           strrchr(scene, '/') + 1, projection, used, lod, a->lod ? a->lod->triangle_count : s->triangle_count, pairs,
+           100.0 * agree / (pairs ? pairs : 1), false_shadow, false_light);
     EXPECT(agree >= pairs - pairs / 20, "shadow maps agree with ray casting on only %u of %u pairs", agree, pairs);
     EXPECT(pairs > 10000, "too few pairs (%u)", pairs);
     char what[96];
-    snprintf(what, sizeof what, "visibility %s, light-VPL shadow maps vs Embree", projection);
+    snprintf(what, sizeof what, "visibility %s shadow_lod=%s, light-VPL shadow maps vs Embree", projection, lod);
     gi_test_failed += vis_check(&score, what, VIS_MARGIN, 1000);
     free(tiles);
     free_gbuffer_images(&gb);
@@ -920,8 +965,12 @@ int main(int argc, char **argv)
     } else if (!strcmp(argv[1], "punctual")) {
         punctual_case(gpu);
     } else if (!strcmp(argv[1], "visibility")) {
-        visibility_case(gpu, "paraboloid");
-        visibility_case(gpu, "perspective");
+        visibility_case(gpu, GI_SOURCE_DIR "/scenes/cornell_box.gltf", "paraboloid", "1");
+        visibility_case(gpu, GI_SOURCE_DIR "/scenes/cornell_box.gltf", "perspective", "1");
+        /* Maps of the lower-detail copy (the auto rule then picks
+         * perspective maps) against rays through the full scene. */
+        visibility_case(gpu, GI_SOURCE_DIR "/scenes/cornell_box.gltf", "auto", "0.1");
+        visibility_case(gpu, GI_SOURCE_DIR "/scenes/cornell_moving.gltf", "auto", "0.1");
     } else {
         fprintf(stderr, "unknown test '%s'\n", argv[1]);
         return 2;
