@@ -237,6 +237,7 @@ static json_object *stats_json(const run_state *r, const ref_opts *o, int camera
     json_object_object_add(j, "wall_seconds", json_object_new_double(wall));
     json_object_object_add(j, "build_seconds", json_object_new_double(st.build_seconds));
     json_object_object_add(j, "render_seconds", json_object_new_double(st.render_seconds));
+    json_object_object_add(j, "render_cpu_seconds", json_object_new_double(st.render_cpu_seconds));
     json_object_object_add(j, "rays", json_object_new_int64((int64_t)st.rays));
     json_object_object_add(j, "mrays_per_second",
                            json_object_new_double(st.render_seconds > 0

@@ -971,7 +971,16 @@ static int pt_convergence(study *st, const char *out_dir, const study_ref *sc, c
         snprintf(stats, sizeof stats, "%s.json", img);
         json_object *sj = cli_read_json(stats);
         json_object *m = runner_diff(img, reference, NULL, st->exposure, why, why_size);
-        double t = rec_num(sj, "wall_seconds", NULL, NULL), e = rec_num(m, "relmse", NULL, NULL);
+        /* the path tracer's time to the image, measured as the methods'
+         * frames are: its render's CPU time (every thread) in studies timed
+         * by CPU time, else its render's wall time (all threads); the BVH
+         * build, like a method's prepare, is not in it. Images made before
+         * the CPU time was recorded give their whole wall time. */
+        double t = rec_num(sj, st->timer && !strcmp(st->timer, "cputime") ? "render_cpu_seconds" : "render_seconds",
+                           NULL, NULL);
+        if (!isfinite(t))
+            t = rec_num(sj, "wall_seconds", NULL, NULL);
+        double e = rec_num(m, "relmse", NULL, NULL);
         if (isfinite(t) && isfinite(e) && t > 0 && e > 0 && curve->n < TRADEOFF_PT_POINTS) {
             curve->t[curve->n] = t;
             curve->e[curve->n] = e;

@@ -35,7 +35,7 @@ struct gi_ref {
     double *acc;
     uint64_t spp;
     uint64_t nonfinite, rays;
-    double build_seconds, render_seconds;
+    double build_seconds, render_seconds, render_cpu_seconds;
     char renderer[64];
 };
 
@@ -188,6 +188,15 @@ static void *work(void *arg)
     return NULL;
 }
 
+/* CPU time of the whole process (all its threads), in seconds. */
+static double process_cpu_seconds(void)
+{
+    struct timespec ts;
+    if (clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts) != 0)
+        return 0.0;
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 gi_result gi_ref_render(gi_ref *r, uint32_t spp, gi_error *err)
 {
     assert(r);
@@ -196,7 +205,7 @@ gi_result gi_ref_render(gi_ref *r, uint32_t spp, gi_error *err)
     if (r->spp + spp > 0xFFFFFFFFull)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
                             "reference: more than 2^32 - 1 samples per pixel");
-    double t0 = gi_now();
+    double t0 = gi_now(), c0 = process_cpu_seconds();
     pass job;
     job.r = r;
     job.first_sample = (uint32_t)r->spp;
@@ -228,6 +237,7 @@ gi_result gi_ref_render(gi_ref *r, uint32_t spp, gi_error *err)
     free(ws);
     r->spp += spp;
     r->render_seconds += gi_now() - t0;
+    r->render_cpu_seconds += process_cpu_seconds() - c0;
     return GI_OK;
 }
 
@@ -310,6 +320,7 @@ void gi_ref_get_stats(const gi_ref *r, gi_ref_stats *out)
     out->threads = r->threads;
     out->build_seconds = r->build_seconds;
     out->render_seconds = r->render_seconds;
+    out->render_cpu_seconds = r->render_cpu_seconds;
 }
 
 const char *gi_ref_renderer(const gi_ref *r)

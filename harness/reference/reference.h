@@ -136,6 +136,8 @@ typedef struct gi_ref_stats {
     uint32_t threads;      /* worker threads */
     double build_seconds;  /* scene validation + BVH build in gi_ref_create */
     double render_seconds; /* wall time inside gi_ref_render, summed */
+    double render_cpu_seconds; /* the process's CPU time (every thread) inside gi_ref_render, summed:
+                                  what studies timed by CPU time compare with (README "Speed against accuracy") */
 } gi_ref_stats;
 void gi_ref_get_stats(const gi_ref *r, gi_ref_stats *out);
 
