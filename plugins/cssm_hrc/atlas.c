@@ -13,7 +13,7 @@
 #include <string.h>
 
 #define MAX_GROUPS_PER_OBJECT 256u
-#define MIN_CHART_TEXELS 16.0
+#define MIN_CHART_TEXELS 4.0
 
 typedef struct group {
     uint32_t object;
@@ -61,27 +61,39 @@ static int rect_cmp(const void *a, const void *b)
     return x->g < y->g ? -1 : (x->g > y->g);
 }
 
-/* Shelf packing, tallest first, 1 texel gutter; 1 when all fit. */
+/* Skyline packing, tallest first, 1 texel gutter: each chart goes where
+ * it sits lowest (leftmost on ties); 1 when all fit. */
 static int pack(rect *r, uint32_t n, uint32_t R, uint32_t *x0, uint32_t *y0)
 {
     qsort(r, n, sizeof *r, rect_cmp);
-    uint32_t x = 0, y = 0, shelf = 0;
-    for (uint32_t i = 0; i < n; i++) {
-        if (r[i].w > R)
-            return 0;
-        if (x + r[i].w > R) {
-            y += shelf + 1;
-            x = 0;
-            shelf = 0;
+    uint32_t *sky = calloc(R, sizeof *sky);
+    if (!sky)
+        return 0;
+    int ok = 1;
+    for (uint32_t i = 0; i < n && ok; i++) {
+        uint32_t w = r[i].w, best_x = 0, best_y = UINT32_MAX;
+        if (w > R) {
+            ok = 0;
+            break;
         }
-        if (y + r[i].h > R)
-            return 0;
-        x0[r[i].g] = x;
-        y0[r[i].g] = y;
-        x += r[i].w + 1;
-        shelf = r[i].h > shelf ? r[i].h : shelf;
+        for (uint32_t x = 0; x + w <= R; x++) {
+            uint32_t y = 0;
+            for (uint32_t k = x; k < x + w; k++)
+                y = sky[k] > y ? sky[k] : y;
+            if (y < best_y)
+                best_y = y, best_x = x;
+        }
+        if (best_y == UINT32_MAX || best_y + r[i].h > R) {
+            ok = 0;
+            break;
+        }
+        x0[r[i].g] = best_x;
+        y0[r[i].g] = best_y;
+        for (uint32_t k = best_x; k < best_x + w + 1 && k < R; k++)
+            sky[k] = best_y + r[i].h + 1;
     }
-    return 1;
+    free(sky);
+    return ok;
 }
 
 gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, cssm_atlas *out, gi_error *err)
@@ -157,9 +169,9 @@ gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, cssm_atlas *o
         if (overflow)
             ng = first_group;
     }
-    /* texel size: start at 60 % fill and grow until the charts pack */
+    /* texel size: start at 90 % fill and grow until the charts pack */
     double chart_area = 0.0;
-    float h = (float)sqrt(out->surface_area / (0.6 * (double)R * (double)R));
+    float h = (float)sqrt(out->surface_area / (0.9 * (double)R * (double)R));
     rect *rects = malloc((ng ? ng : 1) * sizeof *rects);
     uint32_t *x0 = malloc((ng ? ng : 1) * sizeof *x0), *y0 = malloc((ng ? ng : 1) * sizeof *y0);
     gi_vec3 *U = malloc((ng ? ng : 1) * sizeof *U), *V = malloc((ng ? ng : 1) * sizeof *V);
@@ -177,7 +189,7 @@ gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, cssm_atlas *o
         umin[2 * k] = a0, umin[2 * k + 1] = b0;
     }
     uint32_t nr = 0;
-    for (int attempt = 0; attempt < 200; attempt++, h *= 1.05f) {
+    for (int attempt = 0; attempt < 400; attempt++, h *= 1.02f) {
         nr = 0;
         chart_area = 0.0;
         for (uint32_t k = 0; k < ng; k++) {
@@ -188,8 +200,8 @@ gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, cssm_atlas *o
             for (int32_t i = (int32_t)g[k].first_tri; i >= 0; i = next_tri[i])
                 for (int j = 0; j < 3; j++)
                     a1 = fmaxf(a1, gi_v3_dot(P[3 * i + j], U[k])), b1 = fmaxf(b1, gi_v3_dot(P[3 * i + j], V[k]));
-            rects[nr].w = (uint32_t)ceilf((a1 - umin[2 * k]) / h) + 1u;
-            rects[nr].h = (uint32_t)ceilf((b1 - umin[2 * k + 1]) / h) + 1u;
+            rects[nr].w = (uint32_t)ceilf((a1 - umin[2 * k]) / h);
+            rects[nr].h = (uint32_t)ceilf((b1 - umin[2 * k + 1]) / h);
             rects[nr].g = k;
             g[k].chart = (int)nr;
             chart_area += g[k].area;
@@ -197,7 +209,7 @@ gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, cssm_atlas *o
         }
         if (pack(rects, nr, R, x0, y0))
             break;
-        if (attempt == 199) {
+        if (attempt == 399) {
             free(rects), free(x0), free(y0), free(U), free(V), free(umin);
             r = GI_ERR_INVALID_ARGUMENT;
             snprintf(err->text, sizeof err->text, "cssm_hrc: the charts do not pack into a %u x %u atlas", R, R);

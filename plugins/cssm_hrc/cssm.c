@@ -41,8 +41,7 @@ static void dont_care_mask(const gi_vec3 *corners, uint32_t M, gi_vec3 n, int fa
         }
 }
 
-gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order, uint32_t M,
-                          const gi_host *host, cssm_maps *out, gi_error *err)
+gi_result cssm_maps_setup(const cssm_atlas *a, const uint32_t *order, uint32_t M, cssm_maps *out, gi_error *err)
 {
     memset(out, 0, sizeof *out);
     const uint32_t N = a->count;
@@ -53,6 +52,27 @@ gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uin
     out->face_texels = 6ull * M * M * N;
     out->seq = malloc(N * sizeof *out->seq);
     out->eye = malloc(N * sizeof *out->eye);
+    if (!out->seq || !out->eye) {
+        cssm_maps_free(out);
+        snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for %u cube maps", N);
+        return GI_ERR_OUT_OF_MEMORY;
+    }
+    /* the eye sits just above the surface so that its own plane is not seen */
+    for (uint32_t k = 0; k < N; k++) {
+        out->seq[order[k]] = k;
+        const cssm_texel *x = &a->texels[order[k]];
+        out->eye[order[k]] = gi_v3_add(x->p, gi_v3_scale(x->n, 2.0f * out->znear));
+    }
+    return GI_OK;
+}
+
+gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order, uint32_t M,
+                          const gi_host *host, cssm_maps *out, gi_error *err)
+{
+    gi_result r = cssm_maps_setup(a, order, M, out, err);
+    if (r != GI_OK)
+        return r;
+    const uint32_t N = a->count;
     gi_vec3 *corners = malloc(6 * (size_t)(M + 1) * (M + 1) * sizeof *corners);
     float *z1 = malloc((size_t)M * M * sizeof *z1), *z2 = malloc((size_t)M * M * sizeof *z2);
     unsigned char *mask = malloc((size_t)M * M);
@@ -60,8 +80,8 @@ gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uin
     gi_csm_codec *enc[6] = {0};
     gi_depth_renderer *dr = NULL;
     GLuint tex = 0;
-    gi_result r = GI_ERR_OUT_OF_MEMORY;
-    if (!out->seq || !out->eye || !corners || !z1 || !z2 || !mask || !views) {
+    r = GI_ERR_OUT_OF_MEMORY;
+    if (!corners || !z1 || !z2 || !mask || !views) {
         snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for %u cube maps", N);
         goto done;
     }
@@ -74,12 +94,6 @@ gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uin
                 corners[((size_t)f * (M + 1) + y) * (M + 1) + x] =
                     gi_v3_add(fw, gi_v3_add(gi_v3_scale(s, sx), gi_v3_scale(t, sy)));
             }
-    }
-    /* the eye sits just above the surface so that its own plane is not seen */
-    for (uint32_t k = 0; k < N; k++) {
-        out->seq[order[k]] = k;
-        const cssm_texel *x = &a->texels[order[k]];
-        out->eye[order[k]] = gi_v3_add(x->p, gi_v3_scale(x->n, 2.0f * out->znear));
     }
     gi_depth_desc dd = {.size = M, .surfaces = 2, .metric = GI_DEPTH_RADIAL, .only_object = 0, .local = 0, .cull = 0};
     dr = gi_depth_renderer_create(&dd, err);

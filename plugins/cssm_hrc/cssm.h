@@ -105,6 +105,9 @@ typedef struct cssm_maps {
 gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order, uint32_t M,
                           const gi_host *host, cssm_maps *out, gi_error *err);
 void cssm_maps_free(cssm_maps *m);
+/* What cssm_maps_build sets besides the compressed faces (sizes, seq, eye,
+ * near and far planes): for data read back from the cache. */
+gi_result cssm_maps_setup(const cssm_atlas *a, const uint32_t *order, uint32_t M, cssm_maps *out, gi_error *err);
 /* Compressed bytes over the six sequences, and the paper's uncompressed
  * 2 bytes per depth texel (Table 2). */
 uint64_t cssm_maps_bytes(const cssm_maps *m);
@@ -182,5 +185,20 @@ void cssm_gather(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps,
 /* Upper bound of what node S sends to the receiver (the oracle's L_max),
  * luminance. */
 float cssm_bound(const cssm_node *S, const float L[3], const cssm_receiver *rc);
+
+/* The receiver position of a surface point: lifted along its normal as
+ * the cube maps' eyes are (2 near planes). */
+gi_vec3 cssm_receiver_point(const cssm_maps *maps, const cssm_atlas *a, gi_vec3 p, gi_vec3 n);
+
+/* GPU HRC of §4.1.1 on the atlas (Fig. 8): texel_L (3 per texel) gets
+ * emission + R_1 + ... + R_n with
+ *   R_1 = kd/pi gather(pull(emission)) + direct (3 per texel, may be NULL:
+ *         light from sources that are not atlas texels),
+ *   R_k = kd/pi gather(pull(R_{k-1})),  k = 2 .. n,
+ * and node_L (3 per node) its pull. Stage timers direct, pull, bounce when
+ * host is not NULL. */
+gi_result cssm_solve(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps, const cssm_gather_opts *o,
+                     uint32_t bounces, const float *direct, const gi_host *host, float *texel_L, float *node_L,
+                     cssm_gather_stats *st, gi_error *err);
 
 #endif

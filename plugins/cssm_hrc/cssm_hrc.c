@@ -18,6 +18,7 @@
  * drawn by the core's GL passes. */
 #include "cssm.h"
 
+#include "gi/cache.h"
 #include "gi/cubemap.h"
 #include "gi/kit.h"
 #include "gi/lights.h"
@@ -65,9 +66,9 @@ static const gi_param_desc cssm_params[] = {
      "order of the cube maps in the codec"},
     {"bounces", GI_PARAM_INT, 3, 0, 3, NULL, "n (Sec. 4.1)",
      "diffuse indirect bounces n: the atlas holds 1 .. n bounces, the final gather adds one"},
-    {"threshold", GI_PARAM_FLOAT, 0.05, 0.0, 1.0, NULL, "threshold (Sec. 4.3)",
+    {"threshold", GI_PARAM_FLOAT, 0.1, 0.0, 1.0, NULL, "threshold (Sec. 4.3)",
      "refine a sender while the tone-mapped upper bound of its radiance exceeds this"},
-    {"max_cut", GI_PARAM_INT, 256, 1, 65536, NULL, "maximum cut size (Sec. 4.4)", "nodes in one receiver's cut at most"},
+    {"max_cut", GI_PARAM_INT, 1024, 1, 65536, NULL, "maximum cut size (Sec. 4.4)", "nodes in one receiver's cut at most"},
     {"jitter", GI_PARAM_BOOL, 1, 0, 1, NULL, "jittering (Sec. 4.5)",
      "final gather: each node's position drawn inside its area every frame, averaged progressively"},
     {"clamp", GI_PARAM_FLOAT, 0.02, 0.0, 1.0, NULL, "clamping (Sec. 5 Quality)",
@@ -263,76 +264,157 @@ static cssm_gather_opts gather_opts(const cssm_hrc *c, float exposure, uint32_t 
 
 static gi_vec3 offset(const cssm_hrc *c, gi_vec3 p, gi_vec3 n)
 {
-    return gi_v3_add(p, gi_v3_scale(n, 2.0f * c->maps.znear));
+    return cssm_receiver_point(&c->maps, &c->atlas, p, n);
 }
 
-/* The atlas' lighting (§4.1, Fig. 8): direct, n - 1 gathers with pulls,
- * and the pulled tree of emission + reflected light for the final gather. */
+/* The atlas' lighting (§4.1, Fig. 8) with the punctual lights' direct
+ * light per texel added to the first bounce. */
 static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
 {
     const gi_host *host = c->kit.host;
     const cssm_atlas *a = &c->atlas;
     const uint32_t N = a->count, NN = c->tree.count;
-    float *Le = calloc(3 * (size_t)N, sizeof *Le), *Rk = calloc(3 * (size_t)N, sizeof *Rk);
-    float *Rn = calloc(3 * (size_t)N, sizeof *Rn), *B = calloc(3 * (size_t)N, sizeof *B);
-    float *nodes = calloc(3 * (size_t)NN, sizeof *nodes);
+    float *D = calloc(3 * (size_t)N, sizeof *D);
     free(c->texel_L);
     free(c->node_L);
     c->texel_L = calloc(3 * (size_t)N, sizeof *c->texel_L);
     c->node_L = calloc(3 * (size_t)NN, sizeof *c->node_L);
-    if (!Le || !Rk || !Rn || !B || !nodes || !c->texel_L || !c->node_L) {
-        free(Le), free(Rk), free(Rn), free(B), free(nodes);
+    if (!D || !c->texel_L || !c->node_L) {
+        free(D);
         return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the lighting");
     }
+    host->stage_begin(host, "direct");
+    for (uint32_t i = 0; i < N && c->shadow_count; i++) {
+        const cssm_texel *x = &a->texels[i];
+        for (uint32_t l = 0; l < c->shadow_count; l++) {
+            float e[3];
+            punctual(c, gs->scene, l, offset(c, x->p, x->n), x->n, e);
+            for (int k = 0; k < 3; k++)
+                D[3 * i + k] += x->albedo[k] / GI_PI * e[k];
+        }
+    }
+    host->stage_end(host, "direct");
     cssm_gather_opts o = gather_opts(c, 0.0f, NULL);
     cssm_gather_stats st = {0};
-    for (uint32_t i = 0; i < N; i++)
-        memcpy(&Le[3 * i], a->texels[i].emission, 3 * sizeof(float));
-    if (c->bounces >= 1) {
-        host->stage_begin(host, "direct");
-        cssm_tree_pull(&c->tree, a, Le, nodes);
-        for (uint32_t i = 0; i < N; i++) {
-            const cssm_texel *x = &a->texels[i];
-            cssm_receiver rc = {.x = offset(c, x->p, x->n), .n = x->n, .self = (int32_t)i};
-            memcpy(rc.kd, x->albedo, sizeof rc.kd);
-            cssm_gather(&c->tree, a, &c->maps, nodes, &rc, &o, &Rk[3 * i], &st);
-            for (uint32_t l = 0; l < c->shadow_count; l++) {
-                float e[3];
-                punctual(c, gs->scene, l, rc.x, x->n, e);
-                for (int k = 0; k < 3; k++)
-                    Rk[3 * i + k] += x->albedo[k] / GI_PI * e[k];
-            }
-        }
-        memcpy(B, Rk, 3 * (size_t)N * sizeof *B);
-        host->stage_end(host, "direct");
-    }
-    for (int b = 2; b <= c->bounces; b++) {
-        host->stage_begin(host, "pull");
-        cssm_tree_pull(&c->tree, a, Rk, nodes);
-        host->stage_end(host, "pull");
-        host->stage_begin(host, "bounce");
-        for (uint32_t i = 0; i < N; i++) {
-            const cssm_texel *x = &a->texels[i];
-            cssm_receiver rc = {.x = offset(c, x->p, x->n), .n = x->n, .self = (int32_t)i};
-            memcpy(rc.kd, x->albedo, sizeof rc.kd);
-            cssm_gather(&c->tree, a, &c->maps, nodes, &rc, &o, &Rn[3 * i], &st);
-        }
-        for (size_t k = 0; k < 3 * (size_t)N; k++)
-            B[k] += Rn[k];
-        float *t = Rk;
-        Rk = Rn;
-        Rn = t;
-        host->stage_end(host, "bounce");
-    }
-    host->stage_begin(host, "pull");
-    for (size_t k = 0; k < 3 * (size_t)N; k++)
-        c->texel_L[k] = Le[k] + B[k];
-    cssm_tree_pull(&c->tree, a, c->texel_L, c->node_L);
-    host->stage_end(host, "pull");
+    gi_error err;
+    gi_result r = cssm_solve(&c->tree, a, &c->maps, &o, (uint32_t)c->bounces, c->shadow_count ? D : NULL, host,
+                             c->texel_L, c->node_L, &st, &err);
+    free(D);
+    if (r != GI_OK)
+        return gi_kit_fail_with(&c->kit, r, &err);
     if (st.receivers)
         host->stat(host, "cut_size_atlas", (double)st.nodes / (double)st.receivers);
-    free(Le), free(Rk), free(Rn), free(B), free(nodes);
     return GI_OK;
+}
+
+#define CSSM_FORMAT_VERSION 1u
+static const char cache_magic[8] = {'G', 'I', 'C', 'S', 'S', 'M', '\r', '\n'};
+
+/* Cache name: the meshes, their placement at prepare time and every
+ * parameter that changes the maps. */
+static void cache_name(const cssm_hrc *c, const gi_gpu_scene *gs, char *name, size_t size)
+{
+    const gi_scene *s = gs->scene;
+    uint32_t key[5] = {CSSM_FORMAT_VERSION, (uint32_t)c->R, (uint32_t)c->M, (uint32_t)c->traversal, c->atlas.count};
+    uint64_t h = gi_hash64("gibench-cssm", 12, 0);
+    h = gi_hash64(key, sizeof key, h);
+    for (uint32_t k = 0; k < s->object_count; k++) {
+        uint64_t oh = gi_scene_object_hash(s, k);
+        float m[16];
+        gi_scene_object_transform(s, k, gs->time, m);
+        h = gi_hash64(&oh, sizeof oh, h);
+        h = gi_hash64(m, sizeof m, h);
+    }
+    snprintf(name, size, "cssm_hrc-%016llx.bin", (unsigned long long)h);
+}
+
+/* The six compressed faces of a cache file; 1 on a hit. */
+static int cache_load(cssm_hrc *c, const char *path)
+{
+    size_t size = 0;
+    unsigned char *bytes = gi_file_read_all(path, &size);
+    if (!bytes)
+        return 0;
+    int ok = size >= 16 && !memcmp(bytes, cache_magic, 8);
+    size_t at = 16;
+    uint64_t dont_care = 0;
+    if (ok)
+        memcpy(&dont_care, bytes + 8, 8);
+    for (int f = 0; f < 6 && ok; f++) {
+        uint64_t n = 0;
+        gi_error err;
+        ok = at + 8 <= size;
+        if (ok)
+            memcpy(&n, bytes + at, 8);
+        ok = ok && n <= size - at - 8 && gi_csm_data_read(bytes + at + 8, (size_t)n, &c->maps.face[f], &err) == GI_OK &&
+             c->maps.face[f].M == (uint32_t)c->M && c->maps.face[f].N == c->atlas.count;
+        at += 8 + (size_t)n;
+    }
+    free(bytes);
+    if (!ok) {
+        c->kit.host->log(c->kit.host, GI_LOG_WARN, "%s: unusable cache file; recomputing", path);
+        for (int f = 0; f < 6; f++)
+            gi_csm_data_free(&c->maps.face[f]);
+        return 0;
+    }
+    c->maps.dont_care = dont_care;
+    return 1;
+}
+
+static void cache_store(cssm_hrc *c, const char *path)
+{
+    void *part[6] = {0};
+    size_t sz[6] = {0}, total = 16;
+    gi_error err = {{0}};
+    int ok = 1;
+    for (int f = 0; f < 6 && ok; f++) {
+        ok = gi_csm_data_write(&c->maps.face[f], &part[f], &sz[f], &err) == GI_OK;
+        total += 8 + sz[f];
+    }
+    unsigned char *buf = ok ? malloc(total) : NULL;
+    if (buf) {
+        memcpy(buf, cache_magic, 8);
+        memcpy(buf + 8, &c->maps.dont_care, 8);
+        size_t at = 16;
+        for (int f = 0; f < 6; f++) {
+            uint64_t n = sz[f];
+            memcpy(buf + at, &n, 8);
+            memcpy(buf + at + 8, part[f], sz[f]);
+            at += 8 + sz[f];
+        }
+        if (gi_file_write_atomic(path, buf, total, &err) != GI_OK)
+            ok = 0;
+    }
+    if (!ok || !buf)
+        c->kit.host->log(c->kit.host, GI_LOG_WARN, "cssm_hrc: not cached: %s", err.text[0] ? err.text : "no memory");
+    free(buf);
+    for (int f = 0; f < 6; f++)
+        free(part[f]);
+}
+
+static gi_result load_or_build_maps(cssm_hrc *c, const gi_gpu_scene *gs, gi_error *err)
+{
+    const gi_host *host = c->kit.host;
+    char name[64], *path = NULL;
+    cache_name(c, gs, name, sizeof name);
+    path = host->cache_dir ? gi_cache_path(host->cache_dir, name) : NULL;
+    gi_result r = cssm_maps_setup(&c->atlas, c->order, (uint32_t)c->M, &c->maps, err);
+    if (r != GI_OK) {
+        free(path);
+        return r;
+    }
+    if (path && cache_load(c, path)) {
+        host->stat(host, "cache_hit", 1.0);
+        free(path);
+        return GI_OK;
+    }
+    cssm_maps_free(&c->maps);
+    r = cssm_maps_build(gs, &c->atlas, c->order, (uint32_t)c->M, host, &c->maps, err);
+    if (r == GI_OK && path)
+        cache_store(c, path);
+    host->stat(host, "cache_hit", 0.0);
+    free(path);
+    return r;
 }
 
 static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
@@ -357,7 +439,7 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     host->stage_end(host, "traversal");
     if (!c->order)
         return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the traversal");
-    r = cssm_maps_build(gs, a, c->order, (uint32_t)c->M, host, &c->maps, &err);
+    r = load_or_build_maps(c, gs, &err);
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);
     uint64_t bc = cssm_maps_bytes(&c->maps), bu = cssm_maps_bytes_uncompressed(&c->maps);

@@ -298,3 +298,79 @@ void cssm_gather(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps,
         st->receivers++;
     }
 }
+
+static void stage(const gi_host *host, const char *name, int begin)
+{
+    if (!host)
+        return;
+    if (begin)
+        host->stage_begin(host, name);
+    else
+        host->stage_end(host, name);
+}
+
+/* One gather over every texel of the atlas from node radiance node_L. */
+static void gather_atlas(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps, const float *node_L,
+                         const cssm_gather_opts *o, float *out, cssm_gather_stats *st)
+{
+    for (uint32_t i = 0; i < a->count; i++) {
+        const cssm_texel *x = &a->texels[i];
+        cssm_receiver rc = {.x = cssm_receiver_point(maps, a, x->p, x->n), .n = x->n, .self = (int32_t)i};
+        memcpy(rc.kd, x->albedo, sizeof rc.kd);
+        cssm_gather(t, a, maps, node_L, &rc, o, &out[3 * i], st);
+    }
+}
+
+gi_vec3 cssm_receiver_point(const cssm_maps *maps, const cssm_atlas *a, gi_vec3 p, gi_vec3 n)
+{
+    float eps = maps ? maps->znear : 1e-3f * a->diameter;
+    return gi_v3_add(p, gi_v3_scale(n, 2.0f * eps));
+}
+
+gi_result cssm_solve(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps, const cssm_gather_opts *o,
+                     uint32_t bounces, const float *direct, const gi_host *host, float *texel_L, float *node_L,
+                     cssm_gather_stats *st, gi_error *err)
+{
+    const uint32_t N = a->count;
+    float *Le = calloc(3 * (size_t)N, sizeof *Le), *Rk = calloc(3 * (size_t)N, sizeof *Rk);
+    float *Rn = calloc(3 * (size_t)N, sizeof *Rn), *nodes = calloc(3 * (size_t)t->count, sizeof *nodes);
+    if (!Le || !Rk || !Rn || !nodes) {
+        free(Le), free(Rk), free(Rn), free(nodes);
+        snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for the lighting");
+        return GI_ERR_OUT_OF_MEMORY;
+    }
+    for (uint32_t i = 0; i < N; i++)
+        memcpy(&Le[3 * i], a->texels[i].emission, 3 * sizeof(float));
+    memcpy(texel_L, Le, 3 * (size_t)N * sizeof *texel_L);
+    if (bounces >= 1) {
+        /* direct: the emitting texels gathered like any sender, plus the rest */
+        stage(host, "direct", 1);
+        cssm_tree_pull(t, a, Le, nodes);
+        gather_atlas(t, a, maps, nodes, o, Rk, st);
+        if (direct)
+            for (size_t k = 0; k < 3 * (size_t)N; k++)
+                Rk[k] += direct[k];
+        for (size_t k = 0; k < 3 * (size_t)N; k++)
+            texel_L[k] += Rk[k];
+        stage(host, "direct", 0);
+    }
+    for (uint32_t b = 2; b <= bounces; b++) {
+        stage(host, "pull", 1);
+        cssm_tree_pull(t, a, Rk, nodes);
+        stage(host, "pull", 0);
+        stage(host, "bounce", 1);
+        memset(Rn, 0, 3 * (size_t)N * sizeof *Rn);
+        gather_atlas(t, a, maps, nodes, o, Rn, st);
+        for (size_t k = 0; k < 3 * (size_t)N; k++)
+            texel_L[k] += Rn[k];
+        float *sw = Rk;
+        Rk = Rn;
+        Rn = sw;
+        stage(host, "bounce", 0);
+    }
+    stage(host, "pull", 1);
+    cssm_tree_pull(t, a, texel_L, node_L);
+    stage(host, "pull", 0);
+    free(Le), free(Rk), free(Rn), free(nodes);
+    return GI_OK;
+}
