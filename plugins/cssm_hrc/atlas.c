@@ -37,6 +37,8 @@ static void material_of(const gi_scene *s, uint32_t tri, cssm_texel *x)
     const gi_material *m = &s->materials[s->vertices[s->indices[3 * tri]].material];
     memcpy(x->albedo, m->albedo, sizeof x->albedo);
     memcpy(x->emission, m->emission, sizeof x->emission);
+    memcpy(x->ks, m->ks, sizeof x->ks);
+    x->exponent = m->exponent;
 }
 
 /* 2D point-in-triangle (barycentric signs, inclusive). */
@@ -312,6 +314,14 @@ gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, cssm_atlas *o
         /* a chart without a texel centre inside: its area is lost (reported by coverage) */
     }
     out->chart_texels = out->count;
+    out->tri_chart = malloc((size_t)T * sizeof *out->tri_chart);
+    if (!out->tri_chart) {
+        free(rest), free(per_object);
+        free(rects), free(x0), free(y0), free(U), free(V), free(umin);
+        goto fail;
+    }
+    for (uint32_t i = 0; i < T; i++)
+        out->tri_chart[i] = tri_group[i] >= 0 ? g[tri_group[i]].chart : -1;
     /* surface samples: systematic sampling of each object's remaining area */
     if (out->count + samples > cap_texels) {
         cssm_texel *nt = realloc(out->texels, (out->count + samples + 1) * sizeof *nt);
@@ -379,7 +389,54 @@ void cssm_atlas_free(cssm_atlas *a)
     free(a->grid);
     free(a->texels);
     free(a->charts);
+    free(a->tri_chart);
     memset(a, 0, sizeof *a);
+}
+
+static int32_t chart_texel(const cssm_atlas *a, const cssm_chart *c, uint32_t ci, int x, int y);
+
+void cssm_chart_coords(const cssm_atlas *a, uint32_t chart, gi_vec3 p, float *u, float *v)
+{
+    const cssm_chart *c = &a->charts[chart];
+    gi_vec3 d = gi_v3_sub(p, c->origin);
+    float h2 = a->h * a->h;
+    *u = gi_v3_dot(d, c->u) / h2;
+    *v = gi_v3_dot(d, c->v) / h2;
+}
+
+static float bspline(float t)
+{
+    t = fabsf(t);
+    if (t < 1.0f)
+        return (4.0f - 6.0f * t * t + 3.0f * t * t * t) / 6.0f;
+    if (t < 2.0f) {
+        float s = 2.0f - t;
+        return s * s * s / 6.0f;
+    }
+    return 0.0f;
+}
+
+int cssm_chart_bicubic(const cssm_atlas *a, uint32_t chart, float u, float v, const float *values, float out[3])
+{
+    const cssm_chart *c = &a->charts[chart];
+    float gx = u - 0.5f, gy = v - 0.5f, wsum = 0.0f;
+    int x0 = (int)floorf(gx), y0 = (int)floorf(gy);
+    out[0] = out[1] = out[2] = 0.0f;
+    for (int j = -1; j <= 2; j++)
+        for (int i = -1; i <= 2; i++) {
+            int32_t t = chart_texel(a, c, chart, x0 + i, y0 + j);
+            if (t < 0)
+                continue;
+            float w = bspline(gx - (float)(x0 + i)) * bspline(gy - (float)(y0 + j));
+            for (int k = 0; k < 3; k++)
+                out[k] += w * values[3 * t + k];
+            wsum += w;
+        }
+    if (!(wsum > 0.0f))
+        return 0;
+    for (int k = 0; k < 3; k++)
+        out[k] /= wsum;
+    return 1;
 }
 
 const char *cssm_traversal_name(cssm_traversal how)

@@ -34,6 +34,7 @@ typedef struct cssm_texel {
     float area;         /* world area this texel stands for */
     float albedo[3];    /* Lambert albedo of the material (textures not applied) */
     float emission[3];  /* emitted radiance (front face) */
+    float ks[3], exponent; /* Phong lobe of the material (view-dependent lightmap mode) */
     int32_t chart;      /* chart index, -1 for a surface sample without parametrisation */
     uint32_t x, y;      /* atlas texel (CSSM_NO_XY for a surface sample) */
     uint32_t triangle;  /* scene triangle it lies on */
@@ -59,6 +60,7 @@ typedef struct cssm_atlas {
     double surface_area;   /* of every triangle */
     double chart_area;     /* of the triangles in charts */
     double covered_area;   /* chart texels x h^2: the share of chart_area the texel grid covers */
+    int32_t *tri_chart;    /* per scene triangle: its chart, -1 for none */
 } cssm_atlas;
 
 /* Builds the atlas of the scene at time t (world space, every object):
@@ -80,6 +82,15 @@ void cssm_atlas_free(cssm_atlas *a);
  * a left-hand walk along the border of the unvisited region, stepping back
  * along the path when stuck (spiral); surface samples follow, greedily.
  * Returns a malloc'd array or NULL on no memory. */
+/* Continuous texel coordinates (texel centres at x + 1/2) of world point p
+ * in chart c's rectangle. */
+void cssm_chart_coords(const cssm_atlas *a, uint32_t chart, gi_vec3 p, float *u, float *v);
+/* Bicubic (uniform cubic B-spline) interpolation of per-texel values
+ * (3 per texel) at chart-local coordinates (u, v) over the 4 x 4 texels of
+ * that chart around it, weights renormalised over the texels that exist;
+ * 0 when none does. */
+int cssm_chart_bicubic(const cssm_atlas *a, uint32_t chart, float u, float v, const float *values, float out[3]);
+
 uint32_t *cssm_traverse(const cssm_atlas *a, cssm_traversal how);
 const char *cssm_traversal_name(cssm_traversal how);
 

@@ -50,6 +50,11 @@ typedef struct cssm_hrc {
     cssm_tree tree;
     float *texel_L;   /* emission + reflected, 3 per texel */
     float *node_L;    /* pulled texel_L */
+    float *node_Le;   /* pulled emission (texel mode: direct light per pixel) */
+    float *node_B;    /* pulled reflected light (texel mode: indirect) */
+    float *texel_T;   /* texel mode: view-dependent indirect light per texel, 3 per texel */
+    uint32_t *ids;    /* G-buffer ids read-back (texel mode) */
+    int mode;
     shadow_map *shadows;
     uint32_t shadow_count;
     float *accum;     /* running average, 4 per pixel */
@@ -75,6 +80,9 @@ static const gi_param_desc cssm_params[] = {
      "distances below clamp x scene diameter count as that distance"},
     {"bias", GI_PARAM_FLOAT, 0.004, 0.0, 0.1, NULL, "depth bias (Fig. 14)", "CSSM depth bias as a fraction of the scene diameter"},
     {"pcf", GI_PARAM_BOOL, 0, 0, 1, NULL, "PCF (Sec. 3.2.2)", "CSSM look-ups filtered over 2 x 2 texels"},
+    {"mode", GI_PARAM_ENUM, 0, 0, 0, "pixels|texels", "samples (Table 1, Fig. 17)",
+     "pixels: final gather per pixel; texels: view-dependent lightmap, the final (glossy) gather of the indirect light "
+     "per atlas texel with a bicubic look-up, emission and direct light per pixel"},
     {"shadow_size", GI_PARAM_INT, 256, 16, 2048, NULL, NULL,
      "face size of the point/spot lights' shadow cube maps and of directional lights' shadow maps"},
     {0},
@@ -100,6 +108,7 @@ static gi_result cssm_create(const gi_host *host, const gi_params *params, void 
     c->bias_f = gi_params_float(params, "bias");
     c->pcf = gi_params_bool(params, "pcf");
     c->shadow_size = gi_params_int(params, "shadow_size");
+    c->mode = gi_params_enum(params, "mode");
     *out = c;
     return GI_OK;
 }
@@ -121,8 +130,11 @@ static void release_prepared(cssm_hrc *c)
     free(c->order);
     free(c->texel_L);
     free(c->node_L);
+    free(c->node_Le);
+    free(c->node_B);
+    free(c->texel_T);
     c->order = NULL;
-    c->texel_L = c->node_L = NULL;
+    c->texel_L = c->node_L = c->node_Le = c->node_B = c->texel_T = NULL;
     release_shadows(c);
     c->prepared = 0;
 }
@@ -302,6 +314,24 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
     free(D);
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);
+    free(c->node_Le);
+    free(c->node_B);
+    free(c->texel_T);
+    c->node_Le = calloc(3 * (size_t)NN, sizeof *c->node_Le);
+    c->node_B = calloc(3 * (size_t)NN, sizeof *c->node_B);
+    c->texel_T = calloc(3 * (size_t)N, sizeof *c->texel_T);
+    float *tmp = calloc(3 * (size_t)N, sizeof *tmp);
+    if (!c->node_Le || !c->node_B || !c->texel_T || !tmp) {
+        free(tmp);
+        return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the lighting");
+    }
+    for (uint32_t i = 0; i < N; i++)
+        memcpy(&tmp[3 * i], a->texels[i].emission, 3 * sizeof(float));
+    cssm_tree_pull(&c->tree, a, tmp, c->node_Le);
+    for (size_t k = 0; k < 3 * (size_t)N; k++)
+        tmp[k] = c->texel_L[k] - tmp[k];
+    cssm_tree_pull(&c->tree, a, tmp, c->node_B);
+    free(tmp);
     if (st.receivers)
         host->stat(host, "cut_size_atlas", (double)st.nodes / (double)st.receivers);
     return GI_OK;
@@ -485,6 +515,8 @@ static gi_result cssm_update(void *inst, const gi_gpu_scene *gs, const gi_change
                     &gs->scene->materials[gs->scene->vertices[gs->scene->indices[3 * x->triangle]].material];
                 memcpy(x->albedo, m->albedo, sizeof x->albedo);
                 memcpy(x->emission, m->emission, sizeof x->emission);
+                memcpy(x->ks, m->ks, sizeof x->ks);
+                x->exponent = m->exponent;
             }
         }
         const gi_host *host = c->kit.host;
@@ -511,6 +543,15 @@ static gi_result read_gbuffer(cssm_hrc *c, uint32_t w, uint32_t h)
                 return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the G-buffer");
         }
         glGetTextureImage(tex[i], 0, GL_RGBA, GL_FLOAT, (GLsizei)(n * sizeof(float)), c->gb[i]);
+    }
+    if (c->mode == 1) {
+        if (c->acc_w != w || c->acc_h != h || !c->ids) {
+            free(c->ids);
+            c->ids = malloc(n * sizeof *c->ids);
+            if (!c->ids)
+                return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the G-buffer");
+        }
+        glGetTextureImage(g->tex_ids, 0, GL_RGBA_INTEGER, GL_UNSIGNED_INT, (GLsizei)(n * sizeof *c->ids), c->ids);
     }
     if (c->acc_w != w || c->acc_h != h || !c->accum) {
         free(c->accum);
@@ -542,6 +583,24 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
     const gi_scene *s = kit->scene->scene;
     const uint32_t frame = kit->frames;
     cssm_gather_stats st = {0};
+    const int texels = c->mode == 1;
+    if (texels) {
+        /* Fig. 17 right: the final, glossy gather of the indirect light once
+         * per atlas texel toward the eye */
+        host->stage_begin(host, "texel_gather");
+        for (uint32_t i = 0; i < c->atlas.count; i++) {
+            const cssm_texel *x = &c->atlas.texels[i];
+            cssm_receiver rc = {.x = offset(c, x->p, x->n), .n = x->n, .self = (int32_t)i, .glossy = 1,
+                                .exponent = fminf(x->exponent, 1000.0f)};
+            memcpy(rc.kd, x->albedo, sizeof rc.kd);
+            memcpy(rc.ks, x->ks, sizeof rc.ks);
+            rc.wo = gi_v3_normalize(gi_v3_sub(view->eye, x->p));
+            uint32_t rng = gi_rng_init(i, frame, view->seed ^ 0x7e1u);
+            cssm_gather_opts o = gather_opts(c, view->exposure, c->jitter ? &rng : NULL);
+            cssm_gather(&c->tree, &c->atlas, &c->maps, c->node_B, &rc, &o, &c->texel_T[3 * i], &st);
+        }
+        host->stage_end(host, "texel_gather");
+    }
     host->stage_begin(host, "final_gather");
     for (uint32_t y = 0; y < h; y++)
         for (uint32_t x = 0; x < w; x++) {
@@ -559,7 +618,24 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                 rc.wo = gi_v3_normalize(gi_v3_sub(view->eye, P));
                 uint32_t rng = gi_rng_init((uint32_t)p, frame, view->seed ^ 0xc55u);
                 cssm_gather_opts o = gather_opts(c, view->exposure, c->jitter ? &rng : NULL);
-                cssm_gather(&c->tree, &c->atlas, &c->maps, c->node_L, &rc, &o, out, &st);
+                if (!texels) {
+                    cssm_gather(&c->tree, &c->atlas, &c->maps, c->node_L, &rc, &o, out, &st);
+                } else {
+                    /* direct light of the emitting texels per pixel, the indirect light from the lightmap */
+                    cssm_gather(&c->tree, &c->atlas, &c->maps, c->node_Le, &rc, &o, out, NULL);
+                    uint32_t tri = c->ids[4 * p + 2];
+                    int32_t chart = tri < s->triangle_count ? c->atlas.tri_chart[tri] : -1;
+                    float ind[3] = {0, 0, 0}, u, v;
+                    int ok = 0;
+                    if (chart >= 0) {
+                        cssm_chart_coords(&c->atlas, (uint32_t)chart, P, &u, &v);
+                        ok = cssm_chart_bicubic(&c->atlas, (uint32_t)chart, u, v, c->texel_T, ind);
+                    }
+                    if (!ok) /* surface samples have no atlas position: gathered per pixel */
+                        cssm_gather(&c->tree, &c->atlas, &c->maps, c->node_B, &rc, &o, ind, &st);
+                    for (int k = 0; k < 3; k++)
+                        out[k] += ind[k];
+                }
                 for (uint32_t l = 0; l < c->shadow_count; l++) {
                     float e[3];
                     punctual(c, s, l, rc.x, Nn, e);
@@ -605,6 +681,7 @@ static void cssm_destroy(void *inst)
     for (int i = 0; i < 5; i++)
         free(c->gb[i]);
     free(c->accum);
+    free(c->ids);
     gi_kit_free(&c->kit);
     free(c);
 }
