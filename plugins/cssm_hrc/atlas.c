@@ -98,7 +98,8 @@ static int pack(rect *r, uint32_t n, uint32_t R, uint32_t *x0, uint32_t *y0)
     return ok;
 }
 
-gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, cssm_atlas *out, gi_error *err)
+gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_only, cssm_atlas *out,
+                           gi_error *err)
 {
     memset(out, 0, sizeof *out);
     out->R = R;
@@ -217,6 +218,12 @@ gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, cssm_atlas *o
             snprintf(err->text, sizeof err->text, "cssm_hrc: the charts do not pack into a %u x %u atlas", R, R);
             goto fail;
         }
+    }
+    if (samples_only) { /* the charts' texel size, no parametrisation */
+        for (uint32_t k = 0; k < ng; k++)
+            g[k].chart = -1;
+        nr = 0;
+        chart_area = 0.0;
     }
     out->h = h;
     out->chart_area = chart_area;

@@ -68,9 +68,12 @@ typedef struct cssm_atlas {
  * scenes' walls and blocks) packed into the R x R atlas; triangles of no
  * chart large enough (curved meshes) get evenly distributed surface
  * samples of the same density (§3.2.3, last paragraph). Texel areas sum to
- * each chart's / object's area. GI_ERR_INVALID_ARGUMENT when the scene has
- * no area. */
-gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, cssm_atlas *out, gi_error *err);
+ * each chart's / object's area. samples_only: the texel size the charts
+ * would get, but surface samples everywhere (no parametrisation: the
+ * paper's greedy case). GI_ERR_INVALID_ARGUMENT when the scene has no
+ * area. */
+gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_only, cssm_atlas *out,
+                           gi_error *err);
 void cssm_atlas_free(cssm_atlas *a);
 
 /* The order in which the texels' cube maps are rendered and compressed:

@@ -67,8 +67,10 @@ static const gi_param_desc cssm_params[] = {
     {"atlas", GI_PARAM_INT, 32, 8, 128, NULL, "atlas resolution (Sec. 3.2.3, Table 2)",
      "the illumination atlas is atlas x atlas texels; each texel is a surface sample, a cube map and a leaf"},
     {"M", GI_PARAM_INT, 16, 4, 64, NULL, "6 x M x M (Sec. 3.2.1, Table 2)", "cube face size of the CSSM depth cube maps"},
-    {"traversal", GI_PARAM_ENUM, 2, 0, 0, "greedy|zigzag|spiral", "Sec. 3.2.3, Fig. 6/7",
-     "order of the cube maps in the codec"},
+    {"traversal", GI_PARAM_ENUM, 2, 0, 0, "greedy|zigzag|spiral|greedy_atlas", "Sec. 3.2.3, Fig. 6/7",
+     "order of the cube maps in the codec: greedy (the paper's: evenly distributed surface samples instead of the "
+     "atlas, walked nearest-first), zig-zag or spiral over the charts, greedy_atlas (nearest-first over the atlas "
+     "texels)"},
     {"bounces", GI_PARAM_INT, 3, 0, 3, NULL, "n (Sec. 4.1)",
      "diffuse indirect bounces n: the atlas holds 1 .. n bounces, the final gather adds one"},
     {"threshold", GI_PARAM_FLOAT, 0.1, 0.0, 1.0, NULL, "threshold (Sec. 4.3)",
@@ -337,7 +339,7 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
     return GI_OK;
 }
 
-#define CSSM_FORMAT_VERSION 1u
+#define CSSM_FORMAT_VERSION 2u
 static const char cache_magic[8] = {'G', 'I', 'C', 'S', 'S', 'M', '\r', '\n'};
 
 /* Cache name: the meshes, their placement at prepare time and every
@@ -455,7 +457,7 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     const gi_host *host = c->kit.host;
     gi_error err;
     host->stage_begin(host, "atlas");
-    gi_result r = cssm_atlas_build(gs->scene, gs->time, (uint32_t)c->R, &c->atlas, &err);
+    gi_result r = cssm_atlas_build(gs->scene, gs->time, (uint32_t)c->R, c->traversal == 0, &c->atlas, &err);
     host->stage_end(host, "atlas");
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);
@@ -465,7 +467,7 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     host->stat(host, "atlas_charts", (double)a->chart_count);
     host->stat(host, "atlas_coverage", a->covered_area / a->surface_area);
     host->stage_begin(host, "traversal");
-    c->order = cssm_traverse(a, (cssm_traversal)c->traversal);
+    c->order = cssm_traverse(a, c->traversal == 3 ? CSSM_GREEDY : (cssm_traversal)c->traversal);
     host->stage_end(host, "traversal");
     if (!c->order)
         return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the traversal");

@@ -121,7 +121,7 @@ static int part_traversal(void)
         for (uint32_t R = 16; R <= 64; R *= 2) {
             cssm_atlas a;
             gi_error err;
-            gi_result r = cssm_atlas_build(s, 0.0f, R, &a, &err);
+            gi_result r = cssm_atlas_build(s, 0.0f, R, 0, &a, &err);
             CHECK(r == GI_OK, "atlas: %s", err.text);
             if (r != GI_OK)
                 continue;
@@ -141,6 +141,13 @@ static int part_traversal(void)
             snprintf(what, sizeof what, "%s %u^2", k ? "sphere" : "cornell", R);
             check_traversals(&a, what);
             cssm_atlas_free(&a);
+            if (k == 0 && R == 32 && cssm_atlas_build(s, 0.0f, R, 1, &a, &err) == GI_OK) {
+                /* no parametrisation: surface samples at the charts' density (the paper's greedy case) */
+                printf("%s atlas %u^2, samples only: %u texels\n", scenes[k], R, a.count);
+                CHECK(a.chart_count == 0 && a.count > 300, "samples only: %u charts, %u texels", a.chart_count, a.count);
+                check_traversals(&a, "cornell samples");
+                cssm_atlas_free(&a);
+            }
         }
         gi_scene_free(s);
     }
@@ -191,7 +198,7 @@ static int part_tree(void)
     cssm_atlas a;
     cssm_tree t;
     gi_error err;
-    if (cssm_atlas_build(s, 0.0f, 32, &a, &err) != GI_OK || cssm_tree_build(&a, &t, &err) != GI_OK) {
+    if (cssm_atlas_build(s, 0.0f, 32, 0, &a, &err) != GI_OK || cssm_tree_build(&a, &t, &err) != GI_OK) {
         fprintf(stderr, "FAIL: %s\n", err.text);
         gi_scene_free(s);
         return 1;
@@ -266,7 +273,7 @@ static int part_visibility(void)
     }
     cssm_atlas a;
     cssm_maps m;
-    if (cssm_atlas_build(s, 0.0f, 32, &a, &err) != GI_OK) {
+    if (cssm_atlas_build(s, 0.0f, 32, 0, &a, &err) != GI_OK) {
         fprintf(stderr, "FAIL: %s\n", err.text);
         return 1;
     }
@@ -349,7 +356,7 @@ static int part_furnace(void)
     cssm_maps m;
     cssm_tree t;
     gi_error err;
-    if (cssm_atlas_build(s, 0.0f, 24, &a, &err) != GI_OK || cssm_tree_build(&a, &t, &err) != GI_OK) {
+    if (cssm_atlas_build(s, 0.0f, 24, 0, &a, &err) != GI_OK || cssm_tree_build(&a, &t, &err) != GI_OK) {
         fprintf(stderr, "FAIL: %s\n", err.text);
         return 1;
     }
