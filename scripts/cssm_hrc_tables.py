@@ -103,6 +103,7 @@ def main():
     metrics_table("fig16", ["atlas", "bounces"], "Fig. 16: bounce count n (pixels get 0 .. n + 1 bounces)")
     metrics_table("fig14", ["atlas", "pcf"], "Fig. 14: nearest against PCF look-ups")
     metrics_table("fig12", ["jitter"], "Fig. 12: highly glossy Cornell box, jittering, error over accumulated frames")
+    metrics_table("mc", ["indirect", "mc_samples"], "Sec. 4.6: indirect light by Monte Carlo from the atlas as a pdf, against the cuts")
     metrics_table("clamp", ["clamp"], "Clamping: darkening against the clamp distance")
 
 

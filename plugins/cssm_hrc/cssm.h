@@ -200,6 +200,17 @@ void cssm_gather(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps,
  * luminance. */
 float cssm_bound(const cssm_node *S, const float L[3], const cssm_receiver *rc);
 
+/* §4.6 "Indirect Light" alternative (instant radiosity with the atlas as a
+ * pdf): a table to draw texels with probability proportional to
+ * lum(value) x area; cdf has count + 1 entries. Returns the total (0: no
+ * texel sends anything). */
+double cssm_pdf_build(const cssm_atlas *a, const float *texel_values, double *cdf);
+/* S texels drawn from that table, each at a random point of its square
+ * (rng), visibility through its CSSM: the Monte Carlo estimate of the same
+ * sum as cssm_gather (f L_j A_j cos_s cos_r / d^2 V, distances clamped). */
+void cssm_gather_mc(const cssm_atlas *a, const cssm_maps *maps, const float *texel_values, const double *cdf,
+                    uint32_t S, const cssm_receiver *rc, const cssm_gather_opts *o, float out[3]);
+
 /* The receiver position of a surface point: lifted along its normal as
  * the cube maps' eyes are (2 near planes). */
 gi_vec3 cssm_receiver_point(const cssm_maps *maps, const cssm_atlas *a, gi_vec3 p, gi_vec3 n);

@@ -55,6 +55,9 @@ typedef struct cssm_hrc {
     float *texel_T;   /* texel mode: view-dependent indirect light per texel, 3 per texel */
     uint32_t *ids;    /* G-buffer ids read-back (texel mode) */
     int mode;
+    int indirect, mc_samples; /* §4.6 alternative: Monte Carlo from the atlas as a pdf */
+    float *texel_Le, *texel_B; /* emission and reflected light per texel */
+    double *cdf[3];   /* pdf tables of texel_L, texel_Le, texel_B */
     shadow_map *shadows;
     uint32_t shadow_count;
     float *accum;     /* running average, 4 per pixel */
@@ -85,6 +88,11 @@ static const gi_param_desc cssm_params[] = {
     {"mode", GI_PARAM_ENUM, 0, 0, 0, "pixels|texels", "samples (Table 1, Fig. 17)",
      "pixels: final gather per pixel; texels: view-dependent lightmap, the final (glossy) gather of the indirect light "
      "per atlas texel with a bicubic look-up, emission and direct light per pixel"},
+    {"indirect", GI_PARAM_ENUM, 0, 0, 0, "hrc|mc", "Sec. 4.6 Indirect Light",
+     "hrc: the cuts through the hierarchy; mc: the alternative of Sec. 4.6, mc_samples atlas texels per receiver "
+     "and frame drawn with probability proportional to their radiance x area (instant radiosity with the atlas as "
+     "a pdf), CSSM visibility, averaged over frames"},
+    {"mc_samples", GI_PARAM_INT, 16, 1, 4096, NULL, NULL, "texels drawn per receiver and frame with indirect=mc"},
     {"shadow_size", GI_PARAM_INT, 256, 16, 2048, NULL, NULL,
      "face size of the point/spot lights' shadow cube maps and of directional lights' shadow maps"},
     {0},
@@ -111,6 +119,8 @@ static gi_result cssm_create(const gi_host *host, const gi_params *params, void 
     c->pcf = gi_params_bool(params, "pcf");
     c->shadow_size = gi_params_int(params, "shadow_size");
     c->mode = gi_params_enum(params, "mode");
+    c->indirect = gi_params_enum(params, "indirect");
+    c->mc_samples = gi_params_int(params, "mc_samples");
     *out = c;
     return GI_OK;
 }
@@ -137,6 +147,13 @@ static void release_prepared(cssm_hrc *c)
     free(c->texel_T);
     c->order = NULL;
     c->texel_L = c->node_L = c->node_Le = c->node_B = c->texel_T = NULL;
+    free(c->texel_Le);
+    free(c->texel_B);
+    c->texel_Le = c->texel_B = NULL;
+    for (int i = 0; i < 3; i++) {
+        free(c->cdf[i]);
+        c->cdf[i] = NULL;
+    }
     release_shadows(c);
     c->prepared = 0;
 }
@@ -333,7 +350,22 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
     for (size_t k = 0; k < 3 * (size_t)N; k++)
         tmp[k] = c->texel_L[k] - tmp[k];
     cssm_tree_pull(&c->tree, a, tmp, c->node_B);
-    free(tmp);
+    /* per-texel values and pdf tables for indirect=mc */
+    free(c->texel_Le);
+    free(c->texel_B);
+    c->texel_B = tmp;
+    c->texel_Le = calloc(3 * (size_t)N, sizeof *c->texel_Le);
+    for (int i = 0; i < 3; i++) {
+        free(c->cdf[i]);
+        c->cdf[i] = malloc(((size_t)N + 1) * sizeof *c->cdf[i]);
+    }
+    if (!c->texel_Le || !c->cdf[0] || !c->cdf[1] || !c->cdf[2])
+        return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the lighting");
+    for (uint32_t i = 0; i < N; i++)
+        memcpy(&c->texel_Le[3 * i], a->texels[i].emission, 3 * sizeof(float));
+    cssm_pdf_build(a, c->texel_L, c->cdf[0]);
+    cssm_pdf_build(a, c->texel_Le, c->cdf[1]);
+    cssm_pdf_build(a, c->texel_B, c->cdf[2]);
     if (st.receivers)
         host->stat(host, "cut_size_atlas", (double)st.nodes / (double)st.receivers);
     return GI_OK;
@@ -565,6 +597,20 @@ static gi_result read_gbuffer(cssm_hrc *c, uint32_t w, uint32_t h)
     return GI_OK;
 }
 
+/* One gather of light set `which` (0: emission + reflected, 1: emission,
+ * 2: reflected) by the hierarchy's cut, or by Monte Carlo (indirect=mc). */
+static void gather(const cssm_hrc *c, int which, const cssm_receiver *rc, const cssm_gather_opts *o, float out[3],
+                   cssm_gather_stats *st)
+{
+    if (c->indirect == 1) {
+        const float *tv = which == 0 ? c->texel_L : which == 1 ? c->texel_Le : c->texel_B;
+        cssm_gather_mc(&c->atlas, &c->maps, tv, c->cdf[which], (uint32_t)c->mc_samples, rc, o, out);
+        return;
+    }
+    const float *nv = which == 0 ? c->node_L : which == 1 ? c->node_Le : c->node_B;
+    cssm_gather(&c->tree, &c->atlas, &c->maps, nv, rc, o, out, st);
+}
+
 static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *target)
 {
     cssm_hrc *c = inst;
@@ -572,7 +618,8 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
     const gi_host *host = kit->host;
     if (!c->prepared)
         return gi_kit_fail(kit, GI_ERR_INVALID_ARGUMENT, "cssm_hrc: render before prepare");
-    gi_result r = gi_kit_frame_begin(kit, view, GI_KIT_GBUFFER | (c->jitter ? 0u : GI_KIT_NO_AVERAGE));
+    const int random = c->jitter || c->indirect == 1; /* frames differ: average them */
+    gi_result r = gi_kit_frame_begin(kit, view, GI_KIT_GBUFFER | (random ? 0u : GI_KIT_NO_AVERAGE));
     if (r != GI_OK)
         return r;
     r = gi_kit_render_gbuffer(kit, view, "gbuffer");
@@ -598,8 +645,8 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
             memcpy(rc.ks, x->ks, sizeof rc.ks);
             rc.wo = gi_v3_normalize(gi_v3_sub(view->eye, x->p));
             uint32_t rng = gi_rng_init(i, frame, view->seed ^ 0x7e1u);
-            cssm_gather_opts o = gather_opts(c, view->exposure, c->jitter ? &rng : NULL);
-            cssm_gather(&c->tree, &c->atlas, &c->maps, c->node_B, &rc, &o, &c->texel_T[3 * i], &st);
+            cssm_gather_opts o = gather_opts(c, view->exposure, random ? &rng : NULL);
+            gather(c, 2, &rc, &o, &c->texel_T[3 * i], &st);
         }
         host->stage_end(host, "texel_gather");
     }
@@ -619,12 +666,12 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                     rc.exponent = fminf(rc.exponent, 1000.0f);
                 rc.wo = gi_v3_normalize(gi_v3_sub(view->eye, P));
                 uint32_t rng = gi_rng_init((uint32_t)p, frame, view->seed ^ 0xc55u);
-                cssm_gather_opts o = gather_opts(c, view->exposure, c->jitter ? &rng : NULL);
+                cssm_gather_opts o = gather_opts(c, view->exposure, random ? &rng : NULL);
                 if (!texels) {
-                    cssm_gather(&c->tree, &c->atlas, &c->maps, c->node_L, &rc, &o, out, &st);
+                    gather(c, 0, &rc, &o, out, &st);
                 } else {
                     /* direct light of the emitting texels per pixel, the indirect light from the lightmap */
-                    cssm_gather(&c->tree, &c->atlas, &c->maps, c->node_Le, &rc, &o, out, NULL);
+                    gather(c, 1, &rc, &o, out, NULL);
                     uint32_t tri = c->ids[4 * p + 2];
                     int32_t chart = tri < s->triangle_count ? c->atlas.tri_chart[tri] : -1;
                     float ind[3] = {0, 0, 0}, u, v;
@@ -634,7 +681,7 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                         ok = cssm_chart_bicubic(&c->atlas, (uint32_t)chart, u, v, c->texel_T, ind);
                     }
                     if (!ok) /* surface samples have no atlas position: gathered per pixel */
-                        cssm_gather(&c->tree, &c->atlas, &c->maps, c->node_B, &rc, &o, ind, &st);
+                        gather(c, 2, &rc, &o, ind, &st);
                     for (int k = 0; k < 3; k++)
                         out[k] += ind[k];
                 }

@@ -374,3 +374,65 @@ gi_result cssm_solve(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *m
     free(Le), free(Rk), free(Rn), free(nodes);
     return GI_OK;
 }
+
+double cssm_pdf_build(const cssm_atlas *a, const float *texel_values, double *cdf)
+{
+    cdf[0] = 0.0;
+    for (uint32_t i = 0; i < a->count; i++)
+        cdf[i + 1] = cdf[i] + (double)fmaxf(0.0f, gi_luminance(&texel_values[3 * i])) * a->texels[i].area;
+    return cdf[a->count];
+}
+
+void cssm_gather_mc(const cssm_atlas *a, const cssm_maps *maps, const float *texel_values, const double *cdf,
+                    uint32_t S, const cssm_receiver *rc, const cssm_gather_opts *o, float out[3])
+{
+    out[0] = out[1] = out[2] = 0.0f;
+    const double total = cdf[a->count];
+    if (!(total > 0.0) || !S || !o->rng)
+        return;
+    for (uint32_t k = 0; k < S; k++) {
+        double u = gi_rng_next_float(o->rng) * total;
+        uint32_t lo = 0, hi = a->count; /* first i with cdf[i + 1] > u */
+        while (lo + 1 < hi) {
+            uint32_t mid = (lo + hi) / 2;
+            if (cdf[mid] <= u)
+                lo = mid;
+            else
+                hi = mid;
+        }
+        const cssm_texel *x = &a->texels[lo];
+        if (rc->self == (int32_t)lo)
+            continue;
+        double p = (cdf[lo + 1] - cdf[lo]) / total;
+        if (!(p > 0.0))
+            continue;
+        gi_vec3 tu, tv;
+        gi_onb(x->n, &tu, &tv);
+        float side = sqrtf(x->area);
+        float u1 = gi_rng_next_float(o->rng) - 0.5f, u2 = gi_rng_next_float(o->rng) - 0.5f;
+        gi_vec3 y = gi_v3_add(x->p, gi_v3_add(gi_v3_scale(tu, u1 * side), gi_v3_scale(tv, u2 * side)));
+        gi_vec3 w = gi_v3_sub(y, rc->x);
+        float d2 = gi_v3_dot(w, w);
+        if (!(d2 > 0.0f))
+            continue;
+        w = gi_v3_scale(w, 1.0f / sqrtf(d2));
+        float cr = gi_v3_dot(rc->n, w), cs = -gi_v3_dot(x->n, w);
+        if (cr <= 0.0f || cs <= 0.0f)
+            continue;
+        d2 = fmaxf(d2, o->clamp * o->clamp);
+        float v = maps ? cssm_visible(maps, lo, rc->x, o->bias, o->pcf) : 1.0f;
+        if (v <= 0.0f)
+            continue;
+        float g = (float)(x->area * cr * cs / d2 * v / (p * S));
+        float f[3] = {rc->kd[0] / GI_PI, rc->kd[1] / GI_PI, rc->kd[2] / GI_PI};
+        if (rc->glossy && gi_luminance(rc->ks) > 0.0f) {
+            gi_vec3 r = gi_v3_sub(gi_v3_scale(rc->n, 2.0f * gi_v3_dot(rc->n, rc->wo)), rc->wo);
+            float cl = gi_v3_dot(r, w);
+            float lobe = cl > 0.0f ? (rc->exponent + 2.0f) / (2.0f * GI_PI) * powf(cl, rc->exponent) : 0.0f;
+            for (int c = 0; c < 3; c++)
+                f[c] += rc->ks[c] * lobe;
+        }
+        for (int c = 0; c < 3; c++)
+            out[c] += f[c] * texel_values[3 * lo + c] * g;
+    }
+}

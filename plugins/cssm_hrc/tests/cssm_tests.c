@@ -406,6 +406,26 @@ static int part_furnace(void)
                "(expected %.4f, %+.2f %%); emission only %+.1f %%, black -100 %%; mean cut %.1f\n",
                n, mean, atlas_expect, 100 * (mean / atlas_expect - 1), 100 * worst, pmean, pixel_expect,
                100 * (pmean / pixel_expect - 1), 100 * (Le / pixel_expect - 1), (double)st.nodes / st.receivers);
+        /* the same final gather by Monte Carlo from the atlas as a pdf (Sec. 4.6) */
+        double *cdf = malloc((a.count + 1) * sizeof *cdf);
+        double mc = 0;
+        cssm_pdf_build(&a, L, cdf);
+        for (int k = 0; k < P; k++) {
+            const cssm_texel *x = &a.texels[gi_rng_next_u32(&rng) % a.count];
+            cssm_receiver rc = {.x = cssm_receiver_point(&m, &a, x->p, x->n), .n = x->n, .self = -1};
+            for (int c = 0; c < 3; c++)
+                rc.kd[c] = (float)rho;
+            cssm_gather_opts om = o;
+            om.rng = &rng;
+            float out[3];
+            cssm_gather_mc(&a, &m, L, cdf, 64, &rc, &om, out);
+            mc += Le + (out[0] + out[1] + out[2]) / 3.0;
+        }
+        mc /= P;
+        free(cdf);
+        printf("furnace n = %u: Monte Carlo final gather (64 texels x %d receivers) %.4f (%+.2f %%)\n", n, P, mc,
+               100 * (mc / pixel_expect - 1));
+        CHECK(fabs(mc / pixel_expect - 1) <= 0.02, "n = %u: Monte Carlo final gather off by more than 2 %%", n);
         CHECK(fabs(mean / atlas_expect - 1) <= 0.02, "n = %u: atlas off by more than 2 %%", n);
         CHECK(fabs(pmean / pixel_expect - 1) <= 0.02, "n = %u: final gather off by more than 2 %%", n);
     }
