@@ -48,8 +48,10 @@ def main():
     for r in t2:
         p = params(r)
         a, t = int(p["atlas"]), p["traversal"]
-        print("| %d² | %d | %s | %.1f : 1 | %.1f : 1 | %.2f | %.1f | %.1f |" % (
-            a, num(r, "stat_atlas_texels"), t, num(r, "stat_compression_ratio"), PAPER_T2.get(a, {}).get(t, float("nan")),
+        paper = PAPER_T2.get(a, {}).get(t)
+        print("| %d² | %d | %s | %.1f : 1 | %s | %.2f | %.1f | %.1f |" % (
+            a, num(r, "stat_atlas_texels"), t, num(r, "stat_compression_ratio"),
+            "%.1f : 1" % paper if paper else "—",
             num(r, "stat_segments_per_texel"), num(r, "prepare_cssm_render_ms") / 1000, num(r, "prepare_compress_ms") / 1000))
 
     print("\n## Table 1 as ratios: bounces and samples\n")
