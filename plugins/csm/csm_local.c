@@ -143,35 +143,6 @@ void csm_light_grid(gi_vec3 o, gi_vec3 e1, gi_vec3 e2, uint32_t n_u, uint32_t n_
     *v = n_v > 1 && l2 > 0.0f ? gi_v3_dot(q, e2) / l2 * (float)n_v - 0.5f : 0.0f;
 }
 
-int csm_cube_face(gi_vec3 d)
-{
-    float ax = fabsf(d.x), ay = fabsf(d.y), az = fabsf(d.z);
-    if (ax >= ay && ax >= az)
-        return d.x >= 0.0f ? 0 : 1;
-    if (ay >= az)
-        return d.y >= 0.0f ? 2 : 3;
-    return d.z >= 0.0f ? 4 : 5;
-}
-
-void csm_cube_basis(int face, gi_vec3 *s, gi_vec3 *t, gi_vec3 *f)
-{
-    /* as gi_mat4_cube_face_view: forward and the "up" it passes to look_at */
-    static const float dir[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-    static const float up[6][3] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
-    *f = gi_v3_load(dir[face]);
-    *s = gi_v3_cross(*f, gi_v3_load(up[face]));
-    *t = gi_v3_cross(*s, *f);
-}
-
-void csm_cube_project(int face, gi_vec3 d, float *sx, float *sy)
-{
-    gi_vec3 s, t, f;
-    csm_cube_basis(face, &s, &t, &f);
-    float z = gi_v3_dot(f, d);
-    *sx = gi_v3_dot(s, d) / z;
-    *sy = gi_v3_dot(t, d) / z;
-}
-
 /* Map q of one (light, object) pair: cube face q / NP at light point
  * q % NP of the light's enumeration order, faces concatenated as kN + i
  * (§3.3, §4.2). */
@@ -228,9 +199,9 @@ int csm_local_visible_nearest(const gi_csm_data *data, const csm_local_desc *des
     float depth = gi_v3_length(d);
     if (!(depth > 0.0f))
         return 1;
-    int face = csm_cube_face(d);
+    int face = gi_cube_face(d);
     float sx, sy;
-    csm_cube_project(face, d, &sx, &sy);
+    gi_cube_project(face, d, &sx, &sy);
     uint32_t M = data->M;
     int tx = (int)((sx * 0.5f + 0.5f) * (float)M), ty = (int)((sy * 0.5f + 0.5f) * (float)M);
     tx = tx < 0 ? 0 : tx >= (int)M ? (int)M - 1 : tx;

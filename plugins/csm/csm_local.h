@@ -26,13 +26,14 @@
  * depth. Sequence index of face k of grid point i (i = the point's
  * enumeration index, csm_order.h, over the n_u x n_v grid): k N + i, N =
  * n_u n_v, so one codec holds 6 N maps. A point x (same space as the grid
- * point l) is looked up in face csm_cube_face(x - l), at texel
+ * point l) is looked up in face gi_cube_face(x - l), at texel
  *   ((s.d / f.d) / 2 + 1/2) M, ((t.d / f.d) / 2 + 1/2) M   (row 0 at t = -1)
- * with the face's right s, up t and forward f (csm_cube_basis), depth |x - l|. */
+ * with the face's right s, up t and forward f (gi_cube_basis, gi/cubemap.h), depth |x - l|. */
 #ifndef CSM_LOCAL_H
 #define CSM_LOCAL_H
 
 #include "csm_cpu.h"
+#include "gi/cubemap.h"
 
 typedef enum csm_light_kind { CSM_LIGHT_AREA = 0, CSM_LIGHT_LINEAR = 1, CSM_LIGHT_POINT = 2 } csm_light_kind;
 
@@ -56,14 +57,6 @@ uint32_t csm_lights_collect(const gi_scene *s, float t, uint32_t n_points, float
 gi_vec3 csm_light_point(gi_vec3 o, gi_vec3 e1, gi_vec3 e2, uint32_t n_u, uint32_t n_v, uint32_t a, uint32_t b);
 /* Continuous grid coordinates (u, v) of point y. */
 void csm_light_grid(gi_vec3 o, gi_vec3 e1, gi_vec3 e2, uint32_t n_u, uint32_t n_v, gi_vec3 y, float *u, float *v);
-
-/* Cube face holding direction d (the largest |component|; ties go to x,
- * then y), GL order. */
-int csm_cube_face(gi_vec3 d);
-/* The face's right s, up t and forward f (rows of gi_mat4_cube_face_view). */
-void csm_cube_basis(int face, gi_vec3 *s, gi_vec3 *t, gi_vec3 *f);
-/* Map coordinates (sx, sy) in [-1, 1] of direction d in face `face`. */
-void csm_cube_project(int face, gi_vec3 d, float *sx, float *sy);
 
 /* One object's cube-map CSM for one light, in the object's local space:
  * the light's rectangle taken there (o, e1, e2), grid n_u x n_v in

@@ -1,0 +1,237 @@
+/* Coherent surface shadow maps (§3.2): a depth cube map at every atlas
+ * texel, rendered in a coherent traversal order and compressed by the
+ * core's CSM codec (one sequence per cube face), and the visibility query
+ * of §3.2.2. */
+#include "cssm.h"
+
+#include "gi/cubemap.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define CSSM_BATCH 16u /* texels (6 faces each) per gi_depth_render call */
+
+static void timer(const gi_host *host, const char *name, int begin)
+{
+    if (!host)
+        return;
+    if (begin)
+        host->stage_begin(host, name);
+    else
+        host->stage_end(host, name);
+}
+
+/* Per face: 1 where the whole texel cone lies in the negative half-space
+ * of normal n (all four corner directions below the plane): "don't care"
+ * (§3.2.1). corners: 6 (M+1)^2 corner directions. */
+static void dont_care_mask(const gi_vec3 *corners, uint32_t M, gi_vec3 n, int face, unsigned char *mask)
+{
+    const gi_vec3 *c = corners + (size_t)face * (M + 1) * (M + 1);
+    for (uint32_t y = 0; y < M; y++)
+        for (uint32_t x = 0; x < M; x++) {
+            int below = 1;
+            for (uint32_t k = 0; k < 4 && below; k++) {
+                uint32_t cx = x + (k & 1), cy = y + (k >> 1);
+                below = gi_v3_dot(c[cy * (M + 1) + cx], n) < 0.0f;
+            }
+            mask[y * M + x] = (unsigned char)below;
+        }
+}
+
+gi_result cssm_maps_setup(const cssm_atlas *a, const uint32_t *order, uint32_t M, cssm_maps *out, gi_error *err)
+{
+    memset(out, 0, sizeof *out);
+    const uint32_t N = a->count;
+    out->M = M;
+    out->N = N;
+    out->znear = 1e-3f * a->diameter;
+    out->zfar = 1.01f * a->diameter;
+    out->face_texels = 6ull * M * M * N;
+    out->seq = malloc(N * sizeof *out->seq);
+    out->eye = malloc(N * sizeof *out->eye);
+    if (!out->seq || !out->eye) {
+        cssm_maps_free(out);
+        snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for %u cube maps", N);
+        return GI_ERR_OUT_OF_MEMORY;
+    }
+    /* the eye sits just above the surface so that its own plane is not seen */
+    for (uint32_t k = 0; k < N; k++) {
+        out->seq[order[k]] = k;
+        const cssm_texel *x = &a->texels[order[k]];
+        out->eye[order[k]] = gi_v3_add(x->p, gi_v3_scale(x->n, 2.0f * out->znear));
+    }
+    return GI_OK;
+}
+
+gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order, uint32_t M,
+                          const gi_host *host, cssm_maps *out, gi_error *err)
+{
+    gi_result r = cssm_maps_setup(a, order, M, out, err);
+    if (r != GI_OK)
+        return r;
+    const uint32_t N = a->count;
+    gi_vec3 *corners = malloc(6 * (size_t)(M + 1) * (M + 1) * sizeof *corners);
+    float *z1 = malloc((size_t)M * M * sizeof *z1), *z2 = malloc((size_t)M * M * sizeof *z2);
+    unsigned char *mask = malloc((size_t)M * M);
+    gi_depth_view *views = calloc(6 * CSSM_BATCH, sizeof *views);
+    gi_csm_codec *enc[6] = {0};
+    gi_depth_renderer *dr = NULL;
+    GLuint tex = 0;
+    r = GI_ERR_OUT_OF_MEMORY;
+    if (!corners || !z1 || !z2 || !mask || !views) {
+        snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for %u cube maps", N);
+        goto done;
+    }
+    for (int f = 0; f < 6; f++) {
+        gi_vec3 s, t, fw;
+        gi_cube_basis(f, &s, &t, &fw);
+        for (uint32_t y = 0; y <= M; y++)
+            for (uint32_t x = 0; x <= M; x++) {
+                float sx = (float)x / (float)M * 2.0f - 1.0f, sy = (float)y / (float)M * 2.0f - 1.0f;
+                corners[((size_t)f * (M + 1) + y) * (M + 1) + x] =
+                    gi_v3_add(fw, gi_v3_add(gi_v3_scale(s, sx), gi_v3_scale(t, sy)));
+            }
+    }
+    gi_depth_desc dd = {.size = M, .surfaces = 2, .metric = GI_DEPTH_RADIAL, .only_object = 0, .local = 0, .cull = 0};
+    dr = gi_depth_renderer_create(&dd, err);
+    if (!dr) {
+        r = GI_ERR_GL;
+        goto done;
+    }
+    tex = gi_depth_texture_create(dr, 6 * CSSM_BATCH);
+    for (int f = 0; f < 6; f++)
+        if ((r = gi_csm_codec_begin(M, N, &enc[f], err)) != GI_OK)
+            goto done;
+    for (uint32_t first = 0; first < N; first += CSSM_BATCH) {
+        if (host && host->cancelled(host)) {
+            r = GI_ERR_CANCELLED;
+            snprintf(err->text, sizeof err->text, "cssm_hrc: precomputation cancelled");
+            goto done;
+        }
+        uint32_t count = N - first < CSSM_BATCH ? N - first : CSSM_BATCH;
+        for (uint32_t k = 0; k < count; k++)
+            gi_depth_cube_views(out->eye[order[first + k]], out->znear, out->zfar, &views[6 * k]);
+        timer(host, "cssm_render", 1);
+        r = gi_depth_render(dr, gs, views, 6 * count, tex, 0, err);
+        timer(host, "cssm_render", 0);
+        if (r != GI_OK)
+            goto done;
+        for (uint32_t k = 0; k < count; k++) {
+            const cssm_texel *x = &a->texels[order[first + k]];
+            for (int f = 0; f < 6; f++) {
+                timer(host, "cssm_render", 1);
+                float *map = gi_depth_read_layer(tex, M, 6 * k + (uint32_t)f);
+                timer(host, "cssm_render", 0);
+                if (!map) {
+                    r = GI_ERR_OUT_OF_MEMORY;
+                    snprintf(err->text, sizeof err->text, "cssm_hrc: reading cube map %u failed", first + k);
+                    goto done;
+                }
+                timer(host, "compress", 1);
+                dont_care_mask(corners, M, x->n, f, mask);
+                for (uint32_t t = 0; t < M * M; t++) {
+                    if (mask[t]) { /* any value: an interval that never breaks a run */
+                        z1[t] = -FLT_MAX;
+                        z2[t] = FLT_MAX;
+                        out->dont_care++;
+                        continue;
+                    }
+                    float a1 = map[4 * t], a2 = map[4 * t + 1];
+                    z1[t] = a1 >= FLT_MAX ? FLT_MAX : a1;
+                    z2[t] = a1 >= FLT_MAX || a2 >= FLT_MAX ? FLT_MAX : fmaxf(a2, z1[t]);
+                }
+                free(map);
+                r = gi_csm_codec_add_map(enc[f], first + k, z1, z2, err);
+                timer(host, "compress", 0);
+                if (r != GI_OK)
+                    goto done;
+            }
+        }
+        if (host)
+            host->progress(host, "cssm_hrc: cube maps", (float)(first + count) / (float)N);
+    }
+    timer(host, "compress", 1);
+    for (int f = 0; f < 6 && r == GI_OK; f++) {
+        r = gi_csm_codec_finish(enc[f], &out->face[f], err);
+        enc[f] = NULL;
+    }
+    timer(host, "compress", 0);
+done:
+    for (int f = 0; f < 6; f++)
+        gi_csm_codec_free(enc[f]);
+    free(corners), free(z1), free(z2), free(mask), free(views);
+    if (tex)
+        glDeleteTextures(1, &tex);
+    gi_depth_renderer_free(dr);
+    if (r != GI_OK)
+        cssm_maps_free(out);
+    return r;
+}
+
+void cssm_maps_free(cssm_maps *m)
+{
+    if (!m)
+        return;
+    for (int f = 0; f < 6; f++)
+        gi_csm_data_free(&m->face[f]);
+    free(m->seq);
+    free(m->eye);
+    memset(m, 0, sizeof *m);
+}
+
+uint64_t cssm_maps_bytes(const cssm_maps *m)
+{
+    uint64_t b = 0;
+    for (int f = 0; f < 6; f++)
+        b += m->face[f].bytes_compressed;
+    return b;
+}
+
+uint64_t cssm_maps_bytes_uncompressed(const cssm_maps *m)
+{
+    return 2ull * m->face_texels;
+}
+
+uint64_t cssm_maps_segments(const cssm_maps *m)
+{
+    uint64_t b = 0;
+    for (int f = 0; f < 6; f++)
+        b += m->face[f].segment_count;
+    return b;
+}
+
+float cssm_visible(const cssm_maps *m, uint32_t j, gi_vec3 x, float bias, int pcf)
+{
+    gi_vec3 d = gi_v3_sub(x, m->eye[j]);
+    float depth = gi_v3_length(d);
+    if (!(depth > 0.0f))
+        return 1.0f;
+    int face = gi_cube_face(d);
+    float sx, sy;
+    gi_cube_project(face, d, &sx, &sy);
+    const uint32_t M = m->M, i = m->seq[j];
+    const gi_csm_data *data = &m->face[face];
+    float fx = (sx * 0.5f + 0.5f) * (float)M, fy = (sy * 0.5f + 0.5f) * (float)M;
+    if (!pcf) {
+        int tx = (int)fx, ty = (int)fy;
+        tx = tx < 0 ? 0 : tx >= (int)M ? (int)M - 1 : tx;
+        ty = ty < 0 ? 0 : ty >= (int)M ? (int)M - 1 : ty;
+        return (float)gi_csm_visible(data, (uint32_t)ty * M + (uint32_t)tx, i, depth, bias);
+    }
+    /* 2 x 2 texels around the projection, bilinear weights, clamped to the face */
+    float gx = fx - 0.5f, gy = fy - 0.5f;
+    int x0 = (int)floorf(gx), y0 = (int)floorf(gy);
+    float wx = gx - (float)x0, wy = gy - (float)y0, v = 0.0f;
+    for (int k = 0; k < 4; k++) {
+        int tx = x0 + (k & 1), ty = y0 + (k >> 1);
+        tx = tx < 0 ? 0 : tx >= (int)M ? (int)M - 1 : tx;
+        ty = ty < 0 ? 0 : ty >= (int)M ? (int)M - 1 : ty;
+        float w = ((k & 1) ? wx : 1.0f - wx) * ((k >> 1) ? wy : 1.0f - wy);
+        if (w > 0.0f)
+            v += w * (float)gi_csm_visible(data, (uint32_t)ty * M + (uint32_t)tx, i, depth, bias);
+    }
+    return v;
+}

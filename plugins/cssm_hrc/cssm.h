@@ -1,0 +1,229 @@
+/* CPU side of the cssm_hrc plugin (Ritschel, Grosch, Kautz, Seidel,
+ * "Interactive Illumination with Coherent Surface Shadow Maps", GI 2008):
+ *
+ *  - the illumination atlas (§3.2.3, Fig. 5): texels with world position,
+ *    normal, area and material (atlas.c);
+ *  - the coherent traversals of the atlas (§3.2.3, Fig. 6/7): greedy,
+ *    zig-zag and spiral, charts visited nearest-first (atlas.c);
+ *  - the coherent surface shadow maps (§3.2): a depth cube map at each
+ *    texel in traversal order, compressed by the core's CSM codec, and the
+ *    visibility query between a texel and any point (§3.2.2) (cssm.c);
+ *  - the hierarchy (§4.2): median cut, bounding spheres, child and skip
+ *    pointers; the stack-less refine-and-gather traversal with the energy
+ *    oracle and a maximum cut size (§4.3, Fig. 10), pull, and the final
+ *    gather per receiver point with a Phong bound (§4.4), jitter (§4.5) and
+ *    clamping (hrc.c).
+ * All of it is scene-wide and static (the scene at prepare time); see the
+ * README for what the plugin does not do (moving objects, §3.3). */
+#ifndef CSSM_H
+#define CSSM_H
+
+#include "gi/csm_codec.h"
+#include "gi/method.h"
+#include "gi/passes.h"
+#include "gi/vecmath.h"
+
+/* ---------------------------------------------------------------- atlas */
+
+typedef enum cssm_traversal { CSSM_GREEDY = 0, CSSM_ZIGZAG = 1, CSSM_SPIRAL = 2 } cssm_traversal;
+
+#define CSSM_NO_XY 0xFFFFFFFFu
+
+typedef struct cssm_texel {
+    gi_vec3 p, n;       /* world position and (geometric) unit normal */
+    float area;         /* world area this texel stands for */
+    float albedo[3];    /* Lambert albedo of the material (textures not applied) */
+    float emission[3];  /* emitted radiance (front face) */
+    float ks[3], exponent; /* Phong lobe of the material (view-dependent lightmap mode) */
+    int32_t chart;      /* chart index, -1 for a surface sample without parametrisation */
+    uint32_t x, y;      /* atlas texel (CSSM_NO_XY for a surface sample) */
+    uint32_t triangle;  /* scene triangle it lies on */
+} cssm_texel;
+
+typedef struct cssm_chart {
+    uint32_t x0, y0, w, h; /* rectangle in the atlas */
+    uint32_t object;
+    gi_vec3 origin, u, v;  /* world position of atlas corner (x0, y0) and one texel step along x and y */
+    gi_vec3 normal;
+} cssm_chart;
+
+typedef struct cssm_atlas {
+    uint32_t R;            /* the atlas is R x R texels */
+    int32_t *grid;         /* R * R: texel index, -1 where no chart covers it */
+    cssm_texel *texels;
+    uint32_t count;        /* texels (chart texels, then surface samples) */
+    uint32_t chart_texels; /* texels inside charts */
+    cssm_chart *charts;
+    uint32_t chart_count;
+    float h;               /* texel edge length in world units */
+    float diameter;        /* scene bounding-box diagonal */
+    double surface_area;   /* of every triangle */
+    double chart_area;     /* of the triangles in charts */
+    double covered_area;   /* chart texels x h^2: the share of chart_area the texel grid covers */
+    int32_t *tri_chart;    /* per scene triangle: its chart, -1 for none */
+} cssm_atlas;
+
+/* Builds the atlas of the scene at time t (world space, every object):
+ * triangles of one object lying in one plane form a planar chart (the box
+ * scenes' walls and blocks) packed into the R x R atlas; triangles of no
+ * chart large enough (curved meshes) get evenly distributed surface
+ * samples of the same density (§3.2.3, last paragraph). Texel areas sum to
+ * each chart's / object's area. samples_only: the texel size the charts
+ * would get, but surface samples everywhere (no parametrisation: the
+ * paper's greedy case). GI_ERR_INVALID_ARGUMENT when the scene has no
+ * area. */
+gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_only, cssm_atlas *out,
+                           gi_error *err);
+void cssm_atlas_free(cssm_atlas *a);
+
+/* The order in which the texels' cube maps are rendered and compressed:
+ * order[k] = texel visited k-th (a permutation of 0 .. count-1). Greedy:
+ * nearest unvisited texel in 3D from texel 0 on, over all texels. Zig-zag
+ * and spiral: chart after chart, the next chart the one whose first texel
+ * is nearest (3D) to the last texel visited; inside a chart the rows of
+ * its rectangle alternately left to right and right to left (zig-zag) or
+ * a left-hand walk along the border of the unvisited region, stepping back
+ * along the path when stuck (spiral); surface samples follow, greedily.
+ * Returns a malloc'd array or NULL on no memory. */
+/* Continuous texel coordinates (texel centres at x + 1/2) of world point p
+ * in chart c's rectangle. */
+void cssm_chart_coords(const cssm_atlas *a, uint32_t chart, gi_vec3 p, float *u, float *v);
+/* Bicubic (uniform cubic B-spline) interpolation of per-texel values
+ * (3 per texel) at chart-local coordinates (u, v) over the 4 x 4 texels of
+ * that chart around it, weights renormalised over the texels that exist;
+ * 0 when none does. */
+int cssm_chart_bicubic(const cssm_atlas *a, uint32_t chart, float u, float v, const float *values, float out[3]);
+
+uint32_t *cssm_traverse(const cssm_atlas *a, cssm_traversal how);
+const char *cssm_traversal_name(cssm_traversal how);
+
+/* ----------------------------------------------------------------- CSSM */
+
+typedef struct cssm_maps {
+    uint32_t M, N;        /* cube faces M x M, N texels */
+    gi_csm_data face[6];  /* one codec sequence per cube face, maps in traversal order */
+    uint32_t *seq;        /* texel -> index in the sequence */
+    gi_vec3 *eye;         /* texel -> cube map centre (position + eps normal) */
+    float znear, zfar;
+    uint64_t dont_care;   /* face texels in the negative half-space (stored as "any value") */
+    uint64_t face_texels; /* 6 M^2 N */
+} cssm_maps;
+
+/* Renders (core depth renderer: world space, every object, radial depth,
+ * two surfaces) the depth cube map of every texel in order `order`
+ * (§3.2.1: near plane 1e-3 of the diameter, far plane the diameter,
+ * texels whose cone lies wholly in the negative half-space of the texel's
+ * normal "don't care") and streams them into six codecs. host may be NULL;
+ * with a host: stage timers cssm_render and compress, progress,
+ * cancellation. */
+gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order, uint32_t M,
+                          const gi_host *host, cssm_maps *out, gi_error *err);
+void cssm_maps_free(cssm_maps *m);
+/* What cssm_maps_build sets besides the compressed faces (sizes, seq, eye,
+ * near and far planes): for data read back from the cache. */
+gi_result cssm_maps_setup(const cssm_atlas *a, const uint32_t *order, uint32_t M, cssm_maps *out, gi_error *err);
+/* Compressed bytes over the six sequences, and the paper's uncompressed
+ * 2 bytes per depth texel (Table 2). */
+uint64_t cssm_maps_bytes(const cssm_maps *m);
+uint64_t cssm_maps_bytes_uncompressed(const cssm_maps *m);
+uint64_t cssm_maps_segments(const cssm_maps *m);
+
+/* Visibility (§3.2.2, Fig. 4) between texel j and world point x: x is
+ * projected into j's cube map; 1 lit, 0 occluded. bias: depth bias in
+ * world units; pcf: the 2 x 2 texels around the projection, bilinearly
+ * weighted (the generalised PCF of the CSM, over texels of one face). */
+float cssm_visible(const cssm_maps *m, uint32_t j, gi_vec3 x, float bias, int pcf);
+
+/* ------------------------------------------------------------ hierarchy */
+
+typedef struct cssm_node {
+    gi_vec3 c;           /* bounding sphere centre */
+    float r;             /* and radius */
+    gi_vec3 centroid;    /* area-weighted mean position */
+    gi_vec3 n;           /* area-weighted mean normal, unit */
+    float cos_cone;      /* cosine of the normal cone's half-angle (-1: everything) */
+    float area;
+    int32_t child;       /* left child (-1 for a leaf); the right child is the left child's skip */
+    int32_t skip;        /* next node in depth-first order past this subtree (-1: end) */
+    uint32_t first, count; /* leaves [first, first + count) of cssm_tree.leaves */
+    uint32_t rep;        /* representative texel (nearest the centroid) */
+} cssm_node;
+
+typedef struct cssm_tree {
+    cssm_node *nodes;    /* depth-first pre-order: the root is 0, a left child follows its parent */
+    uint32_t count;
+    uint32_t *leaves;    /* texel of leaf k (the median-cut order) */
+    uint32_t *leaf_node; /* texel -> its leaf node */
+} cssm_tree;
+
+/* Median cut over the texel positions (§4.2): split at the median of the
+ * longest axis of the box until one texel is left. */
+gi_result cssm_tree_build(const cssm_atlas *a, cssm_tree *out, gi_error *err);
+void cssm_tree_free(cssm_tree *t);
+/* Pull (§4.1.1): per node the area-weighted mean of per-texel radiance
+ * `texel_L` (3 floats a texel) into `node_L` (3 floats a node). */
+void cssm_tree_pull(const cssm_tree *t, const cssm_atlas *a, const float *texel_L, float *node_L);
+
+/* A receiver of the refine-and-gather traversal: a texel (diffuse, self
+ * skipped) or a G-buffer pixel (Lambert + normalised Phong toward wo). */
+typedef struct cssm_receiver {
+    gi_vec3 x, n;
+    int32_t self;        /* receiver texel (skipped), -1 for a pixel */
+    int glossy;          /* use ks, exponent, wo */
+    float kd[3], ks[3], exponent;
+    gi_vec3 wo;
+} cssm_receiver;
+
+typedef struct cssm_gather_opts {
+    float threshold;     /* refine while the tone-mapped bound exceeds it (§4.3) */
+    uint32_t max_cut;    /* maximum nodes in the cut */
+    float exposure;      /* tone mapping: (L 2^exposure)^(1 / 2.2) */
+    float clamp;         /* distances below it count as it (§5 "Quality") */
+    float bias;          /* CSSM depth bias, world units */
+    int pcf;
+    uint32_t *rng;       /* non-NULL: jitter each gathered node inside its area (§4.5) */
+} cssm_gather_opts;
+
+typedef struct cssm_gather_stats {
+    uint64_t nodes;      /* cut sizes summed */
+    uint64_t receivers;
+    uint64_t clamped;    /* gathers whose distance was clamped */
+} cssm_gather_stats;
+
+/* The stack-less traversal of Fig. 10 for one receiver: returns in out[3]
+ * the reflected radiance f * sum over the cut of L_S A_S cos_s cos_r / d^2
+ * V (for a texel receiver f = kd / pi). node_L: pulled radiance per node.
+ * maps may be NULL (everything visible). */
+void cssm_gather(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps, const float *node_L,
+                 const cssm_receiver *rc, const cssm_gather_opts *o, float out[3], cssm_gather_stats *st);
+/* Upper bound of what node S sends to the receiver (the oracle's L_max),
+ * luminance. */
+float cssm_bound(const cssm_node *S, const float L[3], const cssm_receiver *rc);
+
+/* §4.6 "Indirect Light" alternative (instant radiosity with the atlas as a
+ * pdf): a table to draw texels with probability proportional to
+ * lum(value) x area; cdf has count + 1 entries. Returns the total (0: no
+ * texel sends anything). */
+double cssm_pdf_build(const cssm_atlas *a, const float *texel_values, double *cdf);
+/* S texels drawn from that table, each at a random point of its square
+ * (rng), visibility through its CSSM: the Monte Carlo estimate of the same
+ * sum as cssm_gather (f L_j A_j cos_s cos_r / d^2 V, distances clamped). */
+void cssm_gather_mc(const cssm_atlas *a, const cssm_maps *maps, const float *texel_values, const double *cdf,
+                    uint32_t S, const cssm_receiver *rc, const cssm_gather_opts *o, float out[3]);
+
+/* The receiver position of a surface point: lifted along its normal as
+ * the cube maps' eyes are (2 near planes). */
+gi_vec3 cssm_receiver_point(const cssm_maps *maps, const cssm_atlas *a, gi_vec3 p, gi_vec3 n);
+
+/* GPU HRC of §4.1.1 on the atlas (Fig. 8): texel_L (3 per texel) gets
+ * emission + R_1 + ... + R_n with
+ *   R_1 = kd/pi gather(pull(emission)) + direct (3 per texel, may be NULL:
+ *         light from sources that are not atlas texels),
+ *   R_k = kd/pi gather(pull(R_{k-1})),  k = 2 .. n,
+ * and node_L (3 per node) its pull. Stage timers direct, pull, bounce when
+ * host is not NULL. */
+gi_result cssm_solve(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps, const cssm_gather_opts *o,
+                     uint32_t bounces, const float *direct, const gi_host *host, float *texel_L, float *node_L,
+                     cssm_gather_stats *st, gi_error *err);
+
+#endif
