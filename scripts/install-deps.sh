@@ -5,7 +5,6 @@
 #   scripts/install-deps.sh --sources  also the packages the scene-conversion
 #                                      scripts read (embree-tools, blender-data, npm)
 #                                      and scripts/ref-vs-embree.sh runs (embree-tools)
-#                                      and scripts/startup-time.sh runs (hyperfine)
 set -eu
 
 pkgs=(
@@ -32,7 +31,7 @@ pkgs=(
   python3 bash-completion
 )
 if [ "${1:-}" = "--sources" ]; then
-  pkgs+=(embree-tools blender-data hyperfine)
+  pkgs+=(embree-tools blender-data)
   # npm runs the glTF validator and fetches the bunny and teapot meshes; a
   # machine that already has a Node.js with npm (not from Debian) keeps it.
   command -v npm >/dev/null 2>&1 || pkgs+=(nodejs npm)

@@ -130,6 +130,11 @@ static void compare_ray(const gi_rt *rt, const gi_scene *s, const bf_scene *b, g
     int hit = gi_rt_intersect(rt, o, d, tmin, tmax, &h);
     int bhit = bf_intersect(b, o, d, tmin, tmax, &bh, &near_edge);
     st->rays++;
+    /* The lean query gives the same hit, to the bit. */
+    float tt = 0.0f, tu = 0.0f, tv = 0.0f;
+    uint32_t ttri = 0;
+    int thit = gi_rt_intersect_tuv(rt, o, d, tmin, tmax, &tt, &tu, &tv, &ttri);
+    st->bad_record += thit != hit || (hit && (tt != h.t || tu != h.u || tv != h.v || ttri != h.triangle));
     if (hit != bhit) {
         if (near_edge)
             st->excused++;
@@ -471,6 +476,32 @@ static void test_moving(void)
     gi_scene_free(s);
 }
 
+/* GI_RT_FAST_TRAVERSAL (the reference's default): the same checks against
+ * the brute force as the robust mode passes, on the tessellated box (many
+ * shared edges) with its rays; an unknown option bit is refused. */
+static void test_fast_traversal(void)
+{
+    gi_error err;
+    gi_scene *s = gi_scene_load(GI_SOURCE_DIR "/scenes/cornell_box.gltf", &err);
+    CHECK_MSG(s != NULL, "%s", err.text);
+    if (!s)
+        return;
+    gi_rt *rt = (gi_rt *)&err;
+    CHECK(gi_rt_create_ex(s, 0.0f, 1u << 7, &rt, &err) == GI_ERR_INVALID_ARGUMENT && rt == NULL);
+    printf("unknown option: %s\n", err.text);
+    CHECK_MSG(gi_rt_create_ex(s, 0.0f, GI_RT_FAST_TRAVERSAL, &rt, &err) == GI_OK && rt, "%s",
+              err.text);
+    if (rt) {
+        bf_scene b = bf_place(s, 0.0f);
+        cmp_stats st = {0};
+        random_rays(rt, s, &b, 0.0f, 3000, 7, &st);
+        report("cornell_box.gltf, fast traversal", &st);
+        free(b.p);
+    }
+    gi_rt_free(rt);
+    gi_scene_free(s);
+}
+
 static void test_bad_input(void)
 {
     gi_error err;
@@ -509,6 +540,7 @@ int main(void)
     test_bad_input();
     test_handmade();
     test_scene(GI_SOURCE_DIR "/scenes/cornell_box.gltf", 3000);
+    test_fast_traversal();
     test_moving();
     return gi_test_finish();
 }

@@ -1,4 +1,6 @@
-/* Linear RGBA32F images and their files (EXR, PFM, PNG through OpenImageIO).
+/* Linear RGBA32F images and their files: EXR through OpenEXR, PNG written
+ * through libpng, PFM by hand; every other format read through OpenImageIO,
+ * loaded as a module on the first such read (gi/module.h).
  *
  * gi_image_create / gi_image_read return an image you own; free it with
  * gi_image_free. Pixels are row-major, row 0 = top of the picture, 4 floats a
@@ -28,7 +30,9 @@ typedef struct gi_image {
  * 2^28 pixels) or memory runs out. */
 gi_image *gi_image_create(uint32_t width, uint32_t height);
 void gi_image_free(gi_image *img);
-/* Reads any format OpenImageIO knows; 1-3 channel files are expanded to
+/* Reads EXR (OpenEXR) and any format OpenImageIO knows (the module
+ * gi_image_oiio.so; without it such a read fails with GI_ERR_UNSUPPORTED
+ * and a line naming the module); 1-3 channel files are expanded to
  * RGBA (grey to RGB, alpha 1; 2 channels are grey + alpha). Channels named
  * R, G, B (and A) are used wherever they are in the file. Values are as
  * stored: an 8-bit sRGB PNG reads as its display values in [0, 1], not
