@@ -970,7 +970,7 @@ static int pt_convergence(study *st, const char *out_dir, const study_ref *sc, c
             return 0;
         snprintf(stats, sizeof stats, "%s.json", img);
         json_object *sj = cli_read_json(stats);
-        json_object *m = runner_diff(img, reference, NULL, st->exposure, why, why_size);
+        json_object *m = runner_diff(img, reference, NULL, NULL, st->exposure, why, why_size);
         double t = rec_num(sj, "wall_seconds", NULL, NULL), e = rec_num(m, "relmse", NULL, NULL);
         if (isfinite(t) && isfinite(e) && t > 0 && e > 0 && curve->n < TRADEOFF_PT_POINTS) {
             curve->t[curve->n] = t;

@@ -596,7 +596,8 @@ static void add_run_image(const char *dir, json_object *images, json_object *o)
         json_object_array_add(maps, m);
     }
     char flip[4200];
-    snprintf(flip, sizeof flip, "%s", heat);
+    /* FLIP's map: named in the record, or beside the heat map (older records) */
+    snprintf(flip, sizeof flip, "%s", *raw(o, "flip_map") ? raw(o, "flip_map") : heat);
     char *slash = strrchr(flip, '/');
     if (slash) {
         snprintf(slash + 1, sizeof flip - (size_t)(slash + 1 - flip), "flip.png");
@@ -748,7 +749,7 @@ static void md_to_html(text *t, const char *md)
             const char *a = md + h;
             while (*a == ' ')
                 a++;
-            int level = h + 2 > 6 ? 6 : (int)h + 2;
+            int level = h < 3 ? 3 : h > 5 ? 5 : (int)h; /* below the page's h2 sections */
             put(t, "<h%d>", level);
             md_inline(t, a, (size_t)(md + n - a));
             put(t, "</h%d>\n", level);

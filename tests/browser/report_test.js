@@ -121,6 +121,13 @@ function check(ok, what) {
     });
     check(bar >= 128, `the colour bar is drawn ${bar} px tall`);
     await page.locator('.gib-viewer').first().screenshot({ path: path.join(out_dir, 'viewer_error_map.png') });
+    const maps = await page.evaluate(() => { const v = window.gibViewers[0]; return (v.image(v.a).maps || []).map((m) => m.name); });
+    check(maps.includes('relative error') && maps.includes('FLIP'), `error maps of the run: ${maps.join(', ')}`);
+    await page.keyboard.press('m');
+    const s4 = await state();
+    check(s4.view === 'FLIP', `m again shows ${s4.view}`);
+    await page.waitForTimeout(300);
+    await page.locator('.gib-viewer').first().screenshot({ path: path.join(out_dir, 'viewer_flip_map.png') });
     // modes
     for (const [k, mode] of [['s', 'side'], ['w', 'wipe'], ['f', 'flip']]) {
       await page.keyboard.press(k);
