@@ -279,10 +279,12 @@
   Viewer.prototype.source = function (i) {
     var sz = this.size(i);
     if (!sz) return null;
-    if (this.view !== 'image') {
+    var hasMap = (this.image(i).maps || []).some(function (x) { return x.name === this.view; }, this);
+    if (this.view !== 'image' && hasMap) {
       var m = this.maps[i + '/' + this.view];
       return m && m !== 'loading' ? { cv: m, w: sz.w, h: sz.h } : null;
     }
+    /* an image without that map (a reference) shows itself */
     var h = this.hdr[i];
     if (h && h !== 'loading') {
       if (!this.tone[i] || this.tone[i].ev !== this.ev) this.tone[i] = { ev: this.ev, cv: tonemap(h, this.ev) };
