@@ -970,7 +970,7 @@ static int pt_convergence(study *st, const char *out_dir, const study_ref *sc, c
             return 0;
         snprintf(stats, sizeof stats, "%s.json", img);
         json_object *sj = cli_read_json(stats);
-        json_object *m = runner_diff(img, reference, NULL, st->exposure, why, why_size);
+        json_object *m = runner_diff(img, reference, NULL, NULL, st->exposure, why, why_size);
         /* the path tracer's time to the image, measured as the methods'
          * frames are: its render's CPU time (every thread) in studies timed
          * by CPU time, else its render's wall time (all threads); the BVH
@@ -1171,6 +1171,43 @@ static void execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg)
         st->runs[i].record = run_or_skip(&st->runs[i], reg, 1);
         json_object_object_del(st->runs[i].record, "cached");
     }
+}
+
+/* The path of a reference relative to the output directory (they all lie in references/). */
+static json_object *ref_rel(const char *path)
+{
+    const char *base = strrchr(path, '/');
+    char rel[600];
+    snprintf(rel, sizeof rel, "references/%s", base ? base + 1 : path);
+    return json_object_new_string(rel);
+}
+
+/* For the report's image viewer: per reference set, its full-GI and
+ * bounce-matched references and the runs compared with them (report.h). */
+static void reference_sets(study *st, json_object *meta)
+{
+    json_object *sets = json_object_new_array();
+    for (uint32_t ri = 0; ri < st->ref_count; ri++) {
+        study_ref *sc = &st->refs[ri];
+        json_object *set = json_object_new_object(), *matched = json_object_new_array(), *ids = json_object_new_array();
+        json_object_object_add(set, "name", json_object_new_string(sc->name));
+        json_object_object_add(set, "full", ref_rel(sc->ref_full));
+        json_object_object_add(set, "bounces", json_object_new_int((int)st->ref_bounces));
+        for (uint32_t k = 0; k < sc->matched_count; k++) {
+            json_object *m = json_object_new_object();
+            json_object_object_add(m, "image", ref_rel(sc->ref_matched[k]));
+            json_object_object_add(m, "bounces", json_object_new_int((int)sc->matched_bounces[k]));
+            json_object_array_add(matched, m);
+        }
+        json_object_object_add(set, "matched", matched);
+        for (uint32_t i = 0; i < st->run_count; i++)
+            if (st->runs[i].ref_index == (int)ri)
+                json_object_array_add(ids, json_object_new_string(st->runs[i].id));
+        json_object_object_add(set, "runs", ids);
+        json_object_array_add(sets, set);
+    }
+    json_object_object_add(meta, "references", sets);
+    json_object_object_add(meta, "exposure", json_object_new_double(st->exposure));
 }
 
 /* Per reference set: the error-against-time charts with every run's
@@ -1530,6 +1567,7 @@ int cmd_study(int argc, char **argv)
                      st.ref_spp, st.ref_pixel_center ? "_center" : "");
             json_object_object_add(meta, "reference_png", json_object_new_string(ref_png));
         }
+        reference_sets(&st, meta);
         json_object *chart_list = json_object_new_array();
         charts_and_speedups(&st, out, meta, chart_list);
         user_charts(&st, out, runs, chart_list);

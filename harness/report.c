@@ -4,8 +4,11 @@
 
 #include "cli.h"
 #include "gi/cache.h"
+#include "gi/image.h"
+#include "gi/shader.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -311,7 +314,19 @@ static void md_num(text *t, double v)
         put(t, " – |");
 }
 
-static void write_md(text *t, json_object *runs, json_object *meta)
+/* Whether dir/rel is a file (links in the report point only at files that exist). */
+static int exists_in(const char *dir, const char *rel)
+{
+    if (!rel || !*rel)
+        return 0;
+    char path[4096];
+    if (snprintf(path, sizeof path, "%s/%s", dir, rel) >= (int)sizeof path)
+        return 0;
+    struct stat sb;
+    return stat(path, &sb) == 0 && S_ISREG(sb.st_mode);
+}
+
+static void write_md(text *t, const char *dir, json_object *runs, json_object *meta)
 {
     put(t, "# %s\n\n", str(meta, "title"));
     put(t, "- command: `%s`\n", str(meta, "command"));
@@ -372,19 +387,27 @@ static void write_md(text *t, json_object *runs, json_object *meta)
     put(t, "\nImages (tonemapped at the report's exposure) and relative error against the full reference "
            "(log scale, colour bar in each map):\n\n");
     const char *ref_png = str(meta, "reference_png");
-    if (*ref_png)
+    if (exists_in(dir, ref_png))
         put(t, "reference: ![reference](%s)\n\n", ref_png);
     for (size_t i = 0; i < count; i++) {
         json_object *o = json_object_array_get_idx(runs, i);
-        if (*str(o, "png"))
-            put(t, "%s: ![%s](%s) ![error](%s)\n\n", str(o, "run"), str(o, "run"), str(o, "png"), str(o, "heatmap"));
+        int png = exists_in(dir, str(o, "png")), heat = exists_in(dir, str(o, "heatmap"));
+        if (!png && !heat)
+            continue;
+        put(t, "%s:", str(o, "run"));
+        if (png)
+            put(t, " ![%s](%s)", str(o, "run"), str(o, "png"));
+        if (heat)
+            put(t, " ![error](%s)", str(o, "heatmap"));
+        put(t, "\n\n");
     }
     json_object *charts;
     if (json_object_object_get_ex(meta, "charts", &charts)) {
         put(t, "\n");
         for (size_t i = 0; i < json_object_array_length(charts); i++) {
             const char *c = json_object_get_string(json_object_array_get_idx(charts, i));
-            put(t, "![%s](%s)\n\n", c, c);
+            if (exists_in(dir, c))
+                put(t, "![%s](%s)\n\n", c, c);
         }
     }
     json_object *extra;
@@ -405,65 +428,502 @@ static void html_escape(text *t, const char *s)
     }
 }
 
-static void write_html(text *t, json_object *runs, json_object *meta)
+/* The page's script and style, embedded at build time (harness/CMakeLists.txt). */
+extern const gi_shader_source gi_report_assets[];
+
+static const char *asset(const char *name)
 {
-    put(t, "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>");
+    for (const gi_shader_source *a = gi_report_assets; a->name; a++)
+        if (!strcmp(a->name, name))
+            return a->text;
+    return "";
+}
+
+/* A string field as stored (str() swaps "params" for "params_full"). */
+static const char *raw(json_object *o, const char *key)
+{
+    json_object *v;
+    if (o && json_object_object_get_ex(o, key, &v) && json_object_is_type(v, json_type_string))
+        return json_object_get_string(v);
+    return "";
+}
+
+static const char b64_chars[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+/* Writes the linear RGB of dir/exr_rel as a script beside it (same stem,
+ * .js) for the viewer's exposure control and pixel values: GIB_HDR(key,
+ * width, height, base64 of RGBE bytes), the key being the script's path
+ * relative to the page. js_rel gets that path; 0 when there is no image. */
+static int write_hdr_js(const char *dir, const char *exr_rel, char *js_rel, size_t js_size)
+{
+    size_t n = strlen(exr_rel);
+    if (n < 5 || strcmp(exr_rel + n - 4, ".exr") || !exists_in(dir, exr_rel))
+        return 0;
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s", dir, exr_rel);
+    gi_error err;
+    gi_image *img = gi_image_read(path, &err);
+    if (!img)
+        return 0;
+    snprintf(js_rel, js_size, "%.*s.js", (int)(n - 4), exr_rel);
+    size_t px = (size_t)img->width * img->height, nb = px * 4;
+    unsigned char *rgbe = malloc(nb);
+    text t = {0};
+    int ok = rgbe != NULL;
+    for (size_t i = 0; ok && i < px; i++) {
+        float *c = img->rgba + i * 4;
+        float r = isfinite(c[0]) && c[0] > 0 ? c[0] : 0, g = isfinite(c[1]) && c[1] > 0 ? c[1] : 0,
+              b = isfinite(c[2]) && c[2] > 0 ? c[2] : 0;
+        float v = r > g ? (r > b ? r : b) : (g > b ? g : b);
+        unsigned char *o = rgbe + i * 4;
+        if (v < 1e-32f) {
+            o[0] = o[1] = o[2] = o[3] = 0;
+        } else {
+            int e;
+            float scale = frexpf(v, &e) * 256.0f / v;
+            o[0] = (unsigned char)(r * scale);
+            o[1] = (unsigned char)(g * scale);
+            o[2] = (unsigned char)(b * scale);
+            o[3] = (unsigned char)(e + 128);
+        }
+    }
+    if (ok) {
+        put(&t, "GIB_HDR(\"%s\", %u, %u, \"", js_rel, img->width, img->height);
+        for (size_t i = 0; i < nb; i += 3) {
+            unsigned v = (unsigned)rgbe[i] << 16 | (i + 1 < nb ? (unsigned)rgbe[i + 1] << 8 : 0) |
+                         (i + 2 < nb ? rgbe[i + 2] : 0);
+            put(&t, "%c%c%c%c", b64_chars[v >> 18 & 63], b64_chars[v >> 12 & 63],
+                i + 1 < nb ? b64_chars[v >> 6 & 63] : '=', i + 2 < nb ? b64_chars[v & 63] : '=');
+        }
+        put(&t, "\");\n");
+        ok = snprintf(path, sizeof path, "%s/%s", dir, js_rel) < (int)sizeof path && t.s && gi_file_write_atomic(path, t.s, t.len, &err) == GI_OK;
+    }
+    free(t.s);
+    free(rgbe);
+    gi_image_free(img);
+    return ok;
+}
+
+/* exr_rel with .png for .exr, when that file exists. */
+static const char *png_of(const char *dir, const char *exr_rel, char *buf, size_t size)
+{
+    size_t n = strlen(exr_rel);
+    if (n < 5 || strcmp(exr_rel + n - 4, ".exr"))
+        return NULL;
+    snprintf(buf, size, "%.*s.png", (int)(n - 4), exr_rel);
+    return exists_in(dir, buf) ? buf : NULL;
+}
+
+/* A viewer image: label, title (hover), the PNG, the HDR script, error maps, info line. */
+static json_object *viewer_image(const char *dir, const char *label, const char *title, const char *png,
+                                 const char *exr)
+{
+    json_object *im = json_object_new_object();
+    json_object_object_add(im, "label", json_object_new_string(label));
+    json_object_object_add(im, "title", json_object_new_string(title));
+    char buf[4096], js[4096];
+    if (!png && exr)
+        png = png_of(dir, exr, buf, sizeof buf);
+    if (png && exists_in(dir, png))
+        json_object_object_add(im, "png", json_object_new_string(png));
+    if (exr && write_hdr_js(dir, exr, js, sizeof js))
+        json_object_object_add(im, "hdr", json_object_new_string(js));
+    json_object_object_add(im, "maps", json_object_new_array());
+    return im;
+}
+
+/* A run's short name: method and the parameters the study set. */
+static void run_label(json_object *o, char *buf, size_t size)
+{
+    const char *p = raw(o, "params"), *l = raw(o, "label");
+    snprintf(buf, size, "%s %s%s%s", str(o, "method"), *p ? p : "(defaults)", *l ? " " : "", l);
+}
+
+static void run_info(json_object *o, char *buf, size_t size)
+{
+    snprintf(buf, size, "run %s, %s", str(o, "run"), str(o, "status"));
+    const char *names[] = {"frame ms (median)", "prepare ms", "relMSE full", "relMSE matched", "FLIP full", "SSIM full"};
+    double vals[] = {num(o, "frame_ms", "median", NULL), num(o, "prepare_ms", NULL, NULL),
+                     num(o, "metrics", "full", "relmse"), num(o, "metrics", "matched", "relmse"),
+                     num(o, "metrics", "full", "flip"), num(o, "metrics", "full", "ssim")};
+    for (size_t k = 0; k < sizeof vals / sizeof vals[0]; k++)
+        if (vals[k] == vals[k]) {
+            size_t used = strlen(buf);
+            snprintf(buf + used, size - used, "; %s %.4g", names[k], vals[k]);
+        }
+    size_t used = strlen(buf);
+    snprintf(buf + used, size - used, "; params %s", str(o, "params"));
+}
+
+static json_object *find_run(json_object *runs, const char *id)
+{
+    for (size_t i = 0; i < json_object_array_length(runs); i++) {
+        json_object *o = json_object_array_get_idx(runs, i);
+        if (!strcmp(raw(o, "run"), id))
+            return o;
+    }
+    return NULL;
+}
+
+static void add_run_image(const char *dir, json_object *images, json_object *o)
+{
+    if (strcmp(raw(o, "status"), "ok"))
+        return;
+    char label[600], title[8192], info[8192];
+    run_label(o, label, sizeof label);
+    /* repeats of one setting: numbered */
+    int same = 0;
+    for (size_t k = 0; k < json_object_array_length(images); k++)
+        same += !strncmp(raw(json_object_array_get_idx(images, k), "label"), label, strlen(label));
+    if (same) {
+        size_t used = strlen(label);
+        snprintf(label + used, sizeof label - used, " #%d", same + 1);
+    }
+    snprintf(title, sizeof title, "run %s: %s", raw(o, "run"), str(o, "params"));
+    const char *png = raw(o, "png");
+    json_object *im = viewer_image(dir, label, title, *png ? png : NULL, *raw(o, "image") ? raw(o, "image") : NULL);
+    if (!json_object_object_get_ex(im, "png", NULL) && !json_object_object_get_ex(im, "hdr", NULL)) {
+        json_object_put(im);
+        return;
+    }
+    json_object *maps;
+    json_object_object_get_ex(im, "maps", &maps);
+    const char *heat = raw(o, "heatmap");
+    if (exists_in(dir, heat)) {
+        json_object *m = json_object_new_object();
+        json_object_object_add(m, "name", json_object_new_string("relative error"));
+        json_object_object_add(m, "png", json_object_new_string(heat));
+        json_object_array_add(maps, m);
+    }
+    char flip[4200];
+    /* FLIP's map: named in the record, or beside the heat map (older records) */
+    snprintf(flip, sizeof flip, "%s", *raw(o, "flip_map") ? raw(o, "flip_map") : heat);
+    char *slash = strrchr(flip, '/');
+    if (slash) {
+        snprintf(slash + 1, sizeof flip - (size_t)(slash + 1 - flip), "flip.png");
+        if (exists_in(dir, flip)) {
+            json_object *m = json_object_new_object();
+            json_object_object_add(m, "name", json_object_new_string("FLIP"));
+            json_object_object_add(m, "png", json_object_new_string(flip));
+            json_object_array_add(maps, m);
+        }
+    }
+    run_info(o, info, sizeof info);
+    json_object_object_add(im, "info", json_object_new_string(info));
+    json_object_array_add(images, im);
+}
+
+/* The viewer's data: per reference set, its references and runs
+ * (meta "references", from study), or one set with the report's reference
+ * and every run (compare). */
+static json_object *viewer_sets(const char *dir, json_object *runs, json_object *meta)
+{
+    json_object *sets = json_object_new_array(), *refs;
+    double ev = num(meta, "exposure", NULL, NULL);
+    if (json_object_object_get_ex(meta, "references", &refs) && json_object_is_type(refs, json_type_array)) {
+        for (size_t r = 0; r < json_object_array_length(refs); r++) {
+            json_object *rs = json_object_array_get_idx(refs, r), *set = json_object_new_object();
+            json_object *images = json_object_new_array(), *matched, *ids;
+            json_object_object_add(set, "name", json_object_new_string(raw(rs, "name")));
+            char label[128];
+            snprintf(label, sizeof label, "reference, full GI (%g bounces)", num(rs, "bounces", NULL, NULL));
+            json_object_array_add(images, viewer_image(dir, label, raw(rs, "full"), NULL, raw(rs, "full")));
+            if (json_object_object_get_ex(rs, "matched", &matched))
+                for (size_t k = 0; k < json_object_array_length(matched); k++) {
+                    json_object *m = json_object_array_get_idx(matched, k);
+                    snprintf(label, sizeof label, "reference, %g bounce%s", num(m, "bounces", NULL, NULL),
+                             num(m, "bounces", NULL, NULL) == 1 ? "" : "s");
+                    json_object_array_add(images, viewer_image(dir, label, raw(m, "image"), NULL, raw(m, "image")));
+                }
+            if (json_object_object_get_ex(rs, "runs", &ids))
+                for (size_t k = 0; k < json_object_array_length(ids); k++) {
+                    json_object *o = find_run(runs, json_object_get_string(json_object_array_get_idx(ids, k)));
+                    if (o)
+                        add_run_image(dir, images, o);
+                }
+            json_object_object_add(set, "images", images);
+            json_object_object_add(set, "exposure", json_object_new_double(ev == ev ? ev : 0));
+            json_object_array_add(sets, set);
+        }
+        return sets;
+    }
+    json_object *set = json_object_new_object(), *images = json_object_new_array();
+    const char *ref_png = raw(meta, "reference_png");
+    if (exists_in(dir, ref_png)) {
+        char exr[4096];
+        size_t n = strlen(ref_png);
+        snprintf(exr, sizeof exr, "%.*s.exr", n > 4 ? (int)(n - 4) : 0, ref_png);
+        json_object_array_add(images, viewer_image(dir, "reference", ref_png, ref_png, exr));
+    }
+    for (size_t i = 0; i < json_object_array_length(runs); i++)
+        add_run_image(dir, images, json_object_array_get_idx(runs, i));
+    json_object_object_add(set, "name", json_object_new_string(raw(meta, "title")));
+    json_object_object_add(set, "images", images);
+    json_object_object_add(set, "exposure", json_object_new_double(ev == ev ? ev : 0));
+    json_object_array_add(sets, set);
+    return sets;
+}
+
+static void html_num(text *t, double v)
+{
+    if (v == v)
+        put(t, "<td data-v=\"%.9g\">%.4g</td>", v, v);
+    else
+        put(t, "<td data-v=\"\">–</td>");
+}
+
+/* Inline markdown: `code` spans, the rest escaped. */
+static void md_inline(text *t, const char *s, size_t n)
+{
+    int code = 0;
+    char buf[2];
+    buf[1] = '\0';
+    for (size_t i = 0; i < n; i++) {
+        if (s[i] == '`') {
+            put(t, code ? "</code>" : "<code>");
+            code = !code;
+            continue;
+        }
+        buf[0] = s[i];
+        html_escape(t, buf);
+    }
+    if (code)
+        put(t, "</code>");
+}
+
+/* The speed-against-accuracy text of tradeoff.c (markdown: headings,
+ * paragraphs and pipe tables) as HTML, tables sortable and scrolling in
+ * their box. */
+static void md_to_html(text *t, const char *md)
+{
+    int in_table = 0, in_par = 0, row = 0;
+    while (*md) {
+        const char *end = strchr(md, '\n');
+        size_t n = end ? (size_t)(end - md) : strlen(md);
+        const char *next = end ? end + 1 : md + n;
+        while (n && (md[n - 1] == ' ' || md[n - 1] == '\r'))
+            n--;
+        int is_row = n && md[0] == '|';
+        if (!is_row && in_table) {
+            put(t, "</tbody></table></div>\n");
+            in_table = 0;
+        }
+        if ((is_row || !n || md[0] == '#') && in_par) {
+            put(t, "</p>\n");
+            in_par = 0;
+        }
+        if (is_row) {
+            if (!in_table) {
+                put(t, "<div class=\"scroll\"><table class=\"sortable\"><thead>");
+                in_table = 1;
+                row = 0;
+            }
+            if (row == 1 && strspn(md, "|-: ") == n) { /* the alignment row */
+                row++;
+                md = next;
+                continue;
+            }
+            put(t, "<tr>");
+            const char *c = md + 1, *stop = md + n;
+            while (c < stop) {
+                const char *bar = memchr(c, '|', (size_t)(stop - c));
+                if (!bar)
+                    bar = stop;
+                const char *a = c, *b = bar;
+                while (a < b && *a == ' ')
+                    a++;
+                while (b > a && b[-1] == ' ')
+                    b--;
+                put(t, row == 0 ? "<th class=l>" : "<td%s>", row && b > a && (*a < '0' || *a > '9') ? " class=l" : "");
+                md_inline(t, a, (size_t)(b - a));
+                put(t, row == 0 ? "</th>" : "</td>");
+                c = bar + 1;
+            }
+            put(t, "</tr>");
+            if (row == 0)
+                put(t, "</thead><tbody>");
+            put(t, "\n");
+            row++;
+        } else if (n && md[0] == '#') {
+            size_t h = strspn(md, "#");
+            const char *a = md + h;
+            while (*a == ' ')
+                a++;
+            int level = h < 3 ? 3 : h > 5 ? 5 : (int)h; /* below the page's h2 sections */
+            put(t, "<h%d>", level);
+            md_inline(t, a, (size_t)(md + n - a));
+            put(t, "</h%d>\n", level);
+        } else if (n) {
+            put(t, in_par ? "\n" : "<p>");
+            in_par = 1;
+            md_inline(t, md, n);
+        }
+        md = next;
+    }
+    if (in_table)
+        put(t, "</tbody></table></div>\n");
+    if (in_par)
+        put(t, "</p>\n");
+}
+
+static void params_cell(text *t, json_object *o)
+{
+    const char *given = raw(o, "params"), *full = str(o, "params");
+    put(t, "<td class=\"params\" data-v=\"");
+    html_escape(t, given);
+    put(t, "\"><details><summary title=\"");
+    html_escape(t, full);
+    put(t, "\"><code>");
+    html_escape(t, *given ? given : "(defaults)");
+    put(t, "</code></summary><code>");
+    html_escape(t, full);
+    put(t, "</code></details></td>");
+}
+
+static void write_html(text *t, const char *dir, json_object *runs, json_object *meta)
+{
+    put(t, "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+           "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"><title>");
     html_escape(t, str(meta, "title"));
-    put(t, "</title>\n<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}"
-           "td,th{border:1px solid #ccc;padding:4px 8px;text-align:right}td.l,th.l{text-align:left}"
-           "img{image-rendering:pixelated;width:192px}figure{display:inline-block;margin:4px}"
-           "figcaption{font-size:small}</style></head><body>\n<h1>");
+    put(t, "</title>\n<style>\n%s</style>\n</head><body>\n<h1>", asset("viewer.css"));
     html_escape(t, str(meta, "title"));
-    put(t, "</h1>\n<p>GL renderer: ");
-    html_escape(t, str(meta, "renderer"));
-    put(t, "<br>reference: ");
-    html_escape(t, str(meta, "reference"));
-    put(t, "<br>machine: ");
-    html_escape(t, str(meta, "machine"));
-    put(t, "<br>command: <code>");
-    html_escape(t, str(meta, "command"));
-    put(t, "</code></p>\n");
-    const char *ref_png = str(meta, "reference_png");
-    if (*ref_png)
-        put(t, "<figure><img src=\"%s\"><figcaption>reference</figcaption></figure>\n", ref_png);
-    json_object *charts;
-    if (json_object_object_get_ex(meta, "charts", &charts))
-        for (size_t i = 0; i < json_object_array_length(charts); i++)
-            put(t, "<p><img style=\"width:900px\" src=\"%s\"></p>\n",
-                json_object_get_string(json_object_array_get_idx(charts, i)));
-    put(t, "<table><tr><th class=l>run</th><th class=l>method</th><th class=l>params</th><th class=l>status</th>"
-           "<th>image</th><th>error (relative, vs full)</th><th>frame ms</th><th>prepare ms</th><th>relMSE full</th>"
-           "<th>relMSE matched</th><th>FLIP</th><th>SSIM</th></tr>\n");
+    put(t, "</h1>\n<dl class=\"meta\">");
+    const char *keys[] = {"command", "renderer", "reference", "machine", "date"};
+    const char *names[] = {"command", "GL renderer", "reference", "machine", "date"};
+    for (int k = 0; k < 5; k++) {
+        put(t, "<dt>%s</dt><dd>%s", names[k], k == 0 ? "<code>" : "");
+        html_escape(t, str(meta, keys[k]));
+        put(t, "%s</dd>", k == 0 ? "</code>" : "");
+    }
+    put(t, "</dl>\n<nav><a href=\"#images\">images</a><a href=\"#runs\">runs</a><a href=\"#stages\">stage "
+           "timings</a><a href=\"#tradeoff\">speed against accuracy</a><a href=\"#charts\">charts</a></nav>\n");
+    put(t, "<p>Errors are against the full-GI reference (\"full\") and against the reference limited to the "
+           "method's own bounce count (\"matched\"). Times are medians over the timed frames; on a software "
+           "renderer only ratios within one study mean anything.</p>\n");
+
+    /* the image viewers, one per reference set */
+    json_object *sets = viewer_sets(dir, runs, meta);
+    put(t, "<h2 id=\"images\">Images</h2>\n");
+    for (size_t i = 0; i < json_object_array_length(sets); i++) {
+        json_object *set = json_object_array_get_idx(sets, i);
+        put(t, "<h3>");
+        html_escape(t, raw(set, "name"));
+        put(t, "</h3>\n<div class=\"gib-viewer\" data-set=\"%zu\"></div>\n", i);
+    }
+    put(t, "<noscript><p>The image viewer needs JavaScript; the images are in runs/ and references/.</p></noscript>\n");
+
+    /* every run */
+    put(t, "<h2 id=\"runs\">Runs</h2>\n<p>Click a column header to sort. Parameters: those the study set; click "
+           "for the full string (defaults included).</p>\n<div class=\"scroll\"><table class=\"sortable\"><thead><tr>"
+           "<th class=l>run</th><th class=l>method</th><th class=l>params</th><th class=l>status</th><th>frames</th>"
+           "<th>frame ms</th><th>prepare ms</th><th>relMSE full</th><th>relMSE matched</th><th>FLIP full</th>"
+           "<th>SSIM full</th><th>mean lum. diff %%</th><th>speed-up vs PT</th><th>speed-up vs PT, matched</th>"
+           "</tr></thead><tbody>\n");
     size_t count = json_object_array_length(runs);
     for (size_t i = 0; i < count; i++) {
         json_object *o = json_object_array_get_idx(runs, i);
-        put(t, "<tr><td class=l>");
-        html_escape(t, str(o, "run"));
-        put(t, "</td><td class=l>");
-        html_escape(t, str(o, "method"));
-        put(t, "</td><td class=l><code>");
-        html_escape(t, str(o, "params"));
+        put(t, "<tr><td class=l><code>");
+        html_escape(t, raw(o, "run"));
         put(t, "</code></td><td class=l>");
-        html_escape(t, str(o, "status"));
-        if (strcmp(str(o, "status"), "ok")) {
-            put(t, ": ");
-            html_escape(t, str(o, "reason"));
-        }
-        put(t, "</td><td>");
-        if (*str(o, "png"))
-            put(t, "<img src=\"%s\">", str(o, "png"));
-        put(t, "</td><td>");
-        if (*str(o, "heatmap"))
-            put(t, "<img src=\"%s\">", str(o, "heatmap"));
+        html_escape(t, raw(o, "method"));
         put(t, "</td>");
-        double vals[] = {num(o, "frame_ms", "median", NULL), num(o, "prepare_ms", NULL, NULL),
-                         num(o, "metrics", "full", "relmse"), num(o, "metrics", "matched", "relmse"),
-                         num(o, "metrics", "full", "flip"), num(o, "metrics", "full", "ssim")};
-        for (size_t k = 0; k < sizeof vals / sizeof vals[0]; k++)
-            put(t, vals[k] == vals[k] ? "<td>%.4g</td>" : "<td>–</td>", vals[k]);
+        params_cell(t, o);
+        put(t, "<td class=\"l reason\">");
+        html_escape(t, raw(o, "status"));
+        if (strcmp(raw(o, "status"), "ok")) {
+            put(t, ": ");
+            html_escape(t, raw(o, "reason"));
+        }
+        put(t, "</td>");
+        html_num(t, num(o, "frames", NULL, NULL));
+        html_num(t, num(o, "frame_ms", "median", NULL));
+        html_num(t, num(o, "prepare_ms", NULL, NULL));
+        html_num(t, num(o, "metrics", "full", "relmse"));
+        html_num(t, num(o, "metrics", "matched", "relmse"));
+        html_num(t, num(o, "metrics", "full", "flip"));
+        html_num(t, num(o, "metrics", "full", "ssim"));
+        html_num(t, num(o, "metrics", "full", "mean_lum_diff_pct"));
+        html_num(t, num(o, "speedup_vs_pt", NULL, NULL));
+        html_num(t, num(o, "speedup_vs_pt_matched", NULL, NULL));
         put(t, "</tr>\n");
     }
-    put(t, "</table>\n</body></html>\n");
+    put(t, "</tbody></table></div>\n");
+
+    /* stage timings */
+    const char *stages[32];
+    int ns = stage_names(runs, stages, 32);
+    put(t, "<h2 id=\"stages\">Stage timings</h2>\n");
+    if (ns == 0) {
+        put(t, "<p>No run reported stage timings.</p>\n");
+    } else {
+        put(t, "<p>Milliseconds, median (min – max) over the timed frames.</p>\n<div class=\"scroll\"><table "
+               "class=\"sortable\"><thead><tr><th class=l>run</th><th class=l>method</th><th class=l>params</th>");
+        for (int k = 0; k < ns; k++) {
+            put(t, "<th>");
+            html_escape(t, stages[k]);
+            put(t, "</th>");
+        }
+        put(t, "<th>frame</th></tr></thead><tbody>\n");
+        for (size_t i = 0; i < count; i++) {
+            json_object *o = json_object_array_get_idx(runs, i);
+            if (strcmp(raw(o, "status"), "ok"))
+                continue;
+            put(t, "<tr><td class=l><code>");
+            html_escape(t, raw(o, "run"));
+            put(t, "</code></td><td class=l>");
+            html_escape(t, raw(o, "method"));
+            put(t, "</td>");
+            params_cell(t, o);
+            for (int k = 0; k <= ns; k++) {
+                const char *k1 = k < ns ? "stages" : "frame_ms", *k2 = k < ns ? stages[k] : NULL;
+                double med = k < ns ? num(o, k1, k2, "median") : num(o, k1, "median", NULL);
+                double mn = k < ns ? num(o, k1, k2, "min") : num(o, k1, "min", NULL);
+                double mx = k < ns ? num(o, k1, k2, "max") : num(o, k1, "max", NULL);
+                if (med == med)
+                    put(t, "<td data-v=\"%.9g\">%.4g <small>(%.4g – %.4g)</small></td>", med, med, mn, mx);
+                else
+                    put(t, "<td data-v=\"\">–</td>");
+            }
+            put(t, "</tr>\n");
+        }
+        put(t, "</tbody></table></div>\n");
+    }
+
+    /* speed against accuracy (tradeoff.c's tables) */
+    put(t, "<h2 id=\"tradeoff\">Speed against accuracy</h2>\n");
+    json_object *extra;
+    if (json_object_object_get_ex(meta, "markdown", &extra) && *json_object_get_string(extra))
+        md_to_html(t, json_object_get_string(extra));
+    else
+        put(t, "<p>Not computed for this report.</p>\n");
+
+    put(t, "<h2 id=\"charts\">Charts</h2>\n");
+    json_object *charts;
+    int nc = 0;
+    if (json_object_object_get_ex(meta, "charts", &charts))
+        for (size_t i = 0; i < json_object_array_length(charts); i++) {
+            const char *c = json_object_get_string(json_object_array_get_idx(charts, i));
+            if (!exists_in(dir, c))
+                continue;
+            put(t, "<figure><img class=\"chart\" alt=\"");
+            html_escape(t, c);
+            put(t, "\" src=\"");
+            html_escape(t, c);
+            put(t, "\"><figcaption>");
+            html_escape(t, c);
+            put(t, "</figcaption></figure>\n");
+            nc++;
+        }
+    if (!nc)
+        put(t, "<p>No charts.</p>\n");
+
+    /* the viewer's data; json-c escapes '/', so no "</script>" can occur */
+    put(t, "<script type=\"application/json\" id=\"gib-data\">");
+    json_object *data = json_object_new_object();
+    json_object_object_add(data, "sets", sets);
+    put(t, "%s", json_object_to_json_string_ext(data, JSON_C_TO_STRING_PLAIN));
+    json_object_put(data);
+    put(t, "</script>\n<script>\n%s</script>\n</body></html>\n", asset("viewer.js"));
 }
 
 static int write_text(const char *dir, const char *name, text *t, char *why, size_t why_size)
@@ -491,9 +951,9 @@ int report_write(const char *dir, json_object *runs, json_object *meta, char *wh
     write_curves_csv(&t, runs);
     if (!write_text(dir, "curves.csv", &t, why, why_size))
         return 0;
-    write_md(&t, runs, meta);
+    write_md(&t, dir, runs, meta);
     if (!write_text(dir, "report.md", &t, why, why_size))
         return 0;
-    write_html(&t, runs, meta);
+    write_html(&t, dir, runs, meta);
     return write_text(dir, "index.html", &t, why, why_size);
 }

@@ -7,7 +7,11 @@
  * ("ok", "n/a", "failed"), reason, renderer, timer, frames, prepare_ms,
  * frame_ms {median, min, max}, stages {name: {median, min, max}} (ms), stats {...},
  * metrics {"full": {...}, "matched": {...}} (metric name -> value), and
- * the file names image, png, heatmap (relative to the output directory). */
+ * the file names image, png, heatmap, flip_map (relative to the output
+ * directory). index.html also gets, from meta, "references" (per reference
+ * set: name, full, bounces, matched [{image, bounces}], runs [ids]) and
+ * "exposure"; report_write writes each image's .exr beside it as a .js file
+ * (its linear RGB for the page's exposure control). */
 #ifndef GIBENCH_REPORT_H
 #define GIBENCH_REPORT_H
 

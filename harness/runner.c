@@ -104,8 +104,8 @@ static void fail_record(json_object *o, const char *reason)
     json_object_object_add(o, "reason", json_object_new_string(reason));
 }
 
-json_object *runner_diff(const char *image, const char *reference, const char *heatmap, float exposure, char *why,
-                         size_t why_size)
+json_object *runner_diff(const char *image, const char *reference, const char *heatmap, const char *flip_map,
+                         float exposure, char *why, size_t why_size)
 {
     argv_builder b = {0};
     arg(&b, "%s", cli_self_exe());
@@ -118,6 +118,10 @@ json_object *runner_diff(const char *image, const char *reference, const char *h
     if (heatmap) {
         arg(&b, "%s", "--heatmap");
         arg(&b, "%s", heatmap);
+    }
+    if (flip_map) {
+        arg(&b, "%s", "--flip-map");
+        arg(&b, "%s", flip_map);
     }
     char out[4096], err[4096];
     snprintf(out, sizeof out, "%s.diff.json", image);
@@ -205,13 +209,14 @@ json_object *runner_execute(const run_spec *s, int resume)
         fail_record(rec, "cannot create the run directory");
         return rec;
     }
-    char exr[4096], png[4096], timings[4096], log[4096], result[4096], heat[4096];
+    char exr[4096], png[4096], timings[4096], log[4096], result[4096], heat[4096], flip[4096];
     path_in(exr, sizeof exr, s->dir, "image.exr");
     path_in(png, sizeof png, s->dir, "image.png");
     path_in(timings, sizeof timings, s->dir, "timings.json");
     path_in(log, sizeof log, s->dir, "render.log");
     path_in(result, sizeof result, s->dir, "result.json");
     path_in(heat, sizeof heat, s->dir, "heatmap.png");
+    path_in(flip, sizeof flip, s->dir, "flip.png");
 
     argv_builder b = {0};
     arg(&b, "%s", cli_self_exe());
@@ -323,7 +328,8 @@ json_object *runner_execute(const run_spec *s, int resume)
                 if (!refs[k])
                     continue;
                 char why[1024];
-                json_object *m = runner_diff(exr, refs[k], k == 0 ? heat : NULL, s->exposure, why, sizeof why);
+                json_object *m = runner_diff(exr, refs[k], k == 0 ? heat : NULL, k == 0 ? flip : NULL, s->exposure, why,
+                                            sizeof why);
                 if (m) {
                     json_object_object_add(metrics, names[k], m);
                 } else {
@@ -335,6 +341,8 @@ json_object *runner_execute(const run_spec *s, int resume)
             if (s->ref_full) {
                 snprintf(p, sizeof p, "%s/heatmap.png", s->rel);
                 json_object_object_add(rec, "heatmap", json_object_new_string(p));
+                snprintf(p, sizeof p, "%s/flip.png", s->rel);
+                json_object_object_add(rec, "flip_map", json_object_new_string(p));
             }
         }
     }

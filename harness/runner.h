@@ -43,8 +43,9 @@ int runner_reference(const char *scene, uint64_t scene_hash, const char *camera,
                      int pixel_center, double timeout_s, const char *out_exr, char *why, size_t why_size);
 
 /* Fills metrics of `image` against `reference` by `gibench diff --json`;
- * NULL with why on failure. heatmap may be NULL. */
-json_object *runner_diff(const char *image, const char *reference, const char *heatmap, float exposure, char *why,
-                         size_t why_size);
+ * NULL with why on failure. heatmap (relative error) and flip_map (FLIP's
+ * error map), PNGs for the report, may be NULL. */
+json_object *runner_diff(const char *image, const char *reference, const char *heatmap, const char *flip_map,
+                         float exposure, char *why, size_t why_size);
 
 #endif

@@ -3,7 +3,7 @@
 # As root it runs apt-get; otherwise it prints the exact command and exits 2.
 #   scripts/install-deps.sh            build, test and run dependencies
 #   scripts/install-deps.sh --sources  also the packages the scene-conversion
-#                                      scripts read (embree-tools, blender-data, npm)
+#                                      scripts read (embree-tools, blender-data)
 #                                      and scripts/ref-vs-embree.sh runs (embree-tools)
 set -eu
 
@@ -29,12 +29,16 @@ pkgs=(
   # scripts/*.py (the results tables, their test integration.results_tables;
   # the bash completion, scripts/gen-completion.py, which `make` installs)
   python3 bash-completion
+  # The report page in a real browser (tests/integration/report_browser.cmake):
+  # Debian's Chromium, driven by playwright-core from npm (tests/browser/).
+  chromium
 )
+# npm for the browser test (and the scene-conversion scripts); a machine that
+# already has a Node.js with npm (not from Debian) keeps it.
+command -v npm >/dev/null 2>&1 || pkgs+=(nodejs npm)
 if [ "${1:-}" = "--sources" ]; then
+  # npm (above) also runs the glTF validator and fetches the bunny and teapot meshes.
   pkgs+=(embree-tools blender-data)
-  # npm runs the glTF validator and fetches the bunny and teapot meshes; a
-  # machine that already has a Node.js with npm (not from Debian) keeps it.
-  command -v npm >/dev/null 2>&1 || pkgs+=(nodejs npm)
 elif [ $# -gt 0 ]; then
   echo "install-deps.sh: unknown option '$1' (use --sources or nothing)" >&2
   exit 2
