@@ -1215,7 +1215,7 @@ static void reference_sets(study *st, json_object *meta)
  * the equal-error and equal-time tables (tradeoff.h). */
 static void charts_and_speedups(study *st, const char *out_dir, json_object *meta, json_object *chart_list)
 {
-    tradeoff_text md = {0};
+    gi_text md = {0};
     tradeoff_run *tr = calloc(st->run_count + 1, sizeof *tr);
     for (uint32_t ri = 0; ri < st->ref_count && tr; ri++) {
         study_ref *sc = &st->refs[ri];

@@ -13,30 +13,6 @@
 #define MAX_POINTS 64 /* render records at most this many curve points */
 #define FRONT_MIN_GAIN 0.01 /* a front point must lower the error by this share */
 
-void tradeoff_put(tradeoff_text *t, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    int n = vsnprintf(NULL, 0, fmt, ap);
-    va_end(ap);
-    if (n < 0)
-        return;
-    if (t->len + (size_t)n + 1 > t->cap) {
-        size_t cap = t->cap ? t->cap : 4096;
-        while (cap < t->len + (size_t)n + 1)
-            cap *= 2;
-        char *s = realloc(t->s, cap);
-        if (!s)
-            return;
-        t->s = s;
-        t->cap = cap;
-    }
-    va_start(ap, fmt);
-    vsnprintf(t->s + t->len, t->cap - t->len, fmt, ap);
-    va_end(ap);
-    t->len += (size_t)n;
-}
-
 double tradeoff_pt_time_at(const tradeoff_pt_curve *c, double e, int *extrapolated)
 {
     *extrapolated = 0;
@@ -334,18 +310,18 @@ static void chart(tradeoff_chart_fn write_chart, const char *out_dir, const char
 }
 
 /* relMSE as "median" or "median [min–max]" over repeats. */
-static void put_error(tradeoff_text *md, const setting *g, uint32_t k)
+static void put_error(gi_text *md, const setting *g, uint32_t k)
 {
     if (g->repeats > 1 && g->ef_hi[k] > g->ef_lo[k])
-        tradeoff_put(md, " %.4g [%.4g–%.4g] |", g->ef[k], g->ef_lo[k], g->ef_hi[k]);
+        gi_text_put(md, " %.4g [%.4g–%.4g] |", g->ef[k], g->ef_lo[k], g->ef_hi[k]);
     else
-        tradeoff_put(md, " %.4g |", g->ef[k]);
+        gi_text_put(md, " %.4g |", g->ef[k]);
 }
 
-static void params_cell(tradeoff_text *md, json_object *rec)
+static void params_cell(gi_text *md, json_object *rec)
 {
     const char *p = str(rec, "params");
-    tradeoff_put(md, " `%s` |", *p ? p : "(defaults)");
+    gi_text_put(md, " `%s` |", *p ? p : "(defaults)");
 }
 
 /* Per record: the earliest recorded frame whose error is within 1 % of the
@@ -382,11 +358,11 @@ static void annotate_records(const tradeoff_run *runs, uint32_t run_n, const tra
     }
 }
 
-static void equal_error_table(tradeoff_text *md, const char *name, const tradeoff_pt_curve *full,
+static void equal_error_table(gi_text *md, const char *name, const tradeoff_pt_curve *full,
                               const tradeoff_pt_curve *matched, uint32_t matched_n, const setting *set, uint32_t ns,
                               const char **methods, uint32_t nm, front_point *fp)
 {
-    tradeoff_put(md,
+    gi_text_put(md,
                  "#### %s: equal error (each method's Pareto front against the full-GI reference)\n\n"
                  "Speed-up = the path tracer's time to the same relMSE ÷ the method's time to its image; "
                  "\"matched\" compares the method's error against the reference of its own bounce count with "
@@ -395,7 +371,7 @@ static void equal_error_table(tradeoff_text *md, const char *name, const tradeof
                  "\"*\": the path tracer's time is extrapolated beyond its measured curve (slope −1). "
                  "relMSE over repeats: median [min–max].\n\n",
                  name);
-    tradeoff_put(md, "| method | params | frames | time to image (s) | relMSE full | path tracer, same error (s) | "
+    gi_text_put(md, "| method | params | frames | time to image (s) | relMSE full | path tracer, same error (s) | "
                      "speed-up | relMSE matched | matched path tracer (s) | speed-up matched | precompute (s) | "
                      "amortised ×1 (s) | ×100 (s) | ×10⁴ (s) |\n"
                      "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
@@ -409,17 +385,17 @@ static void equal_error_table(tradeoff_text *md, const char *name, const tradeof
             const tradeoff_pt_curve *mc = curve_for(full, matched, matched_n, g->bounces);
             double tptm = tradeoff_pt_time_at(mc, g->em[p], &exm);
             double prep = isfinite(g->prep_s) ? g->prep_s : 0.0;
-            tradeoff_put(md, "| %s |", methods[m]);
+            gi_text_put(md, "| %s |", methods[m]);
             params_cell(md, g->first);
-            tradeoff_put(md, " %u | %.4g |", g->frame[p], g->t[p]);
+            gi_text_put(md, " %u | %.4g |", g->frame[p], g->t[p]);
             put_error(md, g, p);
-            tradeoff_put(md, " %.4g%s | %.3g%s | %.4g | %.4g%s | %.3g%s | %.4g | %.4g | %.4g | %.4g |\n", tpt,
+            gi_text_put(md, " %.4g%s | %.3g%s | %.4g | %.4g%s | %.3g%s | %.4g | %.4g | %.4g | %.4g |\n", tpt,
                          ex ? "*" : "", tpt / g->t[p], ex ? "*" : "", g->em[p], tptm, exm ? "*" : "",
                          tptm / g->t[p], exm ? "*" : "", prep, g->t[p] + prep, g->t[p] + prep / 100.0,
                          g->t[p] + prep / 1e4);
         }
     }
-    tradeoff_put(md, "\n");
+    gi_text_put(md, "\n");
 }
 
 /* The method's best error among its points reached by time T (NaN if none). */
@@ -442,13 +418,13 @@ static double best_error_by(const setting *set, uint32_t ns, uint32_t m, int mat
     return best;
 }
 
-static void equal_time_table(tradeoff_text *md, const char *name, const tradeoff_pt_curve *full,
+static void equal_time_table(gi_text *md, const char *name, const tradeoff_pt_curve *full,
                              const tradeoff_pt_curve *matched, uint32_t matched_n, const setting *set, uint32_t ns,
                              const char **methods, uint32_t nm)
 {
     if (full->n == 0)
         return;
-    tradeoff_put(md,
+    gi_text_put(md,
                  "#### %s: equal time (each method's best relMSE within the time the path tracer needs for its "
                  "error levels)\n\n"
                  "A column per image of the path tracer's convergence run (time, its relMSE). A cell: the "
@@ -457,13 +433,13 @@ static void equal_time_table(tradeoff_text *md, const char *name, const tradeoff
                  "that fast. \"matched\" rows: against the reference of the method's bounce count, the path "
                  "tracer limited to it (its own time and error at that image).\n\n",
                  name);
-    tradeoff_put(md, "| method |");
+    gi_text_put(md, "| method |");
     for (uint32_t i = 0; i < full->n; i++)
-        tradeoff_put(md, " %.3g s (PT %.3g) |", full->t[i], full->e[i]);
-    tradeoff_put(md, "\n|---|");
+        gi_text_put(md, " %.3g s (PT %.3g) |", full->t[i], full->e[i]);
+    gi_text_put(md, "\n|---|");
     for (uint32_t i = 0; i < full->n; i++)
-        tradeoff_put(md, "---:|");
-    tradeoff_put(md, "\n");
+        gi_text_put(md, "---:|");
+    gi_text_put(md, "\n");
     for (uint32_t m = 0; m < nm; m++) {
         for (int matched_row = 0; matched_row < 2; matched_row++) {
             uint32_t b = 0;
@@ -473,26 +449,26 @@ static void equal_time_table(tradeoff_text *md, const char *name, const tradeoff
             const tradeoff_pt_curve *c = matched_row ? curve_for(full, matched, matched_n, b) : full;
             if (matched_row && c == full)
                 continue; /* the method is full GI: the row above says it */
-            tradeoff_put(md, "| %s%s |", methods[m], matched_row ? " (matched)" : "");
+            gi_text_put(md, "| %s%s |", methods[m], matched_row ? " (matched)" : "");
             for (uint32_t i = 0; i < full->n; i++) {
                 double T = i < c->n ? c->t[i] : NAN, ept = i < c->n ? c->e[i] : NAN;
                 const setting *at = NULL;
                 uint32_t at_k = 0;
                 double e = isfinite(T) ? best_error_by(set, ns, m, matched_row, T, &at, &at_k) : NAN;
                 if (isfinite(e))
-                    tradeoff_put(md, " %.4g (×%.3g) |", e, e / ept);
+                    gi_text_put(md, " %.4g (×%.3g) |", e, e / ept);
                 else
-                    tradeoff_put(md, " – |");
+                    gi_text_put(md, " – |");
             }
-            tradeoff_put(md, "\n");
+            gi_text_put(md, "\n");
         }
     }
-    tradeoff_put(md, "\n");
+    gi_text_put(md, "\n");
 }
 
 void tradeoff_report(const char *out_dir, const char *name, const tradeoff_pt_curve *full,
                      const tradeoff_pt_curve *matched, uint32_t matched_n, const tradeoff_run *runs,
-                     uint32_t run_n, tradeoff_chart_fn write_chart, json_object *chart_list, tradeoff_text *md)
+                     uint32_t run_n, tradeoff_chart_fn write_chart, json_object *chart_list, gi_text *md)
 {
     setting *set = calloc(run_n + 1, sizeof *set);
     const char **methods = calloc(run_n + 1, sizeof *methods);
@@ -510,17 +486,17 @@ void tradeoff_report(const char *out_dir, const char *name, const tradeoff_pt_cu
         chart(write_chart, out_dir, name, 0, full, matched, matched_n, set, ns, methods, nm, chart_list);
     if (write_chart && any_matched)
         chart(write_chart, out_dir, name, 1, full, matched, matched_n, set, ns, methods, nm, chart_list);
-    tradeoff_put(md, "Path tracer convergence on %s (relMSE against the reference, another seed):", name);
+    gi_text_put(md, "Path tracer convergence on %s (relMSE against the reference, another seed):", name);
     const tradeoff_pt_curve *curves[9] = {full};
     uint32_t nc = 1;
     for (uint32_t i = 0; i < matched_n && nc < 9; i++)
         curves[nc++] = &matched[i];
     for (uint32_t c = 0; c < nc; c++) {
-        tradeoff_put(md, "%s max_bounces %u:", c ? ";" : "", curves[c]->bounces);
+        gi_text_put(md, "%s max_bounces %u:", c ? ";" : "", curves[c]->bounces);
         for (uint32_t i = 0; i < curves[c]->n; i++)
-            tradeoff_put(md, " %.3g s → %.3g%s", curves[c]->t[i], curves[c]->e[i], i + 1 < curves[c]->n ? "," : "");
+            gi_text_put(md, " %.3g s → %.3g%s", curves[c]->t[i], curves[c]->e[i], i + 1 < curves[c]->n ? "," : "");
     }
-    tradeoff_put(md, ".\n\n");
+    gi_text_put(md, ".\n\n");
     equal_error_table(md, name, full, matched, matched_n, set, ns, methods, nm, fp);
     equal_time_table(md, name, full, matched, matched_n, set, ns, methods, nm);
     free(set), free(methods), free(fp);

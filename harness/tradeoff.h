@@ -11,6 +11,7 @@
 #define GIBENCH_TRADEOFF_H
 
 #include "charts.h"
+#include "text.h"
 
 #include <json-c/json.h>
 #include <stddef.h>
@@ -40,17 +41,6 @@ typedef struct tradeoff_run {
     uint64_t setting;
 } tradeoff_run;
 
-/* A growing text (markdown). */
-typedef struct tradeoff_text {
-    char *s;
-    size_t len, cap;
-} tradeoff_text;
-void tradeoff_put(tradeoff_text *t, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-
 /* How charts are written: gi_chart_write_png, or a stand-in (tests). */
 typedef gi_result (*tradeoff_chart_fn)(const char *path, const gi_chart_desc *desc, const gi_chart_series *series,
                                        uint32_t n, gi_error *err);
@@ -63,6 +53,6 @@ typedef gi_result (*tradeoff_chart_fn)(const char *path, const gi_chart_desc *de
  * bounce-limited curves (matched_n of them). */
 void tradeoff_report(const char *out_dir, const char *name, const tradeoff_pt_curve *full,
                      const tradeoff_pt_curve *matched, uint32_t matched_n, const tradeoff_run *runs,
-                     uint32_t run_n, tradeoff_chart_fn write_chart, json_object *chart_list, tradeoff_text *md);
+                     uint32_t run_n, tradeoff_chart_fn write_chart, json_object *chart_list, gi_text *md);
 
 #endif

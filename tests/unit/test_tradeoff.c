@@ -104,7 +104,7 @@ static void test_report(void)
     };
     tradeoff_pt_curve full = {65, 3, {1, 4, 16}, {1, 0.25, 0.0625}};
     tradeoff_pt_curve matched = {1, 2, {0.5, 2}, {0.1, 0.025}};
-    tradeoff_text md = {0};
+    gi_text md = {0};
     json_object *charts = json_object_new_array();
     tradeoff_report("/nonexistent", "box", &full, &matched, 1, runs, 4, fake_chart, charts, &md);
     CHECK(md.s != NULL);

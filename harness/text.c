@@ -1,0 +1,39 @@
+/* The report writers' growing text buffer (text.h). */
+#include "text.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+
+void gi_text_vput(gi_text *t, const char *fmt, va_list ap)
+{
+    va_list copy;
+    va_copy(copy, ap);
+    int n = vsnprintf(NULL, 0, fmt, copy);
+    va_end(copy);
+    if (n < 0) {
+        t->failed = 1;
+        return;
+    }
+    if (t->len + (size_t)n + 1 > t->cap) {
+        size_t cap = t->cap ? t->cap : 4096;
+        while (cap < t->len + (size_t)n + 1)
+            cap *= 2;
+        char *s = realloc(t->s, cap);
+        if (!s) {
+            t->failed = 1;
+            return;
+        }
+        t->s = s;
+        t->cap = cap;
+    }
+    vsnprintf(t->s + t->len, (size_t)n + 1, fmt, ap);
+    t->len += (size_t)n;
+}
+
+void gi_text_put(gi_text *t, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    gi_text_vput(t, fmt, ap);
+    va_end(ap);
+}
