@@ -35,8 +35,10 @@ if(m MATCHES "${heavy}")
     fail("gibench methods loads a heavy library again: ${CMAKE_MATCH_0}")
 endif()
 list(LENGTH m n_methods)
-if(n_methods GREATER 40)
-    fail("gibench methods initialises ${n_methods} shared objects (at most 40 expected)")
+# 35 in the release build (meshoptimizer included), 41 under ASan + UBSan
+# (their runtimes); 322 before the heavy libraries became modules.
+if(n_methods GREATER 50)
+    fail("gibench methods initialises ${n_methods} shared objects (at most 50 expected)")
 endif()
 
 loaded(r render --scene ${S} --method direct --size 16x16 --frames 1 --warmup 0
