@@ -236,7 +236,8 @@ def main():
     w("### U room: image mean against the number of VPL slots\n")
     w("| tracing | grid | VPL slots | live VPLs | relMSE matched | image mean matched | image mean full | frame ms |")
     w("|---|---:|---:|---:|---:|---:|---:|---:|")
-    sweep = [r for r in runs if r["scene"] == "scenes/u_room.gltf" and r["label"] != "table2"
+    # the speed sweep (label "speed", issue 14) has its own table in speed/
+    sweep = [r for r in runs if r["scene"] == "scenes/u_room.gltf" and r["label"] not in ("table2", "speed")
              and params(r).get("visibility") == "true"]
     for r in sorted(sweep, key=lambda r: (params(r)["tracing"], int(params(r)["grid"]), int(params(r)["vpls"]))):
         p = params(r)
