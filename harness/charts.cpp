@@ -393,6 +393,50 @@ std::string tick_label(int m, int e, bool dejavu, bool powers)
     return s;
 }
 
+/* Whether an error-bar end v can be drawn on an axis (finite; > 0 on a log axis). */
+bool bar_end_ok(double v, int log)
+{
+    return std::isfinite(v) && !(log && v <= 0.0);
+}
+
+/* The error bars of a series as one line plot of separate segments
+ * (vtkPlotLine without PolyLine joins points 0-1, 2-3, ...): thin, in the
+ * series' colour, no markers, no legend entry. */
+void add_bars(vtkChartXY *chart, const gi_chart_desc &d, const gi_chart_series &s, const unsigned char *c)
+{
+    vtkNew<vtkTable> table;
+    vtkNew<vtkDoubleArray> xs, ys;
+    xs->SetName("x");
+    ys->SetName("y");
+    auto segment = [&](double x0, double y0, double x1, double y1) {
+        if (!bar_end_ok(x0, d.log_x) || !bar_end_ok(x1, d.log_x) || !bar_end_ok(y0, d.log_y) ||
+            !bar_end_ok(y1, d.log_y) || (x0 == x1 && y0 == y1))
+            return;
+        xs->InsertNextValue(x0), ys->InsertNextValue(y0);
+        xs->InsertNextValue(x1), ys->InsertNextValue(y1);
+    };
+    for (uint32_t i = 0; i < s.count; i++) {
+        if (!kept(d, s, i))
+            continue;
+        if (s.x_lo && s.x_hi)
+            segment(s.x_lo[i], s.y[i], s.x_hi[i], s.y[i]);
+        if (s.y_lo && s.y_hi)
+            segment(s.x[i], s.y_lo[i], s.x[i], s.y_hi[i]);
+    }
+    if (xs->GetNumberOfTuples() == 0)
+        return;
+    table->AddColumn(xs);
+    table->AddColumn(ys);
+    vtkNew<vtkPlotLine> bars;
+    chart->AddPlot(bars);
+    bars->SetInputData(table, 0, 1);
+    bars->SetPolyLine(false);
+    bars->SetMarkerStyle(vtkPlotPoints::NONE);
+    bars->SetLegendVisibility(false);
+    bars->SetColor(c[0], c[1], c[2], 255);
+    bars->SetWidth(1.5f);
+}
+
 /* Adds series k to the chart: its own two-column table, colour, marker.
  * `name` (the title, else the file) identifies the chart in warnings. */
 void add_series(vtkChartXY *chart, const gi_chart_desc &d, const gi_chart_series &s, uint32_t k,
@@ -443,14 +487,34 @@ void add_series(vtkChartXY *chart, const gi_chart_desc &d, const gi_chart_series
         plot->SetMarkerStyle(markers[look % marker_count]);
         plot->SetMarkerSize(s.style == GI_CHART_MARKERS ? 9.0f : 7.0f);
     }
+    add_bars(chart, d, s, c);
 }
 
 /* Range of one axis: the kept points' extent widened by 4 % of the span on
  * each side (in log10 on a log axis), so no marker sits on the frame. An
  * empty axis shows [0, 1] (linear) or [1, 10] (log); a single value is
- * widened to a visible interval. */
-void axis_range(double lo, double hi, int log, double out[2])
+ * widened to a visible interval. With `floor`, a short span is first
+ * widened about its middle to a minimum (charts.h, "Axis ranges"), so
+ * that noise is not magnified to fill the axis. */
+void axis_range(double lo, double hi, int log, bool floor, double out[2])
 {
+    if (floor && lo < hi) {
+        if (log) {
+            double f = 2.0;
+            if (hi / lo < f) {
+                double mid = std::sqrt(lo * hi);
+                lo = mid / std::sqrt(f);
+                hi = mid * std::sqrt(f);
+            }
+        } else {
+            double m = std::max(std::fabs(lo), std::fabs(hi)), want = 0.2 * m;
+            if (hi - lo < want) {
+                double mid = 0.5 * (lo + hi);
+                lo = mid - 0.5 * want;
+                hi = mid + 0.5 * want;
+            }
+        }
+    }
     if (!(lo <= hi)) { /* no points: NaN-free defaults */
         out[0] = log ? 1.0 : 0.0;
         out[1] = log ? 10.0 : 1.0;
@@ -527,13 +591,32 @@ void log_ticks(double lo, double hi, bool dejavu, vtkDoubleArray *pos, vtkString
     }
 }
 
-void set_axis(vtkAxis *axis, const char *title, int log, const double range[2], bool dejavu)
+void set_axis(vtkAxis *axis, const char *title, int log, const double range[2], bool dejavu,
+              const double *ticks, uint32_t tick_count)
 {
     axis->SetTitle(title ? title : "");
     axis->SetLogScale(log != 0);
     axis->SetBehavior(vtkAxis::FIXED);
     axis->SetUnscaledRange(range[0], range[1]);
-    if (log) {
+    bool custom = false;
+    if (ticks && tick_count) {
+        /* the caller's values (e.g. the swept ones), in the axis' units */
+        vtkNew<vtkDoubleArray> pos;
+        vtkNew<vtkStringArray> labels;
+        char text[32];
+        for (uint32_t i = 0; i < tick_count; i++) {
+            double v = ticks[i];
+            if (!std::isfinite(v) || v < range[0] || v > range[1] || (log && v <= 0.0))
+                continue;
+            pos->InsertNextValue(log ? std::log10(v) : v);
+            snprintf(text, sizeof text, "%g", v);
+            labels->InsertNextValue(text);
+        }
+        custom = pos->GetNumberOfTuples() > 0;
+        if (custom)
+            axis->SetCustomTickPositions(pos, labels);
+    }
+    if (log && !custom) {
         vtkNew<vtkDoubleArray> pos;
         vtkNew<vtkStringArray> labels;
         log_ticks(range[0], range[1], dejavu, pos, labels);
@@ -542,6 +625,30 @@ void set_axis(vtkAxis *axis, const char *title, int log, const double range[2], 
     style_text(axis->GetTitleProperties(), 14, true, dejavu);
     style_text(axis->GetLabelProperties(), 12, false, dejavu);
     axis->GetGridPen()->SetColor(220, 220, 220, 255);
+}
+
+/* Both axis ranges: the extent of the drawn points and error bars. */
+void ranges(const gi_chart_desc &d, const gi_chart_series *series, uint32_t n, double xr[2], double yr[2])
+{
+    double lo[2] = {HUGE_VAL, HUGE_VAL}, hi[2] = {-HUGE_VAL, -HUGE_VAL};
+    auto take = [&](int axis, double v) {
+        if (bar_end_ok(v, axis ? d.log_y : d.log_x))
+            lo[axis] = std::min(lo[axis], v), hi[axis] = std::max(hi[axis], v);
+    };
+    for (uint32_t k = 0; k < n; k++) {
+        const gi_chart_series &s = series[k];
+        for (uint32_t i = 0; i < s.count; i++)
+            if (kept(d, s, i)) {
+                take(0, s.x[i]);
+                take(1, s.y[i]);
+                if (s.x_lo && s.x_hi && bar_end_ok(s.x_lo[i], d.log_x) && bar_end_ok(s.x_hi[i], d.log_x))
+                    take(0, s.x_lo[i]), take(0, s.x_hi[i]);
+                if (s.y_lo && s.y_hi && bar_end_ok(s.y_lo[i], d.log_y) && bar_end_ok(s.y_hi[i], d.log_y))
+                    take(1, s.y_lo[i]), take(1, s.y_hi[i]);
+            }
+    }
+    axis_range(lo[0], hi[0], d.log_x, false, xr);
+    axis_range(lo[1], hi[1], d.log_y, true, yr);
 }
 
 /* Draws the chart and, when `file` is not NULL, writes it there as PNG.
@@ -582,18 +689,10 @@ gi_result render(const gi_chart_desc &d, const gi_chart_series *series, uint32_t
     chart->SetTitle(title);
     bool dejavu = have_dejavu();
     style_text(chart->GetTitleProperties(), 17, true, dejavu);
-    double lo[2] = {HUGE_VAL, HUGE_VAL}, hi[2] = {-HUGE_VAL, -HUGE_VAL};
-    for (uint32_t k = 0; k < n; k++)
-        for (uint32_t i = 0; i < series[k].count; i++)
-            if (kept(d, series[k], i)) {
-                lo[0] = std::min(lo[0], series[k].x[i]), hi[0] = std::max(hi[0], series[k].x[i]);
-                lo[1] = std::min(lo[1], series[k].y[i]), hi[1] = std::max(hi[1], series[k].y[i]);
-            }
     double xr[2], yr[2];
-    axis_range(lo[0], hi[0], d.log_x, xr);
-    axis_range(lo[1], hi[1], d.log_y, yr);
-    set_axis(chart->GetAxis(vtkAxis::BOTTOM), d.x_label, d.log_x, xr, dejavu);
-    set_axis(chart->GetAxis(vtkAxis::LEFT), d.y_label, d.log_y, yr, dejavu);
+    ranges(d, series, n, xr, yr);
+    set_axis(chart->GetAxis(vtkAxis::BOTTOM), d.x_label, d.log_x, xr, dejavu, d.x_ticks, d.x_tick_count);
+    set_axis(chart->GetAxis(vtkAxis::LEFT), d.y_label, d.log_y, yr, dejavu, nullptr, 0);
     for (uint32_t k = 0; k < n; k++)
         add_series(chart, d, series[k], k, *title ? title : what);
     chart->SetRenderEmpty(true); /* axes and title even without a point */
@@ -663,6 +762,9 @@ gi_result validate(const gi_chart_desc &d, const gi_chart_series *series, uint32
                             d.height, max_side);
     if (n > 0 && !series)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: %u series but no array", what, n);
+    if (d.x_tick_count > 0 && !d.x_ticks)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: %u x ticks but no array", what,
+                            d.x_tick_count);
     for (uint32_t k = 0; k < n; k++) {
         const gi_chart_series &s = series[k];
         if (s.style != GI_CHART_LINE_MARKERS && s.style != GI_CHART_MARKERS &&
@@ -724,8 +826,8 @@ extern "C" gi_result gi_chart_write_png(const char *path, const gi_chart_desc *d
 extern "C" gi_result gi_chart_available(gi_error *err)
 {
     static const double x[] = {1.0, 10.0}, y[] = {1.0, 0.1};
-    gi_chart_series s = {"probe", x, y, 2, GI_CHART_LINE_MARKERS, 0};
-    gi_chart_desc d = {"probe", "x", "y", 1, 1, 64, 48};
+    gi_chart_series s = {"probe", x, y, 2, GI_CHART_LINE_MARKERS, 0, nullptr, nullptr, nullptr, nullptr};
+    gi_chart_desc d = {"probe", "x", "y", 1, 1, 64, 48, nullptr, 0};
     try {
         std::lock_guard<std::mutex> lock(chart_mutex);
         gi_result r = render(d, &s, 1, nullptr, err, "charts");
@@ -737,6 +839,15 @@ extern "C" gi_result gi_chart_available(gi_error *err)
     } catch (...) {
         return gi_error_set(err, GI_ERR_UNSUPPORTED, "charts: unknown exception in VTK");
     }
+}
+
+extern "C" void gi_chart_axis_ranges(const gi_chart_desc *desc, const gi_chart_series *series,
+                                     uint32_t n, double x_range[2], double y_range[2])
+{
+    gi_chart_desc d{};
+    if (desc)
+        d = *desc;
+    ranges(d, series, series ? n : 0, x_range, y_range);
 }
 
 extern "C" uint32_t gi_chart_points_kept(const gi_chart_desc *desc, const gi_chart_series *s)

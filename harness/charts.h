@@ -57,6 +57,12 @@ typedef struct gi_chart_series {
     int style; /* GI_CHART_* */
     int color; /* 0: colour and marker by position in the array; k > 0: those of position k - 1
                   (so that a method's runs and its front share a look) */
+    /* Error bars (the spread of repeats), each NULL or `count` values:
+     * a horizontal bar from x_lo[i] to x_hi[i] at y[i] and a vertical one
+     * from y_lo[i] to y_hi[i] at x[i], in the series' colour, without a
+     * legend entry. A NaN end (or one <= 0 on a log axis) leaves that
+     * point's bar out. Bars count toward the axis ranges. */
+    const double *x_lo, *x_hi, *y_lo, *y_hi;
 } gi_chart_series;
 
 /* Zero means default in every field. */
@@ -64,7 +70,18 @@ typedef struct gi_chart_desc {
     const char *title, *x_label, *y_label; /* NULL = none */
     int log_x, log_y;                      /* non-zero: logarithmic axis */
     uint32_t width, height;                /* pixels; 0 = 900 (width), 600 (height); at most 4096 */
+    /* Tick marks on the x axis at exactly these values (e.g. the swept
+     * values of a parameter), labelled "%g"; NULL or 0: chosen from the
+     * range. Values outside the axis range are left out. */
+    const double *x_ticks;
+    uint32_t x_tick_count;
 } gi_chart_desc;
+
+/* Axis ranges. Each axis spans the drawn points and bars, widened by 4 %
+ * of the span on each side. The y axis does not magnify noise: a linear
+ * y axis spans at least 20 % of its largest magnitude and a logarithmic
+ * one at least a factor of 2, so that values 2 % apart fill a tenth of a
+ * linear axis instead of all of it. */
 
 /* Renders the chart and writes it to `path` (which must end in ".png") as
  * an 8-bit RGB PNG of width x height pixels. desc may be NULL (all
@@ -82,6 +99,12 @@ gi_result gi_chart_write_png(const char *path, const gi_chart_desc *desc,
  * GI_ERR_UNSUPPORTED and the reason in err. Renders a tiny chart in memory,
  * so it costs about as much as one chart. */
 gi_result gi_chart_available(gi_error *err);
+
+/* The x and y ranges (data units) a chart with these arguments is drawn
+ * with (see "Axis ranges" above); for tests and for callers that place
+ * annotations. */
+void gi_chart_axis_ranges(const gi_chart_desc *desc, const gi_chart_series *series, uint32_t n,
+                          double x_range[2], double y_range[2]);
 
 /* How many points of `s` a chart with `desc` draws (see "Points" above). */
 uint32_t gi_chart_points_kept(const gi_chart_desc *desc, const gi_chart_series *s);

@@ -49,3 +49,18 @@ uint32_t gi_chart_points_kept(const gi_chart_desc *desc, const gi_chart_series *
     memcpy(&fn, &sym, sizeof fn);
     return fn(desc, s);
 }
+
+void gi_chart_axis_ranges(const gi_chart_desc *desc, const gi_chart_series *series, uint32_t n,
+                          double x_range[2], double y_range[2])
+{
+    void (*fn)(const gi_chart_desc *, const gi_chart_series *, uint32_t, double[2], double[2]);
+    gi_error err;
+    void *sym = charts_symbol("gi_chart_axis_ranges", &err);
+    if (!sym) { /* no module: nothing is drawn; report the empty axes' ranges */
+        x_range[0] = y_range[0] = 0.0;
+        x_range[1] = y_range[1] = 1.0;
+        return;
+    }
+    memcpy(&fn, &sym, sizeof fn);
+    fn(desc, series, n, x_range, y_range);
+}

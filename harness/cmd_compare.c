@@ -227,6 +227,8 @@ int cmd_compare(int argc, char **argv)
         }
     }
     json_object *runs = json_object_new_array();
+    /* the bounce-matched references made, for the report's viewer */
+    uint32_t matched_b[MAX_METHODS], matched_n = 0;
     int failures = 0;
     char renderer[256] = "";
     for (uint32_t i = 0; i < n && !cli_interrupted; i++) {
@@ -252,9 +254,14 @@ int cmd_compare(int argc, char **argv)
                 snprintf(matched, sizeof matched, "%s/reference_b%u.exr", o.out, b);
                 fprintf(stderr, "compare: bounce-matched reference (%u spp, %u bounces)\n", o.ref_spp, b);
                 if (runner_reference(o.scene, scene_hash, o.camera, o.width, o.height, o.ref_spp, o.ref_target_se, b, o.seed, o.time, 0, o.timeout_s,
-                                     matched, why, sizeof why))
+                                     matched, why, sizeof why)) {
                     ref_matched = matched;
-                else
+                    uint32_t k = 0;
+                    while (k < matched_n && matched_b[k] != b)
+                        k++;
+                    if (k == matched_n)
+                        matched_b[matched_n++] = b;
+                } else
                     fprintf(stderr, "gibench: warning: %s\n", why);
             } else {
                 ref_matched = ref_full; /* the full reference is this method's match */
@@ -290,6 +297,31 @@ int cmd_compare(int argc, char **argv)
         char ref_png[64];
         snprintf(ref_png, sizeof ref_png, "reference_b%u.png", o.ref_bounces);
         json_object_object_add(meta, "reference_png", json_object_new_string(ref_png));
+        /* the viewer's set: the full reference, every bounce-matched one and every run */
+        json_object *sets = json_object_new_array(), *set = json_object_new_object();
+        json_object *mlist = json_object_new_array(), *ids = json_object_new_array();
+        char img[64];
+        snprintf(img, sizeof img, "reference_b%u.exr", o.ref_bounces);
+        json_object_object_add(set, "name", json_object_new_string(title));
+        json_object_object_add(set, "full", json_object_new_string(img));
+        json_object_object_add(set, "bounces", json_object_new_int((int)o.ref_bounces));
+        for (uint32_t k = 0; k < matched_n; k++) {
+            json_object *m = json_object_new_object();
+            snprintf(img, sizeof img, "reference_b%u.exr", matched_b[k]);
+            json_object_object_add(m, "image", json_object_new_string(img));
+            json_object_object_add(m, "bounces", json_object_new_int((int)matched_b[k]));
+            json_object_array_add(mlist, m);
+        }
+        json_object_object_add(set, "matched", mlist);
+        for (size_t i = 0; i < json_object_array_length(runs); i++) {
+            json_object *id;
+            if (json_object_object_get_ex(json_object_array_get_idx(runs, i), "run", &id))
+                json_object_array_add(ids, json_object_get(id));
+        }
+        json_object_object_add(set, "runs", ids);
+        json_object_array_add(sets, set);
+        json_object_object_add(meta, "references", sets);
+        json_object_object_add(meta, "exposure", json_object_new_double(o.exposure));
     }
     rc = report_write(o.out, runs, meta, why, sizeof why) ? EXIT_OK : cli_fail(EXIT_RUN, "compare: %s", why);
     json_object_put(runs);

@@ -1292,6 +1292,12 @@ static int field_equals(json_object *rec, const char *name, json_object *want)
     return eq;
 }
 
+static int cmp_double_asc(const void *a, const void *b)
+{
+    double p = *(const double *)a, q = *(const double *)b;
+    return (p > q) - (p < q);
+}
+
 static int cmp_point(const void *a, const void *b)
 {
     const double *p = a, *q = b;
@@ -1317,6 +1323,7 @@ static void user_charts(study *st, const char *out_dir, json_object *runs, json_
         char *labels[32] = {0};
         double *pts[32] = {0}; /* (x, y) pairs */
         uint32_t counts[32] = {0}, ns = 0;
+        int listed[32] = {0}; /* series drawn from a list field */
         for (size_t i = 0; i < nr; i++) {
             json_object *rec = json_object_array_get_idx(runs, i);
             if (!json_object_object_get_ex(rec, "status", &v) || strcmp(json_object_get_string(v), "ok"))
@@ -1352,6 +1359,7 @@ static void user_charts(study *st, const char *out_dir, json_object *runs, json_
                 ns++;
             }
             if (is_list) {
+                listed[k] = 1;
                 for (size_t j = 0; j < json_object_array_length(y) && counts[k] < MAX_RUNS && pts[k]; j++) {
                     pts[k][2 * counts[k]] = (double)(j + 1);
                     pts[k][2 * counts[k] + 1] = json_object_get_double(json_object_array_get_idx(y, j));
@@ -1366,25 +1374,59 @@ static void user_charts(study *st, const char *out_dir, json_object *runs, json_
             }
             json_object_put(y);
         }
+        /* Runs of one series at the same x (repeats, or settings the
+         * chart does not tell apart) become one point: the median y, with
+         * the min-max spread as an error bar. Series drawn from a list
+         * (one run each) keep their points. */
         gi_chart_series series[32];
-        double *xy[32][2] = {{0}};
+        double *xy[32][4] = {{0}};
+        double ticks[13];
+        uint32_t tick_n = 0;
+        int any_list = 0;
         for (uint32_t k = 0; k < ns; k++) {
             if (pts[k])
                 qsort(pts[k], counts[k], 2 * sizeof(double), cmp_point);
-            xy[k][0] = malloc((counts[k] + 1) * sizeof(double));
-            xy[k][1] = malloc((counts[k] + 1) * sizeof(double));
-            for (uint32_t j = 0; j < counts[k] && xy[k][0] && xy[k][1]; j++) {
-                xy[k][0][j] = pts[k][2 * j];
-                xy[k][1][j] = pts[k][2 * j + 1];
+            for (int a = 0; a < 4; a++)
+                xy[k][a] = malloc((counts[k] + 1) * sizeof(double));
+            uint32_t m = 0;
+            int spread = 0;
+            for (uint32_t j = 0; j < counts[k] && xy[k][0] && xy[k][1] && xy[k][2] && xy[k][3];) {
+                uint32_t e = j + 1;
+                while (!listed[k] && e < counts[k] && pts[k][2 * e] == pts[k][2 * j])
+                    e++;
+                double ys[MAX_RUNS];
+                for (uint32_t q = j; q < e; q++)
+                    ys[q - j] = pts[k][2 * q + 1];
+                qsort(ys, e - j, sizeof(double), cmp_double_asc);
+                uint32_t cnt = e - j;
+                xy[k][0][m] = pts[k][2 * j];
+                xy[k][1][m] = cnt % 2 ? ys[cnt / 2] : 0.5 * (ys[cnt / 2 - 1] + ys[cnt / 2]);
+                xy[k][2][m] = ys[0];
+                xy[k][3][m] = ys[cnt - 1];
+                spread |= cnt > 1 && ys[cnt - 1] > ys[0];
+                m++;
+                j = e;
             }
-            series[k] = (gi_chart_series){labels[k], xy[k][0], xy[k][1], xy[k][0] && xy[k][1] ? counts[k] : 0, 0, 0};
+            any_list |= listed[k];
+            /* the distinct x values of every series: ticks at the swept values */
+            for (uint32_t j = 0; j < m && tick_n <= 12; j++) {
+                uint32_t t = 0;
+                while (t < tick_n && ticks[t] != xy[k][0][j])
+                    t++;
+                if (t == tick_n && isfinite(xy[k][0][j]))
+                    ticks[tick_n++] = xy[k][0][j];
+            }
+            series[k] = (gi_chart_series){labels[k], xy[k][0], xy[k][1], xy[k][0] && xy[k][1] ? m : 0, 0, 0,
+                                          NULL, NULL, spread ? xy[k][2] : NULL, spread ? xy[k][3] : NULL};
         }
         const char *title = json_object_object_get_ex(c, "title", &v) ? json_object_get_string(v) : file;
         const char *xl = json_object_object_get_ex(c, "x_label", &v) ? json_object_get_string(v) : xf;
         const char *yl = json_object_object_get_ex(c, "y_label", &v) ? json_object_get_string(v) : yf;
         int lx = json_object_object_get_ex(c, "log_x", &v) && json_object_get_boolean(v);
         int ly = json_object_object_get_ex(c, "log_y", &v) && json_object_get_boolean(v);
-        gi_chart_desc desc = {title, xl, yl, lx, ly, 0, 0};
+        /* ticks at the swept values when there are few (at most 12) */
+        gi_chart_desc desc = {title, xl, yl, lx, ly, 0, 0, any_list || tick_n > 12 ? NULL : ticks,
+                              any_list || tick_n > 12 ? 0 : tick_n};
         char path[4700];
         snprintf(path, sizeof path, "%s/%s", out_dir, file);
         gi_error err;
@@ -1397,8 +1439,8 @@ static void user_charts(study *st, const char *out_dir, json_object *runs, json_
         for (uint32_t k = 0; k < ns; k++) {
             free(labels[k]);
             free(pts[k]);
-            free(xy[k][0]);
-            free(xy[k][1]);
+            for (int a = 0; a < 4; a++)
+                free(xy[k][a]);
         }
     }
 }

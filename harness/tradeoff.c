@@ -102,7 +102,8 @@ static uint32_t run_curve(json_object *rec, double *t, double *ef, double *em, u
     return 1;
 }
 
-/* The repeats of one setting pooled: medians, and the spread of relMSE. */
+/* The repeats of one setting pooled: medians, and the spread (min, max) of
+ * time and relMSE. */
 typedef struct setting {
     uint64_t key;
     json_object *first;
@@ -110,6 +111,7 @@ typedef struct setting {
     uint32_t bounces, repeats, method_index;
     uint32_t n;
     double t[MAX_POINTS], ef[MAX_POINTS], ef_lo[MAX_POINTS], ef_hi[MAX_POINTS], em[MAX_POINTS];
+    double t_lo[MAX_POINTS], t_hi[MAX_POINTS], em_lo[MAX_POINTS], em_hi[MAX_POINTS];
     uint32_t frame[MAX_POINTS];
     double prep_s;
 } setting;
@@ -178,11 +180,13 @@ static uint32_t pool_settings(const tradeoff_run *runs, uint32_t run_n, setting 
         g->repeats = rep;
         g->n = rep ? n : 0;
         for (uint32_t k = 0; k < g->n; k++) {
+            /* median_of sorts: the ends are the spread */
             g->t[k] = median_of(t[k], rep);
             g->em[k] = median_of(em[k], rep);
-            g->ef[k] = median_of(ef[k], rep); /* sorted: the ends are the spread */
-            g->ef_lo[k] = ef[k][0];
-            g->ef_hi[k] = ef[k][rep - 1];
+            g->ef[k] = median_of(ef[k], rep);
+            g->t_lo[k] = t[k][0], g->t_hi[k] = t[k][rep - 1];
+            g->ef_lo[k] = ef[k][0], g->ef_hi[k] = ef[k][rep - 1];
+            g->em_lo[k] = em[k][0], g->em_hi[k] = em[k][rep - 1];
         }
         g->prep_s = median_of(prep, rep);
     }
@@ -250,12 +254,13 @@ static void chart(tradeoff_chart_fn write_chart, const char *out_dir, const char
 {
     uint32_t cap = ns + 2 * nm + matched_n + 2;
     gi_chart_series *series = calloc(cap, sizeof *series);
-    double *fx = calloc((size_t)nm * ns * MAX_POINTS * 2 + 1, sizeof *fx);
-    double *fy = calloc((size_t)nm * ns * MAX_POINTS * 2 + 1, sizeof *fy);
+    /* per method: the staircase's x, y and its error bars (x lo/hi, y lo/hi) */
+    size_t per = (size_t)ns * MAX_POINTS * 2;
+    double *fx = calloc((size_t)nm * per * 6 + 1, sizeof *fx);
     front_point *fp = calloc((size_t)ns * MAX_POINTS + 1, sizeof *fp);
     char(*labels)[160] = calloc(nm + matched_n + 1, sizeof *labels);
-    if (!series || !fx || !fy || !fp || !labels) {
-        free(series), free(fx), free(fy), free(fp), free(labels);
+    if (!series || !fx || !fp || !labels) {
+        free(series), free(fx), free(fp), free(labels);
         return;
     }
     uint32_t n = 0;
@@ -263,50 +268,65 @@ static void chart(tradeoff_chart_fn write_chart, const char *out_dir, const char
         for (uint32_t s = 0; s < ns; s++)
             if (set[s].method_index == m && set[s].n > 1)
                 series[n++] = (gi_chart_series){NULL, set[s].t, matched ? set[s].em : set[s].ef, set[s].n,
-                                                GI_CHART_THIN, (int)m + 1};
+                                                GI_CHART_THIN, (int)m + 1, NULL, NULL, NULL, NULL};
         uint32_t k = pareto(set, ns, m, matched, fp);
-        double *x = fx + (size_t)m * ns * MAX_POINTS * 2, *y = fy + (size_t)m * ns * MAX_POINTS * 2;
+        double *x = fx + (size_t)m * per * 6, *y = x + per, *xl = y + per, *xh = xl + per, *yl = xh + per,
+               *yh = yl + per;
         /* a staircase: between two settings on the front nothing better is
-         * known than the slower one's error, reached at its own time */
+         * known than the slower one's error, reached at its own time. Each
+         * front point carries the spread of its repeats as error bars
+         * (time and relMSE, min to max); the corners carry none. */
         uint32_t c = 0;
+        int spread = 0;
         for (uint32_t i = 0; i < k; i++) {
-            double t = set[fp[i].s].t[fp[i].k], e = matched ? set[fp[i].s].em[fp[i].k] : set[fp[i].s].ef[fp[i].k];
+            const setting *g = &set[fp[i].s];
+            uint32_t j = fp[i].k;
+            double e = matched ? g->em[j] : g->ef[j];
             if (i > 0) {
-                x[c] = t;
+                x[c] = g->t[j];
                 y[c] = y[c - 1];
+                xl[c] = xh[c] = yl[c] = yh[c] = NAN;
                 c++;
             }
-            x[c] = t;
-            y[c++] = e;
+            x[c] = g->t[j];
+            y[c] = e;
+            xl[c] = g->t_lo[j], xh[c] = g->t_hi[j];
+            yl[c] = matched ? g->em_lo[j] : g->ef_lo[j];
+            yh[c] = matched ? g->em_hi[j] : g->ef_hi[j];
+            spread |= g->repeats > 1;
+            c++;
         }
-        snprintf(labels[m], sizeof labels[m], "%s (Pareto front)", methods[m]);
-        series[n++] = (gi_chart_series){labels[m], x, y, c, GI_CHART_LINE_MARKERS, (int)m + 1};
+        snprintf(labels[m], sizeof labels[m], "%s (Pareto front%s)", methods[m],
+                 spread ? "; bars: min-max of repeats" : "");
+        series[n++] = (gi_chart_series){labels[m], x, y, c, GI_CHART_LINE_MARKERS, (int)m + 1,
+                                        spread ? xl : NULL, spread ? xh : NULL, spread ? yl : NULL,
+                                        spread ? yh : NULL};
     }
     int colour = (int)nm + 1;
     if (!matched) {
         series[n++] = (gi_chart_series){"path tracer (Embree, CPU), full GI", full->t, full->e, full->n,
-                                        GI_CHART_DASHED, colour};
+                                        GI_CHART_DASHED, colour, NULL, NULL, NULL, NULL};
     } else {
         for (uint32_t i = 0; i < matched_n; i++) {
             snprintf(labels[nm + i], sizeof labels[nm + i], "path tracer, max_bounces %u", mcurves[i].bounces);
             series[n++] = (gi_chart_series){labels[nm + i], mcurves[i].t, mcurves[i].e, mcurves[i].n,
-                                            GI_CHART_DASHED, colour + (int)i};
+                                            GI_CHART_DASHED, colour + (int)i, NULL, NULL, NULL, NULL};
         }
         series[n++] = (gi_chart_series){"path tracer, full GI", full->t, full->e, full->n, GI_CHART_DASHED,
-                                        colour + (int)matched_n};
+                                        colour + (int)matched_n, NULL, NULL, NULL, NULL};
     }
     char file[512], path[4700], title[512];
     snprintf(file, sizeof file, "chart_%s_error_vs_time%s.png", name, matched ? "_matched" : "");
     snprintf(path, sizeof path, "%s/%s", out_dir, file);
     snprintf(title, sizeof title, "%s: relMSE against time (%s)", name,
              matched ? "bounce-matched references" : "full-GI reference");
-    gi_chart_desc desc = {title, "time to image (s): sum of frame times so far", "relMSE", 1, 1, 0, 0};
+    gi_chart_desc desc = {title, "time to image (s): sum of frame times so far", "relMSE", 1, 1, 0, 0, NULL, 0};
     gi_error err;
     if (write_chart(path, &desc, series, n, &err) == GI_OK)
         json_object_array_add(chart_list, json_object_new_string(file));
     else
         gi_log(GI_LOG_WARN, "chart %s not written: %s", file, err.text);
-    free(series), free(fx), free(fy), free(fp), free(labels);
+    free(series), free(fx), free(fp), free(labels);
 }
 
 /* relMSE as "median" or "median [min–max]" over repeats. */

@@ -51,6 +51,11 @@ foreach(f report.md index.html reference_b8.exr reference_b1.exr direct/image.ex
 endforeach()
 file(READ ${C}/report.md md)
 match("${md}" "GL renderer: " "report names no GL renderer")
+# The page's viewer holds the full reference, the bounce-matched one
+# (direct: 1 bounce) and the run.
+file(READ ${C}/index.html page)
+match("${page}" "reference, full GI \\(8 bounces\\)" "the viewer has no full-GI reference")
+match("${page}" "reference, 1 bounce[^s]" "the viewer has no bounce-matched reference")
 # Resume: a second run reuses what is done (the result file is not rewritten).
 file(TIMESTAMP ${C}/direct/result.json before "%s")
 execute_process(COMMAND ${CMAKE_COMMAND} -E sleep 1.1)

@@ -2,7 +2,9 @@
  * PNG of the requested size, read back and checked for what a reader needs:
  * each series in its own palette colour, a power law drawn as a straight
  * line (so both axes really are logarithmic), the reference curve dashed
- * and the others solid. Also: points dropped on log axes, empty charts,
+ * and the others solid. Also: y ranges that do not magnify noise, error
+ * bars drawn and counted in the ranges, ticks at given (swept) values,
+ * points dropped on log axes, empty charts,
  * bad arguments and unwritable paths as errors, no temporary files left,
  * the caller's GL context current again afterwards, and the time a chart
  * takes. Registered with the label "charts", not "unit": it runs in the
@@ -137,11 +139,11 @@ static void test_log_log_chart(void)
         e_pt[i] = 2.0 * pow(t[i], -0.5); /* Monte Carlo: 1/sqrt(time) */
     }
     gi_chart_series s[3] = {
-        {"method A (unbiased)", t, e_a, N, GI_CHART_LINE_MARKERS, 0},
-        {"method B (biased)", t, e_b, N, GI_CHART_MARKERS, 0},
-        {"path tracer", t_pt, e_pt, N, GI_CHART_DASHED, 0},
+        {"method A (unbiased)", t, e_a, N, GI_CHART_LINE_MARKERS, 0, NULL, NULL, NULL, NULL},
+        {"method B (biased)", t, e_b, N, GI_CHART_MARKERS, 0, NULL, NULL, NULL, NULL},
+        {"path tracer", t_pt, e_pt, N, GI_CHART_DASHED, 0, NULL, NULL, NULL, NULL},
     };
-    gi_chart_desc d = {"Cornell box: RMSE against time", "time [ms]", "RMSE", 1, 1, 1000, 640};
+    gi_chart_desc d = {"Cornell box: RMSE against time", "time [ms]", "RMSE", 1, 1, 1000, 640, NULL, 0};
     char path[600];
     snprintf(path, sizeof path, "%s/error_time.png", dir);
     gi_error err = {{0}};
@@ -222,7 +224,7 @@ static void test_points_kept(void)
 {
     double x[] = {1, 0, -1, NAN, 2, INFINITY, 3};
     double y[] = {1, 1, 1, 1, -2, 1, 0.5};
-    gi_chart_series s = {"s", x, y, 7, GI_CHART_LINE_MARKERS, 0};
+    gi_chart_series s = {"s", x, y, 7, GI_CHART_LINE_MARKERS, 0, NULL, NULL, NULL, NULL};
     gi_chart_desc lin = {0}, logx = {0}, loglog = {0};
     logx.log_x = 1;
     loglog.log_x = loglog.log_y = 1;
@@ -230,11 +232,11 @@ static void test_points_kept(void)
     CHECK(gi_chart_points_kept(NULL, &s) == 5);
     CHECK(gi_chart_points_kept(&logx, &s) == 3);   /* also x = 0, x = -1 */
     CHECK(gi_chart_points_kept(&loglog, &s) == 2); /* also y = -2 */
-    gi_chart_series empty = {"e", NULL, NULL, 0, GI_CHART_DASHED, 0};
+    gi_chart_series empty = {"e", NULL, NULL, 0, GI_CHART_DASHED, 0, NULL, NULL, NULL, NULL};
     CHECK(gi_chart_points_kept(&loglog, &empty) == 0);
 
     /* Such a series still draws (with a warning), as do empty ones. */
-    gi_chart_series both[3] = {s, empty, {NULL, x, y, 1, GI_CHART_MARKERS, 0}};
+    gi_chart_series both[3] = {s, empty, {NULL, x, y, 1, GI_CHART_MARKERS, 0, NULL, NULL, NULL, NULL}};
     char path[600];
     snprintf(path, sizeof path, "%s/dropped.png", dir);
     gi_error err = {{0}};
@@ -244,7 +246,7 @@ static void test_points_kept(void)
     gi_image_free(img);
 
     /* No series at all: empty axes, still a picture. */
-    gi_chart_desc titled = {"nothing yet", "x", "y", 1, 1, 320, 200};
+    gi_chart_desc titled = {"nothing yet", "x", "y", 1, 1, 320, 200, NULL, 0};
     snprintf(path, sizeof path, "%s/empty.png", dir);
     CHECK_MSG(gi_chart_write_png(path, &titled, NULL, 0, &err) == GI_OK, "%s", err.text);
     img = gi_image_read(path, &err);
@@ -271,14 +273,14 @@ static void test_ranges(void)
         gi_chart_series s;
     } cases[] = {
         {"wide.png",
-         {"seven decades", "samples per pixel", "relMSE", 1, 1, 700, 500},
-         {"1/spp", x, y, N, GI_CHART_LINE_MARKERS, 0}},
+         {"seven decades", "samples per pixel", "relMSE", 1, 1, 700, 500, NULL, 0},
+         {"1/spp", x, y, N, GI_CHART_LINE_MARKERS, 0, NULL, NULL, NULL, NULL}},
         {"single.png",
-         {"one point", "x", "y", 1, 1, 400, 300},
-         {"only", &one_x, &one_y, 1, GI_CHART_LINE_MARKERS, 0}},
+         {"one point", "x", "y", 1, 1, 400, 300, NULL, 0},
+         {"only", &one_x, &one_y, 1, GI_CHART_LINE_MARKERS, 0, NULL, NULL, NULL, NULL}},
         {"linear.png",
-         {"linear axes", "frame", "signed error", 0, 0, 600, 400},
-         {"parabola", lx, ly, N, GI_CHART_LINE_MARKERS, 0}},
+         {"linear axes", "frame", "signed error", 0, 0, 600, 400, NULL, 0},
+         {"parabola", lx, ly, N, GI_CHART_LINE_MARKERS, 0, NULL, NULL, NULL, NULL}},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         char path[600];
@@ -314,10 +316,10 @@ static void test_colour_index(void)
         y2[i] = i * 0.25;
     }
     gi_chart_series s[2] = {
-        {NULL, x, y2, N, GI_CHART_THIN, 2},
-        {"front", x, y, N, GI_CHART_LINE_MARKERS, 2},
+        {NULL, x, y2, N, GI_CHART_THIN, 2, NULL, NULL, NULL, NULL},
+        {"front", x, y, N, GI_CHART_LINE_MARKERS, 2, NULL, NULL, NULL, NULL},
     };
-    gi_chart_desc d = {"colour index", "x", "y", 0, 0, 500, 400};
+    gi_chart_desc d = {"colour index", "x", "y", 0, 0, 500, 400, NULL, 0};
     char path[600];
     snprintf(path, sizeof path, "%s/colour_index.png", dir);
     gi_error err = {{0}};
@@ -338,10 +340,109 @@ static void test_colour_index(void)
     gi_image_free(img);
 }
 
+/* Axis ranges (charts.h): a short span is widened so that noise does not
+ * fill the y axis; a wide one is only padded; error bars count. */
+static void test_noise_ranges(void)
+{
+    double x[3] = {1, 2, 3}, y[3] = {1.00, 1.01, 1.02}, wide[3] = {0, 5, 10};
+    double lo[3] = {0.99, 1.0, 1.01}, hi[3] = {1.01, 50.0, 1.03};
+    gi_chart_series s = {"s", x, y, 3, GI_CHART_LINE_MARKERS, 0, NULL, NULL, NULL, NULL};
+    gi_chart_desc lin = {0}, logy = {0};
+    logy.log_y = 1;
+    double xr[2], yr[2];
+    gi_chart_axis_ranges(&lin, &s, 1, xr, yr);
+    /* 2 % apart: the axis spans at least 20 % of 1.02, the data a tenth of it */
+    CHECK_MSG(yr[1] - yr[0] >= 0.2 * 1.02 && yr[0] < 1.0 && yr[1] > 1.02, "linear y range [%g, %g]", yr[0],
+              yr[1]);
+    CHECK_MSG((1.02 - 1.00) / (yr[1] - yr[0]) < 0.11, "the data fill %.0f %% of the axis",
+              100.0 * 0.02 / (yr[1] - yr[0]));
+    CHECK_MSG(xr[0] < 1.0 && xr[0] > 0.9 && xr[1] > 3.0 && xr[1] < 3.1, "x range [%g, %g] is only padded", xr[0],
+              xr[1]);
+    gi_chart_axis_ranges(&logy, &s, 1, xr, yr);
+    CHECK_MSG(yr[1] / yr[0] >= 2.0 && yr[0] < 1.0 && yr[1] > 1.02, "log y range [%g, %g]", yr[0], yr[1]);
+    s.y = wide;
+    gi_chart_axis_ranges(&lin, &s, 1, xr, yr);
+    CHECK_MSG(fabs(yr[0] + 0.4) < 1e-9 && fabs(yr[1] - 10.4) < 1e-9, "wide range [%g, %g]: 4 %% padding only",
+              yr[0], yr[1]);
+    s.y = y;
+    s.y_lo = lo;
+    s.y_hi = hi;
+    gi_chart_axis_ranges(&lin, &s, 1, xr, yr);
+    CHECK_MSG(yr[1] >= 50.0, "an error bar up to 50 is inside the y range [%g, %g]", yr[0], yr[1]);
+}
+
+/* Error bars are drawn: a point with a bar from 1 to 9 covers far more rows
+ * of its colour than the same point without one (a second series fixes
+ * both charts' ranges to the same [0, 10]). */
+static void test_error_bars(void)
+{
+    double px_[1] = {5}, py_[1] = {5}, blo[1] = {1}, bhi[1] = {9};
+    double fx[2] = {0, 10}, fy[2] = {0, 10};
+    uint32_t extent[2];
+    for (int with = 0; with < 2; with++) {
+        gi_chart_series s[2] = {
+            {"bars", px_, py_, 1, GI_CHART_MARKERS, 0, NULL, NULL, with ? blo : NULL, with ? bhi : NULL},
+            {"frame", fx, fy, 2, GI_CHART_MARKERS, 2, NULL, NULL, NULL, NULL},
+        };
+        gi_chart_desc d = {"error bars", "x", "y", 0, 0, 500, 400, NULL, 0};
+        char path[600];
+        snprintf(path, sizeof path, "%s/bars_%d.png", dir, with);
+        gi_error err = {{0}};
+        CHECK_MSG(gi_chart_write_png(path, &d, s, 2, &err) == GI_OK, "%s", err.text);
+        gi_image *img = gi_image_read(path, &err);
+        CHECK_MSG(img != NULL, "%s", err.text);
+        static const int blue[3] = {0, 114, 178};
+        int top = -1, bottom = -1;
+        /* the plot area only: the legend (right of x = 400) has a blue marker too */
+        for (uint32_t yy = 0; img && yy < img->height; yy++)
+            for (uint32_t xx = 0; xx < 400; xx++) {
+                int rgb[3];
+                px(img, xx, yy, rgb);
+                if (near_colour(rgb, blue, 24)) {
+                    if (top < 0)
+                        top = (int)yy;
+                    bottom = (int)yy;
+                }
+            }
+        extent[with] = top < 0 ? 0 : (uint32_t)(bottom - top + 1);
+        gi_image_free(img);
+    }
+    /* marker ~9 px; the bar spans 8 of the axis' 10.8 units of ~300 px */
+    CHECK_MSG(extent[0] > 0 && extent[0] < 20 && extent[1] > 150, "blue rows: %u without, %u with the bar",
+              extent[0], extent[1]);
+}
+
+/* Ticks at given values: accepted, change the picture, and a count without
+ * an array is an error. */
+static void test_custom_ticks(void)
+{
+    double x[3] = {32, 64, 128}, y[3] = {5.6, 9.0, 16.9}, ticks[3] = {32, 64, 128};
+    gi_chart_series s = {"ratio", x, y, 3, GI_CHART_LINE_MARKERS, 0, NULL, NULL, NULL, NULL};
+    gi_chart_desc d = {"atlas sweep", "atlas", "ratio", 1, 0, 400, 300, NULL, 0};
+    char a[600], b[600];
+    snprintf(a, sizeof a, "%s/ticks_auto.png", dir);
+    snprintf(b, sizeof b, "%s/ticks_swept.png", dir);
+    gi_error err = {{0}};
+    CHECK_MSG(gi_chart_write_png(a, &d, &s, 1, &err) == GI_OK, "%s", err.text);
+    d.x_ticks = ticks;
+    d.x_tick_count = 3;
+    CHECK_MSG(gi_chart_write_png(b, &d, &s, 1, &err) == GI_OK, "%s", err.text);
+    gi_image *ia = gi_image_read(a, &err), *ib = gi_image_read(b, &err);
+    size_t differ = 0;
+    for (size_t i = 0; ia && ib && i < (size_t)ia->width * ia->height * 4; i++)
+        differ += ia->rgba[i] != ib->rgba[i];
+    CHECK_MSG(differ > 100, "ticks at 32, 64, 128 change %zu values of the picture", differ);
+    gi_image_free(ia);
+    gi_image_free(ib);
+    d.x_ticks = NULL;
+    CHECK(gi_chart_write_png(b, &d, &s, 1, &err) == GI_ERR_INVALID_ARGUMENT);
+    CHECK_MSG(strstr(err.text, "ticks") != NULL, "%s", err.text);
+}
+
 static void test_errors(void)
 {
     double x[] = {1, 2}, y[] = {1, 2};
-    gi_chart_series s = {"s", x, y, 2, GI_CHART_LINE_MARKERS, 0};
+    gi_chart_series s = {"s", x, y, 2, GI_CHART_LINE_MARKERS, 0, NULL, NULL, NULL, NULL};
     gi_chart_desc d = {0};
     gi_error err = {{0}};
     char path[600];
@@ -364,13 +465,13 @@ static void test_errors(void)
     CHECK(gi_chart_write_png("", &d, &s, 1, &err) == GI_ERR_INVALID_ARGUMENT);
 
     snprintf(path, sizeof path, "%s/c.png", dir);
-    gi_chart_series bad_style = {"s", x, y, 2, 7, 0};
+    gi_chart_series bad_style = {"s", x, y, 2, 7, 0, NULL, NULL, NULL, NULL};
     CHECK(gi_chart_write_png(path, &d, &bad_style, 1, &err) == GI_ERR_INVALID_ARGUMENT);
     CHECK_MSG(strstr(err.text, "style") != NULL, "%s", err.text);
-    gi_chart_series bad_colour = {"s", x, y, 2, GI_CHART_THIN, -1};
+    gi_chart_series bad_colour = {"s", x, y, 2, GI_CHART_THIN, -1, NULL, NULL, NULL, NULL};
     CHECK(gi_chart_write_png(path, &d, &bad_colour, 1, &err) == GI_ERR_INVALID_ARGUMENT);
     CHECK_MSG(strstr(err.text, "colour") != NULL, "%s", err.text);
-    gi_chart_series no_data = {"s", NULL, y, 2, GI_CHART_MARKERS, 0};
+    gi_chart_series no_data = {"s", NULL, y, 2, GI_CHART_MARKERS, 0, NULL, NULL, NULL, NULL};
     CHECK(gi_chart_write_png(path, &d, &no_data, 1, &err) == GI_ERR_INVALID_ARGUMENT);
     CHECK(gi_chart_write_png(path, &d, NULL, 2, &err) == GI_ERR_INVALID_ARGUMENT);
     gi_chart_desc huge = {0};
@@ -394,8 +495,8 @@ static void test_context_restored(void)
     glBindBuffer(GL_ARRAY_BUFFER, buf);
     glBindBuffer(GL_ARRAY_BUFFER, 0);
     double x[] = {1, 10}, y[] = {1, 0.1};
-    gi_chart_series s = {"s", x, y, 2, GI_CHART_LINE_MARKERS, 0};
-    gi_chart_desc d = {"with the core's context", NULL, NULL, 1, 1, 400, 300};
+    gi_chart_series s = {"s", x, y, 2, GI_CHART_LINE_MARKERS, 0, NULL, NULL, NULL, NULL};
+    gi_chart_desc d = {"with the core's context", NULL, NULL, 1, 1, 400, 300, NULL, 0};
     char path[600];
     snprintf(path, sizeof path, "%s/ctx.png", dir);
     CHECK_MSG(gi_chart_write_png(path, &d, &s, 1, &err) == GI_OK, "%s", err.text);
@@ -421,6 +522,9 @@ int main(void)
     test_points_kept();
     test_ranges();
     test_colour_index();
+    test_noise_ranges();
+    test_error_bars();
+    test_custom_ticks();
     test_errors();
     test_context_restored();
     /* Kept for a look when something failed or GI_KEEP_CHARTS is set. */
