@@ -324,6 +324,44 @@ int gi_rt_intersect_tuv(const gi_rt *rt, gi_vec3 o, gi_vec3 d, float tmin, float
     return 1;
 }
 
+void gi_rt_intersect8_tuv(const gi_rt *rt, uint32_t n, const gi_vec3 *o, const gi_vec3 *d,
+                          const float *tmin, const float *tmax, int *hit, float *t, float *u,
+                          float *v, uint32_t *triangle)
+{
+    assert(rt && n <= 8 && o && d && tmin && tmax && hit && t && u && v && triangle);
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    struct RTCRayHit8 rh;
+    int valid[8];
+    for (uint32_t i = 0; i < 8; i++) {
+        uint32_t k = i < n ? i : 0; /* lanes past n repeat ray 0, masked off */
+        valid[i] = i < n ? -1 : 0;
+        rh.ray.org_x[i] = o[k].x;
+        rh.ray.org_y[i] = o[k].y;
+        rh.ray.org_z[i] = o[k].z;
+        rh.ray.tnear[i] = tmin[k];
+        rh.ray.dir_x[i] = d[k].x;
+        rh.ray.dir_y[i] = d[k].y;
+        rh.ray.dir_z[i] = d[k].z;
+        rh.ray.time[i] = 0.0f;
+        rh.ray.tfar[i] = tmax[k];
+        rh.ray.mask[i] = ~0u;
+        rh.ray.id[i] = i;
+        rh.ray.flags[i] = 0;
+        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect8(valid, rt->rtc, &ctx, &rh);
+    for (uint32_t i = 0; i < n; i++) {
+        hit[i] = rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+        t[i] = rh.ray.tfar[i];
+        u[i] = rh.hit.u[i];
+        v[i] = rh.hit.v[i];
+        triangle[i] = rh.hit.primID[i];
+    }
+}
+
 int gi_rt_intersect(const gi_rt *rt, gi_vec3 o, gi_vec3 d, float tmin, float tmax, gi_rt_hit *hit)
 {
     assert(rt && hit);

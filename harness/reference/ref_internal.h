@@ -73,9 +73,27 @@ typedef struct ref_counters {
     uint64_t rays;
 } ref_counters;
 
-/* Radiance of one camera sample through pixel (x, y), row 0 the top, with
- * the random stream *rng. */
-void ref_path_sample(const ref_scene *rs, uint32_t x, uint32_t y, uint32_t *rng, float L[3],
-                     ref_counters *c);
+/* A camera ray: origin, direction and the interval the rasteriser's
+ * near and far planes leave. */
+typedef struct ref_ray {
+    gi_vec3 o, d;
+    float tnear, tfar;
+} ref_ray;
+
+/* The first hit of a camera ray when the caller has traced it already. */
+typedef struct ref_hit {
+    float t, u, v;
+    uint32_t prim;
+} ref_hit;
+
+/* The camera ray of one sample through pixel (x, y), row 0 the top; draws
+ * the sample's first two numbers from *rng (the position in the pixel). */
+void ref_camera_ray(const ref_scene *rs, uint32_t x, uint32_t y, uint32_t *rng, ref_ray *ray);
+
+/* Radiance along the path that starts with camera ray `ray`, with the
+ * random stream *rng after ref_camera_ray. `first` is the ray's hit when
+ * the caller traced it (hit: 1 or 0), or NULL to trace it here. */
+void ref_path_trace(const ref_scene *rs, const ref_ray *ray, const ref_hit *first, int hit,
+                    uint32_t *rng, float L[3], ref_counters *c);
 
 #endif

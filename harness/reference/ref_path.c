@@ -30,11 +30,6 @@
 #define RR_AFTER 3
 #define RR_MAX_SURVIVAL 0.95f
 
-typedef struct ref_hit {
-    float t, u, v;
-    uint32_t prim;
-} ref_hit;
-
 /* A path vertex, everything oriented to the side wo is on. */
 typedef struct surface {
     gi_vec3 p;  /* position, from the barycentrics */
@@ -264,13 +259,9 @@ static void punctual_lights(const ref_scene *rs, const surface *s, const float b
     }
 }
 
-void ref_path_sample(const ref_scene *rs, uint32_t x, uint32_t y, uint32_t *rng, float L[3],
-                     ref_counters *c)
+void ref_camera_ray(const ref_scene *rs, uint32_t x, uint32_t y, uint32_t *rng, ref_ray *ray)
 {
     const ref_camera *cam = &rs->cam;
-    L[0] = L[1] = L[2] = 0.0f;
-    float beta[3] = {1.0f, 1.0f, 1.0f};
-
     /* Box filter: a uniform point in the pixel; row 0 is the top. With
      * pixel_center the point is the centre (the numbers are still drawn, so
      * that the rest of the path uses the same stream). */
@@ -279,19 +270,37 @@ void ref_path_sample(const ref_scene *rs, uint32_t x, uint32_t y, uint32_t *rng,
         jx = jy = 0.5f;
     float sx = (((float)x + jx) / (float)rs->width * 2.0f - 1.0f) * cam->tan_half_y * cam->aspect;
     float sy = (1.0f - ((float)y + jy) / (float)rs->height * 2.0f) * cam->tan_half_y;
-    gi_vec3 d = gi_v3_normalize(
+    ray->d = gi_v3_normalize(
         gi_v3_add(cam->forward, gi_v3_add(gi_v3_scale(cam->right, sx), gi_v3_scale(cam->up, sy))));
     /* The rasteriser's near and far planes, so both see the same surfaces. */
-    float cos_f = gi_v3_dot(d, cam->forward);
-    gi_vec3 o = cam->eye;
-    float tnear = cam->znear / cos_f, tfar = cam->zfar / cos_f;
+    float cos_f = gi_v3_dot(ray->d, cam->forward);
+    ray->o = cam->eye;
+    ray->tnear = cam->znear / cos_f;
+    ray->tfar = cam->zfar / cos_f;
+}
+
+void ref_path_trace(const ref_scene *rs, const ref_ray *ray, const ref_hit *first, int first_hit,
+                    uint32_t *rng, float L[3], ref_counters *c)
+{
+    L[0] = L[1] = L[2] = 0.0f;
+    float beta[3] = {1.0f, 1.0f, 1.0f};
+    gi_vec3 o = ray->o, d = ray->d;
+    float tnear = ray->tnear, tfar = ray->tfar;
     int prev_delta = 1; /* the camera ray: emission seen directly counts in full */
     float prev_pdf = 0.0f;
     const int nee = rs->strategy != GI_REF_STRATEGY_BSDF;
 
     for (int depth = 0;; depth++) { /* depth = bounces so far */
         ref_hit h;
-        if (!trace(rs, o, d, tnear, tfar, &h, c)) {
+        int found;
+        if (depth == 0 && first) { /* the caller traced the camera ray */
+            c->rays++;
+            h = *first;
+            found = first_hit;
+        } else {
+            found = trace(rs, o, d, tnear, tfar, &h, c);
+        }
+        if (!found) {
             if (rs->env) {
                 float Le[3];
                 gi_envmap_eval(rs->env, d, Le);

@@ -533,6 +533,52 @@ static void test_bad_input(void)
     gi_scene_free(s);
 }
 
+/* The 8-ray packet query gives each ray the hit the single-ray query
+ * gives: camera-like bundles (one origin, directions a few degrees apart)
+ * and scattered rays, full packets and partial ones (n = 1..8). */
+static void test_packets(void)
+{
+    gi_error err;
+    gi_scene *s = gi_scene_load(GI_SOURCE_DIR "/scenes/cornell_box.gltf", &err);
+    CHECK_MSG(s != NULL, "%s", err.text);
+    if (!s)
+        return;
+    gi_rt *rt = NULL;
+    CHECK_MSG(gi_rt_create_ex(s, 0.0f, GI_RT_FAST_TRAVERSAL, &rt, &err) == GI_OK && rt, "%s", err.text);
+    uint32_t rng = 12345u, rays = 0, hits = 0, same = 0;
+    for (int round = 0; rt && round < 400; round++) {
+        uint32_t n = 1u + (uint32_t)round % 8u;
+        int bundle = round % 2 == 0;
+        gi_vec3 o[8], d[8];
+        float tmin[8], tmax[8], t[8], u[8], v[8];
+        uint32_t tri[8];
+        int hit[8];
+        gi_vec3 eye = gi_v3(urand(&rng) * 0.8f + 0.1f, urand(&rng) * 0.8f + 0.1f, urand(&rng) * 0.8f + 0.1f);
+        for (uint32_t i = 0; i < n; i++) {
+            gi_vec3 a = gi_v3(urand(&rng) * 2.0f - 1.0f, urand(&rng) * 2.0f - 1.0f, urand(&rng) * 2.0f - 1.0f);
+            o[i] = bundle ? eye : gi_v3(urand(&rng), urand(&rng), urand(&rng));
+            d[i] = gi_v3_normalize(bundle ? gi_v3_add(gi_v3(0.0f, 0.0f, -1.0f), gi_v3_scale(a, 0.1f)) : a);
+            tmin[i] = i == 3 ? 0.05f : 0.0f;
+            tmax[i] = i == 5 ? 0.3f : INFINITY;
+        }
+        gi_rt_intersect8_tuv(rt, n, o, d, tmin, tmax, hit, t, u, v, tri);
+        for (uint32_t i = 0; i < n; i++) {
+            float t1 = 0, u1 = 0, v1 = 0;
+            uint32_t tri1 = 0;
+            int h1 = gi_rt_intersect_tuv(rt, o[i], d[i], tmin[i], tmax[i], &t1, &u1, &v1, &tri1);
+            rays++;
+            hits += h1 != 0;
+            same += h1 == hit[i] && (!h1 || (tri1 == tri[i] && fabsf(t1 - t[i]) <= 1e-5f * t1 &&
+                                             fabsf(u1 - u[i]) <= 1e-5f && fabsf(v1 - v[i]) <= 1e-5f));
+        }
+    }
+    printf("packets: %u of %u rays agree with single-ray queries (%u hits)\n", same, rays, hits);
+    /* both kinds of answer are covered */
+    CHECK_MSG(rays == 1800 && same == rays && hits > rays / 4 && hits < rays, "%u of %u agree, %u hits", same, rays, hits);
+    gi_rt_free(rt);
+    gi_scene_free(s);
+}
+
 int main(void)
 {
     (void)tg_environment; /* ref_scenes.h helpers this test does not need */
@@ -541,6 +587,7 @@ int main(void)
     test_handmade();
     test_scene(GI_SOURCE_DIR "/scenes/cornell_box.gltf", 3000);
     test_fast_traversal();
+    test_packets();
     test_moving();
     return gi_test_finish();
 }

@@ -101,6 +101,14 @@ int gi_rt_intersect(const gi_rt *rt, gi_vec3 o, gi_vec3 d, float tmin, float tma
  * or 0. Same hits as gi_rt_intersect, without its position and normal. */
 int gi_rt_intersect_tuv(const gi_rt *rt, gi_vec3 o, gi_vec3 d, float tmin, float tmax, float *t,
                         float *u, float *v, uint32_t *triangle);
+/* Up to 8 rays at once through Embree's packet traversal
+ * (rtcIntersect8, marked coherent: meant for rays that start together and
+ * point alike, as a pixel's camera rays do). Ray i < n: origin o[i],
+ * direction d[i], interval [tmin[i], tmax[i]]; hit[i] is 1 with t, u, v and
+ * triangle set as gi_rt_intersect_tuv sets them, or 0. n <= 8. */
+void gi_rt_intersect8_tuv(const gi_rt *rt, uint32_t n, const gi_vec3 *o, const gi_vec3 *d,
+                          const float *tmin, const float *tmax, int *hit, float *t, float *u,
+                          float *v, uint32_t *triangle);
 /* 1 when any triangle lies on o + t d, tmin <= t <= tmax. */
 int gi_rt_occluded(const gi_rt *rt, gi_vec3 o, gi_vec3 d, float tmin, float tmax);
 
