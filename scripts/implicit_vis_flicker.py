@@ -24,10 +24,18 @@ mean luminance of the A frames:
               be told from the reference's noise;
   ratio       flicker / ref noise (about 1 or less: not measurable at this
               reference's noise; well above 1: flicker);
-  static      mean |M_i - A_i| (the still error, which does not flicker).
+  static      mean |M_i - A_i| (the still error, which does not flicker;
+              for the frozen image, implicit_vis's frame 0 against A_i);
+  still px    mean |X_{i+1} - X_i| over the pixels whose reference (mean of
+              A and B) varies by less than 2 % of the mean luminance over
+              the whole sequence: change where nothing changes, i.e. flicker
+              away from the deforming object, for X = M and for the
+              references themselves (their noise).
 
-A second method (default the unshadowed `direct` plugin, --other) is
-measured the same way beside it, as the trivial comparison.
+Two trivial answers beside it: a frozen image (M_i = M_0 for every i: no
+change at all, so its flicker is the reference's own change), and a second
+method (default the unshadowed `direct` plugin, --other) measured the same
+way.
 
 Writes OUT/flicker.csv (one row per pair and method) and prints a Markdown
 table. Stdlib only; images go through .pfm.
@@ -111,12 +119,26 @@ def main():
                  "--out", p] + extra)
             img[(m, i)] = read_pfm(p)
     norm = sum(sum(img[("ref1", i)]) / len(img[("ref1", i)]) for i in range(a.frames)) / a.frames
+    npx = len(img[("ref1", 0)])
+    seq = [[0.5 * (img[("ref1", i)][p] + img[("ref2", i)][p]) for i in range(a.frames)] for p in range(npx)]
+    still = [p for p in range(npx) if max(seq[p]) - min(seq[p]) < 0.02 * norm]
+
+    def still_change(key, i):
+        X0, X1 = img[(key, i)], img[(key, i + 1)]
+        return sum(abs(X1[p] - X0[p]) for p in still) / max(1, len(still)) / norm
+
     rows = []
     for i in range(a.frames - 1):
         A0, A1, B0, B1 = img[("ref1", i)], img[("ref1", i + 1)], img[("ref2", i)], img[("ref2", i + 1)]
         dA = [y - x for x, y in zip(A0, A1)]
         dB = [y - x for x, y in zip(B0, B1)]
         noise = mean_abs([b - r for b, r in zip(dB, dA)]) / norm
+        rows.append({
+            "method": "frozen image", "t0": "%.4g" % times[i], "t1": "%.4g" % times[i + 1],
+            "change_method": 0.0, "change_ref": mean_abs(dA) / norm, "flicker": mean_abs(dA) / norm,
+            "ref_noise": noise, "static_error": mean_abs([x - y for x, y in zip(img[("implicit_vis", 0)], A0)]) / norm,
+            "still_px_change": 0.0, "still_px_ref": still_change("ref1", i),
+        })
         for m, _ in methods:
             M0, M1 = img[(m, i)], img[(m, i + 1)]
             dM = [y - x for x, y in zip(M0, M1)]
@@ -125,6 +147,7 @@ def main():
                 "change_method": mean_abs(dM) / norm, "change_ref": mean_abs(dA) / norm,
                 "flicker": mean_abs([x - y for x, y in zip(dM, dA)]) / norm, "ref_noise": noise,
                 "static_error": mean_abs([x - y for x, y in zip(M0, A0)]) / norm,
+                "still_px_change": still_change(m, i), "still_px_ref": still_change("ref1", i),
             })
     with open(os.path.join(a.out, "flicker.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
@@ -132,22 +155,25 @@ def main():
         for r in rows:
             w.writerow({k: ("%.5g" % v if isinstance(v, float) else v) for k, v in r.items()})
     print("Scene %s, %s, frames t = %s s, reference %d spp %d bounces (seeds 1 and 2); values relative to the "
-          "reference's mean luminance %.4g.\n" % (a.scene, size, ", ".join("%.3g" % t for t in times), a.spp,
-                                                   a.bounces, norm))
-    print("| method | t | change (method) | change (reference) | flicker | reference noise | ratio | still error |")
-    print("|---|---|---|---|---|---|---|---|")
+          "reference's mean luminance %.4g; still pixels: %d of %d.\n" % (
+        a.scene, size, ", ".join("%.3g" % t for t in times), a.spp, a.bounces, norm, len(still), npx))
+    print("| method | t | change (method) | change (reference) | flicker | reference noise | ratio | still error "
+          "| change on still px (method / reference) |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for r in rows:
-        print("| %s | %s → %s | %.4f | %.4f | %.4f | %.4f | %.2f | %.4f |" % (
+        print("| %s | %s → %s | %.4f | %.4f | %.4f | %.4f | %.2f | %.4f | %.4f / %.4f |" % (
             r["method"], r["t0"], r["t1"], r["change_method"], r["change_ref"], r["flicker"], r["ref_noise"],
-            r["flicker"] / r["ref_noise"] if r["ref_noise"] > 0 else float("nan"), r["static_error"]))
-    for m, _ in methods:
+            r["flicker"] / r["ref_noise"] if r["ref_noise"] > 0 else float("nan"), r["static_error"],
+            r["still_px_change"], r["still_px_ref"]))
+    for m in [x for x, _ in methods] + ["frozen image"]:
         rs = [r for r in rows if r["method"] == m]
         fl = sum(r["flicker"] for r in rs) / len(rs)
         nz = sum(r["ref_noise"] for r in rs) / len(rs)
         ch = sum(r["change_method"] for r in rs) / len(rs)
         cr = sum(r["change_ref"] for r in rs) / len(rs)
-        print("| **%s, mean** | | %.4f | %.4f | %.4f | %.4f | %.2f | %.4f |" % (
-            m, ch, cr, fl, nz, fl / nz if nz > 0 else float("nan"), sum(r["static_error"] for r in rs) / len(rs)))
+        print("| **%s, mean** | | %.4f | %.4f | %.4f | %.4f | %.2f | %.4f | %.4f / %.4f |" % (
+            m, ch, cr, fl, nz, fl / nz if nz > 0 else float("nan"), sum(r["static_error"] for r in rs) / len(rs),
+            sum(r["still_px_change"] for r in rs) / len(rs), sum(r["still_px_ref"] for r in rs) / len(rs)))
 
 
 if __name__ == "__main__":
