@@ -31,13 +31,13 @@ void iv_gpu_free(iv_gpu *g)
 {
     if (!g)
         return;
-    GLuint bufs[] = {g->ssbo_elem, g->ssbo_children, g->ssbo_bins, g->ssbo_geom, g->ssbo_links,
-                     g->ssbo_off,  g->ssbo_rad[0],   g->ssbo_rad[1], g->ssbo_out};
+    GLuint bufs[] = {g->ssbo_elem, g->ssbo_children, g->ssbo_bins,   g->ssbo_geom, g->ssbo_links,
+                     g->ssbo_off,  g->ssbo_wlinks,   g->ssbo_rad[0], g->ssbo_rad[1], g->ssbo_out};
     for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++)
         if (bufs[i])
             glDeleteBuffers(1, &bufs[i]);
-    GLuint progs[] = {g->prog_emit, g->prog_pull, g->prog_gather};
-    for (size_t i = 0; i < 3; i++)
+    GLuint progs[] = {g->prog_emit, g->prog_weights, g->prog_pull, g->prog_gather};
+    for (size_t i = 0; i < 4; i++)
         if (progs[i])
             glDeleteProgram(progs[i]);
     free(g->level_off), free(g->geom), free(g->links), free(g->off);
@@ -56,6 +56,12 @@ iv_gpu *iv_gpu_create(const iv_hier *h, const iv_links *l, const gi_envmap *env,
     g->bins = l->bins;
     g->n = l->n;
     g->env = env != NULL;
+    if (h->node_count >= (1u << 30)) { /* iv_weights.comp keeps a node's side in the top two bits */
+        gi_error_set(err, GI_ERR_UNSUPPORTED, "implicit_vis: %u nodes are too many for the GPU illumination (limit 2^30)",
+                     h->node_count);
+        free(g);
+        return NULL;
+    }
     /* the levels: breadth-first order puts each depth in one run of nodes */
     uint8_t *depth = calloc(h->node_count, 1);
     g->level_off = calloc((size_t)h->depth + 2, sizeof *g->level_off);
@@ -120,12 +126,14 @@ iv_gpu *iv_gpu_create(const iv_hier *h, const iv_links *l, const gi_envmap *env,
     g->ssbo_geom = make_dynamic((size_t)h->node_count * 8 * sizeof(float));
     g->ssbo_off = make_dynamic(((size_t)h->elem_count + 1) * 2 * sizeof(uint32_t));
     g->ssbo_links = make_dynamic(16);
+    g->ssbo_wlinks = make_dynamic(8);
     g->links_gpu = 16;
     for (int i = 0; i < 2; i++)
         g->ssbo_rad[i] = make_dynamic((size_t)h->node_count * 8 * sizeof(float));
     g->ssbo_out = make_dynamic((size_t)h->elem_count * 12 * sizeof(float));
     g->prog_emit = gi_program_build_compute("iv_emit.comp", NULL, err);
-    g->prog_pull = g->prog_emit ? gi_program_build_compute("iv_pull.comp", NULL, err) : 0;
+    g->prog_weights = g->prog_emit ? gi_program_build_compute("iv_weights.comp", NULL, err) : 0;
+    g->prog_pull = g->prog_weights ? gi_program_build_compute("iv_pull.comp", NULL, err) : 0;
     g->prog_gather = g->prog_pull ? gi_program_build_compute("iv_gather.comp", NULL, err) : 0;
     if (!g->prog_gather) {
         iv_gpu_free(g);
@@ -192,6 +200,7 @@ gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint
     if (words * sizeof(uint32_t) > g->links_gpu) {
         g->links_gpu = words * sizeof(uint32_t) + words * sizeof(uint32_t) / 4;
         glNamedBufferData(g->ssbo_links, (GLsizeiptr)g->links_gpu, NULL, GL_DYNAMIC_DRAW);
+        glNamedBufferData(g->ssbo_wlinks, (GLsizeiptr)(g->links_gpu / 2), NULL, GL_DYNAMIC_DRAW);
     }
     glNamedBufferSubData(g->ssbo_links, 0, (GLsizeiptr)(words * sizeof(uint32_t)), g->links);
     glNamedBufferSubData(g->ssbo_off, 0, (GLsizeiptr)(((size_t)g->elems + 1) * 2 * sizeof(uint32_t)), g->off);
@@ -202,6 +211,7 @@ gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_GEOM, g->ssbo_geom);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_LINKS, g->ssbo_links);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_LINK_OFF, g->ssbo_off);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_WLINKS, g->ssbo_wlinks);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_ELEM_LIGHT, g->ssbo_out);
 
     /* bounce 0: the emission, pulled up */
@@ -210,6 +220,9 @@ gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint
     glUniform1ui(glGetUniformLocation(g->prog_emit, "u_bins"), g->bins);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_RAD_DST, g->ssbo_rad[cur]);
     dispatch(g->prog_emit, 0, g->elems);
+    glUseProgram(g->prog_weights);
+    glUniform1ui(glGetUniformLocation(g->prog_weights, "u_light_base"), l->leaf_off[g->elems]);
+    dispatch(g->prog_weights, 0, g->elems);
     pull_up(g, g->ssbo_rad[cur]);
     GLuint p = g->prog_gather;
     for (uint32_t k = 0; k <= bounces; k++) {

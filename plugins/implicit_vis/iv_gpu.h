@@ -24,22 +24,23 @@ typedef struct iv_gpu {
     uint32_t levels;      /* depth of the deepest tree */
     uint32_t *level_off;  /* levels + 1: nodes of each depth (breadth-first order keeps them contiguous) */
     int env;              /* the scene has an environment */
-    GLuint prog_emit, prog_pull, prog_gather;
+    GLuint prog_emit, prog_weights, prog_pull, prog_gather;
     GLuint ssbo_elem, ssbo_children, ssbo_bins; /* built once */
     GLuint ssbo_geom, ssbo_links, ssbo_off;     /* every frame */
+    GLuint ssbo_wlinks;   /* per link, made on the GPU every frame: node and side, weight */
     GLuint ssbo_rad[2];   /* outgoing radiance per node, this bounce's and the previous one's */
     GLuint ssbo_out;      /* per element: irradiance on both sides, normal (IV_SSBO_ELEM_LIGHT) */
     float *geom;          /* staging: 8 per node */
     uint32_t *links, *off; /* staging for iv_links_pack */
     size_t links_cap;     /* words */
-    size_t links_gpu;     /* bytes of ssbo_links */
+    size_t links_gpu;     /* bytes of ssbo_links (ssbo_wlinks: half of it) */
 } iv_gpu;
 
 iv_gpu *iv_gpu_create(const iv_hier *h, const iv_links *l, const gi_envmap *env, gi_error *err);
 void iv_gpu_free(iv_gpu *g);
 /* Uploads the frame's node positions, normals and areas and the links,
- * then runs the passes: emission, pull-up, and bounces + 1 gathers each
- * followed by a pull-up (the last one needs none). punctual: the number of
+ * then runs the passes: emission, the links' weights, pull-up, and
+ * bounces + 1 gathers each followed by a pull-up (the last one needs none). punctual: the number of
  * the scene's punctual lights (bound at GI_SSBO_LIGHTS). */
 gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint32_t bounces, uint32_t punctual,
                             gi_error *err);

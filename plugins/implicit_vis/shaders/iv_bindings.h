@@ -15,6 +15,7 @@
 #define IV_SSBO_RAD_DST 16   /* per node: outgoing radiance on both sides, this bounce's */
 #define IV_SSBO_LINKS 17     /* per receiving link: bin, other end, covered share, length */
 #define IV_SSBO_LINK_OFF 18  /* per element + 1: its first receiving link, its first light link */
+#define IV_SSBO_WLINKS 19    /* per receiving link, per frame: node at the other end and its side, Eq. 5's weight */
 #define IV_SSBO_PUNCTUAL 3   /* the scene's punctual lights (GI_SSBO_LIGHTS) */
 /* work-group width of the three passes */
 #define IV_GROUP 64

@@ -2,7 +2,7 @@
 // element, the radiance of the nodes at the other end of its receiving
 // links (the light links only for the direct light, the paper's "Speedup"),
 // each over its bin with Eq. 5 (the nearest node covering its bin, or the
-// share `covered` of it); for the direct light also the environment through
+// share `covered` of it; the weights from iv_weights.comp); for the direct light also the environment through
 // the empty bins and the punctual lights through the bin toward them. The
 // irradiance is added to the element's total, and times albedo / pi becomes
 // the leaf's outgoing radiance for the next bounce. The GLSL twin of
@@ -20,6 +20,7 @@ layout(std430, binding = IV_SSBO_RAD_SRC) readonly buffer IvRadSrc { IvRad iv_sr
 layout(std430, binding = IV_SSBO_RAD_DST) writeonly buffer IvRadDst { IvRad iv_dst[]; };
 layout(std430, binding = IV_SSBO_LINKS) readonly buffer IvLinks { uvec4 iv_link[]; }; // bin, node, covered, length
 layout(std430, binding = IV_SSBO_LINK_OFF) readonly buffer IvLinkOff { uvec2 iv_off[]; };
+layout(std430, binding = IV_SSBO_WLINKS) readonly buffer IvWLinks { uvec2 iv_wl[]; }; // node | side << 30, weight
 layout(std430, binding = IV_SSBO_ELEM_LIGHT) buffer IvOut { IvElemLight iv_out[]; };
 
 struct IvPunctual { // the scene's GiLight (scene.glsl, gpu.h gi_gpu_light)
@@ -58,14 +59,12 @@ uint iv_bin_of(vec3 d)
     return face * u_n * u_n + uint(row) * u_n + uint(col);
 }
 
-// Radiance node `src` sends toward x: the side its mean normal faces x; a
-// cluster facing every way (mean normal shorter than 0.3) sends the mean.
-vec3 node_radiance(uint src, vec3 x)
+// Radiance node `src` sends from its side `side` (iv_weights.comp).
+vec3 node_radiance(uint src, uint side)
 {
-    vec3 ns = iv_node[src].nrm.xyz;
-    if (dot(ns, ns) < 0.09)
+    if (side == IV_SIDE_BOTH)
         return 0.5 * (iv_src[src].front.rgb + iv_src[src].back.rgb);
-    return dot(ns, x - iv_node[src].pos.xyz) >= 0.0 ? iv_src[src].front.rgb : iv_src[src].back.rgb;
+    return side == IV_SIDE_FRONT ? iv_src[src].front.rgb : iv_src[src].back.rgb;
 }
 
 // Radiance L through the share `frac` of bin b onto the side of the disc it falls on.
@@ -106,9 +105,14 @@ void main()
     uint j0 = u_direct != 0 ? u_light_base + o0.y : o0.x;
     uint j1 = u_direct != 0 ? u_light_base + o1.y : o1.x;
     vec3 ep = vec3(0.0), em = vec3(0.0);
-    for (uint j = j0; j < j1; j++) {
-        uvec4 l = iv_link[j];
-        add_bin(l.x, n, norm, uintBitsToFloat(l.z), node_radiance(l.y, p), ep, em);
+    for (uint j = j0; j < j1; j++) { // Eq. 5 with the weights of iv_weights.comp
+        uvec2 l = iv_wl[j];
+        float w = uintBitsToFloat(l.y);
+        vec3 L = node_radiance(l.x & 0x3FFFFFFFu, l.x >> 30);
+        if (w >= 0.0)
+            ep += w * L;
+        else
+            em += -w * L;
     }
     if (u_direct != 0) {
         if (u_env != 0) { // Sec. 4.4: what the links leave open of each bin sees the environment

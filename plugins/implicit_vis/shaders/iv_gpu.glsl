@@ -23,6 +23,9 @@ struct IvRad {
     vec4 front; // radiance leaving the side the normal faces
     vec4 back;  // and the other side
 };
+// Which side of a node sends toward a receiver (iv_weights.comp).
+const uint IV_SIDE_FRONT = 0u, IV_SIDE_BACK = 1u, IV_SIDE_BOTH = 2u;
+
 struct IvElemLight {
     vec4 e_front; // irradiance on the side the element's normal faces
     vec4 e_back;  // on the other side
