@@ -131,6 +131,9 @@ iv_gpu *iv_gpu_create(const iv_hier *h, const iv_links *l, const gi_envmap *env,
     for (int i = 0; i < 2; i++)
         g->ssbo_rad[i] = make_dynamic((size_t)h->node_count * 8 * sizeof(float));
     g->ssbo_out = make_dynamic((size_t)h->elem_count * 12 * sizeof(float));
+    GLint64 max_block = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
+    g->max_block = max_block > 0 ? (size_t)max_block : (size_t)1 << 27; /* GL's minimum: 2^27 bytes */
     g->prog_emit = gi_program_build_compute("iv_emit.comp", NULL, err);
     g->prog_weights = g->prog_emit ? gi_program_build_compute("iv_weights.comp", NULL, err) : 0;
     g->prog_pull = g->prog_weights ? gi_program_build_compute("iv_pull.comp", NULL, err) : 0;
@@ -189,6 +192,11 @@ gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint
     /* the links, flattened */
     size_t nlinks = (size_t)l->leaf_off[g->elems] + l->light_off[g->elems];
     size_t words = 4 * (nlinks ? nlinks : 1);
+    if (words * sizeof(uint32_t) > g->max_block)
+        return gi_error_set(err, GI_ERR_UNSUPPORTED,
+                            "implicit_vis: %zu links need %.0f MiB in one GPU buffer, more than this GL's limit of "
+                            "%.0f MiB: lower N or use illum=cpu",
+                            nlinks, (double)(words * sizeof(uint32_t)) / (1 << 20), (double)g->max_block / (1 << 20));
     if (words > g->links_cap) {
         uint32_t *nl = realloc(g->links, words * sizeof(uint32_t));
         if (!nl)

@@ -34,6 +34,7 @@ typedef struct iv_gpu {
     uint32_t *links, *off; /* staging for iv_links_pack */
     size_t links_cap;     /* words */
     size_t links_gpu;     /* bytes of ssbo_links (ssbo_wlinks: half of it) */
+    size_t max_block;     /* GL_MAX_SHADER_STORAGE_BLOCK_SIZE */
 } iv_gpu;
 
 iv_gpu *iv_gpu_create(const iv_hier *h, const iv_links *l, const gi_envmap *env, gi_error *err);
