@@ -10,12 +10,15 @@
  *   refine_push      refinement and push-down to unidirectional leaf links;
  *   illumination     direct light along the light links, the environment
  *                    through empty bins, punctual lights through their bin,
- *                    then `bounces` gathers and pull-ups;
+ *                    then `bounces` gathers and pull-ups: compute shaders
+ *                    over the flattened links (iv_gpu.c, Sec. 4.3.1), or
+ *                    with `illum=cpu` the same on one CPU thread;
  *   display          the G-buffer and the per-vertex irradiance
  *                    interpolated per pixel (shaders/iv_display.comp).
- * The hierarchy, links and gathering run on the CPU (one thread); only the
- * display runs on the GPU (README "Not yet implemented"). */
+ * The hierarchy and the links are built on the CPU (one thread); the
+ * gathering and pull-up and the display run on the GPU. */
 #include "iv.h"
+#include "iv_gpu.h"
 #include "shaders/iv_bindings.h"
 
 #include "gi/kit.h"
@@ -50,15 +53,18 @@ static const gi_param_desc iv_params[] = {
      "a bin whose links' solid angles sum to less than this share of it passes light through that share only; 0: Eq. 5 (the nearest covers the bin)"},
     {"splat", GI_PARAM_BOOL, 1, 0, 1, NULL, "Sec. 3 (an element covers its bin)",
      "a disc nearer than its size covers every bin it spans, not only its centre's (README \"Deviations\")"},
+    {"illum", GI_PARAM_ENUM, 0, 0, 0, "gpu|cpu", "Sec. 4.3.1 (GPU implementation)",
+     "where the gathering and pull-up run: compute shaders over the flattened links, or one CPU thread"},
     {0},
 };
 
 typedef struct implicit_vis {
     gi_kit kit;
-    int N, bounces, brute, splat, bilinear;
+    int N, bounces, brute, splat, bilinear, cpu_illum;
     float subdiv, remesh, coverage;
     iv_hier *hier;
     iv_links *links;
+    iv_gpu *gpu;         /* the GPU illumination (illum=gpu) */
     float *irr;          /* 6 per element */
     float *elem_light; /* 12 per element: e_front, e_back, normal (vec4 each) */
     GLuint ssbo_light, ssbo_tri, ssbo_grid;
@@ -82,12 +88,14 @@ static gi_result iv_create(const gi_host *host, const gi_params *params, void **
     m->splat = gi_params_bool(params, "splat");
     m->bilinear = gi_params_bool(params, "bilinear");
     m->coverage = gi_params_float(params, "coverage");
+    m->cpu_illum = gi_params_enum(params, "illum") == 1;
     *out = m;
     return GI_OK;
 }
 
 static void release_prepared(implicit_vis *m)
 {
+    iv_gpu_free(m->gpu);
     iv_links_free(m->links);
     iv_hier_free(m->hier);
     free(m->irr);
@@ -98,6 +106,7 @@ static void release_prepared(implicit_vis *m)
             glDeleteBuffers(1, &bufs[i]);
     if (m->prog_display)
         glDeleteProgram(m->prog_display);
+    m->gpu = NULL;
     m->links = NULL;
     m->hier = NULL;
     m->irr = m->elem_light = NULL;
@@ -159,6 +168,11 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
     m->prog_display = gi_program_build_compute("iv_display.comp", NULL, &err);
     if (!m->prog_display)
         return gi_kit_fail_with(&m->kit, GI_ERR_GL, &err);
+    if (!m->cpu_illum) {
+        m->gpu = iv_gpu_create(m->hier, m->links, s->envmap, &err);
+        if (!m->gpu)
+            return gi_kit_fail_with(&m->kit, GI_ERR_GL, &err);
+    }
     host->stat(host, "elements", (double)m->hier->elem_count);
     host->stat(host, "nodes", (double)m->hier->node_count);
     host->stat(host, "segments", (double)m->hier->segment_count);
@@ -213,10 +227,17 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
     host->stage_end(host, "refine_push");
 
     host->stage_begin(host, "illumination");
-    iv_lights li = {s, gs->time, s->envmap};
-    iv_illuminate(m->links, m->hier, &li, (uint32_t)m->bounces, m->irr);
-    upload_elem_light(m);
+    if (m->gpu) { /* Sec. 4.3.1: the punctual lights at the frame's time come from the scene's buffer */
+        gi_gpu_scene_bind(gs);
+        r = iv_gpu_illuminate(m->gpu, m->links, m->hier, (uint32_t)m->bounces, s->light_count, &err);
+    } else {
+        iv_lights li = {s, gs->time, s->envmap};
+        iv_illuminate(m->links, m->hier, &li, (uint32_t)m->bounces, m->irr);
+        upload_elem_light(m);
+    }
     host->stage_end(host, "illumination");
+    if (r != GI_OK)
+        return gi_kit_fail_with(&m->kit, r, &err);
 
     host->stage_begin(host, "display");
     r = gi_kit_render_gbuffer(&m->kit, view, NULL);
@@ -224,7 +245,7 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
         GLuint p = m->prog_display;
         glUseProgram(p);
         gi_kit_bind(&m->kit, p, view, target);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_ELEM_LIGHT, m->ssbo_light);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_ELEM_LIGHT, m->gpu ? m->gpu->ssbo_out : m->ssbo_light);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_TRI, m->ssbo_tri);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_GRID, m->ssbo_grid);
         GLint size[2] = {(GLint)view->width, (GLint)view->height};

@@ -137,6 +137,14 @@ void iv_links_build(iv_links *l, const iv_hier *h, float subdiv, int brute, int 
  * shortest link found on its path to the root; then the leaves' links are
  * listed as receiving links, and those from emitting nodes as light links. */
 void iv_links_refine_push(iv_links *l, const iv_hier *h);
+/* The receiving links of iv_links_refine_push flattened for the GPU
+ * (Sec. 4.3.1): 4 words per link, bin, node at the other end, the share of
+ * the bin it covers (float bits; 1 under Eq. 5) and its length (float
+ * bits); first every receiving link (l->receiving of them, each leaf's in
+ * bin order), then the light links. off: 2 per element + 1, its first
+ * receiving link and its first light link (counted from the light links'
+ * start). links holds 4 (receiving + light links) words, off 2 (elements + 1). */
+void iv_links_pack(const iv_links *l, const iv_hier *h, uint32_t *links, uint32_t *off);
 
 /* ---- illumination (Sec. 4.3, 4.4) ---- */
 

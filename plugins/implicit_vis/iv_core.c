@@ -830,6 +830,39 @@ void iv_links_refine_push(iv_links *l, const iv_hier *h)
 
 /* -------------------------------------------------- illumination (4.3) */
 
+static float covered(const iv_links *l, uint32_t x, uint32_t b);
+
+static uint32_t float_bits(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, sizeof u);
+    return u;
+}
+
+void iv_links_pack(const iv_links *l, const iv_hier *h, uint32_t *links, uint32_t *off)
+{
+    size_t light_base = l->leaf_off[h->elem_count];
+    for (uint32_t e = 0; e <= h->elem_count; e++) {
+        off[2 * e] = l->leaf_off[e];
+        off[2 * e + 1] = l->light_off[e];
+    }
+    for (uint32_t e = 0; e < h->elem_count; e++) {
+        uint32_t x = h->elem_node[e];
+        for (int light = 0; light < 2; light++) {
+            const uint32_t *o = light ? l->light_off : l->leaf_off;
+            const uint32_t *bin = light ? l->light_bin : l->leaf_bin;
+            const uint32_t *src = light ? l->light_src : l->leaf_src;
+            for (uint32_t j = o[e]; j < o[e + 1]; j++) {
+                uint32_t *w = &links[4 * ((light ? light_base : 0) + j)];
+                w[0] = bin[j];
+                w[1] = src[j];
+                w[2] = float_bits(covered(l, x, bin[j]));
+                w[3] = float_bits(l->dist[(size_t)x * l->bins + bin[j]]);
+            }
+        }
+    }
+}
+
 /* Radiance a node sends toward point x: the side its mean normal faces x;
  * a cluster whose children face every way (mean normal shorter than 0.3)
  * sends the mean of both sides. */

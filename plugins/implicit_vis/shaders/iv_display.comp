@@ -7,15 +7,10 @@
 #include "common.glsl"
 #include "scene.glsl"
 #include "gbuffer_read.glsl"
-#include "iv_bindings.h"
+#include "iv_gpu.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-struct IvElemLight {
-    vec4 e_front; // irradiance on the side the element's normal faces
-    vec4 e_back;  // irradiance on the other side
-    vec4 normal;  // the element's world normal
-};
 layout(std430, binding = IV_SSBO_ELEM_LIGHT) readonly buffer IvLight { IvElemLight iv_light[]; };
 layout(std430, binding = IV_SSBO_TRI) readonly buffer IvTri { uvec2 iv_tri[]; };   // k, first grid point
 layout(std430, binding = IV_SSBO_GRID) readonly buffer IvGrid { uint iv_grid[]; }; // grid point -> element

@@ -26,13 +26,20 @@
  *   iv_tests leak       Fig. 10(d): the share of the environment light the
  *                       792-vertex teapot blocks from the ground (Embree)
  *                       that the method lets through, with and without
- *                       splatting, the model as it is and re-meshed. */
+ *                       splatting, the model as it is and re-meshed;
+ *   iv_tests gpu        the GPU gather and pull-up (iv_gpu.c, Sec. 4.3.1)
+ *                       against iv_illuminate on the same links: Cornell
+ *                       box, furnace, environment, punctual lights, the
+ *                       coverage modes; and the furnace through the GPU. */
 #include "iv.h"
+#include "iv_gpu.h"
 
+#include "gi/gpu.h"
 #include "gi/lights.h"
 #include "gi/mesh.h"
 #include "gi/raytrace.h"
 #include "gi/sampling.h"
+#include "gi/shader.h"
 
 #include <float.h>
 #include <math.h>
@@ -42,6 +49,38 @@
 
 #include "check.h"
 #define EXPECT CHECK_MSG
+
+extern const gi_shader_source gi_implicit_vis_shaders[];
+
+/* The GL context of the `gpu` part (NULL elsewhere). */
+static gi_gpu *g_gpu = NULL;
+
+/* The GPU illumination of the links in l (the scene uploaded and its
+ * punctual lights bound at t = 0): irradiance in iv_illuminate's layout.
+ * Returns 0 (and counts a failure) when a step fails. */
+static int gpu_illuminate(const gi_scene *s, const iv_hier *h, const iv_links *l, uint32_t bounces, float *E)
+{
+    gi_error err;
+    gi_gpu_scene *gs = gi_gpu_scene_upload(g_gpu, s, &err);
+    EXPECT(gs != NULL, "upload: %s", err.text);
+    if (!gs)
+        return 0;
+    gi_gpu_scene_set_time(gs, 0.0f);
+    gi_gpu_scene_bind(gs);
+    iv_gpu *g = iv_gpu_create(h, l, s->envmap, &err);
+    EXPECT(g != NULL, "GPU illumination: %s", err.text);
+    int ok = g != NULL;
+    if (g) {
+        gi_result r = iv_gpu_illuminate(g, l, h, bounces, s->light_count, &err);
+        EXPECT(r == GI_OK, "GPU illumination: %s", err.text);
+        ok = r == GI_OK;
+        if (ok)
+            iv_gpu_read(g, E);
+    }
+    iv_gpu_free(g);
+    gi_gpu_scene_free(gs);
+    return ok;
+}
 
 static gi_scene *load(const char *path)
 {
@@ -294,7 +333,10 @@ static int furnace_means(const char *path, uint32_t N, double mean[4], double *r
         iv_links_refine_push(l, h);
         iv_lights li = {s, 0.0f, NULL};
         for (uint32_t n = 0; n <= 3; n++) {
-            iv_illuminate(l, h, &li, n, E);
+            if (g_gpu)
+                gpu_illuminate(s, h, l, n, E);
+            else
+                iv_illuminate(l, h, &li, n, E);
             double sum = 0.0, area = 0.0;
             for (uint32_t e = 0; e < h->elem_count; e++) {
                 uint32_t x = h->elem_node[e];
@@ -325,7 +367,8 @@ static void test_furnace(void)
     for (int mode = 0; mode < 2; mode++) {
         g_bilinear = mode;
         g_coverage = mode ? 0.7f : 0.0f;
-        printf("links: bilinear %d, coverage %.2g\n", g_bilinear, (double)g_coverage);
+        printf("links: bilinear %d, coverage %.2g, illumination on the %s\n", g_bilinear, (double)g_coverage,
+               g_gpu ? "GPU" : "CPU");
         for (int k = 0; k < 2; k++)
             for (int in = 0; in < 2; in++) {
                 double rho = 0.0, le = 0.0, got[4];
@@ -625,6 +668,78 @@ static void test_leak(void)
     EXPECT(coarse <= 0.05 && fine <= 0.05, "with splatting the teapot lets %.3f / %.3f through", coarse, fine);
 }
 
+/* ------------------------------------------------ GPU against the CPU */
+
+/* One scene: the same links gathered by iv_illuminate and by the GPU
+ * passes; their relative L1 difference (area-weighted, both sides, every
+ * channel) must stay within `limit` (float summation order), and be far
+ * below the difference one bounce makes, so that a missing or extra gather
+ * could not pass. */
+static void gpu_case(const char *path, uint32_t N, uint32_t bounces, int bilinear, float coverage, double limit)
+{
+    g_bilinear = bilinear;
+    g_coverage = coverage;
+    frame f;
+    int ok = frame_run(&f, path, 0.0f, N, bounces, 0, 1);
+    EXPECT(ok, "set-up failed for %s", path);
+    float *G = ok ? malloc((size_t)f.h->elem_count * 6 * sizeof(float)) : NULL;
+    float *P = ok ? malloc((size_t)f.h->elem_count * 6 * sizeof(float)) : NULL;
+    if (ok && G && P && gpu_illuminate(f.s, f.h, f.l, bounces, G)) {
+        iv_lights li = {f.s, 0.0f, f.s->envmap};
+        if (bounces > 0)
+            iv_illuminate(f.l, f.h, &li, bounces - 1, P); /* one gather fewer: the answer to tell apart */
+        else
+            memset(P, 0, (size_t)f.h->elem_count * 6 * sizeof(float));
+        double diff = 0.0, fewer = 0.0, sum = 0.0, worst = 0.0;
+        for (uint32_t e = 0; e < f.h->elem_count; e++) {
+            double a = f.h->area[f.h->elem_node[e]];
+            for (int c = 0; c < 6; c++) {
+                double d = fabs((double)G[6 * e + c] - f.E[6 * e + c]);
+                diff += a * d;
+                fewer += a * fabs((double)P[6 * e + c] - f.E[6 * e + c]);
+                sum += a * fabs((double)f.E[6 * e + c]);
+                worst = fmax(worst, d / (fabs((double)f.E[6 * e + c]) + 1e-3));
+            }
+        }
+        double rel = sum > 0.0 ? diff / sum : 1.0, rel_fewer = sum > 0.0 ? fewer / sum : 0.0;
+        printf("%s (N %u, %u bounces, bilinear %d, coverage %.2g, %u discs): GPU against CPU relative L1 %.2e "
+               "(limit %.0e), worst disc %.2e; one bounce fewer on the CPU %.2e\n",
+               strrchr(path, '/') + 1, N, bounces, bilinear, (double)coverage, f.h->elem_count, rel, limit, worst,
+               rel_fewer);
+        EXPECT(sum > 0.0, "%s: no light at all", path);
+        EXPECT(rel <= limit, "%s: GPU and CPU differ by %.2e (limit %.0e)", path, rel, limit);
+        EXPECT(rel_fewer >= 10.0 * limit, "%s: one bounce fewer differs by only %.2e: the test cannot tell", path,
+               rel_fewer);
+    }
+    free(G);
+    free(P);
+    frame_free(&f);
+    g_bilinear = 0;
+    g_coverage = 0.0f;
+}
+
+static void test_gpu(void)
+{
+    gi_error err;
+    g_gpu = gi_gpu_create(NULL, &err);
+    EXPECT(g_gpu != NULL, "no GL context: %s", err.text);
+    if (!g_gpu)
+        return;
+    EXPECT(gi_shader_register(gi_implicit_vis_shaders, &err) == GI_OK, "shaders: %s", err.text);
+    printf("GL renderer: %s\n", gi_gpu_renderer(g_gpu));
+    const double limit = 1e-4;
+    gpu_case(GI_SOURCE_DIR "/scenes/cornell_box.gltf", 12, 3, 0, 0.0f, limit);
+    gpu_case(GI_SOURCE_DIR "/scenes/cornell_box.gltf", 8, 1, 1, 0.7f, limit);
+    gpu_case(GI_SOURCE_DIR "/tests/data/conformance/furnace_050.gltf", 12, 3, 0, 0.0f, limit);
+    gpu_case(GI_SOURCE_DIR "/tests/data/conformance/furnace_080.gltf", 8, 2, 0, 0.0f, limit);
+    gpu_case(GI_SOURCE_DIR "/tests/data/conformance/one_object_area_point.gltf", 8, 2, 0, 0.0f, limit);
+    gpu_case(GI_SOURCE_DIR "/scenes/teapot_plane.glb", 8, 1, 0, 0.0f, limit);
+    /* the furnace through the GPU passes: Le sum rho^k within 2 % */
+    test_furnace();
+    gi_gpu_destroy(g_gpu);
+    g_gpu = NULL;
+}
+
 int main(int argc, char **argv)
 {
     const char *part = argc > 1 ? argv[1] : "all";
@@ -643,6 +758,8 @@ int main(int argc, char **argv)
         test_leak(), known = 1;
     if (all || !strcmp(part, "brute"))
         test_brute(), known = 1;
+    if (all || !strcmp(part, "gpu"))
+        test_gpu(), known = 1;
     if (!known) {
         fprintf(stderr, "iv_tests: unknown part '%s'\n", part);
         return 2;
