@@ -44,6 +44,16 @@ static const gi_param_desc vlf_params_desc[] = {
      "perturbed virtual directions per fixed direction, used only for transport (0: the fixed direction itself; "
      "the paper's high quality uses 36)"},
     {"seed", GI_PARAM_INT, 1, 0, 1000000, NULL, NULL, "seed of the perturbed directions"},
+    {"order", GI_PARAM_ENUM, 0, 0, 0, "faces|rays", "Sec. 3.2",
+     "depth order of a subfield: faces: the faces sorted front to back (Newell's painter's ordering, faces split "
+     "where they overlap in a cycle, BSP cuts orthogonal to the direction), rasterised in that order; rays: each "
+     "ray's fragments sorted by depth"},
+    {"threads", GI_PARAM_INT, 4, 1, 64, NULL, "sort threads (Sec. 6)",
+     "CPU threads of the sort stage, one subfield at a time each (the field is the same for any count)"},
+    {"bsp_levels", GI_PARAM_INT, 2, 0, 8, NULL, "BSP levels (Sec. 3.2, 6)",
+     "cuts of the face list orthogonal to the direction at its centre of mass, levels (paper: 2)"},
+    {"bsp_min", GI_PARAM_INT, 4096, 2, 1000000, NULL, "BSP threshold (Sec. 3.2)",
+     "a face list is cut only with at least this many faces (paper: 4K)"},
     {0},
 };
 
@@ -64,6 +74,10 @@ static gi_result vlf_create(const gi_host *host, const gi_params *params, void *
     v->prm.seed = (uint32_t)gi_params_int(params, "seed");
     v->prm.density = gi_params_float(params, "density");
     v->prm.iterations = (uint32_t)gi_params_int(params, "iterations");
+    v->prm.order = gi_params_enum(params, "order") == 1 ? VLF_ORDER_RAYS : VLF_ORDER_FACES;
+    v->prm.threads = (uint32_t)gi_params_int(params, "threads");
+    v->prm.bsp_levels = (uint32_t)gi_params_int(params, "bsp_levels");
+    v->prm.bsp_min = (uint32_t)gi_params_int(params, "bsp_min");
     if (v->prm.N % v->prm.m != 0) {
         host->log(host, GI_LOG_ERROR, "vlf: N = %u is not a multiple of the tile size m = %u", v->prm.N, v->prm.m);
         gi_kit_free(&v->kit);
@@ -207,6 +221,11 @@ static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
     host->stat(host, "bytes_render", (double)s->bytes_render);
     host->stat(host, "samples_transported", (double)s->samples);
     host->stat(host, "samples_per_s", s->propagate_s > 0 ? (double)s->samples / s->propagate_s : 0.0);
+    host->stat(host, "sort_pieces", (double)s->sort_pieces);
+    host->stat(host, "sort_splits", (double)s->sort_splits);
+    host->stat(host, "sort_bsp_cuts", (double)s->sort_bsp_cuts);
+    host->stat(host, "sort_unresolved", (double)s->sort_unresolved);
+    host->stat(host, "sort_tests", (double)s->sort_tests);
     host->stat(host, "flux_emitted", s->flux_emitted);
     host->stat(host, "flux_received", s->flux_received);
     host->stat(host, "flux_escaped", s->flux_escaped);

@@ -11,9 +11,12 @@
 #include <string.h>
 #include <time.h>
 
+#include <pthread.h>
+
 #include <libqhull_r/qhull_ra.h>
 
 #include "gi/envmap.h"
+#include "vlf_sort.h"
 
 static double now_s(void)
 {
@@ -330,17 +333,99 @@ static int frag_cmp(const void *a, const void *b)
     return x->elem < y->elem ? -1 : (x->elem > y->elem);
 }
 
-/* Per-ray depth order of subfield i (the "sort" stage, §3.2): every face
- * rasterised into the N x N rays, the fragments of each ray sorted front to
- * back; the tile rectangles of non-diffuse faces recorded on the way. */
-static int build_psf(vlf_field *f, uint32_t i, frag_buf *buf, vlf_rect *rects)
+/* Sort counters of one thread. */
+typedef struct sort_counts {
+    uint64_t pieces, splits, bsp_cuts, unresolved, tests;
+} sort_counts;
+
+/* The fragments of every face along subfield frame fr, in buf, grouped by
+ * ray (interface cell) and front to back along fr->n within each ray
+ * (§3.2). Faces order: the faces sorted by vlf_sort_faces and rasterised in
+ * that order, each ray's fragments then kept in the order they came
+ * (a stable bucket sort by cell); rays order: all fragments sorted by cell
+ * and depth. bbox (4 per face, may be NULL) grows by the subfield cells
+ * each face covers. */
+static int list_fragments(const vlf_field *f, const vlf_psf *fr, frag_buf *buf, frag_buf *tmp, vlf_sorter *so,
+                          int32_t *bbox, sort_counts *cnt)
 {
+    uint32_t N = f->prm.N * f->prm.S;
+    int32_t dummy[4];
+    buf->n = 0;
+    if (f->prm.order == VLF_ORDER_RAYS) {
+        for (uint32_t ti = 0; ti < f->tri_count; ti++) {
+            uint32_t fi = f->tri_face[ti];
+            sort_ctx c = {buf, f, fr, &f->faces[fi], N, bbox ? bbox + 4 * fi : dummy};
+            if (!raster_tri(f, fr, f->tri_p + 3 * (size_t)ti, emit_frag, &c))
+                return 0;
+        }
+        qsort(buf->v, buf->n, sizeof *buf->v, frag_cmp);
+        return 1;
+    }
+    int mode = f->prm.order == VLF_ORDER_PLAIN     ? VLF_SORT_PLAIN
+               : f->prm.order == VLF_ORDER_NOSPLIT ? VLF_SORT_NOSPLIT
+                                                   : VLF_SORT_NEWELL;
+    if (vlf_sort_faces(so, f->tri_p, f->tri_count, fr->u, fr->v, fr->n, mode, f->prm.bsp_levels, f->prm.bsp_min) != 0)
+        return 0;
+    cnt->pieces += so->nout;
+    cnt->splits += so->splits;
+    cnt->bsp_cuts += so->bsp_cuts;
+    cnt->unresolved += so->unresolved;
+    cnt->tests += so->tests;
+    for (uint32_t k = 0; k < so->nout; k++) {
+        const vlf_piece *pc = &so->poly[so->out[k]];
+        uint32_t fi = f->tri_face[pc->tri];
+        sort_ctx c = {buf, f, fr, &f->faces[fi], N, bbox ? bbox + 4 * fi : dummy};
+        /* back from the frame to VLF coordinates; a fan over the convex piece */
+        gi_vec3 q[3];
+        const gi_vec3 *v = so->vert + pc->first;
+        for (uint32_t j = 1; j + 1 < pc->count; j++) {
+            const gi_vec3 *w[3] = {&v[0], &v[j], &v[j + 1]};
+            for (int a = 0; a < 3; a++)
+                q[a] = gi_v3_add(gi_v3_add(gi_v3_scale(fr->u, w[a]->x), gi_v3_scale(fr->v, w[a]->y)),
+                                 gi_v3_scale(fr->n, w[a]->z));
+            if (!raster_tri(f, fr, q, emit_frag, &c))
+                return 0;
+        }
+    }
+    /* stable bucket sort by cell: each ray keeps the faces' order */
+    uint32_t *start = calloc((size_t)N * N + 1, sizeof *start);
+    if (!start)
+        return 0;
+    if (tmp->cap < buf->n) {
+        frag_tmp *t = realloc(tmp->v, (buf->n ? buf->n : 1) * sizeof *t);
+        if (!t) {
+            free(start);
+            return 0;
+        }
+        tmp->v = t;
+        tmp->cap = buf->n ? buf->n : 1;
+    }
+    for (size_t k = 0; k < buf->n; k++)
+        start[buf->v[k].cell + 1]++;
+    for (uint32_t c = 0; c < N * N; c++)
+        start[c + 1] += start[c];
+    for (size_t k = 0; k < buf->n; k++)
+        tmp->v[start[buf->v[k].cell]++] = buf->v[k];
+    free(start);
+    tmp->n = buf->n;
+    frag_buf sw = *buf;
+    *buf = *tmp;
+    *tmp = sw;
+    return 1;
+}
+
+/* Depth order of subfield i (the "sort" stage, §3.2): the fragments of
+ * every face on the N S x N S rays, each ray's front to back
+ * (list_fragments); the tile rectangles of non-diffuse faces recorded on
+ * the way. Writes only psf[i] and the rectangles of subfield i. */
+static int build_psf(vlf_field *f, uint32_t i, frag_buf *buf, frag_buf *tmp, vlf_sorter *so, sort_counts *cnt)
+{
+    vlf_rect *rects = f->rects;
     vlf_psf *p = &f->psf[i];
     gi_vec3 w = f->dirs.signed_dirs[i];
     p->n = w;
     gi_onb(w, &p->u, &p->v);
     uint32_t N = f->prm.N * f->prm.S, m = f->prm.m;
-    buf->n = 0;
     int32_t *bbox = malloc(((size_t)f->face_count * 4 + 4) * sizeof *bbox);
     if (!bbox)
         return 0;
@@ -348,13 +433,9 @@ static int build_psf(vlf_field *f, uint32_t i, frag_buf *buf, vlf_rect *rects)
         bbox[4 * fi] = bbox[4 * fi + 1] = INT32_MAX;
         bbox[4 * fi + 2] = bbox[4 * fi + 3] = -1;
     }
-    for (uint32_t ti = 0; ti < f->tri_count; ti++) {
-        uint32_t fi = f->tri_face[ti];
-        sort_ctx c = {buf, f, p, &f->faces[fi], N, bbox + 4 * fi};
-        if (!raster_tri(f, p, f->tri_p + 3 * (size_t)ti, emit_frag, &c)) {
-            free(bbox);
-            return 0;
-        }
+    if (!list_fragments(f, p, buf, tmp, so, bbox, cnt)) {
+        free(bbox);
+        return 0;
     }
     for (uint32_t fi = 0; fi < f->face_count; fi++) {
         if (f->faces[fi].nd < 0)
@@ -371,7 +452,6 @@ static int build_psf(vlf_field *f, uint32_t i, frag_buf *buf, vlf_rect *rects)
         }
     }
     free(bbox);
-    qsort(buf->v, buf->n, sizeof *buf->v, frag_cmp);
     p->cell_start = calloc((size_t)N * N + 1, sizeof *p->cell_start);
     p->frag = malloc((buf->n ? buf->n : 1) * sizeof *p->frag);
     if (!p->cell_start || !p->frag)
@@ -384,6 +464,69 @@ static int build_psf(vlf_field *f, uint32_t i, frag_buf *buf, vlf_rect *rects)
     for (uint32_t c = 0; c < N * N; c++)
         p->cell_start[c + 1] += p->cell_start[c];
     return 1;
+}
+
+/* One thread of the sort stage: subfields t, t + T, t + 2T, ... (each
+ * subfield's order depends on nothing else, so any thread count gives the
+ * same field). */
+typedef struct sort_job {
+    vlf_field *f;
+    uint32_t t, T;
+    int ok;
+    sort_counts cnt;
+} sort_job;
+
+static void *sort_thread(void *arg)
+{
+    sort_job *j = arg;
+    frag_buf buf = {0}, tmp = {0};
+    vlf_sorter so;
+    memset(&so, 0, sizeof so);
+    j->ok = 1;
+    for (uint32_t i = j->t; i < j->f->prm.l && j->ok; i += j->T)
+        j->ok = build_psf(j->f, i, &buf, &tmp, &so, &j->cnt);
+    free(buf.v);
+    free(tmp.v);
+    vlf_sorter_free(&so);
+    return NULL;
+}
+
+/* The sort stage on p->threads threads (the calling one among them). */
+static int build_all_psf(vlf_field *f)
+{
+    uint32_t T = f->prm.threads < 1 ? 1 : f->prm.threads;
+    if (T > f->prm.l)
+        T = f->prm.l;
+    sort_job *jobs = calloc(T, sizeof *jobs);
+    pthread_t *th = calloc(T, sizeof *th);
+    uint8_t *started = calloc(T, 1);
+    if (!jobs || !th || !started) {
+        free(jobs), free(th), free(started);
+        return 0;
+    }
+    for (uint32_t t = 0; t < T; t++) {
+        jobs[t] = (sort_job){f, t, T, 0, {0, 0, 0, 0, 0}};
+        if (t > 0)
+            started[t] = pthread_create(&th[t], NULL, sort_thread, &jobs[t]) == 0;
+    }
+    sort_thread(&jobs[0]);
+    int ok = jobs[0].ok;
+    for (uint32_t t = 1; t < T; t++) {
+        if (started[t])
+            pthread_join(th[t], NULL);
+        else
+            sort_thread(&jobs[t]); /* no thread to be had: do its share here */
+        ok = ok && jobs[t].ok;
+    }
+    for (uint32_t t = 0; t < T; t++) {
+        f->st.sort_pieces += jobs[t].cnt.pieces;
+        f->st.sort_splits += jobs[t].cnt.splits;
+        f->st.sort_bsp_cuts += jobs[t].cnt.bsp_cuts;
+        f->st.sort_unresolved += jobs[t].cnt.unresolved;
+        f->st.sort_tests += jobs[t].cnt.tests;
+    }
+    free(jobs), free(th), free(started);
+    return ok;
 }
 
 static size_t rect_slot(const vlf_rect *r, uint32_t cx, uint32_t cy)
@@ -613,14 +756,8 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
             f->elem_face[fc->first_elem + e] = fi;
     }
     element_areas(f);
-    frag_buf buf = {0};
-    for (uint32_t i = 0; i < p->l; i++) {
-        if (!build_psf(f, i, &buf, f->rects)) {
-            free(buf.v);
-            goto oom;
-        }
-    }
-    free(buf.v);
+    if (!build_all_psf(f))
+        goto oom;
     /* Tile storage offsets, then coverage of each stored cell. */
     size_t cells = 0;
     uint32_t tiles = 0;
@@ -679,19 +816,10 @@ oom:
 /* Fragments of all faces along a perturbed direction (frame fr), sorted
  * per ray front to back; kept with their depths (§3.5: perturbed
  * directions are sorted like fixed ones, used for transport, discarded). */
-static int perturbed_list(vlf_field *f, const vlf_psf *fr, frag_buf *buf)
+static int perturbed_list(vlf_field *f, const vlf_psf *fr, frag_buf *buf, frag_buf *tmp, vlf_sorter *so)
 {
-    int32_t bb[4];
-    buf->n = 0;
-    for (uint32_t ti = 0; ti < f->tri_count; ti++) {
-        bb[0] = bb[1] = INT32_MAX;
-        bb[2] = bb[3] = -1;
-        sort_ctx c = {buf, f, fr, &f->faces[f->tri_face[ti]], f->prm.N * f->prm.S, bb};
-        if (!raster_tri(f, fr, f->tri_p + 3 * (size_t)ti, emit_frag, &c))
-            return 0;
-    }
-    qsort(buf->v, buf->n, sizeof *buf->v, frag_cmp);
-    return 1;
+    sort_counts cnt = {0, 0, 0, 0, 0};
+    return list_fragments(f, fr, buf, tmp, so, NULL, &cnt);
 }
 
 /* The tile slot of non-diffuse face fc in fixed subfield i holding VLF
@@ -1005,11 +1133,13 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
     }
     f->st.flux_shot = f->st.flux_received = f->st.flux_back = f->st.flux_escaped = 0;
     f->st.samples = 0;
-    frag_buf pbuf = {0};
+    frag_buf pbuf = {0}, ptmp = {0};
+    vlf_sorter psort;
+    memset(&psort, 0, sizeof psort);
     for (uint32_t it = 0; it < f->prm.iterations; it++) {
         for (uint32_t i = 0; i < l; i++) {
             if (cancelled && cancelled(user)) {
-                free(pbuf.v);
+                free(pbuf.v), free(ptmp.v), vlf_sorter_free(&psort);
                 return -1;
             }
             for (uint32_t fi = 0; fi < f->face_count; fi++)
@@ -1025,8 +1155,8 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
                     vlf_psf fr;
                     fr.n = perturbed_dir(f, i, k);
                     gi_onb(fr.n, &fr.u, &fr.v);
-                    if (!perturbed_list(f, &fr, &pbuf)) {
-                        free(pbuf.v);
+                    if (!perturbed_list(f, &fr, &pbuf, &ptmp, &psort)) {
+                        free(pbuf.v), free(ptmp.v), vlf_sorter_free(&psort);
                         return -1;
                     }
                     /* each sign's solid angle: the fixed direction's, shared */
@@ -1049,7 +1179,7 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
             f->out_next[k] = 0.0f;
         }
     }
-    free(pbuf.v);
+    free(pbuf.v), free(ptmp.v), vlf_sorter_free(&psort);
     f->st.propagate_s = now_s() - t0;
     return 0;
 }

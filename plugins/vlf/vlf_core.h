@@ -43,7 +43,18 @@ typedef struct vlf_params {
     uint32_t iterations; /* shooting iterations */
     uint32_t perturbed;  /* perturbed virtual directions per fixed direction for transport (0: the fixed one, §3.5) */
     uint32_t seed;
+    uint32_t order;      /* depth order of a subfield (§3.2): VLF_ORDER_FACES, _RAYS or _PLAIN */
+    uint32_t threads;    /* CPU threads building the subfields (the result is the same for any count) */
+    uint32_t bsp_levels; /* BSP cuts orthogonal to the direction, levels (paper: 2) */
+    uint32_t bsp_min;    /* a list is cut only with at least this many faces (paper: 4K) */
 } vlf_params;
+
+/* The depth order of each subfield's rays: the paper's face order (Newell's
+ * painter's ordering with splitting and the BSP cut, vlf_sort.c), or each
+ * ray's fragments sorted by depth (a layered depth image); for the tests
+ * also the faces by nearest depth only and Newell's ordering without
+ * splitting (both wrong where faces overlap in a cycle). */
+enum { VLF_ORDER_FACES = 0, VLF_ORDER_RAYS = 1, VLF_ORDER_PLAIN = 2, VLF_ORDER_NOSPLIT = 3 };
 
 /* A rectangle of tiles of one non-diffuse face in one subfield. */
 typedef struct vlf_rect {
@@ -84,6 +95,11 @@ typedef struct vlf_stats {
     size_t bytes_propagate;  /* storage while propagating */
     size_t bytes_render;     /* storage kept for rendering */
     uint32_t diffuse_elements, nondiffuse_elements, tiles;
+    uint64_t sort_pieces;    /* faces (triangles and their pieces) placed, over all subfields */
+    uint64_t sort_splits;    /* pieces split to break a cycle of overlaps, over all subfields */
+    uint64_t sort_bsp_cuts;  /* pieces cut by a BSP plane, over all subfields */
+    uint64_t sort_unresolved;/* cycles left unbroken (split limit), over all subfields */
+    uint64_t sort_tests;     /* pairs of faces tested by Newell's ordering */
 } vlf_stats;
 
 typedef struct vlf_field {
