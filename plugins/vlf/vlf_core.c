@@ -198,6 +198,128 @@ uint32_t vlf_dirs_locate(const vlf_dirs *d, gi_vec3 w, uint32_t node[3], float a
     return best;
 }
 
+/* ---- Storage precision (§3.1, §6) ----------------------------------------- */
+
+size_t vlf_precision_bytes(uint32_t prec)
+{
+    return prec == VLF_PREC_16F ? 8 : prec == VLF_PREC_RGB9E5 ? 4 : 12;
+}
+
+/* IEEE half from float, rounding to nearest even; beyond the largest half
+ * (65504) the largest half (a GPU would store infinity). */
+static uint16_t float_to_half(float f)
+{
+    uint32_t x;
+    memcpy(&x, &f, sizeof x);
+    uint32_t sign = (x >> 16) & 0x8000u, ax = x & 0x7fffffffu;
+    if (ax > 0x7f800000u)
+        return 0; /* NaN: stored as 0 (values here are never NaN) */
+    if (ax >= 0x477fe000u)
+        return (uint16_t)(sign | 0x7bffu);
+    if (ax < 0x38800000u) { /* below 2^-14: subnormal half or zero */
+        if (ax < 0x33000000u)
+            return (uint16_t)sign;
+        uint32_t e = ax >> 23, m = (ax & 0x7fffffu) | 0x800000u, shift = 126 - e;
+        uint32_t h = m >> shift, rem = m & ((1u << shift) - 1), halfway = 1u << (shift - 1);
+        if (rem > halfway || (rem == halfway && (h & 1u)))
+            h++;
+        return (uint16_t)(sign | h);
+    }
+    uint32_t h = (ax - 0x38000000u) >> 13, rem = ax & 0x1fffu;
+    if (rem > 0x1000u || (rem == 0x1000u && (h & 1u)))
+        h++;
+    if (h >= 0x7c00u)
+        h = 0x7bffu;
+    return (uint16_t)(sign | h);
+}
+
+static float half_to_float(uint16_t h)
+{
+    uint32_t e = (h >> 10) & 0x1fu, m = h & 0x3ffu;
+    float f = e == 0 ? ldexpf((float)m, -24) : ldexpf((float)(m | 0x400u), (int)e - 25);
+    return (h & 0x8000u) ? -f : f;
+}
+
+/* RGB9E5 as the GL spec (EXT_texture_shared_exponent) packs it: 9-bit
+ * mantissas, one 5-bit exponent (bias 15), negative values as 0. */
+static uint32_t pack_9e5(const float *c)
+{
+    const float maxv = 511.0f / 512.0f * 65536.0f;
+    float v[3];
+    for (int k = 0; k < 3; k++)
+        v[k] = c[k] > 0.0f ? fminf(c[k], maxv) : 0.0f;
+    float mx = fmaxf(v[0], fmaxf(v[1], v[2]));
+    int e2 = -16;
+    if (mx > 0.0f) {
+        int ex;
+        frexpf(mx, &ex);
+        e2 = ex - 1 > -16 ? ex - 1 : -16; /* floor(log2 mx), at least -16 */
+    }
+    int es = e2 + 1 + 15;
+    float scale = ldexpf(1.0f, es - 15 - 9);
+    if ((int)floorf(mx / scale + 0.5f) == 512)
+        es++, scale *= 2.0f;
+    uint32_t m[3];
+    for (int k = 0; k < 3; k++) {
+        int q = (int)floorf(v[k] / scale + 0.5f);
+        m[k] = (uint32_t)(q > 511 ? 511 : q);
+    }
+    return m[0] | m[1] << 9 | m[2] << 18 | (uint32_t)es << 27;
+}
+
+static void unpack_9e5(uint32_t x, float *c)
+{
+    float scale = ldexpf(1.0f, (int)(x >> 27) - 24);
+    c[0] = (float)(x & 511u) * scale;
+    c[1] = (float)((x >> 9) & 511u) * scale;
+    c[2] = (float)((x >> 18) & 511u) * scale;
+}
+
+void vlf_pack(uint32_t prec, const float *rgb, size_t count, void *out)
+{
+    if (prec == VLF_PREC_16F) {
+        uint16_t *h = out;
+        for (size_t i = 0; i < count; i++) {
+            for (int k = 0; k < 3; k++)
+                h[4 * i + (size_t)k] = float_to_half(rgb[3 * i + (size_t)k]);
+            h[4 * i + 3] = 0;
+        }
+    } else if (prec == VLF_PREC_RGB9E5) {
+        uint32_t *w = out;
+        for (size_t i = 0; i < count; i++)
+            w[i] = pack_9e5(rgb + 3 * i);
+    } else {
+        memcpy(out, rgb, count * 3 * sizeof(float));
+    }
+}
+
+void vlf_unpack(uint32_t prec, const void *in, size_t count, float *rgb)
+{
+    if (prec == VLF_PREC_16F) {
+        const uint16_t *h = in;
+        for (size_t i = 0; i < count; i++)
+            for (int k = 0; k < 3; k++)
+                rgb[3 * i + (size_t)k] = half_to_float(h[4 * i + (size_t)k]);
+    } else if (prec == VLF_PREC_RGB9E5) {
+        const uint32_t *w = in;
+        for (size_t i = 0; i < count; i++)
+            unpack_9e5(w[i], rgb + 3 * i);
+    } else {
+        memcpy(rgb, in, count * 3 * sizeof(float));
+    }
+}
+
+void vlf_quantise(uint32_t prec, float *rgb, size_t count)
+{
+    if (prec == VLF_PREC_16F) {
+        for (size_t i = 0; i < 3 * count; i++)
+            rgb[i] = half_to_float(float_to_half(rgb[i]));
+    } else if (prec == VLF_PREC_RGB9E5) {
+        for (size_t i = 0; i < count; i++)
+            unpack_9e5(pack_9e5(rgb + 3 * i), rgb + 3 * i);
+    }
+}
+
 /* ---- Subfields ------------------------------------------------------------ */
 
 gi_vec3 vlf_to_vlf(const vlf_field *f, gi_vec3 world)
@@ -692,6 +814,10 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
     memset(f, 0, sizeof *f);
     f->prm = *p;
     double t0 = now_s();
+    if (p->precision > VLF_PREC_RGB9E5) {
+        snprintf(err, err_size, "vlf: storage precision %u unknown", p->precision);
+        return -1;
+    }
     if (p->S < 1 || p->S > 8) {
         snprintf(err, err_size, "vlf: supersampling S = %u outside 1..8", p->S);
         return -1;
@@ -798,12 +924,14 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
     f->st.nondiffuse_elements = ndel;
     f->st.tiles = tiles;
     /* Memory as the paper counts it: current, next and total ir/radiance
-     * (RGB float) for both kinds, plus the depth order; rendering keeps the
-     * totals only. */
-    f->st.bytes_propagate = (size_t)elems * 3 * sizeof(float) * 3 + cells * 3 * sizeof(float) * 4 + cells +
-                            frags * sizeof(uint32_t) + (size_t)p->l * ((size_t)p->N * p->S * p->N * p->S + 1) * sizeof(uint32_t);
-    f->st.bytes_render = (size_t)elems * 3 * sizeof(float) + cells * 3 * sizeof(float) +
-                         (size_t)f->nd_count * p->l * sizeof(vlf_rect);
+     * maps in the storage format for both kinds (and the incoming tiles),
+     * plus the depth order; rendering keeps the totals and the tile index
+     * only (vlf.c uploads exactly these maps). */
+    size_t bpv = vlf_precision_bytes(p->precision);
+    f->st.bytes_maps_render = ((size_t)elems + cells) * bpv;
+    f->st.bytes_propagate = (size_t)elems * bpv * 3 + cells * bpv * 4 + cells + frags * sizeof(uint32_t) +
+                            (size_t)p->l * ((size_t)p->N * p->S * p->N * p->S + 1) * sizeof(uint32_t);
+    f->st.bytes_render = f->st.bytes_maps_render + (size_t)f->nd_count * p->l * sizeof(vlf_rect);
     f->st.sort_s = now_s() - t0;
     return 0;
 oom:
@@ -1108,6 +1236,8 @@ static void scatter(vlf_field *f, uint32_t i)
                     for (int k = 0; k < 3; k++)
                         f->out_next[3 * slot + k] += c[k] * Lin[k];
                 }
+            /* one pass into the target's tiles: written in the storage format */
+            vlf_quantise(f->prm.precision, f->out_next + 3 * (size_t)rj->offset, (size_t)rj->w * rj->h);
         }
     }
     free(g);
@@ -1116,7 +1246,7 @@ static void scatter(vlf_field *f, uint32_t i)
 int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
 {
     double t0 = now_s();
-    uint32_t l = f->prm.l;
+    uint32_t l = f->prm.l, prec = f->prm.precision;
     size_t ne = (size_t)f->elem_count * 3, nc = (size_t)f->nd_cells * 3;
     memset(f->E_tot, 0, ne * sizeof(float));
     memset(f->out_tot, 0, nc * sizeof(float));
@@ -1131,6 +1261,7 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
             f->st.flux_emitted += GI_PI * fc->emission[q] * f->elem_area[e] / 3.0;
         }
     }
+    vlf_quantise(prec, f->L_cur, f->elem_count);
     f->st.flux_shot = f->st.flux_received = f->st.flux_back = f->st.flux_escaped = 0;
     f->st.samples = 0;
     frag_buf pbuf = {0}, ptmp = {0};
@@ -1149,7 +1280,9 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
                 }
             if (f->prm.perturbed == 0) {
                 sweep(f, i, +1, it == 0);
+                vlf_quantise(prec, f->E_next, f->elem_count);
                 sweep(f, i, -1, it == 0);
+                vlf_quantise(prec, f->E_next, f->elem_count);
             } else {
                 for (uint32_t k = 0; k < f->prm.perturbed; k++) {
                     vlf_psf fr;
@@ -1161,9 +1294,17 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
                     }
                     /* each sign's solid angle: the fixed direction's, shared */
                     sweep_perturbed(f, i, &fr, &pbuf, +1, f->dirs.solid_angle[i] / (float)f->prm.perturbed, it == 0);
+                    vlf_quantise(prec, f->E_next, f->elem_count);
                     sweep_perturbed(f, i, &fr, &pbuf, -1, f->dirs.solid_angle[i + l] / (float)f->prm.perturbed, it == 0);
+                    vlf_quantise(prec, f->E_next, f->elem_count);
                 }
             }
+            if (prec != VLF_PREC_32F)
+                for (uint32_t fi = 0; fi < f->face_count; fi++)
+                    if (f->faces[fi].nd >= 0) {
+                        const vlf_rect *r = &f->rects[(size_t)f->faces[fi].nd * l + i];
+                        vlf_quantise(prec, f->in + 3 * (size_t)r->offset, (size_t)r->w * r->h);
+                    }
             if (f->nd_count)
                 scatter(f, i);
         }
@@ -1178,6 +1319,10 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
             f->out_cur[k] = f->out_next[k];
             f->out_next[k] = 0.0f;
         }
+        /* the total and current maps are written in the storage format */
+        vlf_quantise(prec, f->E_tot, f->elem_count);
+        vlf_quantise(prec, f->L_cur, f->elem_count);
+        vlf_quantise(prec, f->out_tot, f->nd_cells);
     }
     free(pbuf.v), free(ptmp.v), vlf_sorter_free(&psort);
     f->st.propagate_s = now_s() - t0;

@@ -47,7 +47,23 @@ typedef struct vlf_params {
     uint32_t threads;    /* CPU threads building the subfields (the result is the same for any count) */
     uint32_t bsp_levels; /* BSP cuts orthogonal to the direction, levels (paper: 2) */
     uint32_t bsp_min;    /* a list is cut only with at least this many faces (paper: 4K) */
+    uint32_t precision;  /* storage format of the ir/radiance maps: VLF_PREC_32F, _16F or _RGB9E5 */
 } vlf_params;
+
+/* Storage formats of the light-field maps (§3.1, §6): three float32 (12
+ * bytes a value), RGBA16F (the paper's 64-bit format: three halves and an
+ * unused alpha, 8 bytes) and the shared-exponent RGB9E5 (4 bytes, the
+ * format the paper proposes to halve memory). */
+enum { VLF_PREC_32F = 0, VLF_PREC_16F = 1, VLF_PREC_RGB9E5 = 2 };
+
+/* Bytes of one stored ir/radiance value in format prec. */
+size_t vlf_precision_bytes(uint32_t prec);
+/* Packs count RGB triplets (non-negative) into count * vlf_precision_bytes
+ * bytes at out (16F: halves r, g, b, 0; RGB9E5: as GL_RGB9_E5), and back. */
+void vlf_pack(uint32_t prec, const float *rgb, size_t count, void *out);
+void vlf_unpack(uint32_t prec, const void *in, size_t count, float *rgb);
+/* Rounds count RGB triplets in place to what format prec stores. */
+void vlf_quantise(uint32_t prec, float *rgb, size_t count);
 
 /* The depth order of each subfield's rays: the paper's face order (Newell's
  * painter's ordering with splitting and the BSP cut, vlf_sort.c), or each
@@ -94,6 +110,7 @@ typedef struct vlf_stats {
     uint64_t samples;        /* fragments visited in propagation (the paper's "ray intersections") */
     size_t bytes_propagate;  /* storage while propagating */
     size_t bytes_render;     /* storage kept for rendering */
+    size_t bytes_maps_render;/* of it the total maps (diffuse atlas and tiles) in the storage format */
     uint32_t diffuse_elements, nondiffuse_elements, tiles;
     uint64_t sort_pieces;    /* faces (triangles and their pieces) placed, over all subfields */
     uint64_t sort_splits;    /* pieces split to break a cycle of overlaps, over all subfields */
