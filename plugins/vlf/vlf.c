@@ -52,6 +52,9 @@ static const gi_param_desc vlf_params_desc[] = {
     {"precision", GI_PARAM_ENUM, 0, 0, 0, "32f|16f|rgb9e5", "storage (Sec. 3.1, 6)",
      "format of the ir/radiance maps, during propagation (every pass writes in it) and for rendering: 32f: three "
      "float32 (12 bytes); 16f: RGBA16F, the paper's 64-bit format (8 bytes); rgb9e5: shared exponent (4 bytes)"},
+    {"subdivide", GI_PARAM_INT, 1, 1, 16, NULL, NULL,
+     "each scene triangle cut into subdivide^2 triangles before sorting and transport: the same surfaces as more "
+     "faces (the tessellation sweep of propagation time against faces)"},
     {"threads", GI_PARAM_INT, 4, 1, 64, NULL, "sort threads (Sec. 6)",
      "CPU threads of the sort stage, one subfield at a time each (the field is the same for any count)"},
     {"bsp_levels", GI_PARAM_INT, 2, 0, 8, NULL, "BSP levels (Sec. 3.2, 6)",
@@ -81,6 +84,7 @@ static gi_result vlf_create(const gi_host *host, const gi_params *params, void *
     v->prm.order = gi_params_enum(params, "order") == 1 ? VLF_ORDER_RAYS : VLF_ORDER_FACES;
     v->prm.threads = (uint32_t)gi_params_int(params, "threads");
     v->prm.precision = (uint32_t)gi_params_enum(params, "precision");
+    v->prm.subdivide = (uint32_t)gi_params_int(params, "subdivide");
     v->prm.bsp_levels = (uint32_t)gi_params_int(params, "bsp_levels");
     v->prm.bsp_min = (uint32_t)gi_params_int(params, "bsp_min");
     if (v->prm.N % v->prm.m != 0) {
@@ -182,7 +186,17 @@ static gi_result vlf_upload(vlf *v)
         }
     upload(v->buf[0], faces, (size_t)f->face_count * 16 * sizeof *faces);
     upload(v->buf[1], irr, (e_words + f->elem_count) * sizeof *irr);
-    upload(v->buf[6], f->tri_face, (size_t)f->tri_count * sizeof *f->tri_face);
+    /* the face of each scene triangle (the G-buffer's ids) */
+    uint32_t scene_tris = f->tri_count / f->tri_sub;
+    uint32_t *scene_face = malloc((size_t)scene_tris * sizeof *scene_face + 4);
+    if (!scene_face) {
+        free(faces), free(irr), free(tiles), free(dirs), free(rects), free(tris), free(lut);
+        return gi_kit_fail(&v->kit, GI_ERR_OUT_OF_MEMORY, "vlf: out of memory uploading the light field");
+    }
+    for (uint32_t t = 0; t < scene_tris; t++)
+        scene_face[t] = f->tri_face[(size_t)t * f->tri_sub];
+    upload(v->buf[6], scene_face, (size_t)scene_tris * sizeof *scene_face);
+    free(scene_face);
     upload(v->buf[2], tiles, (size_t)f->nd_cells * bpv);
     v->gpu_map_bytes = e_words * sizeof *irr + (size_t)f->nd_cells * bpv;
     upload(v->buf[3], rects, (size_t)f->nd_count * l * 8 * sizeof *rects);
@@ -226,6 +240,7 @@ static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
     host->stage_end(host, "gpu_init");
     const vlf_stats *s = &v->field.st;
     host->stat(host, "faces", v->field.face_count);
+    host->stat(host, "triangles", v->field.tri_count);
     host->stat(host, "diffuse_elements", s->diffuse_elements);
     host->stat(host, "nondiffuse_elements", s->nondiffuse_elements);
     host->stat(host, "tiles", s->tiles);

@@ -809,6 +809,48 @@ static void element_areas(vlf_field *f)
     }
 }
 
+/* Cuts every triangle into k^2 (a regular grid of its barycentric
+ * coordinates, the winding kept): the same surfaces as more faces, for the
+ * paper's claim that propagation is linear in the number of faces. */
+static int subdivide_triangles(vlf_field *f, uint32_t k)
+{
+    f->tri_sub = k * k;
+    if (k <= 1)
+        return 1;
+    size_t T = (size_t)f->tri_count * k * k;
+    gi_vec3 *P = malloc(T * 3 * sizeof *P);
+    uint32_t *F = malloc(T * sizeof *F);
+    if (!P || !F) {
+        free(P), free(F);
+        return 0;
+    }
+    size_t n = 0;
+    float inv = 1.0f / (float)k;
+    for (uint32_t ti = 0; ti < f->tri_count; ti++) {
+        const gi_vec3 *p = f->tri_p + 3 * (size_t)ti;
+        gi_vec3 e1 = gi_v3_sub(p[1], p[0]), e2 = gi_v3_sub(p[2], p[0]);
+#define GRID(a, b) gi_v3_add(p[0], gi_v3_add(gi_v3_scale(e1, (float)(a) * inv), gi_v3_scale(e2, (float)(b) * inv)))
+        for (uint32_t a = 0; a < k; a++)
+            for (uint32_t b = 0; a + b < k; b++) {
+                gi_vec3 *q = P + 3 * n;
+                q[0] = GRID(a, b), q[1] = GRID(a + 1, b), q[2] = GRID(a, b + 1);
+                F[n++] = f->tri_face[ti];
+                if (a + b + 2 <= k) {
+                    q = P + 3 * n;
+                    q[0] = GRID(a + 1, b), q[1] = GRID(a + 1, b + 1), q[2] = GRID(a, b + 1);
+                    F[n++] = f->tri_face[ti];
+                }
+            }
+#undef GRID
+    }
+    free(f->tri_p);
+    free(f->tri_face);
+    f->tri_p = P;
+    f->tri_face = F;
+    f->tri_count = (uint32_t)n;
+    return 1;
+}
+
 int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *p, char *err, size_t err_size)
 {
     memset(f, 0, sizeof *f);
@@ -882,7 +924,11 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
             f->elem_face[fc->first_elem + e] = fi;
     }
     element_areas(f);
-    if (!build_all_psf(f))
+    if ((uint64_t)s->triangle_count * p->subdivide * p->subdivide > 50000000u) {
+        snprintf(err, err_size, "vlf: %u triangles cut into %u^2 each are too many", s->triangle_count, p->subdivide);
+        return -1;
+    }
+    if (!subdivide_triangles(f, p->subdivide < 1 ? 1 : p->subdivide) || !build_all_psf(f))
         goto oom;
     /* Tile storage offsets, then coverage of each stored cell. */
     size_t cells = 0;

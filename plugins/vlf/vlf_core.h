@@ -48,6 +48,7 @@ typedef struct vlf_params {
     uint32_t bsp_levels; /* BSP cuts orthogonal to the direction, levels (paper: 2) */
     uint32_t bsp_min;    /* a list is cut only with at least this many faces (paper: 4K) */
     uint32_t precision;  /* storage format of the ir/radiance maps: VLF_PREC_32F, _16F or _RGB9E5 */
+    uint32_t subdivide;  /* each scene triangle cut into subdivide^2 for sorting and transport (tessellation sweep) */
 } vlf_params;
 
 /* Storage formats of the light-field maps (§3.1, §6): three float32 (12
@@ -126,8 +127,9 @@ typedef struct vlf_field {
     float radius;            /* world = centre + radius * vlf */
     uint32_t face_count, elem_count, nd_count;
     vlf_face *faces;
-    uint32_t tri_count;
-    uint32_t *tri_face;      /* face of each scene triangle */
+    uint32_t tri_count;      /* triangles sorted and rasterised: scene triangles x subdivide^2 */
+    uint32_t tri_sub;        /* subdivide^2: triangle k is part of scene triangle k / tri_sub */
+    uint32_t *tri_face;      /* face of each triangle */
     gi_vec3 *tri_p;          /* 3 corners per triangle, VLF coordinates */
     uint32_t *elem_face;
     float *elem_area;
