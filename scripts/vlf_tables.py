@@ -179,16 +179,19 @@ def main():
 
     out.append("\n## Depth order: the paper's face order against the per-ray sort\n")
     out.append("faces = Newell's ordering with splitting and the BSP cuts (default, label table1); rays = each ray's fragments "
-               "sorted by depth (label order). Same field up to ties: compare the image error.\n")
+               "sorted by depth (label order; runs without the parameter predate it and sorted per ray). Same field up to "
+               "ties: compare the image error.\n")
     out.append("| scene | order | triangles | pieces placed | cycle splits | BSP cuts | pair tests | sort (ms) | propagation (ms) | relMSE matched |")
     out.append("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for r in sorted(vlf, key=lambda r: (r["scene"], r["label"])):
         if r["label"] not in ("table1", "order") or not r["scene"].endswith(("cornell_box.gltf", "cornell_glossy.gltf")):
             continue
         st, ps = r.get("stats", {}), r.get("prepare_stages", {})
-        out.append("| {} | {} | {} | {} | {} | {} | {:.3g} | {:.0f} | {:.0f} | {} |".format(
-            os.path.basename(r["scene"]), p(r, "order", "faces"), int(st.get("triangles", 0)), int(st.get("sort_pieces", 0)),
-            int(st.get("sort_splits", 0)), int(st.get("sort_bsp_cuts", 0)), st.get("sort_tests", 0), ps.get("sort", 0),
+        cnt = ["{:.0f}".format(st[k]) if st.get(k) is not None else "–"
+               for k in ("triangles", "sort_pieces", "sort_splits", "sort_bsp_cuts")]
+        out.append("| {} | {} | {} | {} | {} | {} | {} | {:.0f} | {:.0f} | {} |".format(
+            os.path.basename(r["scene"]), p(r, "order", "rays"), *cnt,
+            "{:.3g}".format(st["sort_tests"]) if st.get("sort_tests") is not None else "–", ps.get("sort", 0),
             ps.get("propagate", 0), fmt(metric(r, "matched", "relmse"))))
 
     out.append("\n## Storage precision (glossy Cornell box)\n")
@@ -199,14 +202,17 @@ def main():
                "relMSE matched | mean diff matched (%) | propagation (ms) |")
     out.append("|---|---:|---:|---:|---:|---:|---:|---:|")
     bpv = {"32f": 12, "16f": 8, "rgb9e5": 4}
+    if not any(r["label"] == "precision" for r in vlf):
+        out.append("| – | no run labelled precision in runs.csv (the study predates the entry) | | | | | | |")
     for r in sorted(vlf, key=lambda r: bpv.get(p(r, "precision", "32f"), 0), reverse=True):
         if not r["scene"].endswith("cornell_glossy.gltf") or r["label"] not in ("table1", "precision"):
             continue
         st, ps = r.get("stats", {}), r.get("prepare_stages", {})
         pr = p(r, "precision", "32f")
-        out.append("| {} | {} | {:.2f} | {:.2f} | {:.2f} | {} | {} | {:.0f} |".format(
+        out.append("| {} | {} | {:.2f} | {:.2f} | {} | {} | {} | {:.0f} |".format(
             pr, bpv.get(pr, "?"), st.get("bytes_propagate", 0) / 2**20, st.get("bytes_render", 0) / 2**20,
-            st.get("gpu_bytes_maps", 0) / 2**20, fmt(metric(r, "matched", "relmse")),
+            "{:.2f}".format(st["gpu_bytes_maps"] / 2**20) if st.get("gpu_bytes_maps") is not None else "–",
+            fmt(metric(r, "matched", "relmse")),
             fmt(metric(r, "matched", "mean_lum_diff_pct"), 2), ps.get("propagate", 0)))
 
     out.append("\n## Tessellation sweep: time against faces (coarse Cornell box, every triangle cut into k²)\n")
@@ -216,6 +222,8 @@ def main():
     out.append("| k | triangles | samples transported | sort (ms) | propagation (ms) | render (ms/frame) |")
     out.append("|---:|---:|---:|---:|---:|---:|")
     tess = sorted((r for r in vlf if r["label"] == "tess"), key=lambda r: int(p(r, "subdivide", "1") or 1))
+    if not tess:
+        out.append("| – | no run labelled tess in runs.csv (the study predates the entry) | | | | |")
     for r in tess:
         st, ps = r.get("stats", {}), r.get("prepare_stages", {})
         out.append("| {} | {} | {:.4g} | {:.0f} | {:.0f} | {:.1f} |".format(
