@@ -890,6 +890,29 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
         return -1;
     }
     f->env = s->envmap;
+    /* Directional lights (not in the paper, which has emissive faces and
+     * sky): parallel light, so it enters like the sky of Fig. 6, into the
+     * interfaces of the three directions around the light's with their
+     * barycentric weights, radiance alpha E / dOmega, so that each carries
+     * alpha E through a unit of area across it. */
+    f->sun = calloc((size_t)p->l * 2 * 3, sizeof *f->sun);
+    if (!f->sun)
+        goto oom;
+    for (uint32_t li = 0; li < s->light_count; li++) {
+        if (s->lights[li].type != GI_LIGHT_DIRECTIONAL)
+            continue;
+        gi_light_frame fr = gi_scene_light_at(s, li, t);
+        float len = gi_v3_length(fr.direction);
+        if (!(len > 0.0f))
+            continue;
+        uint32_t node[3];
+        float al[3];
+        vlf_dirs_locate(&f->dirs, gi_v3_scale(fr.direction, 1.0f / len), node, al);
+        for (int k = 0; k < 3; k++)
+            for (int q = 0; q < 3; q++)
+                f->sun[3 * node[k] + (uint32_t)q] += al[k] * s->lights[li].intensity[q] / f->dirs.solid_angle[node[k]];
+        f->sun_count++;
+    }
     if (!group_faces(f, s, t))
         goto oom;
     uint32_t elems = 0;
@@ -1025,6 +1048,9 @@ static void sweep_perturbed(vlf_field *f, uint32_t i, const vlf_psf *fr, const f
     float sky[3] = {0, 0, 0};
     if (first_iteration && f->env)
         gi_envmap_eval(f->env, gi_v3_scale(t, -1.0f), sky);
+    if (first_iteration)
+        for (int q = 0; q < 3; q++)
+            sky[q] += f->sun[3 * (sign > 0 ? i : i + f->prm.l) + (uint32_t)q];
     double shot = 0, recv = 0, back = 0, esc = 0;
     size_t a = 0;
     while (a < buf->n) {
@@ -1113,6 +1139,9 @@ static void sweep(vlf_field *f, uint32_t i, int sign, int first_iteration)
     float sky[3] = {0, 0, 0};
     if (first_iteration && f->env)
         gi_envmap_eval(f->env, gi_v3_scale(t, -1.0f), sky);
+    if (first_iteration)
+        for (int q = 0; q < 3; q++)
+            sky[q] += f->sun[3 * sd + (uint32_t)q];
     double shot = 0, recv = 0, back = 0, esc = 0;
     float min_area = 1.0f / (64.0f * f->prm.density * f->prm.density);
     for (uint32_t c = 0; c < N * N; c++) {
@@ -1398,5 +1427,6 @@ void vlf_field_free(vlf_field *f)
     free(f->out_next);
     free(f->out_tot);
     free(f->in);
+    free(f->sun);
     memset(f, 0, sizeof *f);
 }

@@ -141,6 +141,8 @@ typedef struct vlf_field {
     float *E_tot, *E_next, *L_cur;       /* elem_count * 3: irradiance, unshot diffuse radiance */
     float *out_cur, *out_next, *out_tot, *in; /* nd_cells * 3 */
     const struct gi_envmap *env;
+    float *sun;              /* 2l x RGB: radiance the directional lights put into each signed direction's interface */
+    uint32_t sun_count;      /* directional lights of the scene */
     vlf_stats st;
 } vlf_field;
 

@@ -29,7 +29,9 @@
  *   vlf_tests precision the storage formats (RGBA16F, RGB9E5): encoders,
  *                      the propagated maps against float32 on the glossy
  *                      Cornell box, and the reported memory against the
- *                      packed bytes. */
+ *                      packed bytes;
+ *   vlf_tests sun      a directional light: open floor lit by E cos theta,
+ *                      an occluder's shadow where it falls. */
 #include "vlf_core.h"
 
 #include "gi/raytrace.h"
@@ -625,6 +627,107 @@ static void test_mirror(void)
     free(s);
 }
 
+/* Mean irradiance (channel 0) of the whole elements of face fi whose
+ * centres (world x, y) lie in the box [x0, x1] x [y0, y1]; -1 if none. */
+static double mean_E_in(const vlf_field *f, uint32_t fi, float x0, float x1, float y0, float y1)
+{
+    const vlf_face *fc = &f->faces[fi];
+    double sum = 0.0;
+    uint32_t n = 0;
+    float texel = 1.0f / (f->prm.density * f->prm.density);
+    for (uint32_t iy = 0; iy < fc->H; iy++)
+        for (uint32_t ix = 0; ix < fc->W; ix++) {
+            uint32_t e = fc->first_elem + iy * fc->W + ix;
+            if (f->elem_area[e] < 0.99f * texel)
+                continue;
+            gi_vec3 q = gi_v3_add(fc->origin, gi_v3_add(gi_v3_scale(fc->t, ((float)ix + 0.5f) / f->prm.density),
+                                                        gi_v3_scale(fc->b, ((float)iy + 0.5f) / f->prm.density)));
+            gi_vec3 w = gi_v3_add(f->centre, gi_v3_scale(q, f->radius));
+            if (w.x < x0 || w.x > x1 || w.y < y0 || w.y > y1)
+                continue;
+            sum += f->E_tot[3 * (size_t)e];
+            n++;
+        }
+    return n ? sum / n : -1.0;
+}
+
+/* Directional light: a floor (z = 0, [-1, 1]^2) under a square occluder
+ * (z = 0.5, half size 0.25), a sun of irradiance 2 straight down and 30
+ * degrees off: after one iteration the open floor's irradiance is within
+ * 5 % of 2 cos(theta), and the floor around the shadow's centre (0, 0.5 tan
+ * theta) gets under 5 % of it while the same spot mirrored (where the
+ * shadow would fall were the light reversed) is lit; the always-lit and the
+ * never-lit answers each fail one of these. */
+static void test_sun(void)
+{
+    for (int k = 0; k < 2; k++) {
+        float a = k ? GI_PI / 6.0f : 0.0f;
+        gi_scene *s = calloc(1, sizeof *s);
+        s->triangle_count = 4;
+        s->vertex_count = 8;
+        s->vertices = calloc(8, sizeof *s->vertices);
+        s->indices = calloc(12, sizeof *s->indices);
+        s->material_count = 1;
+        s->materials = calloc(1, sizeof *s->materials);
+        s->materials[0].albedo[0] = s->materials[0].albedo[1] = s->materials[0].albedo[2] = 0.5f;
+        s->materials[0].albedo_texture = -1;
+        s->node_count = 2;
+        s->nodes = calloc(2, sizeof *s->nodes);
+        for (int n = 0; n < 2; n++) {
+            s->nodes[n].parent = -1;
+            s->nodes[n].rotation[3] = 1.0f;
+            s->nodes[n].scale[0] = s->nodes[n].scale[1] = s->nodes[n].scale[2] = 1.0f;
+        }
+        /* the light's node: turned by a about x, its -z pointing along (0, sin a, -cos a) */
+        s->nodes[1].rotation[0] = sinf(0.5f * a);
+        s->nodes[1].rotation[3] = cosf(0.5f * a);
+        s->object_count = 1;
+        s->objects = calloc(1, sizeof *s->objects);
+        s->objects[0].triangle_count = 4;
+        s->objects[0].vertex_count = 8;
+        add_quad(s, 0, gi_v3(-1, -1, 0), gi_v3(1, -1, 0), gi_v3(1, 1, 0), gi_v3(-1, 1, 0), 0);
+        add_quad(s, 1, gi_v3(-0.25f, -0.25f, 0.5f), gi_v3(0.25f, -0.25f, 0.5f), gi_v3(0.25f, 0.25f, 0.5f),
+                 gi_v3(-0.25f, 0.25f, 0.5f), 0);
+        float bounds[6] = {-1, -1, 0, 1, 1, 0.5f};
+        memcpy(s->objects[0].local_bounds, bounds, sizeof bounds);
+        s->light_count = 1;
+        s->lights = calloc(1, sizeof *s->lights);
+        s->lights[0].type = GI_LIGHT_DIRECTIONAL;
+        s->lights[0].node = 1;
+        s->lights[0].intensity[0] = s->lights[0].intensity[1] = s->lights[0].intensity[2] = 2.0f;
+        vlf_params p = defaults();
+        p.iterations = 1;
+        p.density = 16;
+        vlf_field f;
+        char err[256];
+        int rc = vlf_field_build(&f, s, 0.0f, &p, err, sizeof err);
+        EXPECT(rc == 0, "%s", err);
+        if (rc == 0) {
+            vlf_field_propagate(&f, NULL, NULL);
+            uint32_t floor = f.tri_face[0];
+            double want = 2.0 * cos(a), ys = 0.5 * tan(a);
+            double open = mean_E_in(&f, floor, 0.55f, 0.9f, -0.9f, 0.9f);
+            double shadow = mean_E_in(&f, floor, -0.1f, 0.1f, (float)ys - 0.1f, (float)ys + 0.1f);
+            double mirror = mean_E_in(&f, floor, -0.1f, 0.1f, (float)-ys - 0.1f, (float)-ys + 0.1f);
+            printf("sun %2.0f deg: open floor E = %.4f (due %.4f), shadow centre (0, %.3f) E = %.4f, %s E = %.4f\n",
+                   a * 180.0 / GI_PI, open, want, ys, shadow, k ? "the mirrored spot" : "(same spot)", mirror);
+            EXPECT(fabs(open / want - 1.0) < 0.05, "sun: open floor %.4f, due %.4f", open, want);
+            EXPECT(shadow >= 0.0 && shadow < 0.05 * want, "sun: the shadow gets %.4f", shadow);
+            if (k)
+                EXPECT(mirror > 0.9 * want, "sun: the spot opposite the shadow gets %.4f", mirror);
+            EXPECT(f.sun_count == 1, "sun: %u directional lights seen", f.sun_count);
+            vlf_field_free(&f);
+        }
+        free(s->lights);
+        free(s->vertices);
+        free(s->indices);
+        free(s->materials);
+        free(s->objects);
+        free(s->nodes);
+        free(s);
+    }
+}
+
 /* Relative L1 difference of two maps of count RGB values: sum |a - b| / sum |b|. */
 static double rel_l1(const float *a, const float *b, size_t count)
 {
@@ -748,8 +851,10 @@ int main(int argc, char **argv)
         test_mirror(), any = 1;
     if (all || strcmp(part, "precision") == 0)
         test_precision(), any = 1;
+    if (all || strcmp(part, "sun") == 0)
+        test_sun(), any = 1;
     if (!any) {
-        fprintf(stderr, "vlf_tests: unknown part '%s' (dirs, order, energy, furnace, mirror, precision)\n", part);
+        fprintf(stderr, "vlf_tests: unknown part '%s' (dirs, order, energy, furnace, mirror, precision, sun)\n", part);
         return 2;
     }
     return gi_test_finish();
