@@ -49,6 +49,9 @@ static uint32_t add_piece(vlf_sorter *s, uint32_t tri, const gi_vec3 *v, uint32_
     cap = s->cap_state;
     if (!grow((void **)&s->chain, &cap, s->np + 1, sizeof *s->chain))
         return UINT32_MAX;
+    cap = s->cap_state;
+    if (!grow((void **)&s->stamp, &cap, s->np + 1, sizeof *s->stamp))
+        return UINT32_MAX;
     s->cap_state = cap;
     vlf_piece *p = &s->poly[s->np];
     p->tri = tri;
@@ -65,6 +68,7 @@ static uint32_t add_piece(vlf_sorter *s, uint32_t tri, const gi_vec3 *v, uint32_
     }
     s->state[s->np] = 0;
     s->chain_pos[s->np] = -1;
+    s->stamp[s->np] = 0;
     return s->np++;
 }
 
@@ -203,6 +207,106 @@ static int obstructs(vlf_sorter *s, uint32_t q, uint32_t p)
     return zq < zp - EPS;
 }
 
+/* Cell range of piece idx's projected bounds in the grid. */
+static void grid_range(const vlf_sorter *s, uint32_t idx, uint32_t r[4])
+{
+    const vlf_piece *p = &s->poly[idx];
+    float c[4] = {(p->lo[0] - s->gx0) * s->gsx, (p->lo[1] - s->gy0) * s->gsy, (p->hi[0] - s->gx0) * s->gsx,
+                  (p->hi[1] - s->gy0) * s->gsy};
+    for (int k = 0; k < 4; k++) {
+        float v = floorf(c[k]);
+        r[k] = v <= 0.0f ? 0u : v >= (float)(s->G - 1) ? s->G - 1 : (uint32_t)v;
+    }
+}
+
+/* Registers piece idx in the grid cells its projection's bounds meet (in
+ * the wide list if they are more than a quarter of the grid). */
+static int grid_add(vlf_sorter *s, uint32_t idx)
+{
+    uint32_t r[4];
+    grid_range(s, idx, r);
+    uint64_t cells = (uint64_t)(r[2] - r[0] + 1) * (r[3] - r[1] + 1);
+    if (cells * 4 > (uint64_t)s->G * s->G && cells > 4) {
+        if (!grow((void **)&s->wide, &s->cap_wide, s->nwide + 1, sizeof *s->wide))
+            return 0;
+        s->wide[s->nwide++] = idx;
+        return 1;
+    }
+    uint32_t cap = s->cap_node;
+    if (!grow((void **)&s->node_piece, &cap, s->nnode + (uint32_t)cells, sizeof *s->node_piece))
+        return 0;
+    cap = s->cap_node;
+    if (!grow((void **)&s->node_next, &cap, s->nnode + (uint32_t)cells, sizeof *s->node_next))
+        return 0;
+    s->cap_node = cap;
+    for (uint32_t y = r[1]; y <= r[3]; y++)
+        for (uint32_t x = r[0]; x <= r[2]; x++) {
+            uint32_t c = y * s->G + x;
+            s->node_piece[s->nnode] = idx;
+            s->node_next[s->nnode] = s->cell_first[c];
+            s->cell_first[c] = s->nnode++;
+        }
+    return 1;
+}
+
+/* A grid of about two pieces a cell over the projections of items. */
+static int grid_build(vlf_sorter *s, const uint32_t *items, uint32_t n)
+{
+    float lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (uint32_t k = 0; k < n; k++)
+        for (int a = 0; a < 2; a++)
+            lo[a] = fminf(lo[a], s->poly[items[k]].lo[a]), hi[a] = fmaxf(hi[a], s->poly[items[k]].hi[a]);
+    uint32_t G = (uint32_t)sqrtf((float)n * 0.5f);
+    G = G < 1 ? 1 : G > 256 ? 256 : G;
+    s->G = G;
+    s->gx0 = lo[0], s->gy0 = lo[1];
+    s->gsx = (float)G / fmaxf(hi[0] - lo[0], 1e-12f);
+    s->gsy = (float)G / fmaxf(hi[1] - lo[1], 1e-12f);
+    if (!grow((void **)&s->cell_first, &s->cap_cells, G * G, sizeof *s->cell_first))
+        return 0;
+    for (uint32_t c = 0; c < G * G; c++)
+        s->cell_first[c] = UINT32_MAX;
+    s->nnode = s->nwide = 0;
+    for (uint32_t k = 0; k < n; k++)
+        if (!grid_add(s, items[k]))
+            return 0;
+    return 1;
+}
+
+/* Visits a waiting piece q met by the scan for candidate cand: 1 if it
+ * may lie in front of cand. */
+static int scan_one(vlf_sorter *s, uint32_t q, uint32_t cand, float zmax)
+{
+    if (s->stamp[q] == s->scan)
+        return 0;
+    s->stamp[q] = s->scan;
+    if (q == cand || s->state[q] != 0 || s->poly[q].lo[2] >= zmax)
+        return 0;
+    return obstructs(s, q, cand);
+}
+
+/* A waiting piece that may lie in front of cand, or UINT32_MAX: the pieces
+ * of the grid cells cand's projection meets, and the wide ones. */
+static uint32_t find_obstruction(vlf_sorter *s, uint32_t cand)
+{
+    if (++s->scan == 0) {
+        memset(s->stamp, 0, (size_t)s->np * sizeof *s->stamp);
+        s->scan = 1;
+    }
+    float zmax = s->poly[cand].hi[2];
+    for (uint32_t k = 0; k < s->nwide; k++)
+        if (scan_one(s, s->wide[k], cand, zmax))
+            return s->wide[k];
+    uint32_t r[4];
+    grid_range(s, cand, r);
+    for (uint32_t y = r[1]; y <= r[3]; y++)
+        for (uint32_t x = r[0]; x <= r[2]; x++)
+            for (uint32_t nd = s->cell_first[y * s->G + x]; nd != UINT32_MAX; nd = s->node_next[nd])
+                if (scan_one(s, s->node_piece[nd], cand, zmax))
+                    return s->node_piece[nd];
+    return UINT32_MAX;
+}
+
 /* Inserts piece idx into the waiting list, kept ordered by nearest depth. */
 static int list_insert(vlf_sorter *s, uint32_t idx)
 {
@@ -221,7 +325,7 @@ static int list_insert(vlf_sorter *s, uint32_t idx)
     memmove(s->list + lo + 1, s->list + lo, (size_t)(s->nlist - lo) * sizeof *s->list);
     s->list[lo] = idx;
     s->nlist++;
-    return 1;
+    return grid_add(s, idx);
 }
 
 static int emit(vlf_sorter *s, uint32_t idx)
@@ -288,8 +392,9 @@ static int zkey_cmp(const void *a, const void *b)
 
 /* Newell's ordering of pieces items[0 .. n), appended to s->out: the
  * waiting piece nearest in depth is the candidate; a waiting piece that may
- * lie in front of it becomes the candidate in its place (a chain); a piece
- * met again on the chain closes a cycle, which is broken by a split. */
+ * lie in front of it (looked for among the pieces whose projections share
+ * a grid cell with it) becomes the candidate in its place (a chain); a
+ * piece met again on the chain closes a cycle, which is broken by a split. */
 static int order_list(vlf_sorter *s, const uint32_t *items, uint32_t n, int mode, uint32_t split_limit)
 {
     zkey *keys = malloc((size_t)(n ? n : 1) * sizeof *keys);
@@ -304,6 +409,8 @@ static int order_list(vlf_sorter *s, const uint32_t *items, uint32_t n, int mode
         s->list[k] = keys[k].idx;
     s->nlist = n;
     free(keys);
+    if (mode != VLF_SORT_PLAIN && !grid_build(s, items, n))
+        return -1;
     uint32_t head = 0, chain_len = 0;
     for (;;) {
         while (head < s->nlist && s->state[s->list[head]] != 0)
@@ -317,20 +424,8 @@ static int order_list(vlf_sorter *s, const uint32_t *items, uint32_t n, int mode
         }
         uint32_t cand = s->chain[chain_len - 1];
         uint32_t found = UINT32_MAX;
-        if (mode != VLF_SORT_PLAIN) {
-            float zmax = s->poly[cand].hi[2];
-            for (uint32_t k = head; k < s->nlist; k++) {
-                uint32_t q = s->list[k];
-                if (s->poly[q].lo[2] >= zmax)
-                    break;
-                if (q == cand || s->state[q] != 0)
-                    continue;
-                if (obstructs(s, q, cand)) {
-                    found = q;
-                    break;
-                }
-            }
-        }
+        if (mode != VLF_SORT_PLAIN)
+            found = find_obstruction(s, cand);
         if (found == UINT32_MAX) {
             if (!emit(s, cand))
                 return -1;
@@ -482,5 +577,10 @@ void vlf_sorter_free(vlf_sorter *s)
     free(s->chain_pos);
     free(s->chain);
     free(s->state);
+    free(s->stamp);
+    free(s->cell_first);
+    free(s->node_piece);
+    free(s->node_next);
+    free(s->wide);
     memset(s, 0, sizeof *s);
 }

@@ -37,7 +37,16 @@ typedef struct vlf_sorter {
     int32_t *chain_pos;    /* position of a piece on the candidate chain, -1 if not on it */
     uint32_t *chain;
     uint8_t *state;        /* 0 waiting, 1 placed, 2 replaced by its pieces */
+    uint32_t *stamp;       /* last candidate scan that met the piece */
     uint32_t cap_state;
+    /* a uniform grid over the projections of the list being ordered: the
+     * pieces whose projected bounds meet each cell (linked lists), and the
+     * pieces too wide for it, met by every scan */
+    uint32_t G, *cell_first, cap_cells;
+    float gx0, gy0, gsx, gsy;
+    uint32_t *node_piece, *node_next, nnode, cap_node;
+    uint32_t *wide, nwide, cap_wide;
+    uint32_t scan;
     uint64_t tests;        /* pairs tested */
     uint32_t splits;       /* pieces split to break a cycle */
     uint32_t bsp_cuts;     /* pieces cut by a BSP plane */
