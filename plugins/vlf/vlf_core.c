@@ -16,6 +16,8 @@
 #include <libqhull_r/qhull_ra.h>
 
 #include "gi/envmap.h"
+#include "gi/lights.h"
+#include "gi/raytrace.h"
 #include "vlf_sort.h"
 
 static double now_s(void)
@@ -797,14 +799,23 @@ static void element_areas(vlf_field *f)
                 n = clip_poly(px, py, n, 0, -1.0f, -(float)tx);
                 n = clip_poly(px, py, n, 1, 1.0f, (float)ty + 1.0f);
                 n = clip_poly(px, py, n, 1, -1.0f, -(float)ty);
-                float a = 0.0f;
+                float a = 0.0f, mx = 0.0f, my = 0.0f;
                 for (int i = 0; i < n; i++) {
                     int j = (i + 1) % n;
-                    a += px[i] * py[j] - px[j] * py[i];
+                    float c = px[i] * py[j] - px[j] * py[i];
+                    a += c;
+                    mx += (px[i] + px[j]) * c;
+                    my += (py[i] + py[j]) * c;
                 }
                 int cx = tx < 0 ? 0 : tx >= (int)fc->W ? (int)fc->W - 1 : tx;
                 int cy = ty < 0 ? 0 : ty >= (int)fc->H ? (int)fc->H - 1 : ty;
-                f->elem_area[fc->first_elem + (uint32_t)cy * fc->W + (uint32_t)cx] += 0.5f * fabsf(a) * texel;
+                uint32_t e = fc->first_elem + (uint32_t)cy * fc->W + (uint32_t)cx;
+                float ar = 0.5f * fabsf(a) * texel;
+                f->elem_area[e] += ar;
+                if (a != 0.0f) { /* area-weighted centroid of the part on the face, texel units */
+                    f->elem_c[2 * (size_t)e] += ar * mx / (3.0f * a);
+                    f->elem_c[2 * (size_t)e + 1] += ar * my / (3.0f * a);
+                }
             }
     }
 }
@@ -913,6 +924,34 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
                 f->sun[3 * node[k] + (uint32_t)q] += al[k] * s->lights[li].intensity[q] / f->dirs.solid_angle[node[k]];
         f->sun_count++;
     }
+    /* Point and spot lights: a first shot by shadow rays (punctual_first_shot). */
+    for (uint32_t li = 0; li < s->light_count; li++)
+        f->punctual_count += s->lights[li].type != GI_LIGHT_DIRECTIONAL;
+    if (f->punctual_count) {
+        f->punctual = calloc(f->punctual_count, sizeof *f->punctual);
+        if (!f->punctual)
+            goto oom;
+        uint32_t k = 0;
+        for (uint32_t li = 0; li < s->light_count; li++) {
+            const gi_light *L = &s->lights[li];
+            if (L->type == GI_LIGHT_DIRECTIONAL)
+                continue;
+            gi_light_frame fr = gi_scene_light_at(s, li, t);
+            vlf_punctual *P = &f->punctual[k++];
+            P->spot = L->type == GI_LIGHT_SPOT;
+            P->pos = fr.position;
+            P->dir = fr.direction;
+            memcpy(P->I, L->intensity, sizeof P->I);
+            P->range = L->range;
+            P->cos_inner = cosf(L->inner_cone);
+            P->cos_outer = cosf(L->outer_cone);
+        }
+        gi_error e;
+        if (gi_rt_create(s, t, &f->rt, &e) != GI_OK) {
+            snprintf(err, err_size, "vlf: shadow rays for the point lights: %s", e.text);
+            return -1;
+        }
+    }
     if (!group_faces(f, s, t))
         goto oom;
     uint32_t elems = 0;
@@ -934,12 +973,13 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
     f->elem_count = elems;
     f->elem_face = malloc((size_t)elems * sizeof *f->elem_face);
     f->elem_area = calloc((size_t)elems, sizeof *f->elem_area);
+    f->elem_c = calloc((size_t)elems * 2 + 2, sizeof *f->elem_c);
     f->E_tot = calloc((size_t)elems * 3, sizeof(float));
     f->E_next = calloc((size_t)elems * 3, sizeof(float));
     f->L_cur = calloc((size_t)elems * 3, sizeof(float));
     f->psf = calloc(p->l, sizeof *f->psf);
     f->rects = calloc((size_t)f->nd_count * p->l + 1, sizeof *f->rects);
-    if (!f->elem_face || !f->elem_area || !f->E_tot || !f->E_next || !f->L_cur || !f->psf || !f->rects)
+    if (!f->elem_face || !f->elem_area || !f->elem_c || !f->E_tot || !f->E_next || !f->L_cur || !f->psf || !f->rects)
         goto oom;
     for (uint32_t fi = 0; fi < f->face_count; fi++) {
         vlf_face *fc = &f->faces[fi];
@@ -947,6 +987,12 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
             f->elem_face[fc->first_elem + e] = fi;
     }
     element_areas(f);
+    for (uint32_t e = 0; e < elems; e++) {
+        if (f->elem_area[e] > 0.0f) {
+            f->elem_c[2 * (size_t)e] /= f->elem_area[e];
+            f->elem_c[2 * (size_t)e + 1] /= f->elem_area[e];
+        }
+    }
     if ((uint64_t)s->triangle_count * p->subdivide * p->subdivide > 50000000u) {
         snprintf(err, err_size, "vlf: %u triangles cut into %u^2 each are too many", s->triangle_count, p->subdivide);
         return -1;
@@ -1219,6 +1265,150 @@ static int read_in(const vlf_field *f, const vlf_rect *r, float x, float y, floa
     return 1;
 }
 
+/* Weights g over the 2l signed directions of light reflected by
+ * non-diffuse face fc into direction r (§3.4): mirrors and lobes narrower
+ * than the direction set (fewer than ~3 directions' worth of lobe) go to
+ * the three nearest directions of r with their barycentric weights, wider
+ * Phong lobes to every direction of the lobe; directions below the face
+ * get 0. Returns sum_j g_j cos_j dOmega_j (the normaliser that makes the
+ * face reflect ks of what arrives), 0 if nothing is reflected. */
+static double reflect_weights(const vlf_field *f, const vlf_face *fc, gi_vec3 r, float *g)
+{
+    uint32_t n2 = 2 * f->prm.l;
+    memset(g, 0, n2 * sizeof *g);
+    int lobe = 0;
+    if (!fc->mirror) {
+        double s1 = 0, s2 = 0;
+        for (uint32_t j = 0; j < n2; j++) {
+            float cj = gi_v3_dot(f->dirs.signed_dirs[j], r);
+            if (cj > 0.0f && gi_v3_dot(f->dirs.signed_dirs[j], fc->n) > 0.0f) {
+                g[j] = powf(cj, fc->exponent);
+                if (g[j] < 1e-3f)
+                    g[j] = 0.0f;
+                s1 += g[j];
+                s2 += (double)g[j] * g[j];
+            }
+        }
+        lobe = s2 > 0.0 && s1 * s1 / s2 >= 3.0; /* at least ~3 directions in the lobe */
+        if (!lobe)
+            memset(g, 0, n2 * sizeof *g);
+    }
+    if (!lobe) {
+        uint32_t node[3];
+        float al[3];
+        vlf_dirs_locate(&f->dirs, r, node, al);
+        for (int j = 0; j < 3; j++)
+            g[node[j]] += al[j];
+    }
+    double norm = 0.0;
+    for (uint32_t j = 0; j < n2; j++) {
+        float cj = gi_v3_dot(f->dirs.signed_dirs[j], fc->n);
+        if (g[j] > 0.0f && cj > 0.0f)
+            norm += g[j] * cj * f->dirs.solid_angle[j];
+        else
+            g[j] = 0.0f;
+    }
+    return norm;
+}
+
+/* Irradiance at world point x of surface normal n from the point and spot
+ * lights, each through a shadow ray (Embree, core raytrace.h); per light
+ * into E + 3 k, and the unit direction toward it into w + k. */
+static void punctual_at(const vlf_field *f, gi_vec3 x, gi_vec3 n, float *E, gi_vec3 *w)
+{
+    for (uint32_t k = 0; k < f->punctual_count; k++) {
+        const vlf_punctual *L = &f->punctual[k];
+        E[3 * k] = E[3 * k + 1] = E[3 * k + 2] = 0.0f;
+        gi_vec3 d = gi_v3_sub(L->pos, x);
+        float dist = gi_v3_length(d);
+        if (!(dist > 0.0f))
+            continue;
+        w[k] = gi_v3_scale(d, 1.0f / dist);
+        float c = gi_v3_dot(n, w[k]);
+        if (c <= 0.0f)
+            continue;
+        float scale = gi_range_window(dist, L->range) / (dist * dist);
+        if (L->spot)
+            scale *= gi_spot_falloff(-gi_v3_dot(w[k], L->dir), L->cos_inner, L->cos_outer);
+        if (!(scale > 0.0f))
+            continue;
+        gi_vec3 o = gi_v3_add(x, gi_v3_scale(n, 1e-4f * f->radius));
+        float tfar = gi_v3_length(gi_v3_sub(L->pos, o)) * (1.0f - 1e-5f);
+        if (gi_rt_occluded(f->rt, o, w[k], 0.0f, tfar))
+            continue;
+        for (int q = 0; q < 3; q++)
+            E[3 * k + (uint32_t)q] = L->I[q] * c * scale;
+    }
+}
+
+/* The point and spot lights' first shot (not in the paper, which has
+ * emissive faces and sky): their direct irradiance on every diffuse
+ * element (at the element's centroid on its face) and their reflection by
+ * every non-diffuse face into its tiles (each covered cell's point on the
+ * face, reflected as §3.4 reflects the interface's light), added to the
+ * next maps of the first iteration: shot on from there like received
+ * light. */
+static int punctual_first_shot(vlf_field *f)
+{
+    uint32_t P = f->punctual_count, l = f->prm.l;
+    float *E = malloc((size_t)P * 3 * sizeof *E), *g = malloc((size_t)2 * l * sizeof *g);
+    gi_vec3 *w = malloc((size_t)P * sizeof *w);
+    if (!E || !g || !w) {
+        free(E), free(g), free(w);
+        return 0;
+    }
+    for (uint32_t e = 0; e < f->elem_count; e++) {
+        if (!(f->elem_area[e] > 0.0f))
+            continue;
+        const vlf_face *fc = &f->faces[f->elem_face[e]];
+        gi_vec3 q = gi_v3_add(fc->origin, gi_v3_add(gi_v3_scale(fc->t, f->elem_c[2 * (size_t)e] / f->prm.density),
+                                                    gi_v3_scale(fc->b, f->elem_c[2 * (size_t)e + 1] / f->prm.density)));
+        punctual_at(f, gi_v3_add(f->centre, gi_v3_scale(q, f->radius)), fc->n, E, w);
+        for (uint32_t k = 0; k < P; k++)
+            for (int c = 0; c < 3; c++)
+                f->E_next[3 * (size_t)e + (size_t)c] += E[3 * k + (uint32_t)c];
+    }
+    for (uint32_t fi = 0; fi < f->face_count; fi++) {
+        const vlf_face *fc = &f->faces[fi];
+        if (fc->nd < 0)
+            continue;
+        for (uint32_t i = 0; i < l; i++) {
+            const vlf_rect *rj = &f->rects[(size_t)fc->nd * l + i];
+            const vlf_psf *ps = &f->psf[i];
+            float dn = gi_v3_dot(ps->n, fc->n);
+            if (rj->w == 0 || fabsf(dn) < 1e-6f)
+                continue;
+            uint32_t sd = dn > 0.0f ? i : i + l; /* the signed direction leaving the front */
+            for (uint32_t yy = 0; yy < rj->h; yy++)
+                for (uint32_t xx = 0; xx < rj->w; xx++) {
+                    size_t slot = rj->offset + (size_t)yy * rj->w + xx;
+                    if (!f->nd_cover[slot])
+                        continue;
+                    float U = ((float)(rj->x0 + (int32_t)xx) + 0.5f) / (float)f->prm.N * 2.0f - 1.0f;
+                    float V = ((float)(rj->y0 + (int32_t)yy) + 0.5f) / (float)f->prm.N * 2.0f - 1.0f;
+                    gi_vec3 o = gi_v3_add(gi_v3_scale(ps->u, U), gi_v3_scale(ps->v, V));
+                    float tt = gi_v3_dot(fc->n, gi_v3_sub(fc->origin, o)) / dn;
+                    gi_vec3 q = gi_v3_add(o, gi_v3_scale(ps->n, tt));
+                    punctual_at(f, gi_v3_add(f->centre, gi_v3_scale(q, f->radius)), fc->n, E, w);
+                    for (uint32_t k = 0; k < P; k++) {
+                        if (E[3 * k] <= 0.0f && E[3 * k + 1] <= 0.0f && E[3 * k + 2] <= 0.0f)
+                            continue;
+                        /* light travelling along -w, reflected about the face */
+                        gi_vec3 t = gi_v3_scale(w[k], -1.0f);
+                        gi_vec3 r = gi_v3_sub(t, gi_v3_scale(fc->n, 2.0f * gi_v3_dot(t, fc->n)));
+                        double norm = reflect_weights(f, fc, r, g);
+                        if (norm <= 0.0 || g[sd] <= 0.0f)
+                            continue;
+                        for (int c = 0; c < 3; c++)
+                            f->out_next[3 * slot + (size_t)c] += fc->ks[c] * E[3 * k + (uint32_t)c] * (float)(g[sd] / norm);
+                    }
+                }
+        }
+    }
+    free(E), free(g), free(w);
+    return 1;
+}
+
 /* Non-diffuse scattering (§3.4): the radiance that subfield i brought to
  * each non-diffuse face is reflected into the subfields around the
  * reflected direction (mirrors and lobes narrower than the direction set:
@@ -1243,40 +1433,7 @@ static void scatter(vlf_field *f, uint32_t i)
         gi_vec3 t = f->dirs.signed_dirs[sd_in];
         float cos_in = fabsf(ci);
         gi_vec3 r = gi_v3_sub(t, gi_v3_scale(fc->n, 2.0f * gi_v3_dot(t, fc->n)));
-        memset(g, 0, n2 * sizeof *g);
-        int lobe = 0;
-        if (!fc->mirror) {
-            double s1 = 0, s2 = 0;
-            for (uint32_t j = 0; j < n2; j++) {
-                float cj = gi_v3_dot(f->dirs.signed_dirs[j], r);
-                if (cj > 0.0f && gi_v3_dot(f->dirs.signed_dirs[j], fc->n) > 0.0f) {
-                    g[j] = powf(cj, fc->exponent);
-                    if (g[j] < 1e-3f)
-                        g[j] = 0.0f;
-                    s1 += g[j];
-                    s2 += (double)g[j] * g[j];
-                }
-            }
-            lobe = s2 > 0.0 && s1 * s1 / s2 >= 3.0; /* at least ~3 directions in the lobe */
-            if (!lobe)
-                memset(g, 0, n2 * sizeof *g);
-        }
-        if (!lobe) {
-            uint32_t node[3];
-            float al[3];
-            vlf_dirs_locate(&f->dirs, r, node, al);
-            for (int j = 0; j < 3; j++)
-                g[node[j]] += al[j];
-        }
-        /* Normalise: the face reflects ks of the flux that arrives from this direction. */
-        double norm = 0.0;
-        for (uint32_t j = 0; j < n2; j++) {
-            float cj = gi_v3_dot(f->dirs.signed_dirs[j], fc->n);
-            if (g[j] > 0.0f && cj > 0.0f)
-                norm += g[j] * cj * f->dirs.solid_angle[j];
-            else
-                g[j] = 0.0f;
-        }
+        double norm = reflect_weights(f, fc, r, g);
         if (norm <= 0.0)
             continue;
         float scale = (float)((double)cos_in * f->dirs.solid_angle[sd_in] / norm);
@@ -1337,6 +1494,12 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
         }
     }
     vlf_quantise(prec, f->L_cur, f->elem_count);
+    if (f->punctual_count) {
+        if (!punctual_first_shot(f))
+            return -1;
+        vlf_quantise(prec, f->E_next, f->elem_count);
+        vlf_quantise(prec, f->out_next, f->nd_cells);
+    }
     f->st.flux_shot = f->st.flux_received = f->st.flux_back = f->st.flux_escaped = 0;
     f->st.samples = 0;
     frag_buf pbuf = {0}, ptmp = {0};
@@ -1428,5 +1591,9 @@ void vlf_field_free(vlf_field *f)
     free(f->out_tot);
     free(f->in);
     free(f->sun);
+    free(f->punctual);
+    free(f->elem_c);
+    if (f->rt)
+        gi_rt_free(f->rt);
     memset(f, 0, sizeof *f);
 }

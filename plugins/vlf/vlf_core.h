@@ -120,6 +120,13 @@ typedef struct vlf_stats {
     uint64_t sort_tests;     /* pairs of faces tested by Newell's ordering */
 } vlf_stats;
 
+/* A point or spot light (world space): its first shot is by shadow rays. */
+typedef struct vlf_punctual {
+    int spot;
+    gi_vec3 pos, dir;
+    float I[3], range, cos_inner, cos_outer;
+} vlf_punctual;
+
 typedef struct vlf_field {
     vlf_params prm;
     vlf_dirs dirs;
@@ -141,6 +148,10 @@ typedef struct vlf_field {
     float *E_tot, *E_next, *L_cur;       /* elem_count * 3: irradiance, unshot diffuse radiance */
     float *out_cur, *out_next, *out_tot, *in; /* nd_cells * 3 */
     const struct gi_envmap *env;
+    struct vlf_punctual *punctual; /* point and spot lights, world space */
+    uint32_t punctual_count;
+    struct gi_rt *rt;        /* the scene for their shadow rays (NULL without them) */
+    float *elem_c;           /* 2 per element: centroid of its part on the face, chart texels */
     float *sun;              /* 2l x RGB: radiance the directional lights put into each signed direction's interface */
     uint32_t sun_count;      /* directional lights of the scene */
     vlf_stats st;

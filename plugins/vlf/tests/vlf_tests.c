@@ -31,9 +31,12 @@
  *                      Cornell box, and the reported memory against the
  *                      packed bytes;
  *   vlf_tests sun      a directional light: open floor lit by E cos theta,
- *                      an occluder's shadow where it falls. */
+ *                      an occluder's shadow where it falls;
+ *   vlf_tests point    point and spot lights: inverse square law, shadow,
+ *                      spot cone. */
 #include "vlf_core.h"
 
+#include "gi/lights.h"
 #include "gi/raytrace.h"
 #include "gi/rng.h"
 #include "gi/scene.h"
@@ -728,6 +731,110 @@ static void test_sun(void)
     }
 }
 
+/* Point and spot lights: the floor and occluder of test_sun, a point
+ * light (intensity 3) at (0, 0, 1.5): after one iteration every whole
+ * floor element outside the shadow's rim gets I h / d^3 at its centre
+ * (1 %), the elements inside the shadow (|x|, |y| < 0.3; the occluder's
+ * shadow reaches 0.375) nothing; a spot there pointing down (cones 0.3 and
+ * 0.35 rad) the same times the glTF falloff, and nothing beyond its outer
+ * cone. The unshadowed and the black answers each fail. */
+static void test_point(void)
+{
+    for (int k = 0; k < 2; k++) {
+        gi_scene *s = calloc(1, sizeof *s);
+        s->triangle_count = 4;
+        s->vertex_count = 8;
+        s->vertices = calloc(8, sizeof *s->vertices);
+        s->indices = calloc(12, sizeof *s->indices);
+        s->material_count = 1;
+        s->materials = calloc(1, sizeof *s->materials);
+        s->materials[0].albedo[0] = s->materials[0].albedo[1] = s->materials[0].albedo[2] = 0.5f;
+        s->materials[0].albedo_texture = -1;
+        s->node_count = 2;
+        s->nodes = calloc(2, sizeof *s->nodes);
+        for (int n = 0; n < 2; n++) {
+            s->nodes[n].parent = -1;
+            s->nodes[n].rotation[3] = 1.0f;
+            s->nodes[n].scale[0] = s->nodes[n].scale[1] = s->nodes[n].scale[2] = 1.0f;
+        }
+        s->nodes[1].translation[2] = 1.5f; /* -z of the node points down */
+        s->object_count = 1;
+        s->objects = calloc(1, sizeof *s->objects);
+        s->objects[0].triangle_count = 4;
+        s->objects[0].vertex_count = 8;
+        add_quad(s, 0, gi_v3(-1, -1, 0), gi_v3(1, -1, 0), gi_v3(1, 1, 0), gi_v3(-1, 1, 0), 0);
+        add_quad(s, 1, gi_v3(-0.25f, -0.25f, 0.5f), gi_v3(0.25f, -0.25f, 0.5f), gi_v3(0.25f, 0.25f, 0.5f),
+                 gi_v3(-0.25f, 0.25f, 0.5f), 0);
+        float bounds[6] = {-1, -1, 0, 1, 1, 0.5f};
+        memcpy(s->objects[0].local_bounds, bounds, sizeof bounds);
+        s->light_count = 1;
+        s->lights = calloc(1, sizeof *s->lights);
+        s->lights[0].type = k ? GI_LIGHT_SPOT : GI_LIGHT_POINT;
+        s->lights[0].node = 1;
+        s->lights[0].inner_cone = 0.3f;
+        s->lights[0].outer_cone = 0.35f;
+        s->lights[0].intensity[0] = s->lights[0].intensity[1] = s->lights[0].intensity[2] = 3.0f;
+        vlf_params p = defaults();
+        p.iterations = 1;
+        p.density = 16;
+        vlf_field f;
+        char err[256];
+        int rc = vlf_field_build(&f, s, 0.0f, &p, err, sizeof err);
+        EXPECT(rc == 0, "%s", err);
+        if (rc == 0) {
+            vlf_field_propagate(&f, NULL, NULL);
+            const vlf_face *fc = &f.faces[f.tri_face[0]];
+            float texel = 1.0f / (p.density * p.density);
+            double worst = 0.0, shadow = 0.0, beyond = 0.0, lit = 0.0;
+            uint32_t n_lit = 0, n_shadow = 0, n_beyond = 0;
+            float cos_i = cosf(0.3f), cos_o = cosf(0.35f);
+            for (uint32_t iy = 0; iy < fc->H; iy++)
+                for (uint32_t ix = 0; ix < fc->W; ix++) {
+                    uint32_t e = fc->first_elem + iy * fc->W + ix;
+                    if (f.elem_area[e] < 0.99f * texel)
+                        continue;
+                    gi_vec3 q = gi_v3_add(fc->origin, gi_v3_add(gi_v3_scale(fc->t, ((float)ix + 0.5f) / p.density),
+                                                                gi_v3_scale(fc->b, ((float)iy + 0.5f) / p.density)));
+                    gi_vec3 w = gi_v3_add(f.centre, gi_v3_scale(q, f.radius));
+                    double d2 = (double)w.x * w.x + (double)w.y * w.y + 1.5 * 1.5, d = sqrt(d2);
+                    double want = 3.0 * 1.5 / (d2 * d);
+                    double ca = 1.5 / d;
+                    if (k)
+                        want *= gi_spot_falloff((float)ca, cos_i, cos_o);
+                    double got = f.E_tot[3 * (size_t)e];
+                    float rim = fmaxf(fabsf(w.x), fabsf(w.y));
+                    if (rim < 0.3f) {
+                        shadow = fmax(shadow, got);
+                        n_shadow++;
+                    } else if (rim > 0.45f && want > 0.05) {
+                        worst = fmax(worst, fabs(got / want - 1.0));
+                        lit += got;
+                        n_lit++;
+                    } else if (k && ca < cos_o - 0.01) {
+                        beyond = fmax(beyond, got);
+                        n_beyond++;
+                    }
+                }
+            printf("%s: %u lit elements, worst %.3f %% off I h / d^3%s; %u in the shadow, at most %.5f; %u beyond the cone, "
+                   "at most %.5f\n", k ? "spot" : "point", n_lit, 100.0 * worst, k ? " x falloff" : "", n_shadow, shadow,
+                   n_beyond, beyond);
+            EXPECT(n_lit > (k ? 8u : 100u) && n_shadow > 20, "point: too few elements lit (%u) or shadowed (%u)", n_lit, n_shadow);
+            EXPECT(worst < 0.01, "point: lit floor off the inverse square law by %.3g", worst);
+            EXPECT(shadow < 1e-3, "point: the shadow gets %.4g", shadow);
+            if (k)
+                EXPECT(n_beyond > 50 && beyond < 1e-4, "spot: %u elements beyond the cone get up to %.4g", n_beyond, beyond);
+            vlf_field_free(&f);
+        }
+        free(s->lights);
+        free(s->vertices);
+        free(s->indices);
+        free(s->materials);
+        free(s->objects);
+        free(s->nodes);
+        free(s);
+    }
+}
+
 /* Relative L1 difference of two maps of count RGB values: sum |a - b| / sum |b|. */
 static double rel_l1(const float *a, const float *b, size_t count)
 {
@@ -853,8 +960,10 @@ int main(int argc, char **argv)
         test_precision(), any = 1;
     if (all || strcmp(part, "sun") == 0)
         test_sun(), any = 1;
+    if (all || strcmp(part, "point") == 0)
+        test_point(), any = 1;
     if (!any) {
-        fprintf(stderr, "vlf_tests: unknown part '%s' (dirs, order, energy, furnace, mirror, precision, sun)\n", part);
+        fprintf(stderr, "vlf_tests: unknown part '%s' (dirs, order, energy, furnace, mirror, precision, sun, point)\n", part);
         return 2;
     }
     return gi_test_finish();
