@@ -33,7 +33,7 @@
  *   vlf_tests sun      a directional light: open floor lit by E cos theta,
  *                      an occluder's shadow where it falls;
  *   vlf_tests point    point and spot lights: inverse square law, shadow,
- *                      spot cone. */
+ *                      spot cone; a point light's reflection in a mirror. */
 #include "vlf_core.h"
 
 #include "gi/lights.h"
@@ -835,6 +835,119 @@ static void test_point(void)
     }
 }
 
+/* A point light's reflection by a mirror (the first shot into non-diffuse
+ * tiles): the tilted mirror of test_mirror (ks 0.8, 0.6 wide) under a
+ * point light (3 W/sr) at (0, 0, 1): the flux the tiles send out (sum of
+ * L x cell area x dOmega over every direction and covered cell) is within
+ * 5 % of ks times the flux the light brings onto the mirror (I cos / d^2
+ * integrated over it), the most of it goes out along one of the three
+ * directions around the centre's reflection (sin 45, 0, cos 45), and none
+ * along a direction more than 1 rad from it. */
+static void test_point_mirror(void)
+{
+    gi_scene *s = calloc(1, sizeof *s);
+    s->triangle_count = 2;
+    s->vertex_count = 4;
+    s->vertices = calloc(4, sizeof *s->vertices);
+    s->indices = calloc(6, sizeof *s->indices);
+    s->material_count = 1;
+    s->materials = calloc(1, sizeof *s->materials);
+    s->materials[0].albedo_texture = -1;
+    s->materials[0].ks[0] = s->materials[0].ks[1] = s->materials[0].ks[2] = 0.8f;
+    s->materials[0].mirror = 1;
+    s->materials[0].exponent = GI_MIRROR_EXPONENT;
+    s->node_count = 2;
+    s->nodes = calloc(2, sizeof *s->nodes);
+    for (int n = 0; n < 2; n++) {
+        s->nodes[n].parent = -1;
+        s->nodes[n].rotation[3] = 1.0f;
+        s->nodes[n].scale[0] = s->nodes[n].scale[1] = s->nodes[n].scale[2] = 1.0f;
+    }
+    s->nodes[1].translation[2] = 1.0f;
+    s->object_count = 1;
+    s->objects = calloc(1, sizeof *s->objects);
+    s->objects[0].triangle_count = 2;
+    s->objects[0].vertex_count = 4;
+    float c = cosf(GI_PI / 8), sn = sinf(GI_PI / 8);
+    gi_vec3 tx = gi_v3(c, 0, -sn), ty = gi_v3(0, 1, 0);
+    gi_vec3 P[4];
+    float uv[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    for (int k = 0; k < 4; k++)
+        P[k] = gi_v3_add(gi_v3_scale(tx, 0.3f * uv[k][0]), gi_v3_scale(ty, 0.3f * uv[k][1]));
+    add_quad(s, 0, P[0], P[1], P[2], P[3], 0);
+    float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+    for (uint32_t v = 0; v < 4; v++)
+        for (int a = 0; a < 3; a++)
+            lo[a] = fminf(lo[a], s->vertices[v].position[a]), hi[a] = fmaxf(hi[a], s->vertices[v].position[a]);
+    for (int a = 0; a < 3; a++)
+        s->objects[0].local_bounds[a] = lo[a], s->objects[0].local_bounds[3 + a] = hi[a];
+    s->light_count = 1;
+    s->lights = calloc(1, sizeof *s->lights);
+    s->lights[0].type = GI_LIGHT_POINT;
+    s->lights[0].node = 1;
+    s->lights[0].intensity[0] = s->lights[0].intensity[1] = s->lights[0].intensity[2] = 3.0f;
+    vlf_params p = defaults();
+    p.iterations = 1;
+    vlf_field f;
+    char err[256];
+    int rc = vlf_field_build(&f, s, 0.0f, &p, err, sizeof err);
+    EXPECT(rc == 0, "%s", err);
+    if (rc == 0) {
+        vlf_field_propagate(&f, NULL, NULL);
+        const vlf_face *fc = &f.faces[0];
+        gi_vec3 refl = gi_v3_normalize(gi_v3(1, 0, 1));
+        uint32_t node[3];
+        float al[3];
+        vlf_dirs_locate(&f.dirs, refl, node, al);
+        /* the light's flux onto the mirror, world units: I cos / d^2 over it */
+        double in = 0.0;
+        gi_vec3 nrm = gi_v3(sn, 0, c);
+        for (int a = 0; a < 200; a++)
+            for (int b = 0; b < 200; b++) {
+                gi_vec3 x = gi_v3_add(gi_v3_scale(tx, 0.3f * (((float)a + 0.5f) / 100.0f - 1.0f)),
+                                      gi_v3_scale(ty, 0.3f * (((float)b + 0.5f) / 100.0f - 1.0f)));
+                gi_vec3 d = gi_v3_sub(gi_v3(0, 0, 1), x);
+                float d2 = gi_v3_dot(d, d);
+                in += 3.0 * gi_v3_dot(nrm, gi_v3_normalize(d)) / d2 * (0.6 / 200.0) * (0.6 / 200.0);
+            }
+        double out = 0.0, best = 0.0, far = 0.0;
+        uint32_t best_sd = UINT32_MAX;
+        double cell = (2.0 / p.N) * (2.0 / p.N) * (double)f.radius * f.radius;
+        for (uint32_t sd = 0; sd < 2 * p.l; sd++) {
+            gi_vec3 w = f.dirs.signed_dirs[sd];
+            if (gi_v3_dot(w, fc->n) <= 0.0f)
+                continue;
+            const vlf_rect *r = &f.rects[(size_t)fc->nd * p.l + sd % p.l];
+            double sum = 0.0;
+            for (uint32_t k = 0; k < r->w * r->h; k++)
+                if (f.nd_cover[r->offset + k])
+                    sum += f.out_tot[3 * (size_t)(r->offset + k)];
+            double flux = sum * cell * f.dirs.solid_angle[sd];
+            out += flux;
+            if (flux > best)
+                best = flux, best_sd = sd;
+            if (acosf(fminf(1.0f, gi_v3_dot(w, refl))) > 1.0f)
+                far = fmax(far, flux);
+        }
+        int near = best_sd == node[0] || best_sd == node[1] || best_sd == node[2];
+        printf("point light in a mirror: flux out of the tiles %.4f, ks x flux onto the mirror %.4f (%+.2f %%); the "
+               "largest share (%.0f %%) along %s of the reflection's three directions; at most %.2g beyond 1 rad\n",
+               out, 0.8 * in, 100.0 * (out / (0.8 * in) - 1.0), 100.0 * best / (out > 0 ? out : 1), near ? "one" : "none",
+               far);
+        EXPECT(fabs(out / (0.8 * in) - 1.0) < 0.05, "point light in a mirror: out %.4f, due %.4f", out, 0.8 * in);
+        EXPECT(near, "point light in a mirror: the most light leaves along direction %u, not around the reflection", best_sd);
+        EXPECT(far < 1e-6 * out, "point light in a mirror: %.4g away from the reflection", far);
+        vlf_field_free(&f);
+    }
+    free(s->lights);
+    free(s->vertices);
+    free(s->indices);
+    free(s->materials);
+    free(s->objects);
+    free(s->nodes);
+    free(s);
+}
+
 /* Relative L1 difference of two maps of count RGB values: sum |a - b| / sum |b|. */
 static double rel_l1(const float *a, const float *b, size_t count)
 {
@@ -961,7 +1074,7 @@ int main(int argc, char **argv)
     if (all || strcmp(part, "sun") == 0)
         test_sun(), any = 1;
     if (all || strcmp(part, "point") == 0)
-        test_point(), any = 1;
+        test_point(), test_point_mirror(), any = 1;
     if (!any) {
         fprintf(stderr, "vlf_tests: unknown part '%s' (dirs, order, energy, furnace, mirror, precision, sun, point)\n", part);
         return 2;
