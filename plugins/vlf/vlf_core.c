@@ -1475,6 +1475,106 @@ static void scatter(vlf_field *f, uint32_t i)
     free(g);
 }
 
+/* The sorting of one fixed direction's perturbed directions beside its
+ * propagation (§3.5: "carried out on the CPU in parallel with
+ * propagation"): worker threads build the fragment lists of perturbed
+ * directions k = t, t + T, ... into their slots, while the propagating
+ * thread sweeps them in order k = 0, 1, ... as they become ready (the
+ * same lists and the same order of sweeps for any thread count). */
+typedef struct pert_pipe {
+    vlf_field *f;
+    uint32_t i, T, P;
+    frag_buf *slot;  /* P fragment lists */
+    vlf_psf *frame;  /* P frames */
+    uint8_t *ready;  /* P: 0 not yet, 1 ready, 2 failed */
+    int sync;        /* the mutex and condition are set up (and the rest owned) */
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+} pert_pipe;
+
+typedef struct pert_worker {
+    pert_pipe *pp;
+    uint32_t t;
+    frag_buf tmp;
+    vlf_sorter so;
+} pert_worker;
+
+static void *pert_thread(void *arg)
+{
+    pert_worker *w = arg;
+    pert_pipe *pp = w->pp;
+    int ok = 1;
+    for (uint32_t k = w->t; k < pp->P; k += pp->T) {
+        if (ok) {
+            vlf_psf *fr = &pp->frame[k];
+            fr->n = perturbed_dir(pp->f, pp->i, k);
+            gi_onb(fr->n, &fr->u, &fr->v);
+            ok = perturbed_list(pp->f, fr, &pp->slot[k], &w->tmp, &w->so);
+        }
+        pthread_mutex_lock(&pp->mu);
+        pp->ready[k] = ok ? 1 : 2;
+        pthread_cond_broadcast(&pp->cv);
+        pthread_mutex_unlock(&pp->mu);
+    }
+    return NULL;
+}
+
+static void pipe_free(pert_pipe *pp, pert_worker *wk)
+{
+    if (!pp->sync)
+        return;
+    for (uint32_t k = 0; k < pp->P; k++)
+        free(pp->slot[k].v);
+    for (uint32_t t = 0; t < pp->T; t++) {
+        free(wk[t].tmp.v);
+        vlf_sorter_free(&wk[t].so);
+    }
+    free(pp->slot), free(pp->frame), free(pp->ready), free(wk);
+    pthread_mutex_destroy(&pp->mu);
+    pthread_cond_destroy(&pp->cv);
+    pp->sync = 0;
+}
+
+/* The perturbed sweeps of fixed direction i with the lists sorted beside
+ * them on T threads; 0 out of memory. */
+static int perturbed_pipelined(vlf_field *f, uint32_t i, int first_iteration, pert_pipe *pp, pert_worker *wk)
+{
+    uint32_t T = pp->T, P = pp->P, l = f->prm.l, prec = f->prm.precision;
+    pp->i = i;
+    memset(pp->ready, 0, P);
+    pthread_t *th = calloc(T, sizeof *th);
+    uint8_t *started = calloc(T, 1);
+    if (!th || !started) {
+        free(th), free(started);
+        return 0;
+    }
+    for (uint32_t t = 0; t < T; t++)
+        started[t] = pthread_create(&th[t], NULL, pert_thread, &wk[t]) == 0;
+    for (uint32_t t = 0; t < T; t++)
+        if (!started[t])
+            pert_thread(&wk[t]); /* no thread to be had: its share here */
+    int ok = 1;
+    for (uint32_t k = 0; k < P && ok; k++) {
+        pthread_mutex_lock(&pp->mu);
+        while (pp->ready[k] == 0)
+            pthread_cond_wait(&pp->cv, &pp->mu);
+        ok = pp->ready[k] == 1;
+        pthread_mutex_unlock(&pp->mu);
+        if (!ok)
+            break;
+        /* each sign's solid angle: the fixed direction's, shared */
+        sweep_perturbed(f, i, &pp->frame[k], &pp->slot[k], +1, f->dirs.solid_angle[i] / (float)P, first_iteration);
+        vlf_quantise(prec, f->E_next, f->elem_count);
+        sweep_perturbed(f, i, &pp->frame[k], &pp->slot[k], -1, f->dirs.solid_angle[i + l] / (float)P, first_iteration);
+        vlf_quantise(prec, f->E_next, f->elem_count);
+    }
+    for (uint32_t t = 0; t < T; t++)
+        if (started[t])
+            pthread_join(th[t], NULL);
+    free(th), free(started);
+    return ok;
+}
+
 int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
 {
     double t0 = now_s();
@@ -1505,9 +1605,36 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
     frag_buf pbuf = {0}, ptmp = {0};
     vlf_sorter psort;
     memset(&psort, 0, sizeof psort);
+    /* perturbed directions: sorted on `threads` threads beside the sweeps */
+    pert_pipe pp;
+    memset(&pp, 0, sizeof pp);
+    pert_worker *wk = NULL;
+    int pipe_ok = 0;
+    if (f->prm.perturbed > 0 && f->prm.threads > 1) {
+        pp.f = f;
+        pp.T = f->prm.threads < f->prm.perturbed ? f->prm.threads : f->prm.perturbed;
+        pp.P = f->prm.perturbed;
+        pp.slot = calloc(pp.P, sizeof *pp.slot);
+        pp.frame = calloc(pp.P, sizeof *pp.frame);
+        pp.ready = calloc(pp.P, 1);
+        wk = calloc(pp.T, sizeof *wk);
+        pipe_ok = pp.slot && pp.frame && pp.ready && wk && pthread_mutex_init(&pp.mu, NULL) == 0;
+        if (pipe_ok && pthread_cond_init(&pp.cv, NULL) != 0) {
+            pthread_mutex_destroy(&pp.mu);
+            pipe_ok = 0;
+        }
+        if (!pipe_ok) {
+            free(pp.slot), free(pp.frame), free(pp.ready), free(wk);
+            return -1;
+        }
+        pp.sync = 1;
+        for (uint32_t t = 0; t < pp.T; t++)
+            wk[t].pp = &pp, wk[t].t = t;
+    }
     for (uint32_t it = 0; it < f->prm.iterations; it++) {
         for (uint32_t i = 0; i < l; i++) {
             if (cancelled && cancelled(user)) {
+                pipe_free(&pp, wk);
                 free(pbuf.v), free(ptmp.v), vlf_sorter_free(&psort);
                 return -1;
             }
@@ -1521,12 +1648,19 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
                 vlf_quantise(prec, f->E_next, f->elem_count);
                 sweep(f, i, -1, it == 0);
                 vlf_quantise(prec, f->E_next, f->elem_count);
+            } else if (pipe_ok) {
+                if (!perturbed_pipelined(f, i, it == 0, &pp, wk)) {
+                    pipe_free(&pp, wk);
+                    free(pbuf.v), free(ptmp.v), vlf_sorter_free(&psort);
+                    return -1;
+                }
             } else {
                 for (uint32_t k = 0; k < f->prm.perturbed; k++) {
                     vlf_psf fr;
                     fr.n = perturbed_dir(f, i, k);
                     gi_onb(fr.n, &fr.u, &fr.v);
                     if (!perturbed_list(f, &fr, &pbuf, &ptmp, &psort)) {
+                        pipe_free(&pp, wk);
                         free(pbuf.v), free(ptmp.v), vlf_sorter_free(&psort);
                         return -1;
                     }
@@ -1562,6 +1696,7 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
         vlf_quantise(prec, f->L_cur, f->elem_count);
         vlf_quantise(prec, f->out_tot, f->nd_cells);
     }
+    pipe_free(&pp, wk);
     free(pbuf.v), free(ptmp.v), vlf_sorter_free(&psort);
     f->st.propagate_s = now_s() - t0;
     return 0;

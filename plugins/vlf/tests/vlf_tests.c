@@ -19,6 +19,8 @@
  *   vlf_tests energy   closed box: per iteration everything shot is received
  *                      (nothing escapes, nothing lands on a back face), and
  *                      the emitted flux equals the first iteration's shot;
+ *                      perturbed directions sorted beside the sweeps give
+ *                      the same field on 1, 2 and 5 threads;
  *   vlf_tests furnace  the closed emitting sphere (conformance scene):
  *                      the mean irradiance of the propagated field converges
  *                      to Le (1/(1 - rho) - 1) pi within 2 % as iterations grow;
@@ -477,6 +479,21 @@ static void test_energy(void)
            "perturbed: light escaped (%.4g) or met back faces (%.4g)", st->flux_escaped, st->flux_back);
     EXPECT(fabs(st->flux_shot / st->flux_emitted - 1.0) < 0.02, "perturbed: shot %.5g vs emitted %.5g", st->flux_shot,
            st->flux_emitted);
+    /* the perturbed lists sorted beside the sweeps on 2 threads (above) or
+     * in line on 1, or on 5: the same field, bit for bit */
+    uint32_t tc[2] = {1, 5};
+    for (int k = 0; k < 2; k++) {
+        vlf_params q = p;
+        q.threads = tc[k];
+        vlf_field g;
+        EXPECT(vlf_field_build(&g, s, 0.0f, &q, err, sizeof err) == 0, "%s", err);
+        vlf_field_propagate(&g, NULL, NULL);
+        int same = g.elem_count == f.elem_count &&
+                   memcmp(g.E_tot, f.E_tot, (size_t)f.elem_count * 3 * sizeof *f.E_tot) == 0 &&
+                   g.st.flux_shot == f.st.flux_shot && g.st.samples == f.st.samples;
+        EXPECT(same, "perturbed propagation on %u threads differs from 2 threads", tc[k]);
+        vlf_field_free(&g);
+    }
     vlf_field_free(&f);
     gi_scene_free(s);
 }
