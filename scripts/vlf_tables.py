@@ -18,6 +18,7 @@ Usage: scripts/vlf_tables.py DIR > DIR/tables.md
 import csv
 import glob
 import json
+import math
 import os
 import sys
 
@@ -101,6 +102,18 @@ def fmt(x, nd=3):
     return str(x)
 
 
+def fit_exponent(xs, ys):
+    """Least-squares slope of log y against log x (y ~ x^slope); None with
+    fewer than two usable points."""
+    pts = [(math.log(x), math.log(y)) for x, y in zip(xs, ys) if x and y and x > 0 and y > 0]
+    if len(pts) < 2:
+        return None
+    mx = sum(a for a, _ in pts) / len(pts)
+    my = sum(b for _, b in pts) / len(pts)
+    sxx = sum((a - mx) ** 2 for a, _ in pts)
+    return sum((a - mx) * (b - my) for a, b in pts) / sxx if sxx > 0 else None
+
+
 def main():
     d = sys.argv[1] if len(sys.argv) > 1 else "results/vlf"
     runs = load_runs(d)
@@ -163,6 +176,65 @@ def main():
             os.path.basename(r["scene"]), r["method"], fmt(rm * rm if rm is not None else None),
             fmt(rmm * rmm if rmm is not None else None), fmt(metric(r, "matched", "relmse")),
             fmt(metric(r, "matched", "mean_lum_diff_pct"), 2)))
+
+    out.append("\n## Depth order: the paper's face order against the per-ray sort\n")
+    out.append("faces = Newell's ordering with splitting and the BSP cuts (default, label table1); rays = each ray's fragments "
+               "sorted by depth (label order; runs without the parameter predate it and sorted per ray). Same field up to "
+               "ties: compare the image error.\n")
+    out.append("| scene | order | triangles | pieces placed | cycle splits | BSP cuts | pair tests | sort (ms) | propagation (ms) | relMSE matched |")
+    out.append("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for r in sorted(vlf, key=lambda r: (r["scene"], r["label"])):
+        if r["label"] not in ("table1", "order") or not r["scene"].endswith(("cornell_box.gltf", "cornell_glossy.gltf")):
+            continue
+        st, ps = r.get("stats", {}), r.get("prepare_stages", {})
+        cnt = ["{:.0f}".format(st[k]) if st.get(k) is not None else "–"
+               for k in ("triangles", "sort_pieces", "sort_splits", "sort_bsp_cuts")]
+        out.append("| {} | {} | {} | {} | {} | {} | {} | {:.0f} | {:.0f} | {} |".format(
+            os.path.basename(r["scene"]), p(r, "order", "rays"), *cnt,
+            "{:.3g}".format(st["sort_tests"]) if st.get("sort_tests") is not None else "–", ps.get("sort", 0),
+            ps.get("propagate", 0), fmt(metric(r, "matched", "relmse"))))
+
+    out.append("\n## Storage precision (glossy Cornell box)\n")
+    out.append("Memory of the maps as the paper counts it (current, next and total ir/radiance maps and the incoming tiles while "
+               "propagating; the totals and the tile index for rendering); every propagation pass writes its maps in the "
+               "format, rendering reads them packed. Paper: RGBA16F (\"64-bit\"); RGB9E5 proposed to halve the memory.\n")
+    out.append("| precision | bytes a value | memory propagate (MB) | memory render (MB) | of it maps uploaded (MB) | "
+               "relMSE matched | mean diff matched (%) | propagation (ms) |")
+    out.append("|---|---:|---:|---:|---:|---:|---:|---:|")
+    bpv = {"32f": 12, "16f": 8, "rgb9e5": 4}
+    if not any(r["label"] == "precision" for r in vlf):
+        out.append("| – | no run labelled precision in runs.csv (the study predates the entry) | | | | | | |")
+    for r in sorted(vlf, key=lambda r: bpv.get(p(r, "precision", "32f"), 0), reverse=True):
+        if not r["scene"].endswith("cornell_glossy.gltf") or r["label"] not in ("table1", "precision"):
+            continue
+        st, ps = r.get("stats", {}), r.get("prepare_stages", {})
+        pr = p(r, "precision", "32f")
+        out.append("| {} | {} | {:.2f} | {:.2f} | {} | {} | {} | {:.0f} |".format(
+            pr, bpv.get(pr, "?"), st.get("bytes_propagate", 0) / 2**20, st.get("bytes_render", 0) / 2**20,
+            "{:.2f}".format(st["gpu_bytes_maps"] / 2**20) if st.get("gpu_bytes_maps") is not None else "–",
+            fmt(metric(r, "matched", "relmse")),
+            fmt(metric(r, "matched", "mean_lum_diff_pct"), 2), ps.get("propagate", 0)))
+
+    out.append("\n## Tessellation sweep: time against faces (coarse Cornell box, every triangle cut into k²)\n")
+    out.append("Paper: propagation O(n) in the faces n (the GPU rasterises every face per direction). Here the faces are "
+               "the triangles sorted and rasterised; propagation walks each ray's fragments, whose number does not grow "
+               "with cutting the same surfaces finer. Exponents: least-squares slope of log time against log triangles.\n")
+    out.append("| k | triangles | samples transported | sort (ms) | propagation (ms) | render (ms/frame) |")
+    out.append("|---:|---:|---:|---:|---:|---:|")
+    tess = sorted((r for r in vlf if r["label"] == "tess"), key=lambda r: int(p(r, "subdivide", "1") or 1))
+    if not tess:
+        out.append("| – | no run labelled tess in runs.csv (the study predates the entry) | | | | |")
+    for r in tess:
+        st, ps = r.get("stats", {}), r.get("prepare_stages", {})
+        out.append("| {} | {} | {:.4g} | {:.0f} | {:.0f} | {:.1f} |".format(
+            p(r, "subdivide", "1"), int(st.get("triangles", 0)), st.get("samples_transported", 0), ps.get("sort", 0),
+            ps.get("propagate", 0), r["stages"].get("render", {}).get("median") or 0.0))
+    tri = [r.get("stats", {}).get("triangles") for r in tess]
+    for name, key in (("sort", "sort"), ("propagation", "propagate")):
+        e = fit_exponent(tri, [(r.get("prepare_stages") or {}).get(key) for r in tess])
+        out.append("\nFitted exponent, {} time ∝ triangles^e: e = {}".format(name, fmt(e, 3)))
+    e = fit_exponent(tri, [r.get("stats", {}).get("samples_transported") for r in tess])
+    out.append("\nFitted exponent, samples transported ∝ triangles^e: e = {}".format(fmt(e, 3)))
 
     out.append("\n## Samples transported per second beside the reference's rays per second\n")
     out.append("vlf: fragments visited in propagation per second of propagation (the paper's \"equivalent ray "

@@ -28,6 +28,7 @@ typedef struct vlf {
     GLuint program;
     GLuint buf[VLF_BUFFERS];
     GLuint lookup;
+    size_t gpu_map_bytes; /* bytes of the light-field maps uploaded for rendering */
 } vlf;
 
 static const gi_param_desc vlf_params_desc[] = {
@@ -44,6 +45,22 @@ static const gi_param_desc vlf_params_desc[] = {
      "perturbed virtual directions per fixed direction, used only for transport (0: the fixed direction itself; "
      "the paper's high quality uses 36)"},
     {"seed", GI_PARAM_INT, 1, 0, 1000000, NULL, NULL, "seed of the perturbed directions"},
+    {"order", GI_PARAM_ENUM, 0, 0, 0, "faces|rays", "Sec. 3.2",
+     "depth order of a subfield: faces: the faces sorted front to back (Newell's painter's ordering, faces split "
+     "where they overlap in a cycle, BSP cuts orthogonal to the direction), rasterised in that order; rays: each "
+     "ray's fragments sorted by depth"},
+    {"precision", GI_PARAM_ENUM, 0, 0, 0, "32f|16f|rgb9e5", "storage (Sec. 3.1, 6)",
+     "format of the ir/radiance maps, during propagation (every pass writes in it) and for rendering: 32f: three "
+     "float32 (12 bytes); 16f: RGBA16F, the paper's 64-bit format (8 bytes); rgb9e5: shared exponent (4 bytes)"},
+    {"subdivide", GI_PARAM_INT, 1, 1, 16, NULL, NULL,
+     "each scene triangle cut into subdivide^2 triangles before sorting and transport: the same surfaces as more "
+     "faces (the tessellation sweep of propagation time against faces)"},
+    {"threads", GI_PARAM_INT, 4, 1, 64, NULL, "sort threads (Sec. 6)",
+     "CPU threads of the sort stage, one subfield at a time each (the field is the same for any count)"},
+    {"bsp_levels", GI_PARAM_INT, 2, 0, 8, NULL, "BSP levels (Sec. 3.2, 6)",
+     "cuts of the face list orthogonal to the direction at its centre of mass, levels (paper: 2)"},
+    {"bsp_min", GI_PARAM_INT, 4096, 2, 1000000, NULL, "BSP threshold (Sec. 3.2)",
+     "a face list is cut only with at least this many faces (paper: 4K)"},
     {0},
 };
 
@@ -64,6 +81,12 @@ static gi_result vlf_create(const gi_host *host, const gi_params *params, void *
     v->prm.seed = (uint32_t)gi_params_int(params, "seed");
     v->prm.density = gi_params_float(params, "density");
     v->prm.iterations = (uint32_t)gi_params_int(params, "iterations");
+    v->prm.order = gi_params_enum(params, "order") == 1 ? VLF_ORDER_RAYS : VLF_ORDER_FACES;
+    v->prm.threads = (uint32_t)gi_params_int(params, "threads");
+    v->prm.precision = (uint32_t)gi_params_enum(params, "precision");
+    v->prm.subdivide = (uint32_t)gi_params_int(params, "subdivide");
+    v->prm.bsp_levels = (uint32_t)gi_params_int(params, "bsp_levels");
+    v->prm.bsp_min = (uint32_t)gi_params_int(params, "bsp_min");
     if (v->prm.N % v->prm.m != 0) {
         host->log(host, GI_LOG_ERROR, "vlf: N = %u is not a multiple of the tile size m = %u", v->prm.N, v->prm.m);
         gi_kit_free(&v->kit);
@@ -96,13 +119,16 @@ static gi_result vlf_upload(vlf *v)
     if (!v->buf[0])
         glCreateBuffers(VLF_BUFFERS, v->buf);
     float *faces = calloc((size_t)f->face_count * 16, sizeof *faces);
-    float *irr = calloc((size_t)f->elem_count * 4 + 4, sizeof *irr);
+    uint32_t prec = f->prm.precision;
+    size_t bpv = vlf_precision_bytes(prec), e_words = (size_t)f->elem_count * bpv / 4;
+    uint32_t *irr = calloc(e_words + f->elem_count + 4, sizeof *irr);
+    void *tiles = calloc((size_t)f->nd_cells * bpv + 4, 1);
     float *dirs = calloc(((size_t)3 * l + 3 * T + 2 * l) * 4, sizeof *dirs);
     int32_t *rects = calloc((size_t)f->nd_count * l * 8 + 8, sizeof *rects);
     uint32_t *tris = calloc((size_t)T * 4, sizeof *tris);
     uint32_t *lut = calloc((size_t)VLF_LOOKUP_W * VLF_LOOKUP_H, sizeof *lut);
-    if (!faces || !irr || !dirs || !rects || !tris || !lut) {
-        free(faces), free(irr), free(dirs), free(rects), free(tris), free(lut);
+    if (!faces || !irr || !tiles || !dirs || !rects || !tris || !lut) {
+        free(faces), free(irr), free(tiles), free(dirs), free(rects), free(tris), free(lut);
         return gi_kit_fail(&v->kit, GI_ERR_OUT_OF_MEMORY, "vlf: out of memory uploading the light field");
     }
     /* faces: chart origin, axes scaled to texels, then W, H, first element, nd */
@@ -117,14 +143,17 @@ static gi_result vlf_upload(vlf *v)
         uint32_t info[4] = {fc->W, fc->H, fc->first_elem, (uint32_t)fc->nd};
         memcpy(F + 12, info, sizeof info);
     }
-    /* the irradiance atlas; w: the part of the texel that lies on its face
-     * (the filter's weight, so that slivers at a face's border, hit by few
-     * rays, count little) */
+    /* the irradiance atlas in the storage format, then per element the part
+     * of the texel that lies on its face (the filter's weight, so that
+     * slivers at a face's border, hit by few rays, count little); the
+     * tiles in the storage format */
     float texel = 1.0f / (f->prm.density * f->prm.density);
+    vlf_pack(prec, f->E_tot, f->elem_count, irr);
     for (uint32_t e = 0; e < f->elem_count; e++) {
-        memcpy(irr + 4 * (size_t)e, f->E_tot + 3 * (size_t)e, 3 * sizeof(float));
-        irr[4 * (size_t)e + 3] = fminf(1.0f, f->elem_area[e] / texel);
+        float w = fminf(1.0f, f->elem_area[e] / texel);
+        memcpy(irr + e_words + e, &w, sizeof w);
     }
+    vlf_pack(prec, f->out_tot, f->nd_cells, tiles);
     for (uint32_t i = 0; i < l; i++) {
         const vlf_psf *p = &f->psf[i];
         gi_vec3 fr[3] = {p->u, p->v, p->n};
@@ -156,16 +185,27 @@ static gi_result vlf_upload(vlf *v)
             lut[y * VLF_LOOKUP_W + x] = vlf_dirs_locate(&f->dirs, w, node, al);
         }
     upload(v->buf[0], faces, (size_t)f->face_count * 16 * sizeof *faces);
-    upload(v->buf[1], irr, (size_t)f->elem_count * 4 * sizeof *irr);
-    upload(v->buf[6], f->tri_face, (size_t)f->tri_count * sizeof *f->tri_face);
-    upload(v->buf[2], f->out_tot, (size_t)f->nd_cells * 3 * sizeof(float));
+    upload(v->buf[1], irr, (e_words + f->elem_count) * sizeof *irr);
+    /* the face of each scene triangle (the G-buffer's ids) */
+    uint32_t scene_tris = f->tri_count / f->tri_sub;
+    uint32_t *scene_face = malloc((size_t)scene_tris * sizeof *scene_face + 4);
+    if (!scene_face) {
+        free(faces), free(irr), free(tiles), free(dirs), free(rects), free(tris), free(lut);
+        return gi_kit_fail(&v->kit, GI_ERR_OUT_OF_MEMORY, "vlf: out of memory uploading the light field");
+    }
+    for (uint32_t t = 0; t < scene_tris; t++)
+        scene_face[t] = f->tri_face[(size_t)t * f->tri_sub];
+    upload(v->buf[6], scene_face, (size_t)scene_tris * sizeof *scene_face);
+    free(scene_face);
+    upload(v->buf[2], tiles, (size_t)f->nd_cells * bpv);
+    v->gpu_map_bytes = e_words * sizeof *irr + (size_t)f->nd_cells * bpv;
     upload(v->buf[3], rects, (size_t)f->nd_count * l * 8 * sizeof *rects);
     upload(v->buf[4], dirs, ((size_t)3 * l + 3 * T + 2 * l) * 4 * sizeof *dirs);
     upload(v->buf[5], tris, (size_t)T * 4 * sizeof *tris);
     if (!v->lookup)
         v->lookup = gi_gpu_texture_2d(GL_R32UI, VLF_LOOKUP_W, VLF_LOOKUP_H);
     glTextureSubImage2D(v->lookup, 0, 0, 0, VLF_LOOKUP_W, VLF_LOOKUP_H, GL_RED_INTEGER, GL_UNSIGNED_INT, lut);
-    free(faces), free(irr), free(dirs), free(rects), free(tris), free(lut);
+    free(faces), free(irr), free(tiles), free(dirs), free(rects), free(tris), free(lut);
     gi_error err;
     if (gi_gl_check("vlf: upload", &err) != GI_OK)
         return gi_kit_fail_with(&v->kit, GI_ERR_GL, &err);
@@ -200,13 +240,21 @@ static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
     host->stage_end(host, "gpu_init");
     const vlf_stats *s = &v->field.st;
     host->stat(host, "faces", v->field.face_count);
+    host->stat(host, "triangles", v->field.tri_count);
     host->stat(host, "diffuse_elements", s->diffuse_elements);
     host->stat(host, "nondiffuse_elements", s->nondiffuse_elements);
     host->stat(host, "tiles", s->tiles);
     host->stat(host, "bytes_propagate", (double)s->bytes_propagate);
     host->stat(host, "bytes_render", (double)s->bytes_render);
+    host->stat(host, "bytes_maps_render", (double)s->bytes_maps_render);
+    host->stat(host, "gpu_bytes_maps", (double)v->gpu_map_bytes);
     host->stat(host, "samples_transported", (double)s->samples);
     host->stat(host, "samples_per_s", s->propagate_s > 0 ? (double)s->samples / s->propagate_s : 0.0);
+    host->stat(host, "sort_pieces", (double)s->sort_pieces);
+    host->stat(host, "sort_splits", (double)s->sort_splits);
+    host->stat(host, "sort_bsp_cuts", (double)s->sort_bsp_cuts);
+    host->stat(host, "sort_unresolved", (double)s->sort_unresolved);
+    host->stat(host, "sort_tests", (double)s->sort_tests);
     host->stat(host, "flux_emitted", s->flux_emitted);
     host->stat(host, "flux_received", s->flux_received);
     host->stat(host, "flux_escaped", s->flux_escaped);
@@ -265,6 +313,9 @@ static gi_result vlf_render(void *inst, const gi_view *view, const gi_target *ta
     glUniform1ui(glGetUniformLocation(p, "u_l"), f->prm.l);
     glUniform1ui(glGetUniformLocation(p, "u_N"), f->prm.N);
     glUniform1ui(glGetUniformLocation(p, "u_tri_count"), f->dirs.tri_count);
+    glUniform1ui(glGetUniformLocation(p, "u_precision"), f->prm.precision);
+    glUniform1ui(glGetUniformLocation(p, "u_weight_offset"),
+                 (uint32_t)((size_t)f->elem_count * vlf_precision_bytes(f->prm.precision) / 4));
     gi_kit_dispatch_8x8(view->width, view->height);
     glUseProgram(0);
     host->stage_end(host, "render");
@@ -305,7 +356,8 @@ static const gi_method vlf_method = {
     .citation = "Mortensen, Khanna, Slater. Afrigraph 2007",
     .version = "0.1",
     .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_GLOSSY | GI_CAP_MIRROR | GI_CAP_AREA_LIGHTS |
-            GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION | GI_CAP_PRECOMPUTE | GI_CAP_VISIBILITY,
+            GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION |
+            GI_CAP_PRECOMPUTE | GI_CAP_VISIBILITY,
     .max_bounces = 7,
     .params = vlf_params_desc,
     .create = vlf_create,

@@ -11,9 +11,14 @@
 #include <string.h>
 #include <time.h>
 
+#include <pthread.h>
+
 #include <libqhull_r/qhull_ra.h>
 
 #include "gi/envmap.h"
+#include "gi/lights.h"
+#include "gi/raytrace.h"
+#include "vlf_sort.h"
 
 static double now_s(void)
 {
@@ -195,6 +200,128 @@ uint32_t vlf_dirs_locate(const vlf_dirs *d, gi_vec3 w, uint32_t node[3], float a
     return best;
 }
 
+/* ---- Storage precision (§3.1, §6) ----------------------------------------- */
+
+size_t vlf_precision_bytes(uint32_t prec)
+{
+    return prec == VLF_PREC_16F ? 8 : prec == VLF_PREC_RGB9E5 ? 4 : 12;
+}
+
+/* IEEE half from float, rounding to nearest even; beyond the largest half
+ * (65504) the largest half (a GPU would store infinity). */
+static uint16_t float_to_half(float f)
+{
+    uint32_t x;
+    memcpy(&x, &f, sizeof x);
+    uint32_t sign = (x >> 16) & 0x8000u, ax = x & 0x7fffffffu;
+    if (ax > 0x7f800000u)
+        return 0; /* NaN: stored as 0 (values here are never NaN) */
+    if (ax >= 0x477fe000u)
+        return (uint16_t)(sign | 0x7bffu);
+    if (ax < 0x38800000u) { /* below 2^-14: subnormal half or zero */
+        if (ax < 0x33000000u)
+            return (uint16_t)sign;
+        uint32_t e = ax >> 23, m = (ax & 0x7fffffu) | 0x800000u, shift = 126 - e;
+        uint32_t h = m >> shift, rem = m & ((1u << shift) - 1), halfway = 1u << (shift - 1);
+        if (rem > halfway || (rem == halfway && (h & 1u)))
+            h++;
+        return (uint16_t)(sign | h);
+    }
+    uint32_t h = (ax - 0x38000000u) >> 13, rem = ax & 0x1fffu;
+    if (rem > 0x1000u || (rem == 0x1000u && (h & 1u)))
+        h++;
+    if (h >= 0x7c00u)
+        h = 0x7bffu;
+    return (uint16_t)(sign | h);
+}
+
+static float half_to_float(uint16_t h)
+{
+    uint32_t e = (h >> 10) & 0x1fu, m = h & 0x3ffu;
+    float f = e == 0 ? ldexpf((float)m, -24) : ldexpf((float)(m | 0x400u), (int)e - 25);
+    return (h & 0x8000u) ? -f : f;
+}
+
+/* RGB9E5 as the GL spec (EXT_texture_shared_exponent) packs it: 9-bit
+ * mantissas, one 5-bit exponent (bias 15), negative values as 0. */
+static uint32_t pack_9e5(const float *c)
+{
+    const float maxv = 511.0f / 512.0f * 65536.0f;
+    float v[3];
+    for (int k = 0; k < 3; k++)
+        v[k] = c[k] > 0.0f ? fminf(c[k], maxv) : 0.0f;
+    float mx = fmaxf(v[0], fmaxf(v[1], v[2]));
+    int e2 = -16;
+    if (mx > 0.0f) {
+        int ex;
+        frexpf(mx, &ex);
+        e2 = ex - 1 > -16 ? ex - 1 : -16; /* floor(log2 mx), at least -16 */
+    }
+    int es = e2 + 1 + 15;
+    float scale = ldexpf(1.0f, es - 15 - 9);
+    if ((int)floorf(mx / scale + 0.5f) == 512)
+        es++, scale *= 2.0f;
+    uint32_t m[3];
+    for (int k = 0; k < 3; k++) {
+        int q = (int)floorf(v[k] / scale + 0.5f);
+        m[k] = (uint32_t)(q > 511 ? 511 : q);
+    }
+    return m[0] | m[1] << 9 | m[2] << 18 | (uint32_t)es << 27;
+}
+
+static void unpack_9e5(uint32_t x, float *c)
+{
+    float scale = ldexpf(1.0f, (int)(x >> 27) - 24);
+    c[0] = (float)(x & 511u) * scale;
+    c[1] = (float)((x >> 9) & 511u) * scale;
+    c[2] = (float)((x >> 18) & 511u) * scale;
+}
+
+void vlf_pack(uint32_t prec, const float *rgb, size_t count, void *out)
+{
+    if (prec == VLF_PREC_16F) {
+        uint16_t *h = out;
+        for (size_t i = 0; i < count; i++) {
+            for (int k = 0; k < 3; k++)
+                h[4 * i + (size_t)k] = float_to_half(rgb[3 * i + (size_t)k]);
+            h[4 * i + 3] = 0;
+        }
+    } else if (prec == VLF_PREC_RGB9E5) {
+        uint32_t *w = out;
+        for (size_t i = 0; i < count; i++)
+            w[i] = pack_9e5(rgb + 3 * i);
+    } else {
+        memcpy(out, rgb, count * 3 * sizeof(float));
+    }
+}
+
+void vlf_unpack(uint32_t prec, const void *in, size_t count, float *rgb)
+{
+    if (prec == VLF_PREC_16F) {
+        const uint16_t *h = in;
+        for (size_t i = 0; i < count; i++)
+            for (int k = 0; k < 3; k++)
+                rgb[3 * i + (size_t)k] = half_to_float(h[4 * i + (size_t)k]);
+    } else if (prec == VLF_PREC_RGB9E5) {
+        const uint32_t *w = in;
+        for (size_t i = 0; i < count; i++)
+            unpack_9e5(w[i], rgb + 3 * i);
+    } else {
+        memcpy(rgb, in, count * 3 * sizeof(float));
+    }
+}
+
+void vlf_quantise(uint32_t prec, float *rgb, size_t count)
+{
+    if (prec == VLF_PREC_16F) {
+        for (size_t i = 0; i < 3 * count; i++)
+            rgb[i] = half_to_float(float_to_half(rgb[i]));
+    } else if (prec == VLF_PREC_RGB9E5) {
+        for (size_t i = 0; i < count; i++)
+            unpack_9e5(pack_9e5(rgb + 3 * i), rgb + 3 * i);
+    }
+}
+
 /* ---- Subfields ------------------------------------------------------------ */
 
 gi_vec3 vlf_to_vlf(const vlf_field *f, gi_vec3 world)
@@ -330,17 +457,99 @@ static int frag_cmp(const void *a, const void *b)
     return x->elem < y->elem ? -1 : (x->elem > y->elem);
 }
 
-/* Per-ray depth order of subfield i (the "sort" stage, §3.2): every face
- * rasterised into the N x N rays, the fragments of each ray sorted front to
- * back; the tile rectangles of non-diffuse faces recorded on the way. */
-static int build_psf(vlf_field *f, uint32_t i, frag_buf *buf, vlf_rect *rects)
+/* Sort counters of one thread. */
+typedef struct sort_counts {
+    uint64_t pieces, splits, bsp_cuts, unresolved, tests;
+} sort_counts;
+
+/* The fragments of every face along subfield frame fr, in buf, grouped by
+ * ray (interface cell) and front to back along fr->n within each ray
+ * (§3.2). Faces order: the faces sorted by vlf_sort_faces and rasterised in
+ * that order, each ray's fragments then kept in the order they came
+ * (a stable bucket sort by cell); rays order: all fragments sorted by cell
+ * and depth. bbox (4 per face, may be NULL) grows by the subfield cells
+ * each face covers. */
+static int list_fragments(const vlf_field *f, const vlf_psf *fr, frag_buf *buf, frag_buf *tmp, vlf_sorter *so,
+                          int32_t *bbox, sort_counts *cnt)
 {
+    uint32_t N = f->prm.N * f->prm.S;
+    int32_t dummy[4];
+    buf->n = 0;
+    if (f->prm.order == VLF_ORDER_RAYS) {
+        for (uint32_t ti = 0; ti < f->tri_count; ti++) {
+            uint32_t fi = f->tri_face[ti];
+            sort_ctx c = {buf, f, fr, &f->faces[fi], N, bbox ? bbox + 4 * fi : dummy};
+            if (!raster_tri(f, fr, f->tri_p + 3 * (size_t)ti, emit_frag, &c))
+                return 0;
+        }
+        qsort(buf->v, buf->n, sizeof *buf->v, frag_cmp);
+        return 1;
+    }
+    int mode = f->prm.order == VLF_ORDER_PLAIN     ? VLF_SORT_PLAIN
+               : f->prm.order == VLF_ORDER_NOSPLIT ? VLF_SORT_NOSPLIT
+                                                   : VLF_SORT_NEWELL;
+    if (vlf_sort_faces(so, f->tri_p, f->tri_count, fr->u, fr->v, fr->n, mode, f->prm.bsp_levels, f->prm.bsp_min) != 0)
+        return 0;
+    cnt->pieces += so->nout;
+    cnt->splits += so->splits;
+    cnt->bsp_cuts += so->bsp_cuts;
+    cnt->unresolved += so->unresolved;
+    cnt->tests += so->tests;
+    for (uint32_t k = 0; k < so->nout; k++) {
+        const vlf_piece *pc = &so->poly[so->out[k]];
+        uint32_t fi = f->tri_face[pc->tri];
+        sort_ctx c = {buf, f, fr, &f->faces[fi], N, bbox ? bbox + 4 * fi : dummy};
+        /* back from the frame to VLF coordinates; a fan over the convex piece */
+        gi_vec3 q[3];
+        const gi_vec3 *v = so->vert + pc->first;
+        for (uint32_t j = 1; j + 1 < pc->count; j++) {
+            const gi_vec3 *w[3] = {&v[0], &v[j], &v[j + 1]};
+            for (int a = 0; a < 3; a++)
+                q[a] = gi_v3_add(gi_v3_add(gi_v3_scale(fr->u, w[a]->x), gi_v3_scale(fr->v, w[a]->y)),
+                                 gi_v3_scale(fr->n, w[a]->z));
+            if (!raster_tri(f, fr, q, emit_frag, &c))
+                return 0;
+        }
+    }
+    /* stable bucket sort by cell: each ray keeps the faces' order */
+    uint32_t *start = calloc((size_t)N * N + 1, sizeof *start);
+    if (!start)
+        return 0;
+    if (tmp->cap < buf->n) {
+        frag_tmp *t = realloc(tmp->v, (buf->n ? buf->n : 1) * sizeof *t);
+        if (!t) {
+            free(start);
+            return 0;
+        }
+        tmp->v = t;
+        tmp->cap = buf->n ? buf->n : 1;
+    }
+    for (size_t k = 0; k < buf->n; k++)
+        start[buf->v[k].cell + 1]++;
+    for (uint32_t c = 0; c < N * N; c++)
+        start[c + 1] += start[c];
+    for (size_t k = 0; k < buf->n; k++)
+        tmp->v[start[buf->v[k].cell]++] = buf->v[k];
+    free(start);
+    tmp->n = buf->n;
+    frag_buf sw = *buf;
+    *buf = *tmp;
+    *tmp = sw;
+    return 1;
+}
+
+/* Depth order of subfield i (the "sort" stage, §3.2): the fragments of
+ * every face on the N S x N S rays, each ray's front to back
+ * (list_fragments); the tile rectangles of non-diffuse faces recorded on
+ * the way. Writes only psf[i] and the rectangles of subfield i. */
+static int build_psf(vlf_field *f, uint32_t i, frag_buf *buf, frag_buf *tmp, vlf_sorter *so, sort_counts *cnt)
+{
+    vlf_rect *rects = f->rects;
     vlf_psf *p = &f->psf[i];
     gi_vec3 w = f->dirs.signed_dirs[i];
     p->n = w;
     gi_onb(w, &p->u, &p->v);
     uint32_t N = f->prm.N * f->prm.S, m = f->prm.m;
-    buf->n = 0;
     int32_t *bbox = malloc(((size_t)f->face_count * 4 + 4) * sizeof *bbox);
     if (!bbox)
         return 0;
@@ -348,13 +557,9 @@ static int build_psf(vlf_field *f, uint32_t i, frag_buf *buf, vlf_rect *rects)
         bbox[4 * fi] = bbox[4 * fi + 1] = INT32_MAX;
         bbox[4 * fi + 2] = bbox[4 * fi + 3] = -1;
     }
-    for (uint32_t ti = 0; ti < f->tri_count; ti++) {
-        uint32_t fi = f->tri_face[ti];
-        sort_ctx c = {buf, f, p, &f->faces[fi], N, bbox + 4 * fi};
-        if (!raster_tri(f, p, f->tri_p + 3 * (size_t)ti, emit_frag, &c)) {
-            free(bbox);
-            return 0;
-        }
+    if (!list_fragments(f, p, buf, tmp, so, bbox, cnt)) {
+        free(bbox);
+        return 0;
     }
     for (uint32_t fi = 0; fi < f->face_count; fi++) {
         if (f->faces[fi].nd < 0)
@@ -371,7 +576,6 @@ static int build_psf(vlf_field *f, uint32_t i, frag_buf *buf, vlf_rect *rects)
         }
     }
     free(bbox);
-    qsort(buf->v, buf->n, sizeof *buf->v, frag_cmp);
     p->cell_start = calloc((size_t)N * N + 1, sizeof *p->cell_start);
     p->frag = malloc((buf->n ? buf->n : 1) * sizeof *p->frag);
     if (!p->cell_start || !p->frag)
@@ -384,6 +588,69 @@ static int build_psf(vlf_field *f, uint32_t i, frag_buf *buf, vlf_rect *rects)
     for (uint32_t c = 0; c < N * N; c++)
         p->cell_start[c + 1] += p->cell_start[c];
     return 1;
+}
+
+/* One thread of the sort stage: subfields t, t + T, t + 2T, ... (each
+ * subfield's order depends on nothing else, so any thread count gives the
+ * same field). */
+typedef struct sort_job {
+    vlf_field *f;
+    uint32_t t, T;
+    int ok;
+    sort_counts cnt;
+} sort_job;
+
+static void *sort_thread(void *arg)
+{
+    sort_job *j = arg;
+    frag_buf buf = {0}, tmp = {0};
+    vlf_sorter so;
+    memset(&so, 0, sizeof so);
+    j->ok = 1;
+    for (uint32_t i = j->t; i < j->f->prm.l && j->ok; i += j->T)
+        j->ok = build_psf(j->f, i, &buf, &tmp, &so, &j->cnt);
+    free(buf.v);
+    free(tmp.v);
+    vlf_sorter_free(&so);
+    return NULL;
+}
+
+/* The sort stage on p->threads threads (the calling one among them). */
+static int build_all_psf(vlf_field *f)
+{
+    uint32_t T = f->prm.threads < 1 ? 1 : f->prm.threads;
+    if (T > f->prm.l)
+        T = f->prm.l;
+    sort_job *jobs = calloc(T, sizeof *jobs);
+    pthread_t *th = calloc(T, sizeof *th);
+    uint8_t *started = calloc(T, 1);
+    if (!jobs || !th || !started) {
+        free(jobs), free(th), free(started);
+        return 0;
+    }
+    for (uint32_t t = 0; t < T; t++) {
+        jobs[t] = (sort_job){f, t, T, 0, {0, 0, 0, 0, 0}};
+        if (t > 0)
+            started[t] = pthread_create(&th[t], NULL, sort_thread, &jobs[t]) == 0;
+    }
+    sort_thread(&jobs[0]);
+    int ok = jobs[0].ok;
+    for (uint32_t t = 1; t < T; t++) {
+        if (started[t])
+            pthread_join(th[t], NULL);
+        else
+            sort_thread(&jobs[t]); /* no thread to be had: do its share here */
+        ok = ok && jobs[t].ok;
+    }
+    for (uint32_t t = 0; t < T; t++) {
+        f->st.sort_pieces += jobs[t].cnt.pieces;
+        f->st.sort_splits += jobs[t].cnt.splits;
+        f->st.sort_bsp_cuts += jobs[t].cnt.bsp_cuts;
+        f->st.sort_unresolved += jobs[t].cnt.unresolved;
+        f->st.sort_tests += jobs[t].cnt.tests;
+    }
+    free(jobs), free(th), free(started);
+    return ok;
 }
 
 static size_t rect_slot(const vlf_rect *r, uint32_t cx, uint32_t cy)
@@ -532,16 +799,67 @@ static void element_areas(vlf_field *f)
                 n = clip_poly(px, py, n, 0, -1.0f, -(float)tx);
                 n = clip_poly(px, py, n, 1, 1.0f, (float)ty + 1.0f);
                 n = clip_poly(px, py, n, 1, -1.0f, -(float)ty);
-                float a = 0.0f;
+                float a = 0.0f, mx = 0.0f, my = 0.0f;
                 for (int i = 0; i < n; i++) {
                     int j = (i + 1) % n;
-                    a += px[i] * py[j] - px[j] * py[i];
+                    float c = px[i] * py[j] - px[j] * py[i];
+                    a += c;
+                    mx += (px[i] + px[j]) * c;
+                    my += (py[i] + py[j]) * c;
                 }
                 int cx = tx < 0 ? 0 : tx >= (int)fc->W ? (int)fc->W - 1 : tx;
                 int cy = ty < 0 ? 0 : ty >= (int)fc->H ? (int)fc->H - 1 : ty;
-                f->elem_area[fc->first_elem + (uint32_t)cy * fc->W + (uint32_t)cx] += 0.5f * fabsf(a) * texel;
+                uint32_t e = fc->first_elem + (uint32_t)cy * fc->W + (uint32_t)cx;
+                float ar = 0.5f * fabsf(a) * texel;
+                f->elem_area[e] += ar;
+                if (a != 0.0f) { /* area-weighted centroid of the part on the face, texel units */
+                    f->elem_c[2 * (size_t)e] += ar * mx / (3.0f * a);
+                    f->elem_c[2 * (size_t)e + 1] += ar * my / (3.0f * a);
+                }
             }
     }
+}
+
+/* Cuts every triangle into k^2 (a regular grid of its barycentric
+ * coordinates, the winding kept): the same surfaces as more faces, for the
+ * paper's claim that propagation is linear in the number of faces. */
+static int subdivide_triangles(vlf_field *f, uint32_t k)
+{
+    f->tri_sub = k * k;
+    if (k <= 1)
+        return 1;
+    size_t T = (size_t)f->tri_count * k * k;
+    gi_vec3 *P = malloc(T * 3 * sizeof *P);
+    uint32_t *F = malloc(T * sizeof *F);
+    if (!P || !F) {
+        free(P), free(F);
+        return 0;
+    }
+    size_t n = 0;
+    float inv = 1.0f / (float)k;
+    for (uint32_t ti = 0; ti < f->tri_count; ti++) {
+        const gi_vec3 *p = f->tri_p + 3 * (size_t)ti;
+        gi_vec3 e1 = gi_v3_sub(p[1], p[0]), e2 = gi_v3_sub(p[2], p[0]);
+#define GRID(a, b) gi_v3_add(p[0], gi_v3_add(gi_v3_scale(e1, (float)(a) * inv), gi_v3_scale(e2, (float)(b) * inv)))
+        for (uint32_t a = 0; a < k; a++)
+            for (uint32_t b = 0; a + b < k; b++) {
+                gi_vec3 *q = P + 3 * n;
+                q[0] = GRID(a, b), q[1] = GRID(a + 1, b), q[2] = GRID(a, b + 1);
+                F[n++] = f->tri_face[ti];
+                if (a + b + 2 <= k) {
+                    q = P + 3 * n;
+                    q[0] = GRID(a + 1, b), q[1] = GRID(a + 1, b + 1), q[2] = GRID(a, b + 1);
+                    F[n++] = f->tri_face[ti];
+                }
+            }
+#undef GRID
+    }
+    free(f->tri_p);
+    free(f->tri_face);
+    f->tri_p = P;
+    f->tri_face = F;
+    f->tri_count = (uint32_t)n;
+    return 1;
 }
 
 int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *p, char *err, size_t err_size)
@@ -549,6 +867,10 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
     memset(f, 0, sizeof *f);
     f->prm = *p;
     double t0 = now_s();
+    if (p->precision > VLF_PREC_RGB9E5) {
+        snprintf(err, err_size, "vlf: storage precision %u unknown", p->precision);
+        return -1;
+    }
     if (p->S < 1 || p->S > 8) {
         snprintf(err, err_size, "vlf: supersampling S = %u outside 1..8", p->S);
         return -1;
@@ -579,6 +901,57 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
         return -1;
     }
     f->env = s->envmap;
+    /* Directional lights (not in the paper, which has emissive faces and
+     * sky): parallel light, so it enters like the sky of Fig. 6, into the
+     * interfaces of the three directions around the light's with their
+     * barycentric weights, radiance alpha E / dOmega, so that each carries
+     * alpha E through a unit of area across it. */
+    f->sun = calloc((size_t)p->l * 2 * 3, sizeof *f->sun);
+    if (!f->sun)
+        goto oom;
+    for (uint32_t li = 0; li < s->light_count; li++) {
+        if (s->lights[li].type != GI_LIGHT_DIRECTIONAL)
+            continue;
+        gi_light_frame fr = gi_scene_light_at(s, li, t);
+        float len = gi_v3_length(fr.direction);
+        if (!(len > 0.0f))
+            continue;
+        uint32_t node[3];
+        float al[3];
+        vlf_dirs_locate(&f->dirs, gi_v3_scale(fr.direction, 1.0f / len), node, al);
+        for (int k = 0; k < 3; k++)
+            for (int q = 0; q < 3; q++)
+                f->sun[3 * node[k] + (uint32_t)q] += al[k] * s->lights[li].intensity[q] / f->dirs.solid_angle[node[k]];
+        f->sun_count++;
+    }
+    /* Point and spot lights: a first shot by shadow rays (punctual_first_shot). */
+    for (uint32_t li = 0; li < s->light_count; li++)
+        f->punctual_count += s->lights[li].type != GI_LIGHT_DIRECTIONAL;
+    if (f->punctual_count) {
+        f->punctual = calloc(f->punctual_count, sizeof *f->punctual);
+        if (!f->punctual)
+            goto oom;
+        uint32_t k = 0;
+        for (uint32_t li = 0; li < s->light_count; li++) {
+            const gi_light *L = &s->lights[li];
+            if (L->type == GI_LIGHT_DIRECTIONAL)
+                continue;
+            gi_light_frame fr = gi_scene_light_at(s, li, t);
+            vlf_punctual *P = &f->punctual[k++];
+            P->spot = L->type == GI_LIGHT_SPOT;
+            P->pos = fr.position;
+            P->dir = fr.direction;
+            memcpy(P->I, L->intensity, sizeof P->I);
+            P->range = L->range;
+            P->cos_inner = cosf(L->inner_cone);
+            P->cos_outer = cosf(L->outer_cone);
+        }
+        gi_error e;
+        if (gi_rt_create(s, t, &f->rt, &e) != GI_OK) {
+            snprintf(err, err_size, "vlf: shadow rays for the point lights: %s", e.text);
+            return -1;
+        }
+    }
     if (!group_faces(f, s, t))
         goto oom;
     uint32_t elems = 0;
@@ -600,12 +973,13 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
     f->elem_count = elems;
     f->elem_face = malloc((size_t)elems * sizeof *f->elem_face);
     f->elem_area = calloc((size_t)elems, sizeof *f->elem_area);
+    f->elem_c = calloc((size_t)elems * 2 + 2, sizeof *f->elem_c);
     f->E_tot = calloc((size_t)elems * 3, sizeof(float));
     f->E_next = calloc((size_t)elems * 3, sizeof(float));
     f->L_cur = calloc((size_t)elems * 3, sizeof(float));
     f->psf = calloc(p->l, sizeof *f->psf);
     f->rects = calloc((size_t)f->nd_count * p->l + 1, sizeof *f->rects);
-    if (!f->elem_face || !f->elem_area || !f->E_tot || !f->E_next || !f->L_cur || !f->psf || !f->rects)
+    if (!f->elem_face || !f->elem_area || !f->elem_c || !f->E_tot || !f->E_next || !f->L_cur || !f->psf || !f->rects)
         goto oom;
     for (uint32_t fi = 0; fi < f->face_count; fi++) {
         vlf_face *fc = &f->faces[fi];
@@ -613,14 +987,18 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
             f->elem_face[fc->first_elem + e] = fi;
     }
     element_areas(f);
-    frag_buf buf = {0};
-    for (uint32_t i = 0; i < p->l; i++) {
-        if (!build_psf(f, i, &buf, f->rects)) {
-            free(buf.v);
-            goto oom;
+    for (uint32_t e = 0; e < elems; e++) {
+        if (f->elem_area[e] > 0.0f) {
+            f->elem_c[2 * (size_t)e] /= f->elem_area[e];
+            f->elem_c[2 * (size_t)e + 1] /= f->elem_area[e];
         }
     }
-    free(buf.v);
+    if ((uint64_t)s->triangle_count * p->subdivide * p->subdivide > 50000000u) {
+        snprintf(err, err_size, "vlf: %u triangles cut into %u^2 each are too many", s->triangle_count, p->subdivide);
+        return -1;
+    }
+    if (!subdivide_triangles(f, p->subdivide < 1 ? 1 : p->subdivide) || !build_all_psf(f))
+        goto oom;
     /* Tile storage offsets, then coverage of each stored cell. */
     size_t cells = 0;
     uint32_t tiles = 0;
@@ -661,12 +1039,14 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
     f->st.nondiffuse_elements = ndel;
     f->st.tiles = tiles;
     /* Memory as the paper counts it: current, next and total ir/radiance
-     * (RGB float) for both kinds, plus the depth order; rendering keeps the
-     * totals only. */
-    f->st.bytes_propagate = (size_t)elems * 3 * sizeof(float) * 3 + cells * 3 * sizeof(float) * 4 + cells +
-                            frags * sizeof(uint32_t) + (size_t)p->l * ((size_t)p->N * p->S * p->N * p->S + 1) * sizeof(uint32_t);
-    f->st.bytes_render = (size_t)elems * 3 * sizeof(float) + cells * 3 * sizeof(float) +
-                         (size_t)f->nd_count * p->l * sizeof(vlf_rect);
+     * maps in the storage format for both kinds (and the incoming tiles),
+     * plus the depth order; rendering keeps the totals and the tile index
+     * only (vlf.c uploads exactly these maps). */
+    size_t bpv = vlf_precision_bytes(p->precision);
+    f->st.bytes_maps_render = ((size_t)elems + cells) * bpv;
+    f->st.bytes_propagate = (size_t)elems * bpv * 3 + cells * bpv * 4 + cells + frags * sizeof(uint32_t) +
+                            (size_t)p->l * ((size_t)p->N * p->S * p->N * p->S + 1) * sizeof(uint32_t);
+    f->st.bytes_render = f->st.bytes_maps_render + (size_t)f->nd_count * p->l * sizeof(vlf_rect);
     f->st.sort_s = now_s() - t0;
     return 0;
 oom:
@@ -679,19 +1059,10 @@ oom:
 /* Fragments of all faces along a perturbed direction (frame fr), sorted
  * per ray front to back; kept with their depths (§3.5: perturbed
  * directions are sorted like fixed ones, used for transport, discarded). */
-static int perturbed_list(vlf_field *f, const vlf_psf *fr, frag_buf *buf)
+static int perturbed_list(vlf_field *f, const vlf_psf *fr, frag_buf *buf, frag_buf *tmp, vlf_sorter *so)
 {
-    int32_t bb[4];
-    buf->n = 0;
-    for (uint32_t ti = 0; ti < f->tri_count; ti++) {
-        bb[0] = bb[1] = INT32_MAX;
-        bb[2] = bb[3] = -1;
-        sort_ctx c = {buf, f, fr, &f->faces[f->tri_face[ti]], f->prm.N * f->prm.S, bb};
-        if (!raster_tri(f, fr, f->tri_p + 3 * (size_t)ti, emit_frag, &c))
-            return 0;
-    }
-    qsort(buf->v, buf->n, sizeof *buf->v, frag_cmp);
-    return 1;
+    sort_counts cnt = {0, 0, 0, 0, 0};
+    return list_fragments(f, fr, buf, tmp, so, NULL, &cnt);
 }
 
 /* The tile slot of non-diffuse face fc in fixed subfield i holding VLF
@@ -723,6 +1094,9 @@ static void sweep_perturbed(vlf_field *f, uint32_t i, const vlf_psf *fr, const f
     float sky[3] = {0, 0, 0};
     if (first_iteration && f->env)
         gi_envmap_eval(f->env, gi_v3_scale(t, -1.0f), sky);
+    if (first_iteration)
+        for (int q = 0; q < 3; q++)
+            sky[q] += f->sun[3 * (sign > 0 ? i : i + f->prm.l) + (uint32_t)q];
     double shot = 0, recv = 0, back = 0, esc = 0;
     size_t a = 0;
     while (a < buf->n) {
@@ -811,6 +1185,9 @@ static void sweep(vlf_field *f, uint32_t i, int sign, int first_iteration)
     float sky[3] = {0, 0, 0};
     if (first_iteration && f->env)
         gi_envmap_eval(f->env, gi_v3_scale(t, -1.0f), sky);
+    if (first_iteration)
+        for (int q = 0; q < 3; q++)
+            sky[q] += f->sun[3 * sd + (uint32_t)q];
     double shot = 0, recv = 0, back = 0, esc = 0;
     float min_area = 1.0f / (64.0f * f->prm.density * f->prm.density);
     for (uint32_t c = 0; c < N * N; c++) {
@@ -888,6 +1265,150 @@ static int read_in(const vlf_field *f, const vlf_rect *r, float x, float y, floa
     return 1;
 }
 
+/* Weights g over the 2l signed directions of light reflected by
+ * non-diffuse face fc into direction r (§3.4): mirrors and lobes narrower
+ * than the direction set (fewer than ~3 directions' worth of lobe) go to
+ * the three nearest directions of r with their barycentric weights, wider
+ * Phong lobes to every direction of the lobe; directions below the face
+ * get 0. Returns sum_j g_j cos_j dOmega_j (the normaliser that makes the
+ * face reflect ks of what arrives), 0 if nothing is reflected. */
+static double reflect_weights(const vlf_field *f, const vlf_face *fc, gi_vec3 r, float *g)
+{
+    uint32_t n2 = 2 * f->prm.l;
+    memset(g, 0, n2 * sizeof *g);
+    int lobe = 0;
+    if (!fc->mirror) {
+        double s1 = 0, s2 = 0;
+        for (uint32_t j = 0; j < n2; j++) {
+            float cj = gi_v3_dot(f->dirs.signed_dirs[j], r);
+            if (cj > 0.0f && gi_v3_dot(f->dirs.signed_dirs[j], fc->n) > 0.0f) {
+                g[j] = powf(cj, fc->exponent);
+                if (g[j] < 1e-3f)
+                    g[j] = 0.0f;
+                s1 += g[j];
+                s2 += (double)g[j] * g[j];
+            }
+        }
+        lobe = s2 > 0.0 && s1 * s1 / s2 >= 3.0; /* at least ~3 directions in the lobe */
+        if (!lobe)
+            memset(g, 0, n2 * sizeof *g);
+    }
+    if (!lobe) {
+        uint32_t node[3];
+        float al[3];
+        vlf_dirs_locate(&f->dirs, r, node, al);
+        for (int j = 0; j < 3; j++)
+            g[node[j]] += al[j];
+    }
+    double norm = 0.0;
+    for (uint32_t j = 0; j < n2; j++) {
+        float cj = gi_v3_dot(f->dirs.signed_dirs[j], fc->n);
+        if (g[j] > 0.0f && cj > 0.0f)
+            norm += g[j] * cj * f->dirs.solid_angle[j];
+        else
+            g[j] = 0.0f;
+    }
+    return norm;
+}
+
+/* Irradiance at world point x of surface normal n from the point and spot
+ * lights, each through a shadow ray (Embree, core raytrace.h); per light
+ * into E + 3 k, and the unit direction toward it into w + k. */
+static void punctual_at(const vlf_field *f, gi_vec3 x, gi_vec3 n, float *E, gi_vec3 *w)
+{
+    for (uint32_t k = 0; k < f->punctual_count; k++) {
+        const vlf_punctual *L = &f->punctual[k];
+        E[3 * k] = E[3 * k + 1] = E[3 * k + 2] = 0.0f;
+        gi_vec3 d = gi_v3_sub(L->pos, x);
+        float dist = gi_v3_length(d);
+        if (!(dist > 0.0f))
+            continue;
+        w[k] = gi_v3_scale(d, 1.0f / dist);
+        float c = gi_v3_dot(n, w[k]);
+        if (c <= 0.0f)
+            continue;
+        float scale = gi_range_window(dist, L->range) / (dist * dist);
+        if (L->spot)
+            scale *= gi_spot_falloff(-gi_v3_dot(w[k], L->dir), L->cos_inner, L->cos_outer);
+        if (!(scale > 0.0f))
+            continue;
+        gi_vec3 o = gi_v3_add(x, gi_v3_scale(n, 1e-4f * f->radius));
+        float tfar = gi_v3_length(gi_v3_sub(L->pos, o)) * (1.0f - 1e-5f);
+        if (gi_rt_occluded(f->rt, o, w[k], 0.0f, tfar))
+            continue;
+        for (int q = 0; q < 3; q++)
+            E[3 * k + (uint32_t)q] = L->I[q] * c * scale;
+    }
+}
+
+/* The point and spot lights' first shot (not in the paper, which has
+ * emissive faces and sky): their direct irradiance on every diffuse
+ * element (at the element's centroid on its face) and their reflection by
+ * every non-diffuse face into its tiles (each covered cell's point on the
+ * face, reflected as §3.4 reflects the interface's light), added to the
+ * next maps of the first iteration: shot on from there like received
+ * light. */
+static int punctual_first_shot(vlf_field *f)
+{
+    uint32_t P = f->punctual_count, l = f->prm.l;
+    float *E = malloc((size_t)P * 3 * sizeof *E), *g = malloc((size_t)2 * l * sizeof *g);
+    gi_vec3 *w = malloc((size_t)P * sizeof *w);
+    if (!E || !g || !w) {
+        free(E), free(g), free(w);
+        return 0;
+    }
+    for (uint32_t e = 0; e < f->elem_count; e++) {
+        if (!(f->elem_area[e] > 0.0f))
+            continue;
+        const vlf_face *fc = &f->faces[f->elem_face[e]];
+        gi_vec3 q = gi_v3_add(fc->origin, gi_v3_add(gi_v3_scale(fc->t, f->elem_c[2 * (size_t)e] / f->prm.density),
+                                                    gi_v3_scale(fc->b, f->elem_c[2 * (size_t)e + 1] / f->prm.density)));
+        punctual_at(f, gi_v3_add(f->centre, gi_v3_scale(q, f->radius)), fc->n, E, w);
+        for (uint32_t k = 0; k < P; k++)
+            for (int c = 0; c < 3; c++)
+                f->E_next[3 * (size_t)e + (size_t)c] += E[3 * k + (uint32_t)c];
+    }
+    for (uint32_t fi = 0; fi < f->face_count; fi++) {
+        const vlf_face *fc = &f->faces[fi];
+        if (fc->nd < 0)
+            continue;
+        for (uint32_t i = 0; i < l; i++) {
+            const vlf_rect *rj = &f->rects[(size_t)fc->nd * l + i];
+            const vlf_psf *ps = &f->psf[i];
+            float dn = gi_v3_dot(ps->n, fc->n);
+            if (rj->w == 0 || fabsf(dn) < 1e-6f)
+                continue;
+            uint32_t sd = dn > 0.0f ? i : i + l; /* the signed direction leaving the front */
+            for (uint32_t yy = 0; yy < rj->h; yy++)
+                for (uint32_t xx = 0; xx < rj->w; xx++) {
+                    size_t slot = rj->offset + (size_t)yy * rj->w + xx;
+                    if (!f->nd_cover[slot])
+                        continue;
+                    float U = ((float)(rj->x0 + (int32_t)xx) + 0.5f) / (float)f->prm.N * 2.0f - 1.0f;
+                    float V = ((float)(rj->y0 + (int32_t)yy) + 0.5f) / (float)f->prm.N * 2.0f - 1.0f;
+                    gi_vec3 o = gi_v3_add(gi_v3_scale(ps->u, U), gi_v3_scale(ps->v, V));
+                    float tt = gi_v3_dot(fc->n, gi_v3_sub(fc->origin, o)) / dn;
+                    gi_vec3 q = gi_v3_add(o, gi_v3_scale(ps->n, tt));
+                    punctual_at(f, gi_v3_add(f->centre, gi_v3_scale(q, f->radius)), fc->n, E, w);
+                    for (uint32_t k = 0; k < P; k++) {
+                        if (E[3 * k] <= 0.0f && E[3 * k + 1] <= 0.0f && E[3 * k + 2] <= 0.0f)
+                            continue;
+                        /* light travelling along -w, reflected about the face */
+                        gi_vec3 t = gi_v3_scale(w[k], -1.0f);
+                        gi_vec3 r = gi_v3_sub(t, gi_v3_scale(fc->n, 2.0f * gi_v3_dot(t, fc->n)));
+                        double norm = reflect_weights(f, fc, r, g);
+                        if (norm <= 0.0 || g[sd] <= 0.0f)
+                            continue;
+                        for (int c = 0; c < 3; c++)
+                            f->out_next[3 * slot + (size_t)c] += fc->ks[c] * E[3 * k + (uint32_t)c] * (float)(g[sd] / norm);
+                    }
+                }
+        }
+    }
+    free(E), free(g), free(w);
+    return 1;
+}
+
 /* Non-diffuse scattering (§3.4): the radiance that subfield i brought to
  * each non-diffuse face is reflected into the subfields around the
  * reflected direction (mirrors and lobes narrower than the direction set:
@@ -912,40 +1433,7 @@ static void scatter(vlf_field *f, uint32_t i)
         gi_vec3 t = f->dirs.signed_dirs[sd_in];
         float cos_in = fabsf(ci);
         gi_vec3 r = gi_v3_sub(t, gi_v3_scale(fc->n, 2.0f * gi_v3_dot(t, fc->n)));
-        memset(g, 0, n2 * sizeof *g);
-        int lobe = 0;
-        if (!fc->mirror) {
-            double s1 = 0, s2 = 0;
-            for (uint32_t j = 0; j < n2; j++) {
-                float cj = gi_v3_dot(f->dirs.signed_dirs[j], r);
-                if (cj > 0.0f && gi_v3_dot(f->dirs.signed_dirs[j], fc->n) > 0.0f) {
-                    g[j] = powf(cj, fc->exponent);
-                    if (g[j] < 1e-3f)
-                        g[j] = 0.0f;
-                    s1 += g[j];
-                    s2 += (double)g[j] * g[j];
-                }
-            }
-            lobe = s2 > 0.0 && s1 * s1 / s2 >= 3.0; /* at least ~3 directions in the lobe */
-            if (!lobe)
-                memset(g, 0, n2 * sizeof *g);
-        }
-        if (!lobe) {
-            uint32_t node[3];
-            float al[3];
-            vlf_dirs_locate(&f->dirs, r, node, al);
-            for (int j = 0; j < 3; j++)
-                g[node[j]] += al[j];
-        }
-        /* Normalise: the face reflects ks of the flux that arrives from this direction. */
-        double norm = 0.0;
-        for (uint32_t j = 0; j < n2; j++) {
-            float cj = gi_v3_dot(f->dirs.signed_dirs[j], fc->n);
-            if (g[j] > 0.0f && cj > 0.0f)
-                norm += g[j] * cj * f->dirs.solid_angle[j];
-            else
-                g[j] = 0.0f;
-        }
+        double norm = reflect_weights(f, fc, r, g);
         if (norm <= 0.0)
             continue;
         float scale = (float)((double)cos_in * f->dirs.solid_angle[sd_in] / norm);
@@ -980,15 +1468,117 @@ static void scatter(vlf_field *f, uint32_t i)
                     for (int k = 0; k < 3; k++)
                         f->out_next[3 * slot + k] += c[k] * Lin[k];
                 }
+            /* one pass into the target's tiles: written in the storage format */
+            vlf_quantise(f->prm.precision, f->out_next + 3 * (size_t)rj->offset, (size_t)rj->w * rj->h);
         }
     }
     free(g);
 }
 
+/* The sorting of one fixed direction's perturbed directions beside its
+ * propagation (§3.5: "carried out on the CPU in parallel with
+ * propagation"): worker threads build the fragment lists of perturbed
+ * directions k = t, t + T, ... into their slots, while the propagating
+ * thread sweeps them in order k = 0, 1, ... as they become ready (the
+ * same lists and the same order of sweeps for any thread count). */
+typedef struct pert_pipe {
+    vlf_field *f;
+    uint32_t i, T, P;
+    frag_buf *slot;  /* P fragment lists */
+    vlf_psf *frame;  /* P frames */
+    uint8_t *ready;  /* P: 0 not yet, 1 ready, 2 failed */
+    int sync;        /* the mutex and condition are set up (and the rest owned) */
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+} pert_pipe;
+
+typedef struct pert_worker {
+    pert_pipe *pp;
+    uint32_t t;
+    frag_buf tmp;
+    vlf_sorter so;
+} pert_worker;
+
+static void *pert_thread(void *arg)
+{
+    pert_worker *w = arg;
+    pert_pipe *pp = w->pp;
+    int ok = 1;
+    for (uint32_t k = w->t; k < pp->P; k += pp->T) {
+        if (ok) {
+            vlf_psf *fr = &pp->frame[k];
+            fr->n = perturbed_dir(pp->f, pp->i, k);
+            gi_onb(fr->n, &fr->u, &fr->v);
+            ok = perturbed_list(pp->f, fr, &pp->slot[k], &w->tmp, &w->so);
+        }
+        pthread_mutex_lock(&pp->mu);
+        pp->ready[k] = ok ? 1 : 2;
+        pthread_cond_broadcast(&pp->cv);
+        pthread_mutex_unlock(&pp->mu);
+    }
+    return NULL;
+}
+
+static void pipe_free(pert_pipe *pp, pert_worker *wk)
+{
+    if (!pp->sync)
+        return;
+    for (uint32_t k = 0; k < pp->P; k++)
+        free(pp->slot[k].v);
+    for (uint32_t t = 0; t < pp->T; t++) {
+        free(wk[t].tmp.v);
+        vlf_sorter_free(&wk[t].so);
+    }
+    free(pp->slot), free(pp->frame), free(pp->ready), free(wk);
+    pthread_mutex_destroy(&pp->mu);
+    pthread_cond_destroy(&pp->cv);
+    pp->sync = 0;
+}
+
+/* The perturbed sweeps of fixed direction i with the lists sorted beside
+ * them on T threads; 0 out of memory. */
+static int perturbed_pipelined(vlf_field *f, uint32_t i, int first_iteration, pert_pipe *pp, pert_worker *wk)
+{
+    uint32_t T = pp->T, P = pp->P, l = f->prm.l, prec = f->prm.precision;
+    pp->i = i;
+    memset(pp->ready, 0, P);
+    pthread_t *th = calloc(T, sizeof *th);
+    uint8_t *started = calloc(T, 1);
+    if (!th || !started) {
+        free(th), free(started);
+        return 0;
+    }
+    for (uint32_t t = 0; t < T; t++)
+        started[t] = pthread_create(&th[t], NULL, pert_thread, &wk[t]) == 0;
+    for (uint32_t t = 0; t < T; t++)
+        if (!started[t])
+            pert_thread(&wk[t]); /* no thread to be had: its share here */
+    int ok = 1;
+    for (uint32_t k = 0; k < P && ok; k++) {
+        pthread_mutex_lock(&pp->mu);
+        while (pp->ready[k] == 0)
+            pthread_cond_wait(&pp->cv, &pp->mu);
+        ok = pp->ready[k] == 1;
+        pthread_mutex_unlock(&pp->mu);
+        if (!ok)
+            break;
+        /* each sign's solid angle: the fixed direction's, shared */
+        sweep_perturbed(f, i, &pp->frame[k], &pp->slot[k], +1, f->dirs.solid_angle[i] / (float)P, first_iteration);
+        vlf_quantise(prec, f->E_next, f->elem_count);
+        sweep_perturbed(f, i, &pp->frame[k], &pp->slot[k], -1, f->dirs.solid_angle[i + l] / (float)P, first_iteration);
+        vlf_quantise(prec, f->E_next, f->elem_count);
+    }
+    for (uint32_t t = 0; t < T; t++)
+        if (started[t])
+            pthread_join(th[t], NULL);
+    free(th), free(started);
+    return ok;
+}
+
 int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
 {
     double t0 = now_s();
-    uint32_t l = f->prm.l;
+    uint32_t l = f->prm.l, prec = f->prm.precision;
     size_t ne = (size_t)f->elem_count * 3, nc = (size_t)f->nd_cells * 3;
     memset(f->E_tot, 0, ne * sizeof(float));
     memset(f->out_tot, 0, nc * sizeof(float));
@@ -1003,13 +1593,49 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
             f->st.flux_emitted += GI_PI * fc->emission[q] * f->elem_area[e] / 3.0;
         }
     }
+    vlf_quantise(prec, f->L_cur, f->elem_count);
+    if (f->punctual_count) {
+        if (!punctual_first_shot(f))
+            return -1;
+        vlf_quantise(prec, f->E_next, f->elem_count);
+        vlf_quantise(prec, f->out_next, f->nd_cells);
+    }
     f->st.flux_shot = f->st.flux_received = f->st.flux_back = f->st.flux_escaped = 0;
     f->st.samples = 0;
-    frag_buf pbuf = {0};
+    frag_buf pbuf = {0}, ptmp = {0};
+    vlf_sorter psort;
+    memset(&psort, 0, sizeof psort);
+    /* perturbed directions: sorted on `threads` threads beside the sweeps */
+    pert_pipe pp;
+    memset(&pp, 0, sizeof pp);
+    pert_worker *wk = NULL;
+    int pipe_ok = 0;
+    if (f->prm.perturbed > 0 && f->prm.threads > 1) {
+        pp.f = f;
+        pp.T = f->prm.threads < f->prm.perturbed ? f->prm.threads : f->prm.perturbed;
+        pp.P = f->prm.perturbed;
+        pp.slot = calloc(pp.P, sizeof *pp.slot);
+        pp.frame = calloc(pp.P, sizeof *pp.frame);
+        pp.ready = calloc(pp.P, 1);
+        wk = calloc(pp.T, sizeof *wk);
+        pipe_ok = pp.slot && pp.frame && pp.ready && wk && pthread_mutex_init(&pp.mu, NULL) == 0;
+        if (pipe_ok && pthread_cond_init(&pp.cv, NULL) != 0) {
+            pthread_mutex_destroy(&pp.mu);
+            pipe_ok = 0;
+        }
+        if (!pipe_ok) {
+            free(pp.slot), free(pp.frame), free(pp.ready), free(wk);
+            return -1;
+        }
+        pp.sync = 1;
+        for (uint32_t t = 0; t < pp.T; t++)
+            wk[t].pp = &pp, wk[t].t = t;
+    }
     for (uint32_t it = 0; it < f->prm.iterations; it++) {
         for (uint32_t i = 0; i < l; i++) {
             if (cancelled && cancelled(user)) {
-                free(pbuf.v);
+                pipe_free(&pp, wk);
+                free(pbuf.v), free(ptmp.v), vlf_sorter_free(&psort);
                 return -1;
             }
             for (uint32_t fi = 0; fi < f->face_count; fi++)
@@ -1019,21 +1645,38 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
                 }
             if (f->prm.perturbed == 0) {
                 sweep(f, i, +1, it == 0);
+                vlf_quantise(prec, f->E_next, f->elem_count);
                 sweep(f, i, -1, it == 0);
+                vlf_quantise(prec, f->E_next, f->elem_count);
+            } else if (pipe_ok) {
+                if (!perturbed_pipelined(f, i, it == 0, &pp, wk)) {
+                    pipe_free(&pp, wk);
+                    free(pbuf.v), free(ptmp.v), vlf_sorter_free(&psort);
+                    return -1;
+                }
             } else {
                 for (uint32_t k = 0; k < f->prm.perturbed; k++) {
                     vlf_psf fr;
                     fr.n = perturbed_dir(f, i, k);
                     gi_onb(fr.n, &fr.u, &fr.v);
-                    if (!perturbed_list(f, &fr, &pbuf)) {
-                        free(pbuf.v);
+                    if (!perturbed_list(f, &fr, &pbuf, &ptmp, &psort)) {
+                        pipe_free(&pp, wk);
+                        free(pbuf.v), free(ptmp.v), vlf_sorter_free(&psort);
                         return -1;
                     }
                     /* each sign's solid angle: the fixed direction's, shared */
                     sweep_perturbed(f, i, &fr, &pbuf, +1, f->dirs.solid_angle[i] / (float)f->prm.perturbed, it == 0);
+                    vlf_quantise(prec, f->E_next, f->elem_count);
                     sweep_perturbed(f, i, &fr, &pbuf, -1, f->dirs.solid_angle[i + l] / (float)f->prm.perturbed, it == 0);
+                    vlf_quantise(prec, f->E_next, f->elem_count);
                 }
             }
+            if (prec != VLF_PREC_32F)
+                for (uint32_t fi = 0; fi < f->face_count; fi++)
+                    if (f->faces[fi].nd >= 0) {
+                        const vlf_rect *r = &f->rects[(size_t)f->faces[fi].nd * l + i];
+                        vlf_quantise(prec, f->in + 3 * (size_t)r->offset, (size_t)r->w * r->h);
+                    }
             if (f->nd_count)
                 scatter(f, i);
         }
@@ -1048,8 +1691,13 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
             f->out_cur[k] = f->out_next[k];
             f->out_next[k] = 0.0f;
         }
+        /* the total and current maps are written in the storage format */
+        vlf_quantise(prec, f->E_tot, f->elem_count);
+        vlf_quantise(prec, f->L_cur, f->elem_count);
+        vlf_quantise(prec, f->out_tot, f->nd_cells);
     }
-    free(pbuf.v);
+    pipe_free(&pp, wk);
+    free(pbuf.v), free(ptmp.v), vlf_sorter_free(&psort);
     f->st.propagate_s = now_s() - t0;
     return 0;
 }
@@ -1077,5 +1725,10 @@ void vlf_field_free(vlf_field *f)
     free(f->out_next);
     free(f->out_tot);
     free(f->in);
+    free(f->sun);
+    free(f->punctual);
+    free(f->elem_c);
+    if (f->rt)
+        gi_rt_free(f->rt);
     memset(f, 0, sizeof *f);
 }

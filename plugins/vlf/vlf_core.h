@@ -43,7 +43,35 @@ typedef struct vlf_params {
     uint32_t iterations; /* shooting iterations */
     uint32_t perturbed;  /* perturbed virtual directions per fixed direction for transport (0: the fixed one, §3.5) */
     uint32_t seed;
+    uint32_t order;      /* depth order of a subfield (§3.2): VLF_ORDER_FACES, _RAYS or _PLAIN */
+    uint32_t threads;    /* CPU threads building the subfields (the result is the same for any count) */
+    uint32_t bsp_levels; /* BSP cuts orthogonal to the direction, levels (paper: 2) */
+    uint32_t bsp_min;    /* a list is cut only with at least this many faces (paper: 4K) */
+    uint32_t precision;  /* storage format of the ir/radiance maps: VLF_PREC_32F, _16F or _RGB9E5 */
+    uint32_t subdivide;  /* each scene triangle cut into subdivide^2 for sorting and transport (tessellation sweep) */
 } vlf_params;
+
+/* Storage formats of the light-field maps (§3.1, §6): three float32 (12
+ * bytes a value), RGBA16F (the paper's 64-bit format: three halves and an
+ * unused alpha, 8 bytes) and the shared-exponent RGB9E5 (4 bytes, the
+ * format the paper proposes to halve memory). */
+enum { VLF_PREC_32F = 0, VLF_PREC_16F = 1, VLF_PREC_RGB9E5 = 2 };
+
+/* Bytes of one stored ir/radiance value in format prec. */
+size_t vlf_precision_bytes(uint32_t prec);
+/* Packs count RGB triplets (non-negative) into count * vlf_precision_bytes
+ * bytes at out (16F: halves r, g, b, 0; RGB9E5: as GL_RGB9_E5), and back. */
+void vlf_pack(uint32_t prec, const float *rgb, size_t count, void *out);
+void vlf_unpack(uint32_t prec, const void *in, size_t count, float *rgb);
+/* Rounds count RGB triplets in place to what format prec stores. */
+void vlf_quantise(uint32_t prec, float *rgb, size_t count);
+
+/* The depth order of each subfield's rays: the paper's face order (Newell's
+ * painter's ordering with splitting and the BSP cut, vlf_sort.c), or each
+ * ray's fragments sorted by depth (a layered depth image); for the tests
+ * also the faces by nearest depth only and Newell's ordering without
+ * splitting (both wrong where faces overlap in a cycle). */
+enum { VLF_ORDER_FACES = 0, VLF_ORDER_RAYS = 1, VLF_ORDER_PLAIN = 2, VLF_ORDER_NOSPLIT = 3 };
 
 /* A rectangle of tiles of one non-diffuse face in one subfield. */
 typedef struct vlf_rect {
@@ -83,8 +111,21 @@ typedef struct vlf_stats {
     uint64_t samples;        /* fragments visited in propagation (the paper's "ray intersections") */
     size_t bytes_propagate;  /* storage while propagating */
     size_t bytes_render;     /* storage kept for rendering */
+    size_t bytes_maps_render;/* of it the total maps (diffuse atlas and tiles) in the storage format */
     uint32_t diffuse_elements, nondiffuse_elements, tiles;
+    uint64_t sort_pieces;    /* faces (triangles and their pieces) placed, over all subfields */
+    uint64_t sort_splits;    /* pieces split to break a cycle of overlaps, over all subfields */
+    uint64_t sort_bsp_cuts;  /* pieces cut by a BSP plane, over all subfields */
+    uint64_t sort_unresolved;/* cycles left unbroken (split limit), over all subfields */
+    uint64_t sort_tests;     /* pairs of faces tested by Newell's ordering */
 } vlf_stats;
+
+/* A point or spot light (world space): its first shot is by shadow rays. */
+typedef struct vlf_punctual {
+    int spot;
+    gi_vec3 pos, dir;
+    float I[3], range, cos_inner, cos_outer;
+} vlf_punctual;
 
 typedef struct vlf_field {
     vlf_params prm;
@@ -93,8 +134,9 @@ typedef struct vlf_field {
     float radius;            /* world = centre + radius * vlf */
     uint32_t face_count, elem_count, nd_count;
     vlf_face *faces;
-    uint32_t tri_count;
-    uint32_t *tri_face;      /* face of each scene triangle */
+    uint32_t tri_count;      /* triangles sorted and rasterised: scene triangles x subdivide^2 */
+    uint32_t tri_sub;        /* subdivide^2: triangle k is part of scene triangle k / tri_sub */
+    uint32_t *tri_face;      /* face of each triangle */
     gi_vec3 *tri_p;          /* 3 corners per triangle, VLF coordinates */
     uint32_t *elem_face;
     float *elem_area;
@@ -106,6 +148,12 @@ typedef struct vlf_field {
     float *E_tot, *E_next, *L_cur;       /* elem_count * 3: irradiance, unshot diffuse radiance */
     float *out_cur, *out_next, *out_tot, *in; /* nd_cells * 3 */
     const struct gi_envmap *env;
+    struct vlf_punctual *punctual; /* point and spot lights, world space */
+    uint32_t punctual_count;
+    struct gi_rt *rt;        /* the scene for their shadow rays (NULL without them) */
+    float *elem_c;           /* 2 per element: centroid of its part on the face, chart texels */
+    float *sun;              /* 2l x RGB: radiance the directional lights put into each signed direction's interface */
+    uint32_t sun_count;      /* directional lights of the scene */
     vlf_stats st;
 } vlf_field;
 

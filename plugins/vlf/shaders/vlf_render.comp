@@ -13,8 +13,10 @@ struct VlfFace { vec4 origin; vec4 t; vec4 b; uvec4 info; }; // chart origin, ax
 struct VlfRect { ivec4 r; uvec4 o; }; // x0, y0, w, h; offset
 
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 0) readonly buffer VlfFaces { VlfFace vlf_faces[]; };
-layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 1) readonly buffer VlfIrr { vec4 vlf_E[]; }; // w: on the face
-layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 2) readonly buffer VlfOut { float vlf_out[]; };
+// the irradiance atlas in the storage format, then one float per element:
+// the part of the texel on its face
+layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 1) readonly buffer VlfIrr { uint vlf_E[]; };
+layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 2) readonly buffer VlfOut { uint vlf_out[]; }; // tiles, storage format
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 3) readonly buffer VlfRects { VlfRect vlf_rects[]; };
 // psf frames (u, v, n: 3 per fixed direction), then 3 rows of each
 // triangle's inverse, then the 2l signed directions
@@ -29,6 +31,30 @@ uniform float u_radius;
 uniform uint u_l;
 uniform uint u_N;
 uniform uint u_tri_count;
+uniform uint u_precision; // 0: three float32, 1: RGBA16F (4 halves), 2: RGB9E5
+uniform uint u_weight_offset; // first weight in vlf_E (uints)
+
+// A value of a map in the storage format (vlf_pack in vlf_core.c) from its
+// words: three float32, RGBA16F (two words) or RGB9E5 (one word).
+uint vlf_stride() { return u_precision == 1u ? 2u : u_precision == 2u ? 1u : 3u; }
+vec3 vlf_decode(uint w0, uint w1, uint w2)
+{
+    if (u_precision == 1u)
+        return vec3(unpackHalf2x16(w0), unpackHalf2x16(w1).x);
+    if (u_precision == 2u)
+        return vec3(w0 & 511u, (w0 >> 9u) & 511u, (w0 >> 18u) & 511u) * exp2(float(int(w0 >> 27u)) - 24.0);
+    return vec3(uintBitsToFloat(w0), uintBitsToFloat(w1), uintBitsToFloat(w2));
+}
+vec3 vlf_irr_at(uint i)
+{
+    uint k = i * vlf_stride(), n = vlf_stride() - 1u;
+    return vlf_decode(vlf_E[k], vlf_E[k + min(1u, n)], vlf_E[k + min(2u, n)]);
+}
+vec3 vlf_tile_at(uint i)
+{
+    uint k = i * vlf_stride(), n = vlf_stride() - 1u;
+    return vlf_decode(vlf_out[k], vlf_out[k + min(1u, n)], vlf_out[k + min(2u, n)]);
+}
 
 // Irradiance of face f at world point p: bilinear over the chart's texels
 // that lie on the face (the paper's texture filtering of the atlas).
@@ -45,9 +71,11 @@ vec3 vlf_irradiance(VlfFace f, vec3 p)
             ivec2 c = i0 + ivec2(dx, dy);
             if (any(lessThan(c, ivec2(0))) || any(greaterThanEqual(c, WH)))
                 continue;
-            vec4 E = vlf_E[f.info.z + uint(c.y * WH.x + c.x)];
+            uint e = f.info.z + uint(c.y * WH.x + c.x);
+            vec3 E = vlf_irr_at(e);
+            float on_face = uintBitsToFloat(vlf_E[u_weight_offset + e]);
             float w = (dx == 1 ? a.x : 1.0 - a.x) * (dy == 1 ? a.y : 1.0 - a.y) + 1e-3;
-            sum += w * E.w * vec4(E.rgb, 1.0);
+            sum += w * on_face * vec4(E, 1.0);
         }
     return sum.w > 0.0 ? sum.rgb / sum.w : vec3(0.0);
 }
@@ -108,7 +136,7 @@ void main()
                     if (c.x < 0 || c.y < 0 || c.x >= r.r.z || c.y >= r.r.w)
                         continue;
                     uint slot = r.o.x + uint(c.y * r.r.z + c.x);
-                    sum += alpha[j] * vec3(vlf_out[3u * slot], vlf_out[3u * slot + 1u], vlf_out[3u * slot + 2u]);
+                    sum += alpha[j] * vlf_tile_at(slot);
                     wsum += alpha[j];
                 }
                 if (wsum > 0.0)
