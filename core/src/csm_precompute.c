@@ -6,16 +6,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void timer(const gi_host *host, const char *name, int begin)
-{
-    if (!host)
-        return;
-    if (begin)
-        host->stage_begin(host, name);
-    else
-        host->stage_end(host, name);
-}
-
 gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc *d, gi_csm_data *out,
                             gi_error *err)
 {
@@ -58,26 +48,26 @@ gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc
         uint32_t count = N - first < batch ? N - first : batch;
         for (uint32_t k = 0; k < count; k++)
             d->view(d->ctx, first + k, &views[k]);
-        timer(host, render_stage, 1);
+        gi_host_stage(host, render_stage, 1);
         r = gi_depth_render(dr, gs, views, count, tex, 0, err);
-        timer(host, render_stage, 0);
+        gi_host_stage(host, render_stage, 0);
         if (r != GI_OK)
             goto done;
         for (uint32_t k = 0; k < count; k++) {
             const uint32_t q = first + k;
-            timer(host, render_stage, 1);
+            gi_host_stage(host, render_stage, 1);
             float *map = gi_depth_read_layer(tex, M, k);
-            timer(host, render_stage, 0);
+            gi_host_stage(host, render_stage, 0);
             if (!map) {
                 r = GI_ERR_OUT_OF_MEMORY;
                 snprintf(err->text, sizeof err->text, "%s: reading %s %u failed", who, what, q);
                 goto done;
             }
-            timer(host, "compress", 1);
+            gi_host_stage(host, "compress", 1);
             d->depths(d->ctx, q, &views[k], map, z1, z2);
             free(map);
             r = gi_csm_codec_add_map(enc[q % S], q / S, z1, z2, err);
-            timer(host, "compress", 0);
+            gi_host_stage(host, "compress", 0);
             if (r != GI_OK)
                 goto done;
         }
@@ -87,12 +77,12 @@ gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc
             host->progress(host, label, d->p0 + d->p1 * (float)(first + count) / (float)N);
         }
     }
-    timer(host, "compress", 1);
+    gi_host_stage(host, "compress", 1);
     for (uint32_t s = 0; s < S && r == GI_OK; s++) {
         r = gi_csm_codec_finish(enc[s], &out[s], err);
         enc[s] = NULL;
     }
-    timer(host, "compress", 0);
+    gi_host_stage(host, "compress", 0);
 done:
     for (uint32_t s = 0; s < S; s++) {
         gi_csm_codec_free(enc[s]);
