@@ -11,51 +11,21 @@
 #include <ImfPartType.h>
 #include <ImfStdIO.h>
 
-#include <cstdlib>
-#include <cstring>
-#include <exception>
-#include <new>
 #include <string>
 #include <vector>
 
 #include "gi/cache.h"
 #include "image_internal.h"
 
-namespace
-{
-
-/* OpenEXR messages may span lines; gi_error holds one line. */
-std::string one_line(std::string s)
-{
-    while (!s.empty() && (s.back() == '\n' || s.back() == '\r' || s.back() == ' '))
-        s.pop_back();
-    for (char &c : s)
-        if (c == '\n' || c == '\r')
-            c = ' ';
-    return s.empty() ? std::string("unknown OpenEXR error") : s;
-}
-
-template <typename Body> gi_result guarded(const char *path, const char *doing, gi_error *err, Body body)
-{
-    try {
-        return body();
-    } catch (const std::bad_alloc &) {
-        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
-    } catch (const std::exception &e) {
-        return gi_error_set(err, GI_ERR_IO, "%s: %s", path, one_line(e.what()).c_str());
-    } catch (...) {
-        return gi_error_set(err, GI_ERR_IO, "%s: unknown exception while %s", path, doing);
-    }
-}
-
-} // namespace
+using gi_image_detail::guarded;
+using gi_image_detail::guarded_read;
 
 extern "C" {
 
 gi_result gi_exr_write(const char *path, const gi_image *rgba, const gi_image *const *layers,
                        const char *const *names, uint32_t layer_count, gi_error *err)
 {
-    return guarded(path, "writing", err, [&]() -> gi_result {
+    return guarded(path, "writing", "OpenEXR", err, [&]() -> gi_result {
         Imf::Header header((int)rgba->width, (int)rgba->height);
         header.compression() = Imf::ZIP_COMPRESSION;
         Imf::FrameBuffer fb;
@@ -90,8 +60,7 @@ gi_result gi_exr_write(const char *path, const gi_image *rgba, const gi_image *c
 
 gi_result gi_exr_read_channels(const char *path, gi_channels *out, gi_error *err)
 {
-    std::memset(out, 0, sizeof *out);
-    gi_result r = guarded(path, "reading", err, [&]() -> gi_result {
+    return guarded_read(path, "OpenEXR", out, err, [&]() -> gi_result {
         Imf::InputFile file(path, 1);
         const Imf::Header &h = file.header();
         if (h.hasType() && Imf::isDeepData(h.type()))
@@ -102,11 +71,9 @@ gi_result gi_exr_read_channels(const char *path, gi_channels *out, gi_error *err
         int nc = 0;
         for (Imf::ChannelList::ConstIterator it = h.channels().begin(); it != h.channels().end(); ++it)
             nc++;
-        if (w <= 0 || hgt <= 0 || nc <= 0 || nc > 1024 ||
-            (uint64_t)w * (uint64_t)hgt > GI_IMAGE_FILE_MAX_PIXELS)
-            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                                "%s: unsupported image size %lldx%lld with %d channels", path,
-                                (long long)w, (long long)hgt, nc);
+        gi_result ok = gi_channels_check(path, w, hgt, nc, err);
+        if (ok != GI_OK)
+            return ok;
         /* Order: R, G, B, A first (as OpenImageIO lists them), then the rest
          * in the file's (alphabetical) order. */
         std::vector<std::string> order;
@@ -129,43 +96,17 @@ gi_result gi_exr_read_channels(const char *path, gi_channels *out, gi_error *err
         file.setFrameBuffer(fb);
         file.readPixels(dw.min.y, dw.max.y);
 
-        /* Place the data window inside the display window (they differ only
-         * in cropped EXRs); the data window alone when the display window is
-         * absurd. */
-        const int64_t fw0 = (int64_t)disp.max.x - disp.min.x + 1, fh0 = (int64_t)disp.max.y - disp.min.y + 1;
-        const bool use_full = fw0 > 0 && fh0 > 0 && (uint64_t)fw0 * (uint64_t)fh0 <= GI_IMAGE_FILE_MAX_PIXELS;
-        const int64_t fw = use_full ? fw0 : w, fh = use_full ? fh0 : hgt;
-        const int64_t ox = use_full ? (int64_t)dw.min.x - disp.min.x : 0;
-        const int64_t oy = use_full ? (int64_t)dw.min.y - disp.min.y : 0;
-        out->data = (float *)std::calloc((size_t)fw * fh * nc, sizeof(float));
-        out->names = (char **)std::calloc((size_t)nc, sizeof(char *));
-        if (!out->data || !out->names)
-            return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
-        out->width = (uint32_t)fw;
-        out->height = (uint32_t)fh;
-        out->count = nc;
-        for (int c = 0; c < nc; c++) {
-            out->names[c] = strdup(order[c].c_str());
-            if (!out->names[c])
-                return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
-        }
-        for (int64_t y = 0; y < hgt; y++) {
-            int64_t ty = y + oy;
-            if (ty < 0 || ty >= fh)
-                continue;
-            for (int64_t x = 0; x < w; x++) {
-                int64_t tx = x + ox;
-                if (tx < 0 || tx >= fw)
-                    continue;
-                std::memcpy(&out->data[((size_t)ty * fw + tx) * nc], &buf[((size_t)y * w + x) * nc],
-                            sizeof(float) * nc);
-            }
-        }
-        return GI_OK;
+        std::vector<const char *> names;
+        for (const std::string &n : order)
+            names.push_back(n.c_str());
+        const gi_channels_window win = {dw.min.x,
+                                        dw.min.y,
+                                        disp.min.x,
+                                        disp.min.y,
+                                        (int64_t)disp.max.x - disp.min.x + 1,
+                                        (int64_t)disp.max.y - disp.min.y + 1};
+        return gi_channels_place(path, buf.data(), w, hgt, nc, names.data(), &win, out, err);
     });
-    if (r != GI_OK)
-        gi_channels_release(out);
-    return r;
 }
 
 } // extern "C"

@@ -38,6 +38,49 @@ void gi_channels_release(gi_channels *c)
     memset(c, 0, sizeof *c);
 }
 
+gi_result gi_channels_check(const char *path, int64_t w, int64_t h, int nc, gi_error *err)
+{
+    if (w <= 0 || h <= 0 || nc <= 0 || nc > 1024 || (uint64_t)w * (uint64_t)h > GI_IMAGE_FILE_MAX_PIXELS)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: unsupported image size %lldx%lld with %d channels",
+                            path, (long long)w, (long long)h, nc);
+    return GI_OK;
+}
+
+gi_result gi_channels_place(const char *path, const float *buf, int64_t w, int64_t h, int nc,
+                            const char *const *names, const gi_channels_window *win, gi_channels *out,
+                            gi_error *err)
+{
+    const int use_full = win->full_w > 0 && win->full_h > 0 &&
+                         (uint64_t)win->full_w * (uint64_t)win->full_h <= GI_IMAGE_FILE_MAX_PIXELS;
+    const int64_t fw = use_full ? win->full_w : w, fh = use_full ? win->full_h : h;
+    const int64_t ox = use_full ? win->x - win->full_x : 0, oy = use_full ? win->y - win->full_y : 0;
+    out->data = calloc((size_t)fw * (size_t)fh * (size_t)nc, sizeof(float));
+    out->names = calloc((size_t)nc, sizeof(char *));
+    if (!out->data || !out->names)
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+    out->width = (uint32_t)fw;
+    out->height = (uint32_t)fh;
+    out->count = nc;
+    for (int c = 0; c < nc; c++) {
+        out->names[c] = strdup(names[c] ? names[c] : "");
+        if (!out->names[c])
+            return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+    }
+    for (int64_t y = 0; y < h; y++) {
+        int64_t ty = y + oy;
+        if (ty < 0 || ty >= fh)
+            continue;
+        for (int64_t x = 0; x < w; x++) {
+            int64_t tx = x + ox;
+            if (tx < 0 || tx >= fw)
+                continue;
+            memcpy(&out->data[((size_t)ty * (size_t)fw + (size_t)tx) * (size_t)nc],
+                   &buf[((size_t)y * (size_t)w + (size_t)x) * (size_t)nc], sizeof(float) * (size_t)nc);
+        }
+    }
+    return GI_OK;
+}
+
 static int image_ok(const gi_image *img)
 {
     return img && img->rgba && img->width > 0 && img->height > 0 &&

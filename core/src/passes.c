@@ -157,15 +157,19 @@ GLuint gi_depth_texture_create(const gi_depth_renderer *r, uint32_t layers)
     return t;
 }
 
+void gi_depth_cube_view(gi_vec3 eye, float znear, float zfar, int face, gi_depth_view *out)
+{
+    gi_mat4_cube_face_view(out->view, eye, face);
+    gi_mat4_perspective(out->proj, GI_PI * 0.5f, 1.0f, znear, zfar);
+    out->projection = GI_PROJ_PERSPECTIVE;
+    out->znear = znear;
+    out->zfar = zfar;
+}
+
 void gi_depth_cube_views(gi_vec3 eye, float znear, float zfar, gi_depth_view out[6])
 {
-    for (int f = 0; f < 6; f++) {
-        gi_mat4_cube_face_view(out[f].view, eye, f);
-        gi_mat4_perspective(out[f].proj, GI_PI * 0.5f, 1.0f, znear, zfar);
-        out[f].projection = GI_PROJ_PERSPECTIVE;
-        out[f].znear = znear;
-        out[f].zfar = zfar;
-    }
+    for (int f = 0; f < 6; f++)
+        gi_depth_cube_view(eye, znear, zfar, f, &out[f]);
 }
 
 gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi_depth_view *views, uint32_t count,

@@ -112,9 +112,10 @@ typedef struct csm_encode_desc {
     const char *what;
 } csm_encode_desc;
 
-/* The precomputation loop shared by the distant maps and the local lights'
- * cube maps: render, read back, compress (§3.1). Progress, stage timers
- * (depth_render, compress) and cancellation as csm_build_object. */
+/* The distant maps and the local lights' cube maps through the core's
+ * precomputation loop (gi/csm_precompute.h): render, read back, compress
+ * (§3.1). Progress, stage timers (depth_render, compress) and cancellation
+ * as csm_build_object. */
 gi_result csm_encode_maps(const gi_gpu_scene *gs, const csm_encode_desc *desc, const gi_host *host, float p0, float p1,
                           gi_csm_data *out, gi_error *err);
 

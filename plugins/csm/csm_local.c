@@ -163,11 +163,7 @@ static void local_view(void *ctx, uint32_t q, gi_depth_view *out)
     /* everything of the object lies within |eye - c| + R */
     float dist = gi_v3_length(gi_v3_sub(eye, lv->c));
     float zfar = 1.05f * (dist + lv->R) + 1e-6f, znear = 1e-4f * (dist + lv->R);
-    gi_mat4_cube_face_view(out->view, eye, (int)face);
-    gi_mat4_perspective(out->proj, GI_PI * 0.5f, 1.0f, znear, zfar);
-    out->projection = GI_PROJ_PERSPECTIVE;
-    out->znear = znear;
-    out->zfar = zfar;
+    gi_depth_cube_view(eye, znear, zfar, (int)face, out);
 }
 
 gi_result csm_build_local(const gi_gpu_scene *gs, uint32_t object, const float sphere[4], const csm_local_desc *desc,

@@ -1,104 +1,71 @@
 /* Precomputation of one object's Coherent Shadow Map (§3.1, §4.1): the
  * N_theta x N_phi orthographic dual-depth maps around its bounding sphere,
- * rendered in batches by the core's depth renderer (object-local, only this
- * object, eye-z), read back and streamed into the core's codec in the
- * chosen enumeration order. */
+ * rendered by the core's precomputation loop (gi/csm_precompute.h: depth
+ * renderer object-local, only this object, eye-z; read back and streamed
+ * into the codec) in the chosen enumeration order. */
 #include "csm_cpu.h"
+
+#include "gi/csm_precompute.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-static void timer(const gi_host *host, const char *name, int begin)
+/* The depth option of the maps (csm_texel_depths), for gi_csm_precompute. */
+typedef struct encode_depths {
+    const csm_encode_desc *desc;
+    float *far; /* M x M, CSM_DEPTH_SPHERE only */
+} encode_depths;
+
+static void encode_view(void *ctx, uint32_t q, gi_depth_view *out)
 {
-    if (!host)
-        return;
-    if (begin)
-        host->stage_begin(host, name);
-    else
-        host->stage_end(host, name);
+    const encode_depths *e = ctx;
+    e->desc->view(e->desc->ctx, q, out);
+}
+
+static void encode_texel_depths(void *ctx, uint32_t q, const gi_depth_view *v, const float *map, float *z1, float *z2)
+{
+    (void)q;
+    const encode_depths *e = ctx;
+    const csm_encode_desc *desc = e->desc;
+    /* depth option and open surfaces: csm_texel_depths (csm_cpu.h) */
+    if (e->far)
+        csm_sphere_far(v, desc->metric, desc->sphere, desc->M, e->far);
+    csm_texel_depths(map, (size_t)desc->M * desc->M, desc->z3, desc->shell, e->far, z1, z2);
 }
 
 gi_result csm_encode_maps(const gi_gpu_scene *gs, const csm_encode_desc *desc, const gi_host *host, float p0, float p1,
                           gi_csm_data *out, gi_error *err)
 {
     memset(out, 0, sizeof *out);
-    const uint32_t M = desc->M, N = desc->count;
-    const uint32_t batch = desc->batch ? desc->batch : 16;
-    gi_depth_desc dd = {.size = M,
-                        .surfaces = desc->z3 ? 3u : 2u,
-                        .metric = desc->metric,
-                        .only_object = desc->object + 1u,
-                        .local = 1,
-                        .cull = 0};
-    gi_depth_renderer *dr = gi_depth_renderer_create(&dd, err);
-    if (!dr)
-        return GI_ERR_GL;
-    GLuint tex = gi_depth_texture_create(dr, batch);
-    gi_depth_view *views = calloc(batch, sizeof *views);
-    float *z1 = malloc((size_t)M * M * sizeof *z1), *z2 = malloc((size_t)M * M * sizeof *z2);
-    float *far = desc->z3 == CSM_DEPTH_SPHERE ? malloc((size_t)M * M * sizeof *far) : NULL;
-    gi_csm_codec *enc = NULL;
-    gi_result r = GI_ERR_OUT_OF_MEMORY;
-    if (!views || !z1 || !z2 || (desc->z3 == CSM_DEPTH_SPHERE && (!far || !desc->sphere))) {
-        snprintf(err->text, sizeof err->text, "csm: out of memory for %u x %u %s", M, M, desc->what);
-        goto done;
-    }
-    r = gi_csm_codec_begin(M, N, &enc, err);
-    if (r != GI_OK)
-        goto done;
-    for (uint32_t first = 0; first < N; first += batch) {
-        if (host && host->cancelled(host)) {
-            r = GI_ERR_CANCELLED;
-            snprintf(err->text, sizeof err->text, "csm: precomputation cancelled");
-            goto done;
-        }
-        uint32_t count = N - first < batch ? N - first : batch;
-        for (uint32_t k = 0; k < count; k++)
-            desc->view(desc->ctx, first + k, &views[k]);
-        timer(host, "depth_render", 1);
-        r = gi_depth_render(dr, gs, views, count, tex, 0, err);
-        timer(host, "depth_render", 0);
-        if (r != GI_OK)
-            goto done;
-        for (uint32_t k = 0; k < count; k++) {
-            timer(host, "depth_render", 1);
-            float *map = gi_depth_read_layer(tex, M, k);
-            timer(host, "depth_render", 0);
-            if (!map) {
-                r = GI_ERR_OUT_OF_MEMORY;
-                snprintf(err->text, sizeof err->text, "csm: reading %s %u failed", desc->what, first + k);
-                goto done;
-            }
-            timer(host, "compress", 1);
-            /* depth option and open surfaces: csm_texel_depths (csm_cpu.h) */
-            if (far)
-                csm_sphere_far(&views[k], desc->metric, desc->sphere, M, far);
-            csm_texel_depths(map, (size_t)M * M, desc->z3, desc->shell, far, z1, z2);
-            free(map);
-            r = gi_csm_codec_add_map(enc, first + k, z1, z2, err);
-            timer(host, "compress", 0);
-            if (r != GI_OK)
-                goto done;
-        }
-        if (host) {
-            char label[96];
-            snprintf(label, sizeof label, "csm: %s", desc->what);
-            host->progress(host, label, p0 + p1 * (float)(first + count) / (float)N);
+    const uint32_t M = desc->M;
+    encode_depths e = {desc, NULL};
+    if (desc->z3 == CSM_DEPTH_SPHERE) {
+        e.far = desc->sphere ? malloc((size_t)M * M * sizeof *e.far) : NULL;
+        if (!e.far) {
+            snprintf(err->text, sizeof err->text, "csm: out of memory for %u x %u %s", M, M, desc->what);
+            return GI_ERR_OUT_OF_MEMORY;
         }
     }
-    timer(host, "compress", 1);
-    r = gi_csm_codec_finish(enc, out, err);
-    timer(host, "compress", 0);
-    enc = NULL;
-done:
-    gi_csm_codec_free(enc);
-    free(views);
-    free(z1);
-    free(z2);
-    free(far);
-    glDeleteTextures(1, &tex);
-    gi_depth_renderer_free(dr);
+    gi_csm_precompute_desc d = {.depth = {.size = M,
+                                          .surfaces = desc->z3 ? 3u : 2u,
+                                          .metric = desc->metric,
+                                          .only_object = desc->object + 1u,
+                                          .local = 1,
+                                          .cull = 0},
+                                .count = desc->count,
+                                .streams = 1,
+                                .batch = desc->batch,
+                                .view = encode_view,
+                                .depths = encode_texel_depths,
+                                .ctx = &e,
+                                .host = host,
+                                .p0 = p0,
+                                .p1 = p1,
+                                .who = "csm",
+                                .what = desc->what};
+    gi_result r = gi_csm_precompute(gs, &d, out, err);
+    free(e.far);
     return r;
 }
 

@@ -299,16 +299,6 @@ void cssm_gather(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps,
     }
 }
 
-static void stage(const gi_host *host, const char *name, int begin)
-{
-    if (!host)
-        return;
-    if (begin)
-        host->stage_begin(host, name);
-    else
-        host->stage_end(host, name);
-}
-
 /* One gather over every texel of the atlas from node radiance node_L. */
 static void gather_atlas(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps, const float *node_L,
                          const cssm_gather_opts *o, float *out, cssm_gather_stats *st)
@@ -344,7 +334,7 @@ gi_result cssm_solve(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *m
     memcpy(texel_L, Le, 3 * (size_t)N * sizeof *texel_L);
     if (bounces >= 1) {
         /* direct: the emitting texels gathered like any sender, plus the rest */
-        stage(host, "direct", 1);
+        gi_host_stage(host, "direct", 1);
         cssm_tree_pull(t, a, Le, nodes);
         gather_atlas(t, a, maps, nodes, o, Rk, st);
         if (direct)
@@ -352,13 +342,13 @@ gi_result cssm_solve(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *m
                 Rk[k] += direct[k];
         for (size_t k = 0; k < 3 * (size_t)N; k++)
             texel_L[k] += Rk[k];
-        stage(host, "direct", 0);
+        gi_host_stage(host, "direct", 0);
     }
     for (uint32_t b = 2; b <= bounces; b++) {
-        stage(host, "pull", 1);
+        gi_host_stage(host, "pull", 1);
         cssm_tree_pull(t, a, Rk, nodes);
-        stage(host, "pull", 0);
-        stage(host, "bounce", 1);
+        gi_host_stage(host, "pull", 0);
+        gi_host_stage(host, "bounce", 1);
         memset(Rn, 0, 3 * (size_t)N * sizeof *Rn);
         gather_atlas(t, a, maps, nodes, o, Rn, st);
         for (size_t k = 0; k < 3 * (size_t)N; k++)
@@ -366,11 +356,11 @@ gi_result cssm_solve(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *m
         float *sw = Rk;
         Rk = Rn;
         Rn = sw;
-        stage(host, "bounce", 0);
+        gi_host_stage(host, "bounce", 0);
     }
-    stage(host, "pull", 1);
+    gi_host_stage(host, "pull", 1);
     cssm_tree_pull(t, a, texel_L, node_L);
-    stage(host, "pull", 0);
+    gi_host_stage(host, "pull", 0);
     free(Le), free(Rk), free(Rn), free(nodes);
     return GI_OK;
 }

@@ -84,3 +84,83 @@ function(expect_refusal name regex rc err)
         set(failures ${f} PARENT_SCOPE)
     endif()
 endfunction()
+
+# diff_metric(<test image> <reference image> <key> <out var>): one number of
+# `gibench diff --json` (relmse, mean_lum_diff_pct, ...); a failing diff is
+# a failed set-up (FATAL_ERROR).
+function(diff_metric test ref key out_var)
+    execute_process(COMMAND ${GIB} diff ${test} ${ref} --json RESULT_VARIABLE rc OUTPUT_VARIABLE j)
+    if(NOT rc EQUAL 0)
+        message(FATAL_ERROR "gibench diff ${test} ${ref} failed (${rc})")
+    endif()
+    string(JSON v GET "${j}" ${key})
+    set(${out_var} ${v} PARENT_SCOPE)
+endfunction()
+
+# expect_beats_reference(<method> <scene file> LIMIT <relMSE> MEAN <pct> SPP <n> BOUNCES <n>
+#                        [TRIVIAL <relMSE>] [BLACK] [SIZE <WxH>] [METHOD_ARGS <args>...]
+#                        [DIRECT_ARGS <args>...]):
+# a method against the Embree reference (`gibench reference`, SPP samples,
+# BOUNCES bounces, one thread) at SIZE (default 32x32), beside the trivial
+# answers scored on the same reference: the unshadowed `direct` plugin
+# and, with BLACK, a black image (the reference times 0, by oiiotool).
+# The method's relMSE must be under LIMIT, each trivial answer's over
+# TRIVIAL (default LIMIT), and the method's image mean within MEAN % of
+# the reference's. METHOD_ARGS and DIRECT_ARGS go to the two renders.
+# Images: ${OUT}/<method>_{ref,vs_ref,direct,black}_<scene name>.exr.
+function(expect_beats_reference method scene)
+    cmake_parse_arguments(PARSE_ARGV 2 A "BLACK" "LIMIT;TRIVIAL;MEAN;SPP;BOUNCES;SIZE" "METHOD_ARGS;DIRECT_ARGS")
+    if(A_UNPARSED_ARGUMENTS OR NOT DEFINED A_LIMIT OR NOT DEFINED A_MEAN OR NOT DEFINED A_SPP
+       OR NOT DEFINED A_BOUNCES)
+        message(FATAL_ERROR "expect_beats_reference(${method} ${scene} ${ARGN}): LIMIT, MEAN, SPP and BOUNCES "
+                            "are required (left over: ${A_UNPARSED_ARGUMENTS})")
+    endif()
+    if(NOT DEFINED A_TRIVIAL)
+        set(A_TRIVIAL ${A_LIMIT})
+    endif()
+    if(NOT DEFINED A_SIZE)
+        set(A_SIZE 32x32)
+    endif()
+    get_filename_component(name ${scene} NAME_WE)
+    set(ref ${OUT}/${method}_ref_${name}.exr)
+    set(img ${OUT}/${method}_vs_ref_${name}.exr)
+    set(direct ${OUT}/${method}_direct_${name}.exr)
+    expect(0 "" reference --scene ${scene} --size ${A_SIZE} --spp ${A_SPP} --max-bounces ${A_BOUNCES} --threads 1
+           --out ${ref})
+    expect(0 "" render --scene ${scene} --method ${method} --size ${A_SIZE} ${A_METHOD_ARGS} --out ${img})
+    expect(0 "" render --scene ${scene} --method direct --size ${A_SIZE} ${A_DIRECT_ARGS} --out ${direct})
+    diff_metric(${img} ${ref} relmse m_relmse)
+    diff_metric(${img} ${ref} mean_lum_diff_pct m_mean)
+    diff_metric(${direct} ${ref} relmse direct_relmse)
+    diff_metric(${direct} ${ref} mean_lum_diff_pct direct_mean)
+    set(trivial "direct ${direct_relmse}")
+    set(status "${name}: ${method} relMSE ${m_relmse}, mean ${m_mean} %; unshadowed direct relMSE ${direct_relmse}, mean ${direct_mean} %")
+    set(trivial_fail FALSE)
+    if(NOT direct_relmse GREATER ${A_TRIVIAL})
+        set(trivial_fail TRUE)
+    endif()
+    if(A_BLACK)
+        set(black ${OUT}/${method}_black_${name}.exr)
+        execute_process(COMMAND oiiotool ${ref} --mulc 0,0,0,1 -o ${black} RESULT_VARIABLE rc)
+        if(NOT rc EQUAL 0)
+            message(FATAL_ERROR "oiiotool could not write the black image (${rc})")
+        endif()
+        diff_metric(${black} ${ref} relmse black_relmse)
+        string(APPEND trivial ", black ${black_relmse}")
+        string(APPEND status "; black ${black_relmse}")
+        if(NOT black_relmse GREATER ${A_TRIVIAL})
+            set(trivial_fail TRUE)
+        endif()
+    endif()
+    message(STATUS "${status}")
+    if(NOT m_relmse LESS ${A_LIMIT})
+        fail("${name}: ${method} relMSE ${m_relmse} not below ${A_LIMIT}")
+    endif()
+    if(trivial_fail)
+        fail("${name}: a trivial answer scores under ${A_TRIVIAL}: ${trivial}")
+    endif()
+    if(m_mean LESS -${A_MEAN} OR m_mean GREATER ${A_MEAN})
+        fail("${name}: ${method} image mean ${m_mean} % off the reference's by more than ${A_MEAN} %")
+    endif()
+    set(failures ${failures} PARENT_SCOPE)
+endfunction()

@@ -1,6 +1,7 @@
 /* Image files and statistics (image.h): exact EXR/PFM round trips, PNG
  * within one 8-bit step of the tonemapped value, EXR layers, the PFM byte
- * layout against the spec, atomic writes and error messages. */
+ * layout against the spec, atomic writes and error messages, cropped
+ * files placed in their display window (OpenEXR and OpenImageIO readers). */
 #define _POSIX_C_SOURCE 200809L /* mkdtemp */
 #include <dirent.h>
 #include <sys/stat.h>
@@ -292,6 +293,50 @@ static void test_stats(void)
     gi_image_free(NULL);
 }
 
+/* A cropped EXR (data window 12x10 at (5, 7) in a 32x24 display window)
+ * reads as the whole display window, the data in place and zeros around
+ * it; the same file as TIFF (written with the zeros by oiiotool) through
+ * the OpenImageIO module reads the same. The files come from tests/data/
+ * valid/images: gradient.exr = `oiiotool --pattern fill:topleft=1,0,0,1:
+ * topright=0,1,0,1:bottomleft=0,0,1,1:bottomright=1,1,1,1 32x24 4 -d float
+ * -o gradient.exr`, cropped.exr = `oiiotool gradient.exr --crop 12x10+5+7
+ * -o cropped.exr`, cropped.tif = `oiiotool cropped.exr -d float -o
+ * cropped.tif`. */
+static void test_cropped(void)
+{
+    gi_error err = {{0}};
+    gi_image *full = gi_image_read(GI_TEST_DATA "/valid/images/gradient.exr", &err);
+    CHECK_MSG(full != NULL, "%s", err.text);
+    gi_image *exr = gi_image_read(GI_TEST_DATA "/valid/images/cropped.exr", &err);
+    CHECK_MSG(exr != NULL, "%s", err.text);
+    gi_image *tif = gi_image_read(GI_TEST_DATA "/valid/images/cropped.tif", &err);
+    CHECK_MSG(tif != NULL, "%s", err.text);
+    if (!full || !exr || !tif)
+        goto done;
+    CHECK(full->width == 32 && full->height == 24);
+    CHECK(exr->width == 32 && exr->height == 24 && tif->width == 32 && tif->height == 24);
+    int inside_ok = 1, outside_ok = 1, tif_ok = 1;
+    for (uint32_t y = 0; y < 24; y++)
+        for (uint32_t x = 0; x < 32; x++)
+            for (int c = 0; c < 4; c++) {
+                size_t i = ((size_t)y * 32 + x) * 4 + (size_t)c;
+                int inside = x >= 5 && x < 17 && y >= 7 && y < 17;
+                if (inside)
+                    inside_ok &= exr->rgba[i] == full->rgba[i];
+                else
+                    outside_ok &= exr->rgba[i] == 0.0f;
+                tif_ok &= tif->rgba[i] == exr->rgba[i];
+            }
+    CHECK(inside_ok);
+    CHECK(outside_ok);
+    CHECK(tif_ok);
+    CHECK(exr->rgba[((size_t)7 * 32 + 5) * 4 + 3] == 1.0f);
+done:
+    gi_image_free(full);
+    gi_image_free(exr);
+    gi_image_free(tif);
+}
+
 int main(void)
 {
     char dir[1024];
@@ -302,6 +347,7 @@ int main(void)
     test_png(dir);
     test_layers(dir);
     test_atomic_and_errors(dir);
+    test_cropped();
     char cmd[1200];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
     if (gi_test_failed == 0 && system(cmd) != 0)

@@ -1,8 +1,8 @@
 /* Coherent Shadow Maps codec (Ritschel et al., EGSR 2007, §3.1 compression,
  * §3.2 query, §4.4 for the order of the maps): N dual-depth maps of M x M
  * texels, compressed losslessly per texel into piecewise-constant segments.
- * Used by the csm plugin; in core so that the CSSM plugin (cssm_hrc, not
- * written yet) can reuse it. No GPU code here.
+ * Used by the csm and cssm_hrc plugins (their precomputation loop is
+ * gi/csm_precompute.h). No GPU code here.
  *
  * Use:
  *   gi_csm_codec *enc;

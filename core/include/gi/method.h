@@ -163,6 +163,18 @@ struct gi_host {
     int gl_is_software;
 };
 
+/* host->stage_begin (begin != 0) or host->stage_end of stage `name`; nothing
+ * when host is NULL (precomputation code that tests run without a host). */
+static inline void gi_host_stage(const gi_host *host, const char *name, int begin)
+{
+    if (!host)
+        return;
+    if (begin)
+        host->stage_begin(host, name);
+    else
+        host->stage_end(host, name);
+}
+
 /* Sizes of the data structs a plugin reads or embeds, as its build saw
  * them (GI_ABI_LAYOUT fills it). */
 struct gi_abi_layout {

@@ -123,6 +123,8 @@ gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi
                           uint32_t count, GLuint array_tex, uint32_t first_layer, gi_error *err);
 /* Fills six views of a cube map at `eye` (90 degree perspective). */
 void gi_depth_cube_views(gi_vec3 eye, float znear, float zfar, gi_depth_view out[6]);
+/* Face `face` (GL order +X, -X, +Y, -Y, +Z, -Z) of those six views. */
+void gi_depth_cube_view(gi_vec3 eye, float znear, float zfar, int face, gi_depth_view *out);
 /* Reads layer `layer` of a depth array back (size*size*4 floats, row 0 at
  * the bottom), for tests and CPU-side compression. Caller frees. */
 float *gi_depth_read_layer(GLuint array_tex, uint32_t size, uint32_t layer);
