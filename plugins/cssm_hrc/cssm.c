@@ -69,9 +69,21 @@ gi_result cssm_maps_setup(const cssm_atlas *a, const uint32_t *order, uint32_t M
 gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order, uint32_t M,
                           const gi_host *host, cssm_maps *out, gi_error *err)
 {
+    return cssm_maps_build_ex(gs, a, order, M, NULL, host, out, err);
+}
+
+gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order, uint32_t M,
+                             const cssm_build_opts *opts, const gi_host *host, cssm_maps *out, gi_error *err)
+{
+    static const cssm_build_opts none = {0};
+    if (!opts)
+        opts = &none;
     gi_result r = cssm_maps_setup(a, order, M, out, err);
     if (r != GI_OK)
         return r;
+    if (opts->eye_from_world)
+        for (uint32_t i = 0; i < a->count; i++)
+            out->eye[i] = gi_mat4_point(opts->eye_from_world, out->eye[i]);
     const uint32_t N = a->count;
     gi_vec3 *corners = malloc(6 * (size_t)(M + 1) * (M + 1) * sizeof *corners);
     float *z1 = malloc((size_t)M * M * sizeof *z1), *z2 = malloc((size_t)M * M * sizeof *z2);
@@ -95,7 +107,13 @@ gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uin
                     gi_v3_add(fw, gi_v3_add(gi_v3_scale(s, sx), gi_v3_scale(t, sy)));
             }
     }
-    gi_depth_desc dd = {.size = M, .surfaces = 2, .metric = GI_DEPTH_RADIAL, .only_object = 0, .local = 0, .cull = 0};
+    gi_depth_desc dd = {.size = M,
+                        .surfaces = 2,
+                        .metric = GI_DEPTH_RADIAL,
+                        .only_object = opts->only_object,
+                        .local = opts->local,
+                        .cull = 0,
+                        .skip_object = opts->skip_object};
     dr = gi_depth_renderer_create(&dd, err);
     if (!dr) {
         r = GI_ERR_GL;
@@ -121,6 +139,10 @@ gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uin
             goto done;
         for (uint32_t k = 0; k < count; k++) {
             const cssm_texel *x = &a->texels[order[first + k]];
+            const int skipped = opts->dont_care && opts->dont_care[order[first + k]];
+            gi_vec3 xn = x->n;
+            if (opts->eye_from_world) /* the normal in the maps' space (rigid) */
+                xn = gi_v3_normalize(gi_mat4_dir(opts->eye_from_world, xn));
             for (int f = 0; f < 6; f++) {
                 timer(host, "cssm_render", 1);
                 float *map = gi_depth_read_layer(tex, M, 6 * k + (uint32_t)f);
@@ -131,9 +153,9 @@ gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uin
                     goto done;
                 }
                 timer(host, "compress", 1);
-                dont_care_mask(corners, M, x->n, f, mask);
+                dont_care_mask(corners, M, xn, f, mask);
                 for (uint32_t t = 0; t < M * M; t++) {
-                    if (mask[t]) { /* any value: an interval that never breaks a run */
+                    if (mask[t] || skipped) { /* any value: an interval that never breaks a run */
                         z1[t] = -FLT_MAX;
                         z2[t] = FLT_MAX;
                         out->dont_care++;
