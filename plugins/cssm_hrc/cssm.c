@@ -130,10 +130,15 @@ gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const 
             goto done;
         }
         uint32_t count = N - first < CSSM_BATCH ? N - first : CSSM_BATCH;
-        for (uint32_t k = 0; k < count; k++)
-            gi_depth_cube_views(out->eye[order[first + k]], out->znear, out->zfar, &views[6 * k]);
+        uint32_t slot[CSSM_BATCH], drawn = 0; /* texels whose maps are all "don't care" are not drawn */
+        for (uint32_t k = 0; k < count; k++) {
+            slot[k] = drawn;
+            if (opts->dont_care && opts->dont_care[order[first + k]])
+                continue;
+            gi_depth_cube_views(out->eye[order[first + k]], out->znear, out->zfar, &views[6 * drawn++]);
+        }
         timer(host, "cssm_render", 1);
-        r = gi_depth_render(dr, gs, views, 6 * count, tex, 0, err);
+        r = drawn ? gi_depth_render(dr, gs, views, 6 * drawn, tex, 0, err) : GI_OK;
         timer(host, "cssm_render", 0);
         if (r != GI_OK)
             goto done;
@@ -145,7 +150,8 @@ gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const 
                 xn = gi_v3_normalize(gi_mat4_dir(opts->eye_from_world, xn));
             for (int f = 0; f < 6; f++) {
                 timer(host, "cssm_render", 1);
-                float *map = gi_depth_read_layer(tex, M, 6 * k + (uint32_t)f);
+                float *map = skipped ? calloc(1, sizeof(float))
+                                     : gi_depth_read_layer(tex, M, 6 * slot[k] + (uint32_t)f);
                 timer(host, "cssm_render", 0);
                 if (!map) {
                     r = GI_ERR_OUT_OF_MEMORY;

@@ -181,9 +181,6 @@ typedef struct cssm_tree {
  * longest axis of the box until one texel is left. */
 gi_result cssm_tree_build(const cssm_atlas *a, cssm_tree *out, gi_error *err);
 void cssm_tree_free(cssm_tree *t);
-/* The nodes' spheres, centroids, normals, cones, areas and representatives
- * again from the texels (moved objects); the tree's shape stays. */
-void cssm_tree_refit(cssm_tree *t, const cssm_atlas *a);
 /* Pull (§4.1.1): per node the area-weighted mean of per-texel radiance
  * `texel_L` (3 floats a texel) into `node_L` (3 floats a node). */
 void cssm_tree_pull(const cssm_tree *t, const cssm_atlas *a, const float *texel_L, float *node_L);

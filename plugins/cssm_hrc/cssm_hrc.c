@@ -592,13 +592,21 @@ static gi_result cssm_update(void *inst, const gi_gpu_scene *gs, const gi_change
         if (c->motion.moving < 0)
             return gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED,
                                "cssm_hrc: an object moved that was not animated at prepare time");
-        /* §3.3: A's texels placed by T, the tree refitted, the atlas lit
-         * again; the CSSMs are not redone (D T^-1) */
+        /* §3.3: A's texels placed by T, the hierarchy made again over the
+         * moved texels (a median cut of a few thousand points: what a fresh
+         * prepare would make), the atlas lit again; the CSSMs and the CSM
+         * are not made again (D T^-1) */
         const gi_host *host = c->kit.host;
+        gi_error err;
         host->stage_begin(host, "motion");
         cssm_motion_place(&c->motion, gs->scene, gs->time, &c->atlas);
-        cssm_tree_refit(&c->tree, &c->atlas);
         host->stage_end(host, "motion");
+        host->stage_begin(host, "hierarchy");
+        cssm_tree_free(&c->tree);
+        gi_result r = cssm_tree_build(&c->atlas, &c->tree, &err);
+        host->stage_end(host, "hierarchy");
+        if (r != GI_OK)
+            return gi_kit_fail_with(&c->kit, r, &err);
         check_hulls(c, gs->scene, gs->time);
         moved = 1;
     }

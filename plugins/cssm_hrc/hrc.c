@@ -120,13 +120,6 @@ static void fix_skips(cssm_tree *t, int32_t node, int32_t skip)
     fix_skips(t, right, skip);
 }
 
-void cssm_tree_refit(cssm_tree *t, const cssm_atlas *a)
-{
-    float lo[3], hi[3];
-    for (uint32_t i = 0; i < t->count; i++)
-        node_fill(a, t, &t->nodes[i], lo, hi);
-}
-
 gi_result cssm_tree_build(const cssm_atlas *a, cssm_tree *out, gi_error *err)
 {
     memset(out, 0, sizeof *out);
