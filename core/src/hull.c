@@ -162,16 +162,15 @@ static dv3 place(const float m[16], gi_vec3 p)
               (double)m[2] * p.x + (double)m[6] * p.y + (double)m[10] * p.z + m[14]);
 }
 
-/* The placed vertex of h farthest along d. */
-static dv3 support(const gi_hull *h, const float m[16], dv3 d)
+/* The point of p[0 .. n) farthest along d. */
+static dv3 support(const dv3 *p, uint32_t n, dv3 d)
 {
-    dv3 best = place(m, h->vertices[0]);
+    dv3 best = p[0];
     double bd = ddot(best, d);
-    for (uint32_t i = 1; i < h->vertex_count; i++) {
-        dv3 p = place(m, h->vertices[i]);
-        double v = ddot(p, d);
+    for (uint32_t i = 1; i < n; i++) {
+        double v = ddot(p[i], d);
         if (v > bd)
-            bd = v, best = p;
+            bd = v, best = p[i];
     }
     return best;
 }
@@ -282,20 +281,19 @@ static dv3 closest_simplex(dv3 *w, int *n, int *inside)
     return bestp;
 }
 
-double gi_hull_distance(const gi_hull *a, const float ma[16], const gi_hull *b, const float mb[16])
+/* GJK on the placed vertex sets pa (na) and pb (nb). */
+static double gjk(const dv3 *pa, uint32_t na, const dv3 *pb, uint32_t nb)
 {
-    if (!a->vertex_count || !b->vertex_count)
-        return HUGE_VAL;
     dv3 w[4];
     int n = 0;
-    dv3 v = dsub(place(ma, a->vertices[0]), place(mb, b->vertices[0]));
+    dv3 v = dsub(pa[0], pb[0]);
     double scale = sqrt(ddot(v, v)) + 1e-30;
     w[n++] = v; /* v is a point of the difference: the first simplex */
     for (int iter = 0; iter < 128; iter++) {
         double vv = ddot(v, v);
         if (vv <= 1e-24 * scale * scale)
             return 0.0;
-        dv3 p = dsub(support(a, ma, dscale(v, -1.0)), support(b, mb, v));
+        dv3 p = dsub(support(pa, na, dscale(v, -1.0)), support(pb, nb, v));
         /* v.p is a lower bound of the distance times |v|; converged when
          * it meets |v|^2 */
         if (vv - ddot(v, p) <= 1e-12 * vv)
@@ -315,6 +313,23 @@ double gi_hull_distance(const gi_hull *a, const float ma[16], const gi_hull *b, 
         v = nv;
     }
     return sqrt(ddot(v, v));
+}
+
+double gi_hull_distance(const gi_hull *a, const float ma[16], const gi_hull *b, const float mb[16])
+{
+    if (!a->vertex_count || !b->vertex_count)
+        return HUGE_VAL;
+    dv3 *pa = malloc(((size_t)a->vertex_count + b->vertex_count) * sizeof *pa);
+    if (!pa) /* no memory: nothing can be told apart, so call it overlapping */
+        return 0.0;
+    dv3 *pb = pa + a->vertex_count;
+    for (uint32_t i = 0; i < a->vertex_count; i++)
+        pa[i] = place(ma, a->vertices[i]);
+    for (uint32_t i = 0; i < b->vertex_count; i++)
+        pb[i] = place(mb, b->vertices[i]);
+    double d = gjk(pa, a->vertex_count, pb, b->vertex_count);
+    free(pa);
+    return d;
 }
 
 int gi_hull_overlap(const gi_hull *a, const float ma[16], const gi_hull *b, const float mb[16], float margin)

@@ -495,7 +495,7 @@ static void check_hulls(cssm_hrc *c, const gi_scene *s, float t)
     host->stage_end(host, "hull");
     if (bad)
         host->log(host, GI_LOG_WARN,
-                  "cssm_hrc: t = %.3f s: %s; the visibility through the moving object is wrong there (Sec. 3.3)", t,
+                  "t = %.3f s: %s; the visibility through the moving object is wrong there (Sec. 3.3)", t,
                   c->motion.what);
 }
 

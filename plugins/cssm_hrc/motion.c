@@ -196,6 +196,13 @@ uint32_t cssm_motion_check(cssm_motion *m, const gi_scene *s, float t)
     S[0] = S[5] = S[10] = 1.0f - SHRINK;
     S[12] = SHRINK * c.x, S[13] = SHRINK * c.y, S[14] = SHRINK * c.z;
     gi_mat4_mul(TA, m->T, S);
+    /* the placed hull's box: triangles outside it need no GJK */
+    gi_vec3 lo = gi_v3(FLT_MAX, FLT_MAX, FLT_MAX), hi = gi_v3(-FLT_MAX, -FLT_MAX, -FLT_MAX);
+    for (uint32_t v = 0; v < ha->vertex_count; v++) {
+        gi_vec3 q = gi_mat4_point(TA, ha->vertices[v]);
+        lo = gi_v3(fminf(lo.x, q.x), fminf(lo.y, q.y), fminf(lo.z, q.z));
+        hi = gi_v3(fmaxf(hi.x, q.x), fmaxf(hi.y, q.y), fmaxf(hi.z, q.z));
+    }
     m->overlaps = m->intrusions = 0;
     m->what[0] = 0;
     for (uint32_t k = 0; k < s->object_count; k++) {
@@ -211,6 +218,10 @@ uint32_t cssm_motion_check(cssm_motion *m, const gi_scene *s, float t)
         for (uint32_t tri = ob->first_triangle; tri < ob->first_triangle + ob->triangle_count; tri++) {
             gi_vec3 p[3];
             gi_scene_triangle_world(s, tri, t, p);
+            if (fmaxf(p[0].x, fmaxf(p[1].x, p[2].x)) < lo.x || fminf(p[0].x, fminf(p[1].x, p[2].x)) > hi.x ||
+                fmaxf(p[0].y, fmaxf(p[1].y, p[2].y)) < lo.y || fminf(p[0].y, fminf(p[1].y, p[2].y)) > hi.y ||
+                fmaxf(p[0].z, fmaxf(p[1].z, p[2].z)) < lo.z || fminf(p[0].z, fminf(p[1].z, p[2].z)) > hi.z)
+                continue;
             gi_hull th = {.vertices = p, .vertex_count = 3};
             if (gi_hull_overlap(ha, TA, &th, NULL, 0.0f)) {
                 if (!m->intrusions)
