@@ -13,8 +13,9 @@
  *    oracle and a maximum cut size (§4.3, Fig. 10), pull, and the final
  *    gather per receiver point with a Phong bound (§4.4), jitter (§4.5) and
  *    clamping (hrc.c).
- * All of it is scene-wide and static (the scene at prepare time); see the
- * README for what the plugin does not do (moving objects, §3.3). */
+ * One moving rigid object (§3.3) is handled in motion.c: the maps of this
+ * file then see the static objects only (cssm_build_opts), and the moving
+ * object has its own CSSM and CSM in its frame. */
 #ifndef CSSM_H
 #define CSSM_H
 
