@@ -12,10 +12,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define EYE 2.0f     /* the eye sits EYE R from the centre */
-#define BATCH 16u    /* maps per gi_depth_render call */
+#define EYE 2.0f  /* the eye sits EYE R from the centre */
+#define BATCH 16u /* maps per gi_depth_render call */
 
-static void cell_basis(const gi_csm_distant *c, uint32_t a, uint32_t b, gi_vec3 *t, gi_vec3 *bb, gi_vec3 *d)
+static void cell_basis(const gi_csm_distant *c, uint32_t a, uint32_t b, gi_vec3 *t, gi_vec3 *bb,
+                       gi_vec3 *d)
 {
     float theta = GI_PI * ((float)b + 0.5f) / (float)c->n_theta;
     float phi = 2.0f * GI_PI * ((float)a + 0.5f) / (float)c->n_phi;
@@ -31,7 +32,8 @@ static void map_view(const gi_csm_distant *c, uint32_t q, gi_depth_view *out)
     gi_vec3 t, bb, d;
     cell_basis(c, a, b, &t, &bb, &d);
     const float R = c->sphere[3];
-    gi_vec3 eye = gi_v3_add(gi_v3(c->sphere[0], c->sphere[1], c->sphere[2]), gi_v3_scale(d, EYE * R));
+    gi_vec3 eye =
+        gi_v3_add(gi_v3(c->sphere[0], c->sphere[1], c->sphere[2]), gi_v3_scale(d, EYE * R));
     memset(out, 0, sizeof *out);
     float *m = out->view; /* column-major, rows t, b, d */
     m[0] = t.x, m[4] = t.y, m[8] = t.z, m[12] = -gi_v3_dot(t, eye);
@@ -50,14 +52,14 @@ void gi_csm_distant_free(gi_csm_distant *c)
     memset(c, 0, sizeof *c);
 }
 
-gi_result gi_csm_distant_build(const gi_gpu_scene *gs, uint32_t object, const gi_csm_distant_desc *desc,
-                               gi_csm_distant *out, gi_error *err)
+gi_result gi_csm_distant_build(const gi_gpu_scene *gs, uint32_t object,
+                               const gi_csm_distant_desc *desc, gi_csm_distant *out, gi_error *err)
 {
     memset(out, 0, sizeof *out);
     const gi_scene *s = gs->scene;
     if (object >= s->object_count) {
-        snprintf(err->text, sizeof err->text, "csm_distant: object %u out of range (%u objects)", object,
-                 s->object_count);
+        snprintf(err->text, sizeof err->text, "csm_distant: object %u out of range (%u objects)",
+                 object, s->object_count);
         return GI_ERR_INVALID_ARGUMENT;
     }
     const uint32_t M = desc && desc->M ? desc->M : 32u;
@@ -68,7 +70,8 @@ gi_result gi_csm_distant_build(const gi_gpu_scene *gs, uint32_t object, const gi
         out->sphere[3] = 1e-6f;
     const float shell = (desc && desc->shell > 0.0f ? desc->shell : 0.01f) * out->sphere[3];
     const uint32_t N = out->n_theta * out->n_phi;
-    gi_depth_desc dd = {.size = M, .surfaces = 2, .metric = GI_DEPTH_EYE_Z, .only_object = object + 1u, .local = 1};
+    gi_depth_desc dd = {
+        .size = M, .surfaces = 2, .metric = GI_DEPTH_EYE_Z, .only_object = object + 1u, .local = 1};
     gi_depth_renderer *dr = gi_depth_renderer_create(&dd, err);
     if (!dr)
         return GI_ERR_GL;
@@ -93,7 +96,8 @@ gi_result gi_csm_distant_build(const gi_gpu_scene *gs, uint32_t object, const gi
             float *map = gi_depth_read_layer(tex, M, k);
             if (!map) {
                 r = GI_ERR_OUT_OF_MEMORY;
-                snprintf(err->text, sizeof err->text, "csm_distant: reading map %u failed", first + k);
+                snprintf(err->text, sizeof err->text, "csm_distant: reading map %u failed",
+                         first + k);
                 break;
             }
             for (size_t t = 0; t < (size_t)M * M; t++) {
@@ -138,7 +142,8 @@ int gi_csm_distant_blocks(const gi_csm_distant *c, gi_vec3 p, gi_vec3 q, float b
     float theta = atan2f(sqrtf(w.x * w.x + w.z * w.z), w.y), phi = atan2f(w.z, w.x);
     if (phi < 0.0f)
         phi += 2.0f * GI_PI;
-    float u = phi * (0.5f * GI_INV_PI) * (float)c->n_phi - 0.5f, v = theta * GI_INV_PI * (float)c->n_theta - 0.5f;
+    float u = phi * (0.5f * GI_INV_PI) * (float)c->n_phi - 0.5f,
+          v = theta * GI_INV_PI * (float)c->n_theta - 0.5f;
     uint32_t a = (uint32_t)floorf(u + 0.5f) % c->n_phi;
     int bi = (int)floorf(v + 0.5f);
     uint32_t b = (uint32_t)(bi < 0 ? 0 : bi >= (int)c->n_theta ? (int)c->n_theta - 1 : bi);
@@ -155,14 +160,16 @@ int gi_csm_distant_blocks(const gi_csm_distant *c, gi_vec3 p, gi_vec3 q, float b
     if (!(fabsf(sx) < 1.0f && fabsf(sy) < 1.0f))
         return 0;
     const uint32_t M = c->data.M;
-    uint32_t tx = (uint32_t)((sx * 0.5f + 0.5f) * (float)M), ty = (uint32_t)((sy * 0.5f + 0.5f) * (float)M);
+    uint32_t tx = (uint32_t)((sx * 0.5f + 0.5f) * (float)M),
+             ty = (uint32_t)((sy * 0.5f + 0.5f) * (float)M);
     tx = tx >= M ? M - 1 : tx;
     ty = ty >= M ? M - 1 : ty;
     uint32_t i = gi_csm_order_index(GI_CSM_ORDER_SCANLINE, c->n_phi, c->n_theta, a, b);
     float z = gi_csm_lookup(&c->data, ty * M + tx, i);
     if (!(z < FLT_MAX))
         return 0;
-    float dp = EYE * R - gi_v3_dot(gi_v3_sub(p, centre), d), dq = EYE * R - gi_v3_dot(gi_v3_sub(q, centre), d);
+    float dp = EYE * R - gi_v3_dot(gi_v3_sub(p, centre), d),
+          dq = EYE * R - gi_v3_dot(gi_v3_sub(q, centre), d);
     float lo = fminf(dp, dq), hi = fmaxf(dp, dq);
     return lo + bias < z && z < hi - bias;
 }

@@ -114,11 +114,13 @@ gi_result gi_hull_build(const float *points, uint32_t count, gi_hull *out, gi_er
     }
     free(pts);
     if (rc == -1) {
-        snprintf(err->text, sizeof err->text, "hull: out of memory for the hull of %u points", count);
+        snprintf(err->text, sizeof err->text, "hull: out of memory for the hull of %u points",
+                 count);
         return GI_ERR_OUT_OF_MEMORY;
     }
     if (rc != 0) {
-        snprintf(err->text, sizeof err->text, "hull: qhull failed on %u points (exit code %d)", count, rc);
+        snprintf(err->text, sizeof err->text, "hull: qhull failed on %u points (exit code %d)",
+                 count, rc);
         return GI_ERR_INVALID_ARGUMENT;
     }
     return GI_OK;
@@ -147,11 +149,26 @@ static dv3 d3(double x, double y, double z)
     dv3 r = {x, y, z};
     return r;
 }
-static dv3 dsub(dv3 a, dv3 b) { return d3(a.x - b.x, a.y - b.y, a.z - b.z); }
-static dv3 dadd(dv3 a, dv3 b) { return d3(a.x + b.x, a.y + b.y, a.z + b.z); }
-static dv3 dscale(dv3 a, double s) { return d3(a.x * s, a.y * s, a.z * s); }
-static double ddot(dv3 a, dv3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static dv3 dcross(dv3 a, dv3 b) { return d3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x); }
+static dv3 dsub(dv3 a, dv3 b)
+{
+    return d3(a.x - b.x, a.y - b.y, a.z - b.z);
+}
+static dv3 dadd(dv3 a, dv3 b)
+{
+    return d3(a.x + b.x, a.y + b.y, a.z + b.z);
+}
+static dv3 dscale(dv3 a, double s)
+{
+    return d3(a.x * s, a.y * s, a.z * s);
+}
+static double ddot(dv3 a, dv3 b)
+{
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+static dv3 dcross(dv3 a, dv3 b)
+{
+    return d3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
 
 static dv3 place(const float m[16], gi_vec3 p)
 {
@@ -332,7 +349,8 @@ double gi_hull_distance(const gi_hull *a, const float ma[16], const gi_hull *b, 
     return d;
 }
 
-int gi_hull_overlap(const gi_hull *a, const float ma[16], const gi_hull *b, const float mb[16], float margin)
+int gi_hull_overlap(const gi_hull *a, const float ma[16], const gi_hull *b, const float mb[16],
+                    float margin)
 {
     double d = gi_hull_distance(a, ma, b, mb);
     /* touching within float precision of the placed coordinates counts */

@@ -9,7 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define SHRINK 1e-3f /* A's hull shrunk by this about its centroid: resting contact is no intrusion */
+#define SHRINK                                                                                     \
+    1e-3f /* A's hull shrunk by this about its centroid: resting contact is no intrusion */
 
 int32_t cssm_motion_find(const gi_scene *s, uint32_t *count)
 {
@@ -52,8 +53,8 @@ static float transform_scale(const float T[16])
     return cbrtf(fabsf(det));
 }
 
-gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, int32_t moving, cssm_motion *out,
-                           gi_error *err)
+gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, int32_t moving,
+                           cssm_motion *out, gi_error *err)
 {
     memset(out, 0, sizeof *out);
     out->moving = moving;
@@ -68,8 +69,9 @@ gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, int3
     out->obj_first = calloc(O + 1, sizeof *out->obj_first);
     out->obj_texels = calloc(N ? N : 1, sizeof *out->obj_texels);
     out->hulls = calloc(O, sizeof *out->hulls);
-    if (!out->on_moving || !out->on_static || !out->local_p || !out->local_n || !out->local_charts ||
-        !out->object_of || !out->obj_first || !out->obj_texels || !out->hulls) {
+    if (!out->on_moving || !out->on_static || !out->local_p || !out->local_n ||
+        !out->local_charts || !out->object_of || !out->obj_first || !out->obj_texels ||
+        !out->hulls) {
         cssm_motion_free(out);
         snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for the moving object");
         return GI_ERR_OUT_OF_MEMORY;
@@ -78,7 +80,8 @@ gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, int3
     gi_scene_object_transform(s, (uint32_t)moving, t, T0);
     if (!gi_mat4_invert(out->T0inv, T0)) {
         cssm_motion_free(out);
-        snprintf(err->text, sizeof err->text, "cssm_hrc: the moving object '%s' has a singular transform",
+        snprintf(err->text, sizeof err->text,
+                 "cssm_hrc: the moving object '%s' has a singular transform",
                  s->objects[moving].name ? s->objects[moving].name : "?");
         return GI_ERR_INVALID_ARGUMENT;
     }
@@ -132,7 +135,8 @@ gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, int3
         if (r != GI_OK) {
             char why[sizeof err->text];
             memcpy(why, err->text, sizeof why);
-            snprintf(err->text, sizeof err->text, "cssm_hrc: object '%.100s': %.300s", ob->name ? ob->name : "?", why);
+            snprintf(err->text, sizeof err->text, "cssm_hrc: object '%.100s': %.300s",
+                     ob->name ? ob->name : "?", why);
             cssm_motion_free(out);
             return r;
         }
@@ -140,8 +144,9 @@ gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, int3
     return GI_OK;
 }
 
-gi_result cssm_motion_build_maps(cssm_motion *m, const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order,
-                                 uint32_t M, const gi_host *host, gi_error *err)
+gi_result cssm_motion_build_maps(cssm_motion *m, const gi_gpu_scene *gs, const cssm_atlas *a,
+                                 const uint32_t *order, uint32_t M, const gi_host *host,
+                                 gi_error *err)
 {
     /* A alone, in its frame: the eyes of its texels taken there */
     cssm_build_opts o = {.only_object = (uint32_t)m->moving + 1u,
@@ -215,18 +220,24 @@ uint32_t cssm_motion_check(cssm_motion *m, const gi_scene *s, float t)
         m->overlaps++;
         /* the condition the look-ups need: no surface of k inside A's hull */
         const gi_object *ob = &s->objects[k];
-        for (uint32_t tri = ob->first_triangle; tri < ob->first_triangle + ob->triangle_count; tri++) {
+        for (uint32_t tri = ob->first_triangle; tri < ob->first_triangle + ob->triangle_count;
+             tri++) {
             gi_vec3 p[3];
             gi_scene_triangle_world(s, tri, t, p);
-            if (fmaxf(p[0].x, fmaxf(p[1].x, p[2].x)) < lo.x || fminf(p[0].x, fminf(p[1].x, p[2].x)) > hi.x ||
-                fmaxf(p[0].y, fmaxf(p[1].y, p[2].y)) < lo.y || fminf(p[0].y, fminf(p[1].y, p[2].y)) > hi.y ||
-                fmaxf(p[0].z, fmaxf(p[1].z, p[2].z)) < lo.z || fminf(p[0].z, fminf(p[1].z, p[2].z)) > hi.z)
+            if (fmaxf(p[0].x, fmaxf(p[1].x, p[2].x)) < lo.x ||
+                fminf(p[0].x, fminf(p[1].x, p[2].x)) > hi.x ||
+                fmaxf(p[0].y, fmaxf(p[1].y, p[2].y)) < lo.y ||
+                fminf(p[0].y, fminf(p[1].y, p[2].y)) > hi.y ||
+                fmaxf(p[0].z, fmaxf(p[1].z, p[2].z)) < lo.z ||
+                fminf(p[0].z, fminf(p[1].z, p[2].z)) > hi.z)
                 continue;
             gi_hull th = {.vertices = p, .vertex_count = 3};
             if (gi_hull_overlap(ha, TA, &th, NULL, 0.0f)) {
                 if (!m->intrusions)
-                    snprintf(m->what, sizeof m->what, "object '%s' reaches into the convex hull of the moving '%s'",
-                             ob->name ? ob->name : "?", s->objects[A].name ? s->objects[A].name : "?");
+                    snprintf(m->what, sizeof m->what,
+                             "object '%s' reaches into the convex hull of the moving '%s'",
+                             ob->name ? ob->name : "?",
+                             s->objects[A].name ? s->objects[A].name : "?");
                 m->intrusions++;
                 break;
             }
@@ -235,8 +246,8 @@ uint32_t cssm_motion_check(cssm_motion *m, const gi_scene *s, float t)
     return m->intrusions;
 }
 
-int32_t cssm_motion_proxy(const cssm_motion *m, const gi_scene *s, const cssm_atlas *a, uint32_t tri, gi_vec3 p,
-                          gi_vec3 n)
+int32_t cssm_motion_proxy(const cssm_motion *m, const gi_scene *s, const cssm_atlas *a,
+                          uint32_t tri, gi_vec3 p, gi_vec3 n)
 {
     if (tri >= s->triangle_count)
         return -1;
@@ -256,7 +267,8 @@ int32_t cssm_motion_proxy(const cssm_motion *m, const gi_scene *s, const cssm_at
     return best;
 }
 
-float cssm_visible_rc(const cssm_maps *maps, uint32_t j, const cssm_receiver *rc, float bias, int pcf)
+float cssm_visible_rc(const cssm_maps *maps, uint32_t j, const cssm_receiver *rc, float bias,
+                      int pcf)
 {
     const cssm_motion *m = maps->motion;
     if (!m)
@@ -278,7 +290,8 @@ float cssm_visible_rc(const cssm_maps *maps, uint32_t j, const cssm_receiver *rc
     if (v <= 0.0f)
         return v;
     gi_vec3 pj = gi_mat4_point(m->Tinv, maps->eye[j]), xl = gi_mat4_point(m->Tinv, rc->x);
-    if (rmov && r >= 0 && m->on_moving[r]) /* A between j and a receiver on A: the receiver's CSSM toward j */
+    if (rmov && r >= 0 &&
+        m->on_moving[r]) /* A between j and a receiver on A: the receiver's CSSM toward j */
         return v * cssm_visible(&m->self, (uint32_t)r, pj, lbias, pcf);
     /* A between two points outside its hull: A's CSM */
     return gi_csm_distant_blocks(&m->csm, pj, xl, lbias) ? 0.0f : v;

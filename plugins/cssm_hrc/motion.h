@@ -42,16 +42,17 @@ typedef struct cssm_motion {
     gi_vec3 *local_p, *local_n; /* per texel: position and normal in A's frame (A's texels) */
     cssm_chart *local_charts;   /* the atlas' charts in A's frame (A's charts) */
     uint32_t *object_of;        /* per texel: its object */
-    uint32_t *obj_first, *obj_texels; /* texels of object k: obj_texels[obj_first[k] .. obj_first[k + 1]) */
-    cssm_maps self;             /* A's CSSM, A's frame */
-    gi_csm_distant csm;         /* A's CSM, A's frame */
-    float T0inv[16];            /* A's local_from_world at prepare time */
-    float T[16], Tinv[16];      /* A's world_from_local and local_from_world now */
-    float scale;                /* A's transform's scale (world units per local unit) */
-    gi_hull *hulls;             /* per object, local frame */
+    uint32_t *obj_first,
+        *obj_texels;       /* texels of object k: obj_texels[obj_first[k] .. obj_first[k + 1]) */
+    cssm_maps self;        /* A's CSSM, A's frame */
+    gi_csm_distant csm;    /* A's CSM, A's frame */
+    float T0inv[16];       /* A's local_from_world at prepare time */
+    float T[16], Tinv[16]; /* A's world_from_local and local_from_world now */
+    float scale;           /* A's transform's scale (world units per local unit) */
+    gi_hull *hulls;        /* per object, local frame */
     uint32_t object_count;
     uint32_t overlaps, intrusions; /* the last check */
-    char what[160];             /* the last check in words (warning) */
+    char what[160];                /* the last check in words (warning) */
 } cssm_motion;
 
 /* The moving object of scene s: the one animated object, -1 when none;
@@ -60,11 +61,12 @@ int32_t cssm_motion_find(const gi_scene *s, uint32_t *count);
 
 /* Per-texel bookkeeping, A's frame at prepare time t, the hulls. The maps
  * (self, csm) are made by cssm_motion_build_maps. */
-gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, int32_t moving, cssm_motion *out,
-                           gi_error *err);
+gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, int32_t moving,
+                           cssm_motion *out, gi_error *err);
 /* A's CSSM and CSM (a GL context current). host may be NULL. */
-gi_result cssm_motion_build_maps(cssm_motion *m, const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order,
-                                 uint32_t M, const gi_host *host, gi_error *err);
+gi_result cssm_motion_build_maps(cssm_motion *m, const gi_gpu_scene *gs, const cssm_atlas *a,
+                                 const uint32_t *order, uint32_t M, const gi_host *host,
+                                 gi_error *err);
 void cssm_motion_free(cssm_motion *m);
 
 /* Places A at time t: its texels and charts in the atlas, T and T^-1. */
@@ -77,7 +79,7 @@ uint32_t cssm_motion_check(cssm_motion *m, const gi_scene *s, float t);
 /* The proxy texel of a surface point on triangle tri (a pixel): the
  * nearest texel of the triangle's object whose normal faces the same way,
  * -1 when none. */
-int32_t cssm_motion_proxy(const cssm_motion *m, const gi_scene *s, const cssm_atlas *a, uint32_t tri, gi_vec3 p,
-                          gi_vec3 n);
+int32_t cssm_motion_proxy(const cssm_motion *m, const gi_scene *s, const cssm_atlas *a,
+                          uint32_t tri, gi_vec3 p, gi_vec3 n);
 
 #endif

@@ -39,16 +39,16 @@ typedef struct gi_csm_distant_desc {
 } gi_csm_distant_desc;
 
 typedef struct gi_csm_distant {
-    gi_csm_data data;        /* maps in scanline order over (a along phi, b along theta) */
-    float sphere[4];         /* the object's local bounding sphere (gi_mesh_object_sphere) */
+    gi_csm_data data; /* maps in scanline order over (a along phi, b along theta) */
+    float sphere[4];  /* the object's local bounding sphere (gi_mesh_object_sphere) */
     uint32_t n_theta, n_phi;
 } gi_csm_distant;
 
 /* Renders (core depth renderer: this object only, object-local, eye-z, two
  * surfaces) and compresses the maps. GI_ERR_INVALID_ARGUMENT for an object
  * out of range; the depth renderer's and codec's errors. */
-gi_result gi_csm_distant_build(const gi_gpu_scene *gs, uint32_t object, const gi_csm_distant_desc *desc,
-                               gi_csm_distant *out, gi_error *err);
+gi_result gi_csm_distant_build(const gi_gpu_scene *gs, uint32_t object,
+                               const gi_csm_distant_desc *desc, gi_csm_distant *out, gi_error *err);
 void gi_csm_distant_free(gi_csm_distant *c);
 
 /* 1 when the object blocks the segment p-q (object-local points): the

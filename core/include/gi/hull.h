@@ -26,9 +26,9 @@ extern "C" {
 #endif
 
 typedef struct gi_hull {
-    gi_vec3 *vertices;    /* the hull's vertices (a subset of the input points) */
+    gi_vec3 *vertices; /* the hull's vertices (a subset of the input points) */
     uint32_t vertex_count;
-    float *planes;        /* 4 per face: unit outward normal n and offset d, n.x + d <= 0 inside */
+    float *planes; /* 4 per face: unit outward normal n and offset d, n.x + d <= 0 inside */
     uint32_t face_count;
 } gi_hull;
 
@@ -47,7 +47,8 @@ int gi_hull_contains(const gi_hull *h, gi_vec3 p, float margin);
  * come closer than `margin` (0: they intersect or touch), by GJK on the
  * Minkowski difference of the transformed vertices, in double precision.
  * Touching within the numbers' precision counts as overlapping. */
-int gi_hull_overlap(const gi_hull *a, const float ma[16], const gi_hull *b, const float mb[16], float margin);
+int gi_hull_overlap(const gi_hull *a, const float ma[16], const gi_hull *b, const float mb[16],
+                    float margin);
 
 /* Distance between the two placed hulls (0 when they overlap). */
 double gi_hull_distance(const gi_hull *a, const float ma[16], const gi_hull *b, const float mb[16]);
