@@ -544,7 +544,7 @@ static int part_motion(void)
         const float bias = 0.004f * a.diameter;
         const int pairs = 6000;
         int tried = 0, agree = 0, visible = 0, unmoved = 0, affected = 0, agree_aff = 0, vis_aff = 0;
-        int kinds[4] = {0, 0, 0, 0};
+        int kinds[4] = {0, 0, 0, 0}, kind_agree[4] = {0, 0, 0, 0}, kind_vis[4] = {0, 0, 0, 0};
         uint32_t rng = gi_rng_init(11, 0, 0x3a3u);
         int guard = 0;
         while (tried < pairs && guard++ < 4000000) {
@@ -585,6 +585,8 @@ static int part_motion(void)
             visible += truth;
             agree += v == truth;
             unmoved += before == truth;
+            kind_agree[kind] += v == truth;
+            kind_vis[kind] += truth;
             if (before != truth) {
                 affected++;
                 agree_aff += v == truth;
@@ -602,6 +604,18 @@ static int part_motion(void)
         printf("motion: on the %d pairs whose visibility the motion changed: %.2f %% (always-visible %.2f %%, "
                "never-visible %.2f %%, unmoved 0 %%)\n",
                affected, 100 * rate_aff, 100 * always_aff, 100 * (1.0 - always_aff));
+        static const char *const kind_name[4] = {"static-static", "bunny sender", "bunny receiver", "both on it"};
+        for (int k = 0; k < 4; k++) {
+            if (!kinds[k])
+                continue;
+            double rk = (double)kind_agree[k] / kinds[k], ak = (double)kind_vis[k] / kinds[k];
+            printf("motion: %-14s %5d pairs: %.2f %% (always-visible %.2f %%, never-visible %.2f %%)\n", kind_name[k],
+                   kinds[k], 100 * rk, 100 * ak, 100 * (1.0 - ak));
+            /* every case of the combination (motion.h) that the sample reaches often enough */
+            if (kinds[k] >= 200)
+                CHECK(rk >= fmax(ak, 1.0 - ak) + 0.10, "%s: agreement %.4f not 10 points above the best trivial answer",
+                      kind_name[k], rk);
+        }
         double trivial = fmax(fmax(always, never), stale);
         CHECK(tried == pairs, "only %d pairs found", tried);
         CHECK(rate >= 0.90, "agreement %.4f below 0.90", rate);
