@@ -290,9 +290,9 @@ float cssm_visible_rc(const cssm_maps *maps, uint32_t j, const cssm_receiver *rc
     if (v <= 0.0f)
         return v;
     gi_vec3 pj = gi_mat4_point(m->Tinv, maps->eye[j]), xl = gi_mat4_point(m->Tinv, rc->x);
-    if (rmov && r >= 0 &&
-        m->on_moving[r]) /* A between j and a receiver on A: the receiver's CSSM toward j */
+    if (rmov && rc->self >= 0) /* A between j and a texel of A: that texel's CSSM toward j */
         return v * cssm_visible(&m->self, (uint32_t)r, pj, lbias, pcf);
-    /* A between two points outside its hull: A's CSM */
+    /* A between j and a pixel on A, or between two points outside its
+     * hull: A's CSM */
     return gi_csm_distant_blocks(&m->csm, pj, xl, lbias) ? 0.0f : v;
 }

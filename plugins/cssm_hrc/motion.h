@@ -19,8 +19,9 @@
  *   j on A, x on S:  A's CSSM at j (T^-1 x) x the static CSSM of x's texel
  *                    (for a pixel: the nearest texel of its object, its
  *                    "proxy") toward j.
- *   j on S, x on A:  the static CSSM at j x A's CSSM of x's texel (proxy)
- *                    toward T^-1 j.
+ *   j on S, x on A:  the static CSSM at j x, for a texel x, A's CSSM at x
+ *                    toward T^-1 j; for a pixel, A's CSM on the segment
+ *                    T^-1 j - T^-1 x (j lies outside A's hull).
  *   j on S, x on S:  the static CSSM at j x not (A's CSM blocks j-x); both
  *                    ends lie outside A's hull.
  * The condition: no triangle of S inside A's convex hull (shrunk by 0.1 %
