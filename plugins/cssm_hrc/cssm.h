@@ -13,8 +13,9 @@
  *    oracle and a maximum cut size (§4.3, Fig. 10), pull, and the final
  *    gather per receiver point with a Phong bound (§4.4), jitter (§4.5) and
  *    clamping (hrc.c).
- * All of it is scene-wide and static (the scene at prepare time); see the
- * README for what the plugin does not do (moving objects, §3.3). */
+ * One moving rigid object (§3.3) is handled in motion.c: the maps of this
+ * file then see the static objects only (cssm_build_opts), and the moving
+ * object has its own CSSM and CSM in its frame. */
 #ifndef CSSM_H
 #define CSSM_H
 
@@ -22,6 +23,9 @@
 #include "gi/method.h"
 #include "gi/passes.h"
 #include "gi/vecmath.h"
+
+struct cssm_receiver;
+struct cssm_motion;
 
 /* ---------------------------------------------------------------- atlas */
 
@@ -107,7 +111,18 @@ typedef struct cssm_maps {
     float znear, zfar;
     uint64_t dont_care;   /* face texels in the negative half-space (stored as "any value") */
     uint64_t face_texels; /* 6 M^2 N */
+    const struct cssm_motion *motion; /* moving-object mode (§3.3, motion.c), NULL: one static scene */
 } cssm_maps;
+
+/* What the cube maps see (§3.3: per object a CSSM). Zero: every object, in
+ * world space (the static scene). */
+typedef struct cssm_build_opts {
+    uint32_t only_object;            /* k + 1: object k alone */
+    uint32_t skip_object;            /* k + 1: every object but k */
+    int local;                       /* 1: object-local geometry (with only_object) */
+    const float *eye_from_world;     /* maps the texels' eyes (world) into the maps' space; NULL: identity */
+    const unsigned char *dont_care;  /* per texel, 1: a map of "don't care" only (not queried, no segments) */
+} cssm_build_opts;
 
 /* Renders (core depth renderer: world space, every object, radial depth,
  * two surfaces) the depth cube map of every texel in order `order`
@@ -118,6 +133,9 @@ typedef struct cssm_maps {
  * cancellation. */
 gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order, uint32_t M,
                           const gi_host *host, cssm_maps *out, gi_error *err);
+/* The same with what the maps see chosen by opts (NULL: as above). */
+gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order, uint32_t M,
+                             const cssm_build_opts *opts, const gi_host *host, cssm_maps *out, gi_error *err);
 void cssm_maps_free(cssm_maps *m);
 /* What cssm_maps_build sets besides the compressed faces (sizes, seq, eye,
  * near and far planes): for data read back from the cache. */
@@ -133,6 +151,10 @@ uint64_t cssm_maps_segments(const cssm_maps *m);
  * world units; pcf: the 2 x 2 texels around the projection, bilinearly
  * weighted (the generalised PCF of the CSM, over texels of one face). */
 float cssm_visible(const cssm_maps *m, uint32_t j, gi_vec3 x, float bias, int pcf);
+
+/* The visibility of texel j from receiver rc: cssm_visible toward rc->x,
+ * or in moving-object mode the combination of §3.3 (motion.c). */
+float cssm_visible_rc(const cssm_maps *m, uint32_t j, const struct cssm_receiver *rc, float bias, int pcf);
 
 /* ------------------------------------------------------------ hierarchy */
 
@@ -169,6 +191,8 @@ void cssm_tree_pull(const cssm_tree *t, const cssm_atlas *a, const float *texel_
 typedef struct cssm_receiver {
     gi_vec3 x, n;
     int32_t self;        /* receiver texel (skipped), -1 for a pixel */
+    uint32_t proxy1;     /* moving-object mode, a pixel: 1 + a texel on its triangle (0: none) */
+    int moving;          /* moving-object mode, a pixel: it lies on the moving object */
     int glossy;          /* use ks, exponent, wo */
     float kd[3], ks[3], exponent;
     gi_vec3 wo;

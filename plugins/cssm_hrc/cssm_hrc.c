@@ -17,6 +17,7 @@
  * is llvmpipe here); the depth cube maps, shadow maps and G-buffer are
  * drawn by the core's GL passes. */
 #include "cssm.h"
+#include "motion.h"
 
 #include "gi/cache.h"
 #include "gi/cubemap.h"
@@ -63,6 +64,7 @@ typedef struct cssm_hrc {
     float *accum;     /* running average, 4 per pixel */
     float *gb[5];     /* G-buffer read-back: position, normal, albedo, phong, emission */
     uint32_t acc_w, acc_h;
+    cssm_motion motion; /* §3.3: one moving rigid object (motion.h); motion.moving < 0: static scene */
     int prepared;
 } cssm_hrc;
 
@@ -121,6 +123,7 @@ static gi_result cssm_create(const gi_host *host, const gi_params *params, void 
     c->mode = gi_params_enum(params, "mode");
     c->indirect = gi_params_enum(params, "indirect");
     c->mc_samples = gi_params_int(params, "mc_samples");
+    c->motion.moving = -1;
     *out = c;
     return GI_OK;
 }
@@ -155,6 +158,7 @@ static void release_prepared(cssm_hrc *c)
         c->cdf[i] = NULL;
     }
     release_shadows(c);
+    cssm_motion_free(&c->motion);
     c->prepared = 0;
 }
 
@@ -481,6 +485,43 @@ static gi_result load_or_build_maps(cssm_hrc *c, const gi_gpu_scene *gs, gi_erro
     return r;
 }
 
+/* Reports the hull check of §3.3 at time t: stats hull_overlap and
+ * hull_intrusion, and a warning when the look-ups are not valid. */
+static void check_hulls(cssm_hrc *c, const gi_scene *s, float t)
+{
+    const gi_host *host = c->kit.host;
+    host->stage_begin(host, "hull");
+    uint32_t bad = cssm_motion_check(&c->motion, s, t);
+    host->stage_end(host, "hull");
+    if (bad)
+        host->log(host, GI_LOG_WARN,
+                  "t = %.3f s: %s; the visibility through the moving object is wrong there (Sec. 3.3)", t,
+                  c->motion.what);
+}
+
+/* §3.3 with one moving object A: the static CSSM (the scene without A, A's
+ * texels "don't care"), A's own CSSM and CSM in its frame (motion.c). Not
+ * cached. */
+static gi_result build_moving(cssm_hrc *c, const gi_gpu_scene *gs, int32_t A, gi_error *err)
+{
+    const gi_host *host = c->kit.host;
+    gi_result r = cssm_motion_init(gs->scene, gs->time, &c->atlas, A, &c->motion, err);
+    if (r != GI_OK)
+        return r;
+    cssm_build_opts o = {.skip_object = (uint32_t)A + 1u, .dont_care = c->motion.on_moving};
+    r = cssm_maps_build_ex(gs, &c->atlas, c->order, (uint32_t)c->M, &o, host, &c->maps, err);
+    if (r == GI_OK)
+        r = cssm_motion_build_maps(&c->motion, gs, &c->atlas, c->order, (uint32_t)c->M, host, err);
+    if (r != GI_OK)
+        return r;
+    c->maps.motion = &c->motion;
+    host->stat(host, "cache_hit", 0.0);
+    host->stat(host, "moving_cssm_bytes", (double)cssm_maps_bytes(&c->motion.self));
+    host->stat(host, "moving_csm_bytes", (double)c->motion.csm.data.bytes_compressed);
+    check_hulls(c, gs->scene, gs->time);
+    return GI_OK;
+}
+
 static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
 {
     cssm_hrc *c = inst;
@@ -488,6 +529,15 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     gi_kit_prepare(&c->kit, gs);
     const gi_host *host = c->kit.host;
     gi_error err;
+    uint32_t moving = 0;
+    int32_t moving_obj = cssm_motion_find(gs->scene, &moving);
+    if (moving > 1)
+        return gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED,
+                           "cssm_hrc: %u objects of this scene move; moving objects (Sec. 3.3) are implemented for one "
+                           "moving rigid object",
+                           moving);
+    if (moving && gi_scene_deforms(gs->scene))
+        return gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED, "cssm_hrc: deforming objects are not supported");
     host->stage_begin(host, "atlas");
     gi_result r = cssm_atlas_build(gs->scene, gs->time, (uint32_t)c->R, c->traversal == 0, &c->atlas, &err);
     host->stage_end(host, "atlas");
@@ -503,7 +553,7 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     host->stage_end(host, "traversal");
     if (!c->order)
         return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the traversal");
-    r = load_or_build_maps(c, gs, &err);
+    r = moving ? build_moving(c, gs, moving_obj, &err) : load_or_build_maps(c, gs, &err);
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);
     uint64_t bc = cssm_maps_bytes(&c->maps), bu = cssm_maps_bytes_uncompressed(&c->maps);
@@ -535,11 +585,32 @@ static gi_result cssm_update(void *inst, const gi_gpu_scene *gs, const gi_change
     gi_kit_update(&c->kit, gs, changes);
     if (!c->prepared)
         return gi_kit_fail(&c->kit, GI_ERR_INVALID_ARGUMENT, "cssm_hrc: update before prepare");
-    if (changes->flags & (GI_CHANGED_TRANSFORMS | GI_CHANGED_VERTICES))
-        return gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED,
-                           "cssm_hrc: moving objects are not supported (the CSSM is precomputed for the scene at "
-                           "prepare time; Sec. 3.3 is not implemented)");
-    if (changes->flags & (GI_CHANGED_LIGHTS | GI_CHANGED_MATERIALS)) {
+    if (changes->flags & GI_CHANGED_VERTICES)
+        return gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED, "cssm_hrc: deforming objects are not supported");
+    int moved = 0;
+    if (changes->flags & GI_CHANGED_TRANSFORMS) {
+        if (c->motion.moving < 0)
+            return gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED,
+                               "cssm_hrc: an object moved that was not animated at prepare time");
+        /* §3.3: A's texels placed by T, the hierarchy made again over the
+         * moved texels (a median cut of a few thousand points: what a fresh
+         * prepare would make), the atlas lit again; the CSSMs and the CSM
+         * are not made again (D T^-1) */
+        const gi_host *host = c->kit.host;
+        gi_error err;
+        host->stage_begin(host, "motion");
+        cssm_motion_place(&c->motion, gs->scene, gs->time, &c->atlas);
+        host->stage_end(host, "motion");
+        host->stage_begin(host, "hierarchy");
+        cssm_tree_free(&c->tree);
+        gi_result r = cssm_tree_build(&c->atlas, &c->tree, &err);
+        host->stage_end(host, "hierarchy");
+        if (r != GI_OK)
+            return gi_kit_fail_with(&c->kit, r, &err);
+        check_hulls(c, gs->scene, gs->time);
+        moved = 1;
+    }
+    if (moved || (changes->flags & (GI_CHANGED_LIGHTS | GI_CHANGED_MATERIALS))) {
         gi_error err;
         if (changes->flags & GI_CHANGED_MATERIALS) {
             /* materials are read into the atlas texels */
@@ -578,7 +649,7 @@ static gi_result read_gbuffer(cssm_hrc *c, uint32_t w, uint32_t h)
         }
         glGetTextureImage(tex[i], 0, GL_RGBA, GL_FLOAT, (GLsizei)(n * sizeof(float)), c->gb[i]);
     }
-    if (c->mode == 1) {
+    if (c->mode == 1 || c->motion.moving >= 0) {
         if (c->acc_w != w || c->acc_h != h || !c->ids) {
             free(c->ids);
             c->ids = malloc(n * sizeof *c->ids);
@@ -660,6 +731,13 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
             if (pos[3] > 0.0f) {
                 gi_vec3 P = gi_v3(pos[0], pos[1], pos[2]), Nn = gi_v3_normalize(gi_v3(nor[0], nor[1], nor[2]));
                 cssm_receiver rc = {.x = offset(c, P, Nn), .n = Nn, .self = -1, .glossy = 1, .exponent = ph[3]};
+                if (c->motion.moving >= 0) { /* §3.3: the pixel's object and proxy texel */
+                    uint32_t tri = c->ids[4 * p + 2];
+                    int32_t proxy = cssm_motion_proxy(&c->motion, s, &c->atlas, tri, P, Nn);
+                    rc.proxy1 = proxy >= 0 ? (uint32_t)proxy + 1u : 0u;
+                    rc.moving = tri < s->triangle_count &&
+                                s->vertices[s->indices[3 * tri]].object == (uint32_t)c->motion.moving;
+                }
                 memcpy(rc.kd, alb, 3 * sizeof(float));
                 memcpy(rc.ks, ph, 3 * sizeof(float));
                 if (alb[3] > 0.5f) /* mirrors: their Phong lobe stands in (README) */
@@ -711,6 +789,10 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
     host->stage_end(host, "final_gather");
     glTextureSubImage2D(target->texture, 0, 0, 0, (GLsizei)w, (GLsizei)h, GL_RGBA, GL_FLOAT, c->accum);
     gi_kit_frame_end(kit);
+    if (c->motion.moving >= 0) {
+        host->stat(host, "hull_overlap", (double)c->motion.overlaps);
+        host->stat(host, "hull_intrusion", (double)c->motion.intrusions);
+    }
     if (st.receivers) {
         host->stat(host, "cut_size_pixels", (double)st.nodes / (double)st.receivers);
         host->stat(host, "clamped_share", (double)st.clamped / (double)st.nodes);
@@ -748,7 +830,7 @@ static const gi_method cssm_method = {
     .citation = "Ritschel, Grosch, Kautz, Seidel. Interactive Illumination with Coherent Surface Shadow Maps. GI 2008",
     .version = "0.1",
     .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_GLOSSY | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS |
-            GI_CAP_DIRECTIONAL | GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE | GI_CAP_PRECOMPUTE,
+            GI_CAP_DIRECTIONAL | GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE | GI_CAP_PRECOMPUTE | GI_CAP_RIGID_MOTION,
     .max_bounces = 3,
     .params = cssm_params,
     .create = cssm_create,

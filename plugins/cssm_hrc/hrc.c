@@ -35,16 +35,14 @@ static int cmp_axis(const void *x, const void *y)
     return i < j ? -1 : (i > j);
 }
 
-/* Builds the subtree over leaves[first, first + count) at node index *next;
- * returns its index. */
-static int32_t build(const cssm_atlas *a, cssm_tree *t, uint32_t first, uint32_t count, uint32_t *next)
+/* A node's bounds over its leaves [first, first + count): bounding sphere
+ * (grown by each texel's extent), area-weighted centroid and normal, normal
+ * cone, area, representative texel; lo / hi get the box. */
+static void node_fill(const cssm_atlas *a, const cssm_tree *t, cssm_node *nd, float lo[3], float hi[3])
 {
-    int32_t me = (int32_t)(*next)++;
-    cssm_node *nd = &t->nodes[me];
-    memset(nd, 0, sizeof *nd);
-    nd->first = first;
-    nd->count = count;
-    float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+    const uint32_t first = nd->first, count = nd->count;
+    for (int j = 0; j < 3; j++)
+        lo[j] = FLT_MAX, hi[j] = -FLT_MAX;
     gi_vec3 cen = gi_v3(0, 0, 0), nsum = gi_v3(0, 0, 0);
     double area = 0.0;
     for (uint32_t k = first; k < first + count; k++) {
@@ -73,6 +71,19 @@ static int32_t build(const cssm_atlas *a, cssm_tree *t, uint32_t first, uint32_t
     }
     nd->r = r;
     nd->cos_cone = nl > 1e-12f ? cmin : -1.0f;
+}
+
+/* Builds the subtree over leaves[first, first + count) at node index *next;
+ * returns its index. */
+static int32_t build(const cssm_atlas *a, cssm_tree *t, uint32_t first, uint32_t count, uint32_t *next)
+{
+    int32_t me = (int32_t)(*next)++;
+    cssm_node *nd = &t->nodes[me];
+    memset(nd, 0, sizeof *nd);
+    nd->first = first;
+    nd->count = count;
+    float lo[3], hi[3];
+    node_fill(a, t, nd, lo, hi);
     if (count == 1) {
         nd->child = -1;
         t->leaf_node[t->leaves[first]] = (uint32_t)me;
@@ -242,7 +253,7 @@ static void transfer(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *m
         if (st)
             st->clamped++;
     }
-    float v = maps ? cssm_visible(maps, vis_texel, rc->x, o->bias, o->pcf) : 1.0f;
+    float v = maps ? cssm_visible_rc(maps, vis_texel, rc, o->bias, o->pcf) : 1.0f;
     if (v <= 0.0f)
         return;
     float g = S->area * cr * cs / d2 * v;
@@ -410,7 +421,7 @@ void cssm_gather_mc(const cssm_atlas *a, const cssm_maps *maps, const float *tex
         if (cr <= 0.0f || cs <= 0.0f)
             continue;
         d2 = fmaxf(d2, o->clamp * o->clamp);
-        float v = maps ? cssm_visible(maps, lo, rc->x, o->bias, o->pcf) : 1.0f;
+        float v = maps ? cssm_visible_rc(maps, lo, rc, o->bias, o->pcf) : 1.0f;
         if (v <= 0.0f)
             continue;
         float g = (float)(x->area * cr * cs / d2 * v / (p * S));

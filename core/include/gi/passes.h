@@ -109,6 +109,7 @@ typedef struct gi_depth_desc {
     uint32_t only_object;   /* 0 = all objects; k + 1 = object k alone */
     int local;              /* 1: ignore object transforms (object-local maps); 0 = world */
     int cull;               /* 0 none, 1 back faces, 2 front faces */
+    uint32_t skip_object;   /* 0 = none; k + 1 = every object but k (with only_object 0) */
 } gi_depth_desc;
 
 typedef struct gi_depth_renderer gi_depth_renderer;
