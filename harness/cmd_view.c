@@ -814,6 +814,7 @@ static int loop(viewer *v)
             v->frames_since_event++;
         }
         if (v->method_index < 0) {
+            v->need_render = 0; /* the worker renders; the change went with view_changed */
             poll_reference(v);
             char err[GI_ERROR_MAX];
             view_ref_error(&v->ref, err, sizeof err);
