@@ -12,6 +12,7 @@
 #include "gi/image.h"
 #include "gi/log.h"
 #include "gi/timer.h"
+#include "gi/tonemap.h"
 #include "gi/vecmath.h"
 
 #define GLFW_INCLUDE_NONE
@@ -30,22 +31,49 @@ static const char display_vs[] = "#version 450 core\n"
                                  "    uv = p;\n"
                                  "    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);\n"
                                  "}\n";
-/* The display mapping of core/shaders/tonemap.glsl: exposure, clamp, sRGB. */
-static const char display_fs[] = "#version 450 core\n"
-                                 "in vec2 uv;\n"
-                                 "out vec4 color;\n"
-                                 "layout(binding = 0) uniform sampler2D img;\n"
-                                 "uniform float scale;\n"
-                                 "uniform int flip;\n"
-                                 "float enc(float x) {\n"
-                                 "    x = x > 0.0 ? min(x, 1.0) : 0.0;\n"
-                                 "    return x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055;\n"
-                                 "}\n"
-                                 "void main() {\n"
-                                 "    vec2 t = flip != 0 ? vec2(uv.x, 1.0 - uv.y) : uv;\n"
-                                 "    vec3 c = texture(img, t).rgb * scale;\n"
-                                 "    color = vec4(enc(c.r), enc(c.g), enc(c.b), 1.0);\n"
-                                 "}\n";
+/* The display mapping of core/shaders/tonemap.glsl (exposure, clamp,
+ * sRGB); in split view, right of the divider, the reference (`ref`, top
+ * row first) or the method's relative luminance error against it,
+ * |L - Lref| / (Lref + 0.01), on a log scale from 1e-3 (blue) to 1 (red). */
+static const char display_fs[] =
+    "#version 450 core\n"
+    "in vec2 uv;\n"
+    "out vec4 color;\n"
+    "layout(binding = 0) uniform sampler2D img;\n"
+    "layout(binding = 1) uniform sampler2D ref;\n"
+    "uniform float scale;\n"
+    "uniform int flip;\n"
+    "uniform int split;\n"
+    "uniform float divider;\n"
+    "uniform float pixel;\n"
+    "float enc(float x) {\n"
+    "    x = x > 0.0 ? min(x, 1.0) : 0.0;\n"
+    "    return x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055;\n"
+    "}\n"
+    "float lum(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }\n"
+    "vec3 ramp(float t) {\n"
+    "    t = clamp(t, 0.0, 1.0);\n"
+    "    return clamp(vec3(1.5 - abs(4.0 * t - 3.0), 1.5 - abs(4.0 * t - 2.0), 1.5 - abs(4.0 * t - 1.0)), 0.0, 1.0);\n"
+    "}\n"
+    "void main() {\n"
+    "    vec2 t = flip != 0 ? vec2(uv.x, 1.0 - uv.y) : uv;\n"
+    "    vec3 c = texture(img, t).rgb;\n"
+    "    if (split != 0 && abs(uv.x - divider) < pixel) {\n"
+    "        color = vec4(1.0);\n"
+    "        return;\n"
+    "    }\n"
+    "    if (split != 0 && uv.x > divider) {\n"
+    "        vec3 r = texture(ref, vec2(uv.x, 1.0 - uv.y)).rgb;\n"
+    "        if (split == 2) {\n"
+    "            float e = abs(lum(c) - lum(r)) / (lum(r) + 0.01);\n"
+    "            color = vec4(ramp((log(max(e, 1e-4)) / log(10.0) + 3.0) / 3.0), 1.0);\n"
+    "            return;\n"
+    "        }\n"
+    "        c = r;\n"
+    "    }\n"
+    "    c *= scale;\n"
+    "    color = vec4(enc(c.r), enc(c.g), enc(c.b), 1.0);\n"
+    "}\n";
 
 static GLuint compile(GLenum type, const char *src, char *why, size_t size)
 {
@@ -136,11 +164,23 @@ void view_changed(viewer *v)
     v->frame_index = 0;
     v->need_render = 1;
     v->need_display = 1;
-    if (v->method_index < 0) {
+    if (v->method_index < 0 || v->split) {
         gi_camera_frame cf = view_camera(v);
         view_ref_request(&v->ref, &cf, v->time, v->width, v->height, v->seed);
         v->ref_spp = 0;
+        const float black[4] = {0, 0, 0, 1};
+        glClearTexImage(v->ref_tex, 0, GL_RGBA, GL_FLOAT, black);
     }
+}
+
+/* The reference runs while it is shown (alone or in split view) and idles otherwise. */
+static void reference_as_needed(viewer *v)
+{
+    int need = v->method_index < 0 || v->split;
+    if (need && !view_ref_running(&v->ref))
+        view_changed(v);
+    else if (!need)
+        view_ref_pause(&v->ref);
 }
 
 /* ---- methods ---- */
@@ -165,14 +205,12 @@ static void unload_method(viewer *v)
 int view_select(viewer *v, int index)
 {
     unload_method(v);
-    view_ref_pause(&v->ref);
     v->method_index = index;
     v->frame_index = 0;
     v->need_render = v->need_display = 1;
-    if (index < 0) {
-        view_changed(v);
+    reference_as_needed(v);
+    if (index < 0)
         return EXIT_OK;
-    }
     gi_error err;
     v->m = v->reg->items[index].method;
     const char *const *kv = NULL;
@@ -262,6 +300,34 @@ static int set_time(viewer *v, float t)
 
 /* ---- display ---- */
 
+/* The window as shown (split view, divider and all) into a PNG: read back
+ * from the back buffer before the swap. */
+static void write_window(viewer *v, int fw, int fh)
+{
+    gi_image *img = fw > 0 && fh > 0 ? gi_image_create((uint32_t)fw, (uint32_t)fh) : NULL;
+    unsigned char *px = malloc((size_t)fw * (size_t)(fh > 0 ? fh : 0) * 4);
+    gi_error err;
+    if (!img || !px) {
+        v->exit_code = cli_fail(EXIT_RUN, "view: out of memory reading the window back");
+    } else {
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        glReadBuffer(GL_BACK);
+        glReadPixels(0, 0, fw, fh, GL_RGBA, GL_UNSIGNED_BYTE, px);
+        for (int y = 0; y < fh; y++) /* bottom row first -> top row first; sRGB -> linear */
+            for (int x = 0; x < fw; x++)
+                for (int c = 0; c < 4; c++) {
+                    float b = px[4 * ((size_t)(fh - 1 - y) * (size_t)fw + (size_t)x) + (size_t)c] / 255.0f;
+                    img->rgba[4 * ((size_t)y * (size_t)fw + (size_t)x) + (size_t)c] = c == 3 ? 1.0f : gi_srgb_decode(b);
+                }
+        if (gi_image_write(v->window_shot, img, NULL, &err) != GI_OK)
+            v->exit_code = cli_fail(EXIT_RUN, "view: %s", err.text);
+        else if (gi_log_get_level() >= GI_LOG_WARN)
+            printf("view: window %s\n", v->window_shot);
+    }
+    free(px);
+    gi_image_free(img);
+}
+
 static void display(viewer *v)
 {
     double t0 = gi_now();
@@ -280,12 +346,21 @@ static void display(viewer *v)
     glUniform1f(glGetUniformLocation(v->display_prog, "scale"), exp2f(v->exposure));
     int ref = v->method_index < 0;
     glUniform1i(glGetUniformLocation(v->display_prog, "flip"), ref); /* images are top row first */
+    glUniform1i(glGetUniformLocation(v->display_prog, "split"), ref ? 0 : v->split);
+    glUniform1f(glGetUniformLocation(v->display_prog, "divider"), v->divider);
+    glUniform1f(glGetUniformLocation(v->display_prog, "pixel"), fw > 0 ? 0.75f / (float)fw : 0.0f);
     glBindTextureUnit(0, ref ? v->ref_tex : v->target_tex);
+    glBindTextureUnit(1, v->ref_tex);
     glBindSampler(0, 0);
+    glBindSampler(1, 0);
     glBindVertexArray(v->display_vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);
     glUseProgram(0);
+    if (v->window_shot) {
+        write_window(v, fw, fh);
+        v->window_shot = NULL;
+    }
     glfwSwapBuffers(v->win);
     glFinish();
     v->display_ms = 1e3 * (gi_now() - t0);
@@ -298,8 +373,10 @@ static void display(viewer *v)
                  v->playing ? " playing" : "", v->display_ms);
     else
         snprintf(title, sizeof title,
-                 "gibench view | %s | %.1f ms/frame | frame %u | EV %+.1f | t %.2f%s | ui %.1f ms | %s%s%s",
-                 v->m ? v->m->id : "-", v->frame_ms, v->frame_index, (double)v->exposure, (double)v->time,
+                 "gibench view | %s%s | %.1f ms/frame | frame %u | EV %+.1f | t %.2f%s | ui %.1f ms | %s%s%s",
+                 v->m ? v->m->id : "-",
+                 v->split == 1 ? " | reference right" : v->split == 2 ? " | error right (log, 1e-3 blue .. 1 red)" : "",
+                 v->frame_ms, v->frame_index, (double)v->exposure, (double)v->time,
                  v->playing ? " playing" : "", v->display_ms, gi_gpu_renderer(v->gpu), v->status[0] ? " | " : "",
                  v->status);
     glfwSetWindowTitle(v->win, title);
@@ -448,6 +525,10 @@ int view_key(viewer *v, int key, int mods)
             return view_select(v, v->last_method < 0 ? 0 : v->last_method);
         v->last_method = v->method_index;
         return view_select(v, -1);
+    case GLFW_KEY_X:
+        v->split = (v->split + 1) % 3;
+        reference_as_needed(v);
+        return EXIT_OK;
     case GLFW_KEY_SPACE:
         v->playing = !v->playing;
         v->last_tick = gi_now();
@@ -507,6 +588,17 @@ int view_key(viewer *v, int key, int mods)
 
 void view_button(viewer *v, int button, int press, double x, double y)
 {
+    int ww = 0, wh = 0;
+    glfwGetWindowSize(v->win, &ww, &wh);
+    if (press && button == GLFW_MOUSE_BUTTON_LEFT && v->split && v->method_index >= 0 && ww > 0 &&
+        fabs(x - v->divider * ww) <= 6.0) {
+        v->dragging_divider = 1;
+        return;
+    }
+    if (!press && v->dragging_divider) {
+        v->dragging_divider = 0;
+        return;
+    }
     if (press) {
         v->drag_button = button;
         v->mx = x;
@@ -521,6 +613,13 @@ void view_cursor(viewer *v, double x, double y)
     double dx = x - v->mx, dy = y - v->my;
     v->mx = x;
     v->my = y;
+    if (v->dragging_divider) {
+        int ww = 0, wh = 0;
+        glfwGetWindowSize(v->win, &ww, &wh);
+        v->divider = ww > 0 ? fminf(1.0f, fmaxf(0.0f, (float)(x / ww))) : 0.5f;
+        v->need_display = 1;
+        return;
+    }
     if (v->drag_button < 0 || (dx == 0 && dy == 0))
         return;
     if (v->drag_button == GLFW_MOUSE_BUTTON_LEFT) { /* orbit */
@@ -748,6 +847,7 @@ static int setup(viewer *v)
         return cli_fail(EXIT_RUN, "view: cannot start the reference's worker thread");
 
     v->method_index = -2; /* none yet */
+    v->divider = 0.5f;
     v->drag_button = -1;
     v->last_method = start >= 0 ? start : 0;
     view_camera_from_scene(v, camera);
@@ -778,6 +878,7 @@ static void teardown(viewer *v)
     gi_scene_free(v->scene);
     gi_plugins_free(v->reg);
     free(v->cache_dir);
+    free(v->window_shot_buf);
     if (v->script)
         fclose(v->script);
 }
@@ -813,8 +914,9 @@ static int loop(viewer *v)
                 return rc;
             v->frames_since_event++;
         }
-        if (v->method_index < 0) {
+        if (v->method_index < 0)
             v->need_render = 0; /* the worker renders; the change went with view_changed */
+        if (v->method_index < 0 || v->split) {
             poll_reference(v);
             char err[GI_ERROR_MAX];
             view_ref_error(&v->ref, err, sizeof err);
@@ -823,12 +925,14 @@ static int loop(viewer *v)
         }
         if (v->need_display)
             display(v);
+        if (v->exit_code != EXIT_OK)
+            return v->exit_code;
         if (v->script) {
             glfwPollEvents();
             int rc = view_script_step(v);
             if (rc != EXIT_OK)
                 return rc;
-        } else if (v->playing || wants_frame(v)) {
+        } else if (v->playing || wants_frame(v) || v->dragging_divider) {
             glfwPollEvents();
         } else {
             glfwWaitEventsTimeout(v->method_index < 0 ? 0.05 : 0.25);

@@ -52,6 +52,13 @@ typedef struct viewer {
     /* mouse */
     int drag_button;
     double mx, my;
+    /* split view: 0 off, 1 the method left of the divider and the reference
+     * right of it, 2 the method's relative error against the reference right */
+    int split;
+    float divider;        /* the divider's place, a fraction of the window width */
+    int dragging_divider;
+    const char *window_shot; /* the next display also writes the window to this PNG */
+    char *window_shot_buf;   /* its storage (script) */
     /* the reference */
     view_ref ref;
     uint64_t ref_spp;

@@ -120,6 +120,14 @@ void view_ref_request(view_ref *r, const gi_camera_frame *camera, float time, ui
     pthread_mutex_unlock(&r->mu);
 }
 
+int view_ref_running(view_ref *r)
+{
+    pthread_mutex_lock(&r->mu);
+    int a = r->active;
+    pthread_mutex_unlock(&r->mu);
+    return a;
+}
+
 void view_ref_pause(view_ref *r)
 {
     pthread_mutex_lock(&r->mu);

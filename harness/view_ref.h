@@ -35,6 +35,8 @@ int view_ref_start(view_ref *r, const gi_scene *scene);
 /* Asks for the reference of this camera, time and size, from 0 samples. */
 void view_ref_request(view_ref *r, const gi_camera_frame *camera, float time, uint32_t width, uint32_t height,
                       uint32_t seed);
+/* Whether a request is being served (not paused, not failed). */
+int view_ref_running(view_ref *r);
 /* Stops accumulating (the worker idles). */
 void view_ref_pause(view_ref *r);
 /* A copy of the newest image of the current request when there is one

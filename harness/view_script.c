@@ -9,6 +9,7 @@
  *     wait N                  N frames; on the reference, N more samples per pixel
  *     save-view FILE.json     the view, as key V saves it
  *     screenshot PREFIX       PREFIX.exr, PREFIX.png and PREFIX.json (its view)
+ *     window-shot FILE.png    the window as shown (split view, divider) at the next redraw
  *     quit                    exit 0 (so does the end of the file)
  * Blank lines and lines starting with # are skipped. A line runs only once
  * the frame of the line before it has been rendered. */
@@ -147,11 +148,22 @@ static int run_line(viewer *v, char *line)
         return n == 2 ? view_save(v, a) : bad(v, "save-view FILE.json");
     if (!strcmp(cmd, "screenshot"))
         return n == 2 ? view_screenshot(v, a) : bad(v, "screenshot PREFIX");
+    if (!strcmp(cmd, "window-shot")) {
+        if (n != 2)
+            return bad(v, "window-shot FILE.png");
+        free(v->window_shot_buf);
+        v->window_shot_buf = strdup(a);
+        if (!v->window_shot_buf)
+            return cli_fail(EXIT_RUN, "out of memory");
+        v->window_shot = v->window_shot_buf;
+        v->need_display = 1;
+        return EXIT_OK;
+    }
     if (!strcmp(cmd, "quit")) {
         v->quit = 1;
         return EXIT_OK;
     }
-    return bad(v, "unknown command (key, drag, scroll, method, wait, save-view, screenshot, quit)");
+    return bad(v, "unknown command (key, drag, scroll, method, wait, save-view, screenshot, window-shot, quit)");
 }
 
 int view_script_step(viewer *v)
