@@ -75,3 +75,23 @@ if(NOT other GREATER 0.001)
 endif()
 message(STATUS "view script: method ${m0} -> ${m1}, eye moved (|d|^2 = ${d2} mm^2), screenshot vs render --view "
                "rmse ${match}, first view vs render --view rmse ${other}")
+
+# Bad input: one line and exit 2 (a malformed script line names its line;
+# a broken view file names what is wrong).
+file(WRITE ${W}/bad_script.txt "wait 1\nkey NOSUCHKEY\n")
+execute_process(COMMAND ${XVFB_RUN} -a ${GIB} view --script ${W}/bad_script.txt --scene ${ROOT}/scenes/cornell_box_coarse.gltf
+        --method direct --size 32x32
+    RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET TIMEOUT 120)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "bad_script.txt:2: key")
+    message(FATAL_ERROR "a malformed script line: exit ${rc}, expected 2 naming line 2\n${err}")
+endif()
+file(WRITE ${W}/bad_view.json "{\"gibench_view\": 1, \"scene\": \"x.gltf\"}")
+execute_process(COMMAND ${GIB} render --view ${W}/bad_view.json --out ${W}/bad.exr RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "missing or bad method")
+    message(FATAL_ERROR "render --view of a broken view: exit ${rc}, expected 2 naming the method\n${err}")
+endif()
+execute_process(COMMAND ${GIB} render --view ${W}/after.json --camera "#0" --out ${W}/bad.exr RESULT_VARIABLE rc
+    ERROR_VARIABLE err)
+if(NOT rc EQUAL 2)
+    message(FATAL_ERROR "render --view with --camera: exit ${rc}, expected 2\n${err}")
+endif()
