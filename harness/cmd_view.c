@@ -215,7 +215,10 @@ int view_select(viewer *v, int index)
     v->m = v->reg->items[index].method;
     const char *const *kv = NULL;
     uint32_t n = 0;
-    if (v->start_method && !strcmp(v->m->id, v->start_method)) {
+    if (!strcmp(v->m->id, v->kv_method)) {
+        kv = (const char *const *)v->kv.params;
+        n = v->kv.param_count;
+    } else if (v->start_method && !strcmp(v->m->id, v->start_method)) {
         kv = v->opt_params;
         n = v->opt_param_count;
     }
@@ -253,6 +256,55 @@ int view_select(viewer *v, int index)
             return cli_fail(EXIT_RUN, "view: %s: update failed (%s)", v->m->id, gi_result_name(res));
     }
     return EXIT_OK;
+}
+
+/* The selected parameter one step up (dir 1) or down (-1): ints and floats
+ * by a quarter (at least 1 for ints; a twentieth of the range from 0),
+ * within their range; bools toggle; enums go round their choices. The
+ * method is made again with the new values (create + prepare, as a
+ * change of parameter needs a rebuild in general). */
+static int step_param(viewer *v, int dir)
+{
+    if (!v->params || v->params->count == 0) {
+        snprintf(v->status, sizeof v->status, "no parameter");
+        return EXIT_OK;
+    }
+    uint32_t i = (uint32_t)v->param_sel % v->params->count;
+    const gi_param_desc *d = &v->params->desc[i];
+    double old = v->params->values[i], x = old;
+    switch (d->type) {
+    case GI_PARAM_INT:
+        x = dir > 0 ? fmax(old + 1, round(old * 1.25)) : fmin(old - 1, round(old / 1.25));
+        x = fmin(d->max, fmax(d->min, x));
+        break;
+    case GI_PARAM_FLOAT:
+        x = old == 0 ? dir * (d->max - d->min) / 20 : dir > 0 ? old * 1.25 : old / 1.25;
+        x = fmin(d->max, fmax(d->min, x));
+        break;
+    case GI_PARAM_BOOL:
+        x = old != 0 ? 0 : 1;
+        break;
+    case GI_PARAM_ENUM: {
+        int n = 1;
+        for (const char *c = d->choices; c && *c; c++)
+            n += *c == '|';
+        x = (double)(((int)old + (dir > 0 ? 1 : n - 1)) % n);
+        break;
+    }
+    }
+    v->params->values[i] = x;
+    char *s = gi_params_to_string(v->params);
+    v->params->values[i] = old;
+    if (!s || !view_file_set_params(&v->kv, s)) {
+        free(s);
+        return cli_fail(EXIT_RUN, "out of memory");
+    }
+    free(s);
+    snprintf(v->kv_method, sizeof v->kv_method, "%s", v->m->id);
+    int sel = v->param_sel;
+    int rc = view_select(v, v->method_index);
+    v->param_sel = sel;
+    return rc;
 }
 
 /* Renders one frame of the method into the target (timed, with glFinish). */
@@ -379,6 +431,22 @@ static void display(viewer *v)
                  v->frame_ms, v->frame_index, (double)v->exposure, (double)v->time,
                  v->playing ? " playing" : "", v->display_ms, gi_gpu_renderer(v->gpu), v->status[0] ? " | " : "",
                  v->status);
+    if (!ref && v->params && v->params->count) {
+        /* the parameter TAB selected, with its value */
+        char *all = gi_params_to_string(v->params);
+        uint32_t sel = (uint32_t)v->param_sel % v->params->count;
+        const char *p = all;
+        for (uint32_t k = 0; p && k < sel; k++) {
+            p = strchr(p, ',');
+            p = p ? p + 1 : NULL;
+        }
+        if (p) {
+            size_t used = strlen(title);
+            const char *end = strchr(p, ',');
+            snprintf(title + used, sizeof title - used, " | param %.*s (TAB, PgUp/PgDn)", (int)(end ? end - p : (long)strlen(p)), p);
+        }
+        free(all);
+    }
     glfwSetWindowTitle(v->win, title);
 }
 
@@ -518,6 +586,7 @@ int view_key(viewer *v, int key, int mods)
         int n = method_count(v) + 1, cur = v->method_index < 0 ? n - 1 : v->method_index;
         int back = key == GLFW_KEY_N || (mods & GLFW_MOD_SHIFT);
         int next = (cur + (back ? n - 1 : 1)) % n;
+        v->param_sel = 0;
         return view_select(v, next == n - 1 ? -1 : next);
     }
     case GLFW_KEY_R:
@@ -525,6 +594,12 @@ int view_key(viewer *v, int key, int mods)
             return view_select(v, v->last_method < 0 ? 0 : v->last_method);
         v->last_method = v->method_index;
         return view_select(v, -1);
+    case GLFW_KEY_TAB:
+        v->param_sel = v->params && v->params->count ? (v->param_sel + 1) % (int)v->params->count : 0;
+        return EXIT_OK;
+    case GLFW_KEY_PAGE_UP:
+    case GLFW_KEY_PAGE_DOWN:
+        return v->method_index >= 0 ? step_param(v, key == GLFW_KEY_PAGE_UP ? 1 : -1) : EXIT_OK;
     case GLFW_KEY_X:
         v->split = (v->split + 1) % 3;
         reference_as_needed(v);
@@ -879,6 +954,7 @@ static void teardown(viewer *v)
     gi_plugins_free(v->reg);
     free(v->cache_dir);
     free(v->window_shot_buf);
+    view_file_free(&v->kv);
     if (v->script)
         fclose(v->script);
 }

@@ -52,6 +52,11 @@ typedef struct viewer {
     /* mouse */
     int drag_button;
     double mx, my;
+    /* parameter keys: the parameter selected (TAB) and the values a method
+     * was last rebuilt with (PAGE_UP / PAGE_DOWN), for method kv_method */
+    int param_sel;
+    view_file kv;
+    char kv_method[64];
     /* split view: 0 off, 1 the method left of the divider and the reference
      * right of it, 2 the method's relative error against the reference right */
     int split;

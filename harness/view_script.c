@@ -2,7 +2,8 @@
  * the viewer can be driven and tested without a person (README.md
  * "gibench view", "Scripts"). Lines:
  *     key NAME [shift]        a key press: a letter, a digit, SPACE, ESCAPE, LEFT, RIGHT, UP,
- *                             DOWN, MINUS, EQUAL, LEFT_BRACKET, RIGHT_BRACKET, COMMA, PERIOD
+ *                             DOWN, MINUS, EQUAL, LEFT_BRACKET, RIGHT_BRACKET, COMMA, PERIOD,
+ *                             TAB, PAGE_UP, PAGE_DOWN
  *     drag X0 Y0 X1 Y1 [left|right|middle]   press at (X0, Y0), move to (X1, Y1), release
  *     scroll DY               the mouse wheel
  *     method ID               show method ID (or "reference")
@@ -45,6 +46,9 @@ static const key_name keys[] = {
     {"RIGHT_BRACKET", GLFW_KEY_RIGHT_BRACKET},
     {"COMMA", GLFW_KEY_COMMA},
     {"PERIOD", GLFW_KEY_PERIOD},
+    {"TAB", GLFW_KEY_TAB},
+    {"PAGE_UP", GLFW_KEY_PAGE_UP},
+    {"PAGE_DOWN", GLFW_KEY_PAGE_DOWN},
 };
 
 static int key_code(const char *name)

@@ -20,6 +20,12 @@ drag 20 20 50 30
 wait 2
 save-view after.json
 screenshot after
+method direct
+wait 1
+key TAB
+key PAGE_DOWN
+wait 1
+screenshot param
 ")
 view_run(${W}/script.txt --scene ${ROOT}/scenes/cornell_box.gltf --method direct --size 64x64)
 
@@ -75,6 +81,16 @@ if(NOT other GREATER 0.001)
 endif()
 message(STATUS "view script: method ${m0} -> ${m1}, eye moved (|d|^2 = ${d2} mm^2), screenshot vs render --view "
                "rmse ${match}, first view vs render --view rmse ${other}")
+
+# Parameter keys: TAB selects direct's second parameter, PAGE_DOWN lowers
+# it and rebuilds; the screenshot's view has the new value and render --view
+# reproduces it.
+file(READ ${W}/param.json pj)
+string(JSON p0 GET "${pj}" params 1)
+if(NOT p0 STREQUAL "env_samples=13")
+    message(FATAL_ERROR "TAB + PAGE_DOWN on direct: params[1] is ${p0}, expected env_samples=13 (16 / 1.25)")
+endif()
+view_render_matches(${W}/param 1e-4)
 
 # Bad input: one line and exit 2 (a malformed script line names its line;
 # a broken view file names what is wrong).
