@@ -321,6 +321,8 @@ static int render_method(viewer *v)
     gi_result res = v->m->render(v->inst, &view, &target);
     glFinish();
     v->frame_ms = 1e3 * (gi_now() - t0);
+    v->sum_frame_ms += v->frame_ms;
+    v->n_frames++;
     if (res != GI_OK) {
         const char *msg = v->m->last_error(v->inst);
         return cli_fail(EXIT_RUN, "view: %s: render failed (%s)%s%s", v->m->id, gi_result_name(res),
@@ -416,6 +418,8 @@ static void display(viewer *v)
     glfwSwapBuffers(v->win);
     glFinish();
     v->display_ms = 1e3 * (gi_now() - t0);
+    v->sum_display_ms += v->display_ms;
+    v->n_displays++;
     v->need_display = 0;
 
     char title[768];
@@ -1028,6 +1032,12 @@ int cmd_view(int argc, char **argv)
         rc = setup(v);
         if (rc == EXIT_OK)
             rc = loop(v);
+        if (rc == EXIT_OK && gi_log_get_level() >= GI_LOG_WARN && v->gpu)
+            printf("view: %llu method frames, mean %.3g ms; %llu redraws, mean %.3g ms of the viewer's own "
+                   "(tone map, swap); %s\n",
+                   (unsigned long long)v->n_frames, v->n_frames ? v->sum_frame_ms / (double)v->n_frames : 0.0,
+                   (unsigned long long)v->n_displays,
+                   v->n_displays ? v->sum_display_ms / (double)v->n_displays : 0.0, gi_gpu_renderer(v->gpu));
     }
     teardown(v);
     free(v);

@@ -42,6 +42,9 @@ typedef struct viewer {
     int need_render, need_display;
     double frame_ms, display_ms, prepare_ms;
     uint64_t frames_since_event;
+    /* totals for the summary line at exit: method frames and window redraws */
+    double sum_frame_ms, sum_display_ms;
+    uint64_t n_frames, n_displays;
     /* the orbit camera: eye at dist from center, at yaw and pitch */
     gi_vec3 center;
     float yaw, pitch, dist, yfov, znear, zfar;
