@@ -44,7 +44,7 @@ endif()
 # |eye after - eye before| in millimetres (CMake has integer arithmetic only)
 function(milli outvar x)
     if(x MATCHES "[eE]-")
-        set(${outvar} 0 PARENT_SCOPE) # below 1e-1: rounds to 0 mm at most 0.1 m off, and only tiny values print so
+        set(${outvar} 0 PARENT_SCOPE) # json-c writes only values below 1e-4 with a negative exponent: 0 mm
         return()
     endif()
     if(NOT x MATCHES "^(-?)([0-9]+)(\\.([0-9]*))?$")
