@@ -110,5 +110,7 @@ int cmd_study(int argc, char **argv);
 int study_check(const char *file, gi_plugins *reg);
 int cmd_reference(int argc, char **argv);
 int cmd_conformance(int argc, char **argv);
+/* gibench view: the interactive viewer (cmd_view.c). */
+int cmd_view(int argc, char **argv);
 
 #endif

@@ -6,6 +6,7 @@
 #include "gi/log.h"
 #include "gi/passes.h"
 #include "metrics.h"
+#include "view_file.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -30,7 +31,51 @@ typedef struct render_opts {
      * 1, 2, 4, 8, ... (every frame up to 16), in the timings as "curve" */
     const char *curve_name[MAX_CURVE_REFS], *curve_path[MAX_CURVE_REFS];
     int curve_ref_count;
+    /* --view FILE: a saved view of gibench view (camera, time, method,
+     * parameters, size, frames, seed, exposure); options given beside it win */
+    const char *view_path;
+    int has_view;
+    view_file view;
+    int given_size, given_frames, given_seed, given_time, given_exposure;
 } render_opts;
+
+/* --view FILE: what the saved view says, except what the command line gives. */
+static int apply_view(render_opts *o)
+{
+    char why[600];
+    if (o->camera)
+        return cli_fail(EXIT_USAGE, "render: --camera and --view both name a camera; give one");
+    if (!view_file_read(o->view_path, &o->view, why, sizeof why))
+        return cli_fail(EXIT_USAGE, "render: --view %s", why);
+    o->has_view = 1;
+    const view_file *v = &o->view;
+    if (!o->method && !strcmp(v->method, "reference"))
+        return cli_fail(EXIT_USAGE,
+                        "render: the view %s shows the path-traced reference; give --method M (or use gibench reference)",
+                        o->view_path);
+    if (!o->scene)
+        o->scene = v->scene;
+    if (!o->method) {
+        o->method = v->method;
+        /* the view's parameters belong to its method */
+        if (o->param_count == 0)
+            for (uint32_t i = 0; i < v->param_count; i++)
+                o->params[o->param_count++] = v->params[i];
+    }
+    if (!o->given_size) {
+        o->width = v->width;
+        o->height = v->height;
+    }
+    if (!o->given_frames)
+        o->frames = v->frames;
+    if (!o->given_seed)
+        o->seed = v->seed;
+    if (!o->given_time)
+        o->time = v->time;
+    if (!o->given_exposure)
+        o->exposure = v->exposure;
+    return EXIT_OK;
+}
 
 static int parse_opts(int argc, char **argv, render_opts *o)
 {
@@ -49,7 +94,7 @@ static int parse_opts(int argc, char **argv, render_opts *o)
         if (!strcmp(a, "--scene") || !strcmp(a, "--method") || !strcmp(a, "--camera") || !strcmp(a, "--out") ||
             !strcmp(a, "--size") || !strcmp(a, "--param") || !strcmp(a, "--frames") || !strcmp(a, "--warmup") ||
             !strcmp(a, "--time") || !strcmp(a, "--animate") || !strcmp(a, "--seed") || !strcmp(a, "--exposure") ||
-            !strcmp(a, "--timings") || !strcmp(a, "--curve-ref")) {
+            !strcmp(a, "--timings") || !strcmp(a, "--curve-ref") || !strcmp(a, "--view")) {
             if (!v)
                 return cli_fail(EXIT_USAGE, "render: %s needs a value", a);
             i++;
@@ -64,6 +109,8 @@ static int parse_opts(int argc, char **argv, render_opts *o)
             o->camera = v;
         else if (!strcmp(a, "--timings"))
             o->timings = v;
+        else if (!strcmp(a, "--view"))
+            o->view_path = v;
         else if (!strcmp(a, "--curve-ref")) {
             const char *eq = strchr(v, '=');
             if (!eq || eq == v || !eq[1] || eq - v > 31)
@@ -78,6 +125,7 @@ static int parse_opts(int argc, char **argv, render_opts *o)
         } else if (!strcmp(a, "--size")) {
             if (!cli_parse_size(v, &o->width, &o->height))
                 return cli_fail(EXIT_USAGE, "render: --size '%s' is not WxH with 1..16384 each", v);
+            o->given_size = 1;
         } else if (!strcmp(a, "--param")) {
             if (o->param_count == MAX_PARAMS)
                 return cli_fail(EXIT_USAGE, "render: at most %d --param", MAX_PARAMS);
@@ -86,6 +134,7 @@ static int parse_opts(int argc, char **argv, render_opts *o)
             if (!cli_parse_uint(v, 1, 1000000, &u))
                 return cli_fail(EXIT_USAGE, "render: --frames '%s' is not an integer in 1..1000000", v);
             o->frames = (uint32_t)u;
+            o->given_frames = 1;
         } else if (!strcmp(a, "--warmup")) {
             if (!cli_parse_uint(v, 0, 1000, &u))
                 return cli_fail(EXIT_USAGE, "render: --warmup '%s' is not an integer in 0..1000", v);
@@ -94,16 +143,24 @@ static int parse_opts(int argc, char **argv, render_opts *o)
             if (!cli_parse_uint(v, 0, 0xFFFFFFFFul, &u))
                 return cli_fail(EXIT_USAGE, "render: --seed '%s' is not a 32-bit unsigned integer", v);
             o->seed = (uint32_t)u;
+            o->given_seed = 1;
         } else if (!strcmp(a, "--time")) {
             if (!cli_parse_float(v, &o->time) || o->time < 0)
                 return cli_fail(EXIT_USAGE, "render: --time '%s' is not a non-negative number", v);
+            o->given_time = 1;
         } else if (!strcmp(a, "--animate")) {
             if (!cli_parse_float(v, &o->animate_fps) || o->animate_fps <= 0)
                 return cli_fail(EXIT_USAGE, "render: --animate '%s' is not a positive frame rate", v);
         } else if (!strcmp(a, "--exposure")) {
             if (!cli_parse_exposure(v, &o->exposure))
                 return cli_fail(EXIT_USAGE, "render: --exposure '%s' is not a number of stops in -64..64", v);
+            o->given_exposure = 1;
         }
+    }
+    if (o->view_path) {
+        int rc = apply_view(o);
+        if (rc != EXIT_OK)
+            return rc;
     }
     if (!o->scene)
         return cli_fail(EXIT_USAGE, "render: --scene is required");
@@ -118,7 +175,7 @@ static int parse_opts(int argc, char **argv, render_opts *o)
 
 static void make_view(const gi_scene *s, int camera, const render_opts *o, float t, uint32_t frame, gi_view *v)
 {
-    gi_camera_frame cf = gi_scene_camera_at(s, camera, t);
+    gi_camera_frame cf = o->has_view ? view_file_camera(&o->view) : gi_scene_camera_at(s, camera, t);
     gi_view_from_camera(&cf, o->width, o->height, t, v);
     v->frame_index = frame;
     v->seed = o->seed;
@@ -260,7 +317,7 @@ static json_object *timings_json(const run_state *r, const render_opts *o)
     json_object_object_add(j, "params", json_object_new_string(pstr ? pstr : ""));
     free(pstr);
     json_object_object_add(j, "scene", json_object_new_string(o->scene));
-    json_object_object_add(j, "camera", json_object_new_string(o->camera ? o->camera : "#0"));
+    json_object_object_add(j, "camera", json_object_new_string(o->camera ? o->camera : o->has_view ? o->view_path : "#0"));
     json_object_object_add(j, "width", json_object_new_int((int32_t)o->width));
     json_object_object_add(j, "height", json_object_new_int((int32_t)o->height));
     json_object_object_add(j, "frames", json_object_new_int((int32_t)o->frames));
@@ -465,12 +522,15 @@ int cmd_render(int argc, char **argv)
 {
     render_opts o;
     int rc = parse_opts(argc, argv, &o);
-    if (rc != EXIT_OK)
+    if (rc != EXIT_OK) {
+        view_file_free(&o.view);
         return rc;
+    }
     cli_install_signal_handlers();
     run_state r;
     memset(&r, 0, sizeof r);
     rc = run(&r, &o);
     cleanup(&r);
+    view_file_free(&o.view);
     return rc;
 }

@@ -36,6 +36,8 @@ static const command_help helps[] = {
      "  --timings FILE.json    method, parameters, GL renderer, timer mode, per-stage times, stats\n"
      "  --no-cache             precompute afresh and keep nothing (timing of precomputation)\n"
      "  --curve-ref NAME=IMAGE record the error against IMAGE after frames 1, 2, 4, ... (up to 4)\n"
+     "  --view VIEW.json       a view saved by gibench view: its camera, and its scene, method,\n"
+     "                         parameters, size, frames, seed, time and exposure unless given here\n"
      "Prints a progress bar on a terminal and a one-line summary at the end (-q: none).\n"},
     {"reference",
      "usage: gibench reference --scene S --out FILE.exr [--out FILE.png] [options]\n"
@@ -82,6 +84,19 @@ static const command_help helps[] = {
      "The conformance suite on every method (or M): closed emitting sphere = Le * sum rho^k for its\n"
      "bounce count, finiteness, determinism, caps honesty, parameter checks.\n"
      "  --json   as JSON   --size N   image size   --item-timeout S   seconds per check\n"},
+    {"view",
+     "usage: gibench view --scene S [--method M|reference] [options]\n"
+     "The interactive viewer: a window (GLFW, OpenGL 4.5 core) showing a method's image of the scene,\n"
+     "through the same plugins as render, or the progressive path-traced reference.\n"
+     "  --size WxH             image and window size (default 512x512)\n"
+     "  --param k=v            a parameter of the starting method (repeatable)\n"
+     "  --camera NAME|#k       the scene's camera to start from\n"
+     "  --exposure EV  --time T  --seed N\n"
+     "  --screenshot-dir DIR   where keys P (screenshot) and V (save view) write (default .)\n"
+     "  --script FILE          replay key and mouse events from FILE, then exit (README \"gibench view\")\n"
+     "Keys: M/N next/previous method, R reference, mouse left orbit, right dolly, middle pan, wheel zoom,\n"
+     "W/A/S/D/Q/E fly, arrows orbit, C next scene camera, SPACE play/pause, ,/. time step,\n"
+     "[/] or -/= exposure, P screenshot, V save view, ESC quit.\n"},
     {"help", "usage: gibench help [COMMAND]\nThe list of commands, or the help of one.\n"},
 };
 

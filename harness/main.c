@@ -17,7 +17,11 @@ static const char usage[] =
     "  render --scene S --method M --out FILE [--out FILE2] [--camera C] [--size WxH]\n"
     "         [--param k=v]... [--frames N] [--warmup N] [--time T] [--animate FPS]\n"
     "         [--seed N] [--exposure EV] [--timings FILE.json] [--no-cache] [--curve-ref NAME=IMG]\n"
+    "         [--view VIEW.json]\n"
     "                                         render one method (EXR, PFM or PNG output)\n"
+    "  view --scene S [--method M|reference] [--size WxH] [--param k=v]... [--camera C]\n"
+    "       [--exposure EV] [--time T] [--seed N] [--script FILE] [--screenshot-dir DIR]\n"
+    "                                         the interactive viewer (GLFW window)\n"
     "  diff TEST REFERENCE [--json] [--heatmap FILE.png] [--flip-map FILE.png]\n"
     "       [--exposure EV] [--ppd N]         error metrics (RMSE, relMSE, MAE, PSNR, SSIM, FLIP)\n"
     "  compare --scene S --methods a,b,...|all --out DIR [--size WxH] [--frames N] [--warmup N]\n"
@@ -122,5 +126,7 @@ int main(int argc, char **argv)
         return cmd_reference(sub_argc, sub_argv);
     if (!strcmp(cmd, "conformance"))
         return cmd_conformance(sub_argc, sub_argv);
+    if (!strcmp(cmd, "view"))
+        return cmd_view(sub_argc, sub_argv);
     return cli_fail(EXIT_USAGE, "unknown command '%s' (see gibench --help)", cmd);
 }

@@ -11,7 +11,7 @@ import re
 import subprocess
 import sys
 
-COMMANDS = ["methods", "info", "render", "reference", "diff", "compare", "study", "conformance", "help"]
+COMMANDS = ["methods", "info", "render", "reference", "diff", "compare", "study", "conformance", "view", "help"]
 
 
 def options_of(gibench, cmd):
@@ -77,7 +77,8 @@ def main():
               "            fi",
               "            compopt -o nospace 2>/dev/null; return ;;",
               "        --scene) COMPREPLY=($(compgen -f -X '!*.@(gltf|glb)' -- \"$cur\") $(compgen -d -- \"$cur\")); return ;;",
-              "        --out|--timings|--stats|--heatmap|--flip-map|--reference|--curve-ref) COMPREPLY=($(compgen -f -- \"$cur\")); return ;;",
+              "        --out|--timings|--stats|--heatmap|--flip-map|--reference|--curve-ref|--view|--script) COMPREPLY=($(compgen -f -- \"$cur\")); return ;;",
+              "        --screenshot-dir) COMPREPLY=($(compgen -d -- \"$cur\")); return ;;",
               "        --pixel) COMPREPLY=($(compgen -W 'box center' -- \"$cur\")); return ;;",
               "    esac",
               '    case "$cmd" in']

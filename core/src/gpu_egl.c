@@ -18,6 +18,7 @@ struct gi_gpu {
     char version[256];
     const char *platform;
     int software;
+    int adopted; /* the caller's context (gi_gpu_desc.adopt_current): not ours to destroy */
 };
 
 static int has_ext(const char *list, const char *name)
@@ -146,11 +147,49 @@ static void GLAPIENTRY debug_cb(GLenum source, GLenum type, GLuint id, GLenum se
     gi_log(type == GL_DEBUG_TYPE_ERROR ? GI_LOG_WARN : GI_LOG_DEBUG, "GL: %s", msg);
 }
 
+/* What every context gets once current: names, the debug output, the clip convention. */
+static void finish_setup(gi_gpu *gpu, const gi_gpu_desc *d)
+{
+    snprintf(gpu->renderer, sizeof gpu->renderer, "%s", (const char *)glGetString(GL_RENDERER));
+    snprintf(gpu->version, sizeof gpu->version, "%s", (const char *)glGetString(GL_VERSION));
+    gpu->software = strstr(gpu->renderer, "llvmpipe") || strstr(gpu->renderer, "softpipe") ||
+                    strstr(gpu->renderer, "swrast") || strstr(gpu->renderer, "SwiftShader");
+    if (d->debug) {
+        glEnable(GL_DEBUG_OUTPUT);
+        glEnable(GL_DEBUG_OUTPUT_SYNCHRONOUS);
+        glDebugMessageCallback(debug_cb, NULL);
+    }
+    /* Depth in [0, 1] gives better precision for every depth pass. */
+    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+    gi_log(GI_LOG_INFO, "GL %s on %s (%s)", gpu->version, gpu->renderer, gpu->platform);
+}
+
+/* gi_gpu_desc.adopt_current: the caller's current context, if it is 4.5 core. */
+static gi_gpu *adopt_current(const gi_gpu_desc *d, gi_error *err)
+{
+    if (epoxy_gl_version() < 45) {
+        gi_error_set(err, GI_ERR_GL, "the current context is OpenGL %d.%d, not 4.5", epoxy_gl_version() / 10,
+                     epoxy_gl_version() % 10);
+        return NULL;
+    }
+    gi_gpu *gpu = calloc(1, sizeof *gpu);
+    if (!gpu) {
+        gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory");
+        return NULL;
+    }
+    gpu->adopted = 1;
+    gpu->platform = "adopted";
+    finish_setup(gpu, d);
+    return gpu;
+}
+
 gi_gpu *gi_gpu_create(const gi_gpu_desc *desc, gi_error *err)
 {
     gi_gpu_desc d = {0};
     if (desc)
         d = *desc;
+    if (d.adopt_current)
+        return adopt_current(&d, err);
     const char *want = d.platform ? d.platform : getenv("GIBENCH_EGL");
     if (want && *want && strcmp(want, "device") != 0 && strcmp(want, "surfaceless") != 0) {
         gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
@@ -176,18 +215,7 @@ gi_gpu *gi_gpu_create(const gi_gpu_desc *desc, gi_error *err)
         free(gpu);
         return NULL;
     }
-    snprintf(gpu->renderer, sizeof gpu->renderer, "%s", (const char *)glGetString(GL_RENDERER));
-    snprintf(gpu->version, sizeof gpu->version, "%s", (const char *)glGetString(GL_VERSION));
-    gpu->software = strstr(gpu->renderer, "llvmpipe") || strstr(gpu->renderer, "softpipe") ||
-                    strstr(gpu->renderer, "swrast") || strstr(gpu->renderer, "SwiftShader");
-    if (d.debug) {
-        glEnable(GL_DEBUG_OUTPUT);
-        glEnable(GL_DEBUG_OUTPUT_SYNCHRONOUS);
-        glDebugMessageCallback(debug_cb, NULL);
-    }
-    /* Depth in [0, 1] gives better precision for every depth pass. */
-    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-    gi_log(GI_LOG_INFO, "GL %s on %s (%s)", gpu->version, gpu->renderer, gpu->platform);
+    finish_setup(gpu, &d);
     return gpu;
 }
 
@@ -195,6 +223,10 @@ void gi_gpu_destroy(gi_gpu *gpu)
 {
     if (!gpu)
         return;
+    if (gpu->adopted) {
+        free(gpu);
+        return;
+    }
     eglMakeCurrent(gpu->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     eglDestroyContext(gpu->display, gpu->context);
     /* No eglTerminate: the display is a per-process singleton that the next

@@ -71,6 +71,9 @@ typedef struct gi_ref_desc {
     const gi_scene *scene;  /* required; borrowed */
     int camera;             /* camera index for gi_scene_camera_at; -1 (or none in the
                                file) = the default view of the bounds */
+    /* When not NULL, this camera instead of `camera` (copied by gi_ref_create):
+     * a free camera, e.g. gibench view's orbit camera or a saved view. */
+    const gi_camera_frame *camera_frame;
     float time;             /* scene time t: object, light and camera placement */
     uint32_t width, height; /* required, 1..16384 each */
     uint32_t seed;

@@ -34,11 +34,16 @@ typedef struct gi_gpu gi_gpu;
 typedef struct gi_gpu_desc {
     int debug;            /* GL debug context + KHR_debug messages to the log */
     const char *platform; /* "device", "surfaceless" or NULL = auto (or $GIBENCH_EGL) */
+    /* 1: make no context; use the OpenGL 4.5 core context current on this
+     * thread (a window's, made by the caller, e.g. gibench view through
+     * GLFW); gi_gpu_destroy then leaves it alone. platform is ignored. */
+    int adopt_current;
 } gi_gpu_desc;
 
 gi_gpu *gi_gpu_create(const gi_gpu_desc *desc, gi_error *err);
 void gi_gpu_destroy(gi_gpu *gpu);
-/* GL_RENDERER, GL_VERSION, and how the context was made ("device" or "surfaceless"). */
+/* GL_RENDERER, GL_VERSION, and how the context was made ("device",
+ * "surfaceless", or "adopted" for a caller's context). */
 const char *gi_gpu_renderer(const gi_gpu *gpu);
 const char *gi_gpu_version(const gi_gpu *gpu);
 const char *gi_gpu_platform(const gi_gpu *gpu);

@@ -1,0 +1,214 @@
+/* gibench view --script FILE: replays input, one event per line, so that
+ * the viewer can be driven and tested without a person (README.md
+ * "gibench view", "Scripts"). Lines:
+ *     key NAME [shift]        a key press: a letter, a digit, SPACE, ESCAPE, LEFT, RIGHT, UP,
+ *                             DOWN, MINUS, EQUAL, LEFT_BRACKET, RIGHT_BRACKET, COMMA, PERIOD,
+ *                             TAB, PAGE_UP, PAGE_DOWN
+ *     drag X0 Y0 X1 Y1 [left|right|middle]   press at (X0, Y0), move to (X1, Y1), release
+ *     scroll DY               the mouse wheel
+ *     method ID               show method ID (or "reference")
+ *     wait N                  N frames; on the reference, N more samples per pixel
+ *     save-view FILE.json     the view, as key V saves it
+ *     screenshot PREFIX       PREFIX.exr, PREFIX.png and PREFIX.json (its view)
+ *     window-shot FILE.png    the window as shown (split view, divider) at the next redraw
+ *     quit                    exit 0 (so does the end of the file)
+ * Blank lines and lines starting with # are skipped. A line runs only once
+ * the frame of the line before it has been rendered. */
+#define _POSIX_C_SOURCE 200809L
+#include "view.h"
+
+#include "gi/timer.h"
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <ctype.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define REF_WAIT_S 300.0 /* a wait for reference samples gives up after this */
+
+typedef struct key_name {
+    const char *name;
+    int key;
+} key_name;
+
+static const key_name keys[] = {
+    {"SPACE", GLFW_KEY_SPACE},
+    {"ESCAPE", GLFW_KEY_ESCAPE},
+    {"LEFT", GLFW_KEY_LEFT},
+    {"RIGHT", GLFW_KEY_RIGHT},
+    {"UP", GLFW_KEY_UP},
+    {"DOWN", GLFW_KEY_DOWN},
+    {"MINUS", GLFW_KEY_MINUS},
+    {"EQUAL", GLFW_KEY_EQUAL},
+    {"LEFT_BRACKET", GLFW_KEY_LEFT_BRACKET},
+    {"RIGHT_BRACKET", GLFW_KEY_RIGHT_BRACKET},
+    {"COMMA", GLFW_KEY_COMMA},
+    {"PERIOD", GLFW_KEY_PERIOD},
+    {"TAB", GLFW_KEY_TAB},
+    {"PAGE_UP", GLFW_KEY_PAGE_UP},
+    {"PAGE_DOWN", GLFW_KEY_PAGE_DOWN},
+};
+
+static int key_code(const char *name)
+{
+    if (strlen(name) == 1 && isalpha((unsigned char)name[0]))
+        return GLFW_KEY_A + (toupper((unsigned char)name[0]) - 'A');
+    if (strlen(name) == 1 && isdigit((unsigned char)name[0]))
+        return GLFW_KEY_0 + (name[0] - '0');
+    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++)
+        if (!strcmp(keys[i].name, name))
+            return keys[i].key;
+    return -1;
+}
+
+static int bad(viewer *v, const char *what)
+{
+    return cli_fail(EXIT_USAGE, "view: %s:%d: %s", v->script_path, v->script_line, what);
+}
+
+/* The method shown by id ("reference": the path tracer); -2 when unknown. */
+static int method_by_id(const viewer *v, const char *id)
+{
+    if (!strcmp(id, "reference"))
+        return -1;
+    for (uint32_t i = 0; i < v->reg->count; i++)
+        if (!strcmp(v->reg->items[i].method->id, id))
+            return (int)i;
+    return -2;
+}
+
+/* 1 while the reference has no sample of the current view (after
+ * REF_WAIT_S an error is printed and *rc set). */
+static int reference_pending(viewer *v, int *rc)
+{
+    if (v->method_index >= 0 || view_ref_spp(&v->ref) > 0)
+        return 0;
+    if (v->wait_deadline == 0)
+        v->wait_deadline = gi_now() + REF_WAIT_S;
+    if (gi_now() > v->wait_deadline) {
+        *rc = bad(v, "the reference rendered no sample in time");
+        return 1;
+    }
+    return 1;
+}
+
+static int run_line(viewer *v, char *line)
+{
+    char cmd[32] = "", a[4096] = "", b[32] = "";
+    int n = sscanf(line, "%31s %4095s %31s", cmd, a, b);
+    if (n < 1)
+        return EXIT_OK;
+    if (!strcmp(cmd, "key")) {
+        int k = n >= 2 ? key_code(a) : -1;
+        if (k < 0)
+            return bad(v, "key: unknown key name (a letter, a digit, SPACE, ESCAPE, LEFT, ...)");
+        if (n == 3 && strcmp(b, "shift"))
+            return bad(v, "key NAME [shift]");
+        return view_key(v, k, n == 3 ? GLFW_MOD_SHIFT : 0);
+    }
+    if (!strcmp(cmd, "drag")) {
+        double x0, y0, x1, y1;
+        char button[16] = "left";
+        int m = sscanf(line, "%*s %lf %lf %lf %lf %15s", &x0, &y0, &x1, &y1, button);
+        int bt = !strcmp(button, "left") ? GLFW_MOUSE_BUTTON_LEFT
+                 : !strcmp(button, "right") ? GLFW_MOUSE_BUTTON_RIGHT
+                 : !strcmp(button, "middle") ? GLFW_MOUSE_BUTTON_MIDDLE
+                                             : -1;
+        if (m < 4 || bt < 0)
+            return bad(v, "drag X0 Y0 X1 Y1 [left|right|middle]");
+        view_button(v, bt, 1, x0, y0);
+        for (int i = 1; i <= 8; i++)
+            view_cursor(v, x0 + (x1 - x0) * i / 8.0, y0 + (y1 - y0) * i / 8.0);
+        view_button(v, bt, 0, x1, y1);
+        return EXIT_OK;
+    }
+    if (!strcmp(cmd, "scroll")) {
+        double dy;
+        if (sscanf(line, "%*s %lf", &dy) != 1)
+            return bad(v, "scroll DY");
+        view_scroll(v, dy);
+        return EXIT_OK;
+    }
+    if (!strcmp(cmd, "method")) {
+        int idx = n >= 2 ? method_by_id(v, a) : -2;
+        if (idx < -1)
+            return bad(v, "method: no such method (see gibench methods; or reference)");
+        if (idx >= 0)
+            v->last_method = idx;
+        return view_select(v, idx);
+    }
+    if (!strcmp(cmd, "wait")) {
+        unsigned long k;
+        if (n != 2 || !cli_parse_uint(a, 1, 100000, &k))
+            return bad(v, "wait N (frames, 1..100000)");
+        v->wait_left = (uint32_t)k;
+        v->wait_spp = view_ref_spp(&v->ref) + k;
+        v->wait_deadline = gi_now() + REF_WAIT_S;
+        return EXIT_OK;
+    }
+    if (!strcmp(cmd, "save-view"))
+        return n == 2 ? view_save(v, a) : bad(v, "save-view FILE.json");
+    if (!strcmp(cmd, "screenshot"))
+        return n == 2 ? view_screenshot(v, a) : bad(v, "screenshot PREFIX");
+    if (!strcmp(cmd, "window-shot")) {
+        if (n != 2)
+            return bad(v, "window-shot FILE.png");
+        free(v->window_shot_buf);
+        v->window_shot_buf = strdup(a);
+        if (!v->window_shot_buf)
+            return cli_fail(EXIT_RUN, "out of memory");
+        v->window_shot = v->window_shot_buf;
+        v->need_display = 1;
+        return EXIT_OK;
+    }
+    if (!strcmp(cmd, "quit")) {
+        v->quit = 1;
+        return EXIT_OK;
+    }
+    return bad(v, "unknown command (key, drag, scroll, method, wait, save-view, screenshot, window-shot, quit)");
+}
+
+int view_script_step(viewer *v)
+{
+    int rc = EXIT_OK;
+    if (v->need_render)
+        return EXIT_OK; /* the last line's frame first */
+    if (v->wait_left) {
+        if (v->method_index < 0) {
+            if (view_ref_spp(&v->ref) >= v->wait_spp) {
+                v->wait_left = 0;
+            } else if (gi_now() > v->wait_deadline) {
+                return bad(v, "wait: the reference did not reach the samples in time");
+            } else {
+                struct timespec ts = {0, 5000000};
+                nanosleep(&ts, NULL);
+            }
+        } else {
+            v->wait_left--;
+        }
+        return EXIT_OK;
+    }
+    char line[8192];
+    long pos = ftell(v->script);
+    if (!fgets(line, sizeof line, v->script)) {
+        v->quit = 1;
+        return EXIT_OK;
+    }
+    char *p = line;
+    while (isspace((unsigned char)*p))
+        p++;
+    if (!strncmp(p, "screenshot", 10) || !strncmp(p, "save-view", 9)) {
+        /* the reference shows something only after its first pass */
+        if (reference_pending(v, &rc)) {
+            fseek(v->script, pos, SEEK_SET);
+            return rc;
+        }
+    }
+    v->wait_deadline = 0;
+    v->script_line++;
+    if (*p == '#' || *p == '\0')
+        return EXIT_OK;
+    return run_line(v, p);
+}
