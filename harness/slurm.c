@@ -568,8 +568,14 @@ void slurm_tasks_describe(const slurm_tasks *t, uint32_t task, char *buf, size_t
         snprintf(what, sizeof what, "killed while running (%s)", last[0] ? last : "log without an exit line");
     if (s)
         snprintf(buf, size, "Slurm task %s_%u: %s, exit code %s; %s", t->job, task, s->state, s->exit, what);
+    else if (t->n && !exists)
+        /* the controller holds the array's other tasks: this one was
+         * taken out of the array before it ever ran */
+        snprintf(buf, size, "Slurm task %s_%u: CANCELLED while pending (%s keeps no record of it); no log", t->job,
+                 task, t->source);
     else
-        snprintf(buf, size, "Slurm task %s_%u: state unknown (no accounting); %s", t->job, task, what);
+        snprintf(buf, size, "Slurm task %s_%u: state unknown (no accounting, and the controller forgot the job); %s",
+                 t->job, task, what);
 }
 
 void slurm_tasks_free(slurm_tasks *t)
