@@ -325,7 +325,7 @@ static int job_active(const char *out, const char *job, int *known)
     for (int k = 0; active[k]; k++)
         if (!strcmp(state, active[k]))
             return 1;
-    return state[0] == '\0' ? 0 : 0;
+    return 0; /* ended (or not listed: over) */
 }
 
 /* The last line before "gibench-cell-exit N" in a task's log, and N (-1: no such line). */

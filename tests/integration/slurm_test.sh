@@ -7,7 +7,9 @@
 #      metrics (the timings differ);
 #   2. one method-run task cancelled on purpose: only its cell is marked
 #      failed, with the task's Slurm state; the others are done;
-#   3. resubmitting runs that cell alone and completes the study.
+#   3. resubmitting runs that cell alone and completes the study;
+#   4. the reference stage cancelled: no run starts, and the report marks
+#      every run with the reference task's fate.
 # Skipped ("SKIPPED: why") when not root or when the daemons cannot start.
 # usage: slurm_test.sh GIBENCH ROOT OUT
 set -u
@@ -176,4 +178,26 @@ grep -q "(0 to make), 3 runs (2 done before, 0 not applicable, 1 to run)" "$T/re
     fail "resubmitting did not run the one missing cell alone: $(cat "$T/resume.out")"
 same=$(csv_same "$L/runs.csv" "$F/runs.csv") || fail "after resubmitting, results differ from the local run: $same"
 echo "resubmitted: $same"
+# 4. the reference stage cancelled: no run starts (afterok), the collect job
+# still reports, every run marked with the reference task's fate
+R=$OUT/slurm_noref
+rm -rf "$R"
+"$GIB" study "$STUDY" --out "$R" --slurm --no-wait >"$T/noref.out" 2>&1 || fail "--no-wait failed: $(cat "$T/noref.out")"
+read -r refs_job collect_job < <(sed -n 's/^submitted: references \([0-9]*\) .*collect \([0-9]*\)$/\1 \2/p' "$T/noref.out")
+[ -n "${collect_job:-}" ] || fail "--no-wait printed no job ids: $(cat "$T/noref.out")"
+scancel "$refs_job" || fail "scancel $refs_job failed"
+for _ in $(seq 300); do
+    st=$(squeue -h -t all -j "$collect_job" -o %T 2>/dev/null)
+    case "$st" in PENDING|RUNNING|CONFIGURING|COMPLETING) sleep 0.5 ;; *) break ;; esac
+done
+[ "$st" = COMPLETED ] || fail "the collect job ended $st after the references were cancelled"
+python3 - "$R/runs.csv" "$refs_job" <<'PY' || fail "runs without their references are not marked so"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert len(rows) == 3, rows
+for r in rows:
+    assert r["status"] == "failed" and r["reason"].startswith("no reference") and \
+        ("Slurm task %s_0: CANCELLED" % sys.argv[2]) in r["reason"], (r["run"], r["status"], r["reason"])
+print("no references:", rows[0]["reason"])
+PY
 echo "slurm: all checks passed"
