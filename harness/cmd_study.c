@@ -1672,7 +1672,7 @@ static void slurm_collect_runs(study *st, gi_plugins *reg, const char *out, cons
         if (json_object_object_get_ex(rec, "cached", &v)) {
             json_object_object_del(rec, "cached");
         } else if (json_object_object_get_ex(rec, "status", &v) && !strcmp(json_object_get_string(v), "failed")) {
-            char why[1800], task[1000];
+            char why[2200], task[1000];
             if (r->ref_index >= 0 && st->refs[r->ref_index].missing[0]) {
                 slurm_tasks_describe(rt, (uint32_t)r->ref_index, task, sizeof task);
                 snprintf(why, sizeof why, "no reference (%s): %s", st->refs[r->ref_index].missing, task);
@@ -1740,10 +1740,12 @@ int cmd_study(int argc, char **argv)
         if (st.timer)
             setenv("GIBENCH_TIMER", st.timer, 1);
         cli_install_signal_handlers();
+        /* a study running locally in DIR refuses the submission; the lock
+         * is given back at once, for the collect job to take */
         int lock_fd = -1;
         if (so.enabled && !dry && cli_mkdirs(out))
-            lock_fd = lock_out_dir(out, &rc); /* no local study in DIR meanwhile; freed before the collect job runs */
-        if (rc == EXIT_OK && so.enabled && lock_fd >= 0)
+            lock_fd = lock_out_dir(out, &rc);
+        if (lock_fd >= 0)
             close(lock_fd);
         if (rc == EXIT_OK)
             rc = so.cell ? slurm_cell(&st, out, reg, so.cell) : slurm_submit_study(&st, file, out, reg, &so);
