@@ -140,8 +140,8 @@ grep -q "submitted: references [0-9]* (1 tasks), runs [0-9]* (3 tasks), collect 
 [ -s "$S/report.md" ] || fail "the collect job wrote no report"
 same=$(csv_same "$L/runs.csv" "$S/runs.csv") || fail "local and Slurm results differ: $same"
 ls "$S"/slurm/logs/run-*_0.log >/dev/null 2>&1 || fail "no task log in $S/slurm/logs"
-printf 'local vs slurm: %s; wall %.1f s locally, %.1f s through Slurm (submission to report)\n' "$same" \
-    "$(echo "$t1 - $t0" | bc -l)" "$(echo "$t2 - $t1" | bc -l)"
+awk -v s="$same" -v a="$t0" -v b="$t1" -v c="$t2" \
+    'BEGIN { printf "local vs slurm: %s; wall %.1f s locally, %.1f s through Slurm (submission to report)\n", s, b - a, c - b }'
 
 # resubmitting a finished study runs nothing but the collect job
 "$GIB" study "$STUDY" --out "$S" --slurm >"$T/again.out" 2>&1 || fail "resubmitting a done study failed: $(tail -n 3 "$T/again.out")"
