@@ -10,6 +10,7 @@
 #include "gi/cache.h"
 #include "report.h"
 #include "runner.h"
+#include "slurm.h"
 #include "tradeoff.h"
 
 #include <errno.h>
@@ -71,6 +72,7 @@ typedef struct study_ref {
     uint32_t matched_count;
     /* the path tracer's convergence: full GI, and for each matched bounce count */
     tradeoff_pt_curve pt_full, pt_matched[8];
+    char missing[1100]; /* gibench study --slurm-collect: why the set was not made, or "" */
 } study_ref;
 
 typedef struct study {
@@ -992,58 +994,78 @@ static int pt_convergence(study *st, const char *out_dir, const study_ref *sc, c
     return 1;
 }
 
+/* One reference set: the full-GI reference, the bounce-matched ones for
+ * every method bounce count in use and, with `curves`, the path tracer's
+ * convergence images. 1 when all exist (made now or before), else 0 with why. */
+static int build_reference_set(study *st, const char *out_dir, uint32_t ri, int curves, char *why, size_t why_size)
+{
+    study_ref *sc = &st->refs[ri];
+    const char *path = st->scenes[sc->scene_index].path;
+    char dir[2048], stem[320];
+    snprintf(stem, sizeof stem, "%s", sc->name); /* a copy: -Wrestrict sees sc->name and the outputs as one object */
+    snprintf(dir, sizeof dir, "%s/references", out_dir);
+    cli_mkdirs(dir);
+    /* the file name carries every setting that changes the image, so that
+     * runs compared with an older reference are not taken as done */
+    const char *px = st->ref_pixel_center ? "_center" : "";
+    snprintf(sc->ref_full, sizeof sc->ref_full, "%s/%s_b%u_%uspp%s.exr", dir, stem, st->ref_bounces, st->ref_spp,
+             px);
+    fprintf(stderr, "study: reference %s (%ux%u, %u spp, %u bounces)\n", stem, sc->width, sc->height, st->ref_spp,
+            st->ref_bounces);
+    if (!runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width, sc->height, st->ref_spp, st->ref_target_se, st->ref_bounces,
+                          st->seed, sc->time, st->ref_pixel_center, st->timeout_s * 10, sc->ref_full, why,
+                          why_size))
+        return 0;
+    /* bounce-matched references for every method bounce count in use */
+    for (uint32_t r = 0; r < st->run_count; r++) {
+        if (st->runs[r].ref_index != (int)ri || st->runs[r].bounces >= st->ref_bounces)
+            continue;
+        uint32_t b = st->runs[r].bounces, k = 0;
+        while (k < sc->matched_count && sc->matched_bounces[k] != b)
+            k++;
+        if (k == sc->matched_count && k < 8) {
+            sc->matched_bounces[k] = b;
+            snprintf(sc->ref_matched[k], sizeof sc->ref_matched[k], "%s/%s_b%u_%uspp%s.exr", dir, stem, b,
+                     st->ref_spp, px);
+            fprintf(stderr, "study: bounce-matched reference %s (%u bounces)\n", stem, b);
+            if (!runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width, sc->height, st->ref_spp, st->ref_target_se, b,
+                                  st->seed, sc->time, st->ref_pixel_center, st->timeout_s * 10,
+                                  sc->ref_matched[k], why, why_size))
+                return 0;
+            sc->matched_count++;
+        }
+    }
+    if (!curves)
+        return 1;
+    /* the path tracer's convergence, for full GI and for each bounce
+     * count in use: k-spp images (another seed) against the reference
+     * of the same bounce count */
+    sc->pt_full.bounces = st->ref_bounces;
+    if (!pt_convergence(st, out_dir, sc, path, st->ref_bounces, sc->ref_full, &sc->pt_full, why, why_size))
+        return 0;
+    for (uint32_t k = 0; k < sc->matched_count; k++) {
+        sc->pt_matched[k].bounces = sc->matched_bounces[k];
+        if (!pt_convergence(st, out_dir, sc, path, sc->matched_bounces[k], sc->ref_matched[k], &sc->pt_matched[k], why,
+                            why_size))
+            return 0;
+    }
+    return 1;
+}
+
+/* gibench study --slurm-collect: a missing reference set is reported with
+ * its runs, not fatal (slurm_mark_missing_refs) */
+static const slurm_options *slurm_collecting;
+static void slurm_mark_missing_ref(study *st, uint32_t ri, const char *why);
+
 static int build_references(study *st, const char *out_dir)
 {
     char why[1024];
     for (uint32_t ri = 0; ri < st->ref_count; ri++) {
-        study_ref *sc = &st->refs[ri];
-        const char *path = st->scenes[sc->scene_index].path;
-        char dir[2048], stem[320];
-        snprintf(stem, sizeof stem, "%s", sc->name); /* a copy: -Wrestrict sees sc->name and the outputs as one object */
-        snprintf(dir, sizeof dir, "%s/references", out_dir);
-        cli_mkdirs(dir);
-        /* the file name carries every setting that changes the image, so that
-         * runs compared with an older reference are not taken as done */
-        const char *px = st->ref_pixel_center ? "_center" : "";
-        snprintf(sc->ref_full, sizeof sc->ref_full, "%s/%s_b%u_%uspp%s.exr", dir, stem, st->ref_bounces, st->ref_spp,
-                 px);
-        fprintf(stderr, "study: reference %s (%ux%u, %u spp, %u bounces)\n", stem, sc->width, sc->height, st->ref_spp,
-                st->ref_bounces);
-        if (!runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width, sc->height, st->ref_spp, st->ref_target_se, st->ref_bounces,
-                              st->seed, sc->time, st->ref_pixel_center, st->timeout_s * 10, sc->ref_full, why,
-                              sizeof why))
+        if (build_reference_set(st, out_dir, ri, 1, why, sizeof why))
+            continue;
+        if (!slurm_collecting)
             return cli_fail(EXIT_RUN, "study: %s", why);
-        /* bounce-matched references for every method bounce count in use */
-        for (uint32_t r = 0; r < st->run_count; r++) {
-            if (st->runs[r].ref_index != (int)ri || st->runs[r].bounces >= st->ref_bounces)
-                continue;
-            uint32_t b = st->runs[r].bounces, k = 0;
-            while (k < sc->matched_count && sc->matched_bounces[k] != b)
-                k++;
-            if (k == sc->matched_count && k < 8) {
-                sc->matched_bounces[k] = b;
-                snprintf(sc->ref_matched[k], sizeof sc->ref_matched[k], "%s/%s_b%u_%uspp%s.exr", dir, stem, b,
-                         st->ref_spp, px);
-                fprintf(stderr, "study: bounce-matched reference %s (%u bounces)\n", stem, b);
-                if (!runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width, sc->height, st->ref_spp, st->ref_target_se, b,
-                                      st->seed, sc->time, st->ref_pixel_center, st->timeout_s * 10,
-                                      sc->ref_matched[k], why, sizeof why))
-                    return cli_fail(EXIT_RUN, "study: %s", why);
-                sc->matched_count++;
-            }
-        }
-        /* the path tracer's convergence, for full GI and for each bounce
-         * count in use: k-spp images (another seed) against the reference
-         * of the same bounce count */
-        sc->pt_full.bounces = st->ref_bounces;
-        if (!pt_convergence(st, out_dir, sc, path, st->ref_bounces, sc->ref_full, &sc->pt_full, why, sizeof why))
-            return cli_fail(EXIT_RUN, "study: %s", why);
-        for (uint32_t k = 0; k < sc->matched_count; k++) {
-            sc->pt_matched[k].bounces = sc->matched_bounces[k];
-            if (!pt_convergence(st, out_dir, sc, path, sc->matched_bounces[k], sc->ref_matched[k], &sc->pt_matched[k], why,
-                                sizeof why))
-                return cli_fail(EXIT_RUN, "study: %s", why);
-        }
+        slurm_mark_missing_ref(st, ri, why);
     }
     return EXIT_OK;
 }
@@ -1532,13 +1554,154 @@ static int lock_out_dir(const char *out, int *rc)
     return fd;
 }
 
+/* ---- gibench study --slurm (slurm.h): the same cells as Slurm array tasks ---- */
+
+static void slurm_mark_missing_ref(study *st, uint32_t ri, const char *why)
+{
+    snprintf(st->refs[ri].missing, sizeof st->refs[ri].missing, "%s", why);
+}
+
+/* What the planned cells are: a task refuses to run a study that has
+ * changed since it was submitted (its index would name another cell). */
+static uint64_t slurm_plan_hash(const study *st)
+{
+    uint64_t h = gi_hash64(st->name, strlen(st->name), st->run_count * 131u + st->ref_count);
+    for (uint32_t i = 0; i < st->ref_count; i++)
+        h = gi_hash64(st->refs[i].name, strlen(st->refs[i].name), h);
+    for (uint32_t i = 0; i < st->run_count; i++)
+        h = gi_hash64(st->runs[i].id, strlen(st->runs[i].id), h);
+    return h;
+}
+
+/* --cell KIND:K:PLAN: one array task. "ref": reference set K, as the local
+ * runner builds it; "run": run K, after checking that its references exist,
+ * exactly as the local runner runs it (runner_execute, resuming). Exit 0
+ * when the cell is done (or not applicable), 1 when it failed. */
+static int slurm_cell(study *st, const char *out, gi_plugins *reg, const char *cell)
+{
+    char kind[8];
+    unsigned long k;
+    unsigned long long plan;
+    if (sscanf(cell, "%7[a-z]:%lu:%llx", kind, &k, &plan) != 3 || (strcmp(kind, "ref") && strcmp(kind, "run")))
+        return cli_fail(EXIT_USAGE, "study: --cell '%s' is not ref:K:PLAN or run:K:PLAN", cell);
+    if (plan != slurm_plan_hash(st))
+        return cli_fail(EXIT_USAGE, "study: the study's plan changed since it was submitted: resubmit it");
+    uint32_t n = !strcmp(kind, "ref") ? st->ref_count : st->run_count;
+    if (k >= n)
+        return cli_fail(EXIT_USAGE, "study: --cell %s: the study has %u such cells", cell, n);
+    char why[1024];
+    if (!strcmp(kind, "ref")) {
+        if (!build_reference_set(st, out, (uint32_t)k, 1, why, sizeof why))
+            return cli_fail(EXIT_RUN, "study: %s", why);
+        fprintf(stderr, "study: reference set %s done\n", st->refs[k].name);
+        return EXIT_OK;
+    }
+    study_run *r = &st->runs[k];
+    if (r->ref_index >= 0) {
+        runner_set_collect_only(1); /* the references stage made them */
+        int ok = build_reference_set(st, out, (uint32_t)r->ref_index, 0, why, sizeof why);
+        runner_set_collect_only(0);
+        if (!ok)
+            return cli_fail(EXIT_RUN, "study: run %s: %s", r->id, why);
+    }
+    attach_refs(st, r);
+    double t0 = gi_now();
+    r->record = run_or_skip(r, reg, 1);
+    json_object *v;
+    const char *status = json_object_object_get_ex(r->record, "status", &v) ? json_object_get_string(v) : "?";
+    int cached = json_object_object_get_ex(r->record, "cached", &v) && json_object_get_boolean(v);
+    const char *reason = json_object_object_get_ex(r->record, "reason", &v) ? json_object_get_string(v) : "";
+    fprintf(stderr, "study: run %s: %s%s%s%s (%.1f s)\n", r->id, status, cached ? " (cached)" : "",
+            reason[0] ? ": " : "", reason, gi_now() - t0);
+    return !strcmp(status, "ok") || !strcmp(status, "n/a") ? EXIT_OK : EXIT_RUN;
+}
+
+/* --slurm: plans the cells as the local runner does, leaves out those
+ * already done (resume), and hands the rest to Slurm (slurm_run). */
+static int slurm_submit_study(study *st, const char *file, const char *out, gi_plugins *reg, const slurm_options *so)
+{
+    uint32_t *ref_tasks = calloc(st->ref_count + 1, sizeof *ref_tasks);
+    uint32_t *run_tasks = calloc(st->run_count + 1, sizeof *run_tasks);
+    if (!ref_tasks || !run_tasks) {
+        free(ref_tasks);
+        free(run_tasks);
+        return cli_fail(EXIT_RUN, "study: out of memory");
+    }
+    uint32_t nref = 0, nrun = 0, cached = 0, na = 0;
+    char why[1024];
+    runner_set_collect_only(1);
+    for (uint32_t i = 0; i < st->ref_count; i++)
+        if (!build_reference_set(st, out, i, 0, why, sizeof why))
+            ref_tasks[nref++] = i;
+    for (uint32_t i = 0; i < st->run_count; i++) {
+        study_run *r = &st->runs[i];
+        attach_refs(st, r);
+        json_object *rec = run_or_skip(r, reg, 1), *v;
+        const char *status = json_object_object_get_ex(rec, "status", &v) ? json_object_get_string(v) : "";
+        if (json_object_object_get_ex(rec, "cached", &v))
+            cached++;
+        else if (!strcmp(status, "n/a"))
+            na++;
+        else
+            run_tasks[nrun++] = i;
+        json_object_put(rec);
+    }
+    runner_set_collect_only(0);
+    fprintf(stderr, "study: %s: %u reference sets (%u to make), %u runs (%u done before, %u not applicable, %u to run)\n",
+            st->name, st->ref_count, nref, st->run_count, cached, na, nrun);
+    slurm_stage refs = {"ref", ref_tasks, nref}, runs = {"run", run_tasks, nrun};
+    int rc = slurm_run(so, file, out, st->name, slurm_plan_hash(st), &refs, &runs);
+    free(ref_tasks);
+    free(run_tasks);
+    return rc;
+}
+
+/* --slurm-collect REFJOB,RUNJOB: the records of every run from the cells'
+ * results, running nothing; a cell without a result is a failed run whose
+ * reason is how its Slurm task ended. */
+static void slurm_collect_runs(study *st, gi_plugins *reg, const char *out, const char *jobs)
+{
+    char ref_job[64] = "-", run_job[64] = "-";
+    sscanf(jobs, "%63[^,],%63s", ref_job, run_job);
+    slurm_tasks *rt = slurm_tasks_query(out, "ref", ref_job), *mt = slurm_tasks_query(out, "run", run_job);
+    runner_set_collect_only(1);
+    for (uint32_t i = 0; i < st->run_count; i++) {
+        study_run *r = &st->runs[i];
+        attach_refs(st, r);
+        json_object *rec = run_or_skip(r, reg, 1), *v;
+        if (json_object_object_get_ex(rec, "cached", &v)) {
+            json_object_object_del(rec, "cached");
+        } else if (json_object_object_get_ex(rec, "status", &v) && !strcmp(json_object_get_string(v), "failed")) {
+            char why[2200], task[1000];
+            if (r->ref_index >= 0 && st->refs[r->ref_index].missing[0]) {
+                slurm_tasks_describe(rt, (uint32_t)r->ref_index, task, sizeof task);
+                snprintf(why, sizeof why, "no reference (%s): %s", st->refs[r->ref_index].missing, task);
+            } else {
+                slurm_tasks_describe(mt, i, task, sizeof task);
+                snprintf(why, sizeof why, "no result: %s", task);
+            }
+            json_object_object_add(rec, "reason", json_object_new_string(why));
+            json_object_object_del(rec, "config");
+            fprintf(stderr, "study: run %s: %s\n", r->id, why);
+        }
+        r->record = rec;
+    }
+    runner_set_collect_only(0);
+    slurm_tasks_free(rt);
+    slurm_tasks_free(mt);
+}
+
 int cmd_study(int argc, char **argv)
 {
     const char *file = NULL, *out = NULL;
     unsigned long jobs = 1;
-    int fresh = 0, dry = 0;
+    int fresh = 0, dry = 0, taken;
+    slurm_options so = {0};
     for (int i = 0; i < argc; i++) {
-        if (!strcmp(argv[i], "--out") && i + 1 < argc)
+        if ((taken = slurm_take_option(argc, argv, &i, &so)) != 0) {
+            if (taken < 0)
+                return EXIT_USAGE;
+        } else if (!strcmp(argv[i], "--out") && i + 1 < argc)
             out = argv[++i];
         else if (!strcmp(argv[i], "--jobs") && i + 1 < argc) {
             if (!cli_parse_uint(argv[++i], 1, 64, &jobs))
@@ -1558,13 +1721,42 @@ int cmd_study(int argc, char **argv)
     }
     if (!file || (!out && !dry))
         return cli_fail(EXIT_USAGE,
-                        "study: usage: gibench study STUDY.json --out DIR [--jobs N] [--resume|--fresh] [--dry-run]");
+                        "study: usage: gibench study STUDY.json --out DIR [--jobs N] [--resume|--fresh] [--dry-run] "
+                        "[--slurm [--partition P] [--gres G] [--time T] [--array-limit K] [--no-wait]]");
     if (!out)
         out = ".";
+    so.dry_run = dry;
+    int src = slurm_check(&so, file, out);
+    if (src != EXIT_OK)
+        return src;
+    if (fresh && (so.enabled || so.cell || so.collect))
+        return cli_fail(EXIT_USAGE, "study: --fresh does not go with --slurm (remove the results to redo)");
     gi_plugins *reg = cli_load_plugins(0);
     study st;
     memset(&st, 0, sizeof st);
     int rc = load_study(&st, file, out, reg);
+    if (rc == EXIT_OK && (so.enabled || so.cell)) {
+        /* Slurm: submit the cells, or run one as an array task */
+        if (st.timer)
+            setenv("GIBENCH_TIMER", st.timer, 1);
+        cli_install_signal_handlers();
+        /* a study running locally in DIR refuses the submission; the lock
+         * is given back at once, for the collect job to take */
+        int lock_fd = -1;
+        if (so.enabled && !dry && cli_mkdirs(out))
+            lock_fd = lock_out_dir(out, &rc);
+        if (lock_fd >= 0)
+            close(lock_fd);
+        if (rc == EXIT_OK)
+            rc = so.cell ? slurm_cell(&st, out, reg, so.cell) : slurm_submit_study(&st, file, out, reg, &so);
+        study_free(&st);
+        gi_plugins_free(reg);
+        return rc;
+    }
+    if (rc == EXIT_OK && so.collect) {
+        slurm_collecting = &so;
+        runner_set_collect_only(1);
+    }
     if (rc == EXIT_OK && dry)
         print_plan(&st);
     if (rc == EXIT_OK && !dry && !cli_mkdirs(out))
@@ -1580,7 +1772,10 @@ int cmd_study(int argc, char **argv)
         rc = build_references(&st, out);
     }
     if (rc == EXIT_OK && !dry) {
-        execute_runs(&st, (uint32_t)jobs, fresh, reg);
+        if (so.collect)
+            slurm_collect_runs(&st, reg, out, so.collect);
+        else
+            execute_runs(&st, (uint32_t)jobs, fresh, reg);
         json_object *runs = json_object_new_array();
         char renderer[256] = "";
         int failed = 0, interrupted = 0;

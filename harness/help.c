@@ -71,6 +71,7 @@ static const command_help helps[] = {
      "  --fresh                rerun methods even when a result for the same configuration exists\n"},
     {"study",
      "usage: gibench study STUDY.json --out DIR [--jobs N] [--resume|--fresh] [--dry-run]\n"
+     "         [--slurm [--partition P] [--gres G] [--time T] [--array-limit K] [--no-wait]]\n"
      "Run a declarative experiment (README.md, \"Studies\"): every method setting x scene x repeat in\n"
      "its own process, against the references, with convergence curves, Pareto fronts and the\n"
      "equal-error and equal-time tables; cached runs are not run again.\n"
@@ -78,7 +79,12 @@ static const command_help helps[] = {
      "  --jobs N      worker processes\n"
      "  --resume      keep earlier results of the same configuration (the default)\n"
      "  --fresh       run everything again\n"
-     "  --dry-run     check the file and print the plan; run nothing\n"},
+     "  --dry-run     check the file and print the plan; run nothing (with --slurm: print the job scripts)\n"
+     "  --slurm       run the cells as Slurm job arrays (README.md, \"Studies on a Slurm cluster\"):\n"
+     "                references, then method runs (afterok), then a collect job that writes the report\n"
+     "  --partition P --gres G --time T   sbatch's options for the cells' tasks\n"
+     "  --array-limit K   at most K tasks of an array at once\n"
+     "  --no-wait     return once submitted (the collect job still writes the report)\n"},
     {"conformance",
      "usage: gibench conformance [--method M] [--json] [--size N] [--item-timeout S]\n"
      "The conformance suite on every method (or M): closed emitting sphere = Le * sum rho^k for its\n"

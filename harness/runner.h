@@ -31,6 +31,12 @@ typedef struct run_spec {
 /* Runs (or resumes) a run; never fails as a whole: failures are records
  * with status "failed" and the child's own message. Caller owns the result. */
 json_object *runner_execute(const run_spec *spec, int resume);
+/* Collect-only mode (on: 1), for gibench study --slurm, whose cells run
+ * elsewhere: runner_execute runs nothing and writes nothing, returning the
+ * cached result (with "cached": true, resume or not) or a "failed" record
+ * "no result"; runner_reference says whether the reference exists (0 with
+ * why when not) without rendering it. */
+void runner_set_collect_only(int on);
 /* A record for a run that was not attempted ("n/a" with the reason). */
 json_object *runner_not_applicable(const run_spec *spec, const char *reason);
 

@@ -32,6 +32,9 @@ pkgs=(
   # The report page in a real browser (tests/integration/report_browser.cmake):
   # Debian's Chromium, driven by playwright-core from npm (tests/browser/).
   chromium
+  # Studies on a cluster (gibench study --slurm) and their test, a one-node
+  # Slurm brought up by hand (tests/integration/slurm_test.sh)
+  slurm-wlm munge
 )
 # npm for the browser test (and the scene-conversion scripts); a machine that
 # already has a Node.js with npm (not from Debian) keeps it.

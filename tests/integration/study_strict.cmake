@@ -112,6 +112,47 @@ if(NOT rc EQUAL 0 OR NOT nruns EQUAL 2 OR NOT ngiven EQUAL 18)
     fail("csm with all its parameters: expected exit 0, 2 runs of 18 parameters; got exit ${rc}, ${nruns} runs, ${ngiven} parameters\n${out}${err}")
 endif()
 
+# --slurm's options: refused with exit 2 and one line before anything is
+# planned or submitted (no Slurm needed).
+set(TINY tests/data/studies/slurm_tiny.json)
+# refuse_opts(<name> <regex> <args...>)
+function(refuse_opts name regex)
+    execute_process(COMMAND ${ARGN} WORKING_DIRECTORY ${ROOT} TIMEOUT 60
+                    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    expect_refusal(${name} "${regex}" "${rc}" "${err}")
+    set(failures ${failures} PARENT_SCOPE)
+endfunction()
+refuse_opts(slurm_partition "--partition 'a b' is not a partition name"
+            ${GIB} study ${TINY} --out ${D}/s --slurm --dry-run --partition "a b")
+refuse_opts(slurm_time "--time '1:2:3:4' is not a Slurm time"
+            ${GIB} study ${TINY} --out ${D}/s --slurm --dry-run --time 1:2:3:4)
+refuse_opts(slurm_gres "--gres 'gpu[*]1' is not a generic resource"
+            ${GIB} study ${TINY} --out ${D}/s --slurm --dry-run --gres "gpu*1")
+refuse_opts(slurm_array_limit "--array-limit '0' is not an integer"
+            ${GIB} study ${TINY} --out ${D}/s --slurm --dry-run --array-limit 0)
+refuse_opts(slurm_missing_value "--time needs a value" ${GIB} study ${TINY} --out ${D}/s --slurm --time)
+refuse_opts(slurm_without "go with --slurm" ${GIB} study ${TINY} --out ${D}/s --partition p)
+refuse_opts(slurm_fresh "--fresh does not go with --slurm" ${GIB} study ${TINY} --out ${D}/s --slurm --fresh)
+refuse_opts(slurm_blank_out "without blanks" ${GIB} study ${TINY} --out "${D}/a b" --slurm --dry-run)
+refuse_opts(slurm_no_sbatch "sbatch is not on PATH"
+            ${CMAKE_COMMAND} -E env PATH=${D} ${GIB} study ${TINY} --out ${D}/s --slurm)
+refuse_opts(slurm_bad_cell "--cell 'run:x' is not" ${GIB} study ${TINY} --out ${D}/s --cell run:x)
+refuse_opts(slurm_stale_cell "the study's plan changed" ${GIB} study ${TINY} --out ${D}/s --cell run:0:1234)
+# a dry run prints the three scripts, the run array with its limit
+execute_process(COMMAND ${GIB} study ${TINY} --out ${D}/s --slurm --dry-run --array-limit 2 --partition gpu
+                        --gres gpu:1 --time 10:00 WORKING_DIRECTORY ${ROOT} TIMEOUT 60
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+    fail("--slurm --dry-run: exit ${rc}: ${err}")
+endif()
+foreach(want "#SBATCH --array=0%2" "#SBATCH --array=0-2%2" "#SBATCH --partition=gpu" "#SBATCH --gres=gpu:1"
+        "#SBATCH --time=10:00" "--cell run:\"[$]SLURM_ARRAY_TASK_ID\":" "--slurm-collect \"[$]1,[$]2\"")
+    match("${out}" "${want}" "--slurm --dry-run lacks ${want}:\n${out}")
+endforeach()
+if(EXISTS ${D}/s/slurm/runs.sh)
+    fail("--slurm --dry-run wrote a script")
+endif()
+
 if(failures GREATER 0)
     message(FATAL_ERROR "${failures} malformed study file(s) not refused properly")
 endif()
