@@ -1335,6 +1335,17 @@ static void user_charts(study *st, const char *out_dir, json_object *runs, json_
     if (!st->charts)
         return;
     size_t nr = json_object_array_length(runs);
+    /* runs timed under different GL renderers (cluster nodes) never share a
+     * series: their label names the renderer */
+    const char *renderer0 = NULL;
+    int mixed = 0;
+    for (size_t i = 0; i < nr; i++) {
+        json_object *rec = json_object_array_get_idx(runs, i), *r;
+        const char *rn = json_object_object_get_ex(rec, "renderer", &r) ? json_object_get_string(r) : "";
+        if (!renderer0)
+            renderer0 = rn;
+        mixed |= strcmp(renderer0, rn) != 0;
+    }
     for (size_t ci = 0; ci < json_object_array_length(st->charts); ci++) {
         json_object *c = json_object_array_get_idx(st->charts, ci), *v, *where = NULL;
         const char *file = json_object_get_string(json_object_object_get(c, "file"));
@@ -1368,6 +1379,11 @@ static void user_charts(study *st, const char *out_dir, json_object *runs, json_
                 json_object_put(s);
             } else
                 snprintf(label, sizeof label, "%s", yf);
+            json_object *rn;
+            if (mixed && json_object_object_get_ex(rec, "renderer", &rn)) {
+                size_t used = strlen(label);
+                snprintf(label + used, sizeof label - used, " [%s]", json_object_get_string(rn));
+            }
             uint32_t k = 0;
             while (k < ns && strcmp(labels[k], label))
                 k++;

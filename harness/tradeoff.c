@@ -114,6 +114,8 @@ typedef struct setting {
     double t_lo[MAX_POINTS], t_hi[MAX_POINTS], em_lo[MAX_POINTS], em_hi[MAX_POINTS];
     uint32_t frame[MAX_POINTS];
     double prep_s;
+    const char *renderer; /* the GL renderer its runs reported ("" when none) */
+    char label[192];      /* the method, with its renderer when runs of a set differ in it */
 } setting;
 
 typedef struct front_point {
@@ -129,17 +131,33 @@ static const tradeoff_pt_curve *curve_for(const tradeoff_pt_curve *full, const t
     return full;
 }
 
-/* Pools the runs of each setting. Returns the number of settings. */
+/* Pools the runs of each setting. Returns the number of settings. Timings
+ * from different GL renderers (runs on different machines, e.g. cluster
+ * nodes) are never pooled: the runs of one setting are repeats only when
+ * their renderer is the same, and when the runs disagree on the renderer
+ * each method is listed once per renderer ("csm [NVIDIA ...]"), with its
+ * own front and rows. */
 static uint32_t pool_settings(const tradeoff_run *runs, uint32_t run_n, setting *set, const char **methods,
                               uint32_t *nm)
 {
     uint32_t ns = 0;
     *nm = 0;
+    const char *first_renderer = NULL;
+    int mixed = 0;
     for (uint32_t i = 0; i < run_n; i++) {
         if (strcmp(str(runs[i].record, "status"), "ok"))
             continue;
+        const char *r = str(runs[i].record, "renderer");
+        if (!first_renderer)
+            first_renderer = r;
+        mixed |= strcmp(first_renderer, r) != 0;
+    }
+    for (uint32_t i = 0; i < run_n; i++) {
+        if (strcmp(str(runs[i].record, "status"), "ok"))
+            continue;
+        const char *renderer = str(runs[i].record, "renderer");
         uint32_t s = 0;
-        while (s < ns && set[s].key != runs[i].setting)
+        while (s < ns && (set[s].key != runs[i].setting || strcmp(set[s].renderer, renderer)))
             s++;
         if (s < ns)
             continue;
@@ -147,7 +165,12 @@ static uint32_t pool_settings(const tradeoff_run *runs, uint32_t run_n, setting 
         memset(g, 0, sizeof *g);
         g->key = runs[i].setting;
         g->first = runs[i].record;
-        g->method = str(runs[i].record, "method");
+        g->renderer = renderer;
+        if (mixed)
+            snprintf(g->label, sizeof g->label, "%s [%s]", str(runs[i].record, "method"), *renderer ? renderer : "no renderer");
+        else
+            snprintf(g->label, sizeof g->label, "%s", str(runs[i].record, "method"));
+        g->method = g->label;
         g->bounces = runs[i].bounces;
         uint32_t m = 0;
         while (m < *nm && strcmp(methods[m], g->method))
@@ -160,7 +183,8 @@ static uint32_t pool_settings(const tradeoff_run *runs, uint32_t run_n, setting 
         double prep[64];
         uint32_t n = MAX_POINTS, rep = 0;
         for (uint32_t j = i; j < run_n && rep < 64; j++) {
-            if (runs[j].setting != g->key || strcmp(str(runs[j].record, "status"), "ok"))
+            if (runs[j].setting != g->key || strcmp(str(runs[j].record, "status"), "ok") ||
+                strcmp(str(runs[j].record, "renderer"), renderer))
                 continue;
             double rt[MAX_POINTS], ref[MAX_POINTS], rem[MAX_POINTS];
             uint32_t frame[MAX_POINTS];

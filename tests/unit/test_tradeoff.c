@@ -153,9 +153,44 @@ static void test_report(void)
         json_object_put(runs[i].record);
 }
 
+/* Runs of one setting timed under two GL renderers (two cluster nodes) are
+ * not repeats of each other: the tables list the method once per renderer,
+ * each with its own time, and no spread pools the two. With one renderer
+ * the same runs are repeats (the median time, the spread of relMSE). */
+static void test_renderers(void)
+{
+    double t1[2] = {0.01, 0.02}, t2[2] = {0.5, 1.0}, e1[2] = {0.3, 0.3}, e2[2] = {0.31, 0.31};
+    for (int mixed = 0; mixed < 2; mixed++) {
+        tradeoff_run runs[2] = {
+            {record("fast", "A", t1, e1, e1, 2, 0), 65, 7},
+            {record("fast", "A", t2, e2, e2, 2, 0), 65, 7},
+        };
+        json_object_object_add(runs[0].record, "renderer", json_object_new_string("NVIDIA H100"));
+        json_object_object_add(runs[1].record, "renderer", json_object_new_string(mixed ? "llvmpipe" : "NVIDIA H100"));
+        tradeoff_pt_curve full = {65, 3, {1, 4, 16}, {1, 0.25, 0.0625}};
+        gi_text md = {0};
+        json_object *charts = json_object_new_array();
+        tradeoff_report("/nonexistent", "box", &full, NULL, 0, runs, 2, NULL, charts, &md);
+        const char *s = md.s ? md.s : "";
+        if (mixed) {
+            CHECK_MSG(strstr(s, "| fast [NVIDIA H100] | `A` | 1 | 0.01 | 0.3 |") != NULL, "%s", s);
+            CHECK_MSG(strstr(s, "| fast [llvmpipe] | `A` | 1 | 0.5 | 0.31 |") != NULL, "%s", s);
+            CHECK_MSG(strstr(s, "[0.3–0.31]") == NULL, "two renderers pooled into one spread:\n%s", s);
+        } else {
+            CHECK_MSG(strstr(s, "| fast | `A` | 1 | 0.255 | 0.305 [0.3–0.31] |") != NULL, "%s", s);
+            CHECK_MSG(strstr(s, "[NVIDIA") == NULL, "%s", s);
+        }
+        free(md.s);
+        json_object_put(charts);
+        json_object_put(runs[0].record);
+        json_object_put(runs[1].record);
+    }
+}
+
 int main(void)
 {
     test_pt_time();
     test_report();
+    test_renderers();
     return gi_test_finish();
 }
