@@ -179,7 +179,7 @@ static int stage_names(json_object *runs, const char **names, int max)
 /* The last columns of runs.csv: the seed, and what the study's speed
  * against accuracy found for the run (tradeoff.h). */
 static const char *const tradeoff_keys[] = {"seed", "time_to_final_error_s", "frames_to_final_error",
-                                             "speedup_vs_pt", "speedup_vs_pt_matched", NULL};
+                                             "speedup_vs_pt", "speedup_vs_pt_matched", "speedup_extrapolated", NULL};
 
 static void write_csv(text *t, json_object *runs)
 {

@@ -398,7 +398,7 @@ static void annotate_records(const tradeoff_run *runs, uint32_t run_n, const tra
         }
         if (isfinite(tptm) && t[k] > 0)
             json_object_object_add(rec, "speedup_vs_pt_matched", json_object_new_double(tptm / t[k]));
-        json_object_object_add(rec, "speedup_extrapolated", json_object_new_boolean(ex || exm));
+        json_object_object_add(rec, "speedup_extrapolated", json_object_new_int(ex || exm)); /* 1: beyond the measured curve */
     }
 }
 

@@ -49,7 +49,8 @@ typedef gi_result (*tradeoff_chart_fn)(const char *path, const gi_chart_desc *de
  * has fewer bounces than the full reference) into out_dir, appending the
  * file names to chart_list; appends the tables to md; adds to each ok
  * record: time_to_final_error_s, pt_time_at_equal_error_s, speedup_vs_pt,
- * speedup_vs_pt_matched, speedup_extrapolated. `matched` holds the
+ * speedup_vs_pt_matched, speedup_extrapolated (1: the path tracer's time is extrapolated beyond its
+ * measured curve). `matched` holds the
  * bounce-limited curves (matched_n of them). */
 void tradeoff_report(const char *out_dir, const char *name, const tradeoff_pt_curve *full,
                      const tradeoff_pt_curve *matched, uint32_t matched_n, const tradeoff_run *runs,

@@ -1,0 +1,228 @@
+#!/usr/bin/env python3
+"""The five-way comparison's summary tables (issue 18).
+
+Reads DIR/runs.csv written by
+    gibench study harness/studies/compare_all.json --out DIR
+and prints Markdown to stdout:
+  - per method and scene, its most accurate setting's relMSE against the
+    full-GI reference, next to the unshadowed direct baseline's (the
+    trivial answer every method must beat), or why the method cannot
+    render the scene (its caps);
+  - per method and scene, its best equal-error speed-up over the path
+    tracer (the path tracer's time to the method's error / the method's
+    time to its image; precomputation excluded, as in the study's own
+    equal-error tables);
+  - per scene, each method's most accurate setting in full: error against
+    the full-GI and the bounce-matched reference, time to image, speed-ups,
+    precomputation time and memory in their own columns.
+The per-scene Pareto fronts, equal-error and equal-time tables and charts
+are in DIR/report.md (written by the study itself). Stdlib only; runs from
+the committed runs.csv alone.
+
+Usage: scripts/compare_all_tables.py DIR > DIR/tables.md
+"""
+
+import csv
+import os
+import sys
+
+METHODS = ["csm", "cssm_hrc", "avg", "implicit_vis", "vlf", "direct"]
+PAPER = {
+    "csm": "CSM (Ritschel et al. 2007)",
+    "cssm_hrc": "CSSM+HRC (Ritschel et al. 2008)",
+    "avg": "AVG (Bashford-Rogers et al. 2011)",
+    "implicit_vis": "implicit visibility (Dong et al. 2007)",
+    "vlf": "VLF (Mortensen et al. 2007)",
+    "direct": "unshadowed direct (baseline)",
+}
+
+
+def num(x):
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        return None
+    return v if v == v else None
+
+
+def scene_name(path):
+    return os.path.splitext(os.path.basename(path))[0]
+
+
+def memory_mb(row):
+    """The method's own data, MB: the stat data_bytes when the method
+    reports it; else the process's peak resident memory; else None."""
+    for key, scale in (("stat_data_bytes", 1 / 2**20), ("peak_rss_mb", 1.0), ("peak_rss_kb", 1 / 1024)):
+        v = num(row.get(key))
+        if v is not None:
+            return v * scale
+    return None
+
+
+def with_prep(r):
+    """Speed-up over the path tracer with precomputation paid once."""
+    sp, t, prep = num(r.get("speedup_vs_pt")), num(r.get("time_to_final_error_s")), num(r.get("prepare_ms"))
+    if sp is None or t is None or prep is None or t + prep / 1000.0 <= 0:
+        return None
+    return sp * t / (t + prep / 1000.0)
+
+
+def speedup_cell(r, prep):
+    """A speed-up, with "*" where the path tracer's time is extrapolated
+    beyond its measured convergence curve."""
+    v = with_prep(r) if prep else num(r["speedup_vs_pt"])
+    return "%.3g%s" % (v, "*" if num(r.get("speedup_extrapolated")) == 1 else "")
+
+
+def fmt(v, spec="%.3g", none="–"):
+    return none if v is None else spec % v
+
+
+def load(d):
+    with open(os.path.join(d, "runs.csv"), newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit("usage: compare_all_tables.py DIR")
+    d = sys.argv[1]
+    try:
+        rows = load(d)
+    except OSError as e:
+        sys.exit("compare_all_tables.py: %s" % e)
+    if not rows:
+        sys.exit("compare_all_tables.py: %s/runs.csv has no runs" % d)
+
+    scenes = []
+    for r in rows:
+        s = scene_name(r["scene"])
+        if s not in scenes:
+            scenes.append(s)
+    methods = [m for m in METHODS if any(r["method"] == m for r in rows)]
+    methods += sorted({r["method"] for r in rows} - set(methods))
+
+    ok = {}   # (method, scene) -> runs with status ok and an error
+    na = {}   # (method, scene) -> reason
+    for r in rows:
+        key = (r["method"], scene_name(r["scene"]))
+        if r["status"] == "ok" and num(r.get("relmse_full")) is not None:
+            ok.setdefault(key, []).append(r)
+        elif r["status"] != "ok":
+            reason = r.get("reason", "")
+            na.setdefault(key, reason if reason.startswith(r["status"]) else "%s: %s" % (r["status"], reason))
+
+    renderers = sorted({r["renderer"] for r in rows if r.get("renderer")})
+    timers = sorted({r["timer"] for r in rows if r.get("timer")})
+    sizes = sorted({"%sx%s" % (r["width"], r["height"]) for r in rows if r.get("width")})
+    out = []
+    w = out.append
+    w("# The five-way comparison: summary\n")
+    w("Made by `scripts/compare_all_tables.py %s` from `runs.csv` of "
+      "`gibench study harness/studies/compare_all.json --out %s --jobs 1`. "
+      "GL renderer: %s; timer: %s; image size %s. Lower relMSE is better. "
+      "The per-scene Pareto fronts, equal-error and equal-time tables and "
+      "the error-against-time charts are in [report.md](report.md).\n"
+      % (d, d, ", ".join(renderers) or "?", ", ".join(timers) or "?", ", ".join(sizes)))
+
+    def best(key):
+        runs = ok.get(key)
+        if not runs:
+            return None
+        return min(runs, key=lambda r: num(r["relmse_full"]))
+
+    # 1. best error per method and scene, with the baseline's beside it
+    w("## Best relMSE against the full-GI reference\n")
+    w("Each cell: the method's most accurate setting of its sweep. \"n/a\": "
+      "its caps do not cover the scene (the reason is in the per-scene "
+      "tables below). **Bold**: not better than the unshadowed direct "
+      "baseline on that scene (the trivial answer).\n")
+    w("| method | " + " | ".join(scenes) + " |")
+    w("|---|" + "---:|" * len(scenes))
+    for m in methods:
+        cells = []
+        for s in scenes:
+            b = best((m, s))
+            base = best(("direct", s))
+            if b is None:
+                cells.append("n/a" if (m, s) in na else "–")
+                continue
+            e = num(b["relmse_full"])
+            be = num(base["relmse_full"]) if base else None
+            cell = "%.3g" % e
+            if m != "direct" and be is not None and not e < be:
+                cell = "**%s**" % cell
+            cells.append(cell)
+        w("| %s | %s |" % (m, " | ".join(cells)))
+    w("")
+
+    # 2. best equal-error speed-up over the path tracer
+    w("## Best equal-error speed-up over path tracing\n")
+    w("Each cell: the largest speed-up over the method's sweep: the path "
+      "tracer's time to the run's error, divided by the run's time to its "
+      "image (the frames it needs; precomputation not included: see the "
+      "per-scene tables). Below 1: path tracing reaches that error sooner. "
+      "\"*\": the method's error is below the most converged image of the "
+      "path tracer's curve, whose time is then extrapolated (slope -1 on "
+      "log-log axes).\n")
+    w("| method | " + " | ".join(scenes) + " |")
+    w("|---|" + "---:|" * len(scenes))
+    for m in methods:
+        cells = []
+        for s in scenes:
+            runs = [r for r in ok.get((m, s), []) if num(r.get("speedup_vs_pt")) is not None]
+            if not runs:
+                cells.append("n/a" if (m, s) in na else "–")
+                continue
+            b = max(runs, key=lambda r: num(r["speedup_vs_pt"]))
+            cells.append(speedup_cell(b, 0))
+        w("| %s | %s |" % (m, " | ".join(cells)))
+    w("")
+    w("The same with the method's precomputation paid once: the path tracer's "
+      "time to the run's error / (precompute + time to image). This is the "
+      "speed-up for a single still image; the per-scene equal-error tables in "
+      "report.md amortise precomputation over 100 and 10,000 images.\n")
+    w("| method | " + " | ".join(scenes) + " |")
+    w("|---|" + "---:|" * len(scenes))
+    for m in methods:
+        cells = []
+        for s in scenes:
+            runs = [r for r in ok.get((m, s), []) if with_prep(r) is not None]
+            if not runs:
+                cells.append("n/a" if (m, s) in na else "–")
+                continue
+            cells.append(speedup_cell(max(runs, key=with_prep), 1))
+        w("| %s | %s |" % (m, " | ".join(cells)))
+    w("")
+
+    # 3. per scene, each method's most accurate setting
+    w("## Per scene: each method's most accurate setting\n")
+    w("Time to image: the sum of frame times up to the first frame within "
+      "1 % of the final error. Precompute: `prepare` (in these runs "
+      "csm and cssm_hrc, the methods that cache precomputation, run with `\"cache\": false`, so it is measured). Memory: the "
+      "method's own data (stat `data_bytes`) where it reports it, else "
+      "the render process's peak resident memory.\n")
+    for s in scenes:
+        w("### %s\n" % s)
+        w("| method | params | relMSE full | relMSE matched | time to image (s) | "
+          "speed-up | speed-up matched | precompute (s) | memory (MB) |")
+        w("|---|---|---:|---:|---:|---:|---:|---:|---:|")
+        for m in methods:
+            b = best((m, s))
+            if b is None:
+                if (m, s) in na:
+                    w("| %s | %s | | | | | | | |" % (m, na[(m, s)].replace("|", "/")))
+                continue
+            prep = num(b.get("prepare_ms"))
+            w("| %s | `%s` | %s | %s | %s | %s | %s | %s | %s |" % (
+                m, b["params"].split(",label=")[0], fmt(num(b["relmse_full"]), "%.4g"),
+                fmt(num(b.get("relmse_matched")), "%.4g"), fmt(num(b.get("time_to_final_error_s")), "%.4g"),
+                speedup_cell(b, 0) if num(b.get("speedup_vs_pt")) is not None else "–",
+                fmt(num(b.get("speedup_vs_pt_matched"))),
+                fmt(None if prep is None else prep / 1000.0, "%.3g"), fmt(memory_mb(b), "%.3g")))
+        w("")
+    sys.stdout.write("\n".join(out) + "\n")
+
+
+if __name__ == "__main__":
+    main()
