@@ -197,6 +197,15 @@ static void unload_method(viewer *v)
     v->params = NULL;
     v->m = NULL;
     v->status[0] = '\0';
+    v->stale = 0;
+}
+
+void view_go_stale(viewer *v)
+{
+    v->stale = 1;
+    const float black[4] = {0, 0, 0, 1};
+    glClearNamedFramebufferfv(v->target_fbo, GL_COLOR, 0, black);
+    v->need_display = 1;
 }
 
 /* Makes method `index` (into the registry; -1 the reference) the one shown:
@@ -238,10 +247,20 @@ int view_select(viewer *v, int index)
     char title[128];
     snprintf(title, sizeof title, "gibench view: preparing %s ...", v->m->id);
     glfwSetWindowTitle(v->win, title);
+    /* objects or lights moved by hand: the method is prepared with the
+     * scene as the file places it and told of the moves by update(), as
+     * `gibench render --view` does it */
+    int moved = view_moved_any(v);
+    if (moved)
+        view_nodes_swap(v, 1);
     double t0 = gi_now();
     res = v->m->prepare(v->inst, v->gs);
     cli_host_progress_end(&v->host);
     v->prepare_ms = 1e3 * (gi_now() - t0);
+    if (moved) {
+        view_nodes_swap(v, 0);
+        view_changed(v);
+    }
     if (res != GI_OK) {
         const char *msg = v->m->last_error(v->inst);
         return cli_fail(EXIT_RUN, "view: %s: prepare failed (%s)%s%s", v->m->id, gi_result_name(res),
@@ -255,6 +274,8 @@ int view_select(viewer *v, int index)
         if (res != GI_OK)
             return cli_fail(EXIT_RUN, "view: %s: update failed (%s)", v->m->id, gi_result_name(res));
     }
+    if (moved && res == GI_OK)
+        return view_tell_method(v, v->node_moved);
     return EXIT_OK;
 }
 
@@ -492,6 +513,7 @@ void view_describe(const viewer *v, view_file *f)
     f->yfov = v->yfov;
     f->znear = v->znear;
     f->zfar = v->zfar;
+    view_describe_nodes(v, f);
 }
 
 int view_save(const viewer *v, const char *path)
@@ -624,19 +646,27 @@ int view_key(viewer *v, int key, int mods)
     case GLFW_KEY_LEFT_BRACKET:
         v->exposure = fmaxf(-64.0f, v->exposure - 0.5f);
         return EXIT_OK;
+    case GLFW_KEY_L:
+        return view_light_select(v);
     case GLFW_KEY_C:
         view_camera_from_scene(v, v->scene->camera_count ? (v->scene_camera + 1) % (int)v->scene->camera_count : -1);
         return EXIT_OK;
     case GLFW_KEY_W:
     case GLFW_KEY_S:
+        if (mods & GLFW_MOD_SHIFT)
+            return view_light_move(v, gi_v3_scale(fwd, key == GLFW_KEY_W ? 1.0f : -1.0f));
         v->center = gi_v3_add(v->center, gi_v3_scale(fwd, key == GLFW_KEY_W ? step : -step));
         break;
     case GLFW_KEY_A:
     case GLFW_KEY_D:
+        if (mods & GLFW_MOD_SHIFT)
+            return view_light_move(v, gi_v3_scale(right, key == GLFW_KEY_D ? 1.0f : -1.0f));
         v->center = gi_v3_add(v->center, gi_v3_scale(right, key == GLFW_KEY_D ? step : -step));
         break;
     case GLFW_KEY_Q:
     case GLFW_KEY_E:
+        if (mods & GLFW_MOD_SHIFT)
+            return view_light_move(v, gi_v3(0, key == GLFW_KEY_E ? 1.0f : -1.0f, 0));
         v->center = gi_v3_add(v->center, gi_v3(0, key == GLFW_KEY_E ? step : -step, 0));
         break;
     case GLFW_KEY_LEFT:
@@ -665,8 +695,22 @@ int view_key(viewer *v, int key, int mods)
     return EXIT_OK;
 }
 
-void view_button(viewer *v, int button, int press, double x, double y)
+void view_button(viewer *v, int button, int press, double x, double y, int mods)
 {
+    if (!press && v->drag_object) {
+        v->drag_object = 0;
+        return;
+    }
+    if (press && button == GLFW_MOUSE_BUTTON_LEFT && (mods & (GLFW_MOD_SHIFT | GLFW_MOD_CONTROL))) {
+        /* Shift: move the object under the mouse in the view plane; Ctrl: rotate it */
+        int rc = view_pick(v, x, y, (mods & GLFW_MOD_CONTROL) ? 2 : 1);
+        if (rc != EXIT_OK && v->script)
+            v->exit_code = rc;
+        v->mx = x;
+        v->my = y;
+        v->need_display = 1;
+        return;
+    }
     int ww = 0, wh = 0;
     glfwGetWindowSize(v->win, &ww, &wh);
     if (press && button == GLFW_MOUSE_BUTTON_LEFT && v->split && v->method_index >= 0 && ww > 0 &&
@@ -692,6 +736,14 @@ void view_cursor(viewer *v, double x, double y)
     double dx = x - v->mx, dy = y - v->my;
     v->mx = x;
     v->my = y;
+    if (v->drag_object) {
+        if (dx == 0 && dy == 0)
+            return;
+        int rc = view_drag_to(v, x, y);
+        if (rc != EXIT_OK)
+            v->exit_code = rc;
+        return;
+    }
     if (v->dragging_divider) {
         int ww = 0, wh = 0;
         glfwGetWindowSize(v->win, &ww, &wh);
@@ -741,13 +793,12 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
 
 static void on_button(GLFWwindow *w, int button, int action, int mods)
 {
-    (void)mods;
     viewer *v = from(w);
     if (v->script)
         return;
     double x, y;
     glfwGetCursorPos(w, &x, &y);
-    view_button(v, button, action == GLFW_PRESS, x, y);
+    view_button(v, button, action == GLFW_PRESS, x, y, mods);
 }
 
 static void on_cursor(GLFWwindow *w, double x, double y)
@@ -763,6 +814,14 @@ static void on_scroll(GLFWwindow *w, double dx, double dy)
     viewer *v = from(w);
     if (!v->script)
         view_scroll(v, dy);
+}
+
+static void on_size(GLFWwindow *w, int width, int height)
+{
+    viewer *v = from(w);
+    v->win_w = width;
+    v->win_h = height;
+    v->need_display = 1;
 }
 
 static void on_refresh(GLFWwindow *w)
@@ -874,6 +933,8 @@ static int setup(viewer *v)
     v->cache_dir = gi_cache_dir(&err);
     if (!v->cache_dir)
         return cli_fail(EXIT_RUN, "%s", err.text);
+    if (!view_move_init(v))
+        return cli_fail(EXIT_RUN, "out of memory");
 
     glfwSetErrorCallback(on_glfw_error);
     if (!glfwInit())
@@ -894,6 +955,8 @@ static int setup(viewer *v)
     glfwSetCursorPosCallback(v->win, on_cursor);
     glfwSetScrollCallback(v->win, on_scroll);
     glfwSetWindowRefreshCallback(v->win, on_refresh);
+    glfwSetWindowSizeCallback(v->win, on_size);
+    glfwGetWindowSize(v->win, &v->win_w, &v->win_h);
 
     gi_gpu_desc gd = {0};
     gd.adopt_current = 1;
@@ -937,6 +1000,7 @@ static void teardown(viewer *v)
 {
     view_ref_stop(&v->ref);
     unload_method(v);
+    view_move_free(v);
     if (v->win) {
         if (v->display_prog)
             glDeleteProgram(v->display_prog);
@@ -967,7 +1031,7 @@ static void teardown(viewer *v)
  * it is progressive and still accumulating (up to 4096 frames). */
 static int wants_frame(const viewer *v)
 {
-    if (v->method_index < 0 || !v->inst)
+    if (v->method_index < 0 || !v->inst || v->stale)
         return 0;
     if (v->need_render)
         return 1;
