@@ -1058,8 +1058,8 @@ static int loop(viewer *v)
                 return rc;
             v->frames_since_event++;
         }
-        if (v->method_index < 0)
-            v->need_render = 0; /* the worker renders; the change went with view_changed */
+        if (v->method_index < 0 || v->stale)
+            v->need_render = 0; /* the worker renders, or the method shows nothing; the change went with view_changed */
         if (v->method_index < 0 || v->split) {
             poll_reference(v);
             char err[GI_ERROR_MAX];

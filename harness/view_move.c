@@ -117,6 +117,7 @@ int view_tell_method(viewer *v, const unsigned char *moved)
         snprintf(v->status, sizeof v->status, "%s cannot follow moving objects (no GI_CAP_RIGID_MOTION): no image",
                  v->m->id);
         view_go_stale(v);
+        gi_log(GI_LOG_WARN, "view: %s", v->status);
         return EXIT_OK;
     }
     gi_result res = v->m->update(v->inst, v->gs, &ch);
@@ -125,6 +126,7 @@ int view_tell_method(viewer *v, const unsigned char *moved)
         snprintf(v->status, sizeof v->status, "%s cannot follow the move (%s%s%s): no image", v->m->id,
                  gi_result_name(res), msg && *msg ? ": " : "", msg ? msg : "");
         view_go_stale(v);
+        gi_log(GI_LOG_WARN, "view: %s", v->status);
     }
     return EXIT_OK;
 }
@@ -195,15 +197,28 @@ int view_pick(viewer *v, double x, double y, int mode)
         return EXIT_OK;
     }
     int node = ob->node;
+    gi_camera_frame cf = view_camera(v);
+    float depth = gi_v3_dot(gi_v3_sub(hit.position, cf.eye), gi_v3_normalize(cf.forward));
+    if (gi_log_get_level() >= GI_LOG_WARN)
+        printf("view: picked object %d '%s' at depth %.4g (%s)\n", obj, ob->name ? ob->name : "", (double)depth,
+               mode == 2 ? "rotate" : "move");
     /* the objects under the node become moving ones: the method is made
      * again so that it treats them so from its prepare (as a scene
      * animating them would have it) */
     if (view_scene_mark_moving(v->scene, (uint32_t)node) && v->method_index >= 0) {
+        int sel = v->param_sel;
         int rc = view_select(v, v->method_index);
-        if (rc != EXIT_OK)
-            return rc;
+        v->param_sel = sel;
+        if (rc != EXIT_OK) {
+            /* the method cannot be made with this object moving (its
+             * message is printed): no image, and it says so */
+            view_go_stale(v);
+            snprintf(v->status, sizeof v->status, "%s cannot be made with '%s' moving: no image (M: another method)",
+                     v->m ? v->m->id : "the method", ob->name ? ob->name : "the object");
+            gi_log(GI_LOG_WARN, "view: %s", v->status);
+            return EXIT_OK;
+        }
     }
-    gi_camera_frame cf = view_camera(v);
     float world[16];
     gi_scene_node_transform(v->scene, node, v->time, world);
     v->drag_object = mode;
@@ -212,7 +227,6 @@ int view_pick(viewer *v, double x, double y, int mode)
     v->drag_y0 = y;
     get_trs(&v->scene->nodes[node], v->drag_trs);
     v->drag_origin = gi_v3(world[12], world[13], world[14]);
-    float depth = gi_v3_dot(gi_v3_sub(hit.position, cf.eye), gi_v3_normalize(cf.forward));
     v->drag_scale = 2.0f * depth * tanf(0.5f * cf.yfov) / (float)(v->win_h > 0 ? v->win_h : 1);
     /* the pivot of a rotation: the centre of the object's bounds */
     const float *b = ob->local_bounds;
@@ -220,9 +234,6 @@ int view_pick(viewer *v, double x, double y, int mode)
     gi_scene_object_transform(v->scene, (uint32_t)obj, v->time, ow);
     v->drag_pivot = gi_mat4_point(ow, gi_v3(0.5f * (b[0] + b[3]), 0.5f * (b[1] + b[4]), 0.5f * (b[2] + b[5])));
     v->status[0] = '\0';
-    if (gi_log_get_level() >= GI_LOG_WARN)
-        printf("view: picked object %d '%s' at depth %.4g (%s)\n", obj, ob->name ? ob->name : "",
-               (double)depth, mode == 2 ? "rotate" : "move");
     return EXIT_OK;
 }
 
