@@ -239,6 +239,12 @@ int view_select(viewer *v, int index)
         snprintf(v->status, sizeof v->status, "%s", why);
     cli_host_init(&v->host, v->m->id, v->cache_dir, v->gs, gi_gpu_renderer(v->gpu), gi_gpu_is_software(v->gpu));
     v->host_ready = 1;
+    v->host_progress = v->host.host.progress; /* the terminal line, and a bar in the window */
+    v->host.host.progress = view_overlay_progress;
+    gi_timer_free(v->timer);
+    v->timer = gi_timer_create(GI_TIMER_CPU_FINISH, 0);
+    v->timer_frames = 0;
+    v->stage_count = 0;
     gi_result res = v->m->create(&v->host.host, v->params, &v->inst);
     if (res != GI_OK || !v->inst) {
         v->inst = NULL;
@@ -338,10 +344,34 @@ static int render_method(viewer *v)
     view.seed = v->seed;
     view.exposure = v->exposure;
     gi_target target = {v->target_tex, v->target_fbo, v->width, v->height};
+    if (v->timer && v->timer_frames >= 1024) { /* the chart needs the last frame only */
+        gi_timer_free(v->timer);
+        v->timer = gi_timer_create(GI_TIMER_CPU_FINISH, 0);
+        v->timer_frames = 0;
+    }
+    v->host.timer = v->timer;
+    if (v->timer)
+        gi_timer_frame_begin(v->timer);
     double t0 = gi_now();
     gi_result res = v->m->render(v->inst, &view, &target);
     glFinish();
     v->frame_ms = 1e3 * (gi_now() - t0);
+    if (v->timer) {
+        gi_timer_frame_end(v->timer);
+        v->timer_frames++;
+        gi_stage_stats st[GI_TIMER_MAX_STAGES];
+        uint32_t n = gi_timer_stats(v->timer, st, GI_TIMER_MAX_STAGES);
+        v->stage_count = 0;
+        for (uint32_t i = 0; i < n; i++) {
+            uint32_t count = 0;
+            const double *ms = gi_timer_samples(v->timer, st[i].name, &count);
+            if (!ms || !count)
+                continue;
+            snprintf(v->stage_name[v->stage_count], GI_TIMER_NAME_MAX, "%.*s", GI_TIMER_NAME_MAX - 1, st[i].name);
+            v->stage_ms[v->stage_count++] = ms[count - 1];
+        }
+    }
+    v->host.timer = NULL;
     v->sum_frame_ms += v->frame_ms;
     v->n_frames++;
     if (res != GI_OK) {
@@ -432,6 +462,8 @@ static void display(viewer *v)
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);
     glUseProgram(0);
+    view_overlay_draw(v, fw, fh);
+    v->sum_overlay_ms += v->overlay_ms;
     if (v->window_shot) {
         write_window(v, fw, fh);
         v->window_shot = NULL;
@@ -648,6 +680,9 @@ int view_key(viewer *v, int key, int mods)
         return EXIT_OK;
     case GLFW_KEY_L:
         return view_light_select(v);
+    case GLFW_KEY_O:
+        v->show_overlay = !v->show_overlay;
+        return EXIT_OK;
     case GLFW_KEY_C:
         view_camera_from_scene(v, v->scene->camera_count ? (v->scene_camera + 1) % (int)v->scene->camera_count : -1);
         return EXIT_OK;
@@ -985,6 +1020,9 @@ static int setup(viewer *v)
     int rc = build_display(v);
     if (rc != EXIT_OK)
         return rc;
+    if (!view_overlay_init(v))
+        return cli_fail(EXIT_RUN, "view: the overlay's shader or buffers could not be made");
+    v->show_overlay = 1;
     if (!view_ref_start(&v->ref, v->scene))
         return cli_fail(EXIT_RUN, "view: cannot start the reference's worker thread");
 
@@ -1001,6 +1039,7 @@ static void teardown(viewer *v)
     view_ref_stop(&v->ref);
     unload_method(v);
     view_move_free(v);
+    gi_timer_free(v->timer);
     if (v->win) {
         if (v->display_prog)
             glDeleteProgram(v->display_prog);
@@ -1012,6 +1051,7 @@ static void teardown(viewer *v)
             glDeleteTextures(1, &v->target_tex);
         if (v->ref_tex)
             glDeleteTextures(1, &v->ref_tex);
+        view_overlay_free(v);
         gi_gpu_scene_free(v->gs);
         gi_gpu_destroy(v->gpu);
         glfwDestroyWindow(v->win);
@@ -1098,10 +1138,11 @@ int cmd_view(int argc, char **argv)
             rc = loop(v);
         if (rc == EXIT_OK && gi_log_get_level() >= GI_LOG_WARN && v->gpu)
             printf("view: %llu method frames, mean %.3g ms; %llu redraws, mean %.3g ms of the viewer's own "
-                   "(tone map, swap); %s\n",
+                   "(tone map, overlay, swap), of which the overlay %.3g ms; %s\n",
                    (unsigned long long)v->n_frames, v->n_frames ? v->sum_frame_ms / (double)v->n_frames : 0.0,
                    (unsigned long long)v->n_displays,
-                   v->n_displays ? v->sum_display_ms / (double)v->n_displays : 0.0, gi_gpu_renderer(v->gpu));
+                   v->n_displays ? v->sum_display_ms / (double)v->n_displays : 0.0,
+                   v->n_displays ? v->sum_overlay_ms / (double)v->n_displays : 0.0, gi_gpu_renderer(v->gpu));
     }
     teardown(v);
     free(v);

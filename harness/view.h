@@ -5,6 +5,7 @@
 
 #include "cli.h"
 #include "gi/gpu.h"
+#include "gi/timer.h"
 #include "view_file.h"
 #include "view_ref.h"
 
@@ -93,6 +94,17 @@ typedef struct viewer {
     float drag_scale;             /* world length of a window pixel at the picked point's depth */
     int stale;                    /* the method could not follow a move: it shows no image */
     int win_w, win_h;             /* the window's size in screen coordinates */
+    /* the overlay (view_overlay.c) and the last frame's stage times */
+    struct overlay *overlay;
+    int show_overlay;
+    double overlay_ms, sum_overlay_ms; /* the overlay's part of the last redraw (display_ms), and the sum */
+    double last_progress;
+    void (*host_progress)(const gi_host *h, const char *task, float fraction); /* cli_host's own */
+    gi_timer *timer;              /* the method's stages, for the overlay's chart */
+    uint32_t timer_frames;
+    char stage_name[GI_TIMER_MAX_STAGES][GI_TIMER_NAME_MAX];
+    double stage_ms[GI_TIMER_MAX_STAGES];
+    int stage_count;
 } viewer;
 
 /* Input, as the window's callbacks and the script deliver it. Keys are
@@ -133,6 +145,14 @@ int view_drag_to(viewer *v, double x, double y);
 /* Key L: the next punctual light; Shift+W/A/S/D/Q/E: moves it along dir. */
 int view_light_select(viewer *v);
 int view_light_move(viewer *v, gi_vec3 dir);
+
+/* The overlay (view_overlay.c): made once the context is current, drawn
+ * over the image on each redraw (key O shows or hides it); the progress
+ * callback draws a bar while a method precomputes. */
+int view_overlay_init(viewer *v);
+void view_overlay_free(viewer *v);
+void view_overlay_draw(viewer *v, int fw, int fh);
+void view_overlay_progress(const gi_host *h, const char *task, float fraction);
 
 /* Runs the script's next line when the previous one has taken effect;
  * sets quit at its end. EXIT_OK, or an exit code after printing why. */
