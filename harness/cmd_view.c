@@ -1034,6 +1034,29 @@ static int setup(viewer *v)
     return view_select(v, start);
 }
 
+/* The method's target and the reference's texture at w x h: the window
+ * was resized, and the image is rendered again at its new size. */
+static void resize_targets(viewer *v, uint32_t w, uint32_t h)
+{
+    v->width = w;
+    v->height = h;
+    glDeleteTextures(1, &v->target_tex);
+    glDeleteTextures(1, &v->ref_tex);
+    GLuint *tex[2] = {&v->target_tex, &v->ref_tex};
+    const float black[4] = {0, 0, 0, 1};
+    for (int i = 0; i < 2; i++) {
+        glCreateTextures(GL_TEXTURE_2D, 1, tex[i]);
+        glTextureStorage2D(*tex[i], 1, GL_RGBA32F, (GLsizei)w, (GLsizei)h);
+        glTextureParameteri(*tex[i], GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTextureParameteri(*tex[i], GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glClearTexImage(*tex[i], 0, GL_RGBA, GL_FLOAT, black);
+    }
+    glNamedFramebufferTexture(v->target_fbo, GL_COLOR_ATTACHMENT0, v->target_tex, 0);
+    if (gi_log_get_level() >= GI_LOG_WARN)
+        printf("view: resized to %ux%u\n", w, h);
+    view_changed(v);
+}
+
 static void teardown(viewer *v)
 {
     view_ref_stop(&v->ref);
@@ -1081,6 +1104,10 @@ static int wants_frame(const viewer *v)
 static int loop(viewer *v)
 {
     while (!v->quit && !glfwWindowShouldClose(v->win) && !cli_interrupted) {
+        int fw = 0, fh = 0;
+        glfwGetFramebufferSize(v->win, &fw, &fh);
+        if (fw > 0 && fh > 0 && ((uint32_t)fw != v->width || (uint32_t)fh != v->height) && fw <= 16384 && fh <= 16384)
+            resize_targets(v, (uint32_t)fw, (uint32_t)fh);
         if (v->playing) {
             double now = gi_now();
             float dt = (float)(now - v->last_tick);

@@ -16,6 +16,7 @@
  *     save-view FILE.json     the view, as key V saves it
  *     screenshot PREFIX       PREFIX.exr, PREFIX.png and PREFIX.json (its view)
  *     window-shot FILE.png    the window as shown (split view, divider) at the next redraw
+ *     resize W H              the window resized to W x H (the image is rendered again at that size)
  *     quit                    exit 0 (so does the end of the file)
  * Blank lines and lines starting with # are skipped. A line runs only once
  * the frame of the line before it has been rendered. */
@@ -211,11 +212,28 @@ static int run_line(viewer *v, char *line)
         v->need_display = 1;
         return EXIT_OK;
     }
+    if (!strcmp(cmd, "resize")) {
+        unsigned long w, h;
+        if (n != 3 || !cli_parse_uint(a, 1, 16384, &w) || !cli_parse_uint(b, 1, 16384, &h))
+            return bad(v, "resize W H (1..16384 each)");
+        glfwSetWindowSize(v->win, (int)w, (int)h);
+        /* the X server answers asynchronously: wait for the new size (up to 5 s) */
+        double until = gi_now() + 5.0;
+        int fw = 0, fh = 0;
+        do {
+            glfwPollEvents();
+            glfwGetFramebufferSize(v->win, &fw, &fh);
+        } while (((unsigned long)fw != w || (unsigned long)fh != h) && gi_now() < until);
+        if ((unsigned long)fw != w || (unsigned long)fh != h)
+            return bad(v, "resize: the window did not take the size");
+        v->need_render = 1;
+        return EXIT_OK;
+    }
     if (!strcmp(cmd, "quit")) {
         v->quit = 1;
         return EXIT_OK;
     }
-    return bad(v, "unknown command (key, drag, press, move, release, scroll, method, wait, save-view, screenshot, window-shot, quit)");
+    return bad(v, "unknown command (key, drag, press, move, release, scroll, resize, method, wait, save-view, screenshot, window-shot, quit)");
 }
 
 int view_script_step(viewer *v)
