@@ -161,6 +161,13 @@ static int parse_opts(int argc, char **argv, render_opts *o)
         int rc = apply_view(o);
         if (rc != EXIT_OK)
             return rc;
+    } else {
+        /* --camera view:FILE.json: the saved view's camera and moved objects only */
+        char why[600];
+        int got = view_camera_read(o->camera, &o->view, why, sizeof why);
+        if (got < 0)
+            return cli_fail(EXIT_USAGE, "render: --camera %s", why);
+        o->has_view = got;
     }
     if (!o->scene)
         return cli_fail(EXIT_USAGE, "render: --scene is required");
@@ -418,7 +425,7 @@ static int run(run_state *r, const render_opts *o)
                             r->curve_ref[c]->width, r->curve_ref[c]->height, o->width, o->height);
     }
     int camera = 0;
-    if (o->camera) {
+    if (o->camera && !o->has_view) {
         camera = gi_scene_find_camera(r->scene, o->camera);
         if (camera < 0)
             return cli_fail(EXIT_USAGE, "render: %s has no camera '%s' (%u cameras; use a name or #k)", o->scene,

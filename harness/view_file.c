@@ -385,3 +385,14 @@ void view_file_apply_nodes(const view_file *v, gi_scene *s)
         memcpy(d->scale, n->scale, sizeof d->scale);
     }
 }
+
+int view_camera_read(const char *camera, view_file *v, char *why, size_t why_size)
+{
+    if (!camera || strncmp(camera, "view:", 5))
+        return 0;
+    if (!camera[5]) {
+        snprintf(why, why_size, "camera 'view:' names no file (view:FILE.json, a view saved by gibench view)");
+        return -1;
+    }
+    return view_file_read(camera + 5, v, why, why_size) ? 1 : -1;
+}

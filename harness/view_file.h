@@ -64,6 +64,10 @@ int view_scene_under(const gi_scene *s, int node, const unsigned char *moved);
  * light is among them. */
 void view_scene_changes(const gi_scene *s, const unsigned char *moved, uint32_t *flags,
                         uint64_t *moved_objects);
+/* A camera named "view:FILE.json" (render --camera, reference --camera, a
+ * study's "camera"): the saved view's camera and moved nodes, nothing else
+ * of it. 0 when `camera` is not such a name; 1 with *v read; -1 with why. */
+int view_camera_read(const char *camera, view_file *v, char *why, size_t why_size);
 /* Writes the view's node placements into the scene (after view_file_check_nodes). */
 void view_file_apply_nodes(const view_file *v, gi_scene *s);
 
