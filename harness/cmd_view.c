@@ -983,6 +983,7 @@ static int setup(viewer *v)
     if (!v->win)
         return cli_fail(EXIT_RUN, "view: no window with an OpenGL 4.5 core context (GLFW)");
     glfwMakeContextCurrent(v->win);
+    view_pin_gl_driver();
     glfwSwapInterval(v->script ? 0 : 1);
     glfwSetWindowUserPointer(v->win, v);
     glfwSetKeyCallback(v->win, on_key);

@@ -154,6 +154,10 @@ void view_overlay_free(viewer *v);
 void view_overlay_draw(viewer *v, int fw, int fh);
 void view_overlay_progress(const gi_host *h, const char *task, float fraction);
 
+/* ASan build only: keeps Mesa's DRI driver loaded to the end, so that
+ * LeakSanitizer's report names it (view_lsan.c); nothing otherwise. */
+void view_pin_gl_driver(void);
+
 /* Runs the script's next line when the previous one has taken effect;
  * sets quit at its end. EXIT_OK, or an exit code after printing why. */
 int view_script_step(viewer *v);
