@@ -14,6 +14,7 @@
 #  - the short block's rotation is 0.2 rad about +Y (quaternion y = sin 0.1 =
 #    0.0998, within 0.002);
 #  - a method that cannot follow a move says so and the viewer goes on;
+#  - a punctual light moved with L and Shift+D / Shift+E (below);
 #  - the screenshot equals `gibench render --view` of the saved view
 #    within rmse 1e-4, while the same view without the moves (the trivial
 #    answer: the scene as the file has it) is farther than 1e-3 from it.
@@ -102,6 +103,39 @@ if(NOT other GREATER 0.001)
                         " (${match}): the test cannot tell them apart")
 endif()
 
+# A punctual light moved with keys (tests/data/valid/lights.gltf, direct,
+# 32x32): L selects the first light (bulb), Shift+D and Shift+E move it right
+# and up by 5 % of the scene's diagonal (0.05 x sqrt(4^2 + 3^2 + 4^2) = 0.320)
+# each; camera right is +X here. The view records bulb_node at
+# (0.320, 3.320, 0) (from (0, 3, 0)), render --view reproduces the screenshot,
+# and the unmoved light's image is farther than 1e-3 from it.
+file(WRITE ${W}/light.txt "wait 1\nkey L\nkey D shift\nkey E shift\nwait 1\nscreenshot lit\n")
+view_run(${W}/light.txt --scene ${ROOT}/tests/data/valid/lights.gltf --method direct --size 32x32)
+file(READ ${W}/lit.json lj)
+string(JSON lname GET "${lj}" nodes 0 name)
+set(lmm "")
+foreach(i 0 1 2)
+    string(JSON x GET "${lj}" nodes 0 translation ${i})
+    milli(xm "${x}")
+    list(APPEND lmm ${xm})
+endforeach()
+if(NOT lname STREQUAL "bulb_node" OR NOT lmm STREQUAL "320;3320;0")
+    message(FATAL_ERROR "the moved light: node ${lname} at ${lmm} mm; expected bulb_node at 320;3320;0")
+endif()
+view_render_matches(${W}/lit 1e-4)
+set(lmatch ${RENDER_RMSE})
+string(JSON lj REMOVE "${lj}" nodes)
+file(WRITE ${W}/unlit.json "${lj}")
+execute_process(COMMAND ${GIB} -q render --view ${W}/unlit.json --out ${W}/unlit.exr RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "render --view unlit.json: exit ${rc}\n${err}")
+endif()
+view_diff(j ${W}/unlit.exr ${W}/lit_batch.exr)
+string(JSON lother GET "${j}" rmse)
+if(NOT lother GREATER 0.001)
+    message(FATAL_ERROR "the unmoved light's image is as close to the batch render (rmse ${lother}) as the screenshot")
+endif()
+
 # A view naming a node the scene does not have: one line, exit 2.
 string(REPLACE "\"short_block\"" "\"no_such_node\"" badj "${mj}")
 file(WRITE ${W}/bad_node.json "${badj}")
@@ -111,4 +145,5 @@ if(NOT rc EQUAL 2 OR NOT err MATCHES "no_such_node")
     message(FATAL_ERROR "render --view of a view moving an unknown node: exit ${rc}, expected 2\n${err}")
 endif()
 message(STATUS "view drag: ${m}; short block moved (${d0}, ${d1}, ${d2}) mm, rotation y ${qy}; "
-               "screenshot vs render --view rmse ${match}, unmoved vs render --view rmse ${other}")
+               "screenshot vs render --view rmse ${match}, unmoved vs render --view rmse ${other}; light moved: rmse ${lmatch}, "
+               "unmoved light ${lother}")
