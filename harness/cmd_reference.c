@@ -3,6 +3,7 @@
  * the mean (+ a "variance" layer in EXR) and a stats file. */
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
+#include "view_file.h"
 
 #include "reference.h"
 
@@ -270,7 +271,22 @@ static int run(run_state *r, const ref_opts *o)
     if (!r->scene)
         return cli_fail(EXIT_USAGE, "%s", err.text);
     int camera = 0;
-    if (o->camera) {
+    /* --camera view:FILE.json: a saved view's camera, its moved objects and lights placed */
+    view_file view;
+    char why[600];
+    int has_view = view_camera_read(o->camera, &view, why, sizeof why);
+    if (has_view < 0)
+        return cli_fail(EXIT_USAGE, "reference: --camera %s", why);
+    gi_camera_frame view_cf;
+    if (has_view) {
+        int ok = view_file_check_nodes(&view, r->scene, why, sizeof why);
+        if (ok)
+            view_file_apply_nodes(&view, r->scene);
+        view_cf = view_file_camera(&view);
+        view_file_free(&view);
+        if (!ok)
+            return cli_fail(EXIT_USAGE, "reference: --camera %s: %s", o->camera, why);
+    } else if (o->camera) {
         camera = gi_scene_find_camera(r->scene, o->camera);
         if (camera < 0)
             return cli_fail(EXIT_USAGE,
@@ -283,6 +299,8 @@ static int run(run_state *r, const ref_opts *o)
     gi_ref_desc_init(&d);
     d.scene = r->scene;
     d.camera = camera;
+    if (has_view)
+        d.camera_frame = &view_cf;
     d.time = o->scene_time;
     d.width = o->width;
     d.height = o->height;

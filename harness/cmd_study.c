@@ -5,6 +5,7 @@
  * convergence curve. The file format is documented in README.md ("Studies"). */
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
+#include "view_file.h"
 
 #include "charts.h"
 #include "gi/cache.h"
@@ -494,10 +495,34 @@ static int scene_index(study *st, const char *file, const char *jpath, const cha
     gi_scene *s = gi_scene_load(path, &err);
     if (!s)
         return cli_fail(EXIT_USAGE, "%s: %s: %s", file, jpath, err.text);
-    int has_camera = !st->camera || gi_scene_find_camera(s, st->camera) >= 0;
+    /* "camera": "view:FILE.json", a view saved by gibench view: its camera
+     * and moved objects; the view's content joins the scene's in the key */
+    view_file view;
+    char why[600];
+    int is_view = view_camera_read(st->camera, &view, why, sizeof why);
+    if (is_view < 0) {
+        gi_scene_free(s);
+        return cli_fail(EXIT_USAGE, "%s: /camera: %s", file, why);
+    }
+    if (is_view) {
+        int ok = view_file_check_nodes(&view, s, why, sizeof why);
+        view_file_free(&view);
+        if (!ok) {
+            gi_scene_free(s);
+            return cli_fail(EXIT_USAGE, "%s: /camera: %s with %s: %s", file, st->camera + 5, path, why);
+        }
+    }
+    int has_camera = !st->camera || is_view || gi_scene_find_camera(s, st->camera) >= 0;
     /* the scene by its content, not its name */
     uint64_t hash = cli_scene_content_hash(s, path);
     gi_scene_free(s);
+    if (is_view) {
+        size_t n = 0;
+        unsigned char *bytes = (unsigned char *)gi_file_read_all(st->camera + 5, &n);
+        for (size_t i = 0; bytes && i < n; i++)
+            hash = (hash ^ bytes[i]) * 0x100000001b3ull; /* FNV-1a over the view's bytes */
+        free(bytes);
+    }
     if (!has_camera)
         return cli_fail(EXIT_USAGE, "%s: /camera: %s has no camera '%s'", file, path, st->camera);
     study_scene *sc = &st->scenes[st->scene_count];

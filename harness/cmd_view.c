@@ -197,6 +197,15 @@ static void unload_method(viewer *v)
     v->params = NULL;
     v->m = NULL;
     v->status[0] = '\0';
+    v->stale = 0;
+}
+
+void view_go_stale(viewer *v)
+{
+    v->stale = 1;
+    const float black[4] = {0, 0, 0, 1};
+    glClearNamedFramebufferfv(v->target_fbo, GL_COLOR, 0, black);
+    v->need_display = 1;
 }
 
 /* Makes method `index` (into the registry; -1 the reference) the one shown:
@@ -230,6 +239,12 @@ int view_select(viewer *v, int index)
         snprintf(v->status, sizeof v->status, "%s", why);
     cli_host_init(&v->host, v->m->id, v->cache_dir, v->gs, gi_gpu_renderer(v->gpu), gi_gpu_is_software(v->gpu));
     v->host_ready = 1;
+    v->host_progress = v->host.host.progress; /* the terminal line, and a bar in the window */
+    v->host.host.progress = view_overlay_progress;
+    gi_timer_free(v->timer);
+    v->timer = gi_timer_create(GI_TIMER_CPU_FINISH, 0);
+    v->timer_frames = 0;
+    v->stage_count = 0;
     gi_result res = v->m->create(&v->host.host, v->params, &v->inst);
     if (res != GI_OK || !v->inst) {
         v->inst = NULL;
@@ -238,10 +253,20 @@ int view_select(viewer *v, int index)
     char title[128];
     snprintf(title, sizeof title, "gibench view: preparing %s ...", v->m->id);
     glfwSetWindowTitle(v->win, title);
+    /* objects or lights moved by hand: the method is prepared with the
+     * scene as the file places it and told of the moves by update(), as
+     * `gibench render --view` does it */
+    int moved = view_moved_any(v);
+    if (moved)
+        view_nodes_swap(v, 1);
     double t0 = gi_now();
     res = v->m->prepare(v->inst, v->gs);
     cli_host_progress_end(&v->host);
     v->prepare_ms = 1e3 * (gi_now() - t0);
+    if (moved) {
+        view_nodes_swap(v, 0);
+        view_changed(v);
+    }
     if (res != GI_OK) {
         const char *msg = v->m->last_error(v->inst);
         return cli_fail(EXIT_RUN, "view: %s: prepare failed (%s)%s%s", v->m->id, gi_result_name(res),
@@ -255,6 +280,8 @@ int view_select(viewer *v, int index)
         if (res != GI_OK)
             return cli_fail(EXIT_RUN, "view: %s: update failed (%s)", v->m->id, gi_result_name(res));
     }
+    if (moved && res == GI_OK)
+        return view_tell_method(v, v->node_moved);
     return EXIT_OK;
 }
 
@@ -317,10 +344,34 @@ static int render_method(viewer *v)
     view.seed = v->seed;
     view.exposure = v->exposure;
     gi_target target = {v->target_tex, v->target_fbo, v->width, v->height};
+    if (v->timer && v->timer_frames >= 1024) { /* the chart needs the last frame only */
+        gi_timer_free(v->timer);
+        v->timer = gi_timer_create(GI_TIMER_CPU_FINISH, 0);
+        v->timer_frames = 0;
+    }
+    v->host.timer = v->timer;
+    if (v->timer)
+        gi_timer_frame_begin(v->timer);
     double t0 = gi_now();
     gi_result res = v->m->render(v->inst, &view, &target);
     glFinish();
     v->frame_ms = 1e3 * (gi_now() - t0);
+    if (v->timer) {
+        gi_timer_frame_end(v->timer);
+        v->timer_frames++;
+        gi_stage_stats st[GI_TIMER_MAX_STAGES];
+        uint32_t n = gi_timer_stats(v->timer, st, GI_TIMER_MAX_STAGES);
+        v->stage_count = 0;
+        for (uint32_t i = 0; i < n; i++) {
+            uint32_t count = 0;
+            const double *ms = gi_timer_samples(v->timer, st[i].name, &count);
+            if (!ms || !count)
+                continue;
+            snprintf(v->stage_name[v->stage_count], GI_TIMER_NAME_MAX, "%.*s", GI_TIMER_NAME_MAX - 1, st[i].name);
+            v->stage_ms[v->stage_count++] = ms[count - 1];
+        }
+    }
+    v->host.timer = NULL;
     v->sum_frame_ms += v->frame_ms;
     v->n_frames++;
     if (res != GI_OK) {
@@ -411,6 +462,8 @@ static void display(viewer *v)
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);
     glUseProgram(0);
+    view_overlay_draw(v, fw, fh);
+    v->sum_overlay_ms += v->overlay_ms;
     if (v->window_shot) {
         write_window(v, fw, fh);
         v->window_shot = NULL;
@@ -492,6 +545,7 @@ void view_describe(const viewer *v, view_file *f)
     f->yfov = v->yfov;
     f->znear = v->znear;
     f->zfar = v->zfar;
+    view_describe_nodes(v, f);
 }
 
 int view_save(const viewer *v, const char *path)
@@ -624,19 +678,30 @@ int view_key(viewer *v, int key, int mods)
     case GLFW_KEY_LEFT_BRACKET:
         v->exposure = fmaxf(-64.0f, v->exposure - 0.5f);
         return EXIT_OK;
+    case GLFW_KEY_L:
+        return view_light_select(v);
+    case GLFW_KEY_O:
+        v->show_overlay = !v->show_overlay;
+        return EXIT_OK;
     case GLFW_KEY_C:
         view_camera_from_scene(v, v->scene->camera_count ? (v->scene_camera + 1) % (int)v->scene->camera_count : -1);
         return EXIT_OK;
     case GLFW_KEY_W:
     case GLFW_KEY_S:
+        if (mods & GLFW_MOD_SHIFT)
+            return view_light_move(v, gi_v3_scale(fwd, key == GLFW_KEY_W ? 1.0f : -1.0f));
         v->center = gi_v3_add(v->center, gi_v3_scale(fwd, key == GLFW_KEY_W ? step : -step));
         break;
     case GLFW_KEY_A:
     case GLFW_KEY_D:
+        if (mods & GLFW_MOD_SHIFT)
+            return view_light_move(v, gi_v3_scale(right, key == GLFW_KEY_D ? 1.0f : -1.0f));
         v->center = gi_v3_add(v->center, gi_v3_scale(right, key == GLFW_KEY_D ? step : -step));
         break;
     case GLFW_KEY_Q:
     case GLFW_KEY_E:
+        if (mods & GLFW_MOD_SHIFT)
+            return view_light_move(v, gi_v3(0, key == GLFW_KEY_E ? 1.0f : -1.0f, 0));
         v->center = gi_v3_add(v->center, gi_v3(0, key == GLFW_KEY_E ? step : -step, 0));
         break;
     case GLFW_KEY_LEFT:
@@ -665,8 +730,22 @@ int view_key(viewer *v, int key, int mods)
     return EXIT_OK;
 }
 
-void view_button(viewer *v, int button, int press, double x, double y)
+void view_button(viewer *v, int button, int press, double x, double y, int mods)
 {
+    if (!press && v->drag_object) {
+        v->drag_object = 0;
+        return;
+    }
+    if (press && button == GLFW_MOUSE_BUTTON_LEFT && (mods & (GLFW_MOD_SHIFT | GLFW_MOD_CONTROL))) {
+        /* Shift: move the object under the mouse in the view plane; Ctrl: rotate it */
+        int rc = view_pick(v, x, y, (mods & GLFW_MOD_CONTROL) ? 2 : 1);
+        if (rc != EXIT_OK && v->script)
+            v->exit_code = rc;
+        v->mx = x;
+        v->my = y;
+        v->need_display = 1;
+        return;
+    }
     int ww = 0, wh = 0;
     glfwGetWindowSize(v->win, &ww, &wh);
     if (press && button == GLFW_MOUSE_BUTTON_LEFT && v->split && v->method_index >= 0 && ww > 0 &&
@@ -692,6 +771,14 @@ void view_cursor(viewer *v, double x, double y)
     double dx = x - v->mx, dy = y - v->my;
     v->mx = x;
     v->my = y;
+    if (v->drag_object) {
+        if (dx == 0 && dy == 0)
+            return;
+        int rc = view_drag_to(v, x, y);
+        if (rc != EXIT_OK)
+            v->exit_code = rc;
+        return;
+    }
     if (v->dragging_divider) {
         int ww = 0, wh = 0;
         glfwGetWindowSize(v->win, &ww, &wh);
@@ -741,13 +828,12 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
 
 static void on_button(GLFWwindow *w, int button, int action, int mods)
 {
-    (void)mods;
     viewer *v = from(w);
     if (v->script)
         return;
     double x, y;
     glfwGetCursorPos(w, &x, &y);
-    view_button(v, button, action == GLFW_PRESS, x, y);
+    view_button(v, button, action == GLFW_PRESS, x, y, mods);
 }
 
 static void on_cursor(GLFWwindow *w, double x, double y)
@@ -763,6 +849,14 @@ static void on_scroll(GLFWwindow *w, double dx, double dy)
     viewer *v = from(w);
     if (!v->script)
         view_scroll(v, dy);
+}
+
+static void on_size(GLFWwindow *w, int width, int height)
+{
+    viewer *v = from(w);
+    v->win_w = width;
+    v->win_h = height;
+    v->need_display = 1;
 }
 
 static void on_refresh(GLFWwindow *w)
@@ -874,6 +968,8 @@ static int setup(viewer *v)
     v->cache_dir = gi_cache_dir(&err);
     if (!v->cache_dir)
         return cli_fail(EXIT_RUN, "%s", err.text);
+    if (!view_move_init(v))
+        return cli_fail(EXIT_RUN, "out of memory");
 
     glfwSetErrorCallback(on_glfw_error);
     if (!glfwInit())
@@ -887,6 +983,7 @@ static int setup(viewer *v)
     if (!v->win)
         return cli_fail(EXIT_RUN, "view: no window with an OpenGL 4.5 core context (GLFW)");
     glfwMakeContextCurrent(v->win);
+    view_pin_gl_driver();
     glfwSwapInterval(v->script ? 0 : 1);
     glfwSetWindowUserPointer(v->win, v);
     glfwSetKeyCallback(v->win, on_key);
@@ -894,6 +991,8 @@ static int setup(viewer *v)
     glfwSetCursorPosCallback(v->win, on_cursor);
     glfwSetScrollCallback(v->win, on_scroll);
     glfwSetWindowRefreshCallback(v->win, on_refresh);
+    glfwSetWindowSizeCallback(v->win, on_size);
+    glfwGetWindowSize(v->win, &v->win_w, &v->win_h);
 
     gi_gpu_desc gd = {0};
     gd.adopt_current = 1;
@@ -922,6 +1021,9 @@ static int setup(viewer *v)
     int rc = build_display(v);
     if (rc != EXIT_OK)
         return rc;
+    if (!view_overlay_init(v))
+        return cli_fail(EXIT_RUN, "view: the overlay's shader or buffers could not be made");
+    v->show_overlay = 1;
     if (!view_ref_start(&v->ref, v->scene))
         return cli_fail(EXIT_RUN, "view: cannot start the reference's worker thread");
 
@@ -933,10 +1035,35 @@ static int setup(viewer *v)
     return view_select(v, start);
 }
 
+/* The method's target and the reference's texture at w x h: the window
+ * was resized, and the image is rendered again at its new size. */
+static void resize_targets(viewer *v, uint32_t w, uint32_t h)
+{
+    v->width = w;
+    v->height = h;
+    glDeleteTextures(1, &v->target_tex);
+    glDeleteTextures(1, &v->ref_tex);
+    GLuint *tex[2] = {&v->target_tex, &v->ref_tex};
+    const float black[4] = {0, 0, 0, 1};
+    for (int i = 0; i < 2; i++) {
+        glCreateTextures(GL_TEXTURE_2D, 1, tex[i]);
+        glTextureStorage2D(*tex[i], 1, GL_RGBA32F, (GLsizei)w, (GLsizei)h);
+        glTextureParameteri(*tex[i], GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTextureParameteri(*tex[i], GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glClearTexImage(*tex[i], 0, GL_RGBA, GL_FLOAT, black);
+    }
+    glNamedFramebufferTexture(v->target_fbo, GL_COLOR_ATTACHMENT0, v->target_tex, 0);
+    if (gi_log_get_level() >= GI_LOG_WARN)
+        printf("view: resized to %ux%u\n", w, h);
+    view_changed(v);
+}
+
 static void teardown(viewer *v)
 {
     view_ref_stop(&v->ref);
     unload_method(v);
+    view_move_free(v);
+    gi_timer_free(v->timer);
     if (v->win) {
         if (v->display_prog)
             glDeleteProgram(v->display_prog);
@@ -948,6 +1075,7 @@ static void teardown(viewer *v)
             glDeleteTextures(1, &v->target_tex);
         if (v->ref_tex)
             glDeleteTextures(1, &v->ref_tex);
+        view_overlay_free(v);
         gi_gpu_scene_free(v->gs);
         gi_gpu_destroy(v->gpu);
         glfwDestroyWindow(v->win);
@@ -967,7 +1095,7 @@ static void teardown(viewer *v)
  * it is progressive and still accumulating (up to 4096 frames). */
 static int wants_frame(const viewer *v)
 {
-    if (v->method_index < 0 || !v->inst)
+    if (v->method_index < 0 || !v->inst || v->stale)
         return 0;
     if (v->need_render)
         return 1;
@@ -977,6 +1105,10 @@ static int wants_frame(const viewer *v)
 static int loop(viewer *v)
 {
     while (!v->quit && !glfwWindowShouldClose(v->win) && !cli_interrupted) {
+        int fw = 0, fh = 0;
+        glfwGetFramebufferSize(v->win, &fw, &fh);
+        if (fw > 0 && fh > 0 && ((uint32_t)fw != v->width || (uint32_t)fh != v->height) && fw <= 16384 && fh <= 16384)
+            resize_targets(v, (uint32_t)fw, (uint32_t)fh);
         if (v->playing) {
             double now = gi_now();
             float dt = (float)(now - v->last_tick);
@@ -994,8 +1126,8 @@ static int loop(viewer *v)
                 return rc;
             v->frames_since_event++;
         }
-        if (v->method_index < 0)
-            v->need_render = 0; /* the worker renders; the change went with view_changed */
+        if (v->method_index < 0 || v->stale)
+            v->need_render = 0; /* the worker renders, or the method shows nothing; the change went with view_changed */
         if (v->method_index < 0 || v->split) {
             poll_reference(v);
             char err[GI_ERROR_MAX];
@@ -1034,10 +1166,11 @@ int cmd_view(int argc, char **argv)
             rc = loop(v);
         if (rc == EXIT_OK && gi_log_get_level() >= GI_LOG_WARN && v->gpu)
             printf("view: %llu method frames, mean %.3g ms; %llu redraws, mean %.3g ms of the viewer's own "
-                   "(tone map, swap); %s\n",
+                   "(tone map, overlay, swap), of which the overlay %.3g ms; %s\n",
                    (unsigned long long)v->n_frames, v->n_frames ? v->sum_frame_ms / (double)v->n_frames : 0.0,
                    (unsigned long long)v->n_displays,
-                   v->n_displays ? v->sum_display_ms / (double)v->n_displays : 0.0, gi_gpu_renderer(v->gpu));
+                   v->n_displays ? v->sum_display_ms / (double)v->n_displays : 0.0,
+                   v->n_displays ? v->sum_overlay_ms / (double)v->n_displays : 0.0, gi_gpu_renderer(v->gpu));
     }
     teardown(v);
     free(v);

@@ -24,7 +24,8 @@ static const command_help helps[] = {
      "  --scene S              glTF scene (.gltf/.glb)\n"
      "  --method M             method id (gibench methods)\n"
      "  --out FILE             .exr (linear float), .pfm or .png (tonemapped); up to 4\n"
-     "  --camera NAME|#k       the scene's camera (default: its first)\n"
+     "  --camera NAME|#k       the scene's camera (default: its first); view:FILE.json, a view saved\n"
+     "                         by gibench view: its camera and moved objects and lights only\n"
      "  --size WxH             image size (default 256x256)\n"
      "  --param k=v            a method parameter (repeatable; gibench methods lists them)\n"
      "  --frames N             frames of a still view (progressive methods converge); default 1\n"
@@ -42,7 +43,7 @@ static const command_help helps[] = {
     {"reference",
      "usage: gibench reference --scene S --out FILE.exr [--out FILE.png] [options]\n"
      "Embree path-traced reference, progressive passes until a stopping rule; EXR with mean and variance.\n"
-     "  --camera NAME|#k   --size WxH   --seed N   --exposure EV   --threads N\n"
+     "  --camera NAME|#k|view:FILE.json   --size WxH   --seed N   --exposure EV   --threads N\n"
      "  --spp N                 stop at N samples per pixel\n"
      "  --time S                stop after S seconds of rendering\n"
      "  --target-se E           stop when the mean relative standard error reaches E\n"
@@ -101,8 +102,10 @@ static const command_help helps[] = {
      "  --screenshot-dir DIR   where keys P (screenshot) and V (save view) write (default .)\n"
      "  --script FILE          replay key and mouse events from FILE, then exit (README \"gibench view\")\n"
      "Keys: M/N next/previous method, R reference, mouse left orbit, right dolly, middle pan, wheel zoom,\n"
-     "W/A/S/D/Q/E fly, arrows orbit, C next scene camera, SPACE play/pause, ,/. time step,\n"
-     "[/] or -/= exposure, P screenshot, V save view, ESC quit.\n"},
+     "Shift+left drag move the object under the mouse, Ctrl+left drag rotate it, L select a light,\n"
+     "Shift+W/A/S/D/Q/E move it, W/A/S/D/Q/E fly, arrows orbit, C next scene camera, TAB/PgUp/PgDn\n"
+     "parameters, X split view, O overlay, SPACE play/pause, ,/. time step, [/] or -/= exposure,\n"
+     "P screenshot, V save view, ESC quit.\n"},
     {"help", "usage: gibench help [COMMAND]\nThe list of commands, or the help of one.\n"},
 };
 

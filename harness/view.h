@@ -5,6 +5,7 @@
 
 #include "cli.h"
 #include "gi/gpu.h"
+#include "gi/timer.h"
 #include "view_file.h"
 #include "view_ref.h"
 
@@ -79,12 +80,37 @@ typedef struct viewer {
     uint64_t wait_spp;     /* the reference's samples to reach */
     double wait_deadline;  /* a wait for the reference gives up after this */
     int quit, exit_code;
+    /* objects and lights moved by hand (view_move.c) */
+    float (*base_trs)[10];        /* each node's translation, rotation, scale as the file has them */
+    float (*moved_trs)[10];       /* the user's placement while view_nodes_swap has the file's in */
+    unsigned char *node_moved;    /* the nodes placed anew */
+    unsigned char *file_animated; /* per object: animated by the scene file */
+    struct gi_rt *pick_rt;        /* the scene placed for picking; NULL after a change */
+    int sel_object, sel_light;    /* -1: none */
+    int drag_object, drag_node;   /* 1 moving the picked object's node, 2 rotating it; 0 none */
+    double drag_x0, drag_y0;
+    float drag_trs[10];
+    gi_vec3 drag_origin, drag_pivot;
+    float drag_scale;             /* world length of a window pixel at the picked point's depth */
+    int stale;                    /* the method could not follow a move: it shows no image */
+    int win_w, win_h;             /* the window's size in screen coordinates */
+    /* the overlay (view_overlay.c) and the last frame's stage times */
+    struct overlay *overlay;
+    int show_overlay;
+    double overlay_ms, sum_overlay_ms; /* the overlay's part of the last redraw (display_ms), and the sum */
+    double last_progress;
+    void (*host_progress)(const gi_host *h, const char *task, float fraction); /* cli_host's own */
+    gi_timer *timer;              /* the method's stages, for the overlay's chart */
+    uint32_t timer_frames;
+    char stage_name[GI_TIMER_MAX_STAGES][GI_TIMER_NAME_MAX];
+    double stage_ms[GI_TIMER_MAX_STAGES];
+    int stage_count;
 } viewer;
 
 /* Input, as the window's callbacks and the script deliver it. Keys are
  * GLFW key codes; they return EXIT_OK or an exit code after printing why. */
 int view_key(viewer *v, int key, int mods);
-void view_button(viewer *v, int button, int press, double x, double y);
+void view_button(viewer *v, int button, int press, double x, double y, int mods);
 void view_cursor(viewer *v, double x, double y);
 void view_scroll(viewer *v, double dy);
 /* Shows method `index` (-1: the reference). */
@@ -97,6 +123,40 @@ void view_changed(viewer *v);
 gi_vec3 view_eye(const viewer *v);
 gi_camera_frame view_camera(const viewer *v);
 void view_camera_from_scene(viewer *v, int index);
+
+/* Moving objects and lights (view_move.c). */
+int view_move_init(viewer *v);
+void view_move_free(viewer *v);
+int view_moved_any(const viewer *v);
+/* The file's placement of the moved nodes in the scene (base 1) or the
+ * user's back (base 0), the GPU scene placed to match; the reference is
+ * held (the caller restarts it with view_changed). */
+void view_nodes_swap(viewer *v, int base);
+void view_describe_nodes(const viewer *v, view_file *f);
+/* The method's update() for the nodes flagged in `moved`, or a message
+ * on screen and no image where it cannot follow. */
+int view_tell_method(viewer *v, const unsigned char *moved);
+/* The method can no longer show a true image: black until it is made again. */
+void view_go_stale(viewer *v);
+/* Picks the object under window point (x, y) and starts moving (mode 1)
+ * or rotating (mode 2) it. */
+int view_pick(viewer *v, double x, double y, int mode);
+int view_drag_to(viewer *v, double x, double y);
+/* Key L: the next punctual light; Shift+W/A/S/D/Q/E: moves it along dir. */
+int view_light_select(viewer *v);
+int view_light_move(viewer *v, gi_vec3 dir);
+
+/* The overlay (view_overlay.c): made once the context is current, drawn
+ * over the image on each redraw (key O shows or hides it); the progress
+ * callback draws a bar while a method precomputes. */
+int view_overlay_init(viewer *v);
+void view_overlay_free(viewer *v);
+void view_overlay_draw(viewer *v, int fw, int fh);
+void view_overlay_progress(const gi_host *h, const char *task, float fraction);
+
+/* ASan build only: keeps Mesa's DRI driver loaded to the end, so that
+ * LeakSanitizer's report names it (view_lsan.c); nothing otherwise. */
+void view_pin_gl_driver(void);
 
 /* Runs the script's next line when the previous one has taken effect;
  * sets quit at its end. EXIT_OK, or an exit code after printing why. */

@@ -72,9 +72,12 @@ static void *worker(void *arg)
         gi_camera_frame cam = r->camera;
         float time = r->time;
         uint32_t w = r->width, h = r->height, seed = r->seed;
+        r->busy = 1;
         pthread_mutex_unlock(&r->mu);
         serve(r, gen, cam, time, w, h, seed);
         pthread_mutex_lock(&r->mu);
+        r->busy = 0;
+        pthread_cond_broadcast(&r->cv);
         /* a request served to its end (paused or failed) waits for the next */
         if (r->generation == gen && r->active)
             r->active = 0;
@@ -116,7 +119,7 @@ void view_ref_request(view_ref *r, const gi_camera_frame *camera, float time, ui
     r->error[0] = '\0';
     r->latest_spp = 0;
     r->fresh = 0;
-    pthread_cond_signal(&r->cv);
+    pthread_cond_broadcast(&r->cv);
     pthread_mutex_unlock(&r->mu);
 }
 
@@ -133,6 +136,16 @@ void view_ref_pause(view_ref *r)
     pthread_mutex_lock(&r->mu);
     r->generation++;
     r->active = 0;
+    pthread_mutex_unlock(&r->mu);
+}
+
+void view_ref_hold(view_ref *r)
+{
+    pthread_mutex_lock(&r->mu);
+    r->generation++;
+    r->active = 0;
+    while (r->busy)
+        pthread_cond_wait(&r->cv, &r->mu);
     pthread_mutex_unlock(&r->mu);
 }
 
@@ -173,7 +186,7 @@ void view_ref_stop(view_ref *r)
         return;
     pthread_mutex_lock(&r->mu);
     r->stop = 1;
-    pthread_cond_signal(&r->cv);
+    pthread_cond_broadcast(&r->cv);
     pthread_mutex_unlock(&r->mu);
     pthread_join(r->thread, NULL);
     gi_image_free(r->latest);

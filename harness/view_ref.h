@@ -19,6 +19,7 @@ typedef struct view_ref {
     const gi_scene *scene; /* borrowed, read only */
     /* what is asked (under mu) */
     int active, stop;
+    int busy;            /* the worker is serving a request (reading the scene) */
     uint64_t generation; /* raised by every change of what is asked */
     gi_camera_frame camera;
     float time;
@@ -39,6 +40,9 @@ void view_ref_request(view_ref *r, const gi_camera_frame *camera, float time, ui
 int view_ref_running(view_ref *r);
 /* Stops accumulating (the worker idles). */
 void view_ref_pause(view_ref *r);
+/* Stops accumulating and waits until the worker no longer reads the
+ * scene, so that the caller may change it (objects or lights moved). */
+void view_ref_hold(view_ref *r);
 /* A copy of the newest image of the current request when there is one
  * newer than the last taken (or always, with `always`), and its samples
  * per pixel; NULL otherwise. The caller frees it. */

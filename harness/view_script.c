@@ -1,16 +1,22 @@
 /* gibench view --script FILE: replays input, one event per line, so that
  * the viewer can be driven and tested without a person (README.md
  * "gibench view", "Scripts"). Lines:
- *     key NAME [shift]        a key press: a letter, a digit, SPACE, ESCAPE, LEFT, RIGHT, UP,
+ *     key NAME [shift|ctrl]   a key press: a letter, a digit, SPACE, ESCAPE, LEFT, RIGHT, UP,
  *                             DOWN, MINUS, EQUAL, LEFT_BRACKET, RIGHT_BRACKET, COMMA, PERIOD,
  *                             TAB, PAGE_UP, PAGE_DOWN
- *     drag X0 Y0 X1 Y1 [left|right|middle]   press at (X0, Y0), move to (X1, Y1), release
+ *     drag X0 Y0 X1 Y1 [left|right|middle] [shift|ctrl]
+ *                             press at (X0, Y0), move to (X1, Y1) in 8 steps, release
+ *                             (window pixels, top left origin)
+ *     press X Y [left|right|middle] [shift|ctrl]   a mouse button pressed at (X, Y)
+ *     move X Y                the mouse moved to (X, Y)
+ *     release X Y [left|right|middle]              the button released
  *     scroll DY               the mouse wheel
  *     method ID               show method ID (or "reference")
  *     wait N                  N frames; on the reference, N more samples per pixel
  *     save-view FILE.json     the view, as key V saves it
  *     screenshot PREFIX       PREFIX.exr, PREFIX.png and PREFIX.json (its view)
  *     window-shot FILE.png    the window as shown (split view, divider) at the next redraw
+ *     resize W H              the window resized to W x H (the image is rendered again at that size)
  *     quit                    exit 0 (so does the end of the file)
  * Blank lines and lines starting with # are skipped. A line runs only once
  * the frame of the line before it has been rendered. */
@@ -63,6 +69,22 @@ static int key_code(const char *name)
     return -1;
 }
 
+/* "left", "right", "middle" (NULL or "": left) -> GLFW button, -1 unknown. */
+static int button_code(const char *name)
+{
+    if (!name || !*name || !strcmp(name, "left"))
+        return GLFW_MOUSE_BUTTON_LEFT;
+    return !strcmp(name, "right") ? GLFW_MOUSE_BUTTON_RIGHT : !strcmp(name, "middle") ? GLFW_MOUSE_BUTTON_MIDDLE : -1;
+}
+
+/* "shift", "ctrl" (or "") -> GLFW modifier bits, -1 unknown. */
+static int mod_code(const char *name)
+{
+    if (!name || !*name)
+        return 0;
+    return !strcmp(name, "shift") ? GLFW_MOD_SHIFT : !strcmp(name, "ctrl") ? GLFW_MOD_CONTROL : -1;
+}
+
 static int bad(viewer *v, const char *what)
 {
     return cli_fail(EXIT_USAGE, "view: %s:%d: %s", v->script_path, v->script_line, what);
@@ -104,25 +126,52 @@ static int run_line(viewer *v, char *line)
         int k = n >= 2 ? key_code(a) : -1;
         if (k < 0)
             return bad(v, "key: unknown key name (a letter, a digit, SPACE, ESCAPE, LEFT, ...)");
-        if (n == 3 && strcmp(b, "shift"))
-            return bad(v, "key NAME [shift]");
-        return view_key(v, k, n == 3 ? GLFW_MOD_SHIFT : 0);
+        int mods = mod_code(n == 3 ? b : NULL);
+        if (mods < 0)
+            return bad(v, "key NAME [shift|ctrl]");
+        return view_key(v, k, mods);
     }
-    if (!strcmp(cmd, "drag")) {
-        double x0, y0, x1, y1;
-        char button[16] = "left";
-        int m = sscanf(line, "%*s %lf %lf %lf %lf %15s", &x0, &y0, &x1, &y1, button);
-        int bt = !strcmp(button, "left") ? GLFW_MOUSE_BUTTON_LEFT
-                 : !strcmp(button, "right") ? GLFW_MOUSE_BUTTON_RIGHT
-                 : !strcmp(button, "middle") ? GLFW_MOUSE_BUTTON_MIDDLE
-                                             : -1;
-        if (m < 4 || bt < 0)
-            return bad(v, "drag X0 Y0 X1 Y1 [left|right|middle]");
-        view_button(v, bt, 1, x0, y0);
-        for (int i = 1; i <= 8; i++)
-            view_cursor(v, x0 + (x1 - x0) * i / 8.0, y0 + (y1 - y0) * i / 8.0);
-        view_button(v, bt, 0, x1, y1);
-        return EXIT_OK;
+    if (!strcmp(cmd, "drag") || !strcmp(cmd, "press") || !strcmp(cmd, "move") || !strcmp(cmd, "release")) {
+        double x[4];
+        char w1[16] = "", w2[16] = "", extra[16] = "";
+        int need = !strcmp(cmd, "drag") ? 4 : 2, m;
+        if (need == 4)
+            m = sscanf(line, "%*s %lf %lf %lf %lf %15s %15s %15s", &x[0], &x[1], &x[2], &x[3], w1, w2, extra);
+        else
+            m = sscanf(line, "%*s %lf %lf %15s %15s %15s", &x[0], &x[1], w1, w2, extra);
+        /* the words after the numbers: a button, then a modifier (either may be left out) */
+        int bt = button_code(w1), mods = 0;
+        if (bt < 0) {
+            bt = GLFW_MOUSE_BUTTON_LEFT;
+            mods = mod_code(w1);
+            if (w2[0])
+                mods = -1;
+        } else {
+            mods = mod_code(w2);
+        }
+        int words = m - need;
+        const char *usage = need == 4 ? "drag X0 Y0 X1 Y1 [left|right|middle] [shift|ctrl]"
+                            : !strcmp(cmd, "press") ? "press X Y [left|right|middle] [shift|ctrl]"
+                            : !strcmp(cmd, "move")  ? "move X Y"
+                                                    : "release X Y [left|right|middle]";
+        if (m < need || extra[0] || mods < 0 || (!strcmp(cmd, "move") && words > 0) ||
+            (!strcmp(cmd, "release") && (mods != 0 || words > 1)))
+            return bad(v, usage);
+        if (!strcmp(cmd, "press")) {
+            view_button(v, bt, 1, x[0], x[1], mods);
+        } else if (!strcmp(cmd, "move")) {
+            view_cursor(v, x[0], x[1]);
+        } else if (!strcmp(cmd, "release")) {
+            view_cursor(v, x[0], x[1]);
+            view_button(v, bt, 0, x[0], x[1], 0);
+        } else {
+            view_cursor(v, x[0], x[1]); /* the mouse is there before the press */
+            view_button(v, bt, 1, x[0], x[1], mods);
+            for (int i = 1; i <= 8; i++)
+                view_cursor(v, x[0] + (x[2] - x[0]) * i / 8.0, x[1] + (x[3] - x[1]) * i / 8.0);
+            view_button(v, bt, 0, x[2], x[3], 0);
+        }
+        return v->exit_code;
     }
     if (!strcmp(cmd, "scroll")) {
         double dy;
@@ -163,11 +212,28 @@ static int run_line(viewer *v, char *line)
         v->need_display = 1;
         return EXIT_OK;
     }
+    if (!strcmp(cmd, "resize")) {
+        unsigned long w, h;
+        if (n != 3 || !cli_parse_uint(a, 1, 16384, &w) || !cli_parse_uint(b, 1, 16384, &h))
+            return bad(v, "resize W H (1..16384 each)");
+        glfwSetWindowSize(v->win, (int)w, (int)h);
+        /* the X server answers asynchronously: wait for the new size (up to 5 s) */
+        double until = gi_now() + 5.0;
+        int fw = 0, fh = 0;
+        do {
+            glfwPollEvents();
+            glfwGetFramebufferSize(v->win, &fw, &fh);
+        } while (((unsigned long)fw != w || (unsigned long)fh != h) && gi_now() < until);
+        if ((unsigned long)fw != w || (unsigned long)fh != h)
+            return bad(v, "resize: the window did not take the size");
+        v->need_render = 1;
+        return EXIT_OK;
+    }
     if (!strcmp(cmd, "quit")) {
         v->quit = 1;
         return EXIT_OK;
     }
-    return bad(v, "unknown command (key, drag, scroll, method, wait, save-view, screenshot, window-shot, quit)");
+    return bad(v, "unknown command (key, drag, press, move, release, scroll, resize, method, wait, save-view, screenshot, window-shot, quit)");
 }
 
 int view_script_step(viewer *v)

@@ -18,6 +18,25 @@ function(view_run script)
     if(NOT rc EQUAL 0)
         message(FATAL_ERROR "gibench view --script ${script} ${ARGN}: exit ${rc}\n${out}\n${err}")
     endif()
+    set(VIEW_OUT "${out}" PARENT_SCOPE)
+    set(VIEW_ERR "${err}" PARENT_SCOPE)
+endfunction()
+
+# milli(<out var> <number>): a number of a view file in thousandths, rounded
+# towards zero (CMake has integer arithmetic only).
+function(milli outvar x)
+    if(x MATCHES "[eE]-")
+        set(${outvar} 0 PARENT_SCOPE) # json-c writes only values below 1e-4 with a negative exponent: 0
+        return()
+    endif()
+    if(NOT x MATCHES "^(-?)([0-9]+)(\\.([0-9]*))?$")
+        message(FATAL_ERROR "not a plain number in the view file: ${x}")
+    endif()
+    set(sign "${CMAKE_MATCH_1}")
+    set(int "${CMAKE_MATCH_2}")
+    string(SUBSTRING "${CMAKE_MATCH_4}000" 0 3 frac)
+    math(EXPR v "${sign}(${int} * 1000 + 1${frac} - 1000)")
+    set(${outvar} ${v} PARENT_SCOPE)
 endfunction()
 
 # view_diff(<out var> <test.exr> <reference.exr>): gibench diff's JSON.

@@ -1,6 +1,7 @@
 # gibench view --script (issue 16): under Xvfb, a script switches the method,
 # orbits the camera with a mouse drag, saves the view and takes a screenshot.
-# Checks: exit 0; the method switched; the saved camera moved; the
+# Checks: exit 0; the method switched; the saved camera moved; a resized
+# window renders at its new size; the
 # screenshot equals `gibench render --view` of its view (within rmse 1e-4),
 # while the screenshot of the first camera is far from it (so that the match
 # is not one any image would pass).
@@ -26,6 +27,9 @@ key TAB
 key PAGE_DOWN
 wait 1
 screenshot param
+resize 48 40
+wait 1
+screenshot resized
 ")
 view_run(${W}/script.txt --scene ${ROOT}/scenes/cornell_box.gltf --method direct --size 64x64)
 
@@ -41,21 +45,7 @@ string(JSON m1 GET "${after}" method)
 if(NOT m0 STREQUAL "direct" OR m1 STREQUAL "direct")
     message(FATAL_ERROR "key M did not switch the method: ${m0} then ${m1}")
 endif()
-# |eye after - eye before| in millimetres (CMake has integer arithmetic only)
-function(milli outvar x)
-    if(x MATCHES "[eE]-")
-        set(${outvar} 0 PARENT_SCOPE) # json-c writes only values below 1e-4 with a negative exponent: 0 mm
-        return()
-    endif()
-    if(NOT x MATCHES "^(-?)([0-9]+)(\\.([0-9]*))?$")
-        message(FATAL_ERROR "not a plain number in the view file: ${x}")
-    endif()
-    set(sign "${CMAKE_MATCH_1}")
-    set(int "${CMAKE_MATCH_2}")
-    string(SUBSTRING "${CMAKE_MATCH_4}000" 0 3 frac)
-    math(EXPR v "${sign}(${int} * 1000 + 1${frac} - 1000)")
-    set(${outvar} ${v} PARENT_SCOPE)
-endfunction()
+# |eye after - eye before| in millimetres
 set(d2 0)
 foreach(i 0 1 2)
     string(JSON a GET "${before}" camera eye ${i})
@@ -91,6 +81,16 @@ if(NOT p0 STREQUAL "env_samples=13")
     message(FATAL_ERROR "TAB + PAGE_DOWN on direct: params[1] is ${p0}, expected env_samples=13 (16 / 1.25)")
 endif()
 view_render_matches(${W}/param 1e-4)
+
+# Resizing the window renders again at its size: the screenshot after
+# "resize 48 40" is 48x40 and render --view reproduces it.
+file(READ ${W}/resized.json rj)
+string(JSON rw GET "${rj}" width)
+string(JSON rh GET "${rj}" height)
+if(NOT rw EQUAL 48 OR NOT rh EQUAL 40)
+    message(FATAL_ERROR "after resize 48 40 the view is ${rw}x${rh}")
+endif()
+view_render_matches(${W}/resized 1e-4)
 
 # Bad input: one line and exit 2 (a malformed script line names its line;
 # a broken view file names what is wrong).
