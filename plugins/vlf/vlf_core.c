@@ -1169,6 +1169,21 @@ static gi_vec3 perturbed_dir(const vlf_field *f, uint32_t i, uint32_t k)
                                      gi_v3_add(gi_v3_scale(p->u, sz * cosf(phi)), gi_v3_scale(p->v, sz * sinf(phi)))));
 }
 
+/* The radiance the interface of fixed direction i starts a sweep with
+ * (travel direction sign * w_i): the sky's radiance from where the light
+ * comes (Fig. 6) and the directional lights', in the first iteration
+ * only; black after. */
+void vlf_sweep_sky(const vlf_field *f, uint32_t i, int sign, int first_iteration, float sky[3])
+{
+    uint32_t sd = sign > 0 ? i : i + f->prm.l;
+    sky[0] = sky[1] = sky[2] = 0.0f;
+    if (first_iteration && f->env)
+        gi_envmap_eval(f->env, gi_v3_scale(f->dirs.signed_dirs[sd], -1.0f), sky);
+    if (first_iteration)
+        for (int q = 0; q < 3; q++)
+            sky[q] += f->sun[3 * sd + (uint32_t)q];
+}
+
 /* One sweep of subfield i along travel direction t = sign * w_i, front to
  * back along t through every ray's fragments with the radiance interface:
  * receivers (front side facing against t) take the interface's radiance,
@@ -1182,12 +1197,8 @@ static void sweep(vlf_field *f, uint32_t i, int sign, int first_iteration)
     gi_vec3 t = f->dirs.signed_dirs[sd];
     float dW = f->dirs.solid_angle[sd];
     float cell_area = (2.0f / (float)N) * (2.0f / (float)N);
-    float sky[3] = {0, 0, 0};
-    if (first_iteration && f->env)
-        gi_envmap_eval(f->env, gi_v3_scale(t, -1.0f), sky);
-    if (first_iteration)
-        for (int q = 0; q < 3; q++)
-            sky[q] += f->sun[3 * sd + (uint32_t)q];
+    float sky[3];
+    vlf_sweep_sky(f, i, sign, first_iteration, sky);
     double shot = 0, recv = 0, back = 0, esc = 0;
     float min_area = 1.0f / (64.0f * f->prm.density * f->prm.density);
     for (uint32_t c = 0; c < N * N; c++) {
@@ -1272,7 +1283,7 @@ static int read_in(const vlf_field *f, const vlf_rect *r, float x, float y, floa
  * Phong lobes to every direction of the lobe; directions below the face
  * get 0. Returns sum_j g_j cos_j dOmega_j (the normaliser that makes the
  * face reflect ks of what arrives), 0 if nothing is reflected. */
-static double reflect_weights(const vlf_field *f, const vlf_face *fc, gi_vec3 r, float *g)
+double vlf_reflect_weights(const vlf_field *f, const vlf_face *fc, gi_vec3 r, float *g)
 {
     uint32_t n2 = 2 * f->prm.l;
     memset(g, 0, n2 * sizeof *g);
@@ -1396,7 +1407,7 @@ static int punctual_first_shot(vlf_field *f)
                         /* light travelling along -w, reflected about the face */
                         gi_vec3 t = gi_v3_scale(w[k], -1.0f);
                         gi_vec3 r = gi_v3_sub(t, gi_v3_scale(fc->n, 2.0f * gi_v3_dot(t, fc->n)));
-                        double norm = reflect_weights(f, fc, r, g);
+                        double norm = vlf_reflect_weights(f, fc, r, g);
                         if (norm <= 0.0 || g[sd] <= 0.0f)
                             continue;
                         for (int c = 0; c < 3; c++)
@@ -1433,7 +1444,7 @@ static void scatter(vlf_field *f, uint32_t i)
         gi_vec3 t = f->dirs.signed_dirs[sd_in];
         float cos_in = fabsf(ci);
         gi_vec3 r = gi_v3_sub(t, gi_v3_scale(fc->n, 2.0f * gi_v3_dot(t, fc->n)));
-        double norm = reflect_weights(f, fc, r, g);
+        double norm = vlf_reflect_weights(f, fc, r, g);
         if (norm <= 0.0)
             continue;
         float scale = (float)((double)cos_in * f->dirs.solid_angle[sd_in] / norm);
@@ -1575,10 +1586,9 @@ static int perturbed_pipelined(vlf_field *f, uint32_t i, int first_iteration, pe
     return ok;
 }
 
-int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
+int vlf_propagate_init(vlf_field *f)
 {
-    double t0 = now_s();
-    uint32_t l = f->prm.l, prec = f->prm.precision;
+    uint32_t prec = f->prm.precision;
     size_t ne = (size_t)f->elem_count * 3, nc = (size_t)f->nd_cells * 3;
     memset(f->E_tot, 0, ne * sizeof(float));
     memset(f->out_tot, 0, nc * sizeof(float));
@@ -1602,6 +1612,16 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
     }
     f->st.flux_shot = f->st.flux_received = f->st.flux_back = f->st.flux_escaped = 0;
     f->st.samples = 0;
+    return 0;
+}
+
+int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
+{
+    double t0 = now_s();
+    uint32_t l = f->prm.l, prec = f->prm.precision;
+    size_t ne = (size_t)f->elem_count * 3, nc = (size_t)f->nd_cells * 3;
+    if (vlf_propagate_init(f) != 0)
+        return -1;
     frag_buf pbuf = {0}, ptmp = {0};
     vlf_sorter psort;
     memset(&psort, 0, sizeof psort);

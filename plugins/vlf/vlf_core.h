@@ -165,6 +165,20 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
 int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user);
 void vlf_field_free(vlf_field *f);
 
+/* The start of propagation shared by the CPU and the GPU paths: the maps
+ * cleared, emission as the first unshot radiance, the point and spot
+ * lights' first shot into the next maps, the counters zeroed. 0 or -1
+ * (out of memory). */
+int vlf_propagate_init(vlf_field *f);
+/* The radiance the interface of fixed direction i starts a sweep with
+ * along sign * w_i: the sky's and the directional lights' (first
+ * iteration only). */
+void vlf_sweep_sky(const vlf_field *f, uint32_t i, int sign, int first_iteration, float sky[3]);
+/* Weights g over the 2l signed directions of the light non-diffuse face fc
+ * reflects into direction r (§3.4), and their normaliser (0: nothing is
+ * reflected). */
+double vlf_reflect_weights(const vlf_field *f, const vlf_face *fc, gi_vec3 r, float *g);
+
 /* Subfield frame of fixed direction i: cell coordinates (x, y) in [0, N)
  * and depth of VLF point q. */
 void vlf_psf_project(const vlf_field *f, uint32_t i, gi_vec3 q, float *x, float *y, float *depth);
