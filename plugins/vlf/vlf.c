@@ -63,6 +63,9 @@ static const gi_param_desc vlf_params_desc[] = {
     {"propagate", GI_PARAM_ENUM, 0, 0, 0, "cpu|gpu", "propagation (Sec. 3.2-3.4)",
      "where propagation runs: cpu: the sweeps in C (vlf_core.c); gpu: GL compute passes over the same depth order "
      "(vlf_gpu.c), the same maps within float rounding; gpu needs perturbed = 0"},
+    {"hier_min", GI_PARAM_INT, 0, 0, 1000000, NULL, "hierarchical sort (Sec. 3.2)",
+     "objects (glTF nodes) of at least this many triangles whose bounding box in a direction's frame no other "
+     "triangle reaches into are sorted on their own and spliced in at their box's place; 0: off"},
     {"threads", GI_PARAM_INT, 4, 1, 64, NULL, "sort threads (Sec. 6)",
      "CPU threads of the sort stage, one subfield at a time each (the field is the same for any count)"},
     {"bsp_levels", GI_PARAM_INT, 2, 0, 8, NULL, "BSP levels (Sec. 3.2, 6)",
@@ -95,6 +98,7 @@ static gi_result vlf_create(const gi_host *host, const gi_params *params, void *
     v->prm.subdivide = (uint32_t)gi_params_int(params, "subdivide");
     v->prm.bsp_levels = (uint32_t)gi_params_int(params, "bsp_levels");
     v->prm.bsp_min = (uint32_t)gi_params_int(params, "bsp_min");
+    v->prm.hier_min = (uint32_t)gi_params_int(params, "hier_min");
     v->gpu_propagate = gi_params_enum(params, "propagate") == 1;
     if (v->gpu_propagate && v->prm.perturbed > 0) {
         host->log(host, GI_LOG_ERROR, "vlf: propagate = gpu runs the fixed directions only; set perturbed = 0");
@@ -284,6 +288,8 @@ static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
     host->stat(host, "sort_bsp_cuts", (double)s->sort_bsp_cuts);
     host->stat(host, "sort_unresolved", (double)s->sort_unresolved);
     host->stat(host, "sort_tests", (double)s->sort_tests);
+    host->stat(host, "sort_groups", (double)s->sort_groups);
+    host->stat(host, "sort_hier_fallbacks", (double)s->sort_hier_fallbacks);
     host->stat(host, "flux_emitted", s->flux_emitted);
     host->stat(host, "flux_received", s->flux_received);
     host->stat(host, "flux_escaped", s->flux_escaped);

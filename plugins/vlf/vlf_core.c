@@ -459,7 +459,7 @@ static int frag_cmp(const void *a, const void *b)
 
 /* Sort counters of one thread. */
 typedef struct sort_counts {
-    uint64_t pieces, splits, bsp_cuts, unresolved, tests;
+    uint64_t pieces, splits, bsp_cuts, unresolved, tests, groups, fallbacks;
 } sort_counts;
 
 /* The fragments of every face along subfield frame fr, in buf, grouped by
@@ -488,13 +488,16 @@ static int list_fragments(const vlf_field *f, const vlf_psf *fr, frag_buf *buf, 
     int mode = f->prm.order == VLF_ORDER_PLAIN     ? VLF_SORT_PLAIN
                : f->prm.order == VLF_ORDER_NOSPLIT ? VLF_SORT_NOSPLIT
                                                    : VLF_SORT_NEWELL;
-    if (vlf_sort_faces(so, f->tri_p, f->tri_count, fr->u, fr->v, fr->n, mode, f->prm.bsp_levels, f->prm.bsp_min) != 0)
+    if (vlf_sort_faces(so, f->tri_p, f->tri_count, f->tri_group, f->prm.hier_min, fr->u, fr->v, fr->n, mode,
+                       f->prm.bsp_levels, f->prm.bsp_min) != 0)
         return 0;
     cnt->pieces += so->nout;
     cnt->splits += so->splits;
     cnt->bsp_cuts += so->bsp_cuts;
     cnt->unresolved += so->unresolved;
     cnt->tests += so->tests;
+    cnt->groups += so->groups;
+    cnt->fallbacks += so->hier_fallbacks;
     for (uint32_t k = 0; k < so->nout; k++) {
         const vlf_piece *pc = &so->poly[so->out[k]];
         uint32_t fi = f->tri_face[pc->tri];
@@ -629,7 +632,7 @@ static int build_all_psf(vlf_field *f)
         return 0;
     }
     for (uint32_t t = 0; t < T; t++) {
-        jobs[t] = (sort_job){f, t, T, 0, {0, 0, 0, 0, 0}};
+        jobs[t] = (sort_job){f, t, T, 0, {0, 0, 0, 0, 0, 0, 0}};
         if (t > 0)
             started[t] = pthread_create(&th[t], NULL, sort_thread, &jobs[t]) == 0;
     }
@@ -648,6 +651,8 @@ static int build_all_psf(vlf_field *f)
         f->st.sort_bsp_cuts += jobs[t].cnt.bsp_cuts;
         f->st.sort_unresolved += jobs[t].cnt.unresolved;
         f->st.sort_tests += jobs[t].cnt.tests;
+        f->st.sort_groups += jobs[t].cnt.groups;
+        f->st.sort_hier_fallbacks += jobs[t].cnt.fallbacks;
     }
     free(jobs), free(th), free(started);
     return ok;
@@ -683,11 +688,12 @@ static int group_faces(vlf_field *f, const gi_scene *s, float t)
     uint32_t T = s->triangle_count;
     f->tri_count = T;
     f->tri_face = malloc((size_t)T * sizeof *f->tri_face);
+    f->tri_group = malloc((size_t)T * sizeof *f->tri_group);
     f->tri_p = malloc((size_t)T * 3 * sizeof *f->tri_p);
     tri_key *keys = malloc((size_t)T * sizeof *keys);
     gi_vec3 *nrm = malloc((size_t)T * sizeof *nrm);
     f->faces = calloc((size_t)T, sizeof *f->faces);
-    if (!f->tri_face || !f->tri_p || !keys || !nrm || !f->faces) {
+    if (!f->tri_face || !f->tri_group || !f->tri_p || !keys || !nrm || !f->faces) {
         free(keys);
         free(nrm);
         return 0;
@@ -698,6 +704,7 @@ static int group_faces(vlf_field *f, const gi_scene *s, float t)
         gi_vec3 *p = f->tri_p + 3 * (size_t)ti;
         for (int k = 0; k < 3; k++)
             p[k] = vlf_to_vlf(f, w[k]);
+        f->tri_group[ti] = s->vertices[s->indices[3 * ti]].object;
         gi_vec3 n = gi_v3_normalize(gi_v3_cross(gi_v3_sub(p[1], p[0]), gi_v3_sub(p[2], p[0])));
         nrm[ti] = n;
         keys[ti] = (tri_key){ti, s->vertices[s->indices[3 * ti]].material, (int32_t)lrintf(n.x * 1000.0f),
@@ -830,9 +837,9 @@ static int subdivide_triangles(vlf_field *f, uint32_t k)
         return 1;
     size_t T = (size_t)f->tri_count * k * k;
     gi_vec3 *P = malloc(T * 3 * sizeof *P);
-    uint32_t *F = malloc(T * sizeof *F);
-    if (!P || !F) {
-        free(P), free(F);
+    uint32_t *F = malloc(T * sizeof *F), *Gr = malloc(T * sizeof *Gr);
+    if (!P || !F || !Gr) {
+        free(P), free(F), free(Gr);
         return 0;
     }
     size_t n = 0;
@@ -845,10 +852,12 @@ static int subdivide_triangles(vlf_field *f, uint32_t k)
             for (uint32_t b = 0; a + b < k; b++) {
                 gi_vec3 *q = P + 3 * n;
                 q[0] = GRID(a, b), q[1] = GRID(a + 1, b), q[2] = GRID(a, b + 1);
+                Gr[n] = f->tri_group[ti];
                 F[n++] = f->tri_face[ti];
                 if (a + b + 2 <= k) {
                     q = P + 3 * n;
                     q[0] = GRID(a + 1, b), q[1] = GRID(a + 1, b + 1), q[2] = GRID(a, b + 1);
+                    Gr[n] = f->tri_group[ti];
                     F[n++] = f->tri_face[ti];
                 }
             }
@@ -856,8 +865,10 @@ static int subdivide_triangles(vlf_field *f, uint32_t k)
     }
     free(f->tri_p);
     free(f->tri_face);
+    free(f->tri_group);
     f->tri_p = P;
     f->tri_face = F;
+    f->tri_group = Gr;
     f->tri_count = (uint32_t)n;
     return 1;
 }
@@ -1061,7 +1072,7 @@ oom:
  * directions are sorted like fixed ones, used for transport, discarded). */
 static int perturbed_list(vlf_field *f, const vlf_psf *fr, frag_buf *buf, frag_buf *tmp, vlf_sorter *so)
 {
-    sort_counts cnt = {0, 0, 0, 0, 0};
+    sort_counts cnt = {0, 0, 0, 0, 0, 0, 0};
     return list_fragments(f, fr, buf, tmp, so, NULL, &cnt);
 }
 
@@ -1733,6 +1744,7 @@ void vlf_field_free(vlf_field *f)
     vlf_dirs_free(&f->dirs);
     free(f->faces);
     free(f->tri_face);
+    free(f->tri_group);
     free(f->tri_p);
     free(f->elem_face);
     free(f->elem_area);

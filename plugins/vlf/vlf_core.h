@@ -49,6 +49,8 @@ typedef struct vlf_params {
     uint32_t bsp_min;    /* a list is cut only with at least this many faces (paper: 4K) */
     uint32_t precision;  /* storage format of the ir/radiance maps: VLF_PREC_32F, _16F or _RGB9E5 */
     uint32_t subdivide;  /* each scene triangle cut into subdivide^2 for sorting and transport (tessellation sweep) */
+    uint32_t hier_min;   /* hierarchical shortcut (§3.2): objects of at least this many triangles in a box no other
+                          * triangle reaches into are sorted on their own; 0: off */
 } vlf_params;
 
 /* Storage formats of the light-field maps (§3.1, §6): three float32 (12
@@ -118,6 +120,8 @@ typedef struct vlf_stats {
     uint64_t sort_bsp_cuts;  /* pieces cut by a BSP plane, over all subfields */
     uint64_t sort_unresolved;/* cycles left unbroken (split limit), over all subfields */
     uint64_t sort_tests;     /* pairs of faces tested by Newell's ordering */
+    uint64_t sort_groups;    /* objects sorted on their own by the hierarchical shortcut, over all subfields */
+    uint64_t sort_hier_fallbacks; /* subfields sorted again without it (a stand-in split by a cycle) */
 } vlf_stats;
 
 /* A point or spot light (world space): its first shot is by shadow rays. */
@@ -137,6 +141,7 @@ typedef struct vlf_field {
     uint32_t tri_count;      /* triangles sorted and rasterised: scene triangles x subdivide^2 */
     uint32_t tri_sub;        /* subdivide^2: triangle k is part of scene triangle k / tri_sub */
     uint32_t *tri_face;      /* face of each triangle */
+    uint32_t *tri_group;     /* scene object of each triangle (the hierarchical shortcut's groups) */
     gi_vec3 *tri_p;          /* 3 corners per triangle, VLF coordinates */
     uint32_t *elem_face;
     float *elem_area;
