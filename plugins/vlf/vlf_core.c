@@ -322,6 +322,37 @@ void vlf_quantise(uint32_t prec, float *rgb, size_t count)
     }
 }
 
+/* ---- Glossy albedo -------------------------------------------------------- */
+
+double vlf_phong_albedo(float n, float cos_t)
+{
+    /* (n + 2) / (2 pi) * integral over the hemisphere of cos^n(alpha)
+     * cos(theta_o) d omega_o, alpha the angle to the reflected direction:
+     * with u = cos^(n+1) alpha, (n + 2) / (n + 1) times the mean of
+     * max(0, cos theta_o) over u in [0, 1] and phi (a 64 x 64 midpoint rule) */
+    const int K = 64;
+    double ct = fmin(1.0, fabs((double)cos_t)), st = sqrt(fmax(0.0, 1.0 - ct * ct)), sum = 0.0;
+    for (int a = 0; a < K; a++) {
+        double ca = pow(((double)a + 0.5) / K, 1.0 / ((double)n + 1.0)), sa = sqrt(fmax(0.0, 1.0 - ca * ca));
+        for (int b = 0; b < K; b++) {
+            double co = ca * ct + sa * st * cos(2.0 * GI_PI * ((double)b + 0.5) / K);
+            if (co > 0.0)
+                sum += co;
+        }
+    }
+    return ((double)n + 2.0) / ((double)n + 1.0) * sum / (double)(K * K);
+}
+
+float vlf_phong_albedo_at(const vlf_face *fc, float cos_t)
+{
+    float x = fminf(1.0f, fmaxf(0.0f, cos_t)) * (float)(VLF_ALBEDO_TABLE - 1);
+    int k = (int)x;
+    if (k >= VLF_ALBEDO_TABLE - 1)
+        return fc->albedo[VLF_ALBEDO_TABLE - 1];
+    float t = x - (float)k;
+    return fc->albedo[k] * (1.0f - t) + fc->albedo[k + 1] * t;
+}
+
 /* ---- Subfields ------------------------------------------------------------ */
 
 gi_vec3 vlf_to_vlf(const vlf_field *f, gi_vec3 world)
@@ -748,6 +779,9 @@ static int group_faces(vlf_field *f, const gi_scene *s, float t)
         memcpy(fc->ks, mt->ks, sizeof fc->ks);
         fc->exponent = mt->exponent;
         fc->mirror = mt->mirror || mt->exponent >= GI_MIRROR_EXPONENT;
+        for (int k = 0; k < VLF_ALBEDO_TABLE; k++)
+            fc->albedo[k] = fc->mirror ? 1.0f
+                                       : (float)vlf_phong_albedo(fc->exponent, (float)k / (float)(VLF_ALBEDO_TABLE - 1));
         const float *le = gi_scene_triangle_emission(s, t0);
         for (int k = 0; k < 3; k++)
             fc->emission[k] = le ? le[k] : 0.0f;
@@ -1292,8 +1326,10 @@ static int read_in(const vlf_field *f, const vlf_rect *r, float x, float y, floa
  * than the direction set (fewer than ~3 directions' worth of lobe) go to
  * the three nearest directions of r with their barycentric weights, wider
  * Phong lobes to every direction of the lobe; directions below the face
- * get 0. Returns sum_j g_j cos_j dOmega_j (the normaliser that makes the
- * face reflect ks of what arrives), 0 if nothing is reflected. */
+ * get 0. Returns sum_j g_j cos_j dOmega_j divided by the lobe's albedo at
+ * this incidence (the normaliser that makes the face reflect ks A(theta) of
+ * what arrives: ks at normal incidence, less toward grazing as core
+ * brdf.h's lobe; mirrors ks), 0 if nothing is reflected. */
 double vlf_reflect_weights(const vlf_field *f, const vlf_face *fc, gi_vec3 r, float *g)
 {
     uint32_t n2 = 2 * f->prm.l;
@@ -1329,6 +1365,11 @@ double vlf_reflect_weights(const vlf_field *f, const vlf_face *fc, gi_vec3 r, fl
             norm += g[j] * cj * f->dirs.solid_angle[j];
         else
             g[j] = 0.0f;
+    }
+    if (!fc->mirror && norm > 0.0) {
+        /* the Phong lobe's albedo at this incidence (its grazing fall-off) */
+        float a = vlf_phong_albedo_at(fc, gi_v3_dot(r, fc->n));
+        norm = a > 1e-6f ? norm / a : 0.0;
     }
     return norm;
 }

@@ -82,6 +82,8 @@ typedef struct vlf_rect {
     uint32_t offset; /* first cell in the tile storage */
 } vlf_rect;
 
+enum { VLF_ALBEDO_TABLE = 33 };
+
 /* A face: the coplanar triangles of one material (the paper's planar
  * polygons), with a W x H chart of diffuse elements in its plane. */
 typedef struct vlf_face {
@@ -95,6 +97,8 @@ typedef struct vlf_face {
     int mirror;
     int32_t nd;         /* index among non-diffuse faces, -1 for diffuse */
     float send_scale;   /* pi / sum over directions of |cos| dOmega (diffuse emission normalisation) */
+    float albedo[VLF_ALBEDO_TABLE]; /* the glossy lobe's albedo over cos(incidence) 0 .. 1 (1 at normal incidence;
+                                     * mirrors 1 throughout) */
 } vlf_face;
 
 /* Fragment lists of one subfield: the faces each ray meets, front to back
@@ -183,6 +187,12 @@ void vlf_sweep_sky(const vlf_field *f, uint32_t i, int sign, int first_iteration
  * reflects into direction r (§3.4), and their normaliser (0: nothing is
  * reflected). */
 double vlf_reflect_weights(const vlf_field *f, const vlf_face *fc, gi_vec3 r, float *g);
+/* Albedo of the normalised Phong lobe of core brdf.h (ks (n + 2) / (2 pi)
+ * cos^n alpha) per unit ks at incidence cos_t: 1 at normal incidence,
+ * falling toward grazing where the lobe dips below the surface (numerical
+ * quadrature); and face fc's table of it, interpolated. */
+double vlf_phong_albedo(float n, float cos_t);
+float vlf_phong_albedo_at(const vlf_face *fc, float cos_t);
 
 /* Subfield frame of fixed direction i: cell coordinates (x, y) in [0, N)
  * and depth of VLF point q. */
