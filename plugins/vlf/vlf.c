@@ -400,7 +400,7 @@ static const gi_method vlf_method = {
     .version = "0.1",
     .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_GLOSSY | GI_CAP_MIRROR | GI_CAP_AREA_LIGHTS |
             GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION |
-            GI_CAP_PRECOMPUTE | GI_CAP_VISIBILITY,
+            GI_CAP_PRECOMPUTE | GI_CAP_VISIBILITY | GI_CAP_TEXTURES,
     .max_bounces = 7,
     .params = vlf_params_desc,
     .create = vlf_create,

@@ -778,6 +778,8 @@ static int group_faces(vlf_field *f, const gi_scene *s, float t)
         memcpy(fc->kd, mt->albedo, sizeof fc->kd);
         memcpy(fc->ks, mt->ks, sizeof fc->ks);
         fc->exponent = mt->exponent;
+        fc->material = keys[a].material;
+        fc->textured = mt->albedo_texture >= 0 && (uint32_t)mt->albedo_texture < s->texture_count;
         fc->mirror = mt->mirror || mt->exponent >= GI_MIRROR_EXPONENT;
         for (int k = 0; k < VLF_ALBEDO_TABLE; k++)
             fc->albedo[k] = fc->mirror ? 1.0f
@@ -818,7 +820,7 @@ static int clip_poly(float *x, float *y, int n, int k, float s, float c)
 
 /* Area of each element inside its face: every triangle clipped exactly
  * against the texels of its bounding box. */
-static void element_areas(vlf_field *f)
+static void element_areas(vlf_field *f, const gi_scene *s)
 {
     float texel = 1.0f / (f->prm.density * f->prm.density);
     for (uint32_t ti = 0; ti < f->tri_count; ti++) {
@@ -853,6 +855,24 @@ static void element_areas(vlf_field *f)
                 uint32_t e = fc->first_elem + (uint32_t)cy * fc->W + (uint32_t)cx;
                 float ar = 0.5f * fabsf(a) * texel;
                 f->elem_area[e] += ar;
+                if (fc->textured && a != 0.0f) {
+                    /* textured albedo: the texture at the part's centroid
+                     * (barycentric in the triangle), weighted by its area */
+                    float qx = mx / (3.0f * a), qy = my / (3.0f * a);
+                    float d2 = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+                    if (d2 != 0.0f) {
+                        float w1 = ((qx - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (qy - y[0])) / d2;
+                        float w2 = ((x[1] - x[0]) * (qy - y[0]) - (qx - x[0]) * (y[1] - y[0])) / d2;
+                        float w0 = 1.0f - w1 - w2, uv[2] = {0.0f, 0.0f}, alb[3];
+                        const float w[3] = {w0, w1, w2};
+                        for (int k = 0; k < 3; k++)
+                            for (int c = 0; c < 2; c++)
+                                uv[c] += w[k] * s->vertices[s->indices[3 * (size_t)ti + (size_t)k]].uv[c];
+                        gi_scene_albedo(s, fc->material, uv, alb);
+                        for (int c = 0; c < 3; c++)
+                            f->elem_kd[3 * (size_t)e + (size_t)c] += ar * alb[c];
+                    }
+                }
                 if (a != 0.0f) { /* area-weighted centroid of the part on the face, texel units */
                     f->elem_c[2 * (size_t)e] += ar * mx / (3.0f * a);
                     f->elem_c[2 * (size_t)e + 1] += ar * my / (3.0f * a);
@@ -1031,7 +1051,19 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
         for (uint32_t e = 0; e < fc->W * fc->H; e++)
             f->elem_face[fc->first_elem + e] = fi;
     }
-    element_areas(f);
+    f->elem_kd = calloc((size_t)elems * 3 + 3, sizeof *f->elem_kd);
+    if (!f->elem_kd)
+        goto oom;
+    element_areas(f, s);
+    /* each element's albedo: the material's, or on textured faces the
+     * texture averaged over the element's part of the face */
+    for (uint32_t e = 0; e < elems; e++) {
+        const vlf_face *fc = &f->faces[f->elem_face[e]];
+        for (int c = 0; c < 3; c++) {
+            float *kd = &f->elem_kd[3 * (size_t)e + (size_t)c];
+            *kd = fc->textured && f->elem_area[e] > 0.0f ? *kd / f->elem_area[e] : fc->kd[c];
+        }
+    }
     for (uint32_t e = 0; e < elems; e++) {
         if (f->elem_area[e] > 0.0f) {
             f->elem_c[2 * (size_t)e] /= f->elem_area[e];
@@ -1754,8 +1786,7 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
         }
         for (size_t k = 0; k < ne; k++) {
             f->E_tot[k] += f->E_next[k];
-            const vlf_face *fc = &f->faces[f->elem_face[k / 3]];
-            f->L_cur[k] = fc->kd[k % 3] * (float)GI_INV_PI * f->E_next[k];
+            f->L_cur[k] = f->elem_kd[k] * (float)GI_INV_PI * f->E_next[k];
             f->E_next[k] = 0.0f;
         }
         for (size_t k = 0; k < nc; k++) {
@@ -1789,6 +1820,7 @@ void vlf_field_free(vlf_field *f)
     free(f->tri_p);
     free(f->elem_face);
     free(f->elem_area);
+    free(f->elem_kd);
     free(f->rects);
     free(f->nd_cover);
     free(f->E_tot);

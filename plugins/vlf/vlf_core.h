@@ -95,6 +95,8 @@ typedef struct vlf_face {
     uint32_t first_elem;
     float kd[3], ks[3], exponent, emission[3];
     int mirror;
+    uint32_t material;  /* the scene's material */
+    int textured;       /* its albedo has a texture (elements then average it, elem_kd) */
     int32_t nd;         /* index among non-diffuse faces, -1 for diffuse */
     float send_scale;   /* pi / sum over directions of |cos| dOmega (diffuse emission normalisation) */
     float albedo[VLF_ALBEDO_TABLE]; /* the glossy lobe's albedo over cos(incidence) 0 .. 1 (1 at normal incidence;
@@ -149,6 +151,7 @@ typedef struct vlf_field {
     gi_vec3 *tri_p;          /* 3 corners per triangle, VLF coordinates */
     uint32_t *elem_face;
     float *elem_area;
+    float *elem_kd;          /* 3 per element: albedo (the material's, or the texture averaged over the element) */
     vlf_psf *psf;            /* l (fixed directions) */
     vlf_rect *rects;         /* nd_count * l */
     uint32_t nd_cells;

@@ -39,6 +39,7 @@ layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 12) readonly buffer VlfRects { V
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 13) readonly buffer VlfCover { uint cover[]; };
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 14) readonly buffer VlfFrames { vec4 frames[]; }; // u, v, n per fixed direction
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 15) readonly buffer VlfJobs { VlfJob jobs[]; };
+layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 16) readonly buffer VlfElemKd { float elem_kd[]; }; // albedo, 3 an element
 
 uniform uint u_count;       // invocations of the pass (per sign for the sweep)
 uniform uint u_precision;   // 0: float32, 1: RGBA16F, 2: RGB9E5
@@ -273,10 +274,10 @@ void main()
     if (idx >= u_count)
         return;
     if (3u * idx < u_ne) {
-        VlfFace fc = faces[elem_face[idx]];
+        vec3 kd = vec3(elem_kd[3u * idx], elem_kd[3u * idx + 1u], elem_kd[3u * idx + 2u]);
         vec3 En = e_get(E_NEXT, idx);
         e_set(E_TOT, idx, vlf_q(e_get(E_TOT, idx) + En));
-        e_set(L_CUR, idx, vlf_q(fc.kd * 0.318309886 * En));
+        e_set(L_CUR, idx, vlf_q(kd * 0.318309886 * En));
         e_set(E_NEXT, idx, vec3(0.0));
     }
     if (3u * idx < u_nc) {

@@ -38,6 +38,8 @@
  *                      spot cone; a point light's reflection in a mirror;
  *   vlf_tests albedo   the glossy lobe's albedo over incidence (its grazing
  *                      fall-off) against Monte Carlo of core brdf.h's lobe;
+ *   vlf_tests texture  a textured floor: each element's albedo averages the
+ *                      texture over it, and propagation shoots with it;
  *   vlf_tests hier     the hierarchical shortcut of the sort (objects in
  *                      boxes nothing else reaches into sorted on their own)
  *                      keeps the depth order right (Embree) and saves tests;
@@ -1122,6 +1124,90 @@ static void test_albedo(void)
         }
 }
 
+/* Textured albedo in propagation: a floor (albedo 0.8 x a texture of 8 x 1
+ * texels, the left four black, the right four white) under an emitting
+ * square facing down, 1 iteration: each floor element's albedo is the
+ * texture averaged over it (0 on the black half, 0.8 on the white half,
+ * where the bilinear texture is constant), the radiance it shoots on is
+ * albedo x E / pi there (1e-5), and the area-weighted mean albedo of the
+ * floor is within 2 % of 0.8 x the texture's mean over it; the answer
+ * without the texture (0.8 everywhere) fails the black half. */
+static void test_texture(void)
+{
+    /* floor z = 0 over [-1, 1]^2 facing +z; emitter z = 1 over [-0.5, 0.5]^2 facing -z */
+    const float tri[4 * 9] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, -1, 0, 1, 1, 0, -1, 1, 0,
+                              -0.5f, -0.5f, 1, 0.5f, 0.5f, 1, 0.5f, -0.5f, 1, -0.5f, -0.5f, 1, -0.5f, 0.5f, 1, 0.5f, 0.5f, 1};
+    gi_scene *s = triangle_scene(tri, 4);
+    gi_material *m = calloc(2, sizeof *m);
+    m[0] = s->materials[0];
+    m[0].albedo[0] = m[0].albedo[1] = m[0].albedo[2] = 0.8f;
+    m[0].albedo_texture = 0;
+    m[1].albedo_texture = -1;
+    m[1].emission[0] = m[1].emission[1] = m[1].emission[2] = 1.0f;
+    free(s->materials);
+    s->materials = m;
+    s->material_count = 2;
+    gi_texture tex = {NULL, 8, 1, calloc(8 * 4, sizeof(float))};
+    for (int i = 4; i < 8; i++)
+        for (int c = 0; c < 4; c++)
+            tex.rgba[4 * i + c] = 1.0f;
+    s->textures = &tex;
+    s->texture_count = 1;
+    for (uint32_t k = 0; k < 12; k++) {
+        gi_vertex *v = &s->vertices[k];
+        v->material = k < 6 ? 0 : 1;
+        v->uv[0] = 0.5f * (v->position[0] + 1.0f);
+        v->uv[1] = 0.5f * (v->position[1] + 1.0f);
+    }
+    vlf_params p = defaults();
+    p.l = 32, p.N = 32, p.density = 8, p.iterations = 1;
+    vlf_field f;
+    char err[256];
+    int ok = vlf_field_build(&f, s, 0.0f, &p, err, sizeof err) == 0;
+    EXPECT(ok, "%s", err);
+    if (ok) {
+        vlf_field_propagate(&f, NULL, NULL);
+        uint32_t nb = 0, nw = 0, bad = 0;
+        double akd = 0.0, area = 0.0, worst = 0.0;
+        for (uint32_t e = 0; e < f.elem_count; e++) {
+            const vlf_face *fc = &f.faces[f.elem_face[e]];
+            if (fc->emission[0] > 0.0f || !(f.elem_area[e] > 0.0f))
+                continue;
+            gi_vec3 q = gi_v3_add(fc->origin, gi_v3_add(gi_v3_scale(fc->t, f.elem_c[2 * e] / p.density),
+                                                        gi_v3_scale(fc->b, f.elem_c[2 * e + 1] / p.density)));
+            float x = f.centre.x + f.radius * q.x;
+            float half = 0.5f / (p.density / f.radius) + 1e-3f; /* half an element, world units */
+            float kd = f.elem_kd[3 * e];
+            akd += kd * f.elem_area[e], area += f.elem_area[e];
+            float want = -1.0f;
+            if (x + half < -0.125f && x - half > -0.875f)
+                want = 0.0f, nb++;
+            else if (x - half > 0.125f && x + half < 0.875f)
+                want = 0.8f, nw++;
+            if (want < 0.0f)
+                continue;
+            double shot = f.L_cur[3 * e], due = want * f.E_tot[3 * e] * GI_INV_PI;
+            worst = fmax(worst, fabs(shot - due));
+            if (fabsf(kd - want) > 1e-4f)
+                bad++;
+        }
+        /* the texture's mean over the floor: u = (x + 1) / 2 over [0, 1] (clamped bilinear or wrapped, the
+         * two halves are symmetric): 0.5 */
+        double mean = area > 0.0 ? akd / area : 0.0;
+        printf("texture: %u elements on the black half, %u on the white, %u with the wrong albedo; shot radiance off "
+               "by at most %.2e; mean albedo %.4f (due 0.8 x 0.5 = 0.4)\n", nb, nw, bad, worst, mean);
+        EXPECT(nb > 4 && nw > 4, "too few elements inside the halves (%u, %u): the test set-up is wrong", nb, nw);
+        EXPECT(bad == 0, "%u elements with the wrong albedo", bad);
+        EXPECT(worst < 1e-5, "shot radiance differs from albedo E / pi by %.3g", worst);
+        EXPECT(fabs(mean - 0.4) < 0.008, "mean albedo %.4f, due 0.4", mean);
+        vlf_field_free(&f);
+    }
+    s->textures = NULL;
+    s->texture_count = 0;
+    free(tex.rgba);
+    free_random(s);
+}
+
 /* The hierarchical shortcut of the sort (§3.2): clusters of random
  * triangles, each a scene object inside a small ball, among single random
  * triangles (other objects) and pinwheels of cyclically overlapping sticks;
@@ -1324,12 +1410,14 @@ int main(int argc, char **argv)
         test_point(), test_point_mirror(), any = 1;
     if (all || strcmp(part, "albedo") == 0)
         test_albedo(), any = 1;
+    if (all || strcmp(part, "texture") == 0)
+        test_texture(), any = 1;
     if (all || strcmp(part, "hier") == 0)
         test_hier(), any = 1;
     if (all || strcmp(part, "gpu") == 0)
         test_gpu(), any = 1;
     if (!any) {
-        fprintf(stderr, "vlf_tests: unknown part '%s' (dirs, order, energy, furnace, mirror, precision, sun, point, albedo, hier, gpu)\n", part);
+        fprintf(stderr, "vlf_tests: unknown part '%s' (dirs, order, energy, furnace, mirror, precision, sun, point, albedo, texture, hier, gpu)\n", part);
         return 2;
     }
     return gi_test_finish();
