@@ -17,7 +17,7 @@
  * shaders/vlf_propagate.comp). */
 enum {
     B_FACES, B_ELEM_FACE, B_ELEM_AREA, B_CELL_START, B_FRAG, B_FRAG_SLOT, B_RECV, B_EMAP,
-    B_TMAP, B_STATS, B_GATHER, B_PERM, B_RECTS, B_COVER, B_FRAMES, B_JOBS, B_ELEM_KD
+    B_TMAP, B_STATS, B_GATHER, B_PERM, B_RECTS, B_COVER, B_FRAMES, B_JOBS
 };
 enum { P_SWEEP, P_GATHER, P_SCATTER, P_FINISH };
 
@@ -266,8 +266,12 @@ int vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, char *err, size_t err_size)
         memcpy(cover, f->nd_cover, f->nd_cells);
         put(g->buf[B_FACES], faces, (size_t)f->face_count * 12 * sizeof *faces);
         put(g->buf[B_ELEM_FACE], f->elem_face, (size_t)f->elem_count * sizeof(uint32_t));
-        put(g->buf[B_ELEM_AREA], f->elem_area, (size_t)f->elem_count * sizeof(float));
-        put(g->buf[B_ELEM_KD], f->elem_kd, (size_t)f->elem_count * 3 * sizeof(float));
+        /* each element's area, then its albedo (3 floats) */
+        glNamedBufferData(g->buf[B_ELEM_AREA], (GLsizeiptr)(((size_t)f->elem_count * 4 + 4) * sizeof(float)), NULL,
+                          GL_DYNAMIC_DRAW);
+        glNamedBufferSubData(g->buf[B_ELEM_AREA], 0, (GLsizeiptr)((size_t)f->elem_count * sizeof(float)), f->elem_area);
+        glNamedBufferSubData(g->buf[B_ELEM_AREA], (GLintptr)((size_t)f->elem_count * sizeof(float)),
+                             (GLsizeiptr)((size_t)f->elem_count * 3 * sizeof(float)), f->elem_kd);
         put(g->buf[B_CELL_START], start, (size_t)l * (n2 + 1) * sizeof *start);
         put(g->buf[B_FRAG], frag, frags * sizeof *frag);
         put(g->buf[B_FRAG_SLOT], slot, frags * sizeof *slot);

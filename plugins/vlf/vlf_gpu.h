@@ -14,7 +14,7 @@
 
 #include "vlf_core.h"
 
-enum { VLF_GPU_PASSES = 4, VLF_GPU_BUFFERS = 17 };
+enum { VLF_GPU_PASSES = 4, VLF_GPU_BUFFERS = 16 };
 
 typedef struct vlf_gpu {
     GLuint prog[VLF_GPU_PASSES]; /* sweep, gather, scatter, finish */

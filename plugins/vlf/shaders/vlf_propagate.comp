@@ -23,6 +23,7 @@ struct VlfJob { uint src; uint dst; uint face; uint first_cell; vec4 c; };
 
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 0) readonly buffer VlfFaces { VlfFace faces[]; };
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 1) readonly buffer VlfElemFace { uint elem_face[]; };
+// each element's area, then its albedo (3 floats an element, from u_ne / 3)
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 2) readonly buffer VlfElemArea { float elem_area[]; };
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 3) readonly buffer VlfCellStart { uint cell_start[]; };
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 4) readonly buffer VlfFrag { uint frag[]; };
@@ -39,7 +40,6 @@ layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 12) readonly buffer VlfRects { V
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 13) readonly buffer VlfCover { uint cover[]; };
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 14) readonly buffer VlfFrames { vec4 frames[]; }; // u, v, n per fixed direction
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 15) readonly buffer VlfJobs { VlfJob jobs[]; };
-layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 16) readonly buffer VlfElemKd { float elem_kd[]; }; // albedo, 3 an element
 
 uniform uint u_count;       // invocations of the pass (per sign for the sweep)
 uniform uint u_precision;   // 0: float32, 1: RGBA16F, 2: RGB9E5
@@ -274,7 +274,8 @@ void main()
     if (idx >= u_count)
         return;
     if (3u * idx < u_ne) {
-        vec3 kd = vec3(elem_kd[3u * idx], elem_kd[3u * idx + 1u], elem_kd[3u * idx + 2u]);
+        uint kb = u_ne / 3u + 3u * idx;
+        vec3 kd = vec3(elem_area[kb], elem_area[kb + 1u], elem_area[kb + 2u]);
         vec3 En = e_get(E_NEXT, idx);
         e_set(E_TOT, idx, vlf_q(e_get(E_TOT, idx) + En));
         e_set(L_CUR, idx, vlf_q(kd * 0.318309886 * En));

@@ -45,7 +45,7 @@
  *                      keeps the depth order right (Embree) and saves tests;
  *   vlf_tests gpu      propagation by the GL compute passes equals the
  *                      CPU's (glossy Cornell box in the three storage
- *                      formats, a sky-lit scene). */
+ *                      formats, a sky-lit scene, a textured one). */
 #include "vlf_core.h"
 #include "vlf_gpu.h"
 
@@ -1300,8 +1300,8 @@ static void test_hier(void)
 /* Propagation on the GPU (vlf_gpu.c): the same field propagated by the
  * CPU's sweeps and by the compute passes, on the glossy Cornell box (mirror
  * and glossy faces: sweeps, gathers, scattering) in the three storage
- * formats, and on a sky-lit scene. The GPU's irradiance atlas and tiles
- * must lie within a relative L1 of 1e-4 (32f) / 2e-3 (16f, rgb9e5) of the
+ * formats, on a sky-lit scene and on a textured one. The GPU's irradiance
+ * atlas and tiles must lie within a relative L1 of 1e-4 (32f) / 2e-3 (16f, rgb9e5) of the
  * CPU's, and at least 10x closer than the CPU's own field one iteration
  * short (a wrong answer near the right one; the black map scores 100 %);
  * the flux counters agree within 1e-4. Prints both propagation times and
@@ -1383,6 +1383,7 @@ static void test_gpu(void)
         gpu_case(&g, "scenes/cornell_glossy.gltf", VLF_PREC_16F, 2e-3);
         gpu_case(&g, "scenes/cornell_glossy.gltf", VLF_PREC_RGB9E5, 2e-3);
         gpu_case(&g, "scenes/bunny_alone_env.glb", VLF_PREC_32F, 1e-4);
+        gpu_case(&g, "scenes/teapot_plane.glb", VLF_PREC_32F, 1e-4);
         vlf_gpu_free(&g);
     }
     gi_gpu_destroy(ctx);
