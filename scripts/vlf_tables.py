@@ -47,7 +47,8 @@ def load_runs(d):
                 continue
             r = {"method": row["method"], "scene": row["scene"], "label": row["label"], "params_full": row["params"],
                  "renderer": row["renderer"], "timer": row["timer"],
-                 "prepare_stages": {k: num(row.get("prepare_" + k + "_ms")) or 0.0 for k in ("sort", "propagate", "gpu_init")},
+                 "prepare_stages": {k: num(row.get("prepare_" + k + "_ms")) or 0.0
+                                    for k in ("sort", "propagate", "propagate_setup", "gpu_init")},
                  "stages": {k: {"median": num(row.get("stage_" + k + "_ms_median"))} for k in ("render", "shade")
                             if num(row.get("stage_" + k + "_ms_median")) is not None},
                  "stats": {k[5:]: num(v) for k, v in row.items() if k.startswith("stat_") and num(v) is not None},
@@ -252,6 +253,27 @@ def main():
         spc = r["stats"].get("samples_transported", 0) / (cpu_ms * 1e3) if cpu_ms > 0 else 0.0
         out.append("| {} | {:.3g} | {:.2f} | {:.1f} | {} | {} |".format(
             name, r["stats"].get("samples_transported", 0), sps, spc, fmt(mr), fmt(sps / mr if mr else None, 3)))
+
+    out.append("\n## Propagation on the GPU against the CPU (propagate = gpu, label gpu; same run, same renderer)\n")
+    out.append("The same transport as GL compute passes over the same depth order (plugins/vlf/README.md). Times are the "
+               "study's timer; on llvmpipe the \"GPU\" is the same CPU, so the ratio is llvmpipe's compute against C, "
+               "not a statement about a GPU.\n")
+    out.append("| scene | renderer | propagation CPU (ms) | propagation GPU (ms) | of it set-up (ms) | CPU / GPU | "
+               "relMSE matched CPU | relMSE matched GPU |")
+    out.append("|---|---|---:|---:|---:|---:|---:|---:|")
+    gpu_runs = [r for r in vlf if r["label"] == "gpu"]
+    if not gpu_runs:
+        out.append("| – | no run labelled gpu in runs.csv (the study predates the entry) | | | | | | |")
+    for g in sorted(gpu_runs, key=lambda r: r["scene"]):
+        c = next((r for r in vlf if r["label"] == "table1" and r["scene"] == g["scene"]
+                  and r["renderer"] == g["renderer"]), None)
+        if c is None:
+            continue
+        pc, pg = c["prepare_stages"].get("propagate", 0.0), g["prepare_stages"].get("propagate", 0.0)
+        out.append("| {} | {} | {:.0f} | {:.0f} | {:.0f} | {} | {} | {} |".format(
+            os.path.basename(g["scene"]), g["renderer"], pc, pg, g["prepare_stages"].get("propagate_setup", 0.0),
+            fmt(pc / pg if pg else None, 3), fmt(c["metrics"]["matched"]["relmse"], 4),
+            fmt(g["metrics"]["matched"]["relmse"], 4)))
     print("\n".join(out))
 
 

@@ -1,8 +1,9 @@
 /* The `vlf` method: Light Field Propagation and Rendering on the GPU
  * (Mortensen, Khanna, Slater, Afrigraph 2007), the GPU Virtual Light Field.
  *
- * prepare(): the light field is built and propagated on the CPU
- * (vlf_core.c: stages `sort` and `propagate`), then uploaded (`gpu_init`);
+ * prepare(): the light field is built on the CPU (vlf_core.c: stage
+ * `sort`), propagated on the CPU or, with propagate = gpu, by compute
+ * passes (vlf_gpu.c; stage `propagate`), then uploaded (`gpu_init`);
  * render(): the G-buffer and one compute pass reading the irradiance atlas
  * and the non-diffuse tiles (shaders/vlf_render.comp, stage `render`).
  * See plugins/vlf/README.md for what follows the paper and what does not. */
@@ -15,6 +16,7 @@
 #include <string.h>
 
 #include "vlf_core.h"
+#include "vlf_gpu.h"
 
 extern const gi_shader_source gi_vlf_shaders[];
 
@@ -25,6 +27,9 @@ typedef struct vlf {
     vlf_params prm;
     vlf_field field;
     int have_field;
+    int gpu_propagate;  /* propagate = gpu: the compute passes of vlf_gpu.c */
+    vlf_gpu gpu;
+    int have_gpu;
     GLuint program;
     GLuint buf[VLF_BUFFERS];
     GLuint lookup;
@@ -55,6 +60,12 @@ static const gi_param_desc vlf_params_desc[] = {
     {"subdivide", GI_PARAM_INT, 1, 1, 16, NULL, NULL,
      "each scene triangle cut into subdivide^2 triangles before sorting and transport: the same surfaces as more "
      "faces (the tessellation sweep of propagation time against faces)"},
+    {"propagate", GI_PARAM_ENUM, 0, 0, 0, "cpu|gpu", "propagation (Sec. 3.2-3.4)",
+     "where propagation runs: cpu: the sweeps in C (vlf_core.c); gpu: GL compute passes over the same depth order "
+     "(vlf_gpu.c), the same maps within float rounding; gpu needs perturbed = 0"},
+    {"hier_min", GI_PARAM_INT, 0, 0, 1000000, NULL, "hierarchical sort (Sec. 3.2)",
+     "objects (glTF nodes) of at least this many triangles whose bounding box in a direction's frame no other "
+     "triangle reaches into are sorted on their own and spliced in at their box's place; 0: off"},
     {"threads", GI_PARAM_INT, 4, 1, 64, NULL, "sort threads (Sec. 6)",
      "CPU threads of the sort stage, one subfield at a time each (the field is the same for any count)"},
     {"bsp_levels", GI_PARAM_INT, 2, 0, 8, NULL, "BSP levels (Sec. 3.2, 6)",
@@ -87,6 +98,14 @@ static gi_result vlf_create(const gi_host *host, const gi_params *params, void *
     v->prm.subdivide = (uint32_t)gi_params_int(params, "subdivide");
     v->prm.bsp_levels = (uint32_t)gi_params_int(params, "bsp_levels");
     v->prm.bsp_min = (uint32_t)gi_params_int(params, "bsp_min");
+    v->prm.hier_min = (uint32_t)gi_params_int(params, "hier_min");
+    v->gpu_propagate = gi_params_enum(params, "propagate") == 1;
+    if (v->gpu_propagate && v->prm.perturbed > 0) {
+        host->log(host, GI_LOG_ERROR, "vlf: propagate = gpu runs the fixed directions only; set perturbed = 0");
+        gi_kit_free(&v->kit);
+        free(v);
+        return GI_ERR_INVALID_ARGUMENT;
+    }
     if (v->prm.N % v->prm.m != 0) {
         host->log(host, GI_LOG_ERROR, "vlf: N = %u is not a multiple of the tile size m = %u", v->prm.N, v->prm.m);
         gi_kit_free(&v->kit);
@@ -230,10 +249,24 @@ static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
     }
     v->have_field = 1;
     host->stage_begin(host, "propagate");
-    rc = vlf_field_propagate(&v->field, vlf_cancelled, (void *)host);
-    host->stage_end(host, "propagate");
-    if (rc != 0)
-        return gi_kit_fail(&v->kit, GI_ERR_CANCELLED, "vlf: propagation cancelled");
+    if (v->gpu_propagate) {
+        /* the depth order and the gather lists uploaded (propagate_setup),
+         * then the passes; the maps read back for the upload below */
+        host->stage_begin(host, "propagate_setup");
+        rc = vlf_gpu_setup(&v->gpu, &v->field, err, sizeof err);
+        host->stage_end(host, "propagate_setup");
+        if (rc == 0)
+            rc = vlf_gpu_propagate(&v->gpu, &v->field, vlf_cancelled, (void *)host, err, sizeof err);
+        host->stage_end(host, "propagate");
+        if (rc != 0)
+            return gi_kit_fail(&v->kit, host->cancelled && host->cancelled(host) ? GI_ERR_CANCELLED : GI_ERR_GL, "%s",
+                               err);
+    } else {
+        rc = vlf_field_propagate(&v->field, vlf_cancelled, (void *)host);
+        host->stage_end(host, "propagate");
+        if (rc != 0)
+            return gi_kit_fail(&v->kit, GI_ERR_CANCELLED, "vlf: propagation cancelled");
+    }
     host->stage_begin(host, "gpu_init");
     gi_result r = vlf_upload(v);
     glFinish();
@@ -255,6 +288,8 @@ static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
     host->stat(host, "sort_bsp_cuts", (double)s->sort_bsp_cuts);
     host->stat(host, "sort_unresolved", (double)s->sort_unresolved);
     host->stat(host, "sort_tests", (double)s->sort_tests);
+    host->stat(host, "sort_groups", (double)s->sort_groups);
+    host->stat(host, "sort_hier_fallbacks", (double)s->sort_hier_fallbacks);
     host->stat(host, "flux_emitted", s->flux_emitted);
     host->stat(host, "flux_received", s->flux_received);
     host->stat(host, "flux_escaped", s->flux_escaped);
@@ -270,6 +305,12 @@ static gi_result vlf_prepare(void *inst, const gi_gpu_scene *gs)
         v->program = gi_program_build_compute("vlf_render.comp", NULL, &err);
         if (!v->program)
             return gi_kit_fail_with(&v->kit, GI_ERR_GL, &err);
+    }
+    if (v->gpu_propagate && !v->have_gpu) {
+        char e[256];
+        if (vlf_gpu_init(&v->gpu, e, sizeof e) != 0)
+            return gi_kit_fail(&v->kit, GI_ERR_GL, "%s", e);
+        v->have_gpu = 1;
     }
     return vlf_build(v, gs);
 }
@@ -340,6 +381,8 @@ static void vlf_destroy(void *inst)
         glDeleteBuffers(VLF_BUFFERS, v->buf);
     if (v->lookup)
         glDeleteTextures(1, &v->lookup);
+    if (v->have_gpu)
+        vlf_gpu_free(&v->gpu);
     free(v);
 }
 
@@ -357,7 +400,7 @@ static const gi_method vlf_method = {
     .version = "0.1",
     .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_GLOSSY | GI_CAP_MIRROR | GI_CAP_AREA_LIGHTS |
             GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION |
-            GI_CAP_PRECOMPUTE | GI_CAP_VISIBILITY,
+            GI_CAP_PRECOMPUTE | GI_CAP_VISIBILITY | GI_CAP_TEXTURES,
     .max_bounces = 7,
     .params = vlf_params_desc,
     .create = vlf_create,

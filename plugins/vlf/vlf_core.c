@@ -322,6 +322,37 @@ void vlf_quantise(uint32_t prec, float *rgb, size_t count)
     }
 }
 
+/* ---- Glossy albedo -------------------------------------------------------- */
+
+double vlf_phong_albedo(float n, float cos_t)
+{
+    /* (n + 2) / (2 pi) * integral over the hemisphere of cos^n(alpha)
+     * cos(theta_o) d omega_o, alpha the angle to the reflected direction:
+     * with u = cos^(n+1) alpha, (n + 2) / (n + 1) times the mean of
+     * max(0, cos theta_o) over u in [0, 1] and phi (a 64 x 64 midpoint rule) */
+    const int K = 64;
+    double ct = fmin(1.0, fabs((double)cos_t)), st = sqrt(fmax(0.0, 1.0 - ct * ct)), sum = 0.0;
+    for (int a = 0; a < K; a++) {
+        double ca = pow(((double)a + 0.5) / K, 1.0 / ((double)n + 1.0)), sa = sqrt(fmax(0.0, 1.0 - ca * ca));
+        for (int b = 0; b < K; b++) {
+            double co = ca * ct + sa * st * cos(2.0 * GI_PI * ((double)b + 0.5) / K);
+            if (co > 0.0)
+                sum += co;
+        }
+    }
+    return ((double)n + 2.0) / ((double)n + 1.0) * sum / (double)(K * K);
+}
+
+float vlf_phong_albedo_at(const vlf_face *fc, float cos_t)
+{
+    float x = fminf(1.0f, fmaxf(0.0f, cos_t)) * (float)(VLF_ALBEDO_TABLE - 1);
+    int k = (int)x;
+    if (k >= VLF_ALBEDO_TABLE - 1)
+        return fc->albedo[VLF_ALBEDO_TABLE - 1];
+    float t = x - (float)k;
+    return fc->albedo[k] * (1.0f - t) + fc->albedo[k + 1] * t;
+}
+
 /* ---- Subfields ------------------------------------------------------------ */
 
 gi_vec3 vlf_to_vlf(const vlf_field *f, gi_vec3 world)
@@ -459,7 +490,7 @@ static int frag_cmp(const void *a, const void *b)
 
 /* Sort counters of one thread. */
 typedef struct sort_counts {
-    uint64_t pieces, splits, bsp_cuts, unresolved, tests;
+    uint64_t pieces, splits, bsp_cuts, unresolved, tests, groups, fallbacks;
 } sort_counts;
 
 /* The fragments of every face along subfield frame fr, in buf, grouped by
@@ -488,13 +519,16 @@ static int list_fragments(const vlf_field *f, const vlf_psf *fr, frag_buf *buf, 
     int mode = f->prm.order == VLF_ORDER_PLAIN     ? VLF_SORT_PLAIN
                : f->prm.order == VLF_ORDER_NOSPLIT ? VLF_SORT_NOSPLIT
                                                    : VLF_SORT_NEWELL;
-    if (vlf_sort_faces(so, f->tri_p, f->tri_count, fr->u, fr->v, fr->n, mode, f->prm.bsp_levels, f->prm.bsp_min) != 0)
+    if (vlf_sort_faces(so, f->tri_p, f->tri_count, f->tri_group, f->prm.hier_min, fr->u, fr->v, fr->n, mode,
+                       f->prm.bsp_levels, f->prm.bsp_min) != 0)
         return 0;
     cnt->pieces += so->nout;
     cnt->splits += so->splits;
     cnt->bsp_cuts += so->bsp_cuts;
     cnt->unresolved += so->unresolved;
     cnt->tests += so->tests;
+    cnt->groups += so->groups;
+    cnt->fallbacks += so->hier_fallbacks;
     for (uint32_t k = 0; k < so->nout; k++) {
         const vlf_piece *pc = &so->poly[so->out[k]];
         uint32_t fi = f->tri_face[pc->tri];
@@ -629,7 +663,7 @@ static int build_all_psf(vlf_field *f)
         return 0;
     }
     for (uint32_t t = 0; t < T; t++) {
-        jobs[t] = (sort_job){f, t, T, 0, {0, 0, 0, 0, 0}};
+        jobs[t] = (sort_job){f, t, T, 0, {0, 0, 0, 0, 0, 0, 0}};
         if (t > 0)
             started[t] = pthread_create(&th[t], NULL, sort_thread, &jobs[t]) == 0;
     }
@@ -648,6 +682,8 @@ static int build_all_psf(vlf_field *f)
         f->st.sort_bsp_cuts += jobs[t].cnt.bsp_cuts;
         f->st.sort_unresolved += jobs[t].cnt.unresolved;
         f->st.sort_tests += jobs[t].cnt.tests;
+        f->st.sort_groups += jobs[t].cnt.groups;
+        f->st.sort_hier_fallbacks += jobs[t].cnt.fallbacks;
     }
     free(jobs), free(th), free(started);
     return ok;
@@ -683,11 +719,12 @@ static int group_faces(vlf_field *f, const gi_scene *s, float t)
     uint32_t T = s->triangle_count;
     f->tri_count = T;
     f->tri_face = malloc((size_t)T * sizeof *f->tri_face);
+    f->tri_group = malloc((size_t)T * sizeof *f->tri_group);
     f->tri_p = malloc((size_t)T * 3 * sizeof *f->tri_p);
     tri_key *keys = malloc((size_t)T * sizeof *keys);
     gi_vec3 *nrm = malloc((size_t)T * sizeof *nrm);
     f->faces = calloc((size_t)T, sizeof *f->faces);
-    if (!f->tri_face || !f->tri_p || !keys || !nrm || !f->faces) {
+    if (!f->tri_face || !f->tri_group || !f->tri_p || !keys || !nrm || !f->faces) {
         free(keys);
         free(nrm);
         return 0;
@@ -698,6 +735,7 @@ static int group_faces(vlf_field *f, const gi_scene *s, float t)
         gi_vec3 *p = f->tri_p + 3 * (size_t)ti;
         for (int k = 0; k < 3; k++)
             p[k] = vlf_to_vlf(f, w[k]);
+        f->tri_group[ti] = s->vertices[s->indices[3 * ti]].object;
         gi_vec3 n = gi_v3_normalize(gi_v3_cross(gi_v3_sub(p[1], p[0]), gi_v3_sub(p[2], p[0])));
         nrm[ti] = n;
         keys[ti] = (tri_key){ti, s->vertices[s->indices[3 * ti]].material, (int32_t)lrintf(n.x * 1000.0f),
@@ -740,7 +778,12 @@ static int group_faces(vlf_field *f, const gi_scene *s, float t)
         memcpy(fc->kd, mt->albedo, sizeof fc->kd);
         memcpy(fc->ks, mt->ks, sizeof fc->ks);
         fc->exponent = mt->exponent;
+        fc->material = keys[a].material;
+        fc->textured = mt->albedo_texture >= 0 && (uint32_t)mt->albedo_texture < s->texture_count;
         fc->mirror = mt->mirror || mt->exponent >= GI_MIRROR_EXPONENT;
+        for (int k = 0; k < VLF_ALBEDO_TABLE; k++)
+            fc->albedo[k] = fc->mirror ? 1.0f
+                                       : (float)vlf_phong_albedo(fc->exponent, (float)k / (float)(VLF_ALBEDO_TABLE - 1));
         const float *le = gi_scene_triangle_emission(s, t0);
         for (int k = 0; k < 3; k++)
             fc->emission[k] = le ? le[k] : 0.0f;
@@ -777,7 +820,7 @@ static int clip_poly(float *x, float *y, int n, int k, float s, float c)
 
 /* Area of each element inside its face: every triangle clipped exactly
  * against the texels of its bounding box. */
-static void element_areas(vlf_field *f)
+static void element_areas(vlf_field *f, const gi_scene *s)
 {
     float texel = 1.0f / (f->prm.density * f->prm.density);
     for (uint32_t ti = 0; ti < f->tri_count; ti++) {
@@ -812,6 +855,24 @@ static void element_areas(vlf_field *f)
                 uint32_t e = fc->first_elem + (uint32_t)cy * fc->W + (uint32_t)cx;
                 float ar = 0.5f * fabsf(a) * texel;
                 f->elem_area[e] += ar;
+                if (fc->textured && a != 0.0f) {
+                    /* textured albedo: the texture at the part's centroid
+                     * (barycentric in the triangle), weighted by its area */
+                    float qx = mx / (3.0f * a), qy = my / (3.0f * a);
+                    float d2 = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+                    if (d2 != 0.0f) {
+                        float w1 = ((qx - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (qy - y[0])) / d2;
+                        float w2 = ((x[1] - x[0]) * (qy - y[0]) - (qx - x[0]) * (y[1] - y[0])) / d2;
+                        float w0 = 1.0f - w1 - w2, uv[2] = {0.0f, 0.0f}, alb[3];
+                        const float w[3] = {w0, w1, w2};
+                        for (int k = 0; k < 3; k++)
+                            for (int c = 0; c < 2; c++)
+                                uv[c] += w[k] * s->vertices[s->indices[3 * (size_t)ti + (size_t)k]].uv[c];
+                        gi_scene_albedo(s, fc->material, uv, alb);
+                        for (int c = 0; c < 3; c++)
+                            f->elem_kd[3 * (size_t)e + (size_t)c] += ar * alb[c];
+                    }
+                }
                 if (a != 0.0f) { /* area-weighted centroid of the part on the face, texel units */
                     f->elem_c[2 * (size_t)e] += ar * mx / (3.0f * a);
                     f->elem_c[2 * (size_t)e + 1] += ar * my / (3.0f * a);
@@ -830,9 +891,9 @@ static int subdivide_triangles(vlf_field *f, uint32_t k)
         return 1;
     size_t T = (size_t)f->tri_count * k * k;
     gi_vec3 *P = malloc(T * 3 * sizeof *P);
-    uint32_t *F = malloc(T * sizeof *F);
-    if (!P || !F) {
-        free(P), free(F);
+    uint32_t *F = malloc(T * sizeof *F), *Gr = malloc(T * sizeof *Gr);
+    if (!P || !F || !Gr) {
+        free(P), free(F), free(Gr);
         return 0;
     }
     size_t n = 0;
@@ -845,10 +906,12 @@ static int subdivide_triangles(vlf_field *f, uint32_t k)
             for (uint32_t b = 0; a + b < k; b++) {
                 gi_vec3 *q = P + 3 * n;
                 q[0] = GRID(a, b), q[1] = GRID(a + 1, b), q[2] = GRID(a, b + 1);
+                Gr[n] = f->tri_group[ti];
                 F[n++] = f->tri_face[ti];
                 if (a + b + 2 <= k) {
                     q = P + 3 * n;
                     q[0] = GRID(a + 1, b), q[1] = GRID(a + 1, b + 1), q[2] = GRID(a, b + 1);
+                    Gr[n] = f->tri_group[ti];
                     F[n++] = f->tri_face[ti];
                 }
             }
@@ -856,8 +919,10 @@ static int subdivide_triangles(vlf_field *f, uint32_t k)
     }
     free(f->tri_p);
     free(f->tri_face);
+    free(f->tri_group);
     f->tri_p = P;
     f->tri_face = F;
+    f->tri_group = Gr;
     f->tri_count = (uint32_t)n;
     return 1;
 }
@@ -986,7 +1051,19 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
         for (uint32_t e = 0; e < fc->W * fc->H; e++)
             f->elem_face[fc->first_elem + e] = fi;
     }
-    element_areas(f);
+    f->elem_kd = calloc((size_t)elems * 3 + 3, sizeof *f->elem_kd);
+    if (!f->elem_kd)
+        goto oom;
+    element_areas(f, s);
+    /* each element's albedo: the material's, or on textured faces the
+     * texture averaged over the element's part of the face */
+    for (uint32_t e = 0; e < elems; e++) {
+        const vlf_face *fc = &f->faces[f->elem_face[e]];
+        for (int c = 0; c < 3; c++) {
+            float *kd = &f->elem_kd[3 * (size_t)e + (size_t)c];
+            *kd = fc->textured && f->elem_area[e] > 0.0f ? *kd / f->elem_area[e] : fc->kd[c];
+        }
+    }
     for (uint32_t e = 0; e < elems; e++) {
         if (f->elem_area[e] > 0.0f) {
             f->elem_c[2 * (size_t)e] /= f->elem_area[e];
@@ -1061,7 +1138,7 @@ oom:
  * directions are sorted like fixed ones, used for transport, discarded). */
 static int perturbed_list(vlf_field *f, const vlf_psf *fr, frag_buf *buf, frag_buf *tmp, vlf_sorter *so)
 {
-    sort_counts cnt = {0, 0, 0, 0, 0};
+    sort_counts cnt = {0, 0, 0, 0, 0, 0, 0};
     return list_fragments(f, fr, buf, tmp, so, NULL, &cnt);
 }
 
@@ -1169,6 +1246,21 @@ static gi_vec3 perturbed_dir(const vlf_field *f, uint32_t i, uint32_t k)
                                      gi_v3_add(gi_v3_scale(p->u, sz * cosf(phi)), gi_v3_scale(p->v, sz * sinf(phi)))));
 }
 
+/* The radiance the interface of fixed direction i starts a sweep with
+ * (travel direction sign * w_i): the sky's radiance from where the light
+ * comes (Fig. 6) and the directional lights', in the first iteration
+ * only; black after. */
+void vlf_sweep_sky(const vlf_field *f, uint32_t i, int sign, int first_iteration, float sky[3])
+{
+    uint32_t sd = sign > 0 ? i : i + f->prm.l;
+    sky[0] = sky[1] = sky[2] = 0.0f;
+    if (first_iteration && f->env)
+        gi_envmap_eval(f->env, gi_v3_scale(f->dirs.signed_dirs[sd], -1.0f), sky);
+    if (first_iteration)
+        for (int q = 0; q < 3; q++)
+            sky[q] += f->sun[3 * sd + (uint32_t)q];
+}
+
 /* One sweep of subfield i along travel direction t = sign * w_i, front to
  * back along t through every ray's fragments with the radiance interface:
  * receivers (front side facing against t) take the interface's radiance,
@@ -1182,12 +1274,8 @@ static void sweep(vlf_field *f, uint32_t i, int sign, int first_iteration)
     gi_vec3 t = f->dirs.signed_dirs[sd];
     float dW = f->dirs.solid_angle[sd];
     float cell_area = (2.0f / (float)N) * (2.0f / (float)N);
-    float sky[3] = {0, 0, 0};
-    if (first_iteration && f->env)
-        gi_envmap_eval(f->env, gi_v3_scale(t, -1.0f), sky);
-    if (first_iteration)
-        for (int q = 0; q < 3; q++)
-            sky[q] += f->sun[3 * sd + (uint32_t)q];
+    float sky[3];
+    vlf_sweep_sky(f, i, sign, first_iteration, sky);
     double shot = 0, recv = 0, back = 0, esc = 0;
     float min_area = 1.0f / (64.0f * f->prm.density * f->prm.density);
     for (uint32_t c = 0; c < N * N; c++) {
@@ -1270,9 +1358,11 @@ static int read_in(const vlf_field *f, const vlf_rect *r, float x, float y, floa
  * than the direction set (fewer than ~3 directions' worth of lobe) go to
  * the three nearest directions of r with their barycentric weights, wider
  * Phong lobes to every direction of the lobe; directions below the face
- * get 0. Returns sum_j g_j cos_j dOmega_j (the normaliser that makes the
- * face reflect ks of what arrives), 0 if nothing is reflected. */
-static double reflect_weights(const vlf_field *f, const vlf_face *fc, gi_vec3 r, float *g)
+ * get 0. Returns sum_j g_j cos_j dOmega_j divided by the lobe's albedo at
+ * this incidence (the normaliser that makes the face reflect ks A(theta) of
+ * what arrives: ks at normal incidence, less toward grazing as core
+ * brdf.h's lobe; mirrors ks), 0 if nothing is reflected. */
+double vlf_reflect_weights(const vlf_field *f, const vlf_face *fc, gi_vec3 r, float *g)
 {
     uint32_t n2 = 2 * f->prm.l;
     memset(g, 0, n2 * sizeof *g);
@@ -1307,6 +1397,11 @@ static double reflect_weights(const vlf_field *f, const vlf_face *fc, gi_vec3 r,
             norm += g[j] * cj * f->dirs.solid_angle[j];
         else
             g[j] = 0.0f;
+    }
+    if (!fc->mirror && norm > 0.0) {
+        /* the Phong lobe's albedo at this incidence (its grazing fall-off) */
+        float a = vlf_phong_albedo_at(fc, gi_v3_dot(r, fc->n));
+        norm = a > 1e-6f ? norm / a : 0.0;
     }
     return norm;
 }
@@ -1396,7 +1491,7 @@ static int punctual_first_shot(vlf_field *f)
                         /* light travelling along -w, reflected about the face */
                         gi_vec3 t = gi_v3_scale(w[k], -1.0f);
                         gi_vec3 r = gi_v3_sub(t, gi_v3_scale(fc->n, 2.0f * gi_v3_dot(t, fc->n)));
-                        double norm = reflect_weights(f, fc, r, g);
+                        double norm = vlf_reflect_weights(f, fc, r, g);
                         if (norm <= 0.0 || g[sd] <= 0.0f)
                             continue;
                         for (int c = 0; c < 3; c++)
@@ -1433,7 +1528,7 @@ static void scatter(vlf_field *f, uint32_t i)
         gi_vec3 t = f->dirs.signed_dirs[sd_in];
         float cos_in = fabsf(ci);
         gi_vec3 r = gi_v3_sub(t, gi_v3_scale(fc->n, 2.0f * gi_v3_dot(t, fc->n)));
-        double norm = reflect_weights(f, fc, r, g);
+        double norm = vlf_reflect_weights(f, fc, r, g);
         if (norm <= 0.0)
             continue;
         float scale = (float)((double)cos_in * f->dirs.solid_angle[sd_in] / norm);
@@ -1575,10 +1670,9 @@ static int perturbed_pipelined(vlf_field *f, uint32_t i, int first_iteration, pe
     return ok;
 }
 
-int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
+int vlf_propagate_init(vlf_field *f)
 {
-    double t0 = now_s();
-    uint32_t l = f->prm.l, prec = f->prm.precision;
+    uint32_t prec = f->prm.precision;
     size_t ne = (size_t)f->elem_count * 3, nc = (size_t)f->nd_cells * 3;
     memset(f->E_tot, 0, ne * sizeof(float));
     memset(f->out_tot, 0, nc * sizeof(float));
@@ -1602,6 +1696,16 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
     }
     f->st.flux_shot = f->st.flux_received = f->st.flux_back = f->st.flux_escaped = 0;
     f->st.samples = 0;
+    return 0;
+}
+
+int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
+{
+    double t0 = now_s();
+    uint32_t l = f->prm.l, prec = f->prm.precision;
+    size_t ne = (size_t)f->elem_count * 3, nc = (size_t)f->nd_cells * 3;
+    if (vlf_propagate_init(f) != 0)
+        return -1;
     frag_buf pbuf = {0}, ptmp = {0};
     vlf_sorter psort;
     memset(&psort, 0, sizeof psort);
@@ -1682,8 +1786,7 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
         }
         for (size_t k = 0; k < ne; k++) {
             f->E_tot[k] += f->E_next[k];
-            const vlf_face *fc = &f->faces[f->elem_face[k / 3]];
-            f->L_cur[k] = fc->kd[k % 3] * (float)GI_INV_PI * f->E_next[k];
+            f->L_cur[k] = f->elem_kd[k] * (float)GI_INV_PI * f->E_next[k];
             f->E_next[k] = 0.0f;
         }
         for (size_t k = 0; k < nc; k++) {
@@ -1713,9 +1816,11 @@ void vlf_field_free(vlf_field *f)
     vlf_dirs_free(&f->dirs);
     free(f->faces);
     free(f->tri_face);
+    free(f->tri_group);
     free(f->tri_p);
     free(f->elem_face);
     free(f->elem_area);
+    free(f->elem_kd);
     free(f->rects);
     free(f->nd_cover);
     free(f->E_tot);

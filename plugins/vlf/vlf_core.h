@@ -49,6 +49,8 @@ typedef struct vlf_params {
     uint32_t bsp_min;    /* a list is cut only with at least this many faces (paper: 4K) */
     uint32_t precision;  /* storage format of the ir/radiance maps: VLF_PREC_32F, _16F or _RGB9E5 */
     uint32_t subdivide;  /* each scene triangle cut into subdivide^2 for sorting and transport (tessellation sweep) */
+    uint32_t hier_min;   /* hierarchical shortcut (§3.2): objects of at least this many triangles in a box no other
+                          * triangle reaches into are sorted on their own; 0: off */
 } vlf_params;
 
 /* Storage formats of the light-field maps (§3.1, §6): three float32 (12
@@ -80,6 +82,8 @@ typedef struct vlf_rect {
     uint32_t offset; /* first cell in the tile storage */
 } vlf_rect;
 
+enum { VLF_ALBEDO_TABLE = 33 };
+
 /* A face: the coplanar triangles of one material (the paper's planar
  * polygons), with a W x H chart of diffuse elements in its plane. */
 typedef struct vlf_face {
@@ -91,8 +95,12 @@ typedef struct vlf_face {
     uint32_t first_elem;
     float kd[3], ks[3], exponent, emission[3];
     int mirror;
+    uint32_t material;  /* the scene's material */
+    int textured;       /* its albedo has a texture (elements then average it, elem_kd) */
     int32_t nd;         /* index among non-diffuse faces, -1 for diffuse */
     float send_scale;   /* pi / sum over directions of |cos| dOmega (diffuse emission normalisation) */
+    float albedo[VLF_ALBEDO_TABLE]; /* the glossy lobe's albedo over cos(incidence) 0 .. 1 (1 at normal incidence;
+                                     * mirrors 1 throughout) */
 } vlf_face;
 
 /* Fragment lists of one subfield: the faces each ray meets, front to back
@@ -118,6 +126,8 @@ typedef struct vlf_stats {
     uint64_t sort_bsp_cuts;  /* pieces cut by a BSP plane, over all subfields */
     uint64_t sort_unresolved;/* cycles left unbroken (split limit), over all subfields */
     uint64_t sort_tests;     /* pairs of faces tested by Newell's ordering */
+    uint64_t sort_groups;    /* objects sorted on their own by the hierarchical shortcut, over all subfields */
+    uint64_t sort_hier_fallbacks; /* subfields sorted again without it (a stand-in split by a cycle) */
 } vlf_stats;
 
 /* A point or spot light (world space): its first shot is by shadow rays. */
@@ -137,9 +147,11 @@ typedef struct vlf_field {
     uint32_t tri_count;      /* triangles sorted and rasterised: scene triangles x subdivide^2 */
     uint32_t tri_sub;        /* subdivide^2: triangle k is part of scene triangle k / tri_sub */
     uint32_t *tri_face;      /* face of each triangle */
+    uint32_t *tri_group;     /* scene object of each triangle (the hierarchical shortcut's groups) */
     gi_vec3 *tri_p;          /* 3 corners per triangle, VLF coordinates */
     uint32_t *elem_face;
     float *elem_area;
+    float *elem_kd;          /* 3 per element: albedo (the material's, or the texture averaged over the element) */
     vlf_psf *psf;            /* l (fixed directions) */
     vlf_rect *rects;         /* nd_count * l */
     uint32_t nd_cells;
@@ -164,6 +176,26 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
  * `cancelled` (may be NULL) is polled between directions; returns -1 then. */
 int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user);
 void vlf_field_free(vlf_field *f);
+
+/* The start of propagation shared by the CPU and the GPU paths: the maps
+ * cleared, emission as the first unshot radiance, the point and spot
+ * lights' first shot into the next maps, the counters zeroed. 0 or -1
+ * (out of memory). */
+int vlf_propagate_init(vlf_field *f);
+/* The radiance the interface of fixed direction i starts a sweep with
+ * along sign * w_i: the sky's and the directional lights' (first
+ * iteration only). */
+void vlf_sweep_sky(const vlf_field *f, uint32_t i, int sign, int first_iteration, float sky[3]);
+/* Weights g over the 2l signed directions of the light non-diffuse face fc
+ * reflects into direction r (§3.4), and their normaliser (0: nothing is
+ * reflected). */
+double vlf_reflect_weights(const vlf_field *f, const vlf_face *fc, gi_vec3 r, float *g);
+/* Albedo of the normalised Phong lobe of core brdf.h (ks (n + 2) / (2 pi)
+ * cos^n alpha) per unit ks at incidence cos_t: 1 at normal incidence,
+ * falling toward grazing where the lobe dips below the surface (numerical
+ * quadrature); and face fc's table of it, interpolated. */
+double vlf_phong_albedo(float n, float cos_t);
+float vlf_phong_albedo_at(const vlf_face *fc, float cos_t);
 
 /* Subfield frame of fixed direction i: cell coordinates (x, y) in [0, N)
  * and depth of VLF point q. */

@@ -525,19 +525,17 @@ static int order_bsp(vlf_sorter *s, uint32_t *items, uint32_t n, int mode, uint3
     return rc;
 }
 
-int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, gi_vec3 u, gi_vec3 v, gi_vec3 n, int mode,
-                   uint32_t bsp_levels, uint32_t bsp_min)
+/* The triangles in the frame as pieces 0 .. tri_count - 1 (piece k is
+ * triangle k) with their planes; 0, or -1 out of memory. extra: proxy
+ * planes to leave room for. */
+static int load_triangles(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, gi_vec3 u, gi_vec3 v, gi_vec3 n,
+                          uint32_t extra)
 {
     s->nv = s->np = s->nlist = s->nout = 0;
-    s->tests = 0;
-    s->splits = s->bsp_cuts = s->unresolved = 0;
     uint32_t cap = s->cap_plane;
-    if (!grow((void **)&s->plane, &cap, tri_count * 4 + 4, sizeof *s->plane))
+    if (!grow((void **)&s->plane, &cap, (tri_count + extra) * 4 + 4, sizeof *s->plane))
         return -1;
     s->cap_plane = cap;
-    uint32_t *items = malloc((size_t)(tri_count ? tri_count : 1) * sizeof *items);
-    if (!items)
-        return -1;
     for (uint32_t t = 0; t < tri_count; t++) {
         gi_vec3 q[3];
         for (int k = 0; k < 3; k++) {
@@ -553,12 +551,173 @@ int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, gi_v
         } else {
             pl[0] = pl[1] = pl[2] = pl[3] = 0.0f;
         }
-        items[t] = add_piece(s, t, q, 3);
-        if (items[t] == UINT32_MAX) {
-            free(items);
+        if (add_piece(s, t, q, 3) == UINT32_MAX)
             return -1;
+    }
+    return 0;
+}
+
+/* The hierarchical shortcut of §3.2: "objects enclosed by a bounding volume
+ * not intersected by any other object in the scene can be taken out of the
+ * scene and sorted separately", the volume sorted in their place, their
+ * list inserted at its position. The volume is the group's bounding box in
+ * this subfield's frame; no other triangle's bounds may reach into it
+ * (a conservative test). Its front face, the rectangle at its nearest depth,
+ * stands in the global order for it: any piece outside the box that
+ * overlaps it in projection lies wholly in front of its front face or
+ * wholly behind its back face there, so it is ordered against the
+ * rectangle as against every triangle of the group. Returns 0 (s->out is
+ * the order), 1 when the shortcut does not apply or a stand-in was split by
+ * a cycle (the caller sorts without it), -1 out of memory. */
+static int sort_hier(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, const uint32_t *group, uint32_t hier_min,
+                     gi_vec3 u, gi_vec3 v, gi_vec3 n, int mode, uint32_t bsp_levels, uint32_t bsp_min)
+{
+    enum { MAX_GROUPS = 64 };
+    uint32_t G = 0;
+    for (uint32_t t = 0; t < tri_count; t++)
+        if (group[t] + 1 > G)
+            G = group[t] + 1;
+    uint32_t *gcount = calloc((size_t)G + 1, sizeof *gcount);
+    float *gb = malloc(((size_t)G + 1) * 6 * sizeof *gb);
+    int32_t *cand = malloc(((size_t)G + 1) * sizeof *cand); /* candidate slot of each group, -1 none */
+    uint32_t *items = malloc(((size_t)tri_count + MAX_GROUPS + 1) * sizeof *items);
+    uint32_t *order = NULL;
+    int rc = -1;
+    if (!gcount || !gb || !cand || !items)
+        goto done;
+    if (load_triangles(s, tri_p, tri_count, u, v, n, MAX_GROUPS) != 0)
+        goto done;
+    for (uint32_t g = 0; g < G; g++)
+        for (int a = 0; a < 3; a++)
+            gb[6 * g + (uint32_t)a] = INFINITY, gb[6 * g + 3 + (uint32_t)a] = -INFINITY;
+    for (uint32_t t = 0; t < tri_count; t++) {
+        const vlf_piece *p = &s->poly[t];
+        float *b = gb + 6 * (size_t)group[t];
+        gcount[group[t]]++;
+        for (int a = 0; a < 3; a++)
+            b[a] = fminf(b[a], p->lo[a]), b[3 + a] = fmaxf(b[3 + a], p->hi[a]);
+    }
+    uint32_t nc = 0, gid[MAX_GROUPS];
+    uint8_t iso[MAX_GROUPS];
+    for (uint32_t g = 0; g < G; g++) {
+        cand[g] = -1;
+        if (gcount[g] >= hier_min && gcount[g] < tri_count && nc < MAX_GROUPS) {
+            cand[g] = (int32_t)nc;
+            gid[nc] = g;
+            iso[nc++] = 1;
         }
     }
+    rc = 1;
+    if (nc == 0)
+        goto done;
+    /* a group is isolated when no other group's triangle reaches into its box */
+    for (uint32_t t = 0; t < tri_count; t++) {
+        const vlf_piece *p = &s->poly[t];
+        for (uint32_t c = 0; c < nc; c++) {
+            if (!iso[c] || gid[c] == group[t])
+                continue;
+            const float *b = gb + 6 * (size_t)gid[c];
+            int inside = 1;
+            for (int a = 0; a < 3 && inside; a++)
+                inside = p->lo[a] < b[3 + a] - EPS && p->hi[a] > b[a] + EPS;
+            if (inside)
+                iso[c] = 0;
+        }
+    }
+    uint32_t niso = 0;
+    for (uint32_t c = 0; c < nc; c++)
+        niso += iso[c];
+    if (niso == 0)
+        goto done;
+    rc = -1;
+    /* the stand-ins: the front rectangles, planes z = nearest depth */
+    uint32_t proxy[MAX_GROUPS], first_out[MAX_GROUPS], end_out[MAX_GROUPS];
+    for (uint32_t c = 0; c < nc; c++) {
+        if (!iso[c])
+            continue;
+        const float *b = gb + 6 * (size_t)gid[c];
+        gi_vec3 q[4] = {gi_v3(b[0], b[1], b[2]), gi_v3(b[3], b[1], b[2]), gi_v3(b[3], b[4], b[2]), gi_v3(b[0], b[4], b[2])};
+        float *pl = s->plane + 4 * (size_t)(tri_count + c);
+        pl[0] = 0.0f, pl[1] = 0.0f, pl[2] = 1.0f, pl[3] = b[2];
+        proxy[c] = add_piece(s, tri_count + c, q, 4);
+        if (proxy[c] == UINT32_MAX)
+            goto done;
+    }
+    uint32_t split_limit = tri_count > UINT32_MAX / 8 - 4096 ? UINT32_MAX : 8 * tri_count + 4096;
+    /* each isolated group on its own */
+    for (uint32_t c = 0; c < nc; c++) {
+        if (!iso[c])
+            continue;
+        uint32_t ni = 0;
+        for (uint32_t t = 0; t < tri_count; t++)
+            if (group[t] == gid[c])
+                items[ni++] = t;
+        first_out[c] = s->nout;
+        if (order_bsp(s, items, ni, mode, 0, bsp_levels, bsp_min ? bsp_min : 2, split_limit) != 0)
+            goto done;
+        end_out[c] = s->nout;
+    }
+    /* the rest with the stand-ins */
+    uint32_t ni = 0;
+    for (uint32_t t = 0; t < tri_count; t++)
+        if (cand[group[t]] < 0 || !iso[cand[group[t]]])
+            items[ni++] = t;
+    for (uint32_t c = 0; c < nc; c++)
+        if (iso[c])
+            items[ni++] = proxy[c];
+    uint32_t global_first = s->nout;
+    if (order_bsp(s, items, ni, mode, 0, bsp_levels, bsp_min ? bsp_min : 2, split_limit) != 0)
+        goto done;
+    /* each group's list spliced in at its stand-in's place */
+    order = malloc(((size_t)s->nout + 1) * sizeof *order);
+    if (!order)
+        goto done;
+    uint32_t no = 0;
+    rc = 1;
+    for (uint32_t k = global_first; k < s->nout; k++) {
+        uint32_t idx = s->out[k], tri = s->poly[idx].tri;
+        if (tri < tri_count) {
+            order[no++] = idx;
+            continue;
+        }
+        uint32_t c = tri - tri_count;
+        if (idx != proxy[c])
+            goto done; /* the stand-in was split by a cycle */
+        for (uint32_t j = first_out[c]; j < end_out[c]; j++)
+            order[no++] = s->out[j];
+    }
+    memcpy(s->out, order, (size_t)no * sizeof *order);
+    s->nout = no;
+    s->groups += niso;
+    rc = 0;
+done:
+    free(gcount), free(gb), free(cand), free(items), free(order);
+    return rc;
+}
+
+int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, const uint32_t *group, uint32_t hier_min,
+                   gi_vec3 u, gi_vec3 v, gi_vec3 n, int mode, uint32_t bsp_levels, uint32_t bsp_min)
+{
+    s->tests = 0;
+    s->splits = s->bsp_cuts = s->unresolved = 0;
+    s->groups = s->hier_fallbacks = 0;
+    if (group && hier_min > 0) {
+        int r = sort_hier(s, tri_p, tri_count, group, hier_min, u, v, n, mode, bsp_levels, bsp_min);
+        if (r <= 0)
+            return r;
+        if (s->nout > 0) /* it ran and a stand-in was split: again without the shortcut */
+            s->hier_fallbacks++;
+        s->tests = 0;
+        s->splits = s->bsp_cuts = s->unresolved = 0;
+        s->groups = 0;
+    }
+    if (load_triangles(s, tri_p, tri_count, u, v, n, 0) != 0)
+        return -1;
+    uint32_t *items = malloc((size_t)(tri_count ? tri_count : 1) * sizeof *items);
+    if (!items)
+        return -1;
+    for (uint32_t t = 0; t < tri_count; t++)
+        items[t] = t;
     /* splitting stops at 8 pieces per triangle on average (cycles then
      * stay, counted in unresolved) */
     uint32_t split_limit = tri_count > UINT32_MAX / 8 - 4096 ? UINT32_MAX : 8 * tri_count + 4096;

@@ -51,6 +51,8 @@ typedef struct vlf_sorter {
     uint32_t splits;       /* pieces split to break a cycle */
     uint32_t bsp_cuts;     /* pieces cut by a BSP plane */
     uint32_t unresolved;   /* cycles left in place when the split limit was reached */
+    uint32_t groups;       /* groups sorted on their own (the hierarchical shortcut) */
+    uint32_t hier_fallbacks; /* sorts redone without the shortcut (a stand-in split by a cycle) */
 } vlf_sorter;
 
 enum { VLF_SORT_NEWELL = 0, VLF_SORT_PLAIN = 1, VLF_SORT_NOSPLIT = 2 };
@@ -63,9 +65,14 @@ enum { VLF_SORT_NEWELL = 0, VLF_SORT_PLAIN = 1, VLF_SORT_NOSPLIT = 2 };
  * VLF_SORT_NOSPLIT (Newell's ordering leaving cycles in place) are kept for
  * the tests. bsp_levels > 0: lists of at least bsp_min pieces are cut at the
  * depth of their centre of mass into front and back lists, each ordered on
- * its own, up to bsp_levels deep. Returns 0 on success, -1 out of memory. */
-int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, gi_vec3 u, gi_vec3 v, gi_vec3 n, int mode,
-                   uint32_t bsp_levels, uint32_t bsp_min);
+ * its own, up to bsp_levels deep. group (may be NULL) gives each triangle's
+ * group (a scene object); with hier_min > 0, groups of at least hier_min
+ * triangles whose bounding box in the frame no other triangle reaches into
+ * are sorted on their own and spliced in where their box's front face
+ * falls in the order of the rest (the hierarchical shortcut of §3.2).
+ * Returns 0 on success, -1 out of memory. */
+int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, const uint32_t *group, uint32_t hier_min,
+                   gi_vec3 u, gi_vec3 v, gi_vec3 n, int mode, uint32_t bsp_levels, uint32_t bsp_min);
 void vlf_sorter_free(vlf_sorter *s);
 
 #endif

@@ -35,10 +35,24 @@
  *   vlf_tests sun      a directional light: open floor lit by E cos theta,
  *                      an occluder's shadow where it falls;
  *   vlf_tests point    point and spot lights: inverse square law, shadow,
- *                      spot cone; a point light's reflection in a mirror. */
+ *                      spot cone; a point light's reflection in a mirror;
+ *   vlf_tests albedo   the glossy lobe's albedo over incidence (its grazing
+ *                      fall-off) against Monte Carlo of core brdf.h's lobe;
+ *   vlf_tests texture  a textured floor: each element's albedo averages the
+ *                      texture over it, and propagation shoots with it;
+ *   vlf_tests hier     the hierarchical shortcut of the sort (objects in
+ *                      boxes nothing else reaches into sorted on their own)
+ *                      keeps the depth order right (Embree) and saves tests;
+ *   vlf_tests gpu      propagation by the GL compute passes equals the
+ *                      CPU's (glossy Cornell box in the three storage
+ *                      formats, a sky-lit scene, a textured one). */
 #include "vlf_core.h"
+#include "vlf_gpu.h"
 
+#include "gi/brdf.h"
+#include "gi/gpu.h"
 #include "gi/lights.h"
+#include "gi/shader.h"
 #include "gi/raytrace.h"
 #include "gi/rng.h"
 #include "gi/scene.h"
@@ -51,6 +65,8 @@
 
 #include "check.h"
 #define EXPECT CHECK_MSG
+
+extern const gi_shader_source gi_vlf_shaders[];
 
 static gi_scene *load(const char *rel)
 {
@@ -1072,6 +1088,307 @@ static void test_precision(void)
     gi_scene_free(s);
 }
 
+/* The glossy lobe's grazing fall-off: vlf_phong_albedo (a quadrature)
+ * against a Monte Carlo estimate of core brdf.h's lobe (gi_brdf_eval, wi
+ * drawn from the lobe, 200 000 samples) for n = 10 and 50 at incidence
+ * 0, 60, 80 and 88 degrees: within 0.01; 1 at normal incidence (1e-3);
+ * the answer without fall-off (1 everywhere) misses at 80 degrees by more
+ * than 0.1. */
+static void test_albedo(void)
+{
+    const float ns[2] = {10.0f, 50.0f}, deg[4] = {0.0f, 60.0f, 80.0f, 88.0f};
+    uint32_t seed = 31u;
+    for (int a = 0; a < 2; a++)
+        for (int b = 0; b < 4; b++) {
+            float th = deg[b] * GI_PI / 180.0f;
+            gi_vec3 N = gi_v3(0, 0, 1), wo = gi_v3(sinf(th), 0.0f, cosf(th));
+            gi_brdf br = {{0, 0, 0}, {1, 1, 1}, ns[a], 0};
+            gi_vec3 r = gi_reflect(wo, N);
+            double sum = 0.0;
+            const int M = 200000;
+            for (int k = 0; k < M; k++) {
+                gi_vec3 wi = gi_phong_lobe_sample(r, ns[a], frand(&seed), frand(&seed));
+                float fv[3];
+                gi_brdf_eval(&br, N, wo, wi, fv);
+                float pdf = gi_phong_lobe_pdf(r, ns[a], wi);
+                if (pdf > 0.0f)
+                    sum += fv[0] * fmax(0.0, gi_v3_dot(N, wi)) / pdf;
+            }
+            double mc = sum / M, q = vlf_phong_albedo(ns[a], cosf(th));
+            printf("albedo n = %2.0f, %2.0f deg: quadrature %.4f, Monte Carlo %.4f\n", ns[a], deg[b], q, mc);
+            EXPECT(fabs(q - mc) < 0.01, "n %g at %g deg: quadrature %.4f, Monte Carlo %.4f", ns[a], deg[b], q, mc);
+            if (b == 0)
+                EXPECT(fabs(q - 1.0) < 1e-3, "albedo at normal incidence %.5f", q);
+            if (b == 2 && a == 0)
+                EXPECT(fabs(1.0 - mc) > 0.1, "no fall-off at 80 deg (%.4f): the test proves nothing", mc);
+        }
+}
+
+/* Textured albedo in propagation: a floor (albedo 0.8 x a texture of 8 x 1
+ * texels, the left four black, the right four white) under an emitting
+ * square facing down, 1 iteration: each floor element's albedo is the
+ * texture averaged over it (0 on the black half, 0.8 on the white half,
+ * where the bilinear texture is constant), the radiance it shoots on is
+ * albedo x E / pi there (1e-5), and the area-weighted mean albedo of the
+ * floor is within 2 % of 0.8 x the texture's mean over it; the answer
+ * without the texture (0.8 everywhere) fails the black half. */
+static void test_texture(void)
+{
+    /* floor z = 0 over [-1, 1]^2 facing +z; emitter z = 1 over [-0.5, 0.5]^2 facing -z */
+    const float tri[4 * 9] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, -1, 0, 1, 1, 0, -1, 1, 0,
+                              -0.5f, -0.5f, 1, 0.5f, 0.5f, 1, 0.5f, -0.5f, 1, -0.5f, -0.5f, 1, -0.5f, 0.5f, 1, 0.5f, 0.5f, 1};
+    gi_scene *s = triangle_scene(tri, 4);
+    gi_material *m = calloc(2, sizeof *m);
+    m[0] = s->materials[0];
+    m[0].albedo[0] = m[0].albedo[1] = m[0].albedo[2] = 0.8f;
+    m[0].albedo_texture = 0;
+    m[1].albedo_texture = -1;
+    m[1].emission[0] = m[1].emission[1] = m[1].emission[2] = 1.0f;
+    free(s->materials);
+    s->materials = m;
+    s->material_count = 2;
+    gi_texture tex = {NULL, 8, 1, calloc(8 * 4, sizeof(float))};
+    for (int i = 4; i < 8; i++)
+        for (int c = 0; c < 4; c++)
+            tex.rgba[4 * i + c] = 1.0f;
+    s->textures = &tex;
+    s->texture_count = 1;
+    for (uint32_t k = 0; k < 12; k++) {
+        gi_vertex *v = &s->vertices[k];
+        v->material = k < 6 ? 0 : 1;
+        v->uv[0] = 0.5f * (v->position[0] + 1.0f);
+        v->uv[1] = 0.5f * (v->position[1] + 1.0f);
+    }
+    vlf_params p = defaults();
+    p.l = 32, p.N = 32, p.density = 8, p.iterations = 1;
+    vlf_field f;
+    char err[256];
+    int ok = vlf_field_build(&f, s, 0.0f, &p, err, sizeof err) == 0;
+    EXPECT(ok, "%s", err);
+    if (ok) {
+        vlf_field_propagate(&f, NULL, NULL);
+        uint32_t nb = 0, nw = 0, bad = 0;
+        double akd = 0.0, area = 0.0, worst = 0.0;
+        for (uint32_t e = 0; e < f.elem_count; e++) {
+            const vlf_face *fc = &f.faces[f.elem_face[e]];
+            if (fc->emission[0] > 0.0f || !(f.elem_area[e] > 0.0f))
+                continue;
+            gi_vec3 q = gi_v3_add(fc->origin, gi_v3_add(gi_v3_scale(fc->t, f.elem_c[2 * e] / p.density),
+                                                        gi_v3_scale(fc->b, f.elem_c[2 * e + 1] / p.density)));
+            float x = f.centre.x + f.radius * q.x;
+            float half = 0.5f / (p.density / f.radius) + 1e-3f; /* half an element, world units */
+            float kd = f.elem_kd[3 * e];
+            akd += kd * f.elem_area[e], area += f.elem_area[e];
+            float want = -1.0f;
+            if (x + half < -0.125f && x - half > -0.875f)
+                want = 0.0f, nb++;
+            else if (x - half > 0.125f && x + half < 0.875f)
+                want = 0.8f, nw++;
+            if (want < 0.0f)
+                continue;
+            double shot = f.L_cur[3 * e], due = want * f.E_tot[3 * e] * GI_INV_PI;
+            worst = fmax(worst, fabs(shot - due));
+            if (fabsf(kd - want) > 1e-4f)
+                bad++;
+        }
+        /* the texture's mean over the floor: u = (x + 1) / 2 over [0, 1] (clamped bilinear or wrapped, the
+         * two halves are symmetric): 0.5 */
+        double mean = area > 0.0 ? akd / area : 0.0;
+        printf("texture: %u elements on the black half, %u on the white, %u with the wrong albedo; shot radiance off "
+               "by at most %.2e; mean albedo %.4f (due 0.8 x 0.5 = 0.4)\n", nb, nw, bad, worst, mean);
+        EXPECT(nb > 4 && nw > 4, "too few elements inside the halves (%u, %u): the test set-up is wrong", nb, nw);
+        EXPECT(bad == 0, "%u elements with the wrong albedo", bad);
+        EXPECT(worst < 1e-5, "shot radiance differs from albedo E / pi by %.3g", worst);
+        EXPECT(fabs(mean - 0.4) < 0.008, "mean albedo %.4f, due 0.4", mean);
+        vlf_field_free(&f);
+    }
+    s->textures = NULL;
+    s->texture_count = 0;
+    free(tex.rgba);
+    free_random(s);
+}
+
+/* The hierarchical shortcut of the sort (§3.2): clusters of random
+ * triangles, each a scene object inside a small ball, among single random
+ * triangles (other objects) and pinwheels of cyclically overlapping sticks;
+ * with hier_min = 4 the clusters whose box no other triangle reaches into
+ * are sorted on their own: the faces along every ray equal Embree's hits
+ * as without the shortcut (>= 99.5 % of the rays, and no more misses than
+ * without it + 2), the shortcut was taken (groups > 0) and the pairs of
+ * faces tested by Newell's ordering fall. */
+static void test_hier(void)
+{
+    const uint32_t clusters = 12, per = 27, single = 16, cyclic = 8;
+    uint32_t count = clusters * per + single + 6 * cyclic, seed = 4242u;
+    gi_scene *base = random_triangles(single, cyclic, 777u);
+    float *tri = calloc((size_t)count * 9, sizeof *tri), *w = tri;
+    for (uint32_t k = 0; k < 3 * (single + 6 * cyclic); k++)
+        put(&w, gi_v3(base->vertices[k].position[0], base->vertices[k].position[1], base->vertices[k].position[2]));
+    free_random(base);
+    /* a cluster: 3 x 3 x 3 cells of 0.25, a random triangle in the ball of
+     * radius 0.124 around each cell's centre (so none intersect) */
+    for (uint32_t c = 0; c < clusters; c++) {
+        gi_vec3 ctr = gi_v3(4.3f + (float)(c % 3) * 0.9f, 0.2f + (float)(c / 3) * 0.9f, 0.2f + (float)(c % 2) * 0.9f);
+        for (uint32_t t = 0; t < per; t++) {
+            gi_vec3 cell = gi_v3_add(ctr, gi_v3(0.25f * (float)(t % 3), 0.25f * (float)((t / 3) % 3), 0.25f * (float)(t / 9)));
+            for (int k = 0; k < 3; k++)
+                put(&w, gi_v3_add(cell, gi_v3_scale(rand_dir(&seed), 0.124f)));
+        }
+    }
+    gi_scene *s = triangle_scene(tri, count);
+    free(tri);
+    /* objects: the single and cyclic triangles object 0, each cluster its own */
+    uint32_t first = single + 6 * cyclic, nobj = 1 + clusters;
+    gi_object *obj = calloc(nobj, sizeof *obj);
+    for (uint32_t o = 0; o < nobj; o++) {
+        obj[o].node = 0;
+        obj[o].first_triangle = o == 0 ? 0 : first + (o - 1) * per;
+        obj[o].triangle_count = o == 0 ? first : per;
+        obj[o].first_vertex = 3 * obj[o].first_triangle;
+        obj[o].vertex_count = 3 * obj[o].triangle_count;
+        memcpy(obj[o].local_bounds, s->objects[0].local_bounds, sizeof obj[o].local_bounds);
+    }
+    for (uint32_t t = first; t < count; t++)
+        for (int k = 0; k < 3; k++)
+            s->vertices[3 * t + (uint32_t)k].object = 1 + (t - first) / per;
+    free(s->objects);
+    s->objects = obj;
+    s->object_count = nobj;
+    gi_rt *rt = NULL;
+    gi_error e;
+    EXPECT(gi_rt_create(s, 0.0f, &rt, &e) == GI_OK, "embree: %s", e.text);
+    if (!rt) {
+        free_random(s);
+        return;
+    }
+    uint32_t miss[2] = {0, 0}, hits[2] = {0, 0};
+    uint64_t tests[2] = {0, 0}, groups[2] = {0, 0};
+    for (int k = 0; k < 2; k++) {
+        vlf_params p = defaults();
+        p.l = 16, p.N = 64, p.density = 8, p.bsp_levels = 0;
+        p.hier_min = k ? 4 : 0;
+        vlf_field f;
+        char err[256];
+        int rc = vlf_field_build(&f, s, 0.0f, &p, err, sizeof err);
+        EXPECT(rc == 0, "%s", err);
+        if (rc != 0)
+            continue;
+        uint32_t agree, multi;
+        hits[k] = order_against_embree(&f, rt, &agree, &multi);
+        miss[k] = hits[k] - agree;
+        tests[k] = f.st.sort_tests;
+        groups[k] = f.st.sort_groups;
+        printf("hier %-16s %u rays hit, %u meet 2+ faces; agree with Embree on %u (%.3f %%); %llu pairs tested, "
+               "%llu objects sorted on their own (of %u x %u), %llu fallbacks, %llu cycle splits\n",
+               k ? "shortcut on" : "shortcut off", hits[k], multi, agree, 100.0 * agree / (hits[k] ? hits[k] : 1),
+               (unsigned long long)tests[k], (unsigned long long)groups[k], clusters, p.l,
+               (unsigned long long)f.st.sort_hier_fallbacks, (unsigned long long)f.st.sort_splits);
+        EXPECT(multi > hits[k] / 10, "too few rays meet two faces (%u of %u): the test set-up is wrong", multi, hits[k]);
+        EXPECT(agree >= hits[k] - hits[k] / 200, "depth order disagrees with Embree on %u of %u rays", hits[k] - agree,
+               hits[k]);
+        vlf_field_free(&f);
+    }
+    EXPECT(groups[1] > 0, "the shortcut was never taken");
+    EXPECT(groups[0] == 0, "the shortcut was taken while off");
+    EXPECT(miss[1] <= miss[0] + 2, "with the shortcut %u rays miss, without %u", miss[1], miss[0]);
+    EXPECT(tests[1] < tests[0], "the shortcut did not save pair tests (%llu vs %llu)", (unsigned long long)tests[1],
+           (unsigned long long)tests[0]);
+    gi_rt_free(rt);
+    free_random(s);
+}
+
+/* Propagation on the GPU (vlf_gpu.c): the same field propagated by the
+ * CPU's sweeps and by the compute passes, on the glossy Cornell box (mirror
+ * and glossy faces: sweeps, gathers, scattering) in the three storage
+ * formats, on a sky-lit scene and on a textured one. The GPU's irradiance
+ * atlas and tiles must lie within a relative L1 of 1e-4 (32f) / 2e-3 (16f, rgb9e5) of the
+ * CPU's, and at least 10x closer than the CPU's own field one iteration
+ * short (a wrong answer near the right one; the black map scores 100 %);
+ * the flux counters agree within 1e-4. Prints both propagation times and
+ * the GL renderer. */
+static void gpu_case(vlf_gpu *gp, const char *scene, uint32_t prec, double bound)
+{
+    gi_scene *s = load(scene);
+    if (!s)
+        return;
+    static const char *name[3] = {"32f", "16f", "rgb9e5"};
+    vlf_params p = defaults();
+    p.l = 32, p.N = 32, p.density = 8, p.iterations = 4, p.precision = prec;
+    vlf_field cpu, gpu, shortf;
+    char err[256];
+    int ok = vlf_field_build(&cpu, s, 0.0f, &p, err, sizeof err) == 0;
+    EXPECT(ok, "%s", err);
+    ok = ok && vlf_field_build(&gpu, s, 0.0f, &p, err, sizeof err) == 0;
+    EXPECT(ok, "%s", err);
+    vlf_params ps = p;
+    ps.iterations = p.iterations - 1;
+    ok = ok && vlf_field_build(&shortf, s, 0.0f, &ps, err, sizeof err) == 0;
+    EXPECT(ok, "%s", err);
+    if (!ok) {
+        gi_scene_free(s);
+        return;
+    }
+    EXPECT(vlf_field_propagate(&cpu, NULL, NULL) == 0, "CPU propagation failed");
+    EXPECT(vlf_field_propagate(&shortf, NULL, NULL) == 0, "CPU propagation failed");
+    vlf_gpu *g = gp;
+    int gok = vlf_gpu_setup(g, &gpu, err, sizeof err) == 0;
+    EXPECT(gok, "%s", err);
+    if (gok) {
+        gok = vlf_gpu_propagate(g, &gpu, NULL, NULL, err, sizeof err) == 0;
+        EXPECT(gok, "%s", err);
+    }
+    if (gok) {
+        double eE = rel_l1(gpu.E_tot, cpu.E_tot, cpu.elem_count);
+        double eT = rel_l1(gpu.out_tot, cpu.out_tot, cpu.nd_cells);
+        double sE = rel_l1(shortf.E_tot, cpu.E_tot, cpu.elem_count);
+        double sT = cpu.nd_cells ? rel_l1(shortf.out_tot, cpu.out_tot, cpu.nd_cells) : 0.0;
+        double dshot = fabs(gpu.st.flux_shot - cpu.st.flux_shot) / fmax(cpu.st.flux_shot, 1e-30);
+        double drecv = fabs(gpu.st.flux_received - cpu.st.flux_received) / fmax(cpu.st.flux_received, 1e-30);
+        printf("gpu %s %-6s: %u elements, %u tile cells; GPU against CPU: irradiance %.2e, tiles %.2e (one iteration "
+               "short: %.2e, %.2e); shot %.2e, received %.2e; propagate CPU %.3f s, GPU %.3f s (set-up %.3f s, "
+               "read-back %.3f s): CPU/GPU %.2f\n",
+               scene, name[prec], cpu.elem_count, cpu.nd_cells, eE, eT, sE, sT, dshot, drecv, cpu.st.propagate_s,
+               gpu.st.propagate_s, g->setup_s, g->readback_s,
+               cpu.st.propagate_s / fmax(gpu.st.propagate_s + g->setup_s, 1e-9));
+        EXPECT(eE < bound && eE * 10.0 < sE, "%s %s: GPU irradiance differs from the CPU's by %.3g (bound %.3g, "
+               "one iteration short %.3g)", scene, name[prec], eE, bound, sE);
+        if (cpu.nd_cells)
+            EXPECT(eT < bound && eT * 10.0 < sT, "%s %s: GPU tiles differ from the CPU's by %.3g (bound %.3g, one "
+                   "iteration short %.3g)", scene, name[prec], eT, bound, sT);
+        EXPECT(dshot < 1e-4 && drecv < 1e-4, "%s: flux counters differ: shot %.3g, received %.3g", scene, dshot, drecv);
+        EXPECT(gpu.st.samples == cpu.st.samples, "samples %llu vs %llu", (unsigned long long)gpu.st.samples,
+               (unsigned long long)cpu.st.samples);
+    }
+    vlf_field_free(&cpu);
+    vlf_field_free(&gpu);
+    vlf_field_free(&shortf);
+    gi_scene_free(s);
+}
+
+static void test_gpu(void)
+{
+    gi_error e;
+    gi_gpu *ctx = gi_gpu_create(NULL, &e);
+    EXPECT(ctx != NULL, "no GL context: %s", e.text);
+    if (!ctx)
+        return;
+    EXPECT(gi_shader_register(gi_vlf_shaders, &e) == GI_OK, "shaders: %s", e.text);
+    printf("gpu: GL renderer %s\n", gi_gpu_renderer(ctx));
+    vlf_gpu g;
+    char err[256];
+    int ok = vlf_gpu_init(&g, err, sizeof err) == 0;
+    EXPECT(ok, "%s", err);
+    if (ok) {
+        gpu_case(&g, "scenes/cornell_glossy.gltf", VLF_PREC_32F, 1e-4);
+        gpu_case(&g, "scenes/cornell_glossy.gltf", VLF_PREC_16F, 2e-3);
+        gpu_case(&g, "scenes/cornell_glossy.gltf", VLF_PREC_RGB9E5, 2e-3);
+        gpu_case(&g, "scenes/bunny_alone_env.glb", VLF_PREC_32F, 1e-4);
+        gpu_case(&g, "scenes/teapot_plane.glb", VLF_PREC_32F, 1e-4);
+        vlf_gpu_free(&g);
+    }
+    gi_gpu_destroy(ctx);
+}
+
 int main(int argc, char **argv)
 {
     const char *part = argc > 1 ? argv[1] : "all";
@@ -1092,8 +1409,16 @@ int main(int argc, char **argv)
         test_sun(), any = 1;
     if (all || strcmp(part, "point") == 0)
         test_point(), test_point_mirror(), any = 1;
+    if (all || strcmp(part, "albedo") == 0)
+        test_albedo(), any = 1;
+    if (all || strcmp(part, "texture") == 0)
+        test_texture(), any = 1;
+    if (all || strcmp(part, "hier") == 0)
+        test_hier(), any = 1;
+    if (all || strcmp(part, "gpu") == 0)
+        test_gpu(), any = 1;
     if (!any) {
-        fprintf(stderr, "vlf_tests: unknown part '%s' (dirs, order, energy, furnace, mirror, precision, sun, point)\n", part);
+        fprintf(stderr, "vlf_tests: unknown part '%s' (dirs, order, energy, furnace, mirror, precision, sun, point, albedo, texture, hier, gpu)\n", part);
         return 2;
     }
     return gi_test_finish();
