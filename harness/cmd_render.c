@@ -10,6 +10,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <sys/resource.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -173,6 +174,32 @@ static int parse_opts(int argc, char **argv, render_opts *o)
     return EXIT_OK;
 }
 
+/* The process's peak resident memory so far, in MiB: VmHWM of
+ * /proc/self/status, the high-water mark of this program's own memory map.
+ * (getrusage's ru_maxrss would do elsewhere, but on Linux it also keeps the
+ * peak of the process image replaced by exec, here the study or compare
+ * process that forked this render.) On llvmpipe the GPU's buffers and
+ * textures are process memory and count; on a hardware GPU they do not. */
+static double peak_rss_mib(void)
+{
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    double kib = NAN;
+    while (f && fgets(line, sizeof line, f))
+        if (!strncmp(line, "VmHWM:", 6)) {
+            kib = strtod(line + 6, NULL);
+            break;
+        }
+    if (f)
+        fclose(f);
+    if (!isfinite(kib)) {
+        struct rusage ru;
+        if (getrusage(RUSAGE_SELF, &ru) == 0)
+            kib = (double)ru.ru_maxrss;
+    }
+    return kib / 1024.0;
+}
+
 static void make_view(const gi_scene *s, int camera, const render_opts *o, float t, uint32_t frame, gi_view *v)
 {
     gi_camera_frame cf = o->has_view ? view_file_camera(&o->view) : gi_scene_camera_at(s, camera, t);
@@ -200,6 +227,7 @@ typedef struct run_state {
     uint32_t curve_frame[MAX_CURVE_POINTS]; /* 1-based frame after which the error was taken */
     gi_metrics curve_m[MAX_CURVE_POINTS][MAX_CURVE_REFS];
     uint32_t curve_n;
+    double rss_prepare_mib; /* peak resident memory once prepare() returned */
 } run_state;
 
 static void cleanup(run_state *r)
@@ -295,7 +323,7 @@ static int record_curve_point(run_state *r, const render_opts *o, uint32_t k)
     gi_image *img = gi_gpu_read_texture(r->target_tex, o->width, o->height);
     if (!img)
         return cli_fail(EXIT_RUN, "out of memory reading the image back");
-    gi_metrics_opts mo = {o->exposure, 0, 1};
+    gi_metrics_opts mo = {o->exposure, 0, 1, 0};
     for (int c = 0; c < o->curve_ref_count; c++) {
         gi_error err;
         if (gi_metrics_compute(img, r->curve_ref[c], &mo, &r->curve_m[r->curve_n][c], &err) != GI_OK) {
@@ -340,6 +368,9 @@ static json_object *timings_json(const run_state *r, const render_opts *o)
         json_object_array_add(mj, json_object_new_double(mean[c]));
     json_object_object_add(j, "mean_rgb", mj);
     json_object_object_add(j, "nonfinite_pixels", json_object_new_int64((int64_t)gi_image_count_nonfinite(r->image)));
+    /* peak resident memory (MiB): after prepare(), and of the whole run */
+    json_object_object_add(j, "peak_rss_prepare_mib", json_object_new_double(r->rss_prepare_mib));
+    json_object_object_add(j, "peak_rss_mib", json_object_new_double(peak_rss_mib()));
     if (o->curve_ref_count)
         json_object_object_add(j, "curve", curve_json(r, o));
     return j;
@@ -455,6 +486,7 @@ static int run(run_state *r, const render_opts *o)
     cli_host_progress_end(&r->host);
     if (res != GI_OK)
         return method_fail(r, "prepare", res);
+    r->rss_prepare_mib = peak_rss_mib();
 
     r->host.timer = r->render_timer;
     cli_progress bar;

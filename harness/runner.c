@@ -164,6 +164,11 @@ static void take_timings(json_object *rec, json_object *t)
         json_object_object_add(rec, "stats", json_object_get(v));
     if (json_object_object_get_ex(t, "curve", &v))
         json_object_object_add(rec, "curve", json_object_get(v));
+    /* memory: the render process's peak resident set, after prepare and in all */
+    if (json_object_object_get_ex(t, "peak_rss_mib", &v))
+        json_object_object_add(rec, "peak_rss_mib", json_object_get(v));
+    if (json_object_object_get_ex(t, "peak_rss_prepare_mib", &v))
+        json_object_object_add(rec, "peak_rss_prepare_mib", json_object_get(v));
     if (json_object_object_get_ex(t, "prepare", &prepare)) {
         /* the whole of prepare, and its stages (precomputation timings) */
         json_object *pst = json_object_new_object();
