@@ -164,7 +164,7 @@ static void print_human(const diff_opts *o, const gi_metrics *m)
            m->mean_lum_test, m->mean_lum_ref);
     printf("flip       %.6f (LDR-FLIP at %.2f pixels per degree)\n", m->flip, (double)m->flip_ppd);
     printf("leak       %.6g of the reference's light, in its dark pixels (%.4g %% of the image: luminance "
-           "below %g x its mean; the reference's own share there %.6g)\n",
+           "below %g x its mean, the reference's own share there %.6g)\n",
            m->leaked_energy, 100.0 * m->dark_fraction, (double)m->dark_threshold, m->dark_energy_ref);
     if (o->heatmap)
         printf("heatmap    %s (|x - r| / (r + 0.01), log10 %g..%g, viridis)\n", o->heatmap,

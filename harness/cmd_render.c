@@ -35,6 +35,8 @@ typedef struct render_opts {
     /* --view FILE: a saved view of gibench view (camera, time, method,
      * parameters, size, frames, seed, exposure); options given beside it win */
     const char *view_path;
+    /* --frames-out PATTERN: every frame's linear image, PATTERN with one %d */
+    const char *frames_out;
     int has_view;
     view_file view;
     int given_size, given_frames, given_seed, given_time, given_exposure;
@@ -95,7 +97,8 @@ static int parse_opts(int argc, char **argv, render_opts *o)
         if (!strcmp(a, "--scene") || !strcmp(a, "--method") || !strcmp(a, "--camera") || !strcmp(a, "--out") ||
             !strcmp(a, "--size") || !strcmp(a, "--param") || !strcmp(a, "--frames") || !strcmp(a, "--warmup") ||
             !strcmp(a, "--time") || !strcmp(a, "--animate") || !strcmp(a, "--seed") || !strcmp(a, "--exposure") ||
-            !strcmp(a, "--timings") || !strcmp(a, "--curve-ref") || !strcmp(a, "--view")) {
+            !strcmp(a, "--timings") || !strcmp(a, "--curve-ref") || !strcmp(a, "--view") ||
+            !strcmp(a, "--frames-out")) {
             if (!v)
                 return cli_fail(EXIT_USAGE, "render: %s needs a value", a);
             i++;
@@ -112,6 +115,19 @@ static int parse_opts(int argc, char **argv, render_opts *o)
             o->timings = v;
         else if (!strcmp(a, "--view"))
             o->view_path = v;
+        else if (!strcmp(a, "--frames-out")) {
+            char probe[4096];
+            if (!cli_frame_path(v, 0, probe, sizeof probe))
+                return cli_fail(EXIT_USAGE,
+                                "render: --frames-out '%s' needs exactly one %%d (or %%0Nd) for the frame index "
+                                "(%%%% for a percent sign)",
+                                v);
+            size_t pl = strlen(probe);
+            if (pl < 5 || (strcmp(probe + pl - 4, ".exr") && strcmp(probe + pl - 4, ".pfm") &&
+                           strcmp(probe + pl - 4, ".png")))
+                return cli_fail(EXIT_USAGE, "render: --frames-out '%s' must end in .exr, .pfm or .png", v);
+            o->frames_out = v;
+        }
         else if (!strcmp(a, "--curve-ref")) {
             const char *eq = strchr(v, '=');
             if (!eq || eq == v || !eq[1] || eq - v > 31)
@@ -336,6 +352,29 @@ static int record_curve_point(run_state *r, const render_opts *o, uint32_t k)
     return EXIT_OK;
 }
 
+/* --frames-out: frame f (from 0) read back and written as linear radiance
+ * (alpha 1), outside the timed frame. */
+static int write_frame(run_state *r, const render_opts *o, uint32_t f)
+{
+    if (!o->frames_out)
+        return EXIT_OK;
+    char path[4096];
+    if (!cli_frame_path(o->frames_out, f, path, sizeof path))
+        return cli_fail(EXIT_USAGE, "render: --frames-out '%s': bad pattern", o->frames_out);
+    gi_image *img = gi_gpu_read_texture(r->target_tex, o->width, o->height);
+    if (!img)
+        return cli_fail(EXIT_RUN, "out of memory reading frame %u back", f);
+    for (size_t i = 0; i < (size_t)o->width * o->height; i++)
+        img->rgba[4 * i + 3] = 1.0f;
+    gi_image_write_opts wo = {o->exposure};
+    gi_error err;
+    gi_result res = gi_image_write(path, img, &wo, &err);
+    gi_image_free(img);
+    if (res != GI_OK)
+        return cli_fail(EXIT_RUN, "render: frame %u: %s", f, err.text);
+    return EXIT_OK;
+}
+
 static json_object *timings_json(const run_state *r, const render_opts *o)
 {
     json_object *j = json_object_new_object();
@@ -524,6 +563,8 @@ static int run(run_state *r, const render_opts *o)
         if (gi_gl_check("after render", &err) != GI_OK)
             return cli_fail(EXIT_RUN, "%s: %s", r->m->id, err.text);
         int rc = record_curve_point(r, o, f + 1);
+        if (rc == EXIT_OK)
+            rc = write_frame(r, o, f);
         if (rc != EXIT_OK) {
             cli_progress_end(&bar);
             return rc;

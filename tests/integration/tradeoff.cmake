@@ -75,7 +75,7 @@ endforeach()
 # runs.csv: per run, the time its error needed (a method with an error
 # floor is charged fewer frames than it ran) and both speed-ups.
 file(READ ${S}/runs.csv csv)
-match("${csv}" ",seed,time_to_final_error_s,frames_to_final_error,speedup_vs_pt,speedup_vs_pt_matched\n"
+match("${csv}" ",seed,time_to_final_error_s,frames_to_final_error,speedup_vs_pt,speedup_vs_pt_matched,"
       "runs.csv lacks the speed-against-accuracy columns:\n${csv}")
 match_count("${csv}" "\ncornell_box-direct-[^\n]*,[34],[0-9.e-]+,[0-9]+,[0-9.e+-]+,[0-9.e+-]+" 4
             "runs.csv: every run with its seed, time, frames and speed-ups")
