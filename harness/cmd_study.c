@@ -1294,6 +1294,13 @@ static void reference_sets(study *st, json_object *meta)
     json_object *sets = json_object_new_array();
     for (uint32_t ri = 0; ri < st->ref_count; ri++) {
         study_ref *sc = &st->refs[ri];
+        /* the references of an animation's inner frames hold no run's final
+         * image: no viewer for them (the table and charts report them) */
+        int holds_runs = 0;
+        for (uint32_t i = 0; i < st->run_count; i++)
+            holds_runs |= st->runs[i].ref_index == (int)ri;
+        if (sc->frame_only && !holds_runs)
+            continue;
         json_object *set = json_object_new_object(), *matched = json_object_new_array(), *ids = json_object_new_array();
         json_object_object_add(set, "name", json_object_new_string(sc->name));
         json_object_object_add(set, "full", ref_rel(sc->ref_full));
@@ -1673,6 +1680,8 @@ static void user_charts(study *st, const char *out_dir, json_object *runs, json_
             if (is_list) {
                 listed[k] = 1;
                 for (size_t j = 0; j < json_object_array_length(y) && counts[k] < MAX_RUNS && pts[k]; j++) {
+                    if (!json_object_array_get_idx(y, j))
+                        continue; /* null: no value at this position (a warm-up frame, frame 0's change) */
                     pts[k][2 * counts[k]] = (double)(j + 1);
                     pts[k][2 * counts[k] + 1] = json_object_get_double(json_object_array_get_idx(y, j));
                     counts[k]++;
