@@ -438,6 +438,37 @@ json_object *runner_animation_metrics(const run_spec *s, const char *frames_patt
     return a;
 }
 
+/* A result made before the metrics had the leaked energy: its image is
+ * compared again with the same references and only the new keys are
+ * added (every value it had stays as it was), so that resuming a study
+ * fills the column without rendering anything. Nothing happens when the
+ * image is gone (committed results keep PNGs only). */
+static void add_leak_to_cached(json_object *old, const run_spec *s, const char *exr, const char *result)
+{
+    json_object *st, *metrics, *m;
+    if (!json_object_object_get_ex(old, "status", &st) || strcmp(json_object_get_string(st), "ok") ||
+        !json_object_object_get_ex(old, "metrics", &metrics) || access(exr, R_OK) != 0)
+        return;
+    const char *refs[2] = {s->ref_full, s->ref_matched}, *names[2] = {"full", "matched"};
+    static const char *const keys[] = {"leaked_energy", "dark_fraction", "dark_energy_ref", "dark_threshold"};
+    int changed = 0;
+    for (int k = 0; k < 2; k++) {
+        if (!refs[k] || !json_object_object_get_ex(metrics, names[k], &m) || json_object_object_get_ex(m, "leaked_energy", NULL))
+            continue;
+        char why[1024];
+        json_object *fresh = runner_diff(exr, refs[k], NULL, NULL, s->exposure, why, sizeof why), *v;
+        for (size_t q = 0; fresh && q < sizeof keys / sizeof keys[0]; q++)
+            if (json_object_object_get_ex(fresh, keys[q], &v)) {
+                json_object_object_add(m, keys[q], json_object_get(v));
+                changed = 1;
+            }
+        json_object_put(fresh);
+    }
+    char why[GI_ERROR_MAX];
+    if (changed && !cli_write_json(result, old, why, sizeof why))
+        gi_log(GI_LOG_WARN, "%s", why);
+}
+
 json_object *runner_execute(const run_spec *s, int resume)
 {
     json_object *rec = base_record(s);
@@ -542,6 +573,8 @@ json_object *runner_execute(const run_spec *s, int resume)
             !(json_object_object_get_ex(old, "status", &st) && !strcmp(json_object_get_string(st), "interrupted"))) {
             json_object_put(rec);
             args_free(&b);
+            if (!collect_only)
+                add_leak_to_cached(old, s, exr, result);
             /* for the caller's progress line only; it removes the key */
             json_object_object_add(old, "cached", json_object_new_boolean(1));
             return old;
