@@ -91,6 +91,39 @@ int cli_add_out(const char *cmd, const char **outs, int *count, int max, const c
     return 0;
 }
 
+int cli_frame_path(const char *pattern, uint32_t index, char *out, size_t size)
+{
+    size_t n = 0;
+    int conversions = 0;
+    for (const char *p = pattern; *p; p++) {
+        char piece[32];
+        const char *text = piece;
+        if (*p != '%') {
+            piece[0] = *p;
+            piece[1] = '\0';
+        } else if (p[1] == '%') {
+            piece[0] = '%';
+            piece[1] = '\0';
+            p++;
+        } else {
+            int zero = p[1] == '0', width = 0;
+            const char *q = p + 1 + zero;
+            if (*q >= '1' && *q <= '9')
+                width = *q++ - '0';
+            if (*q != 'd' || ++conversions > 1)
+                return 0;
+            snprintf(piece, sizeof piece, zero ? "%0*u" : "%*u", width, index);
+            p = q;
+        }
+        size_t len = strlen(text);
+        if (n + len + 1 > size)
+            return 0;
+        memcpy(out + n, text, len + 1);
+        n += len;
+    }
+    return conversions == 1 && n > 0;
+}
+
 int cli_parse_size(const char *s, uint32_t *w, uint32_t *h)
 {
     const char *x = s ? strchr(s, 'x') : NULL;

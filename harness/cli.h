@@ -23,6 +23,11 @@ int cli_fail(int code, const char *fmt, ...)
 
 /* Parses "WxH" into positive sizes (<= 16384); 0 on malformed text. */
 int cli_parse_size(const char *s, uint32_t *w, uint32_t *h);
+/* The file name of frame `index` from a printf-style PATTERN with exactly
+ * one %d, %Nd or %0Nd (N < 10) and %% for a percent sign (render
+ * --frames-out, and the study's runs that read those frames back). 1 on
+ * success, 0 for a bad pattern or a name that does not fit. */
+int cli_frame_path(const char *pattern, uint32_t index, char *out, size_t size);
 /* Parses an unsigned integer in [min, max]; 0 on failure. */
 int cli_parse_uint(const char *s, unsigned long min, unsigned long max, unsigned long *out);
 /* Parses a finite number that a float holds; 0 on failure. */

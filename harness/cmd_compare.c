@@ -244,7 +244,7 @@ int cmd_compare(int argc, char **argv)
         uint32_t b = m->max_bounces + 1;
         const char *ref_matched = NULL;
         run_spec spec = {m->id, o.scene, m->id, o.camera, o.width, o.height, o.frames, o.warmup, o.seed,
-                         o.time, 0.0f, params, np, o.timeout_s, dir, m->id, ref_full, NULL, o.exposure, 0, NULL};
+                         o.time, 0.0f, params, np, o.timeout_s, dir, m->id, ref_full, NULL, o.exposure, 0, NULL, 0, NULL, NULL, NULL};
         char reason[256];
         json_object *rec;
         if (!cli_caps_cover(m, scene, 0, reason, sizeof reason)) {

@@ -52,7 +52,7 @@ static int parse_opts(int argc, char **argv, diff_opts *o)
             continue;
         }
         if (strcmp(a, "--heatmap") && strcmp(a, "--flip-map") && strcmp(a, "--exposure") &&
-            strcmp(a, "--ppd"))
+            strcmp(a, "--ppd") && strcmp(a, "--dark-threshold"))
             return cli_fail(EXIT_USAGE, "diff: unknown argument '%s' (see gibench --help)", a);
         if (!v)
             return cli_fail(EXIT_USAGE, "diff: %s needs a value", a);
@@ -65,6 +65,13 @@ static int parse_opts(int argc, char **argv, diff_opts *o)
             if (!cli_parse_exposure(v, &o->m.exposure))
                 return cli_fail(EXIT_USAGE,
                                 "diff: --exposure '%s' is not a number of stops in [-64, 64]", v);
+        } else if (!strcmp(a, "--dark-threshold")) {
+            if (!cli_parse_float(v, &o->m.dark_threshold) || !(o->m.dark_threshold > 0.0f) ||
+                o->m.dark_threshold > 1.0f)
+                return cli_fail(EXIT_USAGE,
+                                "diff: --dark-threshold '%s' is not a number in (0, 1] (a share of the "
+                                "reference's mean luminance)",
+                                v);
         } else {
             if (!cli_parse_float(v, &o->m.flip_ppd) || !(o->m.flip_ppd > 0.0f) ||
                 o->m.flip_ppd > 1e4f)
@@ -127,6 +134,10 @@ static void print_json(const diff_opts *o, const gi_image *t, const gi_image *r,
     json_object_object_add(j, "mean_lum_ref", num(m->mean_lum_ref));
     json_object_object_add(j, "mean_lum_diff_pct", num(m->mean_lum_diff_pct));
     json_object_object_add(j, "flip", num(m->flip));
+    json_object_object_add(j, "leaked_energy", num(m->leaked_energy));
+    json_object_object_add(j, "dark_fraction", num(m->dark_fraction));
+    json_object_object_add(j, "dark_energy_ref", num(m->dark_energy_ref));
+    json_object_object_add(j, "dark_threshold", json_object_new_double(m->dark_threshold));
     if (o->heatmap)
         json_object_object_add(j, "heatmap", json_object_new_string(o->heatmap));
     if (o->flip_map)
@@ -152,6 +163,9 @@ static void print_human(const diff_opts *o, const gi_metrics *m)
     printf("mean_lum   %+.4g %% (test %.6g, reference %.6g)\n", m->mean_lum_diff_pct,
            m->mean_lum_test, m->mean_lum_ref);
     printf("flip       %.6f (LDR-FLIP at %.2f pixels per degree)\n", m->flip, (double)m->flip_ppd);
+    printf("leak       %.6g of the reference's light, in its dark pixels (%.4g %% of the image: luminance "
+           "below %g x its mean, the reference's own share there %.6g)\n",
+           m->leaked_energy, 100.0 * m->dark_fraction, (double)m->dark_threshold, m->dark_energy_ref);
     if (o->heatmap)
         printf("heatmap    %s (|x - r| / (r + 0.01), log10 %g..%g, viridis)\n", o->heatmap,
                (double)GI_HEATMAP_RELERR_LO, (double)GI_HEATMAP_RELERR_HI);

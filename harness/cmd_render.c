@@ -10,6 +10,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <sys/resource.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -34,6 +35,8 @@ typedef struct render_opts {
     /* --view FILE: a saved view of gibench view (camera, time, method,
      * parameters, size, frames, seed, exposure); options given beside it win */
     const char *view_path;
+    /* --frames-out PATTERN: every frame's linear image, PATTERN with one %d */
+    const char *frames_out;
     int has_view;
     view_file view;
     int given_size, given_frames, given_seed, given_time, given_exposure;
@@ -94,7 +97,8 @@ static int parse_opts(int argc, char **argv, render_opts *o)
         if (!strcmp(a, "--scene") || !strcmp(a, "--method") || !strcmp(a, "--camera") || !strcmp(a, "--out") ||
             !strcmp(a, "--size") || !strcmp(a, "--param") || !strcmp(a, "--frames") || !strcmp(a, "--warmup") ||
             !strcmp(a, "--time") || !strcmp(a, "--animate") || !strcmp(a, "--seed") || !strcmp(a, "--exposure") ||
-            !strcmp(a, "--timings") || !strcmp(a, "--curve-ref") || !strcmp(a, "--view")) {
+            !strcmp(a, "--timings") || !strcmp(a, "--curve-ref") || !strcmp(a, "--view") ||
+            !strcmp(a, "--frames-out")) {
             if (!v)
                 return cli_fail(EXIT_USAGE, "render: %s needs a value", a);
             i++;
@@ -111,6 +115,19 @@ static int parse_opts(int argc, char **argv, render_opts *o)
             o->timings = v;
         else if (!strcmp(a, "--view"))
             o->view_path = v;
+        else if (!strcmp(a, "--frames-out")) {
+            char probe[4096];
+            if (!cli_frame_path(v, 0, probe, sizeof probe))
+                return cli_fail(EXIT_USAGE,
+                                "render: --frames-out '%s' needs exactly one %%d (or %%0Nd) for the frame index "
+                                "(%%%% for a percent sign)",
+                                v);
+            size_t pl = strlen(probe);
+            if (pl < 5 || (strcmp(probe + pl - 4, ".exr") && strcmp(probe + pl - 4, ".pfm") &&
+                           strcmp(probe + pl - 4, ".png")))
+                return cli_fail(EXIT_USAGE, "render: --frames-out '%s' must end in .exr, .pfm or .png", v);
+            o->frames_out = v;
+        }
         else if (!strcmp(a, "--curve-ref")) {
             const char *eq = strchr(v, '=');
             if (!eq || eq == v || !eq[1] || eq - v > 31)
@@ -180,6 +197,32 @@ static int parse_opts(int argc, char **argv, render_opts *o)
     return EXIT_OK;
 }
 
+/* The process's peak resident memory so far, in MiB: VmHWM of
+ * /proc/self/status, the high-water mark of this program's own memory map.
+ * (getrusage's ru_maxrss would do elsewhere, but on Linux it also keeps the
+ * peak of the process image replaced by exec, here the study or compare
+ * process that forked this render.) On llvmpipe the GPU's buffers and
+ * textures are process memory and count; on a hardware GPU they do not. */
+static double peak_rss_mib(void)
+{
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    double kib = NAN;
+    while (f && fgets(line, sizeof line, f))
+        if (!strncmp(line, "VmHWM:", 6)) {
+            kib = strtod(line + 6, NULL);
+            break;
+        }
+    if (f)
+        fclose(f);
+    if (!isfinite(kib)) {
+        struct rusage ru;
+        if (getrusage(RUSAGE_SELF, &ru) == 0)
+            kib = (double)ru.ru_maxrss;
+    }
+    return kib / 1024.0;
+}
+
 static void make_view(const gi_scene *s, int camera, const render_opts *o, float t, uint32_t frame, gi_view *v)
 {
     gi_camera_frame cf = o->has_view ? view_file_camera(&o->view) : gi_scene_camera_at(s, camera, t);
@@ -207,6 +250,7 @@ typedef struct run_state {
     uint32_t curve_frame[MAX_CURVE_POINTS]; /* 1-based frame after which the error was taken */
     gi_metrics curve_m[MAX_CURVE_POINTS][MAX_CURVE_REFS];
     uint32_t curve_n;
+    double rss_prepare_mib; /* peak resident memory once prepare() returned */
 } run_state;
 
 static void cleanup(run_state *r)
@@ -302,7 +346,7 @@ static int record_curve_point(run_state *r, const render_opts *o, uint32_t k)
     gi_image *img = gi_gpu_read_texture(r->target_tex, o->width, o->height);
     if (!img)
         return cli_fail(EXIT_RUN, "out of memory reading the image back");
-    gi_metrics_opts mo = {o->exposure, 0, 1};
+    gi_metrics_opts mo = {o->exposure, 0, 1, 0};
     for (int c = 0; c < o->curve_ref_count; c++) {
         gi_error err;
         if (gi_metrics_compute(img, r->curve_ref[c], &mo, &r->curve_m[r->curve_n][c], &err) != GI_OK) {
@@ -312,6 +356,29 @@ static int record_curve_point(run_state *r, const render_opts *o, uint32_t k)
     }
     gi_image_free(img);
     r->curve_frame[r->curve_n++] = k;
+    return EXIT_OK;
+}
+
+/* --frames-out: frame f (from 0) read back and written as linear radiance
+ * (alpha 1), outside the timed frame. */
+static int write_frame(run_state *r, const render_opts *o, uint32_t f)
+{
+    if (!o->frames_out)
+        return EXIT_OK;
+    char path[4096];
+    if (!cli_frame_path(o->frames_out, f, path, sizeof path))
+        return cli_fail(EXIT_USAGE, "render: --frames-out '%s': bad pattern", o->frames_out);
+    gi_image *img = gi_gpu_read_texture(r->target_tex, o->width, o->height);
+    if (!img)
+        return cli_fail(EXIT_RUN, "out of memory reading frame %u back", f);
+    for (size_t i = 0; i < (size_t)o->width * o->height; i++)
+        img->rgba[4 * i + 3] = 1.0f;
+    gi_image_write_opts wo = {o->exposure};
+    gi_error err;
+    gi_result res = gi_image_write(path, img, &wo, &err);
+    gi_image_free(img);
+    if (res != GI_OK)
+        return cli_fail(EXIT_RUN, "render: frame %u: %s", f, err.text);
     return EXIT_OK;
 }
 
@@ -347,6 +414,9 @@ static json_object *timings_json(const run_state *r, const render_opts *o)
         json_object_array_add(mj, json_object_new_double(mean[c]));
     json_object_object_add(j, "mean_rgb", mj);
     json_object_object_add(j, "nonfinite_pixels", json_object_new_int64((int64_t)gi_image_count_nonfinite(r->image)));
+    /* peak resident memory (MiB): after prepare(), and of the whole run */
+    json_object_object_add(j, "peak_rss_prepare_mib", json_object_new_double(r->rss_prepare_mib));
+    json_object_object_add(j, "peak_rss_mib", json_object_new_double(peak_rss_mib()));
     if (o->curve_ref_count)
         json_object_object_add(j, "curve", curve_json(r, o));
     return j;
@@ -488,6 +558,7 @@ static int run(run_state *r, const render_opts *o)
         if (res != GI_OK)
             return method_fail(r, "update", res);
     }
+    r->rss_prepare_mib = peak_rss_mib();
 
     r->host.timer = r->render_timer;
     cli_progress bar;
@@ -525,6 +596,8 @@ static int run(run_state *r, const render_opts *o)
         if (gi_gl_check("after render", &err) != GI_OK)
             return cli_fail(EXIT_RUN, "%s: %s", r->m->id, err.text);
         int rc = record_curve_point(r, o, f + 1);
+        if (rc == EXIT_OK)
+            rc = write_frame(r, o, f);
         if (rc != EXIT_OK) {
             cli_progress_end(&bar);
             return rc;

@@ -29,7 +29,7 @@
 #define MAX_SWEEP 64
 #define MAX_KEYS 64 /* parameters of one entry: as many as render takes (--param) */
 #define MAX_SCENES 16
-#define MAX_REFS 32
+#define MAX_REFS 512 /* an animated run compared frame by frame needs a set per frame */
 
 /* What a run is made with: the study's top-level values, overridden per
  * method entry (README.md, "Studies"). */
@@ -53,12 +53,18 @@ typedef struct study_run {
     uint32_t bounces; /* the method's max_bounces + 1 */
     uint64_t setting; /* every input but the seed: runs of one setting are repeats */
     json_object *record;
+    /* an animated compared run: the reference set of each frame's time, and
+     * the file names handed to the runner (run_spec.frame_ref_*) */
+    int *frame_ref;
+    uint32_t frame_ref_n;
+    const char **fr_full, **fr_matched, **fr_alt;
 } study_run;
 
 typedef struct study_scene {
     const char *path;
     char stem[256];
     uint64_t hash; /* its content: the file, every object's geometry, the environment map */
+    uint32_t triangles, vertices; /* for scale studies (records get scene_triangles) */
 } study_scene;
 
 /* The references of one scene at one size and scene time. */
@@ -74,6 +80,9 @@ typedef struct study_ref {
     /* the path tracer's convergence: full GI, and for each matched bounce count */
     tradeoff_pt_curve pt_full, pt_matched[8];
     char missing[1100]; /* gibench study --slurm-collect: why the set was not made, or "" */
+    int frame_only; /* used only by animated runs' frames: no convergence curve, no tradeoff table */
+    int want_alt;   /* a frame: also the full-GI reference with another seed (the noise floor) */
+    char ref_alt[4096];
 } study_ref;
 
 typedef struct study {
@@ -90,7 +99,7 @@ typedef struct study {
     run_settings base;
     study_scene scenes[MAX_SCENES];
     uint32_t scene_count;
-    study_ref refs[MAX_REFS];
+    study_ref *refs; /* MAX_REFS of them, on the heap */
     uint32_t ref_count;
     json_object *charts; /* the "charts" list, or NULL */
     const char *timer;   /* "timer": GIBENCH_TIMER for the runs, or NULL */
@@ -513,6 +522,7 @@ static int scene_index(study *st, const char *file, const char *jpath, const cha
         }
     }
     int has_camera = !st->camera || is_view || gi_scene_find_camera(s, st->camera) >= 0;
+    uint32_t triangles = s->triangle_count, vertices = s->vertex_count;
     /* the scene by its content, not its name */
     uint64_t hash = cli_scene_content_hash(s, path);
     gi_scene_free(s);
@@ -528,18 +538,24 @@ static int scene_index(study *st, const char *file, const char *jpath, const cha
     study_scene *sc = &st->scenes[st->scene_count];
     sc->path = path;
     sc->hash = hash;
+    sc->triangles = triangles;
+    sc->vertices = vertices;
     stem_of(path, sc->stem, sizeof sc->stem);
     *out = (int)st->scene_count++;
     return EXIT_OK;
 }
 
 /* The references a compared run needs: one set per scene, size and time. */
-static int ref_index(study *st, int scene, uint32_t w, uint32_t h, float time)
+static int ref_index(study *st, int scene, uint32_t w, uint32_t h, float time, int frame)
 {
     for (uint32_t i = 0; i < st->ref_count; i++) {
         study_ref *r = &st->refs[i];
-        if (r->scene_index == scene && r->width == w && r->height == h && r->time == time)
+        if (r->scene_index == scene && r->width == w && r->height == h && r->time == time) {
+            if (!frame)
+                r->frame_only = 0; /* a still run compares with it too */
+            r->want_alt |= frame;
             return (int)i;
+        }
     }
     if (st->ref_count == MAX_REFS)
         return -1;
@@ -549,6 +565,8 @@ static int ref_index(study *st, int scene, uint32_t w, uint32_t h, float time)
     r->width = w;
     r->height = h;
     r->time = time;
+    r->frame_only = frame;
+    r->want_alt = frame;
     return (int)st->ref_count++;
 }
 
@@ -559,8 +577,9 @@ static void name_refs(study *st)
     for (uint32_t i = 0; i < st->ref_count; i++) {
         study_ref *r = &st->refs[i];
         int shared = 0;
+        /* the sets of animation frames do not rename the others */
         for (uint32_t k = 0; k < st->ref_count; k++)
-            shared |= k != i && st->refs[k].scene_index == r->scene_index;
+            shared |= k != i && st->refs[k].scene_index == r->scene_index && !st->refs[k].frame_only;
         /* two scenes of one name (in different folders) get apart by content */
         char stem[300];
         const study_scene *sc = &st->scenes[r->scene_index];
@@ -571,7 +590,15 @@ static void name_refs(study *st)
             snprintf(stem, sizeof stem, "%s-%08x", sc->stem, (unsigned)(sc->hash & 0xFFFFFFFFu));
         else
             snprintf(stem, sizeof stem, "%s", sc->stem);
-        if (!shared)
+        if (r->frame_only) {
+            /* the frame's time as %g, or all its digits where two frames would share a name */
+            snprintf(r->name, sizeof r->name, "%.280s_%ux%u_t%g", stem, r->width, r->height, (double)r->time);
+            for (uint32_t k = 0; k < i; k++)
+                if (!strcmp(st->refs[k].name, r->name))
+                    snprintf(r->name, sizeof r->name, "%.280s_%ux%u_t%.9g", stem, r->width, r->height,
+                             (double)r->time);
+        }
+        else if (!shared)
             snprintf(r->name, sizeof r->name, "%s", stem);
         else if (r->time == 0.0f)
             snprintf(r->name, sizeof r->name, "%s_%ux%u", stem, r->width, r->height);
@@ -694,8 +721,27 @@ static int add_run(study *st, const char *file, const char *out_dir, const gi_me
         r->scene_index = si;
         r->bounces = m->max_bounces + 1;
         r->ref_index = -1;
-        if (rs->compare) {
-            r->ref_index = ref_index(st, si, rs->width, rs->height, rs->time);
+        if (rs->compare && rs->animate_fps > 0) {
+            /* compared frame by frame: a reference set per frame's scene
+             * time (as render computes it); the run's final image is its
+             * last frame, compared with the last set */
+            r->frame_ref = calloc(rs->frames, sizeof *r->frame_ref);
+            r->fr_full = calloc(rs->frames, sizeof *r->fr_full);
+            r->fr_matched = calloc(rs->frames, sizeof *r->fr_matched);
+            r->fr_alt = calloc(rs->frames, sizeof *r->fr_alt);
+            if (!r->frame_ref || !r->fr_full || !r->fr_matched || !r->fr_alt)
+                return cli_fail(EXIT_RUN, "out of memory");
+            r->frame_ref_n = rs->frames;
+            for (uint32_t f = 0; f < rs->frames; f++) {
+                float t = rs->time + (float)f / rs->animate_fps;
+                r->frame_ref[f] = ref_index(st, si, rs->width, rs->height, t, 1);
+                if (r->frame_ref[f] < 0)
+                    return cli_fail(EXIT_USAGE, "%s: more than %d (scene, size, time) reference sets (an animated "
+                                    "compared run needs one per frame)", file, MAX_REFS);
+            }
+            r->ref_index = r->frame_ref[rs->frames - 1];
+        } else if (rs->compare) {
+            r->ref_index = ref_index(st, si, rs->width, rs->height, rs->time, 0);
             if (r->ref_index < 0)
                 return cli_fail(EXIT_USAGE, "%s: more than %d (scene, size, time) reference sets", file, MAX_REFS);
         }
@@ -822,6 +868,9 @@ static int check_charts(json_object *charts, const char *file)
 
 static int load_study(study *st, const char *file, const char *out_dir, gi_plugins *reg)
 {
+    st->refs = calloc(MAX_REFS, sizeof *st->refs);
+    if (!st->refs)
+        return cli_fail(EXIT_RUN, "out of memory");
     st->root = read_strict_json(file);
     if (!st->root)
         return EXIT_USAGE;
@@ -1019,6 +1068,17 @@ static int pt_convergence(study *st, const char *out_dir, const study_ref *sc, c
     return 1;
 }
 
+/* Whether run r compares with reference set ri (its final image, or one of its frames). */
+static int run_uses_ref(const study_run *r, uint32_t ri)
+{
+    if (r->ref_index == (int)ri)
+        return 1;
+    for (uint32_t f = 0; f < r->frame_ref_n; f++)
+        if (r->frame_ref[f] == (int)ri)
+            return 1;
+    return 0;
+}
+
 /* One reference set: the full-GI reference, the bounce-matched ones for
  * every method bounce count in use and, with `curves`, the path tracer's
  * convergence images. 1 when all exist (made now or before), else 0 with why. */
@@ -1041,9 +1101,19 @@ static int build_reference_set(study *st, const char *out_dir, uint32_t ri, int 
                           st->seed, sc->time, st->ref_pixel_center, st->timeout_s * 10, sc->ref_full, why,
                           why_size))
         return 0;
+    /* the noise floor of an animation frame: the same reference with another seed */
+    if (sc->want_alt) {
+        snprintf(sc->ref_alt, sizeof sc->ref_alt, "%s/%s_b%u_%uspp%s_alt.exr", dir, stem, st->ref_bounces,
+                 st->ref_spp, px);
+        fprintf(stderr, "study: reference %s, second seed (noise floor)\n", stem);
+        if (!runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width, sc->height,
+                              st->ref_spp, st->ref_target_se, st->ref_bounces, st->seed + 1000003u, sc->time,
+                              st->ref_pixel_center, st->timeout_s * 10, sc->ref_alt, why, why_size))
+            return 0;
+    }
     /* bounce-matched references for every method bounce count in use */
     for (uint32_t r = 0; r < st->run_count; r++) {
-        if (st->runs[r].ref_index != (int)ri || st->runs[r].bounces >= st->ref_bounces)
+        if (!run_uses_ref(&st->runs[r], ri) || st->runs[r].bounces >= st->ref_bounces)
             continue;
         uint32_t b = st->runs[r].bounces, k = 0;
         while (k < sc->matched_count && sc->matched_bounces[k] != b)
@@ -1060,7 +1130,7 @@ static int build_reference_set(study *st, const char *out_dir, uint32_t ri, int 
             sc->matched_count++;
         }
     }
-    if (!curves)
+    if (!curves || sc->frame_only)
         return 1;
     /* the path tracer's convergence, for full GI and for each bounce
      * count in use: k-spp images (another seed) against the reference
@@ -1106,6 +1176,19 @@ static void attach_refs(study *st, study_run *r)
     for (uint32_t k = 0; k < sc->matched_count; k++)
         if (sc->matched_bounces[k] == r->bounces)
             r->spec.ref_matched = sc->ref_matched[k];
+    for (uint32_t f = 0; f < r->frame_ref_n; f++) {
+        const study_ref *fr = &st->refs[r->frame_ref[f]];
+        r->fr_full[f] = fr->ref_full;
+        r->fr_matched[f] = fr->ref_full;
+        for (uint32_t k = 0; k < fr->matched_count; k++)
+            if (fr->matched_bounces[k] == r->bounces)
+                r->fr_matched[f] = fr->ref_matched[k];
+        r->fr_alt[f] = fr->ref_alt[0] ? fr->ref_alt : NULL;
+    }
+    r->spec.frame_ref_count = r->frame_ref_n;
+    r->spec.frame_ref_full = r->fr_full;
+    r->spec.frame_ref_matched = r->fr_matched;
+    r->spec.frame_ref_alt = r->fr_alt;
 }
 
 /* A record for a run, or "n/a" when the method's caps do not cover its scene. */
@@ -1224,7 +1307,7 @@ static void execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg)
 static json_object *ref_rel(const char *path)
 {
     const char *base = strrchr(path, '/');
-    char rel[600];
+    char rel[4200];
     snprintf(rel, sizeof rel, "references/%s", base ? base + 1 : path);
     return json_object_new_string(rel);
 }
@@ -1236,6 +1319,13 @@ static void reference_sets(study *st, json_object *meta)
     json_object *sets = json_object_new_array();
     for (uint32_t ri = 0; ri < st->ref_count; ri++) {
         study_ref *sc = &st->refs[ri];
+        /* the references of an animation's inner frames hold no run's final
+         * image: no viewer for them (the table and charts report them) */
+        int holds_runs = 0;
+        for (uint32_t i = 0; i < st->run_count; i++)
+            holds_runs |= st->runs[i].ref_index == (int)ri;
+        if (sc->frame_only && !holds_runs)
+            continue;
         json_object *set = json_object_new_object(), *matched = json_object_new_array(), *ids = json_object_new_array();
         json_object_object_add(set, "name", json_object_new_string(sc->name));
         json_object_object_add(set, "full", ref_rel(sc->ref_full));
@@ -1266,9 +1356,12 @@ static void charts_and_speedups(study *st, const char *out_dir, json_object *met
     tradeoff_run *tr = calloc(st->run_count + 1, sizeof *tr);
     for (uint32_t ri = 0; ri < st->ref_count && tr; ri++) {
         study_ref *sc = &st->refs[ri];
+        if (sc->frame_only)
+            continue; /* animation frames: the animation section reports them */
         uint32_t n = 0;
+        /* animated runs have no convergence curve (each frame is a new image) */
         for (uint32_t i = 0; i < st->run_count; i++)
-            if (st->runs[i].ref_index == (int)ri && st->runs[i].record)
+            if (st->runs[i].ref_index == (int)ri && st->runs[i].record && st->runs[i].spec.animate_fps <= 0)
                 tr[n++] = (tradeoff_run){st->runs[i].record, st->runs[i].bounces, st->runs[i].setting};
         tradeoff_report(out_dir, sc->name, &sc->pt_full, sc->pt_matched, sc->matched_count, tr, n, gi_chart_write_png,
                         chart_list, &md);
@@ -1276,6 +1369,194 @@ static void charts_and_speedups(study *st, const char *out_dir, json_object *met
     free(tr);
     json_object_object_add(meta, "markdown", json_object_new_string(md.s ? md.s : ""));
     free(md.s);
+}
+
+/* A number of a record at a dotted path ("animation.flicker_full"); NaN if absent. */
+static double anim_num(json_object *rec, const char *key)
+{
+    json_object *a, *v;
+    if (!json_object_object_get_ex(rec, "animation", &a) || !json_object_object_get_ex(a, key, &v) || !v)
+        return NAN;
+    return json_object_get_double(v);
+}
+
+static void md_cell(gi_text *md, double v)
+{
+    if (isfinite(v))
+        gi_text_put(md, " %.4g |", v);
+    else
+        gi_text_put(md, " – |");
+}
+
+/* Series of the animation charts: y per frame of one list of the record's
+ * "animation" against the frame index (from 0). */
+typedef struct anim_series {
+    char label[200];
+    double *x, *y;
+    uint32_t n;
+} anim_series;
+
+static int anim_series_from(json_object *rec, const char *key, const char *label, anim_series *out)
+{
+    json_object *a, *list;
+    memset(out, 0, sizeof *out);
+    if (!json_object_object_get_ex(rec, "animation", &a) || !json_object_object_get_ex(a, key, &list) ||
+        !json_object_is_type(list, json_type_array))
+        return 0;
+    uint32_t n = (uint32_t)json_object_array_length(list);
+    out->x = calloc(n + 1, sizeof *out->x);
+    out->y = calloc(n + 1, sizeof *out->y);
+    if (!out->x || !out->y) {
+        free(out->x), free(out->y);
+        return 0;
+    }
+    /* frames without a value (a warm-up frame's time, the first frame's change) are left out */
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        json_object *e = json_object_array_get_idx(list, i);
+        double y = e ? json_object_get_double(e) : NAN;
+        if (!isfinite(y))
+            continue;
+        out->x[k] = i;
+        out->y[k++] = y;
+    }
+    out->n = k;
+    snprintf(out->label, sizeof out->label, "%s", label);
+    return 1;
+}
+
+/* Animated runs compared frame by frame (README.md, "Animated runs"): a
+ * table of every such run (markdown, into meta "animation_markdown") and,
+ * per scene, charts of relMSE, frame time and frame-to-frame change
+ * against the frame index, one series per run. */
+static void animation_report(study *st, const char *out_dir, json_object *meta, json_object *chart_list)
+{
+    gi_text md = {0};
+    int any = 0;
+    for (uint32_t i = 0; i < st->run_count; i++)
+        any |= st->runs[i].frame_ref_n > 0 && st->runs[i].record;
+    if (!any) {
+        json_object_object_add(meta, "animation_markdown", json_object_new_string(""));
+        return;
+    }
+    gi_text_put(&md,
+                "Every frame of an animated run (`\"animate\"` with comparison on) against references "
+                "rendered at that frame's scene time. relMSE: mean over the frames (max); leaked energy: the "
+                "method's light where the full reference is dark (below 1 %% of its mean luminance), as a "
+                "share of the reference's light, mean over the frames. Change: the mean absolute "
+                "frame-to-frame difference, per pixel and channel (linear radiance), of the method's frames "
+                "and of the references' frames; **flicker** = the method's change − the reference's (> 0: "
+                "the method changes more from frame to frame than the light does). Temporal error: the mean "
+                "of |method's change − reference's change| per pixel and channel. Noise floor: the mean "
+                "absolute difference between two full-GI references of the same frame with different seeds; "
+                "the references of all frames share one seed, so their noise is correlated from frame to "
+                "frame where nothing moves, and the noise floor bounds the noise's share of the reference's "
+                "change from above: a flicker smaller than it is not told apart from reference noise.\n\n");
+    gi_text_put(&md, "| run | method | params | label | frames | fps | frame ms (median) | relMSE full mean | "
+                     "relMSE full max | relMSE matched mean | leaked energy | change method | change reference "
+                     "| flicker full | flicker matched | temporal error | noise floor |\n"
+                     "|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (uint32_t i = 0; i < st->run_count; i++) {
+        study_run *r = &st->runs[i];
+        json_object *v;
+        if (!r->frame_ref_n || !r->record)
+            continue;
+        const char *status = json_object_object_get_ex(r->record, "status", &v) ? json_object_get_string(v) : "?";
+        char params[600] = "";
+        for (uint32_t k = 0; k < r->spec.param_count; k++) {
+            size_t used = strlen(params);
+            snprintf(params + used, sizeof params - used, "%s%s", k ? "," : "", r->spec.params[k]);
+        }
+        gi_text_put(&md, "| %s | %s | `%s` | %s |", r->id, r->spec.method, params[0] ? params : "(defaults)",
+                    r->spec.label ? r->spec.label : "");
+        if (strcmp(status, "ok")) {
+            const char *reason = json_object_object_get_ex(r->record, "reason", &v) ? json_object_get_string(v) : "";
+            gi_text_put(&md, " %s: %s | | | | | | | | | | | | |\n", status, reason);
+            continue;
+        }
+        gi_text_put(&md, " %u | %g |", r->frame_ref_n, (double)r->spec.animate_fps);
+        const char *keys[] = {"frame_ms_median",       "relmse_full_mean",     "relmse_full_max",
+                              "relmse_matched_mean",   "leaked_energy_full_mean", "change_method_mean",
+                              "change_ref_full_mean",  "flicker_full",         "flicker_matched",
+                              "temporal_error_full_mean", "noise_floor_full_mean"};
+        for (size_t k = 0; k < sizeof keys / sizeof keys[0]; k++)
+            md_cell(&md, anim_num(r->record, keys[k]));
+        gi_text_put(&md, "\n");
+    }
+    gi_text_put(&md, "\n");
+    json_object_object_add(meta, "animation_markdown", json_object_new_string(md.s ? md.s : ""));
+    free(md.s);
+
+    /* charts, per scene */
+    for (uint32_t sc = 0; sc < st->scene_count; sc++) {
+        const char *what[3] = {"relmse", "frame_ms", "change"};
+        const char *ylab[3] = {"relMSE against the full-GI reference of the frame",
+                               "frame time (ms; update + render)",
+                               "mean |frame - previous frame| (linear, per pixel and channel)"};
+        for (int c = 0; c < 3; c++) {
+            anim_series ser[32];
+            gi_chart_series cs[32];
+            uint32_t n = 0;
+            double seen_fps[16];
+            uint32_t nseen = 0;
+            for (uint32_t i = 0; i < st->run_count && n < 30; i++) {
+                study_run *r = &st->runs[i];
+                json_object *v;
+                if (!r->frame_ref_n || !r->record || r->scene_index != (int)sc ||
+                    !json_object_object_get_ex(r->record, "status", &v) || strcmp(json_object_get_string(v), "ok"))
+                    continue;
+                char label[200];
+                size_t used = (size_t)snprintf(label, sizeof label, "%s", r->spec.method);
+                for (uint32_t k = 0; k < r->spec.param_count && used < sizeof label; k++)
+                    used += (size_t)snprintf(label + used, sizeof label - used, " %s", r->spec.params[k]);
+                if (r->spec.label && used < sizeof label)
+                    snprintf(label + used, sizeof label - used, " [%s]", r->spec.label);
+                const char *key = c == 0 ? "relmse_full" : c == 1 ? "frame_ms" : "change_method";
+                if (anim_series_from(r->record, key, label, &ser[n])) {
+                    cs[n] = (gi_chart_series){ser[n].label, ser[n].x, ser[n].y, ser[n].n, GI_CHART_LINE_MARKERS,
+                                              0, NULL, NULL, NULL, NULL};
+                    n++;
+                }
+                /* the references' own change and noise floor, once per frame rate */
+                uint32_t q = 0;
+                while (q < nseen && seen_fps[q] != r->spec.animate_fps)
+                    q++;
+                if (c == 2 && q == nseen && nseen < 16 && n < 30) {
+                    seen_fps[nseen++] = r->spec.animate_fps;
+                    char l2[200];
+                    snprintf(l2, sizeof l2, "reference change (%g fps)", (double)r->spec.animate_fps);
+                    if (anim_series_from(r->record, "change_ref_full", l2, &ser[n])) {
+                        cs[n] = (gi_chart_series){ser[n].label, ser[n].x, ser[n].y, ser[n].n, GI_CHART_DASHED, 0,
+                                                  NULL, NULL, NULL, NULL};
+                        n++;
+                    }
+                    snprintf(l2, sizeof l2, "reference noise floor, two seeds (%g fps)", (double)r->spec.animate_fps);
+                    if (anim_series_from(r->record, "noise_floor_full", l2, &ser[n])) {
+                        cs[n] = (gi_chart_series){ser[n].label, ser[n].x, ser[n].y, ser[n].n, GI_CHART_DASHED, 0,
+                                                  NULL, NULL, NULL, NULL};
+                        n++;
+                    }
+                }
+            }
+            if (n) {
+                char file[512], path[4700], title[512];
+                snprintf(file, sizeof file, "chart_%s_anim_%s.png", st->scenes[sc].stem, what[c]);
+                snprintf(path, sizeof path, "%s/%s", out_dir, file);
+                snprintf(title, sizeof title, "%s, animated: %s per frame", st->scenes[sc].stem,
+                         c == 0 ? "relMSE" : c == 1 ? "frame time" : "frame-to-frame change");
+                gi_chart_desc desc = {title, "frame index (from 0)", ylab[c], 0, c == 0, 0, 0, NULL, 0};
+                gi_error err;
+                if (gi_chart_write_png(path, &desc, cs, n, &err) == GI_OK)
+                    json_object_array_add(chart_list, json_object_new_string(file));
+                else
+                    fprintf(stderr, "gibench: warning: chart %s not written: %s\n", file, err.text);
+            }
+            for (uint32_t k = 0; k < n; k++) {
+                free(ser[k].x);
+                free(ser[k].y);
+            }
+        }
+    }
 }
 
 /* A field of a run record by name: a top-level key ("label", "run",
@@ -1424,6 +1705,8 @@ static void user_charts(study *st, const char *out_dir, json_object *runs, json_
             if (is_list) {
                 listed[k] = 1;
                 for (size_t j = 0; j < json_object_array_length(y) && counts[k] < MAX_RUNS && pts[k]; j++) {
+                    if (!json_object_array_get_idx(y, j))
+                        continue; /* null: no value at this position (a warm-up frame, frame 0's change) */
                     pts[k][2 * counts[k]] = (double)(j + 1);
                     pts[k][2 * counts[k] + 1] = json_object_get_double(json_object_array_get_idx(y, j));
                     counts[k]++;
@@ -1521,7 +1804,7 @@ static void print_plan(const study *st)
         const run_spec *s = &r->spec;
         printf("run %s: %s %s %ux%u frames %u warmup %u%s%s%s%s", r->id, s->scene, s->method, s->width, s->height,
                s->frames, s->warmup, s->animate_fps > 0 ? " animate" : "", s->no_cache ? " no-cache" : "",
-               r->ref_index < 0 ? " not-compared" : "", s->label ? " label=" : "");
+               r->ref_index < 0 ? " not-compared" : r->frame_ref_n ? " per-frame" : "", s->label ? " label=" : "");
         if (s->label)
             printf("%s", s->label);
         for (uint32_t k = 0; k < s->param_count; k++)
@@ -1536,8 +1819,13 @@ static void study_free(study *st)
         json_object_put(st->runs[i].record);
         for (int k = 0; k < MAX_KEYS; k++)
             free(st->runs[i].params[k]);
+        free(st->runs[i].frame_ref);
+        free(st->runs[i].fr_full);
+        free(st->runs[i].fr_matched);
+        free(st->runs[i].fr_alt);
     }
     free(st->runs);
+    free(st->refs);
     json_object_put(st->root);
     memset(st, 0, sizeof *st);
 }
@@ -1817,6 +2105,13 @@ int cmd_study(int argc, char **argv)
             slurm_collect_runs(&st, reg, out, so.collect);
         else
             execute_runs(&st, (uint32_t)jobs, fresh, reg);
+        /* the scene's size, for scale studies (cached records too) */
+        for (uint32_t i = 0; i < st.run_count; i++)
+            if (st.runs[i].record) {
+                const study_scene *sc = &st.scenes[st.runs[i].scene_index];
+                json_object_object_add(st.runs[i].record, "scene_triangles", json_object_new_int64(sc->triangles));
+                json_object_object_add(st.runs[i].record, "scene_vertices", json_object_new_int64(sc->vertices));
+            }
         json_object *runs = json_object_new_array();
         char renderer[256] = "";
         int failed = 0, interrupted = 0;
@@ -1848,6 +2143,7 @@ int cmd_study(int argc, char **argv)
         reference_sets(&st, meta);
         json_object *chart_list = json_object_new_array();
         charts_and_speedups(&st, out, meta, chart_list);
+        animation_report(&st, out, meta, chart_list);
         user_charts(&st, out, runs, chart_list);
         json_object_object_add(meta, "charts", chart_list);
         char why[1024];

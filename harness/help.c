@@ -37,6 +37,8 @@ static const command_help helps[] = {
      "  --timings FILE.json    method, parameters, GL renderer, timer mode, per-stage times, stats\n"
      "  --no-cache             precompute afresh and keep nothing (timing of precomputation)\n"
      "  --curve-ref NAME=IMAGE record the error against IMAGE after frames 1, 2, 4, ... (up to 4)\n"
+     "  --frames-out PATTERN   write every frame's linear image, PATTERN with one %d (the frame\n"
+     "                         index from 0), e.g. frames/f%04d.exr (outside the timed frames)\n"
      "  --view VIEW.json       a view saved by gibench view: its camera, and its scene, method,\n"
      "                         parameters, size, frames, seed, time and exposure unless given here\n"
      "Prints a progress bar on a terminal and a one-line summary at the end (-q: none).\n"},
@@ -53,13 +55,16 @@ static const command_help helps[] = {
      "  --stats FILE.json       samples, rays, time, standard error\n"},
     {"diff",
      "usage: gibench diff TEST REFERENCE [--json] [--heatmap FILE.png] [--flip-map FILE.png]\n"
-     "                    [--exposure EV] [--ppd N]\n"
-     "Error metrics of TEST against REFERENCE: RMSE, relMSE, MAE, PSNR, SSIM, FLIP, mean luminance.\n"
+     "                    [--exposure EV] [--ppd N] [--dark-threshold F]\n"
+     "Error metrics of TEST against REFERENCE: RMSE, relMSE, MAE, PSNR, SSIM, FLIP, mean luminance,\n"
+     "leaked energy (TEST's light where REFERENCE is dark).\n"
      "  --json             as JSON\n"
      "  --heatmap FILE     relative error map with its colour bar (log scale)\n"
      "  --flip-map FILE    FLIP map\n"
      "  --exposure EV      stops before tonemapping (PSNR, SSIM, FLIP)\n"
-     "  --ppd N            FLIP pixels per degree (default 67.02)\n"},
+     "  --ppd N            FLIP pixels per degree (default 67.02)\n"
+     "  --dark-threshold F dark pixels of the leaked energy: luminance below F x the reference's\n"
+     "                     mean (default 0.01)\n"},
     {"compare",
      "usage: gibench compare --scene S --methods a,b,...|all --out DIR [options]\n"
      "Methods side by side against the path-traced references (full GI and bounce-matched);\n"

@@ -36,6 +36,9 @@ static gi_result check_opts(const gi_metrics_opts *o, gi_error *err)
     if (!isfinite(o->exposure) || fabsf(o->exposure) > 64.0f)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "exposure %g is not in [-64, 64] stops",
                             (double)o->exposure);
+    if (o->dark_threshold != 0.0f && (!(o->dark_threshold > 0.0f) || !(o->dark_threshold <= 1.0f)))
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "dark threshold %g is not in (0, 1]",
+                            (double)o->dark_threshold);
     if (o->flip_ppd != 0.0f &&
         (!(o->flip_ppd > 0.0f) || !isfinite(o->flip_ppd) || o->flip_ppd > 1e4f))
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
@@ -212,6 +215,7 @@ gi_result gi_metrics_compute(const gi_image *test, const gi_image *ref, const gi
     out->height = test->height;
     out->exposure = o->exposure;
     out->flip_ppd = (float)ppd_of(o);
+    out->dark_threshold = o->dark_threshold > 0.0f ? o->dark_threshold : GI_DARK_THRESHOLD_DEFAULT;
     size_t n = (size_t)test->width * test->height;
 
     uint8_t *mask = malloc(n);
@@ -254,6 +258,7 @@ gi_result gi_metrics_compute(const gi_image *test, const gi_image *ref, const gi
     if (out->pixels == 0) {
         out->mse = out->rmse = out->relmse = out->mae = out->psnr = out->ssim = NAN;
         out->mean_lum_test = out->mean_lum_ref = out->mean_lum_diff_pct = out->flip = NAN;
+        out->leaked_energy = out->dark_fraction = out->dark_energy_ref = NAN;
         goto done;
     }
     double samples = 3.0 * (double)out->pixels;
@@ -270,6 +275,26 @@ gi_result gi_metrics_compute(const gi_image *test, const gi_image *ref, const gi
             100.0 * (out->mean_lum_test - out->mean_lum_ref) / out->mean_lum_ref;
     else
         out->mean_lum_diff_pct = out->mean_lum_test == 0.0 ? 0.0 : NAN;
+
+    /* leaked energy: the test's light where the reference is dark */
+    {
+        double dark_below = (double)out->dark_threshold * out->mean_lum_ref, leak = 0.0, own = 0.0;
+        uint64_t dark = 0;
+        for (size_t i = 0; i < n; i++) {
+            if (!mask[i])
+                continue;
+            double yr = lum(ref->rgba + i * 4);
+            if (yr < dark_below) {
+                double yx = lum(test->rgba + i * 4);
+                leak += yx > 0.0 ? yx : 0.0;
+                own += yr > 0.0 ? yr : 0.0;
+                dark++;
+            }
+        }
+        out->dark_fraction = (double)dark / (double)out->pixels;
+        out->leaked_energy = sum_lr > 0.0 ? leak / sum_lr : NAN;
+        out->dark_energy_ref = sum_lr > 0.0 ? own / sum_lr : NAN;
+    }
 
     res = gi_metrics_ssim_plane(lx, lr, mask, test->width, test->height, &out->ssim, err);
     if (res)

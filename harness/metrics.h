@@ -44,6 +44,16 @@
  *   flip           mean over the N pixels of LDR-FLIP (flip.h) of the
  *                  tonemapped sRGB images T(x), T(r) at flip_ppd pixels per
  *                  degree
+ *   leaked_energy  light the test puts where the reference is dark: the
+ *                  dark pixels D are those with Y(r) < dark_threshold *
+ *                  mean Y(r) (dark_threshold relative, default 0.01);
+ *                  leaked_energy = sum over D of max(Y(x), 0) / sum over all
+ *                  N pixels of Y(r); NaN when the reference is black
+ *   dark_fraction  |D| / N
+ *   dark_energy_ref  the same sum of the reference's own luminance over D
+ *                  divided by its total: what the reference itself has there
+ *                  (at most dark_threshold * dark_fraction), the baseline
+ *                  a leak is read against
  */
 #ifndef GI_HARNESS_METRICS_H
 #define GI_HARNESS_METRICS_H
@@ -56,7 +66,11 @@ typedef struct gi_metrics_opts {
     float exposure; /* stops, applied before tonemapping (psnr, ssim, flip); 0 = none */
     float flip_ppd; /* FLIP pixels per degree; 0 = GI_FLIP_PPD_DEFAULT (67.02) */
     int skip_flip;  /* nonzero: leave flip NaN (it is the slowest metric) */
+    float dark_threshold; /* leaked energy: dark = Y(r) below this times mean Y(r); 0 = GI_DARK_THRESHOLD_DEFAULT */
 } gi_metrics_opts;
+
+/* Dark pixels of leaked_energy: luminance below 1 % of the reference's mean. */
+#define GI_DARK_THRESHOLD_DEFAULT 0.01f
 
 typedef struct gi_metrics {
     uint32_t width, height;
@@ -68,7 +82,8 @@ typedef struct gi_metrics {
     double ssim;
     double mean_lum_test, mean_lum_ref, mean_lum_diff_pct;
     double flip;
-    float exposure, flip_ppd; /* the options in effect */
+    double leaked_energy, dark_fraction, dark_energy_ref;
+    float exposure, flip_ppd, dark_threshold; /* the options in effect */
 } gi_metrics;
 
 /* SSIM constants. */

@@ -181,6 +181,35 @@ static int stage_names(json_object *runs, const char **names, int max)
 static const char *const tradeoff_keys[] = {"seed", "time_to_final_error_s", "frames_to_final_error",
                                              "speedup_vs_pt", "speedup_vs_pt_matched", "speedup_extrapolated", NULL};
 
+/* The columns after those: leaked energy (metrics), memory, the scene's
+ * size and an animated run's per-frame summary ("animation"), each a path
+ * of up to three keys in the record. */
+static const struct {
+    const char *column, *k1, *k2, *k3;
+} extra_columns[] = {
+    {"leaked_energy_full", "metrics", "full", "leaked_energy"},
+    {"dark_fraction_full", "metrics", "full", "dark_fraction"},
+    {"dark_energy_ref_full", "metrics", "full", "dark_energy_ref"},
+    {"leaked_energy_matched", "metrics", "matched", "leaked_energy"},
+    {"peak_rss_mib", "peak_rss_mib", NULL, NULL},
+    {"peak_rss_prepare_mib", "peak_rss_prepare_mib", NULL, NULL},
+    {"data_bytes", "stats", "data_bytes", NULL},
+    {"scene_triangles", "scene_triangles", NULL, NULL},
+    {"anim_frame_ms_median", "animation", "frame_ms_median", NULL},
+    {"anim_relmse_full_mean", "animation", "relmse_full_mean", NULL},
+    {"anim_relmse_full_max", "animation", "relmse_full_max", NULL},
+    {"anim_relmse_matched_mean", "animation", "relmse_matched_mean", NULL},
+    {"anim_leaked_energy_full_mean", "animation", "leaked_energy_full_mean", NULL},
+    {"anim_change_method", "animation", "change_method_mean", NULL},
+    {"anim_change_ref_full", "animation", "change_ref_full_mean", NULL},
+    {"anim_change_ref_matched", "animation", "change_ref_matched_mean", NULL},
+    {"anim_flicker_full", "animation", "flicker_full", NULL},
+    {"anim_flicker_matched", "animation", "flicker_matched", NULL},
+    {"anim_temporal_error_full", "animation", "temporal_error_full_mean", NULL},
+    {"anim_noise_floor_full", "animation", "noise_floor_full_mean", NULL},
+};
+#define EXTRA_COLUMNS (sizeof extra_columns / sizeof extra_columns[0])
+
 static void write_csv(text *t, json_object *runs)
 {
     const char *stages[32], *pstages[32], *stats[64];
@@ -201,6 +230,8 @@ static void write_csv(text *t, json_object *runs)
         put(t, ",stat_%s", stats[k]);
     for (int k = 0; tradeoff_keys[k]; k++)
         put(t, ",%s", tradeoff_keys[k]);
+    for (size_t k = 0; k < EXTRA_COLUMNS; k++)
+        put(t, ",%s", extra_columns[k].column);
     put(t, "\n");
     size_t count = json_object_array_length(runs);
     for (size_t i = 0; i < count; i++) {
@@ -229,7 +260,9 @@ static void write_csv(text *t, json_object *runs)
         for (int k = 0; k < nst; k++)
             csv_num(t, num(o, "stats", stats[k], NULL), 0);
         for (int k = 0; tradeoff_keys[k]; k++)
-            csv_num(t, num(o, tradeoff_keys[k], NULL, NULL), !tradeoff_keys[k + 1]);
+            csv_num(t, num(o, tradeoff_keys[k], NULL, NULL), 0);
+        for (size_t k = 0; k < EXTRA_COLUMNS; k++)
+            csv_num(t, num(o, extra_columns[k].k1, extra_columns[k].k2, extra_columns[k].k3), k + 1 == EXTRA_COLUMNS);
     }
 }
 
@@ -383,6 +416,8 @@ static void write_md(text *t, const char *dir, json_object *runs, json_object *m
     json_object *extra;
     if (json_object_object_get_ex(meta, "markdown", &extra))
         put(t, "\n%s\n", json_object_get_string(extra));
+    if (json_object_object_get_ex(meta, "animation_markdown", &extra) && *json_object_get_string(extra))
+        put(t, "\n## Animated runs, frame by frame\n\n%s\n", json_object_get_string(extra));
 }
 
 static void html_escape(text *t, const char *s)
@@ -766,7 +801,10 @@ static void write_html(text *t, const char *dir, json_object *runs, json_object 
         put(t, "%s</dd>", k == 0 ? "</code>" : "");
     }
     put(t, "</dl>\n<nav><a href=\"#images\">images</a><a href=\"#runs\">runs</a><a href=\"#stages\">stage "
-           "timings</a><a href=\"#tradeoff\">speed against accuracy</a><a href=\"#charts\">charts</a></nav>\n");
+           "timings</a><a href=\"#tradeoff\">speed against accuracy</a>%s<a href=\"#charts\">charts</a></nav>\n",
+        json_object_object_get_ex(meta, "animation_markdown", NULL) && *str(meta, "animation_markdown")
+            ? "<a href=\"#animation\">animation</a>"
+            : "");
     put(t, "<p>Errors are against the full-GI reference (\"full\") and against the reference limited to the "
            "method's own bounce count (\"matched\"). Times are medians over the timed frames; on a software "
            "renderer only ratios within one study mean anything.</p>\n");
@@ -788,7 +826,7 @@ static void write_html(text *t, const char *dir, json_object *runs, json_object 
            "<th class=l>run</th><th class=l>method</th><th class=l>params</th><th class=l>status</th><th>frames</th>"
            "<th>frame ms</th><th>prepare ms</th><th>relMSE full</th><th>relMSE matched</th><th>FLIP full</th>"
            "<th>SSIM full</th><th>mean lum. diff %%</th><th>speed-up vs PT</th><th>speed-up vs PT, matched</th>"
-           "</tr></thead><tbody>\n");
+           "<th>leaked energy full</th><th>peak RSS MiB</th><th>data MiB</th></tr></thead><tbody>\n");
     size_t count = json_object_array_length(runs);
     for (size_t i = 0; i < count; i++) {
         json_object *o = json_object_array_get_idx(runs, i);
@@ -815,6 +853,9 @@ static void write_html(text *t, const char *dir, json_object *runs, json_object 
         html_num(t, num(o, "metrics", "full", "mean_lum_diff_pct"));
         html_num(t, num(o, "speedup_vs_pt", NULL, NULL));
         html_num(t, num(o, "speedup_vs_pt_matched", NULL, NULL));
+        html_num(t, num(o, "metrics", "full", "leaked_energy"));
+        html_num(t, num(o, "peak_rss_mib", NULL, NULL));
+        html_num(t, num(o, "stats", "data_bytes", NULL) / (1024.0 * 1024.0));
         put(t, "</tr>\n");
     }
     put(t, "</tbody></table></div>\n");
@@ -867,6 +908,11 @@ static void write_html(text *t, const char *dir, json_object *runs, json_object 
     else
         put(t, "<p>Not computed for this report.</p>\n");
 
+    if (json_object_object_get_ex(meta, "animation_markdown", &extra) && *json_object_get_string(extra)) {
+        put(t, "<h2 id=\"animation\">Animated runs, frame by frame</h2>\n");
+        md_to_html(t, json_object_get_string(extra));
+    }
+
     put(t, "<h2 id=\"charts\">Charts</h2>\n");
     json_object *charts;
     int nc = 0;
@@ -912,6 +958,11 @@ static int write_text(const char *dir, const char *name, text *t, char *why, siz
 int report_write(const char *dir, json_object *runs, json_object *meta, char *why, size_t why_size)
 {
     text t = {0};
+    /* every run record as it is (scripts read this: scripts/scale_fit.py) */
+    put(&t, "%s\n", json_object_to_json_string_ext(runs, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_SPACED |
+                                                           JSON_C_TO_STRING_NOSLASHESCAPE));
+    if (!write_text(dir, "runs.json", &t, why, why_size))
+        return 0;
     write_csv(&t, runs);
     if (!write_text(dir, "runs.csv", &t, why, why_size))
         return 0;

@@ -4,10 +4,13 @@
 
 #include "cli.h"
 #include "gi/cache.h"
+#include "gi/image.h"
 #include "gi/log.h"
+#include "metrics.h"
 #include "proc.h"
 #include "report.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -164,6 +167,11 @@ static void take_timings(json_object *rec, json_object *t)
         json_object_object_add(rec, "stats", json_object_get(v));
     if (json_object_object_get_ex(t, "curve", &v))
         json_object_object_add(rec, "curve", json_object_get(v));
+    /* memory: the render process's peak resident set, after prepare and in all */
+    if (json_object_object_get_ex(t, "peak_rss_mib", &v))
+        json_object_object_add(rec, "peak_rss_mib", json_object_get(v));
+    if (json_object_object_get_ex(t, "peak_rss_prepare_mib", &v))
+        json_object_object_add(rec, "peak_rss_prepare_mib", json_object_get(v));
     if (json_object_object_get_ex(t, "prepare", &prepare)) {
         /* the whole of prepare, and its stages (precomputation timings) */
         json_object *pst = json_object_new_object();
@@ -208,6 +216,257 @@ static void take_timings(json_object *rec, json_object *t)
         }
     }
     json_object_object_add(rec, "stages", stages);
+}
+
+static int cmp_dbl(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The median of the finite values of v[0..n) (v is left as it was); NaN if none. */
+static double rec_median(const double *v, uint32_t n)
+{
+    double *c = malloc((n + 1) * sizeof *c);
+    uint32_t k = 0;
+    for (uint32_t i = 0; c && i < n; i++)
+        if (isfinite(v[i]))
+            c[k++] = v[i];
+    double m = NAN;
+    if (c && k) {
+        qsort(c, k, sizeof *c, cmp_dbl);
+        m = k % 2 ? c[k / 2] : 0.5 * (c[k / 2 - 1] + c[k / 2]);
+    }
+    free(c);
+    return m;
+}
+
+static json_object *num_or_null(double v)
+{
+    return isfinite(v) ? json_object_new_double(v) : NULL;
+}
+
+/* Mean absolute difference, per pixel and channel, of a and b over the
+ * pixels where `ok` is set; NaN when none. */
+static double mean_abs_diff(const gi_image *a, const gi_image *b, const uint8_t *ok)
+{
+    double sum = 0;
+    uint64_t n = 0;
+    for (size_t i = 0; i < (size_t)a->width * a->height; i++) {
+        if (!ok[i])
+            continue;
+        for (int c = 0; c < 3; c++)
+            sum += fabs((double)a->rgba[4 * i + c] - b->rgba[4 * i + c]);
+        n += 3;
+    }
+    return n ? sum / (double)n : NAN;
+}
+
+static int finite_px(const gi_image *img, size_t i)
+{
+    return img && isfinite(img->rgba[4 * i]) && isfinite(img->rgba[4 * i + 1]) && isfinite(img->rgba[4 * i + 2]);
+}
+
+/* Mean of the finite values of v[0..n), NaN if none. */
+static double mean_finite(const double *v, uint32_t n)
+{
+    double s = 0;
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < n; i++)
+        if (isfinite(v[i])) {
+            s += v[i];
+            k++;
+        }
+    return k ? s / k : NAN;
+}
+
+static json_object *series_json(const double *v, uint32_t n)
+{
+    json_object *a = json_object_new_array();
+    for (uint32_t i = 0; i < n; i++)
+        json_object_array_add(a, num_or_null(v[i]));
+    return a;
+}
+
+json_object *runner_animation_metrics(const run_spec *s, const char *frames_pattern, json_object *timings,
+                                      char *why, size_t why_size)
+{
+    uint32_t n = s->frame_ref_count;
+    enum { RELMSE_FULL, RELMSE_MATCHED, LEAK_FULL, LUM_DIFF_FULL, FRAME_MS, CHANGE_METHOD, CHANGE_REF_FULL,
+           CHANGE_REF_MATCHED, TEMPORAL_FULL, TEMPORAL_MATCHED, NOISE_FULL, SCENE_TIME, SERIES };
+    static const char *const names[SERIES] = {
+        "relmse_full",   "relmse_matched",     "leaked_energy_full",    "mean_lum_diff_pct_full",
+        "frame_ms",      "change_method",      "change_ref_full",       "change_ref_matched",
+        "temporal_error_full", "temporal_error_matched", "noise_floor_full", "scene_time"};
+    double *v[SERIES] = {0};
+    for (int k = 0; k < SERIES; k++)
+        v[k] = malloc((n + 1) * sizeof(double));
+    gi_image *prev[3] = {0}; /* the method, full and matched references of the frame before */
+    int ok = 1;
+    for (uint32_t f = 0; f < n; f++)
+        if (!s->frame_ref_full[f] || !s->frame_ref_matched[f]) {
+            snprintf(why, why_size, "frame %u has no reference", f);
+            return NULL;
+        }
+    for (int k = 0; k < SERIES; k++)
+        ok &= v[k] != NULL;
+    if (!ok)
+        snprintf(why, why_size, "out of memory");
+    /* the frame times the render kept: the timed frames, after the warm-up ones */
+    json_object *samples = NULL, *render, *frame;
+    if (json_object_object_get_ex(timings, "render", &render) && json_object_object_get_ex(render, "frame", &frame))
+        json_object_object_get_ex(frame, "samples_ms", &samples);
+    uint32_t warm = s->warmup < n ? s->warmup : 0;
+    for (uint32_t f = 0; f < n && ok; f++) {
+        char path[4200];
+        gi_error err;
+        cli_frame_path(frames_pattern, f, path, sizeof path);
+        const char *paths[4] = {path, s->frame_ref_full[f], s->frame_ref_matched[f],
+                                s->frame_ref_alt ? s->frame_ref_alt[f] : NULL};
+        gi_image *img[4] = {0};
+        for (int k = 0; k < 4 && ok; k++) {
+            if (!paths[k])
+                continue;
+            img[k] = gi_image_read(paths[k], &err);
+            if (!img[k]) {
+                snprintf(why, why_size, "frame %u: %s", f, err.text);
+                ok = 0;
+            } else if (img[k]->width != s->width || img[k]->height != s->height) {
+                snprintf(why, why_size, "frame %u: %s is %ux%u, not %ux%u", f, paths[k], img[k]->width,
+                         img[k]->height, s->width, s->height);
+                ok = 0;
+            }
+        }
+        if (ok) {
+            gi_metrics m[2];
+            gi_metrics_opts mo = {s->exposure, 0, 1, 0};
+            for (int k = 0; k < 2 && ok; k++)
+                if (gi_metrics_compute(img[0], img[1 + k], &mo, &m[k], &err) != GI_OK) {
+                    snprintf(why, why_size, "frame %u: %s", f, err.text);
+                    ok = 0;
+                }
+            if (ok) {
+                v[RELMSE_FULL][f] = m[0].relmse;
+                v[RELMSE_MATCHED][f] = m[1].relmse;
+                v[LEAK_FULL][f] = m[0].leaked_energy;
+                v[LUM_DIFF_FULL][f] = m[0].mean_lum_diff_pct;
+            }
+        }
+        if (ok) {
+            size_t np = (size_t)s->width * s->height;
+            uint8_t *mask = malloc(np ? np : 1);
+            if (!mask) {
+                snprintf(why, why_size, "out of memory");
+                ok = 0;
+            } else {
+                /* the noise floor: two renders of the reference with different seeds */
+                for (size_t i = 0; i < np; i++)
+                    mask[i] = (uint8_t)(finite_px(img[1], i) && finite_px(img[3], i));
+                v[NOISE_FULL][f] = img[3] ? mean_abs_diff(img[1], img[3], mask) : NAN;
+                /* frame-to-frame change, over the pixels finite in both frames of all three */
+                v[CHANGE_METHOD][f] = v[CHANGE_REF_FULL][f] = v[CHANGE_REF_MATCHED][f] = NAN;
+                v[TEMPORAL_FULL][f] = v[TEMPORAL_MATCHED][f] = NAN;
+                if (f > 0) {
+                    for (size_t i = 0; i < np; i++)
+                        mask[i] = (uint8_t)(finite_px(img[0], i) && finite_px(prev[0], i) && finite_px(img[1], i) &&
+                                            finite_px(prev[1], i) && finite_px(img[2], i) && finite_px(prev[2], i));
+                    v[CHANGE_METHOD][f] = mean_abs_diff(img[0], prev[0], mask);
+                    v[CHANGE_REF_FULL][f] = mean_abs_diff(img[1], prev[1], mask);
+                    v[CHANGE_REF_MATCHED][f] = mean_abs_diff(img[2], prev[2], mask);
+                    /* how far the method's change is from the reference's, pixel by pixel */
+                    for (int k = 0; k < 2; k++) {
+                        double sum = 0;
+                        uint64_t cnt = 0;
+                        for (size_t i = 0; i < np; i++) {
+                            if (!mask[i])
+                                continue;
+                            for (int c = 0; c < 3; c++) {
+                                double dm = (double)img[0]->rgba[4 * i + c] - prev[0]->rgba[4 * i + c];
+                                double dr = (double)img[1 + k]->rgba[4 * i + c] - prev[1 + k]->rgba[4 * i + c];
+                                sum += fabs(dm - dr);
+                            }
+                            cnt += 3;
+                        }
+                        v[k ? TEMPORAL_MATCHED : TEMPORAL_FULL][f] = cnt ? sum / (double)cnt : NAN;
+                    }
+                }
+                free(mask);
+            }
+        }
+        v[SCENE_TIME][f] = s->time + (float)f / s->animate_fps; /* as render computes it */
+        v[FRAME_MS][f] = NAN;
+        if (f >= warm && samples && f - warm < json_object_array_length(samples))
+            v[FRAME_MS][f] = json_object_get_double(json_object_array_get_idx(samples, f - warm));
+        for (int k = 0; k < 3; k++) {
+            gi_image_free(prev[k]);
+            prev[k] = img[k];
+        }
+        gi_image_free(img[3]);
+    }
+    for (int k = 0; k < 3; k++)
+        gi_image_free(prev[k]);
+    json_object *a = NULL;
+    if (ok) {
+        a = json_object_new_object();
+        json_object_object_add(a, "fps", json_object_new_double(s->animate_fps));
+        json_object_object_add(a, "frames", json_object_new_int((int32_t)n));
+        json_object_object_add(a, "time0", json_object_new_double(s->time));
+        for (int k = 0; k < SERIES; k++)
+            json_object_object_add(a, names[k], series_json(v[k], n));
+        double cm = mean_finite(v[CHANGE_METHOD], n), cf = mean_finite(v[CHANGE_REF_FULL], n),
+               cmt = mean_finite(v[CHANGE_REF_MATCHED], n);
+        double emax = NAN;
+        for (uint32_t f = 0; f < n; f++)
+            if (isfinite(v[RELMSE_FULL][f]) && !(v[RELMSE_FULL][f] <= emax))
+                emax = v[RELMSE_FULL][f];
+        json_object_object_add(a, "relmse_full_mean", num_or_null(mean_finite(v[RELMSE_FULL], n)));
+        json_object_object_add(a, "relmse_full_max", num_or_null(emax));
+        json_object_object_add(a, "relmse_matched_mean", num_or_null(mean_finite(v[RELMSE_MATCHED], n)));
+        json_object_object_add(a, "leaked_energy_full_mean", num_or_null(mean_finite(v[LEAK_FULL], n)));
+        json_object_object_add(a, "frame_ms_median", num_or_null(rec_median(v[FRAME_MS], n)));
+        json_object_object_add(a, "change_method_mean", num_or_null(cm));
+        json_object_object_add(a, "change_ref_full_mean", num_or_null(cf));
+        json_object_object_add(a, "change_ref_matched_mean", num_or_null(cmt));
+        json_object_object_add(a, "flicker_full", num_or_null(cm - cf));
+        json_object_object_add(a, "flicker_matched", num_or_null(cm - cmt));
+        json_object_object_add(a, "temporal_error_full_mean", num_or_null(mean_finite(v[TEMPORAL_FULL], n)));
+        json_object_object_add(a, "temporal_error_matched_mean", num_or_null(mean_finite(v[TEMPORAL_MATCHED], n)));
+        json_object_object_add(a, "noise_floor_full_mean", num_or_null(mean_finite(v[NOISE_FULL], n)));
+    }
+    for (int k = 0; k < SERIES; k++)
+        free(v[k]);
+    return a;
+}
+
+/* A result made before the metrics had the leaked energy: its image is
+ * compared again with the same references and only the new keys are
+ * added (every value it had stays as it was), so that resuming a study
+ * fills the column without rendering anything. Nothing happens when the
+ * image is gone (committed results keep PNGs only). */
+static void add_leak_to_cached(json_object *old, const run_spec *s, const char *exr, const char *result)
+{
+    json_object *st, *metrics, *m;
+    if (!json_object_object_get_ex(old, "status", &st) || strcmp(json_object_get_string(st), "ok") ||
+        !json_object_object_get_ex(old, "metrics", &metrics) || access(exr, R_OK) != 0)
+        return;
+    const char *refs[2] = {s->ref_full, s->ref_matched}, *names[2] = {"full", "matched"};
+    static const char *const keys[] = {"leaked_energy", "dark_fraction", "dark_energy_ref", "dark_threshold"};
+    int changed = 0;
+    for (int k = 0; k < 2; k++) {
+        if (!refs[k] || !json_object_object_get_ex(metrics, names[k], &m) || json_object_object_get_ex(m, "leaked_energy", NULL))
+            continue;
+        char why[1024];
+        json_object *fresh = runner_diff(exr, refs[k], NULL, NULL, s->exposure, why, sizeof why), *v;
+        for (size_t q = 0; fresh && q < sizeof keys / sizeof keys[0]; q++)
+            if (json_object_object_get_ex(fresh, keys[q], &v)) {
+                json_object_object_add(m, keys[q], json_object_get(v));
+                changed = 1;
+            }
+        json_object_put(fresh);
+    }
+    char why[GI_ERROR_MAX];
+    if (changed && !cli_write_json(result, old, why, sizeof why))
+        gi_log(GI_LOG_WARN, "%s", why);
 }
 
 json_object *runner_execute(const run_spec *s, int resume)
@@ -269,11 +528,30 @@ json_object *runner_execute(const run_spec *s, int resume)
     /* "curve": results made before render recorded convergence curves are not reused */
     snprintf(config + used, sizeof config - used, " | full=%s | matched=%s | curve%s%s", s->ref_full ? s->ref_full : "-",
              s->ref_matched ? s->ref_matched : "-", timer ? " | timer=" : "", timer ? timer : "");
+    /* an animated run compared frame by frame: every frame written, and the
+     * references of every frame in the key (by a hash of their names) */
+    char frames_dir[4200], frames_pattern[4300];
+    snprintf(frames_dir, sizeof frames_dir, "%s/frames", s->dir);
+    snprintf(frames_pattern, sizeof frames_pattern, "%s/frame_%%04d.exr", frames_dir);
+    if (s->frame_ref_count) {
+        uint64_t h = 0;
+        for (uint32_t f = 0; f < s->frame_ref_count; f++) {
+            const char *names[3] = {s->frame_ref_full[f], s->frame_ref_matched[f], s->frame_ref_alt ? s->frame_ref_alt[f] : NULL};
+            for (int k = 0; k < 3; k++)
+                h = gi_hash64(names[k] ? names[k] : "-", strlen(names[k] ? names[k] : "-"), h);
+        }
+        used = strlen(config);
+        snprintf(config + used, sizeof config - used, " | frame-refs=%u:%016llx", s->frame_ref_count,
+                 (unsigned long long)h);
+        arg(&b, "%s", "--frames-out");
+        arg(&b, "%s", frames_pattern);
+    }
     /* the convergence curve against the same references (they are in the
-     * config already) */
+     * config already); an animated run's frames are compared one by one
+     * instead (each frame is a new image, not a step of a convergence) */
     const char *crefs[2] = {s->ref_full, s->ref_matched};
     const char *cnames[2] = {"full", "matched"};
-    for (int k = 0; k < 2; k++)
+    for (int k = 0; k < 2 && !s->frame_ref_count; k++)
         if (crefs[k]) {
             arg(&b, "%s", "--curve-ref");
             char kv[4200];
@@ -295,6 +573,8 @@ json_object *runner_execute(const run_spec *s, int resume)
             !(json_object_object_get_ex(old, "status", &st) && !strcmp(json_object_get_string(st), "interrupted"))) {
             json_object_put(rec);
             args_free(&b);
+            if (!collect_only)
+                add_leak_to_cached(old, s, exr, result);
             /* for the caller's progress line only; it removes the key */
             json_object_object_add(old, "cached", json_object_new_boolean(1));
             return old;
@@ -308,6 +588,11 @@ json_object *runner_execute(const run_spec *s, int resume)
         return rec;
     }
     unlink(result);
+    if (s->frame_ref_count && !cli_mkdirs(frames_dir)) {
+        args_free(&b);
+        fail_record(rec, "cannot create the frames directory");
+        return rec;
+    }
     cli_proc_result r;
     int started = cli_run(b.argv, s->timeout_s, log, log, &r) == 0;
     args_free(&b);
@@ -326,9 +611,20 @@ json_object *runner_execute(const run_spec *s, int resume)
             fail_record(rec, "the method wrote no timings");
         } else {
             take_timings(rec, t);
+            char anim_why[1100] = "";
+            if (s->frame_ref_count) {
+                char why[1024];
+                json_object *anim = runner_animation_metrics(s, frames_pattern, t, why, sizeof why);
+                if (!anim)
+                    snprintf(anim_why, sizeof anim_why, "per-frame comparison: %s", why);
+                if (anim)
+                    json_object_object_add(rec, "animation", anim);
+            }
             json_object_put(t);
             json_object_object_add(rec, "status", json_object_new_string("ok"));
             json_object_object_add(rec, "reason", json_object_new_string(""));
+            if (anim_why[0])
+                fail_record(rec, anim_why);
             char p[4200];
             snprintf(p, sizeof p, "%s/image.png", s->rel);
             json_object_object_add(rec, "png", json_object_new_string(p));

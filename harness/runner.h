@@ -26,6 +26,15 @@ typedef struct run_spec {
     float exposure;
     int no_cache;         /* render --no-cache: precompute afresh (timing of precomputation) */
     const char *label;    /* the study entry's label, or NULL */
+    /* Per-frame comparison of an animated run (animate_fps > 0): frame f
+     * (scene time time + f / animate_fps) against references of that time:
+     * full GI, bounce-matched, and a second full-GI render with another
+     * seed (the reference's noise floor; may be NULL). frame_ref_count is
+     * 0 or `frames`; with it the run writes every frame
+     * (render --frames-out DIR/frames/frame_%04d.exr) and the record gets
+     * "animation" (README.md, "Animated runs"). */
+    uint32_t frame_ref_count;
+    const char *const *frame_ref_full, *const *frame_ref_matched, *const *frame_ref_alt;
 } run_spec;
 
 /* Runs (or resumes) a run; never fails as a whole: failures are records
@@ -47,6 +56,14 @@ json_object *runner_not_applicable(const run_spec *spec, const char *reason);
 int runner_reference(const char *scene, uint64_t scene_hash, const char *camera, uint32_t width, uint32_t height,
                      uint32_t spp, double target_se, uint32_t max_bounces, uint32_t seed, float time,
                      int pixel_center, double timeout_s, const char *out_exr, char *why, size_t why_size);
+
+/* The per-frame comparison of an animated run whose frames lie at
+ * frames_pattern (cli_frame_path): per-frame relMSE (full and matched),
+ * leaked energy and time, frame-to-frame change of the method and of the
+ * references, flicker and the reference's noise floor. `timings` is the
+ * render's timings file (per-frame times). NULL with why on failure. */
+json_object *runner_animation_metrics(const run_spec *spec, const char *frames_pattern, json_object *timings,
+                                      char *why, size_t why_size);
 
 /* Fills metrics of `image` against `reference` by `gibench diff --json`;
  * NULL with why on failure. heatmap (relative error) and flip_map (FLIP's

@@ -64,8 +64,14 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* The median of the finite values of v[0..n) (sorted to the front); NaN if none. */
 static double median_of(double *v, uint32_t n)
 {
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < n; i++)
+        if (isfinite(v[i]))
+            v[k++] = v[i];
+    n = k;
     if (n == 0)
         return NAN;
     qsort(v, n, sizeof *v, cmp_double);
@@ -114,6 +120,7 @@ typedef struct setting {
     double t_lo[MAX_POINTS], t_hi[MAX_POINTS], em_lo[MAX_POINTS], em_hi[MAX_POINTS];
     uint32_t frame[MAX_POINTS];
     double prep_s;
+    double rss_mib, data_mib; /* medians over repeats: peak resident memory, the method's data_bytes stat */
     const char *renderer; /* the GL renderer its runs reported ("" when none) */
     char label[192];      /* the method, with its renderer when runs of a set differ in it */
 } setting;
@@ -180,7 +187,7 @@ static uint32_t pool_settings(const tradeoff_run *runs, uint32_t run_n, setting 
         g->method_index = m;
         /* every repeat of this setting */
         static double t[MAX_POINTS][64], ef[MAX_POINTS][64], em[MAX_POINTS][64];
-        double prep[64];
+        double prep[64], rss[64], data[64];
         uint32_t n = MAX_POINTS, rep = 0;
         for (uint32_t j = i; j < run_n && rep < 64; j++) {
             if (runs[j].setting != g->key || strcmp(str(runs[j].record, "status"), "ok") ||
@@ -199,6 +206,8 @@ static uint32_t pool_settings(const tradeoff_run *runs, uint32_t run_n, setting 
                     g->frame[k] = frame[k];
             }
             prep[rep] = num(runs[j].record, "prepare_ms", NULL, NULL) / 1000.0;
+            rss[rep] = num(runs[j].record, "peak_rss_mib", NULL, NULL);
+            data[rep] = num(runs[j].record, "stats", "data_bytes", NULL) / (1024.0 * 1024.0);
             rep++;
         }
         g->repeats = rep;
@@ -213,6 +222,8 @@ static uint32_t pool_settings(const tradeoff_run *runs, uint32_t run_n, setting 
             g->em_lo[k] = em[k][0], g->em_hi[k] = em[k][rep - 1];
         }
         g->prep_s = median_of(prep, rep);
+        g->rss_mib = median_of(rss, rep);
+        g->data_mib = median_of(data, rep);
     }
     return ns;
 }
@@ -353,6 +364,16 @@ static void chart(tradeoff_chart_fn write_chart, const char *out_dir, const char
     free(series), free(fx), free(fp), free(labels);
 }
 
+/* A memory cell: MiB, or "–" when not measured (the method reports no
+ * data_bytes; records made before runs measured their memory). */
+static void put_mib(gi_text *md, double mib)
+{
+    if (isfinite(mib))
+        gi_text_put(md, " %.4g |", mib);
+    else
+        gi_text_put(md, " – |");
+}
+
 /* relMSE as "median" or "median [min–max]" over repeats. */
 static void put_error(gi_text *md, const setting *g, uint32_t k)
 {
@@ -411,14 +432,17 @@ static void equal_error_table(gi_text *md, const char *name, const tradeoff_pt_c
                  "Speed-up = the path tracer's time to the same relMSE ÷ the method's time to its image; "
                  "\"matched\" compares the method's error against the reference of its own bounce count with "
                  "the path tracer limited to that count. Precomputation is not in the time to image: it has "
-                 "its own column, and the last three add it amortised over 1, 100 and 10,000 images. "
+                 "its own column, and the next three add it amortised over 1, 100 and 10,000 images. Memory: "
+                 "the render process's peak resident set (MiB; on llvmpipe GPU buffers and textures count, "
+                 "on a hardware GPU they do not) and the size of the method's own precomputed data (its "
+                 "`data_bytes` statistic; \"–\" where it reports none), medians over repeats. "
                  "\"*\": the path tracer's time is extrapolated beyond its measured curve (slope −1). "
                  "relMSE over repeats: median [min–max].\n\n",
                  name);
     gi_text_put(md, "| method | params | frames | time to image (s) | relMSE full | path tracer, same error (s) | "
                      "speed-up | relMSE matched | matched path tracer (s) | speed-up matched | precompute (s) | "
-                     "amortised ×1 (s) | ×100 (s) | ×10⁴ (s) |\n"
-                     "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+                     "amortised ×1 (s) | ×100 (s) | ×10⁴ (s) | peak RSS (MiB) | data (MiB) |\n"
+                     "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (uint32_t m = 0; m < nm; m++) {
         uint32_t k = pareto(set, ns, m, 0, fp);
         for (uint32_t i = 0; i < k; i++) {
@@ -433,10 +457,13 @@ static void equal_error_table(gi_text *md, const char *name, const tradeoff_pt_c
             params_cell(md, g->first);
             gi_text_put(md, " %u | %.4g |", g->frame[p], g->t[p]);
             put_error(md, g, p);
-            gi_text_put(md, " %.4g%s | %.3g%s | %.4g | %.4g%s | %.3g%s | %.4g | %.4g | %.4g | %.4g |\n", tpt,
+            gi_text_put(md, " %.4g%s | %.3g%s | %.4g | %.4g%s | %.3g%s | %.4g | %.4g | %.4g | %.4g |", tpt,
                          ex ? "*" : "", tpt / g->t[p], ex ? "*" : "", g->em[p], tptm, exm ? "*" : "",
                          tptm / g->t[p], exm ? "*" : "", prep, g->t[p] + prep, g->t[p] + prep / 100.0,
                          g->t[p] + prep / 1e4);
+            put_mib(md, g->rss_mib);
+            put_mib(md, g->data_mib);
+            gi_text_put(md, "\n");
         }
     }
     gi_text_put(md, "\n");
@@ -475,13 +502,15 @@ static void equal_time_table(gi_text *md, const char *name, const tradeoff_pt_cu
                  "method's lowest relMSE among its settings and frames whose time to image is within that time "
                  "(precomputation not counted), and its ratio to the path tracer's error; \"–\": no setting is "
                  "that fast. \"matched\" rows: against the reference of the method's bounce count, the path "
-                 "tracer limited to it (its own time and error at that image).\n\n",
+                 "tracer limited to it (its own time and error at that image). The last three columns: the "
+                 "precomputation time, peak resident memory and data size of the settings behind the row's "
+                 "cells (min–max when they differ).\n\n",
                  name);
     gi_text_put(md, "| method |");
     for (uint32_t i = 0; i < full->n; i++)
         gi_text_put(md, " %.3g s (PT %.3g) |", full->t[i], full->e[i]);
-    gi_text_put(md, "\n|---|");
-    for (uint32_t i = 0; i < full->n; i++)
+    gi_text_put(md, " precompute (s) | peak RSS (MiB) | data (MiB) |\n|---|");
+    for (uint32_t i = 0; i < full->n + 3; i++)
         gi_text_put(md, "---:|");
     gi_text_put(md, "\n");
     for (uint32_t m = 0; m < nm; m++) {
@@ -494,6 +523,8 @@ static void equal_time_table(gi_text *md, const char *name, const tradeoff_pt_cu
             if (matched_row && c == full)
                 continue; /* the method is full GI: the row above says it */
             gi_text_put(md, "| %s%s |", methods[m], matched_row ? " (matched)" : "");
+            /* the range of the costs of the settings behind the cells */
+            double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
             for (uint32_t i = 0; i < full->n; i++) {
                 double T = i < c->n ? c->t[i] : NAN, ept = i < c->n ? c->e[i] : NAN;
                 const setting *at = NULL;
@@ -503,6 +534,22 @@ static void equal_time_table(gi_text *md, const char *name, const tradeoff_pt_cu
                     gi_text_put(md, " %.4g (×%.3g) |", e, e / ept);
                 else
                     gi_text_put(md, " – |");
+                if (isfinite(e) && at) {
+                    double v[3] = {at->prep_s, at->rss_mib, at->data_mib};
+                    for (int q = 0; q < 3; q++)
+                        if (isfinite(v[q])) {
+                            lo[q] = v[q] < lo[q] ? v[q] : lo[q];
+                            hi[q] = v[q] > hi[q] ? v[q] : hi[q];
+                        }
+                }
+            }
+            for (int q = 0; q < 3; q++) {
+                if (!isfinite(lo[q]))
+                    gi_text_put(md, " – |");
+                else if (hi[q] > lo[q])
+                    gi_text_put(md, " %.4g–%.4g |", lo[q], hi[q]);
+                else
+                    gi_text_put(md, " %.4g |", lo[q]);
             }
             gi_text_put(md, "\n");
         }

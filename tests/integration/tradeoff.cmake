@@ -76,9 +76,9 @@ endforeach()
 # floor is charged fewer frames than it ran), both speed-ups and whether the
 # path tracer's time was extrapolated beyond its curve.
 file(READ ${S}/runs.csv csv)
-match("${csv}" ",seed,time_to_final_error_s,frames_to_final_error,speedup_vs_pt,speedup_vs_pt_matched,speedup_extrapolated\n"
+match("${csv}" ",seed,time_to_final_error_s,frames_to_final_error,speedup_vs_pt,speedup_vs_pt_matched,speedup_extrapolated,"
       "runs.csv lacks the speed-against-accuracy columns:\n${csv}")
-match_count("${csv}" "\ncornell_box-direct-[^\n]*,[34],[0-9.e-]+,[0-9]+,[0-9.e+-]+,[0-9.e+-]+,[01]" 4
+match_count("${csv}" "\ncornell_box-direct-[^\n]*,[34],[0-9.e-]+,[0-9]+,[0-9.e+-]+,[0-9.e+-]+,[01]," 4
             "runs.csv: every run with its seed, time, frames and speed-ups")
 
 if(failures GREATER 0)

@@ -647,6 +647,57 @@ static void test_flip_against_direct(void)
     free(slow);
 }
 
+
+/* Leaked energy: a reference half lit (grey 1) and half dark (0 and a faint
+ * 0.005, below 1 % of its mean 0.5); the test puts 0.2 into the dark half.
+ * Known answers, then the trivial images: the reference itself leaks only
+ * its own faint light, a black image nothing, an always-lit one the most. */
+static void test_leaked_energy(void)
+{
+    const uint32_t w = 8, h = 4;
+    gi_image *ref = gi_image_create(w, h), *t = gi_image_create(w, h), *black = gi_image_create(w, h),
+             *lit = gi_image_create(w, h);
+    for (uint32_t y = 0; y < h; y++)
+        for (uint32_t x = 0; x < w; x++) {
+            int dark = x >= w / 2;
+            float r = dark ? (x == w - 1 ? 0.005f : 0.0f) : 1.0f;
+            set_px(ref, x, y, r, r, r);
+            set_px(t, x, y, dark ? 0.2f : 1.0f, dark ? 0.2f : 1.0f, dark ? 0.2f : 1.0f);
+            set_px(black, x, y, 0, 0, 0);
+            set_px(lit, x, y, 1, 1, 1);
+        }
+    /* reference: 16 pixels of 1, 4 of 0.005, 12 of 0; total 16.02, mean 0.500625 */
+    double total = 16.0 + 4 * 0.005;
+    gi_metrics m = compute(t, ref, 0);
+    CHECK_NEAR(m.dark_fraction, 0.5, 1e-12);
+    CHECK_NEAR(m.leaked_energy, 16 * 0.2 / total, 1e-6);
+    CHECK_NEAR(m.dark_energy_ref, 4 * 0.005 / total, 1e-6);
+    CHECK_NEAR(m.dark_threshold, 0.01, 1e-7);
+    gi_metrics self = compute(ref, ref, 0), none = compute(black, ref, 0), all = compute(lit, ref, 0);
+    CHECK_NEAR(self.leaked_energy, self.dark_energy_ref, 1e-12);
+    CHECK(none.leaked_energy == 0.0);
+    CHECK_NEAR(all.leaked_energy, 16.0 / total, 1e-6);
+    CHECK(m.leaked_energy > 10 * self.leaked_energy && m.leaked_energy < all.leaked_energy);
+    /* a threshold of 0.5 x mean takes the faint pixels in, and no lit one */
+    gi_metrics_opts o = {0};
+    o.dark_threshold = 0.5f;
+    gi_error err;
+    CHECK(gi_metrics_compute(t, ref, &o, &m, &err) == GI_OK);
+    CHECK_NEAR(m.dark_fraction, 0.5, 1e-12);
+    o.dark_threshold = 2.0f;
+    CHECK(gi_metrics_compute(t, ref, &o, &m, &err) == GI_ERR_INVALID_ARGUMENT);
+    /* a negative test value is no energy; a black reference has no leak */
+    set_px(t, w - 2, 0, -5.0f, -5.0f, -5.0f);
+    m = compute(t, ref, 0);
+    CHECK_NEAR(m.leaked_energy, 15 * 0.2 / total, 1e-6);
+    m = compute(t, black, 0);
+    CHECK(isnan(m.leaked_energy));
+    gi_image_free(ref);
+    gi_image_free(t);
+    gi_image_free(black);
+    gi_image_free(lit);
+}
+
 int main(void)
 {
     test_single_pixel();
@@ -659,5 +710,6 @@ int main(void)
     test_flip_kernels();
     test_flip_values();
     test_flip_against_direct();
+    test_leaked_energy();
     return gi_test_finish();
 }

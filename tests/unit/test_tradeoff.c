@@ -104,6 +104,13 @@ static void test_report(void)
     };
     tradeoff_pt_curve full = {65, 3, {1, 4, 16}, {1, 0.25, 0.0625}};
     tradeoff_pt_curve matched = {1, 2, {0.5, 2}, {0.1, 0.025}};
+    /* memory: "fast" A's repeats peaked at 100 and 300 MiB and keep 1 MiB of data */
+    for (int r = 0; r < 2; r++) {
+        json_object *st = json_object_new_object();
+        json_object_object_add(st, "data_bytes", json_object_new_double(1048576.0));
+        json_object_object_add(runs[r].record, "stats", st);
+        json_object_object_add(runs[r].record, "peak_rss_mib", json_object_new_double(r ? 300.0 : 100.0));
+    }
     gi_text md = {0};
     json_object *charts = json_object_new_array();
     tradeoff_report("/nonexistent", "box", &full, &matched, 1, runs, 4, fake_chart, charts, &md);
@@ -124,7 +131,12 @@ static void test_report(void)
     CHECK_MSG(strstr(s, "`B`") == NULL, "dominated setting listed:\n%s", s);
     CHECK_MSG(strstr(s, "| prog | `P` | 4 | 4 | 0.05 |") != NULL, "%s", s);
     /* precomputation: the median of 0.1 s and 0.3 s, amortised over 100 images */
-    CHECK_MSG(strstr(s, "| 0.2 | 0.21 | 0.012 | 0.01002 |") != NULL, "%s", s);
+    CHECK_MSG(strstr(s, "| 0.2 | 0.21 | 0.012 | 0.01002 | 200 | 1 |\n") != NULL, "%s", s);
+    /* a method that measured no memory: dashes, not zeros */
+    CHECK_MSG(strstr(s, "| 0 | 4 | 4 | 4 | – | – |\n") != NULL, "%s", s);
+    /* equal time: the costs of the settings behind each row */
+    CHECK_MSG(strstr(s, "| precompute (s) | peak RSS (MiB) | data (MiB) |") != NULL, "%s", s);
+    CHECK_MSG(strstr(s, "| fast | 0.4 (×0.4) | 0.4 (×1.6) | 0.4 (×6.4) | 0.2 | 200 | 1 |\n") != NULL, "%s", s);
 
     /* equal time, at the path tracer's 1 s (error 1): fast 0.4, prog 0.2;
      * prog's matched row uses its own curve (0.5 s: no setting that fast) */

@@ -146,7 +146,16 @@ struct gi_host {
     void (*stage_begin)(const gi_host *host, const char *name);
     void (*stage_end)(const gi_host *host, const char *name);
     /* A number worth reporting (bytes, element counts, samples/s); the last
-     * value set for a name wins. Written beside the timings. */
+     * value set for a name wins. Written beside the timings.
+     * Names with a meaning the harness knows (studies put them in their own
+     * table columns):
+     *   "data_bytes"  the size in bytes of the data the method precomputes
+     *                 and keeps for rendering (GPU buffers and textures and
+     *                 CPU copies it holds after prepare()/update(): maps,
+     *                 atlases, grids, VPLs, links), excluding the scene
+     *                 itself and the render target; the tradeoff tables'
+     *                 "data (MB)" column. Parts may be reported beside it as
+     *                 "data_bytes_<part>" (e.g. "data_bytes_atlas"). */
     void (*stat)(const gi_host *host, const char *name, double value);
     /* Non-zero once the user or the time limit asked to stop; long loops in
      * prepare() poll it and return GI_ERR_CANCELLED. */
