@@ -232,6 +232,30 @@ static void make_view(const gi_scene *s, int camera, const render_opts *o, float
     v->exposure = o->exposure;
 }
 
+/* What a step of the scene's animation changes, for update(): transforms
+ * when an object is animated (or deforms: its vertices follow the time),
+ * lights when a punctual light or an emissive object moves, the camera when
+ * the view's camera node is animated, vertices when morph targets deform.
+ * A method that rebuilds on a flag is charged only for what moves. */
+static gi_changes animation_changes(const gi_scene *s, const gi_gpu_scene *gs, int camera)
+{
+    gi_changes ch = {0u, 0.0f, 0ull};
+    for (uint32_t k = 0; k < s->object_count; k++)
+        if (s->objects[k].animated || s->objects[k].morph_track.count) {
+            ch.flags |= GI_CHANGED_TRANSFORMS;
+            ch.moved_objects |= k < 64 ? 1ull << k : 0ull;
+        }
+    if (s->object_count > 64 && (ch.flags & GI_CHANGED_TRANSFORMS))
+        ch.moved_objects = ~0ull;
+    if (gs->deforming)
+        ch.flags |= GI_CHANGED_TRANSFORMS | GI_CHANGED_VERTICES;
+    if (gi_scene_lights_animated(s))
+        ch.flags |= GI_CHANGED_LIGHTS;
+    if (gi_scene_camera_animated(s, camera))
+        ch.flags |= GI_CHANGED_CAMERA;
+    return ch;
+}
+
 typedef struct run_state {
     gi_scene *scene;
     gi_gpu *gpu;
@@ -579,8 +603,8 @@ static int run(run_state *r, const render_opts *o)
         gi_timer_frame_begin(r->render_timer);
         if (f > 0 && o->animate_fps > 0) {
             gi_gpu_scene_set_time(r->gs, t);
-            gi_changes ch = {GI_CHANGED_TRANSFORMS | GI_CHANGED_LIGHTS | (r->gs->deforming ? GI_CHANGED_VERTICES : 0u),
-                             t, ~0ull};
+            gi_changes ch = animation_changes(r->scene, r->gs, o->has_view ? -1 : camera);
+            ch.time = t;
             res = r->m->update(r->inst, r->gs, &ch);
             if (res != GI_OK) {
                 gi_timer_frame_end(r->render_timer);

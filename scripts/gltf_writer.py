@@ -209,6 +209,20 @@ class Gltf:
         q = look_at_quat(eye, target, up)
         return self.node(name, camera=len(cams) - 1, translation=eye, rotation=q)
 
+    def point_light_node(self, name, intensity, color=(1.0, 1.0, 1.0), translation=None):
+        """A KHR_lights_punctual point light (intensity x color = radiant
+        intensity, W/sr, no range) on its own node."""
+        ext = self.doc.setdefault("extensions", {}).setdefault("KHR_lights_punctual",
+                                                                {"lights": []})
+        ext["lights"].append({"name": name, "type": "point",
+                              "color": [float(c) for c in color],
+                              "intensity": float(intensity)})
+        self.ext_used.add("KHR_lights_punctual")
+        nd = self.node(name, translation=translation)
+        self.doc["nodes"][nd]["extensions"] = {
+            "KHR_lights_punctual": {"light": len(ext["lights"]) - 1}}
+        return nd
+
     def animation(self, name, channels):
         """channels: list of (node, path, times, flat values)."""
         samplers, chans = [], []
@@ -241,7 +255,7 @@ class Gltf:
         self.doc["buffers"] = [buf]
         if self.ext_used:
             self.doc["extensionsUsed"] = sorted(self.ext_used)
-        order = ["asset", "extensionsUsed", "scene", "scenes", "nodes", "cameras", "meshes",
+        order = ["asset", "extensionsUsed", "extensions", "scene", "scenes", "nodes", "cameras", "meshes",
                  "materials", "textures", "samplers", "images", "animations", "accessors",
                  "bufferViews", "buffers"]
         return {k: self.doc[k] for k in order if k in self.doc}

@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
-# Regenerates everything under scenes/ (except README.md) from packaged sources:
+# Regenerates everything under scenes/ (except README.md) from packaged sources
+# (and the stress-case scenes under scenes/stress/, which need no inputs:
+# scripts/make_stress_scenes.py):
 #   Debian embree-tools   .../embree3/models/cornell_box.obj
 #   Debian blender-data   .../studiolights/world/forest.exr  (CC0)
 #   Debian openimageio-tools  oiiotool (downsizes the environment map)
@@ -53,3 +55,4 @@ oiiotool "$hdr" --resize:filter=box 512x256 --clamp:min=0 \
 
 python3 "$here/make_scenes.py" --cornell-obj "$obj" --meshes-json "$tmp/meshes.json" \
   --env-name "$ENV_NAME" --out "$out"
+python3 "$here/make_stress_scenes.py" --out "$out/stress"

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Runs the Khronos glTF validator (npm gltf-validator, installed into a temporary
-# directory) on every scene under scenes/ and fails if any has an error.  Also
+# directory) on every scene under scenes/ and scenes/stress/ and fails if any
+# has an error.  Also
 # checks that each environment map a scene names exists.
 # Usage: scripts/validate-scenes.sh [SCENEDIR]      VERBOSE=1 also prints infos/hints
 set -euo pipefail
@@ -14,7 +15,7 @@ trap 'rm -rf "$tmp"' EXIT
    npm install --no-audit --no-fund --silent "gltf-validator@$VALIDATOR_VERSION" >/dev/null)
 
 shopt -s nullglob
-files=("$dir"/*.gltf "$dir"/*.glb)
+files=("$dir"/*.gltf "$dir"/*.glb "$dir"/stress/*.gltf "$dir"/stress/*.glb)
 [ ${#files[@]} -gt 0 ] || { echo "validate-scenes.sh: no scenes in $dir" >&2; exit 1; }
 NODE_PATH="$tmp/node_modules" node "$here/validate_gltf.js" "${files[@]}"
 

@@ -270,6 +270,45 @@ void gi_scene_node_transform(const gi_scene *s, int node, float t, float out[16]
     }
 }
 
+int gi_scene_node_animated(const gi_scene *s, int node)
+{
+    assert(s && node < (int)s->node_count);
+    for (int n = node; n >= 0; n = s->nodes[n].parent) {
+        const gi_node *nd = &s->nodes[n];
+        if (nd->anim_t.count || nd->anim_r.count || nd->anim_s.count)
+            return 1;
+    }
+    return 0;
+}
+
+int gi_scene_camera_animated(const gi_scene *s, int camera)
+{
+    assert(s);
+    if (camera < 0 || (uint32_t)camera >= s->camera_count)
+        return 0;
+    return gi_scene_node_animated(s, s->cameras[camera].node);
+}
+
+int gi_scene_lights_animated(const gi_scene *s)
+{
+    assert(s);
+    for (uint32_t i = 0; i < s->light_count; i++)
+        if (gi_scene_node_animated(s, s->lights[i].node))
+            return 1;
+    for (uint32_t i = 0; i < s->emitter_count; i++) {
+        uint32_t tri = s->emitters[i];
+        for (uint32_t o = 0; o < s->object_count; o++) {
+            const gi_object *ob = &s->objects[o];
+            if (tri >= ob->first_triangle && tri - ob->first_triangle < ob->triangle_count) {
+                if (ob->animated || ob->morph_track.count)
+                    return 1;
+                break;
+            }
+        }
+    }
+    return 0;
+}
+
 void gi_scene_object_transform(const gi_scene *s, uint32_t object, float t, float out[16])
 {
     assert(s && object < s->object_count);

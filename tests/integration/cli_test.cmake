@@ -30,9 +30,14 @@ expect(2 ": /" render --scene ${one_bad} --method direct --out ${OUT}/x.exr)
 # An output directory that does not exist is a run-time failure (1).
 expect(1 "${OUT}/missing-dir/x.exr" render --scene ${SCENES}/cornell_box_coarse.gltf --method direct --size 8x8 --out ${OUT}/missing-dir/x.exr)
 # Every scene renders with the direct baseline and gives a finite image.
-foreach(scene cornell_box_coarse.gltf cornell_glossy.gltf bunny_env.glb teapot_plane.glb teapot_area.glb u_room.gltf cornell_moving.gltf)
-    expect(0 "" render --scene ${SCENES}/${scene} --method direct --size 32x32 --frames 2 --out ${OUT}/all_${scene}.exr --timings ${OUT}/all_${scene}.json)
-    file(READ ${OUT}/all_${scene}.json j)
+set(STRESS_SCENES stress/two_rooms_thin.gltf stress/two_rooms_thick.gltf stress/light_in_hull.gltf
+    stress/hulls_overlap.gltf stress/glossy.gltf stress/moving_light.gltf stress/moving_camera.gltf
+    stress/scale_t00116.gltf stress/scale_t57090.gltf)
+foreach(scene cornell_box_coarse.gltf cornell_glossy.gltf bunny_env.glb teapot_plane.glb teapot_area.glb u_room.gltf cornell_moving.gltf
+              ${STRESS_SCENES})
+    string(REPLACE "/" "_" tag "${scene}")
+    expect(0 "" render --scene ${SCENES}/${scene} --method direct --size 32x32 --frames 2 --out ${OUT}/all_${tag}.exr --timings ${OUT}/all_${tag}.json)
+    file(READ ${OUT}/all_${tag}.json j)
     if(NOT j MATCHES "\"nonfinite_pixels\": 0")
         message(SEND_ERROR "${scene}: non-finite pixels in the direct render")
         math(EXPR failures "${failures} + 1")
@@ -43,6 +48,9 @@ expect(0 "warning: render: avg does not handle environment light in " render --s
 expect(0 "warning: render: csm does not handle deforming meshes" render --scene ${SCENES}/cornell_deform.gltf --method csm --size 16x16 --param N=2 --param M=8 --param M_local=8 --param N_local=1 --out ${OUT}/csm_deform.exr)
 # An animated render advances time and calls update.
 expect(0 "" render --scene ${SCENES}/cornell_moving.gltf --method direct --size 32x32 --frames 3 --animate 2 --out ${OUT}/moving.png)
+foreach(sc moving_light moving_camera hulls_overlap)
+    expect(0 "" render --scene ${SCENES}/stress/${sc}.gltf --method direct --size 32x32 --frames 3 --animate 2 --out ${OUT}/${sc}.png)
+endforeach()
 
 # Plugins are also found on GIBENCH_PLUGIN_PATH; broken ones are refused
 # with a warning naming the file and the reason, and the rest still load.

@@ -14,22 +14,34 @@ match("${csv}" "\ndirect,[^\n]*,ok," "direct did not run ok:\n${csv}")
 match("${csv}" "fake_crash,[^\n]*failed,\"?crashed \\(signal" "the crash was not isolated and reported:\n${csv}")
 match("${csv}" "fake_hang,[^\n]*failed,timed out after" "the hang was not cut off:\n${csv}")
 match("${csv}" "fake_narrow,[^\n]*n/a,fake_narrow does not handle area lights" "n/a cell missing:\n${csv}")
-# render --animate tells update() that vertices changed on a deforming
-# scene, and not on a scene that only moves rigidly.
-foreach(sc cornell_deform cornell_moving)
+# render --animate tells update() what the animation moves: vertices on a
+# deforming scene, transforms when objects move, lights when a light moves,
+# the camera when the view's camera node is animated, and nothing else.
+# want: scene, then changed_vertices transforms lights camera.
+set(stat_keys changed_vertices changed_transforms changed_lights changed_camera)
+foreach(case "cornell_deform 1 1 0 0" "cornell_moving 0 1 0 0" "stress/moving_light 0 0 1 0"
+             "stress/moving_camera 0 0 0 1" "stress/hulls_overlap 0 1 0 0")
+    separate_arguments(case)
+    list(GET case 0 sc)
+    list(SUBLIST case 1 4 want)
+    string(REPLACE "/" "_" tag "${sc}")
     run(0 render --scene scenes/${sc}.gltf --method fake_changes --size 8x8 --time 0 --animate 2 --frames 3
-           --out ${OUT}/fake_changes_${sc}.exr --timings ${OUT}/fake_changes_${sc}.json)
-    file(READ ${OUT}/fake_changes_${sc}.json fj)
+           --out ${OUT}/fake_changes_${tag}.exr --timings ${OUT}/fake_changes_${tag}.json)
+    file(READ ${OUT}/fake_changes_${tag}.json fj)
     string(JSON upd GET "${fj}" stats updates)
-    string(JSON cv GET "${fj}" stats changed_vertices)
-    string(JSON ct GET "${fj}" stats changed_transforms)
-    if(sc STREQUAL "cornell_deform")
-        set(want 1)
-    else()
-        set(want 0)
-    endif()
-    if(NOT upd EQUAL 2 OR NOT cv EQUAL want OR NOT ct EQUAL 1)
-        fail("${sc}: update() saw ${upd} updates, changed_vertices ${cv} (want ${want}), transforms ${ct}")
+    set(got "")
+    set(same 1)
+    foreach(i RANGE 3)
+        list(GET stat_keys ${i} key)
+        list(GET want ${i} w)
+        string(JSON v GET "${fj}" stats ${key})
+        list(APPEND got ${v})
+        if(NOT v EQUAL w)
+            set(same 0)
+        endif()
+    endforeach()
+    if(NOT upd EQUAL 2 OR NOT same)
+        fail("${sc}: update() saw ${upd} updates (want 2), changed vertices/transforms/lights/camera ${got} (want ${want})")
     endif()
 endforeach()
 

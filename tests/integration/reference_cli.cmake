@@ -87,10 +87,13 @@ expect_json(${OUT}/ref_time.json "\"stop\": \"time\"")
 
 # Every committed scene gives a finite image, at time 0 and mid-animation.
 foreach(scene cornell_box.gltf cornell_glossy.gltf bunny_env.glb teapot_plane.glb teapot_area.glb u_room.gltf
-              cornell_moving.gltf)
-    expect(0 "" reference --scene ${SCENES}/${scene} --size 24x24 --spp 4 --out ${OUT}/ref_all_${scene}.exr
-           --stats ${OUT}/ref_all_${scene}.json)
-    expect_json(${OUT}/ref_all_${scene}.json "\"nonfinite_samples\": 0,")
+              cornell_moving.gltf stress/two_rooms_thin.gltf stress/two_rooms_thick.gltf stress/light_in_hull.gltf
+              stress/hulls_overlap.gltf stress/glossy.gltf stress/moving_light.gltf stress/moving_camera.gltf
+              stress/scale_t00116.gltf stress/scale_t57090.gltf)
+    string(REPLACE "/" "_" tag "${scene}")
+    expect(0 "" reference --scene ${SCENES}/${scene} --size 24x24 --spp 4 --out ${OUT}/ref_all_${tag}.exr
+           --stats ${OUT}/ref_all_${tag}.json)
+    expect_json(${OUT}/ref_all_${tag}.json "\"nonfinite_samples\": 0,")
 endforeach()
 expect(0 "" reference --scene ${SCENES}/cornell_moving.gltf --time-of-scene 1.5 --size 24x24 --spp 4
        --max-bounces 0 --out ${OUT}/ref_moving.png --stats ${OUT}/ref_moving.json)

@@ -40,6 +40,8 @@ static gi_result fake_update(void *inst, const gi_gpu_scene *s, const gi_changes
     fake_host->stat(fake_host, "updates", fake_updates);
     fake_host->stat(fake_host, "changed_vertices", (fake_flags_seen & GI_CHANGED_VERTICES) ? 1 : 0);
     fake_host->stat(fake_host, "changed_transforms", (fake_flags_seen & GI_CHANGED_TRANSFORMS) ? 1 : 0);
+    fake_host->stat(fake_host, "changed_lights", (fake_flags_seen & GI_CHANGED_LIGHTS) ? 1 : 0);
+    fake_host->stat(fake_host, "changed_camera", (fake_flags_seen & GI_CHANGED_CAMERA) ? 1 : 0);
 #endif
     return GI_OK;
 }

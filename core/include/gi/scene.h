@@ -199,6 +199,16 @@ void gi_scene_free(gi_scene *scene);
  * composed up the parent chain). */
 void gi_scene_node_transform(const gi_scene *s, int node, float t, float out[16]);
 void gi_scene_object_transform(const gi_scene *s, uint32_t object, float t, float out[16]);
+/* 1 when the node or one of its ancestors has an animation channel on
+ * translation, rotation or scale (its world transform depends on time);
+ * node -1 gives 0. */
+int gi_scene_node_animated(const gi_scene *s, int node);
+/* 1 when camera i (gi_scene_camera_at's index; -1, the default view, is
+ * never animated) moves with time. */
+int gi_scene_camera_animated(const gi_scene *s, int camera);
+/* 1 when some light moves with time: a punctual light's node, or an
+ * object carrying emissive triangles (rigidly animated or morphing). */
+int gi_scene_lights_animated(const gi_scene *s);
 /* World-space frame of punctual light i at time t. */
 gi_light_frame gi_scene_light_at(const gi_scene *s, uint32_t light, float t);
 /* Camera i at time t. With no camera in the file, camera -1 gives a default
