@@ -69,7 +69,7 @@ def with_prep(r):
 
 def speedup_cell(r, prep):
     """A speed-up, with "*" where the path tracer's time is extrapolated
-    beyond its measured convergence curve."""
+    outside its measured convergence curve."""
     v = with_prep(r) if prep else num(r["speedup_vs_pt"])
     return "%.3g%s" % (v, "*" if num(r.get("speedup_extrapolated")) == 1 else "")
 
@@ -162,9 +162,10 @@ def main():
       "tracer's time to the run's error, divided by the run's time to its "
       "image (the frames it needs; precomputation not included: see the "
       "per-scene tables). Below 1: path tracing reaches that error sooner. "
-      "\"*\": the method's error is below the most converged image of the "
-      "path tracer's curve, whose time is then extrapolated (slope -1 on "
-      "log-log axes).\n")
+      "\"*\": the error (full or bounce-matched) lies outside the path "
+      "tracer's measured curve (4 to 256 samples per pixel), below its most "
+      "converged image or above its least converged one, and the path "
+      "tracer's time is extrapolated (slope -1 on log-log axes).\n")
     w("| method | " + " | ".join(scenes) + " |")
     w("|---|" + "---:|" * len(scenes))
     for m in methods:
