@@ -286,6 +286,18 @@ static int samples_isotropic(iv_hier *h, const gi_scene *s, float target, gi_err
     }
     h->tri_grid[nt] = (uint32_t)disp;
     h->disp_count = (uint32_t)disp;
+    /* refused before CGAL runs: about one vertex per two equilateral
+     * triangles of the target edge (area sqrt(3)/4 e^2) */
+    double area = 0.0;
+    for (uint32_t t = 0; t < nt; t++) {
+        gi_vec3 c[3];
+        gi_scene_triangle_world(s, t, 0.0f, c);
+        area += 0.5 * gi_v3_length(gi_v3_cross(gi_v3_sub(c[1], c[0]), gi_v3_sub(c[2], c[0])));
+    }
+    if (area / (0.866 * (double)target * (double)target) > (double)IV_MAX_SAMPLES) {
+        ok = -1;
+        goto done;
+    }
     g_group_key = key;
     qsort(order, nt, sizeof *order, cmp_group);
     double q = weld_quantum(s);

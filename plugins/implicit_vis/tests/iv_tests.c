@@ -774,6 +774,11 @@ static void test_remesh(void)
         EXPECT(mi > 0.6 * 0.08 && mi < 1.4 * 0.08, "isotropic mean edge %.4f, target 0.08", mi);
     }
     iv_hier_free(h0), iv_hier_free(hg), iv_hier_free(hi);
+    /* an edge far too short is refused before CGAL runs, with a message */
+    gi_error e3 = {{0}};
+    iv_hier *tiny = iv_hier_create(s, 1e-5f, IV_REMESH_ISOTROPIC, &e3);
+    EXPECT(tiny == NULL && strstr(e3.text, "raise it"), "edge 1e-5 is not refused: '%s'", e3.text);
+    iv_hier_free(tiny);
     gi_scene_free(s);
 
     /* 3. the hierarchy of the re-meshed Cornell boxes (still, moving,
