@@ -26,6 +26,8 @@ pkgs=(
   libqhull-dev
   # gi/simplify.h: lower-detail geometry (avg's VPL shadow maps)
   libmeshoptimizer-dev
+  # gi/remesh.h: isotropic re-meshing (implicit_vis's re-meshing option)
+  libcgal-dev
   # scripts/*.py (the results tables, their test integration.results_tables;
   # the bash completion, scripts/gen-completion.py, which `make` installs)
   python3 bash-completion

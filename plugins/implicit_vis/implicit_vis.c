@@ -15,8 +15,10 @@
  *                    with `illum=cpu` the same on one CPU thread;
  *   display          the G-buffer and the per-vertex irradiance
  *                    interpolated per pixel (shaders/iv_display.comp).
- * The hierarchy and the links are built on the CPU (one thread); the
- * gathering and pull-up and the display run on the GPU. */
+ * The hierarchy and the links are built on the CPU (the links on
+ * `threads` threads); the gathering and pull-up and the display run on
+ * the GPU. */
+#define _POSIX_C_SOURCE 200809L
 #include "iv.h"
 #include "iv_gpu.h"
 #include "shaders/iv_bindings.h"
@@ -28,6 +30,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 /* Bins x nodes x 12 bytes (link, distance, coverage) above this are refused with a message. */
 #define IV_MAX_LINK_BYTES (3ull << 30)
@@ -46,13 +49,17 @@ static const gi_param_desc iv_params[] = {
     {"links", GI_PARAM_ENUM, 0, 0, 0, "hierarchical|brute", "Sec. 4.2 / 3.1 (Fig. 10 b, c)",
      "hierarchical links, or every leaf against every leaf"},
     {"remesh", GI_PARAM_FLOAT, 0.0, 0.0, 1.0, NULL, "Sec. 5.1 (re-meshing)",
-     "target edge length as a fraction of the scene's largest extent: longer triangles are subdivided; 0 = the model's own vertices"},
+     "target edge length as a fraction of the scene's largest extent (re-meshed by `remesher`); 0 = the model's own vertices"},
+    {"remesher", GI_PARAM_ENUM, 0, 0, 0, "isotropic|grid", "Sec. 5.1 (re-meshing)",
+     "isotropic: CGAL's isotropic re-meshing, each new vertex on an original triangle; grid: each triangle subdivided into a k x k grid"},
     {"bilinear", GI_PARAM_BOOL, 0, 0, 1, NULL, "Sec. 4.2.2 (deviation)",
      "a link goes into the four bins around its direction, each with its share of the node's solid angle (README \"Deviations\")"},
     {"coverage", GI_PARAM_FLOAT, 0.0, 0.0, 1.0, NULL, "Eq. 4 / Eq. 5 (deviation)",
      "a bin whose links' solid angles sum to less than this share of it passes light through that share only; 0: Eq. 5 (the nearest covers the bin)"},
     {"splat", GI_PARAM_BOOL, 1, 0, 1, NULL, "Sec. 3 (an element covers its bin)",
      "a disc nearer than its size covers every bin it spans, not only its centre's (README \"Deviations\")"},
+    {"threads", GI_PARAM_INT, 0, 0, 256, NULL, "Table 1 (create_links on the CPU)",
+     "threads that create the hierarchical links (the same links as on one); 0 = every online core"},
     {"illum", GI_PARAM_ENUM, 0, 0, 0, "gpu|cpu", "Sec. 4.3.1 (GPU implementation)",
      "where the gathering and pull-up run: compute shaders over the flattened links, or one CPU thread"},
     {0},
@@ -60,7 +67,7 @@ static const gi_param_desc iv_params[] = {
 
 typedef struct implicit_vis {
     gi_kit kit;
-    int N, bounces, brute, splat, bilinear, cpu_illum;
+    int N, bounces, brute, splat, bilinear, cpu_illum, remesher, threads;
     float subdiv, remesh, coverage;
     iv_hier *hier;
     iv_links *links;
@@ -84,11 +91,17 @@ static gi_result iv_create(const gi_host *host, const gi_params *params, void **
     m->bounces = gi_params_int(params, "bounces");
     m->subdiv = gi_params_float(params, "subdiv");
     m->remesh = gi_params_float(params, "remesh");
+    m->remesher = gi_params_enum(params, "remesher") == 1 ? IV_REMESH_GRID : IV_REMESH_ISOTROPIC;
     m->brute = gi_params_enum(params, "links") == 1;
     m->splat = gi_params_bool(params, "splat");
     m->bilinear = gi_params_bool(params, "bilinear");
     m->coverage = gi_params_float(params, "coverage");
     m->cpu_illum = gi_params_enum(params, "illum") == 1;
+    m->threads = gi_params_int(params, "threads");
+    if (m->threads == 0) {
+        long n = sysconf(_SC_NPROCESSORS_ONLN);
+        m->threads = n > 0 ? (n > 256 ? 256 : (int)n) : 1;
+    }
     *out = m;
     return GI_OK;
 }
@@ -125,7 +138,7 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
     float ext = 0.0f;
     for (int c = 0; c < 3; c++)
         ext = fmaxf(ext, s->bounds[3 + c] - s->bounds[c]);
-    m->hier = iv_hier_create(s, m->remesh * ext, &err);
+    m->hier = iv_hier_create(s, m->remesh * ext, m->remesher, &err);
     host->stage_end(host, "hierarchy");
     if (!m->hier)
         return gi_kit_fail_with(&m->kit, GI_ERR_INVALID_ARGUMENT, &err);
@@ -142,26 +155,35 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
     if (m->links) {
         m->links->bilinear = m->bilinear;
         m->links->coverage = m->coverage;
+        m->links->threads = (uint32_t)m->threads;
     }
     m->irr = calloc((size_t)m->hier->elem_count * 6, sizeof(float));
     m->elem_light = calloc((size_t)m->hier->elem_count * 12, sizeof(float));
+    const iv_hier *h = m->hier;
     uint32_t *tri = malloc(((size_t)s->triangle_count * 2 + 1) * sizeof(uint32_t));
-    if (!m->links || !m->irr || !m->elem_light || !tri) {
-        free(tri);
+    uint32_t *grid = malloc(((size_t)h->disp_count * 8 + 1) * sizeof(uint32_t));
+    if (!m->links || !m->irr || !m->elem_light || !tri || !grid) {
+        free(tri), free(grid);
         return gi_kit_fail(&m->kit, GI_ERR_OUT_OF_MEMORY, "implicit_vis: out of memory for the links of %u nodes",
                            m->hier->node_count);
     }
-    /* the display's look-up: triangle -> (k, first grid point), grid point -> element */
+    /* the display's look-up: triangle -> (k, first grid point), grid point
+     * -> three elements and their weights (uvec4, vec4) */
     for (uint32_t t = 0; t < s->triangle_count; t++) {
-        tri[2 * t] = m->hier->tri_k[t];
-        tri[2 * t + 1] = m->hier->tri_grid[t];
+        tri[2 * t] = h->tri_k[t];
+        tri[2 * t + 1] = h->tri_grid[t];
+    }
+    for (uint32_t d = 0; d < h->disp_count; d++) {
+        memcpy(&grid[8 * (size_t)d], &h->disp_elem[3 * (size_t)d], 3 * sizeof(uint32_t));
+        grid[8 * (size_t)d + 3] = 0;
+        memcpy(&grid[8 * (size_t)d + 4], &h->disp_w[3 * (size_t)d], 3 * sizeof(float));
+        grid[8 * (size_t)d + 7] = 0;
     }
     glCreateBuffers(1, &m->ssbo_tri);
     glNamedBufferStorage(m->ssbo_tri, (GLsizeiptr)((size_t)s->triangle_count * 2 * sizeof(uint32_t)), tri, 0);
-    free(tri);
     glCreateBuffers(1, &m->ssbo_grid);
-    glNamedBufferStorage(m->ssbo_grid, (GLsizeiptr)((size_t)m->hier->sample_count * sizeof(uint32_t)),
-                         m->hier->samp_elem, 0);
+    glNamedBufferStorage(m->ssbo_grid, (GLsizeiptr)((size_t)h->disp_count * 8 * sizeof(uint32_t)), grid, 0);
+    free(tri), free(grid);
     glCreateBuffers(1, &m->ssbo_light);
     glNamedBufferStorage(m->ssbo_light, (GLsizeiptr)((size_t)m->hier->elem_count * 12 * sizeof(float)), NULL,
                          GL_DYNAMIC_STORAGE_BIT);
@@ -176,7 +198,13 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
     host->stat(host, "elements", (double)m->hier->elem_count);
     host->stat(host, "nodes", (double)m->hier->node_count);
     host->stat(host, "segments", (double)m->hier->segment_count);
+    host->stat(host, "link_threads", (double)m->threads);
     host->stat(host, "surface_points", (double)m->hier->sample_count);
+    host->stat(host, "surface_triangles", (double)m->hier->surf_count);
+    double edge_mean, edge_cv;
+    iv_hier_edge_stats(m->hier, s, &edge_mean, &edge_cv);
+    host->stat(host, "edge_mean", edge_mean);
+    host->stat(host, "edge_cv", edge_cv);
     if (gi_gl_check("implicit_vis: prepare", &err) != GI_OK)
         return gi_kit_fail_with(&m->kit, GI_ERR_GL, &err);
     return GI_OK;

@@ -5,7 +5,7 @@
  * stage on its own.
  *
  * Use (Algorithm 1):
- *     iv_hier *h = iv_hier_create(scene, edge, &err);      // CreateSurfels + CreateGeometricHierarchy
+ *     iv_hier *h = iv_hier_create(scene, edge, IV_REMESH_ISOTROPIC, &err); // CreateSurfels + CreateGeometricHierarchy
  *     iv_links *l = iv_links_create(h, N);
  *     per frame:
  *         iv_hier_update(h, scene, t);               // UpdateElements (Sec. 4.2.1)
@@ -33,9 +33,18 @@ float iv_bin_solid_angle(uint32_t b, uint32_t n);
 
 /* ---- surface elements and the geometric hierarchy (Sec. 4.1) ---- */
 
-/* Re-meshing limits: subdivisions of one triangle, surface points in all. */
+/* Re-meshing limits: subdivisions of one triangle (the display grid, and
+ * the re-meshing by subdivision), surface points in all. */
 #define IV_MAX_K 64u
 #define IV_MAX_SAMPLES (8u * 1024u * 1024u)
+/* Rounds of split, collapse, flip and smoothing of the isotropic re-meshing. */
+#define IV_REMESH_ITERATIONS 3u
+
+/* How the model is re-meshed to the target edge length (Sec. 5.1). */
+enum {
+    IV_REMESH_ISOTROPIC = 0, /* CGAL's isotropic re-meshing (gi/remesh.h), each new vertex on an original triangle */
+    IV_REMESH_GRID = 1,      /* each triangle subdivided into a k x k grid of its own */
+};
 
 /* Grid point (i, j) of a triangle subdivided k times (i + j <= k; the
  * point's barycentric weights of corners 1 and 2 are i / k and j / k):
@@ -46,17 +55,29 @@ static inline uint32_t iv_grid_index(uint32_t k, uint32_t i, uint32_t j)
 }
 
 typedef struct iv_hier {
-    /* Surface points: the corners of every triangle, or with re-meshing
-     * every point of its k x k subdivision grid (Sec. 4.1 and 5.1, the
-     * optional re-meshing to a target edge length). */
-    uint32_t *tri_k;    /* per triangle: subdivisions (1 = none) */
-    uint32_t *tri_grid; /* per triangle + 1: its first point */
+    /* Surface points (Sec. 4.1 and 5.1): the corners of every triangle;
+     * with re-meshing the vertices of the re-meshed surface, each embedded
+     * in an original triangle (triangle, barycentric weights), so that
+     * rigid motion and morph targets move it and albedo, texture and
+     * normals carry over. */
     uint32_t sample_count;
-    uint32_t *samp_tri;  /* triangle of each point */
+    uint32_t *samp_tri;  /* original triangle of each point */
     float *samp_b;       /* 2 per point: barycentric weights of corners 1 and 2 */
-    float *samp_share;   /* per point: its share of the triangle's area (1/3 per sub-triangle around it / k^2) */
     uint32_t *samp_elem; /* point -> element */
     float *rest;         /* 3 per point: object-local rest position */
+    /* The surface the points span: 3 points per triangle (without
+     * re-meshing the original triangles; with the grid the sub-triangles;
+     * isotropic: CGAL's triangles). A disc's area is a third of its
+     * triangles', every frame. */
+    uint32_t surf_count;
+    uint32_t *surf_tri;
+    /* The display's look-up: per original triangle a k x k grid (k = 1:
+     * its corners), each grid point a blend of three elements. */
+    uint32_t *tri_k;    /* per triangle: subdivisions of its display grid */
+    uint32_t *tri_grid; /* per triangle + 1: its first grid point */
+    uint32_t disp_count;
+    uint32_t *disp_elem; /* 3 per grid point: elements */
+    float *disp_w;       /* 3 per grid point: their weights */
     /* Elements: one oriented disc per distinct point (points equal in
      * position and normal merged). */
     uint32_t elem_count;
@@ -79,18 +100,24 @@ typedef struct iv_hier {
     float *pos;  /* 3 per node: area-weighted mean of the children */
     float *nrm;  /* 3 per node: area-weighted mean normal (unit for a leaf; shorter where children disagree) */
     float *area; /* per node: sum of the children */
-    float *tri_area; /* scratch: triangle areas at t */
+    float *spos; /* scratch: 3 per surface point at t */
     gi_vertex *verts; /* scratch: an object's vertices at t */
     float *wpos, *wnrm; /* scratch: the model's vertices at t, world space */
 } iv_hier;
 
-/* target_edge > 0: each triangle subdivided k times, k its longest edge
- * over target_edge rounded up (at most IV_MAX_K); 0: the model as it is. */
-iv_hier *iv_hier_create(const gi_scene *s, float target_edge, gi_error *err);
+/* target_edge > 0: the model re-meshed to that edge length (world units
+ * at t = 0) by `remesher` (IV_REMESH_*); with the grid each triangle is
+ * subdivided k times, k its longest edge over target_edge rounded up (at
+ * most IV_MAX_K). 0: the model as it is. */
+iv_hier *iv_hier_create(const gi_scene *s, float target_edge, int remesher, gi_error *err);
 void iv_hier_free(iv_hier *h);
 /* Positions, normals and areas of the elements at time t (rigid motion and
  * morph targets), then every node from its children (Sec. 4.2.1). */
 void iv_hier_update(iv_hier *h, const gi_scene *s, float t);
+/* Edge lengths of the surface the elements span (surf_tri), rest pose,
+ * world units at t = 0: mean and coefficient of variation (standard
+ * deviation / mean), each edge counted once per triangle. */
+void iv_hier_edge_stats(const iv_hier *h, const gi_scene *s, double *mean, double *cv);
 static inline int iv_is_leaf(const iv_hier *h, uint32_t node) { return h->child_count[node] == 0; }
 
 /* ---- the hierarchical link structure (Sec. 4.2) ---- */
@@ -101,6 +128,8 @@ typedef struct iv_links {
     uint32_t nodes;
     int32_t *other;    /* nodes x bins: the linked node, -1 empty */
     float *dist;       /* nodes x bins: its distance */
+    uint32_t threads;  /* > 1: links created on this many threads, the same links to the bit (README
+                          "Multi-threaded link creation"); 0 or 1: on one */
     int bilinear;      /* links written into the four bins around their direction (README "Deviations") */
     float coverage;    /* > 0: a bin whose links' solid angles sum to less than this share of it is lit
                           through that part only (README "Deviations"); 0: Eq. 5, the nearest covers all */

@@ -6,8 +6,11 @@
 
 #include "gi/lights.h"
 #include "gi/mesh.h"
+#include "gi/remesh.h"
 
 #include <float.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -114,126 +117,359 @@ static uint64_t cell_hash(int64_t x, int64_t y, int64_t z, uint32_t object)
     return h ^ (h >> 29);
 }
 
-/* The mesh's points as discs (Sec. 4.1): every vertex of every triangle,
- * and with re-meshing every point of each triangle's k x k subdivision
- * grid. Points of one object at one rest position (within 1e-5 of the
- * scene's size, the cells around included) whose normals agree
- * (cos > 0.95) are one element; a hard edge keeps two. */
-static int make_elements(iv_hier *h, const gi_scene *s, float target)
+/* Merging of points equal in position (within q per axis, the cells
+ * around included) and normal (cos > 0.95) under one key (the object):
+ * ids 0.. are added in order; pos, nrm, key are read per id. */
+typedef struct welder {
+    uint32_t hsize;
+    int64_t *head, *next;
+    double q;
+    const float *pos, *nrm;
+    const uint32_t *key;
+} welder;
+
+static int welder_init(welder *w, uint32_t n, double q, const float *pos, const float *nrm, const uint32_t *key)
+{
+    w->hsize = 1;
+    while (w->hsize < 2 * n)
+        w->hsize <<= 1;
+    w->head = malloc((size_t)w->hsize * sizeof *w->head);
+    w->next = malloc(((size_t)n + 1) * sizeof *w->next);
+    w->q = q;
+    w->pos = pos, w->nrm = nrm, w->key = key;
+    if (!w->head || !w->next)
+        return 0;
+    for (uint32_t i = 0; i < w->hsize; i++)
+        w->head[i] = -1;
+    return 1;
+}
+
+static void welder_free(welder *w) { free(w->head), free(w->next); }
+
+/* The id merged with point (p, n, key), or the new id `fresh` added. */
+static uint32_t welder_find_or_add(welder *w, const float p[3], gi_vec3 n, uint32_t key, uint32_t fresh)
+{
+    double q = w->q;
+    int64_t cx = (int64_t)floor(p[0] / q), cy = (int64_t)floor(p[1] / q), cz = (int64_t)floor(p[2] / q);
+    for (int dz = -1; dz <= 1; dz++)
+        for (int dy = -1; dy <= 1; dy++)
+            for (int dx = -1; dx <= 1; dx++) {
+                uint64_t hh = cell_hash(cx + dx, cy + dy, cz + dz, key) & (w->hsize - 1);
+                for (int64_t e = w->head[hh]; e >= 0; e = w->next[e]) {
+                    const float *pr = &w->pos[3 * e];
+                    if (w->key[e] == key && fabs(pr[0] - p[0]) <= q && fabs(pr[1] - p[1]) <= q &&
+                        fabs(pr[2] - p[2]) <= q && gi_v3_dot(gi_v3_load(&w->nrm[3 * e]), n) > 0.95f)
+                        return (uint32_t)e;
+                }
+            }
+    uint64_t hh = cell_hash(cx, cy, cz, key) & (w->hsize - 1);
+    w->next[fresh] = w->head[hh];
+    w->head[hh] = fresh;
+    return fresh;
+}
+
+static double weld_quantum(const gi_scene *s)
+{
+    float ext = 0.0f;
+    for (int c = 0; c < 3; c++)
+        ext = fmaxf(ext, s->bounds[3 + c] - s->bounds[c]);
+    return 1e-5 * (ext > 0.0f ? ext : 1.0f);
+}
+
+/* Without re-meshing or with the grid: every point of each triangle's
+ * k x k grid (k = 1: its corners) is a surface point, the sub-triangles
+ * the surface, and the display grid the points themselves. */
+static int samples_grid(iv_hier *h, const gi_scene *s, float target)
+{
+    uint32_t nt = s->triangle_count;
+    uint64_t total = 0, subs = 0;
+    for (uint32_t t = 0; t < nt; t++) {
+        h->tri_k[t] = tri_k(s, t, target);
+        h->tri_grid[t] = (uint32_t)total;
+        uint64_t k = h->tri_k[t];
+        total += (k + 1) * (k + 2) / 2;
+        subs += k * k;
+        if (total > IV_MAX_SAMPLES)
+            return -1;
+    }
+    h->tri_grid[nt] = (uint32_t)total;
+    h->sample_count = h->disp_count = (uint32_t)total;
+    h->surf_count = (uint32_t)subs;
+    uint32_t ns = h->sample_count;
+    h->samp_tri = malloc((ns + 1) * sizeof *h->samp_tri);
+    h->samp_b = malloc(((size_t)ns * 2 + 1) * sizeof *h->samp_b);
+    h->surf_tri = malloc(((size_t)subs * 3 + 1) * sizeof *h->surf_tri);
+    h->disp_elem = malloc(((size_t)ns * 3 + 1) * sizeof *h->disp_elem);
+    h->disp_w = malloc(((size_t)ns * 3 + 1) * sizeof *h->disp_w);
+    if (!h->samp_tri || !h->samp_b || !h->surf_tri || !h->disp_elem || !h->disp_w)
+        return 0;
+    size_t st = 0;
+    for (uint32_t t = 0; t < nt; t++) {
+        uint32_t k = h->tri_k[t], base = h->tri_grid[t];
+        for (uint32_t j = 0; j <= k; j++)
+            for (uint32_t i = 0; i + j <= k; i++) {
+                uint32_t si = base + iv_grid_index(k, i, j);
+                h->samp_tri[si] = t;
+                h->samp_b[2 * si] = (float)i / (float)k;
+                h->samp_b[2 * si + 1] = (float)j / (float)k;
+                for (int c = 0; c < 3; c++) {
+                    h->disp_elem[3 * si + c] = si; /* the point itself (mapped to its element later) */
+                    h->disp_w[3 * si + c] = c == 0 ? 1.0f : 0.0f;
+                }
+                if (i + j + 1 <= k) { /* lower sub-triangle (i,j) (i+1,j) (i,j+1) */
+                    uint32_t *o = &h->surf_tri[3 * st++];
+                    o[0] = si, o[1] = base + iv_grid_index(k, i + 1, j), o[2] = base + iv_grid_index(k, i, j + 1);
+                }
+                if (i + j + 2 <= k) { /* upper sub-triangle (i+1,j) (i+1,j+1) (i,j+1) */
+                    uint32_t *o = &h->surf_tri[3 * st++];
+                    o[0] = base + iv_grid_index(k, i + 1, j), o[1] = base + iv_grid_index(k, i + 1, j + 1);
+                    o[2] = base + iv_grid_index(k, i, j + 1);
+                }
+            }
+    }
+    return 1;
+}
+
+/* Uniform scale of object o at t = 0 (cube root of its transform's
+ * determinant), to turn a world edge length into the object's units. */
+static float object_scale(const gi_scene *s, uint32_t o)
+{
+    float m[16];
+    gi_scene_object_transform(s, o, 0.0f, m);
+    double det = (double)m[0] * ((double)m[5] * m[10] - (double)m[6] * m[9]) -
+                 (double)m[4] * ((double)m[1] * m[10] - (double)m[2] * m[9]) +
+                 (double)m[8] * ((double)m[1] * m[6] - (double)m[2] * m[5]);
+    double sc = cbrt(fabs(det));
+    return sc > 1e-12 ? (float)sc : 1.0f;
+}
+
+static const uint32_t *g_group_key; /* keys the comparator reads */
+
+static int cmp_group(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    uint32_t kx = g_group_key[x], ky = g_group_key[y];
+    return kx != ky ? (kx < ky ? -1 : 1) : (x < y ? -1 : (x > y));
+}
+
+/* Isotropic re-meshing (Sec. 5.1) by CGAL, per object and material (an
+ * emitter keeps its outline). Each patch is welded by position and
+ * normal, so that a hard edge is a border, which keeps its vertices. The
+ * new vertices are the surface points, each on the original triangle CGAL
+ * projected it to; the display grid of every original triangle is located
+ * on the re-meshed surface (triangle, barycentric weights). */
+static int samples_isotropic(iv_hier *h, const gi_scene *s, float target, gi_error *err)
+{
+    uint32_t nt = s->triangle_count;
+    int ok = 0;
+    uint32_t *order = malloc((nt + 1) * sizeof *order), *key = malloc((nt + 1) * sizeof *key);
+    gi_remeshed **rm = calloc(nt + 1, sizeof *rm); /* per patch, indexed by its first triangle in `order` */
+    float *lp = malloc(((size_t)nt * 9 + 1) * sizeof(float)), *ln = malloc(((size_t)nt * 9 + 1) * sizeof(float));
+    uint32_t *lk = calloc((size_t)nt * 3 + 1, sizeof *lk), *lidx = malloc(((size_t)nt * 3 + 1) * sizeof *lidx);
+    float *query = NULL, *qb = NULL;
+    uint32_t *qf = NULL;
+    welder w = {0};
+    if (!order || !key || !rm || !lp || !ln || !lk || !lidx)
+        goto done;
+    uint64_t disp = 0;
+    for (uint32_t t = 0; t < nt; t++) {
+        order[t] = t;
+        key[t] = s->vertices[s->indices[3 * t]].object * (s->material_count + 1) +
+                 s->vertices[s->indices[3 * t]].material;
+        h->tri_k[t] = tri_k(s, t, target);
+        h->tri_grid[t] = (uint32_t)disp;
+        disp += (uint64_t)(h->tri_k[t] + 1) * (h->tri_k[t] + 2) / 2;
+        if (disp > IV_MAX_SAMPLES) {
+            ok = -1;
+            goto done;
+        }
+    }
+    h->tri_grid[nt] = (uint32_t)disp;
+    h->disp_count = (uint32_t)disp;
+    /* refused before CGAL runs: about one vertex per two equilateral
+     * triangles of the target edge (area sqrt(3)/4 e^2) */
+    double area = 0.0;
+    for (uint32_t t = 0; t < nt; t++) {
+        gi_vec3 c[3];
+        gi_scene_triangle_world(s, t, 0.0f, c);
+        area += 0.5 * gi_v3_length(gi_v3_cross(gi_v3_sub(c[1], c[0]), gi_v3_sub(c[2], c[0])));
+    }
+    if (area / (0.866 * (double)target * (double)target) > (double)IV_MAX_SAMPLES) {
+        ok = -1;
+        goto done;
+    }
+    g_group_key = key;
+    qsort(order, nt, sizeof *order, cmp_group);
+    double q = weld_quantum(s);
+    uint64_t total = 0, surf = 0;
+    for (uint32_t a = 0, b; a < nt; a = b) {
+        for (b = a; b < nt && key[order[b]] == key[order[a]]; b++)
+            ;
+        /* the patch's corners welded (object-local rest pose) */
+        welder_free(&w);
+        memset(&w, 0, sizeof w);
+        if (!welder_init(&w, 3 * (b - a), q, lp, ln, lk))
+            goto done;
+        uint32_t nv = 0;
+        for (uint32_t i = a; i < b; i++)
+            for (int c = 0; c < 3; c++) {
+                const gi_vertex *v = &s->vertices[s->indices[3 * order[i] + c]];
+                memcpy(&lp[3 * nv], v->position, 3 * sizeof(float));
+                memcpy(&ln[3 * nv], v->normal, 3 * sizeof(float));
+                gi_vec3 n = gi_v3_normalize(gi_v3_load(v->normal));
+                uint32_t id = welder_find_or_add(&w, v->position, n, 0, nv);
+                nv += id == nv;
+                lidx[3 * (i - a) + (uint32_t)c] = id;
+            }
+        uint32_t obj = s->vertices[s->indices[3 * order[a]]].object;
+        rm[a] = gi_remesh_isotropic(lp, nv, lidx, b - a, target / object_scale(s, obj), IV_REMESH_ITERATIONS, err);
+        if (!rm[a]) {
+            ok = -2;
+            goto done;
+        }
+        total += rm[a]->vertex_count;
+        surf += rm[a]->triangle_count;
+        if (total > IV_MAX_SAMPLES) {
+            ok = -1;
+            goto done;
+        }
+    }
+    h->sample_count = (uint32_t)total;
+    h->surf_count = (uint32_t)surf;
+    h->samp_tri = malloc((total + 1) * sizeof *h->samp_tri);
+    h->samp_b = malloc((total * 2 + 1) * sizeof *h->samp_b);
+    h->surf_tri = malloc((surf * 3 + 1) * sizeof *h->surf_tri);
+    h->disp_elem = malloc((disp * 3 + 1) * sizeof *h->disp_elem);
+    h->disp_w = malloc((disp * 3 + 1) * sizeof *h->disp_w);
+    uint32_t maxq = 0;
+    for (uint32_t t = 0; t < nt; t++)
+        maxq = h->tri_grid[t + 1] - h->tri_grid[t] > maxq ? h->tri_grid[t + 1] - h->tri_grid[t] : maxq;
+    if (!h->samp_tri || !h->samp_b || !h->surf_tri || !h->disp_elem || !h->disp_w)
+        goto done;
+    uint32_t base = 0, sbase = 0;
+    for (uint32_t a = 0, b; a < nt; a = b) {
+        for (b = a; b < nt && key[order[b]] == key[order[a]]; b++)
+            ;
+        const gi_remeshed *r = rm[a];
+        for (uint32_t v = 0; v < r->vertex_count; v++) {
+            h->samp_tri[base + v] = order[a + r->face[v]];
+            h->samp_b[2 * (base + v)] = r->bary[3 * v + 1];
+            h->samp_b[2 * (base + v) + 1] = r->bary[3 * v + 2];
+        }
+        for (uint32_t f = 0; f < 3 * r->triangle_count; f++)
+            h->surf_tri[3 * (size_t)sbase + f] = base + r->indices[f];
+        /* the display grid of each of the patch's triangles, on the re-meshed surface */
+        uint32_t nq = 0;
+        for (uint32_t i = a; i < b; i++)
+            nq += h->tri_grid[order[i] + 1] - h->tri_grid[order[i]];
+        free(query), free(qb), free(qf);
+        query = malloc(((size_t)nq * 3 + 1) * sizeof(float));
+        qb = malloc(((size_t)nq * 3 + 1) * sizeof(float));
+        qf = malloc(((size_t)nq + 1) * sizeof *qf);
+        if (!query || !qb || !qf)
+            goto done;
+        uint32_t qi = 0;
+        for (uint32_t i = a; i < b; i++) {
+            uint32_t t = order[i], k = h->tri_k[t];
+            for (uint32_t j = 0; j <= k; j++)
+                for (uint32_t ii = 0; ii + j <= k; ii++) {
+                    gi_vec3 n;
+                    rest_point(s, t, (float)ii / (float)k, (float)j / (float)k, &query[3 * qi++], &n);
+                }
+        }
+        if (gi_mesh_locate(r->positions, r->vertex_count, r->indices, r->triangle_count, query, nq, qf, qb, err) !=
+            GI_OK) {
+            ok = -2;
+            goto done;
+        }
+        qi = 0;
+        for (uint32_t i = a; i < b; i++) {
+            uint32_t t = order[i];
+            for (uint32_t d = h->tri_grid[t]; d < h->tri_grid[t + 1]; d++, qi++)
+                for (int c = 0; c < 3; c++) {
+                    h->disp_elem[3 * d + c] = base + r->indices[3 * qf[qi] + c]; /* a point (mapped later) */
+                    h->disp_w[3 * d + c] = qb[3 * qi + c];
+                }
+        }
+        base += r->vertex_count;
+        sbase += r->triangle_count;
+    }
+    ok = 1;
+done:
+    if (rm)
+        for (uint32_t i = 0; i < nt; i++)
+            gi_remeshed_free(rm[i]);
+    welder_free(&w);
+    free(order), free(key), free(rm), free(lp), free(ln), free(lk), free(lidx), free(query), free(qb), free(qf);
+    return ok;
+}
+
+/* The surface points as discs (Sec. 4.1). Points of one object at one
+ * rest position (within 1e-5 of the scene's size) whose normals agree
+ * (cos > 0.95) are one element; a hard edge keeps two. Returns 1, 0 (out
+ * of memory), -1 (too many points), -2 (re-meshing failed, err set). */
+static int make_elements(iv_hier *h, const gi_scene *s, float target, int remesher, gi_error *err)
 {
     uint32_t nt = s->triangle_count;
     h->tri_k = malloc((nt + 1) * sizeof *h->tri_k);
     h->tri_grid = malloc((nt + 1) * sizeof *h->tri_grid);
     if (!h->tri_k || !h->tri_grid)
         return 0;
-    uint64_t total = 0;
-    for (uint32_t t = 0; t < nt; t++) {
-        h->tri_k[t] = tri_k(s, t, target);
-        h->tri_grid[t] = (uint32_t)total;
-        uint64_t k = h->tri_k[t];
-        total += (k + 1) * (k + 2) / 2;
-        if (total > IV_MAX_SAMPLES)
-            return -1;
-    }
-    h->tri_grid[nt] = (uint32_t)total;
-    h->sample_count = (uint32_t)total;
+    int r = target > 0.0f && remesher == IV_REMESH_ISOTROPIC ? samples_isotropic(h, s, target, err)
+                                                             : samples_grid(h, s, target);
+    if (r != 1)
+        return r;
     uint32_t ns = h->sample_count;
-    h->samp_tri = malloc((ns + 1) * sizeof *h->samp_tri);
-    h->samp_b = malloc(((size_t)ns * 2 + 1) * sizeof *h->samp_b);
-    h->samp_share = calloc(ns + 1, sizeof *h->samp_share);
     h->samp_elem = malloc((ns + 1) * sizeof *h->samp_elem);
     h->elem_rep = malloc((ns + 1) * sizeof *h->elem_rep);
     float *rest = malloc(((size_t)ns * 3 + 1) * sizeof(float));
     float *rn = malloc(((size_t)ns * 3 + 1) * sizeof(float));
     float *albedo_sum = calloc((size_t)ns * 3 + 1, sizeof(float));
     float *emit = calloc((size_t)ns * 3 + 1, sizeof(float));
+    float *ep = malloc(((size_t)ns * 3 + 1) * sizeof(float)), *en = malloc(((size_t)ns * 3 + 1) * sizeof(float));
+    uint32_t *ek = malloc(((size_t)ns + 1) * sizeof *ek);
     uint8_t *two = calloc(ns + 1, 1);
     uint32_t *count = calloc(ns + 1, sizeof *count);
-    uint32_t hsize = 1;
-    while (hsize < 2 * ns)
-        hsize <<= 1;
-    int64_t *head = malloc((size_t)hsize * sizeof *head);
-    int64_t *next = malloc(((size_t)ns + 1) * sizeof *next);
-    int ok = h->samp_tri && h->samp_b && h->samp_share && h->samp_elem && h->elem_rep && rest && rn && albedo_sum &&
-             emit && two && count && head && next;
+    welder w = {0};
+    int ok = h->samp_elem && h->elem_rep && rest && rn && albedo_sum && emit && ep && en && ek && two && count &&
+             welder_init(&w, ns, weld_quantum(s), ep, en, ek);
     if (!ok)
         goto done;
-    for (uint32_t i = 0; i < hsize; i++)
-        head[i] = -1;
-    float ext = 0.0f;
-    for (int c = 0; c < 3; c++)
-        ext = fmaxf(ext, s->bounds[3 + c] - s->bounds[c]);
-    double q = 1e-5 * (ext > 0.0f ? ext : 1.0f);
     uint32_t ne = 0;
-    for (uint32_t t = 0; t < nt; t++) {
-        uint32_t k = h->tri_k[t], base = h->tri_grid[t];
+    for (uint32_t si = 0; si < ns; si++) {
+        uint32_t t = h->samp_tri[si];
+        float b1 = h->samp_b[2 * si], b2 = h->samp_b[2 * si + 1];
         uint32_t obj = s->vertices[s->indices[3 * t]].object, mat = s->vertices[s->indices[3 * t]].material;
         const gi_material *m = &s->materials[mat];
-        for (uint32_t j = 0; j <= k; j++)
-            for (uint32_t i = 0; i + j <= k; i++) {
-                uint32_t si = base + iv_grid_index(k, i, j);
-                float b1 = (float)i / (float)k, b2 = (float)j / (float)k;
-                h->samp_tri[si] = t;
-                h->samp_b[2 * si] = b1;
-                h->samp_b[2 * si + 1] = b2;
-                gi_vec3 n;
-                rest_point(s, t, b1, b2, &rest[3 * si], &n);
-                gi_v3_store(n, &rn[3 * si]);
-                /* a disc's area: a third of each sub-triangle around it */
-                uint32_t around = 0; /* lower L(a,b): (a,b) (a+1,b) (a,b+1); upper U(a,b): (a+1,b) (a+1,b+1) (a,b+1) */
-                around += i + j <= k - 1;                   /* L(i, j) */
-                around += i >= 1;                           /* L(i - 1, j) */
-                around += j >= 1;                           /* L(i, j - 1) */
-                around += i >= 1 && i + j <= k - 1;         /* U(i - 1, j) */
-                around += i >= 1 && j >= 1;                 /* U(i - 1, j - 1) */
-                around += j >= 1 && i + j <= k - 1;         /* U(i, j - 1) */
-                h->samp_share[si] = (float)around / (3.0f * (float)k * (float)k);
-                /* weld */
-                int64_t cx = (int64_t)floor(rest[3 * si] / q), cy = (int64_t)floor(rest[3 * si + 1] / q),
-                        cz = (int64_t)floor(rest[3 * si + 2] / q);
-                int64_t found = -1;
-                for (int dz = -1; dz <= 1 && found < 0; dz++)
-                    for (int dy = -1; dy <= 1 && found < 0; dy++)
-                        for (int dx = -1; dx <= 1 && found < 0; dx++) {
-                            uint64_t hh = cell_hash(cx + dx, cy + dy, cz + dz, obj) & (hsize - 1);
-                            for (int64_t e = head[hh]; e >= 0; e = next[e]) {
-                                uint32_t r = h->elem_rep[e];
-                                const float *pr = &rest[3 * r];
-                                if (s->vertices[s->indices[3 * h->samp_tri[r]]].object == obj &&
-                                    fabs(pr[0] - rest[3 * si]) <= q && fabs(pr[1] - rest[3 * si + 1]) <= q &&
-                                    fabs(pr[2] - rest[3 * si + 2]) <= q &&
-                                    gi_v3_dot(gi_v3_load(&rn[3 * r]), n) > 0.95f) {
-                                    found = e;
-                                    break;
-                                }
-                            }
-                        }
-                if (found < 0) {
-                    found = ne++;
-                    h->elem_rep[found] = si;
-                    uint64_t hh = cell_hash(cx, cy, cz, obj) & (hsize - 1);
-                    next[found] = head[hh];
-                    head[hh] = found;
-                }
-                h->samp_elem[si] = (uint32_t)found;
-                float uv[2];
-                const gi_vertex *v0 = &s->vertices[s->indices[3 * t]], *v1 = &s->vertices[s->indices[3 * t + 1]],
-                                *v2 = &s->vertices[s->indices[3 * t + 2]];
-                for (int c = 0; c < 2; c++)
-                    uv[c] = (1.0f - b1 - b2) * v0->uv[c] + b1 * v1->uv[c] + b2 * v2->uv[c];
-                float al[3];
-                gi_scene_albedo(s, mat, uv, al);
-                for (int c = 0; c < 3; c++) {
-                    albedo_sum[3 * found + c] += al[c];
-                    emit[3 * found + c] = fmaxf(emit[3 * found + c], m->emission[c]);
-                }
-                two[found] |= (uint8_t)(m->double_sided != 0);
-                count[found]++;
-            }
+        gi_vec3 n;
+        rest_point(s, t, b1, b2, &rest[3 * si], &n);
+        gi_v3_store(n, &rn[3 * si]);
+        memcpy(&ep[3 * ne], &rest[3 * si], 3 * sizeof(float));
+        gi_v3_store(n, &en[3 * ne]);
+        ek[ne] = obj;
+        uint32_t found = welder_find_or_add(&w, &rest[3 * si], n, obj, ne);
+        if (found == ne)
+            h->elem_rep[ne++] = si;
+        h->samp_elem[si] = found;
+        float uv[2];
+        const gi_vertex *v0 = &s->vertices[s->indices[3 * t]], *v1 = &s->vertices[s->indices[3 * t + 1]],
+                        *v2 = &s->vertices[s->indices[3 * t + 2]];
+        for (int c = 0; c < 2; c++)
+            uv[c] = (1.0f - b1 - b2) * v0->uv[c] + b1 * v1->uv[c] + b2 * v2->uv[c];
+        float al[3];
+        gi_scene_albedo(s, mat, uv, al);
+        for (int c = 0; c < 3; c++) {
+            albedo_sum[3 * found + c] += al[c];
+            emit[3 * found + c] = fmaxf(emit[3 * found + c], m->emission[c]);
+        }
+        two[found] |= (uint8_t)(m->double_sided != 0);
+        count[found]++;
     }
     for (uint32_t e = 0; e < ne; e++)
         for (int c = 0; c < 3; c++)
             albedo_sum[3 * e + c] /= (float)count[e];
+    for (size_t d = 0; d < (size_t)h->disp_count * 3; d++)
+        h->disp_elem[d] = h->samp_elem[h->disp_elem[d]];
     h->elem_count = ne;
     h->elem_albedo = albedo_sum;
     h->elem_emit = emit;
@@ -243,7 +479,8 @@ static int make_elements(iv_hier *h, const gi_scene *s, float target)
     two = NULL;
     ok = ne > 0;
 done:
-    free(rn), free(albedo_sum), free(emit), free(two), free(count), free(head), free(next), free(rest);
+    welder_free(&w);
+    free(rn), free(albedo_sum), free(emit), free(two), free(count), free(rest), free(ep), free(en), free(ek);
     return ok;
 }
 
@@ -292,23 +529,13 @@ static int build_tree(iv_hier *h, const gi_scene *s)
             /* objects never share elements: each tree holds one object's */
             memcpy(&rest[3 * e], &h->rest[3 * h->elem_rep[e]], 3 * sizeof(float));
         }
-        for (uint32_t t = 0; t < s->triangle_count; t++) {
-            uint32_t k = h->tri_k[t], base = h->tri_grid[t];
-            for (uint32_t j = 0; j <= k; j++)
-                for (uint32_t i = 0; i + j <= k; i++) {
-                    /* every grid point joins its right and upper neighbours (the sub-triangles' edges) */
-                    uint32_t a = uf_find(uf, h->samp_elem[base + iv_grid_index(k, i, j)]);
-                    if (i + j < k) {
-                        uint32_t b = uf_find(uf, h->samp_elem[base + iv_grid_index(k, i + 1, j)]);
-                        if (a != b)
-                            uf[b] = a;
-                        a = uf_find(uf, a);
-                        b = uf_find(uf, h->samp_elem[base + iv_grid_index(k, i, j + 1)]);
-                        if (a != b)
-                            uf[b] = a;
-                    }
-                }
-        }
+        for (uint32_t t = 0; t < h->surf_count; t++) /* the surface's edges join its points' elements */
+            for (int c = 0; c < 2; c++) {
+                uint32_t a = uf_find(uf, h->samp_elem[h->surf_tri[3 * t + c]]);
+                uint32_t b = uf_find(uf, h->samp_elem[h->surf_tri[3 * t + c + 1]]);
+                if (a != b)
+                    uf[b] = a;
+            }
         for (uint32_t e = 0; e < ne; e++)
             seg[e] = uf_find(uf, e);
         /* elements grouped by segment, in order of first appearance */
@@ -403,10 +630,14 @@ static int build_tree(iv_hier *h, const gi_scene *s)
     return ok;
 }
 
-iv_hier *iv_hier_create(const gi_scene *s, float target_edge, gi_error *err)
+iv_hier *iv_hier_create(const gi_scene *s, float target_edge, int remesher, gi_error *err)
 {
     iv_hier *h = calloc(1, sizeof *h);
-    int made = h && s->triangle_count > 0 ? make_elements(h, s, target_edge) : 0;
+    int made = h && s->triangle_count > 0 ? make_elements(h, s, target_edge, remesher, err) : 0;
+    if (made == -2) { /* err set by the re-meshing */
+        iv_hier_free(h);
+        return NULL;
+    }
     if (made < 0) {
         gi_error_set(err, GI_ERR_UNSUPPORTED,
                      "implicit_vis: re-meshing to edge length %g gives more than %u surface points: raise it", target_edge,
@@ -427,11 +658,11 @@ iv_hier *iv_hier_create(const gi_scene *s, float target_edge, gi_error *err)
     h->pos = calloc((size_t)h->node_count * 3, sizeof(float));
     h->nrm = calloc((size_t)h->node_count * 3, sizeof(float));
     h->area = calloc(h->node_count, sizeof(float));
-    h->tri_area = calloc(s->triangle_count ? s->triangle_count : 1, sizeof(float));
+    h->spos = calloc((size_t)h->sample_count * 3 + 1, sizeof(float));
     h->verts = calloc(maxv ? maxv : 1, sizeof(gi_vertex));
     h->wpos = calloc((size_t)s->vertex_count * 3 + 1, sizeof(float));
     h->wnrm = calloc((size_t)s->vertex_count * 3 + 1, sizeof(float));
-    if (!h->pos || !h->nrm || !h->area || !h->tri_area || !h->verts || !h->wpos || !h->wnrm) {
+    if (!h->pos || !h->nrm || !h->area || !h->spos || !h->verts || !h->wpos || !h->wnrm) {
         gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "implicit_vis: out of memory for %u hierarchy nodes", h->node_count);
         iv_hier_free(h);
         return NULL;
@@ -443,11 +674,12 @@ void iv_hier_free(iv_hier *h)
 {
     if (!h)
         return;
-    free(h->tri_k), free(h->tri_grid), free(h->samp_tri), free(h->samp_b), free(h->samp_share), free(h->samp_elem);
+    free(h->tri_k), free(h->tri_grid), free(h->samp_tri), free(h->samp_b), free(h->samp_elem);
+    free(h->surf_tri), free(h->disp_elem), free(h->disp_w);
     free(h->rest), free(h->wpos), free(h->wnrm);
     free(h->elem_rep), free(h->elem_albedo), free(h->elem_emit), free(h->elem_two_sided_emit);
     free(h->first_child), free(h->child_count), free(h->parent), free(h->node_elem), free(h->elem_node);
-    free(h->pos), free(h->nrm), free(h->area), free(h->tri_area), free(h->verts);
+    free(h->pos), free(h->nrm), free(h->area), free(h->spos), free(h->verts);
     free(h);
 }
 
@@ -474,22 +706,26 @@ void iv_hier_update(iv_hier *h, const gi_scene *s, float t)
             gi_v3_store(gi_v3_normalize(gi_mat4_dir(nm, gi_v3_load(vs[i].normal))), &h->wnrm[3 * v]);
         }
     }
-    for (uint32_t tr = 0; tr < s->triangle_count; tr++) {
-        gi_vec3 p0 = gi_v3_load(&h->wpos[3 * s->indices[3 * tr]]), p1 = gi_v3_load(&h->wpos[3 * s->indices[3 * tr + 1]]),
-                p2 = gi_v3_load(&h->wpos[3 * s->indices[3 * tr + 2]]);
-        h->tri_area[tr] = 0.5f * gi_v3_length(gi_v3_cross(gi_v3_sub(p1, p0), gi_v3_sub(p2, p0)));
-    }
-    /* the discs: points of the triangles, areas a third of the (sub-)triangles around them */
+    /* the discs: points of the triangles, areas a third of the surface's triangles around them */
     for (uint32_t si = 0; si < h->sample_count; si++) {
         uint32_t tr = h->samp_tri[si], e = h->samp_elem[si], leaf = h->elem_node[e];
         const uint32_t *ix = &s->indices[3 * tr];
         float b1 = h->samp_b[2 * si], b2 = h->samp_b[2 * si + 1], b0 = 1.0f - b1 - b2;
+        float *p = &h->spos[3 * si];
+        for (int c = 0; c < 3; c++)
+            p[c] = b0 * h->wpos[3 * ix[0] + c] + b1 * h->wpos[3 * ix[1] + c] + b2 * h->wpos[3 * ix[2] + c];
         if (h->elem_rep[e] == si)
-            for (int c = 0; c < 3; c++)
-                h->pos[3 * leaf + c] = b0 * h->wpos[3 * ix[0] + c] + b1 * h->wpos[3 * ix[1] + c] + b2 * h->wpos[3 * ix[2] + c];
+            memcpy(&h->pos[3 * leaf], p, 3 * sizeof(float));
         for (int c = 0; c < 3; c++)
             h->nrm[3 * leaf + c] += b0 * h->wnrm[3 * ix[0] + c] + b1 * h->wnrm[3 * ix[1] + c] + b2 * h->wnrm[3 * ix[2] + c];
-        h->area[leaf] += h->samp_share[si] * h->tri_area[tr];
+    }
+    for (uint32_t f = 0; f < h->surf_count; f++) {
+        const uint32_t *v = &h->surf_tri[3 * f];
+        gi_vec3 p0 = gi_v3_load(&h->spos[3 * v[0]]), p1 = gi_v3_load(&h->spos[3 * v[1]]),
+                p2 = gi_v3_load(&h->spos[3 * v[2]]);
+        float a = gi_v3_length(gi_v3_cross(gi_v3_sub(p1, p0), gi_v3_sub(p2, p0))) / 6.0f;
+        for (int c = 0; c < 3; c++)
+            h->area[h->elem_node[h->samp_elem[v[c]]]] += a;
     }
     for (uint32_t e = 0; e < h->elem_count; e++) {
         float *n = &h->nrm[3 * h->elem_node[e]];
@@ -515,6 +751,30 @@ void iv_hier_update(iv_hier *h, const gi_scene *s, float t)
         }
         h->area[i] = (float)a;
     }
+}
+
+void iv_hier_edge_stats(const iv_hier *h, const gi_scene *s, double *mean, double *cv)
+{
+    double sum = 0.0, sum2 = 0.0;
+    size_t n = 0;
+    for (uint32_t t = 0; t < h->surf_count; t++) {
+        gi_vec3 p[3];
+        for (int c = 0; c < 3; c++) {
+            uint32_t si = h->surf_tri[3 * t + c];
+            float m[16];
+            gi_scene_object_transform(s, s->vertices[s->indices[3 * h->samp_tri[si]]].object, 0.0f, m);
+            p[c] = gi_mat4_point(m, gi_v3_load(&h->rest[3 * si]));
+        }
+        for (int c = 0; c < 3; c++) {
+            double e = gi_v3_length(gi_v3_sub(p[(c + 1) % 3], p[c]));
+            sum += e;
+            sum2 += e * e;
+            n++;
+        }
+    }
+    double mu = n ? sum / (double)n : 0.0, var = n ? sum2 / (double)n - mu * mu : 0.0;
+    *mean = mu;
+    *cv = mu > 0.0 ? sqrt(var > 0.0 ? var : 0.0) / mu : 0.0;
 }
 
 /* ---------------------------------------------------------- links (4.2) */
@@ -676,12 +936,14 @@ static int coplanar(const iv_hier *h, uint32_t A, uint32_t B, gi_vec3 d, float r
     return fabsf(ca) < 0.01f && fabsf(cb) < 0.01f;
 }
 
-/* Sec. 4.2.2: link A and B, or their children where one looks bigger than
- * a bin from the other. */
-static void link_pair(link_ctx *c, uint32_t A, uint32_t B)
+/* What Sec. 4.2.2 does with the pair (A, B): nothing, link them, or try
+ * B's children, or A's. Depends on the geometry only, never on the links
+ * made so far, so pairs can be enumerated in any order or in parallel. */
+enum { PAIR_NONE, PAIR_LINK, PAIR_SPLIT_B, PAIR_SPLIT_A };
+
+static int pair_decide(const iv_links *l, const iv_hier *h, float subdiv, uint32_t A, uint32_t B, gi_vec3 *dout,
+                       float *r2out)
 {
-    const iv_hier *h = c->h;
-    c->l->tries++;
     gi_vec3 d = gi_v3_sub(gi_v3_load(&h->pos[3 * B]), gi_v3_load(&h->pos[3 * A]));
     float r2 = gi_v3_dot(d, d);
     int leafA = iv_is_leaf(h, A), leafB = iv_is_leaf(h, B);
@@ -690,12 +952,12 @@ static void link_pair(link_ctx *c, uint32_t A, uint32_t B)
         needA = !leafA;
         needB = !leafB;
         if (!needA && !needB)
-            return; /* two discs at one point: no direction to bin them in */
+            return PAIR_NONE; /* two discs at one point: no direction to bin them in */
     } else {
         if (coplanar(h, A, B, d, r2))
-            return;
-        float oa = c->subdiv * c->l->bin_omega[iv_bin_of(gi_v3_scale(d, -1.0f), c->l->n)];
-        float ob = c->subdiv * c->l->bin_omega[iv_bin_of(d, c->l->n)];
+            return PAIR_NONE;
+        float oa = subdiv * l->bin_omega[iv_bin_of(gi_v3_scale(d, -1.0f), l->n)];
+        float ob = subdiv * l->bin_omega[iv_bin_of(d, l->n)];
         needB = !leafB && h->area[B] / r2 > ob;
         needA = !leafA && h->area[A] / r2 > oa;
     }
@@ -705,14 +967,33 @@ static void link_pair(link_ctx *c, uint32_t A, uint32_t B)
         else
             needA = 0;
     }
-    if (needB) {
+    *dout = d;
+    *r2out = r2;
+    return needB ? PAIR_SPLIT_B : (needA ? PAIR_SPLIT_A : PAIR_LINK);
+}
+
+/* Sec. 4.2.2: link A and B, or their children where one looks bigger than
+ * a bin from the other. */
+static void link_pair(link_ctx *c, uint32_t A, uint32_t B)
+{
+    const iv_hier *h = c->h;
+    c->l->tries++;
+    gi_vec3 d;
+    float r2;
+    switch (pair_decide(c->l, h, c->subdiv, A, B, &d, &r2)) {
+    case PAIR_SPLIT_B:
         for (uint32_t k = 0; k < h->child_count[B]; k++)
             link_pair(c, A, h->first_child[B] + k);
-    } else if (needA) {
+        break;
+    case PAIR_SPLIT_A:
         for (uint32_t k = 0; k < h->child_count[A]; k++)
             link_pair(c, h->first_child[A] + k, B);
-    } else {
+        break;
+    case PAIR_LINK:
         insert(c->l, h, A, B, d, sqrtf(r2), c->splat);
+        break;
+    default:
+        break;
     }
 }
 
@@ -728,7 +1009,271 @@ static void link_self(link_ctx *c, uint32_t A)
             link_pair(c, f + i, f + j);
 }
 
-void iv_links_build(iv_links *l, const iv_hier *h, float subdiv, int brute, int splat)
+/* ---- link creation on several threads (README "Multi-threaded link creation") ----
+ * 1. The recursion of link_self / link_pair is unrolled into an ordered
+ *    list of tasks (calls in the order one thread would make them).
+ * 2. Threads take tasks and list the pairs each task links, in order.
+ * 3. Threads write the links: each owns the receiving nodes x with
+ *    x mod threads = its index, and goes through all pairs in task order,
+ *    writing only its own nodes' sides. Every node's bins see the same
+ *    writes in the same order as on one thread, so the result (shortest
+ *    links, ties, coverage sums) is the same to the bit. */
+
+typedef struct link_task {
+    uint32_t A, B; /* B == UINT32_MAX: link_self(A) */
+    uint32_t *pairs; /* 2 per pair linked, in order */
+    size_t n, cap;
+    uint64_t tries;
+} link_task;
+
+typedef struct link_par {
+    iv_links *l;
+    const iv_hier *h;
+    float subdiv;
+    int splat;
+    link_task *tasks;
+    size_t ntasks;
+    atomic_size_t next;
+    int threads;
+    int fail;
+} link_par;
+
+static int task_push(link_task *t, uint32_t A, uint32_t B)
+{
+    if (t->n == t->cap) {
+        size_t c = t->cap ? 2 * t->cap : 256;
+        uint32_t *p = realloc(t->pairs, c * 2 * sizeof *p);
+        if (!p)
+            return 0;
+        t->pairs = p;
+        t->cap = c;
+    }
+    t->pairs[2 * t->n] = A;
+    t->pairs[2 * t->n + 1] = B;
+    t->n++;
+    return 1;
+}
+
+static int collect_pair(link_par *p, link_task *t, uint32_t A, uint32_t B)
+{
+    const iv_hier *h = p->h;
+    t->tries++;
+    gi_vec3 d;
+    float r2;
+    switch (pair_decide(p->l, h, p->subdiv, A, B, &d, &r2)) {
+    case PAIR_SPLIT_B:
+        for (uint32_t k = 0; k < h->child_count[B]; k++)
+            if (!collect_pair(p, t, A, h->first_child[B] + k))
+                return 0;
+        return 1;
+    case PAIR_SPLIT_A:
+        for (uint32_t k = 0; k < h->child_count[A]; k++)
+            if (!collect_pair(p, t, h->first_child[A] + k, B))
+                return 0;
+        return 1;
+    case PAIR_LINK:
+        return task_push(t, A, B);
+    default:
+        return 1;
+    }
+}
+
+static int collect_self(link_par *p, link_task *t, uint32_t A)
+{
+    const iv_hier *h = p->h;
+    uint32_t f = h->first_child[A], n = h->child_count[A];
+    for (uint32_t i = 0; i < n; i++)
+        if (!collect_self(p, t, f + i))
+            return 0;
+    for (uint32_t i = 0; i < n; i++)
+        for (uint32_t j = i + 1; j < n; j++)
+            if (!collect_pair(p, t, f + i, f + j))
+                return 0;
+    return 1;
+}
+
+/* Replaces every task by the calls it makes (in order) until there are
+ * at least `want` or none can be unrolled; a link found while unrolling
+ * stays a one-pair task. tries counts the calls unrolled. */
+static link_task *unroll_tasks(link_par *p, link_task *tasks, size_t *count, size_t want, uint64_t *tries)
+{
+    const iv_hier *h = p->h;
+    for (int pass = 0; pass < 12 && *count < want; pass++) {
+        size_t n = *count, cap = 0, m = 0;
+        for (size_t i = 0; i < n; i++) {
+            uint32_t A = tasks[i].A, B = tasks[i].B;
+            uint32_t ca = h->child_count[A];
+            cap += B == UINT32_MAX ? ca + (size_t)ca * ca / 2 : 4;
+        }
+        link_task *out = calloc(cap + 1, sizeof *out);
+        if (!out)
+            return tasks;
+        int grew = 0;
+        for (size_t i = 0; i < n; i++) {
+            uint32_t A = tasks[i].A, B = tasks[i].B;
+            if (tasks[i].n > 0) { /* a link found while unrolling: kept as it is */
+                out[m++] = tasks[i];
+                continue;
+            }
+            if (B == UINT32_MAX) {
+                uint32_t f = h->first_child[A], c = h->child_count[A];
+                for (uint32_t k = 0; k < c; k++)
+                    out[m++] = (link_task){.A = f + k, .B = UINT32_MAX};
+                for (uint32_t x = 0; x < c; x++)
+                    for (uint32_t y = x + 1; y < c; y++)
+                        out[m++] = (link_task){.A = f + x, .B = f + y};
+                grew = 1;
+                continue;
+            }
+            (*tries)++;
+            gi_vec3 d;
+            float r2;
+            int what = pair_decide(p->l, h, p->subdiv, A, B, &d, &r2);
+            if (what == PAIR_SPLIT_B) {
+                for (uint32_t k = 0; k < h->child_count[B]; k++)
+                    out[m++] = (link_task){.A = A, .B = h->first_child[B] + k};
+                grew = 1;
+            } else if (what == PAIR_SPLIT_A) {
+                for (uint32_t k = 0; k < h->child_count[A]; k++)
+                    out[m++] = (link_task){.A = h->first_child[A] + k, .B = B};
+                grew = 1;
+            } else if (what == PAIR_LINK) {
+                out[m] = (link_task){.A = A, .B = B};
+                if (!task_push(&out[m], A, B)) {
+                    free(out);
+                    return tasks;
+                }
+                m++;
+            }
+        }
+        free(tasks);
+        tasks = out;
+        *count = m;
+        if (!grew)
+            break;
+    }
+    return tasks;
+}
+
+static void *collect_worker(void *arg)
+{
+    link_par *p = arg;
+    for (;;) {
+        size_t i = atomic_fetch_add(&p->next, 1);
+        if (i >= p->ntasks)
+            break;
+        link_task *t = &p->tasks[i];
+        if (t->n > 0)
+            continue; /* a link found while unrolling */
+        int ok = t->B == UINT32_MAX ? collect_self(p, t, t->A) : collect_pair(p, t, t->A, t->B);
+        if (!ok)
+            p->fail = 1;
+    }
+    return NULL;
+}
+
+typedef struct write_arg {
+    link_par *p;
+    uint32_t index;
+    uint64_t created;
+} write_arg;
+
+static void *write_worker(void *arg)
+{
+    write_arg *w = arg;
+    link_par *p = w->p;
+    const iv_hier *h = p->h;
+    uint32_t T = (uint32_t)p->threads, me = w->index;
+    /* a private copy of the counters: `created` is summed afterwards */
+    iv_links mine = *p->l;
+    mine.created = 0;
+    for (uint32_t x = me; x < p->l->nodes; x += T) { /* its nodes' bins emptied */
+        size_t base = (size_t)x * p->l->bins;
+        for (uint32_t b = 0; b < p->l->bins; b++) {
+            p->l->other[base + b] = -1;
+            p->l->dist[base + b] = FLT_MAX;
+            p->l->cover[base + b] = 0.0f;
+        }
+    }
+    for (size_t i = 0; i < p->ntasks; i++) {
+        const link_task *t = &p->tasks[i];
+        for (size_t k = 0; k < t->n; k++) {
+            uint32_t A = t->pairs[2 * k], B = t->pairs[2 * k + 1];
+            int a = A % T == me, b = B % T == me;
+            if (!a && !b)
+                continue;
+            gi_vec3 d = gi_v3_sub(gi_v3_load(&h->pos[3 * B]), gi_v3_load(&h->pos[3 * A]));
+            float r = sqrtf(gi_v3_dot(d, d));
+            if (a)
+                put_side(&mine, h, A, B, d, r, p->splat);
+            if (b)
+                put_side(&mine, h, B, A, gi_v3_scale(d, -1.0f), r, p->splat);
+        }
+    }
+    w->created = mine.created;
+    return NULL;
+}
+
+/* The hierarchical links on `threads` threads; 0 when it could not (out
+ * of memory, no thread), and the caller builds them on one. */
+static int build_parallel(iv_links *l, const iv_hier *h, float subdiv, int splat, int threads)
+{
+    link_par p = {.l = l, .h = h, .subdiv = subdiv, .splat = splat, .threads = threads};
+    size_t n = h->root_count + (size_t)h->root_count * (h->root_count - 1) / 2;
+    link_task *tasks = calloc(n + 1, sizeof *tasks);
+    if (!tasks)
+        return 0;
+    size_t m = 0;
+    for (uint32_t i = 0; i < h->root_count; i++)
+        tasks[m++] = (link_task){.A = i, .B = UINT32_MAX};
+    for (uint32_t i = 0; i < h->root_count; i++)
+        for (uint32_t j = i + 1; j < h->root_count; j++)
+            tasks[m++] = (link_task){.A = i, .B = j};
+    uint64_t tries = 0;
+    tasks = unroll_tasks(&p, tasks, &m, (size_t)64 * (size_t)threads, &tries);
+    p.tasks = tasks;
+    p.ntasks = m;
+    atomic_init(&p.next, 0);
+    pthread_t *tid = malloc((size_t)threads * sizeof *tid);
+    uint8_t *made = calloc((size_t)threads, 1);
+    write_arg *wa = calloc((size_t)threads, sizeof *wa);
+    int ok = tid && made && wa;
+    if (ok) {
+        /* this thread works too; a thread that cannot start is not needed */
+        for (int i = 1; i < threads; i++)
+            made[i] = pthread_create(&tid[i], NULL, collect_worker, &p) == 0;
+        collect_worker(&p);
+        for (int i = 1; i < threads; i++)
+            if (made[i])
+                pthread_join(tid[i], NULL);
+        ok = !p.fail;
+    }
+    if (ok) {
+        for (size_t i = 0; i < m; i++)
+            tries += tasks[i].tries;
+        /* each writer owns its nodes: one that cannot start runs here afterwards */
+        for (int i = 0; i < threads; i++)
+            wa[i] = (write_arg){.p = &p, .index = (uint32_t)i};
+        for (int i = 1; i < threads; i++)
+            made[i] = pthread_create(&tid[i], NULL, write_worker, &wa[i]) == 0;
+        write_worker(&wa[0]);
+        for (int i = 1; i < threads; i++) {
+            if (made[i])
+                pthread_join(tid[i], NULL);
+            else
+                write_worker(&wa[i]);
+        }
+        for (int i = 0; i < threads; i++)
+            l->created += wa[i].created;
+        l->tries = tries;
+    }
+    for (size_t i = 0; i < m; i++)
+        free(tasks[i].pairs);
+    free(tasks), free(tid), free(made), free(wa);
+    return ok;
+}
+
+static void links_clear(iv_links *l)
 {
     size_t cells = (size_t)l->bins * l->nodes;
     for (size_t i = 0; i < cells; i++) {
@@ -737,7 +1282,12 @@ void iv_links_build(iv_links *l, const iv_hier *h, float subdiv, int brute, int 
         l->cover[i] = 0.0f;
     }
     l->tries = l->created = 0;
+}
+
+void iv_links_build(iv_links *l, const iv_hier *h, float subdiv, int brute, int splat)
+{
     if (brute) {
+        links_clear(l);
         for (uint32_t i = 0; i < h->elem_count; i++)
             for (uint32_t j = i + 1; j < h->elem_count; j++) {
                 uint32_t A = h->elem_node[i], B = h->elem_node[j];
@@ -749,6 +1299,10 @@ void iv_links_build(iv_links *l, const iv_hier *h, float subdiv, int brute, int 
             }
         return;
     }
+    l->tries = l->created = 0;
+    if (l->threads > 1 && build_parallel(l, h, subdiv, splat, (int)l->threads))
+        return; /* the writers emptied their nodes' bins first */
+    links_clear(l); /* one thread (or the parallel build could not run) */
     link_ctx c = {l, h, subdiv, splat};
     for (uint32_t i = 0; i < h->root_count; i++)
         link_self(&c, i);

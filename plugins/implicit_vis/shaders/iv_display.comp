@@ -1,7 +1,10 @@
 // Display (Sec. 4.3.1 "For final display"): the elements' irradiance,
 // interpolated across each visible triangle from its three vertices, or
-// with re-meshing from the three points of the sub-triangle the pixel lies
-// in (barycentric coordinates of the pixel's world position), on the side of
+// with re-meshing from the three points of the triangle's k x k display
+// grid around the pixel (barycentric coordinates of the pixel's world
+// position), each grid point a blend of three elements (with the grid
+// re-meshing the point's own element; isotropic: the corners of the
+// re-meshed triangle it lies on), on the side of
 // the disc the pixel's surface faces, times the pixel's albedo / pi, plus
 // the emission seen directly.
 #include "common.glsl"
@@ -13,7 +16,11 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(std430, binding = IV_SSBO_ELEM_LIGHT) readonly buffer IvLight { IvElemLight iv_light[]; };
 layout(std430, binding = IV_SSBO_TRI) readonly buffer IvTri { uvec2 iv_tri[]; };   // k, first grid point
-layout(std430, binding = IV_SSBO_GRID) readonly buffer IvGrid { uint iv_grid[]; }; // grid point -> element
+struct IvDisp {
+    uvec4 elem; // three elements
+    vec4 w;     // their weights
+};
+layout(std430, binding = IV_SSBO_GRID) readonly buffer IvGrid { IvDisp iv_grid[]; }; // grid point
 layout(rgba32f, binding = GI_IMAGE_TARGET) uniform writeonly image2D u_target;
 
 uniform ivec2 u_size;
@@ -68,14 +75,17 @@ void main()
             }
             w = clamp(w, 0.0, 1.0);
             w /= max(w.x + w.y + w.z, 1e-12);
-            uint i0 = iv_grid[base + gi3.x], i1 = iv_grid[base + gi3.y], i2 = iv_grid[base + gi3.z];
-            bc = w;
-            vec3 n = bc.x * iv_light[i0].normal.xyz + bc.y * iv_light[i1].normal.xyz + bc.z * iv_light[i2].normal.xyz;
+            uvec3 g = uvec3(base) + gi3;
+            vec3 n = vec3(0.0);
+            for (int a = 0; a < 3; a++)
+                for (int c = 0; c < 3; c++)
+                    n += w[a] * iv_grid[g[a]].w[c] * iv_light[iv_grid[g[a]].elem[c]].normal.xyz;
             bool front = dot(n, s.normal) >= 0.0;
-            vec3 e0 = front ? iv_light[i0].e_front.rgb : iv_light[i0].e_back.rgb;
-            vec3 e1 = front ? iv_light[i1].e_front.rgb : iv_light[i1].e_back.rgb;
-            vec3 e2 = front ? iv_light[i2].e_front.rgb : iv_light[i2].e_back.rgb;
-            E = bc.x * e0 + bc.y * e1 + bc.z * e2;
+            for (int a = 0; a < 3; a++)
+                for (int c = 0; c < 3; c++) {
+                    uint e = iv_grid[g[a]].elem[c];
+                    E += w[a] * iv_grid[g[a]].w[c] * (front ? iv_light[e].e_front.rgb : iv_light[e].e_back.rgb);
+                }
         }
         L = s.emission + s.brdf.kd * GI_INV_PI * E;
     }

@@ -30,8 +30,17 @@
  *   iv_tests gpu        the GPU gather and pull-up (iv_gpu.c, Sec. 4.3.1)
  *                       against iv_illuminate on the same links: Cornell
  *                       box, furnace, environment, punctual lights, the
- *                       coverage modes; and the furnace through the GPU. */
+ *                       coverage modes; and the furnace through the GPU;
+ *   iv_tests remesh     isotropic re-meshing (gi/remesh.h, CGAL): every new
+ *                       vertex on its embedding, triangle count and edge-
+ *                       length spread before and after, the hierarchy and
+ *                       the display grid of the re-meshed Cornell boxes;
+ *   iv_tests threads    the links built on 2-4 threads are those built on
+ *                       one, to the bit; create_links on 1 and 2 threads
+ *                       timed side by side. */
+#define _POSIX_C_SOURCE 200809L
 #include "iv.h"
+#include "gi/remesh.h"
 #include "iv_gpu.h"
 
 #include "gi/gpu.h"
@@ -46,6 +55,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
+#include <unistd.h>
 
 #include "check.h"
 #define EXPECT CHECK_MSG
@@ -142,7 +153,7 @@ static void test_bins(void)
 
 /* ----------------------------------------------------------- hierarchy */
 
-static void check_hierarchy(const iv_hier *h, const gi_scene *s, float t, const char *what)
+static void check_hierarchy(const iv_hier *h, const gi_scene *s, float t, const char *what, double area_tol)
 {
     uint32_t *seen = calloc(h->elem_count, sizeof *seen);
     int bad_area = 0, bad_pos = 0, bad_tree = 0;
@@ -181,7 +192,7 @@ static void check_hierarchy(const iv_hier *h, const gi_scene *s, float t, const 
     for (uint32_t i = 0; i < s->triangle_count; i++)
         tris += ta[i];
     free(ta);
-    EXPECT(fabs(roots - tris) <= 1e-4 * tris, "%s: roots' area %.6g, scene surface %.6g", what, roots, tris);
+    EXPECT(fabs(roots - tris) <= area_tol * tris, "%s: roots' area %.6g, scene surface %.6g", what, roots, tris);
     /* leaves sit on their model vertex, placed at t */
     int bad_leaf = 0;
     for (uint32_t e = 0; e < h->elem_count; e++) {
@@ -206,7 +217,7 @@ static void test_hierarchy(void)
         if (!s)
             continue;
         gi_error err;
-        iv_hier *h = iv_hier_create(s, 0.0f, &err);
+        iv_hier *h = iv_hier_create(s, 0.0f, IV_REMESH_GRID, &err);
         EXPECT(h != NULL, "%s: %s", scenes[k], err.text);
         if (h) {
             float ts[2] = {0.0f, s->animation_length > 0.0f ? 0.6f * s->animation_length : 0.0f};
@@ -214,7 +225,7 @@ static void test_hierarchy(void)
                 iv_hier_update(h, s, ts[i]);
                 char what[600];
                 snprintf(what, sizeof what, "%s t=%.2f", strrchr(scenes[k], '/') + 1, ts[i]);
-                check_hierarchy(h, s, ts[i], what);
+                check_hierarchy(h, s, ts[i], what, 1e-4);
             }
         }
         iv_hier_free(h);
@@ -230,7 +241,7 @@ static void test_links(void)
     if (!s)
         return;
     gi_error err;
-    iv_hier *h = iv_hier_create(s, 0.0f, &err);
+    iv_hier *h = iv_hier_create(s, 0.0f, IV_REMESH_GRID, &err);
     EXPECT(h != NULL, "%s", err.text);
     if (!h) {
         gi_scene_free(s);
@@ -322,7 +333,7 @@ static int furnace_means(const char *path, uint32_t N, double mean[4], double *r
     if (!s)
         return 0;
     gi_error err;
-    iv_hier *h = iv_hier_create(s, 0.0f, &err);
+    iv_hier *h = iv_hier_create(s, 0.0f, IV_REMESH_GRID, &err);
     EXPECT(h != NULL, "%s: %s", path, err.text);
     if (h) {
         iv_hier_update(h, s, 0.0f);
@@ -399,6 +410,9 @@ typedef struct frame {
     float *E;
 } frame;
 
+/* How frame_run re-meshes (IV_REMESH_*). */
+static int g_remesher = IV_REMESH_GRID;
+
 static int frame_run(frame *f, const char *path, float edge, uint32_t N, uint32_t bounces, int brute, int splat)
 {
     memset(f, 0, sizeof *f);
@@ -406,7 +420,7 @@ static int frame_run(frame *f, const char *path, float edge, uint32_t N, uint32_
     if (!f->s)
         return 0;
     gi_error err;
-    f->h = iv_hier_create(f->s, edge, &err);
+    f->h = iv_hier_create(f->s, edge, g_remesher, &err);
     EXPECT(f->h != NULL, "%s", err.text);
     if (!f->h)
         return 0;
@@ -643,9 +657,10 @@ static double leak_case(float edge, uint32_t N, int splat, uint32_t *discs)
         through += a * fmax(0.0, fmin(m, un) - sh);
     }
     leaked = blocked > 0.0 ? through / blocked : 0.0;
-    printf("teapot_plane, N = %u, splat %d, re-mesh edge %.3g: %u shadowed ground discs near the teapot (%u discs in all); "
+    printf("teapot_plane, N = %u, splat %d, re-mesh edge %.3g (%s): %u shadowed ground discs near the teapot (%u discs in all); "
            "the method lets through %.1f %% of the irradiance the teapot blocks\n",
-           N, splat, (double)edge, n, h->elem_count, 100.0 * leaked);
+           N, splat, (double)edge, g_remesher == IV_REMESH_GRID ? "grid" : "isotropic", n, h->elem_count,
+           100.0 * leaked);
     *discs = n;
     gi_rt_free(rt);
     frame_free(&f);
@@ -654,9 +669,16 @@ static double leak_case(float edge, uint32_t N, int splat, uint32_t *discs)
 
 static void test_leak(void)
 {
-    uint32_t n0 = 0, n1 = 0, n2 = 0, n3 = 0;
+    uint32_t n0 = 0, n1 = 0, n2 = 0, n3 = 0, n4 = 0;
     double literal = leak_case(0.0f, 12, 0, &n2);
     double literal_fine = leak_case(0.08f, 12, 0, &n3);
+    /* the same with CGAL's isotropic re-meshing (the paper's preprocessing) */
+    g_remesher = IV_REMESH_ISOTROPIC;
+    double literal_iso = leak_case(0.08f, 12, 0, &n4);
+    g_remesher = IV_REMESH_GRID;
+    EXPECT(n4 >= 50, "too few shadowed ground discs with isotropic re-meshing (%u)", n4);
+    EXPECT(literal_iso < 0.5 * literal, "without splatting, isotropic re-meshing leaks %.3f, the model %.3f",
+           literal_iso, literal);
     double coarse = leak_case(0.0f, 12, 1, &n0);
     double fine = leak_case(0.08f, 12, 1, &n1);
     EXPECT(n0 >= 50 && n1 >= 50 && n2 >= 50 && n3 >= 50, "too few shadowed ground discs (%u, %u, %u, %u)", n0, n1, n2,
@@ -666,6 +688,238 @@ static void test_leak(void)
            literal);
     /* splatting near discs closes the leak (measured 0.8 % and 0.3 %) */
     EXPECT(coarse <= 0.05 && fine <= 0.05, "with splatting the teapot lets %.3f / %.3f through", coarse, fine);
+}
+
+
+/* ------------------------------------------------------------ re-meshing */
+
+/* The surface the elements span: triangles, elements, edge length mean
+ * and spread (coefficient of variation). */
+static void edge_line(const char *what, const iv_hier *h, const gi_scene *s, double *mean, double *cv)
+{
+    iv_hier_edge_stats(h, s, mean, cv);
+    printf("%-34s %7u triangles, %6u elements, edge mean %.4f, spread (sd / mean) %.3f\n", what, h->surf_count,
+           h->elem_count, *mean, *cv);
+}
+
+static void test_remesh(void)
+{
+    gi_error err;
+    /* 1. gi_remesh_isotropic on the 792-vertex teapot alone: every new
+     * vertex lies where its embedding (original triangle, barycentric
+     * weights) puts it; bad input is refused with a message */
+    gi_scene *s = load(GI_SOURCE_DIR "/scenes/teapot_plane.glb");
+    if (!s)
+        return;
+    uint32_t obj = s->vertices[s->indices[0]].object;
+    const gi_object *o = &s->objects[obj];
+    float *p = malloc((size_t)o->vertex_count * 3 * sizeof(float));
+    uint32_t *ix = malloc((size_t)o->triangle_count * 3 * sizeof(uint32_t));
+    for (uint32_t v = 0; v < o->vertex_count; v++)
+        memcpy(&p[3 * v], s->vertices[o->first_vertex + v].position, 3 * sizeof(float));
+    for (uint32_t t = 0; t < 3 * o->triangle_count; t++)
+        ix[t] = s->indices[3 * (size_t)o->first_triangle + t] - o->first_vertex;
+    float mn[3] = {1e30f, 1e30f, 1e30f}, mx[3] = {-1e30f, -1e30f, -1e30f};
+    for (uint32_t v = 0; v < 3 * o->vertex_count; v++) {
+        mn[v % 3] = fminf(mn[v % 3], p[v]);
+        mx[v % 3] = fmaxf(mx[v % 3], p[v]);
+    }
+    float ext = fmaxf(mx[0] - mn[0], fmaxf(mx[1] - mn[1], mx[2] - mn[2]));
+    gi_remeshed *r = gi_remesh_isotropic(p, o->vertex_count, ix, o->triangle_count, 0.02f * ext, 3, &err);
+    EXPECT(r != NULL, "teapot: %s", err.text);
+    if (r) {
+        int bad = 0;
+        for (uint32_t v = 0; v < r->vertex_count; v++) {
+            const float *w = &r->bary[3 * v];
+            const uint32_t *c = &ix[3 * r->face[v]];
+            bad += !(w[0] >= 0.0f && w[1] >= 0.0f && w[2] >= 0.0f && fabsf(w[0] + w[1] + w[2] - 1.0f) < 1e-4f);
+            double d2 = 0.0;
+            for (int k = 0; k < 3; k++) {
+                double q = w[0] * p[3 * c[0] + k] + w[1] * p[3 * c[1] + k] + w[2] * p[3 * c[2] + k];
+                d2 += (q - r->positions[3 * v + k]) * (q - r->positions[3 * v + k]);
+            }
+            bad += sqrt(d2) > 1e-4 * ext;
+        }
+        printf("teapot alone: %u triangles -> %u (edge 0.02 x its size), %u vertices, %d off their embedding\n",
+               o->triangle_count, r->triangle_count, r->vertex_count, bad);
+        EXPECT(bad == 0, "teapot: %d re-meshed vertices off their embedding", bad);
+        EXPECT(r->triangle_count > 4 * o->triangle_count, "teapot: only %u triangles after re-meshing",
+               r->triangle_count);
+        gi_remeshed_free(r);
+    }
+    ix[5] = o->vertex_count + 7;
+    gi_error e2 = {{0}};
+    EXPECT(gi_remesh_isotropic(p, o->vertex_count, ix, o->triangle_count, 0.02f * ext, 3, &e2) == NULL &&
+               strstr(e2.text, "out of range"),
+           "an index out of range is not refused: '%s'", e2.text);
+    EXPECT(gi_remesh_isotropic(p, o->vertex_count, ix, o->triangle_count, 0.0f, 3, &e2) == NULL && e2.text[0],
+           "a zero target edge is not refused");
+    free(p), free(ix);
+
+    /* 2. triangle count and edge-length spread before and after, the
+     * teapot on its ground plane at edge 0.08: isotropic re-meshing evens
+     * the edges out (spread below half the model's and below the grid's),
+     * its mean edge near the target */
+    double m0, c0, mg, cg, mi, ci;
+    iv_hier *h0 = iv_hier_create(s, 0.0f, IV_REMESH_GRID, &err);
+    iv_hier *hg = iv_hier_create(s, 0.08f, IV_REMESH_GRID, &err);
+    iv_hier *hi = iv_hier_create(s, 0.08f, IV_REMESH_ISOTROPIC, &err);
+    EXPECT(h0 && hg && hi, "teapot_plane: %s", err.text);
+    if (h0 && hg && hi) {
+        edge_line("teapot_plane as it is:", h0, s, &m0, &c0);
+        edge_line("teapot_plane, grid, edge 0.08:", hg, s, &mg, &cg);
+        edge_line("teapot_plane, isotropic, edge 0.08:", hi, s, &mi, &ci);
+        EXPECT(hi->surf_count > 4 * h0->surf_count, "isotropic: %u triangles from %u", hi->surf_count, h0->surf_count);
+        EXPECT(ci < 0.5 * c0 && ci < cg, "isotropic edge spread %.3f, the model's %.3f, the grid's %.3f", ci, c0, cg);
+        EXPECT(mi > 0.6 * 0.08 && mi < 1.4 * 0.08, "isotropic mean edge %.4f, target 0.08", mi);
+    }
+    iv_hier_free(h0), iv_hier_free(hg), iv_hier_free(hi);
+    /* an edge far too short is refused before CGAL runs, with a message */
+    gi_error e3 = {{0}};
+    iv_hier *tiny = iv_hier_create(s, 1e-5f, IV_REMESH_ISOTROPIC, &e3);
+    EXPECT(tiny == NULL && strstr(e3.text, "raise it"), "edge 1e-5 is not refused: '%s'", e3.text);
+    iv_hier_free(tiny);
+    gi_scene_free(s);
+
+    /* 3. the hierarchy of the re-meshed Cornell boxes (still, moving,
+     * deforming: the embedding carries rigid motion and morph targets),
+     * and the display grid: weights summing to 1, each grid point where
+     * its three elements' blend puts it (flat walls: exactly) */
+    const char *scenes[] = {GI_SOURCE_DIR "/scenes/cornell_box.gltf", GI_SOURCE_DIR "/scenes/cornell_moving.gltf",
+                            GI_SOURCE_DIR "/scenes/cornell_deform.gltf"};
+    for (int k = 0; k < 3; k++) {
+        s = load(scenes[k]);
+        if (!s)
+            continue;
+        iv_hier *h = iv_hier_create(s, 0.3f, IV_REMESH_ISOTROPIC, &err);
+        EXPECT(h != NULL, "%s: %s", scenes[k], err.text);
+        if (h) {
+            double m, c;
+            edge_line(strrchr(scenes[k], '/') + 1, h, s, &m, &c);
+            float ts[2] = {0.0f, s->animation_length > 0.0f ? 0.6f * s->animation_length : 0.0f};
+            for (int i = 0; i < 2; i++) {
+                iv_hier_update(h, s, ts[i]);
+                char what[600];
+                snprintf(what, sizeof what, "%s isotropic t=%.2f", strrchr(scenes[k], '/') + 1, ts[i]);
+                check_hierarchy(h, s, ts[i], what, 1e-2); /* chords of curved parts: about e^2 / 8R */
+            }
+            int bad_w = 0, bad_p = 0;
+            /* flat walls and blocks: exactly; the bunny of cornell_moving,
+             * re-meshed far coarser than its own triangles: within half an
+             * edge (a chord's sagitta) */
+            float worst = 0.0f, tol = k == 1 ? 0.5f * 0.3f : 1e-3f;
+            iv_hier_update(h, s, 0.0f);
+            for (uint32_t t = 0; t < s->triangle_count; t++) {
+                uint32_t kk = h->tri_k[t];
+                gi_vec3 c3[3];
+                gi_scene_triangle_world(s, t, 0.0f, c3);
+                for (uint32_t j = 0; j <= kk; j++)
+                    for (uint32_t i = 0; i + j <= kk; i++) {
+                        uint32_t d = h->tri_grid[t] + iv_grid_index(kk, i, j);
+                        const float *w = &h->disp_w[3 * d];
+                        int bw = !(fabsf(w[0] + w[1] + w[2] - 1.0f) < 1e-4f && w[0] >= 0.0f && w[1] >= 0.0f &&
+                                   w[2] >= 0.0f);
+                        bad_w += bw;
+                        float b1 = (float)i / (float)kk, b2 = (float)j / (float)kk;
+                        gi_vec3 want = gi_v3_add(gi_v3_scale(c3[0], 1.0f - b1 - b2),
+                                                 gi_v3_add(gi_v3_scale(c3[1], b1), gi_v3_scale(c3[2], b2)));
+                        gi_vec3 got = gi_v3(0, 0, 0);
+                        for (int q = 0; q < 3; q++)
+                            got = gi_v3_add(got, gi_v3_scale(gi_v3_load(&h->pos[3 * h->elem_node[h->disp_elem[3 * d + q]]]),
+                                                             w[q]));
+                        float off = gi_v3_length(gi_v3_sub(got, want));
+                        worst = fmaxf(worst, off);
+                        bad_p += off > tol;
+                    }
+            }
+            printf("%s: display grid points at most %.3g off their place\n", strrchr(scenes[k], '/') + 1, (double)worst);
+            EXPECT(bad_w == 0 && bad_p == 0, "%s: display grid: %d bad weights, %d points off their place by more than %g",
+                   scenes[k], bad_w, bad_p, (double)tol);
+        }
+        iv_hier_free(h);
+        gi_scene_free(s);
+    }
+}
+
+/* ------------------------------------------------ links on several threads */
+
+static double wall_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+/* One scene: the links built on 1 thread and on 2, 3 and 4 must be the
+ * same to the bit (every bin's link, distance and coverage, the counters,
+ * the receiving and light links after refinement); then the wall time of
+ * the link creation on 1 and on 2 threads, side by side in this run. */
+static void threads_case(const char *path, float edge, int remesher, uint32_t N, int bilinear, int splat, float t,
+                         int timed)
+{
+    gi_scene *s = load(path);
+    if (!s)
+        return;
+    gi_error err;
+    iv_hier *h = iv_hier_create(s, edge, remesher, &err);
+    EXPECT(h != NULL, "%s: %s", path, err.text);
+    if (!h) {
+        gi_scene_free(s);
+        return;
+    }
+    iv_hier_update(h, s, t);
+    iv_links *one = iv_links_create(h, N), *many = iv_links_create(h, N);
+    EXPECT(one && many, "%s: out of memory for the links", path);
+    if (one && many) {
+        one->bilinear = many->bilinear = bilinear;
+        one->threads = 1;
+        iv_links_build(one, h, 1.0f, 0, splat);
+        iv_links_refine_push(one, h);
+        size_t cells = (size_t)one->bins * one->nodes;
+        for (uint32_t T = 2; T <= 4; T++) {
+            many->threads = T;
+            iv_links_build(many, h, 1.0f, 0, splat);
+            iv_links_refine_push(many, h);
+            int same = !memcmp(one->other, many->other, cells * sizeof *one->other) &&
+                       !memcmp(one->dist, many->dist, cells * sizeof *one->dist) &&
+                       !memcmp(one->cover, many->cover, cells * sizeof *one->cover) && one->tries == many->tries &&
+                       one->created == many->created && one->receiving == many->receiving &&
+                       !memcmp(one->leaf_off, many->leaf_off, ((size_t)h->elem_count + 1) * sizeof *one->leaf_off) &&
+                       !memcmp(one->leaf_src, many->leaf_src, one->receiving * sizeof *one->leaf_src) &&
+                       !memcmp(one->leaf_bin, many->leaf_bin, one->receiving * sizeof *one->leaf_bin) &&
+                       !memcmp(one->light_off, many->light_off, ((size_t)h->elem_count + 1) * sizeof *one->light_off);
+            EXPECT(same, "%s: the links on %u threads differ from those on one (tries %llu / %llu, created %llu / %llu)",
+                   path, T, (unsigned long long)one->tries, (unsigned long long)many->tries,
+                   (unsigned long long)one->created, (unsigned long long)many->created);
+        }
+        /* side by side: best of 3 of each, alternating */
+        double best[2] = {1e30, 1e30};
+        for (int rep = 0; rep < (timed ? 3 : 0); rep++)
+            for (int k = 0; k < 2; k++) {
+                many->threads = k ? 2 : 1;
+                double t0 = wall_ms();
+                iv_links_build(many, h, 1.0f, 0, splat);
+                double dt = wall_ms() - t0;
+                best[k] = dt < best[k] ? dt : best[k];
+            }
+        printf("%s (N = %u, %u elements, %llu link tries, %llu bin writes): identical on 1-4 threads\n",
+               strrchr(path, '/') + 1, N, h->elem_count, (unsigned long long)one->tries,
+               (unsigned long long)one->created);
+        if (timed)
+            printf("  create_links, best of 3, wall: %.1f ms on 1 thread, %.1f ms on 2 (%.2fx; %ld cores online)\n",
+                   best[0], best[1], best[0] / best[1], sysconf(_SC_NPROCESSORS_ONLN));
+    }
+    iv_links_free(one), iv_links_free(many);
+    iv_hier_free(h);
+    gi_scene_free(s);
+}
+
+static void test_threads(void)
+{
+    threads_case(GI_SOURCE_DIR "/scenes/cornell_box_coarse.gltf", 0.0f, IV_REMESH_GRID, 12, 0, 1, 0.0f, 0);
+    threads_case(GI_SOURCE_DIR "/scenes/cornell_deform.gltf", 0.0f, IV_REMESH_GRID, 8, 1, 1, 1.5f, 0);
+    threads_case(GI_SOURCE_DIR "/scenes/teapot_area.glb", 0.3f, IV_REMESH_ISOTROPIC, 12, 0, 1, 0.0f, 0);
+    threads_case(GI_SOURCE_DIR "/scenes/teapot_plane.glb", 0.0f, IV_REMESH_GRID, 12, 0, 0, 0.0f, 1);
 }
 
 /* ------------------------------------------------ GPU against the CPU */
@@ -758,6 +1012,10 @@ int main(int argc, char **argv)
         test_leak(), known = 1;
     if (all || !strcmp(part, "brute"))
         test_brute(), known = 1;
+    if (all || !strcmp(part, "threads"))
+        test_threads(), known = 1;
+    if (all || !strcmp(part, "remesh"))
+        test_remesh(), known = 1;
     if (all || !strcmp(part, "gpu"))
         test_gpu(), known = 1;
     if (!known) {
