@@ -118,14 +118,15 @@ typedef struct cssm_maps {
  * world space (the static scene). */
 typedef struct cssm_build_opts {
     uint32_t only_object;            /* k + 1: object k alone */
-    uint32_t skip_object;            /* k + 1: every object but k */
+    const unsigned char *skip_objects; /* per object, 1: not drawn (with only_object 0); NULL: none */
     int local;                       /* 1: object-local geometry (with only_object) */
     const float *eye_from_world;     /* maps the texels' eyes (world) into the maps' space; NULL: identity */
     const unsigned char *dont_care;  /* per texel, 1: a map of "don't care" only (not queried, no segments) */
 } cssm_build_opts;
 
-/* Renders (core depth renderer: world space, every object, radial depth,
- * two surfaces) the depth cube map of every texel in order `order`
+/* Renders (the core's precomputation loop gi/csm_precompute.h with its
+ * depth renderer: world space, every object, radial depth, two surfaces)
+ * the depth cube map of every texel in order `order`
  * (§3.2.1: near plane 1e-3 of the diameter, far plane the diameter,
  * texels whose cone lies wholly in the negative half-space of the texel's
  * normal "don't care") and streams them into six codecs. host may be NULL;

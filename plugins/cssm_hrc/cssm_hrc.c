@@ -508,7 +508,7 @@ static gi_result build_moving(cssm_hrc *c, const gi_gpu_scene *gs, int32_t A, gi
     gi_result r = cssm_motion_init(gs->scene, gs->time, &c->atlas, A, &c->motion, err);
     if (r != GI_OK)
         return r;
-    cssm_build_opts o = {.skip_object = (uint32_t)A + 1u, .dont_care = c->motion.on_moving};
+    cssm_build_opts o = {.skip_objects = c->motion.object_moves, .dont_care = c->motion.on_moving};
     r = cssm_maps_build_ex(gs, &c->atlas, c->order, (uint32_t)c->M, &o, host, &c->maps, err);
     if (r == GI_OK)
         r = cssm_motion_build_maps(&c->motion, gs, &c->atlas, c->order, (uint32_t)c->M, host, err);

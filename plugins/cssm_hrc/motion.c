@@ -35,6 +35,7 @@ void cssm_motion_free(cssm_motion *m)
     free(m->local_n);
     free(m->local_charts);
     free(m->object_of);
+    free(m->object_moves);
     free(m->obj_first);
     free(m->obj_texels);
     cssm_maps_free(&m->self);
@@ -66,11 +67,12 @@ gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, int3
     out->local_n = calloc(N, sizeof *out->local_n);
     out->local_charts = calloc(a->chart_count ? a->chart_count : 1, sizeof *out->local_charts);
     out->object_of = calloc(N, sizeof *out->object_of);
+    out->object_moves = calloc(O ? O : 1, 1);
     out->obj_first = calloc(O + 1, sizeof *out->obj_first);
     out->obj_texels = calloc(N ? N : 1, sizeof *out->obj_texels);
     out->hulls = calloc(O, sizeof *out->hulls);
     if (!out->on_moving || !out->on_static || !out->local_p || !out->local_n ||
-        !out->local_charts || !out->object_of || !out->obj_first || !out->obj_texels ||
+        !out->local_charts || !out->object_of || !out->object_moves || !out->obj_first || !out->obj_texels ||
         !out->hulls) {
         cssm_motion_free(out);
         snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for the moving object");
@@ -85,6 +87,7 @@ gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, int3
                  s->objects[moving].name ? s->objects[moving].name : "?");
         return GI_ERR_INVALID_ARGUMENT;
     }
+    out->object_moves[moving] = 1;
     memcpy(out->T, T0, sizeof out->T);
     memcpy(out->Tinv, out->T0inv, sizeof out->Tinv);
     out->scale = transform_scale(T0);

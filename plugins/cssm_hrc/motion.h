@@ -43,6 +43,7 @@ typedef struct cssm_motion {
     gi_vec3 *local_p, *local_n; /* per texel: position and normal in A's frame (A's texels) */
     cssm_chart *local_charts;   /* the atlas' charts in A's frame (A's charts) */
     uint32_t *object_of;        /* per texel: its object */
+    unsigned char *object_moves; /* per object: 1 for A (what the static CSSM does not draw) */
     uint32_t *obj_first,
         *obj_texels;       /* texels of object k: obj_texels[obj_first[k] .. obj_first[k + 1]) */
     cssm_maps self;        /* A's CSSM, A's frame */

@@ -517,7 +517,7 @@ static int part_motion(void)
         return 1;
     }
     uint32_t *order = cssm_traverse(&a, CSSM_SPIRAL);
-    cssm_build_opts so = {.skip_object = (uint32_t)A + 1u, .dont_care = mo.on_moving};
+    cssm_build_opts so = {.skip_objects = mo.object_moves, .dont_care = mo.on_moving};
     if (!order || cssm_maps_build_ex(gs, &a, order, 32, &so, NULL, &m, &err) != GI_OK ||
         cssm_motion_build_maps(&mo, gs, &a, order, 32, NULL, &err) != GI_OK) {
         fprintf(stderr, "FAIL: %s\n", order ? err.text : "traverse");
