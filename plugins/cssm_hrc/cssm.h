@@ -13,8 +13,8 @@
  *    oracle and a maximum cut size (§4.3, Fig. 10), pull, and the final
  *    gather per receiver point with a Phong bound (§4.4), jitter (§4.5) and
  *    clamping (hrc.c).
- * One moving rigid object (§3.3) is handled in motion.c: the maps of this
- * file then see the static objects only (cssm_build_opts), and the moving
+ * Moving rigid objects (§3.3) are handled in motion.c: the maps of this
+ * file then see the static objects only (cssm_build_opts), and each moving
  * object has its own CSSM and CSM in its frame. */
 #ifndef CSSM_H
 #define CSSM_H
@@ -193,7 +193,7 @@ typedef struct cssm_receiver {
     gi_vec3 x, n;
     int32_t self;        /* receiver texel (skipped), -1 for a pixel */
     uint32_t proxy1;     /* moving-object mode, a pixel: 1 + a texel on its triangle (0: none) */
-    int moving;          /* moving-object mode, a pixel: it lies on the moving object */
+    uint32_t moving;     /* moving-object mode, a pixel: 1 + the mover it lies on, 0 on a static object */
     int glossy;          /* use ks, exponent, wo */
     float kd[3], ks[3], exponent;
     gi_vec3 wo;
