@@ -36,7 +36,7 @@ typedef enum cssm_traversal { CSSM_GREEDY = 0, CSSM_ZIGZAG = 1, CSSM_SPIRAL = 2 
 typedef struct cssm_texel {
     gi_vec3 p, n;       /* world position and (geometric) unit normal */
     float area;         /* world area this texel stands for */
-    float albedo[3];    /* Lambert albedo of the material (textures not applied) */
+    float albedo[3];    /* Lambert albedo: the material's factor x its texture at the texel centre */
     float emission[3];  /* emitted radiance (front face) */
     float ks[3], exponent; /* Phong lobe of the material (view-dependent lightmap mode) */
     int32_t chart;      /* chart index, -1 for a surface sample without parametrisation */
@@ -79,6 +79,10 @@ typedef struct cssm_atlas {
 gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_only, cssm_atlas *out,
                            gi_error *err);
 void cssm_atlas_free(cssm_atlas *a);
+/* Reads texel x's material from triangle tri (world corners p, x->p on
+ * it): albedo factor x albedo texture at x->p (the mesh uvs interpolated,
+ * gi_scene_albedo), emission, Phong lobe. */
+void cssm_texel_material(const gi_scene *s, uint32_t tri, const gi_vec3 p[3], cssm_texel *x);
 
 /* The order in which the texels' cube maps are rendered and compressed:
  * order[k] = texel visited k-th (a permutation of 0 .. count-1). Greedy:

@@ -191,8 +191,10 @@ static gi_result make_shadows(cssm_hrc *c, const gi_gpu_scene *gs, gi_error *err
         int directional = m->type == GI_LIGHT_DIRECTIONAL;
         gi_depth_desc dd = {.size = S, .surfaces = 1, .metric = directional ? GI_DEPTH_EYE_Z : GI_DEPTH_RADIAL};
         gi_depth_renderer *dr = gi_depth_renderer_create(&dd, err);
-        if (!dr)
+        if (!dr) {
+            release_shadows(c);
             return GI_ERR_GL;
+        }
         uint32_t layers = directional ? 1u : 6u;
         GLuint tex = gi_depth_texture_create(dr, layers);
         gi_depth_view views[6];
@@ -225,8 +227,10 @@ static gi_result make_shadows(cssm_hrc *c, const gi_gpu_scene *gs, gi_error *err
         }
         glDeleteTextures(1, &tex);
         gi_depth_renderer_free(dr);
-        if (r != GI_OK)
+        if (r != GI_OK) {
+            release_shadows(c); /* no light left with a half-made map */
             return r;
+        }
     }
     return GI_OK;
 }
@@ -611,8 +615,10 @@ static gi_result cssm_update(void *inst, const gi_gpu_scene *gs, const gi_change
         cssm_tree_free(&c->tree);
         gi_result r = cssm_tree_build(&c->atlas, &c->tree, &err);
         host->stage_end(host, "hierarchy");
-        if (r != GI_OK)
+        if (r != GI_OK) { /* what was made before is gone: render refuses until the next prepare */
+            c->prepared = 0;
             return gi_kit_fail_with(&c->kit, r, &err);
+        }
         check_hulls(c, gs->scene, gs->time);
         moved = 1;
     }
@@ -622,21 +628,23 @@ static gi_result cssm_update(void *inst, const gi_gpu_scene *gs, const gi_change
             /* materials are read into the atlas texels */
             for (uint32_t i = 0; i < c->atlas.count; i++) {
                 cssm_texel *x = &c->atlas.texels[i];
-                const gi_material *m =
-                    &gs->scene->materials[gs->scene->vertices[gs->scene->indices[3 * x->triangle]].material];
-                memcpy(x->albedo, m->albedo, sizeof x->albedo);
-                memcpy(x->emission, m->emission, sizeof x->emission);
-                memcpy(x->ks, m->ks, sizeof x->ks);
-                x->exponent = m->exponent;
+                gi_vec3 p[3];
+                gi_scene_triangle_world(gs->scene, x->triangle, gs->time, p);
+                cssm_texel_material(gs->scene, x->triangle, p, x);
             }
         }
         const gi_host *host = c->kit.host;
         host->stage_begin(host, "direct");
         gi_result r = make_shadows(c, gs, &err);
         host->stage_end(host, "direct");
-        if (r != GI_OK)
+        if (r != GI_OK) { /* what was made before is gone: render refuses until the next prepare */
+            c->prepared = 0;
             return gi_kit_fail_with(&c->kit, r, &err);
-        return lighting(c, gs);
+        }
+        r = lighting(c, gs);
+        if (r != GI_OK)
+            c->prepared = 0;
+        return r;
     }
     return GI_OK;
 }
@@ -845,7 +853,8 @@ static const gi_method cssm_method = {
     .citation = "Ritschel, Grosch, Kautz, Seidel. Interactive Illumination with Coherent Surface Shadow Maps. GI 2008",
     .version = "0.1",
     .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_GLOSSY | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS |
-            GI_CAP_DIRECTIONAL | GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE | GI_CAP_PRECOMPUTE | GI_CAP_RIGID_MOTION,
+            GI_CAP_DIRECTIONAL | GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE | GI_CAP_PRECOMPUTE | GI_CAP_RIGID_MOTION |
+            GI_CAP_TEXTURES,
     .max_bounces = 3,
     .params = cssm_params,
     .create = cssm_create,

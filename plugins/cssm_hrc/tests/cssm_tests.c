@@ -930,10 +930,81 @@ static int part_motion2(void)
 }
 
 
+/* Textured albedo in the atlas: the checker ground of
+ * scenes/teapot_plane.glb. Its texels carry the texture (both checker
+ * colours appear), and their area-weighted mean albedo matches the mean
+ * of the textured albedo at 20 000 random points of the same triangles
+ * (uvs interpolated here) within 5 %, where the untextured factor is off
+ * by more than 50 %. */
+static int part_texture(void)
+{
+    gi_scene *s = load("scenes/teapot_plane.glb");
+    if (!s)
+        return 1;
+    gi_error err;
+    cssm_atlas a;
+    if (cssm_atlas_build(s, 0.0f, 32, 0, &a, &err) != GI_OK) {
+        fprintf(stderr, "FAIL: %s\n", err.text);
+        return 1;
+    }
+    double sum = 0.0, area = 0.0, factor = 0.0;
+    float lo = 1e9f, hi = -1e9f;
+    uint32_t textured = 0;
+    for (uint32_t i = 0; i < a.count; i++) {
+        const cssm_texel *x = &a.texels[i];
+        const gi_material *m = &s->materials[s->vertices[s->indices[3 * x->triangle]].material];
+        if (m->albedo_texture < 0)
+            continue;
+        textured++;
+        sum += x->area * x->albedo[1];
+        area += x->area;
+        factor = m->albedo[1];
+        lo = fminf(lo, x->albedo[1]), hi = fmaxf(hi, x->albedo[1]);
+    }
+    /* the same mean at random points of the textured triangles, by area */
+    double ref = 0.0, ref_area = 0.0;
+    uint32_t rng = gi_rng_init(5, 0, 0x7e7u);
+    for (uint32_t tri = 0; tri < s->triangle_count; tri++) {
+        const uint32_t *idx = &s->indices[3 * tri];
+        const gi_material *m = &s->materials[s->vertices[idx[0]].material];
+        if (m->albedo_texture < 0)
+            continue;
+        gi_vec3 p[3];
+        gi_scene_triangle_world(s, tri, 0.0f, p);
+        float A = 0.5f * gi_v3_length(gi_v3_cross(gi_v3_sub(p[1], p[0]), gi_v3_sub(p[2], p[0])));
+        const int n = 20000 / 2; /* the ground is two triangles or more: points per triangle */
+        double acc = 0.0;
+        for (int k = 0; k < n; k++) {
+            float u = gi_rng_next_float(&rng), v = gi_rng_next_float(&rng);
+            if (u + v > 1.0f)
+                u = 1.0f - u, v = 1.0f - v;
+            float uv[2], al[3];
+            for (int c = 0; c < 2; c++)
+                uv[c] = (1.0f - u - v) * s->vertices[idx[0]].uv[c] + u * s->vertices[idx[1]].uv[c] +
+                        v * s->vertices[idx[2]].uv[c];
+            gi_scene_albedo(s, s->vertices[idx[0]].material, uv, al);
+            acc += al[1];
+        }
+        ref += A * acc / n;
+        ref_area += A;
+    }
+    double mean = area > 0 ? sum / area : 0.0, want = ref_area > 0 ? ref / ref_area : 0.0;
+    printf("texture: %u textured texels, albedo (green) %.3f .. %.3f, area mean %.4f; random points %.4f (%+.2f %%); "
+           "the untextured factor %.3f (%+.1f %%)\n",
+           textured, lo, hi, mean, want, 100.0 * (mean / want - 1.0), factor, 100.0 * (factor / want - 1.0));
+    CHECK(textured >= 100, "only %u textured texels", textured);
+    CHECK(hi > lo + 0.2f, "the checker does not show in the atlas (%.3f .. %.3f)", lo, hi);
+    CHECK(fabs(mean / want - 1.0) <= 0.05, "mean textured albedo %.4f, random points %.4f", mean, want);
+    CHECK(fabs(factor / want - 1.0) > 0.5, "the test cannot tell: the factor is near the textured mean");
+    cssm_atlas_free(&a);
+    gi_scene_free(s);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
-        fprintf(stderr, "usage: cssm_tests traversal|tree|visibility|furnace|hull|motion|motion2\n");
+        fprintf(stderr, "usage: cssm_tests traversal|tree|visibility|furnace|hull|motion|motion2|texture\n");
         return 2;
     }
     int r;
@@ -951,6 +1022,8 @@ int main(int argc, char **argv)
         r = part_motion();
     else if (!strcmp(argv[1], "motion2"))
         r = part_motion2();
+    else if (!strcmp(argv[1], "texture"))
+        r = part_texture();
     else {
         fprintf(stderr, "cssm_tests: unknown part '%s'\n", argv[1]);
         return 2;
