@@ -2,6 +2,7 @@
  * render in batches, read back, compress (Ritschel et al. 2007 §3.1). */
 #include "gi/csm_precompute.h"
 
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -29,10 +30,11 @@ gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc
         return GI_ERR_GL;
     GLuint tex = gi_depth_texture_create(dr, batch);
     gi_depth_view *views = calloc(batch, sizeof *views);
+    uint32_t *slot = calloc(batch, sizeof *slot); /* map k of a batch: its layer, UINT32_MAX not drawn */
     float *z1 = malloc((size_t)M * M * sizeof *z1), *z2 = malloc((size_t)M * M * sizeof *z2);
     gi_csm_codec *enc[GI_CSM_MAX_STREAMS] = {0};
     gi_result r = GI_ERR_OUT_OF_MEMORY;
-    if (!views || !z1 || !z2) {
+    if (!views || !slot || !z1 || !z2) {
         snprintf(err->text, sizeof err->text, "%s: out of memory for %u x %u %s", who, M, M, what);
         goto done;
     }
@@ -46,25 +48,32 @@ gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc
             goto done;
         }
         uint32_t count = N - first < batch ? N - first : batch;
-        for (uint32_t k = 0; k < count; k++)
-            d->view(d->ctx, first + k, &views[k]);
+        uint32_t drawn = 0; /* maps of this batch to draw: layers 0 .. drawn-1 */
+        for (uint32_t k = 0; k < count; k++) {
+            slot[k] = d->skip && d->skip(d->ctx, first + k) ? UINT32_MAX : drawn;
+            if (slot[k] != UINT32_MAX)
+                d->view(d->ctx, first + k, &views[drawn++]);
+        }
         gi_host_stage(host, render_stage, 1);
-        r = gi_depth_render(dr, gs, views, count, tex, 0, err);
+        r = drawn ? gi_depth_render(dr, gs, views, drawn, tex, 0, err) : GI_OK;
         gi_host_stage(host, render_stage, 0);
         if (r != GI_OK)
             goto done;
         for (uint32_t k = 0; k < count; k++) {
             const uint32_t q = first + k;
-            gi_host_stage(host, render_stage, 1);
-            float *map = gi_depth_read_layer(tex, M, k);
-            gi_host_stage(host, render_stage, 0);
-            if (!map) {
-                r = GI_ERR_OUT_OF_MEMORY;
-                snprintf(err->text, sizeof err->text, "%s: reading %s %u failed", who, what, q);
-                goto done;
+            float *map = NULL;
+            if (slot[k] != UINT32_MAX) {
+                gi_host_stage(host, render_stage, 1);
+                map = gi_depth_read_layer(tex, M, slot[k]);
+                gi_host_stage(host, render_stage, 0);
+                if (!map) {
+                    r = GI_ERR_OUT_OF_MEMORY;
+                    snprintf(err->text, sizeof err->text, "%s: reading %s %u failed", who, what, q);
+                    goto done;
+                }
             }
             gi_host_stage(host, "compress", 1);
-            d->depths(d->ctx, q, &views[k], map, z1, z2);
+            d->depths(d->ctx, q, map ? &views[slot[k]] : NULL, map, z1, z2);
             free(map);
             r = gi_csm_codec_add_map(enc[q % S], q / S, z1, z2, err);
             gi_host_stage(host, "compress", 0);
@@ -90,6 +99,7 @@ done:
             gi_csm_data_free(&out[s]);
     }
     free(views);
+    free(slot);
     free(z1);
     free(z2);
     glDeleteTextures(1, &tex);

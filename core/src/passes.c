@@ -223,9 +223,9 @@ gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi
             glClear(GL_DEPTH_BUFFER_BIT);
             glBindTextureUnit(GI_TEX_CORE_DEPTH_PEEL, prev);
             glUniform1i(loc_peel, (GLint)k);
-            if (d->skip_object && !d->only_object) {
+            if ((d->skip_object || d->skip_objects) && !d->only_object) {
                 for (uint32_t o = 0; o < gs->scene->object_count; o++)
-                    if (o + 1 != d->skip_object)
+                    if (o + 1 != d->skip_object && !(d->skip_objects && d->skip_objects[o]))
                         gi_gpu_scene_draw(gs, (int)o, 1);
             } else {
                 gi_gpu_scene_draw(gs, d->only_object ? (int)d->only_object - 1 : -1, 1);

@@ -32,10 +32,30 @@ static float tri_area(const gi_vec3 p[3], gi_vec3 *n)
     return 0.5f * l;
 }
 
-static void material_of(const gi_scene *s, uint32_t tri, cssm_texel *x)
+/* The material of texel x on triangle tri (world corners p): albedo
+ * factor x texture at the texel's centre (the mesh uvs interpolated
+ * there, gi_scene_albedo), emission and Phong lobe. */
+static void material_of(const gi_scene *s, uint32_t tri, const gi_vec3 p[3], cssm_texel *x)
 {
-    const gi_material *m = &s->materials[s->vertices[s->indices[3 * tri]].material];
-    memcpy(x->albedo, m->albedo, sizeof x->albedo);
+    cssm_texel_material(s, tri, p, x);
+}
+
+void cssm_texel_material(const gi_scene *s, uint32_t tri, const gi_vec3 p[3], cssm_texel *x)
+{
+    const uint32_t *idx = &s->indices[3 * (size_t)tri];
+    const uint32_t mat = s->vertices[idx[0]].material;
+    const gi_material *m = &s->materials[mat];
+    /* barycentric coordinates of x->p in the triangle (clamped inside) */
+    gi_vec3 e1 = gi_v3_sub(p[1], p[0]), e2 = gi_v3_sub(p[2], p[0]), d = gi_v3_sub(x->p, p[0]);
+    float a = gi_v3_dot(e1, e1), b = gi_v3_dot(e1, e2), c = gi_v3_dot(e2, e2);
+    float f = gi_v3_dot(d, e1), g = gi_v3_dot(d, e2), den = a * c - b * b;
+    float u = den > 0.0f ? (c * f - b * g) / den : 0.0f, v = den > 0.0f ? (a * g - b * f) / den : 0.0f;
+    u = fminf(fmaxf(u, 0.0f), 1.0f), v = fminf(fmaxf(v, 0.0f), 1.0f - u);
+    float uv[2];
+    for (int k = 0; k < 2; k++)
+        uv[k] = (1.0f - u - v) * s->vertices[idx[0]].uv[k] + u * s->vertices[idx[1]].uv[k] +
+                v * s->vertices[idx[2]].uv[k];
+    gi_scene_albedo(s, mat, uv, x->albedo);
     memcpy(x->emission, m->emission, sizeof x->emission);
     memcpy(x->ks, m->ks, sizeof x->ks);
     x->exponent = m->exponent;
@@ -310,7 +330,7 @@ gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_o
                 x->chart = (int32_t)ci;
                 x->x = c->x0 + xx, x->y = c->y0 + yy;
                 x->triangle = (uint32_t)hit;
-                material_of(s, (uint32_t)hit, x);
+                material_of(s, (uint32_t)hit, &P[3 * (size_t)hit], x);
                 out->grid[(size_t)x->y * R + x->x] = (int32_t)out->count;
                 out->count++;
             }
@@ -365,7 +385,7 @@ gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_o
                 x->chart = -1;
                 x->x = x->y = CSSM_NO_XY;
                 x->triangle = i;
-                material_of(s, i, x);
+                material_of(s, i, &P[3 * (size_t)i], x);
                 made++;
                 target += step;
             }

@@ -4,6 +4,7 @@
  * of §3.2.2. */
 #include "cssm.h"
 
+#include "gi/csm_precompute.h"
 #include "gi/cubemap.h"
 
 #include <float.h>
@@ -13,16 +14,6 @@
 #include <string.h>
 
 #define CSSM_BATCH 16u /* texels (6 faces each) per gi_depth_render call */
-
-static void timer(const gi_host *host, const char *name, int begin)
-{
-    if (!host)
-        return;
-    if (begin)
-        host->stage_begin(host, name);
-    else
-        host->stage_end(host, name);
-}
 
 /* Per face: 1 where the whole texel cone lies in the negative half-space
  * of normal n (all four corner directions below the plane): "don't care"
@@ -72,6 +63,60 @@ gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uin
     return cssm_maps_build_ex(gs, a, order, M, NULL, host, out, err);
 }
 
+/* What the core's precomputation loop (gi/csm_precompute.h) asks of the
+ * cube maps: map q is face q % 6 of the texel visited (q / 6)-th. */
+typedef struct build_ctx {
+    const cssm_atlas *a;
+    const uint32_t *order;
+    const cssm_build_opts *opts;
+    cssm_maps *out;
+    const gi_vec3 *corners; /* 6 (M+1)^2 corner directions of the face texels */
+    unsigned char *mask;
+    gi_depth_view cube[6];  /* the views of the texel last asked for */
+    uint32_t cube_of;       /* its texel + 1 (0: none yet) */
+} build_ctx;
+
+static void build_view(void *ctx, uint32_t q, gi_depth_view *view)
+{
+    build_ctx *b = ctx;
+    const uint32_t i = b->order[q / 6];
+    if (b->cube_of != i + 1) {
+        gi_depth_cube_views(b->out->eye[i], b->out->znear, b->out->zfar, b->cube);
+        b->cube_of = i + 1;
+    }
+    *view = b->cube[q % 6];
+}
+
+/* texels whose maps are all "don't care" are not drawn */
+static int build_skip(void *ctx, uint32_t q)
+{
+    const build_ctx *b = ctx;
+    return b->opts->dont_care && b->opts->dont_care[b->order[q / 6]];
+}
+
+static void build_depths(void *ctx, uint32_t q, const gi_depth_view *view, const float *map, float *z1, float *z2)
+{
+    (void)view;
+    build_ctx *b = ctx;
+    const uint32_t M = b->out->M;
+    const cssm_texel *x = &b->a->texels[b->order[q / 6]];
+    gi_vec3 xn = x->n;
+    if (b->opts->eye_from_world) /* the normal in the maps' space (rigid) */
+        xn = gi_v3_normalize(gi_mat4_dir(b->opts->eye_from_world, xn));
+    dont_care_mask(b->corners, M, xn, (int)(q % 6), b->mask);
+    for (uint32_t t = 0; t < M * M; t++) {
+        if (b->mask[t] || !map) { /* any value: an interval that never breaks a run */
+            z1[t] = -FLT_MAX;
+            z2[t] = FLT_MAX;
+            b->out->dont_care++;
+            continue;
+        }
+        float a1 = map[4 * t], a2 = map[4 * t + 1];
+        z1[t] = a1 >= FLT_MAX ? FLT_MAX : a1;
+        z2[t] = a1 >= FLT_MAX || a2 >= FLT_MAX ? FLT_MAX : fmaxf(a2, z1[t]);
+    }
+}
+
 gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order, uint32_t M,
                              const cssm_build_opts *opts, const gi_host *host, cssm_maps *out, gi_error *err)
 {
@@ -86,16 +131,12 @@ gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const 
             out->eye[i] = gi_mat4_point(opts->eye_from_world, out->eye[i]);
     const uint32_t N = a->count;
     gi_vec3 *corners = malloc(6 * (size_t)(M + 1) * (M + 1) * sizeof *corners);
-    float *z1 = malloc((size_t)M * M * sizeof *z1), *z2 = malloc((size_t)M * M * sizeof *z2);
     unsigned char *mask = malloc((size_t)M * M);
-    gi_depth_view *views = calloc(6 * CSSM_BATCH, sizeof *views);
-    gi_csm_codec *enc[6] = {0};
-    gi_depth_renderer *dr = NULL;
-    GLuint tex = 0;
-    r = GI_ERR_OUT_OF_MEMORY;
-    if (!corners || !z1 || !z2 || !mask || !views) {
+    if (!corners || !mask) {
+        free(corners), free(mask);
+        cssm_maps_free(out);
         snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for %u cube maps", N);
-        goto done;
+        return GI_ERR_OUT_OF_MEMORY;
     }
     for (int f = 0; f < 6; f++) {
         gi_vec3 s, t, fw;
@@ -107,93 +148,28 @@ gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const 
                     gi_v3_add(fw, gi_v3_add(gi_v3_scale(s, sx), gi_v3_scale(t, sy)));
             }
     }
-    gi_depth_desc dd = {.size = M,
-                        .surfaces = 2,
-                        .metric = GI_DEPTH_RADIAL,
-                        .only_object = opts->only_object,
-                        .local = opts->local,
-                        .cull = 0,
-                        .skip_object = opts->skip_object};
-    dr = gi_depth_renderer_create(&dd, err);
-    if (!dr) {
-        r = GI_ERR_GL;
-        goto done;
-    }
-    tex = gi_depth_texture_create(dr, 6 * CSSM_BATCH);
-    for (int f = 0; f < 6; f++)
-        if ((r = gi_csm_codec_begin(M, N, &enc[f], err)) != GI_OK)
-            goto done;
-    for (uint32_t first = 0; first < N; first += CSSM_BATCH) {
-        if (host && host->cancelled(host)) {
-            r = GI_ERR_CANCELLED;
-            snprintf(err->text, sizeof err->text, "cssm_hrc: precomputation cancelled");
-            goto done;
-        }
-        uint32_t count = N - first < CSSM_BATCH ? N - first : CSSM_BATCH;
-        uint32_t slot[CSSM_BATCH], drawn = 0; /* texels whose maps are all "don't care" are not drawn */
-        for (uint32_t k = 0; k < count; k++) {
-            slot[k] = drawn;
-            if (opts->dont_care && opts->dont_care[order[first + k]])
-                continue;
-            gi_depth_cube_views(out->eye[order[first + k]], out->znear, out->zfar, &views[6 * drawn++]);
-        }
-        timer(host, "cssm_render", 1);
-        r = drawn ? gi_depth_render(dr, gs, views, 6 * drawn, tex, 0, err) : GI_OK;
-        timer(host, "cssm_render", 0);
-        if (r != GI_OK)
-            goto done;
-        for (uint32_t k = 0; k < count; k++) {
-            const cssm_texel *x = &a->texels[order[first + k]];
-            const int skipped = opts->dont_care && opts->dont_care[order[first + k]];
-            gi_vec3 xn = x->n;
-            if (opts->eye_from_world) /* the normal in the maps' space (rigid) */
-                xn = gi_v3_normalize(gi_mat4_dir(opts->eye_from_world, xn));
-            for (int f = 0; f < 6; f++) {
-                timer(host, "cssm_render", 1);
-                float *map = skipped ? calloc(1, sizeof(float))
-                                     : gi_depth_read_layer(tex, M, 6 * slot[k] + (uint32_t)f);
-                timer(host, "cssm_render", 0);
-                if (!map) {
-                    r = GI_ERR_OUT_OF_MEMORY;
-                    snprintf(err->text, sizeof err->text, "cssm_hrc: reading cube map %u failed", first + k);
-                    goto done;
-                }
-                timer(host, "compress", 1);
-                dont_care_mask(corners, M, xn, f, mask);
-                for (uint32_t t = 0; t < M * M; t++) {
-                    if (mask[t] || skipped) { /* any value: an interval that never breaks a run */
-                        z1[t] = -FLT_MAX;
-                        z2[t] = FLT_MAX;
-                        out->dont_care++;
-                        continue;
-                    }
-                    float a1 = map[4 * t], a2 = map[4 * t + 1];
-                    z1[t] = a1 >= FLT_MAX ? FLT_MAX : a1;
-                    z2[t] = a1 >= FLT_MAX || a2 >= FLT_MAX ? FLT_MAX : fmaxf(a2, z1[t]);
-                }
-                free(map);
-                r = gi_csm_codec_add_map(enc[f], first + k, z1, z2, err);
-                timer(host, "compress", 0);
-                if (r != GI_OK)
-                    goto done;
-            }
-        }
-        if (host)
-            host->progress(host, "cssm_hrc: cube maps", (float)(first + count) / (float)N);
-    }
-    timer(host, "compress", 1);
-    for (int f = 0; f < 6 && r == GI_OK; f++) {
-        r = gi_csm_codec_finish(enc[f], &out->face[f], err);
-        enc[f] = NULL;
-    }
-    timer(host, "compress", 0);
-done:
-    for (int f = 0; f < 6; f++)
-        gi_csm_codec_free(enc[f]);
-    free(corners), free(z1), free(z2), free(mask), free(views);
-    if (tex)
-        glDeleteTextures(1, &tex);
-    gi_depth_renderer_free(dr);
+    build_ctx b = {.a = a, .order = order, .opts = opts, .out = out, .corners = corners, .mask = mask};
+    gi_csm_precompute_desc d = {.depth = {.size = M,
+                                          .surfaces = 2,
+                                          .metric = GI_DEPTH_RADIAL,
+                                          .only_object = opts->only_object,
+                                          .local = opts->local,
+                                          .cull = 0,
+                                          .skip_objects = opts->skip_objects},
+                                .count = 6 * N,
+                                .streams = 6,
+                                .batch = 6 * CSSM_BATCH,
+                                .view = build_view,
+                                .depths = build_depths,
+                                .skip = opts->dont_care ? build_skip : NULL,
+                                .ctx = &b,
+                                .host = host,
+                                .p1 = 1.0f,
+                                .who = "cssm_hrc",
+                                .what = "cube maps",
+                                .render_stage = "cssm_render"};
+    r = gi_csm_precompute(gs, &d, out->face, err);
+    free(corners), free(mask);
     if (r != GI_OK)
         cssm_maps_free(out);
     return r;

@@ -13,8 +13,8 @@
  *    oracle and a maximum cut size (§4.3, Fig. 10), pull, and the final
  *    gather per receiver point with a Phong bound (§4.4), jitter (§4.5) and
  *    clamping (hrc.c).
- * One moving rigid object (§3.3) is handled in motion.c: the maps of this
- * file then see the static objects only (cssm_build_opts), and the moving
+ * Moving rigid objects (§3.3) are handled in motion.c: the maps of this
+ * file then see the static objects only (cssm_build_opts), and each moving
  * object has its own CSSM and CSM in its frame. */
 #ifndef CSSM_H
 #define CSSM_H
@@ -36,7 +36,7 @@ typedef enum cssm_traversal { CSSM_GREEDY = 0, CSSM_ZIGZAG = 1, CSSM_SPIRAL = 2 
 typedef struct cssm_texel {
     gi_vec3 p, n;       /* world position and (geometric) unit normal */
     float area;         /* world area this texel stands for */
-    float albedo[3];    /* Lambert albedo of the material (textures not applied) */
+    float albedo[3];    /* Lambert albedo: the material's factor x its texture at the texel centre */
     float emission[3];  /* emitted radiance (front face) */
     float ks[3], exponent; /* Phong lobe of the material (view-dependent lightmap mode) */
     int32_t chart;      /* chart index, -1 for a surface sample without parametrisation */
@@ -79,6 +79,10 @@ typedef struct cssm_atlas {
 gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_only, cssm_atlas *out,
                            gi_error *err);
 void cssm_atlas_free(cssm_atlas *a);
+/* Reads texel x's material from triangle tri (world corners p, x->p on
+ * it): albedo factor x albedo texture at x->p (the mesh uvs interpolated,
+ * gi_scene_albedo), emission, Phong lobe. */
+void cssm_texel_material(const gi_scene *s, uint32_t tri, const gi_vec3 p[3], cssm_texel *x);
 
 /* The order in which the texels' cube maps are rendered and compressed:
  * order[k] = texel visited k-th (a permutation of 0 .. count-1). Greedy:
@@ -118,14 +122,15 @@ typedef struct cssm_maps {
  * world space (the static scene). */
 typedef struct cssm_build_opts {
     uint32_t only_object;            /* k + 1: object k alone */
-    uint32_t skip_object;            /* k + 1: every object but k */
+    const unsigned char *skip_objects; /* per object, 1: not drawn (with only_object 0); NULL: none */
     int local;                       /* 1: object-local geometry (with only_object) */
     const float *eye_from_world;     /* maps the texels' eyes (world) into the maps' space; NULL: identity */
     const unsigned char *dont_care;  /* per texel, 1: a map of "don't care" only (not queried, no segments) */
 } cssm_build_opts;
 
-/* Renders (core depth renderer: world space, every object, radial depth,
- * two surfaces) the depth cube map of every texel in order `order`
+/* Renders (the core's precomputation loop gi/csm_precompute.h with its
+ * depth renderer: world space, every object, radial depth, two surfaces)
+ * the depth cube map of every texel in order `order`
  * (§3.2.1: near plane 1e-3 of the diameter, far plane the diameter,
  * texels whose cone lies wholly in the negative half-space of the texel's
  * normal "don't care") and streams them into six codecs. host may be NULL;
@@ -192,7 +197,7 @@ typedef struct cssm_receiver {
     gi_vec3 x, n;
     int32_t self;        /* receiver texel (skipped), -1 for a pixel */
     uint32_t proxy1;     /* moving-object mode, a pixel: 1 + a texel on its triangle (0: none) */
-    int moving;          /* moving-object mode, a pixel: it lies on the moving object */
+    uint32_t moving;     /* moving-object mode, a pixel: 1 + the mover it lies on, 0 on a static object */
     int glossy;          /* use ks, exponent, wo */
     float kd[3], ks[3], exponent;
     gi_vec3 wo;

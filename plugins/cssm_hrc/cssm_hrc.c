@@ -64,7 +64,7 @@ typedef struct cssm_hrc {
     float *accum;     /* running average, 4 per pixel */
     float *gb[5];     /* G-buffer read-back: position, normal, albedo, phong, emission */
     uint32_t acc_w, acc_h;
-    cssm_motion motion; /* §3.3: one moving rigid object (motion.h); motion.moving < 0: static scene */
+    cssm_motion motion; /* §3.3: moving rigid objects (motion.h); motion.moving < 0: static scene */
     int prepared;
 } cssm_hrc;
 
@@ -191,8 +191,10 @@ static gi_result make_shadows(cssm_hrc *c, const gi_gpu_scene *gs, gi_error *err
         int directional = m->type == GI_LIGHT_DIRECTIONAL;
         gi_depth_desc dd = {.size = S, .surfaces = 1, .metric = directional ? GI_DEPTH_EYE_Z : GI_DEPTH_RADIAL};
         gi_depth_renderer *dr = gi_depth_renderer_create(&dd, err);
-        if (!dr)
+        if (!dr) {
+            release_shadows(c);
             return GI_ERR_GL;
+        }
         uint32_t layers = directional ? 1u : 6u;
         GLuint tex = gi_depth_texture_create(dr, layers);
         gi_depth_view views[6];
@@ -225,8 +227,10 @@ static gi_result make_shadows(cssm_hrc *c, const gi_gpu_scene *gs, gi_error *err
         }
         glDeleteTextures(1, &tex);
         gi_depth_renderer_free(dr);
-        if (r != GI_OK)
+        if (r != GI_OK) {
+            release_shadows(c); /* no light left with a half-made map */
             return r;
+        }
     }
     return GI_OK;
 }
@@ -499,16 +503,17 @@ static void check_hulls(cssm_hrc *c, const gi_scene *s, float t)
                   c->motion.what);
 }
 
-/* §3.3 with one moving object A: the static CSSM (the scene without A, A's
- * texels "don't care"), A's own CSSM and CSM in its frame (motion.c). Not
+/* §3.3 with moving objects: the static CSSM (the scene without the
+ * movers, their texels "don't care"), each mover's own CSSM and CSM in its
+ * frame, with two or more movers the static objects' CSMs (motion.c). Not
  * cached. */
-static gi_result build_moving(cssm_hrc *c, const gi_gpu_scene *gs, int32_t A, gi_error *err)
+static gi_result build_moving(cssm_hrc *c, const gi_gpu_scene *gs, gi_error *err)
 {
     const gi_host *host = c->kit.host;
-    gi_result r = cssm_motion_init(gs->scene, gs->time, &c->atlas, A, &c->motion, err);
+    gi_result r = cssm_motion_init(gs->scene, gs->time, &c->atlas, &c->motion, err);
     if (r != GI_OK)
         return r;
-    cssm_build_opts o = {.skip_object = (uint32_t)A + 1u, .dont_care = c->motion.on_moving};
+    cssm_build_opts o = {.skip_objects = c->motion.object_moves, .dont_care = c->motion.on_moving};
     r = cssm_maps_build_ex(gs, &c->atlas, c->order, (uint32_t)c->M, &o, host, &c->maps, err);
     if (r == GI_OK)
         r = cssm_motion_build_maps(&c->motion, gs, &c->atlas, c->order, (uint32_t)c->M, host, err);
@@ -516,8 +521,18 @@ static gi_result build_moving(cssm_hrc *c, const gi_gpu_scene *gs, int32_t A, gi
         return r;
     c->maps.motion = &c->motion;
     host->stat(host, "cache_hit", 0.0);
-    host->stat(host, "moving_cssm_bytes", (double)cssm_maps_bytes(&c->motion.self));
-    host->stat(host, "moving_csm_bytes", (double)c->motion.csm.data.bytes_compressed);
+    double self_bytes = 0, csm_bytes = 0, static_bytes = 0;
+    for (uint32_t k = 0; k < c->motion.mover_count; k++) {
+        self_bytes += (double)cssm_maps_bytes(&c->motion.movers[k].self);
+        csm_bytes += (double)c->motion.movers[k].csm.data.bytes_compressed;
+    }
+    for (uint32_t k = 0; k < c->motion.object_count; k++)
+        static_bytes += (double)c->motion.static_csm[k].data.bytes_compressed;
+    host->stat(host, "moving_objects", (double)c->motion.mover_count);
+    host->stat(host, "moving_cssm_bytes", self_bytes);
+    host->stat(host, "moving_csm_bytes", csm_bytes);
+    if (c->motion.mover_count > 1)
+        host->stat(host, "static_csm_bytes", static_bytes);
     check_hulls(c, gs->scene, gs->time);
     return GI_OK;
 }
@@ -530,12 +545,7 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     const gi_host *host = c->kit.host;
     gi_error err;
     uint32_t moving = 0;
-    int32_t moving_obj = cssm_motion_find(gs->scene, &moving);
-    if (moving > 1)
-        return gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED,
-                           "cssm_hrc: %u objects of this scene move; moving objects (Sec. 3.3) are implemented for one "
-                           "moving rigid object",
-                           moving);
+    cssm_motion_find(gs->scene, &moving);
     if (moving && gi_scene_deforms(gs->scene))
         return gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED, "cssm_hrc: deforming objects are not supported");
     host->stage_begin(host, "atlas");
@@ -553,7 +563,7 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     host->stage_end(host, "traversal");
     if (!c->order)
         return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the traversal");
-    r = moving ? build_moving(c, gs, moving_obj, &err) : load_or_build_maps(c, gs, &err);
+    r = moving ? build_moving(c, gs, &err) : load_or_build_maps(c, gs, &err);
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);
     uint64_t bc = cssm_maps_bytes(&c->maps), bu = cssm_maps_bytes_uncompressed(&c->maps);
@@ -594,7 +604,7 @@ static gi_result cssm_update(void *inst, const gi_gpu_scene *gs, const gi_change
                                "cssm_hrc: an object moved that was not animated at prepare time");
         /* §3.3: A's texels placed by T, the hierarchy made again over the
          * moved texels (a median cut of a few thousand points: what a fresh
-         * prepare would make), the atlas lit again; the CSSMs and the CSM
+         * prepare would make), the atlas lit again; the CSSMs and the CSMs
          * are not made again (D T^-1) */
         const gi_host *host = c->kit.host;
         gi_error err;
@@ -605,8 +615,10 @@ static gi_result cssm_update(void *inst, const gi_gpu_scene *gs, const gi_change
         cssm_tree_free(&c->tree);
         gi_result r = cssm_tree_build(&c->atlas, &c->tree, &err);
         host->stage_end(host, "hierarchy");
-        if (r != GI_OK)
+        if (r != GI_OK) { /* what was made before is gone: render refuses until the next prepare */
+            c->prepared = 0;
             return gi_kit_fail_with(&c->kit, r, &err);
+        }
         check_hulls(c, gs->scene, gs->time);
         moved = 1;
     }
@@ -616,21 +628,23 @@ static gi_result cssm_update(void *inst, const gi_gpu_scene *gs, const gi_change
             /* materials are read into the atlas texels */
             for (uint32_t i = 0; i < c->atlas.count; i++) {
                 cssm_texel *x = &c->atlas.texels[i];
-                const gi_material *m =
-                    &gs->scene->materials[gs->scene->vertices[gs->scene->indices[3 * x->triangle]].material];
-                memcpy(x->albedo, m->albedo, sizeof x->albedo);
-                memcpy(x->emission, m->emission, sizeof x->emission);
-                memcpy(x->ks, m->ks, sizeof x->ks);
-                x->exponent = m->exponent;
+                gi_vec3 p[3];
+                gi_scene_triangle_world(gs->scene, x->triangle, gs->time, p);
+                cssm_texel_material(gs->scene, x->triangle, p, x);
             }
         }
         const gi_host *host = c->kit.host;
         host->stage_begin(host, "direct");
         gi_result r = make_shadows(c, gs, &err);
         host->stage_end(host, "direct");
-        if (r != GI_OK)
+        if (r != GI_OK) { /* what was made before is gone: render refuses until the next prepare */
+            c->prepared = 0;
             return gi_kit_fail_with(&c->kit, r, &err);
-        return lighting(c, gs);
+        }
+        r = lighting(c, gs);
+        if (r != GI_OK)
+            c->prepared = 0;
+        return r;
     }
     return GI_OK;
 }
@@ -735,8 +749,7 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                     uint32_t tri = c->ids[4 * p + 2];
                     int32_t proxy = cssm_motion_proxy(&c->motion, s, &c->atlas, tri, P, Nn);
                     rc.proxy1 = proxy >= 0 ? (uint32_t)proxy + 1u : 0u;
-                    rc.moving = tri < s->triangle_count &&
-                                s->vertices[s->indices[3 * tri]].object == (uint32_t)c->motion.moving;
+                    rc.moving = cssm_motion_mover1(&c->motion, s, tri);
                 }
                 memcpy(rc.kd, alb, 3 * sizeof(float));
                 memcpy(rc.ks, ph, 3 * sizeof(float));
@@ -792,6 +805,16 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
     if (c->motion.moving >= 0) {
         host->stat(host, "hull_overlap", (double)c->motion.overlaps);
         host->stat(host, "hull_intrusion", (double)c->motion.intrusions);
+        for (uint32_t k = 0; k < c->motion.pair_count; k++) { /* per pair of objects with a mover */
+            const cssm_hull_pair *pr = &c->motion.pairs[k];
+            char pair[72], name[96];
+            snprintf(pair, sizeof pair, "%.30s.%.30s", s->objects[pr->a].name ? s->objects[pr->a].name : "?",
+                     s->objects[pr->b].name ? s->objects[pr->b].name : "?");
+            snprintf(name, sizeof name, "hull_overlap.%s", pair);
+            host->stat(host, name, (double)pr->overlap);
+            snprintf(name, sizeof name, "hull_intrusion.%s", pair);
+            host->stat(host, name, (double)pr->intrusion);
+        }
     }
     if (st.receivers) {
         host->stat(host, "cut_size_pixels", (double)st.nodes / (double)st.receivers);
@@ -830,7 +853,8 @@ static const gi_method cssm_method = {
     .citation = "Ritschel, Grosch, Kautz, Seidel. Interactive Illumination with Coherent Surface Shadow Maps. GI 2008",
     .version = "0.1",
     .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_GLOSSY | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS |
-            GI_CAP_DIRECTIONAL | GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE | GI_CAP_PRECOMPUTE | GI_CAP_RIGID_MOTION,
+            GI_CAP_DIRECTIONAL | GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE | GI_CAP_PRECOMPUTE | GI_CAP_RIGID_MOTION |
+            GI_CAP_TEXTURES,
     .max_bounces = 3,
     .params = cssm_params,
     .create = cssm_create,

@@ -5,7 +5,8 @@
  * and for cssm_hrc's cube map at every atlas texel (Ritschel et al. 2008
  * §3.2).
  *
- * Maps are rendered in the order q = 0 .. count-1. Map q goes to codec
+ * Maps are rendered in the order q = 0 .. count-1 (those `skip` names are
+ * left out of the drawing, not of the codec). Map q goes to codec
  * stream q % streams as that stream's map q / streams: one stream for a
  * plain sequence of maps, six for cube maps whose faces are compressed one
  * sequence per face (view q = face q % 6 of cube q / 6).
@@ -50,6 +51,11 @@ typedef struct gi_csm_precompute_desc {
     /* The codec's depths z1, z2 (M * M each) of map q from its read-back
      * layer `map` (M * M * 4 floats, gi_depth_read_layer) and its view. */
     void (*depths)(void *ctx, uint32_t q, const gi_depth_view *view, const float *map, float *z1, float *z2);
+    /* Optional (NULL: every map is drawn): nonzero when map q need not be
+     * drawn (cssm_hrc: a texel whose cube map sees nothing it is asked
+     * about, §3.3). Such a map is neither viewed nor rendered; `depths`
+     * gets view and map NULL for it and still fills z1, z2. */
+    int (*skip)(void *ctx, uint32_t q);
     void *ctx;
     const gi_host *host;      /* may be NULL */
     float p0, p1;             /* progress fraction p0 + p1 * done */

@@ -110,6 +110,8 @@ typedef struct gi_depth_desc {
     int local;              /* 1: ignore object transforms (object-local maps); 0 = world */
     int cull;               /* 0 none, 1 back faces, 2 front faces */
     uint32_t skip_object;   /* 0 = none; k + 1 = every object but k (with only_object 0) */
+    const unsigned char *skip_objects; /* NULL = none; per object, 1: not drawn (with only_object 0);
+                                          read while the renderer draws, so it must outlive it */
 } gi_depth_desc;
 
 typedef struct gi_depth_renderer gi_depth_renderer;
