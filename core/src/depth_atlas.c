@@ -248,6 +248,11 @@ const gi_depth_atlas_desc *gi_depth_atlas_get_desc(const gi_depth_atlas *a)
     return &a->desc;
 }
 
+uint64_t gi_depth_atlas_bytes(const gi_depth_atlas *a)
+{
+    return (uint64_t)a->width * a->height * (sizeof(float) + sizeof(float));
+}
+
 float *gi_depth_atlas_read_tile(const gi_depth_atlas *a, uint32_t tile)
 {
     if (!a || tile >= a->desc.capacity)

@@ -540,6 +540,14 @@ static gi_result avg_render(void *inst, const gi_view *view, const gi_target *ta
     host->stat(host, "vpls_live", (double)a->vpl_count);
     host->stat(host, "light_paths", (double)a->paths);
     host->stat(host, "voxel_size", (double)a->grid->h);
+    /* Kept for rendering: the grid's two RGBA32F 3D textures, the live VPLs
+     * and the shadow-map atlas (rebuilt each frame, but held). */
+    double grid_bytes = 2.0 * 16.0 * (double)a->grid->n * (double)a->grid->n * (double)a->grid->n;
+    double vpl_bytes = (double)a->vpl_count * (double)sizeof(avg_vpl);
+    double atlas_bytes = a->atlas ? (double)gi_depth_atlas_bytes(a->atlas) : 0.0;
+    host->stat(host, "data_bytes_grid", grid_bytes);
+    host->stat(host, "data_bytes_atlas", atlas_bytes);
+    host->stat(host, "data_bytes", grid_bytes + vpl_bytes + atlas_bytes);
     if (a->atlas)
         host->stat(host, "shadow_paraboloid", (double)(gi_depth_atlas_get_desc(a->atlas)->projection == GI_PROJ_PARABOLOID));
     if (a->atlas)

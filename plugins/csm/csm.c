@@ -639,6 +639,7 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
     uint64_t distant_segments = segments_total - local_segments;
     host->stat(host, "bytes_uncompressed", (double)bytes_u);
     host->stat(host, "bytes_compressed", (double)bytes_c);
+    host->stat(host, "data_bytes", (double)bytes_c); /* the compressed maps are what render() reads */
     host->stat(host, "ratio", bytes_c ? (double)bytes_u / (double)bytes_c : 0.0);
     host->stat(host, "segments_per_texel", texels > 0 ? (double)distant_segments / texels : 0.0);
     host->stat(host, "maps", (double)distant_objects * c->N * c->N);

@@ -507,6 +507,19 @@ static void check_hulls(cssm_hrc *c, const gi_scene *s, float t)
  * movers, their texels "don't care"), each mover's own CSSM and CSM in its
  * frame, with two or more movers the static objects' CSMs (motion.c). Not
  * cached. */
+/* Compressed sizes of the §3.3 maps of moving objects: their own CSSMs,
+ * their CSMs, and (several movers) the static objects' CSMs. */
+static void motion_bytes(const cssm_motion *m, double *self_bytes, double *csm_bytes, double *static_bytes)
+{
+    *self_bytes = *csm_bytes = *static_bytes = 0.0;
+    for (uint32_t k = 0; m->movers && k < m->mover_count; k++) {
+        *self_bytes += (double)cssm_maps_bytes(&m->movers[k].self);
+        *csm_bytes += (double)m->movers[k].csm.data.bytes_compressed;
+    }
+    for (uint32_t k = 0; m->static_csm && k < m->object_count; k++)
+        *static_bytes += (double)m->static_csm[k].data.bytes_compressed;
+}
+
 static gi_result build_moving(cssm_hrc *c, const gi_gpu_scene *gs, gi_error *err)
 {
     const gi_host *host = c->kit.host;
@@ -521,13 +534,8 @@ static gi_result build_moving(cssm_hrc *c, const gi_gpu_scene *gs, gi_error *err
         return r;
     c->maps.motion = &c->motion;
     host->stat(host, "cache_hit", 0.0);
-    double self_bytes = 0, csm_bytes = 0, static_bytes = 0;
-    for (uint32_t k = 0; k < c->motion.mover_count; k++) {
-        self_bytes += (double)cssm_maps_bytes(&c->motion.movers[k].self);
-        csm_bytes += (double)c->motion.movers[k].csm.data.bytes_compressed;
-    }
-    for (uint32_t k = 0; k < c->motion.object_count; k++)
-        static_bytes += (double)c->motion.static_csm[k].data.bytes_compressed;
+    double self_bytes, csm_bytes, static_bytes;
+    motion_bytes(&c->motion, &self_bytes, &csm_bytes, &static_bytes);
     host->stat(host, "moving_objects", (double)c->motion.mover_count);
     host->stat(host, "moving_cssm_bytes", self_bytes);
     host->stat(host, "moving_csm_bytes", csm_bytes);
@@ -569,6 +577,11 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     uint64_t bc = cssm_maps_bytes(&c->maps), bu = cssm_maps_bytes_uncompressed(&c->maps);
     host->stat(host, "cssm_bytes", (double)bc);
     host->stat(host, "cssm_bytes_uncompressed", (double)bu);
+    double self_bytes, csm_bytes, static_bytes;
+    motion_bytes(&c->motion, &self_bytes, &csm_bytes, &static_bytes);
+    /* data_bytes counts the compressed visibility maps, the bulk of what is
+     * kept; the atlas and the hierarchy are not counted. */
+    host->stat(host, "data_bytes", (double)bc + self_bytes + csm_bytes + static_bytes);
     host->stat(host, "compression_ratio", bc ? (double)bu / (double)bc : 0.0);
     host->stat(host, "segments_per_texel", (double)cssm_maps_segments(&c->maps) / (6.0 * c->M * c->M));
     host->stat(host, "dont_care_share", (double)c->maps.dont_care / (double)c->maps.face_texels);

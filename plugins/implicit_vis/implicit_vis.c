@@ -292,6 +292,14 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
     host->stat(host, "links_created", (double)m->links->created);
     host->stat(host, "leaf_links", (double)m->links->receiving);
     host->stat(host, "light_links", (double)m->links->light_off[m->hier->elem_count]);
+    /* Kept for rendering: the per-node bins (linked node, distance and, with
+     * coverage, the covered solid angle) and each leaf's receiving and light
+     * links (bin + source). The hierarchy's own arrays are not counted. */
+    const iv_links *L = m->links;
+    double bin_bytes = (double)L->nodes * (double)L->bins * (double)(sizeof(int32_t) + sizeof(float) + (L->cover ? sizeof(float) : 0));
+    double leaf_bytes = 2.0 * sizeof(uint32_t) * ((double)L->leaf_off[m->hier->elem_count] + (double)L->light_off[m->hier->elem_count]);
+    host->stat(host, "data_bytes_links", bin_bytes + leaf_bytes);
+    host->stat(host, "data_bytes", bin_bytes + leaf_bytes);
     return GI_OK;
 }
 

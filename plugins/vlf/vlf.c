@@ -279,6 +279,7 @@ static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
     host->stat(host, "tiles", s->tiles);
     host->stat(host, "bytes_propagate", (double)s->bytes_propagate);
     host->stat(host, "bytes_render", (double)s->bytes_render);
+    host->stat(host, "data_bytes", (double)s->bytes_render); /* what rendering keeps after propagation */
     host->stat(host, "bytes_maps_render", (double)s->bytes_maps_render);
     host->stat(host, "gpu_bytes_maps", (double)v->gpu_map_bytes);
     host->stat(host, "samples_transported", (double)s->samples);

@@ -166,6 +166,8 @@ uint32_t gi_depth_atlas_columns(const gi_depth_atlas *a);
 uint32_t gi_depth_atlas_rows(const gi_depth_atlas *a);
 uint32_t gi_depth_atlas_count(const gi_depth_atlas *a); /* views drawn by the last render */
 const gi_depth_atlas_desc *gi_depth_atlas_get_desc(const gi_depth_atlas *a);
+/* GPU memory the atlas holds: its R32F texture and D32F depth buffer. */
+uint64_t gi_depth_atlas_bytes(const gi_depth_atlas *a);
 /* Tile `tile` read back: tile x tile floats, row 0 at the bottom; NULL when
  * tile >= capacity. For tests and CPU-side use. Caller frees. */
 float *gi_depth_atlas_read_tile(const gi_depth_atlas *a, uint32_t tile);
