@@ -22,9 +22,11 @@ the committed runs.csv alone.
 Usage: scripts/compare_all_tables.py DIR > DIR/tables.md
 """
 
-import csv
 import os
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from study_tables import fmt, load_runs_csv, matrix, num, scene_name  # noqa: E402
 
 METHODS = ["csm", "cssm_hrc", "avg", "implicit_vis", "vlf", "direct"]
 PAPER = {
@@ -37,26 +39,11 @@ PAPER = {
 }
 
 
-def num(x):
-    try:
-        v = float(x)
-    except (TypeError, ValueError):
-        return None
-    return v if v == v else None
-
-
-def scene_name(path):
-    return os.path.splitext(os.path.basename(path))[0]
-
-
-def memory_mb(row):
-    """The method's own data, MB: the stat data_bytes when the method
-    reports it; else the process's peak resident memory; else None."""
-    for key, scale in (("stat_data_bytes", 1 / 2**20), ("peak_rss_mb", 1.0), ("peak_rss_kb", 1 / 1024)):
-        v = num(row.get(key))
-        if v is not None:
-            return v * scale
-    return None
+def memory_cells(row):
+    """The method's own data (stat data_bytes) and the render process's
+    peak resident memory, MiB; "–" where not measured."""
+    data = num(row.get("data_bytes"))
+    return fmt(None if data is None else data / 2**20, "%.3g"), fmt(num(row.get("peak_rss_mib")), "%.3g")
 
 
 def with_prep(r):
@@ -74,21 +61,12 @@ def speedup_cell(r, prep):
     return "%.3g%s" % (v, "*" if num(r.get("speedup_extrapolated")) == 1 else "")
 
 
-def fmt(v, spec="%.3g", none="–"):
-    return none if v is None else spec % v
-
-
-def load(d):
-    with open(os.path.join(d, "runs.csv"), newline="") as fh:
-        return list(csv.DictReader(fh))
-
-
 def main():
     if len(sys.argv) != 2:
         sys.exit("usage: compare_all_tables.py DIR")
     d = sys.argv[1]
     try:
-        rows = load(d)
+        rows = load_runs_csv(d)
     except OSError as e:
         sys.exit("compare_all_tables.py: %s" % e)
     if not rows:
@@ -112,6 +90,7 @@ def main():
             reason = r.get("reason", "")
             na.setdefault(key, reason if reason.startswith(r["status"]) else "%s: %s" % (r["status"], reason))
 
+    shown = os.path.relpath(d)
     renderers = sorted({r["renderer"] for r in rows if r.get("renderer")})
     timers = sorted({r["timer"] for r in rows if r.get("timer")})
     sizes = sorted({"%sx%s" % (r["width"], r["height"]) for r in rows if r.get("width")})
@@ -123,7 +102,7 @@ def main():
       "GL renderer: %s; timer: %s; image size %s. Lower relMSE is better. "
       "The per-scene Pareto fronts, equal-error and equal-time tables and "
       "the error-against-time charts are in [report.md](report.md).\n"
-      % (d, d, ", ".join(renderers) or "?", ", ".join(timers) or "?", ", ".join(sizes)))
+      % (shown, shown, ", ".join(renderers) or "?", ", ".join(timers) or "?", ", ".join(sizes)))
 
     def best(key):
         runs = ok.get(key)
@@ -137,24 +116,14 @@ def main():
       "its caps do not cover the scene (the reason is in the per-scene "
       "tables below). **Bold**: not better than the unshadowed direct "
       "baseline on that scene (the trivial answer).\n")
-    w("| method | " + " | ".join(scenes) + " |")
-    w("|---|" + "---:|" * len(scenes))
-    for m in methods:
-        cells = []
-        for s in scenes:
-            b = best((m, s))
-            base = best(("direct", s))
-            if b is None:
-                cells.append("n/a" if (m, s) in na else "–")
-                continue
-            e = num(b["relmse_full"])
-            be = num(base["relmse_full"]) if base else None
-            cell = "%.3g" % e
-            if m != "direct" and be is not None and not e < be:
-                cell = "**%s**" % cell
-            cells.append(cell)
-        w("| %s | %s |" % (m, " | ".join(cells)))
-    w("")
+    def error_cell(m, s):
+        b, base = best((m, s)), best(("direct", s))
+        if b is None:
+            return "n/a" if (m, s) in na else "–"
+        e = num(b["relmse_full"])
+        be = num(base["relmse_full"]) if base else None
+        return "**%.3g**" % e if m != "direct" and be is not None and not e < be else "%.3g" % e
+    matrix(w, methods, scenes, error_cell)
 
     # 2. best equal-error speed-up over the path tracer
     w("## Best equal-error speed-up over path tracing\n")
@@ -166,34 +135,18 @@ def main():
       "tracer's measured curve (4 to 256 samples per pixel), below its most "
       "converged image or above its least converged one, and the path "
       "tracer's time is extrapolated (slope -1 on log-log axes).\n")
-    w("| method | " + " | ".join(scenes) + " |")
-    w("|---|" + "---:|" * len(scenes))
-    for m in methods:
-        cells = []
-        for s in scenes:
-            runs = [r for r in ok.get((m, s), []) if num(r.get("speedup_vs_pt")) is not None]
-            if not runs:
-                cells.append("n/a" if (m, s) in na else "–")
-                continue
-            b = max(runs, key=lambda r: num(r["speedup_vs_pt"]))
-            cells.append(speedup_cell(b, 0))
-        w("| %s | %s |" % (m, " | ".join(cells)))
+    def speedup(m, s, prep):
+        runs = [r for r in ok.get((m, s), []) if (with_prep(r) if prep else num(r.get("speedup_vs_pt"))) is not None]
+        if not runs:
+            return "n/a" if (m, s) in na else "–"
+        return speedup_cell(max(runs, key=(with_prep if prep else lambda r: num(r["speedup_vs_pt"]))), prep)
+    matrix(w, methods, scenes, lambda m, s: speedup(m, s, 0))
     w("")
     w("The same with the method's precomputation paid once: the path tracer's "
       "time to the run's error / (precompute + time to image). This is the "
       "speed-up for a single still image; the per-scene equal-error tables in "
       "report.md amortise precomputation over 100 and 10,000 images.\n")
-    w("| method | " + " | ".join(scenes) + " |")
-    w("|---|" + "---:|" * len(scenes))
-    for m in methods:
-        cells = []
-        for s in scenes:
-            runs = [r for r in ok.get((m, s), []) if with_prep(r) is not None]
-            if not runs:
-                cells.append("n/a" if (m, s) in na else "–")
-                continue
-            cells.append(speedup_cell(max(runs, key=with_prep), 1))
-        w("| %s | %s |" % (m, " | ".join(cells)))
+    matrix(w, methods, scenes, lambda m, s: speedup(m, s, 1))
     w("")
 
     # 3. per scene, each method's most accurate setting
@@ -201,26 +154,27 @@ def main():
     w("Time to image: the sum of frame times up to the first frame within "
       "1 % of the final error. Precompute: `prepare` (in these runs "
       "csm and cssm_hrc, the methods that cache precomputation, run with `\"cache\": false`, so it is measured). Memory: the "
-      "method's own data (stat `data_bytes`) where it reports it, else "
-      "the render process's peak resident memory.\n")
+      "method's own data as it reports it (stat `data_bytes`, what it "
+      "counts is in README \"Memory\") and the render process's peak "
+      "resident memory (on llvmpipe GPU buffers are process memory).\n")
     for s in scenes:
         w("### %s\n" % s)
         w("| method | params | relMSE full | relMSE matched | time to image (s) | "
-          "speed-up | speed-up matched | precompute (s) | memory (MB) |")
-        w("|---|---|---:|---:|---:|---:|---:|---:|---:|")
+          "speed-up | speed-up matched | precompute (s) | data (MiB) | peak RSS (MiB) |")
+        w("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
         for m in methods:
             b = best((m, s))
             if b is None:
                 if (m, s) in na:
-                    w("| %s | %s | | | | | | | |" % (m, na[(m, s)].replace("|", "/")))
+                    w("| %s | %s | | | | | | | | |" % (m, na[(m, s)].replace("|", "/")))
                 continue
             prep = num(b.get("prepare_ms"))
-            w("| %s | `%s` | %s | %s | %s | %s | %s | %s | %s |" % (
+            w("| %s | `%s` | %s | %s | %s | %s | %s | %s | %s | %s |" % (
                 m, b["params"].split(",label=")[0], fmt(num(b["relmse_full"]), "%.4g"),
                 fmt(num(b.get("relmse_matched")), "%.4g"), fmt(num(b.get("time_to_final_error_s")), "%.4g"),
                 speedup_cell(b, 0) if num(b.get("speedup_vs_pt")) is not None else "–",
                 fmt(num(b.get("speedup_vs_pt_matched"))),
-                fmt(None if prep is None else prep / 1000.0, "%.3g"), fmt(memory_mb(b), "%.3g")))
+                fmt(None if prep is None else prep / 1000.0, "%.3g"), *memory_cells(b)))
         w("")
     sys.stdout.write("\n".join(out) + "\n")
 
