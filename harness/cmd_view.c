@@ -11,6 +11,7 @@
 #include "gi/cache.h"
 #include "gi/image.h"
 #include "gi/log.h"
+#include "gi/shader.h"
 #include "gi/timer.h"
 #include "gi/tonemap.h"
 #include "gi/vecmath.h"
@@ -24,8 +25,7 @@
 
 #define PI_F 3.14159265f
 
-static const char display_vs[] = "#version 450 core\n"
-                                 "out vec2 uv;\n"
+static const char display_vs[] = "out vec2 uv;\n"
                                  "void main() {\n"
                                  "    vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);\n"
                                  "    uv = p;\n"
@@ -36,7 +36,6 @@ static const char display_vs[] = "#version 450 core\n"
  * row first) or the method's relative luminance error against it,
  * |L - Lref| / (Lref + 0.01), on a log scale from 1e-3 (blue) to 1 (red). */
 static const char display_fs[] =
-    "#version 450 core\n"
     "in vec2 uv;\n"
     "out vec4 color;\n"
     "layout(binding = 0) uniform sampler2D img;\n"
@@ -75,41 +74,12 @@ static const char display_fs[] =
     "    color = vec4(enc(c.r), enc(c.g), enc(c.b), 1.0);\n"
     "}\n";
 
-static GLuint compile(GLenum type, const char *src, char *why, size_t size)
-{
-    GLuint s = glCreateShader(type);
-    glShaderSource(s, 1, &src, NULL);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        glGetShaderInfoLog(s, (GLsizei)size, NULL, why);
-        glDeleteShader(s);
-        return 0;
-    }
-    return s;
-}
-
 static int build_display(viewer *v)
 {
-    char why[1024] = "";
-    GLuint vs = compile(GL_VERTEX_SHADER, display_vs, why, sizeof why);
-    GLuint fs = vs ? compile(GL_FRAGMENT_SHADER, display_fs, why, sizeof why) : 0;
-    if (!vs || !fs) {
-        if (vs)
-            glDeleteShader(vs);
-        return cli_fail(EXIT_RUN, "view: display shader: %s", why);
-    }
-    v->display_prog = glCreateProgram();
-    glAttachShader(v->display_prog, vs);
-    glAttachShader(v->display_prog, fs);
-    glLinkProgram(v->display_prog);
-    glDeleteShader(vs);
-    glDeleteShader(fs);
-    GLint ok = 0;
-    glGetProgramiv(v->display_prog, GL_LINK_STATUS, &ok);
-    if (!ok)
-        return cli_fail(EXIT_RUN, "view: display shader does not link");
+    gi_error err;
+    v->display_prog = gi_program_build_text("view display", display_vs, display_fs, NULL, &err);
+    if (!v->display_prog)
+        return cli_fail(EXIT_RUN, "view: display shader: %s", err.text);
     glCreateVertexArrays(1, &v->display_vao);
     return EXIT_OK;
 }

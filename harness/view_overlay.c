@@ -7,6 +7,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "view.h"
 
+#include "gi/shader.h"
 #include "gi/timer.h"
 
 #define GLFW_INCLUDE_NONE
@@ -26,8 +27,7 @@ typedef struct ov_vert {
 
 #define OV_MAX_VERTS 60000
 
-static const char ov_vs[] = "#version 450 core\n"
-                            "layout(location = 0) in vec2 p;\n"
+static const char ov_vs[] = "layout(location = 0) in vec2 p;\n"
                             "layout(location = 1) in vec4 c;\n"
                             "uniform vec2 size;\n"
                             "out vec4 col;\n"
@@ -35,8 +35,7 @@ static const char ov_vs[] = "#version 450 core\n"
                             "    col = c;\n"
                             "    gl_Position = vec4(p.x / size.x * 2.0 - 1.0, 1.0 - p.y / size.y * 2.0, 0.0, 1.0);\n"
                             "}\n";
-static const char ov_fs[] = "#version 450 core\n"
-                            "in vec4 col;\n"
+static const char ov_fs[] = "in vec4 col;\n"
                             "out vec4 color;\n"
                             "void main() { color = col; }\n";
 
@@ -46,20 +45,6 @@ typedef struct overlay {
     int n;
 } overlay;
 
-static GLuint ov_shader(GLenum type, const char *src)
-{
-    GLuint s = glCreateShader(type);
-    glShaderSource(s, 1, &src, NULL);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        glDeleteShader(s);
-        return 0;
-    }
-    return s;
-}
-
 int view_overlay_init(viewer *v)
 {
     overlay *o = calloc(1, sizeof *o);
@@ -67,23 +52,9 @@ int view_overlay_init(viewer *v)
         return 0;
     v->overlay = o;
     o->verts = malloc(OV_MAX_VERTS * sizeof *o->verts);
-    GLuint vs = ov_shader(GL_VERTEX_SHADER, ov_vs), fs = ov_shader(GL_FRAGMENT_SHADER, ov_fs);
-    if (!o->verts || !vs || !fs) {
-        if (vs)
-            glDeleteShader(vs);
-        if (fs)
-            glDeleteShader(fs);
-        return 0;
-    }
-    o->prog = glCreateProgram();
-    glAttachShader(o->prog, vs);
-    glAttachShader(o->prog, fs);
-    glLinkProgram(o->prog);
-    glDeleteShader(vs);
-    glDeleteShader(fs);
-    GLint ok = 0;
-    glGetProgramiv(o->prog, GL_LINK_STATUS, &ok);
-    if (!ok)
+    gi_error err;
+    o->prog = o->verts ? gi_program_build_text("view overlay", ov_vs, ov_fs, NULL, &err) : 0;
+    if (!o->prog)
         return 0;
     glCreateBuffers(1, &o->vbo);
     glNamedBufferStorage(o->vbo, OV_MAX_VERTS * sizeof(ov_vert), NULL, GL_DYNAMIC_STORAGE_BIT);

@@ -285,11 +285,9 @@ static GLuint compile_text(GLenum type, const char *text, const expansion *ex, c
     return sh;
 }
 
-static GLuint compile_named(GLenum type, const char *name, const char *defines, gi_error *err)
+/* Compiles one stage of `src` with the stage's define (GI_VERTEX_SHADER, ...). */
+static GLuint compile_source(GLenum type, const gi_shader_source *src, const char *defines, gi_error *err)
 {
-    const gi_shader_source *src = lookup(name, NULL, err);
-    if (!src)
-        return 0;
     expansion ex = {0};
     const char *stage = type == GL_VERTEX_SHADER     ? "#define GI_VERTEX_SHADER 1\n"
                         : type == GL_FRAGMENT_SHADER ? "#define GI_FRAGMENT_SHADER 1\n"
@@ -301,6 +299,12 @@ static GLuint compile_named(GLenum type, const char *name, const char *defines, 
     GLuint sh = compile_text(type, text, &ex, src->path, err);
     free(text);
     return sh;
+}
+
+static GLuint compile_named(GLenum type, const char *name, const char *defines, gi_error *err)
+{
+    const gi_shader_source *src = lookup(name, NULL, err);
+    return src ? compile_source(type, src, defines, err) : 0;
 }
 
 static GLuint link_program(GLuint *shaders, int n, const char *label, gi_error *err)
@@ -359,11 +363,21 @@ GLuint gi_program_build_compute_text(const char *label, const char *text, const 
                                      gi_error *err)
 {
     gi_shader_source src = {label, label, text};
-    expansion ex = {0};
-    char *full = expand(&src, "#define GI_COMPUTE_SHADER 1\n", defines, &ex, err);
-    if (!full)
-        return 0;
-    GLuint s = compile_text(GL_COMPUTE_SHADER, full, &ex, label, err);
-    free(full);
+    GLuint s = compile_source(GL_COMPUTE_SHADER, &src, defines, err);
     return s ? link_program(&s, 1, label, err) : 0;
+}
+
+GLuint gi_program_build_text(const char *label, const char *vert_text, const char *frag_text, const char *defines,
+                             gi_error *err)
+{
+    gi_shader_source vs = {label, label, vert_text}, fs = {label, label, frag_text};
+    GLuint sh[2] = {compile_source(GL_VERTEX_SHADER, &vs, defines, err), 0};
+    if (sh[0])
+        sh[1] = compile_source(GL_FRAGMENT_SHADER, &fs, defines, err);
+    if (!sh[1]) {
+        if (sh[0])
+            glDeleteShader(sh[0]);
+        return 0;
+    }
+    return link_program(sh, 2, label, err);
 }
