@@ -7,7 +7,8 @@ accurate but puts 5 % of the energy where the reference is dark (its own
 noise there 0.1 %), "bad" is worse than the baseline and "half" is at 0.6
 of it, and "declines" was refused; an animated scene where "shaky" flickers
 at 5x the noise floor and "steady" at 0.5x; scale runs whose frame time is
-T^1.5. Every verdict, the declined reason and the exponent must come out
+T^1.5, vlf's precomputation T^1 (its paper's claim) and implicit_vis's T^2
+(outside its N log N). Every verdict, the declined reason and the exponent must come out
 as stated, and a folder without runs must be refused with exit 1.
 """
 import csv
@@ -33,7 +34,7 @@ def add(scene, method, label, status="ok", **v):
     rows.append(r)
     recs.append({"run": r["run"], "scene": r["scene"], "method": method, "label": label, "status": status,
                  "reason": r["reason"], "scene_triangles": v.get("scene_triangles"),
-                 "frame_ms": {"median": v.get("frame_ms")}})
+                 "frame_ms": {"median": v.get("frame_ms")}, "prepare_ms": v.get("prepare_ms")})
 
 
 add("room", "direct", "static", relmse_full=1.0, relmse_matched=1.0, leaked_energy_full=0.04, dark_energy_ref_full=0.001)
@@ -47,6 +48,8 @@ add("orbit", "shaky", "animation", anim_relmse_full_mean=0.1, anim_flicker_full=
 add("orbit", "steady", "animation", anim_relmse_full_mean=0.1, anim_flicker_full=0.005, anim_noise_floor_full=0.01)
 for t in (100, 400, 1600, 6400):
     add("scale_%d" % t, "good", "scale", scene_triangles=t, frame_ms=0.01 * t ** 1.5)
+    add("scale_%d" % t, "vlf", "scale", scene_triangles=t, prepare_ms=0.5 * t)
+    add("scale_%d" % t, "implicit_vis", "scale", scene_triangles=t, prepare_ms=1e-3 * t * t)
 with open(os.path.join(out, "runs.csv"), "w", newline="") as fh:
     wr = csv.DictWriter(fh, fieldnames=cols)
     wr.writeheader()
@@ -81,6 +84,8 @@ expect("| declines | room | n/a: no point lights")
 expect("| orbit | shaky |", "flickers")
 expect("| orbit | steady |", "| ok |")
 expect("| good | 100–6400 | 1.50 [")
+expect("| vlf | prepare_ms |", "| consistent |")
+expect("| implicit_vis | prepare_ms |", "| 2.00 [", "| not consistent |")
 empty = os.path.join(out, "empty")
 os.makedirs(empty, exist_ok=True)
 open(os.path.join(empty, "runs.csv"), "w").write(",".join(cols) + "\n")
