@@ -127,8 +127,8 @@ static const gi_method direct_method = {
     .citation = "gibench baseline: direct light without visibility",
     .version = "1.0",
     .caps = GI_CAP_DIRECT | GI_CAP_GLOSSY | GI_CAP_MIRROR | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS |
-            GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION | GI_CAP_PROGRESSIVE |
-            GI_CAP_TEXTURES,
+            GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION | GI_CAP_DEFORMATION |
+            GI_CAP_PROGRESSIVE | GI_CAP_TEXTURES,
     .max_bounces = 0,
     .params = direct_params,
     .create = direct_create,
