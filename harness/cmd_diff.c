@@ -16,7 +16,7 @@
 
 typedef struct diff_opts {
     const char *test, *ref, *heatmap, *flip_map;
-    int json;
+    int json, black;
     gi_metrics_opts m;
 } diff_opts;
 
@@ -37,8 +37,8 @@ static int parse_opts(int argc, char **argv, diff_opts *o)
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "--json")) {
-            o->json = 1;
+        if (!strcmp(a, "--json") || !strcmp(a, "--black")) {
+            *(a[2] == 'j' ? &o->json : &o->black) = 1;
             continue;
         }
         if (a[0] != '-' || !a[1]) {
@@ -77,6 +77,17 @@ static int parse_opts(int argc, char **argv, diff_opts *o)
                 o->m.flip_ppd > 1e4f)
                 return cli_fail(EXIT_USAGE, "diff: --ppd '%s' is not a number in (0, 10000]", v);
         }
+    }
+    if (o->black) {
+        /* The trivial answer: a black image of the reference's size. */
+        if (o->ref)
+            return cli_fail(EXIT_USAGE, "diff: --black takes the reference image only (gibench diff --black "
+                                        "REFERENCE)");
+        o->ref = o->test;
+        o->test = NULL;
+        if (!o->ref)
+            return cli_fail(EXIT_USAGE, "diff: --black needs the reference image (gibench diff --black REFERENCE)");
+        return EXIT_OK;
     }
     if (!o->test || !o->ref)
         return cli_fail(
@@ -195,14 +206,17 @@ int cmd_diff(int argc, char **argv)
     if (rc)
         return rc;
     gi_error err;
-    gi_image *t = read_linear(o.test, &err);
-    if (!t)
-        return cli_fail(EXIT_USAGE, "diff: %s", err.text);
     gi_image *r = read_linear(o.ref, &err);
-    if (!r) {
-        gi_image_free(t);
+    if (!r)
         return cli_fail(EXIT_USAGE, "diff: %s", err.text);
+    gi_image *t = o.black ? gi_image_create(r->width, r->height) : read_linear(o.test, &err);
+    if (!t) {
+        gi_image_free(r);
+        return o.black ? cli_fail(EXIT_RUN, "diff: out of memory for the black image")
+                       : cli_fail(EXIT_USAGE, "diff: %s", err.text);
     }
+    if (o.black)
+        o.test = "black";
     if (t->width != r->width || t->height != r->height) {
         rc = cli_fail(EXIT_USAGE,
                       "diff: image sizes differ: test %s is %ux%u, reference %s is %ux%u", o.test,

@@ -56,9 +56,11 @@ static const command_help helps[] = {
     {"diff",
      "usage: gibench diff TEST REFERENCE [--json] [--heatmap FILE.png] [--flip-map FILE.png]\n"
      "                    [--exposure EV] [--ppd N] [--dark-threshold F]\n"
+     "       gibench diff --black REFERENCE [options]\n"
      "Error metrics of TEST against REFERENCE: RMSE, relMSE, MAE, PSNR, SSIM, FLIP, mean luminance,\n"
      "leaked energy (TEST's light where REFERENCE is dark).\n"
      "  --json             as JSON\n"
+     "  --black            score a black image of REFERENCE's size (the trivial answer) in place of TEST\n"
      "  --heatmap FILE     relative error map with its colour bar (log scale)\n"
      "  --flip-map FILE    FLIP map\n"
      "  --exposure EV      stops before tonemapping (PSNR, SSIM, FLIP)\n"

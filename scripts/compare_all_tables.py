@@ -26,7 +26,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from study_tables import fmt, load_runs_csv, matrix, num, scene_name  # noqa: E402
+from study_tables import fmt, load_references, load_runs_csv, load_trivial, matrix, num, scene_name  # noqa: E402
 
 METHODS = ["csm", "cssm_hrc", "avg", "implicit_vis", "vlf", "direct"]
 PAPER = {
@@ -110,20 +110,42 @@ def main():
             return None
         return min(runs, key=lambda r: num(r["relmse_full"]))
 
-    # 1. best error per method and scene, with the baseline's beside it
+    # 1. best error per method and scene, with the trivial answers' beside it
+    refs, trivial = load_references(d), load_trivial(d)
+
+    def black(s):
+        """The black image's relMSE against scene s's full-GI reference."""
+        names = {refs[r["run"]][0] for r in rows if scene_name(r["scene"]) == s and r["run"] in refs}
+        got = [trivial[n] for n in names if trivial.get(n) is not None]
+        return got[0] if len(got) == 1 else None
+
+    def trivial_best(s):
+        """The better of the two trivial answers on scene s: the unshadowed
+        direct baseline's best setting and the black image."""
+        base = best(("direct", s))
+        vals = [v for v in (num(base["relmse_full"]) if base else None, black(s)) if v is not None]
+        return min(vals) if vals else None
+
     w("## Best relMSE against the full-GI reference\n")
     w("Each cell: the method's most accurate setting of its sweep. \"n/a\": "
       "its caps do not cover the scene (the reason is in the per-scene "
-      "tables below). **Bold**: not better than the unshadowed direct "
-      "baseline on that scene (the trivial answer).\n")
+      "tables below). The trivial answers on the same reference: the "
+      "unshadowed direct baseline (`direct`) and a black image (`black`, "
+      "scored by `scripts/trivial_scores.py` into `trivial.csv`); relMSE "
+      "weighs an over-bright pixel without bound and a black one at most 1, "
+      "so black is hard to beat where a scene is mostly dim. **Bold**: not "
+      "better than the better of the two.\n")
+
     def error_cell(m, s):
-        b, base = best((m, s)), best(("direct", s))
+        if m == "black":
+            return fmt(black(s))
+        b = best((m, s))
         if b is None:
             return "n/a" if (m, s) in na else "–"
-        e = num(b["relmse_full"])
-        be = num(base["relmse_full"]) if base else None
-        return "**%.3g**" % e if m != "direct" and be is not None and not e < be else "%.3g" % e
-    matrix(w, methods, scenes, error_cell)
+        e, t = num(b["relmse_full"]), trivial_best(s)
+        return "**%.3g**" % e if m != "direct" and t is not None and not e < t else "%.3g" % e
+    matrix(w, methods + (["black"] if trivial else []), scenes, error_cell)
+    w("")
 
     # 2. best equal-error speed-up over the path tracer
     w("## Best equal-error speed-up over path tracing\n")

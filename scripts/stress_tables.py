@@ -33,12 +33,13 @@ Usage: scripts/stress_tables.py DIR > DIR/tables.md
 import json
 import math
 import os
+import re
 import struct
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from scale_fit import field, fit  # noqa: E402
-from study_tables import fmt, load_runs_csv, matrix, num, scene_name  # noqa: E402
+from study_tables import fmt, load_references, load_runs_csv, load_trivial, matrix, num, scene_name  # noqa: E402
 
 METHODS = ["direct", "csm", "cssm_hrc", "avg", "implicit_vis", "vlf"]
 LEAK_SHARE = 0.01      # leaks: above 1 % of the reference's energy ...
@@ -69,16 +70,6 @@ def scene_purpose(path):
         return doc.get("asset", {}).get("extras", {}).get("gibench", {}).get("isolates", "")
     except (OSError, ValueError, struct.error):
         return ""
-
-
-def matched_refs(records):
-    """run id -> the path of its bounce-matched reference."""
-    out = {}
-    for r in records:
-        ref = ((r.get("metrics") or {}).get("matched") or {}).get("reference") or {}
-        if r.get("run") and ref.get("path"):
-            out[r["run"]] = ref["path"]
-    return out
 
 
 def reason(r):
@@ -122,17 +113,35 @@ def main():
     if not rows or not isinstance(records, list):
         sys.exit("stress_tables.py: %s has no runs" % d)
 
-    refs = matched_refs(records)
+    refs, trivial = load_references(d), load_trivial(d)
+    by_run = {r.get("run"): r for r in records}
+
+    def black(run, which):
+        """The black image's relMSE against run's full-GI (which 0) or
+        bounce-matched (1) reference; for an animated run the mean over its
+        frames' references (named by scene time, as the study names them)."""
+        name = refs.get(run, ("", ""))[which]
+        if not name:
+            return None
+        times = ((by_run.get(run) or {}).get("animation") or {}).get("scene_time")
+        if not times:
+            return trivial.get(name)
+        got = [trivial.get(re.sub(r"_t[-0-9.e+]+_b", "_t%g_b" % t, name, count=1)) for t in times]
+        return sum(got) / len(got) if got and None not in got else None
 
     def judged(r, base, key_full, key_matched):
-        """The error a run is judged on and its baseline's on the same
-        data: full GI, or for a method whose bounce-matched reference is
-        the baseline's own (direct light only) that reference."""
-        if base is None or base["status"] != "ok":
-            return num(r.get(key_full)), None, ""
-        if refs.get(r["run"]) and refs.get(r["run"]) == refs.get(base["run"]):
-            return num(r.get(key_matched)), num(base.get(key_matched)), "†"
-        return num(r.get(key_full)), num(base.get(key_full)), ""
+        """The error a run is judged on and the better trivial answer's on
+        the same data (the direct baseline's, the black image's): full GI,
+        or for a method whose bounce-matched reference is the baseline's own
+        (direct light only) that reference."""
+        which, mark = 0, ""
+        if base is not None and base["status"] == "ok" and refs.get(r["run"]) and \
+                refs[r["run"]][1] == refs.get(base["run"], ("", ""))[1]:
+            which, mark = 1, "†"
+        key = key_matched if which else key_full
+        vals = [v for v in (num(base.get(key)) if base is not None and base["status"] == "ok" else None,
+                            black(r["run"], which)) if v is not None]
+        return num(r.get(key)), (min(vals) if vals else None), mark
 
     shown = os.path.relpath(d)
     out = []
@@ -147,11 +156,14 @@ def main():
       "entries). The report with every metric, the per-frame charts and the images "
       "is [report.md](report.md).\n" % (shown, shown, ", ".join(renderers) or "?",
                                          ", ".join(timers) or "?", ", ".join(sizes)))
-    w("Verdicts: **fails**: relMSE not below the unshadowed direct baseline's "
-      "(the trivial answer); **leaks**: leaked energy above %g %% of the "
+    w("Verdicts: **fails**: relMSE not below the better of the trivial "
+      "answers on the same reference, the unshadowed direct baseline and a "
+      "black image (scored by `scripts/trivial_scores.py` into "
+      "`trivial.csv`; relMSE weighs an over-bright pixel without bound and "
+      "a black one at most 1); **leaks**: leaked energy above %g %% of the "
       "reference's total and above %gx the reference's own energy in its dark "
       "pixels; **flickers**: flicker above %gx the references' noise floor; "
-      "**degraded**: relMSE at least %g of the baseline's; **ok**: none.\n"
+      "**degraded**: relMSE at least %g of that; **ok**: none.\n"
       % (100 * LEAK_SHARE, LEAK_OVER_REF, FLICKER_OVER_FLOOR, DEGRADED_SHARE))
 
     scenes = []
@@ -187,9 +199,16 @@ def main():
           "where it is the baseline's own (methods of direct light only, "
           "which full GI would fault for the indirect light they do not "
           "claim); \"n/a\": the method declines the scene (reason in the "
-          "last table).\n")
+          "last table). The row `black` is the black image against the same "
+          "references (in brackets: against the baseline's bounce-matched "
+          "one, the data of the † verdicts).\n")
 
         def static_cell(m, s):
+            if m == "black":
+                base = st.get(("direct", s))
+                if base is None:
+                    return "–"
+                return "%s (%s) trivial" % (fmt(black(base["run"], 0)), fmt(black(base["run"], 1)))
             r = st.get((m, s))
             if r is None:
                 return "–"
@@ -200,7 +219,7 @@ def main():
             e, be, mark = judged(r, st.get(("direct", s)), "relmse_full", "relmse_matched")
             v = verdict(e, be, num(r.get("leaked_energy_full")), num(r.get("dark_energy_ref_full")))
             return "%s (%s) %s%s" % (fmt(num(r.get("relmse_full"))), fmt(num(r.get("relmse_matched"))), v, mark)
-        matrix(w, methods, sc, static_cell)
+        matrix(w, methods + (["black"] if trivial else []), sc, static_cell)
         w("")
         w("## Static cases: leaked energy\n")
         w("Each cell: the method's energy in the pixels the reference shows "
@@ -256,6 +275,8 @@ def main():
                 w("| %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
                     s, m, fmt(e), fmt(num(r.get("anim_relmse_full_max"))), fmt(num(r.get("anim_relmse_matched_mean"))),
                     fmt(num(r.get("anim_frame_ms_median"))), fmt(fl, "%.2g"), fmt(floor, "%.2g"), v))
+            if trivial and b is not None:
+                w("| %s | black | %s | | %s | | | | trivial |" % (s, fmt(black(b["run"], 0)), fmt(black(b["run"], 1))))
         w("")
 
     # scale

@@ -2,6 +2,7 @@
 Markdown tables (compare_all_tables.py, stress_tables.py). Stdlib only."""
 
 import csv
+import json
 import os
 
 
@@ -34,3 +35,31 @@ def matrix(w, rows, cols, cell):
     w("|---|" + "---:|" * len(cols))
     for r in rows:
         w("| %s | %s |" % (r, " | ".join(cell(r, c) for c in cols)))
+
+
+def load_references(d):
+    """run id -> (full-GI reference file name, bounce-matched one), from
+    DIR/runs.json; {} when the study has none."""
+    try:
+        with open(os.path.join(d, "runs.json")) as fh:
+            records = json.load(fh)
+    except (OSError, ValueError):
+        return {}
+    out = {}
+    for r in records if isinstance(records, list) else []:
+        m = r.get("metrics") or {}
+        names = tuple(os.path.basename(((m.get(k) or {}).get("reference") or {}).get("path") or "")
+                      for k in ("full", "matched"))
+        if r.get("run") and names[0]:
+            out[r["run"]] = names
+    return out
+
+
+def load_trivial(d):
+    """reference file name -> the black image's relMSE against it, from
+    DIR/trivial.csv (scripts/trivial_scores.py); {} without one."""
+    try:
+        with open(os.path.join(d, "trivial.csv"), newline="") as fh:
+            return {r["reference"]: num(r["relmse"]) for r in csv.DictReader(fh)}
+    except OSError:
+        return {}

@@ -77,6 +77,21 @@ string(JSON w GET "${j}" test width)
 string(JSON h GET "${j}" test height)
 check(w GREATER 512 AND h EQUAL 256 MESSAGE "heat map is ${w}x${h}, expected wider than 512 and 256 high")
 
+# The trivial answer --black: a black image of the reference's size; its
+# mean luminance and leaked energy are 0, its relMSE lies in (0, 1) (each
+# pixel's r^2 / (r^2 + eps) is below 1), its path is "black".
+run(0 j diff --black ${IMG} --json)
+string(JSON t GET "${j}" test path)
+string(JSON w GET "${j}" test width)
+string(JSON lum GET "${j}" mean_lum_test)
+string(JSON leak GET "${j}" leaked_energy)
+string(JSON rel GET "${j}" relmse)
+check(t STREQUAL "black" AND w EQUAL 512 MESSAGE "diff --black: test '${t}', width ${w}")
+check(lum EQUAL 0 AND leak EQUAL 0 MESSAGE "diff --black: mean luminance ${lum}, leaked energy ${leak}, expected 0")
+check(rel GREATER 0 AND rel LESS 1 MESSAGE "diff --black: relMSE ${rel}, expected in (0, 1)")
+run(2 text diff --black)
+run(2 text diff --black ${IMG} ${IMG})
+
 # Bad input and usage: exit 2 with one line.
 run(2 text diff ${OUT}/no-such-image.exr ${IMG})
 string(FIND "${text}" "no-such-image.exr" pos)

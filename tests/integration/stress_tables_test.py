@@ -9,7 +9,8 @@ of it, "declines" was refused, and "shadows" (direct light only, sharing the
 baseline's bounce-matched reference) is worse than the baseline on full GI
 but far better on that reference, where it must be judged; an animated scene where "shaky" flickers
 at 5x the noise floor and "steady" at 0.5x; scale runs whose frame time is
-T^1.5, vlf's precomputation T^1 (its paper's claim) and implicit_vis's T^2
+T^1.5, in a dim scene where a black image scores 0.2 (trivial.csv) "dimbad"
+at 0.5 fails though far below the baseline's 3.0; vlf's precomputation T^1 (its paper's claim) and implicit_vis's T^2
 (outside its N log N). Every verdict, the declined reason and the exponent must come out
 as stated, and a folder without runs must be refused with exit 1.
 """
@@ -37,7 +38,8 @@ def add(scene, method, label, status="ok", mref=None, **v):
     recs.append({"run": r["run"], "scene": r["scene"], "method": method, "label": label, "status": status,
                  "reason": r["reason"], "scene_triangles": v.get("scene_triangles"),
                  "frame_ms": {"median": v.get("frame_ms")}, "prepare_ms": v.get("prepare_ms"),
-                 "metrics": {"matched": {"reference": {"path": mref or "refs/%s_%s.exr" % (scene, method)}}}})
+                 "metrics": {"full": {"reference": {"path": "refs/%s_b64.exr" % scene}},
+                             "matched": {"reference": {"path": mref or "refs/%s_%s.exr" % (scene, method)}}}})
 
 
 add("room", "direct", "static", mref="refs/room_b1.exr", relmse_full=1.0, relmse_matched=1.0,
@@ -52,6 +54,9 @@ add("room", "declines", "static", status="n/a", reason="n/a: no point lights")
 add("orbit", "direct", "animation", anim_relmse_full_mean=1.0, anim_flicker_full=0.0, anim_noise_floor_full=0.01)
 add("orbit", "shaky", "animation", anim_relmse_full_mean=0.1, anim_flicker_full=0.05, anim_noise_floor_full=0.01)
 add("orbit", "steady", "animation", anim_relmse_full_mean=0.1, anim_flicker_full=0.005, anim_noise_floor_full=0.01)
+add("dim", "direct", "static", relmse_full=3.0, relmse_matched=3.0)
+add("dim", "dimgood", "static", relmse_full=0.05, relmse_matched=0.05)
+add("dim", "dimbad", "static", relmse_full=0.5, relmse_matched=0.5)
 for t in (100, 400, 1600, 6400):
     add("scale_%d" % t, "good", "scale", scene_triangles=t, frame_ms=0.01 * t ** 1.5)
     add("scale_%d" % t, "vlf", "scale", scene_triangles=t, prepare_ms=0.5 * t)
@@ -62,6 +67,8 @@ with open(os.path.join(out, "runs.csv"), "w", newline="") as fh:
     wr.writerows(rows)
 with open(os.path.join(out, "runs.json"), "w") as fh:
     json.dump(recs, fh)
+with open(os.path.join(out, "trivial.csv"), "w") as fh:
+    fh.write("reference,relmse,rmse,mae,mean_lum_ref\nroom_b64.exr,5,1,1,1\ndim_b64.exr,0.2,1,1,1\n")
 
 p = subprocess.run([sys.executable, script, out], capture_output=True, text=True)
 if p.returncode != 0:
@@ -93,6 +100,9 @@ expect("| good | 100–6400 | 1.50 [")
 expect("| vlf | prepare_ms |", "| consistent |")
 expect("| implicit_vis | frame_ms.median |", "| 2.00 [", "| 2.00 |", "| not consistent |")
 expect("| shadows | 1.2 (0.05) ok†")
+expect("| dimgood | – | 0.05 (0.05) ok")
+expect("| dimbad | – | 0.5 (0.5) fails")
+expect("| black | 5 (–) trivial | 0.2 (–) trivial")
 empty = os.path.join(out, "empty")
 os.makedirs(empty, exist_ok=True)
 open(os.path.join(empty, "runs.csv"), "w").write(",".join(cols) + "\n")
