@@ -7,7 +7,7 @@
 set(failures 0)
 # study folder, script, extra arguments
 set(cases "avg|avg_tables.py|${GIB}" "csm|csm_tables.py|" "csm_local|csm_tables.py|" "vlf|vlf_tables.py|"
-          "stress|stress_tables.py|")
+          "stress|stress_tables.py|" "compare_all|compare_all_tables.py|")
 foreach(c ${cases})
     string(REPLACE "|" ";" parts "${c}")
     list(GET parts 0 study)
