@@ -1,6 +1,6 @@
 # Front door. `make demo` and `make test` each do the whole set-up (Debian
 # packages, configure, build) and then their job.
-.PHONY: all deps build test test-release test-asan demo clean
+.PHONY: all deps build test test-release test-asan demo results clean
 
 BUILD_DIR := build/release
 ASAN_DIR := build/asan
@@ -38,6 +38,11 @@ test-asan: deps
 demo: build
 	$(GIBENCH) study harness/studies/demo.json --out $(DEMO_OUT)
 	@echo "demo: report in $(DEMO_OUT)/report.md and $(DEMO_OUT)/index.html"
+
+# Every committed study under results/ afresh, with its tables (hours on
+# llvmpipe; scripts/regenerate_results.sh STUDY... for one).
+results: build
+	GIBENCH=$(GIBENCH) scripts/regenerate_results.sh
 
 clean:
 	rm -rf build $(DEMO_OUT)
