@@ -536,6 +536,12 @@ int view_save(const viewer *v, const char *path)
 int view_screenshot(viewer *v, const char *prefix)
 {
     gi_image *img = NULL;
+    if (v->method_index >= 0 && v->stale) {
+        /* the method could not follow a change: its black target is not
+         * an image of this view, and the view file would claim it is */
+        gi_log(GI_LOG_WARN, "view: no screenshot %s: %s", prefix, v->status);
+        return EXIT_OK;
+    }
     if (v->method_index < 0) {
         uint64_t spp = 0;
         img = view_ref_take(&v->ref, 1, &spp);
@@ -707,8 +713,10 @@ void view_button(viewer *v, int button, int press, double x, double y, int mods)
         return;
     }
     if (press && button == GLFW_MOUSE_BUTTON_LEFT && (mods & (GLFW_MOD_SHIFT | GLFW_MOD_CONTROL))) {
-        /* Shift: move the object under the mouse in the view plane; Ctrl: rotate it */
-        int rc = view_pick(v, x, y, (mods & GLFW_MOD_CONTROL) ? 2 : 1);
+        /* Shift: move the selected light (key L), or else the object under
+         * the mouse, in the view plane; Ctrl: rotate the object */
+        int rc = v->sel_light >= 0 && !(mods & GLFW_MOD_CONTROL) ? view_light_pick(v, x, y)
+                                                                 : view_pick(v, x, y, (mods & GLFW_MOD_CONTROL) ? 2 : 1);
         if (rc != EXIT_OK && v->script)
             v->exit_code = rc;
         v->mx = x;

@@ -109,8 +109,9 @@ static const command_help helps[] = {
      "  --screenshot-dir DIR   where keys P (screenshot) and V (save view) write (default .)\n"
      "  --script FILE          replay key and mouse events from FILE, then exit (README \"gibench view\")\n"
      "Keys: M/N next/previous method, R reference, mouse left orbit, right dolly, middle pan, wheel zoom,\n"
-     "Shift+left drag move the object under the mouse, Ctrl+left drag rotate it, L select a light,\n"
-     "Shift+W/A/S/D/Q/E move it, W/A/S/D/Q/E fly, arrows orbit, C next scene camera, TAB/PgUp/PgDn\n"
+     "Shift+left drag move the object under the mouse, Ctrl+left drag rotate it, L select a light\n"
+     "(then Shift+left drag or Shift+W/A/S/D/Q/E move it), W/A/S/D/Q/E fly, arrows orbit, C next scene\n"
+     "camera, TAB/PgUp/PgDn\n"
      "parameters, X split view, O overlay, SPACE play/pause, ,/. time step, [/] or -/= exposure,\n"
      "P screenshot, V save view, ESC quit.\n"},
     {"help", "usage: gibench help [COMMAND]\nThe list of commands, or the help of one.\n"},

@@ -87,7 +87,7 @@ typedef struct viewer {
     unsigned char *file_animated; /* per object: animated by the scene file */
     struct gi_rt *pick_rt;        /* the scene placed for picking; NULL after a change */
     int sel_object, sel_light;    /* -1: none */
-    int drag_object, drag_node;   /* 1 moving the picked object's node, 2 rotating it; 0 none */
+    int drag_object, drag_node;   /* 1 moving the picked object's (or the selected light's) node, 2 rotating it; 0 none */
     double drag_x0, drag_y0;
     float drag_trs[10];
     gi_vec3 drag_origin, drag_pivot;
@@ -142,8 +142,11 @@ void view_go_stale(viewer *v);
  * or rotating (mode 2) it. */
 int view_pick(viewer *v, double x, double y, int mode);
 int view_drag_to(viewer *v, double x, double y);
-/* Key L: the next punctual light; Shift+W/A/S/D/Q/E: moves it along dir. */
+/* Key L: the next punctual light; Shift+W/A/S/D/Q/E: moves it along dir;
+ * Shift+drag (view_light_pick, then view_drag_to): moves it in the plane
+ * facing the camera through it, following the mouse. */
 int view_light_select(viewer *v);
+int view_light_pick(viewer *v, double x, double y);
 int view_light_move(viewer *v, gi_vec3 dir);
 
 /* The overlay (view_overlay.c): made once the context is current, drawn

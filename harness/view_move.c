@@ -1,5 +1,6 @@
 /* gibench view: objects picked with the mouse and moved or rotated, lights
- * moved with keys (README.md "gibench view", "Moving objects and lights").
+ * selected with key L and moved with keys or dragged with the mouse
+ * (README.md "gibench view", "Moving objects and lights").
  * A move writes the node's translation and rotation into the viewer's own
  * copy of the scene, places the GPU scene again (gi_gpu_scene_set_time, as
  * the animation does) and tells the method through update() with the
@@ -109,8 +110,8 @@ void view_describe_nodes(const viewer *v, view_file *f)
  * where its caps cannot follow, no image and a message on screen. */
 int view_tell_method(viewer *v, const unsigned char *moved)
 {
-    if (!v->inst)
-        return EXIT_OK;
+    if (!v->inst || v->stale)
+        return EXIT_OK; /* a stale method stays so (and said so once) until it is made again */
     gi_changes ch = {0, v->time, 0};
     view_scene_changes(v->scene, moved, &ch.flags, &ch.moved_objects);
     if ((ch.flags & GI_CHANGED_TRANSFORMS) && !(v->m->caps & GI_CAP_RIGID_MOTION)) {
@@ -298,12 +299,48 @@ int view_light_select(viewer *v)
             free(moved);
         }
         snprintf(v->status, sizeof v->status, "light %d '%s' selected%s", v->sel_light, l->name ? l->name : "",
-                 animated ? " (animated by the scene: it cannot be moved by hand)" : " (Shift+W/A/S/D/Q/E moves it)");
+                 animated ? " (animated by the scene: it cannot be moved by hand)"
+                          : " (Shift+drag or Shift+W/A/S/D/Q/E moves it; L again until none to pick objects)");
         if (animated)
             v->sel_light = -1;
     } else {
         snprintf(v->status, sizeof v->status, "no light selected");
     }
+    return EXIT_OK;
+}
+
+int view_light_pick(viewer *v, double x, double y)
+{
+    if (v->sel_light < 0)
+        return EXIT_OK;
+    const gi_light *l = &v->scene->lights[v->sel_light];
+    int node = l->node;
+    float world[16];
+    gi_scene_node_transform(v->scene, node, v->time, world);
+    gi_vec3 pos = gi_v3(world[12], world[13], world[14]);
+    gi_camera_frame cf = view_camera(v);
+    float depth = gi_v3_dot(gi_v3_sub(pos, cf.eye), gi_v3_normalize(cf.forward));
+    if (!(depth > cf.znear)) {
+        /* no plane facing the camera through it that the mouse can reach */
+        snprintf(v->status, sizeof v->status,
+                 "light %d '%s' is behind the camera: orbit to see its place, or move it with Shift+W/A/S/D/Q/E",
+                 v->sel_light, l->name ? l->name : "");
+        return EXIT_OK;
+    }
+    if (gi_log_get_level() >= GI_LOG_WARN)
+        printf("view: picked light %d '%s' at depth %.4g (move)\n", v->sel_light, l->name ? l->name : "",
+               (double)depth);
+    v->drag_object = 1;
+    v->drag_node = node;
+    v->drag_x0 = x;
+    v->drag_y0 = y;
+    get_trs(&v->scene->nodes[node], v->drag_trs);
+    v->drag_origin = pos;
+    v->drag_pivot = pos;
+    /* as for an object: a window pixel at the light's depth, so that the
+     * light moves on the screen as far as the mouse does */
+    v->drag_scale = 2.0f * depth * tanf(0.5f * cf.yfov) / (float)(v->win_h > 0 ? v->win_h : 1);
+    v->status[0] = '\0';
     return EXIT_OK;
 }
 

@@ -6,7 +6,8 @@
  *                             TAB, PAGE_UP, PAGE_DOWN
  *     drag X0 Y0 X1 Y1 [left|right|middle] [shift|ctrl]
  *                             press at (X0, Y0), move to (X1, Y1) in 8 steps, release
- *                             (window pixels, top left origin)
+ *                             (window pixels, top left origin); with shift after key L,
+ *                             the selected light is dragged
  *     press X Y [left|right|middle] [shift|ctrl]   a mouse button pressed at (X, Y)
  *     move X Y                the mouse moved to (X, Y)
  *     release X Y [left|right|middle]              the button released

@@ -2,7 +2,10 @@
  * times with one FAKE_* macro defined (tests/CMakeLists.txt). The FAKE_CONF_*
  * kinds render something (a constant per pixel) for the conformance suite's
  * own tests: each breaks one rule the suite must catch. FAKE_ENTRY_CRASH and
- * FAKE_CTOR_CRASH crash while loading (in gi_method_entry, in a constructor). */
+ * FAKE_CTOR_CRASH crash while loading (in gi_method_entry, in a constructor).
+ * FAKE_BAKED renders a constant grey, lacks GI_CAP_RIGID_MOTION and refuses
+ * moved lights in update(), as a method that bakes its lights at prepare
+ * would: the viewer's tests of a method that cannot follow a change. */
 #define _POSIX_C_SOURCE 200809L
 #include "gi/kit.h" /* GI_ABI_LAYOUT */
 
@@ -34,6 +37,10 @@ static gi_result fake_prepare(void *inst, const gi_gpu_scene *s)
 static gi_result fake_update(void *inst, const gi_gpu_scene *s, const gi_changes *c)
 {
     (void)inst, (void)s, (void)c;
+#if defined(FAKE_BAKED)
+    if (c->flags & GI_CHANGED_LIGHTS)
+        return GI_ERR_UNSUPPORTED;
+#endif
 #if defined(FAKE_CHANGES) /* reports what the harness passed (stats in --timings) */
     fake_flags_seen |= c->flags;
     fake_updates++;
@@ -66,6 +73,9 @@ static gi_result fake_render(void *inst, const gi_view *v, const gi_target *t)
 #endif
     fake_renders++;
     glClearNamedFramebufferfv(t->fbo, GL_COLOR, 0, c);
+#elif defined(FAKE_BAKED)
+    const float grey[4] = {0.5f, 0.5f, 0.5f, 1.0f};
+    glClearNamedFramebufferfv(t->fbo, GL_COLOR, 0, grey);
 #elif defined(FAKE_CRASH)
     raise(SIGSEGV); /* compare must survive a method that crashes */
 #elif defined(FAKE_HANG)
@@ -81,7 +91,11 @@ static void fake_destroy(void *inst)
 static const char *fake_last_error(void *inst)
 {
     (void)inst;
+#if defined(FAKE_BAKED)
+    return "lights are baked at prepare";
+#else
     return "";
+#endif
 }
 
 static const gi_param_desc fake_params[] = {
@@ -120,6 +134,9 @@ static const gi_method fake_method = {
     .caps = GI_CAP_DIRECT | GI_CAP_AREA_LIGHTS,
 #elif defined(FAKE_CONF_LIAR)
     .caps = GI_CAP_DIRECT | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT,
+#elif defined(FAKE_BAKED) /* no GI_CAP_RIGID_MOTION */
+    .caps = GI_CAP_DIRECT | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT |
+            GI_CAP_PRECOMPUTE,
 #else
     .caps = GI_CAP_DIRECT,
 #endif
