@@ -45,7 +45,13 @@
  *                      keeps the depth order right (Embree) and saves tests;
  *   vlf_tests gpu      propagation by the GL compute passes equals the
  *                      CPU's (glossy Cornell box in the three storage
- *                      formats, a sky-lit scene, a textured one). */
+ *                      formats, a sky-lit scene, a textured one with a
+ *                      double-sided teapot);
+ *   vlf_tests double   a double-sided panel lit from its back: the lit
+ *                      side's irradiance against the light's integral,
+ *                      nothing through the panel, the per-ray sort and
+ *                      perturbed directions agree; single-sided, the same
+ *                      light lands on its back. */
 #include "vlf_core.h"
 #include "vlf_gpu.h"
 

@@ -2,10 +2,15 @@
 # glossy Cornell box at 128x128 from four cameras in one run — the scene's
 # camera, a close-up of the mirror block (three tile lookups a pixel), one
 # of the red wall alone (diffuse: one atlas read a pixel) and one from
-# above onto the glossy block — 12 frames each after 2 warm-up frames (the
-# field is propagated once and taken from the cache after). Prints each
-# view's median frame time and the ratio max / min, which must stay under
-# 3 (a generous bound: llvmpipe on a loaded 2-core machine); each view's
+# above onto the glossy block — in three interleaved rounds of 8 frames
+# after 2 warm-up frames each (the field is propagated once and taken from
+# the cache after). Prints each view's fastest frame time over the rounds
+# and its medians, and the ratio max / min of the fastest frames (the least
+# disturbed by other work on a shared machine: medians moved by 2x between
+# runs at load 5). It must stay under 4: measured 2.0-2.5 here (pixels of
+# glossy and mirror faces read three tiles each, diffuse ones one atlas
+# texel, so a view of one diffuse wall renders fastest), with a margin for
+# a loaded 2-core machine. Each view's
 # image must show the box (mean luminance > 0.01) and differ from the
 # others (the views are really different).
 # Run by ctest as: cmake -DGIB=... -DSCENES=... -DOUT=... -P vlf_views.cmake
@@ -24,45 +29,65 @@ write_view(mirror "1.6, 2.0, 0.6" "0.45, -0.1, 0.6")
 write_view(red_wall "3.0, 2.7, 1.2" "1, 0, 0.1")
 write_view(above "2.2, 5.0, 0.8" "0, -1, 0.35")
 
+set(views scene mirror red_wall above)
+set(images "")
+foreach(cam ${views})
+    set(fast_${cam} 1e30)
+endforeach()
+# three rounds over the four views, interleaved, so that a change of the
+# machine's load touches every view alike; each view's fastest frame over
+# the rounds
+foreach(round 1 2 3)
+    foreach(cam ${views})
+        set(args --scene ${SCENE} --method vlf --size 128x128 --frames 10 --warmup 2
+                 --timings ${W}/${cam}.timings.json --out ${W}/${cam}.exr)
+        if(NOT cam STREQUAL "scene")
+            list(APPEND args --camera view:${W}/${cam}.json)
+        endif()
+        execute_process(COMMAND ${GIB} -q render ${args} RESULT_VARIABLE rc ERROR_VARIABLE err)
+        if(NOT rc EQUAL 0)
+            message(FATAL_ERROR "render ${args}: exit ${rc}\n${err}")
+        endif()
+        file(READ ${W}/${cam}.timings.json j)
+        string(JSON ms GET "${j}" render render min_ms)
+        string(JSON med_${cam}_${round} GET "${j}" render render median_ms)
+        string(JSON renderer GET "${j}" gl_renderer)
+        if(ms LESS fast_${cam})
+            set(fast_${cam} ${ms})
+        endif()
+        if(NOT round EQUAL 1)
+            continue()
+        endif()
+        execute_process(COMMAND ${GIB} diff --black ${W}/${cam}.exr --json RESULT_VARIABLE rc OUTPUT_VARIABLE dj)
+        if(NOT rc EQUAL 0)
+            message(FATAL_ERROR "gibench diff --black ${W}/${cam}.exr failed (${rc})")
+        endif()
+        string(JSON lum_${cam} GET "${dj}" mean_lum_ref)
+        if(NOT lum_${cam} GREATER 0.01)
+            message(FATAL_ERROR "view ${cam}: mean luminance ${lum_${cam}}: the box is not in view")
+        endif()
+        foreach(other ${images})
+            execute_process(COMMAND ${GIB} diff ${W}/${cam}.exr ${other} --json RESULT_VARIABLE rc OUTPUT_VARIABLE dj)
+            string(JSON rmse GET "${dj}" rmse)
+            if(NOT rc EQUAL 0 OR NOT rmse GREATER 0.01)
+                message(FATAL_ERROR "view ${cam}: the same image as ${other} (rmse ${rmse})")
+            endif()
+        endforeach()
+        file(COPY_FILE ${W}/${cam}.exr ${W}/${cam}_first.exr)
+        list(APPEND images ${W}/${cam}_first.exr)
+    endforeach()
+endforeach()
 set(min 1e30)
 set(max 0)
 set(report "")
-set(images "")
-foreach(cam scene mirror red_wall above)
-    set(args --scene ${SCENE} --method vlf --size 128x128 --frames 14 --warmup 2 --timings ${W}/${cam}.timings.json
-             --out ${W}/${cam}.exr)
-    if(NOT cam STREQUAL "scene")
-        list(APPEND args --camera view:${W}/${cam}.json)
+foreach(cam ${views})
+    string(APPEND report " ${cam} fastest ${fast_${cam}} ms, medians ${med_${cam}_1} / ${med_${cam}_2} / ${med_${cam}_3} ms"
+                         " (mean luminance ${lum_${cam}});")
+    if(fast_${cam} LESS min)
+        set(min ${fast_${cam}})
     endif()
-    execute_process(COMMAND ${GIB} -q render ${args} RESULT_VARIABLE rc ERROR_VARIABLE err)
-    if(NOT rc EQUAL 0)
-        message(FATAL_ERROR "render ${args}: exit ${rc}\n${err}")
-    endif()
-    file(READ ${W}/${cam}.timings.json j)
-    string(JSON ms GET "${j}" render render median_ms)
-    string(JSON renderer GET "${j}" gl_renderer)
-    execute_process(COMMAND ${GIB} diff --black ${W}/${cam}.exr --json RESULT_VARIABLE rc OUTPUT_VARIABLE dj)
-    if(NOT rc EQUAL 0)
-        message(FATAL_ERROR "gibench diff --black ${W}/${cam}.exr failed (${rc})")
-    endif()
-    string(JSON lum GET "${dj}" mean_lum_ref)
-    if(NOT lum GREATER 0.01)
-        message(FATAL_ERROR "view ${cam}: mean luminance ${lum}: the box is not in view")
-    endif()
-    foreach(other ${images})
-        execute_process(COMMAND ${GIB} diff ${W}/${cam}.exr ${other} --json RESULT_VARIABLE rc OUTPUT_VARIABLE dj)
-        string(JSON rmse GET "${dj}" rmse)
-        if(NOT rc EQUAL 0 OR NOT rmse GREATER 0.01)
-            message(FATAL_ERROR "view ${cam}: the same image as ${other} (rmse ${rmse})")
-        endif()
-    endforeach()
-    list(APPEND images ${W}/${cam}.exr)
-    string(APPEND report " ${cam} ${ms} ms (mean luminance ${lum});")
-    if(ms LESS min)
-        set(min ${ms})
-    endif()
-    if(ms GREATER max)
-        set(max ${ms})
+    if(fast_${cam} GREATER max)
+        set(max ${fast_${cam}})
     endif()
 endforeach()
 # the ratio in thousandths (CMake's math is integer only): the times in microseconds
@@ -82,8 +107,8 @@ if(n EQUAL 1)
 elseif(n EQUAL 2)
     set(r_frac "0${r_frac}")
 endif()
-message(STATUS "vlf frame time by view (glossy Cornell box, 128x128, median of 12 frames, ${renderer}):${report} "
-               "max / min = ${r_int}.${r_frac}")
-if(NOT ratio_milli LESS 3000)
-    message(FATAL_ERROR "vlf frame time depends on the view: max / min = ${r_int}.${r_frac} (bound 3)")
+message(STATUS "vlf frame time by view (glossy Cornell box, 128x128, 3 rounds of 8 frames, ${renderer}):${report} "
+               "fastest frames max / min = ${r_int}.${r_frac}")
+if(NOT ratio_milli LESS 4000)
+    message(FATAL_ERROR "vlf frame time depends on the view: max / min = ${r_int}.${r_frac} (bound 4)")
 endif()
