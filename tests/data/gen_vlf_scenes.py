@@ -14,6 +14,10 @@ Writes tests/data/vlf/:
       filling the view of a camera looking down at it at 45 degrees; it
       reflects a diffuse wall (left half red, right half white) lit by an
       area light above the camera (Le = 4, facing the wall and the mirror).
+  mirror_back.gltf    the same with the mirror's front side facing down
+      (away from the camera and the wall) and its material `doubleSided`:
+      the camera sees and the wall lights its back side, which must
+      reflect as the front of mirror_wall.gltf does.
 
 Run from anywhere: python3 tests/data/gen_vlf_scenes.py (deterministic
 output; the files are committed).
@@ -67,13 +71,14 @@ def panel(double_sided, path):
     g.write_gltf(path, os.path.basename(path).replace(".gltf", ".bin"))
 
 
-def mirror_wall(path):
+def mirror_wall(path, back=False):
     g = Gltf(GEN)
-    mm = g.material("mirror", (0.0, 0.0, 0.0), ks=(0.9, 0.9, 0.9), exponent=1e4, mirror=True)
+    mm = g.material("mirror", (0.0, 0.0, 0.0), ks=(0.9, 0.9, 0.9), exponent=1e4, mirror=True,
+                    double_sided=back)
     mr = g.material("wall_red", (0.8, 0.2, 0.2))
     mw = g.material("wall_white", (0.8, 0.8, 0.8))
     ml = g.material("light", (0.0, 0.0, 0.0), emission=(1.0, 1.0, 1.0), emission_strength=4.0)
-    mirror = quad((0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, -1.0))  # facing +y
+    mirror = quad((0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0 if back else -1.0))  # facing +y (back: -y)
     red = quad((-1.0, 1.5, -1.2), (1.0, 0.0, 0.0), (0.0, 1.5, 0.0))    # facing +z
     white = quad((1.0, 1.5, -1.2), (1.0, 0.0, 0.0), (0.0, 1.5, 0.0))
     n = unit([0.0, -1.0, -1.0])
@@ -84,8 +89,9 @@ def mirror_wall(path):
     nodes = [cam, g.node("mirror", mesh=g.mesh("mirror", [(mirror, mm)])),
              g.node("wall", mesh=g.mesh("wall", [(red, mr), (white, mw)])),
              g.node("light", mesh=g.mesh("light", [(lt, ml)]))]
-    g.scene("mirror_wall", nodes)
-    g.write_gltf(path, "mirror_wall.bin")
+    name = os.path.basename(path).replace(".gltf", "")
+    g.scene(name, nodes)
+    g.write_gltf(path, name + ".bin")
 
 
 def main():
@@ -93,6 +99,7 @@ def main():
     panel(True, os.path.join(OUT, "panel_double.gltf"))
     panel(False, os.path.join(OUT, "panel_single.gltf"))
     mirror_wall(os.path.join(OUT, "mirror_wall.gltf"))
+    mirror_wall(os.path.join(OUT, "mirror_back.gltf"), back=True)
 
 
 if __name__ == "__main__":

@@ -10,7 +10,9 @@
 #   PART=mirror: an ideal mirror filling the view, reflecting a lit red and
 #     white wall: relMSE < 0.15 and mean within 15 %, while the black image
 #     and the `direct` plugin (direct light only: a black mirror) score
-#     > 0.45 (3x the limit).
+#     > 0.45 (3x the limit); the same with the mirror turned over and
+#     double-sided (mirror_back.gltf: the camera sees its back), whose
+#     image must equal the front's (relMSE < 1e-6).
 # Run by ctest as: cmake -DGIB=... -DDATA=.../tests/data/vlf -DOUT=... -DEXPECT=.../expect.cmake -DPART=... -P vlf_images.cmake
 
 set(failures 0)
@@ -47,8 +49,16 @@ if(PART STREQUAL "double_sided")
         fail("double-sided panel: a trivial answer scores under 0.5: single-sided ${single_relmse}, black ${black_relmse}")
     endif()
 elseif(PART STREQUAL "mirror")
-    expect_beats_reference(vlf ${DATA}/mirror_wall.gltf LIMIT 0.15 TRIVIAL 0.45 BLACK MEAN 15 SPP 256 BOUNCES 8
-                           DIRECT_ARGS --frames 4)
+    foreach(name mirror_wall mirror_back)
+        expect_beats_reference(vlf ${DATA}/${name}.gltf LIMIT 0.15 TRIVIAL 0.45 BLACK MEAN 15 SPP 256 BOUNCES 8
+                               DIRECT_ARGS --frames 4)
+    endforeach()
+    # the double-sided mirror seen from its back reflects as the front does
+    diff_metric(${OUT}/vlf_vs_ref_mirror_back.exr ${OUT}/vlf_vs_ref_mirror_wall.exr relmse back_front)
+    message(STATUS "mirror seen from its double-sided back against the same mirror's front: relMSE ${back_front}")
+    if(NOT back_front LESS 1e-6)
+        fail("the double-sided mirror's back reflects differently from its front: relMSE ${back_front}")
+    endif()
 else()
     message(FATAL_ERROR "vlf_images.cmake: PART must be double_sided or mirror, not '${PART}'")
 endif()
