@@ -150,7 +150,7 @@ static gi_result vlf_upload(vlf *v)
         free(faces), free(irr), free(tiles), free(dirs), free(rects), free(tris), free(lut);
         return gi_kit_fail(&v->kit, GI_ERR_OUT_OF_MEMORY, "vlf: out of memory uploading the light field");
     }
-    /* faces: chart origin, axes scaled to texels, then W, H, first element, nd */
+    /* faces: chart origin and the back side's face, axes scaled to texels, then W, H, first element, nd */
     for (uint32_t i = 0; i < f->face_count; i++) {
         const vlf_face *fc = &f->faces[i];
         gi_vec3 o = gi_v3_add(f->centre, gi_v3_scale(fc->origin, f->radius));
@@ -161,6 +161,8 @@ static gi_result vlf_upload(vlf *v)
         memcpy(F + 8, &b, 3 * sizeof(float));
         uint32_t info[4] = {fc->W, fc->H, fc->first_elem, (uint32_t)fc->nd};
         memcpy(F + 12, info, sizeof info);
+        uint32_t twin = (uint32_t)fc->twin; /* the other side of a double-sided face, ~0u for none */
+        memcpy(F + 3, &twin, sizeof twin);
     }
     /* the irradiance atlas in the storage format, then per element the part
      * of the texel that lies on its face (the filter's weight, so that

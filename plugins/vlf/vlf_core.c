@@ -383,6 +383,7 @@ uint32_t vlf_element_at(const vlf_field *f, const vlf_face *fc, gi_vec3 q)
 typedef struct frag_tmp {
     uint32_t cell;
     float depth;
+    uint32_t rank; /* 0; 1 for the second side of a double-sided face (after the first at the same depth) */
     uint32_t elem;
 } frag_tmp;
 
@@ -391,7 +392,7 @@ typedef struct frag_buf {
     size_t n, cap;
 } frag_buf;
 
-static int frag_push(frag_buf *b, uint32_t cell, float depth, uint32_t elem)
+static int frag_push(frag_buf *b, uint32_t cell, float depth, uint32_t rank, uint32_t elem)
 {
     if (b->n == b->cap) {
         size_t cap = b->cap ? b->cap * 2 : 4096;
@@ -401,7 +402,7 @@ static int frag_push(frag_buf *b, uint32_t cell, float depth, uint32_t elem)
         b->v = v;
         b->cap = cap;
     }
-    b->v[b->n++] = (frag_tmp){cell, depth, elem};
+    b->v[b->n++] = (frag_tmp){cell, depth, rank, elem};
     return 1;
 }
 
@@ -475,7 +476,19 @@ static int emit_frag(void *user, uint32_t cx, uint32_t cy, float depth)
     float U = ((float)cx + 0.5f) / (float)c->N * 2.0f - 1.0f, V = ((float)cy + 0.5f) / (float)c->N * 2.0f - 1.0f;
     gi_vec3 q = gi_v3_add(gi_v3_add(gi_v3_scale(c->psf->u, U), gi_v3_scale(c->psf->v, V)), gi_v3_scale(c->psf->n, depth));
     uint32_t e = vlf_element_at(c->f, c->face, q);
-    return frag_push(c->buf, cy * c->N + cx, depth, e);
+    if (c->face->twin < 0)
+        return frag_push(c->buf, cy * c->N + cx, depth, 0, e);
+    /* A double-sided face (§3.1: values for both sides): two fragments at
+     * the same depth, first the side facing against +w (the receiver of the
+     * sweep along +w), then the side facing along +w; the sweep along -w
+     * walks them the other way, so each sweep meets its receiver first and
+     * its sender second. The two charts are the same, so the element index
+     * differs by the charts' offset. */
+    const vlf_face *tw = &c->f->faces[c->face->twin];
+    uint32_t e2 = tw->first_elem + (e - c->face->first_elem);
+    int own_first = gi_v3_dot(c->face->n, c->psf->n) < 0.0f;
+    return frag_push(c->buf, cy * c->N + cx, depth, 0, own_first ? e : e2) &&
+           frag_push(c->buf, cy * c->N + cx, depth, 1, own_first ? e2 : e);
 }
 
 static int frag_cmp(const void *a, const void *b)
@@ -485,6 +498,8 @@ static int frag_cmp(const void *a, const void *b)
         return x->cell < y->cell ? -1 : 1;
     if (x->depth != y->depth)
         return x->depth < y->depth ? -1 : 1;
+    if (x->rank != y->rank)
+        return x->rank < y->rank ? -1 : 1;
     return x->elem < y->elem ? -1 : (x->elem > y->elem);
 }
 
@@ -595,6 +610,9 @@ static int build_psf(vlf_field *f, uint32_t i, frag_buf *buf, frag_buf *tmp, vlf
         free(bbox);
         return 0;
     }
+    for (uint32_t fi = 0; fi < f->face_count; fi++) /* a back side covers the cells of its front */
+        if (f->faces[fi].back)
+            memcpy(bbox + 4 * fi, bbox + 4 * (size_t)f->faces[fi].twin, 4 * sizeof *bbox);
     for (uint32_t fi = 0; fi < f->face_count; fi++) {
         if (f->faces[fi].nd < 0)
             continue;
@@ -723,7 +741,7 @@ static int group_faces(vlf_field *f, const gi_scene *s, float t)
     f->tri_p = malloc((size_t)T * 3 * sizeof *f->tri_p);
     tri_key *keys = malloc((size_t)T * sizeof *keys);
     gi_vec3 *nrm = malloc((size_t)T * sizeof *nrm);
-    f->faces = calloc((size_t)T, sizeof *f->faces);
+    f->faces = calloc((size_t)T * 2, sizeof *f->faces); /* double-sided faces take two */
     if (!f->tri_face || !f->tri_group || !f->tri_p || !keys || !nrm || !f->faces) {
         free(keys);
         free(nrm);
@@ -787,6 +805,19 @@ static int group_faces(vlf_field *f, const gi_scene *s, float t)
         const float *le = gi_scene_triangle_emission(s, t0);
         for (int k = 0; k < 3; k++)
             fc->emission[k] = le ? le[k] : 0.0f;
+        fc->twin = -1;
+        if (mt->double_sided) {
+            /* the back side (§3.1: receiver faces store values for both
+             * sides): the same plane and chart, the normal reversed; it
+             * emits too (glTF doubleSided) */
+            vlf_face *bk = &f->faces[nf + 1];
+            *bk = *fc;
+            bk->n = gi_v3_scale(fc->n, -1.0f);
+            bk->back = 1;
+            fc->twin = (int32_t)nf + 1;
+            bk->twin = (int32_t)nf;
+            nf++;
+        }
         nf++;
         a = b;
     }
@@ -1055,6 +1086,20 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
     if (!f->elem_kd)
         goto oom;
     element_areas(f, s);
+    /* a back side's elements are its front's texels: the same areas,
+     * centroids and (textured) albedo sums */
+    for (uint32_t fi = 0; fi < f->face_count; fi++) {
+        const vlf_face *fc = &f->faces[fi];
+        if (!fc->back)
+            continue;
+        const vlf_face *fr = &f->faces[fc->twin];
+        for (uint32_t e = 0; e < fc->W * fc->H; e++) {
+            size_t d = fc->first_elem + e, o = fr->first_elem + e;
+            f->elem_area[d] = f->elem_area[o];
+            memcpy(f->elem_c + 2 * d, f->elem_c + 2 * o, 2 * sizeof *f->elem_c);
+            memcpy(f->elem_kd + 3 * d, f->elem_kd + 3 * o, 3 * sizeof *f->elem_kd);
+        }
+    }
     /* each element's albedo: the material's, or on textured faces the
      * texture averaged over the element's part of the face */
     for (uint32_t e = 0; e < elems; e++) {

@@ -98,6 +98,9 @@ typedef struct vlf_face {
     uint32_t material;  /* the scene's material */
     int textured;       /* its albedo has a texture (elements then average it, elem_kd) */
     int32_t nd;         /* index among non-diffuse faces, -1 for diffuse */
+    int32_t twin;       /* double-sided material: the face of the other side (same plane and chart, normal
+                         * reversed, its own elements and tiles), -1 for single-sided */
+    int back;           /* this is the back side of a double-sided face (no triangles of its own) */
     float send_scale;   /* pi / sum over directions of |cos| dOmega (diffuse emission normalisation) */
     float albedo[VLF_ALBEDO_TABLE]; /* the glossy lobe's albedo over cos(incidence) 0 .. 1 (1 at normal incidence;
                                      * mirrors 1 throughout) */

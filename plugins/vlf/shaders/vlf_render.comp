@@ -9,7 +9,9 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-struct VlfFace { vec4 origin; vec4 t; vec4 b; uvec4 info; }; // chart origin, axes (texels per unit); W, H, first element, nd
+// chart origin (w: the bits of the other side's face of a double-sided
+// face, ~0u for none), axes (texels per unit); W, H, first element, nd
+struct VlfFace { vec4 origin; vec4 t; vec4 b; uvec4 info; };
 struct VlfRect { ivec4 r; uvec4 o; }; // x0, y0, w, h; offset
 
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 0) readonly buffer VlfFaces { VlfFace vlf_faces[]; };
@@ -112,8 +114,14 @@ void main()
         gi_triangle_world(tri, p0, p1, p2);
         vec3 ng = cross(p1 - p0, p2 - p0);
         vec3 wo = normalize(u_eye - s.position);
-        if (dot(ng, wo) > 0.0) { // the front side: the light field holds nothing for the back
-            VlfFace f = vlf_faces[vlf_tri_face[tri]];
+        uint fi = vlf_tri_face[tri];
+        uint twin = floatBitsToUint(vlf_faces[fi].origin.w);
+        if (dot(ng, wo) <= 0.0 && twin != 0xffffffffu) { // a double-sided face seen from its back: the back's values
+            fi = twin;
+            ng = -ng;
+        }
+        if (dot(ng, wo) > 0.0) { // the side facing the eye (a single-sided face's back holds nothing)
+            VlfFace f = vlf_faces[fi];
             L += s.brdf.kd * vlf_irradiance(f, s.position) * GI_INV_PI;
             int nd = int(f.info.w);
             if (nd >= 0) {

@@ -45,7 +45,13 @@
  *                      keeps the depth order right (Embree) and saves tests;
  *   vlf_tests gpu      propagation by the GL compute passes equals the
  *                      CPU's (glossy Cornell box in the three storage
- *                      formats, a sky-lit scene, a textured one). */
+ *                      formats, a sky-lit scene, a textured one with a
+ *                      double-sided teapot);
+ *   vlf_tests double   a double-sided panel lit from its back: the lit
+ *                      side's irradiance against the light's integral,
+ *                      nothing through the panel, the per-ray sort and
+ *                      perturbed directions agree; single-sided, the same
+ *                      light lands on its back. */
 #include "vlf_core.h"
 #include "vlf_gpu.h"
 
@@ -1383,10 +1389,137 @@ static void test_gpu(void)
         gpu_case(&g, "scenes/cornell_glossy.gltf", VLF_PREC_16F, 2e-3);
         gpu_case(&g, "scenes/cornell_glossy.gltf", VLF_PREC_RGB9E5, 2e-3);
         gpu_case(&g, "scenes/bunny_alone_env.glb", VLF_PREC_32F, 1e-4);
-        gpu_case(&g, "scenes/teapot_plane.glb", VLF_PREC_32F, 1e-4);
+        gpu_case(&g, "scenes/teapot_plane.glb", VLF_PREC_32F, 1e-4); /* a double-sided teapot */
         vlf_gpu_free(&g);
     }
     gi_gpu_destroy(ctx);
+}
+
+/* Irradiance at world point x on a surface of unit normal n from the
+ * panel scene's light (tests/data/gen_vlf_scenes.py: a 0.5 x 0.5 square at
+ * (0, 1.3, 1) facing the panel's centre, Le = 6), by 32 x 32 point patches
+ * with both cosines; nothing stands between them. */
+static double panel_light_E(gi_vec3 x, gi_vec3 n)
+{
+    gi_vec3 c = gi_v3(0.0f, 1.3f, 1.0f), ln = gi_v3_normalize(gi_v3(0.0f, -1.3f, -1.0f));
+    gi_vec3 e1 = gi_v3(1, 0, 0), e2 = gi_v3_cross(ln, e1);
+    double E = 0.0, dA = 0.25 / (32.0 * 32.0);
+    for (int j = 0; j < 32; j++)
+        for (int i = 0; i < 32; i++) {
+            float u = ((float)i + 0.5f) / 32.0f - 0.5f, v = ((float)j + 0.5f) / 32.0f - 0.5f;
+            gi_vec3 y = gi_v3_add(c, gi_v3_add(gi_v3_scale(e1, 0.5f * u), gi_v3_scale(e2, 0.5f * v)));
+            gi_vec3 d = gi_v3_sub(y, x);
+            double r2 = gi_v3_dot(d, d), r = sqrt(r2);
+            double cx = gi_v3_dot(n, d) / r, cy = -gi_v3_dot(ln, d) / r;
+            if (cx > 0.0 && cy > 0.0)
+                E += 6.0 * cx * cy * dA / r2;
+        }
+    return E;
+}
+
+/* Double-sided materials (§3.1: values for both sides): the thin panel of
+ * tests/data/vlf/panel_double.gltf lit from its back side, 1 iteration. */
+static void test_double(void)
+{
+    const char *names[2] = {"tests/data/vlf/panel_double.gltf", "tests/data/vlf/panel_single.gltf"};
+    double recv_double = -1.0;
+    for (int sc = 0; sc < 2; sc++) {
+        gi_scene *s = load(names[sc]);
+        if (!s)
+            continue;
+        uint32_t orders[3] = {VLF_ORDER_FACES, VLF_ORDER_RAYS, VLF_ORDER_FACES}, perturbed[3] = {0, 0, 3};
+        float *E_faces = NULL;
+        for (int run = 0; run < (sc == 0 ? 3 : 1); run++) {
+            vlf_params p = defaults();
+            p.iterations = 1;
+            p.order = orders[run], p.perturbed = perturbed[run];
+            vlf_field f;
+            char err[256];
+            int rc = vlf_field_build(&f, s, 0.0f, &p, err, sizeof err);
+            EXPECT(rc == 0, "%s", err);
+            if (rc != 0)
+                continue;
+            vlf_field_propagate(&f, NULL, NULL);
+            const vlf_stats *st = &f.st;
+            CHECK_NEAR(st->flux_shot, st->flux_received + st->flux_back + st->flux_escaped, 1e-4 * st->flux_shot);
+            /* the panel's sides: lit (normal toward the light, +z), dark (-z) */
+            int lit = -1, dark = -1;
+            for (uint32_t fi = 0; fi < f.face_count; fi++)
+                if (f.faces[fi].emission[0] == 0.0f)
+                    *(f.faces[fi].n.z > 0.0f ? &lit : &dark) = (int)fi;
+            if (sc == 1) {
+                /* single-sided: only the dark side exists; the light lands on its back */
+                EXPECT(lit < 0 && dark >= 0 && f.faces[dark].twin < 0, "single-sided panel: faces %d / %d", lit, dark);
+                /* the light the double-sided panel's lit side received lands on its back */
+                printf("double: single-sided panel: flux received %.4f, met a back side %.4f (double-sided "
+                       "received %.4f)\n", st->flux_received, st->flux_back, recv_double);
+                EXPECT(st->flux_received < 1e-3 * st->flux_back, "single-sided: received %.4g, back %.4g",
+                       st->flux_received, st->flux_back);
+                EXPECT(fabs(st->flux_back - recv_double) < 0.02 * recv_double,
+                       "single-sided back %.4g, double-sided received %.4g", st->flux_back, recv_double);
+                vlf_field_free(&f);
+                continue;
+            }
+            EXPECT(lit >= 0 && dark >= 0, "double-sided panel: faces %d / %d", lit, dark);
+            if (lit < 0 || dark < 0) {
+                vlf_field_free(&f);
+                continue;
+            }
+            const vlf_face *fl = &f.faces[lit], *fd = &f.faces[dark];
+            EXPECT(fl->twin == dark && fd->twin == lit && fl->back != fd->back && fl->W == fd->W && fl->H == fd->H,
+                   "the two sides are not each other's twin");
+            /* lit side: the mean irradiance of its upper and lower halves (3x apart)
+             * (whole elements) each within 5 % of the light's irradiance at
+             * their centres (single elements alias: the small light is seen
+             * through a few directions only); dark side: nothing (no light
+             * through the panel) */
+            double sum[2] = {0, 0}, sum_ref[2] = {0, 0}, dark_max = 0.0;
+            uint32_t n = 0;
+            float texel = 1.0f / (p.density * p.density);
+            for (uint32_t e = 0; e < fl->W * fl->H; e++) {
+                uint32_t el = fl->first_elem + e, ed = fd->first_elem + e;
+                EXPECT(f.elem_area[el] == f.elem_area[ed], "element areas of the two sides differ");
+                dark_max = fmax(dark_max, f.E_tot[3 * (size_t)ed]);
+                if (f.elem_area[el] < 0.99f * texel)
+                    continue;
+                gi_vec3 q = gi_v3_add(fl->origin,
+                                      gi_v3_add(gi_v3_scale(fl->t, f.elem_c[2 * (size_t)el] / p.density),
+                                                gi_v3_scale(fl->b, f.elem_c[2 * (size_t)el + 1] / p.density)));
+                gi_vec3 x = gi_v3_add(f.centre, gi_v3_scale(q, f.radius));
+                int h = x.y > 0.0f;
+                sum[h] += f.E_tot[3 * (size_t)el];
+                sum_ref[h] += panel_light_E(x, fl->n);
+                n++;
+            }
+            printf("double (order %s, perturbed %u): lit side %u whole elements, irradiance lower half %.4f vs %.4f "
+                   "(%+.2f %%), upper %.4f vs %.4f (%+.2f %%); dark side max E %.3g; flux received %.4f, back %.4g\n",
+                   p.order == VLF_ORDER_RAYS ? "rays" : "faces", p.perturbed, n, sum[0], sum_ref[0],
+                   100.0 * (sum[0] / sum_ref[0] - 1.0), sum[1], sum_ref[1], 100.0 * (sum[1] / sum_ref[1] - 1.0),
+                   dark_max, st->flux_received, st->flux_back);
+            EXPECT(n > 100, "only %u whole elements on the lit side", n);
+            for (int h = 0; h < 2; h++)
+                EXPECT(fabs(sum[h] / sum_ref[h] - 1.0) < 0.05, "lit side half %d: irradiance %.4f vs %.4f", h, sum[h],
+                       sum_ref[h]);
+            EXPECT(dark_max == 0.0, "light through the panel: %.3g on its dark side", dark_max);
+            EXPECT(st->flux_back < 1e-6 * st->flux_received, "light met a back side: %.4g", st->flux_back);
+            if (run == 0) {
+                E_faces = malloc((size_t)f.elem_count * 3 * sizeof *E_faces);
+                if (E_faces)
+                    memcpy(E_faces, f.E_tot, (size_t)f.elem_count * 3 * sizeof *E_faces);
+                recv_double = st->flux_received;
+            } else if (run == 1 && E_faces) {
+                /* the per-ray sort keeps the two sides' fragments in the same order */
+                double d = 0.0, tot = 0.0;
+                for (size_t k = 0; k < (size_t)f.elem_count * 3; k++)
+                    d += fabs(f.E_tot[k] - E_faces[k]), tot += fabs(E_faces[k]);
+                printf("double: order rays against faces: relative L1 %.3g\n", d / tot);
+                EXPECT(d <= 1e-6 * tot, "order rays differs from faces: relative L1 %.3g", d / tot);
+            }
+            vlf_field_free(&f);
+        }
+        free(E_faces);
+        gi_scene_free(s);
+    }
 }
 
 int main(int argc, char **argv)
@@ -1417,8 +1550,10 @@ int main(int argc, char **argv)
         test_hier(), any = 1;
     if (all || strcmp(part, "gpu") == 0)
         test_gpu(), any = 1;
+    if (all || strcmp(part, "double") == 0)
+        test_double(), any = 1;
     if (!any) {
-        fprintf(stderr, "vlf_tests: unknown part '%s' (dirs, order, energy, furnace, mirror, precision, sun, point, albedo, texture, hier, gpu)\n", part);
+        fprintf(stderr, "vlf_tests: unknown part '%s' (dirs, order, energy, furnace, mirror, precision, sun, point, albedo, texture, hier, gpu, double)\n", part);
         return 2;
     }
     return gi_test_finish();
