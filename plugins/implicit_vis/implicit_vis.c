@@ -14,7 +14,9 @@
  *                    over the flattened links (iv_gpu.c, Sec. 4.3.1), or
  *                    with `illum=cpu` the same on one CPU thread;
  *   display          the G-buffer and the per-vertex irradiance
- *                    interpolated per pixel (shaders/iv_display.comp).
+ *                    interpolated per pixel (shaders/iv_display.comp), plus,
+ *                    on glossy materials, the BRDF-weighted sum of the
+ *                    direct light over the elements' bins (Sec. 4.3).
  * The hierarchy and the links are built on the CPU (the links on
  * `threads` threads); the gathering and pull-up and the display run on
  * the GPU. */
