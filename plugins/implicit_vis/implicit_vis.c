@@ -14,7 +14,9 @@
  *                    over the flattened links (iv_gpu.c, Sec. 4.3.1), or
  *                    with `illum=cpu` the same on one CPU thread;
  *   display          the G-buffer and the per-vertex irradiance
- *                    interpolated per pixel (shaders/iv_display.comp).
+ *                    interpolated per pixel (shaders/iv_display.comp), plus,
+ *                    on glossy materials, the BRDF-weighted sum of the
+ *                    direct light over the elements' bins (Sec. 4.3).
  * The hierarchy and the links are built on the CPU (the links on
  * `threads` threads); the gathering and pull-up and the display run on
  * the GPU. */
@@ -60,6 +62,8 @@ static const gi_param_desc iv_params[] = {
      "a disc nearer than its size covers every bin it spans, not only its centre's (README \"Deviations\")"},
     {"threads", GI_PARAM_INT, 0, 0, 256, NULL, "Table 1 (create_links on the CPU)",
      "threads that create the hierarchical links (the same links as on one); 0 = every online core"},
+    {"glossy", GI_PARAM_BOOL, 1, 0, 1, NULL, "Sec. 4.3 (glossy direct light, Fig. 11)",
+     "glossy (Phong) materials reflect the direct light through their lobe, the BRDF-weighted sum over each element's bins; false: diffuse only"},
     {"illum", GI_PARAM_ENUM, 0, 0, 0, "gpu|cpu", "Sec. 4.3.1 (GPU implementation)",
      "where the gathering and pull-up run: compute shaders over the flattened links, or one CPU thread"},
     {0},
@@ -68,6 +72,7 @@ static const gi_param_desc iv_params[] = {
 typedef struct implicit_vis {
     gi_kit kit;
     int N, bounces, brute, splat, bilinear, cpu_illum, remesher, threads;
+    int glossy;          /* the display adds the glossy direct light (a glossy material, glossy=true) */
     float subdiv, remesh, coverage;
     iv_hier *hier;
     iv_links *links;
@@ -98,6 +103,7 @@ static gi_result iv_create(const gi_host *host, const gi_params *params, void **
     m->coverage = gi_params_float(params, "coverage");
     m->cpu_illum = gi_params_enum(params, "illum") == 1;
     m->threads = gi_params_int(params, "threads");
+    m->glossy = gi_params_bool(params, "glossy");
     if (m->threads == 0) {
         long n = sysconf(_SC_NPROCESSORS_ONLN);
         m->threads = n > 0 ? (n > 256 ? 256 : (int)n) : 1;
@@ -187,13 +193,25 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
     glCreateBuffers(1, &m->ssbo_light);
     glNamedBufferStorage(m->ssbo_light, (GLsizeiptr)((size_t)m->hier->elem_count * 12 * sizeof(float)), NULL,
                          GL_DYNAMIC_STORAGE_BIT);
-    m->prog_display = gi_program_build_compute("iv_display.comp", NULL, &err);
+    /* glossy: a Phong material (a mirror's delta lobe is not handled: no GI_CAP_MIRROR) */
+    int glossy = 0;
+    for (uint32_t i = 0; i < s->material_count; i++) {
+        const gi_material *mat = &s->materials[i];
+        glossy |= mat->ks[0] + mat->ks[1] + mat->ks[2] > 0.0f && !mat->mirror && mat->exponent < GI_MIRROR_EXPONENT;
+    }
+    m->glossy = m->glossy != 0 && glossy;
+    if (m->glossy && m->cpu_illum)
+        return gi_kit_fail(&m->kit, GI_ERR_UNSUPPORTED,
+                           "implicit_vis: glossy materials need illum=gpu (the display reads the GPU's links); use "
+                           "illum=gpu or glossy=false");
+    m->prog_display = gi_program_build_compute("iv_display.comp", m->glossy ? "#define IV_GLOSSY 1\n" : NULL, &err);
     if (!m->prog_display)
         return gi_kit_fail_with(&m->kit, GI_ERR_GL, &err);
     if (!m->cpu_illum) {
         m->gpu = iv_gpu_create(m->hier, m->links, s->envmap, &err);
         if (!m->gpu)
             return gi_kit_fail_with(&m->kit, GI_ERR_GL, &err);
+        m->gpu->keep_emit = m->glossy;
     }
     host->stat(host, "elements", (double)m->hier->elem_count);
     host->stat(host, "nodes", (double)m->hier->node_count);
@@ -276,6 +294,13 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_ELEM_LIGHT, m->gpu ? m->gpu->ssbo_out : m->ssbo_light);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_TRI, m->ssbo_tri);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_GRID, m->ssbo_grid);
+        if (m->glossy) { /* Sec. 4.3: the glossy lobe over the elements' direct-light bins */
+            iv_gpu_bind_direct(m->gpu);
+            glUniform1ui(glGetUniformLocation(p, "u_n"), m->gpu->n);
+            glUniform1ui(glGetUniformLocation(p, "u_bins"), m->gpu->bins);
+            glUniform1ui(glGetUniformLocation(p, "u_light_base"), m->links->leaf_off[m->hier->elem_count]);
+            glUniform1i(glGetUniformLocation(p, "u_env"), m->gpu->env);
+        }
         GLint size[2] = {(GLint)view->width, (GLint)view->height};
         glUniform2iv(glGetUniformLocation(p, "u_size"), 1, size);
         gi_kit_dispatch_8x8(view->width, view->height);
@@ -325,7 +350,7 @@ static const gi_method iv_method = {
     .title = "Interactive Global Illumination Using Implicit Visibility",
     .citation = "Dong, Kautz, Theobalt, Seidel. Pacific Graphics 2007",
     .version = "0.1",
-    .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL |
+    .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_GLOSSY | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL |
             GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION | GI_CAP_DEFORMATION | GI_CAP_VISIBILITY | GI_CAP_TEXTURES,
     .max_bounces = 3,
     .params = iv_params,

@@ -32,7 +32,7 @@ void iv_gpu_free(iv_gpu *g)
     if (!g)
         return;
     GLuint bufs[] = {g->ssbo_elem, g->ssbo_children, g->ssbo_bins,   g->ssbo_geom, g->ssbo_links,
-                     g->ssbo_off,  g->ssbo_wlinks,   g->ssbo_rad[0], g->ssbo_rad[1], g->ssbo_out};
+                     g->ssbo_off,  g->ssbo_wlinks,   g->ssbo_rad[0], g->ssbo_rad[1], g->ssbo_out,  g->ssbo_emit};
     for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++)
         if (bufs[i])
             glDeleteBuffers(1, &bufs[i]);
@@ -131,6 +131,7 @@ iv_gpu *iv_gpu_create(const iv_hier *h, const iv_links *l, const gi_envmap *env,
     for (int i = 0; i < 2; i++)
         g->ssbo_rad[i] = make_dynamic((size_t)h->node_count * 8 * sizeof(float));
     g->ssbo_out = make_dynamic((size_t)h->elem_count * 12 * sizeof(float));
+    g->ssbo_emit = make_dynamic((size_t)h->node_count * 8 * sizeof(float));
     GLint64 max_block = 0;
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
     g->max_block = max_block > 0 ? (size_t)max_block : (size_t)1 << 27; /* GL's minimum: 2^27 bytes */
@@ -232,6 +233,11 @@ gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint
     glUniform1ui(glGetUniformLocation(g->prog_weights, "u_light_base"), l->leaf_off[g->elems]);
     dispatch(g->prog_weights, 0, g->elems);
     pull_up(g, g->ssbo_rad[cur]);
+    if (g->keep_emit) { /* the emission, pulled up, for the glossy display's direct light */
+        glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+        glCopyNamedBufferSubData(g->ssbo_rad[cur], g->ssbo_emit, 0, 0,
+                                 (GLsizeiptr)((size_t)g->nodes * 8 * sizeof(float)));
+    }
     GLuint p = g->prog_gather;
     for (uint32_t k = 0; k <= bounces; k++) {
         glUseProgram(p);
@@ -266,4 +272,15 @@ void iv_gpu_read(const iv_gpu *g, float *e_out)
         memcpy(&e_out[6 * (size_t)e + 3], &o[12 * (size_t)e + 4], 3 * sizeof(float));
     }
     free(o);
+}
+
+void iv_gpu_bind_direct(const iv_gpu *g)
+{
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_ELEM, g->ssbo_elem);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_BINS, g->ssbo_bins);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_GEOM, g->ssbo_geom);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_LINKS, g->ssbo_links);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_LINK_OFF, g->ssbo_off);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_WLINKS, g->ssbo_wlinks);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_RAD_SRC, g->ssbo_emit);
 }

@@ -30,6 +30,8 @@ typedef struct iv_gpu {
     GLuint ssbo_wlinks;   /* per link, made on the GPU every frame: node and side, weight */
     GLuint ssbo_rad[2];   /* outgoing radiance per node, this bounce's and the previous one's */
     GLuint ssbo_out;      /* per element: irradiance on both sides, normal (IV_SSBO_ELEM_LIGHT) */
+    GLuint ssbo_emit;     /* per node: the emission pulled up (bounce 0), kept when keep_emit */
+    int keep_emit;        /* set by the caller: keep the emission for the glossy display */
     float *geom;          /* staging: 8 per node */
     uint32_t *links, *off; /* staging for iv_links_pack */
     size_t links_cap;     /* words */
@@ -45,6 +47,11 @@ void iv_gpu_free(iv_gpu *g);
  * the scene's punctual lights (bound at GI_SSBO_LIGHTS). */
 gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint32_t bounces, uint32_t punctual,
                             gi_error *err);
+/* Binds what the glossy display reads of the frame's direct light (after
+ * iv_gpu_illuminate with keep_emit): the elements, bins, node geometry,
+ * receiving links, their offsets and weights, and the pulled-up emission
+ * at IV_SSBO_RAD_SRC. */
+void iv_gpu_bind_direct(const iv_gpu *g);
 /* Reads the result back: 6 floats per element as iv_illuminate writes them. */
 void iv_gpu_read(const iv_gpu *g, float *e_out);
 

@@ -7,6 +7,14 @@
 // re-meshed triangle it lies on), on the side of
 // the disc the pixel's surface faces, times the pixel's albedo / pi, plus
 // the emission seen directly.
+// With IV_GLOSSY (a scene with glossy materials, Sec. 4.3 and Fig. 11): a
+// pixel of a glossy (Phong) material adds the Phong lobe of the direct
+// light, the BRDF-weighted sum over the bins of its elements (blended as
+// the irradiance): each light link's radiance from the direction of the
+// linked node, the environment through the open bins, the punctual lights
+// through their bin, each with its Eq. 5 weight, the lobe toward the eye
+// evaluated with the core's BRDF. Indirect light stays diffuse, as in the
+// paper's GPU version.
 #include "common.glsl"
 #include "scene.glsl"
 #include "gbuffer_read.glsl"
@@ -24,6 +32,77 @@ layout(std430, binding = IV_SSBO_GRID) readonly buffer IvGrid { IvDisp iv_grid[]
 layout(rgba32f, binding = GI_IMAGE_TARGET) uniform writeonly image2D u_target;
 
 uniform ivec2 u_size;
+
+#ifdef IV_GLOSSY
+layout(std430, binding = IV_SSBO_ELEM) readonly buffer IvElems { IvElem iv_elem[]; };
+layout(std430, binding = IV_SSBO_BINS) readonly buffer IvBins { IvBin iv_bin[]; };
+layout(std430, binding = IV_SSBO_GEOM) readonly buffer IvGeom { IvNode iv_node[]; };
+layout(std430, binding = IV_SSBO_RAD_SRC) readonly buffer IvEmit { IvRad iv_emit[]; }; // emission, pulled up
+layout(std430, binding = IV_SSBO_LINKS) readonly buffer IvLinks { uvec4 iv_link[]; }; // bin, node, covered, length
+layout(std430, binding = IV_SSBO_LINK_OFF) readonly buffer IvLinkOff { uvec2 iv_off[]; };
+layout(std430, binding = IV_SSBO_WLINKS) readonly buffer IvWLinks { uvec2 iv_wl[]; }; // node | side << 30, weight
+#include "iv_direct.glsl"
+
+uniform vec3 u_eye;
+uniform uint u_bins;       // 6 n n
+uniform uint u_light_base; // the light links' first record in iv_link
+uniform int u_env;         // 1: the scene has an environment
+
+// The glossy part of Eq. 2 for the direct light reaching element e on the
+// side `front`, seen at pixel x (normal N, toward the eye wo) through the
+// BRDF b: the sum over the element's bins of f(wo, wi) L(wi) times the
+// bin's Eq. 5 weight (its cosine-weighted solid angle from the disc, the
+// share its link covers), as iv_gather.comp gathers the direct light.
+vec3 glossy_direct(uint e, bool front, gi_brdf b, vec3 x, vec3 N, vec3 wo)
+{
+    vec3 sum = vec3(0.0);
+    uvec2 o0 = iv_off[e], o1 = iv_off[e + 1u];
+    for (uint j = u_light_base + o0.y; j < u_light_base + o1.y; j++) { // the light links
+        uvec2 l = iv_wl[j];
+        float w = uintBitsToFloat(l.y);
+        if ((w >= 0.0) != front || w == 0.0)
+            continue;
+        uint src = l.x & 0x3FFFFFFFu, side = l.x >> 30;
+        vec3 Ls = side == IV_SIDE_BOTH ? 0.5 * (iv_emit[src].front.rgb + iv_emit[src].back.rgb)
+                                       : (side == IV_SIDE_FRONT ? iv_emit[src].front.rgb : iv_emit[src].back.rgb);
+        vec3 wi = normalize(iv_node[src].pos.xyz - x);
+        sum += gi_brdf_eval(b, N, wo, wi) * Ls * abs(w);
+    }
+    vec3 n = iv_light[e].normal.xyz;
+    float norm = iv_light[e].normal.w;
+    if (u_env != 0) { // Sec. 4.4: the environment through what the links leave open of each bin
+        uint j = o0.x;
+        for (uint bn = 0u; bn < u_bins; bn++) {
+            float frac = 0.0;
+            if (j < o1.x && iv_link[j].x == bn)
+                frac = uintBitsToFloat(iv_link[j++].z);
+            float open = 1.0 - frac;
+            if (!(open > 0.0))
+                continue;
+            vec3 d = iv_bin[bn].dir.xyz;
+            float w = dot(n, d) * iv_bin[bn].dir.w * norm * open;
+            if ((w >= 0.0) != front || w == 0.0)
+                continue;
+            sum += gi_brdf_eval(b, N, wo, d) * iv_bin[bn].env.rgb * abs(w);
+        }
+    }
+    vec3 p = iv_node[iv_elem[e].info.x].pos.xyz;
+    for (uint i = 0u; i < gi_counts.y; i++) { // punctual lights, the element's bin test
+        GiLight lt = gi_lights[i];
+        vec3 wl;
+        float scale;
+        if (!iv_punctual_seen(lt.position, lt.type, lt.direction, lt.range, lt.cos_inner, lt.cos_outer, p, o0.x,
+                              o1.x, wl, scale))
+            continue;
+        float c = dot(n, wl);
+        if ((c >= 0.0) != front)
+            continue;
+        vec3 wi = lt.type == GI_LIGHT_TYPE_DIRECTIONAL ? wl : normalize(lt.position - x);
+        sum += gi_brdf_eval(b, N, wo, wi) * abs(c) * scale * lt.intensity;
+    }
+    return sum;
+}
+#endif
 
 vec3 barycentric(vec3 p, vec3 a, vec3 b, vec3 c)
 {
@@ -51,6 +130,9 @@ void main()
         return;
     GiSurface s = gi_gbuffer_surface(px);
     vec3 L = vec3(0.0);
+#ifdef IV_GLOSSY
+    vec3 G = vec3(0.0);
+#endif
     if (s.hit) {
         uint tri = gi_gbuffer_ids_at(px).z;
         vec3 E = vec3(0.0);
@@ -86,8 +168,24 @@ void main()
                     uint e = iv_grid[g[a]].elem[c];
                     E += w[a] * iv_grid[g[a]].w[c] * (front ? iv_light[e].e_front.rgb : iv_light[e].e_back.rgb);
                 }
+#ifdef IV_GLOSSY
+            if (!gi_brdf_is_mirror(s.brdf) && any(greaterThan(s.brdf.ks, vec3(0.0)))) {
+                gi_brdf lobe = s.brdf; // the Phong lobe only: the Lambert part is the irradiance's
+                lobe.kd = vec3(0.0);
+                vec3 wo = normalize(u_eye - s.position);
+                for (int a = 0; a < 3; a++)
+                    for (int c = 0; c < 3; c++) {
+                        float wt = w[a] * iv_grid[g[a]].w[c];
+                        if (wt > 0.0)
+                            G += wt * glossy_direct(iv_grid[g[a]].elem[c], front, lobe, s.position, s.normal, wo);
+                    }
+            }
+#endif
         }
         L = s.emission + s.brdf.kd * GI_INV_PI * E;
+#ifdef IV_GLOSSY
+        L += G;
+#endif
     }
     imageStore(u_target, px, vec4(L, 1.0));
 }

@@ -8,7 +8,6 @@
 // the leaf's outgoing radiance for the next bounce. The GLSL twin of
 // iv_illuminate's loop in iv_core.c.
 #include "iv_gpu.glsl"
-#include "lights.glsl"
 
 layout(local_size_x = IV_GROUP) in;
 uniform uint u_base;  // first item of this dispatch
@@ -30,34 +29,13 @@ struct IvPunctual { // the scene's GiLight (scene.glsl, gpu.h gi_gpu_light)
     float cos_outer; float pad0, pad1, pad2;
 };
 layout(std430, binding = IV_SSBO_PUNCTUAL) readonly buffer IvPunctuals { IvPunctual iv_punctual[]; };
+#include "iv_direct.glsl"
 
-uniform uint u_n;           // bins per cube side
 uniform uint u_bins;        // 6 n n
 uniform int u_direct;       // 1: the direct light (light links, environment, punctual lights)
 uniform uint u_light_base;  // the light links' first record in iv_link
 uniform int u_env;          // 1: the scene has an environment
 uniform uint u_punctual;    // number of punctual lights
-
-const float IV_FLT_MAX = 3.402823466e38;
-
-// Bin of direction d (iv_bin_of in iv_core.c).
-uint iv_bin_of(vec3 d)
-{
-    int ax = 0;
-    if (abs(d.y) > abs(d[ax]))
-        ax = 1;
-    if (abs(d.z) > abs(d[ax]))
-        ax = 2;
-    float m = abs(d[ax]);
-    if (!(m > 0.0))
-        return 0u;
-    uint face = 2u * uint(ax) + (d[ax] < 0.0 ? 1u : 0u);
-    float u = d[(ax + 1) % 3] / m, v = d[(ax + 2) % 3] / m;
-    int col = int(floor((u + 1.0) * 0.5 * float(u_n))), row = int(floor((v + 1.0) * 0.5 * float(u_n)));
-    col = clamp(col, 0, int(u_n) - 1);
-    row = clamp(row, 0, int(u_n) - 1);
-    return face * u_n * u_n + uint(row) * u_n + uint(col);
-}
 
 // Radiance node `src` sends from its side `side` (iv_weights.comp).
 vec3 node_radiance(uint src, uint side)
@@ -75,22 +53,6 @@ void add_bin(uint b, vec3 n, float norm, float frac, vec3 L, inout vec3 ep, inou
         ep += w * L;
     else
         em += -w * L;
-}
-
-// The receiving link of the element in bin b (its links are sorted by bin), or -1.
-int find_bin(uint lo, uint hi, uint b)
-{
-    while (lo < hi) {
-        uint mid = (lo + hi) >> 1;
-        uint mb = iv_link[mid].x;
-        if (mb == b)
-            return int(mid);
-        if (mb < b)
-            lo = mid + 1u;
-        else
-            hi = mid;
-    }
-    return -1;
 }
 
 void main()
@@ -129,22 +91,9 @@ void main()
         for (uint i = 0u; i < u_punctual; i++) { // blocked where the bin toward the light holds a nearer link
             IvPunctual lt = iv_punctual[i];
             vec3 wl;
-            float scale, r = IV_FLT_MAX;
-            if (lt.type == GI_LIGHT_TYPE_DIRECTIONAL) {
-                wl = normalize(-lt.direction);
-                scale = 1.0;
-            } else {
-                vec3 d = lt.position - p;
-                r = length(d);
-                if (!(r > 0.0))
-                    continue;
-                wl = d * (1.0 / r);
-                scale = gi_range_window(r, lt.range) / (r * r);
-                if (lt.type == GI_LIGHT_TYPE_SPOT)
-                    scale *= gi_spot_falloff(-dot(wl, normalize(lt.direction)), lt.cos_inner, lt.cos_outer);
-            }
-            int k = find_bin(o0.x, o1.x, iv_bin_of(wl));
-            if (k >= 0 && uintBitsToFloat(iv_link[k].w) < r)
+            float scale;
+            if (!iv_punctual_seen(lt.position, lt.type, lt.direction, lt.range, lt.cos_inner, lt.cos_outer, p, o0.x,
+                                  o1.x, wl, scale))
                 continue;
             float c = dot(n, wl);
             if (c >= 0.0)
