@@ -65,6 +65,8 @@ typedef struct cssm_hrc {
     shadow_map *shadows;
     uint32_t shadow_count;
     int env_samples;  /* environment light: directions per texel (or pixel) */
+    int env_pixel;    /* 1: environment light traced per pixel; 0: the texels' irradiance looked up */
+    gi_rt *rt;        /* the scene for the environment's occlusion, NULL without environment */
     float *texel_E;   /* environment irradiance per texel, 3 per texel; NULL: no environment */
     float *accum;     /* running average, 4 per pixel */
     float *gb[5];     /* G-buffer read-back: position, normal, albedo, phong, emission */
@@ -103,6 +105,9 @@ static const gi_param_desc cssm_params[] = {
     {"env_samples", GI_PARAM_INT, 128, 1, 65536, NULL, "direct light (Sec. 4.7)",
      "environment light: directions per atlas texel (half from the map's importance sampler, half cosine, "
      "multiple importance sampling), occlusion by the core's ray tracer"},
+    {"env_pixel", GI_PARAM_BOOL, 1, 0, 1, NULL, NULL,
+     "environment light per pixel: 1 traced at the pixel (env_samples per pixel and frame, averaged over frames), "
+     "0 the atlas texels' irradiance by the bicubic look-up (surface samples: the nearest texel)"},
     {"shadow_size", GI_PARAM_INT, 256, 16, 2048, NULL, NULL,
      "face size of the point/spot lights' shadow cube maps and of directional lights' shadow maps"},
     {0},
@@ -127,6 +132,7 @@ static gi_result cssm_create(const gi_host *host, const gi_params *params, void 
     c->clamp_f = gi_params_float(params, "clamp");
     c->bias_f = gi_params_float(params, "bias");
     c->env_samples = gi_params_int(params, "env_samples");
+    c->env_pixel = gi_params_bool(params, "env_pixel");
     c->pcf = gi_params_bool(params, "pcf");
     c->shadow_size = gi_params_int(params, "shadow_size");
     c->mode = gi_params_enum(params, "mode");
@@ -163,6 +169,8 @@ static void release_prepared(cssm_hrc *c)
     free(c->texel_B);
     free(c->texel_E);
     c->texel_Le = c->texel_B = c->texel_E = NULL;
+    gi_rt_free(c->rt);
+    c->rt = NULL;
     for (int i = 0; i < 3; i++) {
         free(c->cdf[i]);
         c->cdf[i] = NULL;
@@ -373,6 +381,8 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
     if (env) {
         gi_rt *rt = NULL;
         gi_error rerr;
+        gi_rt_free(c->rt);
+        c->rt = NULL;
         c->texel_E = calloc(3 * (size_t)N, sizeof *c->texel_E);
         gi_result rr = c->texel_E ? gi_rt_create(gs->scene, gs->time, &rt, &rerr) : GI_ERR_OUT_OF_MEMORY;
         if (rr != GI_OK) {
@@ -388,7 +398,7 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
             for (int k = 0; k < 3; k++)
                 D[3 * i + k] += x->albedo[k] / GI_PI * e[k];
         }
-        gi_rt_free(rt);
+        c->rt = rt; /* kept for the per-pixel environment light */
     }
     for (uint32_t i = 0; i < N && c->shadow_count; i++) {
         const cssm_texel *x = &a->texels[i];
@@ -800,7 +810,7 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
     const gi_host *host = kit->host;
     if (!c->prepared)
         return gi_kit_fail(kit, GI_ERR_INVALID_ARGUMENT, "cssm_hrc: render before prepare");
-    const int random = c->jitter || c->indirect == 1; /* frames differ: average them */
+    const int random = c->jitter || c->indirect == 1 || (c->texel_E && c->env_pixel); /* frames differ: average them */
     gi_result r = gi_kit_frame_begin(kit, view, GI_KIT_GBUFFER | (random ? 0u : GI_KIT_NO_AVERAGE));
     if (r != GI_OK)
         return r;
@@ -892,7 +902,11 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                     int32_t chart = tri < s->triangle_count ? c->atlas.tri_chart[tri] : -1;
                     float e[3] = {0, 0, 0}, u, v;
                     int ok = 0;
-                    if (chart >= 0) {
+                    if (c->env_pixel) {
+                        env_irradiance(s->envmap, c->rt, rc.x, Nn, (uint32_t)c->env_samples,
+                                       gi_pcg_hash((uint32_t)p ^ gi_pcg_hash(frame ^ view->seed)), e);
+                        ok = 1;
+                    } else if (chart >= 0) {
                         cssm_chart_coords(&c->atlas, (uint32_t)chart, P, &u, &v);
                         ok = cssm_chart_bicubic(&c->atlas, (uint32_t)chart, u, v, c->texel_E, e);
                     }
@@ -906,6 +920,10 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                 }
                 for (int k = 0; k < 3; k++)
                     out[k] += em[k];
+            } else if (c->texel_E) { /* the environment seen past the scene */
+                gi_vec3 f = gi_mat4_point(view->inv_view_proj, gi_v3(((float)x + 0.5f) / (float)w * 2.0f - 1.0f,
+                                                                      ((float)y + 0.5f) / (float)h * 2.0f - 1.0f, 1.0f));
+                gi_envmap_eval(s->envmap, gi_v3_normalize(gi_v3_sub(f, view->eye)), out);
             }
             float *acc = &c->accum[4 * p];
             float wgt = 1.0f / (float)(frame + 1);
