@@ -313,7 +313,7 @@ static void punctual(const cssm_hrc *c, const gi_scene *s, uint32_t i, gi_vec3 x
  * heuristic; each direction counts when the core's ray tracer finds
  * nothing along it. */
 static void env_irradiance(const gi_envmap *env, const gi_rt *rt, gi_vec3 x, gi_vec3 n, uint32_t K, uint32_t seed,
-                           float e[3])
+                           const cssm_receiver *brdf, float e[3])
 {
     e[0] = e[1] = e[2] = 0.0f;
     uint32_t rng = gi_rng_init(seed, 0, 0x5e17u);
@@ -334,10 +334,15 @@ static void env_irradiance(const gi_envmap *env, const gi_rt *rt, gi_vec3 x, gi_
         float denom = (float)half * pe + (float)Kc * pc;
         if (!(denom > 0.0f) || gi_rt_occluded(rt, x, w, 0.0f, INFINITY))
             continue;
-        float L[3];
+        float L[3], lobe = 0.0f;
         gi_envmap_eval(env, w, L);
+        if (brdf) { /* reflected radiance: the receiver's diffuse + Phong BRDF */
+            gi_vec3 rr = gi_v3_sub(gi_v3_scale(n, 2.0f * gi_v3_dot(n, brdf->wo)), brdf->wo);
+            float cl = gi_v3_dot(rr, w);
+            lobe = cl > 0.0f ? (brdf->exponent + 2.0f) / (2.0f * GI_PI) * powf(cl, brdf->exponent) : 0.0f;
+        }
         for (int j = 0; j < 3; j++)
-            e[j] += L[j] * cs / denom;
+            e[j] += L[j] * cs / denom * (brdf ? brdf->kd[j] / GI_PI + brdf->ks[j] * lobe : 1.0f);
     }
 }
 
@@ -394,7 +399,7 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
         for (uint32_t i = 0; i < N; i++) {
             const cssm_texel *x = &a->texels[i];
             float *e = &c->texel_E[3 * i];
-            env_irradiance(env, rt, offset(c, x->p, x->n), x->n, (uint32_t)c->env_samples, i, e);
+            env_irradiance(env, rt, offset(c, x->p, x->n), x->n, (uint32_t)c->env_samples, i, NULL, e);
             for (int k = 0; k < 3; k++)
                 D[3 * i + k] += x->albedo[k] / GI_PI * e[k];
         }
@@ -902,21 +907,24 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                     int32_t chart = tri < s->triangle_count ? c->atlas.tri_chart[tri] : -1;
                     float e[3] = {0, 0, 0}, u, v;
                     int ok = 0;
-                    if (c->env_pixel) {
+                    if (c->env_pixel) { /* reflected radiance (diffuse and glossy) traced at the pixel */
                         env_irradiance(s->envmap, c->rt, rc.x, Nn, (uint32_t)c->env_samples,
-                                       gi_pcg_hash((uint32_t)p ^ gi_pcg_hash(frame ^ view->seed)), e);
-                        ok = 1;
-                    } else if (chart >= 0) {
-                        cssm_chart_coords(&c->atlas, (uint32_t)chart, P, &u, &v);
-                        ok = cssm_chart_bicubic(&c->atlas, (uint32_t)chart, u, v, c->texel_E, e);
+                                       gi_pcg_hash((uint32_t)p ^ gi_pcg_hash(frame ^ view->seed)), &rc, e);
+                        for (int k = 0; k < 3; k++)
+                            out[k] += e[k];
+                    } else {
+                        if (chart >= 0) {
+                            cssm_chart_coords(&c->atlas, (uint32_t)chart, P, &u, &v);
+                            ok = cssm_chart_bicubic(&c->atlas, (uint32_t)chart, u, v, c->texel_E, e);
+                        }
+                        if (!ok) {
+                            int32_t near = nearest_texel(&c->atlas, P, Nn);
+                            if (near >= 0)
+                                memcpy(e, &c->texel_E[3 * near], sizeof e);
+                        }
+                        for (int k = 0; k < 3; k++)
+                            out[k] += rc.kd[k] / GI_PI * e[k];
                     }
-                    if (!ok) {
-                        int32_t near = nearest_texel(&c->atlas, P, Nn);
-                        if (near >= 0)
-                            memcpy(e, &c->texel_E[3 * near], sizeof e);
-                    }
-                    for (int k = 0; k < 3; k++)
-                        out[k] += rc.kd[k] / GI_PI * e[k];
                 }
                 for (int k = 0; k < 3; k++)
                     out[k] += em[k];
