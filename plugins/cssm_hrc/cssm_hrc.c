@@ -6,12 +6,14 @@
  * a coherent traversal order compressed by the core's CSM codec (§3.2),
  * the median-cut hierarchy with skip pointers (§4.2), shadow maps of the
  * punctual lights, then the lighting of the atlas (lighting()):
- *   direct:  R1 = kd/pi gather(emission) + punctual lights (shadow maps);
+ *   direct:  R1 = kd/pi gather(emission) + punctual lights (shadow maps)
+ *            + the environment (ray-traced, env_irradiance(), §4.7);
  *   bounce:  R_k = kd/pi gather(pull(R_{k-1})), k = 2 .. n (§4.1.1);
  *   pull:    the tree of L = emission + sum R_k.
  * render(): G-buffer; per pixel the same traversal with a Phong bound
  * (§4.4), VPLs jittered inside their area and averaged over frames (§4.5),
- * distances clamped; plus emission and the punctual lights per pixel.
+ * distances clamped; plus emission, the punctual lights and the
+ * environment per pixel.
  * Pixels thus get light paths of 0 .. n + 1 bounces.
  * The traversal, the CSSM look-ups and the shading run on the CPU (the GL
  * is llvmpipe here); the depth cube maps, shadow maps and G-buffer are
