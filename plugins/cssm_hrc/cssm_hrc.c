@@ -104,7 +104,7 @@ static const gi_param_desc cssm_params[] = {
      "and frame drawn with probability proportional to their radiance x area (instant radiosity with the atlas as "
      "a pdf), CSSM visibility, averaged over frames"},
     {"mc_samples", GI_PARAM_INT, 16, 1, 4096, NULL, NULL, "texels drawn per receiver and frame with indirect=mc"},
-    {"env_samples", GI_PARAM_INT, 128, 1, 65536, NULL, "direct light (Sec. 4.7)",
+    {"env_samples", GI_PARAM_INT, 128, 1, 4096, NULL, "direct light (Sec. 4.7)",
      "environment light: directions per atlas texel (half from the map's importance sampler, half cosine, "
      "multiple importance sampling), occlusion by the core's ray tracer"},
     {"env_pixel", GI_PARAM_BOOL, 1, 0, 1, NULL, NULL,
