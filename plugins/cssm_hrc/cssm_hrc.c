@@ -6,12 +6,14 @@
  * a coherent traversal order compressed by the core's CSM codec (§3.2),
  * the median-cut hierarchy with skip pointers (§4.2), shadow maps of the
  * punctual lights, then the lighting of the atlas (lighting()):
- *   direct:  R1 = kd/pi gather(emission) + punctual lights (shadow maps);
+ *   direct:  R1 = kd/pi gather(emission) + punctual lights (shadow maps)
+ *            + the environment (ray-traced, env_irradiance(), §4.7);
  *   bounce:  R_k = kd/pi gather(pull(R_{k-1})), k = 2 .. n (§4.1.1);
  *   pull:    the tree of L = emission + sum R_k.
  * render(): G-buffer; per pixel the same traversal with a Phong bound
  * (§4.4), VPLs jittered inside their area and averaged over frames (§4.5),
- * distances clamped; plus emission and the punctual lights per pixel.
+ * distances clamped; plus emission, the punctual lights and the
+ * environment per pixel.
  * Pixels thus get light paths of 0 .. n + 1 bounces.
  * The traversal, the CSSM look-ups and the shading run on the CPU (the GL
  * is llvmpipe here); the depth cube maps, shadow maps and G-buffer are
@@ -21,10 +23,13 @@
 
 #include "gi/cache.h"
 #include "gi/cubemap.h"
+#include "gi/envmap.h"
 #include "gi/kit.h"
 #include "gi/lights.h"
 #include "gi/log.h"
+#include "gi/raytrace.h"
 #include "gi/rng.h"
+#include "gi/sampling.h"
 
 #include <float.h>
 #include <math.h>
@@ -61,6 +66,10 @@ typedef struct cssm_hrc {
     double *cdf[3];   /* pdf tables of texel_L, texel_Le, texel_B */
     shadow_map *shadows;
     uint32_t shadow_count;
+    int env_samples;  /* environment light: directions per texel (or pixel) */
+    int env_pixel;    /* 1: environment light traced per pixel; 0: the texels' irradiance looked up */
+    gi_rt *rt;        /* the scene for the environment's occlusion, NULL without environment */
+    float *texel_E;   /* environment irradiance per texel, 3 per texel; NULL: no environment */
     float *accum;     /* running average, 4 per pixel */
     float *gb[5];     /* G-buffer read-back: position, normal, albedo, phong, emission */
     uint32_t acc_w, acc_h;
@@ -95,6 +104,12 @@ static const gi_param_desc cssm_params[] = {
      "and frame drawn with probability proportional to their radiance x area (instant radiosity with the atlas as "
      "a pdf), CSSM visibility, averaged over frames"},
     {"mc_samples", GI_PARAM_INT, 16, 1, 4096, NULL, NULL, "texels drawn per receiver and frame with indirect=mc"},
+    {"env_samples", GI_PARAM_INT, 128, 1, 4096, NULL, "direct light (Sec. 4.7)",
+     "environment light: directions per atlas texel (half from the map's importance sampler, half cosine, "
+     "multiple importance sampling), occlusion by the core's ray tracer"},
+    {"env_pixel", GI_PARAM_BOOL, 1, 0, 1, NULL, NULL,
+     "environment light per pixel: 1 traced at the pixel (env_samples per pixel and frame, averaged over frames), "
+     "0 the atlas texels' irradiance by the bicubic look-up (surface samples: the nearest texel)"},
     {"shadow_size", GI_PARAM_INT, 256, 16, 2048, NULL, NULL,
      "face size of the point/spot lights' shadow cube maps and of directional lights' shadow maps"},
     {0},
@@ -118,6 +133,8 @@ static gi_result cssm_create(const gi_host *host, const gi_params *params, void 
     c->jitter = gi_params_bool(params, "jitter");
     c->clamp_f = gi_params_float(params, "clamp");
     c->bias_f = gi_params_float(params, "bias");
+    c->env_samples = gi_params_int(params, "env_samples");
+    c->env_pixel = gi_params_bool(params, "env_pixel");
     c->pcf = gi_params_bool(params, "pcf");
     c->shadow_size = gi_params_int(params, "shadow_size");
     c->mode = gi_params_enum(params, "mode");
@@ -152,7 +169,10 @@ static void release_prepared(cssm_hrc *c)
     c->texel_L = c->node_L = c->node_Le = c->node_B = c->texel_T = NULL;
     free(c->texel_Le);
     free(c->texel_B);
-    c->texel_Le = c->texel_B = NULL;
+    free(c->texel_E);
+    c->texel_Le = c->texel_B = c->texel_E = NULL;
+    gi_rt_free(c->rt);
+    c->rt = NULL;
     for (int i = 0; i < 3; i++) {
         free(c->cdf[i]);
         c->cdf[i] = NULL;
@@ -289,6 +309,45 @@ static void punctual(const cssm_hrc *c, const gi_scene *s, uint32_t i, gi_vec3 x
         e[j] = l->intensity[j] * k;
 }
 
+/* Environment irradiance at x with normal n (any direct-light method will
+ * do, §4.7 "Direct Light"): K directions, half drawn by the core's
+ * environment-map sampler, half cosine-weighted, combined by the balance
+ * heuristic; each direction counts when the core's ray tracer finds
+ * nothing along it. */
+static void env_irradiance(const gi_envmap *env, const gi_rt *rt, gi_vec3 x, gi_vec3 n, uint32_t K, uint32_t seed,
+                           const cssm_receiver *brdf, float e[3])
+{
+    e[0] = e[1] = e[2] = 0.0f;
+    uint32_t rng = gi_rng_init(seed, 0, 0x5e17u);
+    const uint32_t half = K > 1 ? K / 2 : 1, Kc = K - half;
+    for (uint32_t k = 0; k < K; k++) {
+        float u1 = gi_rng_next_float(&rng), u2 = gi_rng_next_float(&rng);
+        gi_vec3 w;
+        if (k < half) {
+            if (!(gi_envmap_sample(env, u1, u2, &w) > 0.0f))
+                continue;
+        } else {
+            w = gi_to_world(gi_sample_cosine_hemisphere(u1, u2), n);
+        }
+        float cs = gi_v3_dot(n, w);
+        if (!(cs > 0.0f))
+            continue;
+        float pe = gi_envmap_pdf(env, w), pc = gi_cosine_hemisphere_pdf(cs);
+        float denom = (float)half * pe + (float)Kc * pc;
+        if (!(denom > 0.0f) || gi_rt_occluded(rt, x, w, 0.0f, INFINITY))
+            continue;
+        float L[3], lobe = 0.0f;
+        gi_envmap_eval(env, w, L);
+        if (brdf) { /* reflected radiance: the receiver's diffuse + Phong BRDF */
+            gi_vec3 rr = gi_v3_sub(gi_v3_scale(n, 2.0f * gi_v3_dot(n, brdf->wo)), brdf->wo);
+            float cl = gi_v3_dot(rr, w);
+            lobe = cl > 0.0f ? (brdf->exponent + 2.0f) / (2.0f * GI_PI) * powf(cl, brdf->exponent) : 0.0f;
+        }
+        for (int j = 0; j < 3; j++)
+            e[j] += L[j] * cs / denom * (brdf ? brdf->kd[j] / GI_PI + brdf->ks[j] * lobe : 1.0f);
+    }
+}
+
 static cssm_gather_opts gather_opts(const cssm_hrc *c, float exposure, uint32_t *rng)
 {
     cssm_gather_opts o = {.threshold = c->threshold,
@@ -323,6 +382,31 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
         return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the lighting");
     }
     host->stage_begin(host, "direct");
+    free(c->texel_E);
+    c->texel_E = NULL;
+    const gi_envmap *env = gs->scene->has_environment ? gs->scene->envmap : NULL;
+    if (env) {
+        gi_rt *rt = NULL;
+        gi_error rerr;
+        gi_rt_free(c->rt);
+        c->rt = NULL;
+        c->texel_E = calloc(3 * (size_t)N, sizeof *c->texel_E);
+        gi_result rr = c->texel_E ? gi_rt_create(gs->scene, gs->time, &rt, &rerr) : GI_ERR_OUT_OF_MEMORY;
+        if (rr != GI_OK) {
+            free(D);
+            host->stage_end(host, "direct");
+            return c->texel_E ? gi_kit_fail_with(&c->kit, rr, &rerr)
+                              : gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the lighting");
+        }
+        for (uint32_t i = 0; i < N; i++) {
+            const cssm_texel *x = &a->texels[i];
+            float *e = &c->texel_E[3 * i];
+            env_irradiance(env, rt, offset(c, x->p, x->n), x->n, (uint32_t)c->env_samples, i, NULL, e);
+            for (int k = 0; k < 3; k++)
+                D[3 * i + k] += x->albedo[k] / GI_PI * e[k];
+        }
+        c->rt = rt; /* kept for the per-pixel environment light */
+    }
     for (uint32_t i = 0; i < N && c->shadow_count; i++) {
         const cssm_texel *x = &a->texels[i];
         for (uint32_t l = 0; l < c->shadow_count; l++) {
@@ -336,7 +420,7 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
     cssm_gather_opts o = gather_opts(c, 0.0f, NULL);
     cssm_gather_stats st = {0};
     gi_error err;
-    gi_result r = cssm_solve(&c->tree, a, &c->maps, &o, (uint32_t)c->bounces, c->shadow_count ? D : NULL, host,
+    gi_result r = cssm_solve(&c->tree, a, &c->maps, &o, (uint32_t)c->bounces, c->shadow_count || env ? D : NULL, host,
                              c->texel_L, c->node_L, &st, &err);
     free(D);
     if (r != GI_OK)
@@ -676,7 +760,7 @@ static gi_result read_gbuffer(cssm_hrc *c, uint32_t w, uint32_t h)
         }
         glGetTextureImage(tex[i], 0, GL_RGBA, GL_FLOAT, (GLsizei)(n * sizeof(float)), c->gb[i]);
     }
-    if (c->mode == 1 || c->motion.moving >= 0) {
+    if (c->mode == 1 || c->motion.moving >= 0 || c->texel_E) { /* triangle ids: charts, movers */
         if (c->acc_w != w || c->acc_h != h || !c->ids) {
             free(c->ids);
             c->ids = malloc(n * sizeof *c->ids);
@@ -709,6 +793,23 @@ static void gather(const cssm_hrc *c, int which, const cssm_receiver *rc, const 
     cssm_gather(&c->tree, &c->atlas, &c->maps, nv, rc, o, out, st);
 }
 
+/* The nearest atlas texel to P whose normal faces the same way (brute
+ * force; only for surface samples, which have no chart). -1: none. */
+static int32_t nearest_texel(const cssm_atlas *a, gi_vec3 P, gi_vec3 n)
+{
+    int32_t best = -1;
+    float bd = INFINITY;
+    for (uint32_t i = 0; i < a->count; i++) {
+        if (gi_v3_dot(a->texels[i].n, n) <= 0.0f)
+            continue;
+        gi_vec3 d = gi_v3_sub(a->texels[i].p, P);
+        float dd = gi_v3_dot(d, d);
+        if (dd < bd)
+            bd = dd, best = (int32_t)i;
+    }
+    return best;
+}
+
 static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *target)
 {
     cssm_hrc *c = inst;
@@ -716,7 +817,7 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
     const gi_host *host = kit->host;
     if (!c->prepared)
         return gi_kit_fail(kit, GI_ERR_INVALID_ARGUMENT, "cssm_hrc: render before prepare");
-    const int random = c->jitter || c->indirect == 1; /* frames differ: average them */
+    const int random = c->jitter || c->indirect == 1 || (c->texel_E && c->env_pixel); /* frames differ: average them */
     gi_result r = gi_kit_frame_begin(kit, view, GI_KIT_GBUFFER | (random ? 0u : GI_KIT_NO_AVERAGE));
     if (r != GI_OK)
         return r;
@@ -803,8 +904,36 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                     for (int k = 0; k < 3; k++)
                         out[k] += (rc.kd[k] / GI_PI + rc.ks[k] * lobe) * e[k];
                 }
+                if (c->texel_E) { /* environment: the texels' irradiance, bicubic (surface samples: nearest) */
+                    uint32_t tri = c->ids[4 * p + 2];
+                    int32_t chart = tri < s->triangle_count ? c->atlas.tri_chart[tri] : -1;
+                    float e[3] = {0, 0, 0}, u, v;
+                    int ok = 0;
+                    if (c->env_pixel) { /* reflected radiance (diffuse and glossy) traced at the pixel */
+                        env_irradiance(s->envmap, c->rt, rc.x, Nn, (uint32_t)c->env_samples,
+                                       gi_pcg_hash((uint32_t)p ^ gi_pcg_hash(frame ^ view->seed)), &rc, e);
+                        for (int k = 0; k < 3; k++)
+                            out[k] += e[k];
+                    } else {
+                        if (chart >= 0) {
+                            cssm_chart_coords(&c->atlas, (uint32_t)chart, P, &u, &v);
+                            ok = cssm_chart_bicubic(&c->atlas, (uint32_t)chart, u, v, c->texel_E, e);
+                        }
+                        if (!ok) {
+                            int32_t near = nearest_texel(&c->atlas, P, Nn);
+                            if (near >= 0)
+                                memcpy(e, &c->texel_E[3 * near], sizeof e);
+                        }
+                        for (int k = 0; k < 3; k++)
+                            out[k] += rc.kd[k] / GI_PI * e[k];
+                    }
+                }
                 for (int k = 0; k < 3; k++)
                     out[k] += em[k];
+            } else if (c->texel_E) { /* the environment seen past the scene */
+                gi_vec3 f = gi_mat4_point(view->inv_view_proj, gi_v3(((float)x + 0.5f) / (float)w * 2.0f - 1.0f,
+                                                                      ((float)y + 0.5f) / (float)h * 2.0f - 1.0f, 1.0f));
+                gi_envmap_eval(s->envmap, gi_v3_normalize(gi_v3_sub(f, view->eye)), out);
             }
             float *acc = &c->accum[4 * p];
             float wgt = 1.0f / (float)(frame + 1);
@@ -866,7 +995,7 @@ static const gi_method cssm_method = {
     .citation = "Ritschel, Grosch, Kautz, Seidel. Interactive Illumination with Coherent Surface Shadow Maps. GI 2008",
     .version = "0.1",
     .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_GLOSSY | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS |
-            GI_CAP_DIRECTIONAL | GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE | GI_CAP_PRECOMPUTE | GI_CAP_RIGID_MOTION |
+            GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT | GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE | GI_CAP_PRECOMPUTE | GI_CAP_RIGID_MOTION |
             GI_CAP_TEXTURES,
     .max_bounces = 3,
     .params = cssm_params,
