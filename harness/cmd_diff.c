@@ -37,8 +37,12 @@ static int parse_opts(int argc, char **argv, diff_opts *o)
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "--json") || !strcmp(a, "--black")) {
-            *(a[2] == 'j' ? &o->json : &o->black) = 1;
+        if (!strcmp(a, "--json")) {
+            o->json = 1;
+            continue;
+        }
+        if (!strcmp(a, "--black")) {
+            o->black = 1;
             continue;
         }
         if (a[0] != '-' || !a[1]) {
