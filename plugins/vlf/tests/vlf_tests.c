@@ -184,28 +184,40 @@ static void test_dirs(void)
     }
 }
 
+/* A hand-built test scene, zeroed: `triangles` triangles and `vertices`
+ * vertices in one object on node 0, `materials` untextured black
+ * materials, `nodes` identity nodes without parents. Freed by
+ * gi_scene_free(). */
+static gi_scene *bare_scene(uint32_t triangles, uint32_t vertices, uint32_t materials, uint32_t nodes)
+{
+    gi_scene *s = calloc(1, sizeof *s);
+    s->triangle_count = triangles;
+    s->vertex_count = vertices;
+    s->vertices = calloc(vertices, sizeof *s->vertices);
+    s->indices = calloc(3 * (size_t)triangles, sizeof *s->indices);
+    s->material_count = materials;
+    s->materials = calloc(materials, sizeof *s->materials);
+    for (uint32_t m = 0; m < materials; m++)
+        s->materials[m].albedo_texture = -1;
+    s->node_count = nodes;
+    s->nodes = calloc(nodes, sizeof *s->nodes);
+    for (uint32_t n = 0; n < nodes; n++) {
+        s->nodes[n].parent = -1;
+        s->nodes[n].rotation[3] = 1.0f;
+        s->nodes[n].scale[0] = s->nodes[n].scale[1] = s->nodes[n].scale[2] = 1.0f;
+    }
+    s->object_count = 1;
+    s->objects = calloc(1, sizeof *s->objects);
+    s->objects[0].triangle_count = triangles;
+    s->objects[0].vertex_count = vertices;
+    return s;
+}
+
 /* A scene of the triangles tri[0 .. 9 count) (3 corners each), one material. */
 static gi_scene *triangle_scene(const float *tri, uint32_t count)
 {
-    gi_scene *s = calloc(1, sizeof *s);
-    s->triangle_count = count;
-    s->vertex_count = 3 * count;
-    s->vertices = calloc(s->vertex_count, sizeof *s->vertices);
-    s->indices = calloc(3 * count, sizeof *s->indices);
-    s->material_count = 1;
-    s->materials = calloc(1, sizeof *s->materials);
+    gi_scene *s = bare_scene(count, 3 * count, 1, 1);
     s->materials[0].albedo[0] = s->materials[0].albedo[1] = s->materials[0].albedo[2] = 0.5f;
-    s->materials[0].albedo_texture = -1;
-    s->object_count = 1;
-    s->objects = calloc(1, sizeof *s->objects);
-    s->node_count = 1;
-    s->nodes = calloc(1, sizeof *s->nodes);
-    s->nodes[0].parent = -1;
-    s->nodes[0].rotation[3] = 1.0f;
-    s->nodes[0].scale[0] = s->nodes[0].scale[1] = s->nodes[0].scale[2] = 1.0f;
-    s->objects[0].node = 0;
-    s->objects[0].triangle_count = count;
-    s->objects[0].vertex_count = 3 * count;
     float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
     for (uint32_t k = 0; k < 3 * count; k++) {
         gi_vertex *v = &s->vertices[k];
@@ -272,16 +284,6 @@ static gi_scene *random_triangles(uint32_t single, uint32_t cyclic, uint32_t see
     gi_scene *s = triangle_scene(tri, count);
     free(tri);
     return s;
-}
-
-static void free_random(gi_scene *s)
-{
-    free(s->vertices);
-    free(s->indices);
-    free(s->materials);
-    free(s->objects);
-    free(s->nodes);
-    free(s);
 }
 
 /* Every ray of every subfield, both ways: the faces it meets, in its
@@ -360,7 +362,7 @@ static void test_order(void)
     gi_error e;
     EXPECT(gi_rt_create(s, 0.0f, &rt, &e) == GI_OK, "embree: %s", e.text);
     if (!rt) {
-        free_random(s);
+        gi_scene_free(s);
         return;
     }
     struct {
@@ -441,7 +443,7 @@ static void test_order(void)
     if (have_ref)
         vlf_field_free(&ref);
     gi_rt_free(rt);
-    free_random(s);
+    gi_scene_free(s);
 }
 
 static void test_energy(void)
@@ -578,27 +580,11 @@ static void add_quad(gi_scene *s, uint32_t q, gi_vec3 a, gi_vec3 b, gi_vec3 c, g
 
 static void test_mirror(void)
 {
-    gi_scene *s = calloc(1, sizeof *s);
-    s->triangle_count = 4;
-    s->vertex_count = 8;
-    s->vertices = calloc(8, sizeof *s->vertices);
-    s->indices = calloc(12, sizeof *s->indices);
-    s->material_count = 2;
-    s->materials = calloc(2, sizeof *s->materials);
+    gi_scene *s = bare_scene(4, 8, 2, 1);
     s->materials[0].emission[0] = s->materials[0].emission[1] = s->materials[0].emission[2] = 1.0f;
-    s->materials[0].albedo_texture = s->materials[1].albedo_texture = -1;
     s->materials[1].ks[0] = s->materials[1].ks[1] = s->materials[1].ks[2] = 0.8f;
     s->materials[1].mirror = 1;
     s->materials[1].exponent = GI_MIRROR_EXPONENT;
-    s->node_count = 1;
-    s->nodes = calloc(1, sizeof *s->nodes);
-    s->nodes[0].parent = -1;
-    s->nodes[0].rotation[3] = 1.0f;
-    s->nodes[0].scale[0] = s->nodes[0].scale[1] = s->nodes[0].scale[2] = 1.0f;
-    s->object_count = 1;
-    s->objects = calloc(1, sizeof *s->objects);
-    s->objects[0].triangle_count = 4;
-    s->objects[0].vertex_count = 8;
     /* emitter at z = 1, normal -z (clockwise seen from above) */
     add_quad(s, 0, gi_v3(-0.3f, -0.3f, 1.0f), gi_v3(-0.3f, 0.3f, 1.0f), gi_v3(0.3f, 0.3f, 1.0f), gi_v3(0.3f, -0.3f, 1.0f), 0);
     /* mirror around the origin, normal (sin 22.5, 0, cos 22.5): light coming
@@ -661,12 +647,7 @@ static void test_mirror(void)
         EXPECT(far < 0.01, "mirror radiance away from the reflection %.4f", far);
         vlf_field_free(&f);
     }
-    free(s->vertices);
-    free(s->indices);
-    free(s->materials);
-    free(s->objects);
-    free(s->nodes);
-    free(s);
+    gi_scene_free(s);
 }
 
 /* Mean irradiance (channel 0) of the whole elements of face fi whose
@@ -704,29 +685,11 @@ static void test_sun(void)
 {
     for (int k = 0; k < 2; k++) {
         float a = k ? GI_PI / 6.0f : 0.0f;
-        gi_scene *s = calloc(1, sizeof *s);
-        s->triangle_count = 4;
-        s->vertex_count = 8;
-        s->vertices = calloc(8, sizeof *s->vertices);
-        s->indices = calloc(12, sizeof *s->indices);
-        s->material_count = 1;
-        s->materials = calloc(1, sizeof *s->materials);
+        gi_scene *s = bare_scene(4, 8, 1, 2);
         s->materials[0].albedo[0] = s->materials[0].albedo[1] = s->materials[0].albedo[2] = 0.5f;
-        s->materials[0].albedo_texture = -1;
-        s->node_count = 2;
-        s->nodes = calloc(2, sizeof *s->nodes);
-        for (int n = 0; n < 2; n++) {
-            s->nodes[n].parent = -1;
-            s->nodes[n].rotation[3] = 1.0f;
-            s->nodes[n].scale[0] = s->nodes[n].scale[1] = s->nodes[n].scale[2] = 1.0f;
-        }
         /* the light's node: turned by a about x, its -z pointing along (0, sin a, -cos a) */
         s->nodes[1].rotation[0] = sinf(0.5f * a);
         s->nodes[1].rotation[3] = cosf(0.5f * a);
-        s->object_count = 1;
-        s->objects = calloc(1, sizeof *s->objects);
-        s->objects[0].triangle_count = 4;
-        s->objects[0].vertex_count = 8;
         add_quad(s, 0, gi_v3(-1, -1, 0), gi_v3(1, -1, 0), gi_v3(1, 1, 0), gi_v3(-1, 1, 0), 0);
         add_quad(s, 1, gi_v3(-0.25f, -0.25f, 0.5f), gi_v3(0.25f, -0.25f, 0.5f), gi_v3(0.25f, 0.25f, 0.5f),
                  gi_v3(-0.25f, 0.25f, 0.5f), 0);
@@ -760,13 +723,7 @@ static void test_sun(void)
             EXPECT(f.sun_count == 1, "sun: %u directional lights seen", f.sun_count);
             vlf_field_free(&f);
         }
-        free(s->lights);
-        free(s->vertices);
-        free(s->indices);
-        free(s->materials);
-        free(s->objects);
-        free(s->nodes);
-        free(s);
+        gi_scene_free(s);
     }
 }
 
@@ -780,27 +737,9 @@ static void test_sun(void)
 static void test_point(void)
 {
     for (int k = 0; k < 2; k++) {
-        gi_scene *s = calloc(1, sizeof *s);
-        s->triangle_count = 4;
-        s->vertex_count = 8;
-        s->vertices = calloc(8, sizeof *s->vertices);
-        s->indices = calloc(12, sizeof *s->indices);
-        s->material_count = 1;
-        s->materials = calloc(1, sizeof *s->materials);
+        gi_scene *s = bare_scene(4, 8, 1, 2);
         s->materials[0].albedo[0] = s->materials[0].albedo[1] = s->materials[0].albedo[2] = 0.5f;
-        s->materials[0].albedo_texture = -1;
-        s->node_count = 2;
-        s->nodes = calloc(2, sizeof *s->nodes);
-        for (int n = 0; n < 2; n++) {
-            s->nodes[n].parent = -1;
-            s->nodes[n].rotation[3] = 1.0f;
-            s->nodes[n].scale[0] = s->nodes[n].scale[1] = s->nodes[n].scale[2] = 1.0f;
-        }
         s->nodes[1].translation[2] = 1.5f; /* -z of the node points down */
-        s->object_count = 1;
-        s->objects = calloc(1, sizeof *s->objects);
-        s->objects[0].triangle_count = 4;
-        s->objects[0].vertex_count = 8;
         add_quad(s, 0, gi_v3(-1, -1, 0), gi_v3(1, -1, 0), gi_v3(1, 1, 0), gi_v3(-1, 1, 0), 0);
         add_quad(s, 1, gi_v3(-0.25f, -0.25f, 0.5f), gi_v3(0.25f, -0.25f, 0.5f), gi_v3(0.25f, 0.25f, 0.5f),
                  gi_v3(-0.25f, 0.25f, 0.5f), 0);
@@ -864,13 +803,7 @@ static void test_point(void)
                 EXPECT(n_beyond > 50 && beyond < 1e-4, "spot: %u elements beyond the cone get up to %.4g", n_beyond, beyond);
             vlf_field_free(&f);
         }
-        free(s->lights);
-        free(s->vertices);
-        free(s->indices);
-        free(s->materials);
-        free(s->objects);
-        free(s->nodes);
-        free(s);
+        gi_scene_free(s);
     }
 }
 
@@ -884,29 +817,11 @@ static void test_point(void)
  * along a direction more than 1 rad from it. */
 static void test_point_mirror(void)
 {
-    gi_scene *s = calloc(1, sizeof *s);
-    s->triangle_count = 2;
-    s->vertex_count = 4;
-    s->vertices = calloc(4, sizeof *s->vertices);
-    s->indices = calloc(6, sizeof *s->indices);
-    s->material_count = 1;
-    s->materials = calloc(1, sizeof *s->materials);
-    s->materials[0].albedo_texture = -1;
+    gi_scene *s = bare_scene(2, 4, 1, 2);
     s->materials[0].ks[0] = s->materials[0].ks[1] = s->materials[0].ks[2] = 0.8f;
     s->materials[0].mirror = 1;
     s->materials[0].exponent = GI_MIRROR_EXPONENT;
-    s->node_count = 2;
-    s->nodes = calloc(2, sizeof *s->nodes);
-    for (int n = 0; n < 2; n++) {
-        s->nodes[n].parent = -1;
-        s->nodes[n].rotation[3] = 1.0f;
-        s->nodes[n].scale[0] = s->nodes[n].scale[1] = s->nodes[n].scale[2] = 1.0f;
-    }
     s->nodes[1].translation[2] = 1.0f;
-    s->object_count = 1;
-    s->objects = calloc(1, sizeof *s->objects);
-    s->objects[0].triangle_count = 2;
-    s->objects[0].vertex_count = 4;
     float c = cosf(GI_PI / 8), sn = sinf(GI_PI / 8);
     gi_vec3 tx = gi_v3(c, 0, -sn), ty = gi_v3(0, 1, 0);
     gi_vec3 P[4];
@@ -978,13 +893,7 @@ static void test_point_mirror(void)
         EXPECT(far < 1e-6 * out, "point light in a mirror: %.4g away from the reflection", far);
         vlf_field_free(&f);
     }
-    free(s->lights);
-    free(s->vertices);
-    free(s->indices);
-    free(s->materials);
-    free(s->objects);
-    free(s->nodes);
-    free(s);
+    gi_scene_free(s);
 }
 
 /* Relative L1 difference of two maps of count RGB values: sum |a - b| / sum |b|. */
@@ -1211,7 +1120,7 @@ static void test_texture(void)
     s->textures = NULL;
     s->texture_count = 0;
     free(tex.rgba);
-    free_random(s);
+    gi_scene_free(s);
 }
 
 /* The hierarchical shortcut of the sort (§3.2): clusters of random
@@ -1230,7 +1139,7 @@ static void test_hier(void)
     float *tri = calloc((size_t)count * 9, sizeof *tri), *w = tri;
     for (uint32_t k = 0; k < 3 * (single + 6 * cyclic); k++)
         put(&w, gi_v3(base->vertices[k].position[0], base->vertices[k].position[1], base->vertices[k].position[2]));
-    free_random(base);
+    gi_scene_free(base);
     /* a cluster: 3 x 3 x 3 cells of 0.25, a random triangle in the ball of
      * radius 0.124 around each cell's centre (so none intersect) */
     for (uint32_t c = 0; c < clusters; c++) {
@@ -1264,7 +1173,7 @@ static void test_hier(void)
     gi_error e;
     EXPECT(gi_rt_create(s, 0.0f, &rt, &e) == GI_OK, "embree: %s", e.text);
     if (!rt) {
-        free_random(s);
+        gi_scene_free(s);
         return;
     }
     uint32_t miss[2] = {0, 0}, hits[2] = {0, 0};
@@ -1300,7 +1209,7 @@ static void test_hier(void)
     EXPECT(tests[1] < tests[0], "the shortcut did not save pair tests (%llu vs %llu)", (unsigned long long)tests[1],
            (unsigned long long)tests[0]);
     gi_rt_free(rt);
-    free_random(s);
+    gi_scene_free(s);
 }
 
 /* Propagation on the GPU (vlf_gpu.c): the same field propagated by the
