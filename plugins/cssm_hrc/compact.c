@@ -14,9 +14,12 @@
  *    the point; the cone angle linear in [0, pi], rounded up after adding
  *    the normal's rounding;
  *  - intensity: a shared exponent (6 bits) and three 6-bit mantissas
- *    relative to the light set's scale: every channel within 1/63.5 of
- *    the largest, 2^-60 to 8 times the scale. */
+ *    relative to the light set's scale, rounded with a per-node dither
+ *    (unbiased): every channel within 1/31.5 of the largest, 2^-60 to 8
+ *    times the scale. */
 #include "cssm.h"
+
+#include "gi/rng.h"
 
 #include <float.h>
 #include <math.h>
@@ -120,7 +123,13 @@ static float angle_unit(gi_vec3 a, gi_vec3 b)
 
 /* --------------------------------------------------------- intensity */
 
-static uint32_t rgb_encode(const float I[3], float scale)
+/* Rounds with a dither fixed per node and channel (seed: the node), so
+ * that nodes of equal intensity (a uniform emitter's texels) do not all
+ * round the same way: the error is below one mantissa step, and zero on
+ * average over nodes, where rounding to nearest would be half a step but
+ * shared by every such node (measured: +0.4 % mean luminance on the
+ * Cornell box from its light's texels). */
+static uint32_t rgb_encode(const float I[3], float scale, uint32_t seed)
 {
     float v[3];
     float mx = 0.0f;
@@ -141,7 +150,8 @@ static uint32_t rgb_encode(const float I[3], float scale)
         uint32_t m[3];
         int over = 0;
         for (int k = 0; k < 3; k++) {
-            float q = rintf(v[k] / unit);
+            float dither = (float)(gi_pcg_hash(seed * 3u + (uint32_t)k) >> 8) * (1.0f / 16777216.0f);
+            float q = floorf(v[k] / unit + dither);
             over |= q > 63.0f;
             m[k] = (uint32_t)fminf(q, 63.0f);
         }
@@ -238,7 +248,7 @@ void cssm_ctree_free(cssm_ctree *ct)
 void cssm_ctree_set_intensity(cssm_ctree *ct, uint32_t i, const float I[3])
 {
     uint32_t *w = &ct->nodes[i].w[2];
-    *w = (*w & 0xFF000000u) | rgb_encode(I, ct->iscale);
+    *w = (*w & 0xFF000000u) | rgb_encode(I, ct->iscale, i);
 }
 
 void cssm_ctree_encode(cssm_ctree *ct, uint32_t i, const cssm_node_view *v)
@@ -260,7 +270,7 @@ void cssm_ctree_encode(cssm_ctree *ct, uint32_t i, const cssm_node_view *v)
     uint32_t aq = code_near(ct->atab, v->area);
     p->w[0] = cq | rq << 24;
     p->w[1] = nq | kq << 24;
-    p->w[2] = rgb_encode(v->I, ct->iscale) | aq << 24;
+    p->w[2] = rgb_encode(v->I, ct->iscale, i) | aq << 24;
     p->w[3] = (uint32_t)ptr16(v->child) | (uint32_t)ptr16(v->skip) << 16;
 }
 
