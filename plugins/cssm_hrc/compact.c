@@ -307,32 +307,16 @@ gi_result cssm_ctree_build(const cssm_tree *t, const cssm_atlas *a, cssm_ctree *
         for (int k = 0; k < 3; k++)
             lo[k] = fminf(lo[k], q[k]), hi[k] = fmaxf(hi[k], q[k]);
     }
-    /* the sphere about each node's centroid over its texels (with their extent) */
-    float *rad = malloc((t->count ? t->count : 1) * sizeof *rad);
-    if (!rad) {
-        snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for the compact hierarchy");
-        return GI_ERR_OUT_OF_MEMORY;
-    }
     float amin = FLT_MAX, amax = 0.0f;
-    for (uint32_t i = 0; i < t->count; i++) {
-        const cssm_node *nd = &t->nodes[i];
-        float r = 0.0f;
-        for (uint32_t k = nd->first; k < nd->first + nd->count; k++) {
-            const cssm_texel *x = &a->texels[t->leaves[k]];
-            r = fmaxf(r, gi_v3_length(gi_v3_sub(x->p, nd->centroid)) + 0.75f * sqrtf(x->area));
-        }
-        rad[i] = r;
-        if (nd->area > 0.0f)
-            amin = fminf(amin, nd->area), amax = fmaxf(amax, nd->area);
-    }
+    for (uint32_t i = 0; i < t->count; i++)
+        if (t->nodes[i].area > 0.0f)
+            amin = fminf(amin, t->nodes[i].area), amax = fmaxf(amax, t->nodes[i].area);
     gi_result res = cssm_ctree_setup(out, t->count, lo, hi, 1.0f, 1.0f, amin, amax, err);
-    if (res != GI_OK) {
-        free(rad);
+    if (res != GI_OK)
         return res;
-    }
     float rmin = FLT_MAX, rmax = 0.0f;
     for (uint32_t i = 0; i < t->count; i++) {
-        float r = radius_needed(out, t->nodes[i].centroid, rad[i]);
+        float r = radius_needed(out, t->nodes[i].c, t->nodes[i].r);
         if (r > 0.0f)
             rmin = fminf(rmin, r);
         rmax = fmaxf(rmax, r);
@@ -340,14 +324,13 @@ gi_result cssm_ctree_build(const cssm_tree *t, const cssm_atlas *a, cssm_ctree *
     log_table(out->rtab, rmin, rmax);
     for (uint32_t i = 0; i < t->count; i++) {
         const cssm_node *nd = &t->nodes[i];
-        cssm_node_view v = {.c = nd->centroid, .r = rad[i], .n = nd->n, .cos_cone = nd->cos_cone,
+        cssm_node_view v = {.c = nd->c, .r = nd->r, .n = nd->n, .cos_cone = nd->cos_cone,
                             .area = nd->area, .child = nd->child, .skip = nd->skip};
         cssm_ctree_encode(out, i, &v);
         out->side[2 * i] = nd->first;
         out->side[2 * i + 1] = nd->rep;
     }
     memcpy(out->leaves, t->leaves, (size_t)a->count * sizeof *out->leaves);
-    free(rad);
     return GI_OK;
 }
 

@@ -217,8 +217,9 @@ void cssm_tree_pull(const cssm_tree *t, const cssm_atlas *a, const float *texel_
  *   w[1]  normal: octahedral 12 + 12 bits          | cone angle: 8 bits, linear in [0, pi]
  *   w[2]  intensity: 6-bit shared exponent + 3 x 6-bit mantissa | area: 8 bits, log
  *   w[3]  child: 16 bits | skip: 16 bits (0xFFFF: none)
- * One centre serves as the sphere's centre and as the gather position (the
- * area-weighted centroid); radius and cone are rounded up so that the
+ * One centre serves as the sphere's centre and as the gather position
+ * without jitter (the float node gathers at its area-weighted centroid);
+ * radius and cone are rounded up so that the
  * decoded sphere holds the true one and the decoded cone the true one
  * (the oracle's bounds stay upper bounds). Node index 0xFFFF is the null
  * pointer: 65 535 nodes at most (32 768 texels). */
@@ -246,8 +247,8 @@ typedef struct cssm_ctree {
 gi_result cssm_ctree_setup(cssm_ctree *ct, uint32_t count, const float lo[3], const float hi[3], float r_lo,
                            float r_hi, float a_lo, float a_hi, gi_error *err);
 /* Packs the float tree (geometry and pointers; the intensity is set by
- * cssm_ctree_pull): centre = the centroid, radius about it over the
- * node's texels (with their extent), cone and area from the float node.
+ * cssm_ctree_pull): the float node's bounding sphere, normal, cone and
+ * area.
  * Refuses trees of more than CSSM_COMPACT_MAX_NODES nodes. */
 gi_result cssm_ctree_build(const cssm_tree *t, const cssm_atlas *a, cssm_ctree *out, gi_error *err);
 void cssm_ctree_free(cssm_ctree *ct);
