@@ -201,17 +201,24 @@ static uint16_t ptr16(int32_t p)
     return p < 0 ? (uint16_t)NULL16 : (uint16_t)p;
 }
 
+gi_result cssm_ctree_check(uint32_t texels, gi_error *err)
+{
+    uint64_t count = texels ? 2ull * texels - 1 : 0;
+    if (count <= CSSM_COMPACT_MAX_NODES)
+        return GI_OK;
+    snprintf(err->text, sizeof err->text,
+             "cssm_hrc: nodes=compact holds at most %u nodes (16-bit pointers, Sec. 4.2.1), this hierarchy has %llu "
+             "(%u texels): lower atlas or use nodes=float",
+             CSSM_COMPACT_MAX_NODES, (unsigned long long)count, texels);
+    return GI_ERR_INVALID_ARGUMENT;
+}
+
 gi_result cssm_ctree_setup(cssm_ctree *ct, uint32_t count, const float lo[3], const float hi[3], float r_lo,
                            float r_hi, float a_lo, float a_hi, gi_error *err)
 {
     memset(ct, 0, sizeof *ct);
-    if (count > CSSM_COMPACT_MAX_NODES) {
-        snprintf(err->text, sizeof err->text,
-                 "cssm_hrc: nodes=compact holds at most %u nodes (16-bit pointers, Sec. 4.2.1), this hierarchy has %u "
-                 "(%u texels): lower atlas or use nodes=float",
-                 CSSM_COMPACT_MAX_NODES, count, (count + 1) / 2);
-        return GI_ERR_INVALID_ARGUMENT;
-    }
+    if (count > CSSM_COMPACT_MAX_NODES)
+        return cssm_ctree_check((count + 1) / 2, err);
     ct->nodes = calloc(count ? count : 1, sizeof *ct->nodes);
     ct->side = calloc(2 * (size_t)(count ? count : 1), sizeof *ct->side);
     ct->leaves = calloc((size_t)count / 2 + 1, sizeof *ct->leaves);

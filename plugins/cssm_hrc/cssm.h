@@ -241,6 +241,10 @@ typedef struct cssm_ctree {
     uint32_t *leaves;      /* leaf rank -> texel (a copy of cssm_tree.leaves) */
 } cssm_ctree;
 
+/* GI_OK when the tree over `texels` texels (2 texels - 1 nodes) fits the
+ * 16-bit pointers; otherwise GI_ERR_INVALID_ARGUMENT and the one-line
+ * error in err. */
+gi_result cssm_ctree_check(uint32_t texels, gi_error *err);
 /* Sets up an empty packed tree of count nodes: the centre box [lo, hi],
  * the radius and area ranges of the log codes. GI_ERR_INVALID_ARGUMENT
  * (one line in err) when count exceeds CSSM_COMPACT_MAX_NODES. */

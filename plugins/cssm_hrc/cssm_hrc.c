@@ -685,6 +685,8 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     host->stat(host, "atlas_chart_texels", (double)a->chart_texels);
     host->stat(host, "atlas_charts", (double)a->chart_count);
     host->stat(host, "atlas_coverage", a->covered_area / a->surface_area);
+    if (c->nodes && (r = cssm_ctree_check(a->count, &err)) != GI_OK) /* before the maps are made */
+        return gi_kit_fail_with(&c->kit, r, &err);
     host->stage_begin(host, "traversal");
     c->order = cssm_traverse(a, c->traversal == 3 ? CSSM_GREEDY : (cssm_traversal)c->traversal);
     host->stage_end(host, "traversal");
