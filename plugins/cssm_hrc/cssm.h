@@ -183,6 +183,23 @@ typedef struct cssm_tree {
     uint32_t *leaf_node; /* texel -> its leaf node */
 } cssm_tree;
 
+/* One node as the traversal reads it, from either layout: the float
+ * cssm_node with its pulled radiance, or a packed 128-bit node decoded
+ * (compact.c). I is the radiant intensity, radiance x area per channel
+ * (what the paper's node stores), so a gather sends I cos_s cos_r / d^2. */
+typedef struct cssm_node_view {
+    gi_vec3 c;           /* bounding sphere centre */
+    float r;             /* and radius */
+    gi_vec3 p;           /* gather position (float: the centroid; packed: the one stored centre) */
+    gi_vec3 n;           /* mean normal */
+    float cos_cone;      /* normal cone (-1: everything) */
+    float area;
+    float I[3];          /* radiant intensity */
+    int32_t child, skip;
+    uint32_t first, count; /* leaves below: leaves[first, first + count) */
+    uint32_t rep;        /* texel whose CSSM gives the node's visibility */
+} cssm_node_view;
+
 /* Median cut over the texel positions (§4.2): split at the median of the
  * longest axis of the box until one texel is left. */
 gi_result cssm_tree_build(const cssm_atlas *a, cssm_tree *out, gi_error *err);
@@ -190,6 +207,69 @@ void cssm_tree_free(cssm_tree *t);
 /* Pull (§4.1.1): per node the area-weighted mean of per-texel radiance
  * `texel_L` (3 floats a texel) into `node_L` (3 floats a node). */
 void cssm_tree_pull(const cssm_tree *t, const cssm_atlas *a, const float *texel_L, float *node_L);
+
+/* ------------------------------------------------ compact nodes (§4.2.1)
+ * "For each node, all data is stored in 128 bits using a single 32-bit
+ * RGBA integer texel. 24 bits are used for: Center position, average
+ * normal and radiant intensity, 8 bits for: radius, normal cone angle and
+ * area, and 16 bits for both pointers." The four words (compact.c):
+ *   w[0]  centre: 8 bits per axis in the scene's box | radius: 8 bits, log
+ *   w[1]  normal: octahedral 12 + 12 bits          | cone angle: 8 bits, linear in [0, pi]
+ *   w[2]  intensity: 6-bit shared exponent + 3 x 6-bit mantissa | area: 8 bits, log
+ *   w[3]  child: 16 bits | skip: 16 bits (0xFFFF: none)
+ * One centre serves as the sphere's centre and as the gather position
+ * without jitter (the float node gathers at its area-weighted centroid);
+ * radius and cone are rounded up so that the
+ * decoded sphere holds the true one and the decoded cone the true one
+ * (the oracle's bounds stay upper bounds). Node index 0xFFFF is the null
+ * pointer: 65 535 nodes at most (32 768 texels). */
+#define CSSM_COMPACT_MAX_NODES 65535u
+
+typedef struct cssm_pnode {
+    uint32_t w[4];
+} cssm_pnode;
+
+typedef struct cssm_ctree {
+    cssm_pnode *nodes;
+    uint32_t count;
+    float lo[3], step[3];  /* centre: lo + q step, q in 0 .. 255 */
+    float rtab[256];       /* radius of each code (log between the smallest and largest node) */
+    float atab[256];       /* area of each code (log) */
+    float ctab[256];       /* cosine of the cone angle pi q / 255 */
+    float iscale;          /* intensity scale of the light set in the nodes (exponent 60 is 1 x iscale) */
+    uint32_t *side;        /* 2 per node: first leaf, representative texel (visibility and jitter, not in the 128 bits) */
+    uint32_t *leaves;      /* leaf rank -> texel (a copy of cssm_tree.leaves) */
+} cssm_ctree;
+
+/* GI_OK when the tree over `texels` texels (2 texels - 1 nodes) fits the
+ * 16-bit pointers; otherwise GI_ERR_INVALID_ARGUMENT and the one-line
+ * error in err. */
+gi_result cssm_ctree_check(uint32_t texels, gi_error *err);
+/* Sets up an empty packed tree of count nodes: the centre box [lo, hi],
+ * the radius and area ranges of the log codes. GI_ERR_INVALID_ARGUMENT
+ * (one line in err) when count exceeds CSSM_COMPACT_MAX_NODES. */
+gi_result cssm_ctree_setup(cssm_ctree *ct, uint32_t count, const float lo[3], const float hi[3], float r_lo,
+                           float r_hi, float a_lo, float a_hi, gi_error *err);
+/* Packs the float tree (geometry and pointers; the intensity is set by
+ * cssm_ctree_pull): the float node's bounding sphere, normal, cone and
+ * area.
+ * Refuses trees of more than CSSM_COMPACT_MAX_NODES nodes. */
+gi_result cssm_ctree_build(const cssm_tree *t, const cssm_atlas *a, cssm_ctree *out, gi_error *err);
+void cssm_ctree_free(cssm_ctree *ct);
+/* Encodes node i's geometry, pointers and intensity from v (v->c, r, n,
+ * cos_cone, area, I, child, skip; v->p is not stored: it is v->c), the
+ * radius grown by the centre's rounding and the cone by the normal's. */
+void cssm_ctree_encode(cssm_ctree *ct, uint32_t i, const cssm_node_view *v);
+/* Re-encodes node i's intensity only. */
+void cssm_ctree_set_intensity(cssm_ctree *ct, uint32_t i, const float I[3]);
+/* Decodes node i (count of leaves from the pointers, first and rep from
+ * the side table). */
+void cssm_ctree_view(const cssm_ctree *ct, uint32_t i, cssm_node_view *v);
+/* Pull on packed nodes (§4.1.1): a leaf gets radiance x area of its texel,
+ * an inner node the sum of its two children as decoded, each re-encoded
+ * (what a shader pass writing the node texture does). The intensity
+ * scale is the largest channel of the sum over the texels. */
+void cssm_ctree_pull(cssm_ctree *ct, const cssm_atlas *a, const float *texel_L);
 
 /* A receiver of the refine-and-gather traversal: a texel (diffuse, self
  * skipped) or a G-buffer pixel (Lambert + normalised Phong toward wo). */
@@ -225,6 +305,10 @@ typedef struct cssm_gather_stats {
  * maps may be NULL (everything visible). */
 void cssm_gather(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps, const float *node_L,
                  const cssm_receiver *rc, const cssm_gather_opts *o, float out[3], cssm_gather_stats *st);
+/* The same traversal over packed nodes (nodes=compact), each decoded as
+ * it is read, intensity as pulled into ct. */
+void cssm_cgather(const cssm_ctree *ct, const cssm_atlas *a, const cssm_maps *maps, const cssm_receiver *rc,
+                  const cssm_gather_opts *o, float out[3], cssm_gather_stats *st);
 /* Upper bound of what node S sends to the receiver (the oracle's L_max),
  * luminance. */
 float cssm_bound(const cssm_node *S, const float L[3], const cssm_receiver *rc);
@@ -254,5 +338,11 @@ gi_vec3 cssm_receiver_point(const cssm_maps *maps, const cssm_atlas *a, gi_vec3 
 gi_result cssm_solve(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps, const cssm_gather_opts *o,
                      uint32_t bounces, const float *direct, const gi_host *host, float *texel_L, float *node_L,
                      cssm_gather_stats *st, gi_error *err);
+/* The same with packed nodes: ct not NULL, every pull goes into ct (re-encoded)
+ * and every gather reads ct; ct ends holding the pull of texel_L (node_L
+ * is filled too). */
+gi_result cssm_solve_ex(const cssm_tree *t, cssm_ctree *ct, const cssm_atlas *a, const cssm_maps *maps,
+                        const cssm_gather_opts *o, uint32_t bounces, const float *direct, const gi_host *host,
+                        float *texel_L, float *node_L, cssm_gather_stats *st, gi_error *err);
 
 #endif

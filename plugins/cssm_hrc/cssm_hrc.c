@@ -74,6 +74,8 @@ typedef struct cssm_hrc {
     float *gb[5];     /* G-buffer read-back: position, normal, albedo, phong, emission */
     uint32_t acc_w, acc_h;
     cssm_motion motion; /* §3.3: moving rigid objects (motion.h); motion.moving < 0: static scene */
+    int nodes;          /* 1: nodes=compact, the gathers read packed 128-bit nodes (§4.2.1, compact.c) */
+    cssm_ctree ct[3];   /* nodes=compact: the packed hierarchy with the intensity of texel_L, emission, reflected */
     int prepared;
 } cssm_hrc;
 
@@ -110,6 +112,10 @@ static const gi_param_desc cssm_params[] = {
     {"env_pixel", GI_PARAM_BOOL, 1, 0, 1, NULL, NULL,
      "environment light per pixel: 1 traced at the pixel (env_samples per pixel and frame, averaged over frames), "
      "0 the atlas texels' irradiance by the bicubic look-up (surface samples: the nearest texel)"},
+    {"nodes", GI_PARAM_ENUM, 0, 0, 0, "float|compact", "node encoding (Sec. 4.2.1)",
+     "float: hierarchy nodes of floats; compact: the paper's 128 bits a node (24-bit centre, normal and intensity, "
+     "8-bit radius, cone and area, 16-bit pointers), decoded as the traversal reads them and re-encoded at each "
+     "pull; at most 65535 nodes (32768 texels)"},
     {"shadow_size", GI_PARAM_INT, 256, 16, 2048, NULL, NULL,
      "face size of the point/spot lights' shadow cube maps and of directional lights' shadow maps"},
     {0},
@@ -140,6 +146,7 @@ static gi_result cssm_create(const gi_host *host, const gi_params *params, void 
     c->mode = gi_params_enum(params, "mode");
     c->indirect = gi_params_enum(params, "indirect");
     c->mc_samples = gi_params_int(params, "mc_samples");
+    c->nodes = gi_params_enum(params, "nodes");
     c->motion.moving = -1;
     *out = c;
     return GI_OK;
@@ -159,6 +166,8 @@ static void release_prepared(cssm_hrc *c)
     cssm_atlas_free(&c->atlas);
     cssm_maps_free(&c->maps);
     cssm_tree_free(&c->tree);
+    for (int i = 0; i < 3; i++)
+        cssm_ctree_free(&c->ct[i]);
     free(c->order);
     free(c->texel_L);
     free(c->node_L);
@@ -365,6 +374,28 @@ static gi_vec3 offset(const cssm_hrc *c, gi_vec3 p, gi_vec3 n)
     return cssm_receiver_point(&c->maps, &c->atlas, p, n);
 }
 
+/* nodes=compact: the packed hierarchy (§4.2.1), one per light set, after
+ * the float one was built; stats of the node memory either way. */
+static gi_result make_compact(cssm_hrc *c, gi_error *err)
+{
+    const gi_host *host = c->kit.host;
+    for (int i = 0; i < 3; i++)
+        cssm_ctree_free(&c->ct[i]);
+    host->stat(host, "node_count", (double)c->tree.count);
+    if (!c->nodes) { /* a float node and its pulled radiance */
+        host->stat(host, "node_bytes", (double)c->tree.count * (double)(sizeof(cssm_node) + 3 * sizeof(float)));
+        return GI_OK;
+    }
+    for (int i = 0; i < 3; i++) {
+        gi_result r = cssm_ctree_build(&c->tree, &c->atlas, &c->ct[i], err);
+        if (r != GI_OK)
+            return r;
+    }
+    host->stat(host, "node_bytes", (double)c->tree.count * (double)sizeof(cssm_pnode));
+    host->stat(host, "node_side_bytes", (double)c->tree.count * 2.0 * sizeof(uint32_t));
+    return GI_OK;
+}
+
 /* The atlas' lighting (§4.1, Fig. 8) with the punctual lights' direct
  * light per texel added to the first bounce. */
 static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
@@ -420,8 +451,8 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
     cssm_gather_opts o = gather_opts(c, 0.0f, NULL);
     cssm_gather_stats st = {0};
     gi_error err;
-    gi_result r = cssm_solve(&c->tree, a, &c->maps, &o, (uint32_t)c->bounces, c->shadow_count || env ? D : NULL, host,
-                             c->texel_L, c->node_L, &st, &err);
+    gi_result r = cssm_solve_ex(&c->tree, c->nodes ? &c->ct[0] : NULL, a, &c->maps, &o, (uint32_t)c->bounces,
+                                c->shadow_count || env ? D : NULL, host, c->texel_L, c->node_L, &st, &err);
     free(D);
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);
@@ -439,9 +470,13 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
     for (uint32_t i = 0; i < N; i++)
         memcpy(&tmp[3 * i], a->texels[i].emission, 3 * sizeof(float));
     cssm_tree_pull(&c->tree, a, tmp, c->node_Le);
+    if (c->nodes)
+        cssm_ctree_pull(&c->ct[1], a, tmp);
     for (size_t k = 0; k < 3 * (size_t)N; k++)
         tmp[k] = c->texel_L[k] - tmp[k];
     cssm_tree_pull(&c->tree, a, tmp, c->node_B);
+    if (c->nodes)
+        cssm_ctree_pull(&c->ct[2], a, tmp);
     /* per-texel values and pdf tables for indirect=mc */
     free(c->texel_Le);
     free(c->texel_B);
@@ -650,6 +685,8 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     host->stat(host, "atlas_chart_texels", (double)a->chart_texels);
     host->stat(host, "atlas_charts", (double)a->chart_count);
     host->stat(host, "atlas_coverage", a->covered_area / a->surface_area);
+    if (c->nodes && (r = cssm_ctree_check(a->count, &err)) != GI_OK) /* before the maps are made */
+        return gi_kit_fail_with(&c->kit, r, &err);
     host->stage_begin(host, "traversal");
     c->order = cssm_traverse(a, c->traversal == 3 ? CSSM_GREEDY : (cssm_traversal)c->traversal);
     host->stage_end(host, "traversal");
@@ -671,6 +708,8 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     host->stat(host, "dont_care_share", (double)c->maps.dont_care / (double)c->maps.face_texels);
     host->stage_begin(host, "hierarchy");
     r = cssm_tree_build(a, &c->tree, &err);
+    if (r == GI_OK)
+        r = make_compact(c, &err);
     host->stage_end(host, "hierarchy");
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);
@@ -711,6 +750,8 @@ static gi_result cssm_update(void *inst, const gi_gpu_scene *gs, const gi_change
         host->stage_begin(host, "hierarchy");
         cssm_tree_free(&c->tree);
         gi_result r = cssm_tree_build(&c->atlas, &c->tree, &err);
+        if (r == GI_OK)
+            r = make_compact(c, &err);
         host->stage_end(host, "hierarchy");
         if (r != GI_OK) { /* what was made before is gone: render refuses until the next prepare */
             c->prepared = 0;
@@ -787,6 +828,10 @@ static void gather(const cssm_hrc *c, int which, const cssm_receiver *rc, const 
     if (c->indirect == 1) {
         const float *tv = which == 0 ? c->texel_L : which == 1 ? c->texel_Le : c->texel_B;
         cssm_gather_mc(&c->atlas, &c->maps, tv, c->cdf[which], (uint32_t)c->mc_samples, rc, o, out);
+        return;
+    }
+    if (c->nodes) {
+        cssm_cgather(&c->ct[which], &c->atlas, &c->maps, rc, o, out, st);
         return;
     }
     const float *nv = which == 0 ? c->node_L : which == 1 ? c->node_Le : c->node_B;

@@ -184,7 +184,33 @@ static float cos_bound(gi_vec3 u, gi_vec3 w, float sin_h)
     return fmaxf(0.0f, c * cos_h + s * sin_h);
 }
 
-float cssm_bound(const cssm_node *S, const float L[3], const cssm_receiver *rc)
+/* Node i as the traversal reads it: the float node with its pulled
+ * radiance (intensity = radiance x area), or the packed node decoded. */
+static void fetch(const cssm_tree *t, const float *node_L, const cssm_ctree *ct, int32_t i, cssm_node_view *v)
+{
+    if (ct) {
+        cssm_ctree_view(ct, (uint32_t)i, v);
+        return;
+    }
+    const cssm_node *S = &t->nodes[i];
+    const float *L = &node_L[3 * i];
+    v->c = S->c;
+    v->r = S->r;
+    v->p = S->centroid;
+    v->n = S->n;
+    v->cos_cone = S->cos_cone;
+    v->area = S->area;
+    for (int k = 0; k < 3; k++)
+        v->I[k] = L[k] * S->area;
+    v->child = S->child;
+    v->skip = S->skip;
+    v->first = S->first;
+    v->count = S->count;
+    v->rep = S->rep;
+}
+
+/* The oracle's upper bound (luminance) of what node S sends to rc. */
+static float bound_view(const cssm_node_view *S, const cssm_receiver *rc)
 {
     gi_vec3 w = gi_v3_sub(S->c, rc->x);
     float d = gi_v3_length(w);
@@ -211,24 +237,30 @@ float cssm_bound(const cssm_node *S, const float L[3], const cssm_receiver *rc)
         float cl = cos_bound(r, w, sin_h);
         f += gi_luminance(rc->ks) * (rc->exponent + 2.0f) / (2.0f * GI_PI) * powf(cl, rc->exponent);
     }
-    float lum = gi_luminance(L);
-    return f * lum * S->area * cr * cs / (dmin * dmin);
+    return f * gi_luminance(S->I) * cr * cs / (dmin * dmin);
 }
 
-/* One gathered node: sample position (the centroid, or with jitter a
- * random point of a random texel below it, §4.5), visibility through that
- * texel's CSSM. */
-static void transfer(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps, const float *L,
-                     const cssm_node *S, const cssm_receiver *rc, const cssm_gather_opts *o, float out[3],
-                     cssm_gather_stats *st)
+float cssm_bound(const cssm_node *S, const float L[3], const cssm_receiver *rc)
 {
-    gi_vec3 y = S->centroid, ny = S->n;
+    cssm_node_view v = {.c = S->c, .r = S->r, .p = S->centroid, .n = S->n, .cos_cone = S->cos_cone, .area = S->area};
+    for (int k = 0; k < 3; k++)
+        v.I[k] = L[k] * S->area;
+    return bound_view(&v, rc);
+}
+
+/* One gathered node: sample position (the node's gather position, or with
+ * jitter a random point of a random texel below it, §4.5), visibility
+ * through that texel's CSSM. leaves: leaf rank -> texel. */
+static void transfer(const uint32_t *leaves, const cssm_atlas *a, const cssm_maps *maps, const cssm_node_view *S,
+                     const cssm_receiver *rc, const cssm_gather_opts *o, float out[3], cssm_gather_stats *st)
+{
+    gi_vec3 y = S->p, ny = S->n;
     uint32_t vis_texel = S->rep;
     if (o->rng) {
         uint32_t k = S->first + (uint32_t)(gi_rng_next_float(o->rng) * (float)S->count);
         if (k >= S->first + S->count)
             k = S->first + S->count - 1;
-        const cssm_texel *x = &a->texels[t->leaves[k]];
+        const cssm_texel *x = &a->texels[leaves[k]];
         gi_vec3 tu, tv;
         gi_onb(x->n, &tu, &tv);
         float side = sqrtf(x->area);
@@ -236,7 +268,7 @@ static void transfer(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *m
         y = gi_v3_add(x->p, gi_v3_add(gi_v3_scale(tu, u1 * side), gi_v3_scale(tv, u2 * side)));
         if (S->count == 1)
             ny = x->n;
-        vis_texel = t->leaves[k];
+        vis_texel = leaves[k];
     }
     gi_vec3 w = gi_v3_sub(y, rc->x);
     float d2 = gi_v3_dot(w, w);
@@ -256,7 +288,7 @@ static void transfer(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *m
     float v = maps ? cssm_visible_rc(maps, vis_texel, rc, o->bias, o->pcf) : 1.0f;
     if (v <= 0.0f)
         return;
-    float g = S->area * cr * cs / d2 * v;
+    float g = cr * cs / d2 * v;
     float f[3] = {rc->kd[0] / GI_PI, rc->kd[1] / GI_PI, rc->kd[2] / GI_PI};
     if (rc->glossy && gi_luminance(rc->ks) > 0.0f) {
         gi_vec3 r = gi_v3_sub(gi_v3_scale(rc->n, 2.0f * gi_v3_dot(rc->n, rc->wo)), rc->wo);
@@ -266,13 +298,16 @@ static void transfer(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *m
             f[k] += rc->ks[k] * lobe;
     }
     for (int k = 0; k < 3; k++)
-        out[k] += f[k] * L[k] * g;
+        out[k] += f[k] * S->I[k] * g;
 }
 
-void cssm_gather(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps, const float *node_L,
-                 const cssm_receiver *rc, const cssm_gather_opts *o, float out[3], cssm_gather_stats *st)
+/* Fig. 10 over either layout (ct NULL: the float nodes with node_L). */
+static void gather_any(const cssm_tree *t, const float *node_L, const cssm_ctree *ct, const cssm_atlas *a,
+                       const cssm_maps *maps, const cssm_receiver *rc, const cssm_gather_opts *o, float out[3],
+                       cssm_gather_stats *st)
 {
     out[0] = out[1] = out[2] = 0.0f;
+    const uint32_t *leaves = ct ? ct->leaves : t->leaves;
     /* Fig. 10: refine by the child pointer, gather and leave by the skip
      * pointer. `pending` counts the subtrees still to be visited, so that
      * gathered + pending is the size the cut reaches at least. */
@@ -281,28 +316,29 @@ void cssm_gather(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps,
     uint32_t gathered = 0, pending = 1;
     int32_t i = 0;
     while (i >= 0) {
-        const cssm_node *S = &t->nodes[i];
-        const float *L = &node_L[3 * i];
-        if (S->child < 0 && rc->self >= 0 && t->leaves[S->first] == (uint32_t)rc->self) {
+        cssm_node_view S;
+        fetch(t, node_L, ct, i, &S);
+        if (S.child < 0 && rc->self >= 0 && leaves[S.first] == (uint32_t)rc->self) {
             pending--;
-            i = S->skip; /* no transfer to itself */
+            i = S.skip; /* no transfer to itself */
             continue;
         }
+        const int lit = S.I[0] > 0.0f || S.I[1] > 0.0f || S.I[2] > 0.0f;
         int refine = 0;
-        if (S->child >= 0 && gathered + pending + 1 <= o->max_cut && (L[0] > 0.0f || L[1] > 0.0f || L[2] > 0.0f)) {
-            float b = cssm_bound(S, L, rc);
+        if (S.child >= 0 && gathered + pending + 1 <= o->max_cut && lit) {
+            float b = bound_view(&S, rc);
             refine = b >= FLT_MAX || powf(b * scale, 1.0f / 2.2f) > thr;
         }
         if (refine) {
             pending++;
-            i = S->child;
+            i = S.child;
             continue;
         }
-        if (L[0] > 0.0f || L[1] > 0.0f || L[2] > 0.0f)
-            transfer(t, a, maps, L, S, rc, o, out, st);
+        if (lit)
+            transfer(leaves, a, maps, &S, rc, o, out, st);
         gathered++;
         pending--;
-        i = S->skip;
+        i = S.skip;
     }
     if (st) {
         st->nodes += gathered;
@@ -310,15 +346,28 @@ void cssm_gather(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps,
     }
 }
 
-/* One gather over every texel of the atlas from node radiance node_L. */
-static void gather_atlas(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps, const float *node_L,
-                         const cssm_gather_opts *o, float *out, cssm_gather_stats *st)
+void cssm_gather(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps, const float *node_L,
+                 const cssm_receiver *rc, const cssm_gather_opts *o, float out[3], cssm_gather_stats *st)
+{
+    gather_any(t, node_L, NULL, a, maps, rc, o, out, st);
+}
+
+void cssm_cgather(const cssm_ctree *ct, const cssm_atlas *a, const cssm_maps *maps, const cssm_receiver *rc,
+                  const cssm_gather_opts *o, float out[3], cssm_gather_stats *st)
+{
+    gather_any(NULL, NULL, ct, a, maps, rc, o, out, st);
+}
+
+/* One gather over every texel of the atlas from node radiance node_L (or
+ * the packed nodes ct). */
+static void gather_atlas(const cssm_tree *t, const float *node_L, const cssm_ctree *ct, const cssm_atlas *a,
+                         const cssm_maps *maps, const cssm_gather_opts *o, float *out, cssm_gather_stats *st)
 {
     for (uint32_t i = 0; i < a->count; i++) {
         const cssm_texel *x = &a->texels[i];
         cssm_receiver rc = {.x = cssm_receiver_point(maps, a, x->p, x->n), .n = x->n, .self = (int32_t)i};
         memcpy(rc.kd, x->albedo, sizeof rc.kd);
-        cssm_gather(t, a, maps, node_L, &rc, o, &out[3 * i], st);
+        gather_any(t, node_L, ct, a, maps, &rc, o, &out[3 * i], st);
     }
 }
 
@@ -328,9 +377,25 @@ gi_vec3 cssm_receiver_point(const cssm_maps *maps, const cssm_atlas *a, gi_vec3 
     return gi_v3_add(p, gi_v3_scale(n, 2.0f * eps));
 }
 
+/* Pull of per-texel values into the layout the gathers read. */
+static void pull_any(const cssm_tree *t, cssm_ctree *ct, const cssm_atlas *a, const float *texel_L, float *nodes)
+{
+    if (ct)
+        cssm_ctree_pull(ct, a, texel_L);
+    else
+        cssm_tree_pull(t, a, texel_L, nodes);
+}
+
 gi_result cssm_solve(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps, const cssm_gather_opts *o,
                      uint32_t bounces, const float *direct, const gi_host *host, float *texel_L, float *node_L,
                      cssm_gather_stats *st, gi_error *err)
+{
+    return cssm_solve_ex(t, NULL, a, maps, o, bounces, direct, host, texel_L, node_L, st, err);
+}
+
+gi_result cssm_solve_ex(const cssm_tree *t, cssm_ctree *ct, const cssm_atlas *a, const cssm_maps *maps,
+                        const cssm_gather_opts *o, uint32_t bounces, const float *direct, const gi_host *host,
+                        float *texel_L, float *node_L, cssm_gather_stats *st, gi_error *err)
 {
     const uint32_t N = a->count;
     float *Le = calloc(3 * (size_t)N, sizeof *Le), *Rk = calloc(3 * (size_t)N, sizeof *Rk);
@@ -346,8 +411,8 @@ gi_result cssm_solve(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *m
     if (bounces >= 1) {
         /* direct: the emitting texels gathered like any sender, plus the rest */
         gi_host_stage(host, "direct", 1);
-        cssm_tree_pull(t, a, Le, nodes);
-        gather_atlas(t, a, maps, nodes, o, Rk, st);
+        pull_any(t, ct, a, Le, nodes);
+        gather_atlas(t, nodes, ct, a, maps, o, Rk, st);
         if (direct)
             for (size_t k = 0; k < 3 * (size_t)N; k++)
                 Rk[k] += direct[k];
@@ -357,11 +422,11 @@ gi_result cssm_solve(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *m
     }
     for (uint32_t b = 2; b <= bounces; b++) {
         gi_host_stage(host, "pull", 1);
-        cssm_tree_pull(t, a, Rk, nodes);
+        pull_any(t, ct, a, Rk, nodes);
         gi_host_stage(host, "pull", 0);
         gi_host_stage(host, "bounce", 1);
         memset(Rn, 0, 3 * (size_t)N * sizeof *Rn);
-        gather_atlas(t, a, maps, nodes, o, Rn, st);
+        gather_atlas(t, nodes, ct, a, maps, o, Rn, st);
         for (size_t k = 0; k < 3 * (size_t)N; k++)
             texel_L[k] += Rn[k];
         float *sw = Rk;
@@ -371,6 +436,8 @@ gi_result cssm_solve(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *m
     }
     gi_host_stage(host, "pull", 1);
     cssm_tree_pull(t, a, texel_L, node_L);
+    if (ct)
+        cssm_ctree_pull(ct, a, texel_L);
     gi_host_stage(host, "pull", 0);
     free(Le), free(Rk), free(Rn), free(nodes);
     return GI_OK;

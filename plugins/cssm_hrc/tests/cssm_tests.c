@@ -23,6 +23,12 @@
  *               made again): visibility against Embree on the moved scene
  *               for pairs near the bunny, against always / never visible
  *               and the unmoved scene's visibility
+ *   compact     the compact nodes of §4.2.1: random round trips within the
+ *               stated bounds, conservative spheres and cones on the
+ *               Cornell box tree, exact pointers, equal traversals, the
+ *               packed pull against the float pull
+ *   compact_furnace  the furnace with nodes=compact
+ *   compact_limit    65 535 nodes pack, 65 537 are refused
  * Usage: cssm_tests PART. Exit 0 on success, 1 with a message otherwise. */
 #include "cssm.h"
 #include "motion.h"
@@ -641,7 +647,7 @@ static int part_motion(void)
 
 /* -------------------------------------------------------------- furnace */
 
-static int part_furnace(void)
+static int part_furnace(int compact)
 {
     gi_scene *s = load("tests/data/conformance/furnace_050.gltf");
     if (!s)
@@ -656,10 +662,13 @@ static int part_furnace(void)
     cssm_maps m;
     cssm_tree t;
     gi_error err;
-    if (cssm_atlas_build(s, 0.0f, 24, 0, &a, &err) != GI_OK || cssm_tree_build(&a, &t, &err) != GI_OK) {
+    cssm_ctree ct = {0};
+    if (cssm_atlas_build(s, 0.0f, 24, 0, &a, &err) != GI_OK || cssm_tree_build(&a, &t, &err) != GI_OK ||
+        (compact && cssm_ctree_build(&t, &a, &ct, &err) != GI_OK)) {
         fprintf(stderr, "FAIL: %s\n", err.text);
         return 1;
     }
+    const char *how = compact ? " (nodes=compact)" : "";
     uint32_t *order = cssm_traverse(&a, CSSM_GREEDY);
     if (!order || cssm_maps_build(gs, &a, order, 16, NULL, &m, &err) != GI_OK) {
         fprintf(stderr, "FAIL: %s\n", order ? err.text : "traverse");
@@ -672,7 +681,7 @@ static int part_furnace(void)
     printf("furnace: %u surface samples on the sphere\n", a.count);
     for (uint32_t n = 1; n <= 3; n++) {
         cssm_gather_stats st = {0};
-        if (cssm_solve(&t, &a, &m, &o, n, NULL, NULL, L, NL, &st, &err) != GI_OK) {
+        if (cssm_solve_ex(&t, compact ? &ct : NULL, &a, &m, &o, n, NULL, NULL, L, NL, &st, &err) != GI_OK) {
             fprintf(stderr, "FAIL: %s\n", err.text);
             return 1;
         }
@@ -698,14 +707,21 @@ static int part_furnace(void)
                 rc.kd[c] = (float)rho;
             rc.wo = x->n;
             float out[3];
-            cssm_gather(&t, &a, &m, NL, &rc, &o, out, NULL);
+            if (compact)
+                cssm_cgather(&ct, &a, &m, &rc, &o, out, NULL);
+            else
+                cssm_gather(&t, &a, &m, NL, &rc, &o, out, NULL);
             pmean += Le + (out[0] + out[1] + out[2]) / 3.0;
         }
         pmean /= P;
-        printf("furnace n = %u: atlas mean %.4f (expected %.4f, %+.2f %%, worst texel %.2f %%), final gather %.4f "
+        printf("furnace%s n = %u: atlas mean %.4f (expected %.4f, %+.2f %%, worst texel %.2f %%), final gather %.4f "
                "(expected %.4f, %+.2f %%); emission only %+.1f %%, black -100 %%; mean cut %.1f\n",
-               n, mean, atlas_expect, 100 * (mean / atlas_expect - 1), 100 * worst, pmean, pixel_expect,
+               how, n, mean, atlas_expect, 100 * (mean / atlas_expect - 1), 100 * worst, pmean, pixel_expect,
                100 * (pmean / pixel_expect - 1), 100 * (Le / pixel_expect - 1), (double)st.nodes / st.receivers);
+        CHECK(fabs(mean / atlas_expect - 1) <= 0.02, "n = %u: atlas off by more than 2 %%", n);
+        CHECK(fabs(pmean / pixel_expect - 1) <= 0.02, "n = %u: final gather off by more than 2 %%", n);
+        if (compact) /* the Monte Carlo gather reads no hierarchy */
+            continue;
         /* the same final gather by Monte Carlo from the atlas as a pdf (Sec. 4.6) */
         double *cdf = malloc((a.count + 1) * sizeof *cdf);
         double mc = 0;
@@ -726,9 +742,8 @@ static int part_furnace(void)
         printf("furnace n = %u: Monte Carlo final gather (64 texels x %d receivers) %.4f (%+.2f %%)\n", n, P, mc,
                100 * (mc / pixel_expect - 1));
         CHECK(fabs(mc / pixel_expect - 1) <= 0.02, "n = %u: Monte Carlo final gather off by more than 2 %%", n);
-        CHECK(fabs(mean / atlas_expect - 1) <= 0.02, "n = %u: atlas off by more than 2 %%", n);
-        CHECK(fabs(pmean / pixel_expect - 1) <= 0.02, "n = %u: final gather off by more than 2 %%", n);
     }
+    cssm_ctree_free(&ct);
     free(L);
     free(NL);
     free(order);
@@ -1001,10 +1016,295 @@ static int part_texture(void)
     return 0;
 }
 
+/* ------------------------------------------------------ compact nodes */
+
+/* Node i's view of the float tree (no light). */
+static cssm_node_view float_view(const cssm_tree *t, int32_t i)
+{
+    const cssm_node *nd = &t->nodes[i];
+    cssm_node_view v = {.c = nd->c, .r = nd->r, .p = nd->centroid, .n = nd->n, .cos_cone = nd->cos_cone,
+                        .area = nd->area, .child = nd->child, .skip = nd->skip, .first = nd->first,
+                        .count = nd->count, .rep = nd->rep};
+    return v;
+}
+
+/* The skip-pointer traversal of part_tree over packed nodes. */
+static void stackless_compact(const cssm_ctree *ct, uint32_t salt, int full, uint32_t *out, uint32_t *n)
+{
+    int32_t i = 0;
+    while (i >= 0) {
+        cssm_node_view v;
+        cssm_ctree_view(ct, (uint32_t)i, &v);
+        if (v.child >= 0 && (full || decide((uint32_t)i, salt))) {
+            i = v.child;
+            continue;
+        }
+        out[(*n)++] = (uint32_t)i;
+        i = v.skip;
+    }
+}
+
+/* Angle between two directions, accurate near 0. */
+static float angle_between(gi_vec3 a, gi_vec3 b)
+{
+    a = gi_v3_normalize(a), b = gi_v3_normalize(b);
+    return 2.0f * atan2f(gi_v3_length(gi_v3_sub(a, b)), gi_v3_length(gi_v3_add(a, b)));
+}
+
+static float rnd_log(uint32_t *rng, float lo, float hi)
+{
+    return lo * powf(hi / lo, gi_rng_next_float(rng));
+}
+
+/* §4.2.1 encoding: random nodes round trip within the stated bounds
+ * (centre half a step per axis; sphere and cone of the decoded node hold
+ * the true ones, at most one code larger; area within half a log step;
+ * intensity within 1/31.5 of its largest channel, zero on average;
+ * pointers exact); on the
+ * Cornell box tree: every texel inside its node's decoded sphere and cone,
+ * pointers equal to the float tree's, skip-pointer traversals over packed
+ * nodes equal to those over float nodes, the packed pull against the float
+ * pull, and the log radius code against a linear one. */
+static int part_compact(void)
+{
+    gi_error err;
+    cssm_ctree ct;
+    const float lo[3] = {-1.0f, 0.0f, 2.0f}, hi[3] = {3.0f, 0.5f, 2.25f};
+    const float r_lo = 1e-3f, r_hi = 4.0f, a_lo = 1e-5f, a_hi = 10.0f;
+    const uint32_t N = 20000;
+    if (cssm_ctree_setup(&ct, N, lo, hi, r_lo, r_hi, a_lo, a_hi, &err) != GI_OK) {
+        fprintf(stderr, "FAIL: %s\n", err.text);
+        return 1;
+    }
+    ct.iscale = 3.0f;
+    const float rstep = powf(r_hi / r_lo, 1.0f / 255.0f), astep = logf(a_hi / a_lo) / 255.0f;
+    uint32_t rng = gi_rng_init(7, 0, 0xc0au);
+    uint32_t bad_c = 0, bad_r = 0, loose_r = 0, bad_n = 0, bad_k = 0, loose_k = 0, bad_a = 0, bad_i = 0, bad_p = 0;
+    float max_n = 0.0f, max_i = 0.0f, max_dk = 0.0f;
+    double bias_i = 0.0;
+    uint32_t bias_n = 0;
+    for (uint32_t i = 0; i < N; i++) {
+        cssm_node_view v = {0}, d;
+        float p[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = lo[k] + (hi[k] - lo[k]) * gi_rng_next_float(&rng);
+        v.c = gi_v3(p[0], p[1], p[2]);
+        v.r = rnd_log(&rng, r_lo, r_hi * 0.5f);
+        v.n = gi_sample_uniform_sphere(gi_rng_next_float(&rng), gi_rng_next_float(&rng));
+        v.cos_cone = (i % 7) == 0 ? -1.0f : 1.0f - 2.0f * gi_rng_next_float(&rng) * gi_rng_next_float(&rng);
+        v.area = rnd_log(&rng, a_lo, a_hi);
+        float mag = ct.iscale * exp2f(-40.0f + 42.0f * gi_rng_next_float(&rng));
+        for (int k = 0; k < 3; k++)
+            v.I[k] = (gi_pcg_hash(i * 3u + (uint32_t)k) % 5u) == 0 ? 0.0f : mag * gi_rng_next_float(&rng);
+        v.child = (i % 5) == 0 ? -1 : (int32_t)(gi_rng_next_u32(&rng) % CSSM_COMPACT_MAX_NODES);
+        v.skip = (i % 3) == 0 ? -1 : (int32_t)(gi_rng_next_u32(&rng) % CSSM_COMPACT_MAX_NODES);
+        if (i == 1)
+            v.child = (int32_t)CSSM_COMPACT_MAX_NODES - 1, v.skip = 0;
+        cssm_ctree_encode(&ct, i, &v);
+        cssm_ctree_view(&ct, i, &d);
+        float dc[3] = {d.c.x - v.c.x, d.c.y - v.c.y, d.c.z - v.c.z};
+        for (int k = 0; k < 3; k++)
+            bad_c += fabsf(dc[k]) > 0.5f * (hi[k] - lo[k]) / 255.0f * 1.0001f + 1e-6f;
+        float need = v.r + gi_v3_length(gi_v3_sub(v.c, d.c));
+        bad_r += d.r < need;
+        loose_r += d.r > fmaxf(need, r_lo) * rstep * 1.0001f;
+        float an = angle_between(v.n, d.n);
+        max_n = fmaxf(max_n, an);
+        bad_n += an > 1e-3f;
+        if (v.cos_cone <= -1.0f) {
+            bad_k += d.cos_cone > -1.0f;
+        } else {
+            /* compared as cosines: the decoded cone must reach the true
+             * cone's angle plus the normal's rounding, and stay within one
+             * code (pi / 255) of it */
+            float kneed = acosf(v.cos_cone) + an;
+            bad_k += kneed < (float)GI_PI && d.cos_cone > cosf(kneed) + 1e-6f;
+            loose_k += kneed + (float)GI_PI / 255.0f < (float)GI_PI &&
+                       d.cos_cone < cosf(kneed + (float)GI_PI / 255.0f) - 1e-6f;
+            max_dk = fmaxf(max_dk, acosf(fmaxf(-1.0f, d.cos_cone)) - kneed);
+        }
+        bad_a += fabsf(logf(d.area / v.area)) > 0.5f * astep * 1.001f;
+        float mx = fmaxf(v.I[0], fmaxf(v.I[1], v.I[2]));
+        for (int k = 0; k < 3; k++) {
+            float e = fabsf(d.I[k] - v.I[k]);
+            bad_i += e > mx / 31.5f * 1.0001f;
+            if (mx > 0.0f) {
+                max_i = fmaxf(max_i, e / mx);
+                bias_i += (double)(d.I[k] - v.I[k]) / mx, bias_n++;
+            }
+        }
+        bad_p += d.child != v.child || d.skip != v.skip;
+    }
+    CHECK(!bad_c, "%u centres off by more than half a step", bad_c);
+    CHECK(!bad_r && !loose_r, "radius: %u smaller than the true sphere needs, %u more than one code larger", bad_r,
+          loose_r);
+    CHECK(!bad_n, "%u normals off by more than 1e-3 rad", bad_n);
+    CHECK(!bad_k && !loose_k, "cone: %u narrower than the true cone, %u more than one code wider", bad_k, loose_k);
+    CHECK(!bad_a, "%u areas off by more than half a log step", bad_a);
+    CHECK(!bad_i, "%u intensity channels off by more than 1/31.5 of the largest", bad_i);
+    CHECK(!bad_p, "%u pointers changed", bad_p);
+    /* the dithered rounding: a mean signed error within a few standard
+     * errors of 0 (one step is at most 1/31.5, a uniform error's sd 1/109) */
+    bias_i /= bias_n;
+    CHECK(fabs(bias_i) < 4.0 / (109.0 * sqrt((double)bias_n)) + 1e-4, "intensity rounding biased by %.5f", bias_i);
+    printf("compact: %u random nodes: normal error at most %.2e rad (%.4f deg), cone widened by at most %.4f rad, "
+           "intensity error at most %.4f of the largest channel (mean signed %+.5f), radius step x%.4f, area step x%.4f\n",
+           N, (double)max_n, (double)max_n * 180.0 / GI_PI, (double)max_dk, (double)max_i, bias_i, (double)rstep,
+           (double)expf(astep));
+    cssm_ctree_free(&ct);
+
+    /* the Cornell box's tree */
+    gi_scene *s = load("scenes/cornell_box.gltf");
+    if (!s)
+        return 1;
+    cssm_atlas a;
+    cssm_tree t;
+    if (cssm_atlas_build(s, 0.0f, 32, 0, &a, &err) != GI_OK || cssm_tree_build(&a, &t, &err) != GI_OK ||
+        cssm_ctree_build(&t, &a, &ct, &err) != GI_OK) {
+        fprintf(stderr, "FAIL: %s\n", err.text);
+        gi_scene_free(s);
+        return 1;
+    }
+    uint32_t outside = 0, out_cone = 0, ptr = 0;
+    double over_log = 0.0, over_lin = 0.0;
+    float rmax = ct.rtab[255];
+    for (uint32_t i = 0; i < t.count; i++) {
+        cssm_node_view f = float_view(&t, (int32_t)i), d;
+        cssm_ctree_view(&ct, i, &d);
+        ptr += d.child != f.child || d.skip != f.skip || d.first != f.first || d.count != f.count || d.rep != f.rep;
+        float need = 0.0f;
+        for (uint32_t k = f.first; k < f.first + f.count; k++) {
+            const cssm_texel *x = &a.texels[t.leaves[k]];
+            float reach = gi_v3_length(gi_v3_sub(x->p, d.c)) + 0.75f * sqrtf(x->area);
+            need = fmaxf(need, reach);
+            outside += reach > d.r;
+            out_cone += d.cos_cone > -1.0f && gi_v3_dot(x->n, d.n) < d.cos_cone - 1e-6f;
+        }
+        /* what a linear code (steps of rmax / 255, rounded up) would give */
+        float lin = ceilf(need / rmax * 255.0f) / 255.0f * rmax;
+        over_log += d.r / need - 1.0;
+        over_lin += lin / need - 1.0;
+    }
+    over_log /= t.count;
+    over_lin /= t.count;
+    CHECK(!outside, "%u texels outside their node's decoded sphere", outside);
+    CHECK(!out_cone, "%u texel normals outside their node's decoded cone", out_cone);
+    CHECK(!ptr, "%u nodes whose pointers, leaves or visibility texel differ from the float tree's", ptr);
+    CHECK(over_log < over_lin, "the log radius code (%.3f) is not tighter than a linear one (%.3f)", over_log,
+          over_lin);
+    uint32_t *x = malloc(t.count * sizeof *x), *y = malloc(t.count * sizeof *y);
+    uint32_t differ = 0;
+    for (uint32_t salt = 0; salt < 65; salt++) {
+        uint32_t nx = 0, ny = 0;
+        int full = salt == 64;
+        stackless(&t, salt, full, x, &nx);
+        stackless_compact(&ct, salt, full, y, &ny);
+        differ += nx != ny || memcmp(x, y, nx * sizeof *x);
+    }
+    CHECK(!differ, "%u of 65 skip-pointer traversals over packed nodes differ from those over float nodes", differ);
+    /* the packed pull (re-encoded at each node) against the float pull x area */
+    float *tl = malloc(3 * a.count * sizeof *tl), *nl = malloc(3 * t.count * sizeof *nl);
+    for (uint32_t i = 0; i < a.count; i++)
+        for (int k = 0; k < 3; k++)
+            tl[3 * i + k] = a.texels[i].albedo[k] + 10.0f * a.texels[i].emission[k];
+    cssm_tree_pull(&t, &a, tl, nl);
+    cssm_ctree_pull(&ct, &a, tl);
+    /* each re-encoding errs by at most 1/31.5 of the node's largest channel
+     * (at most its channel sum S); the nodes of one level below a node sum
+     * to its S, so a node of height h errs by at most (h + 1) S / 31.5 */
+    uint32_t *height = calloc(t.count, sizeof *height), over = 0;
+    double worst = 0.0, mean = 0.0, root = 0.0;
+    for (int32_t i = (int32_t)t.count - 1; i >= 0; i--) {
+        const cssm_node *nd = &t.nodes[i];
+        if (nd->child >= 0)
+            height[i] = 1 + (height[nd->child] > height[t.nodes[nd->child].skip] ? height[nd->child]
+                                                                                  : height[t.nodes[nd->child].skip]);
+        cssm_node_view d;
+        cssm_ctree_view(&ct, (uint32_t)i, &d);
+        float mx = 0.0f, sum = 0.0f;
+        for (int k = 0; k < 3; k++)
+            mx = fmaxf(mx, nl[3 * i + k] * nd->area), sum += nl[3 * i + k] * nd->area;
+        for (int k = 0; k < 3; k++) {
+            double e = fabs(d.I[k] - nl[3 * i + k] * nd->area);
+            over += e > (height[i] + 1) * sum / 31.5 * 1.001;
+            worst = fmax(worst, e / mx);
+            mean += e / mx / (3.0 * t.count);
+            if (i == 0)
+                root = fmax(root, e / mx);
+        }
+    }
+    free(height);
+    CHECK(!over, "packed pull: %u channels beyond the bound (h + 1) S / 31.5", over);
+    printf("compact: Cornell box 32^2, %u nodes (%zu bytes each as floats + radiance, %zu packed): texels inside "
+           "decoded spheres and cones, pointers exact, 65 traversals equal; radius over-estimate log %.3f, linear "
+           "%.3f (mean); packed pull error mean %.4f, worst %.4f, root %.4f of the largest channel\n",
+           t.count, sizeof(cssm_node) + 3 * sizeof(float), sizeof(cssm_pnode), over_log, over_lin, mean, worst, root);
+    free(tl);
+    free(nl);
+    free(x);
+    free(y);
+    cssm_ctree_free(&ct);
+    cssm_tree_free(&t);
+    cssm_atlas_free(&a);
+    gi_scene_free(s);
+    return 0;
+}
+
+/* 16-bit pointers: a tree of 65 535 nodes (32 768 texels) packs with
+ * every pointer exact, one of 65 537 (32 769 texels) is refused with a
+ * one-line error. */
+static int part_compact_limit(void)
+{
+    const uint32_t sizes[2] = {32768, 32769};
+    uint32_t rng = gi_rng_init(3, 0, 0x11au);
+    for (int s = 0; s < 2; s++) {
+        cssm_atlas a = {0};
+        a.count = sizes[s];
+        a.texels = calloc(a.count, sizeof *a.texels);
+        if (!a.texels) {
+            fprintf(stderr, "FAIL: out of memory\n");
+            return 1;
+        }
+        for (uint32_t i = 0; i < a.count; i++) {
+            a.texels[i].p = gi_v3(gi_rng_next_float(&rng), gi_rng_next_float(&rng), gi_rng_next_float(&rng));
+            a.texels[i].n = gi_v3(0, 0, 1);
+            a.texels[i].area = 1e-4f;
+        }
+        cssm_tree t;
+        cssm_ctree ct;
+        gi_error err = {{0}};
+        if (cssm_tree_build(&a, &t, &err) != GI_OK) {
+            fprintf(stderr, "FAIL: %s\n", err.text);
+            return 1;
+        }
+        gi_result r = cssm_ctree_build(&t, &a, &ct, &err);
+        if (s == 0) {
+            CHECK(r == GI_OK, "%u nodes refused: %s", t.count, err.text);
+            uint32_t ptr = 0;
+            for (uint32_t i = 0; r == GI_OK && i < t.count; i++) {
+                cssm_node_view d;
+                cssm_ctree_view(&ct, i, &d);
+                ptr += d.child != t.nodes[i].child || d.skip != t.nodes[i].skip;
+            }
+            CHECK(!ptr, "%u of %u nodes' pointers differ", ptr, t.count);
+            printf("compact_limit: %u nodes packed, pointers exact\n", t.count);
+        } else {
+            CHECK(r == GI_ERR_INVALID_ARGUMENT && strstr(err.text, "at most 65535") && !strchr(err.text, '\n'),
+                  "%u nodes: result %d, '%s'", t.count, (int)r, err.text);
+            printf("compact_limit: %u nodes refused: %s\n", t.count, err.text);
+        }
+        cssm_ctree_free(&ct);
+        cssm_tree_free(&t);
+        free(a.texels);
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
-        fprintf(stderr, "usage: cssm_tests traversal|tree|visibility|furnace|hull|motion|motion2|texture\n");
+        fprintf(stderr, "usage: cssm_tests traversal|tree|visibility|furnace|hull|motion|motion2|texture|compact|compact_furnace|"
+                        "compact_limit\n");
         return 2;
     }
     int r;
@@ -1015,7 +1315,13 @@ int main(int argc, char **argv)
     else if (!strcmp(argv[1], "visibility"))
         r = part_visibility();
     else if (!strcmp(argv[1], "furnace"))
-        r = part_furnace();
+        r = part_furnace(0);
+    else if (!strcmp(argv[1], "compact_furnace"))
+        r = part_furnace(1);
+    else if (!strcmp(argv[1], "compact"))
+        r = part_compact();
+    else if (!strcmp(argv[1], "compact_limit"))
+        r = part_compact_limit();
     else if (!strcmp(argv[1], "hull"))
         r = part_hull();
     else if (!strcmp(argv[1], "motion"))
