@@ -919,13 +919,12 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                     float e[3] = {0, 0, 0}, u, v;
                     int ok = 0;
                     if (c->env_pixel && c->maps.escape) { /* env=cssm: the proxy texel's maps (env_cssm.c) */
-                        int32_t px = cssm_env_proxy(&c->atlas, s, tri, P, Nn);
-                        if (px >= 0) {
-                            cssm_env_proxy_ctx pc = {&c->maps, (uint32_t)px, c->atlas.texels[px].n, c->pcf};
+                        cssm_env_proxy px;
+                        cssm_env_proxies(&c->atlas, &c->maps, s, tri, P, Nn, c->pcf, &px);
+                        if (px.count)
                             cssm_env_estimate(s->envmap, Nn, (uint32_t)c->env_samples,
                                               gi_pcg_hash((uint32_t)p ^ gi_pcg_hash(frame ^ view->seed)), &rc,
-                                              cssm_env_proxy_vis, &pc, e);
-                        }
+                                              cssm_env_proxy_vis, &px, e);
                         for (int k = 0; k < 3; k++)
                             out[k] += e[k];
                     } else if (c->env_pixel) { /* reflected radiance (diffuse and glossy) traced at the pixel */

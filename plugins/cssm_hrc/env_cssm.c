@@ -80,21 +80,35 @@ float cssm_escape(const cssm_maps *m, uint32_t j, gi_vec3 w, int pcf)
     return v;
 }
 
-float cssm_env_proxy_vis(const void *ctx, gi_vec3 w)
+float cssm_env_texel_vis(const void *ctx, gi_vec3 w)
 {
-    const cssm_env_proxy_ctx *p = ctx;
+    const cssm_env_texel_ctx *p = ctx;
     /* below the plane of the map's texel the map holds "don't care" */
     if (!(gi_v3_dot(w, p->n) > 0.0f))
         return 0.0f;
     return cssm_escape(p->m, p->texel, w, p->pcf);
 }
 
+float cssm_env_proxy_vis(const void *ctx, gi_vec3 w)
+{
+    const cssm_env_proxy *p = ctx;
+    float v = 0.0f, wsum = 0.0f;
+    for (uint32_t k = 0; k < p->count; k++) {
+        const uint32_t j = p->texel[k];
+        if (!(gi_v3_dot(w, p->a->texels[j].n) > 0.0f))
+            continue;
+        v += p->weight[k] * cssm_escape(p->m, j, w, p->pcf);
+        wsum += p->weight[k];
+    }
+    return wsum > 0.0f ? v / wsum : 0.0f;
+}
+
 void cssm_env_texels(const gi_envmap *env, const cssm_atlas *a, const cssm_maps *m, uint32_t K, int pcf,
                      float *texel_E)
 {
     for (uint32_t i = 0; i < a->count; i++) {
-        cssm_env_proxy_ctx ctx = {.m = m, .texel = i, .n = a->texels[i].n, .pcf = pcf};
-        cssm_env_estimate(env, a->texels[i].n, K, i, NULL, cssm_env_proxy_vis, &ctx, &texel_E[3 * i]);
+        cssm_env_texel_ctx ctx = {.m = m, .texel = i, .n = a->texels[i].n, .pcf = pcf};
+        cssm_env_estimate(env, a->texels[i].n, K, i, NULL, cssm_env_texel_vis, &ctx, &texel_E[3 * i]);
     }
 }
 
@@ -103,47 +117,60 @@ static uint32_t object_of(const gi_scene *s, uint32_t tri)
     return s->vertices[s->indices[3 * tri]].object;
 }
 
-int32_t cssm_env_proxy(const cssm_atlas *a, const gi_scene *s, uint32_t tri, gi_vec3 P, gi_vec3 n)
+void cssm_env_proxies(const cssm_atlas *a, const cssm_maps *m, const gi_scene *s, uint32_t tri, gi_vec3 P,
+                      gi_vec3 n, int pcf, cssm_env_proxy *out)
 {
+    out->m = m;
+    out->a = a;
+    out->pcf = pcf;
+    out->count = 0;
     if (tri >= s->triangle_count)
-        return -1;
+        return;
     int32_t chart = a->tri_chart[tri];
-    if (chart >= 0) { /* the atlas texel under P, else the chart's nearest */
+    if (chart >= 0) { /* the 2 x 2 chart texels around P, bilinear weights */
         const cssm_chart *c = &a->charts[chart];
         float u, v;
         cssm_chart_coords(a, (uint32_t)chart, P, &u, &v);
-        int x = (int)floorf(u), y = (int)floorf(v);
-        x = x < 0 ? 0 : x >= (int)c->w ? (int)c->w - 1 : x;
-        y = y < 0 ? 0 : y >= (int)c->h ? (int)c->h - 1 : y;
-        int32_t t = a->grid[(size_t)(c->y0 + (uint32_t)y) * a->R + c->x0 + (uint32_t)x];
-        if (t >= 0)
-            return t;
-        int32_t best = -1;
-        float bd = FLT_MAX;
-        for (uint32_t yy = 0; yy < c->h; yy++)
-            for (uint32_t xx = 0; xx < c->w; xx++) {
-                int32_t k = a->grid[(size_t)(c->y0 + yy) * a->R + c->x0 + xx];
-                if (k < 0)
-                    continue;
-                gi_vec3 d = gi_v3_sub(a->texels[k].p, P);
-                float dd = gi_v3_dot(d, d);
-                if (dd < bd)
-                    bd = dd, best = k;
-            }
-        if (best >= 0)
-            return best;
+        float gx = u - 0.5f, gy = v - 0.5f;
+        int x0 = (int)floorf(gx), y0 = (int)floorf(gy);
+        float wx = gx - (float)x0, wy = gy - (float)y0;
+        for (int k = 0; k < 4; k++) {
+            int x = x0 + (k & 1), y = y0 + (k >> 1);
+            x = x < 0 ? 0 : x >= (int)c->w ? (int)c->w - 1 : x;
+            y = y < 0 ? 0 : y >= (int)c->h ? (int)c->h - 1 : y;
+            int32_t t = a->grid[(size_t)(c->y0 + (uint32_t)y) * a->R + c->x0 + (uint32_t)x];
+            float wt = ((k & 1) ? wx : 1.0f - wx) * ((k >> 1) ? wy : 1.0f - wy);
+            if (t < 0 || !(wt > 0.0f))
+                continue;
+            out->texel[out->count] = (uint32_t)t;
+            out->weight[out->count++] = wt;
+        }
+        if (out->count)
+            return;
     }
+    /* the nearest texels of the same object facing the same way */
     const uint32_t o = object_of(s, tri);
-    int32_t best = -1;
-    float bd = FLT_MAX;
+    float best[CSSM_ENV_PROXIES];
     for (uint32_t i = 0; i < a->count; i++) {
         const cssm_texel *x = &a->texels[i];
         if (gi_v3_dot(x->n, n) < 0.5f || object_of(s, x->triangle) != o)
             continue;
         gi_vec3 d = gi_v3_sub(x->p, P);
         float dd = gi_v3_dot(d, d);
-        if (dd < bd)
-            bd = dd, best = (int32_t)i;
+        uint32_t k = out->count < CSSM_ENV_PROXIES ? out->count++ : CSSM_ENV_PROXIES;
+        if (k == CSSM_ENV_PROXIES) {
+            if (dd >= best[k - 1])
+                continue;
+            k--;
+        }
+        for (; k > 0 && best[k - 1] > dd; k--) { /* insertion: best[] ascending */
+            best[k] = best[k - 1];
+            out->texel[k] = out->texel[k - 1];
+        }
+        best[k] = dd;
+        out->texel[k] = i;
     }
-    return best;
+    const float h2 = a->h * a->h; /* keeps a texel under P from taking all the weight */
+    for (uint32_t k = 0; k < out->count; k++)
+        out->weight[k] = 1.0f / (best[k] + h2);
 }

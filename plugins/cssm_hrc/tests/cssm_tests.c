@@ -23,7 +23,7 @@
  *               made again): visibility against Embree on the moved scene
  *               for pairs near the bunny, against always / never visible
  *               and the unmoved scene's visibility
- *   env         env=cssm (§4.7 with the texels' own maps): on bunny_env
+ *   escape      env=cssm (§4.7 with the texels' own maps): on bunny_env
  *               and teapot_plane the escape test of a texel's cube map
  *               against Embree occlusion for random texel / direction
  *               pairs (against always / never escapes), the per-texel
@@ -1145,9 +1145,9 @@ static int env_scene(const char *rel, int check)
         double se_c = 0, se_o = 0, se_b = 0, sum_t = 0, sum_c = 0;
         for (uint32_t i = 0; i < a.count; i++) {
             float ec[3], et[3], eo3[3];
-            cssm_env_proxy_ctx pc = {.m = &m, .texel = i, .n = a.texels[i].n, .pcf = 0};
+            cssm_env_texel_ctx pc = {.m = &m, .texel = i, .n = a.texels[i].n, .pcf = 0};
             env_truth_ctx tc = {.rt = rt, .x = m.eye[i]};
-            cssm_env_estimate(s->envmap, a.texels[i].n, K, i, NULL, cssm_env_proxy_vis, &pc, ec);
+            cssm_env_estimate(s->envmap, a.texels[i].n, K, i, NULL, cssm_env_texel_vis, &pc, ec);
             cssm_env_estimate(s->envmap, a.texels[i].n, K, i, NULL, env_truth, &tc, et);
             cssm_env_estimate(s->envmap, a.texels[i].n, K, i, NULL, env_open, NULL, eo3);
             for (int c = 0; c < 3; c++) {
@@ -1188,7 +1188,7 @@ static int part_env(void)
 int main(int argc, char **argv)
 {
     if (argc != 2) {
-        fprintf(stderr, "usage: cssm_tests traversal|tree|visibility|furnace|hull|motion|motion2|texture|env\n");
+        fprintf(stderr, "usage: cssm_tests traversal|tree|visibility|furnace|hull|motion|motion2|texture|escape\n");
         return 2;
     }
     int r;
@@ -1208,7 +1208,7 @@ int main(int argc, char **argv)
         r = part_motion2();
     else if (!strcmp(argv[1], "texture"))
         r = part_texture();
-    else if (!strcmp(argv[1], "env"))
+    else if (!strcmp(argv[1], "escape"))
         r = part_env();
     else {
         fprintf(stderr, "cssm_tests: unknown part '%s'\n", argv[1]);
