@@ -1013,7 +1013,7 @@ static int part_texture(void)
 
 /* Margins of part_env (README "Tests"): the escape test's agreement with
  * Embree, balanced over escaping and blocked directions, above the 1/2 of
- * always / never escapes (measured 93 and 94 %), and the per-texel
+ * always / never escapes (measured 93.4 and 95.5 %: README "Tests"), and the per-texel
  * irradiance RMSE against the traced estimate as a fraction of the better
  * of black / unshadowed. */
 #define ENV_ESCAPE_MARGIN 0.35
