@@ -7,7 +7,8 @@
  * the median-cut hierarchy with skip pointers (§4.2), shadow maps of the
  * punctual lights, then the lighting of the atlas (lighting()):
  *   direct:  R1 = kd/pi gather(emission) + punctual lights (shadow maps)
- *            + the environment (ray-traced, env_irradiance(), §4.7);
+ *            + the environment (§4.7: ray-traced, env_irradiance(), or
+ *              with env=cssm by the texels' own cube maps, env_cssm.c);
  *   bounce:  R_k = kd/pi gather(pull(R_{k-1})), k = 2 .. n (§4.1.1);
  *   pull:    the tree of L = emission + sum R_k.
  * render(): G-buffer; per pixel the same traversal with a Phong bound
@@ -114,8 +115,8 @@ static const gi_param_desc cssm_params[] = {
      "0 the atlas texels' irradiance by the bicubic look-up (surface samples: the nearest texel)"},
     {"env", GI_PARAM_ENUM, 0, 0, 0, "trace|cssm", "direct light (Sec. 4.7)",
      "environment visibility: trace the core's ray tracer; cssm the escape test in the texels' own cube maps "
-     "(built with the far plane as the mark of 'no surface'; per pixel the proxy texel's maps); not with moving "
-     "objects"},
+     "(built with the far plane as the mark of 'no surface'; per pixel the maps of the texels around it); not "
+     "with moving objects"},
     {"shadow_size", GI_PARAM_INT, 256, 16, 2048, NULL, NULL,
      "face size of the point/spot lights' shadow cube maps and of directional lights' shadow maps"},
     {0},
@@ -918,7 +919,7 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                     int32_t chart = tri < s->triangle_count ? c->atlas.tri_chart[tri] : -1;
                     float e[3] = {0, 0, 0}, u, v;
                     int ok = 0;
-                    if (c->env_pixel && c->maps.escape) { /* env=cssm: the proxy texel's maps (env_cssm.c) */
+                    if (c->env_pixel && c->maps.escape) { /* env=cssm: the maps of the texels around it */
                         cssm_env_proxy px;
                         cssm_env_proxies(&c->atlas, &c->maps, s, tri, P, Nn, c->pcf, &px);
                         if (px.count)
