@@ -112,6 +112,12 @@ static void build_depths(void *ctx, uint32_t q, const gi_depth_view *view, const
             continue;
         }
         float a1 = map[4 * t], a2 = map[4 * t + 1];
+        if (b->opts->escape) { /* surface and "no surface" never share a run (env_cssm.h) */
+            const float far = b->out->zfar;
+            z1[t] = a1 >= far ? far : a1;
+            z2[t] = a1 >= far ? FLT_MAX : fminf(fmaxf(a2, a1), far);
+            continue;
+        }
         z1[t] = a1 >= FLT_MAX ? FLT_MAX : a1;
         z2[t] = a1 >= FLT_MAX || a2 >= FLT_MAX ? FLT_MAX : fmaxf(a2, z1[t]);
     }
@@ -126,6 +132,7 @@ gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const 
     gi_result r = cssm_maps_setup(a, order, M, out, err);
     if (r != GI_OK)
         return r;
+    out->escape = opts->escape;
     if (opts->eye_from_world)
         for (uint32_t i = 0; i < a->count; i++)
             out->eye[i] = gi_mat4_point(opts->eye_from_world, out->eye[i]);

@@ -116,6 +116,7 @@ typedef struct cssm_maps {
     uint64_t dont_care;   /* face texels in the negative half-space (stored as "any value") */
     uint64_t face_texels; /* 6 M^2 N */
     const struct cssm_motion *motion; /* moving-object mode (§3.3, motion.c), NULL: one static scene */
+    int escape;           /* built with escape intervals (cssm_build_opts.escape, env_cssm.h) */
 } cssm_maps;
 
 /* What the cube maps see (§3.3: per object a CSSM). Zero: every object, in
@@ -126,6 +127,9 @@ typedef struct cssm_build_opts {
     int local;                       /* 1: object-local geometry (with only_object) */
     const float *eye_from_world;     /* maps the texels' eyes (world) into the maps' space; NULL: identity */
     const unsigned char *dont_care;  /* per texel, 1: a map of "don't care" only (not queried, no segments) */
+    int escape;                      /* 1: a face texel that saw a surface enters the codec as [z1, min(z2, far)),
+                                        one that saw none as [far, inf): z_avg >= far tells the direction escapes
+                                        (env=cssm, env_cssm.h); 0: [z1, z2), none as (inf, inf) */
 } cssm_build_opts;
 
 /* Renders (the core's precomputation loop gi/csm_precompute.h with its

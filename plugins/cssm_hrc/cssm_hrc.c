@@ -7,7 +7,8 @@
  * the median-cut hierarchy with skip pointers (§4.2), shadow maps of the
  * punctual lights, then the lighting of the atlas (lighting()):
  *   direct:  R1 = kd/pi gather(emission) + punctual lights (shadow maps)
- *            + the environment (ray-traced, env_irradiance(), §4.7);
+ *            + the environment (§4.7: ray-traced, env_irradiance(), or
+ *              with env=cssm by the texels' own cube maps, env_cssm.c);
  *   bounce:  R_k = kd/pi gather(pull(R_{k-1})), k = 2 .. n (§4.1.1);
  *   pull:    the tree of L = emission + sum R_k.
  * render(): G-buffer; per pixel the same traversal with a Phong bound
@@ -19,6 +20,7 @@
  * is llvmpipe here); the depth cube maps, shadow maps and G-buffer are
  * drawn by the core's GL passes. */
 #include "cssm.h"
+#include "env_cssm.h"
 #include "motion.h"
 
 #include "gi/cache.h"
@@ -68,6 +70,7 @@ typedef struct cssm_hrc {
     uint32_t shadow_count;
     int env_samples;  /* environment light: directions per texel (or pixel) */
     int env_pixel;    /* 1: environment light traced per pixel; 0: the texels' irradiance looked up */
+    int env_mode;     /* environment visibility: 0 ray tracer, 1 the texels' own CSSMs (env_cssm.c) */
     gi_rt *rt;        /* the scene for the environment's occlusion, NULL without environment */
     float *texel_E;   /* environment irradiance per texel, 3 per texel; NULL: no environment */
     float *accum;     /* running average, 4 per pixel */
@@ -116,6 +119,10 @@ static const gi_param_desc cssm_params[] = {
      "float: hierarchy nodes of floats; compact: the paper's 128 bits a node (24-bit centre, normal and intensity, "
      "8-bit radius, cone and area, 16-bit pointers), decoded as the traversal reads them and re-encoded at each "
      "pull; at most 65535 nodes (32768 texels)"},
+    {"env", GI_PARAM_ENUM, 0, 0, 0, "trace|cssm", "direct light (Sec. 4.7)",
+     "environment visibility: trace the core's ray tracer; cssm the escape test in the texels' own cube maps "
+     "(built with the far plane as the mark of 'no surface'; per pixel the maps of the texels around it); not "
+     "with moving objects"},
     {"shadow_size", GI_PARAM_INT, 256, 16, 2048, NULL, NULL,
      "face size of the point/spot lights' shadow cube maps and of directional lights' shadow maps"},
     {0},
@@ -141,6 +148,7 @@ static gi_result cssm_create(const gi_host *host, const gi_params *params, void 
     c->bias_f = gi_params_float(params, "bias");
     c->env_samples = gi_params_int(params, "env_samples");
     c->env_pixel = gi_params_bool(params, "env_pixel");
+    c->env_mode = gi_params_enum(params, "env");
     c->pcf = gi_params_bool(params, "pcf");
     c->shadow_size = gi_params_int(params, "shadow_size");
     c->mode = gi_params_enum(params, "mode");
@@ -319,42 +327,24 @@ static void punctual(const cssm_hrc *c, const gi_scene *s, uint32_t i, gi_vec3 x
 }
 
 /* Environment irradiance at x with normal n (any direct-light method will
- * do, §4.7 "Direct Light"): K directions, half drawn by the core's
- * environment-map sampler, half cosine-weighted, combined by the balance
- * heuristic; each direction counts when the core's ray tracer finds
- * nothing along it. */
+ * do, §4.7 "Direct Light"): the estimator of env_cssm.c, each direction
+ * counted when the core's ray tracer finds nothing along it. */
+typedef struct env_ray {
+    const gi_rt *rt;
+    gi_vec3 x;
+} env_ray;
+
+static float env_traced(const void *ctx, gi_vec3 w)
+{
+    const env_ray *r = ctx;
+    return gi_rt_occluded(r->rt, r->x, w, 0.0f, INFINITY) ? 0.0f : 1.0f;
+}
+
 static void env_irradiance(const gi_envmap *env, const gi_rt *rt, gi_vec3 x, gi_vec3 n, uint32_t K, uint32_t seed,
                            const cssm_receiver *brdf, float e[3])
 {
-    e[0] = e[1] = e[2] = 0.0f;
-    uint32_t rng = gi_rng_init(seed, 0, 0x5e17u);
-    const uint32_t half = K > 1 ? K / 2 : 1, Kc = K - half;
-    for (uint32_t k = 0; k < K; k++) {
-        float u1 = gi_rng_next_float(&rng), u2 = gi_rng_next_float(&rng);
-        gi_vec3 w;
-        if (k < half) {
-            if (!(gi_envmap_sample(env, u1, u2, &w) > 0.0f))
-                continue;
-        } else {
-            w = gi_to_world(gi_sample_cosine_hemisphere(u1, u2), n);
-        }
-        float cs = gi_v3_dot(n, w);
-        if (!(cs > 0.0f))
-            continue;
-        float pe = gi_envmap_pdf(env, w), pc = gi_cosine_hemisphere_pdf(cs);
-        float denom = (float)half * pe + (float)Kc * pc;
-        if (!(denom > 0.0f) || gi_rt_occluded(rt, x, w, 0.0f, INFINITY))
-            continue;
-        float L[3], lobe = 0.0f;
-        gi_envmap_eval(env, w, L);
-        if (brdf) { /* reflected radiance: the receiver's diffuse + Phong BRDF */
-            gi_vec3 rr = gi_v3_sub(gi_v3_scale(n, 2.0f * gi_v3_dot(n, brdf->wo)), brdf->wo);
-            float cl = gi_v3_dot(rr, w);
-            lobe = cl > 0.0f ? (brdf->exponent + 2.0f) / (2.0f * GI_PI) * powf(cl, brdf->exponent) : 0.0f;
-        }
-        for (int j = 0; j < 3; j++)
-            e[j] += L[j] * cs / denom * (brdf ? brdf->kd[j] / GI_PI + brdf->ks[j] * lobe : 1.0f);
-    }
+    env_ray r = {rt, x};
+    cssm_env_estimate(env, n, K, seed, brdf, env_traced, &r, e);
 }
 
 static cssm_gather_opts gather_opts(const cssm_hrc *c, float exposure, uint32_t *rng)
@@ -416,7 +406,18 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
     free(c->texel_E);
     c->texel_E = NULL;
     const gi_envmap *env = gs->scene->has_environment ? gs->scene->envmap : NULL;
-    if (env) {
+    if (env && c->maps.escape) { /* env=cssm: the texels' own cube maps (env_cssm.c) */
+        c->texel_E = calloc(3 * (size_t)N, sizeof *c->texel_E);
+        if (!c->texel_E) {
+            free(D);
+            host->stage_end(host, "direct");
+            return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the lighting");
+        }
+        cssm_env_texels(env, a, &c->maps, (uint32_t)c->env_samples, c->pcf, c->texel_E);
+        for (uint32_t i = 0; i < N; i++)
+            for (int k = 0; k < 3; k++)
+                D[3 * i + k] += a->texels[i].albedo[k] / GI_PI * c->texel_E[3 * i + k];
+    } else if (env) {
         gi_rt *rt = NULL;
         gi_error rerr;
         gi_rt_free(c->rt);
@@ -509,6 +510,8 @@ static void cache_name(const cssm_hrc *c, const gi_gpu_scene *gs, char *name, si
     uint32_t key[5] = {CSSM_FORMAT_VERSION, (uint32_t)c->R, (uint32_t)c->M, (uint32_t)c->traversal, c->atlas.count};
     uint64_t h = gi_hash64("gibench-cssm", 12, 0);
     h = gi_hash64(key, sizeof key, h);
+    if (c->maps.escape) /* env=cssm: escape intervals (env_cssm.h) */
+        h = gi_hash64("escape", 6, h);
     for (uint32_t k = 0; k < s->object_count; k++) {
         uint64_t oh = gi_scene_object_hash(s, k);
         float m[16];
@@ -587,6 +590,8 @@ static gi_result load_or_build_maps(cssm_hrc *c, const gi_gpu_scene *gs, gi_erro
 {
     const gi_host *host = c->kit.host;
     char name[64], *path = NULL;
+    const int escape = c->env_mode == 1 && gs->scene->has_environment;
+    c->maps.escape = escape;
     cache_name(c, gs, name, sizeof name);
     path = host->cache_dir ? gi_cache_path(host->cache_dir, name) : NULL;
     gi_result r = cssm_maps_setup(&c->atlas, c->order, (uint32_t)c->M, &c->maps, err);
@@ -594,13 +599,15 @@ static gi_result load_or_build_maps(cssm_hrc *c, const gi_gpu_scene *gs, gi_erro
         free(path);
         return r;
     }
+    c->maps.escape = escape;
     if (path && cache_load(c, path)) {
         host->stat(host, "cache_hit", 1.0);
         free(path);
         return GI_OK;
     }
     cssm_maps_free(&c->maps);
-    r = cssm_maps_build(gs, &c->atlas, c->order, (uint32_t)c->M, host, &c->maps, err);
+    cssm_build_opts bo = {.escape = escape};
+    r = cssm_maps_build_ex(gs, &c->atlas, c->order, (uint32_t)c->M, &bo, host, &c->maps, err);
     if (r == GI_OK && path)
         cache_store(c, path);
     host->stat(host, "cache_hit", 0.0);
@@ -675,6 +682,9 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     cssm_motion_find(gs->scene, &moving);
     if (moving && gi_scene_deforms(gs->scene))
         return gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED, "cssm_hrc: deforming objects are not supported");
+    if (moving && c->env_mode == 1 && gs->scene->has_environment)
+        return gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED,
+                           "cssm_hrc: env=cssm does not support moving objects (use env=trace)");
     host->stage_begin(host, "atlas");
     gi_result r = cssm_atlas_build(gs->scene, gs->time, (uint32_t)c->R, c->traversal == 0, &c->atlas, &err);
     host->stage_end(host, "atlas");
@@ -954,7 +964,16 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                     int32_t chart = tri < s->triangle_count ? c->atlas.tri_chart[tri] : -1;
                     float e[3] = {0, 0, 0}, u, v;
                     int ok = 0;
-                    if (c->env_pixel) { /* reflected radiance (diffuse and glossy) traced at the pixel */
+                    if (c->env_pixel && c->maps.escape) { /* env=cssm: the maps of the texels around it */
+                        cssm_env_proxy px;
+                        cssm_env_proxies(&c->atlas, &c->maps, s, tri, P, Nn, c->pcf, &px);
+                        if (px.count)
+                            cssm_env_estimate(s->envmap, Nn, (uint32_t)c->env_samples,
+                                              gi_pcg_hash((uint32_t)p ^ gi_pcg_hash(frame ^ view->seed)), &rc,
+                                              cssm_env_proxy_vis, &px, e);
+                        for (int k = 0; k < 3; k++)
+                            out[k] += e[k];
+                    } else if (c->env_pixel) { /* reflected radiance (diffuse and glossy) traced at the pixel */
                         env_irradiance(s->envmap, c->rt, rc.x, Nn, (uint32_t)c->env_samples,
                                        gi_pcg_hash((uint32_t)p ^ gi_pcg_hash(frame ^ view->seed)), &rc, e);
                         for (int k = 0; k < 3; k++)

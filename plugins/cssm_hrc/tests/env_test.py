@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
 """The cssm_hrc plugin's environment light, through the gibench command.
 
-env_test.py GIBENCH ROOT OUT furnace|reference
+env_test.py GIBENCH ROOT OUT furnace|reference [PARAM=VALUE ...]
+
+The PARAM=VALUE pairs go to every cssm_hrc render (--param), e.g. env=cssm
+for the environment's visibility from the texels' own cube maps.
 
 furnace:   the conformance scene environment.gltf without its box: a grey
            (rho = 0.6) floor open to a constant environment of radiance 1,
@@ -44,7 +47,7 @@ def rmse(a, b):
     return (sum((x - y) ** 2 for x, y in zip(a, b)) / len(a)) ** 0.5
 
 
-def furnace(gib, root, out):
+def furnace(gib, root, out, params):
     src = os.path.join(root, "tests/data/conformance")
     os.makedirs(out, exist_ok=True)
     for name in ("environment.bin", "env"):
@@ -59,7 +62,8 @@ def furnace(gib, root, out):
     with open(scene, "w") as f:
         json.dump(g, f)
     img, ref = os.path.join(out, "plane_cssm.pfm"), os.path.join(out, "plane_ref.pfm")
-    run([gib, "render", "--scene", scene, "--method", "cssm_hrc", "--size", "32x32", "--out", img, "--no-cache"])
+    run([gib, "render", "--scene", scene, "--method", "cssm_hrc", "--size", "32x32", "--out", img, "--no-cache"]
+        + params)
     run([gib, "reference", "--scene", scene, "--out", ref, "--size", "32x32", "--spp", "4", "--max-bounces", "1",
          "--threads", "1"])
     _, _, t = read_pfm(img)
@@ -90,7 +94,7 @@ def furnace(gib, root, out):
     print("PASS")
 
 
-def reference(gib, root, out):
+def reference(gib, root, out, params):
     os.makedirs(out, exist_ok=True)
     ok = True
     # margin per scene: teapot_plane's checker texture aliases at 32 x 32 in every
@@ -104,7 +108,8 @@ def reference(gib, root, out):
         imgs = {}
         for m in ("cssm_hrc", "direct"):
             p = os.path.join(out, "%s_%s.pfm" % (sc, m))
-            run([gib, "render", "--scene", scene, "--method", m, "--size", "32x32", "--frames", "4", "--out", p])
+            run([gib, "render", "--scene", scene, "--method", m, "--size", "32x32", "--frames", "4", "--out", p]
+                + (params if m == "cssm_hrc" else []))
             imgs[m] = read_pfm(p)[2]
         r = read_pfm(ref)[2]
         e = rmse(imgs["cssm_hrc"], r)
@@ -120,6 +125,9 @@ def reference(gib, root, out):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 5 or sys.argv[4] not in ("furnace", "reference"):
-        sys.exit("usage: env_test.py GIBENCH ROOT OUT furnace|reference")
-    {"furnace": furnace, "reference": reference}[sys.argv[4]](*sys.argv[1:4])
+    if len(sys.argv) < 5 or sys.argv[4] not in ("furnace", "reference") or any("=" not in a for a in sys.argv[5:]):
+        sys.exit("usage: env_test.py GIBENCH ROOT OUT furnace|reference [PARAM=VALUE ...]")
+    params = [x for a in sys.argv[5:] for x in ("--param", a)]
+    if params:
+        print("cssm_hrc parameters: " + " ".join(sys.argv[5:]))
+    {"furnace": furnace, "reference": reference}[sys.argv[4]](*sys.argv[1:4], params)
