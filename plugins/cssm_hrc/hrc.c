@@ -346,8 +346,10 @@ gi_result cssm_solve(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *m
     if (bounces >= 1) {
         /* direct: the emitting texels gathered like any sender, plus the rest */
         gi_host_stage(host, "direct", 1);
-        cssm_tree_pull(t, a, Le, nodes);
-        gather_atlas(t, a, maps, nodes, o, Rk, st);
+        if (!o->no_emission) {
+            cssm_tree_pull(t, a, Le, nodes);
+            gather_atlas(t, a, maps, nodes, o, Rk, st);
+        }
         if (direct)
             for (size_t k = 0; k < 3 * (size_t)N; k++)
                 Rk[k] += direct[k];
