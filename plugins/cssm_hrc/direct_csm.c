@@ -203,8 +203,15 @@ oom:
     return GI_ERR_OUT_OF_MEMORY;
 }
 
-int cssm_csm_direct_open(const cssm_csm_direct *d, gi_vec3 x, gi_vec3 w, float bias)
+int cssm_csm_direct_open(const cssm_csm_direct *d, gi_vec3 x, gi_vec3 n, gi_vec3 w, float bias)
 {
+    /* slope-scaled bias: within one map texel the receiver's plane moves
+     * away from the texel centre's depth by up to a texel x tan(angle
+     * between its normal and w) (the ground plane's own map at grazing
+     * directions) */
+    float cn = fabsf(gi_v3_dot(n, w));
+    cn = cn > 0.1f ? cn : 0.1f;
+    const float slope = sqrtf(1.0f - cn * cn) / cn;
     for (uint32_t k = 0; d->distant && k < d->object_count; k++) {
         const float *sw = &d->sphere_w[4 * k];
         gi_vec3 c = gi_v3(sw[0], sw[1], sw[2]), oc = gi_v3_sub(c, x);
@@ -212,11 +219,12 @@ int cssm_csm_direct_open(const cssm_csm_direct *d, gi_vec3 x, gi_vec3 w, float b
         float d2 = gi_v3_dot(oc, oc) - (t > 0.0f ? t * t : 0.0f);
         if (d2 >= R * R) /* the ray misses the object's sphere */
             continue;
-        /* the segment from x to past the sphere, in the object's frame */
-        float len = (t > 0.0f ? t : 0.0f) + 2.0f * R + 1e-3f * d->diameter;
-        gi_vec3 q = gi_v3_add(x, gi_v3_scale(w, len));
+        /* x projected into the object's map nearest w (its frame), CSM §3.2 */
         const float *Ti = d->local_from_world[k];
-        if (gi_csm_distant_blocks(&d->distant[k], gi_mat4_point(Ti, x), gi_mat4_point(Ti, q), bias / d->scale[k]))
+        const gi_csm_distant *cd = &d->distant[k];
+        const float texel = 2.0f * cd->sphere[3] / (float)(cd->data.M ? cd->data.M : 1u);
+        if (!gi_csm_distant_visible(cd, gi_mat4_point(Ti, x), gi_v3_normalize(gi_mat4_dir(Ti, w)),
+                                    bias / d->scale[k] + texel * slope))
             return 0;
     }
     return 1;
@@ -311,7 +319,7 @@ void cssm_csm_direct_eval(const cssm_csm_direct *d, const gi_scene *s, const css
         if (l->type == GI_LIGHT_DIRECTIONAL) {
             w = gi_v3_scale(gi_v3_normalize(fr.direction), -1.0f);
             float cs = gi_v3_dot(rc->n, w);
-            if (!(cs > 0.0f) || !cssm_csm_direct_open(d, rc->x, w, bias))
+            if (!(cs > 0.0f) || !cssm_csm_direct_open(d, rc->x, rc->n, w, bias))
                 continue;
             k = cs;
         } else {
@@ -356,7 +364,7 @@ void cssm_csm_direct_eval(const cssm_csm_direct *d, const gi_scene *s, const css
             if (!(cs > 0.0f))
                 continue;
             float denom = (float)half * gi_envmap_pdf(env, w) + (float)Kc * gi_cosine_hemisphere_pdf(cs);
-            if (!(denom > 0.0f) || !cssm_csm_direct_open(d, rc->x, w, bias))
+            if (!(denom > 0.0f) || !cssm_csm_direct_open(d, rc->x, rc->n, w, bias))
                 continue;
             float L[3], f[3];
             gi_envmap_eval(env, w, L);

@@ -68,8 +68,10 @@ uint64_t cssm_csm_direct_bytes(const cssm_csm_direct *d);
 void cssm_csm_direct_eval(const cssm_csm_direct *d, const gi_scene *s, const cssm_receiver *rc, uint32_t S,
                           uint32_t env_samples, uint32_t seed, float bias, int pcf, float out[3]);
 
-/* Visibility of direction w from world point x through the objects'
- * distant CSMs (1 lit, 0 blocked); 1 when none was built. */
-int cssm_csm_direct_open(const cssm_csm_direct *d, gi_vec3 x, gi_vec3 w, float bias);
+/* Visibility of direction w from world point x on a surface of normal n
+ * through the objects' distant CSMs (1 lit, 0 blocked; bias in world
+ * units, plus a slope-scaled bias of a map texel x tan(n, w)); 1 when none
+ * was built. */
+int cssm_csm_direct_open(const cssm_csm_direct *d, gi_vec3 x, gi_vec3 n, gi_vec3 w, float bias);
 
 #endif
