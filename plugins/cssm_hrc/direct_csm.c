@@ -44,18 +44,11 @@ uint64_t cssm_csm_direct_bytes(const cssm_csm_direct *d)
     return b;
 }
 
-/* The emitter whose CDF interval holds u (twin of scene.glsl's
- * gi_emitter_find); *u is remapped to [0, 1) inside that interval. */
+/* The emitter whose CDF interval holds u (the core's
+ * gi_emitter_find_cpu); *u is remapped to [0, 1) inside that interval. */
 static uint32_t emitter_find(const cssm_csm_direct *d, float *u)
 {
-    uint32_t lo = 0, hi = d->em_count - 1;
-    while (lo < hi) {
-        uint32_t mid = (lo + hi) / 2;
-        if (d->em[mid].cdf > *u)
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
+    uint32_t lo = gi_emitter_find_cpu(d->em, d->em_count, *u);
     float c0 = lo ? d->em[lo - 1].cdf : 0.0f, w = d->em[lo].cdf - c0;
     float r = w > 0.0f ? (*u - c0) / w : 0.5f;
     *u = r < 0.0f ? 0.0f : r > GI_ONE_MINUS_EPSILON ? GI_ONE_MINUS_EPSILON : r;
@@ -293,14 +286,12 @@ void cssm_csm_direct_eval(const cssm_csm_direct *d, const gi_scene *s, const css
     } else if (d->area_points) {
         float sub[3] = {0, 0, 0};
         for (uint32_t k = 0; k < S; k++) {
-            float u1 = ((float)k + gi_rng_next_float(&rng)) / (float)S, u2 = gi_rng_next_float(&rng),
-                  u3 = gi_rng_next_float(&rng);
+            float u1 = ((float)k + gi_rng_next_float(&rng)) / (float)S, u2 = gi_rng_next_float(&rng);
             u1 = u1 < GI_ONE_MINUS_EPSILON ? u1 : GI_ONE_MINUS_EPSILON;
             uint32_t e = emitter_find(d, &u1);
             gi_vec3 ny;
             float pdf;
-            gi_vec3 y = emitter_point(d, s, e, u1, u3, &ny, &pdf);
-            (void)u2;
+            gi_vec3 y = emitter_point(d, s, e, u1, u2, &ny, &pdf);
             int ds = triangle_double_sided(s, d->em[e].triangle);
             if (ds) /* a double-sided emitter: its normal faces the receiver */
                 ny = gi_v3_dot(ny, gi_v3_sub(rc->x, y)) < 0.0f ? gi_v3_scale(ny, -1.0f) : ny;

@@ -60,14 +60,7 @@ static void traced(const cssm_csm_direct *d, const gi_scene *s, const gi_rt *rt,
     const float eps = 1e-4f * d->diameter;
     for (uint32_t k = 0; d->em_count && k < K; k++) {
         float u = ((float)k + gi_rng_next_float(&rng)) / (float)K, u2 = gi_rng_next_float(&rng);
-        uint32_t lo = 0, hi = d->em_count - 1;
-        while (lo < hi) {
-            uint32_t mid = (lo + hi) / 2;
-            if (d->em[mid].cdf > u)
-                hi = mid;
-            else
-                lo = mid + 1;
-        }
+        uint32_t lo = gi_emitter_find_cpu(d->em, d->em_count, u);
         float c0 = lo ? d->em[lo - 1].cdf : 0.0f, r = (u - c0) / (d->em[lo].cdf - c0);
         r = r < 0.0f ? 0.0f : r > 0.9999f ? 0.9999f : r;
         uint32_t tri = d->em[lo].triangle;
