@@ -10,6 +10,9 @@
  *            + the environment (ray-traced, env_irradiance(), §4.7);
  *   bounce:  R_k = kd/pi gather(pull(R_{k-1})), k = 2 .. n (§4.1.1);
  *   pull:    the tree of L = emission + sum R_k.
+ * With direct=csm (§4.7's alternative, direct_csm.c) R1 is the direct light
+ * of every light by Coherent Shadow Maps and Monte Carlo instead, the
+ * emitting texels not gathered, and pixels get that direct light too.
  * render(): G-buffer; per pixel the same traversal with a Phong bound
  * (§4.4), VPLs jittered inside their area and averaged over frames (§4.5),
  * distances clamped; plus emission, the punctual lights and the
@@ -479,8 +482,9 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
     o.no_emission = c->csm != NULL; /* R1 = the CSMs' direct light alone */
     cssm_gather_stats st = {0};
     gi_error err;
-    gi_result r = cssm_solve(&c->tree, a, &c->maps, &o, (uint32_t)c->bounces, c->shadow_count || env || c->csm ? D : NULL, host,
-                             c->texel_L, c->node_L, &st, &err);
+    const float *direct = c->shadow_count || env || c->csm ? D : NULL;
+    gi_result r = cssm_solve(&c->tree, a, &c->maps, &o, (uint32_t)c->bounces, direct, host, c->texel_L, c->node_L, &st,
+                             &err);
     free(D);
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);
@@ -879,7 +883,8 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
     const gi_host *host = kit->host;
     if (!c->prepared)
         return gi_kit_fail(kit, GI_ERR_INVALID_ARGUMENT, "cssm_hrc: render before prepare");
-    const int random = c->jitter || c->indirect == 1 || (c->texel_E && c->env_pixel) || c->csm; /* frames differ: average them */
+    /* frames differ: average them */
+    const int random = c->jitter || c->indirect == 1 || (c->texel_E && c->env_pixel) || c->csm;
     gi_result r = gi_kit_frame_begin(kit, view, GI_KIT_GBUFFER | (random ? 0u : GI_KIT_NO_AVERAGE));
     if (r != GI_OK)
         return r;
@@ -997,7 +1002,7 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                 }
                 for (int k = 0; k < 3; k++)
                     out[k] += em[k];
-            } else if (c->texel_E || (c->csm && s->has_environment && s->envmap)) { /* the environment seen past the scene */
+            } else if (c->texel_E || (c->csm && s->has_environment && s->envmap)) { /* the environment past the scene */
                 gi_vec3 f = gi_mat4_point(view->inv_view_proj, gi_v3(((float)x + 0.5f) / (float)w * 2.0f - 1.0f,
                                                                       ((float)y + 0.5f) / (float)h * 2.0f - 1.0f, 1.0f));
                 gi_envmap_eval(s->envmap, gi_v3_normalize(gi_v3_sub(f, view->eye)), out);
