@@ -15,15 +15,33 @@
 #define EYE 2.0f  /* the eye sits EYE R from the centre */
 #define BATCH 16u /* maps per gi_depth_render call */
 
-static void cell_basis(const gi_csm_distant *c, uint32_t a, uint32_t b, gi_vec3 *t, gi_vec3 *bb,
-                       gi_vec3 *d)
+static void cell_basis_n(uint32_t n_theta, uint32_t n_phi, uint32_t a, uint32_t b, gi_vec3 *t, gi_vec3 *bb,
+                         gi_vec3 *d)
 {
-    float theta = GI_PI * ((float)b + 0.5f) / (float)c->n_theta;
-    float phi = 2.0f * GI_PI * ((float)a + 0.5f) / (float)c->n_phi;
+    float theta = GI_PI * ((float)b + 0.5f) / (float)n_theta;
+    float phi = 2.0f * GI_PI * ((float)a + 0.5f) / (float)n_phi;
     float st = sinf(theta);
     *d = gi_v3(st * cosf(phi), cosf(theta), st * sinf(phi));
     *t = gi_v3(-sinf(phi), 0.0f, cosf(phi));
     *bb = gi_v3_cross(*d, *t);
+}
+
+static void cell_basis(const gi_csm_distant *c, uint32_t a, uint32_t b, gi_vec3 *t, gi_vec3 *bb,
+                       gi_vec3 *d)
+{
+    cell_basis_n(c->n_theta, c->n_phi, a, b, t, bb, d);
+}
+
+/* The direction cell nearest unit w: a along phi, b along theta. */
+static void nearest_cell(gi_vec3 w, uint32_t n_theta, uint32_t n_phi, uint32_t *a, uint32_t *b)
+{
+    float theta = atan2f(sqrtf(w.x * w.x + w.z * w.z), w.y), phi = atan2f(w.z, w.x);
+    if (phi < 0.0f)
+        phi += 2.0f * GI_PI;
+    float u = phi * (0.5f * GI_INV_PI) * (float)n_phi - 0.5f, v = theta * GI_INV_PI * (float)n_theta - 0.5f;
+    *a = (uint32_t)floorf(u + 0.5f) % n_phi;
+    int bi = (int)floorf(v + 0.5f);
+    *b = (uint32_t)(bi < 0 ? 0 : bi >= (int)n_theta ? (int)n_theta - 1 : bi);
 }
 
 static void map_view(const gi_csm_distant *c, uint32_t q, gi_depth_view *out)
@@ -138,15 +156,8 @@ int gi_csm_distant_blocks(const gi_csm_distant *c, gi_vec3 p, gi_vec3 q, float b
     if (!(len > 0.0f) || !c->data.M)
         return 0;
     w = gi_v3_scale(w, 1.0f / len);
-    /* the nearest direction cell */
-    float theta = atan2f(sqrtf(w.x * w.x + w.z * w.z), w.y), phi = atan2f(w.z, w.x);
-    if (phi < 0.0f)
-        phi += 2.0f * GI_PI;
-    float u = phi * (0.5f * GI_INV_PI) * (float)c->n_phi - 0.5f,
-          v = theta * GI_INV_PI * (float)c->n_theta - 0.5f;
-    uint32_t a = (uint32_t)floorf(u + 0.5f) % c->n_phi;
-    int bi = (int)floorf(v + 0.5f);
-    uint32_t b = (uint32_t)(bi < 0 ? 0 : bi >= (int)c->n_theta ? (int)c->n_theta - 1 : bi);
+    uint32_t a, b;
+    nearest_cell(w, c->n_theta, c->n_phi, &a, &b);
     gi_vec3 t, bb, d;
     cell_basis(c, a, b, &t, &bb, &d);
     const gi_vec3 centre = gi_v3(c->sphere[0], c->sphere[1], c->sphere[2]);
@@ -172,4 +183,31 @@ int gi_csm_distant_blocks(const gi_csm_distant *c, gi_vec3 p, gi_vec3 q, float b
           dq = EYE * R - gi_v3_dot(gi_v3_sub(q, centre), d);
     float lo = fminf(dp, dq), hi = fmaxf(dp, dq);
     return lo + bias < z && z < hi - bias;
+}
+
+int gi_csm_dir_visible(const gi_csm_data *data, const float sphere[4], uint32_t n_theta, uint32_t n_phi,
+                       gi_csm_order order, gi_vec3 x, gi_vec3 w, float bias)
+{
+    if (!data->M || !n_theta || !n_phi)
+        return 1;
+    uint32_t a, b;
+    nearest_cell(w, n_theta, n_phi, &a, &b);
+    gi_vec3 t, bb, d;
+    cell_basis_n(n_theta, n_phi, a, b, &t, &bb, &d);
+    gi_vec3 p = gi_v3_sub(x, gi_v3(sphere[0], sphere[1], sphere[2]));
+    const float R = sphere[3];
+    float sx = gi_v3_dot(p, t) / R, sy = gi_v3_dot(p, bb) / R, depth = EYE * R - gi_v3_dot(p, d);
+    if (!(fabsf(sx) < 1.0f && fabsf(sy) < 1.0f))
+        return 1;
+    const uint32_t M = data->M;
+    uint32_t tx = (uint32_t)((sx * 0.5f + 0.5f) * (float)M), ty = (uint32_t)((sy * 0.5f + 0.5f) * (float)M);
+    tx = tx >= M ? M - 1 : tx;
+    ty = ty >= M ? M - 1 : ty;
+    uint32_t i = gi_csm_order_index(order, n_phi, n_theta, a, b);
+    return gi_csm_visible(data, ty * M + tx, i, depth, bias);
+}
+
+int gi_csm_distant_visible(const gi_csm_distant *c, gi_vec3 x, gi_vec3 w, float bias)
+{
+    return gi_csm_dir_visible(&c->data, c->sphere, c->n_theta, c->n_phi, GI_CSM_ORDER_SCANLINE, x, w, bias);
 }

@@ -82,19 +82,6 @@ void avg_exact_free(avg_exact *x)
     free(x);
 }
 
-/* The emitter whose CDF interval holds u: twin of scene.glsl's gi_emitter_find. */
-static uint32_t emitter_find(const avg_exact *x, float u)
-{
-    uint32_t lo = 0, hi = x->emitter_count - 1;
-    while (lo < hi) {
-        uint32_t mid = (lo + hi) / 2;
-        if (x->emitters[mid].cdf > u)
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
-    return lo;
-}
 
 static gi_vec3 vertex(const float *pos, uint32_t v)
 {
@@ -150,7 +137,7 @@ static void trace_path(const avg_exact *x, const gi_scene *s, const avg_light_ta
     if (l == 0) {
         float ue = (u - lo) / pl;
         ue = ue < 0.0f ? 0.0f : (ue > GI_ONE_MINUS_EPSILON ? GI_ONE_MINUS_EPSILON : ue);
-        const gi_gpu_emitter *em = &x->emitters[emitter_find(x, ue)];
+        const gi_gpu_emitter *em = &x->emitters[gi_emitter_find_cpu(x->emitters, x->emitter_count, ue)];
         uint32_t tri = em->triangle;
         gi_vec3 p0 = vertex(pos, s->indices[3 * tri]), p1 = vertex(pos, s->indices[3 * tri + 1]),
                 p2 = vertex(pos, s->indices[3 * tri + 2]);

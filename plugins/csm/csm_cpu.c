@@ -59,29 +59,6 @@ void csm_map_view(const float sphere[4], float theta, float phi, gi_depth_view *
     out->projection = GI_PROJ_ORTHOGRAPHIC;
 }
 
-int csm_visible_nearest(const gi_csm_data *data, const float sphere[4], uint32_t n_theta, uint32_t n_phi,
-                        gi_csm_order order, gi_vec3 x, gi_vec3 w, float bias)
-{
-    float u, v;
-    csm_grid_coords(w, n_theta, n_phi, &u, &v);
-    uint32_t a = (uint32_t)floorf(u + 0.5f) % n_phi;
-    int bi = (int)floorf(v + 0.5f);
-    uint32_t b = (uint32_t)(bi < 0 ? 0 : bi >= (int)n_theta ? (int)n_theta - 1 : bi);
-    float theta, phi;
-    csm_cell_angles(n_theta, n_phi, a, b, &theta, &phi);
-    gi_vec3 p = csm_project(sphere, theta, phi, x);
-    if (!(fabsf(p.x) < 1.0f && fabsf(p.y) < 1.0f))
-        return 1;
-    uint32_t M = data->M;
-    uint32_t tx = (uint32_t)((p.x * 0.5f + 0.5f) * (float)M), ty = (uint32_t)((p.y * 0.5f + 0.5f) * (float)M);
-    if (tx >= M)
-        tx = M - 1;
-    if (ty >= M)
-        ty = M - 1;
-    uint32_t i = gi_csm_order_index(order, n_phi, n_theta, a, b);
-    return gi_csm_visible(data, ty * M + tx, i, p.z, bias);
-}
-
 void csm_texel_depths(const float *map, size_t texels, int mode, float shell, const float *far, float *z1,
                       float *z2)
 {

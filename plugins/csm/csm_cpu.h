@@ -26,6 +26,7 @@
 #define CSM_CPU_H
 
 #include "gi/csm_codec.h"
+#include "gi/csm_distant.h"
 #include "gi/csm_order.h"
 #include "gi/method.h"
 #include "gi/passes.h"
@@ -126,9 +127,8 @@ gi_result csm_encode_maps(const gi_gpu_scene *gs, const csm_encode_desc *desc, c
 gi_result csm_build_object(const gi_gpu_scene *gs, uint32_t object, const float sphere[4], const csm_build_desc *desc,
                            const gi_host *host, float p0, float p1, gi_csm_data *out, gi_error *err);
 
-/* Nearest-filter visibility (1 lit, 0 shadowed) of local point x toward
- * local unit direction w through one object's CSM; bias in local units. */
-int csm_visible_nearest(const gi_csm_data *data, const float sphere[4], uint32_t n_theta, uint32_t n_phi,
-                        gi_csm_order order, gi_vec3 x, gi_vec3 w, float bias);
+/* The nearest-filter visibility of a local point toward a local direction
+ * through one object's CSM is the core's gi_csm_dir_visible
+ * (gi/csm_distant.h: the same conventions), shared with cssm_hrc. */
 
 #endif

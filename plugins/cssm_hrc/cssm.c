@@ -174,7 +174,7 @@ gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const 
                                 .p1 = 1.0f,
                                 .who = "cssm_hrc",
                                 .what = "cube maps",
-                                .render_stage = "cssm_render"};
+                                .render_stage = opts->render_stage ? opts->render_stage : "cssm_render"};
     r = gi_csm_precompute(gs, &d, out->face, err);
     free(corners), free(mask);
     if (r != GI_OK)

@@ -130,6 +130,7 @@ typedef struct cssm_build_opts {
     int escape;                      /* 1: a face texel that saw a surface enters the codec as [z1, min(z2, far)),
                                         one that saw none as [far, inf): z_avg >= far tells the direction escapes
                                         (env=cssm, env_cssm.h); 0: [z1, z2), none as (inf, inf) */
+    const char *render_stage;        /* stage timer of rendering and read-back; NULL: "cssm_render" */
 } cssm_build_opts;
 
 /* Renders (the core's precomputation loop gi/csm_precompute.h with its
@@ -295,6 +296,8 @@ typedef struct cssm_gather_opts {
     float bias;          /* CSSM depth bias, world units */
     int pcf;
     uint32_t *rng;       /* non-NULL: jitter each gathered node inside its area (§4.5) */
+    int no_emission;     /* cssm_solve: R_1 = direct only, the emitting texels not gathered (their light
+                          * comes from the direct light of direct=csm, §4.7) */
 } cssm_gather_opts;
 
 typedef struct cssm_gather_stats {
@@ -335,7 +338,8 @@ gi_vec3 cssm_receiver_point(const cssm_maps *maps, const cssm_atlas *a, gi_vec3 
 /* GPU HRC of §4.1.1 on the atlas (Fig. 8): texel_L (3 per texel) gets
  * emission + R_1 + ... + R_n with
  *   R_1 = kd/pi gather(pull(emission)) + direct (3 per texel, may be NULL:
- *         light from sources that are not atlas texels),
+ *         light from sources that are not atlas texels; with
+ *         o->no_emission R_1 = direct alone),
  *   R_k = kd/pi gather(pull(R_{k-1})),  k = 2 .. n,
  * and node_L (3 per node) its pull. Stage timers direct, pull, bounce when
  * host is not NULL. */

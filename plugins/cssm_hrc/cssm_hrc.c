@@ -11,6 +11,9 @@
  *              with env=cssm by the texels' own cube maps, env_cssm.c);
  *   bounce:  R_k = kd/pi gather(pull(R_{k-1})), k = 2 .. n (§4.1.1);
  *   pull:    the tree of L = emission + sum R_k.
+ * With direct=csm (§4.7's alternative, direct_csm.c) R1 is the direct light
+ * of every light by Coherent Shadow Maps and Monte Carlo instead, the
+ * emitting texels not gathered, and pixels get that direct light too.
  * render(): G-buffer; per pixel the same traversal with a Phong bound
  * (§4.4), VPLs jittered inside their area and averaged over frames (§4.5),
  * distances clamped; plus emission, the punctual lights and the
@@ -21,6 +24,7 @@
  * drawn by the core's GL passes. */
 #include "cssm.h"
 #include "env_cssm.h"
+#include "direct_csm.h"
 #include "motion.h"
 
 #include "gi/cache.h"
@@ -79,6 +83,8 @@ typedef struct cssm_hrc {
     cssm_motion motion; /* §3.3: moving rigid objects (motion.h); motion.moving < 0: static scene */
     int nodes;          /* 1: nodes=compact, the gathers read packed 128-bit nodes (§4.2.1, compact.c) */
     cssm_ctree ct[3];   /* nodes=compact: the packed hierarchy with the intensity of texel_L, emission, reflected */
+    int direct, csm_points, csm_samples, csm_M; /* §4.7 "Direct Light": direct=csm (direct_csm.h) */
+    cssm_csm_direct *csm; /* its CSMs, NULL with direct=maps */
     int prepared;
 } cssm_hrc;
 
@@ -123,6 +129,16 @@ static const gi_param_desc cssm_params[] = {
      "environment visibility: trace the core's ray tracer; cssm the escape test in the texels' own cube maps "
      "(built with the far plane as the mark of 'no surface'; per pixel the maps of the texels around it); not "
      "with moving objects"},
+    {"direct", GI_PARAM_ENUM, 0, 0, 0, "maps|csm", "Sec. 4.7 Direct Light",
+     "maps: area lights are emitting atlas texels gathered by the first bounce, punctual lights shadow-mapped, the "
+     "environment ray-traced; csm: the Monte-Carlo direct light of the original CSM (area lights: csm_points points "
+     "on the emitters with a compressed depth cube map each; point/spot lights: a cube map each; directional and "
+     "environment: each object's distant CSM), the HRC bounces gathering the reflected light only"},
+    {"csm_points", GI_PARAM_INT, 64, 1, 256, NULL, "N (CSM Sec. 4.2)",
+     "direct=csm: points on the area lights (by power), a depth cube map each"},
+    {"csm_samples", GI_PARAM_INT, 16, 1, 1024, NULL, "S (CSM Sec. 5.1)",
+     "direct=csm: area-light samples per pixel and frame, each shadowed by the nearest point's cube map"},
+    {"csm_M", GI_PARAM_INT, 64, 8, 256, NULL, "M (CSM Sec. 3.3)", "direct=csm: cube face size of the lights' maps"},
     {"shadow_size", GI_PARAM_INT, 256, 16, 2048, NULL, NULL,
      "face size of the point/spot lights' shadow cube maps and of directional lights' shadow maps"},
     {0},
@@ -155,6 +171,10 @@ static gi_result cssm_create(const gi_host *host, const gi_params *params, void 
     c->indirect = gi_params_enum(params, "indirect");
     c->mc_samples = gi_params_int(params, "mc_samples");
     c->nodes = gi_params_enum(params, "nodes");
+    c->direct = gi_params_enum(params, "direct");
+    c->csm_points = gi_params_int(params, "csm_points");
+    c->csm_samples = gi_params_int(params, "csm_samples");
+    c->csm_M = gi_params_int(params, "csm_M");
     c->motion.moving = -1;
     *out = c;
     return GI_OK;
@@ -195,6 +215,9 @@ static void release_prepared(cssm_hrc *c)
         c->cdf[i] = NULL;
     }
     release_shadows(c);
+    cssm_csm_direct_free(c->csm);
+    free(c->csm);
+    c->csm = NULL;
     cssm_motion_free(&c->motion);
     c->prepared = 0;
 }
@@ -269,6 +292,36 @@ static gi_result make_shadows(cssm_hrc *c, const gi_gpu_scene *gs, gi_error *err
             return r;
         }
     }
+    return GI_OK;
+}
+
+/* The direct light's maps: the punctual lights' shadow maps (direct=maps),
+ * or the CSMs of direct=csm (§4.7, direct_csm.h), made again when the
+ * lights or materials change. Stage timer csm_precompute; stats
+ * csm_bytes, csm_points, csm_maps. */
+static gi_result make_direct(cssm_hrc *c, const gi_gpu_scene *gs, gi_error *err)
+{
+    if (!c->direct)
+        return make_shadows(c, gs, err);
+    const gi_host *host = c->kit.host;
+    cssm_csm_direct_free(c->csm);
+    if (!c->csm && !(c->csm = calloc(1, sizeof *c->csm))) {
+        snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for the direct light's CSMs");
+        return GI_ERR_OUT_OF_MEMORY;
+    }
+    host->stage_begin(host, "csm_precompute");
+    gi_result r = cssm_csm_direct_build(gs, c->atlas.diameter, (uint32_t)c->csm_points, (uint32_t)c->csm_M, host,
+                                        c->csm, err);
+    host->stage_end(host, "csm_precompute");
+    if (r != GI_OK) {
+        free(c->csm);
+        c->csm = NULL;
+        return r;
+    }
+    host->stat(host, "csm_bytes", (double)cssm_csm_direct_bytes(c->csm));
+    host->stat(host, "csm_points", (double)c->csm->area_points);
+    host->stat(host, "csm_maps", (double)c->csm->pts.count);
+    host->stat(host, "csm_distant_objects", (double)(c->csm->distant ? c->csm->object_count : 0));
     return GI_OK;
 }
 
@@ -405,7 +458,7 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
     host->stage_begin(host, "direct");
     free(c->texel_E);
     c->texel_E = NULL;
-    const gi_envmap *env = gs->scene->has_environment ? gs->scene->envmap : NULL;
+    const gi_envmap *env = gs->scene->has_environment && !c->csm ? gs->scene->envmap : NULL;
     if (env && c->maps.escape) { /* env=cssm: the texels' own cube maps (env_cssm.c) */
         c->texel_E = calloc(3 * (size_t)N, sizeof *c->texel_E);
         if (!c->texel_E) {
@@ -448,12 +501,22 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
                 D[3 * i + k] += x->albedo[k] / GI_PI * e[k];
         }
     }
+    if (c->csm) /* §4.7: every light's direct light by the CSMs, the fixed estimate over the light points */
+        for (uint32_t i = 0; i < N; i++) {
+            const cssm_texel *x = &a->texels[i];
+            cssm_receiver rc = {.x = offset(c, x->p, x->n), .n = x->n, .self = (int32_t)i};
+            memcpy(rc.kd, x->albedo, sizeof rc.kd);
+            cssm_csm_direct_eval(c->csm, gs->scene, &rc, 0, (uint32_t)c->env_samples, i, c->bias_f * a->diameter,
+                                 c->pcf, &D[3 * i]);
+        }
     host->stage_end(host, "direct");
     cssm_gather_opts o = gather_opts(c, 0.0f, NULL);
+    o.no_emission = c->csm != NULL; /* R1 = the CSMs' direct light alone */
     cssm_gather_stats st = {0};
     gi_error err;
-    gi_result r = cssm_solve_ex(&c->tree, c->nodes ? &c->ct[0] : NULL, a, &c->maps, &o, (uint32_t)c->bounces,
-                                c->shadow_count || env ? D : NULL, host, c->texel_L, c->node_L, &st, &err);
+    const float *direct = c->shadow_count || env || c->csm ? D : NULL;
+    gi_result r = cssm_solve_ex(&c->tree, c->nodes ? &c->ct[0] : NULL, a, &c->maps, &o, (uint32_t)c->bounces, direct,
+                                host, c->texel_L, c->node_L, &st, &err);
     free(D);
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);
@@ -590,7 +653,8 @@ static gi_result load_or_build_maps(cssm_hrc *c, const gi_gpu_scene *gs, gi_erro
 {
     const gi_host *host = c->kit.host;
     char name[64], *path = NULL;
-    const int escape = c->env_mode == 1 && gs->scene->has_environment;
+    /* env=cssm with direct=maps: with direct=csm the environment goes through the distant CSMs */
+    const int escape = c->env_mode == 1 && gs->scene->has_environment && !c->direct;
     c->maps.escape = escape;
     cache_name(c, gs, name, sizeof name);
     path = host->cache_dir ? gi_cache_path(host->cache_dir, name) : NULL;
@@ -685,6 +749,9 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     if (moving && c->env_mode == 1 && gs->scene->has_environment)
         return gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED,
                            "cssm_hrc: env=cssm does not support moving objects (use env=trace)");
+    if (moving && c->direct)
+        return gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED,
+                           "cssm_hrc: direct=csm does not support moving objects (its maps hold the static scene)");
     host->stage_begin(host, "atlas");
     gi_result r = cssm_atlas_build(gs->scene, gs->time, (uint32_t)c->R, c->traversal == 0, &c->atlas, &err);
     host->stage_end(host, "atlas");
@@ -724,7 +791,7 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);
     host->stage_begin(host, "direct");
-    r = make_shadows(c, gs, &err);
+    r = make_direct(c, gs, &err);
     host->stage_end(host, "direct");
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);
@@ -783,7 +850,7 @@ static gi_result cssm_update(void *inst, const gi_gpu_scene *gs, const gi_change
         }
         const gi_host *host = c->kit.host;
         host->stage_begin(host, "direct");
-        gi_result r = make_shadows(c, gs, &err);
+        gi_result r = make_direct(c, gs, &err);
         host->stage_end(host, "direct");
         if (r != GI_OK) { /* what was made before is gone: render refuses until the next prepare */
             c->prepared = 0;
@@ -872,7 +939,8 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
     const gi_host *host = kit->host;
     if (!c->prepared)
         return gi_kit_fail(kit, GI_ERR_INVALID_ARGUMENT, "cssm_hrc: render before prepare");
-    const int random = c->jitter || c->indirect == 1 || (c->texel_E && c->env_pixel); /* frames differ: average them */
+    /* frames differ: average them */
+    const int random = c->jitter || c->indirect == 1 || (c->texel_E && c->env_pixel) || c->csm;
     gi_result r = gi_kit_frame_begin(kit, view, GI_KIT_GBUFFER | (random ? 0u : GI_KIT_NO_AVERAGE));
     if (r != GI_OK)
         return r;
@@ -928,10 +996,11 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                 uint32_t rng = gi_rng_init((uint32_t)p, frame, view->seed ^ 0xc55u);
                 cssm_gather_opts o = gather_opts(c, view->exposure, random ? &rng : NULL);
                 if (!texels) {
-                    gather(c, 0, &rc, &o, out, &st);
+                    gather(c, c->csm ? 2 : 0, &rc, &o, out, &st); /* with direct=csm the reflected light only */
                 } else {
                     /* direct light of the emitting texels per pixel, the indirect light from the lightmap */
-                    gather(c, 1, &rc, &o, out, NULL);
+                    if (!c->csm)
+                        gather(c, 1, &rc, &o, out, NULL);
                     uint32_t tri = c->ids[4 * p + 2];
                     int32_t chart = tri < s->triangle_count ? c->atlas.tri_chart[tri] : -1;
                     float ind[3] = {0, 0, 0}, u, v;
@@ -945,6 +1014,10 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                     for (int k = 0; k < 3; k++)
                         out[k] += ind[k];
                 }
+                if (c->csm) /* §4.7: the direct light of every light by the CSMs, S new light points a frame */
+                    cssm_csm_direct_eval(c->csm, s, &rc, (uint32_t)c->csm_samples, (uint32_t)c->env_samples,
+                                         gi_pcg_hash((uint32_t)p ^ gi_pcg_hash(frame ^ view->seed ^ 0xd1cu)),
+                                         c->bias_f * c->atlas.diameter, c->pcf, out);
                 for (uint32_t l = 0; l < c->shadow_count; l++) {
                     float e[3];
                     punctual(c, s, l, rc.x, Nn, e);
@@ -994,7 +1067,7 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                 }
                 for (int k = 0; k < 3; k++)
                     out[k] += em[k];
-            } else if (c->texel_E) { /* the environment seen past the scene */
+            } else if (c->texel_E || (c->csm && s->has_environment && s->envmap)) { /* the environment past the scene */
                 gi_vec3 f = gi_mat4_point(view->inv_view_proj, gi_v3(((float)x + 0.5f) / (float)w * 2.0f - 1.0f,
                                                                       ((float)y + 0.5f) / (float)h * 2.0f - 1.0f, 1.0f));
                 gi_envmap_eval(s->envmap, gi_v3_normalize(gi_v3_sub(f, view->eye)), out);

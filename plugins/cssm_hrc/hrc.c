@@ -411,8 +411,10 @@ gi_result cssm_solve_ex(const cssm_tree *t, cssm_ctree *ct, const cssm_atlas *a,
     if (bounces >= 1) {
         /* direct: the emitting texels gathered like any sender, plus the rest */
         gi_host_stage(host, "direct", 1);
-        pull_any(t, ct, a, Le, nodes);
-        gather_atlas(t, nodes, ct, a, maps, o, Rk, st);
+        if (!o->no_emission) {
+            pull_any(t, ct, a, Le, nodes);
+            gather_atlas(t, nodes, ct, a, maps, o, Rk, st);
+        }
         if (direct)
             for (size_t k = 0; k < 3 * (size_t)N; k++)
                 Rk[k] += direct[k];

@@ -25,6 +25,7 @@
 #define GI_CSM_DISTANT_H
 
 #include "gi/csm_codec.h"
+#include "gi/csm_order.h"
 #include "gi/passes.h"
 #include "gi/vecmath.h"
 
@@ -59,6 +60,19 @@ void gi_csm_distant_free(gi_csm_distant *c);
  * lie outside the object's convex hull (the line then meets the hull in
  * one interval that holds every surface the map stores). */
 int gi_csm_distant_blocks(const gi_csm_distant *c, gi_vec3 p, gi_vec3 q, float bias);
+
+/* Visibility (1 lit, 0 shadowed) of point x toward unit direction w (both
+ * in the object's local frame) through a CSM over directions with the
+ * conventions above, maps in `order` over (a along phi, b along theta):
+ * x is projected into the map of the direction cell nearest w and lit when
+ * its depth is at most that texel's z_avg + bias (Ritschel et al. 2007
+ * §3.2, the nearest filter of §4.5). Points outside the map's footprint
+ * are lit. The query of the csm plugin and of cssm_hrc's direct=csm
+ * (direct light from directions, receivers on surfaces). */
+int gi_csm_dir_visible(const gi_csm_data *data, const float sphere[4], uint32_t n_theta, uint32_t n_phi,
+                       gi_csm_order order, gi_vec3 x, gi_vec3 w, float bias);
+/* The same through gi_csm_distant's maps (scanline order). */
+int gi_csm_distant_visible(const gi_csm_distant *c, gi_vec3 x, gi_vec3 w, float bias);
 
 #ifdef __cplusplus
 }

@@ -87,6 +87,22 @@ typedef struct gi_gpu_emitter {
     float pdf;       /* probability of choosing this emitter */
 } gi_gpu_emitter;
 
+/* The emitter whose CDF interval holds u in [0, 1) (n >= 1 records):
+ * the CPU twin of scene.glsl's gi_emitter_find, for plugins that read the
+ * emitter table back (avg, cssm_hrc's direct=csm). */
+static inline uint32_t gi_emitter_find_cpu(const gi_gpu_emitter *em, uint32_t n, float u)
+{
+    uint32_t lo = 0, hi = n - 1;
+    while (lo < hi) {
+        uint32_t mid = (lo + hi) / 2;
+        if (em[mid].cdf > u)
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    return lo;
+}
+
 /* The scene on the GPU. All handles are owned by the core; plugins read
  * them and must not delete them. Vertex attributes of `vao`: 0 position
  * (vec3), 1 object (uint), 2 normal (vec3), 3 material (uint), 4 uv (vec2),

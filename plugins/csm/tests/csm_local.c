@@ -664,7 +664,7 @@ static int semi_visible(const setup *st, const semi *sm, uint32_t j, gi_vec3 x, 
         gi_vec3 xl = gi_mat4_point(st->local_from_world[k], x);
         gi_vec3 wl = gi_v3_normalize(gi_mat4_dir(st->local_from_world[k], gi_v3_sub(y, x)));
         if (!snapped) {
-            if (!csm_visible_nearest(&sm->data[k], sm->sphere[k], N_SEMI, N_SEMI, GI_CSM_ORDER_HILBERT, xl, wl,
+            if (!gi_csm_dir_visible(&sm->data[k], sm->sphere[k], N_SEMI, N_SEMI, GI_CSM_ORDER_HILBERT, xl, wl,
                                      0.01f * sm->sphere[k][3]))
                 return 0;
             continue;

@@ -73,7 +73,7 @@ static int csm_lit(const gi_gpu_scene *gs, const uint32_t *ks, const gi_csm_data
         float inv[16];
         gi_mat4_invert(inv, gs->world_from_local[ks[i]]);
         gi_vec3 xl = gi_mat4_point(inv, x), wl = gi_v3_normalize(gi_mat4_dir(inv, w));
-        if (!csm_visible_nearest(data[i], spheres[i], N, N, GI_CSM_ORDER_HILBERT, xl, wl, 0.01f * spheres[i][3]))
+        if (!gi_csm_dir_visible(data[i], spheres[i], N, N, GI_CSM_ORDER_HILBERT, xl, wl, 0.01f * spheres[i][3]))
             return 0;
     }
     return 1;
@@ -433,7 +433,7 @@ int main(void)
             continue;
         }
         int exact = hw == 0;
-        int lit = csm_visible_nearest(&data, sphere, N, N, desc.order, x, w, bias);
+        int lit = gi_csm_dir_visible(&data, sphere, N, N, desc.order, x, w, bias);
         float *q = pin + 8 * pairs;
         q[0] = x.x, q[1] = x.y, q[2] = x.z, q[3] = 1, q[4] = w.x, q[5] = w.y, q[6] = w.z, q[7] = 0;
         cpu_lit[pairs] = lit;
