@@ -196,6 +196,22 @@ float gi_envmap_pdf(const gi_envmap *env, gi_vec3 d)
     return texel_pdf(env, i, j, v);
 }
 
+float gi_envmap_mis_direction(const gi_envmap *env, gi_vec3 n, uint32_t k, uint32_t K, float u1, float u2, gi_vec3 *w)
+{
+    const uint32_t half = K > 1 ? K / 2 : 1, Kc = K > half ? K - half : 0;
+    if (k < half) {
+        if (!(gi_envmap_sample(env, u1, u2, w) > 0.0f))
+            return 0.0f;
+    } else {
+        *w = gi_to_world(gi_sample_cosine_hemisphere(u1, u2), n);
+    }
+    float cs = gi_v3_dot(n, *w);
+    if (!(cs > 0.0f))
+        return 0.0f;
+    float denom = (float)half * gi_envmap_pdf(env, *w) + (float)Kc * gi_cosine_hemisphere_pdf(cs);
+    return denom > 0.0f ? cs / denom : 0.0f;
+}
+
 float gi_envmap_average_radiance(const gi_envmap *env)
 {
     /* (1 / 4 pi) Int L dw, with dw = 2 pi^2 sin(theta) du dv. */

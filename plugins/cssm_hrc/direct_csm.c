@@ -341,27 +341,17 @@ void cssm_csm_direct_eval(const cssm_csm_direct *d, const gi_scene *s, const css
      * cosine-weighted, balance heuristic; visibility by the distant CSMs */
     const gi_envmap *env = s->has_environment ? s->envmap : NULL;
     if (env && env_samples) {
-        const uint32_t K = env_samples, half = K > 1 ? K / 2 : 1, Kc = K - half;
-        for (uint32_t k = 0; k < K; k++) {
+        for (uint32_t k = 0; k < env_samples; k++) {
             float u1 = gi_rng_next_float(&rng), u2 = gi_rng_next_float(&rng);
             gi_vec3 w;
-            if (k < half) {
-                if (!(gi_envmap_sample(env, u1, u2, &w) > 0.0f))
-                    continue;
-            } else {
-                w = gi_to_world(gi_sample_cosine_hemisphere(u1, u2), rc->n);
-            }
-            float cs = gi_v3_dot(rc->n, w);
-            if (!(cs > 0.0f))
-                continue;
-            float denom = (float)half * gi_envmap_pdf(env, w) + (float)Kc * gi_cosine_hemisphere_pdf(cs);
-            if (!(denom > 0.0f) || !cssm_csm_direct_open(d, rc->x, rc->n, w, bias))
+            float weight = gi_envmap_mis_direction(env, rc->n, k, env_samples, u1, u2, &w);
+            if (!(weight > 0.0f) || !cssm_csm_direct_open(d, rc->x, rc->n, w, bias))
                 continue;
             float L[3], f[3];
             gi_envmap_eval(env, w, L);
             brdf(rc, w, f);
             for (int j = 0; j < 3; j++)
-                out[j] += f[j] * L[j] * cs / denom;
+                out[j] += f[j] * L[j] * weight;
         }
     }
 }

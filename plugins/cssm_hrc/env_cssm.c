@@ -16,22 +16,11 @@ void cssm_env_estimate(const gi_envmap *env, gi_vec3 n, uint32_t K, uint32_t see
 {
     e[0] = e[1] = e[2] = 0.0f;
     uint32_t rng = gi_rng_init(seed, 0, 0x5e17u);
-    const uint32_t half = K > 1 ? K / 2 : 1, Kc = K - half;
     for (uint32_t k = 0; k < K; k++) {
         float u1 = gi_rng_next_float(&rng), u2 = gi_rng_next_float(&rng);
         gi_vec3 w;
-        if (k < half) {
-            if (!(gi_envmap_sample(env, u1, u2, &w) > 0.0f))
-                continue;
-        } else {
-            w = gi_to_world(gi_sample_cosine_hemisphere(u1, u2), n);
-        }
-        float cs = gi_v3_dot(n, w);
-        if (!(cs > 0.0f))
-            continue;
-        float pe = gi_envmap_pdf(env, w), pc = gi_cosine_hemisphere_pdf(cs);
-        float denom = (float)half * pe + (float)Kc * pc;
-        if (!(denom > 0.0f))
+        float weight = gi_envmap_mis_direction(env, n, k, K, u1, u2, &w);
+        if (!(weight > 0.0f))
             continue;
         float v = vis(ctx, w);
         if (!(v > 0.0f))
@@ -44,7 +33,7 @@ void cssm_env_estimate(const gi_envmap *env, gi_vec3 n, uint32_t K, uint32_t see
             lobe = cl > 0.0f ? (brdf->exponent + 2.0f) / (2.0f * GI_PI) * powf(cl, brdf->exponent) : 0.0f;
         }
         for (int j = 0; j < 3; j++)
-            e[j] += v * L[j] * cs / denom * (brdf ? brdf->kd[j] / GI_PI + brdf->ks[j] * lobe : 1.0f);
+            e[j] += v * L[j] * weight * (brdf ? brdf->kd[j] / GI_PI + brdf->ks[j] * lobe : 1.0f);
     }
 }
 

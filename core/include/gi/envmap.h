@@ -57,6 +57,15 @@ void gi_envmap_eval(const gi_envmap *env, gi_vec3 d, float out[3]);
  * (0 if the map is black, *dir then +Y). */
 float gi_envmap_sample(const gi_envmap *env, float u1, float u2, gi_vec3 *dir);
 float gi_envmap_pdf(const gi_envmap *env, gi_vec3 d);
+/* Direction k of K for an estimate of the light the environment sends
+ * onto a surface of normal n, from (u1, u2) in [0,1)^2: the first half of
+ * the K directions drawn by the map's sampler, the rest cosine-weighted,
+ * combined by the balance heuristic (the map's bright parts need its
+ * sampler; cosine alone covers the rest of the hemisphere). Returns the
+ * estimate's weight cos / (half pdf_map + (K - half) pdf_cos), so that the
+ * irradiance is the sum over k of weight x L(w) x visibility; 0 when the
+ * direction does not count (below the surface, or a black map). */
+float gi_envmap_mis_direction(const gi_envmap *env, gi_vec3 n, uint32_t k, uint32_t K, float u1, float u2, gi_vec3 *w);
 /* Mean luminance over the sphere, (1 / 4 pi) Int lum(L) dw = total_weight
  * x pi / 2: a power-like weight for choosing between the map and other
  * lights. */

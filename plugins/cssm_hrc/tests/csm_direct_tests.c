@@ -110,24 +110,16 @@ static void traced(const cssm_csm_direct *d, const gi_scene *s, const gi_rt *rt,
      * cosine-weighted, balance heuristic (the map's bright parts need its
      * sampler; cosine alone leaves the reference noisy) */
     const gi_envmap *env = s->has_environment ? s->envmap : NULL;
-    const uint32_t half = K / 2, Kc = K - half;
     for (uint32_t k = 0; env && k < K; k++) {
         float u1 = gi_rng_next_float(&rng), u2 = gi_rng_next_float(&rng);
         gi_vec3 w;
-        if (k < half) {
-            if (!(gi_envmap_sample(env, u1, u2, &w) > 0.0f))
-                continue;
-        } else {
-            w = gi_to_world(gi_sample_cosine_hemisphere(u1, u2), n);
-        }
-        float cs = gi_v3_dot(n, w);
-        float denom = cs > 0.0f ? (float)half * gi_envmap_pdf(env, w) + (float)Kc * gi_cosine_hemisphere_pdf(cs) : 0.0f;
-        if (!(denom > 0.0f) || (rt && gi_rt_occluded(rt, x, w, eps, INFINITY)))
+        float weight = gi_envmap_mis_direction(env, n, k, K, u1, u2, &w);
+        if (!(weight > 0.0f) || (rt && gi_rt_occluded(rt, x, w, eps, INFINITY)))
             continue;
         float L[3];
         gi_envmap_eval(env, w, L);
         for (int j = 0; j < 3; j++)
-            E[j] += L[j] * cs / denom;
+            E[j] += L[j] * weight;
     }
 }
 
