@@ -15,26 +15,9 @@ cornell: the Cornell box at 48 x 48, bounces=0 (direct light only), 8
 """
 import json
 import os
-import struct
-import subprocess
 import sys
 
-
-def read_pfm(path):
-    with open(path, "rb") as f:
-        data = f.read()
-    parts = data.split(b"\n", 3)
-    w, h = map(int, parts[1].split())
-    scale = float(parts[2])
-    n = w * h * 3
-    return w, h, struct.unpack(("<" if scale < 0 else ">") + "%df" % n, parts[3][: 4 * n])
-
-
-def run(cmd):
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    if r.returncode != 0:
-        sys.exit("FAIL: %s: %s" % (" ".join(cmd), r.stderr.strip()[-400:]))
-    return r.stdout
+from pfm_run import read_pfm, run
 
 
 def furnace(gib, root, out):

@@ -22,25 +22,9 @@ reference: bunny_env.glb and teapot_plane.glb at 32 x 32 against the
 import json
 import os
 import shutil
-import struct
-import subprocess
 import sys
 
-
-def read_pfm(path):
-    with open(path, "rb") as f:
-        data = f.read()
-    parts = data.split(b"\n", 3)
-    w, h = map(int, parts[1].split())
-    scale = float(parts[2])
-    n = w * h * 3
-    return w, h, struct.unpack(("<" if scale < 0 else ">") + "%df" % n, parts[3][: 4 * n])
-
-
-def run(cmd):
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    if r.returncode != 0:
-        sys.exit("FAIL: %s: %s" % (" ".join(cmd), r.stderr.strip()[-400:]))
+from pfm_run import read_pfm, run
 
 
 def rmse(a, b):
