@@ -15,6 +15,8 @@
 #include "cssm.h"
 #include "direct_csm.h"
 
+#include "gpu_fixture.h"
+
 #include "gi/envmap.h"
 #include "gi/gpu.h"
 #include "gi/lights.h"
@@ -34,18 +36,6 @@
 
 #define POINTS 600     /* surface points scored */
 #define REF_SAMPLES 4096 /* traced light samples per point (area lights, environment) */
-
-static int fails;
-
-#define CHECK(cond, ...)                                                                                               \
-    do {                                                                                                               \
-        if (!(cond)) {                                                                                                 \
-            fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__);                                                       \
-            fprintf(stderr, __VA_ARGS__);                                                                              \
-            fprintf(stderr, "\n");                                                                                     \
-            fails++;                                                                                                   \
-        }                                                                                                              \
-    } while (0)
 
 /* The direct irradiance at x (normal n) of every light of s, traced:
  * area lights by K points drawn by power on the emitters (the core's
@@ -135,20 +125,17 @@ static int run(const char *rel, int pixel_estimate, double margin)
 {
     char path[1024];
     snprintf(path, sizeof path, "%s/%s", GI_SOURCE_DIR, rel);
-    gi_error err;
-    gi_scene *s = gi_scene_load(path, &err);
-    if (!s) {
-        fprintf(stderr, "FAIL: %s\n", err.text);
+    gi_gpu *gpu;
+    gi_scene *s;
+    gi_gpu_scene *gs;
+    if (!gpu_fixture_load(path, &gpu, &s, &gs) || !gs)
         return 1;
-    }
-    gi_gpu *gpu = gi_gpu_create(NULL, &err);
-    gi_gpu_scene *gs = gpu ? gi_gpu_scene_upload(gpu, s, &err) : NULL;
+    gi_error err;
     gi_rt *rt = NULL;
-    if (!gs || gi_rt_create(s, 0.0f, &rt, &err) != GI_OK) {
+    if (gi_rt_create(s, 0.0f, &rt, &err) != GI_OK) {
         fprintf(stderr, "FAIL: set-up: %s\n", err.text);
         return 1;
     }
-    gi_gpu_scene_set_time(gs, 0.0f);
     cssm_atlas a; /* the surface points: random points in the atlas texels (32^2) */
     if (cssm_atlas_build(s, 0.0f, 32, 0, &a, &err) != GI_OK) {
         fprintf(stderr, "FAIL: atlas: %s\n", err.text);
@@ -201,12 +188,13 @@ static int run(const char *rel, int pixel_estimate, double margin)
            "per-pixel estimate %s%.4f; unshadowed %.4f, black %.4f; mean %+.2f %%\n",
            REF_SAMPLES, e_csm, pixel_estimate ? "" : "(not run) ", pixel_estimate ? e_pix : 0.0, e_unsh, e_black,
            100.0 * (sum_csm / sum_ref - 1.0));
-    CHECK(e_csm < margin * trivial, "CSM atlas estimate %.4f not below %.1f x the better trivial answer %.4f", e_csm,
-          margin, trivial);
+    CHECK_MSG(e_csm < margin * trivial, "CSM atlas estimate %.4f not below %.1f x the better trivial answer %.4f",
+              e_csm, margin, trivial);
     if (pixel_estimate)
-        CHECK(e_pix < margin * trivial, "per-pixel estimate %.4f not below %.1f x the better trivial answer %.4f",
-              e_pix, margin, trivial);
-    CHECK(fabs(sum_csm / sum_ref - 1.0) < 0.05, "mean irradiance off by %+.2f %%", 100.0 * (sum_csm / sum_ref - 1.0));
+        CHECK_MSG(e_pix < margin * trivial, "per-pixel estimate %.4f not below %.1f x the better trivial answer %.4f",
+                  e_pix, margin, trivial);
+    CHECK_MSG(fabs(sum_csm / sum_ref - 1.0) < 0.05, "mean irradiance off by %+.2f %%",
+              100.0 * (sum_csm / sum_ref - 1.0));
     cssm_csm_direct_free(&d);
     cssm_atlas_free(&a);
     gi_rt_free(rt);
@@ -229,8 +217,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: cssm_direct_tests cornell|all|env\n");
         return 2;
     }
-    if (r || fails) {
-        fprintf(stderr, "cssm_direct_tests %s: %d check(s) failed\n", argv[1], fails + r);
+    if (r || gi_test_failed) {
+        fprintf(stderr, "cssm_direct_tests %s: %d check(s) failed\n", argv[1], gi_test_failed + r);
         return 1;
     }
     printf("cssm_direct_tests %s: ok\n", argv[1]);
