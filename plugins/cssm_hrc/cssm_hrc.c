@@ -777,11 +777,6 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     host->stat(host, "cssm_bytes_uncompressed", (double)bu);
     double self_bytes, csm_bytes, static_bytes;
     motion_bytes(&c->motion, &self_bytes, &csm_bytes, &static_bytes);
-    /* data_bytes counts the compressed visibility maps, the bulk of what is
-     * kept; the atlas and the hierarchy are not counted. With direct=csm the
-     * lights' CSMs join it once lighting() has made them (below). */
-    const double data_bytes = (double)bc + self_bytes + csm_bytes + static_bytes;
-    host->stat(host, "data_bytes", data_bytes);
     host->stat(host, "compression_ratio", bc ? (double)bu / (double)bc : 0.0);
     host->stat(host, "segments_per_texel", (double)cssm_maps_segments(&c->maps) / (6.0 * c->M * c->M));
     host->stat(host, "dont_care_share", (double)c->maps.dont_care / (double)c->maps.face_texels);
@@ -797,11 +792,14 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     host->stage_end(host, "direct");
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);
+    /* data_bytes counts the compressed visibility maps, the bulk of what is
+     * kept: the CSSM, the movers' maps and, with direct=csm, the lights'
+     * CSMs; the atlas and the hierarchy are not counted. */
+    host->stat(host, "data_bytes", (double)bc + self_bytes + csm_bytes + static_bytes +
+                                       (c->csm ? (double)cssm_csm_direct_bytes(c->csm) : 0.0));
     r = lighting(c, gs);
     if (r != GI_OK)
         return r;
-    if (c->csm) /* the last value of a stat wins */
-        host->stat(host, "data_bytes", data_bytes + (double)cssm_csm_direct_bytes(c->csm));
     c->prepared = 1;
     return GI_OK;
 }
