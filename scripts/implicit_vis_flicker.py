@@ -46,36 +46,16 @@ Usage: scripts/implicit_vis_flicker.py OUT [--gibench build/release/bin/gibench]
 """
 
 import argparse
-import array
 import csv
 import os
-import subprocess
-import sys
+
+from gi_run import luminance, read_pfm, run
 
 
-def read_pfm(path):
-    with open(path, "rb") as f:
-        kind = f.readline().strip()
-        if kind not in (b"PF", b"Pf"):
-            raise SystemExit("%s: not a PFM image" % path)
-        w, h = (int(x) for x in f.readline().split())
-        scale = float(f.readline())
-        data = array.array("f")
-        data.frombytes(f.read())
-    if (scale > 0) != (sys.byteorder == "big"):
-        data.byteswap()
-    c = 3 if kind == b"PF" else 1
-    if len(data) != w * h * c:
-        raise SystemExit("%s: %d values for %d x %d x %d" % (path, len(data), w, h, c))
-    if c == 1:
-        return list(data)
-    return [0.2126 * data[3 * i] + 0.7152 * data[3 * i + 1] + 0.0722 * data[3 * i + 2] for i in range(w * h)]
-
-
-def run(cmd):
-    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    if r.returncode != 0:
-        raise SystemExit("failed (%d): %s\n%s" % (r.returncode, " ".join(cmd), r.stderr.strip()))
+def read_luminance(path):
+    """The luminance of a PFM image, or its one channel."""
+    _, _, c, data = read_pfm(path)
+    return list(data) if c == 1 else luminance(data)
 
 
 def mean_abs(xs):
@@ -112,12 +92,12 @@ def main():
                 run([a.gibench, "-q", "reference", "--scene", a.scene, "--size", size, "--spp", str(a.spp),
                      "--max-bounces", str(a.bounces), "--seed", str(seed), "--time-of-scene", "%.6g" % t,
                      "--out", p])
-            img[("ref%d" % seed, i)] = read_pfm(p)
+            img[("ref%d" % seed, i)] = read_luminance(p)
         for m, extra in methods:
             p = os.path.join(a.out, "%s_%02d.pfm" % (m, i))
             run([a.gibench, "-q", "render", "--scene", a.scene, "--method", m, "--size", size, "--time", "%.6g" % t,
                  "--out", p] + extra)
-            img[(m, i)] = read_pfm(p)
+            img[(m, i)] = read_luminance(p)
     norm = sum(sum(img[("ref1", i)]) / len(img[("ref1", i)]) for i in range(a.frames)) / a.frames
     npx = len(img[("ref1", 0)])
     seq = [[0.5 * (img[("ref1", i)][p] + img[("ref2", i)][p]) for i in range(a.frames)] for p in range(npx)]

@@ -11,13 +11,15 @@ furnace: the conformance furnaces (closed emitting sphere, Le = 1, rho 0.5
 cornell: the Cornell box at 48 x 48, bounces=0 (direct light only), 8
          frames, direct=csm against the path-traced direct light (max bounces
          1, 256 spp): relMSE (gibench diff) must be below 0.1 x the black
-         image's.
+         image's; the data_bytes stat must be the CSSM's bytes plus the
+         lights' CSMs'.
 """
 import json
 import os
 import sys
 
-from pfm_run import read_pfm, run
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "scripts"))
+from gi_run import read_pfm, run  # noqa: E402
 
 
 def furnace(gib, root, out):
@@ -27,7 +29,7 @@ def furnace(gib, root, out):
         img = os.path.join(out, name + "_csm.pfm")
         run([gib, "render", "--scene", scene, "--method", "cssm_hrc", "--param", "direct=csm", "--size", "32x32",
              "--frames", "4", "--out", img])
-        w, h, v = read_pfm(img)
+        w, h, _, v = read_pfm(img)
         expect = sum(rho ** k for k in range(5))
 
         def score(px):
@@ -51,8 +53,15 @@ def cornell(gib, root, out):
     ref, img = os.path.join(out, "cornell_ref_b1.pfm"), os.path.join(out, "cornell_csm_b0.pfm")
     run([gib, "reference", "--scene", scene, "--out", ref, "--size", "48x48", "--spp", "256", "--max-bounces", "1",
          "--threads", "1"])
+    timings = os.path.join(out, "cornell_csm_b0.json")
     run([gib, "render", "--scene", scene, "--method", "cssm_hrc", "--param", "direct=csm", "--param", "bounces=0",
-         "--size", "48x48", "--frames", "8", "--out", img])
+         "--size", "48x48", "--frames", "8", "--out", img, "--timings", timings])
+    with open(timings) as f:
+        st = json.load(f)["stats"]
+    # the memory the comparisons chart: the CSSM and the lights' CSMs
+    print("data_bytes %d = cssm_bytes %d + csm_bytes %d" % (st["data_bytes"], st["cssm_bytes"], st["csm_bytes"]))
+    if not (st["csm_bytes"] > 0 and st["data_bytes"] == st["cssm_bytes"] + st["csm_bytes"]):
+        sys.exit("FAIL: data_bytes does not count the CSSM and the lights' CSMs")
     e = json.loads(run([gib, "diff", img, ref, "--json"]))["relmse"]
     eb = json.loads(run([gib, "diff", "--black", ref, "--json"]))["relmse"]
     print("Cornell box, direct light only: relMSE direct=csm %.4f, black %.4f (%.3f x, must be < 0.1)"

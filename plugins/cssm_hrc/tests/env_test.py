@@ -24,7 +24,8 @@ import os
 import shutil
 import sys
 
-from pfm_run import read_pfm, run
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "scripts"))
+from gi_run import read_pfm, run  # noqa: E402
 
 
 def rmse(a, b):
@@ -50,8 +51,8 @@ def furnace(gib, root, out, params):
         + params)
     run([gib, "reference", "--scene", scene, "--out", ref, "--size", "32x32", "--spp", "4", "--max-bounces", "1",
          "--threads", "1"])
-    _, _, t = read_pfm(img)
-    _, _, r = read_pfm(ref)
+    t = read_pfm(img)[3]
+    r = read_pfm(ref)[3]
     w, h = 32, 32
     sky = [r[3 * i] >= 0.8 for i in range(w * h)]
     # interior floor pixels: no sky in the pixel or its 8 neighbours (edges mix both)
@@ -94,8 +95,8 @@ def reference(gib, root, out, params):
             p = os.path.join(out, "%s_%s.pfm" % (sc, m))
             run([gib, "render", "--scene", scene, "--method", m, "--size", "32x32", "--frames", "4", "--out", p]
                 + (params if m == "cssm_hrc" else []))
-            imgs[m] = read_pfm(p)[2]
-        r = read_pfm(ref)[2]
+            imgs[m] = read_pfm(p)[3]
+        r = read_pfm(ref)[3]
         e = rmse(imgs["cssm_hrc"], r)
         ed = rmse(imgs["direct"], r)
         eb = rmse([0.0] * len(r), r)
