@@ -1,5 +1,5 @@
 /* Shared set-up of the GL tests (test_passes.c, test_depth_atlas.c,
- * plugins/cssm_hrc/tests/csm_direct_tests.c):
+ * plugins/cssm_hrc/tests/csm_direct_tests.c and cssm_tests.c):
  * the GL context and a scene uploaded to it, each step a CHECK of check.h. */
 #ifndef GI_TEST_GPU_FIXTURE_H
 #define GI_TEST_GPU_FIXTURE_H

@@ -42,6 +42,7 @@
 #include "motion.h"
 
 #include "check.h"
+#include "gpu_fixture.h"
 
 #include "gi/gpu.h"
 #include "gi/hull.h"
@@ -265,20 +266,13 @@ static int part_tree(void)
 
 /* ----------------------------------------------------------- visibility */
 
-static gi_gpu_scene *gpu_scene(gi_gpu **gpu, const gi_scene *s)
+/* The scene at GI_SOURCE_DIR/rel uploaded to a new GL context
+ * (gpu_fixture.h); 0 when any step fails (counted as a failed check). */
+static int load_gpu(const char *rel, gi_gpu **gpu, gi_scene **s, gi_gpu_scene **gs)
 {
-    gi_error err;
-    *gpu = gi_gpu_create(NULL, &err);
-    if (!*gpu) {
-        fprintf(stderr, "FAIL: no GL: %s\n", err.text);
-        return NULL;
-    }
-    gi_gpu_scene *gs = gi_gpu_scene_upload(*gpu, s, &err);
-    if (!gs)
-        fprintf(stderr, "FAIL: upload: %s\n", err.text);
-    else
-        gi_gpu_scene_set_time(gs, 0.0f);
-    return gs;
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", GI_SOURCE_DIR, rel);
+    return gpu_fixture_load(path, gpu, s, gs) && *gs;
 }
 
 /* A scene with the GL context, Embree at t0 (and t1 where it differs:
@@ -303,12 +297,10 @@ typedef struct fixture {
 static int fixture_open(fixture *f, const char *rel, float t0, float t1)
 {
     memset(f, 0, sizeof *f);
-    f->s = load(rel);
-    if (!f->s)
+    if (!load_gpu(rel, &f->gpu, &f->s, &f->gs))
         return 1;
     gi_error err = {0};
-    f->gs = gpu_scene(&f->gpu, f->s);
-    if (!f->gs || gi_rt_create(f->s, t0, &f->rt0, &err) != GI_OK ||
+    if (gi_rt_create(f->s, t0, &f->rt0, &err) != GI_OK ||
         (t1 != t0 && gi_rt_create(f->s, t1, &f->rt1, &err) != GI_OK)) {
         fprintf(stderr, "FAIL: set-up: %s\n", err.text);
         return 1;
@@ -804,15 +796,11 @@ static int part_motion2(void)
 
 static int part_furnace(int compact)
 {
-    gi_scene *s = load("tests/data/conformance/furnace_050.gltf");
-    if (!s)
-        return 1;
     gi_gpu *gpu = NULL;
-    gi_gpu_scene *gs = gpu_scene(&gpu, s);
-    if (!gs) {
-        gi_scene_free(s);
+    gi_scene *s = NULL;
+    gi_gpu_scene *gs = NULL;
+    if (!load_gpu("tests/data/conformance/furnace_050.gltf", &gpu, &s, &gs))
         return 1;
-    }
     cssm_atlas a;
     cssm_maps m;
     cssm_tree t;
