@@ -1,5 +1,5 @@
 #!/bin/sh
-# Fuzzes the study-file reader (tests/fuzz/fuzz_study.c, harness/cmd_study.c
+# Fuzzes the study-file reader (tests/fuzz/fuzz_study.c, harness/study/cmd_study.c
 # study_check) with libFuzzer, at length; `make test` runs the same target
 # for seconds through tests/fuzz/fuzz_driver.c (unit.fuzz_study_brief).
 #

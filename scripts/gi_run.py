@@ -1,5 +1,5 @@
 """Helpers of the scripts and tests that drive the gibench command
-(scripts/implicit_vis_flicker.py, plugins/cssm_hrc/tests/env_test.py and
+(plugins/implicit_vis/flicker.py, plugins/cssm_hrc/tests/env_test.py and
 csm_direct_test.py): read the PFM images `gibench render` and `gibench
 reference` write, and run a command, ending the caller with its last words
 when it fails."""

@@ -9,6 +9,9 @@ set -eu
 
 pkgs=(
   build-essential cmake ninja-build pkg-config clang libclang-rt-14-dev
+  # make test's checks of the tree: formatting (scripts/check_format.sh, Debian's
+  # clang-format 14) and its shape (scripts/check_layout.sh counts functions with ctags)
+  clang-format universal-ctags
   libembree-dev
   # EXR (OpenEXR) and PNG writing (libpng) in the core; every other image
   # format through the OpenImageIO module, loaded only when needed
@@ -19,14 +22,14 @@ pkgs=(
   libglfw3-dev libepoxy-dev
   libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libglx-mesa0
   # An X server for headless tests of the GLFW viewer; the charts do not need it
-  # (VTK draws through EGL, see harness/charts.cpp).
+  # (VTK draws through EGL, see harness/report/charts.cpp).
   xvfb xauth
   libjson-c-dev libxxhash-dev
   # plugins/vlf: the spherical triangulation of the direction set
   libqhull-dev
-  # gi/simplify.h: lower-detail geometry (avg's VPL shadow maps)
+  # gi/algo/simplify.h: lower-detail geometry (avg's VPL shadow maps)
   libmeshoptimizer-dev
-  # gi/remesh.h: isotropic re-meshing (implicit_vis's re-meshing option)
+  # gi/algo/remesh.h: isotropic re-meshing (implicit_vis's re-meshing option)
   libcgal-dev
   # scripts/*.py (the results tables, their test integration.results_tables;
   # the bash completion, scripts/gen-completion.py, which `make` installs)

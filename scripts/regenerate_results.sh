@@ -8,8 +8,11 @@
 # below; the five-way comparison and the stress study last). --dry-run
 # prints the commands without running them. GIBENCH names the binary
 # (default build/release/bin/gibench; `make results` builds it first).
-# Steps done by hand and described in the study's README (avg's VPL region
-# dumps and speed table, cssm_hrc's Fig. 16) are not part of this script.
+# Each paper's study and tables script live in its plugin folder
+# (plugins/<id>/study.json, tables.py); the cross-method ones in
+# harness/studies/. Steps done by hand and described in the study's README
+# (avg's VPL region dumps and speed table, cssm_hrc's Fig. 16) are not part
+# of this script.
 # Exit status: that of the first command that fails; 2 on an unknown study.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -31,37 +34,44 @@ run() {
 tables() {
     local script=$1 study=$2
     shift 2
-    echo "+ scripts/$script results/$study $* > results/$study/tables.md"
+    echo "+ $script results/$study $* > results/$study/tables.md"
     if [[ $dry == 0 ]]; then
-        "scripts/$script" "results/$study" "$@" > "results/$study/tables.md.tmp"
+        "$script" "results/$study" "$@" > "results/$study/tables.md.tmp"
         mv "results/$study/tables.md.tmp" "results/$study/tables.md"
     fi
+}
+# study NAME FILE: the study FILE afresh into results/NAME.
+study() {
+    run "$G" study "$2" --out "results/$1" --jobs 1 --fresh
 }
 
 for s in "${studies[@]}"; do
     case $s in
-    csm | csm_local)
-        run "$G" study "harness/studies/$s.json" --out "results/$s" --jobs 1 --fresh
-        tables csm_tables.py "$s" ;;
+    csm)
+        study csm plugins/csm/study.json
+        tables plugins/csm/tables.py csm ;;
+    csm_local)
+        study csm_local plugins/csm/study_local.json
+        tables plugins/csm/tables.py csm_local ;;
     avg)
-        run "$G" study harness/studies/avg.json --out results/avg --jobs 1 --fresh
-        tables avg_tables.py avg "$G" --measure ;;
+        study avg plugins/avg/study.json
+        tables plugins/avg/tables.py avg "$G" --measure ;;
     cssm_hrc)
-        run "$G" study harness/studies/cssm_hrc.json --out results/cssm_hrc --jobs 1 --fresh
-        tables cssm_hrc_tables.py cssm_hrc ;;
+        study cssm_hrc plugins/cssm_hrc/study.json
+        tables plugins/cssm_hrc/tables.py cssm_hrc ;;
     implicit_vis)
-        run "$G" study harness/studies/implicit_vis.json --out results/implicit_vis --jobs 1 --fresh ;;
+        study implicit_vis plugins/implicit_vis/study.json ;;
     vlf)
-        run "$G" study harness/studies/vlf.json --out results/vlf --jobs 1 --fresh
-        tables vlf_tables.py vlf ;;
+        study vlf plugins/vlf/study.json
+        tables plugins/vlf/tables.py vlf ;;
     compare_all)
-        run "$G" study harness/studies/compare_all.json --out results/compare_all --jobs 1 --fresh
+        study compare_all harness/studies/compare_all.json
         run scripts/trivial_scores.py results/compare_all --gibench "$G"
-        tables compare_all_tables.py compare_all ;;
+        tables harness/studies/compare_all_tables.py compare_all ;;
     stress)
-        run "$G" study harness/studies/stress.json --out results/stress --jobs 1 --fresh
+        study stress harness/studies/stress.json
         run scripts/trivial_scores.py results/stress --gibench "$G"
-        tables stress_tables.py stress ;;
+        tables harness/studies/stress_tables.py stress ;;
     *)
         echo "regenerate_results.sh: unknown study '$s' (one of: ${all[*]})" >&2
         exit 2 ;;

@@ -2,7 +2,6 @@
  * texture, drawn with one instanced draw (depth_atlas.vert/.frag), and the
  * C twin of the GLSL lookup (depth_atlas.glsl). */
 #include "gi/passes.h"
-#include "gi/simplify.h"
 
 #include <float.h>
 #include <math.h>
@@ -29,7 +28,8 @@ struct gi_depth_atlas {
     GLuint program, fbo, tex, depth_rb, ssbo, ssbo_tex;
     GLint loc_grid, loc_views, loc_projection, loc_metric;
     atlas_view_gpu *staging; /* capacity entries */
-    const gi_simplified *geometry; /* drawn instead of the scene's triangles when set */
+    GLuint geometry_ibo;     /* indices drawn instead of the scene's triangles when not 0 */
+    uint32_t geometry_count; /* their triangles */
 };
 
 gi_depth_atlas *gi_depth_atlas_create(const gi_depth_atlas_desc *d, gi_error *err)
@@ -198,8 +198,8 @@ gi_result gi_depth_atlas_render(gi_depth_atlas *a, const gi_gpu_scene *gs, const
         glUniform1i(a->loc_projection, (GLint)d->projection);
         glUniform1i(a->loc_metric, (GLint)d->metric);
         glBindTextureUnit(ATLAS_VIEWS_UNIT, a->ssbo_tex);
-        if (a->geometry)
-            gi_simplified_draw(a->geometry, gs, (GLsizei)count);
+        if (a->geometry_ibo)
+            gi_gpu_scene_draw_indices(gs, a->geometry_ibo, a->geometry_count * 3, (GLsizei)count);
         else
             gi_gpu_scene_draw(gs, -1, (GLsizei)count);
         for (GLenum k = 0; k < 5; k++)
@@ -213,9 +213,10 @@ gi_result gi_depth_atlas_render(gi_depth_atlas *a, const gi_gpu_scene *gs, const
     return gi_gl_check("depth atlas: render", err);
 }
 
-void gi_depth_atlas_set_geometry(gi_depth_atlas *a, const gi_simplified *m)
+void gi_depth_atlas_set_geometry(gi_depth_atlas *a, GLuint ibo, uint32_t triangle_count)
 {
-    a->geometry = m;
+    a->geometry_ibo = ibo;
+    a->geometry_count = ibo ? triangle_count : 0;
 }
 
 GLuint gi_depth_atlas_texture(const gi_depth_atlas *a)

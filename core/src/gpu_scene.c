@@ -358,6 +358,16 @@ void gi_gpu_scene_draw(const gi_gpu_scene *gs, int object, GLsizei instances)
     glBindVertexArray(0);
 }
 
+void gi_gpu_scene_draw_indices(const gi_gpu_scene *gs, GLuint ibo, uint32_t index_count, GLsizei instances)
+{
+    /* The scene's VAO with this index buffer for the one draw, then its own again. */
+    glVertexArrayElementBuffer(gs->vao, ibo);
+    glBindVertexArray(gs->vao);
+    glDrawElementsInstanced(GL_TRIANGLES, (GLsizei)index_count, GL_UNSIGNED_INT, NULL, instances > 0 ? instances : 1);
+    glBindVertexArray(0);
+    glVertexArrayElementBuffer(gs->vao, gs->ibo);
+}
+
 void gi_gpu_scene_free(gi_gpu_scene *gs)
 {
     if (!gs)

@@ -1,7 +1,6 @@
 /* Typed, ranged method parameters (params.h): unknown names are errors. */
 #include "gi/params.h"
 
-#include <assert.h>
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -126,7 +125,8 @@ gi_params *gi_params_parse(const char *method_id, const gi_param_desc *desc, con
     p->count = count;
     p->values = calloc(count ? count : 1, sizeof *p->values);
     p->given = calloc(count ? count : 1, sizeof *p->given);
-    if (!p->values || !p->given)
+    p->undeclared = calloc(GI_PARAM_NAME_MAX, 1);
+    if (!p->values || !p->given || !p->undeclared)
         goto oom;
     for (uint32_t i = 0; i < count; i++)
         p->values[i] = desc[i].def;
@@ -185,33 +185,48 @@ void gi_params_free(gi_params *p)
         return;
     free(p->values);
     free(p->given);
+    free(p->undeclared);
     free(p);
 }
 
-static uint32_t index_of(const gi_params *p, const char *name)
+/* The value of `name`, or 0 when the table does not declare it; the first
+ * such name is kept for gi_params_check (p->undeclared points to memory of
+ * the parameter set's own, so a const set can still record it). */
+static double value_of(const gi_params *p, const char *name)
 {
     for (uint32_t i = 0; i < p->count; i++)
         if (strcmp(p->desc[i].name, name) == 0)
-            return i;
-    assert(!"parameter not declared by the method");
-    return 0;
+            return p->values[i];
+    if (p->undeclared && !p->undeclared[0])
+        snprintf(p->undeclared, GI_PARAM_NAME_MAX, "%s", name && name[0] ? name : "(empty)");
+    return 0.0;
 }
 
 int gi_params_int(const gi_params *p, const char *name)
 {
-    return (int)p->values[index_of(p, name)];
+    return (int)value_of(p, name);
 }
 float gi_params_float(const gi_params *p, const char *name)
 {
-    return (float)p->values[index_of(p, name)];
+    return (float)value_of(p, name);
 }
 int gi_params_bool(const gi_params *p, const char *name)
 {
-    return p->values[index_of(p, name)] != 0.0;
+    return value_of(p, name) != 0.0;
 }
 int gi_params_enum(const gi_params *p, const char *name)
 {
-    return (int)p->values[index_of(p, name)];
+    return (int)value_of(p, name);
+}
+
+gi_result gi_params_check(const gi_params *p, const char *method_id, gi_error *err)
+{
+    if (!p || !p->undeclared || !p->undeclared[0])
+        return GI_OK;
+    return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                        "method '%s' read parameter '%s', which its parameter table does not declare (a bug in the "
+                        "plugin)",
+                        method_id, p->undeclared);
 }
 
 char *gi_params_to_string(const gi_params *p)

@@ -72,6 +72,28 @@ static gi_result validate_params(const gi_method *m, gi_error *err)
     return GI_OK;
 }
 
+gi_result gi_method_create(const gi_method *m, const gi_host *host, const gi_params *params, void **instance,
+                           gi_error *err)
+{
+    *instance = NULL;
+    gi_result r = m->create(host, params, instance);
+    if (r != GI_OK || !*instance) {
+        if (r == GI_OK)
+            r = GI_ERR_UNSUPPORTED; /* created nothing */
+        if (*instance)
+            m->destroy(*instance);
+        *instance = NULL;
+        gi_result bad = gi_params_check(params, m->id, err);
+        return bad != GI_OK ? bad : gi_error_set(err, r, "create failed (%s)", gi_result_name(r));
+    }
+    r = gi_params_check(params, m->id, err);
+    if (r != GI_OK) {
+        m->destroy(*instance);
+        *instance = NULL;
+    }
+    return r;
+}
+
 gi_result gi_method_validate(const gi_method *m, gi_error *err)
 {
     if (GI_ABI_VERSION_MAJOR(m->abi_version) != GI_ABI_MAJOR)

@@ -93,9 +93,7 @@ static const char *example_env_last_error(void *inst)
     return inst ? gi_kit_last_error(&((example_env *)inst)->kit) : "";
 }
 
-static const gi_method example_env_method = {
-    .struct_size = sizeof(gi_method),
-    .abi_version = GI_ABI_VERSION,
+GI_METHOD_EXPORT(example_env,
     .id = "example_env",
     .title = "Unshadowed environment light by cosine sampling (the README's example plugin)",
     .citation = "gibench example",
@@ -103,19 +101,4 @@ static const gi_method example_env_method = {
     .caps = GI_CAP_DIRECT | GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION | GI_CAP_DEFORMATION | GI_CAP_PROGRESSIVE |
             GI_CAP_TEXTURES,
     .max_bounces = 0,
-    .params = example_env_params,
-    .create = example_env_create,
-    .prepare = example_env_prepare,
-    .update = example_env_update,
-    .render = example_env_render,
-    .destroy = example_env_destroy,
-    .last_error = example_env_last_error,
-    .layout = GI_ABI_LAYOUT,
-};
-
-GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)
-{
-    if (GI_ABI_VERSION_MAJOR(host_abi_version) != GI_ABI_MAJOR)
-        return NULL;
-    return &example_env_method;
-}
+    .params = example_env_params);

@@ -17,7 +17,7 @@
 #include "shaders/avg_bindings.h"
 
 #include "gi/log.h"
-#include "gi/simplify.h"
+#include "gi/algo/simplify.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -253,7 +253,7 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
         a->atlas = gi_depth_atlas_create(&d, &err);
         if (!a->atlas)
             return gi_kit_fail_with(&a->kit, GI_ERR_INVALID_ARGUMENT, &err);
-        gi_depth_atlas_set_geometry(a->atlas, a->lod);
+        gi_depth_atlas_set_geometry(a->atlas, a->lod ? a->lod->ibo : 0, a->lod ? a->lod->triangle_count : 0);
         a->views = calloc(a->slots, sizeof *a->views);
         if (!a->views)
             return gi_kit_fail(&a->kit, GI_ERR_OUT_OF_MEMORY, "avg: out of memory for the shadow-map views");
@@ -289,7 +289,7 @@ static gi_result avg_update(void *inst, const gi_gpu_scene *scene, const gi_chan
         gi_result r = build_lod(a, scene->scene, &err);
         if (r != GI_OK)
             return gi_kit_fail_with(&a->kit, r, &err);
-        gi_depth_atlas_set_geometry(a->atlas, a->lod);
+        gi_depth_atlas_set_geometry(a->atlas, a->lod ? a->lod->ibo : 0, a->lod ? a->lod->triangle_count : 0);
     }
     return GI_OK;
 }
@@ -376,7 +376,7 @@ static void compact(avg *a)
 /* Diagnostics: with GIBENCH_AVG_VPLS=FILE every frame (re)writes FILE as
  * CSV, one live VPL a line (position, normal, power, bounce: 0 on the
  * light), so that where the VPLs land can be counted
- * (scripts/avg_vpl_regions.py). A file that cannot be written is reported
+ * (plugins/avg/vpl_regions.py). A file that cannot be written is reported
  * once per frame as a warning and does not stop the render. */
 static void dump_vpls(const avg *a)
 {
@@ -570,9 +570,7 @@ static const char *avg_last_error(void *inst)
     return inst ? gi_kit_last_error(&((avg *)inst)->kit) : "";
 }
 
-static const gi_method avg_method = {
-    .struct_size = sizeof(gi_method),
-    .abi_version = GI_ABI_VERSION,
+GI_METHOD_EXPORT(avg,
     .id = "avg",
     .title = "Approximate Visibility Grids for Interactive Indirect Illumination",
     .citation = "Bashford-Rogers, Debattista, Harvey, Chalmers. VS-Games 2011",
@@ -580,19 +578,4 @@ static const gi_method avg_method = {
     .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_RIGID_MOTION |
             GI_CAP_DEFORMATION | GI_CAP_TEXTURES,
     .max_bounces = 3,
-    .params = avg_params,
-    .create = avg_create,
-    .prepare = avg_prepare,
-    .update = avg_update,
-    .render = avg_render,
-    .destroy = avg_destroy,
-    .last_error = avg_last_error,
-    .layout = GI_ABI_LAYOUT,
-};
-
-GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)
-{
-    if (GI_ABI_VERSION_MAJOR(host_abi_version) != GI_ABI_MAJOR)
-        return NULL;
-    return &avg_method;
-}
+    .params = avg_params);

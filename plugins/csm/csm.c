@@ -768,9 +768,7 @@ static const char *csm_last_error(void *inst)
     return inst ? gi_kit_last_error(&((csm *)inst)->kit) : "";
 }
 
-static const gi_method csm_method = {
-    .struct_size = sizeof(gi_method),
-    .abi_version = GI_ABI_VERSION,
+GI_METHOD_EXPORT(csm,
     .id = "csm",
     .title = "Coherent Shadow Maps",
     .citation = "Ritschel, Grosch, Kautz, Mueller. Interactive Illumination with Coherent Shadow Maps. EGSR 2007",
@@ -779,19 +777,4 @@ static const gi_method csm_method = {
             GI_CAP_GLOSSY | GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE | GI_CAP_PRECOMPUTE | GI_CAP_RIGID_MOTION |
             GI_CAP_TEXTURES,
     .max_bounces = 0,
-    .params = csm_params,
-    .create = csm_create,
-    .prepare = csm_prepare,
-    .update = csm_update,
-    .render = csm_render,
-    .destroy = csm_destroy,
-    .last_error = csm_last_error,
-    .layout = GI_ABI_LAYOUT,
-};
-
-GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)
-{
-    if (GI_ABI_VERSION_MAJOR(host_abi_version) != GI_ABI_MAJOR)
-        return NULL;
-    return &csm_method;
-}
+    .params = csm_params);

@@ -25,9 +25,9 @@
 #ifndef CSM_CPU_H
 #define CSM_CPU_H
 
-#include "gi/csm_codec.h"
-#include "gi/csm_distant.h"
-#include "gi/csm_order.h"
+#include "gi/algo/csm_codec.h"
+#include "gi/algo/csm_distant.h"
+#include "gi/algo/csm_order.h"
 #include "gi/method.h"
 #include "gi/passes.h"
 #include "gi/vecmath.h"
@@ -114,7 +114,7 @@ typedef struct csm_encode_desc {
 } csm_encode_desc;
 
 /* The distant maps and the local lights' cube maps through the core's
- * precomputation loop (gi/csm_precompute.h): render, read back, compress
+ * precomputation loop (gi/algo/csm_precompute.h): render, read back, compress
  * (§3.1). Progress, stage timers (depth_render, compress) and cancellation
  * as csm_build_object. */
 gi_result csm_encode_maps(const gi_gpu_scene *gs, const csm_encode_desc *desc, const gi_host *host, float p0, float p1,
@@ -129,6 +129,6 @@ gi_result csm_build_object(const gi_gpu_scene *gs, uint32_t object, const float 
 
 /* The nearest-filter visibility of a local point toward a local direction
  * through one object's CSM is the core's gi_csm_dir_visible
- * (gi/csm_distant.h: the same conventions), shared with cssm_hrc. */
+ * (gi/algo/csm_distant.h: the same conventions), shared with cssm_hrc. */
 
 #endif

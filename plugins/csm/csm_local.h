@@ -28,12 +28,12 @@
  * n_u n_v, so one codec holds 6 N maps. A point x (same space as the grid
  * point l) is looked up in face gi_cube_face(x - l), at texel
  *   ((s.d / f.d) / 2 + 1/2) M, ((t.d / f.d) / 2 + 1/2) M   (row 0 at t = -1)
- * with the face's right s, up t and forward f (gi_cube_basis, gi/cubemap.h), depth |x - l|. */
+ * with the face's right s, up t and forward f (gi_cube_basis, gi/algo/cubemap.h), depth |x - l|. */
 #ifndef CSM_LOCAL_H
 #define CSM_LOCAL_H
 
 #include "csm_cpu.h"
-#include "gi/cubemap.h"
+#include "gi/algo/cubemap.h"
 
 typedef enum csm_light_kind { CSM_LIGHT_AREA = 0, CSM_LIGHT_LINEAR = 1, CSM_LIGHT_POINT = 2 } csm_light_kind;
 

@@ -1,11 +1,11 @@
 /* Precomputation of one object's Coherent Shadow Map (§3.1, §4.1): the
  * N_theta x N_phi orthographic dual-depth maps around its bounding sphere,
- * rendered by the core's precomputation loop (gi/csm_precompute.h: depth
+ * rendered by the core's precomputation loop (gi/algo/csm_precompute.h: depth
  * renderer object-local, only this object, eye-z; read back and streamed
  * into the codec) in the chosen enumeration order. */
 #include "csm_cpu.h"
 
-#include "gi/csm_precompute.h"
+#include "gi/algo/csm_precompute.h"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -4,8 +4,8 @@
  * of §3.2.2. */
 #include "cssm.h"
 
-#include "gi/csm_precompute.h"
-#include "gi/cubemap.h"
+#include "gi/algo/csm_precompute.h"
+#include "gi/algo/cubemap.h"
 
 #include <float.h>
 #include <math.h>
@@ -63,7 +63,7 @@ gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uin
     return cssm_maps_build_ex(gs, a, order, M, NULL, host, out, err);
 }
 
-/* What the core's precomputation loop (gi/csm_precompute.h) asks of the
+/* What the core's precomputation loop (gi/algo/csm_precompute.h) asks of the
  * cube maps: map q is face q % 6 of the texel visited (q / 6)-th. */
 typedef struct build_ctx {
     const cssm_atlas *a;

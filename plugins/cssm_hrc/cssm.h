@@ -19,7 +19,7 @@
 #ifndef CSSM_H
 #define CSSM_H
 
-#include "gi/csm_codec.h"
+#include "gi/algo/csm_codec.h"
 #include "gi/method.h"
 #include "gi/passes.h"
 #include "gi/vecmath.h"
@@ -133,7 +133,7 @@ typedef struct cssm_build_opts {
     const char *render_stage;        /* stage timer of rendering and read-back; NULL: "cssm_render" */
 } cssm_build_opts;
 
-/* Renders (the core's precomputation loop gi/csm_precompute.h with its
+/* Renders (the core's precomputation loop gi/algo/csm_precompute.h with its
  * depth renderer: world space, every object, radial depth, two surfaces)
  * the depth cube map of every texel in order `order`
  * (§3.2.1: near plane 1e-3 of the diameter, far plane the diameter,

@@ -28,7 +28,7 @@
 #include "motion.h"
 
 #include "gi/cache.h"
-#include "gi/cubemap.h"
+#include "gi/algo/cubemap.h"
 #include "gi/envmap.h"
 #include "gi/kit.h"
 #include "gi/lights.h"
@@ -1126,9 +1126,7 @@ static const char *cssm_last_error(void *inst)
     return inst ? gi_kit_last_error(&((cssm_hrc *)inst)->kit) : "";
 }
 
-static const gi_method cssm_method = {
-    .struct_size = sizeof(gi_method),
-    .abi_version = GI_ABI_VERSION,
+GI_METHOD_EXPORT(cssm,
     .id = "cssm_hrc",
     .title = "Coherent Surface Shadow Maps + hierarchical radiosity",
     .citation = "Ritschel, Grosch, Kautz, Seidel. Interactive Illumination with Coherent Surface Shadow Maps. GI 2008",
@@ -1137,19 +1135,4 @@ static const gi_method cssm_method = {
             GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT | GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE | GI_CAP_PRECOMPUTE | GI_CAP_RIGID_MOTION |
             GI_CAP_TEXTURES,
     .max_bounces = 3,
-    .params = cssm_params,
-    .create = cssm_create,
-    .prepare = cssm_prepare,
-    .update = cssm_update,
-    .render = cssm_render,
-    .destroy = cssm_destroy,
-    .last_error = cssm_last_error,
-    .layout = GI_ABI_LAYOUT,
-};
-
-GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)
-{
-    if (GI_ABI_VERSION_MAJOR(host_abi_version) != GI_ABI_MAJOR)
-        return NULL;
-    return &cssm_method;
-}
+    .params = cssm_params);

@@ -8,10 +8,10 @@
  *    power (the core's emitter CDF, a Hammersley set, so the points are
  *    stratified over the emitting area), a depth cube map at each, all of
  *    them compressed by the core's codec in a greedy nearest-first order
- *    (the CSSM build of cssm.c: gi/csm_precompute.h);
+ *    (the CSSM build of cssm.c: gi/algo/csm_precompute.h);
  *  - point and spot lights: one such cube map at the light each;
  *  - directional lights and the environment map: per object the core's
- *    distant CSM (gi/csm_distant.h), the visibility of a direction the
+ *    distant CSM (gi/algo/csm_distant.h), the visibility of a direction the
  *    product over the objects, directions of the environment drawn from the
  *    core's sampler (gi/envmap.h) and cosine-weighted, balance heuristic.
  *
@@ -26,7 +26,7 @@
 
 #include "cssm.h"
 
-#include "gi/csm_distant.h"
+#include "gi/algo/csm_distant.h"
 #include "gi/gpu.h"
 
 typedef struct cssm_csm_direct {

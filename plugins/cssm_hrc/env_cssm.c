@@ -4,7 +4,7 @@
  * env_cssm.h. */
 #include "env_cssm.h"
 
-#include "gi/cubemap.h"
+#include "gi/algo/cubemap.h"
 #include "gi/rng.h"
 #include "gi/sampling.h"
 

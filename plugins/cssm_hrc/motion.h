@@ -7,12 +7,12 @@
  *  - per mover A its own CSSM: cube maps at A's texels that see A alone,
  *    in A's local frame, made once; queried through the inverse of A's
  *    transform now, the paper's D T^-1;
- *  - per mover A its CSM (gi/csm_distant.h, local frame): whether A blocks
+ *  - per mover A its CSM (gi/algo/csm_distant.h, local frame): whether A blocks
  *    a segment between two points outside its hull;
  *  - with two or more movers, per static object its CSM too (local frame):
  *    whether S blocks a segment between points of two different movers,
  *    which no static cube map sees;
- *  - per object the convex hull of its vertices (gi/hull.h, local frame,
+ *  - per object the convex hull of its vertices (gi/algo/hull.h, local frame,
  *    once); per frame every pair of objects with a mover in it is tested.
  *
  * Visibility between a texel j and a receiver x (cssm_visible_rc), g(.)
@@ -41,8 +41,8 @@
 
 #include "cssm.h"
 
-#include "gi/csm_distant.h"
-#include "gi/hull.h"
+#include "gi/algo/csm_distant.h"
+#include "gi/algo/hull.h"
 
 typedef struct cssm_mover {
     uint32_t object;       /* its scene object */

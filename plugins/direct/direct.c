@@ -119,9 +119,7 @@ static const char *direct_last_error(void *inst)
     return inst ? gi_kit_last_error(&((direct *)inst)->kit) : "";
 }
 
-static const gi_method direct_method = {
-    .struct_size = sizeof(gi_method),
-    .abi_version = GI_ABI_VERSION,
+GI_METHOD_EXPORT(direct,
     .id = "direct",
     .title = "Unshadowed direct light (no-visibility baseline)",
     .citation = "gibench baseline: direct light without visibility",
@@ -130,19 +128,4 @@ static const gi_method direct_method = {
             GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION | GI_CAP_DEFORMATION |
             GI_CAP_PROGRESSIVE | GI_CAP_TEXTURES,
     .max_bounces = 0,
-    .params = direct_params,
-    .create = direct_create,
-    .prepare = direct_prepare,
-    .update = direct_update,
-    .render = direct_render,
-    .destroy = direct_destroy,
-    .last_error = direct_last_error,
-    .layout = GI_ABI_LAYOUT,
-};
-
-GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)
-{
-    if (GI_ABI_VERSION_MAJOR(host_abi_version) != GI_ABI_MAJOR)
-        return NULL;
-    return &direct_method;
-}
+    .params = direct_params);

@@ -343,9 +343,7 @@ static const char *iv_last_error(void *inst)
     return inst ? gi_kit_last_error(&((implicit_vis *)inst)->kit) : "";
 }
 
-static const gi_method iv_method = {
-    .struct_size = sizeof(gi_method),
-    .abi_version = GI_ABI_VERSION,
+GI_METHOD_EXPORT(iv,
     .id = "implicit_vis",
     .title = "Interactive Global Illumination Using Implicit Visibility",
     .citation = "Dong, Kautz, Theobalt, Seidel. Pacific Graphics 2007",
@@ -353,19 +351,4 @@ static const gi_method iv_method = {
     .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_GLOSSY | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL |
             GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION | GI_CAP_DEFORMATION | GI_CAP_VISIBILITY | GI_CAP_TEXTURES,
     .max_bounces = 3,
-    .params = iv_params,
-    .create = iv_create,
-    .prepare = iv_prepare,
-    .update = iv_update,
-    .render = iv_render,
-    .destroy = iv_destroy,
-    .last_error = iv_last_error,
-    .layout = GI_ABI_LAYOUT,
-};
-
-GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)
-{
-    if (GI_ABI_VERSION_MAJOR(host_abi_version) != GI_ABI_MAJOR)
-        return NULL;
-    return &iv_method;
-}
+    .params = iv_params);

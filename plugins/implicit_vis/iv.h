@@ -42,7 +42,7 @@ float iv_bin_solid_angle(uint32_t b, uint32_t n);
 
 /* How the model is re-meshed to the target edge length (Sec. 5.1). */
 enum {
-    IV_REMESH_ISOTROPIC = 0, /* CGAL's isotropic re-meshing (gi/remesh.h), each new vertex on an original triangle */
+    IV_REMESH_ISOTROPIC = 0, /* CGAL's isotropic re-meshing (gi/algo/remesh.h), each new vertex on an original triangle */
     IV_REMESH_GRID = 1,      /* each triangle subdivided into a k x k grid of its own */
 };
 

@@ -6,7 +6,7 @@
 
 #include "gi/lights.h"
 #include "gi/mesh.h"
-#include "gi/remesh.h"
+#include "gi/algo/remesh.h"
 
 #include <float.h>
 #include <pthread.h>

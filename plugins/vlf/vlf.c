@@ -394,9 +394,7 @@ static const char *vlf_last_error(void *inst)
     return inst ? gi_kit_last_error(&((vlf *)inst)->kit) : "";
 }
 
-static const gi_method vlf_method = {
-    .struct_size = sizeof(gi_method),
-    .abi_version = GI_ABI_VERSION,
+GI_METHOD_EXPORT(vlf,
     .id = "vlf",
     .title = "Light Field Propagation and Rendering on the GPU (GPU Virtual Light Field)",
     .citation = "Mortensen, Khanna, Slater. Afrigraph 2007",
@@ -405,19 +403,4 @@ static const gi_method vlf_method = {
             GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION |
             GI_CAP_PRECOMPUTE | GI_CAP_VISIBILITY | GI_CAP_TEXTURES,
     .max_bounces = 7,
-    .params = vlf_params_desc,
-    .create = vlf_create,
-    .prepare = vlf_prepare,
-    .update = vlf_update,
-    .render = vlf_render,
-    .destroy = vlf_destroy,
-    .last_error = vlf_last_error,
-    .layout = GI_ABI_LAYOUT,
-};
-
-GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)
-{
-    if (GI_ABI_VERSION_MAJOR(host_abi_version) != GI_ABI_MAJOR)
-        return NULL;
-    return &vlf_method;
-}
+    .params = vlf_params_desc);

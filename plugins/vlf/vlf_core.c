@@ -3,6 +3,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "vlf_core.h"
 
+#include "gi/algo/hull.h"
+
 #include <float.h>
 #include <stdint.h>
 #include <math.h>
@@ -13,7 +15,6 @@
 
 #include <pthread.h>
 
-#include <libqhull_r/qhull_ra.h>
 
 #include "gi/envmap.h"
 #include "gi/lights.h"
@@ -68,7 +69,7 @@ int vlf_dirs_build(vlf_dirs *d, uint32_t l, char *err, size_t err_size)
     uint32_t n = 2 * l;
     d->signed_dirs = calloc(n, sizeof *d->signed_dirs);
     d->solid_angle = calloc(n, sizeof *d->solid_angle);
-    coordT *pts = calloc((size_t)n * 3, sizeof *pts);
+    float *pts = calloc((size_t)n * 3, sizeof *pts);
     if (!d->signed_dirs || !d->solid_angle || !pts) {
         free(pts);
         vlf_dirs_free(d);
@@ -92,67 +93,47 @@ int vlf_dirs_build(vlf_dirs *d, uint32_t l, char *err, size_t err_size)
         pts[3 * k + 2] = d->signed_dirs[k].z;
     }
     /* The convex hull of points on the sphere is their spherical Delaunay
-     * triangulation; Qt triangulates any non-simplicial facet. */
-    qhT qh_qh;
-    qhT *qh = &qh_qh;
-    qh_zero(qh, stderr);
-    char flags[] = "qhull Qt";
-    int rc = qh_new_qhull(qh, 3, (int)n, pts, False, flags, NULL, NULL);
-    int ok = rc == 0;
+     * triangulation (gi/algo/hull.h). */
+    uint32_t *raw = NULL, count = 0;
+    gi_error hull_err;
+    int ok = gi_hull_triangulate(pts, n, &raw, &count, &hull_err) == GI_OK;
+    free(pts);
     if (ok) {
-        facetT *facet;
-        uint32_t count = 0;
-        FORALLfacets count++;
         d->tris = calloc((size_t)count * 3, sizeof *d->tris);
         d->tri_inv = calloc((size_t)count * 9, sizeof *d->tri_inv);
         ok = d->tris && d->tri_inv;
-        uint32_t t = 0;
-        FORALLfacets
-        {
-            if (!ok)
-                break;
-            vertexT *vertex, **vertexp;
-            uint32_t v[3], nv = 0;
-            FOREACHvertex_(facet->vertices)
-            {
-                if (nv < 3)
-                    v[nv] = (uint32_t)qh_pointid(qh, vertex->point);
-                nv++;
-            }
-            if (nv != 3) {
-                ok = 0;
-                break;
-            }
-            gi_vec3 a = d->signed_dirs[v[0]], b = d->signed_dirs[v[1]], c = d->signed_dirs[v[2]];
-            gi_vec3 nrm = gi_v3_cross(gi_v3_sub(b, a), gi_v3_sub(c, a));
-            if (gi_v3_dot(nrm, gi_v3_add(a, gi_v3_add(b, c))) < 0.0f) {
-                uint32_t tmp = v[1];
-                v[1] = v[2];
-                v[2] = tmp;
-                gi_vec3 tv = b;
-                b = c;
-                c = tv;
-            }
-            float m[9] = {a.x, b.x, c.x, a.y, b.y, c.y, a.z, b.z, c.z};
-            if (!inv3(m, d->tri_inv + 9 * t)) {
-                ok = 0;
-                break;
-            }
-            memcpy(d->tris + 3 * t, v, sizeof v);
-            float area = spherical_area(a, b, c);
-            for (int j = 0; j < 3; j++)
-                d->solid_angle[v[j]] += area / 3.0f;
-            t++;
-        }
-        d->tri_count = t;
+        if (!ok)
+            snprintf(hull_err.text, sizeof hull_err.text, "out of memory");
     }
-    int curlong, totlong;
-    qh_freeqhull(qh, !qh_ALL);
-    qh_memfreeshort(qh, &curlong, &totlong);
-    free(pts);
+    uint32_t t = 0;
+    for (; ok && t < count; t++) {
+        uint32_t v[3] = {raw[3 * t], raw[3 * t + 1], raw[3 * t + 2]};
+        gi_vec3 a = d->signed_dirs[v[0]], b = d->signed_dirs[v[1]], c = d->signed_dirs[v[2]];
+        gi_vec3 nrm = gi_v3_cross(gi_v3_sub(b, a), gi_v3_sub(c, a));
+        if (gi_v3_dot(nrm, gi_v3_add(a, gi_v3_add(b, c))) < 0.0f) {
+            uint32_t tmp = v[1];
+            v[1] = v[2];
+            v[2] = tmp;
+            gi_vec3 tv = b;
+            b = c;
+            c = tv;
+        }
+        float m[9] = {a.x, b.x, c.x, a.y, b.y, c.y, a.z, b.z, c.z};
+        if (!inv3(m, d->tri_inv + 9 * t)) {
+            ok = 0;
+            snprintf(hull_err.text, sizeof hull_err.text, "a degenerate spherical triangle");
+            break;
+        }
+        memcpy(d->tris + 3 * t, v, sizeof v);
+        float area = spherical_area(a, b, c);
+        for (int j = 0; j < 3; j++)
+            d->solid_angle[v[j]] += area / 3.0f;
+    }
+    d->tri_count = t;
+    free(raw);
     if (!ok) {
         vlf_dirs_free(d);
-        snprintf(err, err_size, "vlf: qhull could not triangulate %u directions (code %d)", l, rc);
+        snprintf(err, err_size, "vlf: could not triangulate %u directions: %s", l, hull_err.text);
         return -1;
     }
     return 0;

@@ -7,7 +7,7 @@
  * seeds from harness/studies/ expect. The reader's one-line refusals go to
  * stderr: run with -close_fd_mask=2 to hide them. */
 #define _POSIX_C_SOURCE 200809L
-#include "cli.h"
+#include "study.h"
 
 #include <stdint.h>
 #include <stdio.h>

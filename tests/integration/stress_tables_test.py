@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""scripts/stress_tables.py on a synthetic stress study with known answers.
+"""harness/studies/stress_tables.py on a synthetic stress study with known answers.
 
 stress_tables_test.py SCRIPT OUTDIR writes OUTDIR/runs.csv and runs.json:
 a static scene where "good" beats the direct baseline by far, "leaky" is

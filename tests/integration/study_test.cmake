@@ -1,6 +1,6 @@
 # Study files: every file in harness/studies/ loads and expands (--dry-run),
 # malformed entries and charts are refused, and a tiny study with the
-# features of harness/studies/csm.json runs end to end.
+# features of plugins/csm/study.json runs end to end.
 # cmake -DGIB=... -DROOT=... -DOUT=... -P study_test.cmake
 set(failures 0)
 include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
@@ -12,7 +12,7 @@ foreach(s ${studies})
     run(0 study ${s} --dry-run)
     match("${last_out}" "^study [^\n]*: [1-9][0-9]* runs" "${s}: --dry-run printed no plan:\n${last_out}")
 endforeach()
-run(0 study harness/studies/csm.json --dry-run)
+run(0 study plugins/csm/study.json --dry-run)
 match("${last_out}" "label=table1 N=128 M=128 enumeration=hilbert" "csm.json: no Table 1 run at N = 128, Hilbert")
 match("${last_out}" "no-cache not-compared label=table1" "csm.json: Table 1 runs must skip the cache and the references")
 match("${last_out}" "animate not-compared label=moving" "csm.json: no animated run")

@@ -6,8 +6,9 @@
 
 set(failures 0)
 # study folder, script, extra arguments
-set(cases "avg|avg_tables.py|${GIB}" "csm|csm_tables.py|" "csm_local|csm_tables.py|" "vlf|vlf_tables.py|"
-          "stress|stress_tables.py|" "compare_all|compare_all_tables.py|")
+set(cases "avg|plugins/avg/tables.py|${GIB}" "csm|plugins/csm/tables.py|" "csm_local|plugins/csm/tables.py|"
+          "vlf|plugins/vlf/tables.py|" "stress|harness/studies/stress_tables.py|"
+          "compare_all|harness/studies/compare_all_tables.py|")
 foreach(c ${cases})
     string(REPLACE "|" ";" parts "${c}")
     list(GET parts 0 study)
@@ -18,10 +19,10 @@ foreach(c ${cases})
         list(GET parts 2 extra)
     endif()
     set(got ${OUT}/tables_${study}.md)
-    execute_process(COMMAND ${PYTHON} ${ROOT}/scripts/${script} ${ROOT}/results/${study} ${extra}
+    execute_process(COMMAND ${PYTHON} ${ROOT}/${script} ${ROOT}/results/${study} ${extra}
         WORKING_DIRECTORY ${ROOT} RESULT_VARIABLE rc OUTPUT_FILE ${got} ERROR_VARIABLE err)
     if(NOT rc EQUAL 0)
-        message(SEND_ERROR "scripts/${script} results/${study}: exit ${rc}\n${err}")
+        message(SEND_ERROR "${script} results/${study}: exit ${rc}\n${err}")
         math(EXPR failures "${failures} + 1")
         continue()
     endif()
@@ -29,10 +30,10 @@ foreach(c ${cases})
         RESULT_VARIABLE same)
     if(NOT same EQUAL 0)
         execute_process(COMMAND diff -u ${ROOT}/results/${study}/tables.md ${got} OUTPUT_VARIABLE d)
-        message(SEND_ERROR "scripts/${script} results/${study} differs from results/${study}/tables.md:\n${d}")
+        message(SEND_ERROR "${script} results/${study} differs from results/${study}/tables.md:\n${d}")
         math(EXPR failures "${failures} + 1")
     else()
-        message(STATUS "results/${study}/tables.md: regenerated identically by scripts/${script}")
+        message(STATUS "results/${study}/tables.md: regenerated identically by ${script}")
     endif()
 endforeach()
 if(failures GREATER 0)

@@ -1,4 +1,4 @@
-/* Charts (harness/charts.h): a log-log chart of three series is written as a
+/* Charts (harness/report/charts.h): a log-log chart of three series is written as a
  * PNG of the requested size, read back and checked for what a reader needs:
  * each series in its own palette colour, a power law drawn as a straight
  * line (so both axes really are logarithmic), the reference curve dashed

@@ -6,8 +6,8 @@
  * scene (spheres under a lat-long grid of distant-light directions) for
  * scan-line, zig-zag and Hilbert order. */
 #include "check.h"
-#include "gi/csm_codec.h"
-#include "gi/csm_order.h"
+#include "gi/algo/csm_codec.h"
+#include "gi/algo/csm_order.h"
 
 #include <float.h>
 #include <math.h>

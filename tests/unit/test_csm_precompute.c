@@ -1,4 +1,4 @@
-/* The core's CSM precomputation loop (gi/csm_precompute.h) on the Cornell
+/* The core's CSM precomputation loop (gi/algo/csm_precompute.h) on the Cornell
  * box: cube maps at three points compressed face by face (six codec
  * streams, batches that straddle cube maps) hold, per face and point, the
  * depths of the same face rendered on its own (the codec's lossless bound
@@ -6,7 +6,7 @@
  * its own view; bad descs and a cancelling host fail with nothing owned. */
 #include "check.h"
 #include "gpu_fixture.h"
-#include "gi/csm_precompute.h"
+#include "gi/algo/csm_precompute.h"
 
 #include <float.h>
 #include <stdio.h>

@@ -1,4 +1,4 @@
-/* Heat maps (harness/heatmap.h): colour maps, the built-in font, layout, and
+/* Heat maps (harness/metrics/heatmap.h): colour maps, the built-in font, layout, and
  * that a written PNG shows the colour map's sRGB colours. */
 #define _POSIX_C_SOURCE 200809L /* mkdtemp */
 #include "check.h"

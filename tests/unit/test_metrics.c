@@ -1,4 +1,4 @@
-/* Image-error metrics (harness/metrics.h) and LDR-FLIP (harness/flip.h) on
+/* Image-error metrics (harness/metrics/metrics.h) and LDR-FLIP (harness/metrics/flip.h) on
  * tiny synthetic images against values computed by hand. */
 #include "check.h"
 #include "flip.h"

@@ -1,6 +1,9 @@
-/* Method parameters: defaults, types, ranges, enums, unknown names. */
+/* Method parameters: defaults, types, ranges, enums, unknown names, and a
+ * plugin that reads a name its table does not declare (refused by
+ * gi_method_create in release builds as in debug ones). */
 #include "check.h"
 #include "gi/params.h"
+#include "gi/plugin.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -20,8 +23,55 @@ static gi_params *parse(const char *a, const char *b, gi_error *err)
     return gi_params_parse("csm", desc, kv, n, err);
 }
 
+/* A method whose create() reads a misspelt parameter ("bais" for "bias")
+ * when `misspelt` is set, and counts its destroys. */
+static int misspelt, destroyed;
+static int instance_token;
+
+static gi_result misspelt_create(const gi_host *host, const gi_params *params, void **out)
+{
+    (void)host;
+    float bias = gi_params_float(params, misspelt ? "bais" : "bias");
+    (void)gi_params_int(params, "N");
+    *out = bias >= 0.0f ? &instance_token : NULL;
+    return GI_OK;
+}
+static void misspelt_destroy(void *inst)
+{
+    destroyed += inst == &instance_token;
+}
+
+static void check_undeclared(void)
+{
+    gi_method m = {.id = "csm", .create = misspelt_create, .destroy = misspelt_destroy};
+    gi_error err = {{0}};
+    void *inst = NULL;
+    gi_params *p = parse(NULL, NULL, &err);
+    CHECK(p && gi_params_check(p, "csm", &err) == GI_OK);
+    CHECK(gi_method_create(&m, NULL, p, &inst, &err) == GI_OK && inst == &instance_token);
+    gi_params_free(p);
+
+    misspelt = 1;
+    destroyed = 0;
+    p = parse(NULL, NULL, &err);
+    /* the getter gives 0 for the undeclared name and keeps the first one */
+    CHECK(gi_params_float(p, "bais") == 0.0f && gi_params_int(p, "nn") == 0);
+    CHECK(gi_params_check(p, "csm", &err) == GI_ERR_INVALID_ARGUMENT && strstr(err.text, "'bais'"));
+    gi_params_free(p);
+    p = parse(NULL, NULL, &err);
+    inst = NULL;
+    gi_result r = gi_method_create(&m, NULL, p, &inst, &err);
+    CHECK_MSG(r == GI_ERR_INVALID_ARGUMENT && inst == NULL && destroyed == 1, "result %d, destroyed %d", (int)r,
+              destroyed);
+    CHECK_MSG(strcmp(err.text, "method 'csm' read parameter 'bais', which its parameter table does not declare (a "
+                               "bug in the plugin)") == 0,
+              "'%s'", err.text);
+    gi_params_free(p);
+}
+
 int main(void)
 {
+    check_undeclared();
     gi_error err;
     gi_params *p = parse(NULL, NULL, &err);
     CHECK(p != NULL);

@@ -1,4 +1,4 @@
-/* Lower-detail copies of the scene (gi/simplify.h, meshoptimizer):
+/* Lower-detail copies of the scene (gi/algo/simplify.h, meshoptimizer):
  *   - ratio 1 copies the scene's triangles unchanged;
  *   - the bunny (one closed object) drops to the target triangle count
  *     within 10 % at ratios 0.5, 0.25 and 0.1 (a generous error bound, so
@@ -23,7 +23,7 @@
 
 #include "gi/mesh.h"
 #include "gi/passes.h"
-#include "gi/simplify.h"
+#include "gi/algo/simplify.h"
 
 #include <float.h>
 #include <stdlib.h>
@@ -233,7 +233,7 @@ static void atlas_case(gi_gpu_scene *gs, gi_projection proj, const gi_simplified
     float *tiles[3][4] = {{NULL}};
     const gi_simplified *geo[3] = {NULL, full, low};
     for (int g = 0; g < 3; g++) {
-        gi_depth_atlas_set_geometry(a, geo[g]);
+        gi_depth_atlas_set_geometry(a, geo[g] ? geo[g]->ibo : 0, geo[g] ? geo[g]->triangle_count : 0);
         CHECK_MSG(gi_depth_atlas_render(a, gs, views, 4, &err) == GI_OK, "%s", err.text);
         for (int i = 0; i < 4; i++)
             tiles[g][i] = gi_depth_atlas_read_tile(a, (uint32_t)i);

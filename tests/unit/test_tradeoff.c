@@ -1,4 +1,4 @@
-/* Speed against accuracy (harness/tradeoff.h): the path tracer's time at an
+/* Speed against accuracy (harness/report/tradeoff.h): the path tracer's time at an
  * error, repeats pooled into a spread, the time charged to a run with an
  * error floor, Pareto fronts as staircases, and the equal-error and
  * equal-time tables, on synthetic runs whose answers are known. */

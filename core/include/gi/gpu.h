@@ -147,6 +147,11 @@ void gi_gpu_scene_bind(const gi_gpu_scene *gs);
 /* Draws all triangles (or only object `object` when >= 0) with the scene
  * VAO; the caller has a program bound. `instances` > 1 draws instanced. */
 void gi_gpu_scene_draw(const gi_gpu_scene *gs, int object, GLsizei instances);
+/* Draws `index_count` indices of another element buffer `ibo` (indices into
+ * the scene's vertices, e.g. gi/algo/simplify.h's lower-detail copy) with
+ * the scene's VAO and vertex attributes, then gives the VAO its own
+ * element buffer back; the caller has a program bound. */
+void gi_gpu_scene_draw_indices(const gi_gpu_scene *gs, GLuint ibo, uint32_t index_count, GLsizei instances);
 
 /* A new width x height 2D texture of `format` (one level, contents
  * undefined) with nearest filtering and clamp-to-edge wrapping: the render

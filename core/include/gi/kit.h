@@ -116,6 +116,35 @@ const char *gi_kit_last_error(const gi_kit *k);
             sizeof(gi_depth_atlas_desc), sizeof(gi_kit)                                                               \
     }
 
+/* The descriptor and the exported entry point of a plugin whose lifecycle
+ * functions are named <prefix>_create, _prepare, _update, _render,
+ * _destroy and _last_error; the identity, caps and parameter table follow
+ * as designated initialisers:
+ *
+ *     GI_METHOD_EXPORT(csm, .id = "csm", .title = "Coherent Shadow Maps", .citation = "...",
+ *                      .version = "0.2", .caps = GI_CAP_DIRECT | ..., .max_bounces = 0,
+ *                      .params = csm_params);
+ *
+ * It fills struct_size, abi_version and layout, and defines
+ * gi_method_entry (NULL for a host of another ABI major). */
+#define GI_METHOD_EXPORT(prefix, ...)                                                                              \
+    static const gi_method prefix##_method = {.struct_size = sizeof(gi_method),                                   \
+                                              .abi_version = GI_ABI_VERSION,                                      \
+                                              .create = prefix##_create,                                          \
+                                              .prepare = prefix##_prepare,                                        \
+                                              .update = prefix##_update,                                          \
+                                              .render = prefix##_render,                                          \
+                                              .destroy = prefix##_destroy,                                        \
+                                              .last_error = prefix##_last_error,                                  \
+                                              .layout = GI_ABI_LAYOUT,                                            \
+                                              __VA_ARGS__};                                                       \
+    GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)                                          \
+    {                                                                                                              \
+        return GI_ABI_VERSION_MAJOR(host_abi_version) == GI_ABI_MAJOR ? &prefix##_method : NULL;                   \
+    }                                                                                                              \
+    /* the declaration again, so that the macro's use ends with a semicolon */                                    \
+    GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)
+
 /* GI_OK when `plugin` (a descriptor's layout) equals the core's; else
  * GI_ERR_UNSUPPORTED and "built against <struct> of N bytes, this gibench
  * has M" (or the revisions) in err. */

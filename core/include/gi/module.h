@@ -11,7 +11,7 @@
  *
  * Modules of the tree: gi_image_oiio.so (image formats beyond EXR, PFM and
  * PNG writing and EXR reading; core/modules/image_oiio.cpp) and
- * libgi_charts.so (the report charts; harness/charts.cpp).
+ * libgi_charts.so (the report charts; harness/report/charts.cpp).
  */
 #ifndef GI_MODULE_H
 #define GI_MODULE_H

@@ -5,8 +5,11 @@
  * value of the wrong type or outside [min, max], or an enum value not in
  * the list is an error whose message names the method, the parameter and
  * the allowed values. Parameters not given take their default. Plugins read
- * values by name; asking for a name the table does not have is a bug
- * (assert).
+ * values by name, in create() (the only call that sees them). Asking for a
+ * name the table does not declare is a bug in the plugin that fails in
+ * every build type: the getter returns 0 and remembers the name, and
+ * gi_method_create (gi/plugin.h), through which the host creates every
+ * instance, then refuses the instance with that name.
  */
 #ifndef GI_PARAMS_H
 #define GI_PARAMS_H
@@ -34,11 +37,15 @@ typedef struct gi_param_desc {
     const char *help;    /* one line */
 } gi_param_desc;
 
+/* The longest parameter name kept by gi_params_check's message, with its NUL. */
+#define GI_PARAM_NAME_MAX 64
+
 typedef struct gi_params {
     const gi_param_desc *desc; /* the method's table */
     uint32_t count;
     double *values;            /* count values, desc order */
     uint32_t *given;           /* 1 where set explicitly */
+    char *undeclared;          /* the first name read that desc does not declare; "" when none */
 } gi_params;
 
 /* Fills defaults and applies each "name=value" in kv[0..n). `method_id`
@@ -49,11 +56,17 @@ void gi_params_free(gi_params *p);
 /* Number of entries in a NULL-terminated table. */
 uint32_t gi_param_desc_count(const gi_param_desc *desc);
 
+/* The value of parameter `name`; 0 (and the name kept in p->undeclared)
+ * for a name the table does not declare. */
 int gi_params_int(const gi_params *p, const char *name);
 float gi_params_float(const gi_params *p, const char *name);
 int gi_params_bool(const gi_params *p, const char *name);
 /* Enum value as its index into choices. */
 int gi_params_enum(const gi_params *p, const char *name);
+/* GI_OK, or GI_ERR_INVALID_ARGUMENT naming the first parameter read that
+ * the table does not declare ("method 'x' read parameter 'y', which its
+ * parameter table does not declare"). */
+gi_result gi_params_check(const gi_params *p, const char *method_id, gi_error *err);
 /* Canonical "a=1,b=pcf" text of all values (for cache keys, runs.csv).
  * Returns a malloc'd string. */
 char *gi_params_to_string(const gi_params *p);

@@ -155,11 +155,11 @@ void gi_depth_atlas_free(gi_depth_atlas *a);
  * Leaves the views SSBO bound at GI_SSBO_DEPTH_ATLAS. */
 gi_result gi_depth_atlas_render(gi_depth_atlas *a, const gi_gpu_scene *gs, const gi_depth_view *views,
                                 uint32_t count, gi_error *err);
-/* Draws `m` (a lower-detail copy of the scene, gi/simplify.h, uploaded;
- * NULL = the scene's own triangles) in the renders that follow; the atlas
- * keeps the pointer, the caller keeps `m` alive while it is set. */
-struct gi_simplified;
-void gi_depth_atlas_set_geometry(gi_depth_atlas *a, const struct gi_simplified *m);
+/* Draws the `triangle_count` triangles of index buffer `ibo` (indices into
+ * the scene's vertices, e.g. a lower-detail copy, gi/algo/simplify.h) in
+ * the renders that follow, through gi_gpu_scene_draw_indices; ibo 0 = the
+ * scene's own triangles. The caller keeps the buffer alive while it is set. */
+void gi_depth_atlas_set_geometry(gi_depth_atlas *a, GLuint ibo, uint32_t triangle_count);
 GLuint gi_depth_atlas_texture(const gi_depth_atlas *a);      /* R32F, linear depth, FLT_MAX where empty */
 GLuint gi_depth_atlas_views_buffer(const gi_depth_atlas *a); /* SSBO read by depth_atlas.glsl */
 uint32_t gi_depth_atlas_columns(const gi_depth_atlas *a);

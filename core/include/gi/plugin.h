@@ -43,6 +43,14 @@ const gi_method *gi_plugins_find(const gi_plugins *reg, const char *id);
 void gi_plugins_free(gi_plugins *reg);
 /* Checks a descriptor as the loader does (exposed for tests). */
 gi_result gi_method_validate(const gi_method *m, gi_error *err);
+/* m->create(host, params, instance), and then the parameter contract
+ * (gi/params.h): an instance that read a parameter its table does not
+ * declare is destroyed and refused with GI_ERR_INVALID_ARGUMENT naming the
+ * parameter, in every build type. Any other failure is create()'s result,
+ * with "create failed (<result>)" in err (the plugin's own message went to
+ * host->log). On failure *instance is NULL. */
+gi_result gi_method_create(const gi_method *m, const gi_host *host, const gi_params *params, void **instance,
+                           gi_error *err);
 
 #ifdef __cplusplus
 }

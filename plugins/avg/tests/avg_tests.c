@@ -35,7 +35,7 @@
 #include "gi/raytrace.h"
 #include "gi/rng.h"
 #include "gi/sampling.h"
-#include "gi/simplify.h"
+#include "gi/algo/simplify.h"
 
 #include <float.h>
 #include <math.h>

@@ -1,6 +1,6 @@
 // Direction parameterisation, map basis and projection of the csm plugin:
 // the GLSL twin of plugins/csm/csm_cpu.c (see csm_cpu.h for the formulas);
-// tests/integration/csm_twins.c holds the two equal.
+// plugins/csm/tests/csm_twins.c holds the two equal.
 #ifndef CSM_GEOM_GLSL
 #define CSM_GEOM_GLSL
 

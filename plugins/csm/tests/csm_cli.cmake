@@ -141,7 +141,7 @@ expect(0 "inside the bounds of object walls" ${largs} --param N_local=2 --scene 
        --param N=4 --param M=32 --out ${OUT}/csm_cornell_semi.exr)
 # linear (4 x 1 points: 24 faces for ground, box_a, box_b) and point light
 # (6 faces for those and the bar); rr filter, hilbert order
-set(DATA ${SCENES}/../tests/data/valid)
+set(DATA ${SCENES}/../plugins/csm/data)
 expect(0 "" ${largs} --param N_local=4 --scene ${DATA}/csm_cross.glb --param filter=rr
        --param light_enumeration=hilbert --out ${OUT}/csm_cross.exr --timings ${OUT}/csm_cross.json)
 expect_json(${OUT}/csm_cross.json "\"nonfinite_pixels\": 0" "\"lights\": 2" "\"maps_local\": 96")

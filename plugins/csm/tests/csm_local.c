@@ -10,7 +10,7 @@
  *    to the snapped grid point (isolating the depth/codec path from the
  *    discretisation of the light, §4.5); disagreements are classified as
  *    near a silhouette when moving x by two texels changes the exact answer;
- *  - tests/data/valid/csm_cross.glb: two boxes and the ground under a
+ *  - plugins/csm/data/csm_cross.glb: two boxes and the ground under a
  *    linear light and a point light; receiver points on every surface; the
  *    CSM must agree with ray casting where box A shadows box B (linear
  *    light), where B shadows A (point light), and where the boxes shadow
@@ -778,7 +778,7 @@ int main(void)
     free_setup(&st);
 
     /* Two boxes shadowing each other and the ground (§4.6), a linear and a point light. */
-    if (setup_scene(gpu, GI_SOURCE_DIR "/tests/data/valid/csm_cross.glb", &st, 1)) {
+    if (setup_scene(gpu, GI_SOURCE_DIR "/plugins/csm/data/csm_cross.glb", &st, 1)) {
         EXPECT(st.light_count == 2 && st.lights[0].kind == CSM_LIGHT_LINEAR && st.lights[0].n_v == 1 &&
                    st.lights[1].kind == CSM_LIGHT_POINT,
                "%u lights", st.light_count);

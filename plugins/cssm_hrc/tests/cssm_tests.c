@@ -45,7 +45,7 @@
 #include "gpu_fixture.h"
 
 #include "gi/gpu.h"
-#include "gi/hull.h"
+#include "gi/algo/hull.h"
 #include "gi/mesh.h"
 #include "gi/raytrace.h"
 #include "gi/rng.h"
@@ -722,7 +722,7 @@ static int part_motion(void)
 }
 
 /* Two moving objects (§3.3 for every object): the bunny and a box of
- * tests/data/cssm_hrc/cornell_moving2.gltf (scripts/make_cornell_moving2.py), everything made at t0, both moved to t1
+ * plugins/cssm_hrc/data/cornell_moving2.gltf (plugins/cssm_hrc/data/make_cornell_moving2.py), everything made at t0, both moved to t1
  * by cssm_motion_place alone, facing texel / point pairs that a mover can
  * matter to against Embree on the moved scene; the per-pair hull check,
  * also with the box put onto the bunny. */
@@ -730,7 +730,7 @@ static int part_motion2(void)
 {
     const float t0 = 0.0f, t1 = 1.6f; /* the tall block then hides the box from part of the bunny */
     fixture f;
-    if (motion_open(&f, "tests/data/cssm_hrc/cornell_moving2.gltf", 2, t0, t1, "motion2")) {
+    if (motion_open(&f, "plugins/cssm_hrc/data/cornell_moving2.gltf", 2, t0, t1, "motion2")) {
         fixture_close(&f);
         return 1;
     }

@@ -1,5 +1,5 @@
 # implicit_vis's glossy direct light (Sec. 4.3, Fig. 11) against the Embree
-# path-traced reference, bounce-matched: the scenes of tests/data/glossy/
+# path-traced reference, bounce-matched: the scenes of plugins/implicit_vis/data/
 # (gen_glossy.py: a glossy Phong floor, albedo 0.25, ks 0.6, exponent 30,
 # tessellated 32 x 32, a diffuse box casting a shadow; no mirror), lit by an
 # area light (glossy_floor), a point and a spot light (glossy_punctual),
@@ -27,7 +27,7 @@ function(expect_beats_diffuse name trivial)
     set(ref ${OUT}/implicit_vis_ref_${name}.exr)
     set(img ${OUT}/implicit_vis_vs_ref_${name}.exr)
     set(diffuse ${OUT}/implicit_vis_diffuse_${name}.exr)
-    expect(0 "" render --scene ${DATA}/glossy/${name}.gltf --method implicit_vis --size 64x64 ${ARGN}
+    expect(0 "" render --scene ${DATA}/${name}.gltf --method implicit_vis --size 64x64 ${ARGN}
            --param glossy=false --out ${diffuse})
     diff_metric(${diffuse} ${ref} relmse d_relmse)
     diff_metric(${diffuse} ${ref} mean_lum_diff_pct d_mean)
@@ -44,19 +44,19 @@ endfunction()
 
 # the area light (the light links); measured: method 0.033 (mean +4.4 %);
 # diffuse-only 0.16, direct 0.22, black 0.39
-set(scene ${DATA}/glossy/glossy_floor.gltf)
+set(scene ${DATA}/glossy_floor.gltf)
 set(args --param bounces=0 --param bilinear=true --param coverage=1)
 expect_beats_reference(implicit_vis ${scene} LIMIT 0.08 TRIVIAL 0.12 MEAN 10 SPP 256 BOUNCES 1 SIZE 64x64 BLACK
                        METHOD_ARGS ${args} DIRECT_ARGS --frames 4)
 expect_beats_diffuse(glossy_floor 0.12 ${args})
 # the point and spot light (through their bins); default settings;
 # measured: method 0.016 (mean -1.4 %); diffuse-only 0.16, direct 0.58, black 0.44
-expect_beats_reference(implicit_vis ${DATA}/glossy/glossy_punctual.gltf LIMIT 0.06 TRIVIAL 0.12 MEAN 10 SPP 256
+expect_beats_reference(implicit_vis ${DATA}/glossy_punctual.gltf LIMIT 0.06 TRIVIAL 0.12 MEAN 10 SPP 256
                        BOUNCES 1 SIZE 64x64 BLACK METHOD_ARGS --param bounces=0 DIRECT_ARGS --frames 4)
 expect_beats_diffuse(glossy_punctual 0.12 --param bounces=0)
 # the environment (through the open bins); default settings; measured:
 # method 0.035 (mean -14 %); diffuse-only 0.44, direct 0.33, black 0.96
-expect_beats_reference(implicit_vis ${DATA}/glossy/glossy_env.gltf LIMIT 0.1 TRIVIAL 0.2 MEAN 20 SPP 256
+expect_beats_reference(implicit_vis ${DATA}/glossy_env.gltf LIMIT 0.1 TRIVIAL 0.2 MEAN 20 SPP 256
                        BOUNCES 1 SIZE 64x64 BLACK METHOD_ARGS --param bounces=0 DIRECT_ARGS --frames 4)
 expect_beats_diffuse(glossy_env 0.2 --param bounces=0)
 

@@ -31,7 +31,7 @@
  *                       against iv_illuminate on the same links: Cornell
  *                       box, furnace, environment, punctual lights, the
  *                       coverage modes; and the furnace through the GPU;
- *   iv_tests remesh     isotropic re-meshing (gi/remesh.h, CGAL): every new
+ *   iv_tests remesh     isotropic re-meshing (gi/algo/remesh.h, CGAL): every new
  *                       vertex on its embedding, triangle count and edge-
  *                       length spread before and after, the hierarchy and
  *                       the display grid of the re-meshed Cornell boxes;
@@ -40,7 +40,7 @@
  *                       timed side by side. */
 #define _POSIX_C_SOURCE 200809L
 #include "iv.h"
-#include "gi/remesh.h"
+#include "gi/algo/remesh.h"
 #include "iv_gpu.h"
 
 #include "gi/gpu.h"

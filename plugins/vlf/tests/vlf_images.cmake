@@ -1,6 +1,6 @@
 # The vlf plugin's rendered images against the Embree reference with its
 # bounce count (B = max_bounces + 1 = 8), 32x32, on the scenes of
-# tests/data/gen_vlf_scenes.py, each beside trivial answers scored on the
+# plugins/vlf/data/gen_scenes.py, each beside trivial answers scored on the
 # same reference (measured numbers: plugins/vlf/README.md "Tests").
 #   PART=double_sided: a thin double-sided panel lit from its back side
 #     (the side the camera sees; the panel fills the view). vlf must store
@@ -13,7 +13,7 @@
 #     > 0.45 (3x the limit); the same with the mirror turned over and
 #     double-sided (mirror_back.gltf: the camera sees its back), whose
 #     image must equal the front's (relMSE < 1e-6).
-# Run by ctest as: cmake -DGIB=... -DDATA=.../tests/data/vlf -DOUT=... -DEXPECT=.../expect.cmake -DPART=... -P vlf_images.cmake
+# Run by ctest as: cmake -DGIB=... -DDATA=.../plugins/vlf/data -DOUT=... -DEXPECT=.../expect.cmake -DPART=... -P vlf_images.cmake
 
 set(failures 0)
 include(${EXPECT})

@@ -1305,7 +1305,7 @@ static void test_gpu(void)
 }
 
 /* Irradiance at world point x on a surface of unit normal n from the
- * panel scene's light (tests/data/gen_vlf_scenes.py: a 0.5 x 0.5 square at
+ * panel scene's light (plugins/vlf/data/gen_scenes.py: a 0.5 x 0.5 square at
  * (0, 1.3, 1) facing the panel's centre, Le = 6), by 32 x 32 point patches
  * with both cosines; nothing stands between them. */
 static double panel_light_E(gi_vec3 x, gi_vec3 n)
@@ -1327,10 +1327,10 @@ static double panel_light_E(gi_vec3 x, gi_vec3 n)
 }
 
 /* Double-sided materials (§3.1: values for both sides): the thin panel of
- * tests/data/vlf/panel_double.gltf lit from its back side, 1 iteration. */
+ * plugins/vlf/data/panel_double.gltf lit from its back side, 1 iteration. */
 static void test_double(void)
 {
-    const char *names[2] = {"tests/data/vlf/panel_double.gltf", "tests/data/vlf/panel_single.gltf"};
+    const char *names[2] = {"plugins/vlf/data/panel_double.gltf", "plugins/vlf/data/panel_single.gltf"};
     double recv_double = -1.0;
     for (int sc = 0; sc < 2; sc++) {
         gi_scene *s = load(names[sc]);

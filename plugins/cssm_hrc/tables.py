@@ -1,0 +1,125 @@
+#!/usr/bin/env python3
+"""Tables of the cssm_hrc study (results/cssm_hrc/README.md) from its runs.csv.
+
+Usage: plugins/cssm_hrc/tables.py results/cssm_hrc > results/cssm_hrc/tables.md
+"""
+import csv
+import os
+import sys
+
+# Ritschel et al. 2008, Table 2: compression factors, Cornell box, 6 x 32 x 32.
+PAPER_T2 = {32: {"greedy": 5.6, "zigzag": 7.1, "spiral": 7.4},
+            64: {"greedy": 8.8, "zigzag": 11.2, "spiral": 11.7},
+            128: {"greedy": 12.8, "zigzag": 15.7, "spiral": 16.9}}
+# Table 1: fps (GeForce 8800); Cornell box rows.
+PAPER_T1 = {("pixels", 1): 5.2, ("pixels", 2): 1.4, ("texels", 1): 35.7, ("texels", 2): 10.4}
+
+
+def num(r, k):
+    try:
+        return float(r.get(k, "") or "nan")
+    except ValueError:
+        return float("nan")
+
+
+def params(r):
+    out = {}
+    for kv in r["params"].split(","):
+        if "=" in kv:
+            k, v = kv.split("=", 1)
+            out[k] = v
+    return out
+
+
+def main():
+    d = sys.argv[1]
+    rows = list(csv.DictReader(open(os.path.join(d, "runs.csv"))))
+    ok = [r for r in rows if r["status"] == "ok"]
+    print("# cssm_hrc study tables (made by plugins/cssm_hrc/tables.py from runs.csv)\n")
+    if len(ok) != len(rows):
+        print("Runs not ok: " + ", ".join("%s (%s: %s)" % (r["run"], r["status"], r["reason"]) for r in rows
+                                          if r["status"] != "ok") + "\n")
+
+    print("## Table 2: compression, Cornell box, 6 x 32 x 32 cube maps\n")
+    print("| atlas | texels | traversal | ratio (here) | paper | segments / face texel | cube maps render (s) | compress (s) |")
+    print("|---|---|---|---|---|---|---|---|")
+    t2 = [r for r in ok if r["label"] == "table2"]
+    t2.sort(key=lambda r: (int(params(r)["atlas"]), ["greedy", "zigzag", "spiral", "greedy_atlas"].index(params(r)["traversal"])))
+    for r in t2:
+        p = params(r)
+        a, t = int(p["atlas"]), p["traversal"]
+        paper = PAPER_T2.get(a, {}).get(t)
+        print("| %d² | %d | %s | %.1f : 1 | %s | %.2f | %.1f | %.1f |" % (
+            a, num(r, "stat_atlas_texels"), t, num(r, "stat_compression_ratio"),
+            "%.1f : 1" % paper if paper else "—",
+            num(r, "stat_segments_per_texel"), num(r, "prepare_cssm_render_ms") / 1000, num(r, "prepare_compress_ms") / 1000))
+
+    print("\n## Table 1 as ratios: bounces and samples\n")
+    print("Per frame: the final gather (`frame_ms_median`); per lighting change: the atlas' lighting as prepare() "
+          "measured it (`direct` + `bounce` + `pull`, which includes the punctual lights' shadow maps) plus a frame. "
+          "The paper recomputes the lighting every frame; its fps are for that case.\n")
+    print("| scene | mode | n | texels | frame (ms) | lighting (ms) | lighting + frame (ms) | mean cut (pixels) | mean cut (atlas) |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    t1 = [r for r in ok if r["label"] == "table1"]
+    t1.sort(key=lambda r: (r["scene"], params(r).get("mode", "pixels"), int(params(r)["bounces"])))
+    tot = {}
+    for r in t1:
+        p = params(r)
+        light = num(r, "prepare_direct_ms") + (num(r, "prepare_bounce_ms") if r.get("prepare_bounce_ms") else 0) + \
+            num(r, "prepare_pull_ms")
+        f = num(r, "frame_ms_median")
+        key = (os.path.basename(r["scene"]), p.get("mode", "pixels"), int(p["bounces"]))
+        tot[key] = (f, light + f)
+        print("| %s | %s | %d | %d | %.0f | %.0f | %.0f | %.0f | %.0f |" % (
+            key[0], key[1], key[2], num(r, "stat_atlas_texels"), f, light, light + f,
+            num(r, "stat_cut_size_pixels"), num(r, "stat_cut_size_atlas")))
+    print("\n| scene | ratio | here (lighting + frame) | here (frame only) | paper (Cornell box) |")
+    print("|---|---|---|---|---|")
+    for scene in sorted({k[0] for k in tot}):
+        for mode in ("pixels", "texels"):
+            a, b = tot.get((scene, mode, 1)), tot.get((scene, mode, 2))
+            if a and b:
+                pp = PAPER_T1[(mode, 1)] / PAPER_T1[(mode, 2)]
+                print("| %s | time(n=2) / time(n=1), %s | %.2f | %.2f | %.2f |" % (scene, mode, b[1] / a[1], b[0] / a[0], pp))
+        for n in (1, 2):
+            a, b = tot.get((scene, "pixels", n)), tot.get((scene, "texels", n))
+            if a and b:
+                pp = PAPER_T1[("texels", n)] / PAPER_T1[("pixels", n)]
+                print("| %s | time(pixels) / time(texels), n = %d | %.2f | %.2f | %.2f |" % (scene, n, a[1] / b[1], a[0] / b[0], pp))
+
+    def metrics_table(label_prefix, keys, title, extra=()):
+        """Runs whose label starts with label_prefix: their parameters `keys`,
+        the errors, and `extra` columns (header, runs.csv column, format[, scale])."""
+        sel = [r for r in ok if r["label"].startswith(label_prefix)]
+        if not sel:
+            return
+        print("\n## %s\n" % title)
+        print("| run | scene | " + " | ".join(keys) + " | frames | relMSE full | relMSE matched (4 bounces) | FLIP matched | "
+              "mean lum. diff. matched (%) |" + "".join(" %s |" % e[0] for e in extra))
+        print("|---|---|" + "---|" * len(keys) + "---|---|---|---|---|" + "---|" * len(extra))
+        sel.sort(key=lambda r: (r["label"].split("_")[0], int(r["frames"]), r["params"]))
+        for r in sel:
+            p = params(r)
+            print("| %s | %s | " % (r["run"], os.path.basename(r["scene"])) + " | ".join(p.get(k, "") for k in keys) +
+                  " | %s | %.4f | %.4f | %.4f | %+.1f |" % (r["frames"], num(r, "relmse_full"), num(r, "relmse_matched"),
+                                                         num(r, "flip_matched"), num(r, "mean_lum_diff_pct_matched")) +
+                  "".join(" %s |" % (e[2] % (num(r, e[1]) * (e[3] if len(e) > 3 else 1)) if r.get(e[1]) else "—")
+                          for e in extra))
+
+    metrics_table("fig15", ["atlas", "M", "bounces", "clamp"], "Fig. 15: against the path-traced reference")
+    metrics_table("fig16", ["atlas", "bounces"], "Fig. 16: bounce count n (pixels get 0 .. n + 1 bounces)")
+    metrics_table("fig14", ["atlas", "pcf"], "Fig. 14: nearest against PCF look-ups")
+    metrics_table("fig12", ["jitter"], "Fig. 12: highly glossy Cornell box, jittering, error over accumulated frames")
+    metrics_table("mc", ["indirect", "mc_samples"], "Sec. 4.6: indirect light by Monte Carlo from the atlas as a pdf, against the cuts")
+    metrics_table("clamp", ["clamp"], "Clamping: darkening against the clamp distance")
+    timing = [("prepare (s; CSSMs read from the cache where an earlier run made them)", "prepare_ms", "%.1f", 1e-3), ("frame (ms)", "frame_ms_median", "%.0f")]
+    metrics_table("alt_direct", ["direct"], "Sec. 4.7: direct light by the shadow maps and gathers (maps) or by CSM Monte Carlo (csm)",
+                  timing + [("CSM precompute (s)", "prepare_csm_precompute_ms", "%.1f", 1e-3), ("CSM bytes", "stat_csm_bytes", "%.0f")])
+    metrics_table("alt_nodes", ["atlas", "nodes"], "Sec. 4.2.1: float nodes against the compact 128-bit nodes",
+                  timing + [("node bytes", "stat_node_bytes", "%.0f")])
+    metrics_table("alt_env", ["env"], "Environment light: ray traced (trace) or from the texels' own CSSMs (env=cssm)",
+                  timing + [("compression", "stat_compression_ratio", "%.1f : 1"), ("CSSM bytes", "stat_cssm_bytes", "%.0f")])
+
+
+if __name__ == "__main__":
+    main()
