@@ -15,8 +15,8 @@
 #define EYE 2.0f  /* the eye sits EYE R from the centre */
 #define BATCH 16u /* maps per gi_depth_render call */
 
-static void cell_basis_n(uint32_t n_theta, uint32_t n_phi, uint32_t a, uint32_t b, gi_vec3 *t, gi_vec3 *bb,
-                         gi_vec3 *d)
+static void cell_basis_n(uint32_t n_theta, uint32_t n_phi, uint32_t a, uint32_t b, gi_vec3 *t,
+                         gi_vec3 *bb, gi_vec3 *d)
 {
     float theta = GI_PI * ((float)b + 0.5f) / (float)n_theta;
     float phi = 2.0f * GI_PI * ((float)a + 0.5f) / (float)n_phi;
@@ -38,7 +38,8 @@ static void nearest_cell(gi_vec3 w, uint32_t n_theta, uint32_t n_phi, uint32_t *
     float theta = atan2f(sqrtf(w.x * w.x + w.z * w.z), w.y), phi = atan2f(w.z, w.x);
     if (phi < 0.0f)
         phi += 2.0f * GI_PI;
-    float u = phi * (0.5f * GI_INV_PI) * (float)n_phi - 0.5f, v = theta * GI_INV_PI * (float)n_theta - 0.5f;
+    float u = phi * (0.5f * GI_INV_PI) * (float)n_phi - 0.5f,
+          v = theta * GI_INV_PI * (float)n_theta - 0.5f;
     *a = (uint32_t)floorf(u + 0.5f) % n_phi;
     int bi = (int)floorf(v + 0.5f);
     *b = (uint32_t)(bi < 0 ? 0 : bi >= (int)n_theta ? (int)n_theta - 1 : bi);
@@ -185,8 +186,8 @@ int gi_csm_distant_blocks(const gi_csm_distant *c, gi_vec3 p, gi_vec3 q, float b
     return lo + bias < z && z < hi - bias;
 }
 
-int gi_csm_dir_visible(const gi_csm_data *data, const float sphere[4], uint32_t n_theta, uint32_t n_phi,
-                       gi_csm_order order, gi_vec3 x, gi_vec3 w, float bias)
+int gi_csm_dir_visible(const gi_csm_data *data, const float sphere[4], uint32_t n_theta,
+                       uint32_t n_phi, gi_csm_order order, gi_vec3 x, gi_vec3 w, float bias)
 {
     if (!data->M || !n_theta || !n_phi)
         return 1;
@@ -200,7 +201,8 @@ int gi_csm_dir_visible(const gi_csm_data *data, const float sphere[4], uint32_t 
     if (!(fabsf(sx) < 1.0f && fabsf(sy) < 1.0f))
         return 1;
     const uint32_t M = data->M;
-    uint32_t tx = (uint32_t)((sx * 0.5f + 0.5f) * (float)M), ty = (uint32_t)((sy * 0.5f + 0.5f) * (float)M);
+    uint32_t tx = (uint32_t)((sx * 0.5f + 0.5f) * (float)M),
+             ty = (uint32_t)((sy * 0.5f + 0.5f) * (float)M);
     tx = tx >= M ? M - 1 : tx;
     ty = ty >= M ? M - 1 : ty;
     uint32_t i = gi_csm_order_index(order, n_phi, n_theta, a, b);
@@ -209,5 +211,6 @@ int gi_csm_dir_visible(const gi_csm_data *data, const float sphere[4], uint32_t 
 
 int gi_csm_distant_visible(const gi_csm_distant *c, gi_vec3 x, gi_vec3 w, float bias)
 {
-    return gi_csm_dir_visible(&c->data, c->sphere, c->n_theta, c->n_phi, GI_CSM_ORDER_SCANLINE, x, w, bias);
+    return gi_csm_dir_visible(&c->data, c->sphere, c->n_theta, c->n_phi, GI_CSM_ORDER_SCANLINE, x,
+                              w, bias);
 }

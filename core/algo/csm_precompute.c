@@ -7,8 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc *d, gi_csm_data *out,
-                            gi_error *err)
+gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc *d,
+                            gi_csm_data *out, gi_error *err)
 {
     const uint32_t S = d->streams ? d->streams : 1u;
     const uint32_t M = d->depth.size, N = d->count;
@@ -17,12 +17,14 @@ gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc
     const char *render_stage = d->render_stage ? d->render_stage : "depth_render";
     const gi_host *host = d->host;
     if (S > GI_CSM_MAX_STREAMS) {
-        snprintf(err->text, sizeof err->text, "%s: %u codec streams (at most %u)", who, S, GI_CSM_MAX_STREAMS);
+        snprintf(err->text, sizeof err->text, "%s: %u codec streams (at most %u)", who, S,
+                 GI_CSM_MAX_STREAMS);
         return GI_ERR_INVALID_ARGUMENT;
     }
     memset(out, 0, S * sizeof *out);
     if (N == 0 || N % S != 0 || !d->view || !d->depths) {
-        snprintf(err->text, sizeof err->text, "%s: %u %s do not make %u codec streams", who, N, what, S);
+        snprintf(err->text, sizeof err->text, "%s: %u %s do not make %u codec streams", who, N,
+                 what, S);
         return GI_ERR_INVALID_ARGUMENT;
     }
     gi_depth_renderer *dr = gi_depth_renderer_create(&d->depth, err);
@@ -30,7 +32,8 @@ gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc
         return GI_ERR_GL;
     GLuint tex = gi_depth_texture_create(dr, batch);
     gi_depth_view *views = calloc(batch, sizeof *views);
-    uint32_t *slot = calloc(batch, sizeof *slot); /* map k of a batch: its layer, UINT32_MAX not drawn */
+    uint32_t *slot =
+        calloc(batch, sizeof *slot); /* map k of a batch: its layer, UINT32_MAX not drawn */
     float *z1 = malloc((size_t)M * M * sizeof *z1), *z2 = malloc((size_t)M * M * sizeof *z2);
     gi_csm_codec *enc[GI_CSM_MAX_STREAMS] = {0};
     gi_result r = GI_ERR_OUT_OF_MEMORY;

@@ -67,8 +67,8 @@ static int run_qhull(coordT *pts, uint32_t count, const char *flags, gi_hull *ou
     return rc;
 }
 
-gi_result gi_hull_triangulate(const float *points, uint32_t count, uint32_t **tris, uint32_t *tri_count,
-                              gi_error *err)
+gi_result gi_hull_triangulate(const float *points, uint32_t count, uint32_t **tris,
+                              uint32_t *tri_count, gi_error *err)
 {
     *tris = NULL;
     *tri_count = 0;
@@ -121,7 +121,8 @@ gi_result gi_hull_triangulate(const float *points, uint32_t count, uint32_t **tr
     if (r == GI_ERR_OUT_OF_MEMORY)
         return gi_error_set(err, r, "hull: out of memory for the triangles of %u points", count);
     if (r != GI_OK)
-        return gi_error_set(err, r, "hull: qhull could not triangulate %u points (code %d)", count, rc);
+        return gi_error_set(err, r, "hull: qhull could not triangulate %u points (code %d)", count,
+                            rc);
     return GI_OK;
 }
 

@@ -18,7 +18,8 @@
 #include <exception>
 #include <vector>
 
-namespace {
+namespace
+{
 
 typedef CGAL::Exact_predicates_inexact_constructions_kernel K;
 typedef K::Point_3 Point;
@@ -42,7 +43,8 @@ struct Locator {
         for (uint32_t t = 0; t < nt; t++) {
             const float *a = &p[3 * (size_t)ix[3 * t]], *b = &p[3 * (size_t)ix[3 * t + 1]],
                         *c = &p[3 * (size_t)ix[3 * t + 2]];
-            K::Triangle_3 tr(Point(a[0], a[1], a[2]), Point(b[0], b[1], b[2]), Point(c[0], c[1], c[2]));
+            K::Triangle_3 tr(Point(a[0], a[1], a[2]), Point(b[0], b[1], b[2]),
+                             Point(c[0], c[1], c[2]));
             if (tr.is_degenerate())
                 continue;
             tris.push_back(tr);
@@ -80,8 +82,8 @@ struct Locator {
     }
 };
 
-bool check_input(const float *positions, uint32_t nv, const uint32_t *indices, uint32_t nt, const char *what,
-                 gi_error *err)
+bool check_input(const float *positions, uint32_t nv, const uint32_t *indices, uint32_t nt,
+                 const char *what, gi_error *err)
 {
     if (!positions || !indices || nv == 0 || nt == 0) {
         gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: the mesh has no triangles", what);
@@ -89,8 +91,9 @@ bool check_input(const float *positions, uint32_t nv, const uint32_t *indices, u
     }
     for (size_t i = 0; i < (size_t)nt * 3; i++)
         if (indices[i] >= nv) {
-            gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: index %u of triangle %zu is out of range (%u vertices)",
-                         what, indices[i], i / 3, nv);
+            gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                         "%s: index %u of triangle %zu is out of range (%u vertices)", what,
+                         indices[i], i / 3, nv);
             return false;
         }
     for (size_t i = 0; i < (size_t)nv * 3; i++)
@@ -103,14 +106,16 @@ bool check_input(const float *positions, uint32_t nv, const uint32_t *indices, u
 
 } // namespace
 
-extern "C" gi_remeshed *gi_remesh_isotropic(const float *positions, uint32_t vertex_count, const uint32_t *indices,
-                                            uint32_t triangle_count, float target_edge, uint32_t iterations,
-                                            gi_error *err)
+extern "C" gi_remeshed *gi_remesh_isotropic(const float *positions, uint32_t vertex_count,
+                                            const uint32_t *indices, uint32_t triangle_count,
+                                            float target_edge, uint32_t iterations, gi_error *err)
 {
     if (!check_input(positions, vertex_count, indices, triangle_count, "remesh", err))
         return NULL;
-    if (!(target_edge > 0.0f) || !std::isfinite(target_edge) || iterations == 0 || iterations > 100) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "remesh: target edge %g must be > 0 and iterations %u in 1..100",
+    if (!(target_edge > 0.0f) || !std::isfinite(target_edge) || iterations == 0 ||
+        iterations > 100) {
+        gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                     "remesh: target edge %g must be > 0 and iterations %u in 1..100",
                      (double)target_edge, iterations);
         return NULL;
     }
@@ -163,7 +168,8 @@ extern "C" gi_remeshed *gi_remesh_isotropic(const float *positions, uint32_t ver
                                      .vertex_is_constrained_map(fixed)
                                      .edge_is_constrained_map(sharp));
         /* compact vertex numbering, then each vertex located on the input */
-        std::vector<uint32_t> id(mesh.number_of_vertices() + mesh.number_of_removed_vertices(), UINT32_MAX);
+        std::vector<uint32_t> id(mesh.number_of_vertices() + mesh.number_of_removed_vertices(),
+                                 UINT32_MAX);
         uint32_t nv = 0;
         for (Mesh::Vertex_index v : mesh.vertices())
             id[(size_t)v] = nv++;
@@ -196,7 +202,8 @@ extern "C" gi_remeshed *gi_remesh_isotropic(const float *positions, uint32_t ver
                     r->indices[3 * f + c++] = id[(size_t)v];
             if (c != 3) {
                 gi_remeshed_free(r);
-                gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "remesh: CGAL returned a face with %d corners", c);
+                gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                             "remesh: CGAL returned a face with %d corners", c);
                 return NULL;
             }
             f++;
@@ -224,8 +231,9 @@ extern "C" void gi_remeshed_free(gi_remeshed *r)
     free(r);
 }
 
-extern "C" gi_result gi_mesh_locate(const float *positions, uint32_t vertex_count, const uint32_t *indices,
-                                    uint32_t triangle_count, const float *points, uint32_t count, uint32_t *face,
+extern "C" gi_result gi_mesh_locate(const float *positions, uint32_t vertex_count,
+                                    const uint32_t *indices, uint32_t triangle_count,
+                                    const float *points, uint32_t count, uint32_t *face,
                                     float *bary, gi_error *err)
 {
     if (!check_input(positions, vertex_count, indices, triangle_count, "locate", err))
@@ -233,7 +241,8 @@ extern "C" gi_result gi_mesh_locate(const float *positions, uint32_t vertex_coun
     try {
         Locator loc(positions, indices, triangle_count);
         if (loc.tris.empty())
-            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "locate: every triangle is degenerate");
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "locate: every triangle is degenerate");
         for (uint32_t i = 0; i < count; i++)
             loc.locate(points[3 * i], points[3 * i + 1], points[3 * i + 2], &face[i], &bary[3 * i]);
         return GI_OK;

@@ -28,23 +28,25 @@ static uint32_t simplify_object(const gi_scene *s, const gi_object *o, float rat
     for (size_t i = 0; i < index_count; i++)
         local[i] = src[i] - o->first_vertex;
     for (uint32_t v = 0; v < o->vertex_count; v++)
-        memcpy(&positions[3 * (size_t)v], s->vertices[o->first_vertex + v].position, 3 * sizeof(float));
+        memcpy(&positions[3 * (size_t)v], s->vertices[o->first_vertex + v].position,
+               3 * sizeof(float));
     /* Merge vertices at equal positions (and equal morph displacements, so
      * that merged vertices keep moving together). */
     if (o->morph_count + 1 <= SIMPLIFY_MAX_STREAMS) {
         struct meshopt_Stream streams[SIMPLIFY_MAX_STREAMS];
         streams[0] = (struct meshopt_Stream){positions, 3 * sizeof(float), 3 * sizeof(float)};
         for (uint32_t k = 0; k < o->morph_count; k++)
-            streams[1 + k] = (struct meshopt_Stream){&o->morph_positions[(size_t)k * o->vertex_count * 3],
-                                                     3 * sizeof(float), 3 * sizeof(float)};
+            streams[1 + k] =
+                (struct meshopt_Stream){&o->morph_positions[(size_t)k * o->vertex_count * 3],
+                                        3 * sizeof(float), 3 * sizeof(float)};
         meshopt_generateShadowIndexBufferMulti(merged, local, index_count, o->vertex_count, streams,
                                                1 + o->morph_count);
     } else {
         memcpy(merged, local, index_count * sizeof *merged);
     }
     size_t target = (size_t)ceil((double)ratio * (double)o->triangle_count) * 3;
-    size_t n = meshopt_simplify(out, merged, index_count, positions, o->vertex_count, 3 * sizeof(float), target,
-                                max_error, 0, error);
+    size_t n = meshopt_simplify(out, merged, index_count, positions, o->vertex_count,
+                                3 * sizeof(float), target, max_error, 0, error);
     for (size_t i = 0; i < n; i++)
         out[i] += o->first_vertex;
     return (uint32_t)(n / 3);
@@ -53,14 +55,16 @@ static uint32_t simplify_object(const gi_scene *s, const gi_object *o, float rat
 gi_simplified *gi_simplify_scene(const gi_scene *s, float ratio, float max_error, gi_error *err)
 {
     if (!(ratio > 0.0f && ratio <= 1.0f) || !(max_error >= 0.0f)) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "simplify: ratio %g must be in (0, 1] and max_error %g >= 0",
-                     (double)ratio, (double)max_error);
+        gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                     "simplify: ratio %g must be in (0, 1] and max_error %g >= 0", (double)ratio,
+                     (double)max_error);
         return NULL;
     }
     gi_simplified *m = calloc(1, sizeof *m);
     uint32_t max_tris = 0, max_verts = 0;
     for (uint32_t i = 0; i < s->object_count; i++) {
-        max_tris = s->objects[i].triangle_count > max_tris ? s->objects[i].triangle_count : max_tris;
+        max_tris =
+            s->objects[i].triangle_count > max_tris ? s->objects[i].triangle_count : max_tris;
         max_verts = s->objects[i].vertex_count > max_verts ? s->objects[i].vertex_count : max_verts;
     }
     uint32_t *scratch = malloc(((size_t)max_tris * 6 + 1) * sizeof *scratch);
@@ -80,8 +84,9 @@ gi_simplified *gi_simplify_scene(const gi_scene *s, float ratio, float max_error
     for (uint32_t i = 0; i < s->object_count; i++) {
         float e = 0.0f;
         m->object_first[i] = m->triangle_count;
-        m->object_count[i] = simplify_object(s, &s->objects[i], ratio, max_error,
-                                             &m->indices[(size_t)m->triangle_count * 3], scratch, positions, &e);
+        m->object_count[i] =
+            simplify_object(s, &s->objects[i], ratio, max_error,
+                            &m->indices[(size_t)m->triangle_count * 3], scratch, positions, &e);
         m->triangle_count += m->object_count[i];
         m->max_error = fmaxf(m->max_error, e);
     }
@@ -95,8 +100,9 @@ gi_result gi_simplified_upload(gi_simplified *m, gi_error *err)
     if (m->ibo)
         glDeleteBuffers(1, &m->ibo);
     glCreateBuffers(1, &m->ibo);
-    glNamedBufferStorage(m->ibo, (GLsizeiptr)(((size_t)m->triangle_count * 3 + 1) * sizeof *m->indices), m->indices,
-                         0);
+    glNamedBufferStorage(m->ibo,
+                         (GLsizeiptr)(((size_t)m->triangle_count * 3 + 1) * sizeof *m->indices),
+                         m->indices, 0);
     return gi_gl_check("simplify: upload", err);
 }
 

@@ -41,8 +41,10 @@ gi_result read_all(const char *path, gi_channels *ch, gi_error *err)
     std::vector<const char *> names;
     for (int c = 0; c < nc; c++)
         names.push_back(c < (int)spec.channelnames.size() ? spec.channelnames[c].c_str() : "");
-    const gi_channels_window win = {spec.x, spec.y, spec.full_x, spec.full_y, spec.full_width, spec.full_height};
-    return gi_channels_place(path, buf.data(), spec.width, spec.height, nc, names.data(), &win, ch, err);
+    const gi_channels_window win = {spec.x,      spec.y,          spec.full_x,
+                                    spec.full_y, spec.full_width, spec.full_height};
+    return gi_channels_place(path, buf.data(), spec.width, spec.height, nc, names.data(), &win, ch,
+                             err);
 }
 
 } // namespace
@@ -50,5 +52,6 @@ gi_result read_all(const char *path, gi_channels *ch, gi_error *err)
 extern "C" __attribute__((visibility("default"))) gi_result
 gi_oiio_read_channels(const char *path, gi_channels *out, gi_error *err)
 {
-    return gi_image_detail::guarded_read(path, "OpenImageIO", out, err, [&]() { return read_all(path, out, err); });
+    return gi_image_detail::guarded_read(path, "OpenImageIO", out, err,
+                                         [&]() { return read_all(path, out, err); });
 }

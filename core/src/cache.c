@@ -25,8 +25,8 @@ uint64_t gi_hash64(const void *data, size_t size, uint64_t seed)
 }
 
 /* Positions, normals and uvs of every vertex, then the indices relative to
- * the object's first vertex, then any morph targets with their weights: the same mesh hashes the same wherever it sits
- * in the scene, and any change to what a method precomputes from it changes
+ * the object's first vertex, then any morph targets with their weights: the same mesh hashes the
+ * same wherever it sits in the scene, and any change to what a method precomputes from it changes
  * the hash. The object's transform and material are not part of it. */
 uint64_t gi_scene_object_hash(const gi_scene *s, uint32_t object)
 {
@@ -58,7 +58,8 @@ uint64_t gi_scene_object_hash(const gi_scene *s, uint32_t object)
         XXH64_update(st, o->morph_weights, o->morph_count * sizeof(float));
         if (o->morph_track.count) {
             XXH64_update(st, o->morph_track.times, o->morph_track.count * sizeof(float));
-            XXH64_update(st, o->morph_track.values, (size_t)o->morph_track.count * o->morph_count * sizeof(float));
+            XXH64_update(st, o->morph_track.values,
+                         (size_t)o->morph_track.count * o->morph_count * sizeof(float));
             XXH64_update(st, &o->morph_track.step, sizeof o->morph_track.step);
         }
     }
@@ -214,13 +215,15 @@ gi_result gi_atomic_begin(gi_atomic_file *f, const char *path, gi_error *err)
     const char *slash = strrchr(path, '/');
     const char *base = slash ? slash + 1 : path;
     const char *dot = strrchr(base, '.');
-    size_t dir_len = (size_t)(base - path), stem_len = dot && dot != base ? (size_t)(dot - base) : strlen(base);
+    size_t dir_len = (size_t)(base - path),
+           stem_len = dot && dot != base ? (size_t)(dot - base) : strlen(base);
     const char *ext = dot && dot != base ? dot : "";
-    snprintf(f->tmp, sizeof f->tmp, "%.*s.%.*s.tmp-%ld-XXXXXX%s", (int)dir_len, path, (int)stem_len, base,
-             (long)getpid(), ext);
+    snprintf(f->tmp, sizeof f->tmp, "%.*s.%.*s.tmp-%ld-XXXXXX%s", (int)dir_len, path, (int)stem_len,
+             base, (long)getpid(), ext);
     int fd = mkstemps(f->tmp, (int)strlen(ext));
     if (fd < 0)
-        return gi_error_set(err, GI_ERR_IO, "%s: cannot create a temporary file: %s", path, strerror(errno));
+        return gi_error_set(err, GI_ERR_IO, "%s: cannot create a temporary file: %s", path,
+                            strerror(errno));
     close(fd);
     return GI_OK;
 }
@@ -237,8 +240,8 @@ gi_result gi_atomic_commit(gi_atomic_file *f, int ok, gi_error *err)
         }
         int e = errno;
         unlink(f->tmp);
-        return gi_error_set(err, GI_ERR_IO, "%s: cannot move the temporary file into place: %s", f->path,
-                            strerror(e));
+        return gi_error_set(err, GI_ERR_IO, "%s: cannot move the temporary file into place: %s",
+                            f->path, strerror(e));
     }
     unlink(f->tmp);
     return GI_OK;

@@ -39,21 +39,25 @@ gi_depth_atlas *gi_depth_atlas_create(const gi_depth_atlas_desc *d, gi_error *er
         return NULL;
     }
     if (d->tile == 0 || d->tile > ATLAS_MAX_TILE || d->capacity == 0) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth atlas: tile %u (1..%u) or capacity %u (>= 1) invalid",
-                     d->tile, ATLAS_MAX_TILE, d->capacity);
+        gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                     "depth atlas: tile %u (1..%u) or capacity %u (>= 1) invalid", d->tile,
+                     ATLAS_MAX_TILE, d->capacity);
         return NULL;
     }
     if (d->projection != GI_PROJ_PERSPECTIVE && d->projection != GI_PROJ_PARABOLOID) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth atlas: projection %d is not perspective or paraboloid",
+        gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                     "depth atlas: projection %d is not perspective or paraboloid",
                      (int)d->projection);
         return NULL;
     }
     if (d->metric != GI_DEPTH_EYE_Z && d->metric != GI_DEPTH_RADIAL) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth atlas: metric %d invalid", (int)d->metric);
+        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth atlas: metric %d invalid",
+                     (int)d->metric);
         return NULL;
     }
     if (d->cull < 0 || d->cull > 2) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth atlas: cull %d is not 0, 1 or 2", d->cull);
+        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth atlas: cull %d is not 0, 1 or 2",
+                     d->cull);
         return NULL;
     }
     uint32_t columns = (uint32_t)ceil(sqrt((double)d->capacity));
@@ -68,7 +72,8 @@ gi_depth_atlas *gi_depth_atlas_create(const gi_depth_atlas_desc *d, gi_error *er
     uint64_t limit = (uint64_t)(max_tex < max_rb ? max_tex : max_rb);
     if ((uint64_t)columns * d->tile > limit || (uint64_t)rows * d->tile > limit) {
         gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                     "depth atlas: %u maps of %u^2 need a %llu x %llu texture, more than this GL allows (%llu)",
+                     "depth atlas: %u maps of %u^2 need a %llu x %llu texture, more than this GL "
+                     "allows (%llu)",
                      d->capacity, d->tile, (unsigned long long)columns * d->tile,
                      (unsigned long long)rows * d->tile, (unsigned long long)limit);
         return NULL;
@@ -98,7 +103,8 @@ gi_depth_atlas *gi_depth_atlas_create(const gi_depth_atlas_desc *d, gi_error *er
     a->loc_metric = glGetUniformLocation(a->program, "u_metric");
     a->tex = gi_gpu_texture_2d(GL_R32F, a->width, a->height);
     glCreateRenderbuffers(1, &a->depth_rb);
-    glNamedRenderbufferStorage(a->depth_rb, GL_DEPTH_COMPONENT32F, (GLsizei)a->width, (GLsizei)a->height);
+    glNamedRenderbufferStorage(a->depth_rb, GL_DEPTH_COMPONENT32F, (GLsizei)a->width,
+                               (GLsizei)a->height);
     glCreateFramebuffers(1, &a->fbo);
     glNamedFramebufferTexture(a->fbo, GL_COLOR_ATTACHMENT0, a->tex, 0);
     glNamedFramebufferRenderbuffer(a->fbo, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, a->depth_rb);
@@ -113,7 +119,8 @@ gi_depth_atlas *gi_depth_atlas_create(const gi_depth_atlas_desc *d, gi_error *er
     glCreateTextures(GL_TEXTURE_BUFFER, 1, &a->ssbo_tex);
     glTextureBuffer(a->ssbo_tex, GL_RGBA32F, a->ssbo);
     if (glCheckNamedFramebufferStatus(a->fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-        gi_error_set(err, GI_ERR_GL, "depth atlas: the %ux%u framebuffer is incomplete", a->width, a->height);
+        gi_error_set(err, GI_ERR_GL, "depth atlas: the %ux%u framebuffer is incomplete", a->width,
+                     a->height);
         gi_depth_atlas_free(a);
         return NULL;
     }
@@ -141,26 +148,31 @@ void gi_depth_atlas_free(gi_depth_atlas *a)
     free(a);
 }
 
-gi_result gi_depth_atlas_render(gi_depth_atlas *a, const gi_gpu_scene *gs, const gi_depth_view *views, uint32_t count,
-                                gi_error *err)
+gi_result gi_depth_atlas_render(gi_depth_atlas *a, const gi_gpu_scene *gs,
+                                const gi_depth_view *views, uint32_t count, gi_error *err)
 {
     if (!a || !gs || (count > 0 && !views))
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth atlas: %s is NULL",
-                            !a ? "the atlas" : !gs ? "the GPU scene" : "the view array");
+                            !a    ? "the atlas"
+                            : !gs ? "the GPU scene"
+                                  : "the view array");
     const gi_depth_atlas_desc *d = &a->desc;
     if (count > d->capacity)
-        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth atlas: %u views exceed its capacity of %u maps",
-                            count, d->capacity);
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "depth atlas: %u views exceed its capacity of %u maps", count,
+                            d->capacity);
     for (uint32_t i = 0; i < count; i++) {
         const gi_depth_view *v = &views[i];
         if (v->projection != d->projection)
             return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                                "depth atlas: view %u has projection %d, the atlas %d", i, (int)v->projection,
-                                (int)d->projection);
-        if (d->projection == GI_PROJ_PARABOLOID && !(v->znear >= 0.0f && v->zfar > v->znear && isfinite(v->zfar)))
-            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                                "depth atlas: view %u: paraboloid range %g..%g is not 0 <= znear < zfar", i,
-                                (double)v->znear, (double)v->zfar);
+                                "depth atlas: view %u has projection %d, the atlas %d", i,
+                                (int)v->projection, (int)d->projection);
+        if (d->projection == GI_PROJ_PARABOLOID &&
+            !(v->znear >= 0.0f && v->zfar > v->znear && isfinite(v->zfar)))
+            return gi_error_set(
+                err, GI_ERR_INVALID_ARGUMENT,
+                "depth atlas: view %u: paraboloid range %g..%g is not 0 <= znear < zfar", i,
+                (double)v->znear, (double)v->zfar);
         atlas_view_gpu *g = &a->staging[i];
         memcpy(g->view, v->view, sizeof g->view);
         memcpy(g->proj, v->proj, sizeof g->proj);
@@ -169,8 +181,8 @@ gi_result gi_depth_atlas_render(gi_depth_atlas *a, const gi_gpu_scene *gs, const
         g->range[2] = g->range[3] = 0.0f;
     }
     if (count > 0)
-        glNamedBufferSubData(a->ssbo, sizeof(atlas_info_gpu), (GLsizeiptr)(count * sizeof(atlas_view_gpu)),
-                             a->staging);
+        glNamedBufferSubData(a->ssbo, sizeof(atlas_info_gpu),
+                             (GLsizeiptr)(count * sizeof(atlas_view_gpu)), a->staging);
     glBindFramebuffer(GL_FRAMEBUFFER, a->fbo);
     glViewport(0, 0, (GLsizei)a->width, (GLsizei)a->height);
     const float far_value[4] = {FLT_MAX, FLT_MAX, FLT_MAX, FLT_MAX};
@@ -268,11 +280,12 @@ float *gi_depth_atlas_read_tile(const gi_depth_atlas *a, uint32_t tile)
     return out;
 }
 
-int gi_depth_atlas_texel(const gi_depth_view *v, gi_projection projection, gi_depth_metric metric, uint32_t tile,
-                         gi_vec3 p, uint32_t *tx, uint32_t *ty, float *point_depth)
+int gi_depth_atlas_texel(const gi_depth_view *v, gi_projection projection, gi_depth_metric metric,
+                         uint32_t tile, gi_vec3 p, uint32_t *tx, uint32_t *ty, float *point_depth)
 {
     const float *m = v->view;
-    gi_vec3 eye = gi_v3(m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12], m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13],
+    gi_vec3 eye = gi_v3(m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12],
+                        m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13],
                         m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14]);
     *point_depth = metric == GI_DEPTH_RADIAL ? gi_v3_length(eye) : -eye.z;
     float nx, ny;
@@ -295,7 +308,8 @@ int gi_depth_atlas_texel(const gi_depth_view *v, gi_projection projection, gi_de
     }
     if (!(fabsf(nx) <= 1.0f && fabsf(ny) <= 1.0f))
         return 0;
-    float fx = floorf((nx * 0.5f + 0.5f) * (float)tile), fy = floorf((ny * 0.5f + 0.5f) * (float)tile);
+    float fx = floorf((nx * 0.5f + 0.5f) * (float)tile),
+          fy = floorf((ny * 0.5f + 0.5f) * (float)tile);
     *tx = fx >= (float)tile ? tile - 1 : (uint32_t)fx;
     *ty = fy >= (float)tile ? tile - 1 : (uint32_t)fy;
     return 1;

@@ -196,7 +196,8 @@ float gi_envmap_pdf(const gi_envmap *env, gi_vec3 d)
     return texel_pdf(env, i, j, v);
 }
 
-float gi_envmap_mis_direction(const gi_envmap *env, gi_vec3 n, uint32_t k, uint32_t K, float u1, float u2, gi_vec3 *w)
+float gi_envmap_mis_direction(const gi_envmap *env, gi_vec3 n, uint32_t k, uint32_t K, float u1,
+                              float u2, gi_vec3 *w)
 {
     const uint32_t half = K > 1 ? K / 2 : 1, Kc = K > half ? K - half : 0;
     if (k < half) {

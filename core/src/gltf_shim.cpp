@@ -119,8 +119,8 @@ std::string out_of_range(const char *what, long long index, size_t count, const 
 struct Context {
     std::string name;
     bool has_base = false;
-    std::string base;   /* scene directory as given, without trailing '/' */
-    std::string prefix; /* base + '/' */
+    std::string base;        /* scene directory as given, without trailing '/' */
+    std::string prefix;      /* base + '/' */
     std::string real_prefix; /* realpath(base) + '/': where a resolved file must lie */
     /* First refusal by a callback that tinygltf calls (its own text would not
      * say which JSON element it was). */
@@ -237,7 +237,8 @@ bool resolves_inside(const Context &c, const std::string &path)
         return true;
     std::string r(real);
     free(real);
-    return r.size() > c.real_prefix.size() && r.compare(0, c.real_prefix.size(), c.real_prefix) == 0;
+    return r.size() > c.real_prefix.size() &&
+           r.compare(0, c.real_prefix.size(), c.real_prefix) == 0;
 }
 
 /* The file a relative URI names, or a Failure at `pointer`. */
@@ -254,8 +255,7 @@ std::string resolve_uri(const Context &c, const std::string &pointer, const std:
     if (!decode_uri(uri, &path, &why) || !relative_path_ok(path, &why))
         fail(pointer, "URI " + shown(uri) + " " + why);
     if (!resolves_inside(c, c.prefix + path))
-        fail(pointer, "URI " + shown(uri) +
-                          " leaves the scene directory through a symbolic link");
+        fail(pointer, "URI " + shown(uri) + " leaves the scene directory through a symbolic link");
     return c.prefix + path;
 }
 
@@ -1438,8 +1438,9 @@ const MeshData &Converter::mesh(int index)
             convert_primitive(mi, k, &meshes[mi]);
         MeshData &md = meshes[mi];
         if (!ms.weights.empty() && ms.weights.size() != md.morph_count)
-            fail(fmt("/meshes/%zu/weights", mi), fmt("has %zu weights but the mesh has %zu morph targets",
-                                                     ms.weights.size(), md.morph_count));
+            fail(fmt("/meshes/%zu/weights", mi),
+                 fmt("has %zu weights but the mesh has %zu morph targets", ms.weights.size(),
+                     md.morph_count));
         md.weights.assign(md.morph_count, 0.0f);
         for (size_t k = 0; k < ms.weights.size(); k++) {
             if (!finite_float(ms.weights[k]))
@@ -1610,12 +1611,13 @@ void Converter::read_targets(const std::string &pp, const tinygltf::Primitive &p
                                   prim.targets.size(), out->morph_count));
     }
     if (prim.targets.size() > 255)
-        fail(pp + "/targets", fmt("%zu morph targets exceed the limit of 255", prim.targets.size()));
+        fail(pp + "/targets",
+             fmt("%zu morph targets exceed the limit of 255", prim.targets.size()));
     /* Displacements are stored per target for every vertex of the mesh: as
      * many as GI_MAX_VERTICES vertices at most, like the vertices. */
     if (prim.targets.size() && (first_vertex + nv) * prim.targets.size() > GI_MAX_VERTICES)
-        fail(pp + "/targets", fmt("%zu morph targets x %zu vertices exceed the limit of %u", prim.targets.size(),
-                                  first_vertex + nv, GI_MAX_VERTICES));
+        fail(pp + "/targets", fmt("%zu morph targets x %zu vertices exceed the limit of %u",
+                                  prim.targets.size(), first_vertex + nv, GI_MAX_VERTICES));
     for (size_t k = 0; k < prim.targets.size(); k++) {
         std::string pt = fmt("%s/targets/%zu", pp.c_str(), k);
         std::vector<float> *dst[2] = {&out->tpos[k], &out->tnrm[k]};
@@ -1624,9 +1626,8 @@ void Converter::read_targets(const std::string &pp, const tinygltf::Primitive &p
             fail(pt, "morph target has no attribute");
         for (const auto &attr : prim.targets[k])
             if (attr.first != "POSITION" && attr.first != "NORMAL" && attr.first != "TANGENT")
-                fail(pt + "/" + attr.first,
-                     "morph target attribute " + shown(attr.first) +
-                         " is not supported (POSITION, NORMAL, TANGENT)");
+                fail(pt + "/" + attr.first, "morph target attribute " + shown(attr.first) +
+                                                " is not supported (POSITION, NORMAL, TANGENT)");
         for (int j = 0; j < 2; j++) {
             dst[j]->resize((first_vertex + nv) * 3, 0.0f);
             auto it = prim.targets[k].find(names[j]);
@@ -1634,7 +1635,8 @@ void Converter::read_targets(const std::string &pp, const tinygltf::Primitive &p
                 continue;
             int acc = it->second;
             if (acc < 0 || static_cast<size_t>(acc) >= m.accessors.size())
-                fail(pt + "/" + names[j], out_of_range("accessor", acc, m.accessors.size(), "accessors"));
+                fail(pt + "/" + names[j],
+                     out_of_range("accessor", acc, m.accessors.size(), "accessors"));
             const tinygltf::Accessor &a = m.accessors[static_cast<size_t>(acc)];
             check_accessor_kind(acc, j == 0 ? "morph target POSITION" : "morph target NORMAL",
                                 a.type == TINYGLTF_TYPE_VEC3 &&
@@ -1651,7 +1653,8 @@ void Converter::read_targets(const std::string &pp, const tinygltf::Primitive &p
                     if (!finite_float(x))
                         fail(fmt("/accessors/%d", acc),
                              fmt("morph target %s element %zu is not finite", names[j], e));
-                    (*dst[j])[(first_vertex + e) * 3 + static_cast<size_t>(ax)] = static_cast<float>(x);
+                    (*dst[j])[(first_vertex + e) * 3 + static_cast<size_t>(ax)] =
+                        static_cast<float>(x);
                 }
         }
     }
@@ -1826,8 +1829,8 @@ void Converter::add_object(int node)
     o.morph_count = static_cast<uint32_t>(md.morph_count);
     std::string pw = fmt("/nodes/%d/weights", node);
     if (!nd.weights.empty() && nd.weights.size() != md.morph_count)
-        fail(pw, fmt("has %zu weights but mesh %d has %zu morph targets", nd.weights.size(), nd.mesh,
-                     md.morph_count));
+        fail(pw, fmt("has %zu weights but mesh %d has %zu morph targets", nd.weights.size(),
+                     nd.mesh, md.morph_count));
     om.weights = md.weights;
     for (size_t k = 0; k < nd.weights.size(); k++) {
         if (!finite_float(nd.weights[k]))
@@ -1862,7 +1865,8 @@ void Converter::convert_animations()
     }
     for (size_t i = 0; i < objects.size(); i++)
         if (objects[i].morph_count)
-            morph_bounds(&objects[i], object_morphs[i], nodes[static_cast<size_t>(objects[i].node)].weights);
+            morph_bounds(&objects[i], object_morphs[i],
+                         nodes[static_cast<size_t>(objects[i].node)].weights);
 }
 
 /* Local bounds of a morphing object over every weight it takes: a LINEAR
@@ -1918,11 +1922,13 @@ void Converter::convert_channel(size_t a, size_t k)
     if (ch.target_path == "weights") {
         int mesh_index = m.nodes[static_cast<size_t>(ch.target_node)].mesh;
         if (mesh_index < 0)
-            fail(pc + "/target/node", fmt("node %d animates morph weights but has no mesh", ch.target_node));
+            fail(pc + "/target/node",
+                 fmt("node %d animates morph weights but has no mesh", ch.target_node));
         width = mesh(mesh_index).morph_count;
         if (width == 0)
             fail(pc + "/target/node",
-                 fmt("node %d animates morph weights but mesh %d has no morph targets", ch.target_node, mesh_index));
+                 fmt("node %d animates morph weights but mesh %d has no morph targets",
+                     ch.target_node, mesh_index));
         path = 3;
     }
     if (path < 0)
@@ -1956,8 +1962,9 @@ void Converter::convert_channel(size_t a, size_t k)
                         ok);
     if (path == 3) { /* one scalar per target per key (§3.11) */
         if (out.count != in.count * width)
-            fail(ps + "/output", fmt("weights output has %zu values but %zu keys x %zu morph targets = %zu",
-                                     out.count, in.count, width, in.count * width));
+            fail(ps + "/output",
+                 fmt("weights output has %zu values but %zu keys x %zu morph targets = %zu",
+                     out.count, in.count, width, in.count * width));
     } else if (out.count != in.count) {
         fail(ps + "/output", fmt("output has %zu keys but input has %zu", out.count, in.count));
     }
@@ -2129,7 +2136,8 @@ gi_scene *Converter::build() const
                 s->objects[i].morph_positions = copy_array(om.pos);
                 s->objects[i].morph_normals = copy_array(om.nrm);
                 s->objects[i].morph_weights = copy_array(om.weights);
-                fill_track(&s->objects[i].morph_track, nodes[static_cast<size_t>(objects[i].node)].weights);
+                fill_track(&s->objects[i].morph_track,
+                           nodes[static_cast<size_t>(objects[i].node)].weights);
             }
         }
         s->lights = static_cast<gi_light *>(calloc(lights.size() + 1, sizeof(gi_light)));

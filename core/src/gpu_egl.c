@@ -64,11 +64,18 @@ static int try_display(gi_gpu *gpu, EGLDisplay dpy, int debug, const char **why)
     EGLConfig cfg = NULL;
     EGLint ncfg = 0;
     int have_cfg = eglChooseConfig(dpy, cfg_attr, &cfg, 1, &ncfg) && ncfg > 0;
-    EGLint ctx_attr[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
-                         EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                         EGL_CONTEXT_OPENGL_DEBUG, debug ? EGL_TRUE : EGL_FALSE, EGL_NONE};
+    EGLint ctx_attr[] = {EGL_CONTEXT_MAJOR_VERSION,
+                         4,
+                         EGL_CONTEXT_MINOR_VERSION,
+                         5,
+                         EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                         EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                         EGL_CONTEXT_OPENGL_DEBUG,
+                         debug ? EGL_TRUE : EGL_FALSE,
+                         EGL_NONE};
     /* EGL_KHR_no_config_context lets us skip the config on Mesa. */
-    EGLContext ctx = eglCreateContext(dpy, have_cfg ? cfg : EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, ctx_attr);
+    EGLContext ctx =
+        eglCreateContext(dpy, have_cfg ? cfg : EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, ctx_attr);
     if (ctx == EGL_NO_CONTEXT) {
         *why = "no OpenGL 4.5 core context";
         eglTerminate(dpy);
@@ -95,7 +102,8 @@ static int try_display(gi_gpu *gpu, EGLDisplay dpy, int debug, const char **why)
 static int try_devices(gi_gpu *gpu, int debug, char *reasons, size_t size)
 {
     const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
-    if (!has_ext(client, "EGL_EXT_device_enumeration") || !has_ext(client, "EGL_EXT_platform_device")) {
+    if (!has_ext(client, "EGL_EXT_device_enumeration") ||
+        !has_ext(client, "EGL_EXT_platform_device")) {
         append(reasons, size, "%s%s; ", "device: no EGL_EXT_platform_device", "");
         return 0;
     }
@@ -128,7 +136,8 @@ static int try_surfaceless(gi_gpu *gpu, int debug, char *reasons, size_t size)
         append(reasons, size, "%s%s; ", "surfaceless: no EGL_MESA_platform_surfaceless", "");
         return 0;
     }
-    EGLDisplay dpy = eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
+    EGLDisplay dpy =
+        eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
     const char *why = NULL;
     if (try_display(gpu, dpy, debug, &why)) {
         gpu->platform = "surfaceless";
@@ -168,8 +177,8 @@ static void finish_setup(gi_gpu *gpu, const gi_gpu_desc *d)
 static gi_gpu *adopt_current(const gi_gpu_desc *d, gi_error *err)
 {
     if (epoxy_gl_version() < 45) {
-        gi_error_set(err, GI_ERR_GL, "the current context is OpenGL %d.%d, not 4.5", epoxy_gl_version() / 10,
-                     epoxy_gl_version() % 10);
+        gi_error_set(err, GI_ERR_GL, "the current context is OpenGL %d.%d, not 4.5",
+                     epoxy_gl_version() / 10, epoxy_gl_version() % 10);
         return NULL;
     }
     gi_gpu *gpu = calloc(1, sizeof *gpu);
@@ -260,14 +269,26 @@ gi_result gi_gl_check(const char *what, gi_error *err)
         return GI_OK;
     const char *name = "GL error";
     switch (e) {
-    case GL_INVALID_ENUM: name = "GL_INVALID_ENUM"; break;
-    case GL_INVALID_VALUE: name = "GL_INVALID_VALUE"; break;
-    case GL_INVALID_OPERATION: name = "GL_INVALID_OPERATION"; break;
-    case GL_INVALID_FRAMEBUFFER_OPERATION: name = "GL_INVALID_FRAMEBUFFER_OPERATION"; break;
-    case GL_OUT_OF_MEMORY: name = "GL_OUT_OF_MEMORY"; break;
-    default: break;
+    case GL_INVALID_ENUM:
+        name = "GL_INVALID_ENUM";
+        break;
+    case GL_INVALID_VALUE:
+        name = "GL_INVALID_VALUE";
+        break;
+    case GL_INVALID_OPERATION:
+        name = "GL_INVALID_OPERATION";
+        break;
+    case GL_INVALID_FRAMEBUFFER_OPERATION:
+        name = "GL_INVALID_FRAMEBUFFER_OPERATION";
+        break;
+    case GL_OUT_OF_MEMORY:
+        name = "GL_OUT_OF_MEMORY";
+        break;
+    default:
+        break;
     }
     while (glGetError() != GL_NO_ERROR) {
     }
-    return gi_error_set(err, e == GL_OUT_OF_MEMORY ? GI_ERR_OUT_OF_MEMORY : GI_ERR_GL, "%s: %s", what, name);
+    return gi_error_set(err, e == GL_OUT_OF_MEMORY ? GI_ERR_OUT_OF_MEMORY : GI_ERR_GL, "%s: %s",
+                        what, name);
 }

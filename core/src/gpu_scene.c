@@ -44,7 +44,8 @@ GLuint gi_gpu_texture_2d(GLenum format, uint32_t width, uint32_t height)
     return t;
 }
 
-static GLuint make_texture_2d(GLenum format, uint32_t w, uint32_t h, GLenum data_format, const float *data)
+static GLuint make_texture_2d(GLenum format, uint32_t w, uint32_t h, GLenum data_format,
+                              const float *data)
 {
     GLuint t = gi_gpu_texture_2d(format, w, h);
     glTextureSubImage2D(t, 0, 0, 0, (GLsizei)w, (GLsizei)h, data_format, GL_FLOAT, data);
@@ -105,13 +106,15 @@ static void upload_textures(gi_gpu_scene *gs, const gi_scene *s)
                             xx = xx < 0 ? 0 : (xx >= (int)t->width ? (int)t->width - 1 : xx);
                             yy = yy < 0 ? 0 : (yy >= (int)t->height ? (int)t->height - 1 : yy);
                             float wgt = ((k & 1) ? fx : 1 - fx) * ((k >> 1) ? fy : 1 - fy);
-                            acc += wgt * t->rgba[((size_t)yy * t->width + (size_t)xx) * 4 + (size_t)c];
+                            acc +=
+                                wgt * t->rgba[((size_t)yy * t->width + (size_t)xx) * 4 + (size_t)c];
                         }
                         px[((size_t)y * w + x) * 4 + (size_t)c] = acc;
                     }
                 }
         }
-        glTextureSubImage3D(gs->tex_albedo, 0, 0, 0, (GLint)l, (GLsizei)w, (GLsizei)h, 1, GL_RGBA, GL_FLOAT, px);
+        glTextureSubImage3D(gs->tex_albedo, 0, 0, 0, (GLint)l, (GLsizei)w, (GLsizei)h, 1, GL_RGBA,
+                            GL_FLOAT, px);
     }
     free(px);
     glTextureParameteri(gs->tex_albedo, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
@@ -123,8 +126,8 @@ static void upload_textures(gi_gpu_scene *gs, const gi_scene *s)
 gi_gpu_scene *gi_gpu_scene_upload(gi_gpu *gpu, const gi_scene *s, gi_error *err)
 {
     if (s->object_count > GI_MAX_OBJECTS) {
-        gi_error_set(err, GI_ERR_UNSUPPORTED, "%s: %u objects, the GPU scene holds at most %u", s->path,
-                     s->object_count, GI_MAX_OBJECTS);
+        gi_error_set(err, GI_ERR_UNSUPPORTED, "%s: %u objects, the GPU scene holds at most %u",
+                     s->path, s->object_count, GI_MAX_OBJECTS);
         return NULL;
     }
     gi_gpu_scene *gs = calloc(1, sizeof *gs);
@@ -143,7 +146,8 @@ gi_gpu_scene *gi_gpu_scene_upload(gi_gpu *gpu, const gi_scene *s, gi_error *err)
     gs->emitter_count = s->emitter_count;
 
     /* Updatable: morph targets (set_time) and gi_gpu_scene_update_vertices. */
-    gs->vbo = make_buffer(s->vertices, (size_t)s->vertex_count * sizeof(gi_vertex), GL_DYNAMIC_STORAGE_BIT);
+    gs->vbo = make_buffer(s->vertices, (size_t)s->vertex_count * sizeof(gi_vertex),
+                          GL_DYNAMIC_STORAGE_BIT);
     gs->deforming = gi_scene_deforms(s);
     gs->ibo = make_buffer(s->indices, (size_t)s->triangle_count * 3 * sizeof(uint32_t), 0);
     glCreateVertexArrays(1, &gs->vao);
@@ -162,7 +166,8 @@ gi_gpu_scene *gi_gpu_scene_upload(gi_gpu *gpu, const gi_scene *s, gi_error *err)
     for (size_t i = 0; i < sizeof attrs / sizeof attrs[0]; i++) {
         glEnableVertexArrayAttrib(gs->vao, attrs[i].loc);
         if (attrs[i].type == GL_UNSIGNED_INT)
-            glVertexArrayAttribIFormat(gs->vao, attrs[i].loc, attrs[i].size, attrs[i].type, (GLuint)attrs[i].offset);
+            glVertexArrayAttribIFormat(gs->vao, attrs[i].loc, attrs[i].size, attrs[i].type,
+                                       (GLuint)attrs[i].offset);
         else
             glVertexArrayAttribFormat(gs->vao, attrs[i].loc, attrs[i].size, attrs[i].type, GL_FALSE,
                                       (GLuint)attrs[i].offset);
@@ -180,11 +185,14 @@ gi_gpu_scene *gi_gpu_scene_upload(gi_gpu *gpu, const gi_scene *s, gi_error *err)
     }
     gs->ssbo_materials = make_buffer(mats, (size_t)s->material_count * sizeof *mats, 0);
     free(mats);
-    gs->ssbo_lights = make_buffer(NULL, (size_t)(s->light_count ? s->light_count : 1) * sizeof(gi_gpu_light),
-                                  GL_DYNAMIC_STORAGE_BIT);
-    gs->ssbo_emitters = make_buffer(NULL, (size_t)(s->emitter_count ? s->emitter_count : 1) * sizeof(gi_gpu_emitter),
-                                    GL_DYNAMIC_STORAGE_BIT);
-    gs->ubo_objects = make_buffer(NULL, (size_t)GI_MAX_OBJECTS * 32 * sizeof(float), GL_DYNAMIC_STORAGE_BIT);
+    gs->ssbo_lights =
+        make_buffer(NULL, (size_t)(s->light_count ? s->light_count : 1) * sizeof(gi_gpu_light),
+                    GL_DYNAMIC_STORAGE_BIT);
+    gs->ssbo_emitters = make_buffer(
+        NULL, (size_t)(s->emitter_count ? s->emitter_count : 1) * sizeof(gi_gpu_emitter),
+        GL_DYNAMIC_STORAGE_BIT);
+    gs->ubo_objects =
+        make_buffer(NULL, (size_t)GI_MAX_OBJECTS * 32 * sizeof(float), GL_DYNAMIC_STORAGE_BIT);
     upload_textures(gs, s);
     if (s->envmap && !upload_environment(gs, s->envmap)) {
         gi_gpu_scene_free(gs);
@@ -215,7 +223,8 @@ void gi_gpu_scene_set_time(gi_gpu_scene *gs, float t)
         else
             gi_mat4_identity(ubo[o] + 16);
     }
-    glNamedBufferSubData(gs->ubo_objects, 0, (GLsizeiptr)(s->object_count * 32 * sizeof(float)), ubo);
+    glNamedBufferSubData(gs->ubo_objects, 0, (GLsizeiptr)(s->object_count * 32 * sizeof(float)),
+                         ubo);
 
     /* Morphing objects: their vertices at t into the vertex buffer (one
      * upload per object; the rest of the buffer is untouched). */
@@ -256,7 +265,8 @@ void gi_gpu_scene_set_time(gi_gpu_scene *gs, float t)
             lights[i].cos_outer = cosf(l->outer_cone);
         }
         if (lights)
-            glNamedBufferSubData(gs->ssbo_lights, 0, (GLsizeiptr)(s->light_count * sizeof *lights), lights);
+            glNamedBufferSubData(gs->ssbo_lights, 0, (GLsizeiptr)(s->light_count * sizeof *lights),
+                                 lights);
         free(lights);
     }
 
@@ -267,8 +277,10 @@ void gi_gpu_scene_set_time(gi_gpu_scene *gs, float t)
         for (uint32_t i = 0; em && i < s->emitter_count; i++) {
             gi_vec3 p[3];
             gi_scene_triangle_world(s, s->emitters[i], t, p);
-            float area = 0.5f * gi_v3_length(gi_v3_cross(gi_v3_sub(p[1], p[0]), gi_v3_sub(p[2], p[0])));
-            float power = area * gi_luminance(gi_scene_triangle_emission(s, s->emitters[i])) * GI_PI;
+            float area =
+                0.5f * gi_v3_length(gi_v3_cross(gi_v3_sub(p[1], p[0]), gi_v3_sub(p[2], p[0])));
+            float power =
+                area * gi_luminance(gi_scene_triangle_emission(s, s->emitters[i])) * GI_PI;
             em[i].triangle = s->emitters[i];
             em[i].area = area;
             em[i].pdf = power;
@@ -281,7 +293,8 @@ void gi_gpu_scene_set_time(gi_gpu_scene *gs, float t)
         }
         if (em) {
             em[s->emitter_count - 1].cdf = 1.0f;
-            glNamedBufferSubData(gs->ssbo_emitters, 0, (GLsizeiptr)(s->emitter_count * sizeof *em), em);
+            glNamedBufferSubData(gs->ssbo_emitters, 0, (GLsizeiptr)(s->emitter_count * sizeof *em),
+                                 em);
         }
         free(em);
         gs->emitter_power = (float)total;
@@ -289,7 +302,8 @@ void gi_gpu_scene_set_time(gi_gpu_scene *gs, float t)
 
     gi_scene_bounds_at(s, t, gs->bounds);
     scene_info info = {{s->triangle_count, s->light_count, s->emitter_count, s->envmap ? 1u : 0u},
-                       {gs->emitter_power, s->envmap ? gi_envmap_average_radiance(s->envmap) * 4.0f * GI_PI : 0.0f, t,
+                       {gs->emitter_power,
+                        s->envmap ? gi_envmap_average_radiance(s->envmap) * 4.0f * GI_PI : 0.0f, t,
                         s->envmap ? s->envmap->rotation : 0.0f},
                        {gs->bounds[0], gs->bounds[1], gs->bounds[2], 0},
                        {gs->bounds[3], gs->bounds[4], gs->bounds[5], 0}};
@@ -306,24 +320,28 @@ gi_result gi_gpu_scene_update_vertices(gi_gpu_scene *gs, uint32_t first_vertex, 
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "gpu scene: update_vertices: %s is NULL",
                             !gs ? "the scene" : "the vertex array");
     if (first_vertex > gs->vertex_count || count > gs->vertex_count - first_vertex)
-        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                            "gpu scene: update_vertices: vertices %u..%u+%u past the %u of the scene", first_vertex,
-                            first_vertex, count, gs->vertex_count);
+        return gi_error_set(
+            err, GI_ERR_INVALID_ARGUMENT,
+            "gpu scene: update_vertices: vertices %u..%u+%u past the %u of the scene", first_vertex,
+            first_vertex, count, gs->vertex_count);
     const gi_scene *s = gs->scene;
     for (uint32_t i = 0; i < count; i++) {
         const gi_vertex *x = &v[i], *old = &s->vertices[first_vertex + i];
         if (x->object != old->object || x->material != old->material)
             return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                                "gpu scene: update_vertices: vertex %u changes its object or material (%u/%u -> %u/%u)",
-                                first_vertex + i, old->object, old->material, x->object, x->material);
+                                "gpu scene: update_vertices: vertex %u changes its object or "
+                                "material (%u/%u -> %u/%u)",
+                                first_vertex + i, old->object, old->material, x->object,
+                                x->material);
         for (int k = 0; k < 3; k++)
             if (!isfinite(x->position[k]) || !isfinite(x->normal[k]))
                 return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                                    "gpu scene: update_vertices: vertex %u is not finite", first_vertex + i);
+                                    "gpu scene: update_vertices: vertex %u is not finite",
+                                    first_vertex + i);
     }
     if (count)
-        glNamedBufferSubData(gs->vbo, (GLintptr)((size_t)first_vertex * sizeof *v), (GLsizeiptr)((size_t)count * sizeof *v),
-                             v);
+        glNamedBufferSubData(gs->vbo, (GLintptr)((size_t)first_vertex * sizeof *v),
+                             (GLsizeiptr)((size_t)count * sizeof *v), v);
     return gi_gl_check("gpu scene: update_vertices", err);
 }
 
@@ -354,16 +372,19 @@ void gi_gpu_scene_draw(const gi_gpu_scene *gs, int object, GLsizei instances)
         first = (size_t)s->objects[object].first_triangle * 3 * sizeof(uint32_t);
     }
     glBindVertexArray(gs->vao);
-    glDrawElementsInstanced(GL_TRIANGLES, count, GL_UNSIGNED_INT, (const void *)first, instances > 0 ? instances : 1);
+    glDrawElementsInstanced(GL_TRIANGLES, count, GL_UNSIGNED_INT, (const void *)first,
+                            instances > 0 ? instances : 1);
     glBindVertexArray(0);
 }
 
-void gi_gpu_scene_draw_indices(const gi_gpu_scene *gs, GLuint ibo, uint32_t index_count, GLsizei instances)
+void gi_gpu_scene_draw_indices(const gi_gpu_scene *gs, GLuint ibo, uint32_t index_count,
+                               GLsizei instances)
 {
     /* The scene's VAO with this index buffer for the one draw, then its own again. */
     glVertexArrayElementBuffer(gs->vao, ibo);
     glBindVertexArray(gs->vao);
-    glDrawElementsInstanced(GL_TRIANGLES, (GLsizei)index_count, GL_UNSIGNED_INT, NULL, instances > 0 ? instances : 1);
+    glDrawElementsInstanced(GL_TRIANGLES, (GLsizei)index_count, GL_UNSIGNED_INT, NULL,
+                            instances > 0 ? instances : 1);
     glBindVertexArray(0);
     glVertexArrayElementBuffer(gs->vao, gs->ibo);
 }
@@ -372,7 +393,8 @@ void gi_gpu_scene_free(gi_gpu_scene *gs)
 {
     if (!gs)
         return;
-    GLuint bufs[] = {gs->vbo, gs->ibo, gs->ssbo_materials, gs->ssbo_lights, gs->ssbo_emitters, gs->ubo_objects, gs->ubo_info};
+    GLuint bufs[] = {gs->vbo,           gs->ibo,         gs->ssbo_materials, gs->ssbo_lights,
+                     gs->ssbo_emitters, gs->ubo_objects, gs->ubo_info};
     glDeleteBuffers(sizeof bufs / sizeof bufs[0], bufs);
     GLuint texs[] = {gs->tex_env, gs->tex_env_cond, gs->tex_env_marg, gs->tex_albedo};
     glDeleteTextures(sizeof texs / sizeof texs[0], texs);
@@ -385,7 +407,8 @@ gi_image *gi_gpu_read_texture(GLuint tex, uint32_t width, uint32_t height)
     gi_image *img = gi_image_create(width, height);
     if (!img)
         return NULL;
-    glGetTextureImage(tex, 0, GL_RGBA, GL_FLOAT, (GLsizei)((size_t)width * height * 4 * sizeof(float)), img->rgba);
+    glGetTextureImage(tex, 0, GL_RGBA, GL_FLOAT,
+                      (GLsizei)((size_t)width * height * 4 * sizeof(float)), img->rgba);
     gi_image_flip_rows(img);
     return img;
 }

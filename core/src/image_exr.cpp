@@ -69,7 +69,8 @@ gi_result gi_exr_read_channels(const char *path, gi_channels *out, gi_error *err
         const Imath::Box2i dw = h.dataWindow(), disp = h.displayWindow();
         const int64_t w = (int64_t)dw.max.x - dw.min.x + 1, hgt = (int64_t)dw.max.y - dw.min.y + 1;
         int nc = 0;
-        for (Imf::ChannelList::ConstIterator it = h.channels().begin(); it != h.channels().end(); ++it)
+        for (Imf::ChannelList::ConstIterator it = h.channels().begin(); it != h.channels().end();
+             ++it)
             nc++;
         gi_result ok = gi_channels_check(path, w, hgt, nc, err);
         if (ok != GI_OK)
@@ -80,7 +81,8 @@ gi_result gi_exr_read_channels(const char *path, gi_channels *out, gi_error *err
         for (const char *c : {"R", "G", "B", "A"})
             if (h.channels().findChannel(c))
                 order.push_back(c);
-        for (Imf::ChannelList::ConstIterator it = h.channels().begin(); it != h.channels().end(); ++it) {
+        for (Imf::ChannelList::ConstIterator it = h.channels().begin(); it != h.channels().end();
+             ++it) {
             std::string n = it.name();
             if (n != "R" && n != "G" && n != "B" && n != "A")
                 order.push_back(n);
@@ -92,7 +94,8 @@ gi_result gi_exr_read_channels(const char *path, gi_channels *out, gi_error *err
         char *origin = (char *)buf.data() - (ptrdiff_t)dw.min.x * (ptrdiff_t)xs -
                        (ptrdiff_t)dw.min.y * (ptrdiff_t)ys;
         for (int c = 0; c < nc; c++)
-            fb.insert(order[c], Imf::Slice(Imf::FLOAT, origin + sizeof(float) * c, xs, ys, 1, 1, 0.0));
+            fb.insert(order[c],
+                      Imf::Slice(Imf::FLOAT, origin + sizeof(float) * c, xs, ys, 1, 1, 0.0));
         file.setFrameBuffer(fb);
         file.readPixels(dw.min.y, dw.max.y);
 

@@ -34,7 +34,7 @@ gi_result gi_channels_check(const char *path, int64_t w, int64_t h, int nc, gi_e
 /* Where a file's data window lies in its display window (both in the
  * file's pixel coordinates; they differ only in cropped files). */
 typedef struct gi_channels_window {
-    int64_t x, y;                          /* data window origin */
+    int64_t x, y;                           /* data window origin */
     int64_t full_x, full_y, full_w, full_h; /* display window */
 } gi_channels_window;
 
@@ -45,8 +45,8 @@ typedef struct gi_channels_window {
  * absurd (empty or over GI_IMAGE_FILE_MAX_PIXELS). GI_ERR_OUT_OF_MEMORY
  * leaves what was allocated in `out` for gi_channels_release. */
 gi_result gi_channels_place(const char *path, const float *buf, int64_t w, int64_t h, int nc,
-                            const char *const *names, const gi_channels_window *win, gi_channels *out,
-                            gi_error *err);
+                            const char *const *names, const gi_channels_window *win,
+                            gi_channels *out, gi_error *err);
 
 /* EXR through OpenEXR (image_exr.cpp): every channel as float, placed in the
  * display window (the data window when the display window is absurd). */
@@ -90,7 +90,8 @@ inline std::string one_line(std::string s, const char *library)
  * (`doing`: "reading", "writing"; `library` names the library in an
  * empty message). */
 template <typename Body>
-gi_result guarded(const char *path, const char *doing, const char *library, gi_error *err, Body body)
+gi_result guarded(const char *path, const char *doing, const char *library, gi_error *err,
+                  Body body)
 {
     try {
         return body();
@@ -105,7 +106,9 @@ gi_result guarded(const char *path, const char *doing, const char *library, gi_e
 
 /* A reader's frame: `out` zeroed, body() run guarded, `out` released on
  * any error. */
-template <typename Body> gi_result guarded_read(const char *path, const char *library, gi_channels *out, gi_error *err, Body body)
+template <typename Body>
+gi_result guarded_read(const char *path, const char *library, gi_channels *out, gi_error *err,
+                       Body body)
 {
     std::memset(out, 0, sizeof *out);
     gi_result r = guarded(path, "reading", library, err, body);

@@ -40,20 +40,23 @@ void gi_channels_release(gi_channels *c)
 
 gi_result gi_channels_check(const char *path, int64_t w, int64_t h, int nc, gi_error *err)
 {
-    if (w <= 0 || h <= 0 || nc <= 0 || nc > 1024 || (uint64_t)w * (uint64_t)h > GI_IMAGE_FILE_MAX_PIXELS)
-        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: unsupported image size %lldx%lld with %d channels",
-                            path, (long long)w, (long long)h, nc);
+    if (w <= 0 || h <= 0 || nc <= 0 || nc > 1024 ||
+        (uint64_t)w * (uint64_t)h > GI_IMAGE_FILE_MAX_PIXELS)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "%s: unsupported image size %lldx%lld with %d channels", path,
+                            (long long)w, (long long)h, nc);
     return GI_OK;
 }
 
 gi_result gi_channels_place(const char *path, const float *buf, int64_t w, int64_t h, int nc,
-                            const char *const *names, const gi_channels_window *win, gi_channels *out,
-                            gi_error *err)
+                            const char *const *names, const gi_channels_window *win,
+                            gi_channels *out, gi_error *err)
 {
     const int use_full = win->full_w > 0 && win->full_h > 0 &&
                          (uint64_t)win->full_w * (uint64_t)win->full_h <= GI_IMAGE_FILE_MAX_PIXELS;
     const int64_t fw = use_full ? win->full_w : w, fh = use_full ? win->full_h : h;
-    const int64_t ox = use_full ? win->x - win->full_x : 0, oy = use_full ? win->y - win->full_y : 0;
+    const int64_t ox = use_full ? win->x - win->full_x : 0,
+                  oy = use_full ? win->y - win->full_y : 0;
     out->data = calloc((size_t)fw * (size_t)fh * (size_t)nc, sizeof(float));
     out->names = calloc((size_t)nc, sizeof(char *));
     if (!out->data || !out->names)
@@ -75,7 +78,8 @@ gi_result gi_channels_place(const char *path, const float *buf, int64_t w, int64
             if (tx < 0 || tx >= fw)
                 continue;
             memcpy(&out->data[((size_t)ty * (size_t)fw + (size_t)tx) * (size_t)nc],
-                   &buf[((size_t)y * (size_t)w + (size_t)x) * (size_t)nc], sizeof(float) * (size_t)nc);
+                   &buf[((size_t)y * (size_t)w + (size_t)x) * (size_t)nc],
+                   sizeof(float) * (size_t)nc);
         }
     }
     return GI_OK;
@@ -194,13 +198,14 @@ gi_result gi_image_write_exr_layers(const char *path, const gi_image *rgba,
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: layers or names missing", path);
     const char *ext = extension_of(path);
     if (strcasecmp(ext, ".exr"))
-        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: layered images must be .exr, not '%s'",
-                            path, ext);
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "%s: layered images must be .exr, not '%s'", path, ext);
     for (uint32_t l = 0; l < layer_count; l++) {
         if (!image_ok(layers[l]) || layers[l]->width != rgba->width ||
             layers[l]->height != rgba->height)
-            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: layer %u is missing or not %ux%u",
-                                path, l, rgba->width, rgba->height);
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "%s: layer %u is missing or not %ux%u", path, l, rgba->width,
+                                rgba->height);
         if (!names[l] || !*names[l])
             return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: layer %u has no name", path, l);
         for (uint32_t k = 0; k < l; k++)
@@ -236,7 +241,8 @@ static gi_result probe(const char *path, int *is_exr, gi_error *err)
     unsigned char magic[4] = {0};
     ssize_t n = read(fd, magic, sizeof magic);
     close(fd);
-    *is_exr = n == 4 && magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01;
+    *is_exr =
+        n == 4 && magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01;
     return GI_OK;
 }
 

@@ -45,7 +45,8 @@ static void free_sized(gi_kit *k)
 gi_result gi_kit_frame_begin(gi_kit *k, const gi_view *v, unsigned what)
 {
     int resized = k->width != v->width || k->height != v->height;
-    if (resized || (!k->gbuffer && (what & GI_KIT_GBUFFER)) || (!k->accum && (what & GI_KIT_ACCUMULATE))) {
+    if (resized || (!k->gbuffer && (what & GI_KIT_GBUFFER)) ||
+        (!k->accum && (what & GI_KIT_ACCUMULATE))) {
         free_sized(k);
         gi_error err;
         if (what & GI_KIT_GBUFFER) {
@@ -69,8 +70,9 @@ gi_result gi_kit_frame_begin(gi_kit *k, const gi_view *v, unsigned what)
 gi_result gi_kit_render_gbuffer(gi_kit *k, const gi_view *v, const char *stage)
 {
     if (!k->gbuffer || !k->scene)
-        return gi_kit_fail(k, GI_ERR_INVALID_ARGUMENT,
-                           "G-buffer asked for before prepare() or without GI_KIT_GBUFFER in gi_kit_frame_begin");
+        return gi_kit_fail(
+            k, GI_ERR_INVALID_ARGUMENT,
+            "G-buffer asked for before prepare() or without GI_KIT_GBUFFER in gi_kit_frame_begin");
     if (stage)
         k->host->stage_begin(k->host, stage);
     gi_error err;
@@ -91,7 +93,8 @@ void gi_kit_bind(const gi_kit *k, GLuint program, const gi_view *v, const gi_tar
     if (t)
         glBindImageTexture(GI_IMAGE_TARGET, t->texture, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glUniform3f(glGetUniformLocation(program, "u_eye"), v->eye.x, v->eye.y, v->eye.z);
-    glUniformMatrix4fv(glGetUniformLocation(program, "u_inv_view_proj"), 1, GL_FALSE, v->inv_view_proj);
+    glUniformMatrix4fv(glGetUniformLocation(program, "u_inv_view_proj"), 1, GL_FALSE,
+                       v->inv_view_proj);
     glUniform2i(glGetUniformLocation(program, "u_size"), (GLint)v->width, (GLint)v->height);
     glUniform1ui(glGetUniformLocation(program, "u_frame"), k->frames);
     glUniform1ui(glGetUniformLocation(program, "u_seed"), v->seed);
@@ -102,7 +105,8 @@ void gi_kit_frame_end(gi_kit *k)
     k->frames++;
 }
 
-GLuint gi_kit_scratch_texture(gi_kit *k, unsigned slot, GLenum format, uint32_t width, uint32_t height)
+GLuint gi_kit_scratch_texture(gi_kit *k, unsigned slot, GLenum format, uint32_t width,
+                              uint32_t height)
 {
     if (slot >= GI_KIT_SCRATCH_MAX)
         return 0;
@@ -153,31 +157,50 @@ const char *gi_kit_last_error(const gi_kit *k)
 gi_result gi_abi_layout_check(const gi_abi_layout *plugin, gi_error *err)
 {
     static const gi_abi_layout host = GI_ABI_LAYOUT;
-#define FIELD(f, type) {offsetof(gi_abi_layout, f), #type}
+#define FIELD(f, type)                                                                             \
+    {                                                                                              \
+        offsetof(gi_abi_layout, f), #type                                                          \
+    }
     static const struct {
         size_t offset;
         const char *name;
-    } fields[] = {FIELD(host, gi_host), FIELD(view, gi_view), FIELD(target, gi_target), FIELD(changes, gi_changes),
-                  FIELD(gpu_scene, gi_gpu_scene), FIELD(gpu_material, gi_gpu_material),
-                  FIELD(gpu_light, gi_gpu_light), FIELD(gpu_emitter, gi_gpu_emitter), FIELD(scene, gi_scene),
-                  FIELD(object, gi_object), FIELD(material, gi_material), FIELD(light, gi_light),
-                  FIELD(camera, gi_camera), FIELD(vertex, gi_vertex), FIELD(param_desc, gi_param_desc),
-                  FIELD(gbuffer, gi_gbuffer), FIELD(depth_view, gi_depth_view), FIELD(depth_desc, gi_depth_desc),
-                  FIELD(depth_atlas_desc, gi_depth_atlas_desc), FIELD(kit, gi_kit)};
+    } fields[] = {FIELD(host, gi_host),
+                  FIELD(view, gi_view),
+                  FIELD(target, gi_target),
+                  FIELD(changes, gi_changes),
+                  FIELD(gpu_scene, gi_gpu_scene),
+                  FIELD(gpu_material, gi_gpu_material),
+                  FIELD(gpu_light, gi_gpu_light),
+                  FIELD(gpu_emitter, gi_gpu_emitter),
+                  FIELD(scene, gi_scene),
+                  FIELD(object, gi_object),
+                  FIELD(material, gi_material),
+                  FIELD(light, gi_light),
+                  FIELD(camera, gi_camera),
+                  FIELD(vertex, gi_vertex),
+                  FIELD(param_desc, gi_param_desc),
+                  FIELD(gbuffer, gi_gbuffer),
+                  FIELD(depth_view, gi_depth_view),
+                  FIELD(depth_desc, gi_depth_desc),
+                  FIELD(depth_atlas_desc, gi_depth_atlas_desc),
+                  FIELD(kit, gi_kit)};
 #undef FIELD
-    _Static_assert(sizeof fields / sizeof fields[0] * sizeof(uint32_t) + sizeof(uint32_t) == sizeof(gi_abi_layout),
+    _Static_assert(sizeof fields / sizeof fields[0] * sizeof(uint32_t) + sizeof(uint32_t) ==
+                       sizeof(gi_abi_layout),
                    "every gi_abi_layout field is checked");
     if (plugin->revision != host.revision)
-        return gi_error_set(err, GI_ERR_UNSUPPORTED, "built against data layout revision %u, this gibench has %u",
+        return gi_error_set(err, GI_ERR_UNSUPPORTED,
+                            "built against data layout revision %u, this gibench has %u",
                             plugin->revision, host.revision);
     for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++) {
         uint32_t p, h;
         memcpy(&p, (const char *)plugin + fields[i].offset, sizeof p);
         memcpy(&h, (const char *)&host + fields[i].offset, sizeof h);
         if (p != h)
-            return gi_error_set(err, GI_ERR_UNSUPPORTED,
-                                "built against %s of %u bytes, this gibench has %u: rebuild the plugin",
-                                fields[i].name, p, h);
+            return gi_error_set(
+                err, GI_ERR_UNSUPPORTED,
+                "built against %s of %u bytes, this gibench has %u: rebuild the plugin",
+                fields[i].name, p, h);
     }
     return GI_OK;
 }
@@ -185,6 +208,7 @@ gi_result gi_abi_layout_check(const gi_abi_layout *plugin, gi_error *err)
 void gi_kit_dispatch_8x8(uint32_t width, uint32_t height)
 {
     glDispatchCompute((width + 7) / 8, (height + 7) / 8, 1);
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
-                    GL_FRAMEBUFFER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
+                    GL_TEXTURE_UPDATE_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT |
+                    GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
 }

@@ -27,8 +27,9 @@ void gi_mesh_triangle_areas(const gi_scene *s, float t, float *out)
             const uint32_t *idx = s->indices + (size_t)tri * 3;
             gi_vec3 p[3];
             for (int k = 0; k < 3; k++)
-                p[k] = gi_mat4_point(m, obj->morph_count ? gi_scene_vertex_position(s, idx[k], t)
-                                                         : gi_v3_load(s->vertices[idx[k]].position));
+                p[k] =
+                    gi_mat4_point(m, obj->morph_count ? gi_scene_vertex_position(s, idx[k], t)
+                                                      : gi_v3_load(s->vertices[idx[k]].position));
             out[tri] = triangle_area(p[0], p[1], p[2]);
         }
     }

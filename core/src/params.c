@@ -133,7 +133,8 @@ gi_params *gi_params_parse(const char *method_id, const gi_param_desc *desc, con
     for (uint32_t k = 0; k < n; k++) {
         const char *eq = strchr(kv[k], '=');
         if (!eq || eq == kv[k]) {
-            gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: parameter '%s' is not name=value", method_id, kv[k]);
+            gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: parameter '%s' is not name=value",
+                         method_id, kv[k]);
             goto fail;
         }
         size_t nl = (size_t)(eq - kv[k]);
@@ -144,28 +145,29 @@ gi_params *gi_params_parse(const char *method_id, const gi_param_desc *desc, con
         if (i == count) {
             char names[512];
             list_names(desc, names, sizeof names);
-            gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: unknown parameter '%.*s' (known: %s)", method_id,
-                         (int)nl, kv[k], names);
+            gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: unknown parameter '%.*s' (known: %s)",
+                         method_id, (int)nl, kv[k], names);
             goto fail;
         }
         const gi_param_desc *d = &desc[i];
         double v;
         if (!parse_value(d, value, &v)) {
             if (d->type == GI_PARAM_ENUM)
-                gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: %s='%s' is not one of %s", method_id, d->name,
-                             value, d->choices);
+                gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: %s='%s' is not one of %s",
+                             method_id, d->name, value, d->choices);
             else
-                gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: %s='%s' is not %s", method_id, d->name, value,
-                             type_name(d->type));
+                gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: %s='%s' is not %s", method_id,
+                             d->name, value, type_name(d->type));
             goto fail;
         }
         if ((d->type == GI_PARAM_INT || d->type == GI_PARAM_FLOAT) && (v < d->min || v > d->max)) {
-            gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: %s=%s is outside [%g, %g]", method_id, d->name, value,
-                         d->min, d->max);
+            gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: %s=%s is outside [%g, %g]", method_id,
+                         d->name, value, d->min, d->max);
             goto fail;
         }
         if (p->given[i]) {
-            gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: parameter '%s' given twice", method_id, d->name);
+            gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: parameter '%s' given twice", method_id,
+                         d->name);
             goto fail;
         }
         p->values[i] = v;
@@ -223,10 +225,11 @@ gi_result gi_params_check(const gi_params *p, const char *method_id, gi_error *e
 {
     if (!p || !p->undeclared || !p->undeclared[0])
         return GI_OK;
-    return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                        "method '%s' read parameter '%s', which its parameter table does not declare (a bug in the "
-                        "plugin)",
-                        method_id, p->undeclared);
+    return gi_error_set(
+        err, GI_ERR_INVALID_ARGUMENT,
+        "method '%s' read parameter '%s', which its parameter table does not declare (a bug in the "
+        "plugin)",
+        method_id, p->undeclared);
 }
 
 char *gi_params_to_string(const gi_params *p)

@@ -9,7 +9,8 @@
 gi_gbuffer *gi_gbuffer_create(uint32_t width, uint32_t height, gi_error *err)
 {
     if (width == 0 || height == 0 || width > 16384 || height > 16384) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "G-buffer size %ux%u is not in 1..16384", width, height);
+        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "G-buffer size %ux%u is not in 1..16384", width,
+                     height);
         return NULL;
     }
     gi_gbuffer *gb = calloc(1, sizeof *gb);
@@ -32,7 +33,8 @@ gi_gbuffer *gi_gbuffer_create(uint32_t width, uint32_t height, gi_error *err)
     gb->tex_ids = gi_gpu_texture_2d(GL_RGBA32UI, width, height);
     gb->tex_depth = gi_gpu_texture_2d(GL_DEPTH_COMPONENT32F, width, height);
     glCreateFramebuffers(1, &gb->fbo);
-    GLuint color[6] = {gb->tex_position, gb->tex_normal, gb->tex_albedo, gb->tex_phong, gb->tex_emission, gb->tex_ids};
+    GLuint color[6] = {gb->tex_position, gb->tex_normal,   gb->tex_albedo,
+                       gb->tex_phong,    gb->tex_emission, gb->tex_ids};
     GLenum bufs[6];
     for (int i = 0; i < 6; i++) {
         glNamedFramebufferTexture(gb->fbo, GL_COLOR_ATTACHMENT0 + (GLenum)i, color[i], 0);
@@ -60,8 +62,8 @@ void gi_gbuffer_free(gi_gbuffer *gb)
     free(gb);
 }
 
-gi_result gi_gbuffer_render(gi_gbuffer *gb, const gi_gpu_scene *gs, const float view[16], const float proj[16],
-                            gi_error *err)
+gi_result gi_gbuffer_render(gi_gbuffer *gb, const gi_gpu_scene *gs, const float view[16],
+                            const float proj[16], gi_error *err)
 {
     float inv[16];
     if (!gi_mat4_invert(inv, view))
@@ -91,7 +93,8 @@ gi_result gi_gbuffer_render(gi_gbuffer *gb, const gi_gpu_scene *gs, const float 
 
 void gi_gbuffer_bind(const gi_gbuffer *gb, GLuint first_unit)
 {
-    GLuint t[6] = {gb->tex_position, gb->tex_normal, gb->tex_albedo, gb->tex_phong, gb->tex_emission, gb->tex_ids};
+    GLuint t[6] = {gb->tex_position, gb->tex_normal,   gb->tex_albedo,
+                   gb->tex_phong,    gb->tex_emission, gb->tex_ids};
     for (GLuint i = 0; i < 6; i++)
         glBindTextureUnit(first_unit + i, t[i]);
 }
@@ -110,8 +113,9 @@ gi_depth_renderer *gi_depth_renderer_create(const gi_depth_desc *desc, gi_error 
     if (d.surfaces == 0)
         d.surfaces = 1;
     if (d.size == 0 || d.size > 16384 || d.surfaces > 4) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth maps: size %u (1..16384) or surfaces %u (1..4) invalid",
-                     d.size, d.surfaces);
+        gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                     "depth maps: size %u (1..16384) or surfaces %u (1..4) invalid", d.size,
+                     d.surfaces);
         return NULL;
     }
     gi_depth_renderer *r = calloc(1, sizeof *r);
@@ -127,7 +131,8 @@ gi_depth_renderer *gi_depth_renderer_create(const gi_depth_desc *desc, gi_error 
     }
     glCreateFramebuffers(1, &r->fbo);
     glCreateRenderbuffers(1, &r->depth_rb);
-    glNamedRenderbufferStorage(r->depth_rb, GL_DEPTH_COMPONENT32F, (GLsizei)desc->size, (GLsizei)desc->size);
+    glNamedRenderbufferStorage(r->depth_rb, GL_DEPTH_COMPONENT32F, (GLsizei)desc->size,
+                               (GLsizei)desc->size);
     glNamedFramebufferRenderbuffer(r->fbo, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, r->depth_rb);
     r->peel[0] = gi_gpu_texture_2d(GL_R32F, desc->size, desc->size);
     r->peel[1] = gi_gpu_texture_2d(GL_R32F, desc->size, desc->size);
@@ -149,7 +154,8 @@ GLuint gi_depth_texture_create(const gi_depth_renderer *r, uint32_t layers)
 {
     GLuint t;
     glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &t);
-    glTextureStorage3D(t, 1, GL_RGBA32F, (GLsizei)r->desc.size, (GLsizei)r->desc.size, (GLsizei)(layers ? layers : 1));
+    glTextureStorage3D(t, 1, GL_RGBA32F, (GLsizei)r->desc.size, (GLsizei)r->desc.size,
+                       (GLsizei)(layers ? layers : 1));
     glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glTextureParameteri(t, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -172,8 +178,8 @@ void gi_depth_cube_views(gi_vec3 eye, float znear, float zfar, gi_depth_view out
         gi_depth_cube_view(eye, znear, zfar, f, &out[f]);
 }
 
-gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi_depth_view *views, uint32_t count,
-                          GLuint array_tex, uint32_t first_layer, gi_error *err)
+gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi_depth_view *views,
+                          uint32_t count, GLuint array_tex, uint32_t first_layer, gi_error *err)
 {
     const gi_depth_desc *d = &r->desc;
     GLuint p = r->program;
@@ -193,8 +199,10 @@ gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi
     glUniform1i(glGetUniformLocation(p, "u_metric"), (GLint)d->metric);
     glUniform1i(glGetUniformLocation(p, "u_local"), d->local);
     glUniform1i(glGetUniformLocation(p, "u_prev"), GI_TEX_CORE_DEPTH_PEEL);
-    GLint loc_view = glGetUniformLocation(p, "u_view"), loc_proj = glGetUniformLocation(p, "u_proj");
-    GLint loc_projection = glGetUniformLocation(p, "u_projection"), loc_range = glGetUniformLocation(p, "u_range");
+    GLint loc_view = glGetUniformLocation(p, "u_view"),
+          loc_proj = glGetUniformLocation(p, "u_proj");
+    GLint loc_projection = glGetUniformLocation(p, "u_projection"),
+          loc_range = glGetUniformLocation(p, "u_range");
     GLint loc_peel = glGetUniformLocation(p, "u_peel");
     const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
     glNamedFramebufferDrawBuffers(r->fbo, 2, bufs);
@@ -210,7 +218,8 @@ gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi
         glUniformMatrix4fv(loc_proj, 1, GL_FALSE, dv->proj);
         glUniform1i(loc_projection, (GLint)dv->projection);
         glUniform2f(loc_range, dv->znear, dv->zfar);
-        glNamedFramebufferTextureLayer(r->fbo, GL_COLOR_ATTACHMENT0, array_tex, 0, (GLint)(first_layer + v));
+        glNamedFramebufferTextureLayer(r->fbo, GL_COLOR_ATTACHMENT0, array_tex, 0,
+                                       (GLint)(first_layer + v));
         /* Every channel starts at +inf: fewer surfaces than channels. */
         glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
         glClearBufferfv(GL_COLOR, 0, far_value);
@@ -247,7 +256,7 @@ float *gi_depth_read_layer(GLuint array_tex, uint32_t size, uint32_t layer)
     float *out = malloc(n * sizeof *out);
     if (!out)
         return NULL;
-    glGetTextureSubImage(array_tex, 0, 0, 0, (GLint)layer, (GLsizei)size, (GLsizei)size, 1, GL_RGBA, GL_FLOAT,
-                         (GLsizei)(n * sizeof *out), out);
+    glGetTextureSubImage(array_tex, 0, 0, 0, (GLint)layer, (GLsizei)size, (GLsizei)size, 1, GL_RGBA,
+                         GL_FLOAT, (GLsizei)(n * sizeof *out), out);
     return out;
 }

@@ -48,32 +48,37 @@ static gi_result validate_params(const gi_method *m, gi_error *err)
     for (uint32_t i = 0; m->params && m->params[i].name; i++) {
         const gi_param_desc *d = &m->params[i];
         if (!valid_name(d->name, 1))
-            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "parameter %u has an invalid name", i);
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "parameter %u has an invalid name",
+                                i);
         for (uint32_t k = 0; k < i; k++)
             if (strcmp(m->params[k].name, d->name) == 0)
-                return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "parameter '%s' declared twice", d->name);
+                return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "parameter '%s' declared twice",
+                                    d->name);
         if (d->type > GI_PARAM_ENUM)
-            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "parameter '%s' has an unknown type", d->name);
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "parameter '%s' has an unknown type",
+                                d->name);
         if (d->type == GI_PARAM_ENUM) {
             int n = 1;
             if (!d->choices || !*d->choices)
-                return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "enum parameter '%s' has no choices", d->name);
+                return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                    "enum parameter '%s' has no choices", d->name);
             for (const char *p = d->choices; *p; p++)
                 n += *p == '|';
             if (d->def < 0 || d->def >= n)
-                return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "enum parameter '%s' default out of range",
-                                    d->name);
+                return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                    "enum parameter '%s' default out of range", d->name);
         } else if ((d->type == GI_PARAM_INT || d->type == GI_PARAM_FLOAT) &&
                    !(d->min <= d->def && d->def <= d->max)) {
-            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "parameter '%s' default %g outside [%g, %g]", d->name,
-                                d->def, d->min, d->max);
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "parameter '%s' default %g outside [%g, %g]", d->name, d->def,
+                                d->min, d->max);
         }
     }
     return GI_OK;
 }
 
-gi_result gi_method_create(const gi_method *m, const gi_host *host, const gi_params *params, void **instance,
-                           gi_error *err)
+gi_result gi_method_create(const gi_method *m, const gi_host *host, const gi_params *params,
+                           void **instance, gi_error *err)
 {
     *instance = NULL;
     gi_result r = m->create(host, params, instance);
@@ -97,16 +102,19 @@ gi_result gi_method_create(const gi_method *m, const gi_host *host, const gi_par
 gi_result gi_method_validate(const gi_method *m, gi_error *err)
 {
     if (GI_ABI_VERSION_MAJOR(m->abi_version) != GI_ABI_MAJOR)
-        return gi_error_set(err, GI_ERR_UNSUPPORTED, "built for plugin ABI %u.%u, this gibench speaks %u.%u",
-                            m->abi_version >> 16, m->abi_version & 0xFFFF, GI_ABI_MAJOR, GI_ABI_MINOR);
+        return gi_error_set(
+            err, GI_ERR_UNSUPPORTED, "built for plugin ABI %u.%u, this gibench speaks %u.%u",
+            m->abi_version >> 16, m->abi_version & 0xFFFF, GI_ABI_MAJOR, GI_ABI_MINOR);
     if (m->struct_size < GI_METHOD_SIZE_1_0)
-        return gi_error_set(err, GI_ERR_UNSUPPORTED, "descriptor is %u bytes, ABI %u.0 needs at least %zu",
-                            m->struct_size, GI_ABI_MAJOR, (size_t)GI_METHOD_SIZE_1_0);
+        return gi_error_set(err, GI_ERR_UNSUPPORTED,
+                            "descriptor is %u bytes, ABI %u.0 needs at least %zu", m->struct_size,
+                            GI_ABI_MAJOR, (size_t)GI_METHOD_SIZE_1_0);
     if (!valid_name(m->id, 0))
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "method id '%s' is not [a-z0-9_]{1,31}",
                             m->id ? m->id : "(null)");
     if (!m->title || !m->citation || !m->version)
-        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "method '%s' lacks a title, citation or version", m->id);
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "method '%s' lacks a title, citation or version", m->id);
     struct {
         const char *name;
         int present;
@@ -121,13 +129,14 @@ gi_result gi_method_validate(const gi_method *m, gi_error *err)
     };
     for (size_t i = 0; i < sizeof fns / sizeof fns[0]; i++)
         if (fns[i].end > m->struct_size || !fns[i].present)
-            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "method '%s' lacks the required function %s()", m->id,
-                                fns[i].name);
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "method '%s' lacks the required function %s()", m->id, fns[i].name);
     if (m->struct_size < offsetof(gi_method, layout) + sizeof m->layout)
-        return gi_error_set(err, GI_ERR_UNSUPPORTED,
-                            "method '%s' has no data layout (built for ABI 1.0); rebuild it against this gibench "
-                            "(ABI %u.%u)",
-                            m->id, GI_ABI_MAJOR, GI_ABI_MINOR);
+        return gi_error_set(
+            err, GI_ERR_UNSUPPORTED,
+            "method '%s' has no data layout (built for ABI 1.0); rebuild it against this gibench "
+            "(ABI %u.%u)",
+            m->id, GI_ABI_MAJOR, GI_ABI_MINOR);
     gi_error lerr;
     if (gi_abi_layout_check(&m->layout, &lerr) != GI_OK)
         return gi_error_set(err, GI_ERR_UNSUPPORTED, "method '%s' %s", m->id, lerr.text);
@@ -157,19 +166,21 @@ static gi_result open_and_check(const char *path, const gi_method **out, gi_erro
     void *lib = dlopen(path, RTLD_NOW | RTLD_LOCAL);
     if (!lib) {
         const char *why = dlerror();
-        return gi_error_set(err, GI_ERR_IO, "%s: cannot load: %s", path, why ? why : "unknown reason");
+        return gi_error_set(err, GI_ERR_IO, "%s: cannot load: %s", path,
+                            why ? why : "unknown reason");
     }
     gi_method_entry_fn entry;
     void *sym = dlsym(lib, "gi_method_entry");
     memcpy(&entry, &sym, sizeof entry);
     if (!sym)
-        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: no gi_method_entry symbol (not a gibench plugin)",
-                            path);
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "%s: no gi_method_entry symbol (not a gibench plugin)", path);
     const gi_method *m = entry(GI_ABI_VERSION);
     if (!m)
-        return gi_error_set(err, GI_ERR_UNSUPPORTED,
-                            "%s: gi_method_entry returned NULL for host ABI %u.%u (built for another ABI major)",
-                            path, GI_ABI_MAJOR, GI_ABI_MINOR);
+        return gi_error_set(
+            err, GI_ERR_UNSUPPORTED,
+            "%s: gi_method_entry returned NULL for host ABI %u.%u (built for another ABI major)",
+            path, GI_ABI_MAJOR, GI_ABI_MINOR);
     gi_error verr;
     if (gi_method_validate(m, &verr) != GI_OK)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: %s", path, verr.text);
@@ -210,7 +221,8 @@ static void probe_child(char *const *paths, size_t from, size_t n, int fd)
             if (*c == '\n' || *c == '\r')
                 *c = ' ';
         char line[sizeof cerr.text + 48];
-        int len = snprintf(line, sizeof line, "%zu %d %s\n", i, (int)r, r == GI_OK ? "" : cerr.text);
+        int len =
+            snprintf(line, sizeof line, "%zu %d %s\n", i, (int)r, r == GI_OK ? "" : cerr.text);
         if (len < 0 || (size_t)len >= sizeof line) {
             len = (int)sizeof line - 1;
             line[len - 1] = '\n';
@@ -252,7 +264,8 @@ static size_t probe_from(char *const *paths, size_t from, size_t n, probe_result
             close(fds[0]);
     }
     if (pid < 0) {
-        gi_error_set(&out[from].err, GI_ERR_IO, "%s: cannot probe the plugin: %s", paths[from], strerror(errno));
+        gi_error_set(&out[from].err, GI_ERR_IO, "%s: cannot probe the plugin: %s", paths[from],
+                     strerror(errno));
         out[from].code = GI_ERR_IO;
         return from + 1;
     }
@@ -294,7 +307,8 @@ static size_t probe_from(char *const *paths, size_t from, size_t n, probe_result
             if (idx == next && idx < n && code >= 0) {
                 out[idx].code = code <= GI_ERR_IO ? (gi_result)code : GI_ERR_INVALID_ARGUMENT;
                 if (out[idx].code != GI_OK)
-                    snprintf(out[idx].err.text, sizeof out[idx].err.text, "%s", *rest == ' ' ? rest + 1 : rest);
+                    snprintf(out[idx].err.text, sizeof out[idx].err.text, "%s",
+                             *rest == ' ' ? rest + 1 : rest);
                 next++;
                 clock_gettime(CLOCK_MONOTONIC, &since); /* the time limit is per plugin */
             }
@@ -316,9 +330,11 @@ static size_t probe_from(char *const *paths, size_t from, size_t n, probe_result
     probe_result *bad = &out[next];
     bad->code = GI_ERR_UNSUPPORTED;
     if (hung)
-        gi_error_set(&bad->err, bad->code, "%s: still loading after %d s (killed)", paths[next], GI_PROBE_SECONDS);
+        gi_error_set(&bad->err, bad->code, "%s: still loading after %d s (killed)", paths[next],
+                     GI_PROBE_SECONDS);
     else if (WIFSIGNALED(status))
-        gi_error_set(&bad->err, bad->code, "%s: crashed while loading (signal %d)", paths[next], WTERMSIG(status));
+        gi_error_set(&bad->err, bad->code, "%s: crashed while loading (signal %d)", paths[next],
+                     WTERMSIG(status));
     else
         gi_error_set(&bad->err, bad->code, "%s: exited while loading (status %d)", paths[next],
                      WIFEXITED(status) ? WEXITSTATUS(status) : -1);
@@ -342,8 +358,9 @@ static gi_result add_probed(gi_plugins *reg, const char *path, gi_error *err)
         return GI_OK;
     for (uint32_t i = 0; i < reg->count; i++)
         if (strcmp(reg->items[i].method->id, m->id) == 0)
-            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: duplicate method id '%s' (already loaded from %s)",
-                                path, m->id, reg->items[i].path);
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "%s: duplicate method id '%s' (already loaded from %s)", path,
+                                m->id, reg->items[i].path);
     gi_plugin *items = realloc(reg->items, (reg->count + 1) * sizeof *items);
     if (!items)
         return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory");
@@ -387,7 +404,8 @@ static void scan_dir(path_list *list, const char *dir)
     struct dirent *e;
     while ((e = readdir(d)) != NULL) {
         size_t len = strlen(e->d_name);
-        if (strncmp(e->d_name, "gimethod_", 9) != 0 || len < 12 || strcmp(e->d_name + len - 3, ".so") != 0)
+        if (strncmp(e->d_name, "gimethod_", 9) != 0 || len < 12 ||
+            strcmp(e->d_name + len - 3, ".so") != 0)
             continue;
         char **grown = realloc(names, (n + 1) * sizeof *names);
         if (!grown)
@@ -429,7 +447,8 @@ gi_plugins *gi_plugins_scan(const char *build_dir)
     const char *env = getenv("GIBENCH_PLUGIN_PATH");
     if (env) {
         char *copy = dup_str(env), *save = NULL;
-        for (char *tok = copy ? strtok_r(copy, ":", &save) : NULL; tok; tok = strtok_r(NULL, ":", &save))
+        for (char *tok = copy ? strtok_r(copy, ":", &save) : NULL; tok;
+             tok = strtok_r(NULL, ":", &save))
             if (*tok && (!build_dir || strcmp(tok, build_dir) != 0))
                 scan_dir(&list, tok);
         free(copy);
@@ -475,7 +494,8 @@ void gi_plugins_free(gi_plugins *reg)
     free(reg);
 }
 
-void gi_view_from_camera(const gi_camera_frame *cf, uint32_t width, uint32_t height, float t, gi_view *v)
+void gi_view_from_camera(const gi_camera_frame *cf, uint32_t width, uint32_t height, float t,
+                         gi_view *v)
 {
     memset(v, 0, sizeof *v);
     v->width = width;

@@ -142,8 +142,7 @@ gi_result gi_rt_create(const gi_scene *s, float time, gi_rt **out, gi_error *err
     return gi_rt_create_ex(s, time, 0u, out, err);
 }
 
-gi_result gi_rt_create_ex(const gi_scene *s, float time, unsigned flags, gi_rt **out,
-                          gi_error *err)
+gi_result gi_rt_create_ex(const gi_scene *s, float time, unsigned flags, gi_rt **out, gi_error *err)
 {
     if (out)
         *out = NULL;
@@ -198,9 +197,8 @@ gi_result gi_rt_create_ex(const gi_scene *s, float time, unsigned flags, gi_rt *
         /* Embree owns both buffers; they live as long as the geometry. */
         rt->pos = rtcSetNewGeometryBuffer(rt->geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                           3 * sizeof(float), s->vertex_count);
-        unsigned *ib = rtcSetNewGeometryBuffer(rt->geom, RTC_BUFFER_TYPE_INDEX, 0,
-                                               RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
-                                               s->triangle_count);
+        unsigned *ib = rtcSetNewGeometryBuffer(rt->geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                               3 * sizeof(unsigned), s->triangle_count);
         if (!rt->pos || !ib) {
             res = embree_fail(rt, "vertex and index buffers", err);
             goto fail;
@@ -380,8 +378,8 @@ int gi_rt_intersect(const gi_rt *rt, gi_vec3 o, gi_vec3 d, float tmin, float tma
     hit->triangle = tri;
     hit->u = rh.hit.u;
     hit->v = rh.hit.v;
-    hit->position =
-        gi_v3_add(gi_v3_add(gi_v3_scale(p0, b0), gi_v3_scale(p1, rh.hit.u)), gi_v3_scale(p2, rh.hit.v));
+    hit->position = gi_v3_add(gi_v3_add(gi_v3_scale(p0, b0), gi_v3_scale(p1, rh.hit.u)),
+                              gi_v3_scale(p2, rh.hit.v));
     hit->ng = len > 0.0f && isfinite(len) ? gi_v3_scale(c, 1.0f / len) : gi_v3(0.0f, 0.0f, 1.0f);
     return 1;
 }

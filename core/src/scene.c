@@ -459,7 +459,8 @@ gi_vec3 gi_scene_vertex_position(const gi_scene *s, uint32_t vertex, float t)
     const gi_object *o = v->object < s->object_count ? &s->objects[v->object] : NULL;
     if (!o || !o->morph_count)
         return gi_v3_load(v->position);
-    float wbuf[MORPH_STACK], *w = o->morph_count <= MORPH_STACK ? wbuf : malloc(o->morph_count * sizeof *w);
+    float wbuf[MORPH_STACK],
+        *w = o->morph_count <= MORPH_STACK ? wbuf : malloc(o->morph_count * sizeof *w);
     if (!w)
         return gi_v3_load(v->position);
     gi_scene_morph_weights(s, v->object, t, w);
@@ -481,7 +482,8 @@ void gi_scene_object_vertices(const gi_scene *s, uint32_t object, float t, gi_ve
     memcpy(out, s->vertices + o->first_vertex, nv * sizeof *out);
     if (!o->morph_count)
         return;
-    float wbuf[MORPH_STACK], *w = o->morph_count <= MORPH_STACK ? wbuf : malloc(o->morph_count * sizeof *w);
+    float wbuf[MORPH_STACK],
+        *w = o->morph_count <= MORPH_STACK ? wbuf : malloc(o->morph_count * sizeof *w);
     if (!w)
         return;
     gi_scene_morph_weights(s, object, t, w);

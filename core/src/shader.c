@@ -56,13 +56,15 @@ gi_result gi_shader_register(const gi_shader_source *table, gi_error *err)
     for (const gi_shader_source *s = table; s->name; s++) {
         const gi_shader_source *core = find_in(gi_core_shaders, s->name);
         if (core)
-            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                                "%s: named like the core's %s, which #include and the builders find first; "
-                                "rename it",
-                                s->path, core->path);
+            return gi_error_set(
+                err, GI_ERR_INVALID_ARGUMENT,
+                "%s: named like the core's %s, which #include and the builders find first; "
+                "rename it",
+                s->path, core->path);
     }
     if (g_table_count >= MAX_TABLES)
-        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "more than %d shader tables registered", MAX_TABLES);
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "more than %d shader tables registered",
+                            MAX_TABLES);
     g_tables[g_table_count++] = table;
     return GI_OK;
 }
@@ -83,7 +85,8 @@ static const gi_shader_source *lookup(const char *name, const gi_shader_source *
             continue;
         if (found) {
             gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                         "shader name '%s' is ambiguous: %s and %s; name it by its path", name, found->path, s->path);
+                         "shader name '%s' is ambiguous: %s and %s; name it by its path", name,
+                         found->path, s->path);
             return NULL;
         }
         found = s;
@@ -174,15 +177,16 @@ static int expand_into(buf *out, expansion *ex, const gi_shader_source *src, gi_
         char name[128];
         int inc = parse_include(p, len, name, sizeof name);
         if (inc < 0) {
-            gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s:%d: malformed #include", src->path, line);
+            gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s:%d: malformed #include", src->path,
+                         line);
             return 0;
         }
         if (inc > 0) {
             gi_error why;
             const gi_shader_source *child = lookup(name, table_of(src), &why);
             if (!child) {
-                gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s:%d: #include \"%s\": %s", src->path, line, name,
-                             why.text);
+                gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s:%d: #include \"%s\": %s", src->path,
+                             line, name, why.text);
                 return 0;
             }
             int seen = 0;
@@ -236,7 +240,8 @@ static void report_log(const char *log, const expansion *ex, const char *fallbac
     const char *line = log;
     const char *first = NULL;
     while (line && *line) {
-        if (strstr(line, "error") && (!strchr(line, '\n') || strstr(line, "error") < strchr(line, '\n'))) {
+        if (strstr(line, "error") &&
+            (!strchr(line, '\n') || strstr(line, "error") < strchr(line, '\n'))) {
             first = line;
             break;
         }
@@ -286,7 +291,8 @@ static GLuint compile_text(GLenum type, const char *text, const expansion *ex, c
 }
 
 /* Compiles one stage of `src` with the stage's define (GI_VERTEX_SHADER, ...). */
-static GLuint compile_source(GLenum type, const gi_shader_source *src, const char *defines, gi_error *err)
+static GLuint compile_source(GLenum type, const gi_shader_source *src, const char *defines,
+                             gi_error *err)
 {
     expansion ex = {0};
     const char *stage = type == GL_VERTEX_SHADER     ? "#define GI_VERTEX_SHADER 1\n"
@@ -367,8 +373,8 @@ GLuint gi_program_build_compute_text(const char *label, const char *text, const 
     return s ? link_program(&s, 1, label, err) : 0;
 }
 
-GLuint gi_program_build_text(const char *label, const char *vert_text, const char *frag_text, const char *defines,
-                             gi_error *err)
+GLuint gi_program_build_text(const char *label, const char *vert_text, const char *frag_text,
+                             const char *defines, gi_error *err)
 {
     gi_shader_source vs = {label, label, vert_text}, fs = {label, label, frag_text};
     GLuint sh[2] = {compile_source(GL_VERTEX_SHADER, &vs, defines, err), 0};

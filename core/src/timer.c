@@ -268,7 +268,8 @@ void gi_timer_frame_end(gi_timer *t)
                 t->stages[m->stage].frame_ms += ms - open[d];
                 t->stages[m->stage].used = 1;
                 memmove(open + d, open + d + 1, (size_t)(depth - d - 1) * sizeof *open);
-                memmove(open_stage + d, open_stage + d + 1, (size_t)(depth - d - 1) * sizeof *open_stage);
+                memmove(open_stage + d, open_stage + d + 1,
+                        (size_t)(depth - d - 1) * sizeof *open_stage);
                 depth--;
                 break;
             }

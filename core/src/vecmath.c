@@ -27,38 +27,54 @@ int gi_mat4_invert(float out[16], const float m[16])
 {
     double inv[16], det;
     const float *a = m;
-    inv[0] = (double)a[5] * a[10] * a[15] - (double)a[5] * a[11] * a[14] - (double)a[9] * a[6] * a[15] +
-             (double)a[9] * a[7] * a[14] + (double)a[13] * a[6] * a[11] - (double)a[13] * a[7] * a[10];
-    inv[4] = -(double)a[4] * a[10] * a[15] + (double)a[4] * a[11] * a[14] + (double)a[8] * a[6] * a[15] -
-             (double)a[8] * a[7] * a[14] - (double)a[12] * a[6] * a[11] + (double)a[12] * a[7] * a[10];
-    inv[8] = (double)a[4] * a[9] * a[15] - (double)a[4] * a[11] * a[13] - (double)a[8] * a[5] * a[15] +
-             (double)a[8] * a[7] * a[13] + (double)a[12] * a[5] * a[11] - (double)a[12] * a[7] * a[9];
-    inv[12] = -(double)a[4] * a[9] * a[14] + (double)a[4] * a[10] * a[13] + (double)a[8] * a[5] * a[14] -
-              (double)a[8] * a[6] * a[13] - (double)a[12] * a[5] * a[10] + (double)a[12] * a[6] * a[9];
-    inv[1] = -(double)a[1] * a[10] * a[15] + (double)a[1] * a[11] * a[14] + (double)a[9] * a[2] * a[15] -
-             (double)a[9] * a[3] * a[14] - (double)a[13] * a[2] * a[11] + (double)a[13] * a[3] * a[10];
-    inv[5] = (double)a[0] * a[10] * a[15] - (double)a[0] * a[11] * a[14] - (double)a[8] * a[2] * a[15] +
-             (double)a[8] * a[3] * a[14] + (double)a[12] * a[2] * a[11] - (double)a[12] * a[3] * a[10];
-    inv[9] = -(double)a[0] * a[9] * a[15] + (double)a[0] * a[11] * a[13] + (double)a[8] * a[1] * a[15] -
-             (double)a[8] * a[3] * a[13] - (double)a[12] * a[1] * a[11] + (double)a[12] * a[3] * a[9];
-    inv[13] = (double)a[0] * a[9] * a[14] - (double)a[0] * a[10] * a[13] - (double)a[8] * a[1] * a[14] +
-              (double)a[8] * a[2] * a[13] + (double)a[12] * a[1] * a[10] - (double)a[12] * a[2] * a[9];
-    inv[2] = (double)a[1] * a[6] * a[15] - (double)a[1] * a[7] * a[14] - (double)a[5] * a[2] * a[15] +
-             (double)a[5] * a[3] * a[14] + (double)a[13] * a[2] * a[7] - (double)a[13] * a[3] * a[6];
-    inv[6] = -(double)a[0] * a[6] * a[15] + (double)a[0] * a[7] * a[14] + (double)a[4] * a[2] * a[15] -
-             (double)a[4] * a[3] * a[14] - (double)a[12] * a[2] * a[7] + (double)a[12] * a[3] * a[6];
-    inv[10] = (double)a[0] * a[5] * a[15] - (double)a[0] * a[7] * a[13] - (double)a[4] * a[1] * a[15] +
-              (double)a[4] * a[3] * a[13] + (double)a[12] * a[1] * a[7] - (double)a[12] * a[3] * a[5];
-    inv[14] = -(double)a[0] * a[5] * a[14] + (double)a[0] * a[6] * a[13] + (double)a[4] * a[1] * a[14] -
-              (double)a[4] * a[2] * a[13] - (double)a[12] * a[1] * a[6] + (double)a[12] * a[2] * a[5];
-    inv[3] = -(double)a[1] * a[6] * a[11] + (double)a[1] * a[7] * a[10] + (double)a[5] * a[2] * a[11] -
-             (double)a[5] * a[3] * a[10] - (double)a[9] * a[2] * a[7] + (double)a[9] * a[3] * a[6];
-    inv[7] = (double)a[0] * a[6] * a[11] - (double)a[0] * a[7] * a[10] - (double)a[4] * a[2] * a[11] +
-             (double)a[4] * a[3] * a[10] + (double)a[8] * a[2] * a[7] - (double)a[8] * a[3] * a[6];
-    inv[11] = -(double)a[0] * a[5] * a[11] + (double)a[0] * a[7] * a[9] + (double)a[4] * a[1] * a[11] -
-              (double)a[4] * a[3] * a[9] - (double)a[8] * a[1] * a[7] + (double)a[8] * a[3] * a[5];
-    inv[15] = (double)a[0] * a[5] * a[10] - (double)a[0] * a[6] * a[9] - (double)a[4] * a[1] * a[10] +
-              (double)a[4] * a[2] * a[9] + (double)a[8] * a[1] * a[6] - (double)a[8] * a[2] * a[5];
+    inv[0] = (double)a[5] * a[10] * a[15] - (double)a[5] * a[11] * a[14] -
+             (double)a[9] * a[6] * a[15] + (double)a[9] * a[7] * a[14] +
+             (double)a[13] * a[6] * a[11] - (double)a[13] * a[7] * a[10];
+    inv[4] = -(double)a[4] * a[10] * a[15] + (double)a[4] * a[11] * a[14] +
+             (double)a[8] * a[6] * a[15] - (double)a[8] * a[7] * a[14] -
+             (double)a[12] * a[6] * a[11] + (double)a[12] * a[7] * a[10];
+    inv[8] = (double)a[4] * a[9] * a[15] - (double)a[4] * a[11] * a[13] -
+             (double)a[8] * a[5] * a[15] + (double)a[8] * a[7] * a[13] +
+             (double)a[12] * a[5] * a[11] - (double)a[12] * a[7] * a[9];
+    inv[12] = -(double)a[4] * a[9] * a[14] + (double)a[4] * a[10] * a[13] +
+              (double)a[8] * a[5] * a[14] - (double)a[8] * a[6] * a[13] -
+              (double)a[12] * a[5] * a[10] + (double)a[12] * a[6] * a[9];
+    inv[1] = -(double)a[1] * a[10] * a[15] + (double)a[1] * a[11] * a[14] +
+             (double)a[9] * a[2] * a[15] - (double)a[9] * a[3] * a[14] -
+             (double)a[13] * a[2] * a[11] + (double)a[13] * a[3] * a[10];
+    inv[5] = (double)a[0] * a[10] * a[15] - (double)a[0] * a[11] * a[14] -
+             (double)a[8] * a[2] * a[15] + (double)a[8] * a[3] * a[14] +
+             (double)a[12] * a[2] * a[11] - (double)a[12] * a[3] * a[10];
+    inv[9] = -(double)a[0] * a[9] * a[15] + (double)a[0] * a[11] * a[13] +
+             (double)a[8] * a[1] * a[15] - (double)a[8] * a[3] * a[13] -
+             (double)a[12] * a[1] * a[11] + (double)a[12] * a[3] * a[9];
+    inv[13] = (double)a[0] * a[9] * a[14] - (double)a[0] * a[10] * a[13] -
+              (double)a[8] * a[1] * a[14] + (double)a[8] * a[2] * a[13] +
+              (double)a[12] * a[1] * a[10] - (double)a[12] * a[2] * a[9];
+    inv[2] = (double)a[1] * a[6] * a[15] - (double)a[1] * a[7] * a[14] -
+             (double)a[5] * a[2] * a[15] + (double)a[5] * a[3] * a[14] +
+             (double)a[13] * a[2] * a[7] - (double)a[13] * a[3] * a[6];
+    inv[6] = -(double)a[0] * a[6] * a[15] + (double)a[0] * a[7] * a[14] +
+             (double)a[4] * a[2] * a[15] - (double)a[4] * a[3] * a[14] -
+             (double)a[12] * a[2] * a[7] + (double)a[12] * a[3] * a[6];
+    inv[10] = (double)a[0] * a[5] * a[15] - (double)a[0] * a[7] * a[13] -
+              (double)a[4] * a[1] * a[15] + (double)a[4] * a[3] * a[13] +
+              (double)a[12] * a[1] * a[7] - (double)a[12] * a[3] * a[5];
+    inv[14] = -(double)a[0] * a[5] * a[14] + (double)a[0] * a[6] * a[13] +
+              (double)a[4] * a[1] * a[14] - (double)a[4] * a[2] * a[13] -
+              (double)a[12] * a[1] * a[6] + (double)a[12] * a[2] * a[5];
+    inv[3] = -(double)a[1] * a[6] * a[11] + (double)a[1] * a[7] * a[10] +
+             (double)a[5] * a[2] * a[11] - (double)a[5] * a[3] * a[10] -
+             (double)a[9] * a[2] * a[7] + (double)a[9] * a[3] * a[6];
+    inv[7] = (double)a[0] * a[6] * a[11] - (double)a[0] * a[7] * a[10] -
+             (double)a[4] * a[2] * a[11] + (double)a[4] * a[3] * a[10] +
+             (double)a[8] * a[2] * a[7] - (double)a[8] * a[3] * a[6];
+    inv[11] = -(double)a[0] * a[5] * a[11] + (double)a[0] * a[7] * a[9] +
+              (double)a[4] * a[1] * a[11] - (double)a[4] * a[3] * a[9] -
+              (double)a[8] * a[1] * a[7] + (double)a[8] * a[3] * a[5];
+    inv[15] = (double)a[0] * a[5] * a[10] - (double)a[0] * a[6] * a[9] -
+              (double)a[4] * a[1] * a[10] + (double)a[4] * a[2] * a[9] +
+              (double)a[8] * a[1] * a[6] - (double)a[8] * a[2] * a[5];
     det = a[0] * inv[0] + a[1] * inv[4] + a[2] * inv[8] + a[3] * inv[12];
     if (det == 0.0 || !isfinite(det))
         return 0;
@@ -149,8 +165,10 @@ void gi_mat4_ortho(float out[16], float l, float r, float b, float t, float n, f
 void gi_mat4_cube_face_view(float out[16], gi_vec3 eye, int face)
 {
     /* GL cube map face directions and their "up" (-t axis) vectors. */
-    static const float dir[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-    static const float up[6][3] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+    static const float dir[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                    {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+    static const float up[6][3] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1},
+                                   {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
     gi_vec3 d = gi_v3_load(dir[face]);
     gi_mat4_look_at(out, eye, gi_v3_add(eye, d), gi_v3_load(up[face]));
 }

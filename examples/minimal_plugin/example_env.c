@@ -20,7 +20,8 @@ typedef struct example_env {
 } example_env;
 
 static const gi_param_desc example_env_params[] = {
-    {"samples", GI_PARAM_INT, 4, 1, 256, NULL, "S", "cosine-weighted directions per pixel and frame"},
+    {"samples", GI_PARAM_INT, 4, 1, 256, NULL, "S",
+     "cosine-weighted directions per pixel and frame"},
     {0},
 };
 
@@ -49,7 +50,8 @@ static gi_result example_env_prepare(void *inst, const gi_gpu_scene *scene)
     return e->program ? GI_OK : gi_kit_fail_with(&e->kit, GI_ERR_GL, &err);
 }
 
-static gi_result example_env_update(void *inst, const gi_gpu_scene *scene, const gi_changes *changes)
+static gi_result example_env_update(void *inst, const gi_gpu_scene *scene,
+                                    const gi_changes *changes)
 {
     gi_kit_update(&((example_env *)inst)->kit, scene, changes);
     return GI_OK;
@@ -74,7 +76,9 @@ static gi_result example_env_render(void *inst, const gi_view *view, const gi_ta
     gi_kit_frame_end(k);
     k->host->stat(k->host, "samples_per_pixel_env", (double)k->frames * e->samples);
     gi_error err;
-    return gi_gl_check("example_env: shading", &err) == GI_OK ? GI_OK : gi_kit_fail_with(k, GI_ERR_GL, &err);
+    return gi_gl_check("example_env: shading", &err) == GI_OK
+               ? GI_OK
+               : gi_kit_fail_with(k, GI_ERR_GL, &err);
 }
 
 static void example_env_destroy(void *inst)
@@ -93,12 +97,10 @@ static const char *example_env_last_error(void *inst)
     return inst ? gi_kit_last_error(&((example_env *)inst)->kit) : "";
 }
 
-GI_METHOD_EXPORT(example_env,
-    .id = "example_env",
+GI_METHOD_EXPORT(
+    example_env, .id = "example_env",
     .title = "Unshadowed environment light by cosine sampling (the README's example plugin)",
-    .citation = "gibench example",
-    .version = "1.0",
-    .caps = GI_CAP_DIRECT | GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION | GI_CAP_DEFORMATION | GI_CAP_PROGRESSIVE |
-            GI_CAP_TEXTURES,
-    .max_bounces = 0,
-    .params = example_env_params);
+    .citation = "gibench example", .version = "1.0",
+    .caps = GI_CAP_DIRECT | GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION | GI_CAP_DEFORMATION |
+            GI_CAP_PROGRESSIVE | GI_CAP_TEXTURES,
+    .max_bounces = 0, .params = example_env_params);

@@ -87,7 +87,8 @@ int cli_add_out(const char *cmd, const char **outs, int *count, int max, const c
     if (*count == max)
         return cli_fail(EXIT_USAGE, "%s: at most %d --out files", cmd, max);
     if (!dot || (strcmp(dot, ".exr") && strcmp(dot, ".pfm") && strcmp(dot, ".png")))
-        return cli_fail(EXIT_USAGE, "%s: --out '%s': use a .exr, .pfm or .png file name", cmd, path);
+        return cli_fail(EXIT_USAGE, "%s: --out '%s': use a .exr, .pfm or .png file name", cmd,
+                        path);
     outs[(*count)++] = path;
     return 0;
 }
@@ -155,9 +156,10 @@ gi_plugins *cli_load_plugins(int quiet)
 
 void cli_caps_string(uint32_t caps, char *buf, size_t size)
 {
-    static const char *names[] = {"direct",      "indirect",   "glossy",       "mirror",     "area-lights",
-                                  "point-lights", "directional", "environment", "rigid-motion", "deformation",
-                                  "progressive", "precompute", "visibility",   "textures"};
+    static const char *names[] = {"direct",       "indirect",     "glossy",      "mirror",
+                                  "area-lights",  "point-lights", "directional", "environment",
+                                  "rigid-motion", "deformation",  "progressive", "precompute",
+                                  "visibility",   "textures"};
     buf[0] = '\0';
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
         if (caps & (1u << i)) {
@@ -195,7 +197,10 @@ static void host_log(const gi_host *h, int level, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    gi_log((gi_log_level)(level < 0 ? 0 : level > 3 ? 3 : level), "%s: %s", self(h)->method_id, msg);
+    gi_log((gi_log_level)(level < 0   ? 0
+                          : level > 3 ? 3
+                                      : level),
+           "%s: %s", self(h)->method_id, msg);
 }
 
 void cli_format_duration(double seconds, char *out, size_t size)
@@ -219,7 +224,8 @@ void cli_progress_start(cli_progress *p, const char *label)
     snprintf(p->label, sizeof p->label, "%s", label);
 }
 
-void cli_progress_show(cli_progress *p, double fraction, uint64_t done, uint64_t total, const char *note)
+void cli_progress_show(cli_progress *p, double fraction, uint64_t done, uint64_t total,
+                       const char *note)
 {
     if (!p->on)
         return;
@@ -237,10 +243,11 @@ void cli_progress_show(cli_progress *p, double fraction, uint64_t done, uint64_t
     if (fraction > 0)
         cli_format_duration(elapsed * (1.0 - fraction) / fraction, eta, sizeof eta);
     if (total > 0)
-        snprintf(count, sizeof count, "  %llu/%llu", (unsigned long long)done, (unsigned long long)total);
+        snprintf(count, sizeof count, "  %llu/%llu", (unsigned long long)done,
+                 (unsigned long long)total);
     /* \033[K clears what a longer line left behind */
-    fprintf(stderr, "\r%s [%s] %3d%%%s  %s elapsed, ETA %s%s%s\033[K", p->label, bar, (int)(fraction * 100.0),
-            count, el, eta, note ? "  " : "", note ? note : "");
+    fprintf(stderr, "\r%s [%s] %3d%%%s  %s elapsed, ETA %s%s%s\033[K", p->label, bar,
+            (int)(fraction * 100.0), count, el, eta, note ? "  " : "", note ? note : "");
     fflush(stderr);
     p->open = 1;
 }
@@ -309,8 +316,8 @@ static void *host_proc(const char *name)
     return NULL; /* plugins use libepoxy through gicore */
 }
 
-void cli_host_init(cli_host *h, const char *method_id, const char *cache_dir, const gi_gpu_scene *gs,
-                   const char *renderer, int software)
+void cli_host_init(cli_host *h, const char *method_id, const char *cache_dir,
+                   const gi_gpu_scene *gs, const char *renderer, int software)
 {
     memset(h, 0, sizeof *h);
     h->method_id = method_id;
@@ -341,7 +348,8 @@ void cli_host_free(cli_host *h)
 
 int cli_write_json(const char *path, json_object *obj, char *why, size_t why_size)
 {
-    const char *text = json_object_to_json_string_ext(obj, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_SPACED | JSON_C_TO_STRING_NOSLASHESCAPE);
+    const char *text = json_object_to_json_string_ext(
+        obj, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_SPACED | JSON_C_TO_STRING_NOSLASHESCAPE);
     gi_error err;
     size_t n = strlen(text);
     char *with_nl = malloc(n + 2);
@@ -447,12 +455,14 @@ int cli_caps_cover(const gi_method *m, const gi_scene *s, int animated, char *wh
     if (animated && !(c & GI_CAP_RIGID_MOTION))
         missing[n++] = "moving objects";
     if (gi_scene_deforms(s) && !(c & GI_CAP_DEFORMATION))
-        missing[n++] = "deforming meshes"; /* even for a still frame: the CPU copy holds the rest pose */
+        missing[n++] =
+            "deforming meshes"; /* even for a still frame: the CPU copy holds the rest pose */
     if (n == 0)
         return 1;
     int used = snprintf(why, size, "%s does not handle %s", m->id, missing[0]);
     for (int i = 1; i < n && used >= 0 && (size_t)used < size; i++)
-        used += snprintf(why + used, size - (size_t)used, "%s%s", i == n - 1 ? " or " : ", ", missing[i]);
+        used += snprintf(why + used, size - (size_t)used, "%s%s", i == n - 1 ? " or " : ", ",
+                         missing[i]);
     return 0;
 }
 

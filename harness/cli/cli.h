@@ -61,7 +61,8 @@ typedef struct cli_progress {
 } cli_progress;
 void cli_progress_start(cli_progress *p, const char *label);
 /* fraction in [0, 1]; done/total are shown when total > 0; note may be NULL. */
-void cli_progress_show(cli_progress *p, double fraction, uint64_t done, uint64_t total, const char *note);
+void cli_progress_show(cli_progress *p, double fraction, uint64_t done, uint64_t total,
+                       const char *note);
 /* Ends an open line (a newline); nothing when none is open. */
 void cli_progress_end(cli_progress *p);
 /* "m:ss" or "h:mm:ss" of a duration in seconds. */
@@ -71,14 +72,14 @@ void cli_format_duration(double seconds, char *out, size_t size);
 typedef struct cli_host {
     gi_host host;
     const char *method_id;
-    gi_timer *timer;   /* where stage timers go now (prepare or render timer) */
+    gi_timer *timer; /* where stage timers go now (prepare or render timer) */
     json_object *stats;
     int show_progress;
     cli_progress bar; /* the precomputation's progress line */
 } cli_host;
 
-void cli_host_init(cli_host *h, const char *method_id, const char *cache_dir, const gi_gpu_scene *gs,
-                   const char *renderer, int software);
+void cli_host_init(cli_host *h, const char *method_id, const char *cache_dir,
+                   const gi_gpu_scene *gs, const char *renderer, int software);
 void cli_host_free(cli_host *h);
 /* Completes and ends a precomputation progress line left open (a plugin
  * whose last report was below 100 %). */

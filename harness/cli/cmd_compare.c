@@ -80,15 +80,18 @@ static int parse(int argc, char **argv, compare_opts *o)
                 o->ref_bounces = (uint32_t)u;
         } else if (!strcmp(a, "--timeout")) {
             if (!cli_parse_float(v, &f) || f <= 0)
-                return cli_fail(EXIT_USAGE, "compare: --timeout '%s' is not a positive number of seconds", v);
+                return cli_fail(EXIT_USAGE,
+                                "compare: --timeout '%s' is not a positive number of seconds", v);
             o->timeout_s = f;
         } else if (!strcmp(a, "--ref-target-se")) {
             if (!cli_parse_float(v, &f) || f <= 0)
-                return cli_fail(EXIT_USAGE, "compare: --ref-target-se '%s' is not a positive number", v);
+                return cli_fail(EXIT_USAGE,
+                                "compare: --ref-target-se '%s' is not a positive number", v);
             o->ref_target_se = f;
         } else if (!strcmp(a, "--exposure")) {
             if (!cli_parse_exposure(v, &o->exposure))
-                return cli_fail(EXIT_USAGE, "compare: --exposure '%s' is not a number of stops in -64..64", v);
+                return cli_fail(EXIT_USAGE,
+                                "compare: --exposure '%s' is not a number of stops in -64..64", v);
         } else if (!strcmp(a, "--time")) {
             if (!cli_parse_float(v, &o->time) || o->time < 0)
                 return cli_fail(EXIT_USAGE, "compare: --time '%s' is not a non-negative number", v);
@@ -146,11 +149,13 @@ int cmd_compare(int argc, char **argv)
                 gi_plugins_free(reg);
                 gi_scene_free(scene);
                 if (!*id)
-                    return cli_fail(EXIT_USAGE, "compare: --methods '%s' has an empty method name", o.methods);
+                    return cli_fail(EXIT_USAGE, "compare: --methods '%s' has an empty method name",
+                                    o.methods);
                 if (twice)
                     return cli_fail(EXIT_USAGE, "compare: --methods names '%s' twice", id);
                 if (m)
-                    return cli_fail(EXIT_USAGE, "compare: --methods names more than %d methods", MAX_METHODS);
+                    return cli_fail(EXIT_USAGE, "compare: --methods names more than %d methods",
+                                    MAX_METHODS);
                 return cli_fail(EXIT_USAGE, "compare: no method '%s' (see gibench methods)", id);
             }
             methods[n++] = m;
@@ -169,7 +174,8 @@ int cmd_compare(int argc, char **argv)
         if (!found) {
             gi_plugins_free(reg);
             gi_scene_free(scene);
-            return cli_fail(EXIT_USAGE, "compare: --param '%s' names no method of this comparison", o.params[k]);
+            return cli_fail(EXIT_USAGE, "compare: --param '%s' names no method of this comparison",
+                            o.params[k]);
         }
     }
     /* Each method's parameters against its table, now rather than in a
@@ -200,7 +206,8 @@ int cmd_compare(int argc, char **argv)
             gi_scene_free(scene);
             if (!rw)
                 return cli_fail(EXIT_USAGE, "compare: --reference %s", err.text);
-            return cli_fail(EXIT_USAGE, "compare: --reference %s is %ux%u, the comparison is %ux%u (--size)",
+            return cli_fail(EXIT_USAGE,
+                            "compare: --reference %s is %ux%u, the comparison is %ux%u (--size)",
                             o.reference, rw, rh, o.width, o.height);
         }
     }
@@ -219,8 +226,9 @@ int cmd_compare(int argc, char **argv)
     } else {
         snprintf(ref_full, sizeof ref_full, "%s/reference_b%u.exr", o.out, o.ref_bounces);
         fprintf(stderr, "compare: reference (%u spp, %u bounces)\n", o.ref_spp, o.ref_bounces);
-        if (!runner_reference(o.scene, scene_hash, o.camera, o.width, o.height, o.ref_spp, o.ref_target_se, o.ref_bounces, o.seed, o.time, 0,
-                              o.timeout_s, ref_full, why, sizeof why)) {
+        if (!runner_reference(o.scene, scene_hash, o.camera, o.width, o.height, o.ref_spp,
+                              o.ref_target_se, o.ref_bounces, o.seed, o.time, 0, o.timeout_s,
+                              ref_full, why, sizeof why)) {
             gi_plugins_free(reg);
             gi_scene_free(scene);
             return cli_fail(EXIT_RUN, "compare: %s", why);
@@ -243,8 +251,10 @@ int cmd_compare(int argc, char **argv)
         snprintf(dir, sizeof dir, "%s/%s", o.out, m->id);
         uint32_t b = m->max_bounces + 1;
         const char *ref_matched = NULL;
-        run_spec spec = {m->id, o.scene, m->id, o.camera, o.width, o.height, o.frames, o.warmup, o.seed,
-                         o.time, 0.0f, params, np, o.timeout_s, dir, m->id, ref_full, NULL, o.exposure, 0, NULL, 0, NULL, NULL, NULL};
+        run_spec spec = {m->id,    o.scene, m->id,    o.camera, o.width,    o.height, o.frames,
+                         o.warmup, o.seed,  o.time,   0.0f,     params,     np,       o.timeout_s,
+                         dir,      m->id,   ref_full, NULL,     o.exposure, 0,        NULL,
+                         0,        NULL,    NULL,     NULL};
         char reason[256];
         json_object *rec;
         if (!cli_caps_cover(m, scene, 0, reason, sizeof reason)) {
@@ -252,9 +262,11 @@ int cmd_compare(int argc, char **argv)
         } else {
             if (b < o.ref_bounces) {
                 snprintf(matched, sizeof matched, "%s/reference_b%u.exr", o.out, b);
-                fprintf(stderr, "compare: bounce-matched reference (%u spp, %u bounces)\n", o.ref_spp, b);
-                if (runner_reference(o.scene, scene_hash, o.camera, o.width, o.height, o.ref_spp, o.ref_target_se, b, o.seed, o.time, 0, o.timeout_s,
-                                     matched, why, sizeof why)) {
+                fprintf(stderr, "compare: bounce-matched reference (%u spp, %u bounces)\n",
+                        o.ref_spp, b);
+                if (runner_reference(o.scene, scene_hash, o.camera, o.width, o.height, o.ref_spp,
+                                     o.ref_target_se, b, o.seed, o.time, 0, o.timeout_s, matched,
+                                     why, sizeof why)) {
                     ref_matched = matched;
                     uint32_t k = 0;
                     while (k < matched_n && matched_b[k] != b)
@@ -272,10 +284,12 @@ int cmd_compare(int argc, char **argv)
             json_object *c;
             int cached = json_object_object_get_ex(rec, "cached", &c) && json_object_get_boolean(c);
             json_object_object_del(rec, "cached");
-            fprintf(stderr, "compare: %s %s (%.1f s)\n", m->id, cached ? "cached" : "ran", gi_now() - t0);
+            fprintf(stderr, "compare: %s %s (%.1f s)\n", m->id, cached ? "cached" : "ran",
+                    gi_now() - t0);
         }
         json_object *st, *rn;
-        if (json_object_object_get_ex(rec, "status", &st) && !strcmp(json_object_get_string(st), "failed")) {
+        if (json_object_object_get_ex(rec, "status", &st) &&
+            !strcmp(json_object_get_string(st), "failed")) {
             failures++;
             json_object *r;
             json_object_object_get_ex(rec, "reason", &r);
@@ -288,10 +302,12 @@ int cmd_compare(int argc, char **argv)
     char title[512], refdesc[512];
     snprintf(title, sizeof title, "gibench compare: %s at %ux%u", o.scene, o.width, o.height);
     if (o.reference)
-        snprintf(refdesc, sizeof refdesc, "%s (given); bounce-matched references %u spp", o.reference, o.ref_spp);
+        snprintf(refdesc, sizeof refdesc, "%s (given); bounce-matched references %u spp",
+                 o.reference, o.ref_spp);
     else
-        snprintf(refdesc, sizeof refdesc, "path traced (Embree), %u spp, %u bounces; bounce-matched the same spp",
-                 o.ref_spp, o.ref_bounces);
+        snprintf(refdesc, sizeof refdesc,
+                 "path traced (Embree), %u spp, %u bounces; bounce-matched the same spp", o.ref_spp,
+                 o.ref_bounces);
     json_object *meta = report_meta_new(title, "compare", argc, argv, renderer, refdesc);
     if (!o.reference) {
         char ref_png[64];
@@ -323,7 +339,8 @@ int cmd_compare(int argc, char **argv)
         json_object_object_add(meta, "references", sets);
         json_object_object_add(meta, "exposure", json_object_new_double(o.exposure));
     }
-    rc = report_write(o.out, runs, meta, why, sizeof why) ? EXIT_OK : cli_fail(EXIT_RUN, "compare: %s", why);
+    rc = report_write(o.out, runs, meta, why, sizeof why) ? EXIT_OK
+                                                          : cli_fail(EXIT_RUN, "compare: %s", why);
     json_object_put(runs);
     json_object_put(meta);
     gi_plugins_free(reg);
@@ -331,6 +348,7 @@ int cmd_compare(int argc, char **argv)
     if (rc == EXIT_OK && cli_interrupted)
         return cli_fail(EXIT_RUN, "compare: interrupted; rerun the same command to resume");
     if (rc == EXIT_OK && failures)
-        fprintf(stderr, "gibench: compare: %d of %u methods failed (see %s/report.md)\n", failures, n, o.out);
+        fprintf(stderr, "gibench: compare: %d of %u methods failed (see %s/report.md)\n", failures,
+                n, o.out);
     return rc;
 }

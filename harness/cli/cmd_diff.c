@@ -72,10 +72,11 @@ static int parse_opts(int argc, char **argv, diff_opts *o)
         } else if (!strcmp(a, "--dark-threshold")) {
             if (!cli_parse_float(v, &o->m.dark_threshold) || !(o->m.dark_threshold > 0.0f) ||
                 o->m.dark_threshold > 1.0f)
-                return cli_fail(EXIT_USAGE,
-                                "diff: --dark-threshold '%s' is not a number in (0, 1] (a share of the "
-                                "reference's mean luminance)",
-                                v);
+                return cli_fail(
+                    EXIT_USAGE,
+                    "diff: --dark-threshold '%s' is not a number in (0, 1] (a share of the "
+                    "reference's mean luminance)",
+                    v);
         } else {
             if (!cli_parse_float(v, &o->m.flip_ppd) || !(o->m.flip_ppd > 0.0f) ||
                 o->m.flip_ppd > 1e4f)
@@ -85,12 +86,15 @@ static int parse_opts(int argc, char **argv, diff_opts *o)
     if (o->black) {
         /* The trivial answer: a black image of the reference's size. */
         if (o->ref)
-            return cli_fail(EXIT_USAGE, "diff: --black takes the reference image only (gibench diff --black "
-                                        "REFERENCE)");
+            return cli_fail(EXIT_USAGE,
+                            "diff: --black takes the reference image only (gibench diff --black "
+                            "REFERENCE)");
         o->ref = o->test;
         o->test = NULL;
         if (!o->ref)
-            return cli_fail(EXIT_USAGE, "diff: --black needs the reference image (gibench diff --black REFERENCE)");
+            return cli_fail(
+                EXIT_USAGE,
+                "diff: --black needs the reference image (gibench diff --black REFERENCE)");
         return EXIT_OK;
     }
     if (!o->test || !o->ref)
@@ -178,9 +182,11 @@ static void print_human(const diff_opts *o, const gi_metrics *m)
     printf("mean_lum   %+.4g %% (test %.6g, reference %.6g)\n", m->mean_lum_diff_pct,
            m->mean_lum_test, m->mean_lum_ref);
     printf("flip       %.6f (LDR-FLIP at %.2f pixels per degree)\n", m->flip, (double)m->flip_ppd);
-    printf("leak       %.6g of the reference's light, in its dark pixels (%.4g %% of the image: luminance "
+    printf("leak       %.6g of the reference's light, in its dark pixels (%.4g %% of the image: "
+           "luminance "
            "below %g x its mean, the reference's own share there %.6g)\n",
-           m->leaked_energy, 100.0 * m->dark_fraction, (double)m->dark_threshold, m->dark_energy_ref);
+           m->leaked_energy, 100.0 * m->dark_fraction, (double)m->dark_threshold,
+           m->dark_energy_ref);
     if (o->heatmap)
         printf("heatmap    %s (|x - r| / (r + 0.01), log10 %g..%g, viridis)\n", o->heatmap,
                (double)GI_HEATMAP_RELERR_LO, (double)GI_HEATMAP_RELERR_HI);

@@ -34,11 +34,14 @@ static json_object *scene_json(const gi_scene *s)
     json_object *objs = json_object_new_array();
     for (uint32_t i = 0; i < s->object_count; i++) {
         json_object *x = json_object_new_object();
-        json_object_object_add(x, "name", json_object_new_string(s->objects[i].name ? s->objects[i].name : ""));
+        json_object_object_add(
+            x, "name", json_object_new_string(s->objects[i].name ? s->objects[i].name : ""));
         json_object_object_add(x, "triangles", json_object_new_int64(s->objects[i].triangle_count));
         json_object_object_add(x, "animated", json_object_new_boolean(s->objects[i].animated));
-        json_object_object_add(x, "morph_targets", json_object_new_int64(s->objects[i].morph_count));
-        json_object_object_add(x, "morph_animated", json_object_new_boolean(s->objects[i].morph_track.count > 0));
+        json_object_object_add(x, "morph_targets",
+                               json_object_new_int64(s->objects[i].morph_count));
+        json_object_object_add(x, "morph_animated",
+                               json_object_new_boolean(s->objects[i].morph_track.count > 0));
         json_object_array_add(objs, x);
     }
     json_object_object_add(o, "objects", objs);
@@ -59,7 +62,8 @@ static json_object *scene_json(const gi_scene *s)
     json_object *lights = json_object_new_array();
     for (uint32_t i = 0; i < s->light_count; i++) {
         json_object *x = json_object_new_object();
-        json_object_object_add(x, "name", json_object_new_string(s->lights[i].name ? s->lights[i].name : ""));
+        json_object_object_add(x, "name",
+                               json_object_new_string(s->lights[i].name ? s->lights[i].name : ""));
         json_object_object_add(x, "type", json_object_new_string(light_type(s->lights[i].type)));
         json_object_object_add(x, "intensity", vec3_json(s->lights[i].intensity));
         json_object_array_add(lights, x);
@@ -68,8 +72,10 @@ static json_object *scene_json(const gi_scene *s)
     json_object *cams = json_object_new_array();
     for (uint32_t i = 0; i < s->camera_count; i++) {
         json_object *x = json_object_new_object();
-        json_object_object_add(x, "name", json_object_new_string(s->cameras[i].name ? s->cameras[i].name : ""));
-        json_object_object_add(x, "yfov_deg", json_object_new_double(s->cameras[i].yfov * 180.0 / GI_PI));
+        json_object_object_add(
+            x, "name", json_object_new_string(s->cameras[i].name ? s->cameras[i].name : ""));
+        json_object_object_add(x, "yfov_deg",
+                               json_object_new_double(s->cameras[i].yfov * 180.0 / GI_PI));
         json_object_array_add(cams, x);
     }
     json_object_object_add(o, "cameras", cams);
@@ -77,7 +83,8 @@ static json_object *scene_json(const gi_scene *s)
         json_object *e = json_object_new_object();
         json_object_object_add(e, "uri", json_object_new_string(s->environment.uri));
         json_object_object_add(e, "intensity", json_object_new_double(s->environment.intensity));
-        json_object_object_add(e, "rotation_deg", json_object_new_double(s->environment.rotation_deg));
+        json_object_object_add(e, "rotation_deg",
+                               json_object_new_double(s->environment.rotation_deg));
         json_object_object_add(o, "environment", e);
     }
     return o;
@@ -86,12 +93,14 @@ static json_object *scene_json(const gi_scene *s)
 static void print_scene(const gi_scene *s)
 {
     printf("%s\n", s->path);
-    printf("  %u triangles, %u vertices, %u objects, %u materials, %u textures\n", s->triangle_count,
-           s->vertex_count, s->object_count, s->material_count, s->texture_count);
-    printf("  bounds [%g %g %g] - [%g %g %g]\n", s->bounds[0], s->bounds[1], s->bounds[2], s->bounds[3], s->bounds[4],
-           s->bounds[5]);
+    printf("  %u triangles, %u vertices, %u objects, %u materials, %u textures\n",
+           s->triangle_count, s->vertex_count, s->object_count, s->material_count,
+           s->texture_count);
+    printf("  bounds [%g %g %g] - [%g %g %g]\n", s->bounds[0], s->bounds[1], s->bounds[2],
+           s->bounds[3], s->bounds[4], s->bounds[5]);
     printf("  lights: %u emissive triangles, %u punctual%s%s\n", s->emitter_count, s->light_count,
-           s->has_environment ? ", environment " : "", s->has_environment ? s->environment.uri : "");
+           s->has_environment ? ", environment " : "",
+           s->has_environment ? s->environment.uri : "");
     if (s->animation_length > 0)
         printf("  animation: %g s\n", s->animation_length);
     for (uint32_t i = 0; i < s->object_count; i++) {
@@ -104,8 +113,9 @@ static void print_scene(const gi_scene *s)
     }
     for (uint32_t i = 0; i < s->material_count; i++) {
         const gi_material *m = &s->materials[i];
-        printf("  material %u %-18s albedo (%.3g %.3g %.3g)%s", i, m->name ? m->name : "", m->albedo[0], m->albedo[1],
-               m->albedo[2], m->albedo_texture >= 0 ? " x texture" : "");
+        printf("  material %u %-18s albedo (%.3g %.3g %.3g)%s", i, m->name ? m->name : "",
+               m->albedo[0], m->albedo[1], m->albedo[2],
+               m->albedo_texture >= 0 ? " x texture" : "");
         if (m->mirror)
             printf(" mirror ks (%.3g %.3g %.3g)", m->ks[0], m->ks[1], m->ks[2]);
         else if (m->ks[0] + m->ks[1] + m->ks[2] > 0)
@@ -115,9 +125,9 @@ static void print_scene(const gi_scene *s)
         printf("\n");
     }
     for (uint32_t i = 0; i < s->light_count; i++)
-        printf("  light %u %s %s intensity (%.4g %.4g %.4g)\n", i, s->lights[i].name ? s->lights[i].name : "",
-               light_type(s->lights[i].type), s->lights[i].intensity[0], s->lights[i].intensity[1],
-               s->lights[i].intensity[2]);
+        printf("  light %u %s %s intensity (%.4g %.4g %.4g)\n", i,
+               s->lights[i].name ? s->lights[i].name : "", light_type(s->lights[i].type),
+               s->lights[i].intensity[0], s->lights[i].intensity[1], s->lights[i].intensity[2]);
     for (uint32_t i = 0; i < s->camera_count; i++)
         printf("  camera %u %s yfov %.1f deg\n", i, s->cameras[i].name ? s->cameras[i].name : "",
                s->cameras[i].yfov * 180.0 / GI_PI);
@@ -145,7 +155,8 @@ int cmd_info(int argc, char **argv)
         return cli_fail(EXIT_USAGE, "%s", err.text);
     if (json) {
         json_object *o = scene_json(s);
-        puts(json_object_to_json_string_ext(o, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_SPACED | JSON_C_TO_STRING_NOSLASHESCAPE));
+        puts(json_object_to_json_string_ext(o, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_SPACED |
+                                                   JSON_C_TO_STRING_NOSLASHESCAPE));
         json_object_put(o);
     } else {
         print_scene(s);

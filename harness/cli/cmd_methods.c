@@ -11,7 +11,8 @@ static json_object *param_json(const gi_param_desc *d)
     json_object_object_add(p, "type", json_object_new_string(cli_param_type_name(d->type)));
     if (d->type == GI_PARAM_ENUM) {
         char buf[64];
-        json_object_object_add(p, "default", json_object_new_string(gi_param_choice(d, (int)d->def, buf, sizeof buf)));
+        json_object_object_add(
+            p, "default", json_object_new_string(gi_param_choice(d, (int)d->def, buf, sizeof buf)));
         json_object_object_add(p, "choices", json_object_new_string(d->choices));
     } else if (d->type == GI_PARAM_BOOL) {
         json_object_object_add(p, "default", json_object_new_boolean(d->def != 0.0));
@@ -46,8 +47,9 @@ static void print_param(const gi_param_desc *d)
         snprintf(range, sizeof range, "[%g, %g]", d->min, d->max);
         break;
     }
-    printf("    %-12s %-5s default %-8s %-18s %s%s%s%s\n", d->name, cli_param_type_name(d->type), def, range,
-           d->help ? d->help : "", d->symbol ? " (" : "", d->symbol ? d->symbol : "", d->symbol ? ")" : "");
+    printf("    %-12s %-5s default %-8s %-18s %s%s%s%s\n", d->name, cli_param_type_name(d->type),
+           def, range, d->help ? d->help : "", d->symbol ? " (" : "", d->symbol ? d->symbol : "",
+           d->symbol ? ")" : "");
 }
 
 int cmd_methods(int argc, char **argv)
@@ -82,17 +84,19 @@ int cmd_methods(int argc, char **argv)
             json_object_object_add(o, "params", ps);
             json_object_array_add(arr, o);
         }
-        puts(json_object_to_json_string_ext(arr, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_SPACED | JSON_C_TO_STRING_NOSLASHESCAPE));
+        puts(json_object_to_json_string_ext(arr, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_SPACED |
+                                                     JSON_C_TO_STRING_NOSLASHESCAPE));
         json_object_put(arr);
     } else {
         if (reg->count == 0)
-            printf("no method plugins found (build directory %s, GIBENCH_PLUGIN_PATH)\n", GIBENCH_PLUGIN_DIR);
+            printf("no method plugins found (build directory %s, GIBENCH_PLUGIN_PATH)\n",
+                   GIBENCH_PLUGIN_DIR);
         for (uint32_t i = 0; i < reg->count; i++) {
             const gi_method *m = reg->items[i].method;
             char caps[256];
             cli_caps_string(m->caps, caps, sizeof caps);
-            printf("%s  %s (v%s)\n  %s\n  caps: %s; indirect bounces: %u\n", m->id, m->title, m->version,
-                   m->citation, caps, m->max_bounces);
+            printf("%s  %s (v%s)\n  %s\n  caps: %s; indirect bounces: %u\n", m->id, m->title,
+                   m->version, m->citation, caps, m->max_bounces);
             if (m->params && m->params[0].name) {
                 printf("  parameters:\n");
                 for (const gi_param_desc *d = m->params; d->name; d++)

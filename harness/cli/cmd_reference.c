@@ -50,8 +50,7 @@ static int parse_opts(int argc, char **argv, ref_opts *o)
     static const char *valued[] = {"--scene",    "--camera",        "--size",        "--spp",
                                    "--time",     "--target-se",     "--max-bounces", "--seed",
                                    "--threads",  "--time-of-scene", "--out",         "--stats",
-                                   "--exposure", "--strategy",      "--pixel",
-                                   "--traversal"};
+                                   "--exposure", "--strategy",      "--pixel",       "--traversal"};
     memset(o, 0, sizeof *o);
     o->width = o->height = 256;
     o->seed = 1;
@@ -121,7 +120,9 @@ static int parse_opts(int argc, char **argv, ref_opts *o)
                                 "reference: --time-of-scene '%s' is not a non-negative number", v);
         } else if (!strcmp(a, "--exposure")) {
             if (!cli_parse_exposure(v, &o->exposure))
-                return cli_fail(EXIT_USAGE, "reference: --exposure '%s' is not a number of stops in -64..64", v);
+                return cli_fail(EXIT_USAGE,
+                                "reference: --exposure '%s' is not a number of stops in -64..64",
+                                v);
         } else if (!strcmp(a, "--strategy")) {
             int s = gi_ref_strategy_parse(v);
             if (s < 0)
@@ -177,8 +178,8 @@ static void progress_show(const progress *p, const ref_opts *o, uint64_t spp, do
     cli_format_duration(elapsed, el, sizeof el);
     if (frac > 0)
         cli_format_duration(elapsed * (1.0 - frac) / frac, eta, sizeof eta);
-    fprintf(stderr, "\rreference [%s] %3d%%  %llu spp  %s elapsed, ETA %s  SE %.4g\033[K", bar, (int)(frac * 100.0),
-            (unsigned long long)spp, el, eta, se);
+    fprintf(stderr, "\rreference [%s] %3d%%  %llu spp  %s elapsed, ETA %s  SE %.4g\033[K", bar,
+            (int)(frac * 100.0), (unsigned long long)spp, el, eta, se);
     fflush(stderr);
 }
 
@@ -398,7 +399,8 @@ static int run(run_state *r, const ref_opts *o)
            (unsigned long long)st.spp, st.render_seconds, stop,
            st.render_seconds > 0 ? 1e-6 * (double)st.rays / st.render_seconds : 0.0,
            gi_ref_mean_rel_se(r->ref));
-    return o->stats ? cli_save_json(o->stats, stats_json(r, o, camera, gi_now() - t_start, stop)) : EXIT_OK;
+    return o->stats ? cli_save_json(o->stats, stats_json(r, o, camera, gi_now() - t_start, stop))
+                    : EXIT_OK;
 }
 
 int cmd_reference(int argc, char **argv)

@@ -54,7 +54,8 @@ static int apply_view(render_opts *o)
     const view_file *v = &o->view;
     if (!o->method && !strcmp(v->method, "reference"))
         return cli_fail(EXIT_USAGE,
-                        "render: the view %s shows the path-traced reference; give --method M (or use gibench reference)",
+                        "render: the view %s shows the path-traced reference; give --method M (or "
+                        "use gibench reference)",
                         o->view_path);
     if (!o->scene)
         o->scene = v->scene;
@@ -94,9 +95,10 @@ static int parse_opts(int argc, char **argv, render_opts *o)
             o->no_cache = 1;
             continue;
         }
-        if (!strcmp(a, "--scene") || !strcmp(a, "--method") || !strcmp(a, "--camera") || !strcmp(a, "--out") ||
-            !strcmp(a, "--size") || !strcmp(a, "--param") || !strcmp(a, "--frames") || !strcmp(a, "--warmup") ||
-            !strcmp(a, "--time") || !strcmp(a, "--animate") || !strcmp(a, "--seed") || !strcmp(a, "--exposure") ||
+        if (!strcmp(a, "--scene") || !strcmp(a, "--method") || !strcmp(a, "--camera") ||
+            !strcmp(a, "--out") || !strcmp(a, "--size") || !strcmp(a, "--param") ||
+            !strcmp(a, "--frames") || !strcmp(a, "--warmup") || !strcmp(a, "--time") ||
+            !strcmp(a, "--animate") || !strcmp(a, "--seed") || !strcmp(a, "--exposure") ||
             !strcmp(a, "--timings") || !strcmp(a, "--curve-ref") || !strcmp(a, "--view") ||
             !strcmp(a, "--frames-out")) {
             if (!v)
@@ -119,19 +121,22 @@ static int parse_opts(int argc, char **argv, render_opts *o)
             char probe[4096];
             if (!cli_frame_path(v, 0, probe, sizeof probe))
                 return cli_fail(EXIT_USAGE,
-                                "render: --frames-out '%s' needs exactly one %%d (or %%0Nd) for the frame index "
+                                "render: --frames-out '%s' needs exactly one %%d (or %%0Nd) for "
+                                "the frame index "
                                 "(%%%% for a percent sign)",
                                 v);
             size_t pl = strlen(probe);
             if (pl < 5 || (strcmp(probe + pl - 4, ".exr") && strcmp(probe + pl - 4, ".pfm") &&
                            strcmp(probe + pl - 4, ".png")))
-                return cli_fail(EXIT_USAGE, "render: --frames-out '%s' must end in .exr, .pfm or .png", v);
+                return cli_fail(EXIT_USAGE,
+                                "render: --frames-out '%s' must end in .exr, .pfm or .png", v);
             o->frames_out = v;
-        }
-        else if (!strcmp(a, "--curve-ref")) {
+        } else if (!strcmp(a, "--curve-ref")) {
             const char *eq = strchr(v, '=');
             if (!eq || eq == v || !eq[1] || eq - v > 31)
-                return cli_fail(EXIT_USAGE, "render: --curve-ref '%s' is not NAME=IMAGE (a name of 1..31 characters)", v);
+                return cli_fail(
+                    EXIT_USAGE,
+                    "render: --curve-ref '%s' is not NAME=IMAGE (a name of 1..31 characters)", v);
             if (o->curve_ref_count == MAX_CURVE_REFS)
                 return cli_fail(EXIT_USAGE, "render: at most %d --curve-ref", MAX_CURVE_REFS);
             o->curve_name[o->curve_ref_count] = v;
@@ -149,16 +154,19 @@ static int parse_opts(int argc, char **argv, render_opts *o)
             o->params[o->param_count++] = v;
         } else if (!strcmp(a, "--frames")) {
             if (!cli_parse_uint(v, 1, 1000000, &u))
-                return cli_fail(EXIT_USAGE, "render: --frames '%s' is not an integer in 1..1000000", v);
+                return cli_fail(EXIT_USAGE, "render: --frames '%s' is not an integer in 1..1000000",
+                                v);
             o->frames = (uint32_t)u;
             o->given_frames = 1;
         } else if (!strcmp(a, "--warmup")) {
             if (!cli_parse_uint(v, 0, 1000, &u))
-                return cli_fail(EXIT_USAGE, "render: --warmup '%s' is not an integer in 0..1000", v);
+                return cli_fail(EXIT_USAGE, "render: --warmup '%s' is not an integer in 0..1000",
+                                v);
             o->warmup = (uint32_t)u;
         } else if (!strcmp(a, "--seed")) {
             if (!cli_parse_uint(v, 0, 0xFFFFFFFFul, &u))
-                return cli_fail(EXIT_USAGE, "render: --seed '%s' is not a 32-bit unsigned integer", v);
+                return cli_fail(EXIT_USAGE, "render: --seed '%s' is not a 32-bit unsigned integer",
+                                v);
             o->seed = (uint32_t)u;
             o->given_seed = 1;
         } else if (!strcmp(a, "--time")) {
@@ -167,10 +175,12 @@ static int parse_opts(int argc, char **argv, render_opts *o)
             o->given_time = 1;
         } else if (!strcmp(a, "--animate")) {
             if (!cli_parse_float(v, &o->animate_fps) || o->animate_fps <= 0)
-                return cli_fail(EXIT_USAGE, "render: --animate '%s' is not a positive frame rate", v);
+                return cli_fail(EXIT_USAGE, "render: --animate '%s' is not a positive frame rate",
+                                v);
         } else if (!strcmp(a, "--exposure")) {
             if (!cli_parse_exposure(v, &o->exposure))
-                return cli_fail(EXIT_USAGE, "render: --exposure '%s' is not a number of stops in -64..64", v);
+                return cli_fail(EXIT_USAGE,
+                                "render: --exposure '%s' is not a number of stops in -64..64", v);
             o->given_exposure = 1;
         }
     }
@@ -193,7 +203,8 @@ static int parse_opts(int argc, char **argv, render_opts *o)
     if (o->out_count == 0)
         return cli_fail(EXIT_USAGE, "render: --out is required");
     if (o->warmup >= o->frames && o->frames > 1)
-        return cli_fail(EXIT_USAGE, "render: --warmup %u leaves no timed frame of %u", o->warmup, o->frames);
+        return cli_fail(EXIT_USAGE, "render: --warmup %u leaves no timed frame of %u", o->warmup,
+                        o->frames);
     return EXIT_OK;
 }
 
@@ -223,9 +234,11 @@ static double peak_rss_mib(void)
     return kib / 1024.0;
 }
 
-static void make_view(const gi_scene *s, int camera, const render_opts *o, float t, uint32_t frame, gi_view *v)
+static void make_view(const gi_scene *s, int camera, const render_opts *o, float t, uint32_t frame,
+                      gi_view *v)
 {
-    gi_camera_frame cf = o->has_view ? view_file_camera(&o->view) : gi_scene_camera_at(s, camera, t);
+    gi_camera_frame cf =
+        o->has_view ? view_file_camera(&o->view) : gi_scene_camera_at(s, camera, t);
     gi_view_from_camera(&cf, o->width, o->height, t, v);
     v->frame_index = frame;
     v->seed = o->seed;
@@ -306,9 +319,10 @@ static int method_fail(run_state *r, const char *what, gi_result res)
     if (r->host_ready)
         cli_host_progress_end(&r->host);
     const char *msg = r->m->last_error(r->inst);
-    return cli_fail(res == GI_ERR_INVALID_ARGUMENT || res == GI_ERR_UNSUPPORTED ? EXIT_USAGE : EXIT_RUN,
-                    "%s: %s failed (%s)%s%s", r->m->id, what, gi_result_name(res), msg && *msg ? ": " : "",
-                    msg ? msg : "");
+    return cli_fail(res == GI_ERR_INVALID_ARGUMENT || res == GI_ERR_UNSUPPORTED ? EXIT_USAGE
+                                                                                : EXIT_RUN,
+                    "%s: %s failed (%s)%s%s", r->m->id, what, gi_result_name(res),
+                    msg && *msg ? ": " : "", msg ? msg : "");
 }
 
 /* Whether the error is recorded after 1-based frame k of n: every frame of
@@ -349,10 +363,11 @@ static json_object *curve_json(const run_state *r, const render_opts *o)
             json_object_object_add(mj, "relmse", json_object_new_double(m->relmse));
             json_object_object_add(mj, "rmse", json_object_new_double(m->rmse));
             json_object_object_add(mj, "mae", json_object_new_double(m->mae));
-            json_object_object_add(mj, "mean_lum_diff_pct", json_object_new_double(m->mean_lum_diff_pct));
+            json_object_object_add(mj, "mean_lum_diff_pct",
+                                   json_object_new_double(m->mean_lum_diff_pct));
             char name[32];
-            snprintf(name, sizeof name, "%.*s", (int)(strchr(o->curve_name[c], '=') - o->curve_name[c]),
-                     o->curve_name[c]);
+            snprintf(name, sizeof name, "%.*s",
+                     (int)(strchr(o->curve_name[c], '=') - o->curve_name[c]), o->curve_name[c]);
             json_object_object_add(p, name, mj);
         }
         json_object_array_add(arr, p);
@@ -365,7 +380,8 @@ static json_object *curve_json(const run_state *r, const render_opts *o)
  * against every --curve-ref (outside the timed frame). */
 static int record_curve_point(run_state *r, const render_opts *o, uint32_t k)
 {
-    if (o->curve_ref_count == 0 || !curve_frame_wanted(k, o->frames) || r->curve_n == MAX_CURVE_POINTS)
+    if (o->curve_ref_count == 0 || !curve_frame_wanted(k, o->frames) ||
+        r->curve_n == MAX_CURVE_POINTS)
         return EXIT_OK;
     gi_image *img = gi_gpu_read_texture(r->target_tex, o->width, o->height);
     if (!img)
@@ -373,7 +389,8 @@ static int record_curve_point(run_state *r, const render_opts *o, uint32_t k)
     gi_metrics_opts mo = {o->exposure, 0, 1, 0};
     for (int c = 0; c < o->curve_ref_count; c++) {
         gi_error err;
-        if (gi_metrics_compute(img, r->curve_ref[c], &mo, &r->curve_m[r->curve_n][c], &err) != GI_OK) {
+        if (gi_metrics_compute(img, r->curve_ref[c], &mo, &r->curve_m[r->curve_n][c], &err) !=
+            GI_OK) {
             gi_image_free(img);
             return cli_fail(EXIT_RUN, "render: error against %s: %s", o->curve_path[c], err.text);
         }
@@ -415,7 +432,10 @@ static json_object *timings_json(const run_state *r, const render_opts *o)
     json_object_object_add(j, "params", json_object_new_string(pstr ? pstr : ""));
     free(pstr);
     json_object_object_add(j, "scene", json_object_new_string(o->scene));
-    json_object_object_add(j, "camera", json_object_new_string(o->camera ? o->camera : o->has_view ? o->view_path : "#0"));
+    json_object_object_add(j, "camera",
+                           json_object_new_string(o->camera     ? o->camera
+                                                  : o->has_view ? o->view_path
+                                                                : "#0"));
     json_object_object_add(j, "width", json_object_new_int((int32_t)o->width));
     json_object_object_add(j, "height", json_object_new_int((int32_t)o->height));
     json_object_object_add(j, "frames", json_object_new_int((int32_t)o->frames));
@@ -427,7 +447,8 @@ static json_object *timings_json(const run_state *r, const render_opts *o)
     json_object_object_add(j, "gl_renderer", json_object_new_string(gi_gpu_renderer(r->gpu)));
     json_object_object_add(j, "gl_version", json_object_new_string(gi_gpu_version(r->gpu)));
     json_object_object_add(j, "egl_platform", json_object_new_string(gi_gpu_platform(r->gpu)));
-    json_object_object_add(j, "timer", json_object_new_string(gi_timer_mode_name(gi_timer_get_mode(r->render_timer))));
+    json_object_object_add(
+        j, "timer", json_object_new_string(gi_timer_mode_name(gi_timer_get_mode(r->render_timer))));
     json_object_object_add(j, "prepare", cli_timer_json(r->prep_timer));
     json_object_object_add(j, "render", cli_timer_json(r->render_timer));
     json_object_object_add(j, "stats", json_object_get(r->host.stats));
@@ -437,7 +458,8 @@ static json_object *timings_json(const run_state *r, const render_opts *o)
     for (int c = 0; c < 3; c++)
         json_object_array_add(mj, json_object_new_double(mean[c]));
     json_object_object_add(j, "mean_rgb", mj);
-    json_object_object_add(j, "nonfinite_pixels", json_object_new_int64((int64_t)gi_image_count_nonfinite(r->image)));
+    json_object_object_add(j, "nonfinite_pixels",
+                           json_object_new_int64((int64_t)gi_image_count_nonfinite(r->image)));
     /* peak resident memory (MiB): after prepare(), and of the whole run */
     json_object_object_add(j, "peak_rss_prepare_mib", json_object_new_double(r->rss_prepare_mib));
     json_object_object_add(j, "peak_rss_mib", json_object_new_double(peak_rss_mib()));
@@ -466,9 +488,11 @@ static void print_summary(const run_state *r, const render_opts *o)
         size_t used = strlen(files);
         snprintf(files + used, sizeof files - used, "%s%s", i ? ", " : "", o->outs[i]);
     }
-    printf("render: %s, %ux%u, %u frame%s (%u warm-up), median %.3g ms/frame, prepare %.3g ms (%s); wrote %s%s%s\n",
-           r->m->id, o->width, o->height, o->frames, o->frames == 1 ? "" : "s", o->warmup, median, prep,
-           gi_gpu_renderer(r->gpu), files, o->timings ? ", " : "", o->timings ? o->timings : "");
+    printf("render: %s, %ux%u, %u frame%s (%u warm-up), median %.3g ms/frame, prepare %.3g ms "
+           "(%s); wrote %s%s%s\n",
+           r->m->id, o->width, o->height, o->frames, o->frames == 1 ? "" : "s", o->warmup, median,
+           prep, gi_gpu_renderer(r->gpu), files, o->timings ? ", " : "",
+           o->timings ? o->timings : "");
 }
 
 static int run(run_state *r, const render_opts *o)
@@ -482,9 +506,11 @@ static int run(run_state *r, const render_opts *o)
         char known[512] = "";
         for (uint32_t i = 0; i < r->reg->count; i++) {
             size_t used = strlen(known);
-            snprintf(known + used, sizeof known - used, "%s%s", i ? ", " : "", r->reg->items[i].method->id);
+            snprintf(known + used, sizeof known - used, "%s%s", i ? ", " : "",
+                     r->reg->items[i].method->id);
         }
-        return cli_fail(EXIT_USAGE, "render: no method '%s' (installed: %s)", o->method, known[0] ? known : "none");
+        return cli_fail(EXIT_USAGE, "render: no method '%s' (installed: %s)", o->method,
+                        known[0] ? known : "none");
     }
     r->params = gi_params_parse(r->m->id, r->m->params, o->params, o->param_count, &err);
     if (!r->params)
@@ -507,7 +533,8 @@ static int run(run_state *r, const render_opts *o)
             view_scene_mark_moving(r->scene, o->view.nodes[i].node);
     }
     if (!cli_caps_cover(r->m, r->scene, o->animate_fps > 0 || moves, why, sizeof why))
-        gi_log(GI_LOG_WARN, "render: %s in %s: the image leaves that out (a study marks this cell n/a)", why,
+        gi_log(GI_LOG_WARN,
+               "render: %s in %s: the image leaves that out (a study marks this cell n/a)", why,
                o->scene);
     /* references of the convergence curve: read before anything is timed */
     for (int c = 0; c < o->curve_ref_count; c++) {
@@ -515,15 +542,17 @@ static int run(run_state *r, const render_opts *o)
         if (!r->curve_ref[c])
             return cli_fail(EXIT_USAGE, "render: --curve-ref: %s", err.text);
         if (r->curve_ref[c]->width != o->width || r->curve_ref[c]->height != o->height)
-            return cli_fail(EXIT_USAGE, "render: --curve-ref %s is %ux%u, the render %ux%u", o->curve_path[c],
-                            r->curve_ref[c]->width, r->curve_ref[c]->height, o->width, o->height);
+            return cli_fail(EXIT_USAGE, "render: --curve-ref %s is %ux%u, the render %ux%u",
+                            o->curve_path[c], r->curve_ref[c]->width, r->curve_ref[c]->height,
+                            o->width, o->height);
     }
     int camera = 0;
     if (o->camera && !o->has_view) {
         camera = gi_scene_find_camera(r->scene, o->camera);
         if (camera < 0)
-            return cli_fail(EXIT_USAGE, "render: %s has no camera '%s' (%u cameras; use a name or #k)", o->scene,
-                            o->camera, r->scene->camera_count);
+            return cli_fail(EXIT_USAGE,
+                            "render: %s has no camera '%s' (%u cameras; use a name or #k)",
+                            o->scene, o->camera, r->scene->camera_count);
     } else if (r->scene->camera_count == 0) {
         camera = -1;
     }
@@ -543,7 +572,8 @@ static int run(run_state *r, const render_opts *o)
     gi_timer_mode mode = gi_timer_mode_for(gi_gpu_is_software(r->gpu));
     r->prep_timer = gi_timer_create(mode, 0);
     r->render_timer = gi_timer_create(mode, o->warmup);
-    cli_host_init(&r->host, r->m->id, r->cache_dir, r->gs, gi_gpu_renderer(r->gpu), gi_gpu_is_software(r->gpu));
+    cli_host_init(&r->host, r->m->id, r->cache_dir, r->gs, gi_gpu_renderer(r->gpu),
+                  gi_gpu_is_software(r->gpu));
     r->host_ready = 1;
 
     glCreateTextures(GL_TEXTURE_2D, 1, &r->target_tex);
@@ -557,8 +587,9 @@ static int run(run_state *r, const render_opts *o)
     gi_error cerr;
     gi_result res = gi_method_create(r->m, &r->host.host, r->params, &r->inst, &cerr);
     if (res != GI_OK)
-        return cli_fail(res == GI_ERR_INVALID_ARGUMENT || res == GI_ERR_UNSUPPORTED ? EXIT_USAGE : EXIT_RUN, "%s: %s",
-                        r->m->id, cerr.text);
+        return cli_fail(res == GI_ERR_INVALID_ARGUMENT || res == GI_ERR_UNSUPPORTED ? EXIT_USAGE
+                                                                                    : EXIT_RUN,
+                        "%s: %s", r->m->id, cerr.text);
     r->host.timer = r->prep_timer;
     gi_timer_frame_begin(r->prep_timer);
     res = r->m->prepare(r->inst, r->gs);
@@ -593,7 +624,8 @@ static int run(run_state *r, const render_opts *o)
             cli_progress_show(&bar, (double)f / o->frames, f, o->frames, "frames");
         if (cli_interrupted) {
             cli_progress_end(&bar);
-            return cli_fail(EXIT_RUN, "render: interrupted after %u of %u frames; no image written", f, o->frames);
+            return cli_fail(EXIT_RUN, "render: interrupted after %u of %u frames; no image written",
+                            f, o->frames);
         }
         float t = o->time + (o->animate_fps > 0 ? (float)f / o->animate_fps : 0.0f);
         /* A frame of an animation is update() and render(): what an

@@ -16,7 +16,8 @@ static const char usage[] =
     "  info SCENE [--json]                    describe a scene file\n"
     "  render --scene S --method M --out FILE [--out FILE2] [--camera C] [--size WxH]\n"
     "         [--param k=v]... [--frames N] [--warmup N] [--time T] [--animate FPS]\n"
-    "         [--seed N] [--exposure EV] [--timings FILE.json] [--no-cache] [--curve-ref NAME=IMG]\n"
+    "         [--seed N] [--exposure EV] [--timings FILE.json] [--no-cache] [--curve-ref "
+    "NAME=IMG]\n"
     "         [--view VIEW.json]\n"
     "                                         render one method (EXR, PFM or PNG output)\n"
     "  view --scene S [--method M|reference] [--size WxH] [--param k=v]... [--camera C]\n"
@@ -25,8 +26,10 @@ static const char usage[] =
     "  diff TEST REFERENCE [--json] [--heatmap FILE.png] [--flip-map FILE.png]\n"
     "       [--exposure EV] [--ppd N]         error metrics (RMSE, relMSE, MAE, PSNR, SSIM, FLIP)\n"
     "  compare --scene S --methods a,b,...|all --out DIR [--size WxH] [--frames N] [--warmup N]\n"
-    "          [--camera C] [--reference FILE.exr] [--ref-spp N] [--ref-target-se E] [--ref-bounces B]\n"
-    "          [--timeout S] [--param method.k=v]... [--seed N] [--exposure EV] [--time T] [--fresh]\n"
+    "          [--camera C] [--reference FILE.exr] [--ref-spp N] [--ref-target-se E] "
+    "[--ref-bounces B]\n"
+    "          [--timeout S] [--param method.k=v]... [--seed N] [--exposure EV] [--time T] "
+    "[--fresh]\n"
     "                                         methods side by side against the references\n"
     "  study STUDY.json --out DIR [--jobs N] [--resume|--fresh] [--dry-run]\n"
     "                                         run a declarative experiment and write its report\n"
@@ -36,7 +39,8 @@ static const char usage[] =
     "         [--pixel box|center] [--traversal fast|robust]\n"
     "                                         Embree path-traced reference (EXR: mean + variance)\n"
     "  conformance [--method M] [--json] [--size N] [--item-timeout S]\n"
-    "                                         the conformance suite: every check on every method (or M)\n"
+    "                                         the conformance suite: every check on every method "
+    "(or M)\n"
     "exit status: 0 success, 1 failure while running, 2 bad usage or bad input\n";
 
 /* gibench --version: the version and commit; with -v also the GL renderer
@@ -49,8 +53,8 @@ static int print_version(void)
         gi_gpu *gpu = gi_gpu_create(NULL, &err);
         if (!gpu)
             return cli_fail(EXIT_RUN, "no GL context: %s", err.text);
-        printf("GL renderer: %s\nGL version: %s\nEGL platform: %s\n", gi_gpu_renderer(gpu), gi_gpu_version(gpu),
-               gi_gpu_platform(gpu));
+        printf("GL renderer: %s\nGL version: %s\nEGL platform: %s\n", gi_gpu_renderer(gpu),
+               gi_gpu_version(gpu), gi_gpu_platform(gpu));
         gi_gpu_destroy(gpu);
     }
     return EXIT_OK;
@@ -102,7 +106,8 @@ int main(int argc, char **argv)
             return cli_fail(EXIT_USAGE, "help: one command at a time (gibench help COMMAND)");
         const char *which = wants_help(1, sub_argv) ? "help" : sub_argv[0];
         if (!cli_command_help(which, stdout))
-            return cli_fail(EXIT_USAGE, "help: unknown command '%s' (see gibench --help)", sub_argv[0]);
+            return cli_fail(EXIT_USAGE, "help: unknown command '%s' (see gibench --help)",
+                            sub_argv[0]);
         return EXIT_OK;
     }
     if (wants_help(sub_argc, sub_argv)) {

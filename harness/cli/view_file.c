@@ -182,7 +182,8 @@ static const char *get_nodes(json_object *j, view_file *v)
     json_object *a;
     if (!json_object_object_get_ex(j, "nodes", &a))
         return NULL;
-    if (!json_object_is_type(a, json_type_array) || json_object_array_length(a) > VIEW_FILE_MAX_NODES)
+    if (!json_object_is_type(a, json_type_array) ||
+        json_object_array_length(a) > VIEW_FILE_MAX_NODES)
         return "nodes (an array of at most 256 node placements)";
     for (size_t i = 0; i < json_object_array_length(a); i++) {
         json_object *o = json_object_array_get_idx(a, i), *name;
@@ -191,7 +192,8 @@ static const char *get_nodes(json_object *j, view_file *v)
         if (!json_object_is_type(o, json_type_object) || !get_num(o, "node", 0, 1e9, &d) ||
             (n->node = (uint32_t)d) != d)
             return "nodes[].node (an index)";
-        if (!json_object_object_get_ex(o, "name", &name) || !json_object_is_type(name, json_type_string) ||
+        if (!json_object_object_get_ex(o, "name", &name) ||
+            !json_object_is_type(name, json_type_string) ||
             strlen(json_object_get_string(name)) >= sizeof n->name)
             return "nodes[].name";
         snprintf(n->name, sizeof n->name, "%s", json_object_get_string(name));
@@ -254,14 +256,16 @@ int view_file_read(const char *path, view_file *v, char *why, size_t why_size)
         bad = "time (>= 0)";
     else if (!get_num(j, "exposure", -64, 64, &d) || !isfinite(v->exposure = (float)d))
         bad = "exposure (-64..64)";
-    else if (!json_object_object_get_ex(j, "camera", &cam) || !json_object_is_type(cam, json_type_object))
+    else if (!json_object_object_get_ex(j, "camera", &cam) ||
+             !json_object_is_type(cam, json_type_object))
         bad = "camera";
     else if (!get_vec3(cam, "eye", &v->eye))
         bad = "camera.eye";
     else if (!get_vec3(cam, "forward", &v->forward) || gi_v3_length(v->forward) < 1e-12f)
         bad = "camera.forward (non-zero)";
     else if (!get_vec3(cam, "up", &v->up) ||
-             gi_v3_length(gi_v3_cross(v->forward, v->up)) < 1e-6f * gi_v3_length(v->forward) * gi_v3_length(v->up))
+             gi_v3_length(gi_v3_cross(v->forward, v->up)) <
+                 1e-6f * gi_v3_length(v->forward) * gi_v3_length(v->up))
         bad = "camera.up (not along forward)";
     else if (!get_num(cam, "yfov", 1e-4, 3.14, &d) || !isfinite(v->yfov = (float)d))
         bad = "camera.yfov (radians, 0..pi)";
@@ -269,7 +273,8 @@ int view_file_read(const char *path, view_file *v, char *why, size_t why_size)
         bad = "camera.znear (> 0)";
     else if (!get_num(cam, "zfar", 0, 1e30, &d) || !((v->zfar = (float)d) > v->znear))
         bad = "camera.zfar (> znear)";
-    else if (!json_object_object_get_ex(j, "params", &pa) || !json_object_is_type(pa, json_type_array) ||
+    else if (!json_object_object_get_ex(j, "params", &pa) ||
+             !json_object_is_type(pa, json_type_array) ||
              json_object_array_length(pa) > VIEW_FILE_MAX_PARAMS)
         bad = "params (an array of \"k=v\")";
     for (size_t i = 0; !bad && i < json_object_array_length(pa); i++) {
@@ -291,7 +296,8 @@ int view_file_read(const char *path, view_file *v, char *why, size_t why_size)
 
 int view_scene_under(const gi_scene *s, int node, const unsigned char *moved)
 {
-    for (int k = node, hops = 0; k >= 0 && (uint32_t)k < s->node_count && hops <= (int)s->node_count;
+    for (int k = node, hops = 0;
+         k >= 0 && (uint32_t)k < s->node_count && hops <= (int)s->node_count;
          k = s->nodes[k].parent, hops++)
         if (moved[k])
             return 1;
@@ -301,7 +307,8 @@ int view_scene_under(const gi_scene *s, int node, const unsigned char *moved)
 /* Whether node k or an ancestor carries an animation track. */
 static int node_animated(const gi_scene *s, int node)
 {
-    for (int k = node, hops = 0; k >= 0 && hops <= (int)s->node_count; k = s->nodes[k].parent, hops++) {
+    for (int k = node, hops = 0; k >= 0 && hops <= (int)s->node_count;
+         k = s->nodes[k].parent, hops++) {
         const gi_node *n = &s->nodes[k];
         if (n->anim_t.count || n->anim_r.count || n->anim_s.count)
             return 1;
@@ -314,17 +321,19 @@ int view_file_check_nodes(const view_file *v, const gi_scene *s, char *why, size
     for (uint32_t i = 0; i < v->node_count; i++) {
         const view_node *n = &v->nodes[i];
         if (n->node >= s->node_count) {
-            snprintf(why, why_size, "the view moves node %u; the scene has %u nodes", n->node, s->node_count);
+            snprintf(why, why_size, "the view moves node %u; the scene has %u nodes", n->node,
+                     s->node_count);
             return 0;
         }
         const char *name = s->nodes[n->node].name ? s->nodes[n->node].name : "";
         if (strcmp(name, n->name)) {
-            snprintf(why, why_size, "the view moves node %u '%s'; the scene's node %u is '%s'", n->node, n->name,
-                     n->node, name);
+            snprintf(why, why_size, "the view moves node %u '%s'; the scene's node %u is '%s'",
+                     n->node, n->name, n->node, name);
             return 0;
         }
         if (node_animated(s, (int)n->node)) {
-            snprintf(why, why_size, "the view moves node %u '%s', which the scene animates", n->node, name);
+            snprintf(why, why_size, "the view moves node %u '%s', which the scene animates",
+                     n->node, name);
             return 0;
         }
     }
@@ -390,7 +399,8 @@ int view_camera_read(const char *camera, view_file *v, char *why, size_t why_siz
     if (!camera || strncmp(camera, "view:", 5))
         return 0;
     if (!camera[5]) {
-        snprintf(why, why_size, "camera 'view:' names no file (view:FILE.json, a view saved by gibench view)");
+        snprintf(why, why_size,
+                 "camera 'view:' names no file (view:FILE.json, a view saved by gibench view)");
         return -1;
     }
     return view_file_read(camera + 5, v, why, why_size) ? 1 : -1;

@@ -17,18 +17,18 @@
  * dragged or rotated, a light moved): its local translation, rotation
  * (quaternion x y z w) and scale replace the file's. */
 typedef struct view_node {
-    uint32_t node;   /* index into gi_scene.nodes */
-    char name[128];  /* the node's name ("" when it has none), checked on load */
+    uint32_t node;  /* index into gi_scene.nodes */
+    char name[128]; /* the node's name ("" when it has none), checked on load */
     float translation[3], rotation[4], scale[3];
 } view_node;
 
 typedef struct view_file {
     char scene[4096];
-    char method[64];   /* a method id, or "reference" for the path tracer */
+    char method[64];                    /* a method id, or "reference" for the path tracer */
     char *params[VIEW_FILE_MAX_PARAMS]; /* "k=v", malloc'd */
     uint32_t param_count;
     uint32_t width, height;
-    uint32_t frames;   /* frames accumulated since the last change (progressive methods) */
+    uint32_t frames; /* frames accumulated since the last change (progressive methods) */
     uint32_t seed;
     float time, exposure;
     gi_vec3 eye, forward, up; /* the camera: eye looking along forward, up roughly +Y */

@@ -64,7 +64,8 @@ static uint32_t list_scenes(char names[][512], uint32_t max)
     struct dirent *e;
     while ((e = readdir(d)) && n < max) {
         size_t len = strlen(e->d_name);
-        if ((len > 5 && !strcmp(e->d_name + len - 5, ".gltf")) || (len > 4 && !strcmp(e->d_name + len - 4, ".glb")))
+        if ((len > 5 && !strcmp(e->d_name + len - 5, ".gltf")) ||
+            (len > 4 && !strcmp(e->d_name + len - 4, ".glb")))
             snprintf(names[n++], 512, "%s/%s", CONF_SCENES, e->d_name);
     }
     closedir(d);
@@ -121,11 +122,11 @@ static void param_items(const gi_method *m, conf_item *items, uint32_t *n)
     }
 }
 
-static const char *const check_order[] = {"furnace_0.5", "furnace_0.8", "scenes",       "determinism",
-                                          "resize_prepare", "update_transforms", "update_vertices",
-                                          "update_lights", "update_camera", "params", "unknown_params",
-                                          "light_area", "light_point", "light_spot", "light_directional",
-                                          "light_environment"};
+static const char *const check_order[] = {
+    "furnace_0.5",       "furnace_0.8",     "scenes",        "determinism",   "resize_prepare",
+    "update_transforms", "update_vertices", "update_lights", "update_camera", "params",
+    "unknown_params",    "light_area",      "light_point",   "light_spot",    "light_directional",
+    "light_environment"};
 #define CHECK_COUNT (sizeof check_order / sizeof check_order[0])
 
 static uint32_t build_items(const gi_method *m, conf_item *items)
@@ -217,8 +218,8 @@ static void instance_free(session *S)
 static int method_error(session *S, const char *what, gi_result r)
 {
     const char *msg = S->inst ? S->m->last_error(S->inst) : "";
-    snprintf(S->why, sizeof S->why, "%s failed (%s)%s%s", what, gi_result_name(r), msg && *msg ? ": " : "",
-             msg ? msg : "");
+    snprintf(S->why, sizeof S->why, "%s failed (%s)%s%s", what, gi_result_name(r),
+             msg && *msg ? ": " : "", msg ? msg : "");
     return 0;
 }
 
@@ -233,7 +234,8 @@ static int instance_new(session *S, const char *const *kv, uint32_t n, const sce
         return 0;
     }
     /* No cache directory: precomputation runs afresh, nothing is kept. */
-    cli_host_init(&S->host, S->m->id, NULL, sc->gs, gi_gpu_renderer(S->gpu), gi_gpu_is_software(S->gpu));
+    cli_host_init(&S->host, S->m->id, NULL, sc->gs, gi_gpu_renderer(S->gpu),
+                  gi_gpu_is_software(S->gpu));
     S->host.show_progress = 0;
     S->host_ready = 1;
     gi_error cerr;
@@ -267,11 +269,13 @@ static int target_size(session *S, uint32_t w, uint32_t h)
 
 /* The view of the scene's first camera at time t; shift moves the eye
  * along the camera's right axis (the camera-change check). */
-static void make_view(const gi_scene *s, float t, uint32_t w, uint32_t h, float shift, uint32_t seed, gi_view *v)
+static void make_view(const gi_scene *s, float t, uint32_t w, uint32_t h, float shift,
+                      uint32_t seed, gi_view *v)
 {
     gi_camera_frame cf = gi_scene_camera_at(s, s->camera_count ? 0 : -1, t);
     if (shift != 0.0f) {
-        gi_vec3 right = gi_v3(cf.world_from_camera[0], cf.world_from_camera[1], cf.world_from_camera[2]);
+        gi_vec3 right =
+            gi_v3(cf.world_from_camera[0], cf.world_from_camera[1], cf.world_from_camera[2]);
         cf.eye = gi_v3_add(cf.eye, gi_v3_scale(right, shift));
         cf.world_from_camera[12] = cf.eye.x;
         cf.world_from_camera[13] = cf.eye.y;
@@ -282,8 +286,8 @@ static void make_view(const gi_scene *s, float t, uint32_t w, uint32_t h, float 
 }
 
 /* Renders `frames` frames (frame_index first, first + 1, ...) and reads the image back. */
-static gi_image *render_frames(session *S, const scene_ref *sc, float t, uint32_t w, uint32_t h, uint32_t frames,
-                               uint32_t first, float shift, uint32_t seed)
+static gi_image *render_frames(session *S, const scene_ref *sc, float t, uint32_t w, uint32_t h,
+                               uint32_t frames, uint32_t first, float shift, uint32_t seed)
 {
     gi_error err;
     target_size(S, w, h);
@@ -312,9 +316,12 @@ static gi_image *render_frames(session *S, const scene_ref *sc, float t, uint32_
 
 /* A fresh instance on sc, `frames` frames at t = 0 of size x size with
  * `seed`: the image, or NULL with the reason kept in S. */
-static gi_image *fresh_render(session *S, const scene_ref *sc, uint32_t size, uint32_t frames, uint32_t seed)
+static gi_image *fresh_render(session *S, const scene_ref *sc, uint32_t size, uint32_t frames,
+                              uint32_t seed)
 {
-    return instance_new(S, NULL, 0, sc) ? render_frames(S, sc, 0.0f, size, size, frames, 0, 0.0f, seed) : NULL;
+    return instance_new(S, NULL, 0, sc)
+               ? render_frames(S, sc, 0.0f, size, size, frames, 0, 0.0f, seed)
+               : NULL;
 }
 
 static int update(session *S, scene_ref *sc, uint32_t flags, float t)
@@ -328,7 +335,7 @@ static int update(session *S, scene_ref *sc, uint32_t flags, float t)
 /* ------------------------------------------------------- image measures */
 
 typedef struct img_stats {
-    double mean;       /* of (R + G + B) / 3 over finite pixels */
+    double mean; /* of (R + G + B) / 3 over finite pixels */
     uint64_t nonfinite, negative;
 } img_stats;
 
@@ -418,10 +425,11 @@ static void conf_path(char *out, size_t size, const char *name)
  * resize and camera checks run on it; the parameter sweep on the same
  * scenes made of one object (one_object: per-object precomputation such as
  * csm's N^2 maps costs a third). */
-static int pick_scene_from(session *S, int one_object, char *path, size_t size, scene_ref *sc, result *r)
+static int pick_scene_from(session *S, int one_object, char *path, size_t size, scene_ref *sc,
+                           result *r)
 {
-    static const char *const names[] = {"all.gltf", "area_point.gltf", "area.gltf", "point.gltf",
-                                        "directional.gltf", "environment.gltf"};
+    static const char *const names[] = {"all.gltf",   "area_point.gltf",  "area.gltf",
+                                        "point.gltf", "directional.gltf", "environment.gltf"};
     char why[256] = "";
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
         if (one_object && i < 2)
@@ -484,7 +492,8 @@ static conf_status check_furnace(session *S, const conf_opts *o, const char *arg
     gi_image_free(img);
     int ok = fabs(dev) <= FURNACE_TOL && frac >= FURNACE_PIXEL_SHARE;
     return set(r, ok ? R_PASS : R_FAIL,
-               "rho %.1f, B = %u: mean %.4f, expected %.4f (%+.2f %%); %.1f %% of pixels within 5 %% (worst %.1f %%)",
+               "rho %.1f, B = %u: mean %.4f, expected %.4f (%+.2f %%); %.1f %% of pixels within 5 "
+               "%% (worst %.1f %%)",
                rho, B, mean, expect, 100.0 * dev, 100.0 * frac, 100.0 * worst);
 }
 
@@ -530,9 +539,12 @@ static conf_status check_determinism(session *S, const conf_opts *o, result *r)
     gi_image_free(b);
     const char *base = strrchr(path, '/') + 1;
     if (differ)
-        return set(r, R_FAIL, "%s, seed 7, two fresh instances: %zu of %zu pixels differ (mean relative difference %.2g)",
+        return set(r, R_FAIL,
+                   "%s, seed 7, two fresh instances: %zu of %zu pixels differ (mean relative "
+                   "difference %.2g)",
                    base, differ, n, d);
-    return set(r, R_PASS, "%s, seed 7, two fresh instances, %u frame(s): bit-identical", base, frames);
+    return set(r, R_PASS, "%s, seed 7, two fresh instances, %u frame(s): bit-identical", base,
+               frames);
 }
 
 static conf_status check_resize(session *S, const conf_opts *o, result *r)
@@ -541,7 +553,8 @@ static conf_status check_resize(session *S, const conf_opts *o, result *r)
     scene_ref sc, sc2;
     if (!pick_scene(S, path, sizeof path, &sc, r))
         return r->status;
-    uint32_t w2 = o->size + 16, h2 = o->size > 16 ? o->size - 8 : o->size, frames = frames_for(S->m, 2);
+    uint32_t w2 = o->size + 16, h2 = o->size > 16 ? o->size - 8 : o->size,
+             frames = frames_for(S->m, 2);
     gi_image *a = NULL, *b = NULL, *c = NULL;
     if (instance_new(S, NULL, 0, &sc)) {
         a = render_frames(S, &sc, 0.0f, o->size, o->size, frames, 0, 0.0f, 3);
@@ -563,8 +576,9 @@ static conf_status check_resize(session *S, const conf_opts *o, result *r)
     else if (measure(a).mean > 0 && !(measure(b).mean > 0))
         st = set(r, R_FAIL, "black at %ux%u after %ux%u", w2, h2, o->size, o->size);
     else if (back > 0.01)
-        st = set(r, R_FAIL, "back at %ux%u the image differs from the first by %.2g (mean relative)", o->size,
-                 o->size, back);
+        st =
+            set(r, R_FAIL, "back at %ux%u the image differs from the first by %.2g (mean relative)",
+                o->size, o->size, back);
     gi_image_free(a);
     gi_image_free(b);
     gi_image_free(c);
@@ -579,7 +593,8 @@ static conf_status check_resize(session *S, const conf_opts *o, result *r)
         scene_free(&sc);
         return fail_why(r, S);
     }
-    if (!cli_caps_cover(S->m, sc2.scene, 0, why, sizeof why)) { /* then prepare the same scene again */
+    if (!cli_caps_cover(S->m, sc2.scene, 0, why,
+                        sizeof why)) { /* then prepare the same scene again */
         scene_free(&sc2);
         conf_path(path2, sizeof path2, strrchr(path, '/') + 1);
         if (!scene_open(S, path2, 0.0f, &sc2)) {
@@ -609,9 +624,12 @@ static conf_status check_resize(session *S, const conf_opts *o, result *r)
     if (!ok)
         return set(r, R_FAIL, "after a second prepare: %s", why);
     if (again > 0.01)
-        return set(r, R_FAIL, "after a second prepare (%s) the image differs from a fresh instance's by %.2g",
+        return set(r, R_FAIL,
+                   "after a second prepare (%s) the image differs from a fresh instance's by %.2g",
                    strrchr(path2, '/') + 1, again);
-    return set(r, R_PASS, "%ux%u -> %ux%u -> back (difference %.2g); second prepare on %s equals a fresh instance (%.2g)",
+    return set(r, R_PASS,
+               "%ux%u -> %ux%u -> back (difference %.2g); second prepare on %s equals a fresh "
+               "instance (%.2g)",
                o->size, o->size, w2, h2, back, strrchr(path2, '/') + 1, again);
 }
 
@@ -627,17 +645,21 @@ static conf_status check_update(session *S, const conf_opts *o, const char *whic
     const char *scene_name = NULL;
     int animated = 0;
     if (!strcmp(which, "transforms")) {
-        cap = GI_CAP_RIGID_MOTION, flags = GI_CHANGED_TRANSFORMS, t1 = 1.5f, scene_name = "moving.gltf", animated = 1;
+        cap = GI_CAP_RIGID_MOTION, flags = GI_CHANGED_TRANSFORMS, t1 = 1.5f,
+        scene_name = "moving.gltf", animated = 1;
     } else if (!strcmp(which, "vertices")) {
         cap = GI_CAP_DEFORMATION, flags = GI_CHANGED_VERTICES, t1 = 2.0f;
     } else if (!strcmp(which, "lights")) {
-        cap = GI_CAP_POINT_LIGHTS, flags = GI_CHANGED_LIGHTS, t1 = 1.5f, scene_name = "light_moving.gltf";
+        cap = GI_CAP_POINT_LIGHTS, flags = GI_CHANGED_LIGHTS, t1 = 1.5f,
+        scene_name = "light_moving.gltf";
     } else {
         flags = GI_CHANGED_CAMERA, shift = 0.6f;
     }
     if (cap && !(S->m->caps & cap)) {
-        static const char *const what[] = {"transforms", "rigid motion", "vertices", "deformation", "lights",
-                                           "point lights (the light-change check moves a point light)"};
+        static const char *const what[] = {
+            "transforms", "rigid motion",
+            "vertices",   "deformation",
+            "lights",     "point lights (the light-change check moves a point light)"};
         const char *c = "";
         for (int i = 0; i < 6; i += 2)
             if (!strcmp(which, what[i]))
@@ -686,13 +708,17 @@ static conf_status check_update(session *S, const conf_opts *o, const char *whic
     if (!ok)
         return set(r, R_FAIL, "after update: %s", why);
     if (!(old_d > 0.01))
-        return set(r, R_FAIL, "%s: the change does not show (difference %.2g); the check cannot judge", base, old_d);
+        return set(r, R_FAIL,
+                   "%s: the change does not show (difference %.2g); the check cannot judge", base,
+                   old_d);
     if (!(new_d <= 0.1 * old_d))
         return set(r, R_FAIL,
-                   "%s: after update() the image is %.3g from a fresh instance's of the new state (the old image: %.3g); "
+                   "%s: after update() the image is %.3g from a fresh instance's of the new state "
+                   "(the old image: %.3g); "
                    "limit a tenth",
                    base, new_d, old_d);
-    return set(r, R_PASS, "%s: after update() %.3g from a fresh instance (the old image %.3g)", base, new_d, old_d);
+    return set(r, R_PASS, "%s: after update() %.3g from a fresh instance (the old image %.3g)",
+               base, new_d, old_d);
 }
 
 static conf_status check_param(session *S, const conf_opts *o, const char *kv, result *r)
@@ -711,7 +737,8 @@ static conf_status check_param(session *S, const conf_opts *o, const char *kv, r
         return fail_why(r, S);
     int ok = sane(img, why, sizeof why);
     gi_image_free(img);
-    return ok ? set(r, R_PASS, "%s on %s", kv, strrchr(path, '/') + 1) : set(r, R_FAIL, "%s: %s", kv, why);
+    return ok ? set(r, R_PASS, "%s on %s", kv, strrchr(path, '/') + 1)
+              : set(r, R_FAIL, "%s: %s", kv, why);
 }
 
 /* The host refuses what the table does not allow; checked on the method's
@@ -725,7 +752,8 @@ static conf_status check_unknown(session *S, result *r)
     snprintf(bad[n++], 128, "conformance_no_such_parameter=1");
     for (const gi_param_desc *d = S->m->params; d && d->name && n < 64; d++) {
         if (d->type == GI_PARAM_INT || d->type == GI_PARAM_FLOAT)
-            snprintf(bad[n++], 128, "%s=%.9g", d->name, d->max + (d->type == GI_PARAM_INT ? 1.0 : fabs(d->max) + 1.0));
+            snprintf(bad[n++], 128, "%s=%.9g", d->name,
+                     d->max + (d->type == GI_PARAM_INT ? 1.0 : fabs(d->max) + 1.0));
         else if (d->type == GI_PARAM_ENUM)
             snprintf(bad[n++], 128, "%s=conformance_no_such_choice", d->name);
         else
@@ -743,7 +771,8 @@ static conf_status check_unknown(session *S, result *r)
     }
     if (accepted)
         return set(r, R_FAIL, "%u of %u bad settings accepted, e.g. %s", accepted, n, first);
-    return set(r, R_PASS, "%u bad settings refused (unknown name, out of range, no such choice)", n);
+    return set(r, R_PASS, "%u bad settings refused (unknown name, out of range, no such choice)",
+               n);
 }
 
 /* A scene lit only by one light type must come out non-black and brighter
@@ -781,8 +810,9 @@ static conf_status check_light(session *S, const conf_opts *o, const char *kind,
     if (!ok)
         return set(r, R_FAIL, "%s", why);
     if (!(ml > 1e-3) || !(ml > 2.0 * md + 1e-4))
-        return set(r, R_FAIL, "claims %s light but the scene lit only by it has mean %.3g (without it %.3g)", kind, ml,
-                   md);
+        return set(r, R_FAIL,
+                   "claims %s light but the scene lit only by it has mean %.3g (without it %.3g)",
+                   kind, ml, md);
     return set(r, R_PASS, "mean %.4g lit, %.3g without the light", ml, md);
 }
 
@@ -954,13 +984,16 @@ static void group_cells(const conf_item *items, const item_result *res, uint32_t
                     snprintf(ce->detail, sizeof ce->detail, "%s", res[k].detail);
             continue;
         }
-        append(ce->detail, sizeof ce->detail, "%u run, %u pass, %u n/a, %u fail", total, pass, na, fails);
+        append(ce->detail, sizeof ce->detail, "%u run, %u pass, %u n/a, %u fail", total, pass, na,
+               fails);
         for (uint32_t k = 0; k < n; k++) {
             if (strcmp(items[k].group, check_order[c]) || res[k].status == R_PASS)
                 continue;
-            const char *name = strrchr(items[k].arg, '/') ? strrchr(items[k].arg, '/') + 1 : items[k].arg;
+            const char *name =
+                strrchr(items[k].arg, '/') ? strrchr(items[k].arg, '/') + 1 : items[k].arg;
             if (res[k].status == R_FAIL || !strcmp(check_order[c], "scenes"))
-                append(ce->detail, sizeof ce->detail, "; %s %s: %s", name, status_name[res[k].status], res[k].detail);
+                append(ce->detail, sizeof ce->detail, "; %s %s: %s", name,
+                       status_name[res[k].status], res[k].detail);
         }
     }
 }
@@ -982,10 +1015,21 @@ static int run_method(const conf_opts *o, const gi_method *m, const char *tmpdir
     while (next < n) {
         snprintf(log, sizeof log, "%s/%s-%u.log", tmpdir, m->id, next);
         snprintf(from, sizeof from, "%u", next);
-        char *argv[] = {(char *)cli_self_exe(), "conformance", "--run-items", "--method", (char *)m->id,
-                        "--size", size, "--item-timeout", timeout, "--from", from, NULL};
+        char *argv[] = {(char *)cli_self_exe(),
+                        "conformance",
+                        "--run-items",
+                        "--method",
+                        (char *)m->id,
+                        "--size",
+                        size,
+                        "--item-timeout",
+                        timeout,
+                        "--from",
+                        from,
+                        NULL};
         cli_proc_result pr;
-        /* The alarm in the child limits each item; this limit only guards against a child that ignores it. */
+        /* The alarm in the child limits each item; this limit only guards against a child that
+         * ignores it. */
         double limit = 60.0;
         for (uint32_t k = next; k < n; k++)
             limit += item_limit(m, &items[k], o->item_timeout);
@@ -997,12 +1041,15 @@ static int run_method(const conf_opts *o, const gi_method *m, const char *tmpdir
                 snprintf(res[k].detail, sizeof res[k].detail, "%s", pr.last_line);
             break;
         }
-        if (pr.exit_code == 0 && !pr.signaled && !pr.timed_out && started <= -2 && (uint32_t)(-2 - started) + 1 >= n)
+        if (pr.exit_code == 0 && !pr.signaled && !pr.timed_out && started <= -2 &&
+            (uint32_t)(-2 - started) + 1 >= n)
             break; /* ran to the end */
         /* The child ended early: the item it was in (or, when it died
          * between items, the next one) fails with the child's last words. */
         char d[700];
-        uint32_t at = started >= 0 ? (uint32_t)started : started < -1 ? (uint32_t)(-1 - started) : next;
+        uint32_t at = started >= 0   ? (uint32_t)started
+                      : started < -1 ? (uint32_t)(-1 - started)
+                                     : next;
         if (pr.signaled && pr.signal == SIGALRM)
             snprintf(d, sizeof d, "timed out after %g s (the per-item limit)",
                      at < n ? item_limit(m, &items[at], o->item_timeout) : o->item_timeout);
@@ -1040,15 +1087,16 @@ static void print_table(const gi_method *const *ms, uint32_t count, cell (*cells
         printf("\n");
     }
     for (uint32_t i = 0; i < count; i++) {
-        printf("\n%s (max_bounces %u, furnace bounce limit B = %u):\n", ms[i]->id, ms[i]->max_bounces,
-               ms[i]->max_bounces + 1);
+        printf("\n%s (max_bounces %u, furnace bounce limit B = %u):\n", ms[i]->id,
+               ms[i]->max_bounces, ms[i]->max_bounces + 1);
         for (size_t c = 0; c < CHECK_COUNT; c++)
-            printf("  %-18s %-4s %5.1f s  %s\n", check_order[c], status_name[cells[i][c].status], cells[i][c].seconds,
-                   cells[i][c].detail);
+            printf("  %-18s %-4s %5.1f s  %s\n", check_order[c], status_name[cells[i][c].status],
+                   cells[i][c].seconds, cells[i][c].detail);
     }
 }
 
-static json_object *table_json(const gi_method *const *ms, uint32_t count, cell (*cells)[CHECK_COUNT], int failed)
+static json_object *table_json(const gi_method *const *ms, uint32_t count,
+                               cell (*cells)[CHECK_COUNT], int failed)
 {
     json_object *root = json_object_new_object();
     json_object_object_add(root, "status", json_object_new_string(failed ? "fail" : "pass"));
@@ -1060,7 +1108,8 @@ static json_object *table_json(const gi_method *const *ms, uint32_t count, cell 
         json_object *checks = json_object_new_object();
         for (size_t c = 0; c < CHECK_COUNT; c++) {
             json_object *co = json_object_new_object();
-            json_object_object_add(co, "status", json_object_new_string(status_name[cells[i][c].status]));
+            json_object_object_add(co, "status",
+                                   json_object_new_string(status_name[cells[i][c].status]));
             json_object_object_add(co, "detail", json_object_new_string(cells[i][c].detail));
             json_object_object_add(co, "seconds", json_object_new_double(cells[i][c].seconds));
             json_object_object_add(checks, check_order[c], co);
@@ -1093,18 +1142,22 @@ int cmd_conformance(int argc, char **argv)
                 o.method = v;
             } else if (!strcmp(a, "--size")) {
                 if (!cli_parse_uint(v, 32, 64, &u))
-                    return cli_fail(EXIT_USAGE, "conformance: --size '%s' is not an integer in 32..64", v);
+                    return cli_fail(EXIT_USAGE,
+                                    "conformance: --size '%s' is not an integer in 32..64", v);
                 o.size = (uint32_t)u;
             } else if (!strcmp(a, "--item-timeout")) {
                 float t;
                 if (!cli_parse_float(v, &t) || t < 1.0f)
-                    return cli_fail(EXIT_USAGE, "conformance: --item-timeout '%s' is not a number of seconds >= 1", v);
+                    return cli_fail(
+                        EXIT_USAGE,
+                        "conformance: --item-timeout '%s' is not a number of seconds >= 1", v);
                 o.item_timeout = t;
             } else if (!cli_parse_uint(v, 0, MAX_ITEMS, &from)) {
                 return cli_fail(EXIT_USAGE, "conformance: --from '%s' is not an item index", v);
             }
         } else {
-            return cli_fail(EXIT_USAGE, "conformance: unknown argument '%s' (see gibench --help)", a);
+            return cli_fail(EXIT_USAGE, "conformance: unknown argument '%s' (see gibench --help)",
+                            a);
         }
     }
     if (child) {

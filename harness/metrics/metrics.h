@@ -63,10 +63,11 @@
 #include <stdint.h>
 
 typedef struct gi_metrics_opts {
-    float exposure; /* stops, applied before tonemapping (psnr, ssim, flip); 0 = none */
-    float flip_ppd; /* FLIP pixels per degree; 0 = GI_FLIP_PPD_DEFAULT (67.02) */
-    int skip_flip;  /* nonzero: leave flip NaN (it is the slowest metric) */
-    float dark_threshold; /* leaked energy: dark = Y(r) below this times mean Y(r); 0 = GI_DARK_THRESHOLD_DEFAULT */
+    float exposure;       /* stops, applied before tonemapping (psnr, ssim, flip); 0 = none */
+    float flip_ppd;       /* FLIP pixels per degree; 0 = GI_FLIP_PPD_DEFAULT (67.02) */
+    int skip_flip;        /* nonzero: leave flip NaN (it is the slowest metric) */
+    float dark_threshold; /* leaked energy: dark = Y(r) below this times mean Y(r); 0 =
+                             GI_DARK_THRESHOLD_DEFAULT */
 } gi_metrics_opts;
 
 /* Dark pixels of leaked_energy: luminance below 1 % of the reference's mean. */

@@ -131,7 +131,8 @@ static gi_result place_lights(ref_scene *rs, float t, gi_error *err)
 
 static gi_result place_camera(ref_scene *rs, const gi_ref_desc *d, gi_error *err)
 {
-    gi_camera_frame cf = d->camera_frame ? *d->camera_frame : gi_scene_camera_at(rs->scene, d->camera, d->time);
+    gi_camera_frame cf =
+        d->camera_frame ? *d->camera_frame : gi_scene_camera_at(rs->scene, d->camera, d->time);
     ref_camera *c = &rs->cam;
     c->eye = cf.eye;
     c->forward = gi_v3_normalize(cf.forward);

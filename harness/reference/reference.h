@@ -68,9 +68,9 @@ typedef enum gi_ref_strategy {
 #define GI_REF_UNLIMITED (-1)
 
 typedef struct gi_ref_desc {
-    const gi_scene *scene;  /* required; borrowed */
-    int camera;             /* camera index for gi_scene_camera_at; -1 (or none in the
-                               file) = the default view of the bounds */
+    const gi_scene *scene; /* required; borrowed */
+    int camera;            /* camera index for gi_scene_camera_at; -1 (or none in the
+                              file) = the default view of the bounds */
     /* When not NULL, this camera instead of `camera` (copied by gi_ref_create):
      * a free camera, e.g. gibench view's orbit camera or a saved view. */
     const gi_camera_frame *camera_frame;
@@ -133,14 +133,15 @@ gi_image *gi_ref_variance_image(const gi_ref *r);
 double gi_ref_mean_rel_se(const gi_ref *r);
 
 typedef struct gi_ref_stats {
-    uint64_t spp;          /* samples per pixel */
-    uint64_t nonfinite;    /* NaN/Inf samples, discarded (each counted once) */
-    uint64_t rays;         /* closest-hit and shadow rays traced */
-    uint32_t threads;      /* worker threads */
-    double build_seconds;  /* scene validation + BVH build in gi_ref_create */
-    double render_seconds; /* wall time inside gi_ref_render, summed */
-    double render_cpu_seconds; /* the process's CPU time (every thread) inside gi_ref_render, summed:
-                                  what studies timed by CPU time compare with (README "Speed against accuracy") */
+    uint64_t spp;              /* samples per pixel */
+    uint64_t nonfinite;        /* NaN/Inf samples, discarded (each counted once) */
+    uint64_t rays;             /* closest-hit and shadow rays traced */
+    uint32_t threads;          /* worker threads */
+    double build_seconds;      /* scene validation + BVH build in gi_ref_create */
+    double render_seconds;     /* wall time inside gi_ref_render, summed */
+    double render_cpu_seconds; /* the process's CPU time (every thread) inside gi_ref_render,
+                                  summed: what studies timed by CPU time compare with (README "Speed
+                                  against accuracy") */
 } gi_ref_stats;
 void gi_ref_get_stats(const gi_ref *r, gi_ref_stats *out);
 

@@ -402,7 +402,8 @@ bool bar_end_ok(double v, int log)
 /* The error bars of a series as one line plot of separate segments
  * (vtkPlotLine without PolyLine joins points 0-1, 2-3, ...): thin, in the
  * series' colour, no markers, no legend entry. */
-void add_bars(vtkChartXY *chart, const gi_chart_desc &d, const gi_chart_series &s, const unsigned char *c)
+void add_bars(vtkChartXY *chart, const gi_chart_desc &d, const gi_chart_series &s,
+              const unsigned char *c)
 {
     vtkNew<vtkTable> table;
     vtkNew<vtkDoubleArray> xs, ys;
@@ -628,7 +629,8 @@ void set_axis(vtkAxis *axis, const char *title, int log, const double range[2], 
 }
 
 /* Both axis ranges: the extent of the drawn points and error bars. */
-void ranges(const gi_chart_desc &d, const gi_chart_series *series, uint32_t n, double xr[2], double yr[2])
+void ranges(const gi_chart_desc &d, const gi_chart_series *series, uint32_t n, double xr[2],
+            double yr[2])
 {
     double lo[2] = {HUGE_VAL, HUGE_VAL}, hi[2] = {-HUGE_VAL, -HUGE_VAL};
     auto take = [&](int axis, double v) {
@@ -641,9 +643,11 @@ void ranges(const gi_chart_desc &d, const gi_chart_series *series, uint32_t n, d
             if (kept(d, s, i)) {
                 take(0, s.x[i]);
                 take(1, s.y[i]);
-                if (s.x_lo && s.x_hi && bar_end_ok(s.x_lo[i], d.log_x) && bar_end_ok(s.x_hi[i], d.log_x))
+                if (s.x_lo && s.x_hi && bar_end_ok(s.x_lo[i], d.log_x) &&
+                    bar_end_ok(s.x_hi[i], d.log_x))
                     take(0, s.x_lo[i]), take(0, s.x_hi[i]);
-                if (s.y_lo && s.y_hi && bar_end_ok(s.y_lo[i], d.log_y) && bar_end_ok(s.y_hi[i], d.log_y))
+                if (s.y_lo && s.y_hi && bar_end_ok(s.y_lo[i], d.log_y) &&
+                    bar_end_ok(s.y_hi[i], d.log_y))
                     take(1, s.y_lo[i]), take(1, s.y_hi[i]);
             }
     }
@@ -691,7 +695,8 @@ gi_result render(const gi_chart_desc &d, const gi_chart_series *series, uint32_t
     style_text(chart->GetTitleProperties(), 17, true, dejavu);
     double xr[2], yr[2];
     ranges(d, series, n, xr, yr);
-    set_axis(chart->GetAxis(vtkAxis::BOTTOM), d.x_label, d.log_x, xr, dejavu, d.x_ticks, d.x_tick_count);
+    set_axis(chart->GetAxis(vtkAxis::BOTTOM), d.x_label, d.log_x, xr, dejavu, d.x_ticks,
+             d.x_tick_count);
     set_axis(chart->GetAxis(vtkAxis::LEFT), d.y_label, d.log_y, yr, dejavu, nullptr, 0);
     for (uint32_t k = 0; k < n; k++)
         add_series(chart, d, series[k], k, *title ? title : what);
@@ -732,8 +737,8 @@ gi_result render(const gi_chart_desc &d, const gi_chart_series *series, uint32_t
     writer->SetInputConnection(grab->GetOutputPort());
     writer->Write();
     vtkUnsignedCharArray *result = writer->GetResult();
-    if (writer->GetErrorCode() != vtkErrorCode::NoError || !out.capture->first_error.empty() || !result ||
-        result->GetNumberOfValues() <= 0)
+    if (writer->GetErrorCode() != vtkErrorCode::NoError || !out.capture->first_error.empty() ||
+        !result || result->GetNumberOfValues() <= 0)
         return gi_error_set(err, GI_ERR_IO, "%s: PNG encoding failed: %s", what,
                             !out.capture->first_error.empty()
                                 ? out.capture->first_error.c_str()
@@ -773,8 +778,9 @@ gi_result validate(const gi_chart_desc &d, const gi_chart_series *series, uint32
                                 "%s: series %u ('%s'): unknown style %d", what, k + 1,
                                 label_of(s, k).c_str(), s.style);
         if (s.color < 0)
-            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: series %u ('%s'): colour index %d < 0",
-                                what, k + 1, label_of(s, k).c_str(), s.color);
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "%s: series %u ('%s'): colour index %d < 0", what, k + 1,
+                                label_of(s, k).c_str(), s.color);
         if (s.count > 0 && (!s.x || !s.y))
             return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
                                 "%s: series %u ('%s'): %u points but no x or y array", what, k + 1,
@@ -826,7 +832,8 @@ extern "C" gi_result gi_chart_write_png(const char *path, const gi_chart_desc *d
 extern "C" gi_result gi_chart_available(gi_error *err)
 {
     static const double x[] = {1.0, 10.0}, y[] = {1.0, 0.1};
-    gi_chart_series s = {"probe", x, y, 2, GI_CHART_LINE_MARKERS, 0, nullptr, nullptr, nullptr, nullptr};
+    gi_chart_series s = {"probe", x,       y,       2,       GI_CHART_LINE_MARKERS,
+                         0,       nullptr, nullptr, nullptr, nullptr};
     gi_chart_desc d = {"probe", "x", "y", 1, 1, 64, 48, nullptr, 0};
     try {
         std::lock_guard<std::mutex> lock(chart_mutex);

@@ -19,8 +19,8 @@
 #include <time.h>
 #include <unistd.h>
 
-const char *const report_metric_keys[] = {"relmse", "rmse", "mae", "psnr", "ssim", "flip", "mean_lum_diff_pct", NULL};
-
+const char *const report_metric_keys[] = {
+    "relmse", "rmse", "mae", "psnr", "ssim", "flip", "mean_lum_diff_pct", NULL};
 
 /* The machine, for the report: kernel, architecture, cores. */
 static void machine_string(char *buf, size_t size)
@@ -29,7 +29,8 @@ static void machine_string(char *buf, size_t size)
     if (uname(&u) != 0)
         snprintf(buf, size, "unknown");
     else
-        snprintf(buf, size, "%s %s %s, %ld cores", u.sysname, u.release, u.machine, sysconf(_SC_NPROCESSORS_ONLN));
+        snprintf(buf, size, "%s %s %s, %ld cores", u.sysname, u.release, u.machine,
+                 sysconf(_SC_NPROCESSORS_ONLN));
 }
 
 static void date_string(char *buf, size_t size)
@@ -49,8 +50,8 @@ static void command_string(const char *cmd, int argc, char **argv, char *buf, si
     }
 }
 
-json_object *report_meta_new(const char *title, const char *command, int argc, char **argv, const char *renderer,
-                             const char *reference)
+json_object *report_meta_new(const char *title, const char *command, int argc, char **argv,
+                             const char *renderer, const char *reference)
 {
     char cmd[4096], machine[256], date[64];
     command_string(command, argc, argv, cmd, sizeof cmd);
@@ -59,13 +60,14 @@ json_object *report_meta_new(const char *title, const char *command, int argc, c
     json_object *meta = json_object_new_object();
     json_object_object_add(meta, "title", json_object_new_string(title));
     json_object_object_add(meta, "command", json_object_new_string(cmd));
-    json_object_object_add(meta, "renderer", json_object_new_string(renderer && *renderer ? renderer : "(no run finished)"));
+    json_object_object_add(
+        meta, "renderer",
+        json_object_new_string(renderer && *renderer ? renderer : "(no run finished)"));
     json_object_object_add(meta, "reference", json_object_new_string(reference));
     json_object_object_add(meta, "machine", json_object_new_string(machine));
     json_object_object_add(meta, "date", json_object_new_string(date));
     return meta;
 }
-
 
 /* The text every output file is built in (text.h). */
 typedef gi_text text;
@@ -149,8 +151,13 @@ static int stage_names(json_object *runs, const char **names, int max)
 
 /* The last columns of runs.csv: the seed, and what the study's speed
  * against accuracy found for the run (tradeoff.h). */
-static const char *const tradeoff_keys[] = {"seed", "time_to_final_error_s", "frames_to_final_error",
-                                             "speedup_vs_pt", "speedup_vs_pt_matched", "speedup_extrapolated", NULL};
+static const char *const tradeoff_keys[] = {"seed",
+                                            "time_to_final_error_s",
+                                            "frames_to_final_error",
+                                            "speedup_vs_pt",
+                                            "speedup_vs_pt_matched",
+                                            "speedup_extrapolated",
+                                            NULL};
 
 /* The columns after those: leaked energy (metrics), memory, the scene's
  * size and an animated run's per-frame summary ("animation"), each a path
@@ -187,10 +194,12 @@ static void write_csv(text *t, json_object *runs)
     int ns = stage_names(runs, stages, 32);
     int np = key_names(runs, "prepare_stages", pstages, 32);
     int nst = key_names(runs, "stats", stats, 64);
-    put(t, "run,scene,method,params,status,reason,renderer,timer,frames,prepare_ms,frame_ms_median,frame_ms_min,"
+    put(t, "run,scene,method,params,status,reason,renderer,timer,frames,prepare_ms,frame_ms_median,"
+           "frame_ms_min,"
            "frame_ms_max");
     for (int k = 0; k < ns; k++)
-        put(t, ",stage_%s_ms_median,stage_%s_ms_min,stage_%s_ms_max", stages[k], stages[k], stages[k]);
+        put(t, ",stage_%s_ms_median,stage_%s_ms_min,stage_%s_ms_max", stages[k], stages[k],
+            stages[k]);
     for (int r = 0; r < 2; r++)
         for (int m = 0; report_metric_keys[m]; m++)
             put(t, ",%s_%s", report_metric_keys[m], r ? "matched" : "full");
@@ -207,7 +216,8 @@ static void write_csv(text *t, json_object *runs)
     size_t count = json_object_array_length(runs);
     for (size_t i = 0; i < count; i++) {
         json_object *o = json_object_array_get_idx(runs, i);
-        const char *fields[] = {"run", "scene", "method", "params", "status", "reason", "renderer", "timer"};
+        const char *fields[] = {"run",    "scene",  "method",   "params",
+                                "status", "reason", "renderer", "timer"};
         for (size_t f = 0; f < sizeof fields / sizeof fields[0]; f++)
             csv_field(t, str(o, fields[f]), 0);
         csv_num(t, num(o, "frames", NULL, NULL), 0);
@@ -233,7 +243,8 @@ static void write_csv(text *t, json_object *runs)
         for (int k = 0; tradeoff_keys[k]; k++)
             csv_num(t, num(o, tradeoff_keys[k], NULL, NULL), 0);
         for (size_t k = 0; k < EXTRA_COLUMNS; k++)
-            csv_num(t, num(o, extra_columns[k].k1, extra_columns[k].k2, extra_columns[k].k3), k + 1 == EXTRA_COLUMNS);
+            csv_num(t, num(o, extra_columns[k].k1, extra_columns[k].k2, extra_columns[k].k3),
+                    k + 1 == EXTRA_COLUMNS);
     }
 }
 
@@ -244,7 +255,8 @@ static void write_frames_csv(text *t, json_object *runs)
     size_t count = json_object_array_length(runs);
     for (size_t i = 0; i < count; i++) {
         json_object *o = json_object_array_get_idx(runs, i), *f;
-        if (!json_object_object_get_ex(o, "frame_samples_ms", &f) || !json_object_is_type(f, json_type_array))
+        if (!json_object_object_get_ex(o, "frame_samples_ms", &f) ||
+            !json_object_is_type(f, json_type_array))
             continue;
         for (size_t k = 0; k < json_object_array_length(f); k++) {
             csv_field(t, str(o, "run"), 0);
@@ -308,19 +320,23 @@ static void write_md(text *t, const char *dir, json_object *runs, json_object *m
     put(t, "- reference: %s\n", str(meta, "reference"));
     put(t, "- machine: %s\n", str(meta, "machine"));
     put(t, "- date: %s\n\n", str(meta, "date"));
-    put(t, "Errors are against the full-GI reference (\"full\") and against the reference limited to the "
-           "method's own bounce count (\"matched\"), so that method error and missing light are reported "
-           "apart. Times are medians over the timed frames; on a software renderer only ratios within one "
+    put(t, "Errors are against the full-GI reference (\"full\") and against the reference limited "
+           "to the "
+           "method's own bounce count (\"matched\"), so that method error and missing light are "
+           "reported "
+           "apart. Times are medians over the timed frames; on a software renderer only ratios "
+           "within one "
            "run mean anything.\n\n");
-    put(t, "| run | method | params | status | frame ms | prepare ms | relMSE full | relMSE matched | FLIP full "
+    put(t, "| run | method | params | status | frame ms | prepare ms | relMSE full | relMSE "
+           "matched | FLIP full "
            "| SSIM full | mean lum. diff %% |\n");
     put(t, "|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|\n");
     size_t count = json_object_array_length(runs);
     for (size_t i = 0; i < count; i++) {
         json_object *o = json_object_array_get_idx(runs, i);
         const char *status = str(o, "status");
-        put(t, "| %s | %s | `%s` | %s%s%s |", str(o, "run"), str(o, "method"), str(o, "params"), status,
-            strcmp(status, "ok") ? ": " : "", strcmp(status, "ok") ? str(o, "reason") : "");
+        put(t, "| %s | %s | `%s` | %s%s%s |", str(o, "run"), str(o, "method"), str(o, "params"),
+            status, strcmp(status, "ok") ? ": " : "", strcmp(status, "ok") ? str(o, "reason") : "");
         md_num(t, num(o, "frame_ms", "median", NULL));
         md_num(t, num(o, "prepare_ms", NULL, NULL));
         md_num(t, num(o, "metrics", "full", "relmse"));
@@ -358,7 +374,8 @@ static void write_md(text *t, const char *dir, json_object *runs, json_object *m
             put(t, "\n");
         }
     }
-    put(t, "\nImages (tonemapped at the report's exposure) and relative error against the full reference "
+    put(t, "\nImages (tonemapped at the report's exposure) and relative error against the full "
+           "reference "
            "(log scale, colour bar in each map):\n\n");
     const char *ref_png = str(meta, "reference_png");
     if (exists_in(dir, ref_png))
@@ -387,7 +404,8 @@ static void write_md(text *t, const char *dir, json_object *runs, json_object *m
     json_object *extra;
     if (json_object_object_get_ex(meta, "markdown", &extra))
         put(t, "\n%s\n", json_object_get_string(extra));
-    if (json_object_object_get_ex(meta, "animation_markdown", &extra) && *json_object_get_string(extra))
+    if (json_object_object_get_ex(meta, "animation_markdown", &extra) &&
+        *json_object_get_string(extra))
         put(t, "\n## Animated runs, frame by frame\n\n%s\n", json_object_get_string(extra));
 }
 
@@ -395,11 +413,20 @@ static void html_escape(text *t, const char *s)
 {
     for (; *s; s++) {
         switch (*s) {
-        case '<': put(t, "&lt;"); break;
-        case '>': put(t, "&gt;"); break;
-        case '&': put(t, "&amp;"); break;
-        case '"': put(t, "&quot;"); break;
-        default: put(t, "%c", *s);
+        case '<':
+            put(t, "&lt;");
+            break;
+        case '>':
+            put(t, "&gt;");
+            break;
+        case '&':
+            put(t, "&amp;");
+            break;
+        case '"':
+            put(t, "&quot;");
+            break;
+        default:
+            put(t, "%c", *s);
         }
     }
 }
@@ -472,7 +499,8 @@ static int write_hdr_js(const char *dir, const char *exr_rel, char *js_rel, size
                 i + 1 < nb ? b64_chars[v >> 6 & 63] : '=', i + 2 < nb ? b64_chars[v & 63] : '=');
         }
         put(&t, "\");\n");
-        ok = snprintf(path, sizeof path, "%s/%s", dir, js_rel) < (int)sizeof path && t.s && gi_file_write_atomic(path, t.s, t.len, &err) == GI_OK;
+        ok = snprintf(path, sizeof path, "%s/%s", dir, js_rel) < (int)sizeof path && t.s &&
+             gi_file_write_atomic(path, t.s, t.len, &err) == GI_OK;
     }
     free(t.s);
     free(rgbe);
@@ -491,8 +519,8 @@ static const char *png_of(const char *dir, const char *exr_rel, char *buf, size_
 }
 
 /* A viewer image: label, title (hover), the PNG, the HDR script, error maps, info line. */
-static json_object *viewer_image(const char *dir, const char *label, const char *title, const char *png,
-                                 const char *exr)
+static json_object *viewer_image(const char *dir, const char *label, const char *title,
+                                 const char *png, const char *exr)
 {
     json_object *im = json_object_new_object();
     json_object_object_add(im, "label", json_object_new_string(label));
@@ -518,10 +546,11 @@ static void run_label(json_object *o, char *buf, size_t size)
 static void run_info(json_object *o, char *buf, size_t size)
 {
     snprintf(buf, size, "run %s, %s", str(o, "run"), str(o, "status"));
-    const char *names[] = {"frame ms (median)", "prepare ms", "relMSE full", "relMSE matched", "FLIP full", "SSIM full"};
-    double vals[] = {num(o, "frame_ms", "median", NULL), num(o, "prepare_ms", NULL, NULL),
+    const char *names[] = {"frame ms (median)", "prepare ms", "relMSE full",
+                           "relMSE matched",    "FLIP full",  "SSIM full"};
+    double vals[] = {num(o, "frame_ms", "median", NULL),  num(o, "prepare_ms", NULL, NULL),
                      num(o, "metrics", "full", "relmse"), num(o, "metrics", "matched", "relmse"),
-                     num(o, "metrics", "full", "flip"), num(o, "metrics", "full", "ssim")};
+                     num(o, "metrics", "full", "flip"),   num(o, "metrics", "full", "ssim")};
     for (size_t k = 0; k < sizeof vals / sizeof vals[0]; k++)
         if (vals[k] == vals[k]) {
             size_t used = strlen(buf);
@@ -557,8 +586,10 @@ static void add_run_image(const char *dir, json_object *images, json_object *o)
     }
     snprintf(title, sizeof title, "run %s: %s", raw(o, "run"), str(o, "params"));
     const char *png = raw(o, "png");
-    json_object *im = viewer_image(dir, label, title, *png ? png : NULL, *raw(o, "image") ? raw(o, "image") : NULL);
-    if (!json_object_object_get_ex(im, "png", NULL) && !json_object_object_get_ex(im, "hdr", NULL)) {
+    json_object *im = viewer_image(dir, label, title, *png ? png : NULL,
+                                   *raw(o, "image") ? raw(o, "image") : NULL);
+    if (!json_object_object_get_ex(im, "png", NULL) &&
+        !json_object_object_get_ex(im, "hdr", NULL)) {
         json_object_put(im);
         return;
     }
@@ -596,24 +627,30 @@ static json_object *viewer_sets(const char *dir, json_object *runs, json_object 
 {
     json_object *sets = json_object_new_array(), *refs;
     double ev = num(meta, "exposure", NULL, NULL);
-    if (json_object_object_get_ex(meta, "references", &refs) && json_object_is_type(refs, json_type_array)) {
+    if (json_object_object_get_ex(meta, "references", &refs) &&
+        json_object_is_type(refs, json_type_array)) {
         for (size_t r = 0; r < json_object_array_length(refs); r++) {
             json_object *rs = json_object_array_get_idx(refs, r), *set = json_object_new_object();
             json_object *images = json_object_new_array(), *matched, *ids;
             json_object_object_add(set, "name", json_object_new_string(raw(rs, "name")));
             char label[128];
-            snprintf(label, sizeof label, "reference, full GI (%g bounces)", num(rs, "bounces", NULL, NULL));
-            json_object_array_add(images, viewer_image(dir, label, raw(rs, "full"), NULL, raw(rs, "full")));
+            snprintf(label, sizeof label, "reference, full GI (%g bounces)",
+                     num(rs, "bounces", NULL, NULL));
+            json_object_array_add(images,
+                                  viewer_image(dir, label, raw(rs, "full"), NULL, raw(rs, "full")));
             if (json_object_object_get_ex(rs, "matched", &matched))
                 for (size_t k = 0; k < json_object_array_length(matched); k++) {
                     json_object *m = json_object_array_get_idx(matched, k);
-                    snprintf(label, sizeof label, "reference, %g bounce%s", num(m, "bounces", NULL, NULL),
+                    snprintf(label, sizeof label, "reference, %g bounce%s",
+                             num(m, "bounces", NULL, NULL),
                              num(m, "bounces", NULL, NULL) == 1 ? "" : "s");
-                    json_object_array_add(images, viewer_image(dir, label, raw(m, "image"), NULL, raw(m, "image")));
+                    json_object_array_add(
+                        images, viewer_image(dir, label, raw(m, "image"), NULL, raw(m, "image")));
                 }
             if (json_object_object_get_ex(rs, "runs", &ids))
                 for (size_t k = 0; k < json_object_array_length(ids); k++) {
-                    json_object *o = find_run(runs, json_object_get_string(json_object_array_get_idx(ids, k)));
+                    json_object *o =
+                        find_run(runs, json_object_get_string(json_object_array_get_idx(ids, k)));
                     if (o)
                         add_run_image(dir, images, o);
                 }
@@ -710,7 +747,8 @@ static void md_to_html(text *t, const char *md)
                     a++;
                 while (b > a && b[-1] == ' ')
                     b--;
-                put(t, row == 0 ? "<th class=l>" : "<td%s>", row && b > a && (*a < '0' || *a > '9') ? " class=l" : "");
+                put(t, row == 0 ? "<th class=l>" : "<td%s>",
+                    row && b > a && (*a < '0' || *a > '9') ? " class=l" : "");
                 md_inline(t, a, (size_t)(b - a));
                 put(t, row == 0 ? "</th>" : "</td>");
                 c = bar + 1;
@@ -771,13 +809,19 @@ static void write_html(text *t, const char *dir, json_object *runs, json_object 
         html_escape(t, str(meta, keys[k]));
         put(t, "%s</dd>", k == 0 ? "</code>" : "");
     }
-    put(t, "</dl>\n<nav><a href=\"#images\">images</a><a href=\"#runs\">runs</a><a href=\"#stages\">stage "
-           "timings</a><a href=\"#tradeoff\">speed against accuracy</a>%s<a href=\"#charts\">charts</a></nav>\n",
-        json_object_object_get_ex(meta, "animation_markdown", NULL) && *str(meta, "animation_markdown")
+    put(t,
+        "</dl>\n<nav><a href=\"#images\">images</a><a href=\"#runs\">runs</a><a "
+        "href=\"#stages\">stage "
+        "timings</a><a href=\"#tradeoff\">speed against accuracy</a>%s<a "
+        "href=\"#charts\">charts</a></nav>\n",
+        json_object_object_get_ex(meta, "animation_markdown", NULL) &&
+                *str(meta, "animation_markdown")
             ? "<a href=\"#animation\">animation</a>"
             : "");
-    put(t, "<p>Errors are against the full-GI reference (\"full\") and against the reference limited to the "
-           "method's own bounce count (\"matched\"). Times are medians over the timed frames; on a software "
+    put(t, "<p>Errors are against the full-GI reference (\"full\") and against the reference "
+           "limited to the "
+           "method's own bounce count (\"matched\"). Times are medians over the timed frames; on a "
+           "software "
            "renderer only ratios within one study mean anything.</p>\n");
 
     /* the image viewers, one per reference set */
@@ -789,15 +833,22 @@ static void write_html(text *t, const char *dir, json_object *runs, json_object 
         html_escape(t, raw(set, "name"));
         put(t, "</h3>\n<div class=\"gib-viewer\" data-set=\"%zu\"></div>\n", i);
     }
-    put(t, "<noscript><p>The image viewer needs JavaScript; the images are in runs/ and references/.</p></noscript>\n");
+    put(t, "<noscript><p>The image viewer needs JavaScript; the images are in runs/ and "
+           "references/.</p></noscript>\n");
 
     /* every run */
-    put(t, "<h2 id=\"runs\">Runs</h2>\n<p>Click a column header to sort. Parameters: those the study set; click "
-           "for the full string (defaults included).</p>\n<div class=\"scroll\"><table class=\"sortable\"><thead><tr>"
-           "<th class=l>run</th><th class=l>method</th><th class=l>params</th><th class=l>status</th><th>frames</th>"
-           "<th>frame ms</th><th>prepare ms</th><th>relMSE full</th><th>relMSE matched</th><th>FLIP full</th>"
-           "<th>SSIM full</th><th>mean lum. diff %%</th><th>speed-up vs PT</th><th>speed-up vs PT, matched</th>"
-           "<th>leaked energy full</th><th>peak RSS MiB</th><th>data MiB</th></tr></thead><tbody>\n");
+    put(t,
+        "<h2 id=\"runs\">Runs</h2>\n<p>Click a column header to sort. Parameters: those the study "
+        "set; click "
+        "for the full string (defaults included).</p>\n<div class=\"scroll\"><table "
+        "class=\"sortable\"><thead><tr>"
+        "<th class=l>run</th><th class=l>method</th><th class=l>params</th><th "
+        "class=l>status</th><th>frames</th>"
+        "<th>frame ms</th><th>prepare ms</th><th>relMSE full</th><th>relMSE matched</th><th>FLIP "
+        "full</th>"
+        "<th>SSIM full</th><th>mean lum. diff %%</th><th>speed-up vs PT</th><th>speed-up vs PT, "
+        "matched</th>"
+        "<th>leaked energy full</th><th>peak RSS MiB</th><th>data MiB</th></tr></thead><tbody>\n");
     size_t count = json_object_array_length(runs);
     for (size_t i = 0; i < count; i++) {
         json_object *o = json_object_array_get_idx(runs, i);
@@ -838,8 +889,10 @@ static void write_html(text *t, const char *dir, json_object *runs, json_object 
     if (ns == 0) {
         put(t, "<p>No run reported stage timings.</p>\n");
     } else {
-        put(t, "<p>Milliseconds, median (min – max) over the timed frames.</p>\n<div class=\"scroll\"><table "
-               "class=\"sortable\"><thead><tr><th class=l>run</th><th class=l>method</th><th class=l>params</th>");
+        put(t, "<p>Milliseconds, median (min – max) over the timed frames.</p>\n<div "
+               "class=\"scroll\"><table "
+               "class=\"sortable\"><thead><tr><th class=l>run</th><th class=l>method</th><th "
+               "class=l>params</th>");
         for (int k = 0; k < ns; k++) {
             put(t, "<th>");
             html_escape(t, stages[k]);
@@ -862,7 +915,8 @@ static void write_html(text *t, const char *dir, json_object *runs, json_object 
                 double mn = k < ns ? num(o, k1, k2, "min") : num(o, k1, "min", NULL);
                 double mx = k < ns ? num(o, k1, k2, "max") : num(o, k1, "max", NULL);
                 if (med == med)
-                    put(t, "<td data-v=\"%.9g\">%.4g <small>(%.4g – %.4g)</small></td>", med, med, mn, mx);
+                    put(t, "<td data-v=\"%.9g\">%.4g <small>(%.4g – %.4g)</small></td>", med, med,
+                        mn, mx);
                 else
                     put(t, "<td data-v=\"\">–</td>");
             }
@@ -879,7 +933,8 @@ static void write_html(text *t, const char *dir, json_object *runs, json_object 
     else
         put(t, "<p>Not computed for this report.</p>\n");
 
-    if (json_object_object_get_ex(meta, "animation_markdown", &extra) && *json_object_get_string(extra)) {
+    if (json_object_object_get_ex(meta, "animation_markdown", &extra) &&
+        *json_object_get_string(extra)) {
         put(t, "<h2 id=\"animation\">Animated runs, frame by frame</h2>\n");
         md_to_html(t, json_object_get_string(extra));
     }
@@ -930,8 +985,9 @@ int report_write(const char *dir, json_object *runs, json_object *meta, char *wh
 {
     text t = {0};
     /* every run record as it is (scripts read this: scripts/scale_fit.py) */
-    put(&t, "%s\n", json_object_to_json_string_ext(runs, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_SPACED |
-                                                           JSON_C_TO_STRING_NOSLASHESCAPE));
+    put(&t, "%s\n",
+        json_object_to_json_string_ext(runs, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_SPACED |
+                                                 JSON_C_TO_STRING_NOSLASHESCAPE));
     if (!write_text(dir, "runs.json", &t, why, why_size))
         return 0;
     write_csv(&t, runs);

@@ -28,7 +28,7 @@ int report_write(const char *dir, json_object *runs, json_object *meta, char *wh
 
 /* The report header: title, the command as typed ("gibench <command>
  * <argv...>"), GL renderer, reference description, machine and date. */
-json_object *report_meta_new(const char *title, const char *command, int argc, char **argv, const char *renderer,
-                             const char *reference);
+json_object *report_meta_new(const char *title, const char *command, int argc, char **argv,
+                             const char *renderer, const char *reference);
 
 #endif

@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define MAX_POINTS 64 /* render records at most this many curve points */
+#define MAX_POINTS 64       /* render records at most this many curve points */
 #define FRONT_MIN_GAIN 0.01 /* a front point must lower the error by this share */
 
 double tradeoff_pt_time_at(const tradeoff_pt_curve *c, double e, int *extrapolated)
@@ -120,7 +120,8 @@ typedef struct setting {
     double t_lo[MAX_POINTS], t_hi[MAX_POINTS], em_lo[MAX_POINTS], em_hi[MAX_POINTS];
     uint32_t frame[MAX_POINTS];
     double prep_s;
-    double rss_mib, data_mib; /* medians over repeats: peak resident memory, the method's data_bytes stat */
+    double rss_mib,
+        data_mib; /* medians over repeats: peak resident memory, the method's data_bytes stat */
     const char *renderer; /* the GL renderer its runs reported ("" when none) */
     char label[192];      /* the method, with its renderer when runs of a set differ in it */
 } setting;
@@ -129,8 +130,9 @@ typedef struct front_point {
     uint32_t s, k; /* setting and point */
 } front_point;
 
-static const tradeoff_pt_curve *curve_for(const tradeoff_pt_curve *full, const tradeoff_pt_curve *matched,
-                                          uint32_t matched_n, uint32_t bounces)
+static const tradeoff_pt_curve *curve_for(const tradeoff_pt_curve *full,
+                                          const tradeoff_pt_curve *matched, uint32_t matched_n,
+                                          uint32_t bounces)
 {
     for (uint32_t i = 0; i < matched_n; i++)
         if (matched[i].bounces == bounces && bounces < full->bounces)
@@ -144,8 +146,8 @@ static const tradeoff_pt_curve *curve_for(const tradeoff_pt_curve *full, const t
  * their renderer is the same, and when the runs disagree on the renderer
  * each method is listed once per renderer ("csm [NVIDIA ...]"), with its
  * own front and rows. */
-static uint32_t pool_settings(const tradeoff_run *runs, uint32_t run_n, setting *set, const char **methods,
-                              uint32_t *nm)
+static uint32_t pool_settings(const tradeoff_run *runs, uint32_t run_n, setting *set,
+                              const char **methods, uint32_t *nm)
 {
     uint32_t ns = 0;
     *nm = 0;
@@ -174,7 +176,8 @@ static uint32_t pool_settings(const tradeoff_run *runs, uint32_t run_n, setting 
         g->first = runs[i].record;
         g->renderer = renderer;
         if (mixed)
-            snprintf(g->label, sizeof g->label, "%s [%s]", str(runs[i].record, "method"), *renderer ? renderer : "no renderer");
+            snprintf(g->label, sizeof g->label, "%s [%s]", str(runs[i].record, "method"),
+                     *renderer ? renderer : "no renderer");
         else
             snprintf(g->label, sizeof g->label, "%s", str(runs[i].record, "method"));
         g->method = g->label;
@@ -231,7 +234,8 @@ static uint32_t pool_settings(const tradeoff_run *runs, uint32_t run_n, setting 
 /* Each method's Pareto front over all its settings' points (time, error):
  * no other point of the method is both faster and more accurate, and each
  * point is at least 1 % more accurate than the faster one before it. */
-static uint32_t pareto(const setting *set, uint32_t ns, uint32_t method, int matched, front_point *out)
+static uint32_t pareto(const setting *set, uint32_t ns, uint32_t method, int matched,
+                       front_point *out)
 {
     uint32_t n = 0;
     for (uint32_t s = 0; s < ns; s++) {
@@ -253,7 +257,8 @@ static uint32_t pareto(const setting *set, uint32_t ns, uint32_t method, int mat
             /* of equal points, the first one stands */
             for (uint32_t i = 0; i < n && !dominated; i++) {
                 const setting *o = &set[out[i].s];
-                dominated = o->t[out[i].k] == t && (matched ? o->em[out[i].k] : o->ef[out[i].k]) == e;
+                dominated =
+                    o->t[out[i].k] == t && (matched ? o->em[out[i].k] : o->ef[out[i].k]) == e;
             }
             if (!dominated)
                 out[n++] = (front_point){s, k};
@@ -261,7 +266,8 @@ static uint32_t pareto(const setting *set, uint32_t ns, uint32_t method, int mat
     }
     /* by time */
     for (uint32_t i = 1; i < n; i++)
-        for (uint32_t j = i; j > 0 && set[out[j].s].t[out[j].k] < set[out[j - 1].s].t[out[j - 1].k]; j--) {
+        for (uint32_t j = i; j > 0 && set[out[j].s].t[out[j].k] < set[out[j - 1].s].t[out[j - 1].k];
+             j--) {
             front_point tmp = out[j];
             out[j] = out[j - 1];
             out[j - 1] = tmp;
@@ -283,9 +289,10 @@ static uint32_t pareto(const setting *set, uint32_t ns, uint32_t method, int mat
     return kept;
 }
 
-static void chart(tradeoff_chart_fn write_chart, const char *out_dir, const char *name, int matched, const tradeoff_pt_curve *full,
-                  const tradeoff_pt_curve *mcurves, uint32_t matched_n, const setting *set, uint32_t ns,
-                  const char **methods, uint32_t nm, json_object *chart_list)
+static void chart(tradeoff_chart_fn write_chart, const char *out_dir, const char *name, int matched,
+                  const tradeoff_pt_curve *full, const tradeoff_pt_curve *mcurves,
+                  uint32_t matched_n, const setting *set, uint32_t ns, const char **methods,
+                  uint32_t nm, json_object *chart_list)
 {
     uint32_t cap = ns + 2 * nm + matched_n + 2;
     gi_chart_series *series = calloc(cap, sizeof *series);
@@ -302,11 +309,14 @@ static void chart(tradeoff_chart_fn write_chart, const char *out_dir, const char
     for (uint32_t m = 0; m < nm; m++) {
         for (uint32_t s = 0; s < ns; s++)
             if (set[s].method_index == m && set[s].n > 1)
-                series[n++] = (gi_chart_series){NULL, set[s].t, matched ? set[s].em : set[s].ef, set[s].n,
-                                                GI_CHART_THIN, (int)m + 1, NULL, NULL, NULL, NULL};
+                series[n++] =
+                    (gi_chart_series){NULL,     set[s].t,      matched ? set[s].em : set[s].ef,
+                                      set[s].n, GI_CHART_THIN, (int)m + 1,
+                                      NULL,     NULL,          NULL,
+                                      NULL};
         uint32_t k = pareto(set, ns, m, matched, fp);
-        double *x = fx + (size_t)m * per * 6, *y = x + per, *xl = y + per, *xh = xl + per, *yl = xh + per,
-               *yh = yl + per;
+        double *x = fx + (size_t)m * per * 6, *y = x + per, *xl = y + per, *xh = xl + per,
+               *yl = xh + per, *yh = yl + per;
         /* a staircase: between two settings on the front nothing better is
          * known than the slower one's error, reached at its own time. Each
          * front point carries the spread of its repeats as error bars
@@ -333,29 +343,48 @@ static void chart(tradeoff_chart_fn write_chart, const char *out_dir, const char
         }
         snprintf(labels[m], sizeof labels[m], "%s (Pareto front%s)", methods[m],
                  spread ? "; bars: min-max of repeats" : "");
-        series[n++] = (gi_chart_series){labels[m], x, y, c, GI_CHART_LINE_MARKERS, (int)m + 1,
-                                        spread ? xl : NULL, spread ? xh : NULL, spread ? yl : NULL,
+        series[n++] = (gi_chart_series){labels[m],
+                                        x,
+                                        y,
+                                        c,
+                                        GI_CHART_LINE_MARKERS,
+                                        (int)m + 1,
+                                        spread ? xl : NULL,
+                                        spread ? xh : NULL,
+                                        spread ? yl : NULL,
                                         spread ? yh : NULL};
     }
     int colour = (int)nm + 1;
     if (!matched) {
-        series[n++] = (gi_chart_series){"path tracer (Embree, CPU), full GI", full->t, full->e, full->n,
-                                        GI_CHART_DASHED, colour, NULL, NULL, NULL, NULL};
+        series[n++] = (gi_chart_series){"path tracer (Embree, CPU), full GI",
+                                        full->t,
+                                        full->e,
+                                        full->n,
+                                        GI_CHART_DASHED,
+                                        colour,
+                                        NULL,
+                                        NULL,
+                                        NULL,
+                                        NULL};
     } else {
         for (uint32_t i = 0; i < matched_n; i++) {
-            snprintf(labels[nm + i], sizeof labels[nm + i], "path tracer, max_bounces %u", mcurves[i].bounces);
-            series[n++] = (gi_chart_series){labels[nm + i], mcurves[i].t, mcurves[i].e, mcurves[i].n,
-                                            GI_CHART_DASHED, colour + (int)i, NULL, NULL, NULL, NULL};
+            snprintf(labels[nm + i], sizeof labels[nm + i], "path tracer, max_bounces %u",
+                     mcurves[i].bounces);
+            series[n++] = (gi_chart_series){
+                labels[nm + i],  mcurves[i].t, mcurves[i].e, mcurves[i].n, GI_CHART_DASHED,
+                colour + (int)i, NULL,         NULL,         NULL,         NULL};
         }
-        series[n++] = (gi_chart_series){"path tracer, full GI", full->t, full->e, full->n, GI_CHART_DASHED,
-                                        colour + (int)matched_n, NULL, NULL, NULL, NULL};
+        series[n++] =
+            (gi_chart_series){"path tracer, full GI",  full->t, full->e, full->n, GI_CHART_DASHED,
+                              colour + (int)matched_n, NULL,    NULL,    NULL,    NULL};
     }
     char file[512], path[4700], title[512];
     snprintf(file, sizeof file, "chart_%s_error_vs_time%s.png", name, matched ? "_matched" : "");
     snprintf(path, sizeof path, "%s/%s", out_dir, file);
     snprintf(title, sizeof title, "%s: relMSE against time (%s)", name,
              matched ? "bounce-matched references" : "full-GI reference");
-    gi_chart_desc desc = {title, "time to image (s): sum of frame times so far", "relMSE", 1, 1, 0, 0, NULL, 0};
+    gi_chart_desc desc = {
+        title, "time to image (s): sum of frame times so far", "relMSE", 1, 1, 0, 0, NULL, 0};
     gi_error err;
     if (write_chart(path, &desc, series, n, &err) == GI_OK)
         json_object_array_add(chart_list, json_object_new_string(file));
@@ -392,8 +421,9 @@ static void params_cell(gi_text *md, json_object *rec)
 /* Per record: the earliest recorded frame whose error is within 1 % of the
  * final image's (a method with an error floor is charged only the frames it
  * needs), and its speed-ups there. */
-static void annotate_records(const tradeoff_run *runs, uint32_t run_n, const tradeoff_pt_curve *full,
-                             const tradeoff_pt_curve *matched, uint32_t matched_n)
+static void annotate_records(const tradeoff_run *runs, uint32_t run_n,
+                             const tradeoff_pt_curve *full, const tradeoff_pt_curve *matched,
+                             uint32_t matched_n)
 {
     for (uint32_t i = 0; i < run_n; i++) {
         json_object *rec = runs[i].record;
@@ -408,7 +438,8 @@ static void annotate_records(const tradeoff_run *runs, uint32_t run_n, const tra
         while (k + 1 < n && !(ef[k] <= ef[n - 1] * 1.01))
             k++;
         json_object_object_add(rec, "time_to_final_error_s", json_object_new_double(t[k]));
-        json_object_object_add(rec, "frames_to_final_error", json_object_new_int((int32_t)frame[k]));
+        json_object_object_add(rec, "frames_to_final_error",
+                               json_object_new_int((int32_t)frame[k]));
         int ex = 0, exm = 0;
         double tpt = tradeoff_pt_time_at(full, ef[n - 1], &ex);
         const tradeoff_pt_curve *mc = curve_for(full, matched, matched_n, runs[i].bounces);
@@ -418,31 +449,40 @@ static void annotate_records(const tradeoff_run *runs, uint32_t run_n, const tra
             json_object_object_add(rec, "speedup_vs_pt", json_object_new_double(tpt / t[k]));
         }
         if (isfinite(tptm) && t[k] > 0)
-            json_object_object_add(rec, "speedup_vs_pt_matched", json_object_new_double(tptm / t[k]));
-        json_object_object_add(rec, "speedup_extrapolated", json_object_new_int(ex || exm)); /* 1: beyond the measured curve */
+            json_object_object_add(rec, "speedup_vs_pt_matched",
+                                   json_object_new_double(tptm / t[k]));
+        json_object_object_add(rec, "speedup_extrapolated",
+                               json_object_new_int(ex || exm)); /* 1: beyond the measured curve */
     }
 }
 
 static void equal_error_table(gi_text *md, const char *name, const tradeoff_pt_curve *full,
-                              const tradeoff_pt_curve *matched, uint32_t matched_n, const setting *set, uint32_t ns,
-                              const char **methods, uint32_t nm, front_point *fp)
+                              const tradeoff_pt_curve *matched, uint32_t matched_n,
+                              const setting *set, uint32_t ns, const char **methods, uint32_t nm,
+                              front_point *fp)
 {
-    gi_text_put(md,
-                 "#### %s: equal error (each method's Pareto front against the full-GI reference)\n\n"
-                 "Speed-up = the path tracer's time to the same relMSE ÷ the method's time to its image; "
-                 "\"matched\" compares the method's error against the reference of its own bounce count with "
-                 "the path tracer limited to that count. Precomputation is not in the time to image: it has "
-                 "its own column, and the next three add it amortised over 1, 100 and 10,000 images. Memory: "
-                 "the render process's peak resident set (MiB; on llvmpipe GPU buffers and textures count, "
-                 "on a hardware GPU they do not) and the size of the method's own precomputed data (its "
-                 "`data_bytes` statistic; \"–\" where it reports none), medians over repeats. "
-                 "\"*\": the path tracer's time is extrapolated beyond its measured curve (slope −1). "
-                 "relMSE over repeats: median [min–max].\n\n",
-                 name);
-    gi_text_put(md, "| method | params | frames | time to image (s) | relMSE full | path tracer, same error (s) | "
-                     "speed-up | relMSE matched | matched path tracer (s) | speed-up matched | precompute (s) | "
-                     "amortised ×1 (s) | ×100 (s) | ×10⁴ (s) | peak RSS (MiB) | data (MiB) |\n"
-                     "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    gi_text_put(
+        md,
+        "#### %s: equal error (each method's Pareto front against the full-GI reference)\n\n"
+        "Speed-up = the path tracer's time to the same relMSE ÷ the method's time to its image; "
+        "\"matched\" compares the method's error against the reference of its own bounce count "
+        "with "
+        "the path tracer limited to that count. Precomputation is not in the time to image: it has "
+        "its own column, and the next three add it amortised over 1, 100 and 10,000 images. "
+        "Memory: "
+        "the render process's peak resident set (MiB; on llvmpipe GPU buffers and textures count, "
+        "on a hardware GPU they do not) and the size of the method's own precomputed data (its "
+        "`data_bytes` statistic; \"–\" where it reports none), medians over repeats. "
+        "\"*\": the path tracer's time is extrapolated beyond its measured curve (slope −1). "
+        "relMSE over repeats: median [min–max].\n\n",
+        name);
+    gi_text_put(
+        md,
+        "| method | params | frames | time to image (s) | relMSE full | path tracer, same error "
+        "(s) | "
+        "speed-up | relMSE matched | matched path tracer (s) | speed-up matched | precompute (s) | "
+        "amortised ×1 (s) | ×100 (s) | ×10⁴ (s) | peak RSS (MiB) | data (MiB) |\n"
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (uint32_t m = 0; m < nm; m++) {
         uint32_t k = pareto(set, ns, m, 0, fp);
         for (uint32_t i = 0; i < k; i++) {
@@ -457,10 +497,11 @@ static void equal_error_table(gi_text *md, const char *name, const tradeoff_pt_c
             params_cell(md, g->first);
             gi_text_put(md, " %u | %.4g |", g->frame[p], g->t[p]);
             put_error(md, g, p);
-            gi_text_put(md, " %.4g%s | %.3g%s | %.4g | %.4g%s | %.3g%s | %.4g | %.4g | %.4g | %.4g |", tpt,
-                         ex ? "*" : "", tpt / g->t[p], ex ? "*" : "", g->em[p], tptm, exm ? "*" : "",
-                         tptm / g->t[p], exm ? "*" : "", prep, g->t[p] + prep, g->t[p] + prep / 100.0,
-                         g->t[p] + prep / 1e4);
+            gi_text_put(md,
+                        " %.4g%s | %.3g%s | %.4g | %.4g%s | %.3g%s | %.4g | %.4g | %.4g | %.4g |",
+                        tpt, ex ? "*" : "", tpt / g->t[p], ex ? "*" : "", g->em[p], tptm,
+                        exm ? "*" : "", tptm / g->t[p], exm ? "*" : "", prep, g->t[p] + prep,
+                        g->t[p] + prep / 100.0, g->t[p] + prep / 1e4);
             put_mib(md, g->rss_mib);
             put_mib(md, g->data_mib);
             gi_text_put(md, "\n");
@@ -470,8 +511,8 @@ static void equal_error_table(gi_text *md, const char *name, const tradeoff_pt_c
 }
 
 /* The method's best error among its points reached by time T (NaN if none). */
-static double best_error_by(const setting *set, uint32_t ns, uint32_t m, int matched, double T, const setting **at,
-                            uint32_t *at_k)
+static double best_error_by(const setting *set, uint32_t ns, uint32_t m, int matched, double T,
+                            const setting **at, uint32_t *at_k)
 {
     double best = NAN;
     for (uint32_t s = 0; s < ns; s++) {
@@ -490,22 +531,26 @@ static double best_error_by(const setting *set, uint32_t ns, uint32_t m, int mat
 }
 
 static void equal_time_table(gi_text *md, const char *name, const tradeoff_pt_curve *full,
-                             const tradeoff_pt_curve *matched, uint32_t matched_n, const setting *set, uint32_t ns,
-                             const char **methods, uint32_t nm)
+                             const tradeoff_pt_curve *matched, uint32_t matched_n,
+                             const setting *set, uint32_t ns, const char **methods, uint32_t nm)
 {
     if (full->n == 0)
         return;
-    gi_text_put(md,
-                 "#### %s: equal time (each method's best relMSE within the time the path tracer needs for its "
-                 "error levels)\n\n"
-                 "A column per image of the path tracer's convergence run (time, its relMSE). A cell: the "
-                 "method's lowest relMSE among its settings and frames whose time to image is within that time "
-                 "(precomputation not counted), and its ratio to the path tracer's error; \"–\": no setting is "
-                 "that fast. \"matched\" rows: against the reference of the method's bounce count, the path "
-                 "tracer limited to it (its own time and error at that image). The last three columns: the "
-                 "precomputation time, peak resident memory and data size of the settings behind the row's "
-                 "cells (min–max when they differ).\n\n",
-                 name);
+    gi_text_put(
+        md,
+        "#### %s: equal time (each method's best relMSE within the time the path tracer needs for "
+        "its "
+        "error levels)\n\n"
+        "A column per image of the path tracer's convergence run (time, its relMSE). A cell: the "
+        "method's lowest relMSE among its settings and frames whose time to image is within that "
+        "time "
+        "(precomputation not counted), and its ratio to the path tracer's error; \"–\": no setting "
+        "is "
+        "that fast. \"matched\" rows: against the reference of the method's bounce count, the path "
+        "tracer limited to it (its own time and error at that image). The last three columns: the "
+        "precomputation time, peak resident memory and data size of the settings behind the row's "
+        "cells (min–max when they differ).\n\n",
+        name);
     gi_text_put(md, "| method |");
     for (uint32_t i = 0; i < full->n; i++)
         gi_text_put(md, " %.3g s (PT %.3g) |", full->t[i], full->e[i]);
@@ -519,17 +564,20 @@ static void equal_time_table(gi_text *md, const char *name, const tradeoff_pt_cu
             for (uint32_t s = 0; s < ns; s++)
                 if (set[s].method_index == m)
                     b = set[s].bounces;
-            const tradeoff_pt_curve *c = matched_row ? curve_for(full, matched, matched_n, b) : full;
+            const tradeoff_pt_curve *c =
+                matched_row ? curve_for(full, matched, matched_n, b) : full;
             if (matched_row && c == full)
                 continue; /* the method is full GI: the row above says it */
             gi_text_put(md, "| %s%s |", methods[m], matched_row ? " (matched)" : "");
             /* the range of the costs of the settings behind the cells */
-            double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+            double lo[3] = {INFINITY, INFINITY, INFINITY},
+                   hi[3] = {-INFINITY, -INFINITY, -INFINITY};
             for (uint32_t i = 0; i < full->n; i++) {
                 double T = i < c->n ? c->t[i] : NAN, ept = i < c->n ? c->e[i] : NAN;
                 const setting *at = NULL;
                 uint32_t at_k = 0;
-                double e = isfinite(T) ? best_error_by(set, ns, m, matched_row, T, &at, &at_k) : NAN;
+                double e =
+                    isfinite(T) ? best_error_by(set, ns, m, matched_row, T, &at, &at_k) : NAN;
                 if (isfinite(e))
                     gi_text_put(md, " %.4g (×%.3g) |", e, e / ept);
                 else
@@ -559,7 +607,8 @@ static void equal_time_table(gi_text *md, const char *name, const tradeoff_pt_cu
 
 void tradeoff_report(const char *out_dir, const char *name, const tradeoff_pt_curve *full,
                      const tradeoff_pt_curve *matched, uint32_t matched_n, const tradeoff_run *runs,
-                     uint32_t run_n, tradeoff_chart_fn write_chart, json_object *chart_list, gi_text *md)
+                     uint32_t run_n, tradeoff_chart_fn write_chart, json_object *chart_list,
+                     gi_text *md)
 {
     setting *set = calloc(run_n + 1, sizeof *set);
     const char **methods = calloc(run_n + 1, sizeof *methods);
@@ -574,10 +623,13 @@ void tradeoff_report(const char *out_dir, const char *name, const tradeoff_pt_cu
     for (uint32_t s = 0; s < ns; s++)
         any_matched |= set[s].bounces < full->bounces;
     if (write_chart)
-        chart(write_chart, out_dir, name, 0, full, matched, matched_n, set, ns, methods, nm, chart_list);
+        chart(write_chart, out_dir, name, 0, full, matched, matched_n, set, ns, methods, nm,
+              chart_list);
     if (write_chart && any_matched)
-        chart(write_chart, out_dir, name, 1, full, matched, matched_n, set, ns, methods, nm, chart_list);
-    gi_text_put(md, "Path tracer convergence on %s (relMSE against the reference, another seed):", name);
+        chart(write_chart, out_dir, name, 1, full, matched, matched_n, set, ns, methods, nm,
+              chart_list);
+    gi_text_put(
+        md, "Path tracer convergence on %s (relMSE against the reference, another seed):", name);
     const tradeoff_pt_curve *curves[9] = {full};
     uint32_t nc = 1;
     for (uint32_t i = 0; i < matched_n && nc < 9; i++)
@@ -585,7 +637,8 @@ void tradeoff_report(const char *out_dir, const char *name, const tradeoff_pt_cu
     for (uint32_t c = 0; c < nc; c++) {
         gi_text_put(md, "%s max_bounces %u:", c ? ";" : "", curves[c]->bounces);
         for (uint32_t i = 0; i < curves[c]->n; i++)
-            gi_text_put(md, " %.3g s → %.3g%s", curves[c]->t[i], curves[c]->e[i], i + 1 < curves[c]->n ? "," : "");
+            gi_text_put(md, " %.3g s → %.3g%s", curves[c]->t[i], curves[c]->e[i],
+                        i + 1 < curves[c]->n ? "," : "");
     }
     gi_text_put(md, ".\n\n");
     equal_error_table(md, name, full, matched, matched_n, set, ns, methods, nm, fp);

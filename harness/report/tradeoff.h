@@ -42,18 +42,18 @@ typedef struct tradeoff_run {
 } tradeoff_run;
 
 /* How charts are written: gi_chart_write_png, or a stand-in (tests). */
-typedef gi_result (*tradeoff_chart_fn)(const char *path, const gi_chart_desc *desc, const gi_chart_series *series,
-                                       uint32_t n, gi_error *err);
+typedef gi_result (*tradeoff_chart_fn)(const char *path, const gi_chart_desc *desc,
+                                       const gi_chart_series *series, uint32_t n, gi_error *err);
 
-/* Writes, through write_chart (NULL: no charts), chart_<name>_error_vs_time.png (and _matched.png when a method
- * has fewer bounces than the full reference) into out_dir, appending the
- * file names to chart_list; appends the tables to md; adds to each ok
- * record: time_to_final_error_s, pt_time_at_equal_error_s, speedup_vs_pt,
- * speedup_vs_pt_matched, speedup_extrapolated (1: the path tracer's time is extrapolated beyond its
- * measured curve). `matched` holds the
- * bounce-limited curves (matched_n of them). */
+/* Writes, through write_chart (NULL: no charts), chart_<name>_error_vs_time.png (and _matched.png
+ * when a method has fewer bounces than the full reference) into out_dir, appending the file names
+ * to chart_list; appends the tables to md; adds to each ok record: time_to_final_error_s,
+ * pt_time_at_equal_error_s, speedup_vs_pt, speedup_vs_pt_matched, speedup_extrapolated (1: the path
+ * tracer's time is extrapolated beyond its measured curve). `matched` holds the bounce-limited
+ * curves (matched_n of them). */
 void tradeoff_report(const char *out_dir, const char *name, const tradeoff_pt_curve *full,
                      const tradeoff_pt_curve *matched, uint32_t matched_n, const tradeoff_run *runs,
-                     uint32_t run_n, tradeoff_chart_fn write_chart, json_object *chart_list, gi_text *md);
+                     uint32_t run_n, tradeoff_chart_fn write_chart, json_object *chart_list,
+                     gi_text *md);
 
 #endif

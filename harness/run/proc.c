@@ -59,7 +59,8 @@ static void read_last_line(const char *log_path, char *out, size_t size)
     out[keep] = '\0';
 }
 
-int cli_run(char *const argv[], double timeout_s, const char *out_path, const char *err_path, cli_proc_result *r)
+int cli_run(char *const argv[], double timeout_s, const char *out_path, const char *err_path,
+            cli_proc_result *r)
 {
     memset(r, 0, sizeof *r);
     if (cli_interrupted) { /* nothing new starts once gibench is interrupted */

@@ -7,12 +7,12 @@
 #include <stddef.h>
 
 typedef struct cli_proc_result {
-    int exit_code;      /* valid when !signaled && !timed_out */
-    int signaled;       /* killed by a signal (crash) */
+    int exit_code; /* valid when !signaled && !timed_out */
+    int signaled;  /* killed by a signal (crash) */
     int signal;
-    int timed_out;      /* killed by us at the time limit */
-    int interrupted;    /* stopped (or never started) because gibench was interrupted */
-    double seconds;     /* wall time */
+    int timed_out;       /* killed by us at the time limit */
+    int interrupted;     /* stopped (or never started) because gibench was interrupted */
+    double seconds;      /* wall time */
     char last_line[512]; /* last non-empty line the child printed (stderr + stdout) */
 } cli_proc_result;
 

@@ -115,8 +115,8 @@ static void fail_record(json_object *o, const char *reason)
     json_object_object_add(o, "reason", json_object_new_string(reason));
 }
 
-json_object *runner_diff(const char *image, const char *reference, const char *heatmap, const char *flip_map,
-                         float exposure, char *why, size_t why_size)
+json_object *runner_diff(const char *image, const char *reference, const char *heatmap,
+                         const char *flip_map, float exposure, char *why, size_t why_size)
 {
     argv_builder b = {0};
     arg(&b, "%s", cli_self_exe());
@@ -264,7 +264,8 @@ static double mean_abs_diff(const gi_image *a, const gi_image *b, const uint8_t 
 
 static int finite_px(const gi_image *img, size_t i)
 {
-    return img && isfinite(img->rgba[4 * i]) && isfinite(img->rgba[4 * i + 1]) && isfinite(img->rgba[4 * i + 2]);
+    return img && isfinite(img->rgba[4 * i]) && isfinite(img->rgba[4 * i + 1]) &&
+           isfinite(img->rgba[4 * i + 2]);
 }
 
 /* Mean of the finite values of v[0..n), NaN if none. */
@@ -288,16 +289,37 @@ static json_object *series_json(const double *v, uint32_t n)
     return a;
 }
 
-json_object *runner_animation_metrics(const run_spec *s, const char *frames_pattern, json_object *timings,
-                                      char *why, size_t why_size)
+json_object *runner_animation_metrics(const run_spec *s, const char *frames_pattern,
+                                      json_object *timings, char *why, size_t why_size)
 {
     uint32_t n = s->frame_ref_count;
-    enum { RELMSE_FULL, RELMSE_MATCHED, LEAK_FULL, LUM_DIFF_FULL, FRAME_MS, CHANGE_METHOD, CHANGE_REF_FULL,
-           CHANGE_REF_MATCHED, TEMPORAL_FULL, TEMPORAL_MATCHED, NOISE_FULL, SCENE_TIME, SERIES };
-    static const char *const names[SERIES] = {
-        "relmse_full",   "relmse_matched",     "leaked_energy_full",    "mean_lum_diff_pct_full",
-        "frame_ms",      "change_method",      "change_ref_full",       "change_ref_matched",
-        "temporal_error_full", "temporal_error_matched", "noise_floor_full", "scene_time"};
+    enum {
+        RELMSE_FULL,
+        RELMSE_MATCHED,
+        LEAK_FULL,
+        LUM_DIFF_FULL,
+        FRAME_MS,
+        CHANGE_METHOD,
+        CHANGE_REF_FULL,
+        CHANGE_REF_MATCHED,
+        TEMPORAL_FULL,
+        TEMPORAL_MATCHED,
+        NOISE_FULL,
+        SCENE_TIME,
+        SERIES
+    };
+    static const char *const names[SERIES] = {"relmse_full",
+                                              "relmse_matched",
+                                              "leaked_energy_full",
+                                              "mean_lum_diff_pct_full",
+                                              "frame_ms",
+                                              "change_method",
+                                              "change_ref_full",
+                                              "change_ref_matched",
+                                              "temporal_error_full",
+                                              "temporal_error_matched",
+                                              "noise_floor_full",
+                                              "scene_time"};
     double *v[SERIES] = {0};
     for (int k = 0; k < SERIES; k++)
         v[k] = malloc((n + 1) * sizeof(double));
@@ -314,7 +336,8 @@ json_object *runner_animation_metrics(const run_spec *s, const char *frames_patt
         snprintf(why, why_size, "out of memory");
     /* the frame times the render kept: the timed frames, after the warm-up ones */
     json_object *samples = NULL, *render, *frame;
-    if (json_object_object_get_ex(timings, "render", &render) && json_object_object_get_ex(render, "frame", &frame))
+    if (json_object_object_get_ex(timings, "render", &render) &&
+        json_object_object_get_ex(render, "frame", &frame))
         json_object_object_get_ex(frame, "samples_ms", &samples);
     uint32_t warm = s->warmup < n ? s->warmup : 0;
     for (uint32_t f = 0; f < n && ok; f++) {
@@ -332,8 +355,8 @@ json_object *runner_animation_metrics(const run_spec *s, const char *frames_patt
                 snprintf(why, why_size, "frame %u: %s", f, err.text);
                 ok = 0;
             } else if (img[k]->width != s->width || img[k]->height != s->height) {
-                snprintf(why, why_size, "frame %u: %s is %ux%u, not %ux%u", f, paths[k], img[k]->width,
-                         img[k]->height, s->width, s->height);
+                snprintf(why, why_size, "frame %u: %s is %ux%u, not %ux%u", f, paths[k],
+                         img[k]->width, img[k]->height, s->width, s->height);
                 ok = 0;
             }
         }
@@ -368,8 +391,9 @@ json_object *runner_animation_metrics(const run_spec *s, const char *frames_patt
                 v[TEMPORAL_FULL][f] = v[TEMPORAL_MATCHED][f] = NAN;
                 if (f > 0) {
                     for (size_t i = 0; i < np; i++)
-                        mask[i] = (uint8_t)(finite_px(img[0], i) && finite_px(prev[0], i) && finite_px(img[1], i) &&
-                                            finite_px(prev[1], i) && finite_px(img[2], i) && finite_px(prev[2], i));
+                        mask[i] = (uint8_t)(finite_px(img[0], i) && finite_px(prev[0], i) &&
+                                            finite_px(img[1], i) && finite_px(prev[1], i) &&
+                                            finite_px(img[2], i) && finite_px(prev[2], i));
                     v[CHANGE_METHOD][f] = mean_abs_diff(img[0], prev[0], mask);
                     v[CHANGE_REF_FULL][f] = mean_abs_diff(img[1], prev[1], mask);
                     v[CHANGE_REF_MATCHED][f] = mean_abs_diff(img[2], prev[2], mask);
@@ -381,8 +405,10 @@ json_object *runner_animation_metrics(const run_spec *s, const char *frames_patt
                             if (!mask[i])
                                 continue;
                             for (int c = 0; c < 3; c++) {
-                                double dm = (double)img[0]->rgba[4 * i + c] - prev[0]->rgba[4 * i + c];
-                                double dr = (double)img[1 + k]->rgba[4 * i + c] - prev[1 + k]->rgba[4 * i + c];
+                                double dm =
+                                    (double)img[0]->rgba[4 * i + c] - prev[0]->rgba[4 * i + c];
+                                double dr = (double)img[1 + k]->rgba[4 * i + c] -
+                                            prev[1 + k]->rgba[4 * i + c];
                                 sum += fabs(dm - dr);
                             }
                             cnt += 3;
@@ -421,17 +447,22 @@ json_object *runner_animation_metrics(const run_spec *s, const char *frames_patt
                 emax = v[RELMSE_FULL][f];
         json_object_object_add(a, "relmse_full_mean", num_or_null(mean_finite(v[RELMSE_FULL], n)));
         json_object_object_add(a, "relmse_full_max", num_or_null(emax));
-        json_object_object_add(a, "relmse_matched_mean", num_or_null(mean_finite(v[RELMSE_MATCHED], n)));
-        json_object_object_add(a, "leaked_energy_full_mean", num_or_null(mean_finite(v[LEAK_FULL], n)));
+        json_object_object_add(a, "relmse_matched_mean",
+                               num_or_null(mean_finite(v[RELMSE_MATCHED], n)));
+        json_object_object_add(a, "leaked_energy_full_mean",
+                               num_or_null(mean_finite(v[LEAK_FULL], n)));
         json_object_object_add(a, "frame_ms_median", num_or_null(rec_median(v[FRAME_MS], n)));
         json_object_object_add(a, "change_method_mean", num_or_null(cm));
         json_object_object_add(a, "change_ref_full_mean", num_or_null(cf));
         json_object_object_add(a, "change_ref_matched_mean", num_or_null(cmt));
         json_object_object_add(a, "flicker_full", num_or_null(cm - cf));
         json_object_object_add(a, "flicker_matched", num_or_null(cm - cmt));
-        json_object_object_add(a, "temporal_error_full_mean", num_or_null(mean_finite(v[TEMPORAL_FULL], n)));
-        json_object_object_add(a, "temporal_error_matched_mean", num_or_null(mean_finite(v[TEMPORAL_MATCHED], n)));
-        json_object_object_add(a, "noise_floor_full_mean", num_or_null(mean_finite(v[NOISE_FULL], n)));
+        json_object_object_add(a, "temporal_error_full_mean",
+                               num_or_null(mean_finite(v[TEMPORAL_FULL], n)));
+        json_object_object_add(a, "temporal_error_matched_mean",
+                               num_or_null(mean_finite(v[TEMPORAL_MATCHED], n)));
+        json_object_object_add(a, "noise_floor_full_mean",
+                               num_or_null(mean_finite(v[NOISE_FULL], n)));
     }
     for (int k = 0; k < SERIES; k++)
         free(v[k]);
@@ -443,20 +474,25 @@ json_object *runner_animation_metrics(const run_spec *s, const char *frames_patt
  * added (every value it had stays as it was), so that resuming a study
  * fills the column without rendering anything. Nothing happens when the
  * image is gone (committed results keep PNGs only). */
-static void add_leak_to_cached(json_object *old, const run_spec *s, const char *exr, const char *result)
+static void add_leak_to_cached(json_object *old, const run_spec *s, const char *exr,
+                               const char *result)
 {
     json_object *st, *metrics, *m;
-    if (!json_object_object_get_ex(old, "status", &st) || strcmp(json_object_get_string(st), "ok") ||
+    if (!json_object_object_get_ex(old, "status", &st) ||
+        strcmp(json_object_get_string(st), "ok") ||
         !json_object_object_get_ex(old, "metrics", &metrics) || access(exr, R_OK) != 0)
         return;
     const char *refs[2] = {s->ref_full, s->ref_matched}, *names[2] = {"full", "matched"};
-    static const char *const keys[] = {"leaked_energy", "dark_fraction", "dark_energy_ref", "dark_threshold"};
+    static const char *const keys[] = {"leaked_energy", "dark_fraction", "dark_energy_ref",
+                                       "dark_threshold"};
     int changed = 0;
     for (int k = 0; k < 2; k++) {
-        if (!refs[k] || !json_object_object_get_ex(metrics, names[k], &m) || json_object_object_get_ex(m, "leaked_energy", NULL))
+        if (!refs[k] || !json_object_object_get_ex(metrics, names[k], &m) ||
+            json_object_object_get_ex(m, "leaked_energy", NULL))
             continue;
         char why[1024];
-        json_object *fresh = runner_diff(exr, refs[k], NULL, NULL, s->exposure, why, sizeof why), *v;
+        json_object *fresh = runner_diff(exr, refs[k], NULL, NULL, s->exposure, why, sizeof why),
+                    *v;
         for (size_t q = 0; fresh && q < sizeof keys / sizeof keys[0]; q++)
             if (json_object_object_get_ex(fresh, keys[q], &v)) {
                 json_object_object_add(m, keys[q], json_object_get(v));
@@ -526,8 +562,9 @@ json_object *runner_execute(const run_spec *s, int resume)
     size_t used = strlen(config);
     const char *timer = getenv("GIBENCH_TIMER"); /* the timer mode changes every timing */
     /* "curve": results made before render recorded convergence curves are not reused */
-    snprintf(config + used, sizeof config - used, " | full=%s | matched=%s | curve%s%s", s->ref_full ? s->ref_full : "-",
-             s->ref_matched ? s->ref_matched : "-", timer ? " | timer=" : "", timer ? timer : "");
+    snprintf(config + used, sizeof config - used, " | full=%s | matched=%s | curve%s%s",
+             s->ref_full ? s->ref_full : "-", s->ref_matched ? s->ref_matched : "-",
+             timer ? " | timer=" : "", timer ? timer : "");
     /* an animated run compared frame by frame: every frame written, and the
      * references of every frame in the key (by a hash of their names) */
     char frames_dir[4200], frames_pattern[4300];
@@ -536,13 +573,14 @@ json_object *runner_execute(const run_spec *s, int resume)
     if (s->frame_ref_count) {
         uint64_t h = 0;
         for (uint32_t f = 0; f < s->frame_ref_count; f++) {
-            const char *names[3] = {s->frame_ref_full[f], s->frame_ref_matched[f], s->frame_ref_alt ? s->frame_ref_alt[f] : NULL};
+            const char *names[3] = {s->frame_ref_full[f], s->frame_ref_matched[f],
+                                    s->frame_ref_alt ? s->frame_ref_alt[f] : NULL};
             for (int k = 0; k < 3; k++)
                 h = gi_hash64(names[k] ? names[k] : "-", strlen(names[k] ? names[k] : "-"), h);
         }
         used = strlen(config);
-        snprintf(config + used, sizeof config - used, " | frame-refs=%u:%016llx", s->frame_ref_count,
-                 (unsigned long long)h);
+        snprintf(config + used, sizeof config - used, " | frame-refs=%u:%016llx",
+                 s->frame_ref_count, (unsigned long long)h);
         arg(&b, "%s", "--frames-out");
         arg(&b, "%s", frames_pattern);
     }
@@ -569,8 +607,10 @@ json_object *runner_execute(const run_spec *s, int resume)
         json_object *old = cli_read_json(result);
         json_object *c;
         json_object *st;
-        if (old && json_object_object_get_ex(old, "config", &c) && strcmp(json_object_get_string(c), config) == 0 &&
-            !(json_object_object_get_ex(old, "status", &st) && !strcmp(json_object_get_string(st), "interrupted"))) {
+        if (old && json_object_object_get_ex(old, "config", &c) &&
+            strcmp(json_object_get_string(c), config) == 0 &&
+            !(json_object_object_get_ex(old, "status", &st) &&
+              !strcmp(json_object_get_string(st), "interrupted"))) {
             json_object_put(rec);
             args_free(&b);
             if (!collect_only)
@@ -637,8 +677,8 @@ json_object *runner_execute(const run_spec *s, int resume)
                 if (!refs[k])
                     continue;
                 char why[1024];
-                json_object *m = runner_diff(exr, refs[k], k == 0 ? heat : NULL, k == 0 ? flip : NULL, s->exposure, why,
-                                            sizeof why);
+                json_object *m = runner_diff(exr, refs[k], k == 0 ? heat : NULL,
+                                             k == 0 ? flip : NULL, s->exposure, why, sizeof why);
                 if (m) {
                     json_object_object_add(metrics, names[k], m);
                 } else {
@@ -662,7 +702,8 @@ json_object *runner_execute(const run_spec *s, int resume)
     if (cli_interrupted && !(json_object_object_get_ex(rec, "status", &status) &&
                              !strcmp(json_object_get_string(status), "ok"))) {
         json_object_object_add(rec, "status", json_object_new_string("interrupted"));
-        json_object_object_add(rec, "reason", json_object_new_string("interrupted: resuming the study redoes it"));
+        json_object_object_add(rec, "reason",
+                               json_object_new_string("interrupted: resuming the study redoes it"));
         return rec;
     }
     char why[GI_ERROR_MAX];
@@ -671,9 +712,10 @@ json_object *runner_execute(const run_spec *s, int resume)
     return rec;
 }
 
-int runner_reference(const char *scene, uint64_t scene_hash, const char *camera, uint32_t width, uint32_t height,
-                     uint32_t spp, double target_se, uint32_t max_bounces, uint32_t seed, float time,
-                     int pixel_center, double timeout_s, const char *out_exr, char *why, size_t why_size)
+int runner_reference(const char *scene, uint64_t scene_hash, const char *camera, uint32_t width,
+                     uint32_t height, uint32_t spp, double target_se, uint32_t max_bounces,
+                     uint32_t seed, float time, int pixel_center, double timeout_s,
+                     const char *out_exr, char *why, size_t why_size)
 {
     argv_builder b = {0};
     arg(&b, "%s", cli_self_exe());
@@ -709,13 +751,15 @@ int runner_reference(const char *scene, uint64_t scene_hash, const char *camera,
     /* The scene's content joins the command line in the key: an edited
      * scene under the same name is rendered again, never reused. */
     size_t used = strlen(config);
-    snprintf(config + used, sizeof config - used, "\nscene-content %016llx", (unsigned long long)scene_hash);
+    snprintf(config + used, sizeof config - used, "\nscene-content %016llx",
+             (unsigned long long)scene_hash);
     snprintf(cfg_path, sizeof cfg_path, "%s.config", out_exr);
     snprintf(log, sizeof log, "%s.log", out_exr);
     snprintf(stats, sizeof stats, "%s.json", out_exr);
     size_t n = 0;
     char *old = gi_file_read_all(cfg_path, &n);
-    int same = old && n == strlen(config) && memcmp(old, config, n) == 0 && access(out_exr, R_OK) == 0;
+    int same =
+        old && n == strlen(config) && memcmp(old, config, n) == 0 && access(out_exr, R_OK) == 0;
     free(old);
     if (same || collect_only) {
         args_free(&b);
@@ -724,7 +768,8 @@ int runner_reference(const char *scene, uint64_t scene_hash, const char *camera,
         return same;
     }
     char png[4200];
-    snprintf(png, sizeof png, "%.*s.png", (int)(strlen(out_exr) > 4 ? strlen(out_exr) - 4 : strlen(out_exr)), out_exr);
+    snprintf(png, sizeof png, "%.*s.png",
+             (int)(strlen(out_exr) > 4 ? strlen(out_exr) - 4 : strlen(out_exr)), out_exr);
     arg(&b, "%s", "--out");
     arg(&b, "%s", out_exr);
     arg(&b, "%s", "--out");

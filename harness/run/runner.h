@@ -9,23 +9,23 @@
 #include <stdint.h>
 
 typedef struct run_spec {
-    const char *run_id;   /* name in tables, e.g. "direct" or "direct#3" */
+    const char *run_id; /* name in tables, e.g. "direct" or "direct#3" */
     const char *scene;
     const char *method;
-    const char *camera;   /* NULL: the scene's first */
+    const char *camera; /* NULL: the scene's first */
     uint32_t width, height, frames, warmup, seed;
-    float time;           /* scene time */
-    float animate_fps;    /* > 0: animated frames */
+    float time;                /* scene time */
+    float animate_fps;         /* > 0: animated frames */
     const char *const *params; /* "k=v" */
     uint32_t param_count;
     double timeout_s;
-    const char *dir;      /* this run's directory (created) */
-    const char *rel;      /* dir relative to the report directory, for links */
+    const char *dir;         /* this run's directory (created) */
+    const char *rel;         /* dir relative to the report directory, for links */
     const char *ref_full;    /* full-GI reference EXR, or NULL */
     const char *ref_matched; /* bounce-matched reference EXR, or NULL */
     float exposure;
-    int no_cache;         /* render --no-cache: precompute afresh (timing of precomputation) */
-    const char *label;    /* the study entry's label, or NULL */
+    int no_cache;      /* render --no-cache: precompute afresh (timing of precomputation) */
+    const char *label; /* the study entry's label, or NULL */
     /* Per-frame comparison of an animated run (animate_fps > 0): frame f
      * (scene time time + f / animate_fps) against references of that time:
      * full GI, bounce-matched, and a second full-GI render with another
@@ -53,22 +53,23 @@ json_object *runner_not_applicable(const run_spec *spec, const char *reason);
  * settings exists; stops at `spp` samples or, when target_se > 0, as soon
  * as the relative standard error reaches it; pixel_center: --pixel center.
  * 1 on success, else 0 with why. */
-int runner_reference(const char *scene, uint64_t scene_hash, const char *camera, uint32_t width, uint32_t height,
-                     uint32_t spp, double target_se, uint32_t max_bounces, uint32_t seed, float time,
-                     int pixel_center, double timeout_s, const char *out_exr, char *why, size_t why_size);
+int runner_reference(const char *scene, uint64_t scene_hash, const char *camera, uint32_t width,
+                     uint32_t height, uint32_t spp, double target_se, uint32_t max_bounces,
+                     uint32_t seed, float time, int pixel_center, double timeout_s,
+                     const char *out_exr, char *why, size_t why_size);
 
 /* The per-frame comparison of an animated run whose frames lie at
  * frames_pattern (cli_frame_path): per-frame relMSE (full and matched),
  * leaked energy and time, frame-to-frame change of the method and of the
  * references, flicker and the reference's noise floor. `timings` is the
  * render's timings file (per-frame times). NULL with why on failure. */
-json_object *runner_animation_metrics(const run_spec *spec, const char *frames_pattern, json_object *timings,
-                                      char *why, size_t why_size);
+json_object *runner_animation_metrics(const run_spec *spec, const char *frames_pattern,
+                                      json_object *timings, char *why, size_t why_size);
 
 /* Fills metrics of `image` against `reference` by `gibench diff --json`;
  * NULL with why on failure. heatmap (relative error) and flip_map (FLIP's
  * error map), PNGs for the report, may be NULL. */
-json_object *runner_diff(const char *image, const char *reference, const char *heatmap, const char *flip_map,
-                         float exposure, char *why, size_t why_size);
+json_object *runner_diff(const char *image, const char *reference, const char *heatmap,
+                         const char *flip_map, float exposure, char *why, size_t why_size);
 
 #endif

@@ -49,7 +49,7 @@ typedef struct study_run {
     char id[512], dir[4096], rel[1024];
     char *params[MAX_KEYS];
     int scene_index;
-    int ref_index; /* -1: not compared */
+    int ref_index;    /* -1: not compared */
     uint32_t bounces; /* the method's max_bounces + 1 */
     uint64_t setting; /* every input but the seed: runs of one setting are repeats */
     json_object *record;
@@ -80,7 +80,8 @@ typedef struct study_ref {
     /* the path tracer's convergence: full GI, and for each matched bounce count */
     tradeoff_pt_curve pt_full, pt_matched[8];
     char missing[1100]; /* gibench study --slurm-collect: why the set was not made, or "" */
-    int frame_only; /* used only by animated runs' frames: no convergence curve, no tradeoff table */
+    int frame_only; /* used only by animated runs' frames: no convergence curve, no tradeoff table
+                     */
     int want_alt;   /* a frame: also the full-GI reference with another seed (the noise floor) */
     char ref_alt[4096];
 } study_ref;
@@ -114,14 +115,15 @@ static int fail_json(const char *file, const char *path, const char *what)
 
 /* o[key] as an integer in [min, max] (absent or null: def); `prefix` is the
  * JSON path of o for messages. */
-static int get_uint(json_object *o, const char *prefix, const char *key, uint32_t min, uint32_t max, uint32_t def,
-                    uint32_t *out, const char *file)
+static int get_uint(json_object *o, const char *prefix, const char *key, uint32_t min, uint32_t max,
+                    uint32_t def, uint32_t *out, const char *file)
 {
     json_object *v;
     *out = def;
     if (!json_object_object_get_ex(o, key, &v) || json_object_is_type(v, json_type_null))
         return EXIT_OK;
-    if (!json_object_is_type(v, json_type_int) || json_object_get_int64(v) < min || json_object_get_int64(v) > max) {
+    if (!json_object_is_type(v, json_type_int) || json_object_get_int64(v) < min ||
+        json_object_get_int64(v) > max) {
         char msg[128];
         snprintf(msg, sizeof msg, "must be an integer in [%u, %u]", min, max);
         char path[160];
@@ -133,16 +135,16 @@ static int get_uint(json_object *o, const char *prefix, const char *key, uint32_
 }
 
 /* o[key] as a number in [min, max] (absent or null: def). */
-static int get_number(json_object *o, const char *prefix, const char *key, double min, double max, double def,
-                      double *out, const char *file)
+static int get_number(json_object *o, const char *prefix, const char *key, double min, double max,
+                      double def, double *out, const char *file)
 {
     json_object *v;
     *out = def;
     if (!json_object_object_get_ex(o, key, &v) || json_object_is_type(v, json_type_null))
         return EXIT_OK;
     double d = json_object_get_double(v);
-    if ((!json_object_is_type(v, json_type_int) && !json_object_is_type(v, json_type_double)) || !(d >= min) ||
-        !(d <= max)) {
+    if ((!json_object_is_type(v, json_type_int) && !json_object_is_type(v, json_type_double)) ||
+        !(d >= min) || !(d <= max)) {
         char msg[128], path[160];
         snprintf(msg, sizeof msg, "must be a number in [%g, %g]", min, max);
         snprintf(path, sizeof path, "%s/%s", prefix, key);
@@ -153,12 +155,13 @@ static int get_number(json_object *o, const char *prefix, const char *key, doubl
 }
 
 /* o[key] as a string (absent: def; null too when null_ok). */
-static int get_string(json_object *o, const char *prefix, const char *key, int null_ok, const char *def,
-                      const char **out, const char *file)
+static int get_string(json_object *o, const char *prefix, const char *key, int null_ok,
+                      const char *def, const char **out, const char *file)
 {
     json_object *v;
     *out = def;
-    if (!json_object_object_get_ex(o, key, &v) || (null_ok && json_object_is_type(v, json_type_null)))
+    if (!json_object_object_get_ex(o, key, &v) ||
+        (null_ok && json_object_is_type(v, json_type_null)))
         return EXIT_OK;
     if (!json_object_is_type(v, json_type_string)) {
         char path[160];
@@ -177,7 +180,7 @@ static int get_string(json_object *o, const char *prefix, const char *key, int n
  * (escapes are not decoded). Returns EXIT_OK or EXIT_USAGE after printing. */
 typedef struct key_frame {
     int is_object, want_key;
-    size_t index; /* arrays: the element being read */
+    size_t index;    /* arrays: the element being read */
     const char *key; /* objects: the key being read */
     size_t key_len;
     const char **keys; /* objects: keys seen (into the text) */
@@ -210,9 +213,10 @@ static int check_duplicate_keys(const char *file, const char *text, size_t n)
                         size_t used = 0;
                         for (int d = 0; d < top && used < sizeof path; d++) {
                             int w = st[d].is_object
-                                        ? snprintf(path + used, sizeof path - used, "/%.*s", (int)st[d].key_len,
-                                                   st[d].key)
-                                        : snprintf(path + used, sizeof path - used, "/%zu", st[d].index);
+                                        ? snprintf(path + used, sizeof path - used, "/%.*s",
+                                                   (int)st[d].key_len, st[d].key)
+                                        : snprintf(path + used, sizeof path - used, "/%zu",
+                                                   st[d].index);
                             used += w > 0 ? (size_t)w : 0;
                         }
                         if (used < sizeof path)
@@ -294,7 +298,8 @@ static json_object *read_strict_json(const char *file)
             size_t line = 1;
             for (size_t i = 0; i < end && i < n; i++)
                 line += text[i] == '\n';
-            cli_fail(EXIT_USAGE, "%s: line %zu: not valid JSON: %s", file, line, json_tokener_error_desc(e));
+            cli_fail(EXIT_USAGE, "%s: line %zu: not valid JSON: %s", file, line,
+                     json_tokener_error_desc(e));
             json_object_put(o);
             o = NULL;
         }
@@ -309,7 +314,8 @@ static json_object *read_strict_json(const char *file)
 }
 
 /* Rejects keys of o that are not in `known` (NULL-terminated). */
-static int check_keys(json_object *o, const char *const *known, const char *prefix, const char *file)
+static int check_keys(json_object *o, const char *const *known, const char *prefix,
+                      const char *file)
 {
     if (!json_object_is_type(o, json_type_object))
         return fail_json(file, *prefix ? prefix : "/", "must be an object {key: value}");
@@ -340,15 +346,16 @@ static int scalar_text(json_object *e, const char **out)
 
 /* Appends "name=value" to out[0..*n), refusing a value the range already
  * holds (a step or a count finer than the values can resolve). */
-static int push_value(const char *file, const char *path, const char *name, const char *value, char out[][128],
-                      int *n)
+static int push_value(const char *file, const char *path, const char *name, const char *value,
+                      char out[][128], int *n)
 {
     char kv[128];
     if (snprintf(kv, sizeof kv, "%s=%s", name, value) >= (int)sizeof kv)
         return fail_json(file, path, "the value is too long");
     for (int i = 0; i < *n; i++)
         if (!strcmp(out[i], kv))
-            return fail_json(file, path, "the range gives the same value twice (its step is lost to rounding)");
+            return fail_json(file, path,
+                             "the range gives the same value twice (its step is lost to rounding)");
     memcpy(out[(*n)++], kv, sizeof kv);
     return EXIT_OK;
 }
@@ -356,8 +363,8 @@ static int push_value(const char *file, const char *path, const char *name, cons
 /* The values of a range object. Their number is computed and bounded
  * (at most MAX_SWEEP) before any is written, and integer ranges are
  * stepped in integers, so that no rounding can stretch the loop. */
-static int range_values(const char *file, const char *path, const char *name, json_object *v, char out[][128],
-                        int *n)
+static int range_values(const char *file, const char *path, const char *name, json_object *v,
+                        char out[][128], int *n)
 {
     static const char *const keys[] = {"from", "to", "step", "count", "scale", NULL};
     json_object_object_foreach(v, key, val)
@@ -367,12 +374,15 @@ static int range_values(const char *file, const char *path, const char *name, js
         for (int i = 0; keys[i]; i++)
             ok |= !strcmp(keys[i], key);
         if (!ok)
-            return fail_json(file, path, "a range has only \"from\", \"to\", \"step\" or \"count\", and \"scale\"");
+            return fail_json(
+                file, path,
+                "a range has only \"from\", \"to\", \"step\" or \"count\", and \"scale\"");
     }
     json_object *from, *to, *step = NULL, *count = NULL, *scale = NULL;
     if (!json_object_object_get_ex(v, "from", &from) || !json_object_object_get_ex(v, "to", &to))
         return fail_json(file, path, "a range needs \"from\" and \"to\"");
-    int has_step = json_object_object_get_ex(v, "step", &step), has_count = json_object_object_get_ex(v, "count", &count);
+    int has_step = json_object_object_get_ex(v, "step", &step),
+        has_count = json_object_object_get_ex(v, "count", &count);
     if (has_step == has_count)
         return fail_json(file, path, "a range needs \"step\" or \"count\" (one of them)");
     json_object *nums[3] = {from, to, has_step ? step : NULL};
@@ -383,7 +393,8 @@ static int range_values(const char *file, const char *path, const char *name, js
             return fail_json(file, path, "\"from\", \"to\" and \"step\" must be finite numbers");
     int log_scale = 0;
     if (json_object_object_get_ex(v, "scale", &scale)) {
-        const char *sv = json_object_is_type(scale, json_type_string) ? json_object_get_string(scale) : "";
+        const char *sv =
+            json_object_is_type(scale, json_type_string) ? json_object_get_string(scale) : "";
         if (has_step || (strcmp(sv, "lin") && strcmp(sv, "log")))
             return fail_json(file, path, "\"scale\" is \"lin\" or \"log\", with \"count\"");
         log_scale = !strcmp(sv, "log");
@@ -413,7 +424,8 @@ static int range_values(const char *file, const char *path, const char *name, js
         return EXIT_OK;
     }
     if (is_int && json_object_is_type(step, json_type_int)) {
-        int64_t ia = json_object_get_int64(from), ib = json_object_get_int64(to), is = json_object_get_int64(step);
+        int64_t ia = json_object_get_int64(from), ib = json_object_get_int64(to),
+                is = json_object_get_int64(step);
         if (is <= 0)
             return fail_json(file, path, "\"step\" must be positive");
         if (ib < ia)
@@ -450,8 +462,8 @@ static int range_values(const char *file, const char *path, const char *name, js
 /* Values of one parameter: a scalar, a list, or a range
  * {"from": a, "to": b, "step": s} / {"from": a, "to": b, "count": n, "scale": "log"}.
  * Written as text "name=value", at most MAX_SWEEP of them. */
-static int sweep_values(const char *file, const char *mpath, const char *name, json_object *v, char out[][128],
-                        int *n)
+static int sweep_values(const char *file, const char *mpath, const char *name, json_object *v,
+                        char out[][128], int *n)
 {
     char path[512];
     snprintf(path, sizeof path, "%s/params/%s", mpath, name);
@@ -518,7 +530,8 @@ static int scene_index(study *st, const char *file, const char *jpath, const cha
         view_file_free(&view);
         if (!ok) {
             gi_scene_free(s);
-            return cli_fail(EXIT_USAGE, "%s: /camera: %s with %s: %s", file, st->camera + 5, path, why);
+            return cli_fail(EXIT_USAGE, "%s: /camera: %s with %s: %s", file, st->camera + 5, path,
+                            why);
         }
     }
     int has_camera = !st->camera || is_view || gi_scene_find_camera(s, st->camera) >= 0;
@@ -579,7 +592,8 @@ static void name_refs(study *st)
         int shared = 0;
         /* the sets of animation frames do not rename the others */
         for (uint32_t k = 0; k < st->ref_count; k++)
-            shared |= k != i && st->refs[k].scene_index == r->scene_index && !st->refs[k].frame_only;
+            shared |=
+                k != i && st->refs[k].scene_index == r->scene_index && !st->refs[k].frame_only;
         /* two scenes of one name (in different folders) get apart by content */
         char stem[300];
         const study_scene *sc = &st->scenes[r->scene_index];
@@ -592,24 +606,26 @@ static void name_refs(study *st)
             snprintf(stem, sizeof stem, "%s", sc->stem);
         if (r->frame_only) {
             /* the frame's time as %g, or all its digits where two frames would share a name */
-            snprintf(r->name, sizeof r->name, "%.280s_%ux%u_t%g", stem, r->width, r->height, (double)r->time);
+            snprintf(r->name, sizeof r->name, "%.280s_%ux%u_t%g", stem, r->width, r->height,
+                     (double)r->time);
             for (uint32_t k = 0; k < i; k++)
                 if (!strcmp(st->refs[k].name, r->name))
-                    snprintf(r->name, sizeof r->name, "%.280s_%ux%u_t%.9g", stem, r->width, r->height,
-                             (double)r->time);
-        }
-        else if (!shared)
+                    snprintf(r->name, sizeof r->name, "%.280s_%ux%u_t%.9g", stem, r->width,
+                             r->height, (double)r->time);
+        } else if (!shared)
             snprintf(r->name, sizeof r->name, "%s", stem);
         else if (r->time == 0.0f)
             snprintf(r->name, sizeof r->name, "%s_%ux%u", stem, r->width, r->height);
         else
-            snprintf(r->name, sizeof r->name, "%s_%ux%u_t%g", stem, r->width, r->height, (double)r->time);
+            snprintf(r->name, sizeof r->name, "%s_%ux%u_t%g", stem, r->width, r->height,
+                     (double)r->time);
     }
 }
 
 /* Reads the run settings that a method entry (or the top level) may give:
  * scenes, size, frames, warmup, time, animate, cache, compare, label. */
-static int parse_settings(study *st, json_object *o, const char *prefix, const char *file, run_settings *rs)
+static int parse_settings(study *st, json_object *o, const char *prefix, const char *file,
+                          run_settings *rs)
 {
     json_object *v;
     char path[160];
@@ -637,8 +653,8 @@ static int parse_settings(study *st, json_object *o, const char *prefix, const c
             return fail_json(file, path, "must be [width, height]");
         json_object *jw = json_object_array_get_idx(v, 0), *jh = json_object_array_get_idx(v, 1);
         int64_t w = json_object_get_int64(jw), h = json_object_get_int64(jh);
-        if (!json_object_is_type(jw, json_type_int) || !json_object_is_type(jh, json_type_int) || w < 1 || h < 1 ||
-            w > 16384 || h > 16384)
+        if (!json_object_is_type(jw, json_type_int) || !json_object_is_type(jh, json_type_int) ||
+            w < 1 || h < 1 || w > 16384 || h > 16384)
             return fail_json(file, path, "width and height must be integers in 1..16384");
         rs->width = (uint32_t)w;
         rs->height = (uint32_t)h;
@@ -656,10 +672,12 @@ static int parse_settings(study *st, json_object *o, const char *prefix, const c
     rs->time = (float)d;
     if (json_object_object_get_ex(o, "animate", &v) && !json_object_is_type(v, json_type_null)) {
         d = json_object_get_double(v);
-        if ((!json_object_is_type(v, json_type_int) && !json_object_is_type(v, json_type_double)) || !(d > 0) ||
-            !(d <= 1e4)) {
+        if ((!json_object_is_type(v, json_type_int) && !json_object_is_type(v, json_type_double)) ||
+            !(d > 0) || !(d <= 1e4)) {
             snprintf(path, sizeof path, "%s/animate", prefix);
-            return fail_json(file, path, "must be a positive frame rate (frames per second of scene time, at most 1e4)");
+            return fail_json(
+                file, path,
+                "must be a positive frame rate (frames per second of scene time, at most 1e4)");
         }
         rs->animate_fps = (float)d;
     }
@@ -683,8 +701,8 @@ static int parse_settings(study *st, json_object *o, const char *prefix, const c
     return EXIT_OK;
 }
 
-static int add_run(study *st, const char *file, const char *out_dir, const gi_method *m, char combo[][128], int nk,
-                   uint32_t repeat, const run_settings *rs)
+static int add_run(study *st, const char *file, const char *out_dir, const gi_method *m,
+                   char combo[][128], int nk, uint32_t repeat, const run_settings *rs)
 {
     for (uint32_t k = 0; k < rs->scene_n; k++) {
         int si = rs->scenes[k];
@@ -692,15 +710,17 @@ static int add_run(study *st, const char *file, const char *out_dir, const gi_me
             return cli_fail(EXIT_USAGE, "%s: more than %d runs", file, MAX_RUNS);
         study_run *r = &st->runs[st->run_count];
         memset(r, 0, sizeof *r);
-        char key[MAX_KEYS * 128 + 4096]; /* every parameter's text: a cut key would merge two runs */
+        char
+            key[MAX_KEYS * 128 + 4096]; /* every parameter's text: a cut key would merge two runs */
         /* every input that changes the result: the scene by its content, the
          * method, seed, camera, size, frames, times, exposure, timer mode,
          * cache and comparison, and each parameter */
-        snprintf(key, sizeof key, "%016llx|%s|seed=%u|camera=%s|%ux%u|%u/%u|%.9g|%.9g|ev=%.9g|timer=%s|%d|%d",
+        snprintf(key, sizeof key,
+                 "%016llx|%s|seed=%u|camera=%s|%ux%u|%u/%u|%.9g|%.9g|ev=%.9g|timer=%s|%d|%d",
                  (unsigned long long)st->scenes[si].hash, m->id, st->seed + repeat,
-                 st->camera ? st->camera : "-", rs->width, rs->height, rs->frames, rs->warmup, (double)rs->time,
-                 (double)rs->animate_fps, (double)st->exposure, st->timer ? st->timer : "-", rs->cache,
-                 rs->compare);
+                 st->camera ? st->camera : "-", rs->width, rs->height, rs->frames, rs->warmup,
+                 (double)rs->time, (double)rs->animate_fps, (double)st->exposure,
+                 st->timer ? st->timer : "-", rs->cache, rs->compare);
         for (int p = 0; p < nk; p++) {
             r->params[p] = strdup(combo[p]);
             size_t used = strlen(key);
@@ -715,7 +735,8 @@ static int add_run(study *st, const char *file, const char *out_dir, const gi_me
                 memmove(seed_at, end, strlen(end) + 1);
         }
         r->setting = gi_hash64(key, strlen(key), 0);
-        snprintf(r->id, sizeof r->id, "%s-%s-%08x", st->scenes[si].stem, m->id, (unsigned)(h & 0xFFFFFFFFu));
+        snprintf(r->id, sizeof r->id, "%s-%s-%08x", st->scenes[si].stem, m->id,
+                 (unsigned)(h & 0xFFFFFFFFu));
         snprintf(r->rel, sizeof r->rel, "runs/%s", r->id);
         snprintf(r->dir, sizeof r->dir, "%s/%s", out_dir, r->rel);
         r->scene_index = si;
@@ -736,14 +757,18 @@ static int add_run(study *st, const char *file, const char *out_dir, const gi_me
                 float t = rs->time + (float)f / rs->animate_fps;
                 r->frame_ref[f] = ref_index(st, si, rs->width, rs->height, t, 1);
                 if (r->frame_ref[f] < 0)
-                    return cli_fail(EXIT_USAGE, "%s: more than %d (scene, size, time) reference sets (an animated "
-                                    "compared run needs one per frame)", file, MAX_REFS);
+                    return cli_fail(
+                        EXIT_USAGE,
+                        "%s: more than %d (scene, size, time) reference sets (an animated "
+                        "compared run needs one per frame)",
+                        file, MAX_REFS);
             }
             r->ref_index = r->frame_ref[rs->frames - 1];
         } else if (rs->compare) {
             r->ref_index = ref_index(st, si, rs->width, rs->height, rs->time, 0);
             if (r->ref_index < 0)
-                return cli_fail(EXIT_USAGE, "%s: more than %d (scene, size, time) reference sets", file, MAX_REFS);
+                return cli_fail(EXIT_USAGE, "%s: more than %d (scene, size, time) reference sets",
+                                file, MAX_REFS);
         }
         run_spec *s = &r->spec;
         s->run_id = r->id;
@@ -771,8 +796,8 @@ static int add_run(study *st, const char *file, const char *out_dir, const gi_me
 }
 
 /* Expands one method entry: the Cartesian product of its sweeps. */
-static int expand_method(study *st, const char *file, const char *out_dir, const gi_method *m, json_object *params,
-                         const char *mpath, const run_settings *rs)
+static int expand_method(study *st, const char *file, const char *out_dir, const gi_method *m,
+                         json_object *params, const char *mpath, const run_settings *rs)
 {
     static char values[MAX_KEYS][MAX_SWEEP][128];
     int counts[MAX_KEYS], nk = 0;
@@ -831,8 +856,8 @@ static int check_charts(json_object *charts, const char *file)
 {
     if (!json_object_is_type(charts, json_type_array) || json_object_array_length(charts) > 32)
         return fail_json(file, "/charts", "must be a list of at most 32 charts");
-    static const char *known[] = {"file", "title", "where", "x", "y", "series", "log_x", "log_y", "x_label",
-                                  "y_label", NULL};
+    static const char *known[] = {"file",  "title", "where",   "x",       "y", "series",
+                                  "log_x", "log_y", "x_label", "y_label", NULL};
     for (size_t i = 0; i < json_object_array_length(charts); i++) {
         json_object *c = json_object_array_get_idx(charts, i), *v;
         char path[64];
@@ -844,8 +869,8 @@ static int check_charts(json_object *charts, const char *file)
             return rc;
         const char *need[3] = {"file", "x", "y"};
         for (int k = 0; k < 3; k++)
-            if (!json_object_object_get_ex(c, need[k], &v) || !json_object_is_type(v, json_type_string) ||
-                !*json_object_get_string(v))
+            if (!json_object_object_get_ex(c, need[k], &v) ||
+                !json_object_is_type(v, json_type_string) || !*json_object_get_string(v))
                 return fail_json(file, path, "a chart needs \"file\", \"x\" and \"y\" (strings)");
         const char *f = json_object_get_string(json_object_object_get(c, "file"));
         size_t n = strlen(f);
@@ -857,10 +882,13 @@ static int check_charts(json_object *charts, const char *file)
             return fail_json(file, path, "\"series\" must be a field name");
         const char *texts[3] = {"title", "x_label", "y_label"}, *flags[2] = {"log_x", "log_y"};
         for (int k = 0; k < 3; k++)
-            if (json_object_object_get_ex(c, texts[k], &v) && !json_object_is_type(v, json_type_string))
-                return fail_json(file, path, "\"title\", \"x_label\" and \"y_label\" must be strings");
+            if (json_object_object_get_ex(c, texts[k], &v) &&
+                !json_object_is_type(v, json_type_string))
+                return fail_json(file, path,
+                                 "\"title\", \"x_label\" and \"y_label\" must be strings");
         for (int k = 0; k < 2; k++)
-            if (json_object_object_get_ex(c, flags[k], &v) && !json_object_is_type(v, json_type_boolean))
+            if (json_object_object_get_ex(c, flags[k], &v) &&
+                !json_object_is_type(v, json_type_boolean))
                 return fail_json(file, path, "\"log_x\" and \"log_y\" must be true or false");
     }
     return EXIT_OK;
@@ -877,9 +905,10 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
     json_object *o = st->root, *v;
     if (!json_object_is_type(o, json_type_object))
         return fail_json(file, "/", "a study is a JSON object");
-    static const char *known[] = {"name", "description", "scenes", "size", "frames", "warmup", "repeats", "seed",
-                                  "camera", "time", "animate", "cache", "compare", "exposure", "timeout",
-                                  "methods", "reference", "charts", "timer", NULL};
+    static const char *known[] = {"name",    "description", "scenes",  "size",     "frames",
+                                  "warmup",  "repeats",     "seed",    "camera",   "time",
+                                  "animate", "cache",       "compare", "exposure", "timeout",
+                                  "methods", "reference",   "charts",  "timer",    NULL};
     int rc = check_keys(o, known, "", file);
     if (rc != EXIT_OK)
         return rc;
@@ -932,28 +961,35 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
             (rc = get_uint(ref, "/reference", "max_bounces", 0, 1024, 64, &st->ref_bounces, file)))
             return rc;
         json_object *cs, *tse, *px;
-        static const char *ref_keys[] = {"spp", "target_se", "max_bounces", "convergence_spp", "pixel", NULL};
+        static const char *ref_keys[] = {"spp",   "target_se", "max_bounces", "convergence_spp",
+                                         "pixel", NULL};
         if ((rc = check_keys(ref, ref_keys, "/reference", file)))
             return rc;
         if (json_object_object_get_ex(ref, "pixel", &px)) {
             const char *pv = json_object_get_string(px);
-            if (!json_object_is_type(px, json_type_string) || (strcmp(pv, "box") && strcmp(pv, "center")))
-                return fail_json(file, "/reference/pixel", "must be \"box\" (the pixel's average) or \"center\"");
+            if (!json_object_is_type(px, json_type_string) ||
+                (strcmp(pv, "box") && strcmp(pv, "center")))
+                return fail_json(file, "/reference/pixel",
+                                 "must be \"box\" (the pixel's average) or \"center\"");
             st->ref_pixel_center = !strcmp(pv, "center");
         }
-        if (json_object_object_get_ex(ref, "target_se", &tse) && !json_object_is_type(tse, json_type_null)) {
+        if (json_object_object_get_ex(ref, "target_se", &tse) &&
+            !json_object_is_type(tse, json_type_null)) {
             st->ref_target_se = json_object_get_double(tse);
             if (!(st->ref_target_se > 0))
-                return fail_json(file, "/reference/target_se", "must be a positive relative standard error");
+                return fail_json(file, "/reference/target_se",
+                                 "must be a positive relative standard error");
         }
         if (json_object_object_get_ex(ref, "convergence_spp", &cs)) {
             if (!json_object_is_type(cs, json_type_array) || json_object_array_length(cs) > 32)
-                return fail_json(file, "/reference/convergence_spp", "must be a list of at most 32 sample counts");
+                return fail_json(file, "/reference/convergence_spp",
+                                 "must be a list of at most 32 sample counts");
             for (size_t i = 0; i < json_object_array_length(cs); i++) {
                 json_object *kj = json_object_array_get_idx(cs, i);
                 int64_t k = json_object_get_int64(kj);
                 if (!json_object_is_type(kj, json_type_int) || k < 1 || (uint64_t)k >= st->ref_spp)
-                    return fail_json(file, "/reference/convergence_spp", "each count must be 1 .. spp-1");
+                    return fail_json(file, "/reference/convergence_spp",
+                                     "each count must be 1 .. spp-1");
                 st->conv_spp[st->conv_n++] = (uint32_t)k;
             }
         }
@@ -971,14 +1007,18 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
         return EXIT_OK;
     }
     if (!json_object_is_type(v, json_type_array) || json_object_array_length(v) == 0)
-        return fail_json(file, "/methods", "must be \"all\" or a non-empty list of {\"method\": id, \"params\": {...}}");
-    static const char *entry_keys[] = {"method", "params", "label", "scenes", "size", "frames", "warmup",
-                                       "repeats", "time", "animate", "cache", "compare", NULL};
+        return fail_json(
+            file, "/methods",
+            "must be \"all\" or a non-empty list of {\"method\": id, \"params\": {...}}");
+    static const char *entry_keys[] = {"method", "params",  "label",   "scenes", "size",
+                                       "frames", "warmup",  "repeats", "time",   "animate",
+                                       "cache",  "compare", NULL};
     for (size_t i = 0; i < json_object_array_length(v); i++) {
         json_object *e = json_object_array_get_idx(v, i), *id, *params = NULL;
         char mpath[64];
         snprintf(mpath, sizeof mpath, "/methods/%zu", i);
-        if (!json_object_is_type(e, json_type_object) || !json_object_object_get_ex(e, "method", &id))
+        if (!json_object_is_type(e, json_type_object) ||
+            !json_object_object_get_ex(e, "method", &id))
             return fail_json(file, mpath, "needs \"method\"");
         if (!json_object_is_type(id, json_type_string))
             return fail_json(file, mpath, "\"method\" must be a method id (a string) or \"all\"");
@@ -993,7 +1033,8 @@ static int load_study(study *st, const char *file, const char *out_dir, gi_plugi
         const char *mid = json_object_get_string(id);
         if (!strcmp(mid, "all")) {
             if (params)
-                return fail_json(file, mpath, "\"all\" runs every method with its defaults: no \"params\"");
+                return fail_json(file, mpath,
+                                 "\"all\" runs every method with its defaults: no \"params\"");
             for (uint32_t k = 0; k < reg->count; k++)
                 if ((rc = expand_method(st, file, out_dir, reg->items[k].method, NULL, mpath, &rs)))
                     return rc;
@@ -1028,8 +1069,9 @@ static double rec_num(json_object *o, const char *k1, const char *k2, const char
  * each convergence_spp count (another seed) against `reference`. The
  * full-GI images keep their old names (references made before per-bounce
  * curves are reused). */
-static int pt_convergence(study *st, const char *out_dir, const study_ref *sc, const char *scene, uint32_t bounces,
-                          const char *reference, tradeoff_pt_curve *curve, char *why, size_t why_size)
+static int pt_convergence(study *st, const char *out_dir, const study_ref *sc, const char *scene,
+                          uint32_t bounces, const char *reference, tradeoff_pt_curve *curve,
+                          char *why, size_t why_size)
 {
     const char *px = st->ref_pixel_center ? "_center" : "";
     curve->n = 0;
@@ -1039,10 +1081,11 @@ static int pt_convergence(study *st, const char *out_dir, const study_ref *sc, c
             snprintf(b, sizeof b, "b%u_", bounces);
         char stem[320];
         snprintf(stem, sizeof stem, "%s", sc->name);
-        snprintf(img, sizeof img, "%s/references/%s_conv_%s%uspp%s.exr", out_dir, stem, b, st->conv_spp[c], px);
-        if (!runner_reference(scene, st->scenes[sc->scene_index].hash, st->camera, sc->width, sc->height,
-                              st->conv_spp[c], 0.0, bounces, st->seed + 7919, sc->time, st->ref_pixel_center,
-                              st->timeout_s, img, why, why_size))
+        snprintf(img, sizeof img, "%s/references/%s_conv_%s%uspp%s.exr", out_dir, stem, b,
+                 st->conv_spp[c], px);
+        if (!runner_reference(scene, st->scenes[sc->scene_index].hash, st->camera, sc->width,
+                              sc->height, st->conv_spp[c], 0.0, bounces, st->seed + 7919, sc->time,
+                              st->ref_pixel_center, st->timeout_s, img, why, why_size))
             return 0;
         snprintf(stats, sizeof stats, "%s.json", img);
         json_object *sj = cli_read_json(stats);
@@ -1052,7 +1095,9 @@ static int pt_convergence(study *st, const char *out_dir, const study_ref *sc, c
          * by CPU time, else its render's wall time (all threads); the BVH
          * build, like a method's prepare, is not in it. Images made before
          * the CPU time was recorded give their whole wall time. */
-        double t = rec_num(sj, st->timer && !strcmp(st->timer, "cputime") ? "render_cpu_seconds" : "render_seconds",
+        double t = rec_num(sj,
+                           st->timer && !strcmp(st->timer, "cputime") ? "render_cpu_seconds"
+                                                                      : "render_seconds",
                            NULL, NULL);
         if (!isfinite(t))
             t = rec_num(sj, "wall_seconds", NULL, NULL);
@@ -1082,33 +1127,36 @@ static int run_uses_ref(const study_run *r, uint32_t ri)
 /* One reference set: the full-GI reference, the bounce-matched ones for
  * every method bounce count in use and, with `curves`, the path tracer's
  * convergence images. 1 when all exist (made now or before), else 0 with why. */
-static int build_reference_set(study *st, const char *out_dir, uint32_t ri, int curves, char *why, size_t why_size)
+static int build_reference_set(study *st, const char *out_dir, uint32_t ri, int curves, char *why,
+                               size_t why_size)
 {
     study_ref *sc = &st->refs[ri];
     const char *path = st->scenes[sc->scene_index].path;
     char dir[2048], stem[320];
-    snprintf(stem, sizeof stem, "%s", sc->name); /* a copy: -Wrestrict sees sc->name and the outputs as one object */
+    snprintf(stem, sizeof stem, "%s",
+             sc->name); /* a copy: -Wrestrict sees sc->name and the outputs as one object */
     snprintf(dir, sizeof dir, "%s/references", out_dir);
     cli_mkdirs(dir);
     /* the file name carries every setting that changes the image, so that
      * runs compared with an older reference are not taken as done */
     const char *px = st->ref_pixel_center ? "_center" : "";
-    snprintf(sc->ref_full, sizeof sc->ref_full, "%s/%s_b%u_%uspp%s.exr", dir, stem, st->ref_bounces, st->ref_spp,
-             px);
-    fprintf(stderr, "study: reference %s (%ux%u, %u spp, %u bounces)\n", stem, sc->width, sc->height, st->ref_spp,
-            st->ref_bounces);
-    if (!runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width, sc->height, st->ref_spp, st->ref_target_se, st->ref_bounces,
-                          st->seed, sc->time, st->ref_pixel_center, st->timeout_s * 10, sc->ref_full, why,
-                          why_size))
+    snprintf(sc->ref_full, sizeof sc->ref_full, "%s/%s_b%u_%uspp%s.exr", dir, stem, st->ref_bounces,
+             st->ref_spp, px);
+    fprintf(stderr, "study: reference %s (%ux%u, %u spp, %u bounces)\n", stem, sc->width,
+            sc->height, st->ref_spp, st->ref_bounces);
+    if (!runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width, sc->height,
+                          st->ref_spp, st->ref_target_se, st->ref_bounces, st->seed, sc->time,
+                          st->ref_pixel_center, st->timeout_s * 10, sc->ref_full, why, why_size))
         return 0;
     /* the noise floor of an animation frame: the same reference with another seed */
     if (sc->want_alt) {
-        snprintf(sc->ref_alt, sizeof sc->ref_alt, "%s/%s_b%u_%uspp%s_alt.exr", dir, stem, st->ref_bounces,
-                 st->ref_spp, px);
+        snprintf(sc->ref_alt, sizeof sc->ref_alt, "%s/%s_b%u_%uspp%s_alt.exr", dir, stem,
+                 st->ref_bounces, st->ref_spp, px);
         fprintf(stderr, "study: reference %s, second seed (noise floor)\n", stem);
-        if (!runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width, sc->height,
-                              st->ref_spp, st->ref_target_se, st->ref_bounces, st->seed + 1000003u, sc->time,
-                              st->ref_pixel_center, st->timeout_s * 10, sc->ref_alt, why, why_size))
+        if (!runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width,
+                              sc->height, st->ref_spp, st->ref_target_se, st->ref_bounces,
+                              st->seed + 1000003u, sc->time, st->ref_pixel_center,
+                              st->timeout_s * 10, sc->ref_alt, why, why_size))
             return 0;
     }
     /* bounce-matched references for every method bounce count in use */
@@ -1120,12 +1168,13 @@ static int build_reference_set(study *st, const char *out_dir, uint32_t ri, int 
             k++;
         if (k == sc->matched_count && k < 8) {
             sc->matched_bounces[k] = b;
-            snprintf(sc->ref_matched[k], sizeof sc->ref_matched[k], "%s/%s_b%u_%uspp%s.exr", dir, stem, b,
-                     st->ref_spp, px);
+            snprintf(sc->ref_matched[k], sizeof sc->ref_matched[k], "%s/%s_b%u_%uspp%s.exr", dir,
+                     stem, b, st->ref_spp, px);
             fprintf(stderr, "study: bounce-matched reference %s (%u bounces)\n", stem, b);
-            if (!runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width, sc->height, st->ref_spp, st->ref_target_se, b,
-                                  st->seed, sc->time, st->ref_pixel_center, st->timeout_s * 10,
-                                  sc->ref_matched[k], why, why_size))
+            if (!runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width,
+                                  sc->height, st->ref_spp, st->ref_target_se, b, st->seed, sc->time,
+                                  st->ref_pixel_center, st->timeout_s * 10, sc->ref_matched[k], why,
+                                  why_size))
                 return 0;
             sc->matched_count++;
         }
@@ -1136,12 +1185,13 @@ static int build_reference_set(study *st, const char *out_dir, uint32_t ri, int 
      * count in use: k-spp images (another seed) against the reference
      * of the same bounce count */
     sc->pt_full.bounces = st->ref_bounces;
-    if (!pt_convergence(st, out_dir, sc, path, st->ref_bounces, sc->ref_full, &sc->pt_full, why, why_size))
+    if (!pt_convergence(st, out_dir, sc, path, st->ref_bounces, sc->ref_full, &sc->pt_full, why,
+                        why_size))
         return 0;
     for (uint32_t k = 0; k < sc->matched_count; k++) {
         sc->pt_matched[k].bounces = sc->matched_bounces[k];
-        if (!pt_convergence(st, out_dir, sc, path, sc->matched_bounces[k], sc->ref_matched[k], &sc->pt_matched[k], why,
-                            why_size))
+        if (!pt_convergence(st, out_dir, sc, path, sc->matched_bounces[k], sc->ref_matched[k],
+                            &sc->pt_matched[k], why, why_size))
             return 0;
     }
     return 1;
@@ -1215,11 +1265,12 @@ typedef struct run_progress {
     uint32_t ran, left;
 } run_progress;
 
-static void report_run(run_progress *p, const study *st, uint32_t i, json_object *rec, double seconds,
-                       const char *who)
+static void report_run(run_progress *p, const study *st, uint32_t i, json_object *rec,
+                       double seconds, const char *who)
 {
     json_object *v;
-    const char *status = json_object_object_get_ex(rec, "status", &v) ? json_object_get_string(v) : "?";
+    const char *status =
+        json_object_object_get_ex(rec, "status", &v) ? json_object_get_string(v) : "?";
     int cached = json_object_object_get_ex(rec, "cached", &v) && json_object_get_boolean(v);
     json_object_object_del(rec, "cached"); /* what the runner told us, not part of the record */
     const char *what = !strcmp(status, "ok") ? (cached ? "cached" : "ran") : status;
@@ -1239,8 +1290,9 @@ static void report_run(run_progress *p, const study *st, uint32_t i, json_object
         size_t used = strlen(params);
         snprintf(params + used, sizeof params - used, "%s%s", k ? "," : " ", s->params[k]);
     }
-    fprintf(stderr, "study: %s[%u/%u] %s %s (%s%s) %.1f s; elapsed %s, ETA %s\n", who, i + 1, st->run_count, what,
-            st->runs[i].id, s->method, params, seconds, el, p->left ? eta : "0:00");
+    fprintf(stderr, "study: %s[%u/%u] %s %s (%s%s) %.1f s; elapsed %s, ETA %s\n", who, i + 1,
+            st->run_count, what, st->runs[i].id, s->method, params, seconds, el,
+            p->left ? eta : "0:00");
 }
 
 /* Runs every run not yet done: `jobs` worker processes, each taking runs
@@ -1326,7 +1378,8 @@ static void reference_sets(study *st, json_object *meta)
             holds_runs |= st->runs[i].ref_index == (int)ri;
         if (sc->frame_only && !holds_runs)
             continue;
-        json_object *set = json_object_new_object(), *matched = json_object_new_array(), *ids = json_object_new_array();
+        json_object *set = json_object_new_object(), *matched = json_object_new_array(),
+                    *ids = json_object_new_array();
         json_object_object_add(set, "name", json_object_new_string(sc->name));
         json_object_object_add(set, "full", ref_rel(sc->ref_full));
         json_object_object_add(set, "bounces", json_object_new_int((int)st->ref_bounces));
@@ -1350,7 +1403,8 @@ static void reference_sets(study *st, json_object *meta)
 /* Per reference set: the error-against-time charts with every run's
  * convergence curve, the Pareto fronts and the path tracer's curves, and
  * the equal-error and equal-time tables (tradeoff.h). */
-static void charts_and_speedups(study *st, const char *out_dir, json_object *meta, json_object *chart_list)
+static void charts_and_speedups(study *st, const char *out_dir, json_object *meta,
+                                json_object *chart_list)
 {
     gi_text md = {0};
     tradeoff_run *tr = calloc(st->run_count + 1, sizeof *tr);
@@ -1361,10 +1415,12 @@ static void charts_and_speedups(study *st, const char *out_dir, json_object *met
         uint32_t n = 0;
         /* animated runs have no convergence curve (each frame is a new image) */
         for (uint32_t i = 0; i < st->run_count; i++)
-            if (st->runs[i].ref_index == (int)ri && st->runs[i].record && st->runs[i].spec.animate_fps <= 0)
-                tr[n++] = (tradeoff_run){st->runs[i].record, st->runs[i].bounces, st->runs[i].setting};
-        tradeoff_report(out_dir, sc->name, &sc->pt_full, sc->pt_matched, sc->matched_count, tr, n, gi_chart_write_png,
-                        chart_list, &md);
+            if (st->runs[i].ref_index == (int)ri && st->runs[i].record &&
+                st->runs[i].spec.animate_fps <= 0)
+                tr[n++] =
+                    (tradeoff_run){st->runs[i].record, st->runs[i].bounces, st->runs[i].setting};
+        tradeoff_report(out_dir, sc->name, &sc->pt_full, sc->pt_matched, sc->matched_count, tr, n,
+                        gi_chart_write_png, chart_list, &md);
     }
     free(tr);
     json_object_object_add(meta, "markdown", json_object_new_string(md.s ? md.s : ""));
@@ -1375,7 +1431,8 @@ static void charts_and_speedups(study *st, const char *out_dir, json_object *met
 static double anim_num(json_object *rec, const char *key)
 {
     json_object *a, *v;
-    if (!json_object_object_get_ex(rec, "animation", &a) || !json_object_object_get_ex(a, key, &v) || !v)
+    if (!json_object_object_get_ex(rec, "animation", &a) ||
+        !json_object_object_get_ex(a, key, &v) || !v)
         return NAN;
     return json_object_get_double(v);
 }
@@ -1400,8 +1457,8 @@ static int anim_series_from(json_object *rec, const char *key, const char *label
 {
     json_object *a, *list;
     memset(out, 0, sizeof *out);
-    if (!json_object_object_get_ex(rec, "animation", &a) || !json_object_object_get_ex(a, key, &list) ||
-        !json_object_is_type(list, json_type_array))
+    if (!json_object_object_get_ex(rec, "animation", &a) ||
+        !json_object_object_get_ex(a, key, &list) || !json_object_is_type(list, json_type_array))
         return 0;
     uint32_t n = (uint32_t)json_object_array_length(list);
     out->x = calloc(n + 1, sizeof *out->x);
@@ -1429,7 +1486,8 @@ static int anim_series_from(json_object *rec, const char *key, const char *label
  * table of every such run (markdown, into meta "animation_markdown") and,
  * per scene, charts of relMSE, frame time and frame-to-frame change
  * against the frame index, one series per run. */
-static void animation_report(study *st, const char *out_dir, json_object *meta, json_object *chart_list)
+static void animation_report(study *st, const char *out_dir, json_object *meta,
+                             json_object *chart_list)
 {
     gi_text md = {0};
     int any = 0;
@@ -1439,46 +1497,58 @@ static void animation_report(study *st, const char *out_dir, json_object *meta, 
         json_object_object_add(meta, "animation_markdown", json_object_new_string(""));
         return;
     }
-    gi_text_put(&md,
-                "Every frame of an animated run (`\"animate\"` with comparison on) against references "
-                "rendered at that frame's scene time. relMSE: mean over the frames (max); leaked energy: the "
-                "method's light where the full reference is dark (below 1 %% of its mean luminance), as a "
-                "share of the reference's light, mean over the frames. Change: the mean absolute "
-                "frame-to-frame difference, per pixel and channel (linear radiance), of the method's frames "
-                "and of the references' frames; **flicker** = the method's change − the reference's (> 0: "
-                "the method changes more from frame to frame than the light does). Temporal error: the mean "
-                "of |method's change − reference's change| per pixel and channel. Noise floor: the mean "
-                "absolute difference between two full-GI references of the same frame with different seeds; "
-                "the references of all frames share one seed, so their noise is correlated from frame to "
-                "frame where nothing moves, and the noise floor bounds the noise's share of the reference's "
-                "change from above: a flicker smaller than it is not told apart from reference noise.\n\n");
-    gi_text_put(&md, "| run | method | params | label | frames | fps | frame ms (median) | relMSE full mean | "
-                     "relMSE full max | relMSE matched mean | leaked energy | change method | change reference "
-                     "| flicker full | flicker matched | temporal error | noise floor |\n"
-                     "|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    gi_text_put(
+        &md,
+        "Every frame of an animated run (`\"animate\"` with comparison on) against references "
+        "rendered at that frame's scene time. relMSE: mean over the frames (max); leaked energy: "
+        "the "
+        "method's light where the full reference is dark (below 1 %% of its mean luminance), as a "
+        "share of the reference's light, mean over the frames. Change: the mean absolute "
+        "frame-to-frame difference, per pixel and channel (linear radiance), of the method's "
+        "frames "
+        "and of the references' frames; **flicker** = the method's change − the reference's (> 0: "
+        "the method changes more from frame to frame than the light does). Temporal error: the "
+        "mean "
+        "of |method's change − reference's change| per pixel and channel. Noise floor: the mean "
+        "absolute difference between two full-GI references of the same frame with different "
+        "seeds; "
+        "the references of all frames share one seed, so their noise is correlated from frame to "
+        "frame where nothing moves, and the noise floor bounds the noise's share of the "
+        "reference's "
+        "change from above: a flicker smaller than it is not told apart from reference noise.\n\n");
+    gi_text_put(
+        &md,
+        "| run | method | params | label | frames | fps | frame ms (median) | relMSE full mean | "
+        "relMSE full max | relMSE matched mean | leaked energy | change method | change reference "
+        "| flicker full | flicker matched | temporal error | noise floor |\n"
+        "|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (uint32_t i = 0; i < st->run_count; i++) {
         study_run *r = &st->runs[i];
         json_object *v;
         if (!r->frame_ref_n || !r->record)
             continue;
-        const char *status = json_object_object_get_ex(r->record, "status", &v) ? json_object_get_string(v) : "?";
+        const char *status =
+            json_object_object_get_ex(r->record, "status", &v) ? json_object_get_string(v) : "?";
         char params[600] = "";
         for (uint32_t k = 0; k < r->spec.param_count; k++) {
             size_t used = strlen(params);
             snprintf(params + used, sizeof params - used, "%s%s", k ? "," : "", r->spec.params[k]);
         }
-        gi_text_put(&md, "| %s | %s | `%s` | %s |", r->id, r->spec.method, params[0] ? params : "(defaults)",
-                    r->spec.label ? r->spec.label : "");
+        gi_text_put(&md, "| %s | %s | `%s` | %s |", r->id, r->spec.method,
+                    params[0] ? params : "(defaults)", r->spec.label ? r->spec.label : "");
         if (strcmp(status, "ok")) {
-            const char *reason = json_object_object_get_ex(r->record, "reason", &v) ? json_object_get_string(v) : "";
+            const char *reason =
+                json_object_object_get_ex(r->record, "reason", &v) ? json_object_get_string(v) : "";
             gi_text_put(&md, " %s: %s | | | | | | | | | | | | |\n", status, reason);
             continue;
         }
         gi_text_put(&md, " %u | %g |", r->frame_ref_n, (double)r->spec.animate_fps);
-        const char *keys[] = {"frame_ms_median",       "relmse_full_mean",     "relmse_full_max",
-                              "relmse_matched_mean",   "leaked_energy_full_mean", "change_method_mean",
-                              "change_ref_full_mean",  "flicker_full",         "flicker_matched",
-                              "temporal_error_full_mean", "noise_floor_full_mean"};
+        const char *keys[] = {"frame_ms_median",         "relmse_full_mean",
+                              "relmse_full_max",         "relmse_matched_mean",
+                              "leaked_energy_full_mean", "change_method_mean",
+                              "change_ref_full_mean",    "flicker_full",
+                              "flicker_matched",         "temporal_error_full_mean",
+                              "noise_floor_full_mean"};
         for (size_t k = 0; k < sizeof keys / sizeof keys[0]; k++)
             md_cell(&md, anim_num(r->record, keys[k]));
         gi_text_put(&md, "\n");
@@ -1503,18 +1573,21 @@ static void animation_report(study *st, const char *out_dir, json_object *meta, 
                 study_run *r = &st->runs[i];
                 json_object *v;
                 if (!r->frame_ref_n || !r->record || r->scene_index != (int)sc ||
-                    !json_object_object_get_ex(r->record, "status", &v) || strcmp(json_object_get_string(v), "ok"))
+                    !json_object_object_get_ex(r->record, "status", &v) ||
+                    strcmp(json_object_get_string(v), "ok"))
                     continue;
                 char label[200];
                 size_t used = (size_t)snprintf(label, sizeof label, "%s", r->spec.method);
                 for (uint32_t k = 0; k < r->spec.param_count && used < sizeof label; k++)
-                    used += (size_t)snprintf(label + used, sizeof label - used, " %s", r->spec.params[k]);
+                    used += (size_t)snprintf(label + used, sizeof label - used, " %s",
+                                             r->spec.params[k]);
                 if (r->spec.label && used < sizeof label)
                     snprintf(label + used, sizeof label - used, " [%s]", r->spec.label);
                 const char *key = c == 0 ? "relmse_full" : c == 1 ? "frame_ms" : "change_method";
                 if (anim_series_from(r->record, key, label, &ser[n])) {
-                    cs[n] = (gi_chart_series){ser[n].label, ser[n].x, ser[n].y, ser[n].n, GI_CHART_LINE_MARKERS,
-                                              0, NULL, NULL, NULL, NULL};
+                    cs[n] = (gi_chart_series){
+                        ser[n].label, ser[n].x, ser[n].y, ser[n].n, GI_CHART_LINE_MARKERS, 0,
+                        NULL,         NULL,     NULL,     NULL};
                     n++;
                 }
                 /* the references' own change and noise floor, once per frame rate */
@@ -1524,16 +1597,20 @@ static void animation_report(study *st, const char *out_dir, json_object *meta, 
                 if (c == 2 && q == nseen && nseen < 16 && n < 30) {
                     seen_fps[nseen++] = r->spec.animate_fps;
                     char l2[200];
-                    snprintf(l2, sizeof l2, "reference change (%g fps)", (double)r->spec.animate_fps);
+                    snprintf(l2, sizeof l2, "reference change (%g fps)",
+                             (double)r->spec.animate_fps);
                     if (anim_series_from(r->record, "change_ref_full", l2, &ser[n])) {
-                        cs[n] = (gi_chart_series){ser[n].label, ser[n].x, ser[n].y, ser[n].n, GI_CHART_DASHED, 0,
-                                                  NULL, NULL, NULL, NULL};
+                        cs[n] = (gi_chart_series){
+                            ser[n].label, ser[n].x, ser[n].y, ser[n].n, GI_CHART_DASHED, 0,
+                            NULL,         NULL,     NULL,     NULL};
                         n++;
                     }
-                    snprintf(l2, sizeof l2, "reference noise floor, two seeds (%g fps)", (double)r->spec.animate_fps);
+                    snprintf(l2, sizeof l2, "reference noise floor, two seeds (%g fps)",
+                             (double)r->spec.animate_fps);
                     if (anim_series_from(r->record, "noise_floor_full", l2, &ser[n])) {
-                        cs[n] = (gi_chart_series){ser[n].label, ser[n].x, ser[n].y, ser[n].n, GI_CHART_DASHED, 0,
-                                                  NULL, NULL, NULL, NULL};
+                        cs[n] = (gi_chart_series){
+                            ser[n].label, ser[n].x, ser[n].y, ser[n].n, GI_CHART_DASHED, 0,
+                            NULL,         NULL,     NULL,     NULL};
                         n++;
                     }
                 }
@@ -1543,8 +1620,11 @@ static void animation_report(study *st, const char *out_dir, json_object *meta, 
                 snprintf(file, sizeof file, "chart_%s_anim_%s.png", st->scenes[sc].stem, what[c]);
                 snprintf(path, sizeof path, "%s/%s", out_dir, file);
                 snprintf(title, sizeof title, "%s, animated: %s per frame", st->scenes[sc].stem,
-                         c == 0 ? "relMSE" : c == 1 ? "frame time" : "frame-to-frame change");
-                gi_chart_desc desc = {title, "frame index (from 0)", ylab[c], 0, c == 0, 0, 0, NULL, 0};
+                         c == 0   ? "relMSE"
+                         : c == 1 ? "frame time"
+                                  : "frame-to-frame change");
+                gi_chart_desc desc = {title, "frame index (from 0)", ylab[c], 0, c == 0, 0, 0, NULL,
+                                      0};
                 gi_error err;
                 if (gi_chart_write_png(path, &desc, cs, n, &err) == GI_OK)
                     json_object_array_add(chart_list, json_object_new_string(file));
@@ -1568,7 +1648,8 @@ static json_object *record_field(json_object *rec, const char *name)
 {
     json_object *v;
     if (!strncmp(name, "params.", 7)) {
-        const char *ps = json_object_object_get_ex(rec, "params_full", &v) || json_object_object_get_ex(rec, "params", &v)
+        const char *ps = json_object_object_get_ex(rec, "params_full", &v) ||
+                                 json_object_object_get_ex(rec, "params", &v)
                              ? json_object_get_string(v)
                              : "";
         size_t kl = strlen(name + 7);
@@ -1584,7 +1665,8 @@ static json_object *record_field(json_object *rec, const char *name)
     char buf[256];
     snprintf(buf, sizeof buf, "%s", name);
     json_object *o = rec;
-    for (char *save = NULL, *tok = strtok_r(buf, ".", &save); tok; tok = strtok_r(NULL, ".", &save)) {
+    for (char *save = NULL, *tok = strtok_r(buf, ".", &save); tok;
+         tok = strtok_r(NULL, ".", &save)) {
         if (!o || !json_object_object_get_ex(o, tok, &o))
             return NULL;
     }
@@ -1614,7 +1696,9 @@ static int field_equals(json_object *rec, const char *name, json_object *want)
     int eq = 0;
     if (f) {
         double a = field_num(f), b = field_num(want);
-        eq = isfinite(a) && isfinite(b) ? a == b : !strcmp(json_object_get_string(f), json_object_get_string(want));
+        eq = isfinite(a) && isfinite(b)
+                 ? a == b
+                 : !strcmp(json_object_get_string(f), json_object_get_string(want));
     }
     json_object_put(f);
     return eq;
@@ -1647,7 +1731,8 @@ static void user_charts(study *st, const char *out_dir, json_object *runs, json_
     int mixed = 0;
     for (size_t i = 0; i < nr; i++) {
         json_object *rec = json_object_array_get_idx(runs, i), *r;
-        const char *rn = json_object_object_get_ex(rec, "renderer", &r) ? json_object_get_string(r) : "";
+        const char *rn =
+            json_object_object_get_ex(rec, "renderer", &r) ? json_object_get_string(r) : "";
         if (!renderer0)
             renderer0 = rn;
         mixed |= strcmp(renderer0, rn) != 0;
@@ -1657,7 +1742,8 @@ static void user_charts(study *st, const char *out_dir, json_object *runs, json_
         const char *file = json_object_get_string(json_object_object_get(c, "file"));
         const char *xf = json_object_get_string(json_object_object_get(c, "x"));
         const char *yf = json_object_get_string(json_object_object_get(c, "y"));
-        const char *sf = json_object_object_get_ex(c, "series", &v) ? json_object_get_string(v) : NULL;
+        const char *sf =
+            json_object_object_get_ex(c, "series", &v) ? json_object_get_string(v) : NULL;
         json_object_object_get_ex(c, "where", &where);
         char *labels[32] = {0};
         double *pts[32] = {0}; /* (x, y) pairs */
@@ -1665,7 +1751,8 @@ static void user_charts(study *st, const char *out_dir, json_object *runs, json_
         int listed[32] = {0}; /* series drawn from a list field */
         for (size_t i = 0; i < nr; i++) {
             json_object *rec = json_object_array_get_idx(runs, i);
-            if (!json_object_object_get_ex(rec, "status", &v) || strcmp(json_object_get_string(v), "ok"))
+            if (!json_object_object_get_ex(rec, "status", &v) ||
+                strcmp(json_object_get_string(v), "ok"))
                 continue;
             int match = 1;
             if (where) {
@@ -1677,7 +1764,8 @@ static void user_charts(study *st, const char *out_dir, json_object *runs, json_
             int is_list = y && json_object_is_type(y, json_type_array);
             char label[256];
             if (is_list && !sf)
-                snprintf(label, sizeof label, "%s", json_object_get_string(json_object_object_get(rec, "run")));
+                snprintf(label, sizeof label, "%s",
+                         json_object_get_string(json_object_object_get(rec, "run")));
             else if (sf) {
                 json_object *s = record_field(rec, sf);
                 const char *leaf = strrchr(sf, '.') ? strrchr(sf, '.') + 1 : sf;
@@ -1704,11 +1792,14 @@ static void user_charts(study *st, const char *out_dir, json_object *runs, json_
             }
             if (is_list) {
                 listed[k] = 1;
-                for (size_t j = 0; j < json_object_array_length(y) && counts[k] < MAX_RUNS && pts[k]; j++) {
+                for (size_t j = 0;
+                     j < json_object_array_length(y) && counts[k] < MAX_RUNS && pts[k]; j++) {
                     if (!json_object_array_get_idx(y, j))
-                        continue; /* null: no value at this position (a warm-up frame, frame 0's change) */
+                        continue; /* null: no value at this position (a warm-up frame, frame 0's
+                                     change) */
                     pts[k][2 * counts[k]] = (double)(j + 1);
-                    pts[k][2 * counts[k] + 1] = json_object_get_double(json_object_array_get_idx(y, j));
+                    pts[k][2 * counts[k] + 1] =
+                        json_object_get_double(json_object_array_get_idx(y, j));
                     counts[k]++;
                 }
             } else if (pts[k] && counts[k] < MAX_RUNS) {
@@ -1762,16 +1853,34 @@ static void user_charts(study *st, const char *out_dir, json_object *runs, json_
                 if (t == tick_n && isfinite(xy[k][0][j]))
                     ticks[tick_n++] = xy[k][0][j];
             }
-            series[k] = (gi_chart_series){labels[k], xy[k][0], xy[k][1], xy[k][0] && xy[k][1] ? m : 0, 0, 0,
-                                          NULL, NULL, spread ? xy[k][2] : NULL, spread ? xy[k][3] : NULL};
+            series[k] = (gi_chart_series){labels[k],
+                                          xy[k][0],
+                                          xy[k][1],
+                                          xy[k][0] && xy[k][1] ? m : 0,
+                                          0,
+                                          0,
+                                          NULL,
+                                          NULL,
+                                          spread ? xy[k][2] : NULL,
+                                          spread ? xy[k][3] : NULL};
         }
-        const char *title = json_object_object_get_ex(c, "title", &v) ? json_object_get_string(v) : file;
-        const char *xl = json_object_object_get_ex(c, "x_label", &v) ? json_object_get_string(v) : xf;
-        const char *yl = json_object_object_get_ex(c, "y_label", &v) ? json_object_get_string(v) : yf;
+        const char *title =
+            json_object_object_get_ex(c, "title", &v) ? json_object_get_string(v) : file;
+        const char *xl =
+            json_object_object_get_ex(c, "x_label", &v) ? json_object_get_string(v) : xf;
+        const char *yl =
+            json_object_object_get_ex(c, "y_label", &v) ? json_object_get_string(v) : yf;
         int lx = json_object_object_get_ex(c, "log_x", &v) && json_object_get_boolean(v);
         int ly = json_object_object_get_ex(c, "log_y", &v) && json_object_get_boolean(v);
         /* ticks at the swept values when there are few (at most 12) */
-        gi_chart_desc desc = {title, xl, yl, lx, ly, 0, 0, any_list || tick_n > 12 ? NULL : ticks,
+        gi_chart_desc desc = {title,
+                              xl,
+                              yl,
+                              lx,
+                              ly,
+                              0,
+                              0,
+                              any_list || tick_n > 12 ? NULL : ticks,
                               any_list || tick_n > 12 ? 0 : tick_n};
         char path[4700];
         snprintf(path, sizeof path, "%s/%s", out_dir, file);
@@ -1794,17 +1903,22 @@ static void user_charts(study *st, const char *out_dir, json_object *runs, json_
 /* --dry-run: what the study would do, without doing it. */
 static void print_plan(const study *st)
 {
-    printf("study %s: %u runs, %u scenes, %u reference sets\n", st->name, st->run_count, st->scene_count,
-           st->ref_count);
+    printf("study %s: %u runs, %u scenes, %u reference sets\n", st->name, st->run_count,
+           st->scene_count, st->ref_count);
     for (uint32_t i = 0; i < st->ref_count; i++)
-        printf("reference %s: %s %ux%u time %g\n", st->refs[i].name, st->scenes[st->refs[i].scene_index].path,
-               st->refs[i].width, st->refs[i].height, (double)st->refs[i].time);
+        printf("reference %s: %s %ux%u time %g\n", st->refs[i].name,
+               st->scenes[st->refs[i].scene_index].path, st->refs[i].width, st->refs[i].height,
+               (double)st->refs[i].time);
     for (uint32_t i = 0; i < st->run_count; i++) {
         const study_run *r = &st->runs[i];
         const run_spec *s = &r->spec;
-        printf("run %s: %s %s %ux%u frames %u warmup %u%s%s%s%s", r->id, s->scene, s->method, s->width, s->height,
-               s->frames, s->warmup, s->animate_fps > 0 ? " animate" : "", s->no_cache ? " no-cache" : "",
-               r->ref_index < 0 ? " not-compared" : r->frame_ref_n ? " per-frame" : "", s->label ? " label=" : "");
+        printf("run %s: %s %s %ux%u frames %u warmup %u%s%s%s%s", r->id, s->scene, s->method,
+               s->width, s->height, s->frames, s->warmup, s->animate_fps > 0 ? " animate" : "",
+               s->no_cache ? " no-cache" : "",
+               r->ref_index < 0 ? " not-compared"
+               : r->frame_ref_n ? " per-frame"
+                                : "",
+               s->label ? " label=" : "");
         if (s->label)
             printf("%s", s->label);
         for (uint32_t k = 0; k < s->param_count; k++)
@@ -1865,8 +1979,8 @@ static int lock_out_dir(const char *out, int *rc)
             ssize_t n = pread(fd, pid, sizeof pid - 1, 0);
             pid[n > 0 ? n : 0] = '\0';
             pid[strcspn(pid, "\n")] = '\0';
-            *rc = cli_fail(EXIT_USAGE, "study: %s is in use by another study (pid %s holds %s)", out,
-                           pid[0] ? pid : "unknown", path);
+            *rc = cli_fail(EXIT_USAGE, "study: %s is in use by another study (pid %s holds %s)",
+                           out, pid[0] ? pid : "unknown", path);
         } else {
             *rc = cli_fail(EXIT_RUN, "study: cannot lock %s: %s", path, strerror(errno));
         }
@@ -1911,10 +2025,12 @@ static int slurm_cell(study *st, const char *out, gi_plugins *reg, const char *c
     char kind[8];
     unsigned long k;
     unsigned long long plan;
-    if (sscanf(cell, "%7[a-z]:%lu:%llx", kind, &k, &plan) != 3 || (strcmp(kind, "ref") && strcmp(kind, "run")))
+    if (sscanf(cell, "%7[a-z]:%lu:%llx", kind, &k, &plan) != 3 ||
+        (strcmp(kind, "ref") && strcmp(kind, "run")))
         return cli_fail(EXIT_USAGE, "study: --cell '%s' is not ref:K:PLAN or run:K:PLAN", cell);
     if (plan != slurm_plan_hash(st))
-        return cli_fail(EXIT_USAGE, "study: the study's plan changed since it was submitted: resubmit it");
+        return cli_fail(EXIT_USAGE,
+                        "study: the study's plan changed since it was submitted: resubmit it");
     uint32_t n = !strcmp(kind, "ref") ? st->ref_count : st->run_count;
     if (k >= n)
         return cli_fail(EXIT_USAGE, "study: --cell %s: the study has %u such cells", cell, n);
@@ -1937,9 +2053,11 @@ static int slurm_cell(study *st, const char *out, gi_plugins *reg, const char *c
     double t0 = gi_now();
     r->record = run_or_skip(r, reg, 1);
     json_object *v;
-    const char *status = json_object_object_get_ex(r->record, "status", &v) ? json_object_get_string(v) : "?";
+    const char *status =
+        json_object_object_get_ex(r->record, "status", &v) ? json_object_get_string(v) : "?";
     int cached = json_object_object_get_ex(r->record, "cached", &v) && json_object_get_boolean(v);
-    const char *reason = json_object_object_get_ex(r->record, "reason", &v) ? json_object_get_string(v) : "";
+    const char *reason =
+        json_object_object_get_ex(r->record, "reason", &v) ? json_object_get_string(v) : "";
     fprintf(stderr, "study: run %s: %s%s%s%s (%.1f s)\n", r->id, status, cached ? " (cached)" : "",
             reason[0] ? ": " : "", reason, gi_now() - t0);
     return !strcmp(status, "ok") || !strcmp(status, "n/a") ? EXIT_OK : EXIT_RUN;
@@ -1947,7 +2065,8 @@ static int slurm_cell(study *st, const char *out, gi_plugins *reg, const char *c
 
 /* --slurm: plans the cells as the local runner does, leaves out those
  * already done (resume), and hands the rest to Slurm (slurm_run). */
-static int slurm_submit_study(study *st, const char *file, const char *out, gi_plugins *reg, const slurm_options *so)
+static int slurm_submit_study(study *st, const char *file, const char *out, gi_plugins *reg,
+                              const slurm_options *so)
 {
     uint32_t *ref_tasks = calloc(st->ref_count + 1, sizeof *ref_tasks);
     uint32_t *run_tasks = calloc(st->run_count + 1, sizeof *run_tasks);
@@ -1966,7 +2085,8 @@ static int slurm_submit_study(study *st, const char *file, const char *out, gi_p
         study_run *r = &st->runs[i];
         attach_refs(st, r);
         json_object *rec = run_or_skip(r, reg, 1), *v;
-        const char *status = json_object_object_get_ex(rec, "status", &v) ? json_object_get_string(v) : "";
+        const char *status =
+            json_object_object_get_ex(rec, "status", &v) ? json_object_get_string(v) : "";
         if (json_object_object_get_ex(rec, "cached", &v))
             cached++;
         else if (!strcmp(status, "n/a"))
@@ -1976,7 +2096,9 @@ static int slurm_submit_study(study *st, const char *file, const char *out, gi_p
         json_object_put(rec);
     }
     runner_set_collect_only(0);
-    fprintf(stderr, "study: %s: %u reference sets (%u to make), %u runs (%u done before, %u not applicable, %u to run)\n",
+    fprintf(stderr,
+            "study: %s: %u reference sets (%u to make), %u runs (%u done before, %u not "
+            "applicable, %u to run)\n",
             st->name, st->ref_count, nref, st->run_count, cached, na, nrun);
     slurm_stage refs = {"ref", ref_tasks, nref}, runs = {"run", run_tasks, nrun};
     int rc = slurm_run(so, file, out, st->name, slurm_plan_hash(st), &refs, &runs);
@@ -1992,7 +2114,8 @@ static void slurm_collect_runs(study *st, gi_plugins *reg, const char *out, cons
 {
     char ref_job[64] = "-", run_job[64] = "-";
     sscanf(jobs, "%63[^,],%63s", ref_job, run_job);
-    slurm_tasks *rt = slurm_tasks_query(out, "ref", ref_job), *mt = slurm_tasks_query(out, "run", run_job);
+    slurm_tasks *rt = slurm_tasks_query(out, "ref", ref_job),
+                *mt = slurm_tasks_query(out, "run", run_job);
     runner_set_collect_only(1);
     for (uint32_t i = 0; i < st->run_count; i++) {
         study_run *r = &st->runs[i];
@@ -2000,11 +2123,13 @@ static void slurm_collect_runs(study *st, gi_plugins *reg, const char *out, cons
         json_object *rec = run_or_skip(r, reg, 1), *v;
         if (json_object_object_get_ex(rec, "cached", &v)) {
             json_object_object_del(rec, "cached");
-        } else if (json_object_object_get_ex(rec, "status", &v) && !strcmp(json_object_get_string(v), "failed")) {
+        } else if (json_object_object_get_ex(rec, "status", &v) &&
+                   !strcmp(json_object_get_string(v), "failed")) {
             char why[2200], task[1000];
             if (r->ref_index >= 0 && st->refs[r->ref_index].missing[0]) {
                 slurm_tasks_describe(rt, (uint32_t)r->ref_index, task, sizeof task);
-                snprintf(why, sizeof why, "no reference (%s): %s", st->refs[r->ref_index].missing, task);
+                snprintf(why, sizeof why, "no reference (%s): %s", st->refs[r->ref_index].missing,
+                         task);
             } else {
                 slurm_tasks_describe(mt, i, task, sizeof task);
                 snprintf(why, sizeof why, "no result: %s", task);
@@ -2034,7 +2159,8 @@ int cmd_study(int argc, char **argv)
             out = argv[++i];
         else if (!strcmp(argv[i], "--jobs") && i + 1 < argc) {
             if (!cli_parse_uint(argv[++i], 1, 64, &jobs))
-                return cli_fail(EXIT_USAGE, "study: --jobs '%s' is not an integer in 1..64", argv[i]);
+                return cli_fail(EXIT_USAGE, "study: --jobs '%s' is not an integer in 1..64",
+                                argv[i]);
         } else if (!strcmp(argv[i], "--resume"))
             fresh = 0;
         else if (!strcmp(argv[i], "--fresh"))
@@ -2049,9 +2175,11 @@ int cmd_study(int argc, char **argv)
             return cli_fail(EXIT_USAGE, "study: one study file at a time");
     }
     if (!file || (!out && !dry))
-        return cli_fail(EXIT_USAGE,
-                        "study: usage: gibench study STUDY.json --out DIR [--jobs N] [--resume|--fresh] [--dry-run] "
-                        "[--slurm [--partition P] [--gres G] [--time T] [--array-limit K] [--no-wait]]");
+        return cli_fail(
+            EXIT_USAGE,
+            "study: usage: gibench study STUDY.json --out DIR [--jobs N] [--resume|--fresh] "
+            "[--dry-run] "
+            "[--slurm [--partition P] [--gres G] [--time T] [--array-limit K] [--no-wait]]");
     if (!out)
         out = ".";
     so.dry_run = dry;
@@ -2059,7 +2187,8 @@ int cmd_study(int argc, char **argv)
     if (src != EXIT_OK)
         return src;
     if (fresh && (so.enabled || so.cell || so.collect))
-        return cli_fail(EXIT_USAGE, "study: --fresh does not go with --slurm (remove the results to redo)");
+        return cli_fail(EXIT_USAGE,
+                        "study: --fresh does not go with --slurm (remove the results to redo)");
     gi_plugins *reg = cli_load_plugins(0);
     study st;
     memset(&st, 0, sizeof st);
@@ -2077,7 +2206,8 @@ int cmd_study(int argc, char **argv)
         if (lock_fd >= 0)
             close(lock_fd);
         if (rc == EXIT_OK)
-            rc = so.cell ? slurm_cell(&st, out, reg, so.cell) : slurm_submit_study(&st, file, out, reg, &so);
+            rc = so.cell ? slurm_cell(&st, out, reg, so.cell)
+                         : slurm_submit_study(&st, file, out, reg, &so);
         study_free(&st);
         gi_plugins_free(reg);
         return rc;
@@ -2109,8 +2239,10 @@ int cmd_study(int argc, char **argv)
         for (uint32_t i = 0; i < st.run_count; i++)
             if (st.runs[i].record) {
                 const study_scene *sc = &st.scenes[st.runs[i].scene_index];
-                json_object_object_add(st.runs[i].record, "scene_triangles", json_object_new_int64(sc->triangles));
-                json_object_object_add(st.runs[i].record, "scene_vertices", json_object_new_int64(sc->vertices));
+                json_object_object_add(st.runs[i].record, "scene_triangles",
+                                       json_object_new_int64(sc->triangles));
+                json_object_object_add(st.runs[i].record, "scene_vertices",
+                                       json_object_new_int64(sc->vertices));
             }
         json_object *runs = json_object_new_array();
         char renderer[256] = "";
@@ -2121,7 +2253,8 @@ int cmd_study(int argc, char **argv)
                 continue;
             if (!renderer[0] && json_object_object_get_ex(st.runs[i].record, "renderer", &v))
                 snprintf(renderer, sizeof renderer, "%s", json_object_get_string(v));
-            if (json_object_object_get_ex(st.runs[i].record, "status", &v) && !strcmp(json_object_get_string(v), "failed"))
+            if (json_object_object_get_ex(st.runs[i].record, "status", &v) &&
+                !strcmp(json_object_get_string(v), "failed"))
                 failed++;
             if (json_object_object_get_ex(st.runs[i].record, "status", &v) &&
                 !strcmp(json_object_get_string(v), "interrupted"))
@@ -2129,15 +2262,17 @@ int cmd_study(int argc, char **argv)
             json_object_array_add(runs, json_object_get(st.runs[i].record));
         }
         char title[512], refdesc[256];
-        snprintf(title, sizeof title, "gibench study: %s (%ux%u, %u frames)", st.name, st.base.width, st.base.height,
-                 st.base.frames);
-        snprintf(refdesc, sizeof refdesc, "path traced (Embree), %u spp, %u bounces; bounce-matched the same spp%s",
-                 st.ref_spp, st.ref_bounces, st.ref_pixel_center ? "; camera rays through pixel centres" : "");
+        snprintf(title, sizeof title, "gibench study: %s (%ux%u, %u frames)", st.name,
+                 st.base.width, st.base.height, st.base.frames);
+        snprintf(refdesc, sizeof refdesc,
+                 "path traced (Embree), %u spp, %u bounces; bounce-matched the same spp%s",
+                 st.ref_spp, st.ref_bounces,
+                 st.ref_pixel_center ? "; camera rays through pixel centres" : "");
         json_object *meta = report_meta_new(title, "study", argc, argv, renderer, refdesc);
         if (st.ref_count) {
             char ref_png[512];
-            snprintf(ref_png, sizeof ref_png, "references/%s_b%u_%uspp%s.png", st.refs[0].name, st.ref_bounces,
-                     st.ref_spp, st.ref_pixel_center ? "_center" : "");
+            snprintf(ref_png, sizeof ref_png, "references/%s_b%u_%uspp%s.png", st.refs[0].name,
+                     st.ref_bounces, st.ref_spp, st.ref_pixel_center ? "_center" : "");
             json_object_object_add(meta, "reference_png", json_object_new_string(ref_png));
         }
         reference_sets(&st, meta);
@@ -2150,10 +2285,13 @@ int cmd_study(int argc, char **argv)
         if (!report_write(out, runs, meta, why, sizeof why))
             rc = cli_fail(EXIT_RUN, "study: %s", why);
         else
-            fprintf(stderr, "study: wrote %s/report.md, index.html, runs.csv, frames.csv, curves.csv (%d failed runs)\n", out,
-                    failed);
+            fprintf(stderr,
+                    "study: wrote %s/report.md, index.html, runs.csv, frames.csv, curves.csv (%d "
+                    "failed runs)\n",
+                    out, failed);
         if (rc == EXIT_OK && cli_interrupted)
-            rc = cli_fail(EXIT_RUN, "study: interrupted (%d runs to redo); rerun the same command to resume",
+            rc = cli_fail(EXIT_RUN,
+                          "study: interrupted (%d runs to redo); rerun the same command to resume",
                           interrupted);
         json_object_put(runs);
         json_object_put(meta);

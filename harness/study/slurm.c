@@ -99,7 +99,8 @@ static int on_path(const char *name)
 
 /* Runs a Slurm command (argv[0] a name looked up on PATH) with its output
  * in out_path; cli_run wants a path. 1 when it exited 0. */
-static int run_tool(char *const argv[], const char *out_path, const char *err_path, cli_proc_result *r)
+static int run_tool(char *const argv[], const char *out_path, const char *err_path,
+                    cli_proc_result *r)
 {
     char exe[4200];
     char *args[16];
@@ -113,7 +114,8 @@ static int run_tool(char *const argv[], const char *out_path, const char *err_pa
         return 0;
     }
     args[0] = exe;
-    return cli_run(args, 120, out_path, err_path, r) == 0 && !r->timed_out && !r->signaled && r->exit_code == 0;
+    return cli_run(args, 120, out_path, err_path, r) == 0 && !r->timed_out && !r->signaled &&
+           r->exit_code == 0;
 }
 
 /* Slurm's time formats: minutes, MM:SS, HH:MM:SS, D-HH, D-HH:MM, D-HH:MM:SS. */
@@ -144,34 +146,46 @@ int slurm_check(const slurm_options *o, const char *file, const char *out)
 {
     if (o->cell || o->collect) {
         if (o->enabled)
-            return cli_fail(EXIT_USAGE, "study: --cell and --slurm-collect are for Slurm's tasks, not with --slurm");
+            return cli_fail(
+                EXIT_USAGE,
+                "study: --cell and --slurm-collect are for Slurm's tasks, not with --slurm");
         return EXIT_OK;
     }
     if (!o->enabled) {
         if (o->partition || o->gres || o->time || o->array_limit || o->no_wait)
-            return cli_fail(EXIT_USAGE, "study: --partition, --gres, --time, --array-limit and --no-wait go with --slurm");
+            return cli_fail(
+                EXIT_USAGE,
+                "study: --partition, --gres, --time, --array-limit and --no-wait go with --slurm");
         return EXIT_OK;
     }
     if (o->partition && !chars_in(o->partition, "_-.,"))
-        return cli_fail(EXIT_USAGE, "study: --partition '%s' is not a partition name (letters, digits, _ - . ,)",
-                        o->partition);
+        return cli_fail(
+            EXIT_USAGE,
+            "study: --partition '%s' is not a partition name (letters, digits, _ - . ,)",
+            o->partition);
     if (o->gres && !chars_in(o->gres, "_-.,:=/"))
-        return cli_fail(EXIT_USAGE, "study: --gres '%s' is not a generic resource such as gpu:1", o->gres);
+        return cli_fail(EXIT_USAGE, "study: --gres '%s' is not a generic resource such as gpu:1",
+                        o->gres);
     if (o->time && !valid_time(o->time))
         return cli_fail(EXIT_USAGE,
-                        "study: --time '%s' is not a Slurm time (minutes, MM:SS, HH:MM:SS, D-HH, D-HH:MM, D-HH:MM:SS)",
+                        "study: --time '%s' is not a Slurm time (minutes, MM:SS, HH:MM:SS, D-HH, "
+                        "D-HH:MM, D-HH:MM:SS)",
                         o->time);
     /* the paths go into #SBATCH lines and shell words: nothing to quote */
     const char *paths[2] = {file, out};
     for (int k = 0; k < 2; k++)
         if (!chars_in(paths[k], "_-.,/+=@%"))
-            return cli_fail(EXIT_USAGE, "study: --slurm needs %s '%s' without blanks, quotes or shell characters",
-                            k ? "an output directory" : "a study file name", paths[k]);
+            return cli_fail(
+                EXIT_USAGE,
+                "study: --slurm needs %s '%s' without blanks, quotes or shell characters",
+                k ? "an output directory" : "a study file name", paths[k]);
     if (!o->dry_run)
         for (int k = 0; k < 2; k++) {
             const char *cmd = k ? "squeue" : "sbatch";
             if (!on_path(cmd))
-                return cli_fail(EXIT_USAGE, "study: --slurm: %s is not on PATH (is this a Slurm login node?)", cmd);
+                return cli_fail(EXIT_USAGE,
+                                "study: --slurm: %s is not on PATH (is this a Slurm login node?)",
+                                cmd);
         }
     return EXIT_OK;
 }
@@ -188,8 +202,8 @@ static char *array_spec(const slurm_stage *s, unsigned long limit)
         uint32_t j = i;
         while (j + 1 < s->n && s->tasks[j + 1] == s->tasks[j] + 1)
             j++;
-        used += (size_t)snprintf(b + used, cap - used, j > i ? "%s%u-%u" : "%s%u", i ? "," : "", s->tasks[i],
-                                 s->tasks[j]);
+        used += (size_t)snprintf(b + used, cap - used, j > i ? "%s%u-%u" : "%s%u", i ? "," : "",
+                                 s->tasks[i], s->tasks[j]);
         i = j + 1;
     }
     if (limit)
@@ -198,8 +212,8 @@ static char *array_spec(const slurm_stage *s, unsigned long limit)
 }
 
 /* The #SBATCH lines every script shares. */
-static void common_lines(gi_text *t, const slurm_options *o, const char *name, const char *what, const char *out,
-                         const char *log, const char *cwd)
+static void common_lines(gi_text *t, const slurm_options *o, const char *name, const char *what,
+                         const char *out, const char *log, const char *cwd)
 {
     gi_text_put(t, "#SBATCH --job-name=gibench-%s-%s\n", name, what);
     gi_text_put(t, "#SBATCH --output=%s/slurm/logs/%s\n", out, log);
@@ -214,47 +228,54 @@ static void common_lines(gi_text *t, const slurm_options *o, const char *name, c
 }
 
 /* The script of one stage's array: each task runs one cell (--cell). */
-static char *stage_script(const slurm_options *o, const char *file, const char *out, const char *name,
-                          uint64_t plan, const slurm_stage *s, const char *cwd)
+static char *stage_script(const slurm_options *o, const char *file, const char *out,
+                          const char *name, uint64_t plan, const slurm_stage *s, const char *cwd)
 {
     char *spec = array_spec(s, o->array_limit);
     if (!spec)
         return NULL;
     gi_text t = {0};
-    gi_text_put(&t, "#!/bin/sh\n# gibench study %s: the %s stage, one array task per cell\n"
-                       "# (written by gibench study --slurm; the task index is the cell's index in the plan)\n",
-                   name, !strcmp(s->kind, "ref") ? "reference" : "method-run");
+    gi_text_put(
+        &t,
+        "#!/bin/sh\n# gibench study %s: the %s stage, one array task per cell\n"
+        "# (written by gibench study --slurm; the task index is the cell's index in the plan)\n",
+        name, !strcmp(s->kind, "ref") ? "reference" : "method-run");
     char log[64];
     snprintf(log, sizeof log, "%s-%%A_%%a.log", s->kind);
     common_lines(&t, o, name, !strcmp(s->kind, "ref") ? "refs" : "runs", out, log, cwd);
     gi_text_put(&t, "#SBATCH --array=%s\n", spec);
     gi_text_put(&t,
-                   "'%s' study '%s' --out '%s' --cell %s:\"$SLURM_ARRAY_TASK_ID\":%016llx\n"
-                   "rc=$?\necho \"gibench-cell-exit $rc\"\nexit $rc\n",
-                   cli_self_exe(), file, out, s->kind, (unsigned long long)plan);
+                "'%s' study '%s' --out '%s' --cell %s:\"$SLURM_ARRAY_TASK_ID\":%016llx\n"
+                "rc=$?\necho \"gibench-cell-exit $rc\"\nexit $rc\n",
+                cli_self_exe(), file, out, s->kind, (unsigned long long)plan);
     free(spec);
     return t.s;
 }
 
 /* The collect job: the report from the cells' results ($1, $2: the array job ids). */
-static char *collect_script(const slurm_options *o, const char *file, const char *out, const char *name,
-                            const char *cwd)
+static char *collect_script(const slurm_options *o, const char *file, const char *out,
+                            const char *name, const char *cwd)
 {
     gi_text t = {0};
-    gi_text_put(&t, "#!/bin/sh\n# gibench study %s: the report from the cells' results\n"
-                       "# (written by gibench study --slurm; $1 and $2: the reference and method-run array jobs)\n",
-                   name);
+    gi_text_put(&t,
+                "#!/bin/sh\n# gibench study %s: the report from the cells' results\n"
+                "# (written by gibench study --slurm; $1 and $2: the reference and method-run "
+                "array jobs)\n",
+                name);
     slurm_options plain = *o;
     plain.gres = NULL; /* the report needs no GPU */
     common_lines(&t, &plain, name, "collect", out, "collect-%j.log", cwd);
-    gi_text_put(&t, "'%s' study '%s' --out '%s' --slurm-collect \"$1,$2\"\nrc=$?\necho \"gibench-cell-exit $rc\"\nexit $rc\n",
-                   cli_self_exe(), file, out);
+    gi_text_put(&t,
+                "'%s' study '%s' --out '%s' --slurm-collect \"$1,$2\"\nrc=$?\necho "
+                "\"gibench-cell-exit $rc\"\nexit $rc\n",
+                cli_self_exe(), file, out);
     return t.s;
 }
 
 /* Runs a Slurm command; its first output line into `line`, its last error
  * line into `err`. 1 when it exited 0. */
-static int slurm_cmd(char *const argv[], const char *out, char *line, size_t size, char *err, size_t err_size)
+static int slurm_cmd(char *const argv[], const char *out, char *line, size_t size, char *err,
+                     size_t err_size)
 {
     char o[4200], e[4200];
     snprintf(o, sizeof o, "%s/slurm/.cmd.out", out);
@@ -276,8 +297,8 @@ static int slurm_cmd(char *const argv[], const char *out, char *line, size_t siz
 }
 
 /* sbatch --parsable [extra...] script [args...]: the job id, or 0 after printing why. */
-static int submit(const char *out, const char *script, const char *dep, const char *a1, const char *a2, char *id,
-                  size_t size)
+static int submit(const char *out, const char *script, const char *dep, const char *a1,
+                  const char *a2, char *id, size_t size)
 {
     char *argv[12];
     int n = 0;
@@ -320,8 +341,9 @@ static int job_active(const char *out, const char *job, int *known)
         return !*known;
     }
     *known = 1;
-    static const char *active[] = {"PENDING", "RUNNING", "CONFIGURING", "COMPLETING", "SUSPENDED", "REQUEUED",
-                                   "REQUEUE_HOLD", "REQUEUE_FED", "RESIZING", "SIGNALING", "STAGE_OUT", NULL};
+    static const char *active[] = {"PENDING",   "RUNNING",   "CONFIGURING",  "COMPLETING",
+                                   "SUSPENDED", "REQUEUED",  "REQUEUE_HOLD", "REQUEUE_FED",
+                                   "RESIZING",  "SIGNALING", "STAGE_OUT",    NULL};
     for (int k = 0; active[k]; k++)
         if (!strcmp(state, active[k]))
             return 1;
@@ -352,14 +374,16 @@ static int log_exit(const char *path, char *last, size_t size, int *exists)
     return code;
 }
 
-int slurm_run(const slurm_options *o, const char *file, const char *out, const char *name, uint64_t plan,
-              const slurm_stage *refs, const slurm_stage *runs)
+int slurm_run(const slurm_options *o, const char *file, const char *out, const char *name,
+              uint64_t plan, const slurm_stage *refs, const slurm_stage *runs)
 {
     char cwd[4096], dir[4200], logs[4300];
     if (!getcwd(cwd, sizeof cwd))
         return cli_fail(EXIT_RUN, "study: cannot read the working directory");
     if (!chars_in(cwd, "_-.,/+=@%"))
-        return cli_fail(EXIT_USAGE, "study: --slurm needs a working directory without blanks or shell characters");
+        return cli_fail(
+            EXIT_USAGE,
+            "study: --slurm needs a working directory without blanks or shell characters");
     snprintf(dir, sizeof dir, "%s/slurm", out);
     snprintf(logs, sizeof logs, "%s/logs", dir);
     char *texts[3] = {refs->n ? stage_script(o, file, out, name, plan, refs, cwd) : NULL,
@@ -372,7 +396,8 @@ int slurm_run(const slurm_options *o, const char *file, const char *out, const c
         for (int k = 0; k < 3; k++)
             if (texts[k])
                 printf("==> %s/%s <==\n%s\n", dir, names[k], texts[k]);
-        printf("# %u reference cells and %u method-run cells to submit; then: sbatch --parsable refs.sh; "
+        printf("# %u reference cells and %u method-run cells to submit; then: sbatch --parsable "
+               "refs.sh; "
                "sbatch --parsable --dependency=afterok:REFS runs.sh; "
                "sbatch --parsable --dependency=afterany:REFS:RUNS collect.sh REFS RUNS\n",
                refs->n, runs->n);
@@ -390,14 +415,15 @@ int slurm_run(const slurm_options *o, const char *file, const char *out, const c
         if (refs->n && !submit(out, paths[0], NULL, NULL, NULL, ref_id, sizeof ref_id))
             rc = EXIT_RUN;
         snprintf(dep, sizeof dep, "--dependency=afterok:%s", ref_id);
-        if (rc == EXIT_OK && runs->n && !submit(out, paths[1], refs->n ? dep : NULL, NULL, NULL, run_id, sizeof run_id))
+        if (rc == EXIT_OK && runs->n &&
+            !submit(out, paths[1], refs->n ? dep : NULL, NULL, NULL, run_id, sizeof run_id))
             rc = EXIT_RUN;
         if (refs->n && runs->n)
             snprintf(dep, sizeof dep, "--dependency=afterany:%s:%s", ref_id, run_id);
         else
             snprintf(dep, sizeof dep, "--dependency=afterany:%s", refs->n ? ref_id : run_id);
-        if (rc == EXIT_OK &&
-            !submit(out, paths[2], refs->n || runs->n ? dep : NULL, ref_id, run_id, col_id, sizeof col_id))
+        if (rc == EXIT_OK && !submit(out, paths[2], refs->n || runs->n ? dep : NULL, ref_id, run_id,
+                                     col_id, sizeof col_id))
             rc = EXIT_RUN;
         /* a submitted job whose followers could not be: cancelled, not left behind */
         if (rc != EXIT_OK) {
@@ -421,13 +447,14 @@ int slurm_run(const slurm_options *o, const char *file, const char *out, const c
         fprintf(f, "%ld refs %s runs %s collect %s\n", (long)time(NULL), ref_id, run_id, col_id);
         fclose(f);
     }
-    snprintf(line, sizeof line, "references %s (%u tasks), runs %s (%u tasks), collect %s", ref_id, refs->n, run_id,
-             runs->n, col_id);
+    snprintf(line, sizeof line, "references %s (%u tasks), runs %s (%u tasks), collect %s", ref_id,
+             refs->n, run_id, runs->n, col_id);
     printf("submitted: %s\n", line);
     fflush(stdout);
     fprintf(stderr, "study: submitted %s; logs in %s/slurm/logs\n", line, out);
     if (o->no_wait) {
-        fprintf(stderr, "study: not waiting (--no-wait): the collect job %s writes %s/report.md\n", col_id, out);
+        fprintf(stderr, "study: not waiting (--no-wait): the collect job %s writes %s/report.md\n",
+                col_id, out);
         return EXIT_OK;
     }
     /* wait for the collect job, which waits for the others */
@@ -437,10 +464,12 @@ int slurm_run(const slurm_options *o, const char *file, const char *out, const c
         if (!active && known)
             break;
         if (!known && ++unknown_polls > 30)
-            return cli_fail(EXIT_RUN, "study: squeue cannot tell job %s's state: %s", col_id, "giving up waiting");
+            return cli_fail(EXIT_RUN, "study: squeue cannot tell job %s's state: %s", col_id,
+                            "giving up waiting");
         if (cli_interrupted)
-            return cli_fail(EXIT_RUN, "study: interrupted while waiting; the jobs go on (scancel %s %s %s)",
-                            strcmp(ref_id, "-") ? ref_id : "", strcmp(run_id, "-") ? run_id : "", col_id);
+            return cli_fail(
+                EXIT_RUN, "study: interrupted while waiting; the jobs go on (scancel %s %s %s)",
+                strcmp(ref_id, "-") ? ref_id : "", strcmp(run_id, "-") ? run_id : "", col_id);
         struct timespec ts = {2, 0};
         nanosleep(&ts, NULL);
     }
@@ -450,7 +479,8 @@ int slurm_run(const slurm_options *o, const char *file, const char *out, const c
     int code = log_exit(log, last, sizeof last, &exists);
     if (code != 0)
         return cli_fail(EXIT_RUN, "study: the collect job %s %s (%s)%s%s", col_id,
-                        code > 0 ? "failed" : "ended without finishing", log, last[0] ? ": " : "", last);
+                        code > 0 ? "failed" : "ended without finishing", log, last[0] ? ": " : "",
+                        last);
     fprintf(stderr, "study: collect job %s done: %s\n", col_id, last);
     return EXIT_OK;
 }
@@ -509,10 +539,12 @@ slurm_tasks *slurm_tasks_query(const char *out, const char *kind, const char *jo
     if (!strcmp(job, "-") || !*job)
         return t;
     /* sacct where accounting is on: "JOB_K|STATE|EXIT:SIGNAL" */
-    char *sacct[] = {"sacct", "-n", "-P", "-X", "-j", (char *)job, "--format=JobID,State,ExitCode", NULL};
+    char *sacct[] = {"sacct", "-n", "-P", "-X", "-j", (char *)job, "--format=JobID,State,ExitCode",
+                     NULL};
     char *text = on_path("sacct") ? slurm_output(sacct, out) : NULL;
     char *save = NULL;
-    for (char *line = text ? strtok_r(text, "\n", &save) : NULL; line; line = strtok_r(NULL, "\n", &save)) {
+    for (char *line = text ? strtok_r(text, "\n", &save) : NULL; line;
+         line = strtok_r(NULL, "\n", &save)) {
         char id[96], state[64], code[32];
         unsigned task;
         if (sscanf(line, "%95[^|]|%63[^|]|%31s", id, state, code) == 3 && strchr(id, '_') &&
@@ -527,11 +559,14 @@ slurm_tasks *slurm_tasks_query(const char *out, const char *kind, const char *jo
     /* else the controller's memory of finished jobs (MinJobAge): one line per task */
     char *sctl[] = {"scontrol", "-o", "show", "job", (char *)job, NULL};
     text = slurm_output(sctl, out);
-    for (char *line = text ? strtok_r(text, "\n", &save) : NULL; line; line = strtok_r(NULL, "\n", &save)) {
-        const char *a = strstr(line, "ArrayTaskId="), *s = strstr(line, "JobState="), *e = strstr(line, "ExitCode=");
+    for (char *line = text ? strtok_r(text, "\n", &save) : NULL; line;
+         line = strtok_r(NULL, "\n", &save)) {
+        const char *a = strstr(line, "ArrayTaskId="), *s = strstr(line, "JobState="),
+                   *e = strstr(line, "ExitCode=");
         unsigned task;
         char state[32] = "", code[16] = "";
-        if (!a || !s || sscanf(a + 12, "%u", &task) != 1 || isdigit((unsigned char)a[12 + strspn(a + 12, "0123456789")]))
+        if (!a || !s || sscanf(a + 12, "%u", &task) != 1 ||
+            isdigit((unsigned char)a[12 + strspn(a + 12, "0123456789")]))
             continue;
         if (a[12 + strspn(a + 12, "0123456789")] != ' ')
             continue; /* "1-5%2": tasks not yet split off, still pending */
@@ -565,16 +600,21 @@ void slurm_tasks_describe(const slurm_tasks *t, uint32_t task, char *buf, size_t
     else if (code >= 0)
         snprintf(what, sizeof what, "the cell exited %d: %s", code, last);
     else
-        snprintf(what, sizeof what, "killed while running (%s)", last[0] ? last : "log without an exit line");
+        snprintf(what, sizeof what, "killed while running (%s)",
+                 last[0] ? last : "log without an exit line");
     if (s)
-        snprintf(buf, size, "Slurm task %s_%u: %s, exit code %s; %s", t->job, task, s->state, s->exit, what);
+        snprintf(buf, size, "Slurm task %s_%u: %s, exit code %s; %s", t->job, task, s->state,
+                 s->exit, what);
     else if (t->n && !exists)
         /* the controller holds the array's other tasks: this one was
          * taken out of the array before it ever ran */
-        snprintf(buf, size, "Slurm task %s_%u: CANCELLED while pending (%s keeps no record of it); no log", t->job,
-                 task, t->source);
+        snprintf(buf, size,
+                 "Slurm task %s_%u: CANCELLED while pending (%s keeps no record of it); no log",
+                 t->job, task, t->source);
     else
-        snprintf(buf, size, "Slurm task %s_%u: state unknown (no accounting, and the controller forgot the job); %s",
+        snprintf(buf, size,
+                 "Slurm task %s_%u: state unknown (no accounting, and the controller forgot the "
+                 "job); %s",
                  t->job, task, what);
 }
 

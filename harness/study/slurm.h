@@ -12,15 +12,16 @@
 #include <stdint.h>
 
 typedef struct slurm_options {
-    int enabled;               /* --slurm */
-    const char *partition;     /* --partition P */
-    const char *gres;          /* --gres G, e.g. gpu:1 */
-    const char *time;          /* --time T: each task's limit, in Slurm's format */
-    unsigned long array_limit; /* --array-limit K: at most K tasks of a stage at once (0: no limit) */
-    int no_wait;               /* --no-wait: return once submitted */
-    int dry_run;               /* --dry-run with --slurm: print the scripts */
-    const char *cell;          /* hidden --cell ref:K:PLAN or run:K:PLAN: one array task */
-    const char *collect;       /* hidden --slurm-collect REFJOB,RUNJOB: the collect job */
+    int enabled;           /* --slurm */
+    const char *partition; /* --partition P */
+    const char *gres;      /* --gres G, e.g. gpu:1 */
+    const char *time;      /* --time T: each task's limit, in Slurm's format */
+    unsigned long
+        array_limit;     /* --array-limit K: at most K tasks of a stage at once (0: no limit) */
+    int no_wait;         /* --no-wait: return once submitted */
+    int dry_run;         /* --dry-run with --slurm: print the scripts */
+    const char *cell;    /* hidden --cell ref:K:PLAN or run:K:PLAN: one array task */
+    const char *collect; /* hidden --slurm-collect REFJOB,RUNJOB: the collect job */
 } slurm_options;
 
 /* Takes argv[*i] (and its value) when it is one of the options above,
@@ -44,8 +45,8 @@ typedef struct slurm_stage {
  * prints them) submits them and, unless --no-wait, waits for the collect
  * job. `plan` identifies the planned cells (a task refuses a study changed
  * since). Returns the exit status for gibench. */
-int slurm_run(const slurm_options *o, const char *file, const char *out, const char *name, uint64_t plan,
-              const slurm_stage *refs, const slurm_stage *runs);
+int slurm_run(const slurm_options *o, const char *file, const char *out, const char *name,
+              uint64_t plan, const slurm_stage *refs, const slurm_stage *runs);
 
 /* The collect job's view of one stage's tasks: why task K of job `job`
  * (its array job id, "-" for none) left no result: Slurm's state and exit

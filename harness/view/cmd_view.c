@@ -52,7 +52,8 @@ static const char display_fs[] =
     "float lum(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }\n"
     "vec3 ramp(float t) {\n"
     "    t = clamp(t, 0.0, 1.0);\n"
-    "    return clamp(vec3(1.5 - abs(4.0 * t - 3.0), 1.5 - abs(4.0 * t - 2.0), 1.5 - abs(4.0 * t - 1.0)), 0.0, 1.0);\n"
+    "    return clamp(vec3(1.5 - abs(4.0 * t - 3.0), 1.5 - abs(4.0 * t - 2.0), 1.5 - abs(4.0 * t - "
+    "1.0)), 0.0, 1.0);\n"
     "}\n"
     "void main() {\n"
     "    vec2 t = flip != 0 ? vec2(uv.x, 1.0 - uv.y) : uv;\n"
@@ -111,7 +112,8 @@ void view_camera_from_scene(viewer *v, int index)
 {
     gi_camera_frame cf = gi_scene_camera_at(v->scene, index, v->time);
     gi_vec3 f = gi_v3_normalize(cf.forward);
-    gi_vec3 mid = gi_v3(0.5f * (v->gs->bounds[0] + v->gs->bounds[3]), 0.5f * (v->gs->bounds[1] + v->gs->bounds[4]),
+    gi_vec3 mid = gi_v3(0.5f * (v->gs->bounds[0] + v->gs->bounds[3]),
+                        0.5f * (v->gs->bounds[1] + v->gs->bounds[4]),
                         0.5f * (v->gs->bounds[2] + v->gs->bounds[5]));
     float d = gi_v3_dot(gi_v3_sub(mid, cf.eye), f);
     if (!(d > 1e-3f))
@@ -207,7 +209,8 @@ int view_select(viewer *v, int index)
     char why[256];
     if (!cli_caps_cover(v->m, v->scene, v->playing, why, sizeof why))
         snprintf(v->status, sizeof v->status, "%s", why);
-    cli_host_init(&v->host, v->m->id, v->cache_dir, v->gs, gi_gpu_renderer(v->gpu), gi_gpu_is_software(v->gpu));
+    cli_host_init(&v->host, v->m->id, v->cache_dir, v->gs, gi_gpu_renderer(v->gpu),
+                  gi_gpu_is_software(v->gpu));
     v->host_ready = 1;
     v->host_progress = v->host.host.progress; /* the terminal line, and a bar in the window */
     v->host.host.progress = view_overlay_progress;
@@ -238,16 +241,18 @@ int view_select(viewer *v, int index)
     }
     if (res != GI_OK) {
         const char *msg = v->m->last_error(v->inst);
-        return cli_fail(EXIT_RUN, "view: %s: prepare failed (%s)%s%s", v->m->id, gi_result_name(res),
-                        msg && *msg ? ": " : "", msg ? msg : "");
+        return cli_fail(EXIT_RUN, "view: %s: prepare failed (%s)%s%s", v->m->id,
+                        gi_result_name(res), msg && *msg ? ": " : "", msg ? msg : "");
     }
     if (v->time != v->prepared_time) {
         /* the scene moved since the upload: tell the method */
-        gi_changes ch = {GI_CHANGED_TRANSFORMS | GI_CHANGED_LIGHTS | (v->gs->deforming ? GI_CHANGED_VERTICES : 0u),
+        gi_changes ch = {GI_CHANGED_TRANSFORMS | GI_CHANGED_LIGHTS |
+                             (v->gs->deforming ? GI_CHANGED_VERTICES : 0u),
                          v->time, ~0ull};
         res = v->m->update(v->inst, v->gs, &ch);
         if (res != GI_OK)
-            return cli_fail(EXIT_RUN, "view: %s: update failed (%s)", v->m->id, gi_result_name(res));
+            return cli_fail(EXIT_RUN, "view: %s: update failed (%s)", v->m->id,
+                            gi_result_name(res));
     }
     if (moved && res == GI_OK)
         return view_tell_method(v, v->node_moved);
@@ -336,7 +341,8 @@ static int render_method(viewer *v)
             const double *ms = gi_timer_samples(v->timer, st[i].name, &count);
             if (!ms || !count)
                 continue;
-            snprintf(v->stage_name[v->stage_count], GI_TIMER_NAME_MAX, "%.*s", GI_TIMER_NAME_MAX - 1, st[i].name);
+            snprintf(v->stage_name[v->stage_count], GI_TIMER_NAME_MAX, "%.*s",
+                     GI_TIMER_NAME_MAX - 1, st[i].name);
             v->stage_ms[v->stage_count++] = ms[count - 1];
         }
     }
@@ -362,11 +368,13 @@ static int set_time(viewer *v, float t)
     v->time = t;
     gi_gpu_scene_set_time(v->gs, t);
     if (v->inst) {
-        gi_changes ch = {GI_CHANGED_TRANSFORMS | GI_CHANGED_LIGHTS | (v->gs->deforming ? GI_CHANGED_VERTICES : 0u),
+        gi_changes ch = {GI_CHANGED_TRANSFORMS | GI_CHANGED_LIGHTS |
+                             (v->gs->deforming ? GI_CHANGED_VERTICES : 0u),
                          t, ~0ull};
         gi_result res = v->m->update(v->inst, v->gs, &ch);
         if (res != GI_OK)
-            return cli_fail(EXIT_RUN, "view: %s: update failed (%s)", v->m->id, gi_result_name(res));
+            return cli_fail(EXIT_RUN, "view: %s: update failed (%s)", v->m->id,
+                            gi_result_name(res));
     }
     view_changed(v);
     return EXIT_OK;
@@ -390,8 +398,10 @@ static void write_window(viewer *v, int fw, int fh)
         for (int y = 0; y < fh; y++) /* bottom row first -> top row first; sRGB -> linear */
             for (int x = 0; x < fw; x++)
                 for (int c = 0; c < 4; c++) {
-                    float b = px[4 * ((size_t)(fh - 1 - y) * (size_t)fw + (size_t)x) + (size_t)c] / 255.0f;
-                    img->rgba[4 * ((size_t)y * (size_t)fw + (size_t)x) + (size_t)c] = c == 3 ? 1.0f : gi_srgb_decode(b);
+                    float b = px[4 * ((size_t)(fh - 1 - y) * (size_t)fw + (size_t)x) + (size_t)c] /
+                              255.0f;
+                    img->rgba[4 * ((size_t)y * (size_t)fw + (size_t)x) + (size_t)c] =
+                        c == 3 ? 1.0f : gi_srgb_decode(b);
                 }
         if (gi_image_write(v->window_shot, img, NULL, &err) != GI_OK)
             v->exit_code = cli_fail(EXIT_RUN, "view: %s", err.text);
@@ -446,17 +456,21 @@ static void display(viewer *v)
 
     char title[768];
     if (ref)
-        snprintf(title, sizeof title, "gibench view | reference | %llu spp | EV %+.1f | t %.2f%s | ui %.1f ms",
+        snprintf(title, sizeof title,
+                 "gibench view | reference | %llu spp | EV %+.1f | t %.2f%s | ui %.1f ms",
                  (unsigned long long)v->ref_spp, (double)v->exposure, (double)v->time,
                  v->playing ? " playing" : "", v->display_ms);
     else
         snprintf(title, sizeof title,
-                 "gibench view | %s%s | %.1f ms/frame | frame %u | EV %+.1f | t %.2f%s | ui %.1f ms | %s%s%s",
+                 "gibench view | %s%s | %.1f ms/frame | frame %u | EV %+.1f | t %.2f%s | ui %.1f "
+                 "ms | %s%s%s",
                  v->m ? v->m->id : "-",
-                 v->split == 1 ? " | reference right" : v->split == 2 ? " | error right (log, 1e-3 blue .. 1 red)" : "",
+                 v->split == 1   ? " | reference right"
+                 : v->split == 2 ? " | error right (log, 1e-3 blue .. 1 red)"
+                                 : "",
                  v->frame_ms, v->frame_index, (double)v->exposure, (double)v->time,
-                 v->playing ? " playing" : "", v->display_ms, gi_gpu_renderer(v->gpu), v->status[0] ? " | " : "",
-                 v->status);
+                 v->playing ? " playing" : "", v->display_ms, gi_gpu_renderer(v->gpu),
+                 v->status[0] ? " | " : "", v->status);
     if (!ref && v->params && v->params->count) {
         /* the parameter TAB selected, with its value */
         char *all = gi_params_to_string(v->params);
@@ -469,7 +483,8 @@ static void display(viewer *v)
         if (p) {
             size_t used = strlen(title);
             const char *end = strchr(p, ',');
-            snprintf(title + used, sizeof title - used, " | param %.*s (TAB, PgUp/PgDn)", (int)(end ? end - p : (long)strlen(p)), p);
+            snprintf(title + used, sizeof title - used, " | param %.*s (TAB, PgUp/PgDn)",
+                     (int)(end ? end - p : (long)strlen(p)), p);
         }
         free(all);
     }
@@ -483,7 +498,8 @@ static void poll_reference(viewer *v)
     gi_image *img = view_ref_take(&v->ref, 0, &spp);
     if (!img)
         return;
-    glTextureSubImage2D(v->ref_tex, 0, 0, 0, (GLsizei)img->width, (GLsizei)img->height, GL_RGBA, GL_FLOAT, img->rgba);
+    glTextureSubImage2D(v->ref_tex, 0, 0, 0, (GLsizei)img->width, (GLsizei)img->height, GL_RGBA,
+                        GL_FLOAT, img->rgba);
     gi_image_free(img);
     v->ref_spp = spp;
     v->need_display = 1;
@@ -503,7 +519,8 @@ void view_describe(const viewer *v, view_file *f)
     }
     f->width = v->width;
     f->height = v->height;
-    f->frames = v->method_index < 0 ? (uint32_t)(v->ref_spp ? v->ref_spp : 1) : (v->frame_index ? v->frame_index : 1);
+    f->frames = v->method_index < 0 ? (uint32_t)(v->ref_spp ? v->ref_spp : 1)
+                                    : (v->frame_index ? v->frame_index : 1);
     f->seed = v->seed;
     f->time = v->time;
     f->exposure = v->exposure;
@@ -628,7 +645,8 @@ int view_key(viewer *v, int key, int mods)
         v->last_method = v->method_index;
         return view_select(v, -1);
     case GLFW_KEY_TAB:
-        v->param_sel = v->params && v->params->count ? (v->param_sel + 1) % (int)v->params->count : 0;
+        v->param_sel =
+            v->params && v->params->count ? (v->param_sel + 1) % (int)v->params->count : 0;
         return EXIT_OK;
     case GLFW_KEY_PAGE_UP:
     case GLFW_KEY_PAGE_DOWN:
@@ -659,7 +677,8 @@ int view_key(viewer *v, int key, int mods)
         v->show_overlay = !v->show_overlay;
         return EXIT_OK;
     case GLFW_KEY_C:
-        view_camera_from_scene(v, v->scene->camera_count ? (v->scene_camera + 1) % (int)v->scene->camera_count : -1);
+        view_camera_from_scene(
+            v, v->scene->camera_count ? (v->scene_camera + 1) % (int)v->scene->camera_count : -1);
         return EXIT_OK;
     case GLFW_KEY_W:
     case GLFW_KEY_S:
@@ -714,8 +733,9 @@ void view_button(viewer *v, int button, int press, double x, double y, int mods)
     if (press && button == GLFW_MOUSE_BUTTON_LEFT && (mods & (GLFW_MOD_SHIFT | GLFW_MOD_CONTROL))) {
         /* Shift: move the selected light (key L), or else the object under
          * the mouse, in the view plane; Ctrl: rotate the object */
-        int rc = v->sel_light >= 0 && !(mods & GLFW_MOD_CONTROL) ? view_light_pick(v, x, y)
-                                                                 : view_pick(v, x, y, (mods & GLFW_MOD_CONTROL) ? 2 : 1);
+        int rc = v->sel_light >= 0 && !(mods & GLFW_MOD_CONTROL)
+                     ? view_light_pick(v, x, y)
+                     : view_pick(v, x, y, (mods & GLFW_MOD_CONTROL) ? 2 : 1);
         if (rc != EXIT_OK && v->script)
             v->exit_code = rc;
         v->mx = x;
@@ -776,7 +796,8 @@ void view_cursor(viewer *v, double x, double y)
         gi_vec3 right = gi_v3_normalize(gi_v3_cross(fwd, gi_v3(0, 1, 0)));
         gi_vec3 up = gi_v3_cross(right, fwd);
         float s = 2.0f * v->dist * tanf(0.5f * v->yfov) / (float)v->height;
-        v->center = gi_v3_add(v->center, gi_v3_add(gi_v3_scale(right, -(float)dx * s), gi_v3_scale(up, (float)dy * s)));
+        v->center = gi_v3_add(v->center, gi_v3_add(gi_v3_scale(right, -(float)dx * s),
+                                                   gi_v3_scale(up, (float)dy * s)));
     }
     view_changed(v);
 }
@@ -857,9 +878,10 @@ static int parse_opts(int argc, char **argv, viewer *v)
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         const char *val = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "--scene") || !strcmp(a, "--method") || !strcmp(a, "--size") || !strcmp(a, "--script") ||
-            !strcmp(a, "--screenshot-dir") || !strcmp(a, "--param") || !strcmp(a, "--camera") ||
-            !strcmp(a, "--exposure") || !strcmp(a, "--time") || !strcmp(a, "--seed")) {
+        if (!strcmp(a, "--scene") || !strcmp(a, "--method") || !strcmp(a, "--size") ||
+            !strcmp(a, "--script") || !strcmp(a, "--screenshot-dir") || !strcmp(a, "--param") ||
+            !strcmp(a, "--camera") || !strcmp(a, "--exposure") || !strcmp(a, "--time") ||
+            !strcmp(a, "--seed")) {
             if (!val)
                 return cli_fail(EXIT_USAGE, "view: %s needs a value", a);
             i++;
@@ -886,13 +908,15 @@ static int parse_opts(int argc, char **argv, viewer *v)
             v->opt_params[v->opt_param_count++] = val;
         } else if (!strcmp(a, "--exposure")) {
             if (!cli_parse_exposure(val, &v->exposure))
-                return cli_fail(EXIT_USAGE, "view: --exposure '%s' is not a number of stops in -64..64", val);
+                return cli_fail(EXIT_USAGE,
+                                "view: --exposure '%s' is not a number of stops in -64..64", val);
         } else if (!strcmp(a, "--time")) {
             if (!cli_parse_float(val, &v->time) || v->time < 0)
                 return cli_fail(EXIT_USAGE, "view: --time '%s' is not a non-negative number", val);
         } else if (!strcmp(a, "--seed")) {
             if (!cli_parse_uint(val, 0, 0xFFFFFFFFul, &u))
-                return cli_fail(EXIT_USAGE, "view: --seed '%s' is not a 32-bit unsigned integer", val);
+                return cli_fail(EXIT_USAGE, "view: --seed '%s' is not a 32-bit unsigned integer",
+                                val);
             v->seed = (uint32_t)u;
         }
     }
@@ -916,12 +940,14 @@ static int setup(viewer *v)
             if (!strcmp(v->reg->items[i].method->id, v->start_method))
                 start = (int)i;
         if (start < 0 && strcmp(v->start_method, "reference"))
-            return cli_fail(EXIT_USAGE, "view: no method '%s' (see gibench methods; or 'reference')",
+            return cli_fail(EXIT_USAGE,
+                            "view: no method '%s' (see gibench methods; or 'reference')",
                             v->start_method);
         /* parameters are checked before a window opens */
         if (start >= 0) {
             const gi_method *m = v->reg->items[start].method;
-            gi_params *p = gi_params_parse(m->id, m->params, v->opt_params, v->opt_param_count, &err);
+            gi_params *p =
+                gi_params_parse(m->id, m->params, v->opt_params, v->opt_param_count, &err);
             if (!p)
                 return cli_fail(EXIT_USAGE, "%s", err.text);
             gi_params_free(p);
@@ -939,8 +965,9 @@ static int setup(viewer *v)
     if (v->camera_name) {
         camera = gi_scene_find_camera(v->scene, v->camera_name);
         if (camera < 0)
-            return cli_fail(EXIT_USAGE, "view: %s has no camera '%s' (%u cameras; use a name or #k)", v->scene_path,
-                            v->camera_name, v->scene->camera_count);
+            return cli_fail(EXIT_USAGE,
+                            "view: %s has no camera '%s' (%u cameras; use a name or #k)",
+                            v->scene_path, v->camera_name, v->scene->camera_count);
     }
     v->cache_dir = gi_cache_dir(&err);
     if (!v->cache_dir)
@@ -950,7 +977,8 @@ static int setup(viewer *v)
 
     glfwSetErrorCallback(on_glfw_error);
     if (!glfwInit())
-        return cli_fail(EXIT_RUN, "view: GLFW cannot start (no display? run it under xvfb-run or set DISPLAY)");
+        return cli_fail(
+            EXIT_RUN, "view: GLFW cannot start (no display? run it under xvfb-run or set DISPLAY)");
     v->glfw_ready = 1;
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
@@ -1084,14 +1112,16 @@ static int loop(viewer *v)
     while (!v->quit && !glfwWindowShouldClose(v->win) && !cli_interrupted) {
         int fw = 0, fh = 0;
         glfwGetFramebufferSize(v->win, &fw, &fh);
-        if (fw > 0 && fh > 0 && ((uint32_t)fw != v->width || (uint32_t)fh != v->height) && fw <= 16384 && fh <= 16384)
+        if (fw > 0 && fh > 0 && ((uint32_t)fw != v->width || (uint32_t)fh != v->height) &&
+            fw <= 16384 && fh <= 16384)
             resize_targets(v, (uint32_t)fw, (uint32_t)fh);
         if (v->playing) {
             double now = gi_now();
             float dt = (float)(now - v->last_tick);
             v->last_tick = now;
             if (v->script)
-                dt = 1.0f / 30.0f; /* a scripted run steps the animation by frames, not by the clock */
+                dt = 1.0f /
+                     30.0f; /* a scripted run steps the animation by frames, not by the clock */
             int rc = set_time(v, v->time + dt);
             if (rc != EXIT_OK)
                 return rc;
@@ -1104,7 +1134,8 @@ static int loop(viewer *v)
             v->frames_since_event++;
         }
         if (v->method_index < 0 || v->stale)
-            v->need_render = 0; /* the worker renders, or the method shows nothing; the change went with view_changed */
+            v->need_render = 0; /* the worker renders, or the method shows nothing; the change went
+                                   with view_changed */
         if (v->method_index < 0 || v->split) {
             poll_reference(v);
             char err[GI_ERROR_MAX];
@@ -1142,12 +1173,15 @@ int cmd_view(int argc, char **argv)
         if (rc == EXIT_OK)
             rc = loop(v);
         if (rc == EXIT_OK && gi_log_get_level() >= GI_LOG_WARN && v->gpu)
-            printf("view: %llu method frames, mean %.3g ms; %llu redraws, mean %.3g ms of the viewer's own "
+            printf("view: %llu method frames, mean %.3g ms; %llu redraws, mean %.3g ms of the "
+                   "viewer's own "
                    "(tone map, overlay, swap), of which the overlay %.3g ms; %s\n",
-                   (unsigned long long)v->n_frames, v->n_frames ? v->sum_frame_ms / (double)v->n_frames : 0.0,
+                   (unsigned long long)v->n_frames,
+                   v->n_frames ? v->sum_frame_ms / (double)v->n_frames : 0.0,
                    (unsigned long long)v->n_displays,
                    v->n_displays ? v->sum_display_ms / (double)v->n_displays : 0.0,
-                   v->n_displays ? v->sum_overlay_ms / (double)v->n_displays : 0.0, gi_gpu_renderer(v->gpu));
+                   v->n_displays ? v->sum_overlay_ms / (double)v->n_displays : 0.0,
+                   gi_gpu_renderer(v->gpu));
     }
     teardown(v);
     free(v);

@@ -64,7 +64,7 @@ typedef struct viewer {
     /* split view: 0 off, 1 the method left of the divider and the reference
      * right of it, 2 the method's relative error against the reference right */
     int split;
-    float divider;        /* the divider's place, a fraction of the window width */
+    float divider; /* the divider's place, a fraction of the window width */
     int dragging_divider;
     const char *window_shot; /* the next display also writes the window to this PNG */
     char *window_shot_buf;   /* its storage (script) */
@@ -76,31 +76,33 @@ typedef struct viewer {
     /* the script */
     FILE *script;
     int script_line;
-    uint32_t wait_left;    /* frames (or reference passes) still to wait */
-    uint64_t wait_spp;     /* the reference's samples to reach */
-    double wait_deadline;  /* a wait for the reference gives up after this */
+    uint32_t wait_left;   /* frames (or reference passes) still to wait */
+    uint64_t wait_spp;    /* the reference's samples to reach */
+    double wait_deadline; /* a wait for the reference gives up after this */
     int quit, exit_code;
     /* objects and lights moved by hand (view_move.c) */
-    float (*base_trs)[10];        /* each node's translation, rotation, scale as the file has them */
-    float (*moved_trs)[10];       /* the user's placement while view_nodes_swap has the file's in */
-    unsigned char *node_moved;    /* the nodes placed anew */
+    float (*base_trs)[10];     /* each node's translation, rotation, scale as the file has them */
+    float (*moved_trs)[10];    /* the user's placement while view_nodes_swap has the file's in */
+    unsigned char *node_moved; /* the nodes placed anew */
     unsigned char *file_animated; /* per object: animated by the scene file */
     struct gi_rt *pick_rt;        /* the scene placed for picking; NULL after a change */
     int sel_object, sel_light;    /* -1: none */
-    int drag_object, drag_node;   /* 1 moving the picked object's (or the selected light's) node, 2 rotating it; 0 none */
+    int drag_object, drag_node;   /* 1 moving the picked object's (or the selected light's) node, 2
+                                     rotating it; 0 none */
     double drag_x0, drag_y0;
     float drag_trs[10];
     gi_vec3 drag_origin, drag_pivot;
-    float drag_scale;             /* world length of a window pixel at the picked point's depth */
-    int stale;                    /* the method could not follow a move: it shows no image */
-    int win_w, win_h;             /* the window's size in screen coordinates */
+    float drag_scale; /* world length of a window pixel at the picked point's depth */
+    int stale;        /* the method could not follow a move: it shows no image */
+    int win_w, win_h; /* the window's size in screen coordinates */
     /* the overlay (view_overlay.c) and the last frame's stage times */
     struct overlay *overlay;
     int show_overlay;
-    double overlay_ms, sum_overlay_ms; /* the overlay's part of the last redraw (display_ms), and the sum */
+    double overlay_ms,
+        sum_overlay_ms; /* the overlay's part of the last redraw (display_ms), and the sum */
     double last_progress;
     void (*host_progress)(const gi_host *h, const char *task, float fraction); /* cli_host's own */
-    gi_timer *timer;              /* the method's stages, for the overlay's chart */
+    gi_timer *timer; /* the method's stages, for the overlay's chart */
     uint32_t timer_frames;
     char stage_name[GI_TIMER_MAX_STAGES][GI_TIMER_NAME_MAX];
     double stage_ms[GI_TIMER_MAX_STAGES];

@@ -19,7 +19,8 @@ static int pin(struct dl_phdr_info *info, size_t size, void *data)
     (void)data;
     const char *name = info->dlpi_name;
     if (name && strstr(name, "_dri.so"))
-        dlopen(name, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE); /* a reference kept to the end: not closed */
+        dlopen(name, RTLD_NOW | RTLD_NOLOAD |
+                         RTLD_NODELETE); /* a reference kept to the end: not closed */
     return 0;
 }
 
@@ -28,7 +29,5 @@ void view_pin_gl_driver(void)
     dl_iterate_phdr(pin, NULL);
 }
 #else
-void view_pin_gl_driver(void)
-{
-}
+void view_pin_gl_driver(void) {}
 #endif

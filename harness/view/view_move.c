@@ -115,8 +115,8 @@ int view_tell_method(viewer *v, const unsigned char *moved)
     gi_changes ch = {0, v->time, 0};
     view_scene_changes(v->scene, moved, &ch.flags, &ch.moved_objects);
     if ((ch.flags & GI_CHANGED_TRANSFORMS) && !(v->m->caps & GI_CAP_RIGID_MOTION)) {
-        snprintf(v->status, sizeof v->status, "%s cannot follow moving objects (no GI_CAP_RIGID_MOTION): no image",
-                 v->m->id);
+        snprintf(v->status, sizeof v->status,
+                 "%s cannot follow moving objects (no GI_CAP_RIGID_MOTION): no image", v->m->id);
         view_go_stale(v);
         gi_log(GI_LOG_WARN, "view: %s", v->status);
         return EXIT_OK;
@@ -124,8 +124,8 @@ int view_tell_method(viewer *v, const unsigned char *moved)
     gi_result res = v->m->update(v->inst, v->gs, &ch);
     if (res != GI_OK) {
         const char *msg = v->m->last_error(v->inst);
-        snprintf(v->status, sizeof v->status, "%s cannot follow the move (%s%s%s): no image", v->m->id,
-                 gi_result_name(res), msg && *msg ? ": " : "", msg ? msg : "");
+        snprintf(v->status, sizeof v->status, "%s cannot follow the move (%s%s%s): no image",
+                 v->m->id, gi_result_name(res), msg && *msg ? ": " : "", msg ? msg : "");
         view_go_stale(v);
         gi_log(GI_LOG_WARN, "view: %s", v->status);
     }
@@ -167,9 +167,11 @@ static void window_ray(const viewer *v, double x, double y, gi_vec3 *o, gi_vec3 
     int ww = (int)v->win_w, wh = (int)v->win_h;
     gi_camera_frame cf = view_camera(v);
     float th = tanf(0.5f * cf.yfov), aspect = (float)v->width / (float)v->height;
-    float nx = 2.0f * (float)x / (float)(ww > 0 ? ww : 1) - 1.0f, ny = 1.0f - 2.0f * (float)y / (float)(wh > 0 ? wh : 1);
+    float nx = 2.0f * (float)x / (float)(ww > 0 ? ww : 1) - 1.0f,
+          ny = 1.0f - 2.0f * (float)y / (float)(wh > 0 ? wh : 1);
     *o = cf.eye;
-    *d = gi_v3_normalize(gi_mat4_dir(cf.world_from_camera, gi_v3(nx * th * aspect, ny * th, -1.0f)));
+    *d =
+        gi_v3_normalize(gi_mat4_dir(cf.world_from_camera, gi_v3(nx * th * aspect, ny * th, -1.0f)));
 }
 
 int view_pick(viewer *v, double x, double y, int mode)
@@ -193,7 +195,8 @@ int view_pick(viewer *v, double x, double y, int mode)
     const gi_object *ob = &v->scene->objects[obj];
     v->sel_object = obj;
     if (v->file_animated[obj]) {
-        snprintf(v->status, sizeof v->status, "%s follows the scene's animation: it cannot be moved by hand",
+        snprintf(v->status, sizeof v->status,
+                 "%s follows the scene's animation: it cannot be moved by hand",
                  ob->name ? ob->name : "the object");
         return EXIT_OK;
     }
@@ -201,8 +204,8 @@ int view_pick(viewer *v, double x, double y, int mode)
     gi_camera_frame cf = view_camera(v);
     float depth = gi_v3_dot(gi_v3_sub(hit.position, cf.eye), gi_v3_normalize(cf.forward));
     if (gi_log_get_level() >= GI_LOG_WARN)
-        printf("view: picked object %d '%s' at depth %.4g (%s)\n", obj, ob->name ? ob->name : "", (double)depth,
-               mode == 2 ? "rotate" : "move");
+        printf("view: picked object %d '%s' at depth %.4g (%s)\n", obj, ob->name ? ob->name : "",
+               (double)depth, mode == 2 ? "rotate" : "move");
     /* the objects under the node become moving ones: the method is made
      * again so that it treats them so from its prepare (as a scene
      * animating them would have it) */
@@ -214,7 +217,8 @@ int view_pick(viewer *v, double x, double y, int mode)
             /* the method cannot be made with this object moving (its
              * message is printed): no image, and it says so */
             view_go_stale(v);
-            snprintf(v->status, sizeof v->status, "%s cannot be made with '%s' moving: no image (M: another method)",
+            snprintf(v->status, sizeof v->status,
+                     "%s cannot be made with '%s' moving: no image (M: another method)",
                      v->m ? v->m->id : "the method", ob->name ? ob->name : "the object");
             gi_log(GI_LOG_WARN, "view: %s", v->status);
             return EXIT_OK;
@@ -233,7 +237,8 @@ int view_pick(viewer *v, double x, double y, int mode)
     const float *b = ob->local_bounds;
     float ow[16];
     gi_scene_object_transform(v->scene, (uint32_t)obj, v->time, ow);
-    v->drag_pivot = gi_mat4_point(ow, gi_v3(0.5f * (b[0] + b[3]), 0.5f * (b[1] + b[4]), 0.5f * (b[2] + b[5])));
+    v->drag_pivot =
+        gi_mat4_point(ow, gi_v3(0.5f * (b[0] + b[3]), 0.5f * (b[1] + b[4]), 0.5f * (b[2] + b[5])));
     v->status[0] = '\0';
     return EXIT_OK;
 }
@@ -262,15 +267,16 @@ int view_drag_to(viewer *v, double x, double y)
         /* in the view plane, at the picked point's depth: the object follows the mouse */
         gi_camera_frame cf = view_camera(v);
         gi_vec3 right = gi_v3_load(cf.world_from_camera), up = gi_v3_load(cf.world_from_camera + 4);
-        origin = gi_v3_add(v->drag_origin,
-                           gi_v3_add(gi_v3_scale(right, dx * v->drag_scale), gi_v3_scale(up, -dy * v->drag_scale)));
+        origin = gi_v3_add(v->drag_origin, gi_v3_add(gi_v3_scale(right, dx * v->drag_scale),
+                                                     gi_v3_scale(up, -dy * v->drag_scale)));
     } else {
         /* about the vertical through the object's centre, 0.01 rad a pixel */
         float a = dx * 0.01f, c = cosf(a), s = sinf(a);
         gi_vec3 r = gi_v3_sub(v->drag_origin, v->drag_pivot);
         origin = gi_v3_add(v->drag_pivot, gi_v3(c * r.x + s * r.z, r.y, -s * r.x + c * r.z));
         gi_vec3 axis = gi_v3_normalize(gi_mat4_dir(pinv, gi_v3(0, 1, 0)));
-        float q[4] = {axis.x * sinf(0.5f * a), axis.y * sinf(0.5f * a), axis.z * sinf(0.5f * a), cosf(0.5f * a)};
+        float q[4] = {axis.x * sinf(0.5f * a), axis.y * sinf(0.5f * a), axis.z * sinf(0.5f * a),
+                      cosf(0.5f * a)};
         quat_mul(trs + 3, q, v->drag_trs + 3);
         gi_quat_normalize(trs + 3);
     }
@@ -298,9 +304,11 @@ int view_light_select(viewer *v)
             animated = view_scene_under(v->scene, l->node, moved);
             free(moved);
         }
-        snprintf(v->status, sizeof v->status, "light %d '%s' selected%s", v->sel_light, l->name ? l->name : "",
+        snprintf(v->status, sizeof v->status, "light %d '%s' selected%s", v->sel_light,
+                 l->name ? l->name : "",
                  animated ? " (animated by the scene: it cannot be moved by hand)"
-                          : " (Shift+drag or Shift+W/A/S/D/Q/E moves it; L again until none to pick objects)");
+                          : " (Shift+drag or Shift+W/A/S/D/Q/E moves it; L again until none to "
+                            "pick objects)");
         if (animated)
             v->sel_light = -1;
     } else {
@@ -323,13 +331,14 @@ int view_light_pick(viewer *v, double x, double y)
     if (!(depth > cf.znear)) {
         /* no plane facing the camera through it that the mouse can reach */
         snprintf(v->status, sizeof v->status,
-                 "light %d '%s' is behind the camera: orbit to see its place, or move it with Shift+W/A/S/D/Q/E",
+                 "light %d '%s' is behind the camera: orbit to see its place, or move it with "
+                 "Shift+W/A/S/D/Q/E",
                  v->sel_light, l->name ? l->name : "");
         return EXIT_OK;
     }
     if (gi_log_get_level() >= GI_LOG_WARN)
-        printf("view: picked light %d '%s' at depth %.4g (move)\n", v->sel_light, l->name ? l->name : "",
-               (double)depth);
+        printf("view: picked light %d '%s' at depth %.4g (move)\n", v->sel_light,
+               l->name ? l->name : "", (double)depth);
     v->drag_object = 1;
     v->drag_node = node;
     v->drag_x0 = x;

@@ -27,14 +27,15 @@ typedef struct ov_vert {
 
 #define OV_MAX_VERTS 60000
 
-static const char ov_vs[] = "layout(location = 0) in vec2 p;\n"
-                            "layout(location = 1) in vec4 c;\n"
-                            "uniform vec2 size;\n"
-                            "out vec4 col;\n"
-                            "void main() {\n"
-                            "    col = c;\n"
-                            "    gl_Position = vec4(p.x / size.x * 2.0 - 1.0, 1.0 - p.y / size.y * 2.0, 0.0, 1.0);\n"
-                            "}\n";
+static const char ov_vs[] =
+    "layout(location = 0) in vec2 p;\n"
+    "layout(location = 1) in vec4 c;\n"
+    "uniform vec2 size;\n"
+    "out vec4 col;\n"
+    "void main() {\n"
+    "    col = c;\n"
+    "    gl_Position = vec4(p.x / size.x * 2.0 - 1.0, 1.0 - p.y / size.y * 2.0, 0.0, 1.0);\n"
+    "}\n";
 static const char ov_fs[] = "in vec4 col;\n"
                             "out vec4 color;\n"
                             "void main() { color = col; }\n";
@@ -131,11 +132,13 @@ static void text(overlay *o, float x, float y, const char *s, const unsigned cha
 #define LINE 11.0f
 
 static const unsigned char WHITE[4] = {235, 235, 235, 255}, GREY[4] = {160, 160, 160, 255},
-                           ORANGE[4] = {255, 170, 60, 255}, PANEL[4] = {0, 0, 0, 150}, BAR[4] = {90, 170, 255, 255},
-                           BAR_BG[4] = {60, 60, 60, 200}, GREEN[4] = {110, 220, 110, 255};
+                           ORANGE[4] = {255, 170, 60, 255}, PANEL[4] = {0, 0, 0, 150},
+                           BAR[4] = {90, 170, 255, 255}, BAR_BG[4] = {60, 60, 60, 200},
+                           GREEN[4] = {110, 220, 110, 255};
 
 /* Text wrapped at the window's width; returns the next line's y. */
-static float wrapped(overlay *o, float x, float y, float width, const char *s, const unsigned char c[4])
+static float wrapped(overlay *o, float x, float y, float width, const char *s,
+                     const unsigned char c[4])
 {
     size_t per = width > 24 ? (size_t)((width - x - 4) / 6.0f) : 4;
     if (per < 4)
@@ -173,7 +176,8 @@ static void flush(viewer *v, int fw, int fh, int w, int h)
     glEnable(GL_BLEND);
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
     glUseProgram(o->prog);
-    glUniform2f(glGetUniformLocation(o->prog, "size"), (float)(w > 0 ? w : 1), (float)(h > 0 ? h : 1));
+    glUniform2f(glGetUniformLocation(o->prog, "size"), (float)(w > 0 ? w : 1),
+                (float)(h > 0 ? h : 1));
     glBindVertexArray(o->vao);
     glDrawArrays(GL_TRIANGLES, 0, o->n);
     glBindVertexArray(0);
@@ -196,10 +200,13 @@ void view_overlay_draw(viewer *v, int fw, int fh)
     rect(o, 0, 0, 0, 0, PANEL);
     int ref = v->method_index < 0;
     if (ref)
-        snprintf(buf, sizeof buf, "reference (path tracer) | %llu spp", (unsigned long long)v->ref_spp);
+        snprintf(buf, sizeof buf, "reference (path tracer) | %llu spp",
+                 (unsigned long long)v->ref_spp);
     else
         snprintf(buf, sizeof buf, "%s%s", v->m ? v->m->id : "-",
-                 v->split == 1 ? " | reference right" : v->split == 2 ? " | error right (1e-3 blue .. 1 red)" : "");
+                 v->split == 1   ? " | reference right"
+                 : v->split == 2 ? " | error right (1e-3 blue .. 1 red)"
+                                 : "");
     y = wrapped(o, x, y, w, buf, WHITE);
     y = wrapped(o, x, y, w, gi_gpu_renderer(v->gpu), GREY);
     if (!ref && v->params && v->params->count) {
@@ -221,11 +228,12 @@ void view_overlay_draw(viewer *v, int fw, int fh)
         y = wrapped(o, x, y, w, buf, GREY);
     }
     if (ref)
-        snprintf(buf, sizeof buf, "EV %+.1f | t %.2f%s | ui %.2f ms", (double)v->exposure, (double)v->time,
-                 v->playing ? " playing" : "", v->display_ms);
+        snprintf(buf, sizeof buf, "EV %+.1f | t %.2f%s | ui %.2f ms", (double)v->exposure,
+                 (double)v->time, v->playing ? " playing" : "", v->display_ms);
     else
-        snprintf(buf, sizeof buf, "frame %u | %.1f ms | EV %+.1f | t %.2f%s | ui %.2f ms", v->frame_index, v->frame_ms,
-                 (double)v->exposure, (double)v->time, v->playing ? " playing" : "", v->display_ms);
+        snprintf(buf, sizeof buf, "frame %u | %.1f ms | EV %+.1f | t %.2f%s | ui %.2f ms",
+                 v->frame_index, v->frame_ms, (double)v->exposure, (double)v->time,
+                 v->playing ? " playing" : "", v->display_ms);
     y = wrapped(o, x, y, w, buf, WHITE);
     if (v->status[0])
         y = wrapped(o, x, y, w, v->status, ORANGE);
@@ -274,8 +282,8 @@ void view_overlay_progress(const gi_host *h, const char *task, float fraction)
         return;
     v->last_progress = now;
     GLint fbo_draw = 0, fbo_read = 0, prog = 0, vao = 0, vp[4], blend_src = 0, blend_dst = 0;
-    GLboolean blend = glIsEnabled(GL_BLEND), depth = glIsEnabled(GL_DEPTH_TEST), cull = glIsEnabled(GL_CULL_FACE),
-              scissor = glIsEnabled(GL_SCISSOR_TEST), mask[4];
+    GLboolean blend = glIsEnabled(GL_BLEND), depth = glIsEnabled(GL_DEPTH_TEST),
+              cull = glIsEnabled(GL_CULL_FACE), scissor = glIsEnabled(GL_SCISSOR_TEST), mask[4];
     GLfloat clear[4];
     glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &fbo_draw);
     glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &fbo_read);

@@ -10,7 +10,8 @@
 
 /* One request: a renderer made for it, passes of one sample until the
  * request changes or the worker is stopped or paused. */
-static void serve(view_ref *r, uint64_t gen, gi_camera_frame cam, float time, uint32_t w, uint32_t h, uint32_t seed)
+static void serve(view_ref *r, uint64_t gen, gi_camera_frame cam, float time, uint32_t w,
+                  uint32_t h, uint32_t seed)
 {
     gi_ref_desc d;
     gi_ref_desc_init(&d);
@@ -105,8 +106,8 @@ int view_ref_start(view_ref *r, const gi_scene *scene)
     return 1;
 }
 
-void view_ref_request(view_ref *r, const gi_camera_frame *camera, float time, uint32_t width, uint32_t height,
-                      uint32_t seed)
+void view_ref_request(view_ref *r, const gi_camera_frame *camera, float time, uint32_t width,
+                      uint32_t height, uint32_t seed)
 {
     pthread_mutex_lock(&r->mu);
     r->generation++;
@@ -156,7 +157,8 @@ gi_image *view_ref_take(view_ref *r, int always, uint64_t *spp)
     if (r->latest && r->latest_generation == r->generation && (r->fresh || always)) {
         copy = gi_image_create(r->latest->width, r->latest->height);
         if (copy)
-            memcpy(copy->rgba, r->latest->rgba, sizeof(float) * 4 * (size_t)copy->width * copy->height);
+            memcpy(copy->rgba, r->latest->rgba,
+                   sizeof(float) * 4 * (size_t)copy->width * copy->height);
         r->fresh = 0;
         if (spp)
             *spp = r->latest_spp;

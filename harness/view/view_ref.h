@@ -25,17 +25,17 @@ typedef struct view_ref {
     float time;
     uint32_t width, height, seed;
     /* what was rendered (under mu) */
-    gi_image *latest;    /* the mean after latest_spp samples of latest_generation */
+    gi_image *latest; /* the mean after latest_spp samples of latest_generation */
     uint64_t latest_generation, latest_spp;
-    int fresh;           /* latest is newer than what the caller took */
+    int fresh;                /* latest is newer than what the caller took */
     char error[GI_ERROR_MAX]; /* set when the reference could not be made */
 } view_ref;
 
 /* Starts the worker (idle until view_ref_request); 1 on success. */
 int view_ref_start(view_ref *r, const gi_scene *scene);
 /* Asks for the reference of this camera, time and size, from 0 samples. */
-void view_ref_request(view_ref *r, const gi_camera_frame *camera, float time, uint32_t width, uint32_t height,
-                      uint32_t seed);
+void view_ref_request(view_ref *r, const gi_camera_frame *camera, float time, uint32_t width,
+                      uint32_t height, uint32_t seed);
 /* Whether a request is being served (not paused, not failed). */
 int view_ref_running(view_ref *r);
 /* Stops accumulating (the worker idles). */

@@ -17,10 +17,9 @@
  *     save-view FILE.json     the view, as key V saves it
  *     screenshot PREFIX       PREFIX.exr, PREFIX.png and PREFIX.json (its view)
  *     window-shot FILE.png    the window as shown (split view, divider) at the next redraw
- *     resize W H              the window resized to W x H (the image is rendered again at that size)
- *     quit                    exit 0 (so does the end of the file)
- * Blank lines and lines starting with # are skipped. A line runs only once
- * the frame of the line before it has been rendered. */
+ *     resize W H              the window resized to W x H (the image is rendered again at that
+ * size) quit                    exit 0 (so does the end of the file) Blank lines and lines starting
+ * with # are skipped. A line runs only once the frame of the line before it has been rendered. */
 #define _POSIX_C_SOURCE 200809L
 #include "view.h"
 
@@ -75,7 +74,9 @@ static int button_code(const char *name)
 {
     if (!name || !*name || !strcmp(name, "left"))
         return GLFW_MOUSE_BUTTON_LEFT;
-    return !strcmp(name, "right") ? GLFW_MOUSE_BUTTON_RIGHT : !strcmp(name, "middle") ? GLFW_MOUSE_BUTTON_MIDDLE : -1;
+    return !strcmp(name, "right")    ? GLFW_MOUSE_BUTTON_RIGHT
+           : !strcmp(name, "middle") ? GLFW_MOUSE_BUTTON_MIDDLE
+                                     : -1;
 }
 
 /* "shift", "ctrl" (or "") -> GLFW modifier bits, -1 unknown. */
@@ -132,12 +133,14 @@ static int run_line(viewer *v, char *line)
             return bad(v, "key NAME [shift|ctrl]");
         return view_key(v, k, mods);
     }
-    if (!strcmp(cmd, "drag") || !strcmp(cmd, "press") || !strcmp(cmd, "move") || !strcmp(cmd, "release")) {
+    if (!strcmp(cmd, "drag") || !strcmp(cmd, "press") || !strcmp(cmd, "move") ||
+        !strcmp(cmd, "release")) {
         double x[4];
         char w1[16] = "", w2[16] = "", extra[16] = "";
         int need = !strcmp(cmd, "drag") ? 4 : 2, m;
         if (need == 4)
-            m = sscanf(line, "%*s %lf %lf %lf %lf %15s %15s %15s", &x[0], &x[1], &x[2], &x[3], w1, w2, extra);
+            m = sscanf(line, "%*s %lf %lf %lf %lf %15s %15s %15s", &x[0], &x[1], &x[2], &x[3], w1,
+                       w2, extra);
         else
             m = sscanf(line, "%*s %lf %lf %15s %15s %15s", &x[0], &x[1], w1, w2, extra);
         /* the words after the numbers: a button, then a modifier (either may be left out) */
@@ -234,7 +237,8 @@ static int run_line(viewer *v, char *line)
         v->quit = 1;
         return EXIT_OK;
     }
-    return bad(v, "unknown command (key, drag, press, move, release, scroll, resize, method, wait, save-view, screenshot, window-shot, quit)");
+    return bad(v, "unknown command (key, drag, press, move, release, scroll, resize, method, wait, "
+                  "save-view, screenshot, window-shot, quit)");
 }
 
 int view_script_step(viewer *v)

@@ -33,30 +33,40 @@
 #define AVG_LOD_ERROR 0.02f
 
 static const gi_param_desc avg_params[] = {
-    {"grid", GI_PARAM_INT, 64, 4, 512, NULL, "AVG resolution (Sec. III-A, 64^3)", "voxels per axis of the grid"},
+    {"grid", GI_PARAM_INT, 64, 4, 512, NULL, "AVG resolution (Sec. III-A, 64^3)",
+     "voxels per axis of the grid"},
     {"vpls", GI_PARAM_INT, 1024, 1, 65536, NULL, "N_VPL (Sec. IV, 1024)",
      "VPL slots: N_VPL / (B + 1) light paths, each with a VPL on the light and at up to B hits"},
-    {"bounces", GI_PARAM_INT, 3, 0, 3, NULL, "bounces (Sec. IV, 3)", "indirect bounces B (VPLs at hits 1..B)"},
+    {"bounces", GI_PARAM_INT, 3, 0, 3, NULL, "bounces (Sec. IV, 3)",
+     "indirect bounces B (VPLs at hits 1..B)"},
     {"M", GI_PARAM_INT, 16, 1, 64, NULL, "M (Sec. III-C, 16)",
      "interleaved-sampling subsets, a square number (mx x mx pixel pattern)"},
     {"clamp", GI_PARAM_FLOAT, 1.0, 0.0, 100.0, NULL, "G clamping",
      "the geometry term's distance is clamped below at this many voxel edges"},
     {"visibility", GI_PARAM_BOOL, 1, 0, 1, NULL, "Table I FPS (V) / (NV)",
      "VPL visibility from shadow maps; off: every VPL reaches every point it faces"},
-    {"shadow_size", GI_PARAM_INT, 32, 4, 512, NULL, "Sec. III-C (low resolution)", "each VPL's shadow map is this many texels square"},
+    {"shadow_size", GI_PARAM_INT, 32, 4, 512, NULL, "Sec. III-C (low resolution)",
+     "each VPL's shadow map is this many texels square"},
     {"projection", GI_PARAM_ENUM, 0, 0, 0, "auto|paraboloid|perspective", "Sec. IV",
-     "shadow-map projection; auto: paraboloid for scenes of small triangles, perspective for large ones (as the paper)"},
-    {"fov", GI_PARAM_FLOAT, 120.0, 10.0, 170.0, NULL, "Sec. IV", "field of view of perspective shadow maps, degrees"},
-    {"shadow_lod", GI_PARAM_FLOAT, 1.0, 0.01, 1.0, NULL, "Sec. V (lower-detail geometry for the maps)",
+     "shadow-map projection; auto: paraboloid for scenes of small triangles, perspective for large "
+     "ones (as the paper)"},
+    {"fov", GI_PARAM_FLOAT, 120.0, 10.0, 170.0, NULL, "Sec. IV",
+     "field of view of perspective shadow maps, degrees"},
+    {"shadow_lod", GI_PARAM_FLOAT, 1.0, 0.01, 1.0, NULL,
+     "Sec. V (lower-detail geometry for the maps)",
      "the VPL shadow maps draw a simplified copy of each object with this share of its triangles "
      "(meshoptimizer, surface moved by at most 2 % of the object's size); 1: the scene itself"},
-    {"filter", GI_PARAM_BOOL, 1, 0, 1, NULL, "Sec. III-C", "discontinuity-aware mx x mx box filter"},
+    {"filter", GI_PARAM_BOOL, 1, 0, 1, NULL, "Sec. III-C",
+     "discontinuity-aware mx x mx box filter"},
     {"voxeliser", GI_PARAM_ENUM, 0, 0, 0, "conservative|paper|single", "Sec. III-A",
-     "exact triangle-box voxels drawn slice by slice (one instance per Z slice), the paper's epsilon shift and "
-     "stand-in triangles (slice by slice), or the exact voxels in a single pass (dominant-axis projection, "
+     "exact triangle-box voxels drawn slice by slice (one instance per Z slice), the paper's "
+     "epsilon shift and "
+     "stand-in triangles (slice by slice), or the exact voxels in a single pass (dominant-axis "
+     "projection, "
      "integer atomics)"},
     {"tracing", GI_PARAM_ENUM, 0, 0, 0, "avg|exact", "Fig. 6",
-     "VPL paths marched through the AVG on the GPU, or the same paths traced exactly by Embree on the CPU"},
+     "VPL paths marched through the AVG on the GPU, or the same paths traced exactly by Embree on "
+     "the CPU"},
     {"offset", GI_PARAM_FLOAT, 1.5, 0.0, 8.0, NULL, NULL,
      "ray origins leave a surface this many voxel edges along its normal"},
     {0},
@@ -170,7 +180,8 @@ static gi_result shadow_maps(avg *a, gi_error *err)
 {
     const gi_depth_atlas_desc *d = gi_depth_atlas_get_desc(a->atlas);
     const float *b = a->kit.scene->bounds;
-    float diag = sqrtf((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) + (b[5] - b[2]) * (b[5] - b[2]));
+    float diag = sqrtf((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) +
+                       (b[5] - b[2]) * (b[5] - b[2]));
     float zfar = 2.0f * diag + 1e-6f, znear = 1e-3f * a->grid->h;
     for (uint32_t j = 0; j < a->vpl_count; j++) {
         const avg_vpl *v = &a->cpu_vpls[j];
@@ -195,7 +206,8 @@ static void release_prepared(avg *a)
     gi_simplified_free(a->lod);
     a->lod = NULL;
     free(a->views);
-    GLuint progs[5] = {a->prog_trace, a->prog_split, a->prog_shade, a->prog_assemble, a->prog_final};
+    GLuint progs[5] = {a->prog_trace, a->prog_split, a->prog_shade, a->prog_assemble,
+                       a->prog_final};
     for (int i = 0; i < 5; i++)
         if (progs[i])
             glDeleteProgram(progs[i]);
@@ -230,8 +242,9 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
     /* Directional light and the environment, which the caps leave out, the
      * host names (gibench render warns, a study marks the cell n/a). */
     if (scene->light_count > AVG_MAX_PUNCTUAL)
-        a->kit.host->log(a->kit.host, GI_LOG_WARN, "only the first %d of %u punctual lights emit VPLs", AVG_MAX_PUNCTUAL,
-                     scene->light_count);
+        a->kit.host->log(a->kit.host, GI_LOG_WARN,
+                         "only the first %d of %u punctual lights emit VPLs", AVG_MAX_PUNCTUAL,
+                         scene->light_count);
     /* Before the grid's textures are made: at grid=512 they are 4 GiB. */
     if (a->voxeliser == AVG_VOX_SINGLE && avg_grid_check_single((uint32_t)a->grid_n, &err) != GI_OK)
         return gi_kit_fail_with(&a->kit, GI_ERR_INVALID_ARGUMENT, &err);
@@ -244,19 +257,23 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
         gi_result r = build_lod(a, scene->scene, &err);
         if (r != GI_OK)
             return gi_kit_fail_with(&a->kit, r, &err);
-        gi_depth_atlas_desc d = {(uint32_t)a->tile, a->slots, choose_projection(a, scene->scene), GI_DEPTH_RADIAL, 1};
+        gi_depth_atlas_desc d = {(uint32_t)a->tile, a->slots, choose_projection(a, scene->scene),
+                                 GI_DEPTH_RADIAL, 1};
         if (a->lod && a->projection == 1)
             a->kit.host->log(a->kit.host, GI_LOG_WARN,
-                             "shadow_lod=%g with projection=paraboloid: the warp bends the simplified copy's long "
+                             "shadow_lod=%g with projection=paraboloid: the warp bends the "
+                             "simplified copy's long "
                              "edges (projection=auto or perspective avoids it)",
                              (double)a->shadow_lod);
         a->atlas = gi_depth_atlas_create(&d, &err);
         if (!a->atlas)
             return gi_kit_fail_with(&a->kit, GI_ERR_INVALID_ARGUMENT, &err);
-        gi_depth_atlas_set_geometry(a->atlas, a->lod ? a->lod->ibo : 0, a->lod ? a->lod->triangle_count : 0);
+        gi_depth_atlas_set_geometry(a->atlas, a->lod ? a->lod->ibo : 0,
+                                    a->lod ? a->lod->triangle_count : 0);
         a->views = calloc(a->slots, sizeof *a->views);
         if (!a->views)
-            return gi_kit_fail(&a->kit, GI_ERR_OUT_OF_MEMORY, "avg: out of memory for the shadow-map views");
+            return gi_kit_fail(&a->kit, GI_ERR_OUT_OF_MEMORY,
+                               "avg: out of memory for the shadow-map views");
     }
     if (a->tracing == 1) {
         a->exact = avg_exact_create(scene, &err);
@@ -268,9 +285,11 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
     if (!a->cpu_slots || !a->cpu_vpls)
         return gi_kit_fail(&a->kit, GI_ERR_OUT_OF_MEMORY, "avg: out of memory for the VPL slots");
     glCreateBuffers(1, &a->ssbo_slots);
-    glNamedBufferStorage(a->ssbo_slots, (GLsizeiptr)(a->slots * sizeof(avg_vpl)), NULL, GL_DYNAMIC_STORAGE_BIT);
+    glNamedBufferStorage(a->ssbo_slots, (GLsizeiptr)(a->slots * sizeof(avg_vpl)), NULL,
+                         GL_DYNAMIC_STORAGE_BIT);
     glCreateBuffers(1, &a->ssbo_vpls);
-    glNamedBufferStorage(a->ssbo_vpls, (GLsizeiptr)(a->slots * sizeof(avg_vpl)), NULL, GL_DYNAMIC_STORAGE_BIT);
+    glNamedBufferStorage(a->ssbo_vpls, (GLsizeiptr)(a->slots * sizeof(avg_vpl)), NULL,
+                         GL_DYNAMIC_STORAGE_BIT);
     if (gi_gl_check("avg: prepare", &err) != GI_OK)
         return gi_kit_fail_with(&a->kit, GI_ERR_GL, &err);
     return GI_OK;
@@ -289,7 +308,8 @@ static gi_result avg_update(void *inst, const gi_gpu_scene *scene, const gi_chan
         gi_result r = build_lod(a, scene->scene, &err);
         if (r != GI_OK)
             return gi_kit_fail_with(&a->kit, r, &err);
-        gi_depth_atlas_set_geometry(a->atlas, a->lod ? a->lod->ibo : 0, a->lod ? a->lod->triangle_count : 0);
+        gi_depth_atlas_set_geometry(a->atlas, a->lod ? a->lod->ibo : 0,
+                                    a->lod ? a->lod->triangle_count : 0);
     }
     return GI_OK;
 }
@@ -302,7 +322,8 @@ void avg_light_table_build(const gi_gpu_scene *gs, avg_light_table *t)
     power[0] = gs->emitter_count > 0 ? gs->emitter_power : 0.0;
     if (np > 0) {
         gi_gpu_light lights[AVG_MAX_PUNCTUAL];
-        glGetNamedBufferSubData(gs->ssbo_lights, 0, (GLsizeiptr)(np * sizeof(gi_gpu_light)), lights);
+        glGetNamedBufferSubData(gs->ssbo_lights, 0, (GLsizeiptr)(np * sizeof(gi_gpu_light)),
+                                lights);
         for (uint32_t l = 0; l < np; l++) {
             double lum = gi_luminance(lights[l].intensity);
             double p = 0.0;
@@ -355,7 +376,8 @@ static gi_result trace_avg(avg *a, const avg_light_table *lt, uint32_t seed, gi_
     glDispatchCompute((a->paths + 63) / 64, 1, 1);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
     glUseProgram(0);
-    glGetNamedBufferSubData(a->ssbo_slots, 0, (GLsizeiptr)(a->slots * sizeof(avg_vpl)), a->cpu_slots);
+    glGetNamedBufferSubData(a->ssbo_slots, 0, (GLsizeiptr)(a->slots * sizeof(avg_vpl)),
+                            a->cpu_slots);
     return gi_gl_check("avg: VPL tracing", err);
 }
 
@@ -370,7 +392,8 @@ static void compact(avg *a)
             a->cpu_vpls[a->vpl_count++] = a->cpu_slots[s];
     }
     if (a->vpl_count)
-        glNamedBufferSubData(a->ssbo_vpls, 0, (GLsizeiptr)(a->vpl_count * sizeof(avg_vpl)), a->cpu_vpls);
+        glNamedBufferSubData(a->ssbo_vpls, 0, (GLsizeiptr)(a->vpl_count * sizeof(avg_vpl)),
+                             a->cpu_vpls);
 }
 
 /* Diagnostics: with GIBENCH_AVG_VPLS=FILE every frame (re)writes FILE as
@@ -391,9 +414,9 @@ static void dump_vpls(const avg *a)
     fprintf(f, "x,y,z,nx,ny,nz,r,g,b,bounce\n");
     for (uint32_t i = 0; i < a->vpl_count; i++) {
         const avg_vpl *v = &a->cpu_vpls[i];
-        fprintf(f, "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%u\n", v->position[0], v->position[1],
-                v->position[2], v->normal[0], v->normal[1], v->normal[2], v->power[0], v->power[1], v->power[2],
-                (v->kind >> 8) & 0xffu);
+        fprintf(f, "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%u\n", v->position[0],
+                v->position[1], v->position[2], v->normal[0], v->normal[1], v->normal[2],
+                v->power[0], v->power[1], v->power[2], (v->kind >> 8) & 0xffu);
     }
     if (fclose(f) != 0)
         gi_log(GI_LOG_WARN, "avg: cannot write GIBENCH_AVG_VPLS file '%s'", path);
@@ -406,9 +429,12 @@ static void size_scratch(avg *a, uint32_t w, uint32_t h)
     uint32_t mx = (uint32_t)a->mx;
     a->split_w = (w + mx - 1) / mx;
     a->split_h = (h + mx - 1) / mx;
-    a->tex_split_pos = gi_kit_scratch_texture(&a->kit, 0, GL_RGBA32F, a->split_w * mx, a->split_h * mx);
-    a->tex_split_nrm = gi_kit_scratch_texture(&a->kit, 1, GL_RGBA32F, a->split_w * mx, a->split_h * mx);
-    a->tex_split_out = gi_kit_scratch_texture(&a->kit, 2, GL_RGBA32F, a->split_w * mx, a->split_h * mx);
+    a->tex_split_pos =
+        gi_kit_scratch_texture(&a->kit, 0, GL_RGBA32F, a->split_w * mx, a->split_h * mx);
+    a->tex_split_nrm =
+        gi_kit_scratch_texture(&a->kit, 1, GL_RGBA32F, a->split_w * mx, a->split_h * mx);
+    a->tex_split_out =
+        gi_kit_scratch_texture(&a->kit, 2, GL_RGBA32F, a->split_w * mx, a->split_h * mx);
     a->tex_indirect = gi_kit_scratch_texture(&a->kit, 3, GL_RGBA32F, w, h);
 }
 
@@ -447,7 +473,8 @@ static gi_result illuminate(avg *a, const gi_view *view, const gi_target *target
     glUniform1i(glGetUniformLocation(p, "u_visibility"), a->atlas != NULL);
     if (a->atlas) {
         glBindTextureUnit(AVG_TEX_ATLAS, gi_depth_atlas_texture(a->atlas));
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, AVG_SSBO_ATLAS_VIEWS, gi_depth_atlas_views_buffer(a->atlas));
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, AVG_SSBO_ATLAS_VIEWS,
+                         gi_depth_atlas_views_buffer(a->atlas));
         /* Depth bias for maps of `tile` texels: half a voxel plus a share
          * of the distance that grows as the maps get coarser (and with the
          * slope, in the shader). */
@@ -481,8 +508,8 @@ static gi_result illuminate(avg *a, const gi_view *view, const gi_target *target
     float footprint = 2.0f * tanf(0.5f * view->yfov) / (float)view->height;
     glUniform1f(glGetUniformLocation(p, "u_max_dist"), 2.0f * (float)a->mx * footprint);
     glDispatchCompute((view->width + 7) / 8, (view->height + 7) / 8, 1);
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
-                    GL_FRAMEBUFFER_BARRIER_BIT);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
+                    GL_TEXTURE_UPDATE_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
     glUseProgram(0);
     return gi_gl_check("avg: shading", err);
 }
@@ -549,9 +576,11 @@ static gi_result avg_render(void *inst, const gi_view *view, const gi_target *ta
     host->stat(host, "data_bytes_atlas", atlas_bytes);
     host->stat(host, "data_bytes", grid_bytes + vpl_bytes + atlas_bytes);
     if (a->atlas)
-        host->stat(host, "shadow_paraboloid", (double)(gi_depth_atlas_get_desc(a->atlas)->projection == GI_PROJ_PARABOLOID));
+        host->stat(host, "shadow_paraboloid",
+                   (double)(gi_depth_atlas_get_desc(a->atlas)->projection == GI_PROJ_PARABOLOID));
     if (a->atlas)
-        host->stat(host, "shadow_triangles", (double)(a->lod ? a->lod->triangle_count : a->kit.scene->triangle_count));
+        host->stat(host, "shadow_triangles",
+                   (double)(a->lod ? a->lod->triangle_count : a->kit.scene->triangle_count));
     return GI_OK;
 }
 
@@ -570,12 +599,11 @@ static const char *avg_last_error(void *inst)
     return inst ? gi_kit_last_error(&((avg *)inst)->kit) : "";
 }
 
-GI_METHOD_EXPORT(avg,
-    .id = "avg",
-    .title = "Approximate Visibility Grids for Interactive Indirect Illumination",
-    .citation = "Bashford-Rogers, Debattista, Harvey, Chalmers. VS-Games 2011",
-    .version = "0.1",
-    .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_RIGID_MOTION |
-            GI_CAP_DEFORMATION | GI_CAP_TEXTURES,
-    .max_bounces = 3,
-    .params = avg_params);
+GI_METHOD_EXPORT(avg, .id = "avg",
+                 .title = "Approximate Visibility Grids for Interactive Indirect Illumination",
+                 .citation = "Bashford-Rogers, Debattista, Harvey, Chalmers. VS-Games 2011",
+                 .version = "0.1",
+                 .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_AREA_LIGHTS |
+                         GI_CAP_POINT_LIGHTS | GI_CAP_RIGID_MOTION | GI_CAP_DEFORMATION |
+                         GI_CAP_TEXTURES,
+                 .max_bounces = 3, .params = avg_params);

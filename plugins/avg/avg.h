@@ -26,21 +26,22 @@ extern const gi_shader_source gi_avg_shaders[];
 /* Voxelisation variants (param `voxeliser`). */
 typedef enum avg_vox_mode {
     AVG_VOX_CONSERVATIVE = 0, /* bounding quad per slice + exact triangle-box test per fragment */
-    AVG_VOX_PAPER = 1,        /* the paper's: slice part of the triangle, epsilon shift, stand-ins */
-    AVG_VOX_SINGLE = 2,       /* one draw, dominant-axis projection, the conservative test per column voxel */
+    AVG_VOX_PAPER = 1, /* the paper's: slice part of the triangle, epsilon shift, stand-ins */
+    AVG_VOX_SINGLE =
+        2, /* one draw, dominant-axis projection, the conservative test per column voxel */
 } avg_vox_mode;
 
 typedef struct avg_grid {
-    uint32_t n;         /* n x n x n voxels */
-    float origin[3];    /* world position of the grid's corner (0, 0, 0) */
-    float h;            /* voxel edge length (voxels are cubes) */
-    GLuint tex_normal;  /* RGBA32F 3D: sum of triangle normals, count in w */
-    GLuint tex_colour;  /* RGBA32F 3D: sum of albedos, count in w */
-    GLuint fbo, program[3]; /* layered FBO; programs per avg_vox_mode */
-    GLuint fbo_single;      /* the single pass: no attachments, n x n */
-    GLuint prog_resolve;    /* the single pass: fixed-point sums -> textures */
-    GLuint ssbo_sums;       /* the single pass: 8 ints a voxel (avg_vox1.frag) */
-    GLuint ssbo_colours;    /* per material: albedo x mean texture colour */
+    uint32_t n;                   /* n x n x n voxels */
+    float origin[3];              /* world position of the grid's corner (0, 0, 0) */
+    float h;                      /* voxel edge length (voxels are cubes) */
+    GLuint tex_normal;            /* RGBA32F 3D: sum of triangle normals, count in w */
+    GLuint tex_colour;            /* RGBA32F 3D: sum of albedos, count in w */
+    GLuint fbo, program[3];       /* layered FBO; programs per avg_vox_mode */
+    GLuint fbo_single;            /* the single pass: no attachments, n x n */
+    GLuint prog_resolve;          /* the single pass: fixed-point sums -> textures */
+    GLuint ssbo_sums;             /* the single pass: 8 ints a voxel (avg_vox1.frag) */
+    GLuint ssbo_colours;          /* per material: albedo x mean texture colour */
     const gi_scene *colour_scene; /* the scene ssbo_colours was made for */
 } avg_grid;
 
@@ -64,29 +65,30 @@ void avg_grid_bind(const avg_grid *g, GLuint program, GLuint unit_normal, GLuint
 enum { AVG_VPL_DIFFUSE = 0, AVG_VPL_POINT = 1, AVG_VPL_SPOT = 2 };
 typedef struct avg_vpl {
     float position[3];
-    uint32_t kind;      /* AVG_VPL_* | bounce << 8 | double-sided << 16 */
-    float normal[3];    /* surface normal (diffuse) or spot axis */
+    uint32_t kind;   /* AVG_VPL_* | bounce << 8 | double-sided << 16 */
+    float normal[3]; /* surface normal (diffuse) or spot axis */
     float cos_inner;
-    float power[3];     /* diffuse: flux, radiant intensity = power cos / pi; point/spot: intensity */
+    float power[3]; /* diffuse: flux, radiant intensity = power cos / pi; point/spot: intensity */
     float cos_outer;
-    float spot_dir[3];  /* spot lights: the cone's axis */
-    float range;        /* punctual lights: glTF range (0 = none) */
+    float spot_dir[3]; /* spot lights: the cone's axis */
+    float range;       /* punctual lights: glTF range (0 = none) */
 } avg_vpl;
 
 /* Tracing settings shared by the GPU and CPU tracers. */
 typedef struct avg_trace_desc {
-    uint32_t paths;     /* light paths; each owns bounces + 1 VPL slots */
-    uint32_t bounces;   /* indirect bounces B: VPLs at hits 1..B */
-    float offset;       /* ray origins move this many voxels along the normal */
-    uint32_t seed;      /* the run's seed (gi_view.seed); 1, the default, gives the sequence of earlier versions */
+    uint32_t paths;   /* light paths; each owns bounces + 1 VPL slots */
+    uint32_t bounces; /* indirect bounces B: VPLs at hits 1..B */
+    float offset;     /* ray origins move this many voxels along the normal */
+    uint32_t seed; /* the run's seed (gi_view.seed); 1, the default, gives the sequence of earlier
+                      versions */
 } avg_trace_desc;
 
 /* Light choice of the tracers: the area lights as one group (emitter CDF
  * inside) followed by the punctual lights, by power (§III-B "weighted by the
  * power of the light source"). */
 typedef struct avg_light_table {
-    uint32_t count;        /* 1 + punctual lights (entry 0 = all area lights) */
-    float cdf[1 + 64];     /* inclusive CDF over the entries */
+    uint32_t count;    /* 1 + punctual lights (entry 0 = all area lights) */
+    float cdf[1 + 64]; /* inclusive CDF over the entries */
     float pdf[1 + 64];
 } avg_light_table;
 #define AVG_MAX_PUNCTUAL 64
@@ -104,35 +106,37 @@ void avg_qr(uint32_t i, uint32_t pair, uint32_t mask, uint32_t seed, float out[2
 typedef struct avg_exact avg_exact;
 avg_exact *avg_exact_create(const gi_gpu_scene *gs, gi_error *err);
 void avg_exact_free(avg_exact *x);
-gi_result avg_exact_trace(avg_exact *x, const gi_gpu_scene *gs, const avg_light_table *lt, const avg_trace_desc *d,
-                          avg_vpl *slots, gi_error *err);
+gi_result avg_exact_trace(avg_exact *x, const gi_gpu_scene *gs, const avg_light_table *lt,
+                          const avg_trace_desc *d, avg_vpl *slots, gi_error *err);
 
 /* C twin of avg_vpl.glsl's avg_vpl_contribution (for tests): what VPL v
  * sends to a receiver at x with unit normal n without visibility, S such
  * that the Lambert receiver reflects (albedo / pi) S. */
-void avg_vpl_contribution(const avg_vpl *v, const float x[3], const float n[3], float dmin2, float out[3]);
+void avg_vpl_contribution(const avg_vpl *v, const float x[3], const float n[3], float dmin2,
+                          float out[3]);
 
 /* The method instance (avg.c). */
 typedef struct avg {
-    gi_kit kit;                 /* host, scene, G-buffer, scratch textures, error text */
+    gi_kit kit; /* host, scene, G-buffer, scratch textures, error text */
     /* parameters */
     int grid_n, vpls, bounces, M, tile, projection, filter, visibility, tracing, voxeliser;
     float clamp, offset, fov, shadow_lod;
-    int mx;                     /* sqrt(M): M = mx x mx subsets */
+    int mx; /* sqrt(M): M = mx x mx subsets */
     /* resources */
     avg_grid *grid;
     GLuint prog_trace, prog_split, prog_shade, prog_assemble, prog_final;
     GLuint ssbo_slots, ssbo_vpls, ubo_lights;
-    GLuint tex_split_pos, tex_split_nrm, tex_split_out, tex_indirect; /* the kit's scratch textures 0-3 */
+    GLuint tex_split_pos, tex_split_nrm, tex_split_out,
+        tex_indirect; /* the kit's scratch textures 0-3 */
     uint32_t split_w, split_h;
     uint32_t slots, paths;
-    avg_vpl *cpu_slots;         /* readback of the slots */
-    avg_vpl *cpu_vpls;          /* compacted live VPLs, in slot order */
+    avg_vpl *cpu_slots; /* readback of the slots */
+    avg_vpl *cpu_vpls;  /* compacted live VPLs, in slot order */
     uint32_t vpl_count;
-    avg_exact *exact;           /* the CPU tracer (avg_trace_cpu.c), NULL for avg tracing */
-    gi_depth_atlas *atlas;      /* the VPLs' shadow maps when visibility is on */
-    gi_depth_view *views;       /* one per VPL slot */
-    struct gi_simplified *lod;  /* the shadow maps' lower-detail copy (shadow_lod < 1), else NULL */
+    avg_exact *exact;          /* the CPU tracer (avg_trace_cpu.c), NULL for avg tracing */
+    gi_depth_atlas *atlas;     /* the VPLs' shadow maps when visibility is on */
+    gi_depth_view *views;      /* one per VPL slot */
+    struct gi_simplified *lod; /* the shadow maps' lower-detail copy (shadow_lod < 1), else NULL */
 } avg;
 
 #ifdef __cplusplus

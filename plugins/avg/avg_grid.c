@@ -47,14 +47,18 @@ avg_grid *avg_grid_create(uint32_t n, gi_error *err)
         return NULL;
     }
     for (int mode = 0; mode < 2; mode++) {
-        g->program[mode] = gi_program_build("avg_vox.vert", "avg_vox.geom", "avg_vox.frag", NULL, err);
+        g->program[mode] =
+            gi_program_build("avg_vox.vert", "avg_vox.geom", "avg_vox.frag", NULL, err);
         if (!g->program[mode]) {
             avg_grid_free(g);
             return NULL;
         }
     }
-    g->program[AVG_VOX_SINGLE] = gi_program_build("avg_vox.vert", "avg_vox1.geom", "avg_vox1.frag", NULL, err);
-    g->prog_resolve = g->program[AVG_VOX_SINGLE] ? gi_program_build_compute("avg_vox_resolve.comp", NULL, err) : 0;
+    g->program[AVG_VOX_SINGLE] =
+        gi_program_build("avg_vox.vert", "avg_vox1.geom", "avg_vox1.frag", NULL, err);
+    g->prog_resolve = g->program[AVG_VOX_SINGLE]
+                          ? gi_program_build_compute("avg_vox_resolve.comp", NULL, err)
+                          : 0;
     if (!g->prog_resolve) {
         avg_grid_free(g);
         return NULL;
@@ -161,10 +165,11 @@ gi_result avg_grid_check_single(uint32_t n, gi_error *err)
     GLint64 limit = 0;
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &limit);
     if ((GLint64)bytes > limit)
-        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                            "avg: voxeliser=single needs %zu MiB of sums at grid=%u, more than this GL's "
-                            "largest storage buffer (%lld MiB); use a smaller grid or voxeliser=conservative",
-                            bytes >> 20, n, (long long)(limit >> 20));
+        return gi_error_set(
+            err, GI_ERR_INVALID_ARGUMENT,
+            "avg: voxeliser=single needs %zu MiB of sums at grid=%u, more than this GL's "
+            "largest storage buffer (%lld MiB); use a smaller grid or voxeliser=conservative",
+            bytes >> 20, n, (long long)(limit >> 20));
     return GI_OK;
 }
 
@@ -206,7 +211,8 @@ static gi_result voxelise_single(avg_grid *g, const gi_gpu_scene *gs, gi_error *
     glBindImageTexture(1, g->tex_colour, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     GLuint groups = (g->n + 3) / 4;
     glDispatchCompute(groups, groups, groups);
-    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                    GL_TEXTURE_UPDATE_BARRIER_BIT);
     glUseProgram(0);
     return gi_gl_check("avg: single-pass voxelisation", err);
 }
@@ -250,8 +256,8 @@ float *avg_grid_read(const avg_grid *g, int colour)
     float *out = malloc(count * sizeof *out);
     if (!out)
         return NULL;
-    glGetTextureImage(colour ? g->tex_colour : g->tex_normal, 0, GL_RGBA, GL_FLOAT, (GLsizei)(count * sizeof *out),
-                      out);
+    glGetTextureImage(colour ? g->tex_colour : g->tex_normal, 0, GL_RGBA, GL_FLOAT,
+                      (GLsizei)(count * sizeof *out), out);
     return out;
 }
 
@@ -259,7 +265,8 @@ void avg_grid_bind(const avg_grid *g, GLuint program, GLuint unit_normal, GLuint
 {
     glBindTextureUnit(unit_normal, g->tex_normal);
     glBindTextureUnit(unit_colour, g->tex_colour);
-    glUniform3f(glGetUniformLocation(program, "u_grid_origin"), g->origin[0], g->origin[1], g->origin[2]);
+    glUniform3f(glGetUniformLocation(program, "u_grid_origin"), g->origin[0], g->origin[1],
+                g->origin[2]);
     glUniform1f(glGetUniformLocation(program, "u_grid_h"), g->h);
     glUniform1i(glGetUniformLocation(program, "u_grid_n"), (GLint)g->n);
 }

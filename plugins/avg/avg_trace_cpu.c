@@ -54,7 +54,9 @@ static uint32_t avg_permute(uint32_t i, uint32_t mask, uint32_t p)
 
 void avg_qr(uint32_t i, uint32_t pair, uint32_t mask, uint32_t seed, float out[2])
 {
-    uint32_t j = avg_permute(i, mask, gi_pcg_hash(pair * 0x9E3779B9u + 0x632BE5ABu) ^ gi_pcg_hash(seed) ^ gi_pcg_hash(1u));
+    uint32_t j = avg_permute(i, mask,
+                             gi_pcg_hash(pair * 0x9E3779B9u + 0x632BE5ABu) ^ gi_pcg_hash(seed) ^
+                                 gi_pcg_hash(1u));
     out[0] = gi_radical_inverse2(j);
     out[1] = gi_sobol2(j);
 }
@@ -82,7 +84,6 @@ void avg_exact_free(avg_exact *x)
     free(x);
 }
 
-
 static gi_vec3 vertex(const float *pos, uint32_t v)
 {
     return gi_v3(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]);
@@ -95,7 +96,8 @@ static gi_vec3 material_albedo(const gi_scene *s, uint32_t tri, float bu, float 
     gi_vec3 a = gi_v3(m->albedo[0], m->albedo[1], m->albedo[2]);
     if (m->albedo_texture < 0)
         return a;
-    const gi_vertex *v1 = &s->vertices[s->indices[3 * tri + 1]], *v2 = &s->vertices[s->indices[3 * tri + 2]];
+    const gi_vertex *v1 = &s->vertices[s->indices[3 * tri + 1]],
+                    *v2 = &s->vertices[s->indices[3 * tri + 2]];
     float u = (1 - bu - bv) * v0->uv[0] + bu * v1->uv[0] + bv * v2->uv[0];
     float v = (1 - bu - bv) * v0->uv[1] + bu * v1->uv[1] + bv * v2->uv[1];
     const gi_texture *t = &s->textures[m->albedo_texture];
@@ -115,8 +117,9 @@ static void set_v3(float *dst, gi_vec3 v)
     dst[2] = v.z;
 }
 
-static void trace_path(const avg_exact *x, const gi_scene *s, const avg_light_table *lt, const avg_trace_desc *d,
-                       uint32_t mask, float eps, uint32_t i, avg_vpl *slots)
+static void trace_path(const avg_exact *x, const gi_scene *s, const avg_light_table *lt,
+                       const avg_trace_desc *d, uint32_t mask, float eps, uint32_t i,
+                       avg_vpl *slots)
 {
     const float *pos = gi_rt_positions(x->rt);
     float N = (float)d->paths;
@@ -137,7 +140,8 @@ static void trace_path(const avg_exact *x, const gi_scene *s, const avg_light_ta
     if (l == 0) {
         float ue = (u - lo) / pl;
         ue = ue < 0.0f ? 0.0f : (ue > GI_ONE_MINUS_EPSILON ? GI_ONE_MINUS_EPSILON : ue);
-        const gi_gpu_emitter *em = &x->emitters[gi_emitter_find_cpu(x->emitters, x->emitter_count, ue)];
+        const gi_gpu_emitter *em =
+            &x->emitters[gi_emitter_find_cpu(x->emitters, x->emitter_count, ue)];
         uint32_t tri = em->triangle;
         gi_vec3 p0 = vertex(pos, s->indices[3 * tri]), p1 = vertex(pos, s->indices[3 * tri + 1]),
                 p2 = vertex(pos, s->indices[3 * tri + 2]);
@@ -150,17 +154,20 @@ static void trace_path(const avg_exact *x, const gi_scene *s, const avg_light_ta
         const gi_material *m = &s->materials[s->vertices[s->indices[3 * tri]].material];
         gi_vec3 axis = gi_v3_scale(ng, 1.0f / (2.0f * area));
         float pdf_area = pl * em->pdf / area;
-        gi_vec3 y = gi_v3_add(gi_v3_add(gi_v3_scale(p0, bc[0]), gi_v3_scale(p1, bc[1])), gi_v3_scale(p2, bc[2]));
+        gi_vec3 y = gi_v3_add(gi_v3_add(gi_v3_scale(p0, bc[0]), gi_v3_scale(p1, bc[1])),
+                              gi_v3_scale(p2, bc[2]));
         set_v3(v.position, y);
         v.kind = AVG_VPL_DIFFUSE | (m->double_sided ? 0x10000u : 0u);
         set_v3(v.normal, axis);
-        flux = gi_v3_scale(gi_v3(m->emission[0], m->emission[1], m->emission[2]), GI_PI / (pdf_area * N));
+        flux = gi_v3_scale(gi_v3(m->emission[0], m->emission[1], m->emission[2]),
+                           GI_PI / (pdf_area * N));
         set_v3(v.power, flux);
         dir = gi_to_world(gi_sample_cosine_hemisphere(q1[0], q1[1]), axis);
         origin = gi_v3_add(y, gi_v3_scale(axis, eps));
     } else {
         const gi_gpu_light *L = &x->lights[l - 1];
-        gi_vec3 I = gi_v3_scale(gi_v3(L->intensity[0], L->intensity[1], L->intensity[2]), 1.0f / (pl * N));
+        gi_vec3 I =
+            gi_v3_scale(gi_v3(L->intensity[0], L->intensity[1], L->intensity[2]), 1.0f / (pl * N));
         gi_vec3 ldir = gi_v3(L->direction[0], L->direction[1], L->direction[2]);
         memcpy(v.position, L->position, sizeof v.position);
         v.range = L->range;
@@ -179,8 +186,9 @@ static void trace_path(const avg_exact *x, const gi_scene *s, const avg_light_ta
         }
         if (spot) {
             dir = gi_to_world(gi_sample_uniform_cone(q1[0], q1[1], L->cos_outer), ldir);
-            flux = gi_v3_scale(I, gi_spot_falloff(gi_v3_dot(dir, ldir), L->cos_inner, L->cos_outer) /
-                                      gi_uniform_cone_pdf(L->cos_outer));
+            flux =
+                gi_v3_scale(I, gi_spot_falloff(gi_v3_dot(dir, ldir), L->cos_inner, L->cos_outer) /
+                                   gi_uniform_cone_pdf(L->cos_outer));
         } else {
             dir = gi_sample_uniform_sphere(q1[0], q1[1]);
             flux = gi_v3_scale(I, 1.0f / gi_uniform_sphere_pdf());
@@ -219,8 +227,8 @@ static void trace_path(const avg_exact *x, const gi_scene *s, const avg_light_ta
     }
 }
 
-gi_result avg_exact_trace(avg_exact *x, const gi_gpu_scene *gs, const avg_light_table *lt, const avg_trace_desc *d,
-                          avg_vpl *slots, gi_error *err)
+gi_result avg_exact_trace(avg_exact *x, const gi_gpu_scene *gs, const avg_light_table *lt,
+                          const avg_trace_desc *d, avg_vpl *slots, gi_error *err)
 {
     if (gi_rt_time(x->rt) != gs->time && gi_rt_set_time(x->rt, gs->time, err) != GI_OK)
         return GI_ERR_INVALID_ARGUMENT;
@@ -233,11 +241,13 @@ gi_result avg_exact_trace(avg_exact *x, const gi_gpu_scene *gs, const avg_light_
         x->emitter_count = gs->emitter_count;
     }
     if (x->emitter_count)
-        glGetNamedBufferSubData(gs->ssbo_emitters, 0, (GLsizeiptr)(x->emitter_count * sizeof(gi_gpu_emitter)),
+        glGetNamedBufferSubData(gs->ssbo_emitters, 0,
+                                (GLsizeiptr)(x->emitter_count * sizeof(gi_gpu_emitter)),
                                 x->emitters);
     x->light_count = gs->light_count < AVG_MAX_PUNCTUAL ? gs->light_count : AVG_MAX_PUNCTUAL;
     if (x->light_count)
-        glGetNamedBufferSubData(gs->ssbo_lights, 0, (GLsizeiptr)(x->light_count * sizeof(gi_gpu_light)), x->lights);
+        glGetNamedBufferSubData(gs->ssbo_lights, 0,
+                                (GLsizeiptr)(x->light_count * sizeof(gi_gpu_light)), x->lights);
     memset(slots, 0, (size_t)d->paths * (d->bounces + 1) * sizeof *slots);
     for (size_t s = 0; s < (size_t)d->paths * (d->bounces + 1); s++)
         slots[s].normal[1] = 1.0f;
@@ -256,7 +266,8 @@ gi_result avg_exact_trace(avg_exact *x, const gi_gpu_scene *gs, const avg_light_
     return GI_OK;
 }
 
-void avg_vpl_contribution(const avg_vpl *v, const float x[3], const float n[3], float dmin2, float out[3])
+void avg_vpl_contribution(const avg_vpl *v, const float x[3], const float n[3], float dmin2,
+                          float out[3])
 {
     out[0] = out[1] = out[2] = 0.0f;
     gi_vec3 d = gi_v3_sub(gi_v3_load(v->position), gi_v3_load(x));
@@ -281,7 +292,8 @@ void avg_vpl_contribution(const avg_vpl *v, const float x[3], const float n[3], 
             return;
         f = cos_x / fmaxf(d2, dmin2) * gi_range_window(sqrtf(d2), v->range);
         if (kind == AVG_VPL_SPOT)
-            f *= gi_spot_falloff(-gi_v3_dot(w, gi_v3_load(v->spot_dir)), v->cos_inner, v->cos_outer);
+            f *=
+                gi_spot_falloff(-gi_v3_dot(w, gi_v3_load(v->spot_dir)), v->cos_inner, v->cos_outer);
     }
     for (int c = 0; c < 3; c++)
         out[c] = v->power[c] * f;

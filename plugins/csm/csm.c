@@ -40,8 +40,18 @@ extern const gi_shader_source gi_csm_shaders[];
 #define CSM_LOCAL_FORMAT_VERSION 1u
 #define CSM_PATTERNS 256u
 
-enum { B_OBJECTS = 8, B_OFFSETS = 9, B_ZAVG = 10, B_IEND = 11, B_CELLS = 12, B_PATTERNS = 13, B_LIGHTS = 14,
-       B_PAIRS = 15, B_LIGHT_CELLS = 16, B_COUNT = 17 };
+enum {
+    B_OBJECTS = 8,
+    B_OFFSETS = 9,
+    B_ZAVG = 10,
+    B_IEND = 11,
+    B_CELLS = 12,
+    B_PATTERNS = 13,
+    B_LIGHTS = 14,
+    B_PAIRS = 15,
+    B_LIGHT_CELLS = 16,
+    B_COUNT = 17
+};
 enum { LIGHTS_LOCAL = 0, LIGHTS_SEMILOCAL = 1 };
 enum { RECEIVERS_NONE = 0, RECEIVERS_PLANAR = 1 };
 
@@ -65,7 +75,8 @@ typedef struct csm {
     unsigned char *casts; /* per object: 1 if it has CSMs (not receiver-only) */
     csm_light *lights;
     csm_gpu_object *objects;
-    GLuint ssbo[9]; /* objects, offsets, z_avg, i_end, cells, patterns, lights, pairs, light cells */
+    GLuint
+        ssbo[9]; /* objects, offsets, z_avg, i_end, cells, patterns, lights, pairs, light cells */
     GLuint program, count; /* count: samples taken this frame */
 } csm;
 
@@ -76,38 +87,52 @@ static const gi_param_desc csm_params[] = {
     {"enumeration", GI_PARAM_ENUM, 2, 0, 0, "scanline|zigzag|hilbert|diagonal", "Sec. 4.4",
      "order of the maps in the codec"},
     {"depth", GI_PARAM_ENUM, 0, 0, 0, "z2|z3|sphere", "Sec. 3.1",
-     "second depth of a segment: z2; z3 (closed-manifold option), z2 where there is no third surface; sphere: z3, the "
+     "second depth of a segment: z2; z3 (closed-manifold option), z2 where there is no third "
+     "surface; sphere: z3, the "
      "spherical far plane (exit from the bounding sphere) where there is no third surface"},
     {"open_surfaces", GI_PARAM_ENUM, 0, 0, 0, "shell|open", NULL,
-     "a texel with a first surface and no second (open or single-sided mesh, e.g. a ground plane): shell: second "
-     "depth z1 + shell_thickness, so that what lies behind stays shadowed; open: none (the codec may light it)"},
+     "a texel with a first surface and no second (open or single-sided mesh, e.g. a ground plane): "
+     "shell: second "
+     "depth z1 + shell_thickness, so that what lies behind stays shadowed; open: none (the codec "
+     "may light it)"},
     {"shell_thickness", GI_PARAM_FLOAT, 1e-3, 1e-6, 1, NULL, NULL,
      "thickness of that shell as a fraction of the object's bounding-sphere radius"},
     {"filter", GI_PARAM_ENUM, 0, 0, 0, "nearest|pcf|rr", "Sec. 4.5",
      "nearest map and texel; generalised PCF (4 maps x 4 texels); Russian roulette over those 16"},
-    {"S", GI_PARAM_INT, 16, 1, 1024, NULL, "S (Sec. 5.1)", "environment samples per pixel and frame"},
-    {"bias", GI_PARAM_FLOAT, 0.01, 0, 1, NULL, "bias (Sec. 6)", "depth bias as a fraction of the bounding-sphere radius"},
+    {"S", GI_PARAM_INT, 16, 1, 1024, NULL, "S (Sec. 5.1)",
+     "environment samples per pixel and frame"},
+    {"bias", GI_PARAM_FLOAT, 0.01, 0, 1, NULL, "bias (Sec. 6)",
+     "depth bias as a fraction of the bounding-sphere radius"},
     {"normal_offset", GI_PARAM_FLOAT, 1, 0, 16, NULL, NULL,
-     "receivers move along their normal by this many texels of each object's map (against shadow acne)"},
+     "receivers move along their normal by this many texels of each object's map (against shadow "
+     "acne)"},
     {"normal_offset_local", GI_PARAM_FLOAT, 0.25, 0, 16, NULL, NULL,
-     "for local lights' cube maps: receivers move along their normal by this many texels (2 |x - l| / M_local)"},
+     "for local lights' cube maps: receivers move along their normal by this many texels (2 |x - "
+     "l| / M_local)"},
     {"lights", GI_PARAM_ENUM, 0, 0, 0, "local|semilocal", "Sec. 4.2, 4.3",
-     "point and area lights: fixed local (cube maps at points on the light) or semi-local (orthographic maps, d = l - p)"},
+     "point and area lights: fixed local (cube maps at points on the light) or semi-local "
+     "(orthographic maps, d = l - p)"},
     {"N_local", GI_PARAM_INT, 4, 1, 64, NULL, "N (Sec. 4.2)",
      "points per dimension on an area light (N x N), linear light (N x 1); point lights have 1"},
-    {"M_local", GI_PARAM_INT, 64, 8, 1024, NULL, "M (Sec. 3.3)", "cube face size M x M of local lights' depth cube maps"},
+    {"M_local", GI_PARAM_INT, 64, 8, 1024, NULL, "M (Sec. 3.3)",
+     "cube face size M x M of local lights' depth cube maps"},
     {"light_enumeration", GI_PARAM_ENUM, 3, 0, 0, "scanline|zigzag|hilbert|diagonal", "Sec. 4.4",
      "order of the points on a light in the codec (diagonal: the zig-zag area curve)"},
     {"linear_aspect", GI_PARAM_FLOAT, 4, 1, 1e6, NULL, "d = 1 (Sec. 4.2)",
-     "an emissive object whose bounding rectangle is longer than this times its width is a linear light"},
+     "an emissive object whose bounding rectangle is longer than this times its width is a linear "
+     "light"},
     {"local_motion", GI_PARAM_ENUM, 0, 0, 0, "rebuild|keep", "Sec. 4.2",
-     "fixed local lights when a light or an object moves: rebuild their cube maps (a precomputation in that frame's "
-     "update, stage 'rebuild'), or keep the first placement's (the paper's fixed lights; shadows then stale)"},
+     "fixed local lights when a light or an object moves: rebuild their cube maps (a "
+     "precomputation in that frame's "
+     "update, stage 'rebuild'), or keep the first placement's (the paper's fixed lights; shadows "
+     "then stale)"},
     {"receivers", GI_PARAM_ENUM, 0, 0, 0, "none|planar", "Sec. 4.6",
      "receiver-only objects without CSMs: none, or every planar object"},
     {"mode", GI_PARAM_ENUM, 0, 0, 0, "shade|random|coherent", "Table 2",
-     "shade: the image; random/coherent: Table 2's benchmark, S shadow tests per pixel in uniform directions, "
-     "per-pixel patterns (random) or one direction per sample for all pixels (coherent); image = visible fraction"},
+     "shade: the image; random/coherent: Table 2's benchmark, S shadow tests per pixel in uniform "
+     "directions, "
+     "per-pixel patterns (random) or one direction per sample for all pixels (coherent); image = "
+     "visible fraction"},
     {0},
 };
 
@@ -154,10 +179,21 @@ static float shell_depth(const csm *c, float R)
 /* Cache file name: hash of the format version, the object's mesh, its
  * sphere and every parameter that changes the data (the shell depth is 0
  * for open surfaces, so shell_thickness only counts with shell). */
-static void cache_name(const csm *c, const gi_scene *s, uint32_t k, const float sphere[4], char *name, size_t size)
+static void cache_name(const csm *c, const gi_scene *s, uint32_t k, const float sphere[4],
+                       char *name, size_t size)
 {
-    uint32_t key[12] = {CSM_FORMAT_VERSION, (uint32_t)c->M, (uint32_t)c->N, (uint32_t)c->N, (uint32_t)c->order,
-                        (uint32_t)c->z3, 0, 0, 0, 0, 0, 0};
+    uint32_t key[12] = {CSM_FORMAT_VERSION,
+                        (uint32_t)c->M,
+                        (uint32_t)c->N,
+                        (uint32_t)c->N,
+                        (uint32_t)c->order,
+                        (uint32_t)c->z3,
+                        0,
+                        0,
+                        0,
+                        0,
+                        0,
+                        0};
     memcpy(&key[6], sphere, 4 * sizeof(float));
     float shell = shell_depth(c, sphere[3]);
     memcpy(&key[10], &shell, sizeof shell);
@@ -171,9 +207,10 @@ static void cache_name(const csm *c, const gi_scene *s, uint32_t k, const float 
 static void cache_name_local(const csm *c, const gi_scene *s, uint32_t k, const float sphere[4],
                              const csm_local_desc *d, char *name, size_t size)
 {
-    float key_f[14] = {sphere[0], sphere[1], sphere[2], sphere[3], d->o.x, d->o.y,  d->o.z,
+    float key_f[14] = {sphere[0], sphere[1], sphere[2], sphere[3], d->o.x,  d->o.y,  d->o.z,
                        d->e1.x,   d->e1.y,   d->e1.z,   d->e2.x,   d->e2.y, d->e2.z, d->shell};
-    uint32_t key_u[6] = {CSM_LOCAL_FORMAT_VERSION, d->M, d->n_u, d->n_v, (uint32_t)d->order, (uint32_t)d->z3};
+    uint32_t key_u[6] = {CSM_LOCAL_FORMAT_VERSION, d->M,           d->n_u, d->n_v,
+                         (uint32_t)d->order,       (uint32_t)d->z3};
     uint64_t h = gi_hash64("gibench-csm-local", 17, gi_scene_object_hash(s, k));
     h = gi_hash64(key_u, sizeof key_u, h);
     h = gi_hash64(key_f, sizeof key_f, h);
@@ -184,7 +221,8 @@ static void cache_name_local(const csm *c, const gi_scene *s, uint32_t k, const 
 /* Loads cache file `name` into *data if it holds M x M maps, N of them;
  * a file that does not parse or has other sizes is reported and ignored.
  * Returns 1 on a hit. *path is the file's path (NULL without a cache). */
-static int cache_load(csm *c, const char *name, uint32_t M, uint32_t N, gi_csm_data *data, char **path)
+static int cache_load(csm *c, const char *name, uint32_t M, uint32_t N, gi_csm_data *data,
+                      char **path)
 {
     const gi_host *host = c->kit.host;
     *path = host->cache_dir ? gi_cache_path(host->cache_dir, name) : NULL;
@@ -214,7 +252,8 @@ static void cache_store(csm *c, const char *path, const gi_csm_data *data)
     gi_error err;
     void *bytes = NULL;
     size_t size = 0;
-    if (gi_csm_data_write(data, &bytes, &size, &err) != GI_OK || gi_file_write_atomic(path, bytes, size, &err) != GI_OK)
+    if (gi_csm_data_write(data, &bytes, &size, &err) != GI_OK ||
+        gi_file_write_atomic(path, bytes, size, &err) != GI_OK)
         c->kit.host->log(c->kit.host, GI_LOG_WARN, "csm: not cached: %s", err.text);
     free(bytes);
 }
@@ -229,8 +268,8 @@ static uint32_t batch_for(int M)
     return (uint32_t)batch;
 }
 
-static gi_result load_or_build(csm *c, const gi_gpu_scene *gs, uint32_t k, const float sphere[4], float p0, float p1,
-                               gi_csm_data *data, int *hit)
+static gi_result load_or_build(csm *c, const gi_gpu_scene *gs, uint32_t k, const float sphere[4],
+                               float p0, float p1, gi_csm_data *data, int *hit)
 {
     char name[64], *path = NULL;
     cache_name(c, gs->scene, k, sphere, name, sizeof name);
@@ -254,8 +293,9 @@ static gi_result load_or_build(csm *c, const gi_gpu_scene *gs, uint32_t k, const
     return r == GI_OK ? GI_OK : gi_kit_fail_with(&c->kit, r, &err);
 }
 
-static gi_result load_or_build_local(csm *c, const gi_gpu_scene *gs, uint32_t k, const float sphere[4],
-                                     const csm_local_desc *desc, float p0, float p1, gi_csm_data *data, int *hit)
+static gi_result load_or_build_local(csm *c, const gi_gpu_scene *gs, uint32_t k,
+                                     const float sphere[4], const csm_local_desc *desc, float p0,
+                                     float p1, gi_csm_data *data, int *hit)
 {
     char name[80], *path = NULL;
     cache_name_local(c, gs->scene, k, sphere, desc, name, sizeof name);
@@ -328,7 +368,8 @@ static void object_world_bounds(const gi_gpu_scene *gs, uint32_t k, float out[6]
     for (int i = 0; i < 3; i++)
         out[i] = FLT_MAX, out[3 + i] = -FLT_MAX;
     for (int corner = 0; corner < 8; corner++) {
-        gi_vec3 p = gi_v3(lb[(corner & 1) ? 3 : 0], lb[(corner & 2) ? 4 : 1], lb[(corner & 4) ? 5 : 2]);
+        gi_vec3 p =
+            gi_v3(lb[(corner & 1) ? 3 : 0], lb[(corner & 2) ? 4 : 1], lb[(corner & 4) ? 5 : 2]);
         p = gi_mat4_point(gs->world_from_local[k], p);
         float q[3] = {p.x, p.y, p.z};
         for (int i = 0; i < 3; i++)
@@ -429,7 +470,8 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
         return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "csm: out of memory");
     }
     /* Lights (§4.2) at the current time; directional lights stay distant. */
-    c->light_count = csm_lights_collect(s, gs->time, (uint32_t)c->n_local, c->linear_aspect, &c->lights);
+    c->light_count =
+        csm_lights_collect(s, gs->time, (uint32_t)c->n_local, c->linear_aspect, &c->lights);
     int directional = 0;
     for (uint32_t i = 0; i < s->light_count; i++)
         directional |= s->lights[i].type == GI_LIGHT_DIRECTIONAL;
@@ -496,8 +538,10 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
                 object_world_bounds(gs, k, wb);
                 if (light_in_bounds(l, wb)) {
                     host->log(host, GI_LOG_WARN,
-                              "semi-local light %u lies inside the bounds of object %s, which then casts no "
-                              "shadow of it (semi-local lights are valid outside an object's convex hull only)",
+                              "semi-local light %u lies inside the bounds of object %s, which then "
+                              "casts no "
+                              "shadow of it (semi-local lights are valid outside an object's "
+                              "convex hull only)",
                               j, s->objects[k].name);
                     shadows = 0;
                 }
@@ -523,7 +567,8 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
                 continue;
             gi_csm_data *d = &ldata[j * n + k];
             int hit = 0;
-            r = load_or_build_local(c, gs, k, c->objects[k].sphere, &desc, share * (float)done++, share, d, &hit);
+            r = load_or_build_local(c, gs, k, c->objects[k].sphere, &desc, share * (float)done++,
+                                    share, d, &hit);
             if (r != GI_OK)
                 break;
             hits += hit;
@@ -562,8 +607,10 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
                 continue;
             size_t m2 = (size_t)c->M * (size_t)c->M + 1u;
             memcpy(offsets + c->objects[k].offsets_base, data[k].offsets, m2 * sizeof *offsets);
-            memcpy(z + c->objects[k].segments_base, data[k].z_avg, data[k].segment_count * sizeof *z);
-            memcpy(iend + c->objects[k].segments_base, data[k].i_end, data[k].segment_count * sizeof *iend);
+            memcpy(z + c->objects[k].segments_base, data[k].z_avg,
+                   data[k].segment_count * sizeof *z);
+            memcpy(iend + c->objects[k].segments_base, data[k].i_end,
+                   data[k].segment_count * sizeof *iend);
         }
         for (uint32_t q = 0; r == GI_OK && q < n_pairs; q++) {
             if (!pairs[q].info[0])
@@ -575,7 +622,8 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
         }
         for (uint32_t b = 0; r == GI_OK && b < (uint32_t)c->N; b++)
             for (uint32_t a = 0; a < (uint32_t)c->N; a++)
-                cells[b * (uint32_t)c->N + a] = gi_csm_order_index(c->order, (uint32_t)c->N, (uint32_t)c->N, a, b);
+                cells[b * (uint32_t)c->N + a] =
+                    gi_csm_order_index(c->order, (uint32_t)c->N, (uint32_t)c->N, a, b);
         if (r == GI_OK) {
             /* object -> light, then each light's grid cells -> enumeration index */
             for (uint32_t k = 0; k < n; k++)
@@ -591,10 +639,12 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
                 lrec[j].info[0] = l->n_u;
                 lrec[j].info[1] = l->n_v;
                 lrec[j].info[2] = base;
-                lrec[j].info[3] = l->object >= 0 ? (uint32_t)l->object : 0x80000000u | (uint32_t)l->punctual;
+                lrec[j].info[3] =
+                    l->object >= 0 ? (uint32_t)l->object : 0x80000000u | (uint32_t)l->punctual;
                 for (uint32_t b = 0; b < l->n_v; b++)
                     for (uint32_t a = 0; a < l->n_u; a++)
-                        lcells[base + b * l->n_u + a] = gi_csm_order_index(c->light_order, l->n_u, l->n_v, a, b);
+                        lcells[base + b * l->n_u + a] =
+                            gi_csm_order_index(c->light_order, l->n_u, l->n_v, a, b);
                 base += l->n_u * l->n_v;
             }
             glCreateBuffers(9, c->ssbo);
@@ -602,14 +652,20 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
             glNamedBufferStorage(c->count, 4, NULL, GL_DYNAMIC_STORAGE_BIT);
             glNamedBufferStorage(c->ssbo[0], (GLsizeiptr)(n * sizeof *c->objects), c->objects,
                                  GL_DYNAMIC_STORAGE_BIT);
-            glNamedBufferStorage(c->ssbo[1], (GLsizeiptr)((offsets_total ? offsets_total : 1) * 4), offsets, 0);
-            glNamedBufferStorage(c->ssbo[2], (GLsizeiptr)((segments_total ? segments_total : 1) * 4), z, 0);
-            glNamedBufferStorage(c->ssbo[3], (GLsizeiptr)((segments_total ? segments_total : 1) * 4), iend, 0);
+            glNamedBufferStorage(c->ssbo[1], (GLsizeiptr)((offsets_total ? offsets_total : 1) * 4),
+                                 offsets, 0);
+            glNamedBufferStorage(c->ssbo[2],
+                                 (GLsizeiptr)((segments_total ? segments_total : 1) * 4), z, 0);
+            glNamedBufferStorage(c->ssbo[3],
+                                 (GLsizeiptr)((segments_total ? segments_total : 1) * 4), iend, 0);
             glNamedBufferStorage(c->ssbo[4], (GLsizeiptr)(cells_n * 4), cells, 0);
-            glNamedBufferStorage(c->ssbo[5], (GLsizeiptr)(CSM_PATTERNS * (size_t)c->S * 8), patterns, 0);
-            glNamedBufferStorage(c->ssbo[6], (GLsizeiptr)((c->light_count ? c->light_count : 1) * sizeof *lrec), lrec,
-                                 0);
-            glNamedBufferStorage(c->ssbo[7], (GLsizeiptr)((n_pairs ? n_pairs : 1) * sizeof *pairs), pairs, 0);
+            glNamedBufferStorage(c->ssbo[5], (GLsizeiptr)(CSM_PATTERNS * (size_t)c->S * 8),
+                                 patterns, 0);
+            glNamedBufferStorage(c->ssbo[6],
+                                 (GLsizeiptr)((c->light_count ? c->light_count : 1) * sizeof *lrec),
+                                 lrec, 0);
+            glNamedBufferStorage(c->ssbo[7], (GLsizeiptr)((n_pairs ? n_pairs : 1) * sizeof *pairs),
+                                 pairs, 0);
             glNamedBufferStorage(c->ssbo[8], (GLsizeiptr)(lcells_n * 4), lcells, 0);
             if (gi_gl_check("csm: upload", &err) != GI_OK)
                 r = gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
@@ -639,12 +695,14 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
     uint64_t distant_segments = segments_total - local_segments;
     host->stat(host, "bytes_uncompressed", (double)bytes_u);
     host->stat(host, "bytes_compressed", (double)bytes_c);
-    host->stat(host, "data_bytes", (double)bytes_c); /* the compressed maps are what render() reads */
+    host->stat(host, "data_bytes",
+               (double)bytes_c); /* the compressed maps are what render() reads */
     host->stat(host, "ratio", bytes_c ? (double)bytes_u / (double)bytes_c : 0.0);
     host->stat(host, "segments_per_texel", texels > 0 ? (double)distant_segments / texels : 0.0);
     host->stat(host, "maps", (double)distant_objects * c->N * c->N);
     host->stat(host, "maps_local", (double)maps_local);
-    host->stat(host, "segments_per_texel_local", local_texels ? (double)local_segments / (double)local_texels : 0.0);
+    host->stat(host, "segments_per_texel_local",
+               local_texels ? (double)local_segments / (double)local_texels : 0.0);
     host->stat(host, "lights", (double)c->light_count);
     host->stat(host, "receiver_only_objects", (double)(c->object_count - casters));
     host->stat(host, "cache_hit", tries > 0 && hits == tries ? 1.0 : 0.0);
@@ -661,11 +719,13 @@ static gi_result csm_update(void *inst, const gi_gpu_scene *scene, const gi_chan
         (changes->flags & (GI_CHANGED_TRANSFORMS | GI_CHANGED_LIGHTS))) {
         int moved = 0;
         for (uint32_t k = 0; k < c->object_count && k < GI_MAX_OBJECTS; k++)
-            moved |= memcmp(c->prepare_transforms + 16 * k, scene->world_from_local[k], 16 * sizeof(float)) != 0;
+            moved |= memcmp(c->prepare_transforms + 16 * k, scene->world_from_local[k],
+                            16 * sizeof(float)) != 0;
         for (uint32_t j = 0; j < c->light_count; j++) {
             const csm_light *l = &c->lights[j];
             if (l->punctual >= 0) {
-                gi_light_frame f = gi_scene_light_at(scene->scene, (uint32_t)l->punctual, scene->time);
+                gi_light_frame f =
+                    gi_scene_light_at(scene->scene, (uint32_t)l->punctual, scene->time);
                 moved |= gi_v3_length(gi_v3_sub(f.position, l->origin)) > 0.0f;
             }
         }
@@ -683,8 +743,10 @@ static gi_result csm_update(void *inst, const gi_gpu_scene *scene, const gi_chan
         }
         if (moved) {
             c->kit.host->log(c->kit.host, GI_LOG_WARN,
-                         "objects or lights moved since the precomputation; with local_motion=keep fixed local "
-                         "lights' cube maps are not rebuilt (their shadows are those of the first frame's placement)");
+                             "objects or lights moved since the precomputation; with "
+                             "local_motion=keep fixed local "
+                             "lights' cube maps are not rebuilt (their shadows are those of the "
+                             "first frame's placement)");
             c->warned_moved = 1;
         }
     }
@@ -709,7 +771,8 @@ static gi_result csm_render(void *inst, const gi_view *view, const gi_target *ta
             gi_mat4_identity(o->local_from_world);
     }
     if (c->object_count)
-        glNamedBufferSubData(c->ssbo[0], 0, (GLsizeiptr)(c->object_count * sizeof *c->objects), c->objects);
+        glNamedBufferSubData(c->ssbo[0], 0, (GLsizeiptr)(c->object_count * sizeof *c->objects),
+                             c->objects);
 
     r = gi_kit_render_gbuffer(kit, view, "gbuffer");
     if (r != GI_OK)
@@ -719,8 +782,8 @@ static gi_result csm_render(void *inst, const gi_view *view, const gi_target *ta
     GLuint p = c->program;
     glUseProgram(p);
     gi_kit_bind(kit, p, view, target);
-    static const GLuint bindings[9] = {B_OBJECTS, B_OFFSETS, B_ZAVG, B_IEND, B_CELLS, B_PATTERNS, B_LIGHTS, B_PAIRS,
-                                       B_LIGHT_CELLS};
+    static const GLuint bindings[9] = {B_OBJECTS,  B_OFFSETS, B_ZAVG,  B_IEND,       B_CELLS,
+                                       B_PATTERNS, B_LIGHTS,  B_PAIRS, B_LIGHT_CELLS};
     for (int i = 0; i < 9; i++)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, bindings[i], c->ssbo[i]);
     glUniform1i(glGetUniformLocation(p, "u_S"), c->S);
@@ -768,13 +831,12 @@ static const char *csm_last_error(void *inst)
     return inst ? gi_kit_last_error(&((csm *)inst)->kit) : "";
 }
 
-GI_METHOD_EXPORT(csm,
-    .id = "csm",
-    .title = "Coherent Shadow Maps",
-    .citation = "Ritschel, Grosch, Kautz, Mueller. Interactive Illumination with Coherent Shadow Maps. EGSR 2007",
-    .version = "0.2",
-    .caps = GI_CAP_DIRECT | GI_CAP_ENVIRONMENT | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL |
-            GI_CAP_GLOSSY | GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE | GI_CAP_PRECOMPUTE | GI_CAP_RIGID_MOTION |
-            GI_CAP_TEXTURES,
-    .max_bounces = 0,
-    .params = csm_params);
+GI_METHOD_EXPORT(csm, .id = "csm", .title = "Coherent Shadow Maps",
+                 .citation = "Ritschel, Grosch, Kautz, Mueller. Interactive Illumination with "
+                             "Coherent Shadow Maps. EGSR 2007",
+                 .version = "0.2",
+                 .caps = GI_CAP_DIRECT | GI_CAP_ENVIRONMENT | GI_CAP_AREA_LIGHTS |
+                         GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_GLOSSY |
+                         GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE | GI_CAP_PRECOMPUTE |
+                         GI_CAP_RIGID_MOTION | GI_CAP_TEXTURES,
+                 .max_bounces = 0, .params = csm_params);

@@ -4,7 +4,8 @@
 #include <float.h>
 #include <math.h>
 
-void csm_cell_angles(uint32_t n_theta, uint32_t n_phi, uint32_t a, uint32_t b, float *theta, float *phi)
+void csm_cell_angles(uint32_t n_theta, uint32_t n_phi, uint32_t a, uint32_t b, float *theta,
+                     float *phi)
 {
     *theta = GI_PI * ((float)b + 0.5f) / (float)n_theta;
     *phi = 2.0f * GI_PI * ((float)a + 0.5f) / (float)n_phi;
@@ -59,8 +60,8 @@ void csm_map_view(const float sphere[4], float theta, float phi, gi_depth_view *
     out->projection = GI_PROJ_ORTHOGRAPHIC;
 }
 
-void csm_texel_depths(const float *map, size_t texels, int mode, float shell, const float *far, float *z1,
-                      float *z2)
+void csm_texel_depths(const float *map, size_t texels, int mode, float shell, const float *far,
+                      float *z1, float *z2)
 {
     for (size_t t = 0; t < texels; t++) {
         float a = map[4 * t], b = map[4 * t + 1];
@@ -77,7 +78,8 @@ void csm_texel_depths(const float *map, size_t texels, int mode, float shell, co
     }
 }
 
-void csm_sphere_far(const gi_depth_view *v, gi_depth_metric metric, const float sphere[4], uint32_t M, float *far)
+void csm_sphere_far(const gi_depth_view *v, gi_depth_metric metric, const float sphere[4],
+                    uint32_t M, float *far)
 {
     float vp[16], inv[16];
     gi_mat4_mul(vp, v->proj, v->view);
@@ -90,9 +92,12 @@ void csm_sphere_far(const gi_depth_view *v, gi_depth_metric metric, const float 
     const double R = sphere[3];
     for (uint32_t j = 0; j < M; j++)
         for (uint32_t i = 0; i < M; i++) {
-            float x = ((float)i + 0.5f) / (float)M * 2.0f - 1.0f, y = ((float)j + 0.5f) / (float)M * 2.0f - 1.0f;
-            /* the texel's ray: from its point on the near plane (clip z 0) toward the far plane (z 1) */
-            gi_vec3 p0 = gi_mat4_point(inv, gi_v3(x, y, 0.0f)), p1 = gi_mat4_point(inv, gi_v3(x, y, 1.0f));
+            float x = ((float)i + 0.5f) / (float)M * 2.0f - 1.0f,
+                  y = ((float)j + 0.5f) / (float)M * 2.0f - 1.0f;
+            /* the texel's ray: from its point on the near plane (clip z 0) toward the far plane (z
+             * 1) */
+            gi_vec3 p0 = gi_mat4_point(inv, gi_v3(x, y, 0.0f)),
+                    p1 = gi_mat4_point(inv, gi_v3(x, y, 1.0f));
             gi_vec3 d = gi_v3_normalize(gi_v3_sub(p1, p0)), oc = gi_v3_sub(p0, c);
             double b = gi_v3_dot(oc, d), disc = b * b - ((double)gi_v3_dot(oc, oc) - R * R);
             float *out = &far[(size_t)j * M + i];

@@ -34,7 +34,8 @@
 
 #define CSM_EYE 2.0f
 
-void csm_cell_angles(uint32_t n_theta, uint32_t n_phi, uint32_t a, uint32_t b, float *theta, float *phi);
+void csm_cell_angles(uint32_t n_theta, uint32_t n_phi, uint32_t a, uint32_t b, float *theta,
+                     float *phi);
 gi_vec3 csm_dir(float theta, float phi);
 /* Continuous grid coordinates (u along phi, v along theta) of unit w. */
 void csm_grid_coords(gi_vec3 w, uint32_t n_theta, uint32_t n_phi, float *u, float *v);
@@ -53,12 +54,12 @@ typedef struct csm_gpu_object {
 } csm_gpu_object;
 
 typedef struct csm_build_desc {
-    uint32_t M;        /* map size */
+    uint32_t M; /* map size */
     uint32_t n_theta, n_phi;
     gi_csm_order order;
-    int z3;            /* CSM_DEPTH_*: 0 z2; 1 z3, else z2; 2 z3, else the spherical far plane (§3.1) */
-    float shell;       /* > 0: thin-shell depth (local units) behind a lone first surface; 0: open */
-    uint32_t batch;    /* maps per gi_depth_render call */
+    int z3;      /* CSM_DEPTH_*: 0 z2; 1 z3, else z2; 2 z3, else the spherical far plane (§3.1) */
+    float shell; /* > 0: thin-shell depth (local units) behind a lone first surface; 0: open */
+    uint32_t batch; /* maps per gi_depth_render call */
 } csm_build_desc;
 
 /* Second-depth options of §3.1 ("Details on depth values"), the `depth`
@@ -74,8 +75,8 @@ enum { CSM_DEPTH_Z2 = 0, CSM_DEPTH_Z3 = 1, CSM_DEPTH_SPHERE = 2 };
  * >= FLT_MAX): z1 as it is; the second depth is z2 (mode CSM_DEPTH_Z2), or
  * the third surface where the texel has one and else z2 (CSM_DEPTH_Z3: the
  * far side of the last shell) or else far[t] (CSM_DEPTH_SPHERE: the
- * spherical far plane, csm_sphere_far; `far` is only read in that mode). A texel with a first surface and no
- * second one (an open or single-sided surface: a ground plane, a quad, the
+ * spherical far plane, csm_sphere_far; `far` is only read in that mode). A texel with a first
+ * surface and no second one (an open or single-sided surface: a ground plane, a quad, the
  * silhouette of a mesh with holes) gets z1 + shell when shell > 0: the
  * surface is taken as a shell of that thickness, so the codec's z_avg stays
  * within [z1, z1 + shell) and points of other objects behind the surface
@@ -85,15 +86,16 @@ enum { CSM_DEPTH_Z2 = 0, CSM_DEPTH_Z3 = 1, CSM_DEPTH_SPHERE = 2 };
  * behind the surface test lit. z1 + shell may round to z1 when shell is
  * below the float spacing at z1; the codec then stores z1 (a classic
  * shadow-map texel), still shadowing what lies behind. */
-void csm_texel_depths(const float *map, size_t texels, int mode, float shell, const float *far, float *z1,
-                      float *z2);
+void csm_texel_depths(const float *map, size_t texels, int mode, float shell, const float *far,
+                      float *z1, float *z2);
 
 /* The spherical far plane of one M x M map: for each texel the depth, in
  * the map's metric, at which the ray through the texel's centre leaves the
  * sphere (centre sphere[0..2], radius sphere[3], the map's own space);
  * FLT_MAX where the ray misses it. `v` is the map's view (orthographic or
  * perspective, core clip depth [0, 1]). */
-void csm_sphere_far(const gi_depth_view *v, gi_depth_metric metric, const float sphere[4], uint32_t M, float *far);
+void csm_sphere_far(const gi_depth_view *v, gi_depth_metric metric, const float sphere[4],
+                    uint32_t M, float *far);
 
 /* What csm_encode_maps renders: `count` maps of `object` (object-local,
  * only that object), map q's view given by view(ctx, q, &v), rendered in
@@ -117,15 +119,16 @@ typedef struct csm_encode_desc {
  * precomputation loop (gi/algo/csm_precompute.h): render, read back, compress
  * (§3.1). Progress, stage timers (depth_render, compress) and cancellation
  * as csm_build_object. */
-gi_result csm_encode_maps(const gi_gpu_scene *gs, const csm_encode_desc *desc, const gi_host *host, float p0, float p1,
-                          gi_csm_data *out, gi_error *err);
+gi_result csm_encode_maps(const gi_gpu_scene *gs, const csm_encode_desc *desc, const gi_host *host,
+                          float p0, float p1, gi_csm_data *out, gi_error *err);
 
 /* Renders and compresses the N_theta N_phi maps of `object` (local space,
  * bounding sphere `sphere`). `host` may be NULL (tests); with a host it
  * reports progress (fraction p0 + p1 * done), stage timers depth_render and
  * compress, and returns GI_ERR_CANCELLED when host->cancelled(). */
-gi_result csm_build_object(const gi_gpu_scene *gs, uint32_t object, const float sphere[4], const csm_build_desc *desc,
-                           const gi_host *host, float p0, float p1, gi_csm_data *out, gi_error *err);
+gi_result csm_build_object(const gi_gpu_scene *gs, uint32_t object, const float sphere[4],
+                           const csm_build_desc *desc, const gi_host *host, float p0, float p1,
+                           gi_csm_data *out, gi_error *err);
 
 /* The nearest-filter visibility of a local point toward a local direction
  * through one object's CSM is the core's gi_csm_dir_visible

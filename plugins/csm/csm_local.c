@@ -81,7 +81,8 @@ static void fit_rectangle(const gi_scene *s, uint32_t k, float t, csm_light *l)
     l->normal = n;
 }
 
-uint32_t csm_lights_collect(const gi_scene *s, float t, uint32_t n_points, float linear_aspect, csm_light **out)
+uint32_t csm_lights_collect(const gi_scene *s, float t, uint32_t n_points, float linear_aspect,
+                            csm_light **out)
 {
     *out = NULL;
     uint32_t n = s->light_count;
@@ -129,13 +130,15 @@ uint32_t csm_lights_collect(const gi_scene *s, float t, uint32_t n_points, float
     return count;
 }
 
-gi_vec3 csm_light_point(gi_vec3 o, gi_vec3 e1, gi_vec3 e2, uint32_t n_u, uint32_t n_v, uint32_t a, uint32_t b)
+gi_vec3 csm_light_point(gi_vec3 o, gi_vec3 e1, gi_vec3 e2, uint32_t n_u, uint32_t n_v, uint32_t a,
+                        uint32_t b)
 {
     float fu = ((float)a + 0.5f) / (float)n_u, fv = ((float)b + 0.5f) / (float)n_v;
     return gi_v3_add(o, gi_v3_add(gi_v3_scale(e1, fu), gi_v3_scale(e2, fv)));
 }
 
-void csm_light_grid(gi_vec3 o, gi_vec3 e1, gi_vec3 e2, uint32_t n_u, uint32_t n_v, gi_vec3 y, float *u, float *v)
+void csm_light_grid(gi_vec3 o, gi_vec3 e1, gi_vec3 e2, uint32_t n_u, uint32_t n_v, gi_vec3 y,
+                    float *u, float *v)
 {
     gi_vec3 q = gi_v3_sub(y, o);
     float l1 = gi_v3_dot(e1, e1), l2 = gi_v3_dot(e2, e2);
@@ -166,8 +169,9 @@ static void local_view(void *ctx, uint32_t q, gi_depth_view *out)
     gi_depth_cube_view(eye, znear, zfar, (int)face, out);
 }
 
-gi_result csm_build_local(const gi_gpu_scene *gs, uint32_t object, const float sphere[4], const csm_local_desc *desc,
-                          const gi_host *host, float p0, float p1, gi_csm_data *out, gi_error *err)
+gi_result csm_build_local(const gi_gpu_scene *gs, uint32_t object, const float sphere[4],
+                          const csm_local_desc *desc, const gi_host *host, float p0, float p1,
+                          gi_csm_data *out, gi_error *err)
 {
     local_views lv = {desc, gi_v3(sphere[0], sphere[1], sphere[2]), sphere[3]};
     csm_encode_desc e = {.object = object,
@@ -184,8 +188,8 @@ gi_result csm_build_local(const gi_gpu_scene *gs, uint32_t object, const float s
     return csm_encode_maps(gs, &e, host, p0, p1, out, err);
 }
 
-int csm_local_visible_nearest(const gi_csm_data *data, const csm_local_desc *desc, gi_vec3 x, float u, float v,
-                              float bias)
+int csm_local_visible_nearest(const gi_csm_data *data, const csm_local_desc *desc, gi_vec3 x,
+                              float u, float v, float bias)
 {
     int ai = (int)floorf(u + 0.5f), bi = (int)floorf(v + 0.5f);
     uint32_t a = (uint32_t)(ai < 0 ? 0 : ai >= (int)desc->n_u ? (int)desc->n_u - 1 : ai);
@@ -203,6 +207,6 @@ int csm_local_visible_nearest(const gi_csm_data *data, const csm_local_desc *des
     tx = tx < 0 ? 0 : tx >= (int)M ? (int)M - 1 : tx;
     ty = ty < 0 ? 0 : ty >= (int)M ? (int)M - 1 : ty;
     uint32_t i = gi_csm_order_index(desc->order, desc->n_u, desc->n_v, a, b);
-    return gi_csm_visible(data, (uint32_t)ty * M + (uint32_t)tx, (uint32_t)face * desc->n_u * desc->n_v + i, depth,
-                          bias);
+    return gi_csm_visible(data, (uint32_t)ty * M + (uint32_t)tx,
+                          (uint32_t)face * desc->n_u * desc->n_v + i, depth, bias);
 }

@@ -35,7 +35,11 @@
 #include "csm_cpu.h"
 #include "gi/algo/cubemap.h"
 
-typedef enum csm_light_kind { CSM_LIGHT_AREA = 0, CSM_LIGHT_LINEAR = 1, CSM_LIGHT_POINT = 2 } csm_light_kind;
+typedef enum csm_light_kind {
+    CSM_LIGHT_AREA = 0,
+    CSM_LIGHT_LINEAR = 1,
+    CSM_LIGHT_POINT = 2
+} csm_light_kind;
 
 typedef struct csm_light {
     csm_light_kind kind;
@@ -51,12 +55,15 @@ typedef struct csm_light {
  * n_points: grid points per dimension of area lights (linear lights get
  * n_points x 1). *out is malloc'd (NULL when there is none); returns the
  * count. */
-uint32_t csm_lights_collect(const gi_scene *s, float t, uint32_t n_points, float linear_aspect, csm_light **out);
+uint32_t csm_lights_collect(const gi_scene *s, float t, uint32_t n_points, float linear_aspect,
+                            csm_light **out);
 
 /* Grid point (a, b) of the rectangle (o, e1, e2) with n_u x n_v points. */
-gi_vec3 csm_light_point(gi_vec3 o, gi_vec3 e1, gi_vec3 e2, uint32_t n_u, uint32_t n_v, uint32_t a, uint32_t b);
+gi_vec3 csm_light_point(gi_vec3 o, gi_vec3 e1, gi_vec3 e2, uint32_t n_u, uint32_t n_v, uint32_t a,
+                        uint32_t b);
 /* Continuous grid coordinates (u, v) of point y. */
-void csm_light_grid(gi_vec3 o, gi_vec3 e1, gi_vec3 e2, uint32_t n_u, uint32_t n_v, gi_vec3 y, float *u, float *v);
+void csm_light_grid(gi_vec3 o, gi_vec3 e1, gi_vec3 e2, uint32_t n_u, uint32_t n_v, gi_vec3 y,
+                    float *u, float *v);
 
 /* One object's cube-map CSM for one light, in the object's local space:
  * the light's rectangle taken there (o, e1, e2), grid n_u x n_v in
@@ -66,7 +73,7 @@ typedef struct csm_local_desc {
     gi_vec3 o, e1, e2;
     uint32_t n_u, n_v;
     gi_csm_order order;
-    int z3; /* CSM_DEPTH_* (csm_cpu.h) */
+    int z3;      /* CSM_DEPTH_* (csm_cpu.h) */
     float shell; /* thin-shell depth behind a lone first surface (csm_texel_depths); 0: open */
     uint32_t batch;
 } csm_local_desc;
@@ -75,13 +82,14 @@ typedef struct csm_local_desc {
  * local) and compresses the 6 n_u n_v cube faces in the sequence order
  * above. host may be NULL (tests); otherwise progress, timers depth_render
  * and compress, and cancellation as csm_build_object. */
-gi_result csm_build_local(const gi_gpu_scene *gs, uint32_t object, const float sphere[4], const csm_local_desc *desc,
-                          const gi_host *host, float p0, float p1, gi_csm_data *out, gi_error *err);
+gi_result csm_build_local(const gi_gpu_scene *gs, uint32_t object, const float sphere[4],
+                          const csm_local_desc *desc, const gi_host *host, float p0, float p1,
+                          gi_csm_data *out, gi_error *err);
 
 /* Nearest-filter visibility (1 lit) between local point x and the grid
  * point nearest to grid coordinates (u, v) through that CSM; bias in local
  * units. */
-int csm_local_visible_nearest(const gi_csm_data *data, const csm_local_desc *desc, gi_vec3 x, float u, float v,
-                              float bias);
+int csm_local_visible_nearest(const gi_csm_data *data, const csm_local_desc *desc, gi_vec3 x,
+                              float u, float v, float bias);
 
 #endif

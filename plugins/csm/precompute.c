@@ -23,7 +23,8 @@ static void encode_view(void *ctx, uint32_t q, gi_depth_view *out)
     e->desc->view(e->desc->ctx, q, out);
 }
 
-static void encode_texel_depths(void *ctx, uint32_t q, const gi_depth_view *v, const float *map, float *z1, float *z2)
+static void encode_texel_depths(void *ctx, uint32_t q, const gi_depth_view *v, const float *map,
+                                float *z1, float *z2)
 {
     (void)q;
     const encode_depths *e = ctx;
@@ -34,8 +35,8 @@ static void encode_texel_depths(void *ctx, uint32_t q, const gi_depth_view *v, c
     csm_texel_depths(map, (size_t)desc->M * desc->M, desc->z3, desc->shell, e->far, z1, z2);
 }
 
-gi_result csm_encode_maps(const gi_gpu_scene *gs, const csm_encode_desc *desc, const gi_host *host, float p0, float p1,
-                          gi_csm_data *out, gi_error *err)
+gi_result csm_encode_maps(const gi_gpu_scene *gs, const csm_encode_desc *desc, const gi_host *host,
+                          float p0, float p1, gi_csm_data *out, gi_error *err)
 {
     memset(out, 0, sizeof *out);
     const uint32_t M = desc->M;
@@ -43,7 +44,8 @@ gi_result csm_encode_maps(const gi_gpu_scene *gs, const csm_encode_desc *desc, c
     if (desc->z3 == CSM_DEPTH_SPHERE) {
         e.far = desc->sphere ? malloc((size_t)M * M * sizeof *e.far) : NULL;
         if (!e.far) {
-            snprintf(err->text, sizeof err->text, "csm: out of memory for %u x %u %s", M, M, desc->what);
+            snprintf(err->text, sizeof err->text, "csm: out of memory for %u x %u %s", M, M,
+                     desc->what);
             return GI_ERR_OUT_OF_MEMORY;
         }
     }
@@ -86,8 +88,9 @@ static void distant_view(void *ctx, uint32_t q, gi_depth_view *out)
     csm_map_view(dv->sphere, theta, phi, out);
 }
 
-gi_result csm_build_object(const gi_gpu_scene *gs, uint32_t object, const float sphere[4], const csm_build_desc *desc,
-                           const gi_host *host, float p0, float p1, gi_csm_data *out, gi_error *err)
+gi_result csm_build_object(const gi_gpu_scene *gs, uint32_t object, const float sphere[4],
+                           const csm_build_desc *desc, const gi_host *host, float p0, float p1,
+                           gi_csm_data *out, gi_error *err)
 {
     distant_views dv = {desc, sphere};
     csm_encode_desc e = {.object = object,

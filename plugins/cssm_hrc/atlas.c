@@ -49,7 +49,8 @@ void cssm_texel_material(const gi_scene *s, uint32_t tri, const gi_vec3 p[3], cs
     gi_vec3 e1 = gi_v3_sub(p[1], p[0]), e2 = gi_v3_sub(p[2], p[0]), d = gi_v3_sub(x->p, p[0]);
     float a = gi_v3_dot(e1, e1), b = gi_v3_dot(e1, e2), c = gi_v3_dot(e2, e2);
     float f = gi_v3_dot(d, e1), g = gi_v3_dot(d, e2), den = a * c - b * b;
-    float u = den > 0.0f ? (c * f - b * g) / den : 0.0f, v = den > 0.0f ? (a * g - b * f) / den : 0.0f;
+    float u = den > 0.0f ? (c * f - b * g) / den : 0.0f,
+          v = den > 0.0f ? (a * g - b * f) / den : 0.0f;
     u = fminf(fmaxf(u, 0.0f), 1.0f), v = fminf(fmaxf(v, 0.0f), 1.0f - u);
     float uv[2];
     for (int k = 0; k < 2; k++)
@@ -67,7 +68,7 @@ static int inside(float px, float py, const float t[6])
     float d1 = (px - t[2]) * (t[1] - t[3]) - (t[0] - t[2]) * (py - t[3]);
     float d2 = (px - t[4]) * (t[3] - t[5]) - (t[2] - t[4]) * (py - t[5]);
     float d3 = (px - t[0]) * (t[5] - t[1]) - (t[4] - t[0]) * (py - t[1]);
-    int neg = d1 < 0 || d2 < 0 || d3 < 0, pos = d1 > 0 || d2 > 0 || d3 > 0;
+    int neg = d1 < 0 || d2 < 0 || d3<0, pos = d1> 0 || d2 > 0 || d3 > 0;
     return !(neg && pos);
 }
 
@@ -118,15 +119,16 @@ static int pack(rect *r, uint32_t n, uint32_t R, uint32_t *x0, uint32_t *y0)
     return ok;
 }
 
-gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_only, cssm_atlas *out,
-                           gi_error *err)
+gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_only,
+                           cssm_atlas *out, gi_error *err)
 {
     memset(out, 0, sizeof *out);
     out->R = R;
     const uint32_t T = s->triangle_count;
     gi_vec3 *P = malloc((size_t)T * 3 * sizeof *P), *Nf = malloc((size_t)T * sizeof *Nf);
     float *A = malloc((size_t)T * sizeof *A);
-    int32_t *tri_group = malloc((size_t)T * sizeof *tri_group), *next_tri = malloc((size_t)T * sizeof *next_tri);
+    int32_t *tri_group = malloc((size_t)T * sizeof *tri_group),
+            *next_tri = malloc((size_t)T * sizeof *next_tri);
     group *g = NULL;
     uint32_t ng = 0, cap = 0;
     gi_result r = GI_ERR_OUT_OF_MEMORY;
@@ -147,7 +149,8 @@ gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_o
     }
     if (!(out->surface_area > 0.0)) {
         r = GI_ERR_INVALID_ARGUMENT;
-        snprintf(err->text, sizeof err->text, "cssm_hrc: the scene has no surface area to build an atlas on");
+        snprintf(err->text, sizeof err->text,
+                 "cssm_hrc: the scene has no surface area to build an atlas on");
         goto fail;
     }
     out->diameter = gi_v3_length(gi_v3(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]));
@@ -178,7 +181,12 @@ gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_o
                         goto fail;
                     g = ng_;
                 }
-                g[ng] = (group){.object = o, .n = Nf[i], .d = d, .area = 0, .first_tri = UINT32_MAX, .chart = -1};
+                g[ng] = (group){.object = o,
+                                .n = Nf[i],
+                                .d = d,
+                                .area = 0,
+                                .first_tri = UINT32_MAX,
+                                .chart = -1};
                 ng++;
             }
             g[k].area += A[i];
@@ -208,7 +216,8 @@ gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_o
         float a0 = FLT_MAX, b0 = FLT_MAX;
         for (int32_t i = (int32_t)g[k].first_tri; i >= 0; i = next_tri[i])
             for (int j = 0; j < 3; j++)
-                a0 = fminf(a0, gi_v3_dot(P[3 * i + j], U[k])), b0 = fminf(b0, gi_v3_dot(P[3 * i + j], V[k]));
+                a0 = fminf(a0, gi_v3_dot(P[3 * i + j], U[k])),
+                b0 = fminf(b0, gi_v3_dot(P[3 * i + j], V[k]));
         umin[2 * k] = a0, umin[2 * k + 1] = b0;
     }
     uint32_t nr = 0;
@@ -222,7 +231,8 @@ gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_o
             float a1 = -FLT_MAX, b1 = -FLT_MAX;
             for (int32_t i = (int32_t)g[k].first_tri; i >= 0; i = next_tri[i])
                 for (int j = 0; j < 3; j++)
-                    a1 = fmaxf(a1, gi_v3_dot(P[3 * i + j], U[k])), b1 = fmaxf(b1, gi_v3_dot(P[3 * i + j], V[k]));
+                    a1 = fmaxf(a1, gi_v3_dot(P[3 * i + j], U[k])),
+                    b1 = fmaxf(b1, gi_v3_dot(P[3 * i + j], V[k]));
             rects[nr].w = (uint32_t)ceilf((a1 - umin[2 * k]) / h);
             rects[nr].h = (uint32_t)ceilf((b1 - umin[2 * k + 1]) / h);
             rects[nr].g = k;
@@ -235,7 +245,8 @@ gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_o
         if (attempt == 399) {
             free(rects), free(x0), free(y0), free(U), free(V), free(umin);
             r = GI_ERR_INVALID_ARGUMENT;
-            snprintf(err->text, sizeof err->text, "cssm_hrc: the charts do not pack into a %u x %u atlas", R, R);
+            snprintf(err->text, sizeof err->text,
+                     "cssm_hrc: the charts do not pack into a %u x %u atlas", R, R);
             goto fail;
         }
     }
@@ -267,7 +278,8 @@ gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_o
         goto fail;
     }
     for (uint32_t o = 0; o < s->object_count; o++) {
-        per_object[o] = rest[o] > 0.0 ? (uint32_t)fmax(1.0, floor(rest[o] / ((double)h * h) + 0.5)) : 0u;
+        per_object[o] =
+            rest[o] > 0.0 ? (uint32_t)fmax(1.0, floor(rest[o] / ((double)h * h) + 0.5)) : 0u;
         samples += per_object[o];
     }
     for (size_t i = 0; i < (size_t)R * R; i++)
@@ -295,8 +307,9 @@ gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_o
         c->u = gi_v3_scale(U[k], h);
         c->v = gi_v3_scale(V[k], h);
         /* the plane point at (umin, vmin) */
-        c->origin = gi_v3_add(gi_v3_scale(g[k].n, g[k].d),
-                              gi_v3_add(gi_v3_scale(U[k], umin[2 * k]), gi_v3_scale(V[k], umin[2 * k + 1])));
+        c->origin =
+            gi_v3_add(gi_v3_scale(g[k].n, g[k].d), gi_v3_add(gi_v3_scale(U[k], umin[2 * k]),
+                                                             gi_v3_scale(V[k], umin[2 * k + 1])));
         uint32_t first = out->count;
         for (uint32_t yy = 0; yy < c->h; yy++)
             for (uint32_t xx = 0; xx < c->w; xx++) {
@@ -325,7 +338,8 @@ gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_o
                 }
                 cssm_texel *x = &out->texels[out->count];
                 memset(x, 0, sizeof *x);
-                x->p = gi_v3_add(c->origin, gi_v3_add(gi_v3_scale(U[k], pu), gi_v3_scale(V[k], pv)));
+                x->p =
+                    gi_v3_add(c->origin, gi_v3_add(gi_v3_scale(U[k], pu), gi_v3_scale(V[k], pv)));
                 x->n = g[k].n;
                 x->chart = (int32_t)ci;
                 x->x = c->x0 + xx, x->y = c->y0 + yy;
@@ -366,8 +380,8 @@ gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_o
         uint32_t rng = gi_rng_init(o, 0, 0xa71a5u);
         double step = rest[o] / per_object[o], acc = 0.0, target = step * gi_rng_next_float(&rng);
         uint32_t made = 0;
-        for (uint32_t i = ob->first_triangle; i < ob->first_triangle + ob->triangle_count && made < per_object[o];
-             i++) {
+        for (uint32_t i = ob->first_triangle;
+             i < ob->first_triangle + ob->triangle_count && made < per_object[o]; i++) {
             if (tri_group[i] >= 0 && g[tri_group[i]].chart >= 0)
                 continue;
             acc += A[i];
@@ -443,7 +457,8 @@ static float bspline(float t)
     return 0.0f;
 }
 
-int cssm_chart_bicubic(const cssm_atlas *a, uint32_t chart, float u, float v, const float *values, float out[3])
+int cssm_chart_bicubic(const cssm_atlas *a, uint32_t chart, float u, float v, const float *values,
+                       float out[3])
 {
     const cssm_chart *c = &a->charts[chart];
     float gx = u - 0.5f, gy = v - 0.5f, wsum = 0.0f;
@@ -479,8 +494,8 @@ static float dist2(gi_vec3 a, gi_vec3 b)
 
 /* Greedy nearest-neighbour walk over the texels with visited[i] == 0,
  * starting nearest to `from` (or at the first one); appends to order. */
-static void greedy_walk(const cssm_atlas *a, unsigned char *visited, const gi_vec3 *from, uint32_t *order,
-                        uint32_t *n)
+static void greedy_walk(const cssm_atlas *a, unsigned char *visited, const gi_vec3 *from,
+                        uint32_t *order, uint32_t *n)
 {
     uint32_t left = 0;
     for (uint32_t i = 0; i < a->count; i++)
@@ -531,7 +546,8 @@ static int32_t chart_first(const cssm_atlas *a, uint32_t ci, const unsigned char
     return -1;
 }
 
-static void zigzag_chart(const cssm_atlas *a, uint32_t ci, unsigned char *visited, uint32_t *order, uint32_t *n)
+static void zigzag_chart(const cssm_atlas *a, uint32_t ci, unsigned char *visited, uint32_t *order,
+                         uint32_t *n)
 {
     const cssm_chart *c = &a->charts[ci];
     for (int y = 0; y < (int)c->h; y++)
@@ -546,8 +562,8 @@ static void zigzag_chart(const cssm_atlas *a, uint32_t ci, unsigned char *visite
 }
 
 /* Left-hand walk along the border of the unvisited region (§3.2.3). */
-static void spiral_chart(const cssm_atlas *a, uint32_t ci, unsigned char *visited, uint32_t *order, uint32_t *n,
-                         uint32_t *stack)
+static void spiral_chart(const cssm_atlas *a, uint32_t ci, unsigned char *visited, uint32_t *order,
+                         uint32_t *n, uint32_t *stack)
 {
     const cssm_chart *c = &a->charts[ci];
     int32_t start;

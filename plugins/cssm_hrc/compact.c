@@ -80,7 +80,8 @@ static float sgn(float x)
 
 static gi_vec3 oct_decode(uint32_t code)
 {
-    float u = (float)(code & 0xFFFu) / 4095.0f * 2.0f - 1.0f, v = (float)(code >> 12) / 4095.0f * 2.0f - 1.0f;
+    float u = (float)(code & 0xFFFu) / 4095.0f * 2.0f - 1.0f,
+          v = (float)(code >> 12) / 4095.0f * 2.0f - 1.0f;
     gi_vec3 n = gi_v3(u, v, 1.0f - fabsf(u) - fabsf(v));
     if (n.z < 0.0f) {
         float x = n.x;
@@ -101,7 +102,8 @@ static uint32_t oct_encode(gi_vec3 n)
         u = (1.0f - fabsf(v)) * sgn(x);
         v = (1.0f - fabsf(x)) * sgn(v);
     }
-    float fu = (clampf(u, -1.0f, 1.0f) + 1.0f) * 0.5f * 4095.0f, fv = (clampf(v, -1.0f, 1.0f) + 1.0f) * 0.5f * 4095.0f;
+    float fu = (clampf(u, -1.0f, 1.0f) + 1.0f) * 0.5f * 4095.0f,
+          fv = (clampf(v, -1.0f, 1.0f) + 1.0f) * 0.5f * 4095.0f;
     uint32_t best = 0;
     float bd = -2.0f;
     for (int k = 0; k < 4; k++) { /* the four codes around (u, v): the nearest direction */
@@ -143,14 +145,15 @@ static uint32_t rgb_encode(const float I[3], float scale, uint32_t seed)
     frexpf(mx, &E); /* mx = f 2^E, f in [0.5, 1) */
     if (E > 63 - EBIAS)
         E = 63 - EBIAS; /* beyond 8 x the scale: saturates */
-    if (E < -EBIAS) /* below 2^-60 of the scale: black */
+    if (E < -EBIAS)     /* below 2^-60 of the scale: black */
         return 0;
     for (;;) {
         float unit = ldexpf(1.0f, E - 6);
         uint32_t m[3];
         int over = 0;
         for (int k = 0; k < 3; k++) {
-            float dither = (float)(gi_pcg_hash(seed * 3u + (uint32_t)k) >> 8) * (1.0f / 16777216.0f);
+            float dither =
+                (float)(gi_pcg_hash(seed * 3u + (uint32_t)k) >> 8) * (1.0f / 16777216.0f);
             float q = floorf(v[k] / unit + dither);
             over |= q > 63.0f;
             m[k] = (uint32_t)fminf(q, 63.0f);
@@ -178,7 +181,9 @@ static uint32_t centre_q(const cssm_ctree *ct, gi_vec3 c, gi_vec3 *dec)
     float x[3] = {c.x, c.y, c.z}, d[3];
     uint32_t code = 0;
     for (int k = 0; k < 3; k++) {
-        uint32_t q = ct->step[k] > 0.0f ? (uint32_t)clampf(rintf((x[k] - ct->lo[k]) / ct->step[k]), 0.0f, 255.0f) : 0u;
+        uint32_t q = ct->step[k] > 0.0f
+                         ? (uint32_t)clampf(rintf((x[k] - ct->lo[k]) / ct->step[k]), 0.0f, 255.0f)
+                         : 0u;
         d[k] = ct->lo[k] + (float)q * ct->step[k];
         code |= q << (8 * k);
     }
@@ -207,14 +212,15 @@ gi_result cssm_ctree_check(uint32_t texels, gi_error *err)
     if (count <= CSSM_COMPACT_MAX_NODES)
         return GI_OK;
     snprintf(err->text, sizeof err->text,
-             "cssm_hrc: nodes=compact holds at most %u nodes (16-bit pointers, Sec. 4.2.1), this hierarchy has %llu "
+             "cssm_hrc: nodes=compact holds at most %u nodes (16-bit pointers, Sec. 4.2.1), this "
+             "hierarchy has %llu "
              "(%u texels): lower atlas or use nodes=float",
              CSSM_COMPACT_MAX_NODES, (unsigned long long)count, texels);
     return GI_ERR_INVALID_ARGUMENT;
 }
 
-gi_result cssm_ctree_setup(cssm_ctree *ct, uint32_t count, const float lo[3], const float hi[3], float r_lo,
-                           float r_hi, float a_lo, float a_hi, gi_error *err)
+gi_result cssm_ctree_setup(cssm_ctree *ct, uint32_t count, const float lo[3], const float hi[3],
+                           float r_lo, float r_hi, float a_lo, float a_hi, gi_error *err)
 {
     memset(ct, 0, sizeof *ct);
     if (count > CSSM_COMPACT_MAX_NODES)
@@ -272,7 +278,9 @@ void cssm_ctree_encode(cssm_ctree *ct, uint32_t i, const cssm_node_view *v)
         float dn = angle_unit(oct_decode(nq), gi_v3_normalize(v->n));
         float need = acosf(clampf(v->cos_cone, -1.0f, 1.0f)) + dn;
         need = need * 1.000001f + 1e-6f;
-        kq = need >= (float)GI_PI ? 255u : (uint32_t)clampf(ceilf(need / (float)GI_PI * 255.0f), 0.0f, 255.0f);
+        kq = need >= (float)GI_PI
+                 ? 255u
+                 : (uint32_t)clampf(ceilf(need / (float)GI_PI * 255.0f), 0.0f, 255.0f);
     }
     uint32_t aq = code_near(ct->atab, v->area);
     p->w[0] = cq | rq << 24;
@@ -307,7 +315,8 @@ gi_result cssm_ctree_build(const cssm_tree *t, const cssm_atlas *a, cssm_ctree *
 {
     memset(out, 0, sizeof *out);
     if (t->count > CSSM_COMPACT_MAX_NODES) /* refused before anything is computed */
-        return cssm_ctree_setup(out, t->count, (float[3]){0, 0, 0}, (float[3]){0, 0, 0}, 1, 1, 1, 1, err);
+        return cssm_ctree_setup(out, t->count, (float[3]){0, 0, 0}, (float[3]){0, 0, 0}, 1, 1, 1, 1,
+                                err);
     float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
     for (uint32_t i = 0; i < a->count; i++) {
         float q[3] = {a->texels[i].p.x, a->texels[i].p.y, a->texels[i].p.z};
@@ -331,8 +340,13 @@ gi_result cssm_ctree_build(const cssm_tree *t, const cssm_atlas *a, cssm_ctree *
     log_table(out->rtab, rmin, rmax);
     for (uint32_t i = 0; i < t->count; i++) {
         const cssm_node *nd = &t->nodes[i];
-        cssm_node_view v = {.c = nd->c, .r = nd->r, .n = nd->n, .cos_cone = nd->cos_cone,
-                            .area = nd->area, .child = nd->child, .skip = nd->skip};
+        cssm_node_view v = {.c = nd->c,
+                            .r = nd->r,
+                            .n = nd->n,
+                            .cos_cone = nd->cos_cone,
+                            .area = nd->area,
+                            .child = nd->child,
+                            .skip = nd->skip};
         cssm_ctree_encode(out, i, &v);
         out->side[2 * i] = nd->first;
         out->side[2 * i + 1] = nd->rep;

@@ -18,7 +18,8 @@
 /* Per face: 1 where the whole texel cone lies in the negative half-space
  * of normal n (all four corner directions below the plane): "don't care"
  * (§3.2.1). corners: 6 (M+1)^2 corner directions. */
-static void dont_care_mask(const gi_vec3 *corners, uint32_t M, gi_vec3 n, int face, unsigned char *mask)
+static void dont_care_mask(const gi_vec3 *corners, uint32_t M, gi_vec3 n, int face,
+                           unsigned char *mask)
 {
     const gi_vec3 *c = corners + (size_t)face * (M + 1) * (M + 1);
     for (uint32_t y = 0; y < M; y++)
@@ -32,7 +33,8 @@ static void dont_care_mask(const gi_vec3 *corners, uint32_t M, gi_vec3 n, int fa
         }
 }
 
-gi_result cssm_maps_setup(const cssm_atlas *a, const uint32_t *order, uint32_t M, cssm_maps *out, gi_error *err)
+gi_result cssm_maps_setup(const cssm_atlas *a, const uint32_t *order, uint32_t M, cssm_maps *out,
+                          gi_error *err)
 {
     memset(out, 0, sizeof *out);
     const uint32_t N = a->count;
@@ -57,8 +59,8 @@ gi_result cssm_maps_setup(const cssm_atlas *a, const uint32_t *order, uint32_t M
     return GI_OK;
 }
 
-gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order, uint32_t M,
-                          const gi_host *host, cssm_maps *out, gi_error *err)
+gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order,
+                          uint32_t M, const gi_host *host, cssm_maps *out, gi_error *err)
 {
     return cssm_maps_build_ex(gs, a, order, M, NULL, host, out, err);
 }
@@ -72,8 +74,8 @@ typedef struct build_ctx {
     cssm_maps *out;
     const gi_vec3 *corners; /* 6 (M+1)^2 corner directions of the face texels */
     unsigned char *mask;
-    gi_depth_view cube[6];  /* the views of the texel last asked for */
-    uint32_t cube_of;       /* its texel + 1 (0: none yet) */
+    gi_depth_view cube[6]; /* the views of the texel last asked for */
+    uint32_t cube_of;      /* its texel + 1 (0: none yet) */
 } build_ctx;
 
 static void build_view(void *ctx, uint32_t q, gi_depth_view *view)
@@ -94,7 +96,8 @@ static int build_skip(void *ctx, uint32_t q)
     return b->opts->dont_care && b->opts->dont_care[b->order[q / 6]];
 }
 
-static void build_depths(void *ctx, uint32_t q, const gi_depth_view *view, const float *map, float *z1, float *z2)
+static void build_depths(void *ctx, uint32_t q, const gi_depth_view *view, const float *map,
+                         float *z1, float *z2)
 {
     (void)view;
     build_ctx *b = ctx;
@@ -123,8 +126,9 @@ static void build_depths(void *ctx, uint32_t q, const gi_depth_view *view, const
     }
 }
 
-gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order, uint32_t M,
-                             const cssm_build_opts *opts, const gi_host *host, cssm_maps *out, gi_error *err)
+gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order,
+                             uint32_t M, const cssm_build_opts *opts, const gi_host *host,
+                             cssm_maps *out, gi_error *err)
 {
     static const cssm_build_opts none = {0};
     if (!opts)
@@ -150,12 +154,14 @@ gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const 
         gi_cube_basis(f, &s, &t, &fw);
         for (uint32_t y = 0; y <= M; y++)
             for (uint32_t x = 0; x <= M; x++) {
-                float sx = (float)x / (float)M * 2.0f - 1.0f, sy = (float)y / (float)M * 2.0f - 1.0f;
+                float sx = (float)x / (float)M * 2.0f - 1.0f,
+                      sy = (float)y / (float)M * 2.0f - 1.0f;
                 corners[((size_t)f * (M + 1) + y) * (M + 1) + x] =
                     gi_v3_add(fw, gi_v3_add(gi_v3_scale(s, sx), gi_v3_scale(t, sy)));
             }
     }
-    build_ctx b = {.a = a, .order = order, .opts = opts, .out = out, .corners = corners, .mask = mask};
+    build_ctx b = {
+        .a = a, .order = order, .opts = opts, .out = out, .corners = corners, .mask = mask};
     gi_csm_precompute_desc d = {.depth = {.size = M,
                                           .surfaces = 2,
                                           .metric = GI_DEPTH_RADIAL,
@@ -174,7 +180,8 @@ gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const 
                                 .p1 = 1.0f,
                                 .who = "cssm_hrc",
                                 .what = "cube maps",
-                                .render_stage = opts->render_stage ? opts->render_stage : "cssm_render"};
+                                .render_stage =
+                                    opts->render_stage ? opts->render_stage : "cssm_render"};
     r = gi_csm_precompute(gs, &d, out->face, err);
     free(corners), free(mask);
     if (r != GI_OK)

@@ -34,37 +34,38 @@ typedef enum cssm_traversal { CSSM_GREEDY = 0, CSSM_ZIGZAG = 1, CSSM_SPIRAL = 2 
 #define CSSM_NO_XY 0xFFFFFFFFu
 
 typedef struct cssm_texel {
-    gi_vec3 p, n;       /* world position and (geometric) unit normal */
-    float area;         /* world area this texel stands for */
-    float albedo[3];    /* Lambert albedo: the material's factor x its texture at the texel centre */
-    float emission[3];  /* emitted radiance (front face) */
+    gi_vec3 p, n;      /* world position and (geometric) unit normal */
+    float area;        /* world area this texel stands for */
+    float albedo[3];   /* Lambert albedo: the material's factor x its texture at the texel centre */
+    float emission[3]; /* emitted radiance (front face) */
     float ks[3], exponent; /* Phong lobe of the material (view-dependent lightmap mode) */
-    int32_t chart;      /* chart index, -1 for a surface sample without parametrisation */
-    uint32_t x, y;      /* atlas texel (CSSM_NO_XY for a surface sample) */
-    uint32_t triangle;  /* scene triangle it lies on */
+    int32_t chart;         /* chart index, -1 for a surface sample without parametrisation */
+    uint32_t x, y;         /* atlas texel (CSSM_NO_XY for a surface sample) */
+    uint32_t triangle;     /* scene triangle it lies on */
 } cssm_texel;
 
 typedef struct cssm_chart {
     uint32_t x0, y0, w, h; /* rectangle in the atlas */
     uint32_t object;
-    gi_vec3 origin, u, v;  /* world position of atlas corner (x0, y0) and one texel step along x and y */
+    gi_vec3 origin, u,
+        v; /* world position of atlas corner (x0, y0) and one texel step along x and y */
     gi_vec3 normal;
 } cssm_chart;
 
 typedef struct cssm_atlas {
-    uint32_t R;            /* the atlas is R x R texels */
-    int32_t *grid;         /* R * R: texel index, -1 where no chart covers it */
+    uint32_t R;    /* the atlas is R x R texels */
+    int32_t *grid; /* R * R: texel index, -1 where no chart covers it */
     cssm_texel *texels;
     uint32_t count;        /* texels (chart texels, then surface samples) */
     uint32_t chart_texels; /* texels inside charts */
     cssm_chart *charts;
     uint32_t chart_count;
-    float h;               /* texel edge length in world units */
-    float diameter;        /* scene bounding-box diagonal */
-    double surface_area;   /* of every triangle */
-    double chart_area;     /* of the triangles in charts */
-    double covered_area;   /* chart texels x h^2: the share of chart_area the texel grid covers */
-    int32_t *tri_chart;    /* per scene triangle: its chart, -1 for none */
+    float h;             /* texel edge length in world units */
+    float diameter;      /* scene bounding-box diagonal */
+    double surface_area; /* of every triangle */
+    double chart_area;   /* of the triangles in charts */
+    double covered_area; /* chart texels x h^2: the share of chart_area the texel grid covers */
+    int32_t *tri_chart;  /* per scene triangle: its chart, -1 for none */
 } cssm_atlas;
 
 /* Builds the atlas of the scene at time t (world space, every object):
@@ -76,8 +77,8 @@ typedef struct cssm_atlas {
  * would get, but surface samples everywhere (no parametrisation: the
  * paper's greedy case). GI_ERR_INVALID_ARGUMENT when the scene has no
  * area. */
-gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_only, cssm_atlas *out,
-                           gi_error *err);
+gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_only,
+                           cssm_atlas *out, gi_error *err);
 void cssm_atlas_free(cssm_atlas *a);
 /* Reads texel x's material from triangle tri (world corners p, x->p on
  * it): albedo factor x albedo texture at x->p (the mesh uvs interpolated,
@@ -100,7 +101,8 @@ void cssm_chart_coords(const cssm_atlas *a, uint32_t chart, gi_vec3 p, float *u,
  * (3 per texel) at chart-local coordinates (u, v) over the 4 x 4 texels of
  * that chart around it, weights renormalised over the texels that exist;
  * 0 when none does. */
-int cssm_chart_bicubic(const cssm_atlas *a, uint32_t chart, float u, float v, const float *values, float out[3]);
+int cssm_chart_bicubic(const cssm_atlas *a, uint32_t chart, float u, float v, const float *values,
+                       float out[3]);
 
 uint32_t *cssm_traverse(const cssm_atlas *a, cssm_traversal how);
 const char *cssm_traversal_name(cssm_traversal how);
@@ -108,29 +110,33 @@ const char *cssm_traversal_name(cssm_traversal how);
 /* ----------------------------------------------------------------- CSSM */
 
 typedef struct cssm_maps {
-    uint32_t M, N;        /* cube faces M x M, N texels */
-    gi_csm_data face[6];  /* one codec sequence per cube face, maps in traversal order */
-    uint32_t *seq;        /* texel -> index in the sequence */
-    gi_vec3 *eye;         /* texel -> cube map centre (position + eps normal) */
+    uint32_t M, N;       /* cube faces M x M, N texels */
+    gi_csm_data face[6]; /* one codec sequence per cube face, maps in traversal order */
+    uint32_t *seq;       /* texel -> index in the sequence */
+    gi_vec3 *eye;        /* texel -> cube map centre (position + eps normal) */
     float znear, zfar;
     uint64_t dont_care;   /* face texels in the negative half-space (stored as "any value") */
     uint64_t face_texels; /* 6 M^2 N */
-    const struct cssm_motion *motion; /* moving-object mode (§3.3, motion.c), NULL: one static scene */
-    int escape;           /* built with escape intervals (cssm_build_opts.escape, env_cssm.h) */
+    const struct cssm_motion
+        *motion; /* moving-object mode (§3.3, motion.c), NULL: one static scene */
+    int escape;  /* built with escape intervals (cssm_build_opts.escape, env_cssm.h) */
 } cssm_maps;
 
 /* What the cube maps see (§3.3: per object a CSSM). Zero: every object, in
  * world space (the static scene). */
 typedef struct cssm_build_opts {
-    uint32_t only_object;            /* k + 1: object k alone */
-    const unsigned char *skip_objects; /* per object, 1: not drawn (with only_object 0); NULL: none */
-    int local;                       /* 1: object-local geometry (with only_object) */
-    const float *eye_from_world;     /* maps the texels' eyes (world) into the maps' space; NULL: identity */
-    const unsigned char *dont_care;  /* per texel, 1: a map of "don't care" only (not queried, no segments) */
-    int escape;                      /* 1: a face texel that saw a surface enters the codec as [z1, min(z2, far)),
-                                        one that saw none as [far, inf): z_avg >= far tells the direction escapes
-                                        (env=cssm, env_cssm.h); 0: [z1, z2), none as (inf, inf) */
-    const char *render_stage;        /* stage timer of rendering and read-back; NULL: "cssm_render" */
+    uint32_t only_object; /* k + 1: object k alone */
+    const unsigned char
+        *skip_objects; /* per object, 1: not drawn (with only_object 0); NULL: none */
+    int local;         /* 1: object-local geometry (with only_object) */
+    const float
+        *eye_from_world; /* maps the texels' eyes (world) into the maps' space; NULL: identity */
+    const unsigned char
+        *dont_care; /* per texel, 1: a map of "don't care" only (not queried, no segments) */
+    int escape;     /* 1: a face texel that saw a surface enters the codec as [z1, min(z2, far)),
+                       one that saw none as [far, inf): z_avg >= far tells the direction escapes
+                       (env=cssm, env_cssm.h); 0: [z1, z2), none as (inf, inf) */
+    const char *render_stage; /* stage timer of rendering and read-back; NULL: "cssm_render" */
 } cssm_build_opts;
 
 /* Renders (the core's precomputation loop gi/algo/csm_precompute.h with its
@@ -141,15 +147,17 @@ typedef struct cssm_build_opts {
  * normal "don't care") and streams them into six codecs. host may be NULL;
  * with a host: stage timers cssm_render and compress, progress,
  * cancellation. */
-gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order, uint32_t M,
-                          const gi_host *host, cssm_maps *out, gi_error *err);
+gi_result cssm_maps_build(const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order,
+                          uint32_t M, const gi_host *host, cssm_maps *out, gi_error *err);
 /* The same with what the maps see chosen by opts (NULL: as above). */
-gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order, uint32_t M,
-                             const cssm_build_opts *opts, const gi_host *host, cssm_maps *out, gi_error *err);
+gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const uint32_t *order,
+                             uint32_t M, const cssm_build_opts *opts, const gi_host *host,
+                             cssm_maps *out, gi_error *err);
 void cssm_maps_free(cssm_maps *m);
 /* What cssm_maps_build sets besides the compressed faces (sizes, seq, eye,
  * near and far planes): for data read back from the cache. */
-gi_result cssm_maps_setup(const cssm_atlas *a, const uint32_t *order, uint32_t M, cssm_maps *out, gi_error *err);
+gi_result cssm_maps_setup(const cssm_atlas *a, const uint32_t *order, uint32_t M, cssm_maps *out,
+                          gi_error *err);
 /* Compressed bytes over the six sequences, and the paper's uncompressed
  * 2 bytes per depth texel (Table 2). */
 uint64_t cssm_maps_bytes(const cssm_maps *m);
@@ -164,25 +172,26 @@ float cssm_visible(const cssm_maps *m, uint32_t j, gi_vec3 x, float bias, int pc
 
 /* The visibility of texel j from receiver rc: cssm_visible toward rc->x,
  * or in moving-object mode the combination of §3.3 (motion.c). */
-float cssm_visible_rc(const cssm_maps *m, uint32_t j, const struct cssm_receiver *rc, float bias, int pcf);
+float cssm_visible_rc(const cssm_maps *m, uint32_t j, const struct cssm_receiver *rc, float bias,
+                      int pcf);
 
 /* ------------------------------------------------------------ hierarchy */
 
 typedef struct cssm_node {
-    gi_vec3 c;           /* bounding sphere centre */
-    float r;             /* and radius */
-    gi_vec3 centroid;    /* area-weighted mean position */
-    gi_vec3 n;           /* area-weighted mean normal, unit */
-    float cos_cone;      /* cosine of the normal cone's half-angle (-1: everything) */
+    gi_vec3 c;        /* bounding sphere centre */
+    float r;          /* and radius */
+    gi_vec3 centroid; /* area-weighted mean position */
+    gi_vec3 n;        /* area-weighted mean normal, unit */
+    float cos_cone;   /* cosine of the normal cone's half-angle (-1: everything) */
     float area;
-    int32_t child;       /* left child (-1 for a leaf); the right child is the left child's skip */
-    int32_t skip;        /* next node in depth-first order past this subtree (-1: end) */
+    int32_t child; /* left child (-1 for a leaf); the right child is the left child's skip */
+    int32_t skip;  /* next node in depth-first order past this subtree (-1: end) */
     uint32_t first, count; /* leaves [first, first + count) of cssm_tree.leaves */
-    uint32_t rep;        /* representative texel (nearest the centroid) */
+    uint32_t rep;          /* representative texel (nearest the centroid) */
 } cssm_node;
 
 typedef struct cssm_tree {
-    cssm_node *nodes;    /* depth-first pre-order: the root is 0, a left child follows its parent */
+    cssm_node *nodes; /* depth-first pre-order: the root is 0, a left child follows its parent */
     uint32_t count;
     uint32_t *leaves;    /* texel of leaf k (the median-cut order) */
     uint32_t *leaf_node; /* texel -> its leaf node */
@@ -193,16 +202,16 @@ typedef struct cssm_tree {
  * (compact.c). I is the radiant intensity, radiance x area per channel
  * (what the paper's node stores), so a gather sends I cos_s cos_r / d^2. */
 typedef struct cssm_node_view {
-    gi_vec3 c;           /* bounding sphere centre */
-    float r;             /* and radius */
-    gi_vec3 p;           /* gather position (float: the centroid; packed: the one stored centre) */
-    gi_vec3 n;           /* mean normal */
-    float cos_cone;      /* normal cone (-1: everything) */
+    gi_vec3 c;      /* bounding sphere centre */
+    float r;        /* and radius */
+    gi_vec3 p;      /* gather position (float: the centroid; packed: the one stored centre) */
+    gi_vec3 n;      /* mean normal */
+    float cos_cone; /* normal cone (-1: everything) */
     float area;
-    float I[3];          /* radiant intensity */
+    float I[3]; /* radiant intensity */
     int32_t child, skip;
     uint32_t first, count; /* leaves below: leaves[first, first + count) */
-    uint32_t rep;        /* texel whose CSSM gives the node's visibility */
+    uint32_t rep;          /* texel whose CSSM gives the node's visibility */
 } cssm_node_view;
 
 /* Median cut over the texel positions (§4.2): split at the median of the
@@ -237,13 +246,14 @@ typedef struct cssm_pnode {
 typedef struct cssm_ctree {
     cssm_pnode *nodes;
     uint32_t count;
-    float lo[3], step[3];  /* centre: lo + q step, q in 0 .. 255 */
-    float rtab[256];       /* radius of each code (log between the smallest and largest node) */
-    float atab[256];       /* area of each code (log) */
-    float ctab[256];       /* cosine of the cone angle pi q / 255 */
-    float iscale;          /* intensity scale of the light set in the nodes (exponent 60 is 1 x iscale) */
-    uint32_t *side;        /* 2 per node: first leaf, representative texel (visibility and jitter, not in the 128 bits) */
-    uint32_t *leaves;      /* leaf rank -> texel (a copy of cssm_tree.leaves) */
+    float lo[3], step[3]; /* centre: lo + q step, q in 0 .. 255 */
+    float rtab[256];      /* radius of each code (log between the smallest and largest node) */
+    float atab[256];      /* area of each code (log) */
+    float ctab[256];      /* cosine of the cone angle pi q / 255 */
+    float iscale;   /* intensity scale of the light set in the nodes (exponent 60 is 1 x iscale) */
+    uint32_t *side; /* 2 per node: first leaf, representative texel (visibility and jitter, not in
+                       the 128 bits) */
+    uint32_t *leaves; /* leaf rank -> texel (a copy of cssm_tree.leaves) */
 } cssm_ctree;
 
 /* GI_OK when the tree over `texels` texels (2 texels - 1 nodes) fits the
@@ -253,8 +263,8 @@ gi_result cssm_ctree_check(uint32_t texels, gi_error *err);
 /* Sets up an empty packed tree of count nodes: the centre box [lo, hi],
  * the radius and area ranges of the log codes. GI_ERR_INVALID_ARGUMENT
  * (one line in err) when count exceeds CSSM_COMPACT_MAX_NODES. */
-gi_result cssm_ctree_setup(cssm_ctree *ct, uint32_t count, const float lo[3], const float hi[3], float r_lo,
-                           float r_hi, float a_lo, float a_hi, gi_error *err);
+gi_result cssm_ctree_setup(cssm_ctree *ct, uint32_t count, const float lo[3], const float hi[3],
+                           float r_lo, float r_hi, float a_lo, float a_hi, gi_error *err);
 /* Packs the float tree (geometry and pointers; the intensity is set by
  * cssm_ctree_pull): the float node's bounding sphere, normal, cone and
  * area.
@@ -280,42 +290,45 @@ void cssm_ctree_pull(cssm_ctree *ct, const cssm_atlas *a, const float *texel_L);
  * skipped) or a G-buffer pixel (Lambert + normalised Phong toward wo). */
 typedef struct cssm_receiver {
     gi_vec3 x, n;
-    int32_t self;        /* receiver texel (skipped), -1 for a pixel */
-    uint32_t proxy1;     /* moving-object mode, a pixel: 1 + a texel on its triangle (0: none) */
-    uint32_t moving;     /* moving-object mode, a pixel: 1 + the mover it lies on, 0 on a static object */
-    int glossy;          /* use ks, exponent, wo */
+    int32_t self;    /* receiver texel (skipped), -1 for a pixel */
+    uint32_t proxy1; /* moving-object mode, a pixel: 1 + a texel on its triangle (0: none) */
+    uint32_t
+        moving; /* moving-object mode, a pixel: 1 + the mover it lies on, 0 on a static object */
+    int glossy; /* use ks, exponent, wo */
     float kd[3], ks[3], exponent;
     gi_vec3 wo;
 } cssm_receiver;
 
 typedef struct cssm_gather_opts {
-    float threshold;     /* refine while the tone-mapped bound exceeds it (§4.3) */
-    uint32_t max_cut;    /* maximum nodes in the cut */
-    float exposure;      /* tone mapping: (L 2^exposure)^(1 / 2.2) */
-    float clamp;         /* distances below it count as it (§5 "Quality") */
-    float bias;          /* CSSM depth bias, world units */
+    float threshold;  /* refine while the tone-mapped bound exceeds it (§4.3) */
+    uint32_t max_cut; /* maximum nodes in the cut */
+    float exposure;   /* tone mapping: (L 2^exposure)^(1 / 2.2) */
+    float clamp;      /* distances below it count as it (§5 "Quality") */
+    float bias;       /* CSSM depth bias, world units */
     int pcf;
-    uint32_t *rng;       /* non-NULL: jitter each gathered node inside its area (§4.5) */
-    int no_emission;     /* cssm_solve: R_1 = direct only, the emitting texels not gathered (their light
-                          * comes from the direct light of direct=csm, §4.7) */
+    uint32_t *rng;   /* non-NULL: jitter each gathered node inside its area (§4.5) */
+    int no_emission; /* cssm_solve: R_1 = direct only, the emitting texels not gathered (their light
+                      * comes from the direct light of direct=csm, §4.7) */
 } cssm_gather_opts;
 
 typedef struct cssm_gather_stats {
-    uint64_t nodes;      /* cut sizes summed */
+    uint64_t nodes; /* cut sizes summed */
     uint64_t receivers;
-    uint64_t clamped;    /* gathers whose distance was clamped */
+    uint64_t clamped; /* gathers whose distance was clamped */
 } cssm_gather_stats;
 
 /* The stack-less traversal of Fig. 10 for one receiver: returns in out[3]
  * the reflected radiance f * sum over the cut of L_S A_S cos_s cos_r / d^2
  * V (for a texel receiver f = kd / pi). node_L: pulled radiance per node.
  * maps may be NULL (everything visible). */
-void cssm_gather(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps, const float *node_L,
-                 const cssm_receiver *rc, const cssm_gather_opts *o, float out[3], cssm_gather_stats *st);
+void cssm_gather(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps,
+                 const float *node_L, const cssm_receiver *rc, const cssm_gather_opts *o,
+                 float out[3], cssm_gather_stats *st);
 /* The same traversal over packed nodes (nodes=compact), each decoded as
  * it is read, intensity as pulled into ct. */
-void cssm_cgather(const cssm_ctree *ct, const cssm_atlas *a, const cssm_maps *maps, const cssm_receiver *rc,
-                  const cssm_gather_opts *o, float out[3], cssm_gather_stats *st);
+void cssm_cgather(const cssm_ctree *ct, const cssm_atlas *a, const cssm_maps *maps,
+                  const cssm_receiver *rc, const cssm_gather_opts *o, float out[3],
+                  cssm_gather_stats *st);
 /* Upper bound of what node S sends to the receiver (the oracle's L_max),
  * luminance. */
 float cssm_bound(const cssm_node *S, const float L[3], const cssm_receiver *rc);
@@ -328,8 +341,9 @@ double cssm_pdf_build(const cssm_atlas *a, const float *texel_values, double *cd
 /* S texels drawn from that table, each at a random point of its square
  * (rng), visibility through its CSSM: the Monte Carlo estimate of the same
  * sum as cssm_gather (f L_j A_j cos_s cos_r / d^2 V, distances clamped). */
-void cssm_gather_mc(const cssm_atlas *a, const cssm_maps *maps, const float *texel_values, const double *cdf,
-                    uint32_t S, const cssm_receiver *rc, const cssm_gather_opts *o, float out[3]);
+void cssm_gather_mc(const cssm_atlas *a, const cssm_maps *maps, const float *texel_values,
+                    const double *cdf, uint32_t S, const cssm_receiver *rc,
+                    const cssm_gather_opts *o, float out[3]);
 
 /* The receiver position of a surface point: lifted along its normal as
  * the cube maps' eyes are (2 near planes). */
@@ -343,14 +357,16 @@ gi_vec3 cssm_receiver_point(const cssm_maps *maps, const cssm_atlas *a, gi_vec3 
  *   R_k = kd/pi gather(pull(R_{k-1})),  k = 2 .. n,
  * and node_L (3 per node) its pull. Stage timers direct, pull, bounce when
  * host is not NULL. */
-gi_result cssm_solve(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps, const cssm_gather_opts *o,
-                     uint32_t bounces, const float *direct, const gi_host *host, float *texel_L, float *node_L,
-                     cssm_gather_stats *st, gi_error *err);
+gi_result cssm_solve(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps,
+                     const cssm_gather_opts *o, uint32_t bounces, const float *direct,
+                     const gi_host *host, float *texel_L, float *node_L, cssm_gather_stats *st,
+                     gi_error *err);
 /* The same with packed nodes: ct not NULL, every pull goes into ct (re-encoded)
  * and every gather reads ct; ct ends holding the pull of texel_L (node_L
  * is filled too). */
-gi_result cssm_solve_ex(const cssm_tree *t, cssm_ctree *ct, const cssm_atlas *a, const cssm_maps *maps,
-                        const cssm_gather_opts *o, uint32_t bounces, const float *direct, const gi_host *host,
-                        float *texel_L, float *node_L, cssm_gather_stats *st, gi_error *err);
+gi_result cssm_solve_ex(const cssm_tree *t, cssm_ctree *ct, const cssm_atlas *a,
+                        const cssm_maps *maps, const cssm_gather_opts *o, uint32_t bounces,
+                        const float *direct, const gi_host *host, float *texel_L, float *node_L,
+                        cssm_gather_stats *st, gi_error *err);
 
 #endif

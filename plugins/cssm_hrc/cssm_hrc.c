@@ -44,12 +44,12 @@
 #include <string.h>
 
 typedef struct shadow_map {
-    int type;           /* GI_LIGHT_* */
+    int type; /* GI_LIGHT_* */
     uint32_t size;
-    gi_vec3 pos, dir;   /* light frame */
-    float view[16];     /* directional: world -> eye */
-    float half;         /* directional: half extent of the orthographic map */
-    float *depth;       /* 6 faces (point, spot) or 1 map, size^2 floats each */
+    gi_vec3 pos, dir; /* light frame */
+    float view[16];   /* directional: world -> eye */
+    float half;       /* directional: half extent of the orthographic map */
+    float *depth;     /* 6 faces (point, spot) or 1 map, size^2 floats each */
 } shadow_map;
 
 typedef struct cssm_hrc {
@@ -60,85 +60,110 @@ typedef struct cssm_hrc {
     uint32_t *order;
     cssm_maps maps;
     cssm_tree tree;
-    float *texel_L;   /* emission + reflected, 3 per texel */
-    float *node_L;    /* pulled texel_L */
-    float *node_Le;   /* pulled emission (texel mode: direct light per pixel) */
-    float *node_B;    /* pulled reflected light (texel mode: indirect) */
-    float *texel_T;   /* texel mode: view-dependent indirect light per texel, 3 per texel */
-    uint32_t *ids;    /* G-buffer ids read-back (texel mode) */
+    float *texel_L; /* emission + reflected, 3 per texel */
+    float *node_L;  /* pulled texel_L */
+    float *node_Le; /* pulled emission (texel mode: direct light per pixel) */
+    float *node_B;  /* pulled reflected light (texel mode: indirect) */
+    float *texel_T; /* texel mode: view-dependent indirect light per texel, 3 per texel */
+    uint32_t *ids;  /* G-buffer ids read-back (texel mode) */
     int mode;
-    int indirect, mc_samples; /* §4.6 alternative: Monte Carlo from the atlas as a pdf */
+    int indirect, mc_samples;  /* §4.6 alternative: Monte Carlo from the atlas as a pdf */
     float *texel_Le, *texel_B; /* emission and reflected light per texel */
-    double *cdf[3];   /* pdf tables of texel_L, texel_Le, texel_B */
+    double *cdf[3];            /* pdf tables of texel_L, texel_Le, texel_B */
     shadow_map *shadows;
     uint32_t shadow_count;
-    int env_samples;  /* environment light: directions per texel (or pixel) */
-    int env_pixel;    /* 1: environment light traced per pixel; 0: the texels' irradiance looked up */
-    int env_mode;     /* environment visibility: 0 ray tracer, 1 the texels' own CSSMs (env_cssm.c) */
-    gi_rt *rt;        /* the scene for the environment's occlusion, NULL without environment */
-    float *texel_E;   /* environment irradiance per texel, 3 per texel; NULL: no environment */
-    float *accum;     /* running average, 4 per pixel */
-    float *gb[5];     /* G-buffer read-back: position, normal, albedo, phong, emission */
+    int env_samples; /* environment light: directions per texel (or pixel) */
+    int env_pixel;  /* 1: environment light traced per pixel; 0: the texels' irradiance looked up */
+    int env_mode;   /* environment visibility: 0 ray tracer, 1 the texels' own CSSMs (env_cssm.c) */
+    gi_rt *rt;      /* the scene for the environment's occlusion, NULL without environment */
+    float *texel_E; /* environment irradiance per texel, 3 per texel; NULL: no environment */
+    float *accum;   /* running average, 4 per pixel */
+    float *gb[5];   /* G-buffer read-back: position, normal, albedo, phong, emission */
     uint32_t acc_w, acc_h;
     cssm_motion motion; /* §3.3: moving rigid objects (motion.h); motion.moving < 0: static scene */
-    int nodes;          /* 1: nodes=compact, the gathers read packed 128-bit nodes (§4.2.1, compact.c) */
-    cssm_ctree ct[3];   /* nodes=compact: the packed hierarchy with the intensity of texel_L, emission, reflected */
+    int nodes; /* 1: nodes=compact, the gathers read packed 128-bit nodes (§4.2.1, compact.c) */
+    cssm_ctree ct[3]; /* nodes=compact: the packed hierarchy with the intensity of texel_L,
+                         emission, reflected */
     int direct, csm_points, csm_samples, csm_M; /* §4.7 "Direct Light": direct=csm (direct_csm.h) */
-    cssm_csm_direct *csm; /* its CSMs, NULL with direct=maps */
+    cssm_csm_direct *csm;                       /* its CSMs, NULL with direct=maps */
     int prepared;
 } cssm_hrc;
 
 static const gi_param_desc cssm_params[] = {
     {"atlas", GI_PARAM_INT, 32, 8, 128, NULL, "atlas resolution (Sec. 3.2.3, Table 2)",
-     "the illumination atlas is atlas x atlas texels; each texel is a surface sample, a cube map and a leaf"},
-    {"M", GI_PARAM_INT, 16, 4, 64, NULL, "6 x M x M (Sec. 3.2.1, Table 2)", "cube face size of the CSSM depth cube maps"},
-    {"traversal", GI_PARAM_ENUM, 2, 0, 0, "greedy|zigzag|spiral|greedy_atlas", "Sec. 3.2.3, Fig. 6/7",
-     "order of the cube maps in the codec: greedy (the paper's: evenly distributed surface samples instead of the "
-     "atlas, walked nearest-first), zig-zag or spiral over the charts, greedy_atlas (nearest-first over the atlas "
+     "the illumination atlas is atlas x atlas texels; each texel is a surface sample, a cube map "
+     "and a leaf"},
+    {"M", GI_PARAM_INT, 16, 4, 64, NULL, "6 x M x M (Sec. 3.2.1, Table 2)",
+     "cube face size of the CSSM depth cube maps"},
+    {"traversal", GI_PARAM_ENUM, 2, 0, 0, "greedy|zigzag|spiral|greedy_atlas",
+     "Sec. 3.2.3, Fig. 6/7",
+     "order of the cube maps in the codec: greedy (the paper's: evenly distributed surface samples "
+     "instead of the "
+     "atlas, walked nearest-first), zig-zag or spiral over the charts, greedy_atlas (nearest-first "
+     "over the atlas "
      "texels)"},
     {"bounces", GI_PARAM_INT, 3, 0, 3, NULL, "n (Sec. 4.1)",
      "diffuse indirect bounces n: the atlas holds 1 .. n bounces, the final gather adds one"},
     {"threshold", GI_PARAM_FLOAT, 0.1, 0.0, 1.0, NULL, "threshold (Sec. 4.3)",
      "refine a sender while the tone-mapped upper bound of its radiance exceeds this"},
-    {"max_cut", GI_PARAM_INT, 1024, 1, 65536, NULL, "maximum cut size (Sec. 4.4)", "nodes in one receiver's cut at most"},
+    {"max_cut", GI_PARAM_INT, 1024, 1, 65536, NULL, "maximum cut size (Sec. 4.4)",
+     "nodes in one receiver's cut at most"},
     {"jitter", GI_PARAM_BOOL, 1, 0, 1, NULL, "jittering (Sec. 4.5)",
-     "final gather: each node's position drawn inside its area every frame, averaged progressively"},
+     "final gather: each node's position drawn inside its area every frame, averaged "
+     "progressively"},
     {"clamp", GI_PARAM_FLOAT, 0.02, 0.0, 1.0, NULL, "clamping (Sec. 5 Quality)",
      "distances below clamp x scene diameter count as that distance"},
-    {"bias", GI_PARAM_FLOAT, 0.004, 0.0, 0.1, NULL, "depth bias (Fig. 14)", "CSSM depth bias as a fraction of the scene diameter"},
-    {"pcf", GI_PARAM_BOOL, 0, 0, 1, NULL, "PCF (Sec. 3.2.2)", "CSSM look-ups filtered over 2 x 2 texels"},
+    {"bias", GI_PARAM_FLOAT, 0.004, 0.0, 0.1, NULL, "depth bias (Fig. 14)",
+     "CSSM depth bias as a fraction of the scene diameter"},
+    {"pcf", GI_PARAM_BOOL, 0, 0, 1, NULL, "PCF (Sec. 3.2.2)",
+     "CSSM look-ups filtered over 2 x 2 texels"},
     {"mode", GI_PARAM_ENUM, 0, 0, 0, "pixels|texels", "samples (Table 1, Fig. 17)",
-     "pixels: final gather per pixel; texels: view-dependent lightmap, the final (glossy) gather of the indirect light "
+     "pixels: final gather per pixel; texels: view-dependent lightmap, the final (glossy) gather "
+     "of the indirect light "
      "per atlas texel with a bicubic look-up, emission and direct light per pixel"},
     {"indirect", GI_PARAM_ENUM, 0, 0, 0, "hrc|mc", "Sec. 4.6 Indirect Light",
-     "hrc: the cuts through the hierarchy; mc: the alternative of Sec. 4.6, mc_samples atlas texels per receiver "
-     "and frame drawn with probability proportional to their radiance x area (instant radiosity with the atlas as "
+     "hrc: the cuts through the hierarchy; mc: the alternative of Sec. 4.6, mc_samples atlas "
+     "texels per receiver "
+     "and frame drawn with probability proportional to their radiance x area (instant radiosity "
+     "with the atlas as "
      "a pdf), CSSM visibility, averaged over frames"},
-    {"mc_samples", GI_PARAM_INT, 16, 1, 4096, NULL, NULL, "texels drawn per receiver and frame with indirect=mc"},
+    {"mc_samples", GI_PARAM_INT, 16, 1, 4096, NULL, NULL,
+     "texels drawn per receiver and frame with indirect=mc"},
     {"env_samples", GI_PARAM_INT, 128, 1, 4096, NULL, "direct light (Sec. 4.7)",
-     "environment light: directions per atlas texel (half from the map's importance sampler, half cosine, "
+     "environment light: directions per atlas texel (half from the map's importance sampler, half "
+     "cosine, "
      "multiple importance sampling), occlusion by the core's ray tracer"},
     {"env_pixel", GI_PARAM_BOOL, 1, 0, 1, NULL, NULL,
-     "environment light per pixel: 1 traced at the pixel (env_samples per pixel and frame, averaged over frames), "
+     "environment light per pixel: 1 traced at the pixel (env_samples per pixel and frame, "
+     "averaged over frames), "
      "0 the atlas texels' irradiance by the bicubic look-up (surface samples: the nearest texel)"},
     {"nodes", GI_PARAM_ENUM, 0, 0, 0, "float|compact", "node encoding (Sec. 4.2.1)",
-     "float: hierarchy nodes of floats; compact: the paper's 128 bits a node (24-bit centre, normal and intensity, "
-     "8-bit radius, cone and area, 16-bit pointers), decoded as the traversal reads them and re-encoded at each "
+     "float: hierarchy nodes of floats; compact: the paper's 128 bits a node (24-bit centre, "
+     "normal and intensity, "
+     "8-bit radius, cone and area, 16-bit pointers), decoded as the traversal reads them and "
+     "re-encoded at each "
      "pull; at most 65535 nodes (32768 texels)"},
     {"env", GI_PARAM_ENUM, 0, 0, 0, "trace|cssm", "direct light (Sec. 4.7)",
-     "environment visibility: trace the core's ray tracer; cssm the escape test in the texels' own cube maps "
-     "(built with the far plane as the mark of 'no surface'; per pixel the maps of the texels around it); not "
+     "environment visibility: trace the core's ray tracer; cssm the escape test in the texels' own "
+     "cube maps "
+     "(built with the far plane as the mark of 'no surface'; per pixel the maps of the texels "
+     "around it); not "
      "with moving objects"},
     {"direct", GI_PARAM_ENUM, 0, 0, 0, "maps|csm", "Sec. 4.7 Direct Light",
-     "maps: area lights are emitting atlas texels gathered by the first bounce, punctual lights shadow-mapped, the "
-     "environment ray-traced; csm: the Monte-Carlo direct light of the original CSM (area lights: csm_points points "
-     "on the emitters with a compressed depth cube map each; point/spot lights: a cube map each; directional and "
+     "maps: area lights are emitting atlas texels gathered by the first bounce, punctual lights "
+     "shadow-mapped, the "
+     "environment ray-traced; csm: the Monte-Carlo direct light of the original CSM (area lights: "
+     "csm_points points "
+     "on the emitters with a compressed depth cube map each; point/spot lights: a cube map each; "
+     "directional and "
      "environment: each object's distant CSM), the HRC bounces gathering the reflected light only"},
     {"csm_points", GI_PARAM_INT, 64, 1, 256, NULL, "N (CSM Sec. 4.2)",
      "direct=csm: points on the area lights (by power), a depth cube map each"},
     {"csm_samples", GI_PARAM_INT, 16, 1, 1024, NULL, "S (CSM Sec. 5.1)",
-     "direct=csm: area-light samples per pixel and frame, each shadowed by the nearest point's cube map"},
-    {"csm_M", GI_PARAM_INT, 64, 8, 256, NULL, "M (CSM Sec. 3.3)", "direct=csm: cube face size of the lights' maps"},
+     "direct=csm: area-light samples per pixel and frame, each shadowed by the nearest point's "
+     "cube map"},
+    {"csm_M", GI_PARAM_INT, 64, 8, 256, NULL, "M (CSM Sec. 3.3)",
+     "direct=csm: cube face size of the lights' maps"},
     {"shadow_size", GI_PARAM_INT, 256, 16, 2048, NULL, NULL,
      "face size of the point/spot lights' shadow cube maps and of directional lights' shadow maps"},
     {0},
@@ -239,8 +264,9 @@ static gi_result make_shadows(cssm_hrc *c, const gi_gpu_scene *gs, gi_error *err
     }
     const uint32_t S = (uint32_t)c->shadow_size;
     const float D = c->atlas.diameter;
-    gi_vec3 centre = gi_v3(0.5f * (gs->bounds[0] + gs->bounds[3]), 0.5f * (gs->bounds[1] + gs->bounds[4]),
-                           0.5f * (gs->bounds[2] + gs->bounds[5]));
+    gi_vec3 centre =
+        gi_v3(0.5f * (gs->bounds[0] + gs->bounds[3]), 0.5f * (gs->bounds[1] + gs->bounds[4]),
+              0.5f * (gs->bounds[2] + gs->bounds[5]));
     for (uint32_t i = 0; i < s->light_count; i++) {
         shadow_map *m = &c->shadows[c->shadow_count++];
         gi_light_frame f = gi_scene_light_at(s, i, gs->time);
@@ -249,7 +275,8 @@ static gi_result make_shadows(cssm_hrc *c, const gi_gpu_scene *gs, gi_error *err
         m->pos = f.position;
         m->dir = gi_v3_normalize(f.direction);
         int directional = m->type == GI_LIGHT_DIRECTIONAL;
-        gi_depth_desc dd = {.size = S, .surfaces = 1, .metric = directional ? GI_DEPTH_EYE_Z : GI_DEPTH_RADIAL};
+        gi_depth_desc dd = {
+            .size = S, .surfaces = 1, .metric = directional ? GI_DEPTH_EYE_Z : GI_DEPTH_RADIAL};
         gi_depth_renderer *dr = gi_depth_renderer_create(&dd, err);
         if (!dr) {
             release_shadows(c);
@@ -306,12 +333,13 @@ static gi_result make_direct(cssm_hrc *c, const gi_gpu_scene *gs, gi_error *err)
     const gi_host *host = c->kit.host;
     cssm_csm_direct_free(c->csm);
     if (!c->csm && !(c->csm = calloc(1, sizeof *c->csm))) {
-        snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for the direct light's CSMs");
+        snprintf(err->text, sizeof err->text,
+                 "cssm_hrc: out of memory for the direct light's CSMs");
         return GI_ERR_OUT_OF_MEMORY;
     }
     host->stage_begin(host, "csm_precompute");
-    gi_result r = cssm_csm_direct_build(gs, c->atlas.diameter, (uint32_t)c->csm_points, (uint32_t)c->csm_M, host,
-                                        c->csm, err);
+    gi_result r = cssm_csm_direct_build(gs, c->atlas.diameter, (uint32_t)c->csm_points,
+                                        (uint32_t)c->csm_M, host, c->csm, err);
     host->stage_end(host, "csm_precompute");
     if (r != GI_OK) {
         free(c->csm);
@@ -328,7 +356,8 @@ static gi_result make_direct(cssm_hrc *c, const gi_gpu_scene *gs, gi_error *err)
 /* Irradiance-like factor of punctual light i at point x with normal n
  * (E / colour: intensity x cos / d^2 x spot x range, or E cos), shadowed by
  * its shadow map. Returns the light's irradiance in e[3]. */
-static void punctual(const cssm_hrc *c, const gi_scene *s, uint32_t i, gi_vec3 x, gi_vec3 n, float e[3])
+static void punctual(const cssm_hrc *c, const gi_scene *s, uint32_t i, gi_vec3 x, gi_vec3 n,
+                     float e[3])
 {
     const shadow_map *m = &c->shadows[i];
     const gi_light *l = &s->lights[i];
@@ -342,7 +371,8 @@ static void punctual(const cssm_hrc *c, const gi_scene *s, uint32_t i, gi_vec3 x
         if (cs <= 0.0f)
             return;
         gi_vec3 q = gi_mat4_point(m->view, x);
-        int tx = (int)((q.x / m->half * 0.5f + 0.5f) * (float)S), ty = (int)((q.y / m->half * 0.5f + 0.5f) * (float)S);
+        int tx = (int)((q.x / m->half * 0.5f + 0.5f) * (float)S),
+            ty = (int)((q.y / m->half * 0.5f + 0.5f) * (float)S);
         if (tx >= 0 && ty >= 0 && tx < (int)S && ty < (int)S) {
             float z = m->depth[(size_t)ty * S + (size_t)tx];
             float slope = 2.0f * m->half / (float)S * 1.5f;
@@ -361,7 +391,8 @@ static void punctual(const cssm_hrc *c, const gi_scene *s, uint32_t i, gi_vec3 x
             return;
         k = cs / (dist * dist) * gi_range_window(dist, l->range);
         if (m->type == GI_LIGHT_SPOT)
-            k *= gi_spot_falloff(gi_v3_dot(m->dir, gi_v3_scale(w, -1.0f)), cosf(l->inner_cone), cosf(l->outer_cone));
+            k *= gi_spot_falloff(gi_v3_dot(m->dir, gi_v3_scale(w, -1.0f)), cosf(l->inner_cone),
+                                 cosf(l->outer_cone));
         if (k <= 0.0f)
             return;
         int face = gi_cube_face(d);
@@ -393,8 +424,8 @@ static float env_traced(const void *ctx, gi_vec3 w)
     return gi_rt_occluded(r->rt, r->x, w, 0.0f, INFINITY) ? 0.0f : 1.0f;
 }
 
-static void env_irradiance(const gi_envmap *env, const gi_rt *rt, gi_vec3 x, gi_vec3 n, uint32_t K, uint32_t seed,
-                           const cssm_receiver *brdf, float e[3])
+static void env_irradiance(const gi_envmap *env, const gi_rt *rt, gi_vec3 x, gi_vec3 n, uint32_t K,
+                           uint32_t seed, const cssm_receiver *brdf, float e[3])
 {
     env_ray r = {rt, x};
     cssm_env_estimate(env, n, K, seed, brdf, env_traced, &r, e);
@@ -426,7 +457,8 @@ static gi_result make_compact(cssm_hrc *c, gi_error *err)
         cssm_ctree_free(&c->ct[i]);
     host->stat(host, "node_count", (double)c->tree.count);
     if (!c->nodes) { /* a float node and its pulled radiance */
-        host->stat(host, "node_bytes", (double)c->tree.count * (double)(sizeof(cssm_node) + 3 * sizeof(float)));
+        host->stat(host, "node_bytes",
+                   (double)c->tree.count * (double)(sizeof(cssm_node) + 3 * sizeof(float)));
         return GI_OK;
     }
     for (int i = 0; i < 3; i++) {
@@ -453,7 +485,8 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
     c->node_L = calloc(3 * (size_t)NN, sizeof *c->node_L);
     if (!D || !c->texel_L || !c->node_L) {
         free(D);
-        return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the lighting");
+        return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY,
+                           "cssm_hrc: out of memory for the lighting");
     }
     host->stage_begin(host, "direct");
     free(c->texel_E);
@@ -464,7 +497,8 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
         if (!c->texel_E) {
             free(D);
             host->stage_end(host, "direct");
-            return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the lighting");
+            return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY,
+                               "cssm_hrc: out of memory for the lighting");
         }
         cssm_env_texels(env, a, &c->maps, (uint32_t)c->env_samples, c->pcf, c->texel_E);
         for (uint32_t i = 0; i < N; i++)
@@ -476,17 +510,20 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
         gi_rt_free(c->rt);
         c->rt = NULL;
         c->texel_E = calloc(3 * (size_t)N, sizeof *c->texel_E);
-        gi_result rr = c->texel_E ? gi_rt_create(gs->scene, gs->time, &rt, &rerr) : GI_ERR_OUT_OF_MEMORY;
+        gi_result rr =
+            c->texel_E ? gi_rt_create(gs->scene, gs->time, &rt, &rerr) : GI_ERR_OUT_OF_MEMORY;
         if (rr != GI_OK) {
             free(D);
             host->stage_end(host, "direct");
             return c->texel_E ? gi_kit_fail_with(&c->kit, rr, &rerr)
-                              : gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the lighting");
+                              : gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY,
+                                            "cssm_hrc: out of memory for the lighting");
         }
         for (uint32_t i = 0; i < N; i++) {
             const cssm_texel *x = &a->texels[i];
             float *e = &c->texel_E[3 * i];
-            env_irradiance(env, rt, offset(c, x->p, x->n), x->n, (uint32_t)c->env_samples, i, NULL, e);
+            env_irradiance(env, rt, offset(c, x->p, x->n), x->n, (uint32_t)c->env_samples, i, NULL,
+                           e);
             for (int k = 0; k < 3; k++)
                 D[3 * i + k] += x->albedo[k] / GI_PI * e[k];
         }
@@ -501,13 +538,14 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
                 D[3 * i + k] += x->albedo[k] / GI_PI * e[k];
         }
     }
-    if (c->csm) /* §4.7: every light's direct light by the CSMs, the fixed estimate over the light points */
+    if (c->csm) /* §4.7: every light's direct light by the CSMs, the fixed estimate over the light
+                   points */
         for (uint32_t i = 0; i < N; i++) {
             const cssm_texel *x = &a->texels[i];
             cssm_receiver rc = {.x = offset(c, x->p, x->n), .n = x->n, .self = (int32_t)i};
             memcpy(rc.kd, x->albedo, sizeof rc.kd);
-            cssm_csm_direct_eval(c->csm, gs->scene, &rc, 0, (uint32_t)c->env_samples, i, c->bias_f * a->diameter,
-                                 c->pcf, &D[3 * i]);
+            cssm_csm_direct_eval(c->csm, gs->scene, &rc, 0, (uint32_t)c->env_samples, i,
+                                 c->bias_f * a->diameter, c->pcf, &D[3 * i]);
         }
     host->stage_end(host, "direct");
     cssm_gather_opts o = gather_opts(c, 0.0f, NULL);
@@ -515,8 +553,9 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
     cssm_gather_stats st = {0};
     gi_error err;
     const float *direct = c->shadow_count || env || c->csm ? D : NULL;
-    gi_result r = cssm_solve_ex(&c->tree, c->nodes ? &c->ct[0] : NULL, a, &c->maps, &o, (uint32_t)c->bounces, direct,
-                                host, c->texel_L, c->node_L, &st, &err);
+    gi_result r =
+        cssm_solve_ex(&c->tree, c->nodes ? &c->ct[0] : NULL, a, &c->maps, &o, (uint32_t)c->bounces,
+                      direct, host, c->texel_L, c->node_L, &st, &err);
     free(D);
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);
@@ -529,7 +568,8 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
     float *tmp = calloc(3 * (size_t)N, sizeof *tmp);
     if (!c->node_Le || !c->node_B || !c->texel_T || !tmp) {
         free(tmp);
-        return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the lighting");
+        return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY,
+                           "cssm_hrc: out of memory for the lighting");
     }
     for (uint32_t i = 0; i < N; i++)
         memcpy(&tmp[3 * i], a->texels[i].emission, 3 * sizeof(float));
@@ -551,7 +591,8 @@ static gi_result lighting(cssm_hrc *c, const gi_gpu_scene *gs)
         c->cdf[i] = malloc(((size_t)N + 1) * sizeof *c->cdf[i]);
     }
     if (!c->texel_Le || !c->cdf[0] || !c->cdf[1] || !c->cdf[2])
-        return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the lighting");
+        return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY,
+                           "cssm_hrc: out of memory for the lighting");
     for (uint32_t i = 0; i < N; i++)
         memcpy(&c->texel_Le[3 * i], a->texels[i].emission, 3 * sizeof(float));
     cssm_pdf_build(a, c->texel_L, c->cdf[0]);
@@ -570,7 +611,8 @@ static const char cache_magic[8] = {'G', 'I', 'C', 'S', 'S', 'M', '\r', '\n'};
 static void cache_name(const cssm_hrc *c, const gi_gpu_scene *gs, char *name, size_t size)
 {
     const gi_scene *s = gs->scene;
-    uint32_t key[5] = {CSSM_FORMAT_VERSION, (uint32_t)c->R, (uint32_t)c->M, (uint32_t)c->traversal, c->atlas.count};
+    uint32_t key[5] = {CSSM_FORMAT_VERSION, (uint32_t)c->R, (uint32_t)c->M, (uint32_t)c->traversal,
+                       c->atlas.count};
     uint64_t h = gi_hash64("gibench-cssm", 12, 0);
     h = gi_hash64(key, sizeof key, h);
     if (c->maps.escape) /* env=cssm: escape intervals (env_cssm.h) */
@@ -603,7 +645,8 @@ static int cache_load(cssm_hrc *c, const char *path)
         ok = at + 8 <= size;
         if (ok)
             memcpy(&n, bytes + at, 8);
-        ok = ok && n <= size - at - 8 && gi_csm_data_read(bytes + at + 8, (size_t)n, &c->maps.face[f], &err) == GI_OK &&
+        ok = ok && n <= size - at - 8 &&
+             gi_csm_data_read(bytes + at + 8, (size_t)n, &c->maps.face[f], &err) == GI_OK &&
              c->maps.face[f].M == (uint32_t)c->M && c->maps.face[f].N == c->atlas.count;
         at += 8 + (size_t)n;
     }
@@ -643,7 +686,8 @@ static void cache_store(cssm_hrc *c, const char *path)
             ok = 0;
     }
     if (!ok || !buf)
-        c->kit.host->log(c->kit.host, GI_LOG_WARN, "cssm_hrc: not cached: %s", err.text[0] ? err.text : "no memory");
+        c->kit.host->log(c->kit.host, GI_LOG_WARN, "cssm_hrc: not cached: %s",
+                         err.text[0] ? err.text : "no memory");
     free(buf);
     for (int f = 0; f < 6; f++)
         free(part[f]);
@@ -688,9 +732,10 @@ static void check_hulls(cssm_hrc *c, const gi_scene *s, float t)
     uint32_t bad = cssm_motion_check(&c->motion, s, t);
     host->stage_end(host, "hull");
     if (bad)
-        host->log(host, GI_LOG_WARN,
-                  "t = %.3f s: %s; the visibility through the moving object is wrong there (Sec. 3.3)", t,
-                  c->motion.what);
+        host->log(
+            host, GI_LOG_WARN,
+            "t = %.3f s: %s; the visibility through the moving object is wrong there (Sec. 3.3)", t,
+            c->motion.what);
 }
 
 /* §3.3 with moving objects: the static CSSM (the scene without the
@@ -699,7 +744,8 @@ static void check_hulls(cssm_hrc *c, const gi_scene *s, float t)
  * cached. */
 /* Compressed sizes of the §3.3 maps of moving objects: their own CSSMs,
  * their CSMs, and (several movers) the static objects' CSMs. */
-static void motion_bytes(const cssm_motion *m, double *self_bytes, double *csm_bytes, double *static_bytes)
+static void motion_bytes(const cssm_motion *m, double *self_bytes, double *csm_bytes,
+                         double *static_bytes)
 {
     *self_bytes = *csm_bytes = *static_bytes = 0.0;
     for (uint32_t k = 0; m->movers && k < m->mover_count; k++) {
@@ -745,15 +791,18 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     uint32_t moving = 0;
     cssm_motion_find(gs->scene, &moving);
     if (moving && gi_scene_deforms(gs->scene))
-        return gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED, "cssm_hrc: deforming objects are not supported");
+        return gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED,
+                           "cssm_hrc: deforming objects are not supported");
     if (moving && c->env_mode == 1 && gs->scene->has_environment)
         return gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED,
                            "cssm_hrc: env=cssm does not support moving objects (use env=trace)");
     if (moving && c->direct)
         return gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED,
-                           "cssm_hrc: direct=csm does not support moving objects (its maps hold the static scene)");
+                           "cssm_hrc: direct=csm does not support moving objects (its maps hold "
+                           "the static scene)");
     host->stage_begin(host, "atlas");
-    gi_result r = cssm_atlas_build(gs->scene, gs->time, (uint32_t)c->R, c->traversal == 0, &c->atlas, &err);
+    gi_result r =
+        cssm_atlas_build(gs->scene, gs->time, (uint32_t)c->R, c->traversal == 0, &c->atlas, &err);
     host->stage_end(host, "atlas");
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);
@@ -768,7 +817,8 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     c->order = cssm_traverse(a, c->traversal == 3 ? CSSM_GREEDY : (cssm_traversal)c->traversal);
     host->stage_end(host, "traversal");
     if (!c->order)
-        return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the traversal");
+        return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY,
+                           "cssm_hrc: out of memory for the traversal");
     r = moving ? build_moving(c, gs, &err) : load_or_build_maps(c, gs, &err);
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);
@@ -778,7 +828,8 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     double self_bytes, csm_bytes, static_bytes;
     motion_bytes(&c->motion, &self_bytes, &csm_bytes, &static_bytes);
     host->stat(host, "compression_ratio", bc ? (double)bu / (double)bc : 0.0);
-    host->stat(host, "segments_per_texel", (double)cssm_maps_segments(&c->maps) / (6.0 * c->M * c->M));
+    host->stat(host, "segments_per_texel",
+               (double)cssm_maps_segments(&c->maps) / (6.0 * c->M * c->M));
     host->stat(host, "dont_care_share", (double)c->maps.dont_care / (double)c->maps.face_texels);
     host->stage_begin(host, "hierarchy");
     r = cssm_tree_build(a, &c->tree, &err);
@@ -795,8 +846,9 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     /* data_bytes counts the compressed visibility maps, the bulk of what is
      * kept: the CSSM, the movers' maps and, with direct=csm, the lights'
      * CSMs; the atlas and the hierarchy are not counted. */
-    host->stat(host, "data_bytes", (double)bc + self_bytes + csm_bytes + static_bytes +
-                                       (c->csm ? (double)cssm_csm_direct_bytes(c->csm) : 0.0));
+    host->stat(host, "data_bytes",
+               (double)bc + self_bytes + csm_bytes + static_bytes +
+                   (c->csm ? (double)cssm_csm_direct_bytes(c->csm) : 0.0));
     r = lighting(c, gs);
     if (r != GI_OK)
         return r;
@@ -811,7 +863,8 @@ static gi_result cssm_update(void *inst, const gi_gpu_scene *gs, const gi_change
     if (!c->prepared)
         return gi_kit_fail(&c->kit, GI_ERR_INVALID_ARGUMENT, "cssm_hrc: update before prepare");
     if (changes->flags & GI_CHANGED_VERTICES)
-        return gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED, "cssm_hrc: deforming objects are not supported");
+        return gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED,
+                           "cssm_hrc: deforming objects are not supported");
     int moved = 0;
     if (changes->flags & GI_CHANGED_TRANSFORMS) {
         if (c->motion.moving < 0)
@@ -876,7 +929,8 @@ static gi_result read_gbuffer(cssm_hrc *c, uint32_t w, uint32_t h)
             free(c->gb[i]);
             c->gb[i] = malloc(n * sizeof(float));
             if (!c->gb[i])
-                return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the G-buffer");
+                return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY,
+                                   "cssm_hrc: out of memory for the G-buffer");
         }
         glGetTextureImage(tex[i], 0, GL_RGBA, GL_FLOAT, (GLsizei)(n * sizeof(float)), c->gb[i]);
     }
@@ -885,15 +939,18 @@ static gi_result read_gbuffer(cssm_hrc *c, uint32_t w, uint32_t h)
             free(c->ids);
             c->ids = malloc(n * sizeof *c->ids);
             if (!c->ids)
-                return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the G-buffer");
+                return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY,
+                                   "cssm_hrc: out of memory for the G-buffer");
         }
-        glGetTextureImage(g->tex_ids, 0, GL_RGBA_INTEGER, GL_UNSIGNED_INT, (GLsizei)(n * sizeof *c->ids), c->ids);
+        glGetTextureImage(g->tex_ids, 0, GL_RGBA_INTEGER, GL_UNSIGNED_INT,
+                          (GLsizei)(n * sizeof *c->ids), c->ids);
     }
     if (c->acc_w != w || c->acc_h != h || !c->accum) {
         free(c->accum);
         c->accum = calloc(n, sizeof(float));
         if (!c->accum)
-            return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the image");
+            return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY,
+                               "cssm_hrc: out of memory for the image");
         c->acc_w = w, c->acc_h = h;
     }
     return GI_OK;
@@ -901,8 +958,8 @@ static gi_result read_gbuffer(cssm_hrc *c, uint32_t w, uint32_t h)
 
 /* One gather of light set `which` (0: emission + reflected, 1: emission,
  * 2: reflected) by the hierarchy's cut, or by Monte Carlo (indirect=mc). */
-static void gather(const cssm_hrc *c, int which, const cssm_receiver *rc, const cssm_gather_opts *o, float out[3],
-                   cssm_gather_stats *st)
+static void gather(const cssm_hrc *c, int which, const cssm_receiver *rc, const cssm_gather_opts *o,
+                   float out[3], cssm_gather_stats *st)
 {
     if (c->indirect == 1) {
         const float *tv = which == 0 ? c->texel_L : which == 1 ? c->texel_Le : c->texel_B;
@@ -963,7 +1020,10 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
         host->stage_begin(host, "texel_gather");
         for (uint32_t i = 0; i < c->atlas.count; i++) {
             const cssm_texel *x = &c->atlas.texels[i];
-            cssm_receiver rc = {.x = offset(c, x->p, x->n), .n = x->n, .self = (int32_t)i, .glossy = 1,
+            cssm_receiver rc = {.x = offset(c, x->p, x->n),
+                                .n = x->n,
+                                .self = (int32_t)i,
+                                .glossy = 1,
                                 .exponent = fminf(x->exponent, 1000.0f)};
             memcpy(rc.kd, x->albedo, sizeof rc.kd);
             memcpy(rc.ks, x->ks, sizeof rc.ks);
@@ -982,8 +1042,10 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
             const float *ph = &c->gb[3][4 * p], *em = &c->gb[4][4 * p];
             float out[3] = {0, 0, 0};
             if (pos[3] > 0.0f) {
-                gi_vec3 P = gi_v3(pos[0], pos[1], pos[2]), Nn = gi_v3_normalize(gi_v3(nor[0], nor[1], nor[2]));
-                cssm_receiver rc = {.x = offset(c, P, Nn), .n = Nn, .self = -1, .glossy = 1, .exponent = ph[3]};
+                gi_vec3 P = gi_v3(pos[0], pos[1], pos[2]),
+                        Nn = gi_v3_normalize(gi_v3(nor[0], nor[1], nor[2]));
+                cssm_receiver rc = {
+                    .x = offset(c, P, Nn), .n = Nn, .self = -1, .glossy = 1, .exponent = ph[3]};
                 if (c->motion.moving >= 0) { /* §3.3: the pixel's object and proxy texel */
                     uint32_t tri = c->ids[4 * p + 2];
                     int32_t proxy = cssm_motion_proxy(&c->motion, s, &c->atlas, tri, P, Nn);
@@ -998,9 +1060,11 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                 uint32_t rng = gi_rng_init((uint32_t)p, frame, view->seed ^ 0xc55u);
                 cssm_gather_opts o = gather_opts(c, view->exposure, random ? &rng : NULL);
                 if (!texels) {
-                    gather(c, c->csm ? 2 : 0, &rc, &o, out, &st); /* with direct=csm the reflected light only */
+                    gather(c, c->csm ? 2 : 0, &rc, &o, out,
+                           &st); /* with direct=csm the reflected light only */
                 } else {
-                    /* direct light of the emitting texels per pixel, the indirect light from the lightmap */
+                    /* direct light of the emitting texels per pixel, the indirect light from the
+                     * lightmap */
                     if (!c->csm)
                         gather(c, 1, &rc, &o, out, NULL);
                     uint32_t tri = c->ids[4 * p + 2];
@@ -1016,10 +1080,12 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                     for (int k = 0; k < 3; k++)
                         out[k] += ind[k];
                 }
-                if (c->csm) /* §4.7: the direct light of every light by the CSMs, S new light points a frame */
-                    cssm_csm_direct_eval(c->csm, s, &rc, (uint32_t)c->csm_samples, (uint32_t)c->env_samples,
-                                         gi_pcg_hash((uint32_t)p ^ gi_pcg_hash(frame ^ view->seed ^ 0xd1cu)),
-                                         c->bias_f * c->atlas.diameter, c->pcf, out);
+                if (c->csm) /* §4.7: the direct light of every light by the CSMs, S new light points
+                               a frame */
+                    cssm_csm_direct_eval(
+                        c->csm, s, &rc, (uint32_t)c->csm_samples, (uint32_t)c->env_samples,
+                        gi_pcg_hash((uint32_t)p ^ gi_pcg_hash(frame ^ view->seed ^ 0xd1cu)),
+                        c->bias_f * c->atlas.diameter, c->pcf, out);
                 for (uint32_t l = 0; l < c->shadow_count; l++) {
                     float e[3];
                     punctual(c, s, l, rc.x, Nn, e);
@@ -1030,33 +1096,41 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                                      : gi_v3_normalize(gi_v3_sub(c->shadows[l].pos, P));
                     gi_vec3 rr = gi_v3_sub(gi_v3_scale(Nn, 2.0f * gi_v3_dot(Nn, rc.wo)), rc.wo);
                     float cl = gi_v3_dot(rr, wi);
-                    float lobe = cl > 0.0f ? (rc.exponent + 2.0f) / (2.0f * GI_PI) * powf(cl, rc.exponent) : 0.0f;
+                    float lobe = cl > 0.0f
+                                     ? (rc.exponent + 2.0f) / (2.0f * GI_PI) * powf(cl, rc.exponent)
+                                     : 0.0f;
                     for (int k = 0; k < 3; k++)
                         out[k] += (rc.kd[k] / GI_PI + rc.ks[k] * lobe) * e[k];
                 }
-                if (c->texel_E) { /* environment: the texels' irradiance, bicubic (surface samples: nearest) */
+                if (c->texel_E) { /* environment: the texels' irradiance, bicubic (surface samples:
+                                     nearest) */
                     uint32_t tri = c->ids[4 * p + 2];
                     int32_t chart = tri < s->triangle_count ? c->atlas.tri_chart[tri] : -1;
                     float e[3] = {0, 0, 0}, u, v;
                     int ok = 0;
-                    if (c->env_pixel && c->maps.escape) { /* env=cssm: the maps of the texels around it */
+                    if (c->env_pixel &&
+                        c->maps.escape) { /* env=cssm: the maps of the texels around it */
                         cssm_env_proxy px;
                         cssm_env_proxies(&c->atlas, &c->maps, s, tri, P, Nn, c->pcf, &px);
                         if (px.count)
-                            cssm_env_estimate(s->envmap, Nn, (uint32_t)c->env_samples,
-                                              gi_pcg_hash((uint32_t)p ^ gi_pcg_hash(frame ^ view->seed)), &rc,
-                                              cssm_env_proxy_vis, &px, e);
+                            cssm_env_estimate(
+                                s->envmap, Nn, (uint32_t)c->env_samples,
+                                gi_pcg_hash((uint32_t)p ^ gi_pcg_hash(frame ^ view->seed)), &rc,
+                                cssm_env_proxy_vis, &px, e);
                         for (int k = 0; k < 3; k++)
                             out[k] += e[k];
-                    } else if (c->env_pixel) { /* reflected radiance (diffuse and glossy) traced at the pixel */
+                    } else if (c->env_pixel) { /* reflected radiance (diffuse and glossy) traced at
+                                                  the pixel */
                         env_irradiance(s->envmap, c->rt, rc.x, Nn, (uint32_t)c->env_samples,
-                                       gi_pcg_hash((uint32_t)p ^ gi_pcg_hash(frame ^ view->seed)), &rc, e);
+                                       gi_pcg_hash((uint32_t)p ^ gi_pcg_hash(frame ^ view->seed)),
+                                       &rc, e);
                         for (int k = 0; k < 3; k++)
                             out[k] += e[k];
                     } else {
                         if (chart >= 0) {
                             cssm_chart_coords(&c->atlas, (uint32_t)chart, P, &u, &v);
-                            ok = cssm_chart_bicubic(&c->atlas, (uint32_t)chart, u, v, c->texel_E, e);
+                            ok =
+                                cssm_chart_bicubic(&c->atlas, (uint32_t)chart, u, v, c->texel_E, e);
                         }
                         if (!ok) {
                             int32_t near = nearest_texel(&c->atlas, P, Nn);
@@ -1069,9 +1143,11 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
                 }
                 for (int k = 0; k < 3; k++)
                     out[k] += em[k];
-            } else if (c->texel_E || (c->csm && s->has_environment && s->envmap)) { /* the environment past the scene */
-                gi_vec3 f = gi_mat4_point(view->inv_view_proj, gi_v3(((float)x + 0.5f) / (float)w * 2.0f - 1.0f,
-                                                                      ((float)y + 0.5f) / (float)h * 2.0f - 1.0f, 1.0f));
+            } else if (c->texel_E || (c->csm && s->has_environment &&
+                                      s->envmap)) { /* the environment past the scene */
+                gi_vec3 f = gi_mat4_point(view->inv_view_proj,
+                                          gi_v3(((float)x + 0.5f) / (float)w * 2.0f - 1.0f,
+                                                ((float)y + 0.5f) / (float)h * 2.0f - 1.0f, 1.0f));
                 gi_envmap_eval(s->envmap, gi_v3_normalize(gi_v3_sub(f, view->eye)), out);
             }
             float *acc = &c->accum[4 * p];
@@ -1081,7 +1157,8 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
             acc[3] = 1.0f;
         }
     host->stage_end(host, "final_gather");
-    glTextureSubImage2D(target->texture, 0, 0, 0, (GLsizei)w, (GLsizei)h, GL_RGBA, GL_FLOAT, c->accum);
+    glTextureSubImage2D(target->texture, 0, 0, 0, (GLsizei)w, (GLsizei)h, GL_RGBA, GL_FLOAT,
+                        c->accum);
     gi_kit_frame_end(kit);
     if (c->motion.moving >= 0) {
         host->stat(host, "hull_overlap", (double)c->motion.overlaps);
@@ -1089,7 +1166,8 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
         for (uint32_t k = 0; k < c->motion.pair_count; k++) { /* per pair of objects with a mover */
             const cssm_hull_pair *pr = &c->motion.pairs[k];
             char pair[72], name[96];
-            snprintf(pair, sizeof pair, "%.30s.%.30s", s->objects[pr->a].name ? s->objects[pr->a].name : "?",
+            snprintf(pair, sizeof pair, "%.30s.%.30s",
+                     s->objects[pr->a].name ? s->objects[pr->a].name : "?",
                      s->objects[pr->b].name ? s->objects[pr->b].name : "?");
             snprintf(name, sizeof name, "hull_overlap.%s", pair);
             host->stat(host, name, (double)pr->overlap);
@@ -1126,13 +1204,13 @@ static const char *cssm_last_error(void *inst)
     return inst ? gi_kit_last_error(&((cssm_hrc *)inst)->kit) : "";
 }
 
-GI_METHOD_EXPORT(cssm,
-    .id = "cssm_hrc",
-    .title = "Coherent Surface Shadow Maps + hierarchical radiosity",
-    .citation = "Ritschel, Grosch, Kautz, Seidel. Interactive Illumination with Coherent Surface Shadow Maps. GI 2008",
-    .version = "0.1",
-    .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_GLOSSY | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS |
-            GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT | GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE | GI_CAP_PRECOMPUTE | GI_CAP_RIGID_MOTION |
-            GI_CAP_TEXTURES,
-    .max_bounces = 3,
-    .params = cssm_params);
+GI_METHOD_EXPORT(cssm, .id = "cssm_hrc",
+                 .title = "Coherent Surface Shadow Maps + hierarchical radiosity",
+                 .citation = "Ritschel, Grosch, Kautz, Seidel. Interactive Illumination with "
+                             "Coherent Surface Shadow Maps. GI 2008",
+                 .version = "0.1",
+                 .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_GLOSSY | GI_CAP_AREA_LIGHTS |
+                         GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT |
+                         GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE | GI_CAP_PRECOMPUTE |
+                         GI_CAP_RIGID_MOTION | GI_CAP_TEXTURES,
+                 .max_bounces = 3, .params = cssm_params);

@@ -56,8 +56,8 @@ static uint32_t emitter_find(const cssm_csm_direct *d, float *u)
 }
 
 /* A point on emitter e at (u1, u2): position, unit normal, area pdf. */
-static gi_vec3 emitter_point(const cssm_csm_direct *d, const gi_scene *s, uint32_t e, float u1, float u2,
-                             gi_vec3 *n, float *pdf_area)
+static gi_vec3 emitter_point(const cssm_csm_direct *d, const gi_scene *s, uint32_t e, float u1,
+                             float u2, gi_vec3 *n, float *pdf_area)
 {
     gi_vec3 p[3];
     gi_scene_triangle_world(s, d->em[e].triangle, d->time, p);
@@ -67,7 +67,8 @@ static gi_vec3 emitter_point(const cssm_csm_direct *d, const gi_scene *s, uint32
     gi_sample_uniform_triangle(u1, u2, b);
     *n = area > 0.0f ? gi_v3_scale(ng, 0.5f / area) : gi_v3(0, 0, 0);
     *pdf_area = area > 0.0f ? d->em[e].pdf / area : 0.0f;
-    return gi_v3_add(gi_v3_add(gi_v3_scale(p[0], b[0]), gi_v3_scale(p[1], b[1])), gi_v3_scale(p[2], b[2]));
+    return gi_v3_add(gi_v3_add(gi_v3_scale(p[0], b[0]), gi_v3_scale(p[1], b[1])),
+                     gi_v3_scale(p[2], b[2]));
 }
 
 static int triangle_double_sided(const gi_scene *s, uint32_t tri)
@@ -75,8 +76,8 @@ static int triangle_double_sided(const gi_scene *s, uint32_t tri)
     return s->materials[s->vertices[s->indices[3 * tri]].material].double_sided;
 }
 
-gi_result cssm_csm_direct_build(const gi_gpu_scene *gs, float diameter, uint32_t N, uint32_t M, const gi_host *host,
-                                cssm_csm_direct *out, gi_error *err)
+gi_result cssm_csm_direct_build(const gi_gpu_scene *gs, float diameter, uint32_t N, uint32_t M,
+                                const gi_host *host, cssm_csm_direct *out, gi_error *err)
 {
     memset(out, 0, sizeof *out);
     const gi_scene *s = gs->scene;
@@ -88,7 +89,8 @@ gi_result cssm_csm_direct_build(const gi_gpu_scene *gs, float diameter, uint32_t
         out->em = malloc(out->em_count * sizeof *out->em);
         if (!out->em)
             goto oom;
-        glGetNamedBufferSubData(gs->ssbo_emitters, 0, (GLsizeiptr)(out->em_count * sizeof *out->em), out->em);
+        glGetNamedBufferSubData(gs->ssbo_emitters, 0, (GLsizeiptr)(out->em_count * sizeof *out->em),
+                                out->em);
     }
     const uint32_t NA = out->em_count ? N : 0;
     uint32_t punctual = 0, directional = 0;
@@ -128,10 +130,12 @@ gi_result cssm_csm_direct_build(const gi_gpu_scene *gs, float diameter, uint32_t
             x->chart = -1;
             x->x = x->y = CSSM_NO_XY;
             x->triangle = out->em[e].triangle;
-            memcpy(&out->pt_Le[3 * i], gi_scene_triangle_emission(s, out->em[e].triangle), 3 * sizeof(float));
+            memcpy(&out->pt_Le[3 * i], gi_scene_triangle_emission(s, out->em[e].triangle),
+                   3 * sizeof(float));
             out->pt_w[i] = pdf > 0.0f ? 1.0f / ((float)NA * pdf) : 0.0f;
             out->pt_ds[i] = (unsigned char)triangle_double_sided(s, out->em[e].triangle);
-            if (out->pt_ds[i]) /* a double-sided emitter lights both sides: its whole cube map counts */
+            if (out->pt_ds[i]) /* a double-sided emitter lights both sides: its whole cube map
+                                  counts */
                 x->n = gi_v3(0, 0, 0);
         }
         for (uint32_t i = 0; i < s->light_count; i++)
@@ -172,7 +176,8 @@ gi_result cssm_csm_direct_build(const gi_gpu_scene *gs, float diameter, uint32_t
             gi_scene_object_transform(s, k, gs->time, T);
             if (!gi_mat4_invert(out->local_from_world[k], T)) {
                 cssm_csm_direct_free(out);
-                snprintf(err->text, sizeof err->text, "cssm_hrc: object %u has a singular transform", k);
+                snprintf(err->text, sizeof err->text,
+                         "cssm_hrc: object %u has a singular transform", k);
                 return GI_ERR_INVALID_ARGUMENT;
             }
             float sc = gi_v3_length(gi_mat4_dir(T, gi_v3(1, 0, 0)));
@@ -185,7 +190,8 @@ gi_result cssm_csm_direct_build(const gi_gpu_scene *gs, float diameter, uint32_t
             }
             const float *sp = out->distant[k].sphere;
             gi_vec3 c = gi_mat4_point(T, gi_v3(sp[0], sp[1], sp[2]));
-            out->sphere_w[4 * k] = c.x, out->sphere_w[4 * k + 1] = c.y, out->sphere_w[4 * k + 2] = c.z;
+            out->sphere_w[4 * k] = c.x, out->sphere_w[4 * k + 1] = c.y,
+                              out->sphere_w[4 * k + 2] = c.z;
             out->sphere_w[4 * k + 3] = sp[3] * out->scale[k];
         }
     }
@@ -254,8 +260,9 @@ static uint32_t nearest_point(const cssm_csm_direct *d, gi_vec3 y)
 
 /* One area-light sample: light point y (normal ny, emitted Le, weight wgt =
  * 1 / (count pdf)), shadowed by cube map j. */
-static void area_sample(const cssm_csm_direct *d, const cssm_receiver *rc, gi_vec3 y, gi_vec3 ny, int ds,
-                        const float Le[3], float wgt, uint32_t j, float bias, int pcf, float out[3])
+static void area_sample(const cssm_csm_direct *d, const cssm_receiver *rc, gi_vec3 y, gi_vec3 ny,
+                        int ds, const float Le[3], float wgt, uint32_t j, float bias, int pcf,
+                        float out[3])
 {
     gi_vec3 v = gi_v3_sub(y, rc->x);
     float d2 = gi_v3_dot(v, v);
@@ -274,19 +281,21 @@ static void area_sample(const cssm_csm_direct *d, const cssm_receiver *rc, gi_ve
         out[k] += f[k] * Le[k] * g;
 }
 
-void cssm_csm_direct_eval(const cssm_csm_direct *d, const gi_scene *s, const cssm_receiver *rc, uint32_t S,
-                          uint32_t env_samples, uint32_t seed, float bias, int pcf, float out[3])
+void cssm_csm_direct_eval(const cssm_csm_direct *d, const gi_scene *s, const cssm_receiver *rc,
+                          uint32_t S, uint32_t env_samples, uint32_t seed, float bias, int pcf,
+                          float out[3])
 {
     uint32_t rng = gi_rng_init(seed, 0, 0xc5d1u);
     /* area lights */
     if (d->area_points && S == 0) {
         for (uint32_t i = 0; i < d->area_points; i++)
-            area_sample(d, rc, d->pts.texels[i].p, d->pts.texels[i].n, d->pt_ds[i], &d->pt_Le[3 * i], d->pt_w[i], i,
-                        bias, pcf, out);
+            area_sample(d, rc, d->pts.texels[i].p, d->pts.texels[i].n, d->pt_ds[i],
+                        &d->pt_Le[3 * i], d->pt_w[i], i, bias, pcf, out);
     } else if (d->area_points) {
         float sub[3] = {0, 0, 0};
         for (uint32_t k = 0; k < S; k++) {
-            float u1 = ((float)k + gi_rng_next_float(&rng)) / (float)S, u2 = gi_rng_next_float(&rng);
+            float u1 = ((float)k + gi_rng_next_float(&rng)) / (float)S,
+                  u2 = gi_rng_next_float(&rng);
             u1 = u1 < GI_ONE_MINUS_EPSILON ? u1 : GI_ONE_MINUS_EPSILON;
             uint32_t e = emitter_find(d, &u1);
             gi_vec3 ny;
@@ -296,7 +305,8 @@ void cssm_csm_direct_eval(const cssm_csm_direct *d, const gi_scene *s, const css
             if (ds) /* a double-sided emitter: its normal faces the receiver */
                 ny = gi_v3_dot(ny, gi_v3_sub(rc->x, y)) < 0.0f ? gi_v3_scale(ny, -1.0f) : ny;
             area_sample(d, rc, y, ny, 1, gi_scene_triangle_emission(s, d->em[e].triangle),
-                        pdf > 0.0f ? 1.0f / ((float)S * pdf) : 0.0f, nearest_point(d, y), bias, pcf, sub);
+                        pdf > 0.0f ? 1.0f / ((float)S * pdf) : 0.0f, nearest_point(d, y), bias, pcf,
+                        sub);
         }
         for (int k = 0; k < 3; k++)
             out[k] += sub[k];
@@ -324,8 +334,9 @@ void cssm_csm_direct_eval(const cssm_csm_direct *d, const gi_scene *s, const css
                 continue;
             k = cs / (dist * dist) * gi_range_window(dist, l->range);
             if (l->type == GI_LIGHT_SPOT)
-                k *= gi_spot_falloff(gi_v3_dot(gi_v3_normalize(fr.direction), gi_v3_scale(w, -1.0f)),
-                                     cosf(l->inner_cone), cosf(l->outer_cone));
+                k *=
+                    gi_spot_falloff(gi_v3_dot(gi_v3_normalize(fr.direction), gi_v3_scale(w, -1.0f)),
+                                    cosf(l->inner_cone), cosf(l->outer_cone));
             if (!(k > 0.0f))
                 continue;
             k *= cssm_visible(&d->maps, d->light_point[i], rc->x, bias, pcf);

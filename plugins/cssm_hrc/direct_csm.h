@@ -30,20 +30,23 @@
 #include "gi/gpu.h"
 
 typedef struct cssm_csm_direct {
-    cssm_atlas pts;          /* the light points as "texels": position, normal (zero at punctual lights) */
-    uint32_t *order;         /* their order in the codec (greedy nearest-first) */
-    cssm_maps maps;          /* a depth cube map per point */
-    uint32_t area_points;    /* points 0 .. area_points-1 lie on emitters, then one per point/spot light */
-    float *pt_Le;            /* per area point: its emitted radiance (3) */
-    float *pt_w;             /* per area point: 1 / (N pdf_area) */
-    unsigned char *pt_ds;    /* per area point: its emitter is double-sided */
-    uint32_t *light_point;   /* per scene light: its point (point / spot), UINT32_MAX for directional */
-    gi_gpu_emitter *em;      /* the core's emitter table (read back): triangle, area, cdf, pdf */
+    cssm_atlas pts;  /* the light points as "texels": position, normal (zero at punctual lights) */
+    uint32_t *order; /* their order in the codec (greedy nearest-first) */
+    cssm_maps maps;  /* a depth cube map per point */
+    uint32_t
+        area_points; /* points 0 .. area_points-1 lie on emitters, then one per point/spot light */
+    float *pt_Le;    /* per area point: its emitted radiance (3) */
+    float *pt_w;     /* per area point: 1 / (N pdf_area) */
+    unsigned char *pt_ds; /* per area point: its emitter is double-sided */
+    uint32_t
+        *light_point;   /* per scene light: its point (point / spot), UINT32_MAX for directional */
+    gi_gpu_emitter *em; /* the core's emitter table (read back): triangle, area, cdf, pdf */
     uint32_t em_count;
-    gi_csm_distant *distant; /* per object (directional lights, environment), NULL when none is needed */
+    gi_csm_distant
+        *distant; /* per object (directional lights, environment), NULL when none is needed */
     float (*local_from_world)[16];
-    float *scale;            /* per object: world units per local unit (bias conversion) */
-    float *sphere_w;         /* per object: world bounding sphere (4), for a quick reject */
+    float *scale;    /* per object: world units per local unit (bias conversion) */
+    float *sphere_w; /* per object: world bounding sphere (4), for a quick reject */
     uint32_t object_count;
     float diameter;
     float time;
@@ -53,8 +56,8 @@ typedef struct cssm_csm_direct {
  * lights (0 when there are none), cube faces M x M. host may be NULL; with
  * one: stage timers csm_render and compress (of the precomputation loop),
  * progress, cancellation. GL context current. */
-gi_result cssm_csm_direct_build(const gi_gpu_scene *gs, float diameter, uint32_t N, uint32_t M, const gi_host *host,
-                                cssm_csm_direct *out, gi_error *err);
+gi_result cssm_csm_direct_build(const gi_gpu_scene *gs, float diameter, uint32_t N, uint32_t M,
+                                const gi_host *host, cssm_csm_direct *out, gi_error *err);
 void cssm_csm_direct_free(cssm_csm_direct *d);
 /* Compressed bytes of the cube maps and of the distant CSMs. */
 uint64_t cssm_csm_direct_bytes(const cssm_csm_direct *d);
@@ -65,8 +68,9 @@ uint64_t cssm_csm_direct_bytes(const cssm_csm_direct *d);
  * S > 0: S points drawn on the emitters from seed (pixels, one frame).
  * env_samples directions of the environment. bias: depth bias in world
  * units; pcf: 2 x 2 PCF in the cube maps. */
-void cssm_csm_direct_eval(const cssm_csm_direct *d, const gi_scene *s, const cssm_receiver *rc, uint32_t S,
-                          uint32_t env_samples, uint32_t seed, float bias, int pcf, float out[3]);
+void cssm_csm_direct_eval(const cssm_csm_direct *d, const gi_scene *s, const cssm_receiver *rc,
+                          uint32_t S, uint32_t env_samples, uint32_t seed, float bias, int pcf,
+                          float out[3]);
 
 /* Visibility of direction w from world point x on a surface of normal n
  * through the objects' distant CSMs (1 lit, 0 blocked; bias in world

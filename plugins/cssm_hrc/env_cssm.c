@@ -11,8 +11,8 @@
 #include <float.h>
 #include <math.h>
 
-void cssm_env_estimate(const gi_envmap *env, gi_vec3 n, uint32_t K, uint32_t seed, const cssm_receiver *brdf,
-                       cssm_env_vis_fn vis, const void *ctx, float e[3])
+void cssm_env_estimate(const gi_envmap *env, gi_vec3 n, uint32_t K, uint32_t seed,
+                       const cssm_receiver *brdf, cssm_env_vis_fn vis, const void *ctx, float e[3])
 {
     e[0] = e[1] = e[2] = 0.0f;
     uint32_t rng = gi_rng_init(seed, 0, 0x5e17u);
@@ -30,7 +30,8 @@ void cssm_env_estimate(const gi_envmap *env, gi_vec3 n, uint32_t K, uint32_t see
         if (brdf) { /* reflected radiance: the receiver's diffuse + Phong BRDF */
             gi_vec3 rr = gi_v3_sub(gi_v3_scale(n, 2.0f * gi_v3_dot(n, brdf->wo)), brdf->wo);
             float cl = gi_v3_dot(rr, w);
-            lobe = cl > 0.0f ? (brdf->exponent + 2.0f) / (2.0f * GI_PI) * powf(cl, brdf->exponent) : 0.0f;
+            lobe = cl > 0.0f ? (brdf->exponent + 2.0f) / (2.0f * GI_PI) * powf(cl, brdf->exponent)
+                             : 0.0f;
         }
         for (int j = 0; j < 3; j++)
             e[j] += v * L[j] * weight * (brdf ? brdf->kd[j] / GI_PI + brdf->ks[j] * lobe : 1.0f);
@@ -92,12 +93,13 @@ float cssm_env_proxy_vis(const void *ctx, gi_vec3 w)
     return wsum > 0.0f ? v / wsum : 0.0f;
 }
 
-void cssm_env_texels(const gi_envmap *env, const cssm_atlas *a, const cssm_maps *m, uint32_t K, int pcf,
-                     float *texel_E)
+void cssm_env_texels(const gi_envmap *env, const cssm_atlas *a, const cssm_maps *m, uint32_t K,
+                     int pcf, float *texel_E)
 {
     for (uint32_t i = 0; i < a->count; i++) {
         cssm_env_texel_ctx ctx = {.m = m, .texel = i, .n = a->texels[i].n, .pcf = pcf};
-        cssm_env_estimate(env, a->texels[i].n, K, i, NULL, cssm_env_texel_vis, &ctx, &texel_E[3 * i]);
+        cssm_env_estimate(env, a->texels[i].n, K, i, NULL, cssm_env_texel_vis, &ctx,
+                          &texel_E[3 * i]);
     }
 }
 
@@ -106,8 +108,8 @@ static uint32_t object_of(const gi_scene *s, uint32_t tri)
     return s->vertices[s->indices[3 * tri]].object;
 }
 
-void cssm_env_proxies(const cssm_atlas *a, const cssm_maps *m, const gi_scene *s, uint32_t tri, gi_vec3 P,
-                      gi_vec3 n, int pcf, cssm_env_proxy *out)
+void cssm_env_proxies(const cssm_atlas *a, const cssm_maps *m, const gi_scene *s, uint32_t tri,
+                      gi_vec3 P, gi_vec3 n, int pcf, cssm_env_proxy *out)
 {
     out->m = m;
     out->a = a;

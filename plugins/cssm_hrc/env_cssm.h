@@ -27,8 +27,8 @@ typedef float (*cssm_env_vis_fn)(const void *ctx, gi_vec3 w);
  * NULL: irradiance E in e[3]; otherwise the radiance reflected toward
  * brdf->wo by its diffuse + normalised Phong BRDF. seed picks the
  * directions (the same seed, the same directions whatever vis is). */
-void cssm_env_estimate(const gi_envmap *env, gi_vec3 n, uint32_t K, uint32_t seed, const cssm_receiver *brdf,
-                       cssm_env_vis_fn vis, const void *ctx, float e[3]);
+void cssm_env_estimate(const gi_envmap *env, gi_vec3 n, uint32_t K, uint32_t seed,
+                       const cssm_receiver *brdf, cssm_env_vis_fn vis, const void *ctx, float e[3]);
 
 /* Whether direction w escapes from texel j's cube map (maps built with
  * escape intervals): z_avg >= far in the face texel of w. pcf: the 2 x 2
@@ -39,15 +39,15 @@ float cssm_escape(const cssm_maps *m, uint32_t j, gi_vec3 w, int pcf);
  * texel_E): cssm_env_estimate with the texel's own escape test, K
  * directions, seed = texel index (the same directions as the traced
  * estimate of env=trace). */
-void cssm_env_texels(const gi_envmap *env, const cssm_atlas *a, const cssm_maps *m, uint32_t K, int pcf,
-                     float *texel_E);
+void cssm_env_texels(const gi_envmap *env, const cssm_atlas *a, const cssm_maps *m, uint32_t K,
+                     int pcf, float *texel_E);
 
 /* What cssm_escape asks of one texel's map for a direction w: below the
  * plane of the texel the map holds "don't care", counted as blocked. */
 typedef struct cssm_env_texel_ctx {
     const cssm_maps *m;
     uint32_t texel;
-    gi_vec3 n;     /* the texel's normal */
+    gi_vec3 n; /* the texel's normal */
     int pcf;
 } cssm_env_texel_ctx;
 float cssm_env_texel_vis(const void *ctx, gi_vec3 w);
@@ -57,7 +57,7 @@ float cssm_env_texel_vis(const void *ctx, gi_vec3 w);
 typedef struct cssm_env_proxy {
     const cssm_maps *m;
     const cssm_atlas *a;
-    uint32_t count;                  /* 0: none found */
+    uint32_t count; /* 0: none found */
     uint32_t texel[CSSM_ENV_PROXIES];
     float weight[CSSM_ENV_PROXIES];
     int pcf;
@@ -68,8 +68,8 @@ typedef struct cssm_env_proxy {
  * exist); elsewhere (surface samples) the 4 nearest texels of the same
  * object whose normal is within 60 degrees of n, weighted by inverse
  * squared distance (brute force over the texels). */
-void cssm_env_proxies(const cssm_atlas *a, const cssm_maps *m, const gi_scene *s, uint32_t tri, gi_vec3 P,
-                      gi_vec3 n, int pcf, cssm_env_proxy *out);
+void cssm_env_proxies(const cssm_atlas *a, const cssm_maps *m, const gi_scene *s, uint32_t tri,
+                      gi_vec3 P, gi_vec3 n, int pcf, cssm_env_proxy *out);
 /* The pixel's visibility of direction w: the proxies' escape tests,
  * weighted, over the proxies whose plane w lies above; 0 when it lies
  * below all of them (as for one texel; counting it as escaping instead

@@ -29,7 +29,8 @@ static float axis_of(gi_vec3 p, int k)
 static int cmp_axis(const void *x, const void *y)
 {
     uint32_t i = *(const uint32_t *)x, j = *(const uint32_t *)y;
-    float a = axis_of(sort_atlas->texels[i].p, sort_axis), b = axis_of(sort_atlas->texels[j].p, sort_axis);
+    float a = axis_of(sort_atlas->texels[i].p, sort_axis),
+          b = axis_of(sort_atlas->texels[j].p, sort_axis);
     if (a != b)
         return a < b ? -1 : 1;
     return i < j ? -1 : (i > j);
@@ -38,7 +39,8 @@ static int cmp_axis(const void *x, const void *y)
 /* A node's bounds over its leaves [first, first + count): bounding sphere
  * (grown by each texel's extent), area-weighted centroid and normal, normal
  * cone, area, representative texel; lo / hi get the box. */
-static void node_fill(const cssm_atlas *a, const cssm_tree *t, cssm_node *nd, float lo[3], float hi[3])
+static void node_fill(const cssm_atlas *a, const cssm_tree *t, cssm_node *nd, float lo[3],
+                      float hi[3])
 {
     const uint32_t first = nd->first, count = nd->count;
     for (int j = 0; j < 3; j++)
@@ -55,7 +57,8 @@ static void node_fill(const cssm_atlas *a, const cssm_tree *t, cssm_node *nd, fl
         area += x->area;
     }
     nd->area = (float)area;
-    nd->centroid = area > 0.0 ? gi_v3_scale(cen, (float)(1.0 / area)) : a->texels[t->leaves[first]].p;
+    nd->centroid =
+        area > 0.0 ? gi_v3_scale(cen, (float)(1.0 / area)) : a->texels[t->leaves[first]].p;
     float nl = gi_v3_length(nsum);
     nd->n = nl > 1e-12f ? gi_v3_scale(nsum, 1.0f / nl) : gi_v3(0, 1, 0);
     nd->c = gi_v3(0.5f * (lo[0] + hi[0]), 0.5f * (lo[1] + hi[1]), 0.5f * (lo[2] + hi[2]));
@@ -75,7 +78,8 @@ static void node_fill(const cssm_atlas *a, const cssm_tree *t, cssm_node *nd, fl
 
 /* Builds the subtree over leaves[first, first + count) at node index *next;
  * returns its index. */
-static int32_t build(const cssm_atlas *a, cssm_tree *t, uint32_t first, uint32_t count, uint32_t *next)
+static int32_t build(const cssm_atlas *a, cssm_tree *t, uint32_t first, uint32_t count,
+                     uint32_t *next)
 {
     int32_t me = (int32_t)(*next)++;
     cssm_node *nd = &t->nodes[me];
@@ -186,7 +190,8 @@ static float cos_bound(gi_vec3 u, gi_vec3 w, float sin_h)
 
 /* Node i as the traversal reads it: the float node with its pulled
  * radiance (intensity = radiance x area), or the packed node decoded. */
-static void fetch(const cssm_tree *t, const float *node_L, const cssm_ctree *ct, int32_t i, cssm_node_view *v)
+static void fetch(const cssm_tree *t, const float *node_L, const cssm_ctree *ct, int32_t i,
+                  cssm_node_view *v)
 {
     if (ct) {
         cssm_ctree_view(ct, (uint32_t)i, v);
@@ -242,7 +247,12 @@ static float bound_view(const cssm_node_view *S, const cssm_receiver *rc)
 
 float cssm_bound(const cssm_node *S, const float L[3], const cssm_receiver *rc)
 {
-    cssm_node_view v = {.c = S->c, .r = S->r, .p = S->centroid, .n = S->n, .cos_cone = S->cos_cone, .area = S->area};
+    cssm_node_view v = {.c = S->c,
+                        .r = S->r,
+                        .p = S->centroid,
+                        .n = S->n,
+                        .cos_cone = S->cos_cone,
+                        .area = S->area};
     for (int k = 0; k < 3; k++)
         v.I[k] = L[k] * S->area;
     return bound_view(&v, rc);
@@ -251,8 +261,9 @@ float cssm_bound(const cssm_node *S, const float L[3], const cssm_receiver *rc)
 /* One gathered node: sample position (the node's gather position, or with
  * jitter a random point of a random texel below it, §4.5), visibility
  * through that texel's CSSM. leaves: leaf rank -> texel. */
-static void transfer(const uint32_t *leaves, const cssm_atlas *a, const cssm_maps *maps, const cssm_node_view *S,
-                     const cssm_receiver *rc, const cssm_gather_opts *o, float out[3], cssm_gather_stats *st)
+static void transfer(const uint32_t *leaves, const cssm_atlas *a, const cssm_maps *maps,
+                     const cssm_node_view *S, const cssm_receiver *rc, const cssm_gather_opts *o,
+                     float out[3], cssm_gather_stats *st)
 {
     gi_vec3 y = S->p, ny = S->n;
     uint32_t vis_texel = S->rep;
@@ -293,7 +304,8 @@ static void transfer(const uint32_t *leaves, const cssm_atlas *a, const cssm_map
     if (rc->glossy && gi_luminance(rc->ks) > 0.0f) {
         gi_vec3 r = gi_v3_sub(gi_v3_scale(rc->n, 2.0f * gi_v3_dot(rc->n, rc->wo)), rc->wo);
         float cl = gi_v3_dot(r, w);
-        float lobe = cl > 0.0f ? (rc->exponent + 2.0f) / (2.0f * GI_PI) * powf(cl, rc->exponent) : 0.0f;
+        float lobe =
+            cl > 0.0f ? (rc->exponent + 2.0f) / (2.0f * GI_PI) * powf(cl, rc->exponent) : 0.0f;
         for (int k = 0; k < 3; k++)
             f[k] += rc->ks[k] * lobe;
     }
@@ -302,9 +314,9 @@ static void transfer(const uint32_t *leaves, const cssm_atlas *a, const cssm_map
 }
 
 /* Fig. 10 over either layout (ct NULL: the float nodes with node_L). */
-static void gather_any(const cssm_tree *t, const float *node_L, const cssm_ctree *ct, const cssm_atlas *a,
-                       const cssm_maps *maps, const cssm_receiver *rc, const cssm_gather_opts *o, float out[3],
-                       cssm_gather_stats *st)
+static void gather_any(const cssm_tree *t, const float *node_L, const cssm_ctree *ct,
+                       const cssm_atlas *a, const cssm_maps *maps, const cssm_receiver *rc,
+                       const cssm_gather_opts *o, float out[3], cssm_gather_stats *st)
 {
     out[0] = out[1] = out[2] = 0.0f;
     const uint32_t *leaves = ct ? ct->leaves : t->leaves;
@@ -346,26 +358,30 @@ static void gather_any(const cssm_tree *t, const float *node_L, const cssm_ctree
     }
 }
 
-void cssm_gather(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps, const float *node_L,
-                 const cssm_receiver *rc, const cssm_gather_opts *o, float out[3], cssm_gather_stats *st)
+void cssm_gather(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps,
+                 const float *node_L, const cssm_receiver *rc, const cssm_gather_opts *o,
+                 float out[3], cssm_gather_stats *st)
 {
     gather_any(t, node_L, NULL, a, maps, rc, o, out, st);
 }
 
-void cssm_cgather(const cssm_ctree *ct, const cssm_atlas *a, const cssm_maps *maps, const cssm_receiver *rc,
-                  const cssm_gather_opts *o, float out[3], cssm_gather_stats *st)
+void cssm_cgather(const cssm_ctree *ct, const cssm_atlas *a, const cssm_maps *maps,
+                  const cssm_receiver *rc, const cssm_gather_opts *o, float out[3],
+                  cssm_gather_stats *st)
 {
     gather_any(NULL, NULL, ct, a, maps, rc, o, out, st);
 }
 
 /* One gather over every texel of the atlas from node radiance node_L (or
  * the packed nodes ct). */
-static void gather_atlas(const cssm_tree *t, const float *node_L, const cssm_ctree *ct, const cssm_atlas *a,
-                         const cssm_maps *maps, const cssm_gather_opts *o, float *out, cssm_gather_stats *st)
+static void gather_atlas(const cssm_tree *t, const float *node_L, const cssm_ctree *ct,
+                         const cssm_atlas *a, const cssm_maps *maps, const cssm_gather_opts *o,
+                         float *out, cssm_gather_stats *st)
 {
     for (uint32_t i = 0; i < a->count; i++) {
         const cssm_texel *x = &a->texels[i];
-        cssm_receiver rc = {.x = cssm_receiver_point(maps, a, x->p, x->n), .n = x->n, .self = (int32_t)i};
+        cssm_receiver rc = {
+            .x = cssm_receiver_point(maps, a, x->p, x->n), .n = x->n, .self = (int32_t)i};
         memcpy(rc.kd, x->albedo, sizeof rc.kd);
         gather_any(t, node_L, ct, a, maps, &rc, o, &out[3 * i], st);
     }
@@ -378,7 +394,8 @@ gi_vec3 cssm_receiver_point(const cssm_maps *maps, const cssm_atlas *a, gi_vec3 
 }
 
 /* Pull of per-texel values into the layout the gathers read. */
-static void pull_any(const cssm_tree *t, cssm_ctree *ct, const cssm_atlas *a, const float *texel_L, float *nodes)
+static void pull_any(const cssm_tree *t, cssm_ctree *ct, const cssm_atlas *a, const float *texel_L,
+                     float *nodes)
 {
     if (ct)
         cssm_ctree_pull(ct, a, texel_L);
@@ -386,20 +403,23 @@ static void pull_any(const cssm_tree *t, cssm_ctree *ct, const cssm_atlas *a, co
         cssm_tree_pull(t, a, texel_L, nodes);
 }
 
-gi_result cssm_solve(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps, const cssm_gather_opts *o,
-                     uint32_t bounces, const float *direct, const gi_host *host, float *texel_L, float *node_L,
-                     cssm_gather_stats *st, gi_error *err)
+gi_result cssm_solve(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps,
+                     const cssm_gather_opts *o, uint32_t bounces, const float *direct,
+                     const gi_host *host, float *texel_L, float *node_L, cssm_gather_stats *st,
+                     gi_error *err)
 {
     return cssm_solve_ex(t, NULL, a, maps, o, bounces, direct, host, texel_L, node_L, st, err);
 }
 
-gi_result cssm_solve_ex(const cssm_tree *t, cssm_ctree *ct, const cssm_atlas *a, const cssm_maps *maps,
-                        const cssm_gather_opts *o, uint32_t bounces, const float *direct, const gi_host *host,
-                        float *texel_L, float *node_L, cssm_gather_stats *st, gi_error *err)
+gi_result cssm_solve_ex(const cssm_tree *t, cssm_ctree *ct, const cssm_atlas *a,
+                        const cssm_maps *maps, const cssm_gather_opts *o, uint32_t bounces,
+                        const float *direct, const gi_host *host, float *texel_L, float *node_L,
+                        cssm_gather_stats *st, gi_error *err)
 {
     const uint32_t N = a->count;
     float *Le = calloc(3 * (size_t)N, sizeof *Le), *Rk = calloc(3 * (size_t)N, sizeof *Rk);
-    float *Rn = calloc(3 * (size_t)N, sizeof *Rn), *nodes = calloc(3 * (size_t)t->count, sizeof *nodes);
+    float *Rn = calloc(3 * (size_t)N, sizeof *Rn),
+          *nodes = calloc(3 * (size_t)t->count, sizeof *nodes);
     if (!Le || !Rk || !Rn || !nodes) {
         free(Le), free(Rk), free(Rn), free(nodes);
         snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for the lighting");
@@ -449,12 +469,14 @@ double cssm_pdf_build(const cssm_atlas *a, const float *texel_values, double *cd
 {
     cdf[0] = 0.0;
     for (uint32_t i = 0; i < a->count; i++)
-        cdf[i + 1] = cdf[i] + (double)fmaxf(0.0f, gi_luminance(&texel_values[3 * i])) * a->texels[i].area;
+        cdf[i + 1] =
+            cdf[i] + (double)fmaxf(0.0f, gi_luminance(&texel_values[3 * i])) * a->texels[i].area;
     return cdf[a->count];
 }
 
-void cssm_gather_mc(const cssm_atlas *a, const cssm_maps *maps, const float *texel_values, const double *cdf,
-                    uint32_t S, const cssm_receiver *rc, const cssm_gather_opts *o, float out[3])
+void cssm_gather_mc(const cssm_atlas *a, const cssm_maps *maps, const float *texel_values,
+                    const double *cdf, uint32_t S, const cssm_receiver *rc,
+                    const cssm_gather_opts *o, float out[3])
 {
     out[0] = out[1] = out[2] = 0.0f;
     const double total = cdf[a->count];
@@ -480,7 +502,8 @@ void cssm_gather_mc(const cssm_atlas *a, const cssm_maps *maps, const float *tex
         gi_onb(x->n, &tu, &tv);
         float side = sqrtf(x->area);
         float u1 = gi_rng_next_float(o->rng) - 0.5f, u2 = gi_rng_next_float(o->rng) - 0.5f;
-        gi_vec3 y = gi_v3_add(x->p, gi_v3_add(gi_v3_scale(tu, u1 * side), gi_v3_scale(tv, u2 * side)));
+        gi_vec3 y =
+            gi_v3_add(x->p, gi_v3_add(gi_v3_scale(tu, u1 * side), gi_v3_scale(tv, u2 * side)));
         gi_vec3 w = gi_v3_sub(y, rc->x);
         float d2 = gi_v3_dot(w, w);
         if (!(d2 > 0.0f))
@@ -498,7 +521,8 @@ void cssm_gather_mc(const cssm_atlas *a, const cssm_maps *maps, const float *tex
         if (rc->glossy && gi_luminance(rc->ks) > 0.0f) {
             gi_vec3 r = gi_v3_sub(gi_v3_scale(rc->n, 2.0f * gi_v3_dot(rc->n, rc->wo)), rc->wo);
             float cl = gi_v3_dot(r, w);
-            float lobe = cl > 0.0f ? (rc->exponent + 2.0f) / (2.0f * GI_PI) * powf(cl, rc->exponent) : 0.0f;
+            float lobe =
+                cl > 0.0f ? (rc->exponent + 2.0f) / (2.0f * GI_PI) * powf(cl, rc->exponent) : 0.0f;
             for (int c = 0; c < 3; c++)
                 f[c] += rc->ks[c] * lobe;
         }

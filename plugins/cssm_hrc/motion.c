@@ -71,7 +71,8 @@ static gi_result oom(cssm_motion *m, gi_error *err, const char *what)
     return GI_ERR_OUT_OF_MEMORY;
 }
 
-gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, cssm_motion *out, gi_error *err)
+gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, cssm_motion *out,
+                           gi_error *err)
 {
     memset(out, 0, sizeof *out);
     uint32_t K = 0;
@@ -94,9 +95,10 @@ gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, cssm
     out->static_csm = calloc(O ? O : 1, sizeof *out->static_csm);
     out->static_Tinv = calloc(16 * (size_t)(O ? O : 1), sizeof *out->static_Tinv);
     out->static_scale = calloc(O ? O : 1, sizeof *out->static_scale);
-    if (!out->on_moving || !out->on_static || !out->local_p || !out->local_n || !out->local_charts ||
-        !out->object_of || !out->object_moves || !out->mover_of || !out->movers || !out->obj_first ||
-        !out->obj_texels || !out->hulls || !out->static_csm || !out->static_Tinv || !out->static_scale)
+    if (!out->on_moving || !out->on_static || !out->local_p || !out->local_n ||
+        !out->local_charts || !out->object_of || !out->object_moves || !out->mover_of ||
+        !out->movers || !out->obj_first || !out->obj_texels || !out->hulls || !out->static_csm ||
+        !out->static_Tinv || !out->static_scale)
         return oom(out, err, "the moving objects");
     for (uint32_t k = 0, i = 0; k < O; k++) {
         out->mover_of[k] = -1;
@@ -105,7 +107,8 @@ gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, cssm
         if (!gi_mat4_invert(Ti, T0)) {
             const char *name = s->objects[k].name ? s->objects[k].name : "?";
             cssm_motion_free(out);
-            snprintf(err->text, sizeof err->text, "cssm_hrc: the object '%.100s' has a singular transform", name);
+            snprintf(err->text, sizeof err->text,
+                     "cssm_hrc: the object '%.100s' has a singular transform", name);
             return GI_ERR_INVALID_ARGUMENT;
         }
         out->static_scale[k] = transform_scale(T0);
@@ -190,7 +193,8 @@ gi_result cssm_motion_build_maps(cssm_motion *m, const gi_gpu_scene *gs, const c
 {
     unsigned char *elsewhere = malloc(a->count ? a->count : 1);
     if (!elsewhere) {
-        snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for the moving objects' maps");
+        snprintf(err->text, sizeof err->text,
+                 "cssm_hrc: out of memory for the moving objects' maps");
         return GI_ERR_OUT_OF_MEMORY;
     }
     gi_result r = GI_OK;
@@ -255,7 +259,8 @@ void cssm_motion_place(cssm_motion *m, const gi_scene *s, float t, cssm_atlas *a
 
 /* Mover A's hull shrunk about its vertices' centroid, then placed by T:
  * the transform into *TA and the placed box. */
-static void shrunk_hull(const gi_hull *ha, const float T[16], float TA[16], gi_vec3 *lo, gi_vec3 *hi)
+static void shrunk_hull(const gi_hull *ha, const float T[16], float TA[16], gi_vec3 *lo,
+                        gi_vec3 *hi)
 {
     gi_vec3 c = gi_v3(0, 0, 0);
     for (uint32_t v = 0; v < ha->vertex_count; v++)
@@ -276,20 +281,24 @@ static void shrunk_hull(const gi_hull *ha, const float T[16], float TA[16], gi_v
 
 /* 1 when a triangle of object k (at time t) lies in the placed hull (TA,
  * box lo..hi) of object A. */
-static int reaches_into(const cssm_motion *m, const gi_scene *s, float t, uint32_t A, const float TA[16],
-                        gi_vec3 lo, gi_vec3 hi, uint32_t k)
+static int reaches_into(const cssm_motion *m, const gi_scene *s, float t, uint32_t A,
+                        const float TA[16], gi_vec3 lo, gi_vec3 hi, uint32_t k)
 {
     const gi_object *ob = &s->objects[k];
     for (uint32_t tri = ob->first_triangle; tri < ob->first_triangle + ob->triangle_count; tri++) {
         gi_vec3 p[3];
         if (m->object_moves[k]) /* placed by the mover's transform (cssm_motion_place) */
             for (uint32_t c = 0; c < 3; c++)
-                p[c] = gi_mat4_point(m->movers[m->mover_of[k]].T, gi_scene_vertex_position(s, s->indices[3 * tri + c], t));
+                p[c] = gi_mat4_point(m->movers[m->mover_of[k]].T,
+                                     gi_scene_vertex_position(s, s->indices[3 * tri + c], t));
         else
             gi_scene_triangle_world(s, tri, t, p);
-        if (fmaxf(p[0].x, fmaxf(p[1].x, p[2].x)) < lo.x || fminf(p[0].x, fminf(p[1].x, p[2].x)) > hi.x ||
-            fmaxf(p[0].y, fmaxf(p[1].y, p[2].y)) < lo.y || fminf(p[0].y, fminf(p[1].y, p[2].y)) > hi.y ||
-            fmaxf(p[0].z, fmaxf(p[1].z, p[2].z)) < lo.z || fminf(p[0].z, fminf(p[1].z, p[2].z)) > hi.z)
+        if (fmaxf(p[0].x, fmaxf(p[1].x, p[2].x)) < lo.x ||
+            fminf(p[0].x, fminf(p[1].x, p[2].x)) > hi.x ||
+            fmaxf(p[0].y, fmaxf(p[1].y, p[2].y)) < lo.y ||
+            fminf(p[0].y, fminf(p[1].y, p[2].y)) > hi.y ||
+            fmaxf(p[0].z, fmaxf(p[1].z, p[2].z)) < lo.z ||
+            fminf(p[0].z, fminf(p[1].z, p[2].z)) > hi.z)
             continue;
         gi_hull th = {.vertices = p, .vertex_count = 3};
         if (gi_hull_overlap(&m->hulls[A], TA, &th, NULL, 0.0f))
@@ -330,7 +339,8 @@ uint32_t cssm_motion_check(cssm_motion *m, const gi_scene *s, float t)
         if (!pr->intrusion)
             continue;
         if (!m->intrusions)
-            snprintf(m->what, sizeof m->what, "object '%.60s' reaches into the convex hull of the moving '%.60s'",
+            snprintf(m->what, sizeof m->what,
+                     "object '%.60s' reaches into the convex hull of the moving '%.60s'",
                      s->objects[from].name ? s->objects[from].name : "?",
                      s->objects[into].name ? s->objects[into].name : "?");
         m->intrusions++;
@@ -377,15 +387,16 @@ int32_t cssm_motion_proxy(const cssm_motion *m, const gi_scene *s, const cssm_at
 
 /* Whether a mover other than skip1, skip2 blocks the segment p-q (world):
  * its CSM through its T^-1. */
-static float other_movers(const cssm_motion *m, float v, gi_vec3 p, gi_vec3 q, int32_t skip1, int32_t skip2,
-                          float bias)
+static float other_movers(const cssm_motion *m, float v, gi_vec3 p, gi_vec3 q, int32_t skip1,
+                          int32_t skip2, float bias)
 {
     for (uint32_t k = 0; k < m->mover_count && v > 0.0f; k++) {
         if ((int32_t)k == skip1 || (int32_t)k == skip2)
             continue;
         const cssm_mover *mv = &m->movers[k];
         const float lb = bias / (mv->scale > 0.0f ? mv->scale : 1.0f);
-        if (gi_csm_distant_blocks(&mv->csm, gi_mat4_point(mv->Tinv, p), gi_mat4_point(mv->Tinv, q), lb))
+        if (gi_csm_distant_blocks(&mv->csm, gi_mat4_point(mv->Tinv, p), gi_mat4_point(mv->Tinv, q),
+                                  lb))
             v = 0.0f;
     }
     return v;
@@ -418,7 +429,8 @@ float cssm_visible_rc(const cssm_maps *maps, uint32_t j, const cssm_receiver *rc
         return cssm_visible(maps, j, rc->x, bias, pcf);
     const int32_t r = rc->self >= 0 ? rc->self : (int32_t)rc->proxy1 - 1;
     /* the movers of the two ends, -1 for S */
-    const int32_t gx = rc->self >= 0 ? m->mover_of[m->object_of[rc->self]] : (int32_t)rc->moving - 1;
+    const int32_t gx =
+        rc->self >= 0 ? m->mover_of[m->object_of[rc->self]] : (int32_t)rc->moving - 1;
     const int32_t gj = m->mover_of[m->object_of[j]];
     const cssm_mover *B = gx >= 0 ? &m->movers[gx] : NULL;
     const float bbias = B ? bias / (B->scale > 0.0f ? B->scale : 1.0f) : bias;
@@ -427,8 +439,8 @@ float cssm_visible_rc(const cssm_maps *maps, uint32_t j, const cssm_receiver *rc
     if (gj >= 0) {
         const cssm_mover *A = &m->movers[gj];
         /* D T^-1: the receiver in A's frame, looked up in A's CSSM at j */
-        v = cssm_visible(&A->self, j, gi_mat4_point(A->Tinv, rc->x), bias / (A->scale > 0.0f ? A->scale : 1.0f),
-                         pcf);
+        v = cssm_visible(&A->self, j, gi_mat4_point(A->Tinv, rc->x),
+                         bias / (A->scale > 0.0f ? A->scale : 1.0f), pcf);
         if (v <= 0.0f || gx == gj)
             return v;
         pj = gi_mat4_point(A->T, A->self.eye[j]);
@@ -439,8 +451,10 @@ float cssm_visible_rc(const cssm_maps *maps, uint32_t j, const cssm_receiver *rc
         } else {
             /* two movers: the receiver's own test toward j, then S by its objects' CSMs */
             if (rc->self >= 0)
-                v *= cssm_visible(&B->self, (uint32_t)rc->self, gi_mat4_point(B->Tinv, pj), bbias, pcf);
-            else if (gi_csm_distant_blocks(&B->csm, gi_mat4_point(B->Tinv, pj), gi_mat4_point(B->Tinv, rc->x), bbias))
+                v *= cssm_visible(&B->self, (uint32_t)rc->self, gi_mat4_point(B->Tinv, pj), bbias,
+                                  pcf);
+            else if (gi_csm_distant_blocks(&B->csm, gi_mat4_point(B->Tinv, pj),
+                                           gi_mat4_point(B->Tinv, rc->x), bbias))
                 v = 0.0f;
             if (v > 0.0f)
                 v = static_objects(m, v, pj, rc->x, bias);
@@ -455,7 +469,8 @@ float cssm_visible_rc(const cssm_maps *maps, uint32_t j, const cssm_receiver *rc
         /* B between j and a texel of B: that texel's CSSM toward j; a pixel on B: B's CSM */
         if (rc->self >= 0)
             v *= cssm_visible(&B->self, (uint32_t)rc->self, gi_mat4_point(B->Tinv, pj), bbias, pcf);
-        else if (gi_csm_distant_blocks(&B->csm, gi_mat4_point(B->Tinv, pj), gi_mat4_point(B->Tinv, rc->x), bbias))
+        else if (gi_csm_distant_blocks(&B->csm, gi_mat4_point(B->Tinv, pj),
+                                       gi_mat4_point(B->Tinv, rc->x), bbias))
             return 0.0f;
         if (v <= 0.0f)
             return v;

@@ -55,13 +55,13 @@ typedef struct cssm_mover {
 
 /* A pair of objects with a mover in it, and its last hull check. */
 typedef struct cssm_hull_pair {
-    uint32_t a, b;        /* objects, a < b */
+    uint32_t a, b;           /* objects, a < b */
     unsigned char overlap;   /* the placed hulls meet */
     unsigned char intrusion; /* a surface of one lies inside the other's (mover's) hull */
 } cssm_hull_pair;
 
 typedef struct cssm_motion {
-    int32_t moving;             /* the first mover's object, -1: not in moving-object mode */
+    int32_t moving; /* the first mover's object, -1: not in moving-object mode */
     uint32_t mover_count;
     cssm_mover *movers;
     int32_t *mover_of;          /* per object: its mover, -1 for a static object */
@@ -70,14 +70,16 @@ typedef struct cssm_motion {
     gi_vec3 *local_p, *local_n; /* per texel on a mover: position and normal in its frame */
     cssm_chart *local_charts;   /* the atlas' charts of movers in their frames */
     uint32_t *object_of;        /* per texel: its object */
-    unsigned char *object_moves; /* per object: 1 for a mover (what the static CSSM does not draw) */
+    unsigned char
+        *object_moves; /* per object: 1 for a mover (what the static CSSM does not draw) */
     uint32_t *obj_first,
-        *obj_texels;       /* texels of object k: obj_texels[obj_first[k] .. obj_first[k + 1]) */
-    gi_hull *hulls;        /* per object, local frame */
+        *obj_texels; /* texels of object k: obj_texels[obj_first[k] .. obj_first[k + 1]) */
+    gi_hull *hulls;  /* per object, local frame */
     uint32_t object_count;
-    gi_csm_distant *static_csm; /* per object, with two or more movers: a static object's CSM (else zero) */
-    float *static_Tinv;         /* per object: 16 floats, a static object's local_from_world */
-    float *static_scale;        /* per object: its transform's scale */
+    gi_csm_distant
+        *static_csm;    /* per object, with two or more movers: a static object's CSM (else zero) */
+    float *static_Tinv; /* per object: 16 floats, a static object's local_from_world */
+    float *static_scale; /* per object: its transform's scale */
     cssm_hull_pair *pairs;
     uint32_t pair_count;
     uint32_t overlaps, intrusions; /* the last check: pairs that overlap / intrude */
@@ -92,7 +94,8 @@ int32_t cssm_motion_find(const gi_scene *s, uint32_t *count);
  * and pairs; every animated object of s is a mover. The maps (each
  * mover's self and csm, the static CSMs) are made by
  * cssm_motion_build_maps. */
-gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, cssm_motion *out, gi_error *err);
+gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, cssm_motion *out,
+                           gi_error *err);
 /* Each mover's CSSM and CSM, and with two or more movers the static
  * objects' CSMs (a GL context current). host may be NULL. */
 gi_result cssm_motion_build_maps(cssm_motion *m, const gi_gpu_scene *gs, const cssm_atlas *a,

@@ -32,7 +32,8 @@ static const gi_param_desc direct_params[] = {
      "area-light samples per pixel and frame"},
     {"env_samples", GI_PARAM_INT, 16, 0, 4096, NULL, "S (environment)",
      "environment-map samples per pixel and frame (and as many BRDF samples with mis)"},
-    {"mis", GI_PARAM_BOOL, 1, 0, 1, NULL, NULL, "combine environment and BRDF sampling (power heuristic)"},
+    {"mis", GI_PARAM_BOOL, 1, 0, 1, NULL, NULL,
+     "combine environment and BRDF sampling (power heuristic)"},
     {"accumulate", GI_PARAM_BOOL, 1, 0, 1, NULL, NULL, "average frames of a still view"},
     {0},
 };
@@ -78,7 +79,8 @@ static gi_result direct_render(void *inst, const gi_view *view, const gi_target 
     direct *d = inst;
     gi_kit *k = &d->kit;
     const gi_host *host = k->host;
-    gi_result r = gi_kit_frame_begin(k, view, GI_KIT_GBUFFER | GI_KIT_ACCUMULATE | (d->accumulate ? 0 : GI_KIT_NO_AVERAGE));
+    gi_result r = gi_kit_frame_begin(
+        k, view, GI_KIT_GBUFFER | GI_KIT_ACCUMULATE | (d->accumulate ? 0 : GI_KIT_NO_AVERAGE));
     if (r == GI_OK)
         r = gi_kit_render_gbuffer(k, view, "gbuffer");
     if (r != GI_OK)
@@ -119,13 +121,11 @@ static const char *direct_last_error(void *inst)
     return inst ? gi_kit_last_error(&((direct *)inst)->kit) : "";
 }
 
-GI_METHOD_EXPORT(direct,
-    .id = "direct",
-    .title = "Unshadowed direct light (no-visibility baseline)",
-    .citation = "gibench baseline: direct light without visibility",
-    .version = "1.0",
-    .caps = GI_CAP_DIRECT | GI_CAP_GLOSSY | GI_CAP_MIRROR | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS |
-            GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION | GI_CAP_DEFORMATION |
-            GI_CAP_PROGRESSIVE | GI_CAP_TEXTURES,
-    .max_bounces = 0,
-    .params = direct_params);
+GI_METHOD_EXPORT(direct, .id = "direct",
+                 .title = "Unshadowed direct light (no-visibility baseline)",
+                 .citation = "gibench baseline: direct light without visibility", .version = "1.0",
+                 .caps = GI_CAP_DIRECT | GI_CAP_GLOSSY | GI_CAP_MIRROR | GI_CAP_AREA_LIGHTS |
+                         GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT |
+                         GI_CAP_RIGID_MOTION | GI_CAP_DEFORMATION | GI_CAP_PROGRESSIVE |
+                         GI_CAP_TEXTURES,
+                 .max_bounces = 0, .params = direct_params);

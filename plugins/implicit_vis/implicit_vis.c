@@ -47,37 +47,46 @@ static const gi_param_desc iv_params[] = {
     {"bounces", GI_PARAM_INT, 3, 0, 3, NULL, "light bounces (Algorithm 1, line 8)",
      "indirect bounces after the direct light (Table 1: 1)"},
     {"subdiv", GI_PARAM_FLOAT, 1.0, 0.01, 100.0, NULL, "Sec. 4.2.2",
-     "a node is subdivided while its solid angle seen from the other end exceeds this many bins' solid angle"},
+     "a node is subdivided while its solid angle seen from the other end exceeds this many bins' "
+     "solid angle"},
     {"links", GI_PARAM_ENUM, 0, 0, 0, "hierarchical|brute", "Sec. 4.2 / 3.1 (Fig. 10 b, c)",
      "hierarchical links, or every leaf against every leaf"},
     {"remesh", GI_PARAM_FLOAT, 0.0, 0.0, 1.0, NULL, "Sec. 5.1 (re-meshing)",
-     "target edge length as a fraction of the scene's largest extent (re-meshed by `remesher`); 0 = the model's own vertices"},
+     "target edge length as a fraction of the scene's largest extent (re-meshed by `remesher`); 0 "
+     "= the model's own vertices"},
     {"remesher", GI_PARAM_ENUM, 0, 0, 0, "isotropic|grid", "Sec. 5.1 (re-meshing)",
-     "isotropic: CGAL's isotropic re-meshing, each new vertex on an original triangle; grid: each triangle subdivided into a k x k grid"},
+     "isotropic: CGAL's isotropic re-meshing, each new vertex on an original triangle; grid: each "
+     "triangle subdivided into a k x k grid"},
     {"bilinear", GI_PARAM_BOOL, 0, 0, 1, NULL, "Sec. 4.2.2 (deviation)",
-     "a link goes into the four bins around its direction, each with its share of the node's solid angle (README \"Deviations\")"},
+     "a link goes into the four bins around its direction, each with its share of the node's solid "
+     "angle (README \"Deviations\")"},
     {"coverage", GI_PARAM_FLOAT, 0.0, 0.0, 1.0, NULL, "Eq. 4 / Eq. 5 (deviation)",
-     "a bin whose links' solid angles sum to less than this share of it passes light through that share only; 0: Eq. 5 (the nearest covers the bin)"},
+     "a bin whose links' solid angles sum to less than this share of it passes light through that "
+     "share only; 0: Eq. 5 (the nearest covers the bin)"},
     {"splat", GI_PARAM_BOOL, 1, 0, 1, NULL, "Sec. 3 (an element covers its bin)",
-     "a disc nearer than its size covers every bin it spans, not only its centre's (README \"Deviations\")"},
+     "a disc nearer than its size covers every bin it spans, not only its centre's (README "
+     "\"Deviations\")"},
     {"threads", GI_PARAM_INT, 0, 0, 256, NULL, "Table 1 (create_links on the CPU)",
-     "threads that create the hierarchical links (the same links as on one); 0 = every online core"},
+     "threads that create the hierarchical links (the same links as on one); 0 = every online "
+     "core"},
     {"glossy", GI_PARAM_BOOL, 1, 0, 1, NULL, "Sec. 4.3 (glossy direct light, Fig. 11)",
-     "glossy (Phong) materials reflect the direct light through their lobe, the BRDF-weighted sum over each element's bins; false: diffuse only"},
+     "glossy (Phong) materials reflect the direct light through their lobe, the BRDF-weighted sum "
+     "over each element's bins; false: diffuse only"},
     {"illum", GI_PARAM_ENUM, 0, 0, 0, "gpu|cpu", "Sec. 4.3.1 (GPU implementation)",
-     "where the gathering and pull-up run: compute shaders over the flattened links, or one CPU thread"},
+     "where the gathering and pull-up run: compute shaders over the flattened links, or one CPU "
+     "thread"},
     {0},
 };
 
 typedef struct implicit_vis {
     gi_kit kit;
     int N, bounces, brute, splat, bilinear, cpu_illum, remesher, threads;
-    int glossy;          /* the display adds the glossy direct light (a glossy material, glossy=true) */
+    int glossy; /* the display adds the glossy direct light (a glossy material, glossy=true) */
     float subdiv, remesh, coverage;
     iv_hier *hier;
     iv_links *links;
-    iv_gpu *gpu;         /* the GPU illumination (illum=gpu) */
-    float *irr;          /* 6 per element */
+    iv_gpu *gpu;       /* the GPU illumination (illum=gpu) */
+    float *irr;        /* 6 per element */
     float *elem_light; /* 12 per element: e_front, e_back, normal (vec4 each) */
     GLuint ssbo_light, ssbo_tri, ssbo_grid;
     GLuint prog_display;
@@ -148,14 +157,17 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
     host->stage_end(host, "hierarchy");
     if (!m->hier)
         return gi_kit_fail_with(&m->kit, GI_ERR_INVALID_ARGUMENT, &err);
-    unsigned long long bytes = 6ull * (unsigned long long)m->N * (unsigned long long)m->N * m->hier->node_count * 12ull;
+    unsigned long long bytes =
+        6ull * (unsigned long long)m->N * (unsigned long long)m->N * m->hier->node_count * 12ull;
     if (bytes > IV_MAX_LINK_BYTES)
         return gi_kit_fail(&m->kit, GI_ERR_UNSUPPORTED,
-                           "implicit_vis: %u nodes x 6 x %d x %d bins need %.1f GiB of links (limit 3 GiB): lower N",
+                           "implicit_vis: %u nodes x 6 x %d x %d bins need %.1f GiB of links "
+                           "(limit 3 GiB): lower N",
                            m->hier->node_count, m->N, m->N, (double)bytes / (1u << 30));
     if (m->brute && m->hier->elem_count > IV_MAX_BRUTE_ELEMENTS)
         return gi_kit_fail(&m->kit, GI_ERR_UNSUPPORTED,
-                           "implicit_vis: links=brute compares every two of %u elements (limit %u): use links=hierarchical",
+                           "implicit_vis: links=brute compares every two of %u elements (limit "
+                           "%u): use links=hierarchical",
                            m->hier->elem_count, IV_MAX_BRUTE_ELEMENTS);
     m->links = iv_links_create(m->hier, (uint32_t)m->N);
     if (m->links) {
@@ -170,7 +182,8 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
     uint32_t *grid = malloc(((size_t)h->disp_count * 8 + 1) * sizeof(uint32_t));
     if (!m->links || !m->irr || !m->elem_light || !tri || !grid) {
         free(tri), free(grid);
-        return gi_kit_fail(&m->kit, GI_ERR_OUT_OF_MEMORY, "implicit_vis: out of memory for the links of %u nodes",
+        return gi_kit_fail(&m->kit, GI_ERR_OUT_OF_MEMORY,
+                           "implicit_vis: out of memory for the links of %u nodes",
                            m->hier->node_count);
     }
     /* the display's look-up: triangle -> (k, first grid point), grid point
@@ -186,25 +199,31 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
         grid[8 * (size_t)d + 7] = 0;
     }
     glCreateBuffers(1, &m->ssbo_tri);
-    glNamedBufferStorage(m->ssbo_tri, (GLsizeiptr)((size_t)s->triangle_count * 2 * sizeof(uint32_t)), tri, 0);
+    glNamedBufferStorage(m->ssbo_tri,
+                         (GLsizeiptr)((size_t)s->triangle_count * 2 * sizeof(uint32_t)), tri, 0);
     glCreateBuffers(1, &m->ssbo_grid);
-    glNamedBufferStorage(m->ssbo_grid, (GLsizeiptr)((size_t)h->disp_count * 8 * sizeof(uint32_t)), grid, 0);
+    glNamedBufferStorage(m->ssbo_grid, (GLsizeiptr)((size_t)h->disp_count * 8 * sizeof(uint32_t)),
+                         grid, 0);
     free(tri), free(grid);
     glCreateBuffers(1, &m->ssbo_light);
-    glNamedBufferStorage(m->ssbo_light, (GLsizeiptr)((size_t)m->hier->elem_count * 12 * sizeof(float)), NULL,
+    glNamedBufferStorage(m->ssbo_light,
+                         (GLsizeiptr)((size_t)m->hier->elem_count * 12 * sizeof(float)), NULL,
                          GL_DYNAMIC_STORAGE_BIT);
     /* glossy: a Phong material (a mirror's delta lobe is not handled: no GI_CAP_MIRROR) */
     int glossy = 0;
     for (uint32_t i = 0; i < s->material_count; i++) {
         const gi_material *mat = &s->materials[i];
-        glossy |= mat->ks[0] + mat->ks[1] + mat->ks[2] > 0.0f && !mat->mirror && mat->exponent < GI_MIRROR_EXPONENT;
+        glossy |= mat->ks[0] + mat->ks[1] + mat->ks[2] > 0.0f && !mat->mirror &&
+                  mat->exponent < GI_MIRROR_EXPONENT;
     }
     m->glossy = m->glossy != 0 && glossy;
     if (m->glossy && m->cpu_illum)
         return gi_kit_fail(&m->kit, GI_ERR_UNSUPPORTED,
-                           "implicit_vis: glossy materials need illum=gpu (the display reads the GPU's links); use "
+                           "implicit_vis: glossy materials need illum=gpu (the display reads the "
+                           "GPU's links); use "
                            "illum=gpu or glossy=false");
-    m->prog_display = gi_program_build_compute("iv_display.comp", m->glossy ? "#define IV_GLOSSY 1\n" : NULL, &err);
+    m->prog_display = gi_program_build_compute("iv_display.comp",
+                                               m->glossy ? "#define IV_GLOSSY 1\n" : NULL, &err);
     if (!m->prog_display)
         return gi_kit_fail_with(&m->kit, GI_ERR_GL, &err);
     if (!m->cpu_illum) {
@@ -246,7 +265,8 @@ static void upload_elem_light(implicit_vis *m)
         memcpy(o + 8, &h->nrm[3 * h->elem_node[e]], 3 * sizeof(float));
         o[3] = o[7] = o[11] = 0.0f;
     }
-    glNamedBufferSubData(m->ssbo_light, 0, (GLsizeiptr)((size_t)h->elem_count * 12 * sizeof(float)), m->elem_light);
+    glNamedBufferSubData(m->ssbo_light, 0, (GLsizeiptr)((size_t)h->elem_count * 12 * sizeof(float)),
+                         m->elem_light);
 }
 
 static gi_result iv_render(void *inst, const gi_view *view, const gi_target *target)
@@ -273,9 +293,11 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
     host->stage_end(host, "refine_push");
 
     host->stage_begin(host, "illumination");
-    if (m->gpu) { /* Sec. 4.3.1: the punctual lights at the frame's time come from the scene's buffer */
+    if (m->gpu) { /* Sec. 4.3.1: the punctual lights at the frame's time come from the scene's
+                     buffer */
         gi_gpu_scene_bind(gs);
-        r = iv_gpu_illuminate(m->gpu, m->links, m->hier, (uint32_t)m->bounces, s->light_count, &err);
+        r = iv_gpu_illuminate(m->gpu, m->links, m->hier, (uint32_t)m->bounces, s->light_count,
+                              &err);
     } else {
         iv_lights li = {s, gs->time, s->envmap};
         iv_illuminate(m->links, m->hier, &li, (uint32_t)m->bounces, m->irr);
@@ -291,14 +313,16 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
         GLuint p = m->prog_display;
         glUseProgram(p);
         gi_kit_bind(&m->kit, p, view, target);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_ELEM_LIGHT, m->gpu ? m->gpu->ssbo_out : m->ssbo_light);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_ELEM_LIGHT,
+                         m->gpu ? m->gpu->ssbo_out : m->ssbo_light);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_TRI, m->ssbo_tri);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_GRID, m->ssbo_grid);
         if (m->glossy) { /* Sec. 4.3: the glossy lobe over the elements' direct-light bins */
             iv_gpu_bind_direct(m->gpu);
             glUniform1ui(glGetUniformLocation(p, "u_n"), m->gpu->n);
             glUniform1ui(glGetUniformLocation(p, "u_bins"), m->gpu->bins);
-            glUniform1ui(glGetUniformLocation(p, "u_light_base"), m->links->leaf_off[m->hier->elem_count]);
+            glUniform1ui(glGetUniformLocation(p, "u_light_base"),
+                         m->links->leaf_off[m->hier->elem_count]);
             glUniform1i(glGetUniformLocation(p, "u_env"), m->gpu->env);
         }
         GLint size[2] = {(GLint)view->width, (GLint)view->height};
@@ -321,8 +345,11 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
      * coverage, the covered solid angle) and each leaf's receiving and light
      * links (bin + source). The hierarchy's own arrays are not counted. */
     const iv_links *L = m->links;
-    double bin_bytes = (double)L->nodes * (double)L->bins * (double)(sizeof(int32_t) + sizeof(float) + (L->cover ? sizeof(float) : 0));
-    double leaf_bytes = 2.0 * sizeof(uint32_t) * ((double)L->leaf_off[m->hier->elem_count] + (double)L->light_off[m->hier->elem_count]);
+    double bin_bytes = (double)L->nodes * (double)L->bins *
+                       (double)(sizeof(int32_t) + sizeof(float) + (L->cover ? sizeof(float) : 0));
+    double leaf_bytes =
+        2.0 * sizeof(uint32_t) *
+        ((double)L->leaf_off[m->hier->elem_count] + (double)L->light_off[m->hier->elem_count]);
     host->stat(host, "data_bytes_links", bin_bytes + leaf_bytes);
     host->stat(host, "data_bytes", bin_bytes + leaf_bytes);
     return GI_OK;
@@ -343,12 +370,12 @@ static const char *iv_last_error(void *inst)
     return inst ? gi_kit_last_error(&((implicit_vis *)inst)->kit) : "";
 }
 
-GI_METHOD_EXPORT(iv,
-    .id = "implicit_vis",
-    .title = "Interactive Global Illumination Using Implicit Visibility",
-    .citation = "Dong, Kautz, Theobalt, Seidel. Pacific Graphics 2007",
-    .version = "0.1",
-    .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_GLOSSY | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL |
-            GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION | GI_CAP_DEFORMATION | GI_CAP_VISIBILITY | GI_CAP_TEXTURES,
-    .max_bounces = 3,
-    .params = iv_params);
+GI_METHOD_EXPORT(iv, .id = "implicit_vis",
+                 .title = "Interactive Global Illumination Using Implicit Visibility",
+                 .citation = "Dong, Kautz, Theobalt, Seidel. Pacific Graphics 2007",
+                 .version = "0.1",
+                 .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_GLOSSY | GI_CAP_AREA_LIGHTS |
+                         GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT |
+                         GI_CAP_RIGID_MOTION | GI_CAP_DEFORMATION | GI_CAP_VISIBILITY |
+                         GI_CAP_TEXTURES,
+                 .max_bounces = 3, .params = iv_params);

@@ -5,13 +5,12 @@
  * stage on its own.
  *
  * Use (Algorithm 1):
- *     iv_hier *h = iv_hier_create(scene, edge, IV_REMESH_ISOTROPIC, &err); // CreateSurfels + CreateGeometricHierarchy
- *     iv_links *l = iv_links_create(h, N);
- *     per frame:
- *         iv_hier_update(h, scene, t);               // UpdateElements (Sec. 4.2.1)
- *         iv_links_build(l, h, subdiv, brute, splat);        // CreateHierarchicalLinks (Sec. 4.2.2)
- *         iv_links_refine_push(l, h);                 // Refine + PushDownLinks (Sec. 4.2.3-4.2.4)
- *         iv_illuminate(l, h, &lights, bounces, E);   // ComputeIlluminate + PullupEnergy (Sec. 4.3)
+ *     iv_hier *h = iv_hier_create(scene, edge, IV_REMESH_ISOTROPIC, &err); // CreateSurfels +
+ * CreateGeometricHierarchy iv_links *l = iv_links_create(h, N); per frame: iv_hier_update(h, scene,
+ * t);               // UpdateElements (Sec. 4.2.1) iv_links_build(l, h, subdiv, brute, splat); //
+ * CreateHierarchicalLinks (Sec. 4.2.2) iv_links_refine_push(l, h);                 // Refine +
+ * PushDownLinks (Sec. 4.2.3-4.2.4) iv_illuminate(l, h, &lights, bounces, E);   // ComputeIlluminate
+ * + PullupEnergy (Sec. 4.3)
  */
 #ifndef IV_H
 #define IV_H
@@ -42,7 +41,8 @@ float iv_bin_solid_angle(uint32_t b, uint32_t n);
 
 /* How the model is re-meshed to the target edge length (Sec. 5.1). */
 enum {
-    IV_REMESH_ISOTROPIC = 0, /* CGAL's isotropic re-meshing (gi/algo/remesh.h), each new vertex on an original triangle */
+    IV_REMESH_ISOTROPIC = 0, /* CGAL's isotropic re-meshing (gi/algo/remesh.h), each new vertex on
+                                an original triangle */
     IV_REMESH_GRID = 1,      /* each triangle subdivided into a k x k grid of its own */
 };
 
@@ -81,9 +81,9 @@ typedef struct iv_hier {
     /* Elements: one oriented disc per distinct point (points equal in
      * position and normal merged). */
     uint32_t elem_count;
-    uint32_t *elem_rep;  /* element -> one of its points */
-    float *elem_albedo;  /* 3 per element: mean albedo of its points */
-    float *elem_emit;    /* 3 per element: emitted radiance */
+    uint32_t *elem_rep; /* element -> one of its points */
+    float *elem_albedo; /* 3 per element: mean albedo of its points */
+    float *elem_emit;   /* 3 per element: emitted radiance */
     uint8_t *elem_two_sided_emit;
     uint32_t segment_count; /* connected parts of each object: the roots */
     /* Nodes in breadth-first order: the roots first, children contiguous
@@ -98,10 +98,11 @@ typedef struct iv_hier {
     uint32_t depth;       /* levels of the deepest tree */
     /* Per frame (iv_hier_update), world space. */
     float *pos;  /* 3 per node: area-weighted mean of the children */
-    float *nrm;  /* 3 per node: area-weighted mean normal (unit for a leaf; shorter where children disagree) */
+    float *nrm;  /* 3 per node: area-weighted mean normal (unit for a leaf; shorter where children
+                    disagree) */
     float *area; /* per node: sum of the children */
     float *spos; /* scratch: 3 per surface point at t */
-    gi_vertex *verts; /* scratch: an object's vertices at t */
+    gi_vertex *verts;   /* scratch: an object's vertices at t */
     float *wpos, *wnrm; /* scratch: the model's vertices at t, world space */
 } iv_hier;
 
@@ -118,37 +119,42 @@ void iv_hier_update(iv_hier *h, const gi_scene *s, float t);
  * world units at t = 0: mean and coefficient of variation (standard
  * deviation / mean), each edge counted once per triangle. */
 void iv_hier_edge_stats(const iv_hier *h, const gi_scene *s, double *mean, double *cv);
-static inline int iv_is_leaf(const iv_hier *h, uint32_t node) { return h->child_count[node] == 0; }
+static inline int iv_is_leaf(const iv_hier *h, uint32_t node)
+{
+    return h->child_count[node] == 0;
+}
 
 /* ---- the hierarchical link structure (Sec. 4.2) ---- */
 
 typedef struct iv_links {
-    uint32_t n;        /* bins per cube side (the paper's N) */
-    uint32_t bins;     /* 6 n n */
+    uint32_t n;    /* bins per cube side (the paper's N) */
+    uint32_t bins; /* 6 n n */
     uint32_t nodes;
-    int32_t *other;    /* nodes x bins: the linked node, -1 empty */
-    float *dist;       /* nodes x bins: its distance */
-    uint32_t threads;  /* > 1: links created on this many threads, the same links to the bit (README
-                          "Multi-threaded link creation"); 0 or 1: on one */
-    int bilinear;      /* links written into the four bins around their direction (README "Deviations") */
-    float coverage;    /* > 0: a bin whose links' solid angles sum to less than this share of it is lit
-                          through that part only (README "Deviations"); 0: Eq. 5, the nearest covers all */
-    float *cover;      /* nodes x bins: solid angle of every node linked in the bin (Eq. 4's sum); after
-                          refinement summed down each leaf's path */
-    float *bin_dir;    /* 3 per bin: centre direction */
-    float *bin_omega;  /* per bin: solid angle */
+    int32_t *other;   /* nodes x bins: the linked node, -1 empty */
+    float *dist;      /* nodes x bins: its distance */
+    uint32_t threads; /* > 1: links created on this many threads, the same links to the bit (README
+                         "Multi-threaded link creation"); 0 or 1: on one */
+    int bilinear;   /* links written into the four bins around their direction (README "Deviations")
+                     */
+    float coverage; /* > 0: a bin whose links' solid angles sum to less than this share of it is lit
+                       through that part only (README "Deviations"); 0: Eq. 5, the nearest covers
+                       all */
+    float *cover; /* nodes x bins: solid angle of every node linked in the bin (Eq. 4's sum); after
+                     refinement summed down each leaf's path */
+    float *bin_dir;   /* 3 per bin: centre direction */
+    float *bin_omega; /* per bin: solid angle */
     /* After iv_links_refine_push: the receiving links of each leaf
      * (unidirectional), and the light links among them (Sec. 4.3.1 "Speedup"). */
-    uint32_t *leaf_off;   /* elements + 1 */
-    uint32_t *leaf_bin;   /* bin of each receiving link */
-    uint32_t *leaf_src;   /* node at its other end */
-    uint32_t *light_off;  /* elements + 1 */
+    uint32_t *leaf_off;  /* elements + 1 */
+    uint32_t *leaf_bin;  /* bin of each receiving link */
+    uint32_t *leaf_src;  /* node at its other end */
+    uint32_t *light_off; /* elements + 1 */
     uint32_t *light_bin, *light_src;
     size_t leaf_cap, light_cap;
     /* Counters of the last build. */
-    uint64_t tries;       /* node pairs considered */
-    uint64_t created;     /* bin entries written (a shorter link replacing one counts) */
-    uint64_t receiving;   /* leaf links after refinement and push-down */
+    uint64_t tries;     /* node pairs considered */
+    uint64_t created;   /* bin entries written (a shorter link replacing one counts) */
+    uint64_t receiving; /* leaf links after refinement and push-down */
 } iv_links;
 
 iv_links *iv_links_create(const iv_hier *h, uint32_t n);
@@ -179,8 +185,8 @@ void iv_links_pack(const iv_links *l, const iv_hier *h, uint32_t *links, uint32_
 
 typedef struct iv_lights {
     const gi_scene *scene;
-    float t;                  /* punctual lights placed at this time */
-    const gi_envmap *env;     /* NULL: black */
+    float t;              /* punctual lights placed at this time */
+    const gi_envmap *env; /* NULL: black */
 } iv_lights;
 
 /* Gathers the direct light (light links, punctual lights through their bin,
@@ -189,6 +195,7 @@ typedef struct iv_lights {
  * reflected radiance up after each gather. Out: per element the irradiance
  * on both sides of its disc, e_out[6 e + 0..2] on the normal's side,
  * [6 e + 3..5] on the other. */
-void iv_illuminate(const iv_links *l, iv_hier *h, const iv_lights *lights, uint32_t bounces, float *e_out);
+void iv_illuminate(const iv_links *l, iv_hier *h, const iv_lights *lights, uint32_t bounces,
+                   float *e_out);
 
 #endif

@@ -30,14 +30,16 @@ uint32_t iv_bin_of(gi_vec3 d, uint32_t n)
         return 0;
     uint32_t face = 2u * (uint32_t)ax + (a[ax] < 0.0f ? 1u : 0u);
     float u = a[(ax + 1) % 3] / m, v = a[(ax + 2) % 3] / m;
-    int col = (int)floorf((u + 1.0f) * 0.5f * (float)n), row = (int)floorf((v + 1.0f) * 0.5f * (float)n);
+    int col = (int)floorf((u + 1.0f) * 0.5f * (float)n),
+        row = (int)floorf((v + 1.0f) * 0.5f * (float)n);
     col = col < 0 ? 0 : (col >= (int)n ? (int)n - 1 : col);
     row = row < 0 ? 0 : (row >= (int)n ? (int)n - 1 : row);
     return face * n * n + (uint32_t)row * n + (uint32_t)col;
 }
 
 /* Face, and the texel's square [u0, u1] x [v0, v1] on it. */
-static void bin_square(uint32_t b, uint32_t n, uint32_t *face, float *u0, float *u1, float *v0, float *v1)
+static void bin_square(uint32_t b, uint32_t n, uint32_t *face, float *u0, float *u1, float *v0,
+                       float *v1)
 {
     *face = b / (n * n);
     uint32_t r = b % (n * n), row = r / n, col = r % n;
@@ -60,7 +62,10 @@ gi_vec3 iv_bin_centre(uint32_t b, uint32_t n)
     return gi_v3_normalize(gi_v3(a[0], a[1], a[2]));
 }
 
-static double texel_f(double x, double y) { return atan2(x * y, sqrt(x * x + y * y + 1.0)); }
+static double texel_f(double x, double y)
+{
+    return atan2(x * y, sqrt(x * x + y * y + 1.0));
+}
 
 float iv_bin_solid_angle(uint32_t b, uint32_t n)
 {
@@ -99,7 +104,8 @@ static uint32_t tri_k(const gi_scene *s, uint32_t t, float target)
 /* Rest position and normal (object-local) of a point of triangle t. */
 static void rest_point(const gi_scene *s, uint32_t t, float b1, float b2, float p[3], gi_vec3 *n)
 {
-    const gi_vertex *v0 = &s->vertices[s->indices[3 * t]], *v1 = &s->vertices[s->indices[3 * t + 1]],
+    const gi_vertex *v0 = &s->vertices[s->indices[3 * t]],
+                    *v1 = &s->vertices[s->indices[3 * t + 1]],
                     *v2 = &s->vertices[s->indices[3 * t + 2]];
     float b0 = 1.0f - b1 - b2;
     for (int c = 0; c < 3; c++)
@@ -128,7 +134,8 @@ typedef struct welder {
     const uint32_t *key;
 } welder;
 
-static int welder_init(welder *w, uint32_t n, double q, const float *pos, const float *nrm, const uint32_t *key)
+static int welder_init(welder *w, uint32_t n, double q, const float *pos, const float *nrm,
+                       const uint32_t *key)
 {
     w->hsize = 1;
     while (w->hsize < 2 * n)
@@ -144,13 +151,18 @@ static int welder_init(welder *w, uint32_t n, double q, const float *pos, const 
     return 1;
 }
 
-static void welder_free(welder *w) { free(w->head), free(w->next); }
+static void welder_free(welder *w)
+{
+    free(w->head), free(w->next);
+}
 
 /* The id merged with point (p, n, key), or the new id `fresh` added. */
-static uint32_t welder_find_or_add(welder *w, const float p[3], gi_vec3 n, uint32_t key, uint32_t fresh)
+static uint32_t welder_find_or_add(welder *w, const float p[3], gi_vec3 n, uint32_t key,
+                                   uint32_t fresh)
 {
     double q = w->q;
-    int64_t cx = (int64_t)floor(p[0] / q), cy = (int64_t)floor(p[1] / q), cz = (int64_t)floor(p[2] / q);
+    int64_t cx = (int64_t)floor(p[0] / q), cy = (int64_t)floor(p[1] / q),
+            cz = (int64_t)floor(p[2] / q);
     for (int dz = -1; dz <= 1; dz++)
         for (int dy = -1; dy <= 1; dy++)
             for (int dx = -1; dx <= 1; dx++) {
@@ -213,16 +225,19 @@ static int samples_grid(iv_hier *h, const gi_scene *s, float target)
                 h->samp_b[2 * si] = (float)i / (float)k;
                 h->samp_b[2 * si + 1] = (float)j / (float)k;
                 for (int c = 0; c < 3; c++) {
-                    h->disp_elem[3 * si + c] = si; /* the point itself (mapped to its element later) */
+                    h->disp_elem[3 * si + c] =
+                        si; /* the point itself (mapped to its element later) */
                     h->disp_w[3 * si + c] = c == 0 ? 1.0f : 0.0f;
                 }
                 if (i + j + 1 <= k) { /* lower sub-triangle (i,j) (i+1,j) (i,j+1) */
                     uint32_t *o = &h->surf_tri[3 * st++];
-                    o[0] = si, o[1] = base + iv_grid_index(k, i + 1, j), o[2] = base + iv_grid_index(k, i, j + 1);
+                    o[0] = si, o[1] = base + iv_grid_index(k, i + 1, j),
+                    o[2] = base + iv_grid_index(k, i, j + 1);
                 }
                 if (i + j + 2 <= k) { /* upper sub-triangle (i+1,j) (i+1,j+1) (i,j+1) */
                     uint32_t *o = &h->surf_tri[3 * st++];
-                    o[0] = base + iv_grid_index(k, i + 1, j), o[1] = base + iv_grid_index(k, i + 1, j + 1);
+                    o[0] = base + iv_grid_index(k, i + 1, j),
+                    o[1] = base + iv_grid_index(k, i + 1, j + 1);
                     o[2] = base + iv_grid_index(k, i, j + 1);
                 }
             }
@@ -263,9 +278,12 @@ static int samples_isotropic(iv_hier *h, const gi_scene *s, float target, gi_err
     uint32_t nt = s->triangle_count;
     int ok = 0;
     uint32_t *order = malloc((nt + 1) * sizeof *order), *key = malloc((nt + 1) * sizeof *key);
-    gi_remeshed **rm = calloc(nt + 1, sizeof *rm); /* per patch, indexed by its first triangle in `order` */
-    float *lp = malloc(((size_t)nt * 9 + 1) * sizeof(float)), *ln = malloc(((size_t)nt * 9 + 1) * sizeof(float));
-    uint32_t *lk = calloc((size_t)nt * 3 + 1, sizeof *lk), *lidx = malloc(((size_t)nt * 3 + 1) * sizeof *lidx);
+    gi_remeshed **rm =
+        calloc(nt + 1, sizeof *rm); /* per patch, indexed by its first triangle in `order` */
+    float *lp = malloc(((size_t)nt * 9 + 1) * sizeof(float)),
+          *ln = malloc(((size_t)nt * 9 + 1) * sizeof(float));
+    uint32_t *lk = calloc((size_t)nt * 3 + 1, sizeof *lk),
+             *lidx = malloc(((size_t)nt * 3 + 1) * sizeof *lidx);
     float *query = NULL, *qb = NULL;
     uint32_t *qf = NULL;
     welder w = {0};
@@ -322,7 +340,8 @@ static int samples_isotropic(iv_hier *h, const gi_scene *s, float target, gi_err
                 lidx[3 * (i - a) + (uint32_t)c] = id;
             }
         uint32_t obj = s->vertices[s->indices[3 * order[a]]].object;
-        rm[a] = gi_remesh_isotropic(lp, nv, lidx, b - a, target / object_scale(s, obj), IV_REMESH_ITERATIONS, err);
+        rm[a] = gi_remesh_isotropic(lp, nv, lidx, b - a, target / object_scale(s, obj),
+                                    IV_REMESH_ITERATIONS, err);
         if (!rm[a]) {
             ok = -2;
             goto done;
@@ -343,7 +362,8 @@ static int samples_isotropic(iv_hier *h, const gi_scene *s, float target, gi_err
     h->disp_w = malloc((disp * 3 + 1) * sizeof *h->disp_w);
     uint32_t maxq = 0;
     for (uint32_t t = 0; t < nt; t++)
-        maxq = h->tri_grid[t + 1] - h->tri_grid[t] > maxq ? h->tri_grid[t + 1] - h->tri_grid[t] : maxq;
+        maxq =
+            h->tri_grid[t + 1] - h->tri_grid[t] > maxq ? h->tri_grid[t + 1] - h->tri_grid[t] : maxq;
     if (!h->samp_tri || !h->samp_b || !h->surf_tri || !h->disp_elem || !h->disp_w)
         goto done;
     uint32_t base = 0, sbase = 0;
@@ -374,11 +394,12 @@ static int samples_isotropic(iv_hier *h, const gi_scene *s, float target, gi_err
             for (uint32_t j = 0; j <= k; j++)
                 for (uint32_t ii = 0; ii + j <= k; ii++) {
                     gi_vec3 n;
-                    rest_point(s, t, (float)ii / (float)k, (float)j / (float)k, &query[3 * qi++], &n);
+                    rest_point(s, t, (float)ii / (float)k, (float)j / (float)k, &query[3 * qi++],
+                               &n);
                 }
         }
-        if (gi_mesh_locate(r->positions, r->vertex_count, r->indices, r->triangle_count, query, nq, qf, qb, err) !=
-            GI_OK) {
+        if (gi_mesh_locate(r->positions, r->vertex_count, r->indices, r->triangle_count, query, nq,
+                           qf, qb, err) != GI_OK) {
             ok = -2;
             goto done;
         }
@@ -387,7 +408,8 @@ static int samples_isotropic(iv_hier *h, const gi_scene *s, float target, gi_err
             uint32_t t = order[i];
             for (uint32_t d = h->tri_grid[t]; d < h->tri_grid[t + 1]; d++, qi++)
                 for (int c = 0; c < 3; c++) {
-                    h->disp_elem[3 * d + c] = base + r->indices[3 * qf[qi] + c]; /* a point (mapped later) */
+                    h->disp_elem[3 * d + c] =
+                        base + r->indices[3 * qf[qi] + c]; /* a point (mapped later) */
                     h->disp_w[3 * d + c] = qb[3 * qi + c];
                 }
         }
@@ -400,7 +422,8 @@ done:
         for (uint32_t i = 0; i < nt; i++)
             gi_remeshed_free(rm[i]);
     welder_free(&w);
-    free(order), free(key), free(rm), free(lp), free(ln), free(lk), free(lidx), free(query), free(qb), free(qf);
+    free(order), free(key), free(rm), free(lp), free(ln), free(lk), free(lidx), free(query),
+        free(qb), free(qf);
     return ok;
 }
 
@@ -426,20 +449,22 @@ static int make_elements(iv_hier *h, const gi_scene *s, float target, int remesh
     float *rn = malloc(((size_t)ns * 3 + 1) * sizeof(float));
     float *albedo_sum = calloc((size_t)ns * 3 + 1, sizeof(float));
     float *emit = calloc((size_t)ns * 3 + 1, sizeof(float));
-    float *ep = malloc(((size_t)ns * 3 + 1) * sizeof(float)), *en = malloc(((size_t)ns * 3 + 1) * sizeof(float));
+    float *ep = malloc(((size_t)ns * 3 + 1) * sizeof(float)),
+          *en = malloc(((size_t)ns * 3 + 1) * sizeof(float));
     uint32_t *ek = malloc(((size_t)ns + 1) * sizeof *ek);
     uint8_t *two = calloc(ns + 1, 1);
     uint32_t *count = calloc(ns + 1, sizeof *count);
     welder w = {0};
-    int ok = h->samp_elem && h->elem_rep && rest && rn && albedo_sum && emit && ep && en && ek && two && count &&
-             welder_init(&w, ns, weld_quantum(s), ep, en, ek);
+    int ok = h->samp_elem && h->elem_rep && rest && rn && albedo_sum && emit && ep && en && ek &&
+             two && count && welder_init(&w, ns, weld_quantum(s), ep, en, ek);
     if (!ok)
         goto done;
     uint32_t ne = 0;
     for (uint32_t si = 0; si < ns; si++) {
         uint32_t t = h->samp_tri[si];
         float b1 = h->samp_b[2 * si], b2 = h->samp_b[2 * si + 1];
-        uint32_t obj = s->vertices[s->indices[3 * t]].object, mat = s->vertices[s->indices[3 * t]].material;
+        uint32_t obj = s->vertices[s->indices[3 * t]].object,
+                 mat = s->vertices[s->indices[3 * t]].material;
         const gi_material *m = &s->materials[mat];
         gi_vec3 n;
         rest_point(s, t, b1, b2, &rest[3 * si], &n);
@@ -452,7 +477,8 @@ static int make_elements(iv_hier *h, const gi_scene *s, float target, int remesh
             h->elem_rep[ne++] = si;
         h->samp_elem[si] = found;
         float uv[2];
-        const gi_vertex *v0 = &s->vertices[s->indices[3 * t]], *v1 = &s->vertices[s->indices[3 * t + 1]],
+        const gi_vertex *v0 = &s->vertices[s->indices[3 * t]],
+                        *v1 = &s->vertices[s->indices[3 * t + 1]],
                         *v2 = &s->vertices[s->indices[3 * t + 2]];
         for (int c = 0; c < 2; c++)
             uv[c] = (1.0f - b1 - b2) * v0->uv[c] + b1 * v1->uv[c] + b2 * v2->uv[c];
@@ -480,7 +506,8 @@ static int make_elements(iv_hier *h, const gi_scene *s, float target, int remesh
     ok = ne > 0;
 done:
     welder_free(&w);
-    free(rn), free(albedo_sum), free(emit), free(two), free(count), free(rest), free(ep), free(en), free(ek);
+    free(rn), free(albedo_sum), free(emit), free(two), free(count), free(rest), free(ep), free(en),
+        free(ek);
     return ok;
 }
 
@@ -491,8 +518,12 @@ static int g_sort_axis;
 
 static int cmp_axis(const void *a, const void *b)
 {
-    float x = g_sort_pos[3 * *(const uint32_t *)a + g_sort_axis], y = g_sort_pos[3 * *(const uint32_t *)b + g_sort_axis];
-    return x < y ? -1 : (x > y ? 1 : (int)(*(const uint32_t *)a > *(const uint32_t *)b) - (int)(*(const uint32_t *)a < *(const uint32_t *)b));
+    float x = g_sort_pos[3 * *(const uint32_t *)a + g_sort_axis],
+          y = g_sort_pos[3 * *(const uint32_t *)b + g_sort_axis];
+    return x < y ? -1
+                 : (x > y ? 1
+                          : (int)(*(const uint32_t *)a > *(const uint32_t *)b) -
+                                (int)(*(const uint32_t *)a < *(const uint32_t *)b));
 }
 
 static void sort_range(uint32_t *perm, uint32_t lo, uint32_t hi, const float *pos, int axis)
@@ -521,15 +552,16 @@ static int build_tree(iv_hier *h, const gi_scene *s)
     h->node_elem = malloc(cap * sizeof *h->node_elem);
     h->elem_node = malloc(ne * sizeof *h->elem_node);
     uint8_t *lvl = calloc(cap, 1);
-    int ok = uf && rest && perm && seg && lo && hi && h->first_child && h->child_count && h->parent && h->node_elem &&
-             h->elem_node && lvl;
+    int ok = uf && rest && perm && seg && lo && hi && h->first_child && h->child_count &&
+             h->parent && h->node_elem && h->elem_node && lvl;
     if (ok) {
         for (uint32_t e = 0; e < ne; e++) {
             uf[e] = e;
             /* objects never share elements: each tree holds one object's */
             memcpy(&rest[3 * e], &h->rest[3 * h->elem_rep[e]], 3 * sizeof(float));
         }
-        for (uint32_t t = 0; t < h->surf_count; t++) /* the surface's edges join its points' elements */
+        for (uint32_t t = 0; t < h->surf_count;
+             t++) /* the surface's edges join its points' elements */
             for (int c = 0; c < 2; c++) {
                 uint32_t a = uf_find(uf, h->samp_elem[h->surf_tri[3 * t + c]]);
                 uint32_t b = uf_find(uf, h->samp_elem[h->surf_tri[3 * t + c + 1]]);
@@ -582,7 +614,8 @@ static int build_tree(iv_hier *h, const gi_scene *s)
                         cut[k] = lo[i] + k;
                     parts = n;
                 } else {
-                    float mn[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, mx[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+                    float mn[3] = {FLT_MAX, FLT_MAX, FLT_MAX},
+                          mx[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
                     for (uint32_t k = lo[i]; k < hi[i]; k++)
                         for (int c = 0; c < 3; c++) {
                             mn[c] = fminf(mn[c], rest[3 * perm[k] + c]);
@@ -640,8 +673,9 @@ iv_hier *iv_hier_create(const gi_scene *s, float target_edge, int remesher, gi_e
     }
     if (made < 0) {
         gi_error_set(err, GI_ERR_UNSUPPORTED,
-                     "implicit_vis: re-meshing to edge length %g gives more than %u surface points: raise it", target_edge,
-                     (unsigned)IV_MAX_SAMPLES);
+                     "implicit_vis: re-meshing to edge length %g gives more than %u surface "
+                     "points: raise it",
+                     target_edge, (unsigned)IV_MAX_SAMPLES);
         iv_hier_free(h);
         return NULL;
     }
@@ -663,7 +697,8 @@ iv_hier *iv_hier_create(const gi_scene *s, float target_edge, int remesher, gi_e
     h->wpos = calloc((size_t)s->vertex_count * 3 + 1, sizeof(float));
     h->wnrm = calloc((size_t)s->vertex_count * 3 + 1, sizeof(float));
     if (!h->pos || !h->nrm || !h->area || !h->spos || !h->verts || !h->wpos || !h->wnrm) {
-        gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "implicit_vis: out of memory for %u hierarchy nodes", h->node_count);
+        gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                     "implicit_vis: out of memory for %u hierarchy nodes", h->node_count);
         iv_hier_free(h);
         return NULL;
     }
@@ -678,7 +713,8 @@ void iv_hier_free(iv_hier *h)
     free(h->surf_tri), free(h->disp_elem), free(h->disp_w);
     free(h->rest), free(h->wpos), free(h->wnrm);
     free(h->elem_rep), free(h->elem_albedo), free(h->elem_emit), free(h->elem_two_sided_emit);
-    free(h->first_child), free(h->child_count), free(h->parent), free(h->node_elem), free(h->elem_node);
+    free(h->first_child), free(h->child_count), free(h->parent), free(h->node_elem),
+        free(h->elem_node);
     free(h->pos), free(h->nrm), free(h->area), free(h->spos), free(h->verts);
     free(h);
 }
@@ -703,7 +739,8 @@ void iv_hier_update(iv_hier *h, const gi_scene *s, float t)
         for (uint32_t i = 0; i < ob->vertex_count; i++) {
             size_t v = ob->first_vertex + i;
             gi_v3_store(gi_mat4_point(m, gi_v3_load(vs[i].position)), &h->wpos[3 * v]);
-            gi_v3_store(gi_v3_normalize(gi_mat4_dir(nm, gi_v3_load(vs[i].normal))), &h->wnrm[3 * v]);
+            gi_v3_store(gi_v3_normalize(gi_mat4_dir(nm, gi_v3_load(vs[i].normal))),
+                        &h->wnrm[3 * v]);
         }
     }
     /* the discs: points of the triangles, areas a third of the surface's triangles around them */
@@ -713,11 +750,13 @@ void iv_hier_update(iv_hier *h, const gi_scene *s, float t)
         float b1 = h->samp_b[2 * si], b2 = h->samp_b[2 * si + 1], b0 = 1.0f - b1 - b2;
         float *p = &h->spos[3 * si];
         for (int c = 0; c < 3; c++)
-            p[c] = b0 * h->wpos[3 * ix[0] + c] + b1 * h->wpos[3 * ix[1] + c] + b2 * h->wpos[3 * ix[2] + c];
+            p[c] = b0 * h->wpos[3 * ix[0] + c] + b1 * h->wpos[3 * ix[1] + c] +
+                   b2 * h->wpos[3 * ix[2] + c];
         if (h->elem_rep[e] == si)
             memcpy(&h->pos[3 * leaf], p, 3 * sizeof(float));
         for (int c = 0; c < 3; c++)
-            h->nrm[3 * leaf + c] += b0 * h->wnrm[3 * ix[0] + c] + b1 * h->wnrm[3 * ix[1] + c] + b2 * h->wnrm[3 * ix[2] + c];
+            h->nrm[3 * leaf + c] += b0 * h->wnrm[3 * ix[0] + c] + b1 * h->wnrm[3 * ix[1] + c] +
+                                    b2 * h->wnrm[3 * ix[2] + c];
     }
     for (uint32_t f = 0; f < h->surf_count; f++) {
         const uint32_t *v = &h->surf_tri[3 * f];
@@ -762,7 +801,8 @@ void iv_hier_edge_stats(const iv_hier *h, const gi_scene *s, double *mean, doubl
         for (int c = 0; c < 3; c++) {
             uint32_t si = h->surf_tri[3 * t + c];
             float m[16];
-            gi_scene_object_transform(s, s->vertices[s->indices[3 * h->samp_tri[si]]].object, 0.0f, m);
+            gi_scene_object_transform(s, s->vertices[s->indices[3 * h->samp_tri[si]]].object, 0.0f,
+                                      m);
             p[c] = gi_mat4_point(m, gi_v3_load(&h->rest[3 * si]));
         }
         for (int c = 0; c < 3; c++) {
@@ -795,7 +835,8 @@ iv_links *iv_links_create(const iv_hier *h, uint32_t n)
     l->bin_omega = malloc(l->bins * sizeof(float));
     l->leaf_off = calloc((size_t)h->elem_count + 1, sizeof *l->leaf_off);
     l->light_off = calloc((size_t)h->elem_count + 1, sizeof *l->light_off);
-    if (!l->other || !l->dist || !l->cover || !l->bin_dir || !l->bin_omega || !l->leaf_off || !l->light_off) {
+    if (!l->other || !l->dist || !l->cover || !l->bin_dir || !l->bin_omega || !l->leaf_off ||
+        !l->light_off) {
         iv_links_free(l);
         return NULL;
     }
@@ -846,7 +887,8 @@ static void put_bilinear(iv_links *l, uint32_t A, gi_vec3 d, uint32_t B, float r
         return;
     int n = (int)l->n;
     uint32_t face = 2u * (uint32_t)ax + (a[ax] < 0.0f ? 1u : 0u);
-    float fu = (a[(ax + 1) % 3] / m + 1.0f) * 0.5f * (float)n - 0.5f, fv = (a[(ax + 2) % 3] / m + 1.0f) * 0.5f * (float)n - 0.5f;
+    float fu = (a[(ax + 1) % 3] / m + 1.0f) * 0.5f * (float)n - 0.5f,
+          fv = (a[(ax + 2) % 3] / m + 1.0f) * 0.5f * (float)n - 0.5f;
     int i0 = (int)floorf(fu), j0 = (int)floorf(fv);
     float tx = fu - (float)i0, ty = fv - (float)j0;
     for (int dj = 0; dj < 2; dj++)
@@ -866,7 +908,8 @@ static void put_bilinear(iv_links *l, uint32_t A, gi_vec3 d, uint32_t B, float r
  * is written into every bin it covers when `splat` is on: its disc,
  * oriented by its normal, sampled on a grid as fine as a bin seen at its
  * distance, as a shadow map rasterises a near occluder. */
-static void put_side(iv_links *l, const iv_hier *h, uint32_t A, uint32_t B, gi_vec3 d, float r, int splat)
+static void put_side(iv_links *l, const iv_hier *h, uint32_t A, uint32_t B, gi_vec3 d, float r,
+                     int splat)
 {
     uint32_t b = iv_bin_of(d, l->n);
     float cover = h->area[B] / (r * r) / l->bin_omega[b];
@@ -893,13 +936,15 @@ static void put_side(iv_links *l, const iv_hier *h, uint32_t A, uint32_t B, gi_v
     int inside = 0;
     for (int j = 0; j < g; j++)
         for (int i = 0; i < g; i++) {
-            float x = (2.0f * ((float)i + 0.5f) / (float)g - 1.0f), y = (2.0f * ((float)j + 0.5f) / (float)g - 1.0f);
+            float x = (2.0f * ((float)i + 0.5f) / (float)g - 1.0f),
+                  y = (2.0f * ((float)j + 0.5f) / (float)g - 1.0f);
             inside += x * x + y * y <= 1.0f;
         }
     put(l, A, b, B, r, 0.0f);
     for (int j = 0; j < g; j++)
         for (int i = 0; i < g; i++) {
-            float x = (2.0f * ((float)i + 0.5f) / (float)g - 1.0f), y = (2.0f * ((float)j + 0.5f) / (float)g - 1.0f);
+            float x = (2.0f * ((float)i + 0.5f) / (float)g - 1.0f),
+                  y = (2.0f * ((float)j + 0.5f) / (float)g - 1.0f);
             if (x * x + y * y > 1.0f)
                 continue;
             gi_vec3 q = gi_v3_add(pb, gi_v3_add(gi_v3_scale(u, x * rad), gi_v3_scale(v, y * rad)));
@@ -911,7 +956,8 @@ static void put_side(iv_links *l, const iv_hier *h, uint32_t A, uint32_t B, gi_v
 }
 
 /* Stores the link A-B in A's bin toward B and B's bin toward A. */
-static void insert(iv_links *l, const iv_hier *h, uint32_t A, uint32_t B, gi_vec3 d, float r, int splat)
+static void insert(iv_links *l, const iv_hier *h, uint32_t A, uint32_t B, gi_vec3 d, float r,
+                   int splat)
 {
     put_side(l, h, A, B, d, r, splat);
     put_side(l, h, B, A, gi_v3_scale(d, -1.0f), r, splat);
@@ -941,8 +987,8 @@ static int coplanar(const iv_hier *h, uint32_t A, uint32_t B, gi_vec3 d, float r
  * made so far, so pairs can be enumerated in any order or in parallel. */
 enum { PAIR_NONE, PAIR_LINK, PAIR_SPLIT_B, PAIR_SPLIT_A };
 
-static int pair_decide(const iv_links *l, const iv_hier *h, float subdiv, uint32_t A, uint32_t B, gi_vec3 *dout,
-                       float *r2out)
+static int pair_decide(const iv_links *l, const iv_hier *h, float subdiv, uint32_t A, uint32_t B,
+                       gi_vec3 *dout, float *r2out)
 {
     gi_vec3 d = gi_v3_sub(gi_v3_load(&h->pos[3 * B]), gi_v3_load(&h->pos[3 * A]));
     float r2 = gi_v3_dot(d, d);
@@ -1020,7 +1066,7 @@ static void link_self(link_ctx *c, uint32_t A)
  *    links, ties, coverage sums) is the same to the bit. */
 
 typedef struct link_task {
-    uint32_t A, B; /* B == UINT32_MAX: link_self(A) */
+    uint32_t A, B;   /* B == UINT32_MAX: link_self(A) */
     uint32_t *pairs; /* 2 per pair linked, in order */
     size_t n, cap;
     uint64_t tries;
@@ -1095,7 +1141,8 @@ static int collect_self(link_par *p, link_task *t, uint32_t A)
 /* Replaces every task by the calls it makes (in order) until there are
  * at least `want` or none can be unrolled; a link found while unrolling
  * stays a one-pair task. tries counts the calls unrolled. */
-static link_task *unroll_tasks(link_par *p, link_task *tasks, size_t *count, size_t want, uint64_t *tries)
+static link_task *unroll_tasks(link_par *p, link_task *tasks, size_t *count, size_t want,
+                               uint64_t *tries)
 {
     const iv_hier *h = p->h;
     for (int pass = 0; pass < 12 && *count < want; pass++) {
@@ -1301,7 +1348,7 @@ void iv_links_build(iv_links *l, const iv_hier *h, float subdiv, int brute, int 
     }
     l->tries = l->created = 0;
     if (l->threads > 1 && build_parallel(l, h, subdiv, splat, (int)l->threads))
-        return; /* the writers emptied their nodes' bins first */
+        return;     /* the writers emptied their nodes' bins first */
     links_clear(l); /* one thread (or the parallel build could not run) */
     link_ctx c = {l, h, subdiv, splat};
     for (uint32_t i = 0; i < h->root_count; i++)
@@ -1420,7 +1467,8 @@ void iv_links_pack(const iv_links *l, const iv_hier *h, uint32_t *links, uint32_
 /* Radiance a node sends toward point x: the side its mean normal faces x;
  * a cluster whose children face every way (mean normal shorter than 0.3)
  * sends the mean of both sides. */
-static void node_radiance(const iv_hier *h, const float *sp, const float *sm, uint32_t src, gi_vec3 x, float out[3])
+static void node_radiance(const iv_hier *h, const float *sp, const float *sm, uint32_t src,
+                          gi_vec3 x, float out[3])
 {
     gi_vec3 ns = gi_v3_load(&h->nrm[3 * src]);
     float len2 = gi_v3_dot(ns, ns);
@@ -1471,8 +1519,8 @@ static float covered(const iv_links *l, uint32_t x, uint32_t b)
  * irradiance of the side of the disc (normal n) it falls on: the bin's
  * share of the hemisphere weighted by its cosine. With frac = 1 this is
  * Eq. 5 with the nearest element covering its bin. */
-static void add_bin(const iv_links *l, uint32_t b, gi_vec3 n, float norm, float frac, const float L[3], double ep[3],
-                    double em[3])
+static void add_bin(const iv_links *l, uint32_t b, gi_vec3 n, float norm, float frac,
+                    const float L[3], double ep[3], double em[3])
 {
     float w = gi_v3_dot(n, gi_v3_load(&l->bin_dir[3 * b])) * l->bin_omega[b] * norm * frac;
     double *e = w >= 0.0f ? ep : em;
@@ -1484,7 +1532,8 @@ static void add_bin(const iv_links *l, uint32_t b, gi_vec3 n, float norm, float 
 /* Irradiance from the punctual lights at leaf x, each seen through the bin
  * toward it: blocked where the bin holds a link shorter than the light's
  * distance (a directional light: where the bin holds any link). */
-static void punctual(const iv_links *l, const iv_hier *h, const iv_lights *li, uint32_t leaf, double ep[3], double em[3])
+static void punctual(const iv_links *l, const iv_hier *h, const iv_lights *li, uint32_t leaf,
+                     double ep[3], double em[3])
 {
     const gi_scene *s = li->scene;
     gi_vec3 x = gi_v3_load(&h->pos[3 * leaf]), n = gi_v3_load(&h->nrm[3 * leaf]);
@@ -1505,8 +1554,8 @@ static void punctual(const iv_links *l, const iv_hier *h, const iv_lights *li, u
             wl = gi_v3_scale(d, 1.0f / r);
             scale = gi_range_window(r, lt->range) / (r * r);
             if (lt->type == GI_LIGHT_SPOT)
-                scale *= gi_spot_falloff(-gi_v3_dot(wl, gi_v3_normalize(f.direction)), cosf(lt->inner_cone),
-                                         cosf(lt->outer_cone));
+                scale *= gi_spot_falloff(-gi_v3_dot(wl, gi_v3_normalize(f.direction)),
+                                         cosf(lt->inner_cone), cosf(lt->outer_cone));
         }
         size_t k = base + iv_bin_of(wl, l->n);
         if (l->other[k] >= 0 && l->dist[k] < r)
@@ -1518,7 +1567,8 @@ static void punctual(const iv_links *l, const iv_hier *h, const iv_lights *li, u
     }
 }
 
-void iv_illuminate(const iv_links *l, iv_hier *h, const iv_lights *li, uint32_t bounces, float *e_out)
+void iv_illuminate(const iv_links *l, iv_hier *h, const iv_lights *li, uint32_t bounces,
+                   float *e_out)
 {
     uint32_t nn = h->node_count, ne = h->elem_count;
     float *sp = calloc((size_t)nn * 3, sizeof(float)), *sm = calloc((size_t)nn * 3, sizeof(float));
@@ -1562,7 +1612,8 @@ void iv_illuminate(const iv_links *l, iv_hier *h, const iv_lights *li, uint32_t 
                 add_bin(l, bin[j], n, norm[e], covered(l, x, bin[j]), L, ep, em);
             }
             if (direct) {
-                if (li->env) { /* Sec. 4.4: an empty bin (or what its links leave uncovered) sees the environment */
+                if (li->env) { /* Sec. 4.4: an empty bin (or what its links leave uncovered) sees
+                                  the environment */
                     for (uint32_t b = 0; b < l->bins; b++) {
                         float open = 1.0f - covered(l, x, b);
                         if (open > 0.0f) {

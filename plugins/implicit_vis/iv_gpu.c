@@ -31,8 +31,9 @@ void iv_gpu_free(iv_gpu *g)
 {
     if (!g)
         return;
-    GLuint bufs[] = {g->ssbo_elem, g->ssbo_children, g->ssbo_bins,   g->ssbo_geom, g->ssbo_links,
-                     g->ssbo_off,  g->ssbo_wlinks,   g->ssbo_rad[0], g->ssbo_rad[1], g->ssbo_out,  g->ssbo_emit};
+    GLuint bufs[] = {g->ssbo_elem,   g->ssbo_children, g->ssbo_bins,   g->ssbo_geom,
+                     g->ssbo_links,  g->ssbo_off,      g->ssbo_wlinks, g->ssbo_rad[0],
+                     g->ssbo_rad[1], g->ssbo_out,      g->ssbo_emit};
     for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++)
         if (bufs[i])
             glDeleteBuffers(1, &bufs[i]);
@@ -48,7 +49,8 @@ iv_gpu *iv_gpu_create(const iv_hier *h, const iv_links *l, const gi_envmap *env,
 {
     iv_gpu *g = calloc(1, sizeof *g);
     if (!g) {
-        gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "implicit_vis: out of memory for the GPU illumination");
+        gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                     "implicit_vis: out of memory for the GPU illumination");
         return NULL;
     }
     g->nodes = h->node_count;
@@ -57,7 +59,8 @@ iv_gpu *iv_gpu_create(const iv_hier *h, const iv_links *l, const gi_envmap *env,
     g->n = l->n;
     g->env = env != NULL;
     if (h->node_count >= (1u << 30)) { /* iv_weights.comp keeps a node's side in the top two bits */
-        gi_error_set(err, GI_ERR_UNSUPPORTED, "implicit_vis: %u nodes are too many for the GPU illumination (limit 2^30)",
+        gi_error_set(err, GI_ERR_UNSUPPORTED,
+                     "implicit_vis: %u nodes are too many for the GPU illumination (limit 2^30)",
                      h->node_count);
         free(g);
         return NULL;
@@ -71,7 +74,8 @@ iv_gpu *iv_gpu_create(const iv_hier *h, const iv_links *l, const gi_envmap *env,
     for (uint32_t i = 0; ok && i < h->node_count; i++) {
         depth[i] = h->parent[i] < 0 ? 0 : (uint8_t)(depth[h->parent[i]] + 1);
         if (depth[i] >= h->depth || (i > 0 && depth[i] < depth[i - 1])) {
-            gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "implicit_vis: the hierarchy's nodes are not in breadth-first order");
+            gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                         "implicit_vis: the hierarchy's nodes are not in breadth-first order");
             free(depth);
             iv_gpu_free(g);
             return NULL;
@@ -95,7 +99,8 @@ iv_gpu *iv_gpu_create(const iv_hier *h, const iv_links *l, const gi_envmap *env,
     ok = ok && elem && children && bins && g->geom && g->off;
     if (!ok) {
         free(elem), free(children), free(bins);
-        gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "implicit_vis: out of memory for the GPU illumination");
+        gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                     "implicit_vis: out of memory for the GPU illumination");
         iv_gpu_free(g);
         return NULL;
     }
@@ -116,7 +121,8 @@ iv_gpu *iv_gpu_create(const iv_hier *h, const iv_links *l, const gi_envmap *env,
     for (uint32_t b = 0; b < l->bins; b++) {
         memcpy(&bins[8 * b], &l->bin_dir[3 * b], 3 * sizeof(float));
         bins[8 * b + 3] = l->bin_omega[b];
-        if (env) /* Sec. 4.4: the environment seen through the bin's centre, as iv_illuminate looks it up */
+        if (env) /* Sec. 4.4: the environment seen through the bin's centre, as iv_illuminate looks
+                    it up */
             gi_envmap_eval(env, gi_v3_load(&l->bin_dir[3 * b]), &bins[8 * b + 4]);
     }
     g->ssbo_elem = make_static(elem, (size_t)h->elem_count * 12 * sizeof(uint32_t));
@@ -134,7 +140,8 @@ iv_gpu *iv_gpu_create(const iv_hier *h, const iv_links *l, const gi_envmap *env,
     g->ssbo_emit = make_dynamic((size_t)h->node_count * 8 * sizeof(float));
     GLint64 max_block = 0;
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
-    g->max_block = max_block > 0 ? (size_t)max_block : (size_t)1 << 27; /* GL's minimum: 2^27 bytes */
+    g->max_block =
+        max_block > 0 ? (size_t)max_block : (size_t)1 << 27; /* GL's minimum: 2^27 bytes */
     g->prog_emit = gi_program_build_compute("iv_emit.comp", NULL, err);
     g->prog_weights = g->prog_emit ? gi_program_build_compute("iv_weights.comp", NULL, err) : 0;
     g->prog_pull = g->prog_weights ? gi_program_build_compute("iv_pull.comp", NULL, err) : 0;
@@ -178,8 +185,8 @@ static void pull_up(const iv_gpu *g, GLuint rad)
             dispatch(g->prog_pull, g->level_off[d], g->level_off[d + 1] - g->level_off[d]);
 }
 
-gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint32_t bounces, uint32_t punctual,
-                            gi_error *err)
+gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint32_t bounces,
+                            uint32_t punctual, gi_error *err)
 {
     /* the frame's geometry: position and area, mean normal */
     for (uint32_t i = 0; i < g->nodes; i++) {
@@ -189,19 +196,23 @@ gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint
         memcpy(o + 4, &h->nrm[3 * i], 3 * sizeof(float));
         o[7] = 0.0f;
     }
-    glNamedBufferSubData(g->ssbo_geom, 0, (GLsizeiptr)((size_t)g->nodes * 8 * sizeof(float)), g->geom);
+    glNamedBufferSubData(g->ssbo_geom, 0, (GLsizeiptr)((size_t)g->nodes * 8 * sizeof(float)),
+                         g->geom);
     /* the links, flattened */
     size_t nlinks = (size_t)l->leaf_off[g->elems] + l->light_off[g->elems];
     size_t words = 4 * (nlinks ? nlinks : 1);
     if (words * sizeof(uint32_t) > g->max_block)
-        return gi_error_set(err, GI_ERR_UNSUPPORTED,
-                            "implicit_vis: %zu links need %.0f MiB in one GPU buffer, more than this GL's limit of "
-                            "%.0f MiB: lower N or use illum=cpu",
-                            nlinks, (double)(words * sizeof(uint32_t)) / (1 << 20), (double)g->max_block / (1 << 20));
+        return gi_error_set(
+            err, GI_ERR_UNSUPPORTED,
+            "implicit_vis: %zu links need %.0f MiB in one GPU buffer, more than this GL's limit of "
+            "%.0f MiB: lower N or use illum=cpu",
+            nlinks, (double)(words * sizeof(uint32_t)) / (1 << 20),
+            (double)g->max_block / (1 << 20));
     if (words > g->links_cap) {
         uint32_t *nl = realloc(g->links, words * sizeof(uint32_t));
         if (!nl)
-            return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "implicit_vis: out of memory for %zu links", nlinks);
+            return gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                                "implicit_vis: out of memory for %zu links", nlinks);
         g->links = nl;
         g->links_cap = words;
     }
@@ -212,7 +223,8 @@ gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint
         glNamedBufferData(g->ssbo_wlinks, (GLsizeiptr)(g->links_gpu / 2), NULL, GL_DYNAMIC_DRAW);
     }
     glNamedBufferSubData(g->ssbo_links, 0, (GLsizeiptr)(words * sizeof(uint32_t)), g->links);
-    glNamedBufferSubData(g->ssbo_off, 0, (GLsizeiptr)(((size_t)g->elems + 1) * 2 * sizeof(uint32_t)), g->off);
+    glNamedBufferSubData(g->ssbo_off, 0,
+                         (GLsizeiptr)(((size_t)g->elems + 1) * 2 * sizeof(uint32_t)), g->off);
 
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_ELEM, g->ssbo_elem);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_CHILDREN, g->ssbo_children);

@@ -6,10 +6,9 @@
  * the CPU.
  *
  * Use (a GL context current, the plugin's shader table registered):
- *     iv_gpu *g = iv_gpu_create(h, l, scene->envmap, &err);  // after iv_hier_create, iv_links_create
- *     per frame, after iv_links_refine_push, the scene's punctual lights
- *     bound (gi_gpu_scene_bind) at the frame's time:
- *         iv_gpu_illuminate(g, l, h, bounces, light_count, &err);
+ *     iv_gpu *g = iv_gpu_create(h, l, scene->envmap, &err);  // after iv_hier_create,
+ * iv_links_create per frame, after iv_links_refine_push, the scene's punctual lights bound
+ * (gi_gpu_scene_bind) at the frame's time: iv_gpu_illuminate(g, l, h, bounces, light_count, &err);
  *         the result: g->ssbo_out (iv_display.comp's IvElemLight), or
  *         iv_gpu_read(g, e_out) in iv_illuminate's layout. */
 #ifndef IV_GPU_H
@@ -21,22 +20,23 @@
 
 typedef struct iv_gpu {
     uint32_t nodes, elems, bins, n;
-    uint32_t levels;      /* depth of the deepest tree */
-    uint32_t *level_off;  /* levels + 1: nodes of each depth (breadth-first order keeps them contiguous) */
-    int env;              /* the scene has an environment */
+    uint32_t levels; /* depth of the deepest tree */
+    uint32_t *
+        level_off; /* levels + 1: nodes of each depth (breadth-first order keeps them contiguous) */
+    int env;       /* the scene has an environment */
     GLuint prog_emit, prog_weights, prog_pull, prog_gather;
     GLuint ssbo_elem, ssbo_children, ssbo_bins; /* built once */
     GLuint ssbo_geom, ssbo_links, ssbo_off;     /* every frame */
-    GLuint ssbo_wlinks;   /* per link, made on the GPU every frame: node and side, weight */
-    GLuint ssbo_rad[2];   /* outgoing radiance per node, this bounce's and the previous one's */
-    GLuint ssbo_out;      /* per element: irradiance on both sides, normal (IV_SSBO_ELEM_LIGHT) */
-    GLuint ssbo_emit;     /* per node: the emission pulled up (bounce 0), kept when keep_emit */
-    int keep_emit;        /* set by the caller: keep the emission for the glossy display */
-    float *geom;          /* staging: 8 per node */
+    GLuint ssbo_wlinks;    /* per link, made on the GPU every frame: node and side, weight */
+    GLuint ssbo_rad[2];    /* outgoing radiance per node, this bounce's and the previous one's */
+    GLuint ssbo_out;       /* per element: irradiance on both sides, normal (IV_SSBO_ELEM_LIGHT) */
+    GLuint ssbo_emit;      /* per node: the emission pulled up (bounce 0), kept when keep_emit */
+    int keep_emit;         /* set by the caller: keep the emission for the glossy display */
+    float *geom;           /* staging: 8 per node */
     uint32_t *links, *off; /* staging for iv_links_pack */
-    size_t links_cap;     /* words */
-    size_t links_gpu;     /* bytes of ssbo_links (ssbo_wlinks: half of it) */
-    size_t max_block;     /* GL_MAX_SHADER_STORAGE_BLOCK_SIZE */
+    size_t links_cap;      /* words */
+    size_t links_gpu;      /* bytes of ssbo_links (ssbo_wlinks: half of it) */
+    size_t max_block;      /* GL_MAX_SHADER_STORAGE_BLOCK_SIZE */
 } iv_gpu;
 
 iv_gpu *iv_gpu_create(const iv_hier *h, const iv_links *l, const gi_envmap *env, gi_error *err);
@@ -45,8 +45,8 @@ void iv_gpu_free(iv_gpu *g);
  * then runs the passes: emission, the links' weights, pull-up, and
  * bounces + 1 gathers each followed by a pull-up (the last one needs none). punctual: the number of
  * the scene's punctual lights (bound at GI_SSBO_LIGHTS). */
-gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint32_t bounces, uint32_t punctual,
-                            gi_error *err);
+gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint32_t bounces,
+                            uint32_t punctual, gi_error *err);
 /* Binds what the glossy display reads of the frame's direct light (after
  * iv_gpu_illuminate with keep_emit): the elements, bins, node geometry,
  * receiving links, their offsets and weights, and the pulled-up emission

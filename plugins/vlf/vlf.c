@@ -27,7 +27,7 @@ typedef struct vlf {
     vlf_params prm;
     vlf_field field;
     int have_field;
-    int gpu_propagate;  /* propagate = gpu: the compute passes of vlf_gpu.c */
+    int gpu_propagate; /* propagate = gpu: the compute passes of vlf_gpu.c */
     vlf_gpu gpu;
     int have_gpu;
     GLuint program;
@@ -37,37 +37,50 @@ typedef struct vlf {
 } vlf;
 
 static const gi_param_desc vlf_params_desc[] = {
-    {"l", GI_PARAM_INT, 128, 8, 1024, NULL, "l (Sec. 2.1)", "bi-directional directions spread over the hemisphere"},
-    {"N", GI_PARAM_INT, 64, 8, 256, NULL, "N (Sec. 2.1)", "rays per side of each parallel subfield (N x N)"},
-    {"m", GI_PARAM_INT, 8, 1, 64, NULL, "m (Sec. 2.1)", "cells per side of a tile of non-diffuse storage; N must be a multiple"},
+    {"l", GI_PARAM_INT, 128, 8, 1024, NULL, "l (Sec. 2.1)",
+     "bi-directional directions spread over the hemisphere"},
+    {"N", GI_PARAM_INT, 64, 8, 256, NULL, "N (Sec. 2.1)",
+     "rays per side of each parallel subfield (N x N)"},
+    {"m", GI_PARAM_INT, 8, 1, 64, NULL, "m (Sec. 2.1)",
+     "cells per side of a tile of non-diffuse storage; N must be a multiple"},
     {"S", GI_PARAM_INT, 2, 1, 8, NULL, "RI super-sampling (Sec. 3.3)",
      "radiance interface cells per subfield cell and side: transport on (N S)^2 rays"},
     {"density", GI_PARAM_FLOAT, 12, 1, 64, NULL, "texel density",
-     "diffuse elements per unit length, the scene scaled into the unit sphere (faces get k x k elements, k <= 64)"},
+     "diffuse elements per unit length, the scene scaled into the unit sphere (faces get k x k "
+     "elements, k <= 64)"},
     {"iterations", GI_PARAM_INT, 8, 1, 64, NULL, "iterations (Sec. 6)",
      "shooting iterations; k iterations carry k bounces (max_bounces = 7 describes the default 8)"},
     {"perturbed", GI_PARAM_INT, 0, 0, 36, NULL, "perturbed samples (Sec. 3.5)",
-     "perturbed virtual directions per fixed direction, used only for transport (0: the fixed direction itself; "
+     "perturbed virtual directions per fixed direction, used only for transport (0: the fixed "
+     "direction itself; "
      "the paper's high quality uses 36)"},
     {"seed", GI_PARAM_INT, 1, 0, 1000000, NULL, NULL, "seed of the perturbed directions"},
     {"order", GI_PARAM_ENUM, 0, 0, 0, "faces|rays", "Sec. 3.2",
-     "depth order of a subfield: faces: the faces sorted front to back (Newell's painter's ordering, faces split "
-     "where they overlap in a cycle, BSP cuts orthogonal to the direction), rasterised in that order; rays: each "
+     "depth order of a subfield: faces: the faces sorted front to back (Newell's painter's "
+     "ordering, faces split "
+     "where they overlap in a cycle, BSP cuts orthogonal to the direction), rasterised in that "
+     "order; rays: each "
      "ray's fragments sorted by depth"},
     {"precision", GI_PARAM_ENUM, 0, 0, 0, "32f|16f|rgb9e5", "storage (Sec. 3.1, 6)",
-     "format of the ir/radiance maps, during propagation (every pass writes in it) and for rendering: 32f: three "
-     "float32 (12 bytes); 16f: RGBA16F, the paper's 64-bit format (8 bytes); rgb9e5: shared exponent (4 bytes)"},
+     "format of the ir/radiance maps, during propagation (every pass writes in it) and for "
+     "rendering: 32f: three "
+     "float32 (12 bytes); 16f: RGBA16F, the paper's 64-bit format (8 bytes); rgb9e5: shared "
+     "exponent (4 bytes)"},
     {"subdivide", GI_PARAM_INT, 1, 1, 16, NULL, NULL,
-     "each scene triangle cut into subdivide^2 triangles before sorting and transport: the same surfaces as more "
+     "each scene triangle cut into subdivide^2 triangles before sorting and transport: the same "
+     "surfaces as more "
      "faces (the tessellation sweep of propagation time against faces)"},
     {"propagate", GI_PARAM_ENUM, 0, 0, 0, "cpu|gpu", "propagation (Sec. 3.2-3.4)",
-     "where propagation runs: cpu: the sweeps in C (vlf_core.c); gpu: GL compute passes over the same depth order "
+     "where propagation runs: cpu: the sweeps in C (vlf_core.c); gpu: GL compute passes over the "
+     "same depth order "
      "(vlf_gpu.c), the same maps within float rounding; gpu needs perturbed = 0"},
     {"hier_min", GI_PARAM_INT, 0, 0, 1000000, NULL, "hierarchical sort (Sec. 3.2)",
-     "objects (glTF nodes) of at least this many triangles whose bounding box in a direction's frame no other "
+     "objects (glTF nodes) of at least this many triangles whose bounding box in a direction's "
+     "frame no other "
      "triangle reaches into are sorted on their own and spliced in at their box's place; 0: off"},
     {"threads", GI_PARAM_INT, 4, 1, 64, NULL, "sort threads (Sec. 6)",
-     "CPU threads of the sort stage, one subfield at a time each (the field is the same for any count)"},
+     "CPU threads of the sort stage, one subfield at a time each (the field is the same for any "
+     "count)"},
     {"bsp_levels", GI_PARAM_INT, 2, 0, 8, NULL, "BSP levels (Sec. 3.2, 6)",
      "cuts of the face list orthogonal to the direction at its centre of mass, levels (paper: 2)"},
     {"bsp_min", GI_PARAM_INT, 4096, 2, 1000000, NULL, "BSP threshold (Sec. 3.2)",
@@ -101,13 +114,15 @@ static gi_result vlf_create(const gi_host *host, const gi_params *params, void *
     v->prm.hier_min = (uint32_t)gi_params_int(params, "hier_min");
     v->gpu_propagate = gi_params_enum(params, "propagate") == 1;
     if (v->gpu_propagate && v->prm.perturbed > 0) {
-        host->log(host, GI_LOG_ERROR, "vlf: propagate = gpu runs the fixed directions only; set perturbed = 0");
+        host->log(host, GI_LOG_ERROR,
+                  "vlf: propagate = gpu runs the fixed directions only; set perturbed = 0");
         gi_kit_free(&v->kit);
         free(v);
         return GI_ERR_INVALID_ARGUMENT;
     }
     if (v->prm.N % v->prm.m != 0) {
-        host->log(host, GI_LOG_ERROR, "vlf: N = %u is not a multiple of the tile size m = %u", v->prm.N, v->prm.m);
+        host->log(host, GI_LOG_ERROR, "vlf: N = %u is not a multiple of the tile size m = %u",
+                  v->prm.N, v->prm.m);
         gi_kit_free(&v->kit);
         free(v);
         return GI_ERR_INVALID_ARGUMENT;
@@ -125,7 +140,8 @@ static int vlf_cancelled(void *user)
 static void upload(GLuint b, const void *data, size_t bytes)
 {
     static const float zero[4] = {0, 0, 0, 0};
-    glNamedBufferData(b, (GLsizeiptr)(bytes ? bytes : sizeof zero), bytes ? data : zero, GL_STATIC_DRAW);
+    glNamedBufferData(b, (GLsizeiptr)(bytes ? bytes : sizeof zero), bytes ? data : zero,
+                      GL_STATIC_DRAW);
 }
 
 /* Uploads the propagated field: faces, irradiance atlas, tiles, their
@@ -148,20 +164,24 @@ static gi_result vlf_upload(vlf *v)
     uint32_t *lut = calloc((size_t)VLF_LOOKUP_W * VLF_LOOKUP_H, sizeof *lut);
     if (!faces || !irr || !tiles || !dirs || !rects || !tris || !lut) {
         free(faces), free(irr), free(tiles), free(dirs), free(rects), free(tris), free(lut);
-        return gi_kit_fail(&v->kit, GI_ERR_OUT_OF_MEMORY, "vlf: out of memory uploading the light field");
+        return gi_kit_fail(&v->kit, GI_ERR_OUT_OF_MEMORY,
+                           "vlf: out of memory uploading the light field");
     }
-    /* faces: chart origin and the back side's face, axes scaled to texels, then W, H, first element, nd */
+    /* faces: chart origin and the back side's face, axes scaled to texels, then W, H, first
+     * element, nd */
     for (uint32_t i = 0; i < f->face_count; i++) {
         const vlf_face *fc = &f->faces[i];
         gi_vec3 o = gi_v3_add(f->centre, gi_v3_scale(fc->origin, f->radius));
-        gi_vec3 t = gi_v3_scale(fc->t, f->prm.density / f->radius), b = gi_v3_scale(fc->b, f->prm.density / f->radius);
+        gi_vec3 t = gi_v3_scale(fc->t, f->prm.density / f->radius),
+                b = gi_v3_scale(fc->b, f->prm.density / f->radius);
         float *F = faces + 16 * (size_t)i;
         memcpy(F, &o, 3 * sizeof(float));
         memcpy(F + 4, &t, 3 * sizeof(float));
         memcpy(F + 8, &b, 3 * sizeof(float));
         uint32_t info[4] = {fc->W, fc->H, fc->first_elem, (uint32_t)fc->nd};
         memcpy(F + 12, info, sizeof info);
-        uint32_t twin = (uint32_t)fc->twin; /* the other side of a double-sided face, ~0u for none */
+        uint32_t twin =
+            (uint32_t)fc->twin; /* the other side of a double-sided face, ~0u for none */
         memcpy(F + 3, &twin, sizeof twin);
     }
     /* the irradiance atlas in the storage format, then per element the part
@@ -183,7 +203,8 @@ static gi_result vlf_upload(vlf *v)
     }
     for (uint32_t t = 0; t < T; t++) {
         for (int k = 0; k < 3; k++)
-            memcpy(dirs + 4 * (3 * l + 3 * t + (uint32_t)k), f->dirs.tri_inv + 9 * t + 3 * k, 3 * sizeof(float));
+            memcpy(dirs + 4 * (3 * l + 3 * t + (uint32_t)k), f->dirs.tri_inv + 9 * t + 3 * k,
+                   3 * sizeof(float));
         memcpy(tris + 4 * t, f->dirs.tris + 3 * t, 3 * sizeof(uint32_t));
     }
     for (uint32_t s = 0; s < 2 * l; s++)
@@ -212,7 +233,8 @@ static gi_result vlf_upload(vlf *v)
     uint32_t *scene_face = malloc((size_t)scene_tris * sizeof *scene_face + 4);
     if (!scene_face) {
         free(faces), free(irr), free(tiles), free(dirs), free(rects), free(tris), free(lut);
-        return gi_kit_fail(&v->kit, GI_ERR_OUT_OF_MEMORY, "vlf: out of memory uploading the light field");
+        return gi_kit_fail(&v->kit, GI_ERR_OUT_OF_MEMORY,
+                           "vlf: out of memory uploading the light field");
     }
     for (uint32_t t = 0; t < scene_tris; t++)
         scene_face[t] = f->tri_face[(size_t)t * f->tri_sub];
@@ -225,7 +247,8 @@ static gi_result vlf_upload(vlf *v)
     upload(v->buf[5], tris, (size_t)T * 4 * sizeof *tris);
     if (!v->lookup)
         v->lookup = gi_gpu_texture_2d(GL_R32UI, VLF_LOOKUP_W, VLF_LOOKUP_H);
-    glTextureSubImage2D(v->lookup, 0, 0, 0, VLF_LOOKUP_W, VLF_LOOKUP_H, GL_RED_INTEGER, GL_UNSIGNED_INT, lut);
+    glTextureSubImage2D(v->lookup, 0, 0, 0, VLF_LOOKUP_W, VLF_LOOKUP_H, GL_RED_INTEGER,
+                        GL_UNSIGNED_INT, lut);
     free(faces), free(irr), free(tiles), free(dirs), free(rects), free(tris), free(lut);
     gi_error err;
     if (gi_gl_check("vlf: upload", &err) != GI_OK)
@@ -258,11 +281,13 @@ static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
         rc = vlf_gpu_setup(&v->gpu, &v->field, err, sizeof err);
         host->stage_end(host, "propagate_setup");
         if (rc == 0)
-            rc = vlf_gpu_propagate(&v->gpu, &v->field, vlf_cancelled, (void *)host, err, sizeof err);
+            rc =
+                vlf_gpu_propagate(&v->gpu, &v->field, vlf_cancelled, (void *)host, err, sizeof err);
         host->stage_end(host, "propagate");
         if (rc != 0)
-            return gi_kit_fail(&v->kit, host->cancelled && host->cancelled(host) ? GI_ERR_CANCELLED : GI_ERR_GL, "%s",
-                               err);
+            return gi_kit_fail(
+                &v->kit, host->cancelled && host->cancelled(host) ? GI_ERR_CANCELLED : GI_ERR_GL,
+                "%s", err);
     } else {
         rc = vlf_field_propagate(&v->field, vlf_cancelled, (void *)host);
         host->stage_end(host, "propagate");
@@ -281,11 +306,13 @@ static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
     host->stat(host, "tiles", s->tiles);
     host->stat(host, "bytes_propagate", (double)s->bytes_propagate);
     host->stat(host, "bytes_render", (double)s->bytes_render);
-    host->stat(host, "data_bytes", (double)s->bytes_render); /* what rendering keeps after propagation */
+    host->stat(host, "data_bytes",
+               (double)s->bytes_render); /* what rendering keeps after propagation */
     host->stat(host, "bytes_maps_render", (double)s->bytes_maps_render);
     host->stat(host, "gpu_bytes_maps", (double)v->gpu_map_bytes);
     host->stat(host, "samples_transported", (double)s->samples);
-    host->stat(host, "samples_per_s", s->propagate_s > 0 ? (double)s->samples / s->propagate_s : 0.0);
+    host->stat(host, "samples_per_s",
+               s->propagate_s > 0 ? (double)s->samples / s->propagate_s : 0.0);
     host->stat(host, "sort_pieces", (double)s->sort_pieces);
     host->stat(host, "sort_splits", (double)s->sort_splits);
     host->stat(host, "sort_bsp_cuts", (double)s->sort_bsp_cuts);
@@ -394,13 +421,11 @@ static const char *vlf_last_error(void *inst)
     return inst ? gi_kit_last_error(&((vlf *)inst)->kit) : "";
 }
 
-GI_METHOD_EXPORT(vlf,
-    .id = "vlf",
+GI_METHOD_EXPORT(
+    vlf, .id = "vlf",
     .title = "Light Field Propagation and Rendering on the GPU (GPU Virtual Light Field)",
-    .citation = "Mortensen, Khanna, Slater. Afrigraph 2007",
-    .version = "0.1",
+    .citation = "Mortensen, Khanna, Slater. Afrigraph 2007", .version = "0.1",
     .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_GLOSSY | GI_CAP_MIRROR | GI_CAP_AREA_LIGHTS |
             GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION |
             GI_CAP_PRECOMPUTE | GI_CAP_VISIBILITY | GI_CAP_TEXTURES,
-    .max_bounces = 7,
-    .params = vlf_params_desc);
+    .max_bounces = 7, .params = vlf_params_desc);

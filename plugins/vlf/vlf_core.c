@@ -15,7 +15,6 @@
 
 #include <pthread.h>
 
-
 #include "gi/envmap.h"
 #include "gi/lights.h"
 #include "gi/raytrace.h"
@@ -314,7 +313,8 @@ double vlf_phong_albedo(float n, float cos_t)
     const int K = 64;
     double ct = fmin(1.0, fabs((double)cos_t)), st = sqrt(fmax(0.0, 1.0 - ct * ct)), sum = 0.0;
     for (int a = 0; a < K; a++) {
-        double ca = pow(((double)a + 0.5) / K, 1.0 / ((double)n + 1.0)), sa = sqrt(fmax(0.0, 1.0 - ca * ca));
+        double ca = pow(((double)a + 0.5) / K, 1.0 / ((double)n + 1.0)),
+               sa = sqrt(fmax(0.0, 1.0 - ca * ca));
         for (int b = 0; b < K; b++) {
             double co = ca * ct + sa * st * cos(2.0 * GI_PI * ((double)b + 0.5) / K);
             if (co > 0.0)
@@ -364,7 +364,8 @@ uint32_t vlf_element_at(const vlf_field *f, const vlf_face *fc, gi_vec3 q)
 typedef struct frag_tmp {
     uint32_t cell;
     float depth;
-    uint32_t rank; /* 0; 1 for the second side of a double-sided face (after the first at the same depth) */
+    uint32_t rank; /* 0; 1 for the second side of a double-sided face (after the first at the same
+                      depth) */
     uint32_t elem;
 } frag_tmp;
 
@@ -391,7 +392,8 @@ static int frag_push(frag_buf *b, uint32_t cell, float depth, uint32_t rank, uin
  * the projected triangle). Calls emit for each covered cell. */
 typedef int (*cell_fn)(void *user, uint32_t cx, uint32_t cy, float depth);
 
-static int raster_tri(const vlf_field *f, const vlf_psf *fr, const gi_vec3 *p, cell_fn emit, void *user)
+static int raster_tri(const vlf_field *f, const vlf_psf *fr, const gi_vec3 *p, cell_fn emit,
+                      void *user)
 {
     float x[3], y[3], z[3];
     float NS = (float)(f->prm.N * f->prm.S);
@@ -404,8 +406,10 @@ static int raster_tri(const vlf_field *f, const vlf_psf *fr, const gi_vec3 *p, c
     if (fabsf(area2) < 1e-9f)
         return 1;
     int N = (int)(f->prm.N * f->prm.S);
-    int x0 = (int)floorf(fminf(x[0], fminf(x[1], x[2])) - 0.5f), x1 = (int)ceilf(fmaxf(x[0], fmaxf(x[1], x[2])));
-    int y0 = (int)floorf(fminf(y[0], fminf(y[1], y[2])) - 0.5f), y1 = (int)ceilf(fmaxf(y[0], fmaxf(y[1], y[2])));
+    int x0 = (int)floorf(fminf(x[0], fminf(x[1], x[2])) - 0.5f),
+        x1 = (int)ceilf(fmaxf(x[0], fmaxf(x[1], x[2])));
+    int y0 = (int)floorf(fminf(y[0], fminf(y[1], y[2])) - 0.5f),
+        y1 = (int)ceilf(fmaxf(y[0], fmaxf(y[1], y[2])));
     if (x0 < 0)
         x0 = 0;
     if (y0 < 0)
@@ -445,7 +449,8 @@ static int emit_frag(void *user, uint32_t cx, uint32_t cy, float depth)
 {
     sort_ctx *c = user;
     int32_t *bb = c->bbox;
-    int32_t X = (int32_t)(cx / c->f->prm.S), Y = (int32_t)(cy / c->f->prm.S); /* the subfield's cell */
+    int32_t X = (int32_t)(cx / c->f->prm.S),
+            Y = (int32_t)(cy / c->f->prm.S); /* the subfield's cell */
     if (X < bb[0])
         bb[0] = X;
     if (Y < bb[1])
@@ -454,8 +459,10 @@ static int emit_frag(void *user, uint32_t cx, uint32_t cy, float depth)
         bb[2] = X;
     if (Y > bb[3])
         bb[3] = Y;
-    float U = ((float)cx + 0.5f) / (float)c->N * 2.0f - 1.0f, V = ((float)cy + 0.5f) / (float)c->N * 2.0f - 1.0f;
-    gi_vec3 q = gi_v3_add(gi_v3_add(gi_v3_scale(c->psf->u, U), gi_v3_scale(c->psf->v, V)), gi_v3_scale(c->psf->n, depth));
+    float U = ((float)cx + 0.5f) / (float)c->N * 2.0f - 1.0f,
+          V = ((float)cy + 0.5f) / (float)c->N * 2.0f - 1.0f;
+    gi_vec3 q = gi_v3_add(gi_v3_add(gi_v3_scale(c->psf->u, U), gi_v3_scale(c->psf->v, V)),
+                          gi_v3_scale(c->psf->n, depth));
     uint32_t e = vlf_element_at(c->f, c->face, q);
     if (c->face->twin < 0)
         return frag_push(c->buf, cy * c->N + cx, depth, 0, e);
@@ -496,8 +503,8 @@ typedef struct sort_counts {
  * (a stable bucket sort by cell); rays order: all fragments sorted by cell
  * and depth. bbox (4 per face, may be NULL) grows by the subfield cells
  * each face covers. */
-static int list_fragments(const vlf_field *f, const vlf_psf *fr, frag_buf *buf, frag_buf *tmp, vlf_sorter *so,
-                          int32_t *bbox, sort_counts *cnt)
+static int list_fragments(const vlf_field *f, const vlf_psf *fr, frag_buf *buf, frag_buf *tmp,
+                          vlf_sorter *so, int32_t *bbox, sort_counts *cnt)
 {
     uint32_t N = f->prm.N * f->prm.S;
     int32_t dummy[4];
@@ -515,8 +522,8 @@ static int list_fragments(const vlf_field *f, const vlf_psf *fr, frag_buf *buf, 
     int mode = f->prm.order == VLF_ORDER_PLAIN     ? VLF_SORT_PLAIN
                : f->prm.order == VLF_ORDER_NOSPLIT ? VLF_SORT_NOSPLIT
                                                    : VLF_SORT_NEWELL;
-    if (vlf_sort_faces(so, f->tri_p, f->tri_count, f->tri_group, f->prm.hier_min, fr->u, fr->v, fr->n, mode,
-                       f->prm.bsp_levels, f->prm.bsp_min) != 0)
+    if (vlf_sort_faces(so, f->tri_p, f->tri_count, f->tri_group, f->prm.hier_min, fr->u, fr->v,
+                       fr->n, mode, f->prm.bsp_levels, f->prm.bsp_min) != 0)
         return 0;
     cnt->pieces += so->nout;
     cnt->splits += so->splits;
@@ -535,8 +542,9 @@ static int list_fragments(const vlf_field *f, const vlf_psf *fr, frag_buf *buf, 
         for (uint32_t j = 1; j + 1 < pc->count; j++) {
             const gi_vec3 *w[3] = {&v[0], &v[j], &v[j + 1]};
             for (int a = 0; a < 3; a++)
-                q[a] = gi_v3_add(gi_v3_add(gi_v3_scale(fr->u, w[a]->x), gi_v3_scale(fr->v, w[a]->y)),
-                                 gi_v3_scale(fr->n, w[a]->z));
+                q[a] =
+                    gi_v3_add(gi_v3_add(gi_v3_scale(fr->u, w[a]->x), gi_v3_scale(fr->v, w[a]->y)),
+                              gi_v3_scale(fr->n, w[a]->z));
             if (!raster_tri(f, fr, q, emit_frag, &c))
                 return 0;
         }
@@ -572,7 +580,8 @@ static int list_fragments(const vlf_field *f, const vlf_psf *fr, frag_buf *buf, 
  * every face on the N S x N S rays, each ray's front to back
  * (list_fragments); the tile rectangles of non-diffuse faces recorded on
  * the way. Writes only psf[i] and the rectangles of subfield i. */
-static int build_psf(vlf_field *f, uint32_t i, frag_buf *buf, frag_buf *tmp, vlf_sorter *so, sort_counts *cnt)
+static int build_psf(vlf_field *f, uint32_t i, frag_buf *buf, frag_buf *tmp, vlf_sorter *so,
+                     sort_counts *cnt)
 {
     vlf_rect *rects = f->rects;
     vlf_psf *p = &f->psf[i];
@@ -737,16 +746,21 @@ static int group_faces(vlf_field *f, const gi_scene *s, float t)
         f->tri_group[ti] = s->vertices[s->indices[3 * ti]].object;
         gi_vec3 n = gi_v3_normalize(gi_v3_cross(gi_v3_sub(p[1], p[0]), gi_v3_sub(p[2], p[0])));
         nrm[ti] = n;
-        keys[ti] = (tri_key){ti, s->vertices[s->indices[3 * ti]].material, (int32_t)lrintf(n.x * 1000.0f),
-                             (int32_t)lrintf(n.y * 1000.0f), (int32_t)lrintf(n.z * 1000.0f),
+        keys[ti] = (tri_key){ti,
+                             s->vertices[s->indices[3 * ti]].material,
+                             (int32_t)lrintf(n.x * 1000.0f),
+                             (int32_t)lrintf(n.y * 1000.0f),
+                             (int32_t)lrintf(n.z * 1000.0f),
                              (int32_t)lrintf(gi_v3_dot(n, p[0]) * 1000.0f)};
     }
     qsort(keys, T, sizeof *keys, key_cmp);
     uint32_t nf = 0;
     for (uint32_t a = 0; a < T;) {
         uint32_t b = a + 1;
-        while (b < T && key_cmp(&(tri_key){0, keys[a].material, keys[a].nx, keys[a].ny, keys[a].nz, keys[a].d},
-                                &(tri_key){0, keys[b].material, keys[b].nx, keys[b].ny, keys[b].nz, keys[b].d}) == 0)
+        while (b < T && key_cmp(&(tri_key){0, keys[a].material, keys[a].nx, keys[a].ny, keys[a].nz,
+                                           keys[a].d},
+                                &(tri_key){0, keys[b].material, keys[b].nx, keys[b].ny, keys[b].nz,
+                                           keys[b].d}) == 0)
             b++;
         vlf_face *fc = &f->faces[nf];
         uint32_t t0 = keys[a].tri;
@@ -770,7 +784,8 @@ static int group_faces(vlf_field *f, const gi_scene *s, float t)
                 hi[0] = fmaxf(hi[0], x), hi[1] = fmaxf(hi[1], y);
             }
         fc->origin = gi_v3_add(p0, gi_v3_add(gi_v3_scale(fc->t, lo[0]), gi_v3_scale(fc->b, lo[1])));
-        float W = ceilf((hi[0] - lo[0]) * f->prm.density), H = ceilf((hi[1] - lo[1]) * f->prm.density);
+        float W = ceilf((hi[0] - lo[0]) * f->prm.density),
+              H = ceilf((hi[1] - lo[1]) * f->prm.density);
         fc->W = W < 1.0f ? 1u : W > 1024.0f ? 1024u : (uint32_t)W;
         fc->H = H < 1.0f ? 1u : H > 1024.0f ? 1024u : (uint32_t)H;
         const gi_material *mt = &s->materials[keys[a].material];
@@ -781,8 +796,10 @@ static int group_faces(vlf_field *f, const gi_scene *s, float t)
         fc->textured = mt->albedo_texture >= 0 && (uint32_t)mt->albedo_texture < s->texture_count;
         fc->mirror = mt->mirror || mt->exponent >= GI_MIRROR_EXPONENT;
         for (int k = 0; k < VLF_ALBEDO_TABLE; k++)
-            fc->albedo[k] = fc->mirror ? 1.0f
-                                       : (float)vlf_phong_albedo(fc->exponent, (float)k / (float)(VLF_ALBEDO_TABLE - 1));
+            fc->albedo[k] = fc->mirror
+                                ? 1.0f
+                                : (float)vlf_phong_albedo(fc->exponent,
+                                                          (float)k / (float)(VLF_ALBEDO_TABLE - 1));
         const float *le = gi_scene_triangle_emission(s, t0);
         for (int k = 0; k < 3; k++)
             fc->emission[k] = le ? le[k] : 0.0f;
@@ -844,8 +861,10 @@ static void element_areas(vlf_field *f, const gi_scene *s)
             x[k] = gi_v3_dot(d, fc->t) * f->prm.density;
             y[k] = gi_v3_dot(d, fc->b) * f->prm.density;
         }
-        int x0 = (int)floorf(fminf(x[0], fminf(x[1], x[2]))), x1 = (int)floorf(fmaxf(x[0], fmaxf(x[1], x[2])));
-        int y0 = (int)floorf(fminf(y[0], fminf(y[1], y[2]))), y1 = (int)floorf(fmaxf(y[0], fmaxf(y[1], y[2])));
+        int x0 = (int)floorf(fminf(x[0], fminf(x[1], x[2]))),
+            x1 = (int)floorf(fmaxf(x[0], fmaxf(x[1], x[2])));
+        int y0 = (int)floorf(fminf(y[0], fminf(y[1], y[2]))),
+            y1 = (int)floorf(fmaxf(y[0], fmaxf(y[1], y[2])));
         for (int ty = y0; ty <= y1; ty++)
             for (int tx = x0; tx <= x1; tx++) {
                 float px[16] = {x[0], x[1], x[2]}, py[16] = {y[0], y[1], y[2]};
@@ -879,7 +898,8 @@ static void element_areas(vlf_field *f, const gi_scene *s)
                         const float w[3] = {w0, w1, w2};
                         for (int k = 0; k < 3; k++)
                             for (int c = 0; c < 2; c++)
-                                uv[c] += w[k] * s->vertices[s->indices[3 * (size_t)ti + (size_t)k]].uv[c];
+                                uv[c] += w[k] *
+                                         s->vertices[s->indices[3 * (size_t)ti + (size_t)k]].uv[c];
                         gi_scene_albedo(s, fc->material, uv, alb);
                         for (int c = 0; c < 3; c++)
                             f->elem_kd[3 * (size_t)e + (size_t)c] += ar * alb[c];
@@ -913,7 +933,8 @@ static int subdivide_triangles(vlf_field *f, uint32_t k)
     for (uint32_t ti = 0; ti < f->tri_count; ti++) {
         const gi_vec3 *p = f->tri_p + 3 * (size_t)ti;
         gi_vec3 e1 = gi_v3_sub(p[1], p[0]), e2 = gi_v3_sub(p[2], p[0]);
-#define GRID(a, b) gi_v3_add(p[0], gi_v3_add(gi_v3_scale(e1, (float)(a) * inv), gi_v3_scale(e2, (float)(b) * inv)))
+#define GRID(a, b)                                                                                 \
+    gi_v3_add(p[0], gi_v3_add(gi_v3_scale(e1, (float)(a)*inv), gi_v3_scale(e2, (float)(b)*inv)))
         for (uint32_t a = 0; a < k; a++)
             for (uint32_t b = 0; a + b < k; b++) {
                 gi_vec3 *q = P + 3 * n;
@@ -939,7 +960,8 @@ static int subdivide_triangles(vlf_field *f, uint32_t k)
     return 1;
 }
 
-int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *p, char *err, size_t err_size)
+int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *p, char *err,
+                    size_t err_size)
 {
     memset(f, 0, sizeof *f);
     f->prm = *p;
@@ -953,12 +975,15 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
         return -1;
     }
     if (p->N < 4 || p->m < 1 || p->N % p->m != 0) {
-        snprintf(err, err_size, "vlf: N = %u must be a multiple of the tile size m = %u", p->N, p->m);
+        snprintf(err, err_size, "vlf: N = %u must be a multiple of the tile size m = %u", p->N,
+                 p->m);
         return -1;
     }
-    double ray_bytes = (double)p->l * (double)(p->N * p->S) * (double)(p->N * p->S) * sizeof(uint32_t);
+    double ray_bytes =
+        (double)p->l * (double)(p->N * p->S) * (double)(p->N * p->S) * sizeof(uint32_t);
     if (ray_bytes > 2.0 * 1024 * 1024 * 1024) {
-        snprintf(err, err_size, "vlf: l (N S)^2 = %.3g rays need %.1f GB of depth lists alone; lower l, N or S",
+        snprintf(err, err_size,
+                 "vlf: l (N S)^2 = %.3g rays need %.1f GB of depth lists alone; lower l, N or S",
                  ray_bytes / sizeof(uint32_t), ray_bytes / (1024.0 * 1024 * 1024));
         return -1;
     }
@@ -971,7 +996,8 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
     float b[6];
     gi_scene_bounds_at(s, t, b);
     f->centre = gi_v3(0.5f * (b[0] + b[3]), 0.5f * (b[1] + b[4]), 0.5f * (b[2] + b[5]));
-    f->radius = 0.5f * sqrtf((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) + (b[5] - b[2]) * (b[5] - b[2]));
+    f->radius = 0.5f * sqrtf((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) +
+                             (b[5] - b[2]) * (b[5] - b[2]));
     f->radius *= 1.001f;
     if (!(f->radius > 0.0f) || !isfinite(f->radius)) {
         snprintf(err, err_size, "vlf: the scene's bounds are empty or not finite");
@@ -998,7 +1024,8 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
         vlf_dirs_locate(&f->dirs, gi_v3_scale(fr.direction, 1.0f / len), node, al);
         for (int k = 0; k < 3; k++)
             for (int q = 0; q < 3; q++)
-                f->sun[3 * node[k] + (uint32_t)q] += al[k] * s->lights[li].intensity[q] / f->dirs.solid_angle[node[k]];
+                f->sun[3 * node[k] + (uint32_t)q] +=
+                    al[k] * s->lights[li].intensity[q] / f->dirs.solid_angle[node[k]];
         f->sun_count++;
     }
     /* Point and spot lights: a first shot by shadow rays (punctual_first_shot). */
@@ -1036,7 +1063,8 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
         vlf_face *fc = &f->faces[fi];
         fc->first_elem = elems;
         elems += fc->W * fc->H;
-        fc->nd = (fc->ks[0] > 0.0f || fc->ks[1] > 0.0f || fc->ks[2] > 0.0f) ? (int32_t)f->nd_count++ : -1;
+        fc->nd = (fc->ks[0] > 0.0f || fc->ks[1] > 0.0f || fc->ks[2] > 0.0f) ? (int32_t)f->nd_count++
+                                                                            : -1;
         /* Diffuse emission normalised so that the discrete directions carry
          * exactly pi L per unit area out of the face. */
         double sum = 0.0;
@@ -1056,7 +1084,8 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
     f->L_cur = calloc((size_t)elems * 3, sizeof(float));
     f->psf = calloc(p->l, sizeof *f->psf);
     f->rects = calloc((size_t)f->nd_count * p->l + 1, sizeof *f->rects);
-    if (!f->elem_face || !f->elem_area || !f->elem_c || !f->E_tot || !f->E_next || !f->L_cur || !f->psf || !f->rects)
+    if (!f->elem_face || !f->elem_area || !f->elem_c || !f->E_tot || !f->E_next || !f->L_cur ||
+        !f->psf || !f->rects)
         goto oom;
     for (uint32_t fi = 0; fi < f->face_count; fi++) {
         vlf_face *fc = &f->faces[fi];
@@ -1097,7 +1126,8 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
         }
     }
     if ((uint64_t)s->triangle_count * p->subdivide * p->subdivide > 50000000u) {
-        snprintf(err, err_size, "vlf: %u triangles cut into %u^2 each are too many", s->triangle_count, p->subdivide);
+        snprintf(err, err_size, "vlf: %u triangles cut into %u^2 each are too many",
+                 s->triangle_count, p->subdivide);
         return -1;
     }
     if (!subdivide_triangles(f, p->subdivide < 1 ? 1 : p->subdivide) || !build_all_psf(f))
@@ -1132,7 +1162,8 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
             for (uint32_t k = ps->cell_start[c]; k < ps->cell_start[c + 1]; k++) {
                 const vlf_face *fc = &f->faces[f->elem_face[ps->frag[k]]];
                 if (fc->nd >= 0)
-                    f->nd_cover[rect_slot(&f->rects[(size_t)fc->nd * p->l + i], (c % NS) / p->S, (c / NS) / p->S)] = 1;
+                    f->nd_cover[rect_slot(&f->rects[(size_t)fc->nd * p->l + i], (c % NS) / p->S,
+                                          (c / NS) / p->S)] = 1;
             }
     }
     uint32_t ndel = 0;
@@ -1147,13 +1178,15 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
      * only (vlf.c uploads exactly these maps). */
     size_t bpv = vlf_precision_bytes(p->precision);
     f->st.bytes_maps_render = ((size_t)elems + cells) * bpv;
-    f->st.bytes_propagate = (size_t)elems * bpv * 3 + cells * bpv * 4 + cells + frags * sizeof(uint32_t) +
-                            (size_t)p->l * ((size_t)p->N * p->S * p->N * p->S + 1) * sizeof(uint32_t);
+    f->st.bytes_propagate =
+        (size_t)elems * bpv * 3 + cells * bpv * 4 + cells + frags * sizeof(uint32_t) +
+        (size_t)p->l * ((size_t)p->N * p->S * p->N * p->S + 1) * sizeof(uint32_t);
     f->st.bytes_render = f->st.bytes_maps_render + (size_t)f->nd_count * p->l * sizeof(vlf_rect);
     f->st.sort_s = now_s() - t0;
     return 0;
 oom:
-    snprintf(err, err_size, "vlf: out of memory building the light field (N = %u, l = %u)", p->N, p->l);
+    snprintf(err, err_size, "vlf: out of memory building the light field (N = %u, l = %u)", p->N,
+             p->l);
     return -1;
 }
 
@@ -1162,7 +1195,8 @@ oom:
 /* Fragments of all faces along a perturbed direction (frame fr), sorted
  * per ray front to back; kept with their depths (§3.5: perturbed
  * directions are sorted like fixed ones, used for transport, discarded). */
-static int perturbed_list(vlf_field *f, const vlf_psf *fr, frag_buf *buf, frag_buf *tmp, vlf_sorter *so)
+static int perturbed_list(vlf_field *f, const vlf_psf *fr, frag_buf *buf, frag_buf *tmp,
+                          vlf_sorter *so)
 {
     sort_counts cnt = {0, 0, 0, 0, 0, 0, 0};
     return list_fragments(f, fr, buf, tmp, so, NULL, &cnt);
@@ -1186,8 +1220,8 @@ static size_t slot_at(const vlf_field *f, const vlf_face *fc, uint32_t i, gi_vec
  * for fixed direction i with weight dW: as sweep() below, but non-diffuse
  * faces read and write the tiles of fixed subfield i at each fragment's
  * point. */
-static void sweep_perturbed(vlf_field *f, uint32_t i, const vlf_psf *fr, const frag_buf *buf, int sign, float dW,
-                            int first_iteration)
+static void sweep_perturbed(vlf_field *f, uint32_t i, const vlf_psf *fr, const frag_buf *buf,
+                            int sign, float dW, int first_iteration)
 {
     uint32_t S = f->prm.S, N = f->prm.N * S;
     float inv_s2 = 1.0f / (float)(S * S);
@@ -1207,7 +1241,8 @@ static void sweep_perturbed(vlf_field *f, uint32_t i, const vlf_psf *fr, const f
         while (e < buf->n && buf->v[e].cell == buf->v[a].cell)
             e++;
         uint32_t c = buf->v[a].cell;
-        float U = ((float)(c % N) + 0.5f) / (float)N * 2.0f - 1.0f, V = ((float)(c / N) + 0.5f) / (float)N * 2.0f - 1.0f;
+        float U = ((float)(c % N) + 0.5f) / (float)N * 2.0f - 1.0f,
+              V = ((float)(c / N) + 0.5f) / (float)N * 2.0f - 1.0f;
         gi_vec3 o = gi_v3_add(gi_v3_scale(fr->u, U), gi_v3_scale(fr->v, V));
         float L[3] = {sky[0], sky[1], sky[2]};
         for (size_t j = 0; j < e - a; j++) {
@@ -1268,8 +1303,9 @@ static gi_vec3 perturbed_dir(const vlf_field *f, uint32_t i, uint32_t k)
     float cz = 1.0f - u[0] * (1.0f - cos_max), sz = sqrtf(fmaxf(0.0f, 1.0f - cz * cz));
     float phi = 2.0f * GI_PI * u[1];
     const vlf_psf *p = &f->psf[i];
-    return gi_v3_normalize(gi_v3_add(gi_v3_scale(p->n, cz),
-                                     gi_v3_add(gi_v3_scale(p->u, sz * cosf(phi)), gi_v3_scale(p->v, sz * sinf(phi)))));
+    return gi_v3_normalize(
+        gi_v3_add(gi_v3_scale(p->n, cz),
+                  gi_v3_add(gi_v3_scale(p->u, sz * cosf(phi)), gi_v3_scale(p->v, sz * sinf(phi)))));
 }
 
 /* The radiance the interface of fixed direction i starts a sweep with
@@ -1308,8 +1344,10 @@ static void sweep(vlf_field *f, uint32_t i, int sign, int first_iteration)
         uint32_t a = p->cell_start[c], e = p->cell_start[c + 1];
         float L[3] = {sky[0], sky[1], sky[2]};
         int32_t step = sign > 0 ? 1 : -1;
-        int32_t k = sign > 0 ? (int32_t)a : (int32_t)e - 1, end = sign > 0 ? (int32_t)e : (int32_t)a - 1;
-        uint32_t cx = (c % N) / S, cy = (c / N) / S; /* the subfield's cell of this interface cell */
+        int32_t k = sign > 0 ? (int32_t)a : (int32_t)e - 1,
+                end = sign > 0 ? (int32_t)e : (int32_t)a - 1;
+        uint32_t cx = (c % N) / S,
+                 cy = (c / N) / S; /* the subfield's cell of this interface cell */
         for (; k != end; k += step) {
             uint32_t el = p->frag[k];
             const vlf_face *fc = &f->faces[f->elem_face[el]];
@@ -1482,8 +1520,10 @@ static int punctual_first_shot(vlf_field *f)
         if (!(f->elem_area[e] > 0.0f))
             continue;
         const vlf_face *fc = &f->faces[f->elem_face[e]];
-        gi_vec3 q = gi_v3_add(fc->origin, gi_v3_add(gi_v3_scale(fc->t, f->elem_c[2 * (size_t)e] / f->prm.density),
-                                                    gi_v3_scale(fc->b, f->elem_c[2 * (size_t)e + 1] / f->prm.density)));
+        gi_vec3 q =
+            gi_v3_add(fc->origin,
+                      gi_v3_add(gi_v3_scale(fc->t, f->elem_c[2 * (size_t)e] / f->prm.density),
+                                gi_v3_scale(fc->b, f->elem_c[2 * (size_t)e + 1] / f->prm.density)));
         punctual_at(f, gi_v3_add(f->centre, gi_v3_scale(q, f->radius)), fc->n, E, w);
         for (uint32_t k = 0; k < P; k++)
             for (int c = 0; c < 3; c++)
@@ -1505,8 +1545,10 @@ static int punctual_first_shot(vlf_field *f)
                     size_t slot = rj->offset + (size_t)yy * rj->w + xx;
                     if (!f->nd_cover[slot])
                         continue;
-                    float U = ((float)(rj->x0 + (int32_t)xx) + 0.5f) / (float)f->prm.N * 2.0f - 1.0f;
-                    float V = ((float)(rj->y0 + (int32_t)yy) + 0.5f) / (float)f->prm.N * 2.0f - 1.0f;
+                    float U =
+                        ((float)(rj->x0 + (int32_t)xx) + 0.5f) / (float)f->prm.N * 2.0f - 1.0f;
+                    float V =
+                        ((float)(rj->y0 + (int32_t)yy) + 0.5f) / (float)f->prm.N * 2.0f - 1.0f;
                     gi_vec3 o = gi_v3_add(gi_v3_scale(ps->u, U), gi_v3_scale(ps->v, V));
                     float tt = gi_v3_dot(fc->n, gi_v3_sub(fc->origin, o)) / dn;
                     gi_vec3 q = gi_v3_add(o, gi_v3_scale(ps->n, tt));
@@ -1521,7 +1563,8 @@ static int punctual_first_shot(vlf_field *f)
                         if (norm <= 0.0 || g[sd] <= 0.0f)
                             continue;
                         for (int c = 0; c < 3; c++)
-                            f->out_next[3 * slot + (size_t)c] += fc->ks[c] * E[3 * k + (uint32_t)c] * (float)(g[sd] / norm);
+                            f->out_next[3 * slot + (size_t)c] +=
+                                fc->ks[c] * E[3 * k + (uint32_t)c] * (float)(g[sd] / norm);
                     }
                 }
         }
@@ -1576,8 +1619,10 @@ static void scatter(vlf_field *f, uint32_t i)
                     if (!f->nd_cover[slot])
                         continue;
                     /* the cell's ray meets the face's plane at q */
-                    float U = ((float)(rj->x0 + (int32_t)xx) + 0.5f) / (float)f->prm.N * 2.0f - 1.0f;
-                    float V = ((float)(rj->y0 + (int32_t)yy) + 0.5f) / (float)f->prm.N * 2.0f - 1.0f;
+                    float U =
+                        ((float)(rj->x0 + (int32_t)xx) + 0.5f) / (float)f->prm.N * 2.0f - 1.0f;
+                    float V =
+                        ((float)(rj->y0 + (int32_t)yy) + 0.5f) / (float)f->prm.N * 2.0f - 1.0f;
                     gi_vec3 o = gi_v3_add(gi_v3_scale(P->u, U), gi_v3_scale(P->v, V));
                     float tt = gi_v3_dot(fc->n, gi_v3_sub(fc->origin, o)) / dn;
                     gi_vec3 q = gi_v3_add(o, gi_v3_scale(P->n, tt));
@@ -1590,7 +1635,8 @@ static void scatter(vlf_field *f, uint32_t i)
                         f->out_next[3 * slot + k] += c[k] * Lin[k];
                 }
             /* one pass into the target's tiles: written in the storage format */
-            vlf_quantise(f->prm.precision, f->out_next + 3 * (size_t)rj->offset, (size_t)rj->w * rj->h);
+            vlf_quantise(f->prm.precision, f->out_next + 3 * (size_t)rj->offset,
+                         (size_t)rj->w * rj->h);
         }
     }
     free(g);
@@ -1605,10 +1651,10 @@ static void scatter(vlf_field *f, uint32_t i)
 typedef struct pert_pipe {
     vlf_field *f;
     uint32_t i, T, P;
-    frag_buf *slot;  /* P fragment lists */
-    vlf_psf *frame;  /* P frames */
-    uint8_t *ready;  /* P: 0 not yet, 1 ready, 2 failed */
-    int sync;        /* the mutex and condition are set up (and the rest owned) */
+    frag_buf *slot; /* P fragment lists */
+    vlf_psf *frame; /* P frames */
+    uint8_t *ready; /* P: 0 not yet, 1 ready, 2 failed */
+    int sync;       /* the mutex and condition are set up (and the rest owned) */
     pthread_mutex_t mu;
     pthread_cond_t cv;
 } pert_pipe;
@@ -1658,7 +1704,8 @@ static void pipe_free(pert_pipe *pp, pert_worker *wk)
 
 /* The perturbed sweeps of fixed direction i with the lists sorted beside
  * them on T threads; 0 out of memory. */
-static int perturbed_pipelined(vlf_field *f, uint32_t i, int first_iteration, pert_pipe *pp, pert_worker *wk)
+static int perturbed_pipelined(vlf_field *f, uint32_t i, int first_iteration, pert_pipe *pp,
+                               pert_worker *wk)
 {
     uint32_t T = pp->T, P = pp->P, l = f->prm.l, prec = f->prm.precision;
     pp->i = i;
@@ -1684,9 +1731,11 @@ static int perturbed_pipelined(vlf_field *f, uint32_t i, int first_iteration, pe
         if (!ok)
             break;
         /* each sign's solid angle: the fixed direction's, shared */
-        sweep_perturbed(f, i, &pp->frame[k], &pp->slot[k], +1, f->dirs.solid_angle[i] / (float)P, first_iteration);
+        sweep_perturbed(f, i, &pp->frame[k], &pp->slot[k], +1, f->dirs.solid_angle[i] / (float)P,
+                        first_iteration);
         vlf_quantise(prec, f->E_next, f->elem_count);
-        sweep_perturbed(f, i, &pp->frame[k], &pp->slot[k], -1, f->dirs.solid_angle[i + l] / (float)P, first_iteration);
+        sweep_perturbed(f, i, &pp->frame[k], &pp->slot[k], -1,
+                        f->dirs.solid_angle[i + l] / (float)P, first_iteration);
         vlf_quantise(prec, f->E_next, f->elem_count);
     }
     for (uint32_t t = 0; t < T; t++)
@@ -1771,7 +1820,8 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
             for (uint32_t fi = 0; fi < f->face_count; fi++)
                 if (f->faces[fi].nd >= 0) {
                     const vlf_rect *r = &f->rects[(size_t)f->faces[fi].nd * l + i];
-                    memset(f->in + 3 * (size_t)r->offset, 0, (size_t)r->w * r->h * 3 * sizeof(float));
+                    memset(f->in + 3 * (size_t)r->offset, 0,
+                           (size_t)r->w * r->h * 3 * sizeof(float));
                 }
             if (f->prm.perturbed == 0) {
                 sweep(f, i, +1, it == 0);
@@ -1795,9 +1845,11 @@ int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
                         return -1;
                     }
                     /* each sign's solid angle: the fixed direction's, shared */
-                    sweep_perturbed(f, i, &fr, &pbuf, +1, f->dirs.solid_angle[i] / (float)f->prm.perturbed, it == 0);
+                    sweep_perturbed(f, i, &fr, &pbuf, +1,
+                                    f->dirs.solid_angle[i] / (float)f->prm.perturbed, it == 0);
                     vlf_quantise(prec, f->E_next, f->elem_count);
-                    sweep_perturbed(f, i, &fr, &pbuf, -1, f->dirs.solid_angle[i + l] / (float)f->prm.perturbed, it == 0);
+                    sweep_perturbed(f, i, &fr, &pbuf, -1,
+                                    f->dirs.solid_angle[i + l] / (float)f->prm.perturbed, it == 0);
                     vlf_quantise(prec, f->E_next, f->elem_count);
                 }
             }

@@ -18,11 +18,11 @@
  * triangulation of the 2l signed directions (s < l: +w_s, s >= l: -w_{s-l}). */
 typedef struct vlf_dirs {
     uint32_t l;
-    gi_vec3 *signed_dirs;  /* 2l unit vectors */
-    float *solid_angle;    /* 2l: a third of the areas of the triangles at each node (sum 4 pi) */
+    gi_vec3 *signed_dirs; /* 2l unit vectors */
+    float *solid_angle;   /* 2l: a third of the areas of the triangles at each node (sum 4 pi) */
     uint32_t tri_count;
-    uint32_t *tris;        /* 3 per spherical triangle, counter-clockwise seen from outside */
-    float *tri_inv;        /* 9 per triangle: inverse of the matrix with columns a, b, c (row-major) */
+    uint32_t *tris; /* 3 per spherical triangle, counter-clockwise seen from outside */
+    float *tri_inv; /* 9 per triangle: inverse of the matrix with columns a, b, c (row-major) */
 } vlf_dirs;
 
 /* Builds the set with qhull. 0 on success, else -1 with a message in err. */
@@ -35,22 +35,25 @@ uint32_t vlf_dirs_locate(const vlf_dirs *d, gi_vec3 w, uint32_t node[3], float a
 
 /* Parameters (names of the paper where it has them). */
 typedef struct vlf_params {
-    uint32_t l;          /* bi-directional directions */
-    uint32_t N;          /* cells per side of a parallel subfield */
-    uint32_t m;          /* cells per side of a tile of non-diffuse storage */
-    uint32_t S;          /* radiance interface cells per subfield cell and side (its super-sampling, §3.3) */
+    uint32_t l; /* bi-directional directions */
+    uint32_t N; /* cells per side of a parallel subfield */
+    uint32_t m; /* cells per side of a tile of non-diffuse storage */
+    uint32_t S; /* radiance interface cells per subfield cell and side (its super-sampling, §3.3) */
     float density;       /* diffuse elements per unit length (scene scaled into the unit sphere) */
     uint32_t iterations; /* shooting iterations */
-    uint32_t perturbed;  /* perturbed virtual directions per fixed direction for transport (0: the fixed one, §3.5) */
+    uint32_t perturbed;  /* perturbed virtual directions per fixed direction for transport (0: the
+                            fixed one, §3.5) */
     uint32_t seed;
-    uint32_t order;      /* depth order of a subfield (§3.2): VLF_ORDER_FACES, _RAYS or _PLAIN */
-    uint32_t threads;    /* CPU threads building the subfields (the result is the same for any count) */
+    uint32_t order; /* depth order of a subfield (§3.2): VLF_ORDER_FACES, _RAYS or _PLAIN */
+    uint32_t
+        threads; /* CPU threads building the subfields (the result is the same for any count) */
     uint32_t bsp_levels; /* BSP cuts orthogonal to the direction, levels (paper: 2) */
     uint32_t bsp_min;    /* a list is cut only with at least this many faces (paper: 4K) */
     uint32_t precision;  /* storage format of the ir/radiance maps: VLF_PREC_32F, _16F or _RGB9E5 */
-    uint32_t subdivide;  /* each scene triangle cut into subdivide^2 for sorting and transport (tessellation sweep) */
-    uint32_t hier_min;   /* hierarchical shortcut (§3.2): objects of at least this many triangles in a box no other
-                          * triangle reaches into are sorted on their own; 0: off */
+    uint32_t subdivide;  /* each scene triangle cut into subdivide^2 for sorting and transport
+                            (tessellation sweep) */
+    uint32_t hier_min; /* hierarchical shortcut (§3.2): objects of at least this many triangles in a
+                        * box no other triangle reaches into are sorted on their own; 0: off */
 } vlf_params;
 
 /* Storage formats of the light-field maps (§3.1, §6): three float32 (12
@@ -87,23 +90,24 @@ enum { VLF_ALBEDO_TABLE = 33 };
 /* A face: the coplanar triangles of one material (the paper's planar
  * polygons), with a W x H chart of diffuse elements in its plane. */
 typedef struct vlf_face {
-    gi_vec3 origin;     /* a point of the plane, the chart's corner (VLF coordinates) */
-    gi_vec3 n;          /* unit normal */
-    gi_vec3 t, b;       /* chart axes in the plane, unit */
-    float area;         /* VLF units */
-    uint32_t W, H;      /* chart texels */
+    gi_vec3 origin; /* a point of the plane, the chart's corner (VLF coordinates) */
+    gi_vec3 n;      /* unit normal */
+    gi_vec3 t, b;   /* chart axes in the plane, unit */
+    float area;     /* VLF units */
+    uint32_t W, H;  /* chart texels */
     uint32_t first_elem;
     float kd[3], ks[3], exponent, emission[3];
     int mirror;
-    uint32_t material;  /* the scene's material */
-    int textured;       /* its albedo has a texture (elements then average it, elem_kd) */
-    int32_t nd;         /* index among non-diffuse faces, -1 for diffuse */
-    int32_t twin;       /* double-sided material: the face of the other side (same plane and chart, normal
-                         * reversed, its own elements and tiles), -1 for single-sided */
-    int back;           /* this is the back side of a double-sided face (no triangles of its own) */
-    float send_scale;   /* pi / sum over directions of |cos| dOmega (diffuse emission normalisation) */
-    float albedo[VLF_ALBEDO_TABLE]; /* the glossy lobe's albedo over cos(incidence) 0 .. 1 (1 at normal incidence;
-                                     * mirrors 1 throughout) */
+    uint32_t material; /* the scene's material */
+    int textured;      /* its albedo has a texture (elements then average it, elem_kd) */
+    int32_t nd;        /* index among non-diffuse faces, -1 for diffuse */
+    int32_t twin; /* double-sided material: the face of the other side (same plane and chart, normal
+                   * reversed, its own elements and tiles), -1 for single-sided */
+    int back;     /* this is the back side of a double-sided face (no triangles of its own) */
+    float
+        send_scale; /* pi / sum over directions of |cos| dOmega (diffuse emission normalisation) */
+    float albedo[VLF_ALBEDO_TABLE]; /* the glossy lobe's albedo over cos(incidence) 0 .. 1 (1 at
+                                     * normal incidence; mirrors 1 throughout) */
 } vlf_face;
 
 /* Fragment lists of one subfield: the faces each ray meets, front to back
@@ -118,19 +122,23 @@ typedef struct vlf_psf {
 
 typedef struct vlf_stats {
     double sort_s, propagate_s;
-    double flux_emitted, flux_shot, flux_received, flux_back, flux_escaped; /* sums over iterations */
-    uint64_t samples;        /* fragments visited in propagation (the paper's "ray intersections") */
-    size_t bytes_propagate;  /* storage while propagating */
-    size_t bytes_render;     /* storage kept for rendering */
-    size_t bytes_maps_render;/* of it the total maps (diffuse atlas and tiles) in the storage format */
+    double flux_emitted, flux_shot, flux_received, flux_back,
+        flux_escaped;       /* sums over iterations */
+    uint64_t samples;       /* fragments visited in propagation (the paper's "ray intersections") */
+    size_t bytes_propagate; /* storage while propagating */
+    size_t bytes_render;    /* storage kept for rendering */
+    size_t bytes_maps_render; /* of it the total maps (diffuse atlas and tiles) in the storage
+                                 format */
     uint32_t diffuse_elements, nondiffuse_elements, tiles;
-    uint64_t sort_pieces;    /* faces (triangles and their pieces) placed, over all subfields */
-    uint64_t sort_splits;    /* pieces split to break a cycle of overlaps, over all subfields */
-    uint64_t sort_bsp_cuts;  /* pieces cut by a BSP plane, over all subfields */
-    uint64_t sort_unresolved;/* cycles left unbroken (split limit), over all subfields */
-    uint64_t sort_tests;     /* pairs of faces tested by Newell's ordering */
-    uint64_t sort_groups;    /* objects sorted on their own by the hierarchical shortcut, over all subfields */
-    uint64_t sort_hier_fallbacks; /* subfields sorted again without it (a stand-in split by a cycle) */
+    uint64_t sort_pieces;     /* faces (triangles and their pieces) placed, over all subfields */
+    uint64_t sort_splits;     /* pieces split to break a cycle of overlaps, over all subfields */
+    uint64_t sort_bsp_cuts;   /* pieces cut by a BSP plane, over all subfields */
+    uint64_t sort_unresolved; /* cycles left unbroken (split limit), over all subfields */
+    uint64_t sort_tests;      /* pairs of faces tested by Newell's ordering */
+    uint64_t sort_groups;     /* objects sorted on their own by the hierarchical shortcut, over all
+                                 subfields */
+    uint64_t
+        sort_hier_fallbacks; /* subfields sorted again without it (a stand-in split by a cycle) */
 } vlf_stats;
 
 /* A point or spot light (world space): its first shot is by shadow rays. */
@@ -144,37 +152,40 @@ typedef struct vlf_field {
     vlf_params prm;
     vlf_dirs dirs;
     gi_vec3 centre;
-    float radius;            /* world = centre + radius * vlf */
+    float radius; /* world = centre + radius * vlf */
     uint32_t face_count, elem_count, nd_count;
     vlf_face *faces;
-    uint32_t tri_count;      /* triangles sorted and rasterised: scene triangles x subdivide^2 */
-    uint32_t tri_sub;        /* subdivide^2: triangle k is part of scene triangle k / tri_sub */
-    uint32_t *tri_face;      /* face of each triangle */
-    uint32_t *tri_group;     /* scene object of each triangle (the hierarchical shortcut's groups) */
-    gi_vec3 *tri_p;          /* 3 corners per triangle, VLF coordinates */
+    uint32_t tri_count;  /* triangles sorted and rasterised: scene triangles x subdivide^2 */
+    uint32_t tri_sub;    /* subdivide^2: triangle k is part of scene triangle k / tri_sub */
+    uint32_t *tri_face;  /* face of each triangle */
+    uint32_t *tri_group; /* scene object of each triangle (the hierarchical shortcut's groups) */
+    gi_vec3 *tri_p;      /* 3 corners per triangle, VLF coordinates */
     uint32_t *elem_face;
     float *elem_area;
-    float *elem_kd;          /* 3 per element: albedo (the material's, or the texture averaged over the element) */
-    vlf_psf *psf;            /* l (fixed directions) */
-    vlf_rect *rects;         /* nd_count * l */
+    float *elem_kd;  /* 3 per element: albedo (the material's, or the texture averaged over the
+                        element) */
+    vlf_psf *psf;    /* l (fixed directions) */
+    vlf_rect *rects; /* nd_count * l */
     uint32_t nd_cells;
-    uint8_t *nd_cover;       /* nd_cells: the face covers this cell */
+    uint8_t *nd_cover; /* nd_cells: the face covers this cell */
     /* radiance storage (RGB) */
-    float *E_tot, *E_next, *L_cur;       /* elem_count * 3: irradiance, unshot diffuse radiance */
+    float *E_tot, *E_next, *L_cur; /* elem_count * 3: irradiance, unshot diffuse radiance */
     float *out_cur, *out_next, *out_tot, *in; /* nd_cells * 3 */
     const struct gi_envmap *env;
     struct vlf_punctual *punctual; /* point and spot lights, world space */
     uint32_t punctual_count;
-    struct gi_rt *rt;        /* the scene for their shadow rays (NULL without them) */
-    float *elem_c;           /* 2 per element: centroid of its part on the face, chart texels */
-    float *sun;              /* 2l x RGB: radiance the directional lights put into each signed direction's interface */
-    uint32_t sun_count;      /* directional lights of the scene */
+    struct gi_rt *rt; /* the scene for their shadow rays (NULL without them) */
+    float *elem_c;    /* 2 per element: centroid of its part on the face, chart texels */
+    float *sun;       /* 2l x RGB: radiance the directional lights put into each signed direction's
+                         interface */
+    uint32_t sun_count; /* directional lights of the scene */
     vlf_stats st;
 } vlf_field;
 
 /* Builds the field for scene s at time t: faces, elements, directions and
  * the per-ray depth order of every subfield ("sort"). 0 or -1 with err. */
-int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *p, char *err, size_t err_size);
+int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *p, char *err,
+                    size_t err_size);
 /* Shoots unshot radiance for p->iterations iterations ("propagate").
  * `cancelled` (may be NULL) is polled between directions; returns -1 then. */
 int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user);

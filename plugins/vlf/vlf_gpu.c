@@ -16,8 +16,22 @@
 /* The buffers, in binding order after GI_SSBO_PLUGIN_FIRST (as in
  * shaders/vlf_propagate.comp). */
 enum {
-    B_FACES, B_ELEM_FACE, B_ELEM_AREA, B_CELL_START, B_FRAG, B_FRAG_SLOT, B_RECV, B_EMAP,
-    B_TMAP, B_STATS, B_GATHER, B_PERM, B_RECTS, B_COVER, B_FRAMES, B_JOBS
+    B_FACES,
+    B_ELEM_FACE,
+    B_ELEM_AREA,
+    B_CELL_START,
+    B_FRAG,
+    B_FRAG_SLOT,
+    B_RECV,
+    B_EMAP,
+    B_TMAP,
+    B_STATS,
+    B_GATHER,
+    B_PERM,
+    B_RECTS,
+    B_COVER,
+    B_FRAMES,
+    B_JOBS
 };
 enum { P_SWEEP, P_GATHER, P_SCATTER, P_FINISH };
 
@@ -60,7 +74,8 @@ void vlf_gpu_free(vlf_gpu *g)
 static void put(GLuint b, const void *data, size_t bytes)
 {
     static const uint32_t zero[4] = {0, 0, 0, 0};
-    glNamedBufferData(b, (GLsizeiptr)(bytes ? bytes : sizeof zero), bytes ? data : zero, GL_DYNAMIC_DRAW);
+    glNamedBufferData(b, (GLsizeiptr)(bytes ? bytes : sizeof zero), bytes ? data : zero,
+                      GL_DYNAMIC_DRAW);
 }
 
 typedef struct gath_entry {
@@ -96,7 +111,8 @@ int vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, char *err, size_t err_size)
     double t0 = now_s();
     uint32_t l = f->prm.l, S = f->prm.S, NS = f->prm.N * S, n2 = NS * NS;
     if (f->prm.perturbed > 0) {
-        snprintf(err, err_size, "vlf: propagate = gpu runs the fixed directions only (perturbed = 0)");
+        snprintf(err, err_size,
+                 "vlf: propagate = gpu runs the fixed directions only (perturbed = 0)");
         return -1;
     }
     if (!g->buf[0])
@@ -126,8 +142,10 @@ int vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, char *err, size_t err_size)
     if ((size_t)f->nd_cells * 12 * sizeof(float) > largest)
         largest = (size_t)f->nd_cells * 12 * sizeof(float);
     if (max_block > 0 && largest > (size_t)max_block) {
-        snprintf(err, err_size, "vlf: propagate = gpu needs a %zu-byte buffer, the GL allows %lld (lower l, N or S)",
-                 largest, (long long)max_block);
+        snprintf(
+            err, err_size,
+            "vlf: propagate = gpu needs a %zu-byte buffer, the GL allows %lld (lower l, N or S)",
+            largest, (long long)max_block);
         return -1;
     }
     uint32_t *start = malloc(((size_t)l * (n2 + 1)) * sizeof *start);
@@ -143,9 +161,9 @@ int vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, char *err, size_t err_size)
     float *wg = malloc((size_t)2 * l * sizeof *wg);
     uint8_t *cover = calloc((size_t)f->nd_cells + 4, 1);
     grow gath = {NULL, 0, 0, sizeof(gath_entry)}, jobs = {NULL, 0, 0, sizeof(job_entry)};
-    int ok = g->start_base && g->frag_base && g->g_first && g->g_elem && g->g_count && g->j_first && g->j_count &&
-             g->j_cells && start && frag && slot && perm && cnt && pos && touched && faces && rects && frames && wg &&
-             cover;
+    int ok = g->start_base && g->frag_base && g->g_first && g->g_elem && g->g_count && g->j_first &&
+             g->j_count && g->j_cells && start && frag && slot && perm && cnt && pos && touched &&
+             faces && rects && frames && wg && cover;
     size_t fbase = 0, pfill = 0;
     for (uint32_t i = 0; ok && i < l; i++) {
         const vlf_psf *ps = &f->psf[i];
@@ -231,7 +249,8 @@ int vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, char *err, size_t err_size)
                     ok = 0;
                     break;
                 }
-                *je = (job_entry){(uint32_t)fc->nd * l + i, (uint32_t)fc->nd * l + pj, fi, cells, {0, 0, 0, 0}};
+                *je = (job_entry){
+                    (uint32_t)fc->nd * l + i, (uint32_t)fc->nd * l + pj, fi, cells, {0, 0, 0, 0}};
                 for (int q = 0; q < 3; q++)
                     je->c[q] = fc->ks[q] * wg[j] * scale;
                 cells += rj->w * rj->h;
@@ -267,17 +286,19 @@ int vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, char *err, size_t err_size)
         put(g->buf[B_FACES], faces, (size_t)f->face_count * 12 * sizeof *faces);
         put(g->buf[B_ELEM_FACE], f->elem_face, (size_t)f->elem_count * sizeof(uint32_t));
         /* each element's area, then its albedo (3 floats) */
-        glNamedBufferData(g->buf[B_ELEM_AREA], (GLsizeiptr)(((size_t)f->elem_count * 4 + 4) * sizeof(float)), NULL,
+        glNamedBufferData(g->buf[B_ELEM_AREA],
+                          (GLsizeiptr)(((size_t)f->elem_count * 4 + 4) * sizeof(float)), NULL,
                           GL_DYNAMIC_DRAW);
-        glNamedBufferSubData(g->buf[B_ELEM_AREA], 0, (GLsizeiptr)((size_t)f->elem_count * sizeof(float)), f->elem_area);
+        glNamedBufferSubData(g->buf[B_ELEM_AREA], 0,
+                             (GLsizeiptr)((size_t)f->elem_count * sizeof(float)), f->elem_area);
         glNamedBufferSubData(g->buf[B_ELEM_AREA], (GLintptr)((size_t)f->elem_count * sizeof(float)),
                              (GLsizeiptr)((size_t)f->elem_count * 3 * sizeof(float)), f->elem_kd);
         put(g->buf[B_CELL_START], start, (size_t)l * (n2 + 1) * sizeof *start);
         put(g->buf[B_FRAG], frag, frags * sizeof *frag);
         put(g->buf[B_FRAG_SLOT], slot, frags * sizeof *slot);
         put(g->buf[B_RECV], NULL, 0);
-        glNamedBufferData(g->buf[B_RECV], (GLsizeiptr)(((size_t)max_frags + 1) * 3 * sizeof(float)), NULL,
-                          GL_DYNAMIC_DRAW);
+        glNamedBufferData(g->buf[B_RECV], (GLsizeiptr)(((size_t)max_frags + 1) * 3 * sizeof(float)),
+                          NULL, GL_DYNAMIC_DRAW);
         put(g->buf[B_GATHER], gath.v, gath.n * sizeof(gath_entry));
         put(g->buf[B_PERM], perm, pfill * sizeof *perm);
         put(g->buf[B_RECTS], rects, (size_t)f->nd_count * l * 8 * sizeof *rects);
@@ -322,7 +343,8 @@ static void set_f(GLuint p, const char *name, float v)
     glProgramUniform1f(p, glGetUniformLocation(p, name), v);
 }
 
-int vlf_gpu_propagate(vlf_gpu *g, vlf_field *f, int (*cancelled)(void *), void *user, char *err, size_t err_size)
+int vlf_gpu_propagate(vlf_gpu *g, vlf_field *f, int (*cancelled)(void *), void *user, char *err,
+                      size_t err_size)
 {
     double t0 = now_s();
     uint32_t l = f->prm.l, S = f->prm.S, NS = f->prm.N * S, n2 = NS * NS;
@@ -332,14 +354,20 @@ int vlf_gpu_propagate(vlf_gpu *g, vlf_field *f, int (*cancelled)(void *), void *
     }
     size_t ne = (size_t)f->elem_count * 3, nc = (size_t)f->nd_cells * 3;
     /* the maps as vlf_propagate_init left them */
-    glNamedBufferData(g->buf[B_EMAP], (GLsizeiptr)((3 * ne + 3) * sizeof(float)), NULL, GL_DYNAMIC_DRAW);
+    glNamedBufferData(g->buf[B_EMAP], (GLsizeiptr)((3 * ne + 3) * sizeof(float)), NULL,
+                      GL_DYNAMIC_DRAW);
     glNamedBufferSubData(g->buf[B_EMAP], 0, (GLsizeiptr)(ne * sizeof(float)), f->E_next);
-    glNamedBufferSubData(g->buf[B_EMAP], (GLintptr)(ne * sizeof(float)), (GLsizeiptr)(ne * sizeof(float)), f->E_tot);
-    glNamedBufferSubData(g->buf[B_EMAP], (GLintptr)(2 * ne * sizeof(float)), (GLsizeiptr)(ne * sizeof(float)), f->L_cur);
-    glNamedBufferData(g->buf[B_TMAP], (GLsizeiptr)((4 * nc + 3) * sizeof(float)), NULL, GL_DYNAMIC_DRAW);
+    glNamedBufferSubData(g->buf[B_EMAP], (GLintptr)(ne * sizeof(float)),
+                         (GLsizeiptr)(ne * sizeof(float)), f->E_tot);
+    glNamedBufferSubData(g->buf[B_EMAP], (GLintptr)(2 * ne * sizeof(float)),
+                         (GLsizeiptr)(ne * sizeof(float)), f->L_cur);
+    glNamedBufferData(g->buf[B_TMAP], (GLsizeiptr)((4 * nc + 3) * sizeof(float)), NULL,
+                      GL_DYNAMIC_DRAW);
     glClearNamedBufferData(g->buf[B_TMAP], GL_R32F, GL_RED, GL_FLOAT, NULL);
-    glNamedBufferSubData(g->buf[B_TMAP], (GLintptr)(nc * sizeof(float)), (GLsizeiptr)(nc * sizeof(float)), f->out_next);
-    glNamedBufferData(g->buf[B_STATS], (GLsizeiptr)((size_t)2 * n2 * 4 * sizeof(float)), NULL, GL_DYNAMIC_DRAW);
+    glNamedBufferSubData(g->buf[B_TMAP], (GLintptr)(nc * sizeof(float)),
+                         (GLsizeiptr)(nc * sizeof(float)), f->out_next);
+    glNamedBufferData(g->buf[B_STATS], (GLsizeiptr)((size_t)2 * n2 * 4 * sizeof(float)), NULL,
+                      GL_DYNAMIC_DRAW);
     glClearNamedBufferData(g->buf[B_STATS], GL_R32F, GL_RED, GL_FLOAT, NULL);
     for (int b = 0; b < VLF_GPU_BUFFERS; b++)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, GI_SSBO_PLUGIN_FIRST + (GLuint)b, g->buf[b]);
@@ -416,28 +444,31 @@ int vlf_gpu_propagate(vlf_gpu *g, vlf_field *f, int (*cancelled)(void *), void *
     if (rc == 0) {
         /* the maps and the flux counters back into the field */
         glGetNamedBufferSubData(g->buf[B_EMAP], 0, (GLsizeiptr)(ne * sizeof(float)), f->E_next);
-        glGetNamedBufferSubData(g->buf[B_EMAP], (GLintptr)(ne * sizeof(float)), (GLsizeiptr)(ne * sizeof(float)), f->E_tot);
-        glGetNamedBufferSubData(g->buf[B_EMAP], (GLintptr)(2 * ne * sizeof(float)), (GLsizeiptr)(ne * sizeof(float)),
-                                f->L_cur);
+        glGetNamedBufferSubData(g->buf[B_EMAP], (GLintptr)(ne * sizeof(float)),
+                                (GLsizeiptr)(ne * sizeof(float)), f->E_tot);
+        glGetNamedBufferSubData(g->buf[B_EMAP], (GLintptr)(2 * ne * sizeof(float)),
+                                (GLsizeiptr)(ne * sizeof(float)), f->L_cur);
         glGetNamedBufferSubData(g->buf[B_TMAP], 0, (GLsizeiptr)(nc * sizeof(float)), f->out_cur);
-        glGetNamedBufferSubData(g->buf[B_TMAP], (GLintptr)(nc * sizeof(float)), (GLsizeiptr)(nc * sizeof(float)),
-                                f->out_next);
-        glGetNamedBufferSubData(g->buf[B_TMAP], (GLintptr)(2 * nc * sizeof(float)), (GLsizeiptr)(nc * sizeof(float)),
-                                f->out_tot);
-        glGetNamedBufferSubData(g->buf[B_TMAP], (GLintptr)(3 * nc * sizeof(float)), (GLsizeiptr)(nc * sizeof(float)),
-                                f->in);
+        glGetNamedBufferSubData(g->buf[B_TMAP], (GLintptr)(nc * sizeof(float)),
+                                (GLsizeiptr)(nc * sizeof(float)), f->out_next);
+        glGetNamedBufferSubData(g->buf[B_TMAP], (GLintptr)(2 * nc * sizeof(float)),
+                                (GLsizeiptr)(nc * sizeof(float)), f->out_tot);
+        glGetNamedBufferSubData(g->buf[B_TMAP], (GLintptr)(3 * nc * sizeof(float)),
+                                (GLsizeiptr)(nc * sizeof(float)), f->in);
         float *st = malloc((size_t)2 * n2 * 4 * sizeof *st);
         if (!st) {
             snprintf(err, err_size, "vlf: out of memory reading the GPU's counters");
             return -1;
         }
-        glGetNamedBufferSubData(g->buf[B_STATS], 0, (GLsizeiptr)((size_t)2 * n2 * 4 * sizeof *st), st);
+        glGetNamedBufferSubData(g->buf[B_STATS], 0, (GLsizeiptr)((size_t)2 * n2 * 4 * sizeof *st),
+                                st);
         double sum[4] = {0, 0, 0, 0};
         for (size_t k = 0; k < (size_t)2 * n2; k++)
             for (int q = 0; q < 4; q++)
                 sum[q] += st[4 * k + (size_t)q];
         free(st);
-        f->st.flux_shot = sum[0], f->st.flux_received = sum[1], f->st.flux_back = sum[2], f->st.flux_escaped = sum[3];
+        f->st.flux_shot = sum[0], f->st.flux_received = sum[1], f->st.flux_back = sum[2],
+        f->st.flux_escaped = sum[3];
     }
     gi_error e;
     if (rc == 0 && gi_gl_check("vlf: GPU propagation", &e) != GI_OK) {

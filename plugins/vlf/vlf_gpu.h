@@ -34,7 +34,8 @@ int vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, char *err, size_t err_size);
  * vlf_gpu_setup on the same field) and reads the maps back into f (the
  * same arrays and counters as vlf_field_propagate). `cancelled` (may be
  * NULL) is polled between directions. 0, or -1 with err. */
-int vlf_gpu_propagate(vlf_gpu *g, vlf_field *f, int (*cancelled)(void *), void *user, char *err, size_t err_size);
+int vlf_gpu_propagate(vlf_gpu *g, vlf_field *f, int (*cancelled)(void *), void *user, char *err,
+                      size_t err_size);
 void vlf_gpu_free(vlf_gpu *g);
 
 #endif

@@ -10,8 +10,8 @@
 enum { MAX_VERTS = 32, SPLIT_MAX_VERTS = 24 };
 
 /* Lengths are in the scene's unit sphere. */
-static const float EPS = 1e-6f;        /* a vertex this close to a plane lies on it */
-static const float AREA_EPS = 1e-10f;  /* projections overlapping less than this do not overlap */
+static const float EPS = 1e-6f;       /* a vertex this close to a plane lies on it */
+static const float AREA_EPS = 1e-10f; /* projections overlapping less than this do not overlap */
 
 static int grow(void **p, uint32_t *cap, uint32_t need, size_t elem)
 {
@@ -119,7 +119,8 @@ static int split_piece(vlf_sorter *s, uint32_t idx, const float *pl, uint32_t *a
 
 /* Area and centroid of the overlap of the projections (x, y) of pieces p
  * and q: p's polygon clipped by each edge of q's (Sutherland-Hodgman). */
-static float overlap(const vlf_sorter *s, const vlf_piece *p, const vlf_piece *q, float *cx, float *cy)
+static float overlap(const vlf_sorter *s, const vlf_piece *p, const vlf_piece *q, float *cx,
+                     float *cy)
 {
     float x[2 * MAX_VERTS + 8], y[2 * MAX_VERTS + 8], ox[2 * MAX_VERTS + 8], oy[2 * MAX_VERTS + 8];
     int n = (int)p->count;
@@ -180,7 +181,8 @@ static int obstructs(vlf_sorter *s, uint32_t q, uint32_t p)
     s->tests++;
     if (Q->lo[2] >= P->hi[2])
         return 0; /* depth ranges apart */
-    if (Q->hi[0] <= P->lo[0] || Q->lo[0] >= P->hi[0] || Q->hi[1] <= P->lo[1] || Q->lo[1] >= P->hi[1])
+    if (Q->hi[0] <= P->lo[0] || Q->lo[0] >= P->hi[0] || Q->hi[1] <= P->lo[1] ||
+        Q->lo[1] >= P->hi[1])
         return 0; /* projected bounds apart */
     const float *pp = s->plane + 4 * (size_t)P->tri, *pq = s->plane + 4 * (size_t)Q->tri;
     if (pp[2] > 1e-4f) { /* q entirely behind p's plane */
@@ -211,8 +213,8 @@ static int obstructs(vlf_sorter *s, uint32_t q, uint32_t p)
 static void grid_range(const vlf_sorter *s, uint32_t idx, uint32_t r[4])
 {
     const vlf_piece *p = &s->poly[idx];
-    float c[4] = {(p->lo[0] - s->gx0) * s->gsx, (p->lo[1] - s->gy0) * s->gsy, (p->hi[0] - s->gx0) * s->gsx,
-                  (p->hi[1] - s->gy0) * s->gsy};
+    float c[4] = {(p->lo[0] - s->gx0) * s->gsx, (p->lo[1] - s->gy0) * s->gsy,
+                  (p->hi[0] - s->gx0) * s->gsx, (p->hi[1] - s->gy0) * s->gsy};
     for (int k = 0; k < 4; k++) {
         float v = floorf(c[k]);
         r[k] = v <= 0.0f ? 0u : v >= (float)(s->G - 1) ? s->G - 1 : (uint32_t)v;
@@ -255,7 +257,8 @@ static int grid_build(vlf_sorter *s, const uint32_t *items, uint32_t n)
     float lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
     for (uint32_t k = 0; k < n; k++)
         for (int a = 0; a < 2; a++)
-            lo[a] = fminf(lo[a], s->poly[items[k]].lo[a]), hi[a] = fmaxf(hi[a], s->poly[items[k]].hi[a]);
+            lo[a] = fminf(lo[a], s->poly[items[k]].lo[a]),
+            hi[a] = fmaxf(hi[a], s->poly[items[k]].hi[a]);
     uint32_t G = (uint32_t)sqrtf((float)n * 0.5f);
     G = G < 1 ? 1 : G > 256 ? 256 : G;
     s->G = G;
@@ -347,7 +350,8 @@ static int break_cycle(vlf_sorter *s, uint32_t start, uint32_t top)
     uint32_t len = top - start + 1;
     for (uint32_t j = 0; j < len; j++) {
         /* the closing pair first: chain[top] is obstructed by chain[start] */
-        uint32_t a = s->chain[j == 0 ? top : start + j - 1], b = s->chain[j == 0 ? start : start + j];
+        uint32_t a = s->chain[j == 0 ? top : start + j - 1],
+                 b = s->chain[j == 0 ? start : start + j];
         uint32_t pa, pb;
         int r = split_piece(s, b, s->plane + 4 * (size_t)s->poly[a].tri, &pa, &pb);
         if (r == 0)
@@ -369,7 +373,8 @@ static int break_cycle(vlf_sorter *s, uint32_t start, uint32_t top)
         return 0;
     const vlf_piece *p = &s->poly[widest];
     int ax = p->hi[0] - p->lo[0] >= p->hi[1] - p->lo[1] ? 0 : 1;
-    float pl[4] = {ax == 0 ? 1.0f : 0.0f, ax == 1 ? 1.0f : 0.0f, 0.0f, 0.5f * (p->lo[ax] + p->hi[ax])};
+    float pl[4] = {ax == 0 ? 1.0f : 0.0f, ax == 1 ? 1.0f : 0.0f, 0.0f,
+                   0.5f * (p->lo[ax] + p->hi[ax])};
     uint32_t pa, pb;
     int r = split_piece(s, widest, pl, &pa, &pb);
     if (r <= 0)
@@ -395,7 +400,8 @@ static int zkey_cmp(const void *a, const void *b)
  * lie in front of it (looked for among the pieces whose projections share
  * a grid cell with it) becomes the candidate in its place (a chain); a
  * piece met again on the chain closes a cycle, which is broken by a split. */
-static int order_list(vlf_sorter *s, const uint32_t *items, uint32_t n, int mode, uint32_t split_limit)
+static int order_list(vlf_sorter *s, const uint32_t *items, uint32_t n, int mode,
+                      uint32_t split_limit)
 {
     zkey *keys = malloc((size_t)(n ? n : 1) * sizeof *keys);
     if (!keys || !grow((void **)&s->list, &s->cap_list, n, sizeof *s->list)) {
@@ -439,7 +445,9 @@ static int order_list(vlf_sorter *s, const uint32_t *items, uint32_t n, int mode
             continue;
         }
         /* a cycle: chain[pos(found) .. top] */
-        int r = s->np < split_limit && mode == VLF_SORT_NEWELL ? break_cycle(s, (uint32_t)s->chain_pos[found], chain_len - 1) : 0;
+        int r = s->np < split_limit && mode == VLF_SORT_NEWELL
+                    ? break_cycle(s, (uint32_t)s->chain_pos[found], chain_len - 1)
+                    : 0;
         if (r < 0)
             return -1;
         if (r == 0) {
@@ -462,8 +470,8 @@ static int order_list(vlf_sorter *s, const uint32_t *items, uint32_t n, int mode
 /* The BSP step: pieces items[0 .. n) cut at the depth of their centre of
  * mass (area-weighted) by a plane orthogonal to the direction, the front
  * list ordered before the back one. */
-static int order_bsp(vlf_sorter *s, uint32_t *items, uint32_t n, int mode, uint32_t level, uint32_t levels,
-                     uint32_t bsp_min, uint32_t split_limit)
+static int order_bsp(vlf_sorter *s, uint32_t *items, uint32_t n, int mode, uint32_t level,
+                     uint32_t levels, uint32_t bsp_min, uint32_t split_limit)
 {
     if (level >= levels || n < bsp_min || n < 2)
         return order_list(s, items, n, mode, split_limit);
@@ -472,7 +480,8 @@ static int order_bsp(vlf_sorter *s, uint32_t *items, uint32_t n, int mode, uint3
         const vlf_piece *p = &s->poly[items[k]];
         const gi_vec3 *v = s->vert + p->first;
         for (uint32_t j = 1; j + 1 < p->count; j++) {
-            float a = 0.5f * gi_v3_length(gi_v3_cross(gi_v3_sub(v[j], v[0]), gi_v3_sub(v[j + 1], v[0])));
+            float a =
+                0.5f * gi_v3_length(gi_v3_cross(gi_v3_sub(v[j], v[0]), gi_v3_sub(v[j + 1], v[0])));
             wz += (double)a * (v[0].z + v[j].z + v[j + 1].z) / 3.0;
             w += a;
         }
@@ -481,7 +490,8 @@ static int order_bsp(vlf_sorter *s, uint32_t *items, uint32_t n, int mode, uint3
         return order_list(s, items, n, mode, split_limit);
     float zc = (float)(wz / w);
     float pl[4] = {0.0f, 0.0f, 1.0f, zc};
-    uint32_t *front = malloc((size_t)n * 2 * sizeof *front), *back = malloc((size_t)n * 2 * sizeof *back);
+    uint32_t *front = malloc((size_t)n * 2 * sizeof *front),
+             *back = malloc((size_t)n * 2 * sizeof *back);
     if (!front || !back) {
         free(front), free(back);
         return -1;
@@ -528,8 +538,8 @@ static int order_bsp(vlf_sorter *s, uint32_t *items, uint32_t n, int mode, uint3
 /* The triangles in the frame as pieces 0 .. tri_count - 1 (piece k is
  * triangle k) with their planes; 0, or -1 out of memory. extra: proxy
  * planes to leave room for. */
-static int load_triangles(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, gi_vec3 u, gi_vec3 v, gi_vec3 n,
-                          uint32_t extra)
+static int load_triangles(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, gi_vec3 u,
+                          gi_vec3 v, gi_vec3 n, uint32_t extra)
 {
     s->nv = s->np = s->nlist = s->nout = 0;
     uint32_t cap = s->cap_plane;
@@ -569,8 +579,9 @@ static int load_triangles(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_coun
  * rectangle as against every triangle of the group. Returns 0 (s->out is
  * the order), 1 when the shortcut does not apply or a stand-in was split by
  * a cycle (the caller sorts without it), -1 out of memory. */
-static int sort_hier(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, const uint32_t *group, uint32_t hier_min,
-                     gi_vec3 u, gi_vec3 v, gi_vec3 n, int mode, uint32_t bsp_levels, uint32_t bsp_min)
+static int sort_hier(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, const uint32_t *group,
+                     uint32_t hier_min, gi_vec3 u, gi_vec3 v, gi_vec3 n, int mode,
+                     uint32_t bsp_levels, uint32_t bsp_min)
 {
     enum { MAX_GROUPS = 64 };
     uint32_t G = 0;
@@ -579,7 +590,8 @@ static int sort_hier(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, co
             G = group[t] + 1;
     uint32_t *gcount = calloc((size_t)G + 1, sizeof *gcount);
     float *gb = malloc(((size_t)G + 1) * 6 * sizeof *gb);
-    int32_t *cand = malloc(((size_t)G + 1) * sizeof *cand); /* candidate slot of each group, -1 none */
+    int32_t *cand =
+        malloc(((size_t)G + 1) * sizeof *cand); /* candidate slot of each group, -1 none */
     uint32_t *items = malloc(((size_t)tri_count + MAX_GROUPS + 1) * sizeof *items);
     uint32_t *order = NULL;
     int rc = -1;
@@ -636,7 +648,8 @@ static int sort_hier(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, co
         if (!iso[c])
             continue;
         const float *b = gb + 6 * (size_t)gid[c];
-        gi_vec3 q[4] = {gi_v3(b[0], b[1], b[2]), gi_v3(b[3], b[1], b[2]), gi_v3(b[3], b[4], b[2]), gi_v3(b[0], b[4], b[2])};
+        gi_vec3 q[4] = {gi_v3(b[0], b[1], b[2]), gi_v3(b[3], b[1], b[2]), gi_v3(b[3], b[4], b[2]),
+                        gi_v3(b[0], b[4], b[2])};
         float *pl = s->plane + 4 * (size_t)(tri_count + c);
         pl[0] = 0.0f, pl[1] = 0.0f, pl[2] = 1.0f, pl[3] = b[2];
         proxy[c] = add_piece(s, tri_count + c, q, 4);
@@ -695,8 +708,9 @@ done:
     return rc;
 }
 
-int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, const uint32_t *group, uint32_t hier_min,
-                   gi_vec3 u, gi_vec3 v, gi_vec3 n, int mode, uint32_t bsp_levels, uint32_t bsp_min)
+int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, const uint32_t *group,
+                   uint32_t hier_min, gi_vec3 u, gi_vec3 v, gi_vec3 n, int mode,
+                   uint32_t bsp_levels, uint32_t bsp_min)
 {
     s->tests = 0;
     s->splits = s->bsp_cuts = s->unresolved = 0;
@@ -721,7 +735,8 @@ int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, cons
     /* splitting stops at 8 pieces per triangle on average (cycles then
      * stay, counted in unresolved) */
     uint32_t split_limit = tri_count > UINT32_MAX / 8 - 4096 ? UINT32_MAX : 8 * tri_count + 4096;
-    int rc = order_bsp(s, items, tri_count, mode, 0, bsp_levels, bsp_min ? bsp_min : 2, split_limit);
+    int rc =
+        order_bsp(s, items, tri_count, mode, 0, bsp_levels, bsp_min ? bsp_min : 2, split_limit);
     free(items);
     return rc;
 }

@@ -28,16 +28,16 @@ typedef struct vlf_sorter {
     uint32_t nv, cap_v;
     vlf_piece *poly;
     uint32_t np, cap_p;
-    float *plane;          /* 4 per scene triangle: unit normal with z >= 0 and offset, in the frame */
+    float *plane; /* 4 per scene triangle: unit normal with z >= 0 and offset, in the frame */
     uint32_t cap_plane;
-    uint32_t *list;        /* pieces still to place, by nearest depth */
+    uint32_t *list; /* pieces still to place, by nearest depth */
     uint32_t nlist, cap_list;
-    uint32_t *out;         /* the order: pieces front to back */
+    uint32_t *out; /* the order: pieces front to back */
     uint32_t nout, cap_out;
-    int32_t *chain_pos;    /* position of a piece on the candidate chain, -1 if not on it */
+    int32_t *chain_pos; /* position of a piece on the candidate chain, -1 if not on it */
     uint32_t *chain;
-    uint8_t *state;        /* 0 waiting, 1 placed, 2 replaced by its pieces */
-    uint32_t *stamp;       /* last candidate scan that met the piece */
+    uint8_t *state;  /* 0 waiting, 1 placed, 2 replaced by its pieces */
+    uint32_t *stamp; /* last candidate scan that met the piece */
     uint32_t cap_state;
     /* a uniform grid over the projections of the list being ordered: the
      * pieces whose projected bounds meet each cell (linked lists), and the
@@ -47,11 +47,11 @@ typedef struct vlf_sorter {
     uint32_t *node_piece, *node_next, nnode, cap_node;
     uint32_t *wide, nwide, cap_wide;
     uint32_t scan;
-    uint64_t tests;        /* pairs tested */
-    uint32_t splits;       /* pieces split to break a cycle */
-    uint32_t bsp_cuts;     /* pieces cut by a BSP plane */
-    uint32_t unresolved;   /* cycles left in place when the split limit was reached */
-    uint32_t groups;       /* groups sorted on their own (the hierarchical shortcut) */
+    uint64_t tests;          /* pairs tested */
+    uint32_t splits;         /* pieces split to break a cycle */
+    uint32_t bsp_cuts;       /* pieces cut by a BSP plane */
+    uint32_t unresolved;     /* cycles left in place when the split limit was reached */
+    uint32_t groups;         /* groups sorted on their own (the hierarchical shortcut) */
     uint32_t hier_fallbacks; /* sorts redone without the shortcut (a stand-in split by a cycle) */
 } vlf_sorter;
 
@@ -71,8 +71,9 @@ enum { VLF_SORT_NEWELL = 0, VLF_SORT_PLAIN = 1, VLF_SORT_NOSPLIT = 2 };
  * are sorted on their own and spliced in where their box's front face
  * falls in the order of the rest (the hierarchical shortcut of §3.2).
  * Returns 0 on success, -1 out of memory. */
-int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, const uint32_t *group, uint32_t hier_min,
-                   gi_vec3 u, gi_vec3 v, gi_vec3 n, int mode, uint32_t bsp_levels, uint32_t bsp_min);
+int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, const uint32_t *group,
+                   uint32_t hier_min, gi_vec3 u, gi_vec3 v, gi_vec3 n, int mode,
+                   uint32_t bsp_levels, uint32_t bsp_min);
 void vlf_sorter_free(vlf_sorter *s);
 
 #endif

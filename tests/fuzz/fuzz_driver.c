@@ -224,7 +224,8 @@ int main(int argc, char **argv)
         free(m.data);
         tried++;
     }
-    printf("fuzz_driver: %zu seeds, %llu mutated inputs in %.1f s, no crash\n", seed_count, tried, now() - t0);
+    printf("fuzz_driver: %zu seeds, %llu mutated inputs in %.1f s, no crash\n", seed_count, tried,
+           now() - t0);
     for (size_t i = 0; i < seed_count; i++)
         free(seeds[i].data);
     free(seeds);

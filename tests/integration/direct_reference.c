@@ -99,7 +99,8 @@ int main(int argc, char **argv)
     uint32_t W = (uint32_t)atoi(argv[2]), H = (uint32_t)atoi(argv[3]);
     double tol = atof(argv[5]);
     for (uint32_t i = 0; i < s->material_count; i++)
-        if (s->materials[i].ks[0] + s->materials[i].ks[1] + s->materials[i].ks[2] > 0 && !s->materials[i].mirror) {
+        if (s->materials[i].ks[0] + s->materials[i].ks[1] + s->materials[i].ks[2] > 0 &&
+            !s->materials[i].mirror) {
             fprintf(stderr, "direct_reference: material %u is glossy; Lambertian scenes only\n", i);
             return 2;
         }
@@ -117,8 +118,8 @@ int main(int argc, char **argv)
             memcpy(tris[t].uv[k], v->uv, sizeof v->uv);
         }
         tris[t].material = v0->material;
-        tris[t].ng = gi_v3_normalize(
-            gi_v3_cross(gi_v3_sub(tris[t].p[1], tris[t].p[0]), gi_v3_sub(tris[t].p[2], tris[t].p[0])));
+        tris[t].ng = gi_v3_normalize(gi_v3_cross(gi_v3_sub(tris[t].p[1], tris[t].p[0]),
+                                                 gi_v3_sub(tris[t].p[2], tris[t].p[0])));
     }
     gi_camera_frame cam = gi_scene_camera_at(s, s->camera_count ? 0 : -1, 0.0f);
     float aspect = (float)W / (float)H, th = tanf(cam.yfov * 0.5f);
@@ -146,8 +147,9 @@ int main(int argc, char **argv)
             const gi_material *mat = &s->materials[t->material];
             gi_vec3 x = gi_v3_add(cam.eye, gi_v3_scale(d, best));
             float bw = 1.0f - bu - bv;
-            gi_vec3 N = gi_v3_normalize(gi_v3_add(gi_v3_scale(t->n[0], bw),
-                                                  gi_v3_add(gi_v3_scale(t->n[1], bu), gi_v3_scale(t->n[2], bv))));
+            gi_vec3 N = gi_v3_normalize(
+                gi_v3_add(gi_v3_scale(t->n[0], bw),
+                          gi_v3_add(gi_v3_scale(t->n[1], bu), gi_v3_scale(t->n[2], bv))));
             if (gi_v3_dot(N, d) > 0)
                 N = gi_v3_scale(N, -1.0f);
             float L[3] = {0, 0, 0};
@@ -185,8 +187,8 @@ int main(int argc, char **argv)
     gi_image_mean(img, mean);
     for (int c = 0; c < 3; c++) {
         double rel = fabs(mean[c] - ref[c]) / ref[c];
-        printf("channel %d: gibench %.6f reference %.6f relative difference %.4f%%\n", c, mean[c], ref[c],
-               100.0 * rel);
+        printf("channel %d: gibench %.6f reference %.6f relative difference %.4f%%\n", c, mean[c],
+               ref[c], 100.0 * rel);
         fail |= !(rel <= tol);
     }
     gi_image_free(img);

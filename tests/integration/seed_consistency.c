@@ -40,10 +40,12 @@ int main(int argc, char **argv)
         for (int c = 0; c < 3; c++)
             sum += va->rgba[4 * i + (size_t)c] + vb->rgba[4 * i + (size_t)c];
     double expected = sum / (3.0 * (double)n);
-    double mse = field(argv[3], "mse"), self_mse = field(argv[4], "mse"), self_flip = field(argv[4], "flip");
+    double mse = field(argv[3], "mse"), self_mse = field(argv[4], "mse"),
+           self_flip = field(argv[4], "flip");
     double ratio = mse / expected;
-    printf("diff MSE of two seeds %.6g, mean var(a)+var(b) %.6g, ratio %.3f; self MSE %g, self FLIP %g\n", mse,
-           expected, ratio, self_mse, self_flip);
+    printf("diff MSE of two seeds %.6g, mean var(a)+var(b) %.6g, ratio %.3f; self MSE %g, self "
+           "FLIP %g\n",
+           mse, expected, ratio, self_mse, self_flip);
     gi_image_free(va);
     gi_image_free(vb);
     /* 16x16x3 values at 64 spp: the ratio's own spread is a few percent;

@@ -15,7 +15,7 @@ static int gi_test_passed, gi_test_failed;
             gi_test_passed++;                                                                      \
         } else {                                                                                   \
             gi_test_failed++;                                                                      \
-            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond);              \
+            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond);               \
         }                                                                                          \
     } while (0)
 
@@ -25,7 +25,7 @@ static int gi_test_passed, gi_test_failed;
             gi_test_passed++;                                                                      \
         } else {                                                                                   \
             gi_test_failed++;                                                                      \
-            fprintf(stderr, "%s:%d: check failed: %s: ", __FILE__, __LINE__, #cond);              \
+            fprintf(stderr, "%s:%d: check failed: %s: ", __FILE__, __LINE__, #cond);               \
             fprintf(stderr, __VA_ARGS__);                                                          \
             fputc('\n', stderr);                                                                   \
         }                                                                                          \

@@ -46,13 +46,15 @@ static gi_result fake_update(void *inst, const gi_gpu_scene *s, const gi_changes
     fake_updates++;
     fake_host->stat(fake_host, "updates", fake_updates);
     fake_host->stat(fake_host, "changed_vertices", (fake_flags_seen & GI_CHANGED_VERTICES) ? 1 : 0);
-    fake_host->stat(fake_host, "changed_transforms", (fake_flags_seen & GI_CHANGED_TRANSFORMS) ? 1 : 0);
+    fake_host->stat(fake_host, "changed_transforms",
+                    (fake_flags_seen & GI_CHANGED_TRANSFORMS) ? 1 : 0);
     fake_host->stat(fake_host, "changed_lights", (fake_flags_seen & GI_CHANGED_LIGHTS) ? 1 : 0);
     fake_host->stat(fake_host, "changed_camera", (fake_flags_seen & GI_CHANGED_CAMERA) ? 1 : 0);
 #endif
     return GI_OK;
 }
-#if defined(FAKE_CONF_WRONG) || defined(FAKE_CONF_NAN) || defined(FAKE_CONF_NONDET) || defined(FAKE_CONF_LIAR)
+#if defined(FAKE_CONF_WRONG) || defined(FAKE_CONF_NAN) || defined(FAKE_CONF_NONDET) ||             \
+    defined(FAKE_CONF_LIAR)
 #define FAKE_CONF 1
 static uint32_t fake_renders; /* renders so far in this process */
 #endif
@@ -68,7 +70,7 @@ static gi_result fake_render(void *inst, const gi_view *v, const gi_target *t)
     c[0] = c[1] = c[2] = NAN;
 #elif defined(FAKE_CONF_NONDET) /* a different image on every call */
     c[0] = c[1] = c[2] = 0.5f + 0.01f * (float)(fake_renders % 64u);
-#elif defined(FAKE_CONF_LIAR) /* claims every light, renders none */
+#elif defined(FAKE_CONF_LIAR)   /* claims every light, renders none */
     c[0] = c[1] = c[2] = 0.0f;
 #endif
     fake_renders++;
@@ -129,14 +131,15 @@ static const gi_method fake_method = {
     .title = "Fake method",
     .citation = "none",
     .version = "0",
-#if defined(FAKE_CRASH) || defined(FAKE_HANG) || defined(FAKE_CONF_WRONG) || defined(FAKE_CONF_NAN) || \
-    defined(FAKE_CONF_NONDET)
+#if defined(FAKE_CRASH) || defined(FAKE_HANG) || defined(FAKE_CONF_WRONG) ||                       \
+    defined(FAKE_CONF_NAN) || defined(FAKE_CONF_NONDET)
     .caps = GI_CAP_DIRECT | GI_CAP_AREA_LIGHTS,
 #elif defined(FAKE_CONF_LIAR)
-    .caps = GI_CAP_DIRECT | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT,
+    .caps = GI_CAP_DIRECT | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL |
+            GI_CAP_ENVIRONMENT,
 #elif defined(FAKE_BAKED) /* no GI_CAP_RIGID_MOTION */
-    .caps = GI_CAP_DIRECT | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT |
-            GI_CAP_PRECOMPUTE,
+    .caps = GI_CAP_DIRECT | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL |
+            GI_CAP_ENVIRONMENT | GI_CAP_PRECOMPUTE,
 #else
     .caps = GI_CAP_DIRECT,
 #endif
@@ -175,11 +178,11 @@ GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)
      * such a build would have recorded. */
     static gi_method other;
     other = fake_method;
-#if defined(FAKE_LAYOUT_OLD) /* an older gi_view, 16 bytes shorter */
+#if defined(FAKE_LAYOUT_OLD)   /* an older gi_view, 16 bytes shorter */
     other.layout.view -= 16;
 #elif defined(FAKE_LAYOUT_NEW) /* a newer gi_scene, 8 bytes longer */
     other.layout.scene += 8;
-#else /* same sizes, a struct reordered */
+#else                          /* same sizes, a struct reordered */
     other.layout.revision += 1;
 #endif
     return &other;

@@ -143,7 +143,8 @@ static void test_log_log_chart(void)
         {"method B (biased)", t, e_b, N, GI_CHART_MARKERS, 0, NULL, NULL, NULL, NULL},
         {"path tracer", t_pt, e_pt, N, GI_CHART_DASHED, 0, NULL, NULL, NULL, NULL},
     };
-    gi_chart_desc d = {"Cornell box: RMSE against time", "time [ms]", "RMSE", 1, 1, 1000, 640, NULL, 0};
+    gi_chart_desc d = {
+        "Cornell box: RMSE against time", "time [ms]", "RMSE", 1, 1, 1000, 640, NULL, 0};
     char path[600];
     snprintf(path, sizeof path, "%s/error_time.png", dir);
     gi_error err = {{0}};
@@ -236,7 +237,8 @@ static void test_points_kept(void)
     CHECK(gi_chart_points_kept(&loglog, &empty) == 0);
 
     /* Such a series still draws (with a warning), as do empty ones. */
-    gi_chart_series both[3] = {s, empty, {NULL, x, y, 1, GI_CHART_MARKERS, 0, NULL, NULL, NULL, NULL}};
+    gi_chart_series both[3] = {
+        s, empty, {NULL, x, y, 1, GI_CHART_MARKERS, 0, NULL, NULL, NULL, NULL}};
     char path[600];
     snprintf(path, sizeof path, "%s/dropped.png", dir);
     gi_error err = {{0}};
@@ -352,18 +354,19 @@ static void test_noise_ranges(void)
     double xr[2], yr[2];
     gi_chart_axis_ranges(&lin, &s, 1, xr, yr);
     /* 2 % apart: the axis spans at least 20 % of 1.02, the data a tenth of it */
-    CHECK_MSG(yr[1] - yr[0] >= 0.2 * 1.02 && yr[0] < 1.0 && yr[1] > 1.02, "linear y range [%g, %g]", yr[0],
-              yr[1]);
+    CHECK_MSG(yr[1] - yr[0] >= 0.2 * 1.02 && yr[0] < 1.0 && yr[1] > 1.02, "linear y range [%g, %g]",
+              yr[0], yr[1]);
     CHECK_MSG((1.02 - 1.00) / (yr[1] - yr[0]) < 0.11, "the data fill %.0f %% of the axis",
               100.0 * 0.02 / (yr[1] - yr[0]));
-    CHECK_MSG(xr[0] < 1.0 && xr[0] > 0.9 && xr[1] > 3.0 && xr[1] < 3.1, "x range [%g, %g] is only padded", xr[0],
-              xr[1]);
+    CHECK_MSG(xr[0] < 1.0 && xr[0] > 0.9 && xr[1] > 3.0 && xr[1] < 3.1,
+              "x range [%g, %g] is only padded", xr[0], xr[1]);
     gi_chart_axis_ranges(&logy, &s, 1, xr, yr);
-    CHECK_MSG(yr[1] / yr[0] >= 2.0 && yr[0] < 1.0 && yr[1] > 1.02, "log y range [%g, %g]", yr[0], yr[1]);
+    CHECK_MSG(yr[1] / yr[0] >= 2.0 && yr[0] < 1.0 && yr[1] > 1.02, "log y range [%g, %g]", yr[0],
+              yr[1]);
     s.y = wide;
     gi_chart_axis_ranges(&lin, &s, 1, xr, yr);
-    CHECK_MSG(fabs(yr[0] + 0.4) < 1e-9 && fabs(yr[1] - 10.4) < 1e-9, "wide range [%g, %g]: 4 %% padding only",
-              yr[0], yr[1]);
+    CHECK_MSG(fabs(yr[0] + 0.4) < 1e-9 && fabs(yr[1] - 10.4) < 1e-9,
+              "wide range [%g, %g]: 4 %% padding only", yr[0], yr[1]);
     s.y = y;
     s.y_lo = lo;
     s.y_hi = hi;
@@ -381,7 +384,8 @@ static void test_error_bars(void)
     uint32_t extent[2];
     for (int with = 0; with < 2; with++) {
         gi_chart_series s[2] = {
-            {"bars", px_, py_, 1, GI_CHART_MARKERS, 0, NULL, NULL, with ? blo : NULL, with ? bhi : NULL},
+            {"bars", px_, py_, 1, GI_CHART_MARKERS, 0, NULL, NULL, with ? blo : NULL,
+             with ? bhi : NULL},
             {"frame", fx, fy, 2, GI_CHART_MARKERS, 2, NULL, NULL, NULL, NULL},
         };
         gi_chart_desc d = {"error bars", "x", "y", 0, 0, 500, 400, NULL, 0};
@@ -408,8 +412,8 @@ static void test_error_bars(void)
         gi_image_free(img);
     }
     /* marker ~9 px; the bar spans 8 of the axis' 10.8 units of ~300 px */
-    CHECK_MSG(extent[0] > 0 && extent[0] < 20 && extent[1] > 150, "blue rows: %u without, %u with the bar",
-              extent[0], extent[1]);
+    CHECK_MSG(extent[0] > 0 && extent[0] < 20 && extent[1] > 150,
+              "blue rows: %u without, %u with the bar", extent[0], extent[1]);
 }
 
 /* Ticks at given values: accepted, change the picture, and a count without

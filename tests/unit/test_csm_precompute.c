@@ -29,7 +29,8 @@ static void cube_view(void *c, uint32_t q, gi_depth_view *out)
     gi_depth_cube_view(x->eye[q / 6], 0.01f, 50.0f, (int)(q % 6), out);
 }
 
-static void plain_depths(void *c, uint32_t q, const gi_depth_view *v, const float *map, float *z1, float *z2)
+static void plain_depths(void *c, uint32_t q, const gi_depth_view *v, const float *map, float *z1,
+                         float *z2)
 {
     ctx *x = c;
     x->order_ok &= q == x->next_depths++;
@@ -58,7 +59,8 @@ static void cube_view_skipping(void *c, uint32_t q, gi_depth_view *out)
     x->next_view += q / 6 == 0 && q % 6 == 5 ? 6 : 0; /* the views of cube 1 are not asked for */
 }
 
-static void skipping_depths(void *c, uint32_t q, const gi_depth_view *v, const float *map, float *z1, float *z2)
+static void skipping_depths(void *c, uint32_t q, const gi_depth_view *v, const float *map,
+                            float *z1, float *z2)
 {
     ctx *x = c;
     if (q / 6 != 1) {
@@ -101,15 +103,16 @@ int main(void)
     for (uint32_t k = 0; k < POINTS; k++)
         x.eye[k] = gi_v3(cx + dx * ((float)k - 1.0f), cy, cz);
 
-    gi_csm_precompute_desc d = {.depth = {.size = MAPSIZE, .surfaces = 2, .metric = GI_DEPTH_RADIAL},
-                                .count = 6 * POINTS,
-                                .streams = 6,
-                                .batch = 5, /* batches straddle cube maps */
-                                .view = cube_view,
-                                .depths = plain_depths,
-                                .ctx = &x,
-                                .who = "test",
-                                .what = "cube faces"};
+    gi_csm_precompute_desc d = {
+        .depth = {.size = MAPSIZE, .surfaces = 2, .metric = GI_DEPTH_RADIAL},
+        .count = 6 * POINTS,
+        .streams = 6,
+        .batch = 5, /* batches straddle cube maps */
+        .view = cube_view,
+        .depths = plain_depths,
+        .ctx = &x,
+        .who = "test",
+        .what = "cube faces"};
     gi_csm_data face[6];
     CHECK_MSG(gi_csm_precompute(gs, &d, face, &err) == GI_OK, "%s", err.text);
     CHECK(x.order_ok && x.view_ok && x.next_view == 6 * POINTS && x.next_depths == 6 * POINTS);
@@ -135,8 +138,9 @@ int main(void)
             free(map);
         }
     }
-    printf("6 streams x %u cube maps of %u^2: %u of %u texels outside [z1, z2) (%u with a surface)\n", POINTS, MAPSIZE,
-           bad, 6 * POINTS * MAPSIZE * MAPSIZE, finite);
+    printf(
+        "6 streams x %u cube maps of %u^2: %u of %u texels outside [z1, z2) (%u with a surface)\n",
+        POINTS, MAPSIZE, bad, 6 * POINTS * MAPSIZE * MAPSIZE, finite);
     CHECK(bad == 0);
     CHECK(finite >= 6 * POINTS * MAPSIZE * MAPSIZE * 3 / 4); /* the box is open at the front only */
     for (int f = 0; f < 6; f++)

@@ -133,7 +133,8 @@ static void test_raytrace(const gi_scene *s)
         float w[2];
         gi_scene_morph_weights(s, 0, ts[i], w);
         gi_rt_hit h;
-        int hit = gi_rt_intersect(rt, gi_v3(0.0f, 0.0f, 5.0f), gi_v3(0.0f, 0.0f, -1.0f), 0.0f, INFINITY, &h);
+        int hit = gi_rt_intersect(rt, gi_v3(0.0f, 0.0f, 5.0f), gi_v3(0.0f, 0.0f, -1.0f), 0.0f,
+                                  INFINITY, &h);
         CHECK(hit && h.object == 0);
         CHECK_NEAR(h.t, 5.0f - w[0], 1e-5);
         /* every placed vertex equals the CPU blend, placed by the transform */
@@ -153,7 +154,8 @@ static void test_raytrace(const gi_scene *s)
 /* The GPU vertex buffer after set_time(t) holds exactly the CPU vertices. */
 static int gpu_matches(const gi_gpu_scene *gs, const gi_scene *s, float t)
 {
-    gi_vertex *gpu = malloc(s->vertex_count * sizeof *gpu), *cpu = malloc(s->vertex_count * sizeof *cpu);
+    gi_vertex *gpu = malloc(s->vertex_count * sizeof *gpu),
+              *cpu = malloc(s->vertex_count * sizeof *cpu);
     if (!gpu || !cpu)
         exit(1);
     glGetNamedBufferSubData(gs->vbo, 0, (GLsizeiptr)(s->vertex_count * sizeof *gpu), gpu);
@@ -190,31 +192,40 @@ static void test_gpu(gi_gpu *gpu, gi_scene *s)
     CHECK(gi_rt_create(s, 1.0f, &rt, &err) == GI_OK);
     gi_rt_hit h;
     /* rigid quad at y - 3: a ray down -Z through (0, -3.9) hits it, later misses */
-    CHECK(rt && gi_rt_intersect(rt, gi_v3(0.0f, -3.9f, 5.0f), gi_v3(0.0f, 0.0f, -1.0f), 0.0f, INFINITY, &h) &&
+    CHECK(rt &&
+          gi_rt_intersect(rt, gi_v3(0.0f, -3.9f, 5.0f), gi_v3(0.0f, 0.0f, -1.0f), 0.0f, INFINITY,
+                          &h) &&
           h.object == 2);
     for (uint32_t i = 0; i < o->vertex_count; i++)
         v[i].position[1] += 0.5f;
     CHECK(gi_gpu_scene_update_vertices(gs, o->first_vertex, o->vertex_count, v, &err) == GI_OK);
     CHECK(gpu_matches(gs, s, 1.0f));
     CHECK(gi_rt_set_time(rt, 1.0f, &err) == GI_OK); /* same time: no re-placement ... */
-    CHECK(rt && gi_rt_intersect(rt, gi_v3(0.0f, -3.9f, 5.0f), gi_v3(0.0f, 0.0f, -1.0f), 0.0f, INFINITY, &h));
+    CHECK(rt && gi_rt_intersect(rt, gi_v3(0.0f, -3.9f, 5.0f), gi_v3(0.0f, 0.0f, -1.0f), 0.0f,
+                                INFINITY, &h));
     CHECK(gi_rt_refresh(rt, &err) == GI_OK); /* ... until refreshed */
-    CHECK(rt && !gi_rt_occluded(rt, gi_v3(0.0f, -3.9f, 5.0f), gi_v3(0.0f, 0.0f, -1.0f), 0.0f, INFINITY));
-    CHECK(rt && gi_rt_intersect(rt, gi_v3(0.0f, -3.4f, 5.0f), gi_v3(0.0f, 0.0f, -1.0f), 0.0f, INFINITY, &h) &&
+    CHECK(rt &&
+          !gi_rt_occluded(rt, gi_v3(0.0f, -3.9f, 5.0f), gi_v3(0.0f, 0.0f, -1.0f), 0.0f, INFINITY));
+    CHECK(rt &&
+          gi_rt_intersect(rt, gi_v3(0.0f, -3.4f, 5.0f), gi_v3(0.0f, 0.0f, -1.0f), 0.0f, INFINITY,
+                          &h) &&
           h.object == 2);
     gi_rt_free(rt);
 
     /* errors: past the end, object changed, NaN, NULL */
     gi_vertex bad = v[0];
-    CHECK(gi_gpu_scene_update_vertices(gs, s->vertex_count, 1, &bad, &err) == GI_ERR_INVALID_ARGUMENT);
+    CHECK(gi_gpu_scene_update_vertices(gs, s->vertex_count, 1, &bad, &err) ==
+          GI_ERR_INVALID_ARGUMENT);
     CHECK(strstr(err.text, "past the") != NULL);
     CHECK(gi_gpu_scene_update_vertices(gs, UINT32_MAX, 2, &bad, &err) == GI_ERR_INVALID_ARGUMENT);
     bad.object = 0;
-    CHECK(gi_gpu_scene_update_vertices(gs, o->first_vertex, 1, &bad, &err) == GI_ERR_INVALID_ARGUMENT);
+    CHECK(gi_gpu_scene_update_vertices(gs, o->first_vertex, 1, &bad, &err) ==
+          GI_ERR_INVALID_ARGUMENT);
     CHECK(strstr(err.text, "changes its object") != NULL);
     bad = v[0];
     bad.position[0] = NAN;
-    CHECK(gi_gpu_scene_update_vertices(gs, o->first_vertex, 1, &bad, &err) == GI_ERR_INVALID_ARGUMENT);
+    CHECK(gi_gpu_scene_update_vertices(gs, o->first_vertex, 1, &bad, &err) ==
+          GI_ERR_INVALID_ARGUMENT);
     CHECK(strstr(err.text, "not finite") != NULL);
     CHECK(gi_gpu_scene_update_vertices(gs, 0, 1, NULL, &err) == GI_ERR_INVALID_ARGUMENT);
     CHECK(gpu_matches(gs, s, 1.0f)); /* failures wrote nothing */
@@ -236,7 +247,8 @@ static void test_cornell(gi_gpu *gpu)
     if (ob == UINT32_MAX)
         return;
     const gi_object *o = &s->objects[ob];
-    gi_vertex *v1 = malloc(o->vertex_count * sizeof *v1), *v3 = malloc(o->vertex_count * sizeof *v3);
+    gi_vertex *v1 = malloc(o->vertex_count * sizeof *v1),
+              *v3 = malloc(o->vertex_count * sizeof *v3);
     gi_scene_object_vertices(s, ob, 1.0f, v1);
     gi_scene_object_vertices(s, ob, 3.0f, v3);
     float h = 0.0f;
@@ -247,8 +259,9 @@ static void test_cornell(gi_gpu *gpu)
         const float *r = s->vertices[o->first_vertex + i].position;
         float b = 0.2f * sinf(GI_PI * r[1] / h);
         e1 = fmax(e1, fabs(v1[i].position[1] - 1.5 * r[1]) + fabs(v1[i].position[0] - r[0]));
-        e3 = fmax(e3, fabs(v3[i].position[0] - (1 + b) * r[0]) + fabs(v3[i].position[2] - (1 + b) * r[2]) +
-                          fabs(v3[i].position[1] - r[1]));
+        e3 =
+            fmax(e3, fabs(v3[i].position[0] - (1 + b) * r[0]) +
+                         fabs(v3[i].position[2] - (1 + b) * r[2]) + fabs(v3[i].position[1] - r[1]));
     }
     CHECK_MSG(e1 < 1e-5 && e3 < 1e-5, "max error %g (t = 1), %g (t = 3)", e1, e3);
     /* bounds hold every pose */
@@ -257,7 +270,8 @@ static void test_cornell(gi_gpu *gpu)
         gi_scene_object_vertices(s, ob, t, v1);
         for (uint32_t i = 0; i < o->vertex_count; i++)
             for (int k = 0; k < 3; k++)
-                inside &= v1[i].position[k] >= o->local_bounds[k] && v1[i].position[k] <= o->local_bounds[k + 3];
+                inside &= v1[i].position[k] >= o->local_bounds[k] &&
+                          v1[i].position[k] <= o->local_bounds[k + 3];
     }
     CHECK(inside);
     free(v1);

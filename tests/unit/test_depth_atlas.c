@@ -52,17 +52,20 @@ static void random_view(const gi_scene *s, gi_projection proj, uint32_t *rng, gi
     int outside = urand(rng) < 0.25f;
     for (int k = 0; k < 3; k++) {
         float ext = b[3 + k] - b[k];
-        e[k] = outside ? b[k] - 0.5f * ext + 2.0f * ext * urand(rng) : b[k] + ext * (0.05f + 0.9f * urand(rng));
+        e[k] = outside ? b[k] - 0.5f * ext + 2.0f * ext * urand(rng)
+                       : b[k] + ext * (0.05f + 0.9f * urand(rng));
     }
     gi_vec3 c = gi_v3(0.5f * (b[0] + b[3]), 0.5f * (b[1] + b[4]), 0.5f * (b[2] + b[5]));
-    gi_vec3 dir = outside ? gi_v3_normalize(gi_v3_sub(c, eye)) : gi_sample_uniform_sphere(urand(rng), urand(rng));
+    gi_vec3 dir = outside ? gi_v3_normalize(gi_v3_sub(c, eye))
+                          : gi_sample_uniform_sphere(urand(rng), urand(rng));
     gi_vec3 up = fabsf(dir.y) > 0.9f ? gi_v3(1, 0, 0) : gi_v3(0, 1, 0);
     gi_mat4_look_at(v->view, eye, gi_v3_add(eye, dir), up);
     v->projection = proj;
     v->znear = 0.02f;
     v->zfar = 60.0f;
     if (proj == GI_PROJ_PERSPECTIVE)
-        gi_mat4_perspective(v->proj, (50.0f + 60.0f * urand(rng)) * (float)GI_PI / 180.0f, 1.0f, v->znear, v->zfar);
+        gi_mat4_perspective(v->proj, (50.0f + 60.0f * urand(rng)) * (float)GI_PI / 180.0f, 1.0f,
+                            v->znear, v->zfar);
 }
 
 typedef struct tile_stats {
@@ -86,15 +89,17 @@ static int near_jump(const float *m, uint32_t n, uint32_t x, uint32_t y)
 }
 
 /* Atlas tiles against per-view maps of the same views. */
-static void compare_with_per_view(gi_gpu_scene *gs, const gi_scene *s, const char *name, gi_projection proj,
-                                  gi_depth_metric metric, int cull, uint32_t tile, uint32_t nviews, uint32_t seed)
+static void compare_with_per_view(gi_gpu_scene *gs, const gi_scene *s, const char *name,
+                                  gi_projection proj, gi_depth_metric metric, int cull,
+                                  uint32_t tile, uint32_t nviews, uint32_t seed)
 {
     gi_error err;
     uint32_t rng = gi_rng_init(seed, 0, 1);
     gi_depth_view *views = malloc(nviews * sizeof *views);
     for (uint32_t i = 0; i < nviews; i++)
         random_view(s, proj, &rng, &views[i]);
-    gi_depth_atlas_desc ad = {.tile = tile, .capacity = nviews + 3, .projection = proj, .metric = metric, .cull = cull};
+    gi_depth_atlas_desc ad = {
+        .tile = tile, .capacity = nviews + 3, .projection = proj, .metric = metric, .cull = cull};
     gi_depth_atlas *a = gi_depth_atlas_create(&ad, &err);
     CHECK_MSG(a != NULL, "%s", err.text);
     gi_depth_desc dd = {.size = tile, .surfaces = 1, .metric = metric, .cull = cull};
@@ -124,7 +129,8 @@ static void compare_with_per_view(gi_gpu_scene *gs, const gi_scene *s, const cha
                     st.exact++;
                     continue;
                 }
-                double rel = (r >= FLT_MAX || v >= FLT_MAX) ? INFINITY : fabs((double)r - v) / fmin(r, v);
+                double rel =
+                    (r >= FLT_MAX || v >= FLT_MAX) ? INFINITY : fabs((double)r - v) / fmin(r, v);
                 if (rel <= 1e-5) {
                     st.close++;
                     st.worst_rel = fmax(st.worst_rel, rel);
@@ -134,8 +140,8 @@ static void compare_with_per_view(gi_gpu_scene *gs, const gi_scene *s, const cha
                     st.bad++;
                     st.worst_rel = fmax(st.worst_rel, rel);
                     if (st.bad <= 3)
-                        fprintf(stderr, "%s: view %u texel %u,%u: atlas %g, per view %g\n", name, i, x, y, (double)v,
-                                (double)r);
+                        fprintf(stderr, "%s: view %u texel %u,%u: atlas %g, per view %g\n", name, i,
+                                x, y, (double)v, (double)r);
                 }
             }
         free(ref4);
@@ -151,13 +157,16 @@ static void compare_with_per_view(gi_gpu_scene *gs, const gi_scene *s, const cha
         free(t);
     }
     CHECK(spare_ok);
-    printf("%s: %u views of %u^2 (atlas %u x %u tiles): %llu texels, %.3f%% bit-equal, %.3f%% within 1e-5 "
+    printf("%s: %u views of %u^2 (atlas %u x %u tiles): %llu texels, %.3f%% bit-equal, %.3f%% "
+           "within 1e-5 "
            "(worst %.2g), %.3f%% differ on silhouettes, %llu elsewhere; %.1f%% empty\n",
-           name, nviews, tile, gi_depth_atlas_columns(a), gi_depth_atlas_rows(a), (unsigned long long)st.texels,
-           100.0 * st.exact / st.texels, 100.0 * st.close / st.texels, st.worst_rel, 100.0 * st.silhouette / st.texels,
+           name, nviews, tile, gi_depth_atlas_columns(a), gi_depth_atlas_rows(a),
+           (unsigned long long)st.texels, 100.0 * st.exact / st.texels,
+           100.0 * st.close / st.texels, st.worst_rel, 100.0 * st.silhouette / st.texels,
            (unsigned long long)st.bad, 100.0 * st.empty / st.texels);
     CHECK(st.bad == 0);
-    CHECK_MSG(st.silhouette * 200 <= st.texels, "%llu silhouette texels", (unsigned long long)st.silhouette);
+    CHECK_MSG(st.silhouette * 200 <= st.texels, "%llu silhouette texels",
+              (unsigned long long)st.silhouette);
     CHECK(st.empty < st.texels); /* something was drawn */
     glDeleteTextures(1, &arr);
     gi_depth_renderer_free(dr);
@@ -167,22 +176,23 @@ static void compare_with_per_view(gi_gpu_scene *gs, const gi_scene *s, const cha
 
 /* The GLSL lookup on random points: per point, in: xyz + view; out:
  * stored depth, point depth, texel x, texel y (-1 outside). */
-static const char *lookup_comp = "#include \"depth_atlas.glsl\"\n"
-                                 "layout(local_size_x = 64) in;\n"
-                                 "layout(std430, binding = 8) readonly buffer In { vec4 pts[]; };\n"
-                                 "layout(std430, binding = 9) writeonly buffer Out { vec4 res[]; };\n"
-                                 "layout(binding = 0) uniform sampler2D u_atlas;\n"
-                                 "uniform uint u_count;\n"
-                                 "void main() {\n"
-                                 "    uint i = gl_GlobalInvocationID.x;\n"
-                                 "    if (i >= u_count) return;\n"
-                                 "    uint view = floatBitsToUint(pts[i].w);\n"
-                                 "    float pd, pd2;\n"
-                                 "    float z = gi_atlas_depth(u_atlas, view, pts[i].xyz, pd);\n"
-                                 "    ivec2 t;\n"
-                                 "    bool in_fp = gi_atlas_texel(view, pts[i].xyz, t, pd2);\n"
-                                 "    res[i] = vec4(z, pd, in_fp ? float(t.x) : -1.0, in_fp ? float(t.y) : -1.0);\n"
-                                 "}\n";
+static const char *lookup_comp =
+    "#include \"depth_atlas.glsl\"\n"
+    "layout(local_size_x = 64) in;\n"
+    "layout(std430, binding = 8) readonly buffer In { vec4 pts[]; };\n"
+    "layout(std430, binding = 9) writeonly buffer Out { vec4 res[]; };\n"
+    "layout(binding = 0) uniform sampler2D u_atlas;\n"
+    "uniform uint u_count;\n"
+    "void main() {\n"
+    "    uint i = gl_GlobalInvocationID.x;\n"
+    "    if (i >= u_count) return;\n"
+    "    uint view = floatBitsToUint(pts[i].w);\n"
+    "    float pd, pd2;\n"
+    "    float z = gi_atlas_depth(u_atlas, view, pts[i].xyz, pd);\n"
+    "    ivec2 t;\n"
+    "    bool in_fp = gi_atlas_texel(view, pts[i].xyz, t, pd2);\n"
+    "    res[i] = vec4(z, pd, in_fp ? float(t.x) : -1.0, in_fp ? float(t.y) : -1.0);\n"
+    "}\n";
 
 /* Distance of coordinate f (in texels) to the nearest texel edge. */
 static float edge_dist(float f)
@@ -190,7 +200,8 @@ static float edge_dist(float f)
     return fabsf(f - roundf(f));
 }
 
-static void test_lookup(gi_gpu_scene *gs, const gi_scene *s, gi_projection proj, gi_depth_metric metric)
+static void test_lookup(gi_gpu_scene *gs, const gi_scene *s, gi_projection proj,
+                        gi_depth_metric metric)
 {
     gi_error err;
     const uint32_t tile = 32, nviews = 20, N = 4096;
@@ -198,10 +209,12 @@ static void test_lookup(gi_gpu_scene *gs, const gi_scene *s, gi_projection proj,
     gi_depth_view views[20];
     for (uint32_t i = 0; i < nviews; i++)
         random_view(s, proj, &rng, &views[i]);
-    gi_depth_atlas_desc ad = {.tile = tile, .capacity = nviews, .projection = proj, .metric = metric};
+    gi_depth_atlas_desc ad = {
+        .tile = tile, .capacity = nviews, .projection = proj, .metric = metric};
     gi_depth_atlas *a = gi_depth_atlas_create(&ad, &err);
     CHECK_MSG(a != NULL, "%s", err.text);
-    GLuint prog = gi_program_build_compute_text("tests/unit/depth_atlas_lookup.comp", lookup_comp, NULL, &err);
+    GLuint prog = gi_program_build_compute_text("tests/unit/depth_atlas_lookup.comp", lookup_comp,
+                                                NULL, &err);
     CHECK_MSG(prog != 0, "%s", err.text);
     gi_rt *rt = NULL;
     CHECK_MSG(gi_rt_create(s, 0.0f, &rt, &err) == GI_OK, "%s", err.text);
@@ -217,7 +230,8 @@ static void test_lookup(gi_gpu_scene *gs, const gi_scene *s, gi_projection proj,
     for (uint32_t i = 0; i < N; i++) {
         gi_vec3 p;
         if (i % 2 == 0) {
-            p = gi_v3(b[0] + (b[3] - b[0]) * (1.2f * urand(&rng) - 0.1f), b[1] + (b[4] - b[1]) * (1.2f * urand(&rng) - 0.1f),
+            p = gi_v3(b[0] + (b[3] - b[0]) * (1.2f * urand(&rng) - 0.1f),
+                      b[1] + (b[4] - b[1]) * (1.2f * urand(&rng) - 0.1f),
                       b[2] + (b[5] - b[2]) * (1.2f * urand(&rng) - 0.1f));
         } else {
             uint32_t t = (uint32_t)(urand(&rng) * (float)s->triangle_count) % s->triangle_count;
@@ -226,7 +240,8 @@ static void test_lookup(gi_gpu_scene *gs, const gi_scene *s, gi_projection proj,
             float u = urand(&rng), v = urand(&rng);
             if (u + v > 1.0f)
                 u = 1.0f - u, v = 1.0f - v;
-            p = gi_v3_add(q[0], gi_v3_add(gi_v3_scale(gi_v3_sub(q[1], q[0]), u), gi_v3_scale(gi_v3_sub(q[2], q[0]), v)));
+            p = gi_v3_add(q[0], gi_v3_add(gi_v3_scale(gi_v3_sub(q[1], q[0]), u),
+                                          gi_v3_scale(gi_v3_sub(q[2], q[0]), v)));
         }
         uint32_t view = (uint32_t)(urand(&rng) * nviews) % nviews;
         pts[4 * i] = p.x, pts[4 * i + 1] = p.y, pts[4 * i + 2] = p.z;
@@ -265,7 +280,8 @@ static void test_lookup(gi_gpu_scene *gs, const gi_scene *s, gi_projection proj,
         float near_edge = 1.0f, nx = 0.0f, ny = 0.0f;
         {
             const float *m = views[view].view;
-            gi_vec3 e = gi_v3(m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12], m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13],
+            gi_vec3 e = gi_v3(m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12],
+                              m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13],
                               m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14]);
             if (proj == GI_PROJ_PARABOLOID) {
                 gi_vec3 d = gi_v3_normalize(e);
@@ -277,7 +293,8 @@ static void test_lookup(gi_gpu_scene *gs, const gi_scene *s, gi_projection proj,
                 nx = (q[0] * e.x + q[4] * e.y + q[8] * e.z + q[12]) / w;
                 ny = (q[1] * e.x + q[5] * e.y + q[9] * e.z + q[13]) / w;
             }
-            near_edge = fminf(near_edge, fminf(edge_dist((nx * 0.5f + 0.5f) * tile), edge_dist((ny * 0.5f + 0.5f) * tile)));
+            near_edge = fminf(near_edge, fminf(edge_dist((nx * 0.5f + 0.5f) * tile),
+                                               edge_dist((ny * 0.5f + 0.5f) * tile)));
         }
         if (in != gin || (in && (r[2] != (float)tx || r[3] != (float)ty))) {
             if (near_edge < 1e-3f)
@@ -285,8 +302,8 @@ static void test_lookup(gi_gpu_scene *gs, const gi_scene *s, gi_projection proj,
             else {
                 bad++;
                 if (bad <= 3)
-                    fprintf(stderr, "point %u view %u: C in %d texel %u %u, GLSL %g %g\n", i, view, in, tx, ty,
-                            (double)r[2], (double)r[3]);
+                    fprintf(stderr, "point %u view %u: C in %d texel %u %u, GLSL %g %g\n", i, view,
+                            in, tx, ty, (double)r[2], (double)r[3]);
             }
             continue;
         }
@@ -305,29 +322,38 @@ static void test_lookup(gi_gpu_scene *gs, const gi_scene *s, gi_projection proj,
         {
             float inv[16];
             gi_mat4_invert(inv, views[view].view);
-            float sx = ((float)tx + 0.5f) / (float)tile * 2.0f - 1.0f, sy = ((float)ty + 0.5f) / (float)tile * 2.0f - 1.0f;
+            float sx = ((float)tx + 0.5f) / (float)tile * 2.0f - 1.0f,
+                  sy = ((float)ty + 0.5f) / (float)tile * 2.0f - 1.0f;
             /* p's own projection lies in that texel (row 0 at the bottom) */
-            texel_ok += fabsf(nx - sx) <= 1.0f / (float)tile + 1e-5f && fabsf(ny - sy) <= 1.0f / (float)tile + 1e-5f;
+            texel_ok += fabsf(nx - sx) <= 1.0f / (float)tile + 1e-5f &&
+                        fabsf(ny - sy) <= 1.0f / (float)tile + 1e-5f;
             gi_vec3 de;
             if (proj == GI_PROJ_PARABOLOID) {
                 float r2 = sx * sx + sy * sy;
                 de = gi_v3(2 * sx / (1 + r2), 2 * sy / (1 + r2), -(1 - r2) / (1 + r2));
             } else {
-                de = gi_v3_normalize(gi_v3(sx / views[view].proj[0], sy / views[view].proj[5], -1.0f));
+                de = gi_v3_normalize(
+                    gi_v3(sx / views[view].proj[0], sy / views[view].proj[5], -1.0f));
             }
-            gi_vec3 eye = gi_mat4_point(inv, gi_v3(0, 0, 0)), d = gi_v3_normalize(gi_mat4_dir(inv, de));
+            gi_vec3 eye = gi_mat4_point(inv, gi_v3(0, 0, 0)),
+                    d = gi_v3_normalize(gi_mat4_dir(inv, de));
             gi_rt_hit h;
             int hit = gi_rt_intersect(rt, eye, d, 0.0f, INFINITY, &h);
             float want = !hit ? FLT_MAX : metric == GI_DEPTH_RADIAL ? h.t : h.t * -de.z;
-            float tol = proj == GI_PROJ_PARABOLOID ? 0.01f : 1e-3f; /* paraboloid: triangles bend (test_passes.c) */
+            float tol = proj == GI_PROJ_PARABOLOID
+                            ? 0.01f
+                            : 1e-3f; /* paraboloid: triangles bend (test_passes.c) */
             ray_n++;
             ray_agree += stored >= FLT_MAX ? want >= FLT_MAX : fabsf(stored - want) <= tol * want;
         }
     }
-    printf("lookup (%s, %s): %u points, %d in a footprint: %d equal the C twin, %d differ at texel edges "
-           "(< 1e-3 texel), %d wrong; the stored depth equals a ray cast through the texel centre for %.1f%%\n",
-           proj == GI_PROJ_PARABOLOID ? "paraboloid" : "perspective", metric == GI_DEPTH_RADIAL ? "radial" : "eye z", N,
-           inside, same, edge_excused, bad, 100.0 * ray_agree / (ray_n ? ray_n : 1));
+    printf("lookup (%s, %s): %u points, %d in a footprint: %d equal the C twin, %d differ at texel "
+           "edges "
+           "(< 1e-3 texel), %d wrong; the stored depth equals a ray cast through the texel centre "
+           "for %.1f%%\n",
+           proj == GI_PROJ_PARABOLOID ? "paraboloid" : "perspective",
+           metric == GI_DEPTH_RADIAL ? "radial" : "eye z", N, inside, same, edge_excused, bad,
+           100.0 * ray_agree / (ray_n ? ray_n : 1));
     CHECK(bad == 0);
     CHECK(edge_excused * 100 <= (int)N);
     CHECK(inside > (int)N / 10);
@@ -347,7 +373,8 @@ static void test_lookup(gi_gpu_scene *gs, const gi_scene *s, gi_projection proj,
 static void test_errors(gi_gpu_scene *gs, const gi_scene *s)
 {
     gi_error err;
-    gi_depth_atlas_desc ad = {.tile = 16, .capacity = 5, .projection = GI_PROJ_PERSPECTIVE, .metric = GI_DEPTH_EYE_Z};
+    gi_depth_atlas_desc ad = {
+        .tile = 16, .capacity = 5, .projection = GI_PROJ_PERSPECTIVE, .metric = GI_DEPTH_EYE_Z};
     gi_depth_atlas_desc bad = ad;
     bad.tile = 0;
     CHECK(gi_depth_atlas_create(&bad, &err) == NULL);
@@ -405,7 +432,8 @@ static void test_errors(gi_gpu_scene *gs, const gi_scene *s)
 }
 
 /* Instanced atlas against per-view rendering, side by side. */
-static int bench(gi_gpu *gpu, gi_gpu_scene *gs, const gi_scene *s, uint32_t maps, uint32_t tile, gi_projection proj)
+static int bench(gi_gpu *gpu, gi_gpu_scene *gs, const gi_scene *s, uint32_t maps, uint32_t tile,
+                 gi_projection proj)
 {
     gi_error err;
     uint32_t rng = gi_rng_init(77, 0, 1);
@@ -450,10 +478,11 @@ static int bench(gi_gpu *gpu, gi_gpu_scene *gs, const gi_scene *s, uint32_t maps
             per = st[i].median_ms;
     }
     printf("bench (%s, timer %s): %u %s maps of %u^2 of %s (%u triangles), median of %d frames: "
-           "instanced atlas %.1f ms, per-view gi_depth_render %.1f ms, ratio per-view / instanced = %.2f\n",
+           "instanced atlas %.1f ms, per-view gi_depth_render %.1f ms, ratio per-view / instanced "
+           "= %.2f\n",
            gi_gpu_renderer(gpu), gi_timer_mode_name(gi_timer_get_mode(t)), maps,
-           proj == GI_PROJ_PARABOLOID ? "paraboloid" : "perspective", tile, s->path, s->triangle_count, frames - 1,
-           inst, per, per / inst);
+           proj == GI_PROJ_PARABOLOID ? "paraboloid" : "perspective", tile, s->path,
+           s->triangle_count, frames - 1, inst, per, per / inst);
     gi_timer_free(t);
     glDeleteTextures(1, &arr);
     gi_depth_renderer_free(dr);
@@ -473,17 +502,21 @@ int main(int argc, char **argv)
     if (argc > 1 && strcmp(argv[1], "--bench") == 0) {
         uint32_t maps = argc > 2 ? (uint32_t)strtoul(argv[2], NULL, 10) : 1024;
         uint32_t tile = argc > 3 ? (uint32_t)strtoul(argv[3], NULL, 10) : 32;
-        int r = bench(gpu, gs, s, maps, tile, GI_PROJ_PARABOLOID) | bench(gpu, gs, s, maps, tile, GI_PROJ_PERSPECTIVE);
+        int r = bench(gpu, gs, s, maps, tile, GI_PROJ_PARABOLOID) |
+                bench(gpu, gs, s, maps, tile, GI_PROJ_PERSPECTIVE);
         gi_gpu_scene_free(gs);
         gi_scene_free(s);
         gi_gpu_destroy(gpu);
         return r;
     }
-    compare_with_per_view(gs, s, "perspective, eye z", GI_PROJ_PERSPECTIVE, GI_DEPTH_EYE_Z, 0, 32, 24, 1);
-    compare_with_per_view(gs, s, "perspective, radial, back faces culled", GI_PROJ_PERSPECTIVE, GI_DEPTH_RADIAL, 1, 24,
-                          16, 2);
-    compare_with_per_view(gs, s, "paraboloid, radial", GI_PROJ_PARABOLOID, GI_DEPTH_RADIAL, 0, 32, 24, 3);
-    compare_with_per_view(gs, s, "paraboloid, 64 maps of 16^2", GI_PROJ_PARABOLOID, GI_DEPTH_RADIAL, 0, 16, 64, 4);
+    compare_with_per_view(gs, s, "perspective, eye z", GI_PROJ_PERSPECTIVE, GI_DEPTH_EYE_Z, 0, 32,
+                          24, 1);
+    compare_with_per_view(gs, s, "perspective, radial, back faces culled", GI_PROJ_PERSPECTIVE,
+                          GI_DEPTH_RADIAL, 1, 24, 16, 2);
+    compare_with_per_view(gs, s, "paraboloid, radial", GI_PROJ_PARABOLOID, GI_DEPTH_RADIAL, 0, 32,
+                          24, 3);
+    compare_with_per_view(gs, s, "paraboloid, 64 maps of 16^2", GI_PROJ_PARABOLOID, GI_DEPTH_RADIAL,
+                          0, 16, 64, 4);
     test_lookup(gs, s, GI_PROJ_PERSPECTIVE, GI_DEPTH_EYE_Z);
     test_lookup(gs, s, GI_PROJ_PARABOLOID, GI_DEPTH_RADIAL);
     test_errors(gs, s);

@@ -9,9 +9,11 @@
 
 static const gi_shader_source test_sources[] = {
     {"smoke_lib.glsl", "tests/smoke_lib.glsl", "float smoke_twice(float x) { return 2.0 * x; }\n"},
-    {"smoke_bad.glsl", "tests/smoke_bad.glsl", "// line 1\n// line 2\nfloat broken( { return 1.0; }\n"},
+    {"smoke_bad.glsl", "tests/smoke_bad.glsl",
+     "// line 1\n// line 2\nfloat broken( { return 1.0; }\n"},
     {"smoke_user.comp", "tests/smoke_user.comp",
-     "#include \"smoke_lib.glsl\"\n#include \"smoke_bad.glsl\"\nlayout(local_size_x = 1) in;\nvoid main() {}\n"},
+     "#include \"smoke_lib.glsl\"\n#include \"smoke_bad.glsl\"\nlayout(local_size_x = 1) in;\nvoid "
+     "main() {}\n"},
     {0, 0, 0},
 };
 
@@ -24,14 +26,16 @@ static const gi_shader_source clash_core[] = {
 static const gi_shader_source plugin_a[] = {
     {"helper.glsl", "plugins/a/shaders/helper.glsl", "float helper() { return 1.0; }\n"},
     {"a.comp", "plugins/a/shaders/a.comp",
-     "#include \"helper.glsl\"\nlayout(local_size_x = 1) in;\nlayout(std430, binding = 8) buffer O { float v; };\n"
+     "#include \"helper.glsl\"\nlayout(local_size_x = 1) in;\nlayout(std430, binding = 8) buffer O "
+     "{ float v; };\n"
      "void main() { v = helper(); }\n"},
     {0, 0, 0},
 };
 static const gi_shader_source plugin_b[] = {
     {"helper.glsl", "plugins/b/shaders/helper.glsl", "float helper() { return 2.0; }\n"},
     {"b.comp", "plugins/b/shaders/b.comp",
-     "#include \"helper.glsl\"\nlayout(local_size_x = 1) in;\nlayout(std430, binding = 8) buffer O { float v; };\n"
+     "#include \"helper.glsl\"\nlayout(local_size_x = 1) in;\nlayout(std430, binding = 8) buffer O "
+     "{ float v; };\n"
      "void main() { v = helper(); }\n"},
     {0, 0, 0},
 };
@@ -57,10 +61,14 @@ static void check_namespaces(void)
 {
     gi_error err;
     CHECK(gi_shader_register(clash_core, &err) == GI_ERR_INVALID_ARGUMENT);
-    CHECK_MSG(strstr(err.text, "plugins/clash/shaders/brdf.glsl: named like the core's core/shaders/brdf.glsl"),
-              "'%s'", err.text);
-    CHECK(gi_shader_find("brdf.glsl") && strcmp(gi_shader_find("brdf.glsl")->path, "core/shaders/brdf.glsl") == 0);
-    CHECK(gi_shader_register(plugin_a, &err) == GI_OK && gi_shader_register(plugin_b, NULL) == GI_OK);
+    CHECK_MSG(
+        strstr(err.text,
+               "plugins/clash/shaders/brdf.glsl: named like the core's core/shaders/brdf.glsl"),
+        "'%s'", err.text);
+    CHECK(gi_shader_find("brdf.glsl") &&
+          strcmp(gi_shader_find("brdf.glsl")->path, "core/shaders/brdf.glsl") == 0);
+    CHECK(gi_shader_register(plugin_a, &err) == GI_OK &&
+          gi_shader_register(plugin_b, NULL) == GI_OK);
     GLuint pa = gi_program_build_compute("a.comp", NULL, &err);
     CHECK_MSG(pa != 0, "%s", err.text);
     GLuint pb = gi_program_build_compute("b.comp", NULL, &err);
@@ -70,7 +78,8 @@ static void check_namespaces(void)
     glDeleteProgram(pa);
     glDeleteProgram(pb);
     CHECK(gi_shader_expand("helper.glsl", NULL, &err) == NULL);
-    CHECK_MSG(strstr(err.text, "'helper.glsl' is ambiguous: plugins/a/shaders/helper.glsl and plugins/b/shaders/helper.glsl"),
+    CHECK_MSG(strstr(err.text, "'helper.glsl' is ambiguous: plugins/a/shaders/helper.glsl and "
+                               "plugins/b/shaders/helper.glsl"),
               "'%s'", err.text);
     CHECK(gi_shader_find("plugins/b/shaders/helper.glsl") == &plugin_b[0]);
 }
@@ -82,7 +91,8 @@ int main(void)
     CHECK_MSG(gpu != NULL, "%s", err.text);
     if (!gpu)
         return gi_test_finish();
-    printf("renderer: %s | %s | %s\n", gi_gpu_renderer(gpu), gi_gpu_version(gpu), gi_gpu_platform(gpu));
+    printf("renderer: %s | %s | %s\n", gi_gpu_renderer(gpu), gi_gpu_version(gpu),
+           gi_gpu_platform(gpu));
     GLint major = 0, minor = 0;
     glGetIntegerv(GL_MAJOR_VERSION, &major);
     glGetIntegerv(GL_MINOR_VERSION, &minor);
@@ -93,11 +103,13 @@ int main(void)
 
     CHECK(gi_shader_register(test_sources, &err) == GI_OK);
     /* A compute shader that uses an included function and writes an SSBO. */
-    const char *text = "#include \"smoke_lib.glsl\"\n"
-                       "layout(local_size_x = 64) in;\n"
-                       "layout(std430, binding = 8) buffer Out { float v[]; };\n"
-                       "void main() { uint i = gl_GlobalInvocationID.x; v[i] = smoke_twice(float(i)) + K; }\n";
-    GLuint prog = gi_program_build_compute_text("tests/smoke_inline.comp", text, "#define K 0.5\n", &err);
+    const char *text =
+        "#include \"smoke_lib.glsl\"\n"
+        "layout(local_size_x = 64) in;\n"
+        "layout(std430, binding = 8) buffer Out { float v[]; };\n"
+        "void main() { uint i = gl_GlobalInvocationID.x; v[i] = smoke_twice(float(i)) + K; }\n";
+    GLuint prog =
+        gi_program_build_compute_text("tests/smoke_inline.comp", text, "#define K 0.5\n", &err);
     CHECK_MSG(prog != 0, "%s", err.text);
     GLuint buf;
     glCreateBuffers(1, &buf);
@@ -120,11 +132,12 @@ int main(void)
     CHECK(prog == 0);
     CHECK_MSG(strncmp(err.text, "tests/smoke_bad.glsl:3: ", 24) == 0, "'%s'", err.text);
     /* Missing include and unknown program names. */
-    CHECK(gi_shader_expand("nope.glsl", NULL, &err) == NULL && strstr(err.text, "no shader source named 'nope.glsl'"));
+    CHECK(gi_shader_expand("nope.glsl", NULL, &err) == NULL &&
+          strstr(err.text, "no shader source named 'nope.glsl'"));
     const char *missing = "#include \"missing.glsl\"\nvoid main() {}\n";
     CHECK(gi_program_build_compute_text("tests/missing.comp", missing, NULL, &err) == 0);
-    CHECK_MSG(strcmp(err.text, "tests/missing.comp:1: #include \"missing.glsl\": no shader source named 'missing.glsl'") ==
-                  0,
+    CHECK_MSG(strcmp(err.text, "tests/missing.comp:1: #include \"missing.glsl\": no shader source "
+                               "named 'missing.glsl'") == 0,
               "'%s'", err.text);
     check_namespaces();
     /* Every core shader compiles on this driver. */

@@ -58,8 +58,10 @@ static const char *constants_kernel =
     "#include \"glsl_shared.h\"\n"
     "layout(local_size_x = 1) in;\n"
     "layout(std430, binding = GI_SSBO_PLUGIN_FIRST) buffer O { uint v[8]; };\n"
-    "void main() { v[0] = uint(GI_MAX_OBJECTS); v[1] = GI_MATERIAL_FLAG_DOUBLE_SIDED; v[2] = GI_LIGHT_TYPE_SPOT;\n"
-    "  v[3] = uint(GI_TEX_GBUFFER_IDS); v[4] = uint(GI_TEX_PLUGIN_FIRST); v[5] = uint(GI_IMAGE_TARGET);\n"
+    "void main() { v[0] = uint(GI_MAX_OBJECTS); v[1] = GI_MATERIAL_FLAG_DOUBLE_SIDED; v[2] = "
+    "GI_LIGHT_TYPE_SPOT;\n"
+    "  v[3] = uint(GI_TEX_GBUFFER_IDS); v[4] = uint(GI_TEX_PLUGIN_FIRST); v[5] = "
+    "uint(GI_IMAGE_TARGET);\n"
     "  v[6] = uint(GI_SSBO_DEPTH_ATLAS); v[7] = GI_NO_ID; }\n";
 
 int main(void)
@@ -69,12 +71,15 @@ int main(void)
     gi_gpu_scene *gs;
     if (!gpu_fixture_load(GI_SOURCE_DIR "/scenes/cornell_box_coarse.gltf", &gpu, &s, &gs) || !gs)
         return gi_test_finish();
-    gi_host host = {.struct_size = sizeof host, .log = host_log, .stage_begin = stage_begin, .stage_end = stage_end};
+    gi_host host = {.struct_size = sizeof host,
+                    .log = host_log,
+                    .stage_begin = stage_begin,
+                    .stage_end = stage_end};
 
     gi_kit k;
     CHECK(gi_kit_init(&k, &host, clash) == GI_ERR_INVALID_ARGUMENT);
-    CHECK_MSG(strstr(gi_kit_last_error(&k), "plugins/x/shaders/scene.glsl: named like the core's"), "'%s'",
-              gi_kit_last_error(&k));
+    CHECK_MSG(strstr(gi_kit_last_error(&k), "plugins/x/shaders/scene.glsl: named like the core's"),
+              "'%s'", gi_kit_last_error(&k));
     CHECK(gi_kit_init(&k, &host, NULL) == GI_OK && gi_kit_last_error(&k)[0] == '\0');
 
     /* Restarts: a new run, a moved view, a resize, a scene change, no averaging. */
@@ -84,20 +89,21 @@ int main(void)
     CHECK(frame(&k, &a, what) == 0);
     CHECK(k.gbuffer && k.accum && k.width == 16 && k.height == 8);
     CHECK(frame(&k, &a1, what) == 1 && frame(&k, &a1, what) == 2);
-    CHECK(frame(&k, &b, what) == 0);        /* the view moved */
+    CHECK(frame(&k, &b, what) == 0); /* the view moved */
     CHECK(frame(&k, &b, what) == 1);
-    CHECK(frame(&k, &a, what) == 0);        /* frame_index 0: a new run */
+    CHECK(frame(&k, &a, what) == 0); /* frame_index 0: a new run */
     gi_changes none = {0}, moved = {.flags = GI_CHANGED_TRANSFORMS};
     gi_kit_update(&k, gs, &none);
-    CHECK(frame(&k, &a1, what) == 1);       /* nothing changed */
+    CHECK(frame(&k, &a1, what) == 1); /* nothing changed */
     gi_kit_update(&k, gs, &moved);
-    CHECK(frame(&k, &a1, what) == 0);       /* the scene changed */
+    CHECK(frame(&k, &a1, what) == 0); /* the scene changed */
     gi_view big = view_of(24, 12, 0.0f, 5);
-    CHECK(frame(&k, &big, what) == 0);      /* resized: re-made */
+    CHECK(frame(&k, &big, what) == 0); /* resized: re-made */
     CHECK(k.width == 24 && k.height == 12 && k.gbuffer && k.gbuffer->width == 24 && k.accum);
-    CHECK(frame(&k, &big, what | GI_KIT_NO_AVERAGE) == 0 && frame(&k, &big, what | GI_KIT_NO_AVERAGE) == 0);
+    CHECK(frame(&k, &big, what | GI_KIT_NO_AVERAGE) == 0 &&
+          frame(&k, &big, what | GI_KIT_NO_AVERAGE) == 0);
     gi_kit_prepare(&k, gs);
-    CHECK(frame(&k, &big, what) == 0);      /* prepare restarts */
+    CHECK(frame(&k, &big, what) == 0); /* prepare restarts */
 
     /* The G-buffer for the view, inside the named stage. */
     int before = stages_begun;
@@ -116,14 +122,16 @@ int main(void)
     CHECK(strcmp(gi_kit_last_error(&k), "pass 3: broken") == 0);
     gi_error e;
     gi_error_set(&e, GI_OK, "from elsewhere");
-    CHECK(gi_kit_fail_with(&k, GI_ERR_IO, &e) == GI_ERR_IO && strcmp(gi_kit_last_error(&k), "from elsewhere") == 0);
+    CHECK(gi_kit_fail_with(&k, GI_ERR_IO, &e) == GI_ERR_IO &&
+          strcmp(gi_kit_last_error(&k), "from elsewhere") == 0);
     gi_kit_free(&k);
     CHECK(k.gbuffer == NULL && k.accum == 0 && k.scratch[0].texture == 0);
     gi_kit_free(&k); /* twice is harmless */
 
     /* The shared constants as GLSL sees them equal the C values. */
     gi_error err;
-    GLuint prog = gi_program_build_compute_text("tests/kit_constants.comp", constants_kernel, NULL, &err);
+    GLuint prog =
+        gi_program_build_compute_text("tests/kit_constants.comp", constants_kernel, NULL, &err);
     CHECK_MSG(prog != 0, "%s", err.text);
     if (prog) {
         GLuint buf;
@@ -135,8 +143,10 @@ int main(void)
         glDispatchCompute(1, 1, 1);
         glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
         glGetNamedBufferSubData(buf, 0, sizeof out, out);
-        CHECK(out[0] == GI_MAX_OBJECTS && out[1] == GI_MATERIAL_FLAG_DOUBLE_SIDED && out[2] == (uint32_t)GI_LIGHT_SPOT);
-        CHECK(out[3] == GI_TEX_GBUFFER_IDS && out[4] == GI_TEX_PLUGIN_FIRST && out[5] == GI_IMAGE_TARGET);
+        CHECK(out[0] == GI_MAX_OBJECTS && out[1] == GI_MATERIAL_FLAG_DOUBLE_SIDED &&
+              out[2] == (uint32_t)GI_LIGHT_SPOT);
+        CHECK(out[3] == GI_TEX_GBUFFER_IDS && out[4] == GI_TEX_PLUGIN_FIRST &&
+              out[5] == GI_IMAGE_TARGET);
         CHECK(out[6] == GI_SSBO_DEPTH_ATLAS && out[7] == GI_NO_ID);
         glDeleteBuffers(1, &buf);
         glDeleteProgram(prog);

@@ -23,7 +23,8 @@ static void expect_refused(const char *kind, const char *substring)
     snprintf(path, sizeof path, "%s/gimethod_fake_%s.so", FAKE_DIR, kind);
     gi_error err = {{0}};
     gi_result r = gi_plugins_add(NULL, path, &err);
-    CHECK_MSG(r != GI_OK && strstr(err.text, substring) && strstr(err.text, path), "%s: '%s'", kind, err.text);
+    CHECK_MSG(r != GI_OK && strstr(err.text, substring) && strstr(err.text, path), "%s: '%s'", kind,
+              err.text);
 }
 
 int main(void)
@@ -40,14 +41,15 @@ int main(void)
     expect_refused("ctor_crash", "crashed while loading (signal 11)");
     /* Built against other data layouts: refused with the struct named. */
     char msg[160];
-    snprintf(msg, sizeof msg, "built against gi_view of %zu bytes, this gibench has %zu: rebuild the plugin",
+    snprintf(msg, sizeof msg,
+             "built against gi_view of %zu bytes, this gibench has %zu: rebuild the plugin",
              sizeof(gi_view) - 16, sizeof(gi_view));
     expect_refused("layout_old", msg);
-    snprintf(msg, sizeof msg, "built against gi_scene of %zu bytes, this gibench has %zu", sizeof(gi_scene) + 8,
-             sizeof(gi_scene));
+    snprintf(msg, sizeof msg, "built against gi_scene of %zu bytes, this gibench has %zu",
+             sizeof(gi_scene) + 8, sizeof(gi_scene));
     expect_refused("layout_new", msg);
-    snprintf(msg, sizeof msg, "built against data layout revision %u, this gibench has %u", GI_LAYOUT_REVISION + 1u,
-             GI_LAYOUT_REVISION);
+    snprintf(msg, sizeof msg, "built against data layout revision %u, this gibench has %u",
+             GI_LAYOUT_REVISION + 1u, GI_LAYOUT_REVISION);
     expect_refused("layout_revision", msg);
 
     gi_error err;
@@ -84,14 +86,16 @@ int main(void)
     /* Validation of a descriptor without a library. */
     gi_method bad = *m;
     bad.abi_version = (GI_ABI_MAJOR + 1) << 16;
-    CHECK(gi_method_validate(&bad, &err) == GI_ERR_UNSUPPORTED && strstr(err.text, "plugin ABI 2.0"));
+    CHECK(gi_method_validate(&bad, &err) == GI_ERR_UNSUPPORTED &&
+          strstr(err.text, "plugin ABI 2.0"));
     bad = *m;
     bad.destroy = NULL;
     CHECK(gi_method_validate(&bad, &err) != GI_OK && strstr(err.text, "destroy()"));
     /* A 1.0 descriptor (ends at last_error) has no layout: refused. */
     bad = *m;
     bad.struct_size = (uint32_t)offsetof(gi_method, layout);
-    CHECK(gi_method_validate(&bad, &err) == GI_ERR_UNSUPPORTED && strstr(err.text, "has no data layout"));
+    CHECK(gi_method_validate(&bad, &err) == GI_ERR_UNSUPPORTED &&
+          strstr(err.text, "has no data layout"));
     /* A plugin built against the current headers passes the check. */
     static const gi_abi_layout current = GI_ABI_LAYOUT;
     CHECK(gi_abi_layout_check(&current, &err) == GI_OK);

@@ -647,7 +647,6 @@ static void test_flip_against_direct(void)
     free(slow);
 }
 
-
 /* Leaked energy: a reference half lit (grey 1) and half dark (0 and a faint
  * 0.005, below 1 % of its mean 0.5); the test puts 0.2 into the dark half.
  * Known answers, then the trivial images: the reference itself leaks only
@@ -655,8 +654,8 @@ static void test_flip_against_direct(void)
 static void test_leaked_energy(void)
 {
     const uint32_t w = 8, h = 4;
-    gi_image *ref = gi_image_create(w, h), *t = gi_image_create(w, h), *black = gi_image_create(w, h),
-             *lit = gi_image_create(w, h);
+    gi_image *ref = gi_image_create(w, h), *t = gi_image_create(w, h),
+             *black = gi_image_create(w, h), *lit = gi_image_create(w, h);
     for (uint32_t y = 0; y < h; y++)
         for (uint32_t x = 0; x < w; x++) {
             int dark = x >= w / 2;
@@ -673,7 +672,8 @@ static void test_leaked_energy(void)
     CHECK_NEAR(m.leaked_energy, 16 * 0.2 / total, 1e-6);
     CHECK_NEAR(m.dark_energy_ref, 4 * 0.005 / total, 1e-6);
     CHECK_NEAR(m.dark_threshold, 0.01, 1e-7);
-    gi_metrics self = compute(ref, ref, 0), none = compute(black, ref, 0), all = compute(lit, ref, 0);
+    gi_metrics self = compute(ref, ref, 0), none = compute(black, ref, 0),
+               all = compute(lit, ref, 0);
     CHECK_NEAR(self.leaked_energy, self.dark_energy_ref, 1e-12);
     CHECK(none.leaked_energy == 0.0);
     CHECK_NEAR(all.leaked_energy, 16.0 / total, 1e-6);

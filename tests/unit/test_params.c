@@ -61,11 +61,13 @@ static void check_undeclared(void)
     p = parse(NULL, NULL, &err);
     inst = NULL;
     gi_result r = gi_method_create(&m, NULL, p, &inst, &err);
-    CHECK_MSG(r == GI_ERR_INVALID_ARGUMENT && inst == NULL && destroyed == 1, "result %d, destroyed %d", (int)r,
-              destroyed);
-    CHECK_MSG(strcmp(err.text, "method 'csm' read parameter 'bais', which its parameter table does not declare (a "
-                               "bug in the plugin)") == 0,
-              "'%s'", err.text);
+    CHECK_MSG(r == GI_ERR_INVALID_ARGUMENT && inst == NULL && destroyed == 1,
+              "result %d, destroyed %d", (int)r, destroyed);
+    CHECK_MSG(
+        strcmp(err.text,
+               "method 'csm' read parameter 'bais', which its parameter table does not declare (a "
+               "bug in the plugin)") == 0,
+        "'%s'", err.text);
     gi_params_free(p);
 }
 
@@ -81,7 +83,8 @@ int main(void)
     CHECK(gi_params_enum(p, "filter") == 1);
     char *s = gi_params_to_string(p);
     /* canonical text: every parameter in table order, defaults included */
-    CHECK_MSG(s && strcmp(s, "N=32,bias=0.01,jitter=true,filter=pcf") == 0, "'%s'", s ? s : "(null)");
+    CHECK_MSG(s && strcmp(s, "N=32,bias=0.01,jitter=true,filter=pcf") == 0, "'%s'",
+              s ? s : "(null)");
     free(s);
     gi_params_free(p);
 
@@ -109,7 +112,8 @@ int main(void)
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         err.text[0] = '\0';
         p = parse(bad[i].kv, NULL, &err);
-        CHECK_MSG(p == NULL && strcmp(err.text, bad[i].msg) == 0, "%s -> '%s'", bad[i].kv, err.text);
+        CHECK_MSG(p == NULL && strcmp(err.text, bad[i].msg) == 0, "%s -> '%s'", bad[i].kv,
+                  err.text);
         gi_params_free(p);
     }
     p = parse("N=4", "N=5", &err);

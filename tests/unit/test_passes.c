@@ -12,7 +12,8 @@
 #include <string.h>
 
 /* All hit distances along a ray, sorted, up to max. */
-static int cast_all(const gi_scene *s, gi_vec3 o, gi_vec3 d, float *out, int max, uint32_t *first_tri)
+static int cast_all(const gi_scene *s, gi_vec3 o, gi_vec3 d, float *out, int max,
+                    uint32_t *first_tri)
 {
     int n = 0;
     float best = FLT_MAX;
@@ -54,8 +55,9 @@ static int cast_all(const gi_scene *s, gi_vec3 o, gi_vec3 d, float *out, int max
 
 /* Compares depth-map texels with CPU casts; returns the fraction that agree
  * within tol (relative). Texels near silhouettes may legitimately differ. */
-static float compare_map(const gi_scene *s, const float *map, uint32_t size, int surfaces, const float view[16],
-                         int projection, const float proj_inv_scale[2], float tol, int metric_radial)
+static float compare_map(const gi_scene *s, const float *map, uint32_t size, int surfaces,
+                         const float view[16], int projection, const float proj_inv_scale[2],
+                         float tol, int metric_radial)
 {
     float inv[16];
     gi_mat4_invert(inv, view);
@@ -69,7 +71,8 @@ static float compare_map(const gi_scene *s, const float *map, uint32_t size, int
                 d = gi_v3_normalize(gi_mat4_dir(inv, gi_v3(0, 0, -1)));
             } else if (projection == GI_PROJ_PERSPECTIVE) {
                 o = gi_mat4_point(inv, gi_v3(0, 0, 0));
-                d = gi_v3_normalize(gi_mat4_dir(inv, gi_v3(sx * proj_inv_scale[0], sy * proj_inv_scale[1], -1)));
+                d = gi_v3_normalize(
+                    gi_mat4_dir(inv, gi_v3(sx * proj_inv_scale[0], sy * proj_inv_scale[1], -1)));
             } else { /* paraboloid: (sx, sy) -> direction around -Z */
                 float r2 = sx * sx + sy * sy;
                 if (r2 > 0.95f)
@@ -95,7 +98,8 @@ static float compare_map(const gi_scene *s, const float *map, uint32_t size, int
                     ok &= fabsf(texel[k] - want) <= tol * want;
             }
             if (!ok && getenv("GI_DEBUG"))
-                printf("texel %u %u: map %g %g expected %g %g (n %d)\n", x, y, texel[0], texel[1], n > 0 ? hits[0] : -1.0, n > 1 ? hits[1] : -1.0, n);
+                printf("texel %u %u: map %g %g expected %g %g (n %d)\n", x, y, texel[0], texel[1],
+                       n > 0 ? hits[0] : -1.0, n > 1 ? hits[1] : -1.0, n);
             agree += ok;
             total++;
         }
@@ -129,11 +133,14 @@ int main(void)
     glGetTextureImage(gb->tex_ids, 0, GL_RGBA_INTEGER, GL_UNSIGNED_INT, W * H * 16, ids);
     int id_ok = 0, depth_ok = 0, normal_ok = 0, albedo_ok = 0, n = 0;
     float th = tanf(cam.yfov * 0.5f);
-    gi_vec3 right = gi_v3_normalize(gi_v3_cross(cam.forward, cam.up)), up = gi_v3_cross(right, cam.forward);
+    gi_vec3 right = gi_v3_normalize(gi_v3_cross(cam.forward, cam.up)),
+            up = gi_v3_cross(right, cam.forward);
     for (uint32_t y = 1; y < H; y += 3)
         for (uint32_t x = 1; x < W; x += 3) {
-            float sx = ((x + 0.5f) / W * 2 - 1) * th, sy = ((y + 0.5f) / H * 2 - 1) * th; /* GL row 0 = bottom */
-            gi_vec3 d = gi_v3_normalize(gi_v3_add(cam.forward, gi_v3_add(gi_v3_scale(right, sx), gi_v3_scale(up, sy))));
+            float sx = ((x + 0.5f) / W * 2 - 1) * th,
+                  sy = ((y + 0.5f) / H * 2 - 1) * th; /* GL row 0 = bottom */
+            gi_vec3 d = gi_v3_normalize(
+                gi_v3_add(cam.forward, gi_v3_add(gi_v3_scale(right, sx), gi_v3_scale(up, sy))));
             float hits[4];
             uint32_t tri = 0xFFFFFFFFu;
             int k = cast_all(s, cam.eye, d, hits, 4, &tri);
@@ -148,11 +155,12 @@ int main(void)
             id_ok += ids[i + 2] == tri && ids[i + 1] == mat;
             depth_ok += fabsf(pos[i + 3] - hits[0] * gi_v3_dot(d, cam.forward)) < 1e-3f * hits[0];
             float nl = sqrtf(nrm[i] * nrm[i] + nrm[i + 1] * nrm[i + 1] + nrm[i + 2] * nrm[i + 2]);
-            normal_ok += fabsf(nl - 1) < 1e-2f && (nrm[i] * d.x + nrm[i + 1] * d.y + nrm[i + 2] * d.z) <= 0;
+            normal_ok +=
+                fabsf(nl - 1) < 1e-2f && (nrm[i] * d.x + nrm[i + 1] * d.y + nrm[i + 2] * d.z) <= 0;
             albedo_ok += fabsf(alb[i] - s->materials[mat].albedo[0]) < 2e-3f;
         }
-    printf("G-buffer vs ray casting: ids %d/%d, depth %d/%d, normals %d/%d, albedo %d/%d\n", id_ok, n, depth_ok, n,
-           normal_ok, n, albedo_ok, n);
+    printf("G-buffer vs ray casting: ids %d/%d, depth %d/%d, normals %d/%d, albedo %d/%d\n", id_ok,
+           n, depth_ok, n, normal_ok, n, albedo_ok, n);
     /* A few texel centres may sit exactly on a triangle edge. */
     CHECK(id_ok >= n * 97 / 100);
     CHECK(depth_ok >= n * 97 / 100);

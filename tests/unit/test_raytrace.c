@@ -134,7 +134,8 @@ static void compare_ray(const gi_rt *rt, const gi_scene *s, const bf_scene *b, g
     float tt = 0.0f, tu = 0.0f, tv = 0.0f;
     uint32_t ttri = 0;
     int thit = gi_rt_intersect_tuv(rt, o, d, tmin, tmax, &tt, &tu, &tv, &ttri);
-    st->bad_record += thit != hit || (hit && (tt != h.t || tu != h.u || tv != h.v || ttri != h.triangle));
+    st->bad_record +=
+        thit != hit || (hit && (tt != h.t || tu != h.u || tv != h.v || ttri != h.triangle));
     if (hit != bhit) {
         if (near_edge)
             st->excused++;
@@ -181,12 +182,13 @@ static void compare_ray(const gi_rt *rt, const gi_scene *s, const bf_scene *b, g
     gi_vec3 ng = gi_v3_normalize(c);
     gi_vec3 at = gi_v3_add(o, gi_v3_scale(d, h.t));
     float scale = 1e-4f * (1.0f + gi_v3_length(at));
-    int ok = h.object == s->vertices[idx[0]].object && h.object < s->object_count &&
-             h.triangle >= s->objects[h.object].first_triangle &&
-             h.triangle < s->objects[h.object].first_triangle + s->objects[h.object].triangle_count &&
-             gi_v3_length(gi_v3_sub(h.position, at)) <= scale &&
-             fabsf(gi_v3_length(h.ng) - 1.0f) < 1e-5f && gi_v3_dot(h.ng, ng) > 0.9999f &&
-             h.u >= 0.0f && h.v >= 0.0f && h.u + h.v <= 1.0f + 1e-6f;
+    int ok =
+        h.object == s->vertices[idx[0]].object && h.object < s->object_count &&
+        h.triangle >= s->objects[h.object].first_triangle &&
+        h.triangle < s->objects[h.object].first_triangle + s->objects[h.object].triangle_count &&
+        gi_v3_length(gi_v3_sub(h.position, at)) <= scale &&
+        fabsf(gi_v3_length(h.ng) - 1.0f) < 1e-5f && gi_v3_dot(h.ng, ng) > 0.9999f && h.u >= 0.0f &&
+        h.v >= 0.0f && h.u + h.v <= 1.0f + 1e-6f;
     if (!ok && st->bad_record < 3)
         fprintf(stderr, "bad record: tri %u object %u pos %g %g %g vs %g %g %g\n", h.triangle,
                 h.object, (double)h.position.x, (double)h.position.y, (double)h.position.z,
@@ -298,8 +300,8 @@ static void test_threads(const gi_rt *rt, const gi_scene *s)
         pthread_join(th[k], NULL);
         bad += jobs[k].bad;
     }
-    printf("threads: %d threads x 4 passes over %d rays, %d results differ from one thread\n", T,
-           N, bad);
+    printf("threads: %d threads x 4 passes over %d rays, %d results differ from one thread\n", T, N,
+           bad);
     CHECK(bad == 0);
     free(o);
     free(d);
@@ -366,7 +368,8 @@ static void test_handmade(void)
         else
             ok += h.object == 1 ? d.y < 0.0f : d.y > 0.0f;
     }
-    CHECK_MSG(n == 500 && ok == 500, "%d of %d rays from the centre hit, %d as expected", n, 500, ok);
+    CHECK_MSG(n == 500 && ok == 500, "%d of %d rays from the centre hit, %d as expected", n, 500,
+              ok);
     /* Empty interval and tmin past everything: no hit. */
     gi_rt_hit h;
     CHECK(!gi_rt_intersect(rt, gi_v3(0, 0.2f, 0), gi_v3(1, 0, 0), 10.0f, INFINITY, &h));
@@ -452,7 +455,8 @@ static void test_moving(void)
     int diff = 0;
     for (int i = 0; i < 500; i++) {
         gi_vec3 d = gi_sample_uniform_sphere(urand(&rng), urand(&rng));
-        gi_vec3 o = gi_v3(1.0f + 3.0f * urand(&rng), 0.1f + 4.0f * urand(&rng), 1.0f + 3.0f * urand(&rng));
+        gi_vec3 o =
+            gi_v3(1.0f + 3.0f * urand(&rng), 0.1f + 4.0f * urand(&rng), 1.0f + 3.0f * urand(&rng));
         gi_rt_hit ha, hb;
         int a = gi_rt_intersect(rt, o, d, 0.0f, INFINITY, &ha);
         int c = gi_rt_intersect(old, o, d, 0.0f, INFINITY, &hb);
@@ -465,7 +469,8 @@ static void test_moving(void)
     CHECK(gi_rt_time(rt) == t0);
     float saved = s->vertices[ob->first_vertex].position[0];
     s->vertices[ob->first_vertex].position[0] = NAN;
-    CHECK(gi_rt_set_time(rt, t1, &err) == GI_ERR_INVALID_ARGUMENT && strstr(err.text, "not finite"));
+    CHECK(gi_rt_set_time(rt, t1, &err) == GI_ERR_INVALID_ARGUMENT &&
+          strstr(err.text, "not finite"));
     printf("NaN vertex at set_time: %s\n", err.text);
     s->vertices[ob->first_vertex].position[0] = saved;
     CHECK(gi_rt_time(rt) == t0 && memcmp(gi_rt_positions(rt), gi_rt_positions(old),
@@ -544,7 +549,8 @@ static void test_packets(void)
     if (!s)
         return;
     gi_rt *rt = NULL;
-    CHECK_MSG(gi_rt_create_ex(s, 0.0f, GI_RT_FAST_TRAVERSAL, &rt, &err) == GI_OK && rt, "%s", err.text);
+    CHECK_MSG(gi_rt_create_ex(s, 0.0f, GI_RT_FAST_TRAVERSAL, &rt, &err) == GI_OK && rt, "%s",
+              err.text);
     uint32_t rng = 12345u, rays = 0, hits = 0, same = 0;
     for (int round = 0; rt && round < 400; round++) {
         uint32_t n = 1u + (uint32_t)round % 8u;
@@ -553,11 +559,14 @@ static void test_packets(void)
         float tmin[8], tmax[8], t[8], u[8], v[8];
         uint32_t tri[8];
         int hit[8];
-        gi_vec3 eye = gi_v3(urand(&rng) * 0.8f + 0.1f, urand(&rng) * 0.8f + 0.1f, urand(&rng) * 0.8f + 0.1f);
+        gi_vec3 eye =
+            gi_v3(urand(&rng) * 0.8f + 0.1f, urand(&rng) * 0.8f + 0.1f, urand(&rng) * 0.8f + 0.1f);
         for (uint32_t i = 0; i < n; i++) {
-            gi_vec3 a = gi_v3(urand(&rng) * 2.0f - 1.0f, urand(&rng) * 2.0f - 1.0f, urand(&rng) * 2.0f - 1.0f);
+            gi_vec3 a = gi_v3(urand(&rng) * 2.0f - 1.0f, urand(&rng) * 2.0f - 1.0f,
+                              urand(&rng) * 2.0f - 1.0f);
             o[i] = bundle ? eye : gi_v3(urand(&rng), urand(&rng), urand(&rng));
-            d[i] = gi_v3_normalize(bundle ? gi_v3_add(gi_v3(0.0f, 0.0f, -1.0f), gi_v3_scale(a, 0.1f)) : a);
+            d[i] = gi_v3_normalize(
+                bundle ? gi_v3_add(gi_v3(0.0f, 0.0f, -1.0f), gi_v3_scale(a, 0.1f)) : a);
             tmin[i] = i == 3 ? 0.05f : 0.0f;
             tmax[i] = i == 5 ? 0.3f : INFINITY;
         }
@@ -568,13 +577,15 @@ static void test_packets(void)
             int h1 = gi_rt_intersect_tuv(rt, o[i], d[i], tmin[i], tmax[i], &t1, &u1, &v1, &tri1);
             rays++;
             hits += h1 != 0;
-            same += h1 == hit[i] && (!h1 || (tri1 == tri[i] && fabsf(t1 - t[i]) <= 1e-5f * t1 &&
-                                             fabsf(u1 - u[i]) <= 1e-5f && fabsf(v1 - v[i]) <= 1e-5f));
+            same +=
+                h1 == hit[i] && (!h1 || (tri1 == tri[i] && fabsf(t1 - t[i]) <= 1e-5f * t1 &&
+                                         fabsf(u1 - u[i]) <= 1e-5f && fabsf(v1 - v[i]) <= 1e-5f));
         }
     }
     printf("packets: %u of %u rays agree with single-ray queries (%u hits)\n", same, rays, hits);
     /* both kinds of answer are covered */
-    CHECK_MSG(rays == 1800 && same == rays && hits > rays / 4 && hits < rays, "%u of %u agree, %u hits", same, rays, hits);
+    CHECK_MSG(rays == 1800 && same == rays && hits > rays / 4 && hits < rays,
+              "%u of %u agree, %u hits", same, rays, hits);
     gi_rt_free(rt);
     gi_scene_free(s);
 }

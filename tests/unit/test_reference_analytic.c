@@ -196,8 +196,8 @@ static int write_sky(const char *path, float L, uint32_t w, uint32_t h)
  * rotation about +Y in degrees), seen straight down from above (eye_x,
  * eye_z), rendered with each of the three direct-light strategies at its
  * own sample count and held against the expected radiance. */
-static void plane_under_env(const char *name, float rho, float eye_x, float eye_z, const char *env, float scale,
-                            float rotation, const uint32_t spp[3], double expected)
+static void plane_under_env(const char *name, float rho, float eye_x, float eye_z, const char *env,
+                            float scale, float rotation, const uint32_t spp[3], double expected)
 {
     static const gi_ref_strategy strategies[3] = {GI_REF_STRATEGY_MIS, GI_REF_STRATEGY_LIGHT,
                                                   GI_REF_STRATEGY_BSDF};
@@ -233,7 +233,8 @@ static void test_plane_under_sky(void)
     /* Cosine-weighted BSDF sampling of a constant sky has no variance;
      * light sampling (uniform over the sphere) needs many samples. */
     static const uint32_t spp[3] = {1024, 16384, 64};
-    plane_under_env("plane under uniform sky", rho, 0.3f, -0.2f, "reference_sky_const.exr", L, 0.0f, spp, rho * L);
+    plane_under_env("plane under uniform sky", rho, 0.3f, -0.2f, "reference_sky_const.exr", L, 0.0f,
+                    spp, rho * L);
 }
 
 /* Plane under a 16x8 map with a gradient and one very bright texel,
@@ -254,8 +255,8 @@ static void test_plane_under_map(void)
             sum += map_texel(i, j) * (1.0 / w) * (s1 * s1 - s0 * s0);
         }
     static const uint32_t spp[3] = {4096, 4096, 32768};
-    plane_under_env("plane under a bright texel", rho, -0.4f, 0.1f, "reference_sky_map.exr", 1.0f, 30.0f, spp,
-                    rho * sum);
+    plane_under_env("plane under a bright texel", rho, -0.4f, 0.1f, "reference_sky_map.exr", 1.0f,
+                    30.0f, spp, rho * sum);
 }
 
 /* One punctual light over a diffuse plane; a narrow camera looks at

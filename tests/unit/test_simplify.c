@@ -39,7 +39,8 @@ static gi_scene *load(const char *path)
 
 /* World bounds and area at time t of object o's triangles in m (or the
  * scene's own when m is NULL). */
-static double object_measure(const gi_scene *s, const gi_simplified *m, uint32_t o, float t, float box[6])
+static double object_measure(const gi_scene *s, const gi_simplified *m, uint32_t o, float t,
+                             float box[6])
 {
     const gi_object *ob = &s->objects[o];
     gi_vertex *v = malloc((size_t)ob->vertex_count * sizeof *v);
@@ -48,7 +49,8 @@ static double object_measure(const gi_scene *s, const gi_simplified *m, uint32_t
         box[a] = FLT_MAX;
         box[3 + a] = -FLT_MAX;
     }
-    uint32_t first = m ? m->object_first[o] : ob->first_triangle, count = m ? m->object_count[o] : ob->triangle_count;
+    uint32_t first = m ? m->object_first[o] : ob->first_triangle,
+             count = m ? m->object_count[o] : ob->triangle_count;
     const uint32_t *idx = m ? m->indices : s->indices;
     double area = 0.0;
     for (uint32_t tri = first; tri < first + count; tri++) {
@@ -73,7 +75,8 @@ static int indices_valid(const gi_scene *s, const gi_simplified *m)
     int bad = 0;
     for (uint32_t o = 0; o < s->object_count; o++) {
         const gi_object *ob = &s->objects[o];
-        for (uint32_t tri = m->object_first[o]; tri < m->object_first[o] + m->object_count[o]; tri++) {
+        for (uint32_t tri = m->object_first[o]; tri < m->object_first[o] + m->object_count[o];
+             tri++) {
             const uint32_t *t = &m->indices[3 * (size_t)tri];
             for (int k = 0; k < 3; k++)
                 bad += t[k] < ob->first_vertex || t[k] >= ob->first_vertex + ob->vertex_count;
@@ -118,14 +121,16 @@ static void test_bunny(void)
         float worst = 0.0f;
         for (int a = 0; a < 6; a++)
             worst = fmaxf(worst, fabsf(box[a] - box0[a]));
-        printf("bunny ratio %.2f: %u of %u triangles (target %.0f), meshopt error %.4f, bounds moved by %.4f of "
+        printf("bunny ratio %.2f: %u of %u triangles (target %.0f), meshopt error %.4f, bounds "
+               "moved by %.4f of "
                "the extent, area %.4f of the original\n",
-               (double)ratios[i], m->triangle_count, s->triangle_count, target, (double)m->max_error,
-               (double)(worst / ext), area / area0);
-        CHECK_MSG(m->triangle_count <= target && m->triangle_count >= 0.9 * target, "%u triangles, target %.0f",
-                  m->triangle_count, target);
-        CHECK_MSG(worst <= 2.0f * m->max_error * ext + 1e-6f * ext, "bounds moved by %g, error %g x extent %g",
-                  (double)worst, (double)m->max_error, (double)ext);
+               (double)ratios[i], m->triangle_count, s->triangle_count, target,
+               (double)m->max_error, (double)(worst / ext), area / area0);
+        CHECK_MSG(m->triangle_count <= target && m->triangle_count >= 0.9 * target,
+                  "%u triangles, target %.0f", m->triangle_count, target);
+        CHECK_MSG(worst <= 2.0f * m->max_error * ext + 1e-6f * ext,
+                  "bounds moved by %g, error %g x extent %g", (double)worst, (double)m->max_error,
+                  (double)ext);
         CHECK_MSG(fabs(area / area0 - 1.0) < 0.05, "area ratio %.4f", area / area0);
         CHECK(indices_valid(s, m));
         gi_simplified_free(m);
@@ -152,11 +157,12 @@ static void test_cornell(void)
             for (int a = 0; a < 6; a++)
                 worst = fmaxf(worst, fabsf(b1[a] - b0[a]));
         }
-        printf("cornell ratio 0.01, error 1e-3: %u of %u triangles, meshopt error %.2g, area %.5f of the original, "
+        printf("cornell ratio 0.01, error 1e-3: %u of %u triangles, meshopt error %.2g, area %.5f "
+               "of the original, "
                "bounds moved by %g\n",
                m->triangle_count, s->triangle_count, (double)m->max_error, a1 / a0, (double)worst);
-        CHECK_MSG(m->triangle_count * 4 < s->triangle_count, "only down to %u of %u", m->triangle_count,
-                  s->triangle_count);
+        CHECK_MSG(m->triangle_count * 4 < s->triangle_count, "only down to %u of %u",
+                  m->triangle_count, s->triangle_count);
         CHECK_MSG(fabs(a1 / a0 - 1.0) < 0.01, "area ratio %.5f", a1 / a0);
         CHECK(worst < 1e-5f);
         CHECK(m->max_error <= 1e-3f);
@@ -192,8 +198,9 @@ static void test_deform(void)
         float ext = fmaxf(b0[3] - b0[0], fmaxf(b0[4] - b0[1], b0[5] - b0[2])), worst = 0.0f;
         for (int a = 0; a < 6; a++)
             worst = fmaxf(worst, fabsf(b1[a] - b0[a]));
-        printf("deform object %u at t = 2: %u of %u triangles, bounds moved by %.4f of the extent\n", o,
-               m->object_count[o], s->objects[o].triangle_count, (double)(worst / ext));
+        printf(
+            "deform object %u at t = 2: %u of %u triangles, bounds moved by %.4f of the extent\n",
+            o, m->object_count[o], s->objects[o].triangle_count, (double)(worst / ext));
         CHECK(m->object_count[o] < s->objects[o].triangle_count);
         CHECK_MSG(worst <= 0.02f * ext, "bounds moved by %g of %g", (double)worst, (double)ext);
     }
@@ -209,8 +216,8 @@ static void test_deform(void)
  * are drawn wrongly there (the paper's reason for perspective maps with
  * large triangles, Sec. IV): that is measured and must be large, and the
  * perspective maps of the copy must be close to the scene's. */
-static void atlas_case(gi_gpu_scene *gs, gi_projection proj, const gi_simplified *full, const gi_simplified *low,
-                       size_t *differ_full, size_t *differ_low)
+static void atlas_case(gi_gpu_scene *gs, gi_projection proj, const gi_simplified *full,
+                       const gi_simplified *low, size_t *differ_full, size_t *differ_low)
 {
     gi_error err;
     gi_depth_atlas_desc d = {32, 4, proj, GI_DEPTH_RADIAL, 0};
@@ -233,7 +240,8 @@ static void atlas_case(gi_gpu_scene *gs, gi_projection proj, const gi_simplified
     float *tiles[3][4] = {{NULL}};
     const gi_simplified *geo[3] = {NULL, full, low};
     for (int g = 0; g < 3; g++) {
-        gi_depth_atlas_set_geometry(a, geo[g] ? geo[g]->ibo : 0, geo[g] ? geo[g]->triangle_count : 0);
+        gi_depth_atlas_set_geometry(a, geo[g] ? geo[g]->ibo : 0,
+                                    geo[g] ? geo[g]->triangle_count : 0);
         CHECK_MSG(gi_depth_atlas_render(a, gs, views, 4, &err) == GI_OK, "%s", err.text);
         for (int i = 0; i < 4; i++)
             tiles[g][i] = gi_depth_atlas_read_tile(a, (uint32_t)i);
@@ -242,7 +250,8 @@ static void atlas_case(gi_gpu_scene *gs, gi_projection proj, const gi_simplified
     for (int i = 0; i < 4; i++)
         for (int t = 0; t < 32 * 32; t++) {
             *differ_full += tiles[0][i][t] != tiles[1][i][t];
-            *differ_low += fabsf(tiles[0][i][t] - tiles[2][i][t]) > 0.02f * fmaxf(1.0f, tiles[0][i][t]);
+            *differ_low +=
+                fabsf(tiles[0][i][t] - tiles[2][i][t]) > 0.02f * fmaxf(1.0f, tiles[0][i][t]);
         }
     for (int g = 0; g < 3; g++)
         for (int i = 0; i < 4; i++)
@@ -260,13 +269,16 @@ static void test_atlas(void)
         return;
     }
     gi_error err;
-    gi_simplified *full = gi_simplify_scene(s, 1.0f, 0.0f, &err), *low = gi_simplify_scene(s, 0.25f, 0.01f, &err);
+    gi_simplified *full = gi_simplify_scene(s, 1.0f, 0.0f, &err),
+                  *low = gi_simplify_scene(s, 0.25f, 0.01f, &err);
     CHECK(full && low);
-    if (full && low && gi_simplified_upload(full, &err) == GI_OK && gi_simplified_upload(low, &err) == GI_OK) {
+    if (full && low && gi_simplified_upload(full, &err) == GI_OK &&
+        gi_simplified_upload(low, &err) == GI_OK) {
         size_t texels = 4 * 32 * 32, pf, pl, qf, ql;
         atlas_case(gs, GI_PROJ_PERSPECTIVE, full, low, &pf, &pl);
         atlas_case(gs, GI_PROJ_PARABOLOID, full, low, &qf, &ql);
-        printf("atlas (%u of %u triangles at ratio 0.25), texels of %zu differing by more than 2 %%: perspective "
+        printf("atlas (%u of %u triangles at ratio 0.25), texels of %zu differing by more than 2 "
+               "%%: perspective "
                "ratio 1 %zu, ratio 0.25 %zu; paraboloid ratio 1 %zu, ratio 0.25 %zu\n",
                low->triangle_count, s->triangle_count, texels, pf, pl, qf, ql);
         CHECK(pf == 0 && qf == 0);

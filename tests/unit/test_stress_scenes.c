@@ -38,7 +38,8 @@ static void test_moving_light(void)
         return;
     CHECK(s->light_count == 1 && s->emitter_count == 0);
     CHECK_NEAR(s->animation_length, 4.0, TOL);
-    const float want[4][3] = {{3.0f, 2.4f, 2.0f}, {2.0f, 2.4f, 3.0f}, {1.0f, 2.4f, 2.0f}, {2.0f, 2.4f, 1.0f}};
+    const float want[4][3] = {
+        {3.0f, 2.4f, 2.0f}, {2.0f, 2.4f, 3.0f}, {1.0f, 2.4f, 2.0f}, {2.0f, 2.4f, 1.0f}};
     for (int k = 0; k < 4; k++) {
         gi_light_frame f = gi_scene_light_at(s, 0, (float)k);
         CHECK_NEAR(f.position.x, want[k][0], TOL);
@@ -60,8 +61,11 @@ static void test_moving_camera(void)
     if (!s)
         return;
     CHECK(s->camera_count == 1 && s->light_count == 0 && s->emitter_count == 2);
-    const float eyes[5][3] = {{1.0f, 1.7f, -3.0f}, {0.9f, 1.8f, 0.8f}, {3.0f, 1.7f, -3.0f},
-                              {2.0f, 2.2f, -4.5f}, {1.0f, 1.7f, -3.0f}};
+    const float eyes[5][3] = {{1.0f, 1.7f, -3.0f},
+                              {0.9f, 1.8f, 0.8f},
+                              {3.0f, 1.7f, -3.0f},
+                              {2.0f, 2.2f, -4.5f},
+                              {1.0f, 1.7f, -3.0f}};
     for (int k = 0; k < 5; k++) {
         gi_camera_frame c = gi_scene_camera_at(s, 0, (float)k);
         CHECK_NEAR(c.eye.x, eyes[k][0], TOL);

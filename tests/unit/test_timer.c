@@ -53,7 +53,8 @@ int main(void)
     gi_stage_stats st[8];
     uint32_t n = gi_timer_stats(t, st, 8);
     CHECK(n == 3);
-    const gi_stage_stats *inner = find(st, n, "inner"), *outer = find(st, n, "outer"), *frame = find(st, n, "frame");
+    const gi_stage_stats *inner = find(st, n, "inner"), *outer = find(st, n, "outer"),
+                         *frame = find(st, n, "frame");
     CHECK(inner && outer && frame);
     if (inner && outer && frame) {
         CHECK(inner->samples == 3 && outer->samples == 3 && frame->samples == 3);
@@ -89,7 +90,8 @@ int main(void)
             n = gi_timer_stats(t, st, 8);
             const gi_stage_stats *c = find(st, n, "clear");
             CHECK(c && c->samples == 3 && c->min_ms >= 0.0);
-            printf("%s: clear median %.4f ms\n", gi_timer_mode_name(modes[m]), c ? c->median_ms : -1.0);
+            printf("%s: clear median %.4f ms\n", gi_timer_mode_name(modes[m]),
+                   c ? c->median_ms : -1.0);
             gi_timer_free(t);
         }
         glDeleteBuffers(1, &buf);
@@ -107,9 +109,12 @@ int main(void)
         gi_timer_frame_end(t);
         n = gi_timer_stats(t, st, 8);
         const gi_stage_stats *sl = find(st, n, "sleep"), *bu = find(st, n, "busy");
-        CHECK_MSG(sl && sl->median_ms < 10.0, "a 50 ms sleep cost %.2f ms of CPU time", sl ? sl->median_ms : -1.0);
-        CHECK_MSG(bu && bu->median_ms > 25.0, "30 ms of busy work cost %.2f ms of CPU time", bu ? bu->median_ms : -1.0);
-        CHECK(strcmp(gi_timer_mode_name(GI_TIMER_CPU_TIME), "process-cpu-time-around-glFinish") == 0);
+        CHECK_MSG(sl && sl->median_ms < 10.0, "a 50 ms sleep cost %.2f ms of CPU time",
+                  sl ? sl->median_ms : -1.0);
+        CHECK_MSG(bu && bu->median_ms > 25.0, "30 ms of busy work cost %.2f ms of CPU time",
+                  bu ? bu->median_ms : -1.0);
+        CHECK(strcmp(gi_timer_mode_name(GI_TIMER_CPU_TIME), "process-cpu-time-around-glFinish") ==
+              0);
         gi_timer_free(t);
         CHECK(gi_gl_check("timer", &err) == GI_OK);
         gi_gpu_destroy(gpu);

@@ -19,7 +19,8 @@ static json_object *record(const char *method, const char *params, const double 
     json_object_object_add(o, "prepare_ms", json_object_new_double(prep_ms));
     json_object *c = json_object_new_array();
     for (int k = 0; k < n; k++) {
-        json_object *p = json_object_new_object(), *f = json_object_new_object(), *m = json_object_new_object();
+        json_object *p = json_object_new_object(), *f = json_object_new_object(),
+                    *m = json_object_new_object();
         json_object_object_add(p, "frame", json_object_new_int(1 << k));
         json_object_object_add(p, "time_ms", json_object_new_double(t[k] * 1000.0));
         json_object_object_add(f, "relmse", json_object_new_double(e[k]));
@@ -47,8 +48,8 @@ static struct {
     uint32_t thin, dashed;
 } seen;
 
-static gi_result fake_chart(const char *path, const gi_chart_desc *desc, const gi_chart_series *s, uint32_t n,
-                            gi_error *err)
+static gi_result fake_chart(const char *path, const gi_chart_desc *desc, const gi_chart_series *s,
+                            uint32_t n, gi_error *err)
 {
     (void)desc, (void)err;
     seen.calls++;
@@ -60,7 +61,9 @@ static gi_result fake_chart(const char *path, const gi_chart_desc *desc, const g
             seen.thin++;
         if (s[i].style == GI_CHART_DASHED)
             seen.dashed++;
-        int m = s[i].label && !strncmp(s[i].label, "fast", 4) ? 0 : s[i].label && !strncmp(s[i].label, "prog", 4) ? 1 : -1;
+        int m = s[i].label && !strncmp(s[i].label, "fast", 4)   ? 0
+                : s[i].label && !strncmp(s[i].label, "prog", 4) ? 1
+                                                                : -1;
         if (m >= 0 && s[i].style == GI_CHART_LINE_MARKERS) {
             seen.front_count[m] = s[i].count;
             for (uint32_t k = 0; k < s[i].count && k < 16; k++) {
@@ -79,7 +82,8 @@ static void test_pt_time(void)
     int ex = -1;
     CHECK_NEAR(tradeoff_pt_time_at(&c, 0.5, &ex), 2.0, 1e-12);
     CHECK(ex == 0);
-    CHECK_NEAR(tradeoff_pt_time_at(&c, 2.0, &ex), 0.5, 1e-12); /* beyond the first point: slope -1 */
+    CHECK_NEAR(tradeoff_pt_time_at(&c, 2.0, &ex), 0.5,
+               1e-12); /* beyond the first point: slope -1 */
     CHECK(ex == 1);
     CHECK_NEAR(tradeoff_pt_time_at(&c, 0.01, &ex), 100.0, 1e-9);
     CHECK(ex == 1);
@@ -109,7 +113,8 @@ static void test_report(void)
         json_object *st = json_object_new_object();
         json_object_object_add(st, "data_bytes", json_object_new_double(1048576.0));
         json_object_object_add(runs[r].record, "stats", st);
-        json_object_object_add(runs[r].record, "peak_rss_mib", json_object_new_double(r ? 300.0 : 100.0));
+        json_object_object_add(runs[r].record, "peak_rss_mib",
+                               json_object_new_double(r ? 300.0 : 100.0));
     }
     gi_text md = {0};
     json_object *charts = json_object_new_array();
@@ -136,7 +141,9 @@ static void test_report(void)
     CHECK_MSG(strstr(s, "| 0 | 4 | 4 | 4 | – | – |\n") != NULL, "%s", s);
     /* equal time: the costs of the settings behind each row */
     CHECK_MSG(strstr(s, "| precompute (s) | peak RSS (MiB) | data (MiB) |") != NULL, "%s", s);
-    CHECK_MSG(strstr(s, "| fast | 0.4 (×0.4) | 0.4 (×1.6) | 0.4 (×6.4) | 0.2 | 200 | 1 |\n") != NULL, "%s", s);
+    CHECK_MSG(strstr(s, "| fast | 0.4 (×0.4) | 0.4 (×1.6) | 0.4 (×6.4) | 0.2 | 200 | 1 |\n") !=
+                  NULL,
+              "%s", s);
 
     /* equal time, at the path tracer's 1 s (error 1): fast 0.4, prog 0.2;
      * prog's matched row uses its own curve (0.5 s: no setting that fast) */
@@ -178,7 +185,8 @@ static void test_renderers(void)
             {record("fast", "A", t2, e2, e2, 2, 0), 65, 7},
         };
         json_object_object_add(runs[0].record, "renderer", json_object_new_string("NVIDIA H100"));
-        json_object_object_add(runs[1].record, "renderer", json_object_new_string(mixed ? "llvmpipe" : "NVIDIA H100"));
+        json_object_object_add(runs[1].record, "renderer",
+                               json_object_new_string(mixed ? "llvmpipe" : "NVIDIA H100"));
         tradeoff_pt_curve full = {65, 3, {1, 4, 16}, {1, 0.25, 0.0625}};
         gi_text md = {0};
         json_object *charts = json_object_new_array();
@@ -187,7 +195,8 @@ static void test_renderers(void)
         if (mixed) {
             CHECK_MSG(strstr(s, "| fast [NVIDIA H100] | `A` | 1 | 0.01 | 0.3 |") != NULL, "%s", s);
             CHECK_MSG(strstr(s, "| fast [llvmpipe] | `A` | 1 | 0.5 | 0.31 |") != NULL, "%s", s);
-            CHECK_MSG(strstr(s, "[0.3–0.31]") == NULL, "two renderers pooled into one spread:\n%s", s);
+            CHECK_MSG(strstr(s, "[0.3–0.31]") == NULL, "two renderers pooled into one spread:\n%s",
+                      s);
         } else {
             CHECK_MSG(strstr(s, "| fast | `A` | 1 | 0.255 | 0.305 [0.3–0.31] |") != NULL, "%s", s);
             CHECK_MSG(strstr(s, "[NVIDIA") == NULL, "%s", s);

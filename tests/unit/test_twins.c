@@ -175,17 +175,31 @@ static char *make_defines(const slots *s)
     add_define(&text, &len, "IN_F", IN_F);
     add_define(&text, &len, "OUT_U", OUT_U);
     add_define(&text, &len, "OUT_F", s->out_f);
-#define DEF_IN(name) add_define(&text, &len, #name, name);
-    DEF_IN(I_U1)
-    DEF_IN(I_U2)
-    DEF_IN(I_U3)
-    DEF_IN(I_U4)
-    DEF_IN(I_N) DEF_IN(I_EXP) DEF_IN(I_WO) DEF_IN(I_COSMAX) DEF_IN(I_WI) DEF_IN(I_EXPOSURE)
-        DEF_IN(I_KD) DEF_IN(I_MIRROR) DEF_IN(I_KS) DEF_IN(I_LINEAR) DEF_IN(I_D) DEF_IN(I_SRGB)
-            DEF_IN(I_NF) DEF_IN(I_FPDF) DEF_IN(I_NG) DEF_IN(I_GPDF)
+#define DEF_IN(name) add_define(&text, &len, #name, name)
+    DEF_IN(I_U1);
+    DEF_IN(I_U2);
+    DEF_IN(I_U3);
+    DEF_IN(I_U4);
+    DEF_IN(I_N);
+    DEF_IN(I_EXP);
+    DEF_IN(I_WO);
+    DEF_IN(I_COSMAX);
+    DEF_IN(I_WI);
+    DEF_IN(I_EXPOSURE);
+    DEF_IN(I_KD);
+    DEF_IN(I_MIRROR);
+    DEF_IN(I_KS);
+    DEF_IN(I_LINEAR);
+    DEF_IN(I_D);
+    DEF_IN(I_SRGB);
+    DEF_IN(I_NF);
+    DEF_IN(I_FPDF);
+    DEF_IN(I_NG);
+    DEF_IN(I_GPDF);
 #define DEF_U(name) add_define(&text, &len, #name, name);
-                UINT_SLOTS(DEF_U) for (int i = 0; i < FLOAT_SLOT_COUNT; i++)
-                    add_define(&text, &len, float_slots[i].name, s->off[i]);
+    UINT_SLOTS(DEF_U)
+    for (int i = 0; i < FLOAT_SLOT_COUNT; i++)
+        add_define(&text, &len, float_slots[i].name, s->off[i]);
     return text;
 }
 

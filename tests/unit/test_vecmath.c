@@ -27,7 +27,8 @@ int main(void)
     /* Cube face f looks along its axis: the axis point maps to the centre of
      * the face in front of the eye (z_eye < 0); GL's +Y face has "up" +Z
      * seen as -t, so a point at +Z lands at the top (t < 0 means v up). */
-    static const float axes[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    static const float axes[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                     {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
     for (int f = 0; f < 6; f++) {
         float v[16];
         gi_mat4_cube_face_view(v, gi_v3(1, 2, 3), f);

@@ -52,23 +52,28 @@ static inline void vis_add(vis_score *s, int exact_lit, int method_lit)
 static inline int vis_check(const vis_score *s, const char *what, double margin, long min_each)
 {
     long lit = s->pairs - s->occluded;
-    long trivial_wrong = lit < s->occluded ? lit : s->occluded; /* the better trivial answer's mistakes */
+    long trivial_wrong =
+        lit < s->occluded ? lit : s->occluded; /* the better trivial answer's mistakes */
     long wrong = s->pairs - s->agree;
     double n = s->pairs > 0 ? (double)s->pairs : 1.0;
     double removed = trivial_wrong > 0 ? 1.0 - (double)wrong / (double)trivial_wrong : 0.0;
-    printf("%s: %ld pairs (%ld occluded, %ld unoccluded): method %.1f %%, always lit %.1f %%, never lit %.1f %%; "
-           "the method removes %.0f %% of the better trivial answer's %ld disagreements (required %.0f %%)\n",
+    printf("%s: %ld pairs (%ld occluded, %ld unoccluded): method %.1f %%, always lit %.1f %%, "
+           "never lit %.1f %%; "
+           "the method removes %.0f %% of the better trivial answer's %ld disagreements (required "
+           "%.0f %%)\n",
            what, s->pairs, s->occluded, lit, 100.0 * (double)s->agree / n, 100.0 * (double)lit / n,
            100.0 * (double)s->occluded / n, 100.0 * removed, trivial_wrong, 100.0 * margin);
     int fails = 0;
     if (s->occluded < min_each || lit < min_each) {
-        fprintf(stderr, "%s: %ld occluded and %ld unoccluded pairs; at least %ld of each are needed\n", what,
-                s->occluded, lit, min_each);
+        fprintf(stderr,
+                "%s: %ld occluded and %ld unoccluded pairs; at least %ld of each are needed\n",
+                what, s->occluded, lit, min_each);
         fails++;
     }
     if ((double)wrong > (1.0 - margin) * (double)trivial_wrong) {
-        fprintf(stderr, "%s: %ld disagreements, more than %.0f %% of the better trivial answer's %ld\n", what, wrong,
-                100.0 * (1.0 - margin), trivial_wrong);
+        fprintf(stderr,
+                "%s: %ld disagreements, more than %.0f %% of the better trivial answer's %ld\n",
+                what, wrong, 100.0 * (1.0 - margin), trivial_wrong);
         fails++;
     }
     return fails;

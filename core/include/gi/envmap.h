@@ -65,7 +65,8 @@ float gi_envmap_pdf(const gi_envmap *env, gi_vec3 d);
  * estimate's weight cos / (half pdf_map + (K - half) pdf_cos), so that the
  * irradiance is the sum over k of weight x L(w) x visibility; 0 when the
  * direction does not count (below the surface, or a black map). */
-float gi_envmap_mis_direction(const gi_envmap *env, gi_vec3 n, uint32_t k, uint32_t K, float u1, float u2, gi_vec3 *w);
+float gi_envmap_mis_direction(const gi_envmap *env, gi_vec3 n, uint32_t k, uint32_t K, float u1,
+                              float u2, gi_vec3 *w);
 /* Mean luminance over the sphere, (1 / 4 pi) Int lum(L) dw = total_weight
  * x pi / 2: a power-like weight for choosing between the map and other
  * lights. */

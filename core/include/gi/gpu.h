@@ -82,9 +82,9 @@ typedef struct gi_gpu_light {
  * the area-light power (for sampling by radiance distribution). */
 typedef struct gi_gpu_emitter {
     uint32_t triangle;
-    float area;      /* world area at the current time */
-    float cdf;       /* inclusive running sum of power, normalised to 1 at the end */
-    float pdf;       /* probability of choosing this emitter */
+    float area; /* world area at the current time */
+    float cdf;  /* inclusive running sum of power, normalised to 1 at the end */
+    float pdf;  /* probability of choosing this emitter */
 } gi_gpu_emitter;
 
 /* The emitter whose CDF interval holds u in [0, 1) (n >= 1 records):
@@ -112,16 +112,16 @@ typedef struct gi_gpu_scene {
     const gi_scene *scene;
     GLuint vao, vbo, ibo;
     GLuint ssbo_materials, ssbo_lights, ssbo_emitters;
-    GLuint ubo_objects;   /* GI_MAX_OBJECTS x {mat4 world_from_local; mat4 normal matrix} */
-    GLuint ubo_info;      /* scene counts, light powers, time, bounds (GiSceneInfo) */
+    GLuint ubo_objects; /* GI_MAX_OBJECTS x {mat4 world_from_local; mat4 normal matrix} */
+    GLuint ubo_info;    /* scene counts, light powers, time, bounds (GiSceneInfo) */
     GLuint tex_env, tex_env_cond, tex_env_marg; /* 0 when no environment */
-    GLuint tex_albedo;    /* 2D array, 1 x 1 x 1 white when the scene has no texture */
+    GLuint tex_albedo; /* 2D array, 1 x 1 x 1 white when the scene has no texture */
     uint32_t triangle_count, vertex_count, light_count, emitter_count;
-    float emitter_power;  /* total area-light power (sum of area x luminance x pi) */
-    float time;           /* time the transforms were last set for */
+    float emitter_power; /* total area-light power (sum of area x luminance x pi) */
+    float time;          /* time the transforms were last set for */
     float world_from_local[GI_MAX_OBJECTS][16]; /* CPU copy of the UBO */
-    float bounds[6];      /* world bounds at `time` */
-    int deforming;        /* the scene has morph targets: set_time rewrites their vertices */
+    float bounds[6];                            /* world bounds at `time` */
+    int deforming; /* the scene has morph targets: set_time rewrites their vertices */
 } gi_gpu_scene;
 
 gi_gpu_scene *gi_gpu_scene_upload(gi_gpu *gpu, const gi_scene *scene, gi_error *err);
@@ -151,7 +151,8 @@ void gi_gpu_scene_draw(const gi_gpu_scene *gs, int object, GLsizei instances);
  * the scene's vertices, e.g. gi/algo/simplify.h's lower-detail copy) with
  * the scene's VAO and vertex attributes, then gives the VAO its own
  * element buffer back; the caller has a program bound. */
-void gi_gpu_scene_draw_indices(const gi_gpu_scene *gs, GLuint ibo, uint32_t index_count, GLsizei instances);
+void gi_gpu_scene_draw_indices(const gi_gpu_scene *gs, GLuint ibo, uint32_t index_count,
+                               GLsizei instances);
 
 /* A new width x height 2D texture of `format` (one level, contents
  * undefined) with nearest filtering and clamp-to-edge wrapping: the render

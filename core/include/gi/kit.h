@@ -48,7 +48,8 @@ extern "C" {
 enum {
     GI_KIT_GBUFFER = 1u << 0,    /* a G-buffer (gi_kit.gbuffer) */
     GI_KIT_ACCUMULATE = 1u << 1, /* an RGBA32F running average (gi_kit.accum) */
-    GI_KIT_NO_AVERAGE = 1u << 2, /* restart the average every frame (an "accumulate off" parameter) */
+    GI_KIT_NO_AVERAGE =
+        1u << 2, /* restart the average every frame (an "accumulate off" parameter) */
 };
 
 typedef struct gi_kit_scratch {
@@ -59,11 +60,11 @@ typedef struct gi_kit_scratch {
 
 typedef struct gi_kit {
     const gi_host *host;
-    const gi_gpu_scene *scene;  /* set by prepare and update */
-    gi_gbuffer *gbuffer;        /* with GI_KIT_GBUFFER: view-sized */
-    GLuint accum;               /* with GI_KIT_ACCUMULATE: view-sized RGBA32F */
-    uint32_t width, height;     /* size of the last frame */
-    uint32_t frames;            /* frames already in the running average (u_frame) */
+    const gi_gpu_scene *scene; /* set by prepare and update */
+    gi_gbuffer *gbuffer;       /* with GI_KIT_GBUFFER: view-sized */
+    GLuint accum;              /* with GI_KIT_ACCUMULATE: view-sized RGBA32F */
+    uint32_t width, height;    /* size of the last frame */
+    uint32_t frames;           /* frames already in the running average (u_frame) */
     float last_view_proj[16];
     gi_kit_scratch scratch[GI_KIT_SCRATCH_MAX];
     gi_error error;
@@ -91,7 +92,8 @@ void gi_kit_bind(const gi_kit *k, GLuint program, const gi_view *v, const gi_tar
 void gi_kit_frame_end(gi_kit *k);
 /* Scratch texture `slot` (< GI_KIT_SCRATCH_MAX) of `format` and size,
  * re-made when either changed (contents then undefined); 0 on a bad slot. */
-GLuint gi_kit_scratch_texture(gi_kit *k, unsigned slot, GLenum format, uint32_t width, uint32_t height);
+GLuint gi_kit_scratch_texture(gi_kit *k, unsigned slot, GLenum format, uint32_t width,
+                              uint32_t height);
 void gi_kit_free(gi_kit *k);
 
 /* Keeps "fmt ..." as the error and returns r. */
@@ -107,13 +109,14 @@ const char *gi_kit_last_error(const gi_kit *k);
 /* The data layout this build sees (gi_method.layout; method.h "Data
  * layout"). Bump GI_LAYOUT_REVISION on a same-size change of one of them. */
 #define GI_LAYOUT_REVISION 1u
-#define GI_ABI_LAYOUT                                                                                                 \
-    {                                                                                                                 \
-        GI_LAYOUT_REVISION, sizeof(gi_host), sizeof(gi_view), sizeof(gi_target), sizeof(gi_changes),                 \
-            sizeof(gi_gpu_scene), sizeof(gi_gpu_material), sizeof(gi_gpu_light), sizeof(gi_gpu_emitter),              \
-            sizeof(gi_scene), sizeof(gi_object), sizeof(gi_material), sizeof(gi_light), sizeof(gi_camera),            \
-            sizeof(gi_vertex), sizeof(gi_param_desc), sizeof(gi_gbuffer), sizeof(gi_depth_view), sizeof(gi_depth_desc), \
-            sizeof(gi_depth_atlas_desc), sizeof(gi_kit)                                                               \
+#define GI_ABI_LAYOUT                                                                              \
+    {                                                                                              \
+        GI_LAYOUT_REVISION, sizeof(gi_host), sizeof(gi_view), sizeof(gi_target),                   \
+            sizeof(gi_changes), sizeof(gi_gpu_scene), sizeof(gi_gpu_material),                     \
+            sizeof(gi_gpu_light), sizeof(gi_gpu_emitter), sizeof(gi_scene), sizeof(gi_object),     \
+            sizeof(gi_material), sizeof(gi_light), sizeof(gi_camera), sizeof(gi_vertex),           \
+            sizeof(gi_param_desc), sizeof(gi_gbuffer), sizeof(gi_depth_view),                      \
+            sizeof(gi_depth_desc), sizeof(gi_depth_atlas_desc), sizeof(gi_kit)                     \
     }
 
 /* The descriptor and the exported entry point of a plugin whose lifecycle
@@ -127,22 +130,22 @@ const char *gi_kit_last_error(const gi_kit *k);
  *
  * It fills struct_size, abi_version and layout, and defines
  * gi_method_entry (NULL for a host of another ABI major). */
-#define GI_METHOD_EXPORT(prefix, ...)                                                                              \
-    static const gi_method prefix##_method = {.struct_size = sizeof(gi_method),                                   \
-                                              .abi_version = GI_ABI_VERSION,                                      \
-                                              .create = prefix##_create,                                          \
-                                              .prepare = prefix##_prepare,                                        \
-                                              .update = prefix##_update,                                          \
-                                              .render = prefix##_render,                                          \
-                                              .destroy = prefix##_destroy,                                        \
-                                              .last_error = prefix##_last_error,                                  \
-                                              .layout = GI_ABI_LAYOUT,                                            \
-                                              __VA_ARGS__};                                                       \
-    GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)                                          \
-    {                                                                                                              \
-        return GI_ABI_VERSION_MAJOR(host_abi_version) == GI_ABI_MAJOR ? &prefix##_method : NULL;                   \
-    }                                                                                                              \
-    /* the declaration again, so that the macro's use ends with a semicolon */                                    \
+#define GI_METHOD_EXPORT(prefix, ...)                                                              \
+    static const gi_method prefix##_method = {.struct_size = sizeof(gi_method),                    \
+                                              .abi_version = GI_ABI_VERSION,                       \
+                                              .create = prefix##_create,                           \
+                                              .prepare = prefix##_prepare,                         \
+                                              .update = prefix##_update,                           \
+                                              .render = prefix##_render,                           \
+                                              .destroy = prefix##_destroy,                         \
+                                              .last_error = prefix##_last_error,                   \
+                                              .layout = GI_ABI_LAYOUT,                             \
+                                              __VA_ARGS__};                                        \
+    GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)                          \
+    {                                                                                              \
+        return GI_ABI_VERSION_MAJOR(host_abi_version) == GI_ABI_MAJOR ? &prefix##_method : NULL;   \
+    }                                                                                              \
+    /* the declaration again, so that the macro's use ends with a semicolon */                     \
     GI_EXPORT const gi_method *gi_method_entry(uint32_t host_abi_version)
 
 /* GI_OK when `plugin` (a descriptor's layout) equals the core's; else

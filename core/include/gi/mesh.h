@@ -26,13 +26,13 @@ void gi_mesh_object_sphere(const gi_scene *s, uint32_t object, float out[4]);
  * per object; normals averaged. */
 typedef struct gi_welded {
     uint32_t vertex_count;
-    float *positions;        /* 3 per welded vertex, object-local */
-    float *normals;          /* 3 per welded vertex, unit */
-    uint32_t *object;        /* object of each welded vertex */
-    uint32_t *remap;         /* scene vertex -> welded vertex */
-    uint32_t *tri_offsets;   /* vertex_count + 1 offsets into tri_list */
-    uint32_t *tri_list;      /* triangles around each welded vertex */
-    float *areas;            /* a third of the adjacent triangles' areas (local space) */
+    float *positions;      /* 3 per welded vertex, object-local */
+    float *normals;        /* 3 per welded vertex, unit */
+    uint32_t *object;      /* object of each welded vertex */
+    uint32_t *remap;       /* scene vertex -> welded vertex */
+    uint32_t *tri_offsets; /* vertex_count + 1 offsets into tri_list */
+    uint32_t *tri_list;    /* triangles around each welded vertex */
+    float *areas;          /* a third of the adjacent triangles' areas (local space) */
 } gi_welded;
 
 gi_welded *gi_mesh_weld(const gi_scene *s, float eps);

@@ -64,20 +64,20 @@ extern "C" {
 /* What a method can do. The harness runs a method only on scenes and
  * settings its caps cover, and marks other cells "n/a" with the reason. */
 typedef enum gi_caps {
-    GI_CAP_DIRECT = 1u << 0,         /* direct light */
-    GI_CAP_INDIRECT = 1u << 1,       /* at least one indirect (diffuse) bounce */
-    GI_CAP_GLOSSY = 1u << 2,         /* glossy final bounce (Phong lobe) */
-    GI_CAP_MIRROR = 1u << 3,         /* ideal mirrors */
-    GI_CAP_AREA_LIGHTS = 1u << 4,    /* emissive triangles */
-    GI_CAP_POINT_LIGHTS = 1u << 5,   /* KHR_lights_punctual point and spot */
-    GI_CAP_DIRECTIONAL = 1u << 6,    /* KHR_lights_punctual directional */
-    GI_CAP_ENVIRONMENT = 1u << 7,    /* environment map */
-    GI_CAP_RIGID_MOTION = 1u << 8,   /* objects move between frames */
-    GI_CAP_DEFORMATION = 1u << 9,    /* vertices change between frames */
-    GI_CAP_PROGRESSIVE = 1u << 10,   /* converges over frames of a still view */
-    GI_CAP_PRECOMPUTE = 1u << 11,    /* prepare() does real precomputation */
-    GI_CAP_VISIBILITY = 1u << 12,    /* direct light is shadowed */
-    GI_CAP_TEXTURES = 1u << 13,      /* albedo textures */
+    GI_CAP_DIRECT = 1u << 0,       /* direct light */
+    GI_CAP_INDIRECT = 1u << 1,     /* at least one indirect (diffuse) bounce */
+    GI_CAP_GLOSSY = 1u << 2,       /* glossy final bounce (Phong lobe) */
+    GI_CAP_MIRROR = 1u << 3,       /* ideal mirrors */
+    GI_CAP_AREA_LIGHTS = 1u << 4,  /* emissive triangles */
+    GI_CAP_POINT_LIGHTS = 1u << 5, /* KHR_lights_punctual point and spot */
+    GI_CAP_DIRECTIONAL = 1u << 6,  /* KHR_lights_punctual directional */
+    GI_CAP_ENVIRONMENT = 1u << 7,  /* environment map */
+    GI_CAP_RIGID_MOTION = 1u << 8, /* objects move between frames */
+    GI_CAP_DEFORMATION = 1u << 9,  /* vertices change between frames */
+    GI_CAP_PROGRESSIVE = 1u << 10, /* converges over frames of a still view */
+    GI_CAP_PRECOMPUTE = 1u << 11,  /* prepare() does real precomputation */
+    GI_CAP_VISIBILITY = 1u << 12,  /* direct light is shadowed */
+    GI_CAP_TEXTURES = 1u << 13,    /* albedo textures */
 } gi_caps;
 
 /* Which scene things changed since the last frame (gi_changes.flags). */
@@ -86,36 +86,38 @@ enum {
     GI_CHANGED_LIGHTS = 1u << 1,     /* light placement or power */
     GI_CHANGED_MATERIALS = 1u << 2,
     GI_CHANGED_CAMERA = 1u << 3,
-    GI_CHANGED_VERTICES = 1u << 4,   /* vertex positions/normals (deformation: morph targets at the new
-                                        time, or gi_gpu_scene_update_vertices); needs GI_CAP_DEFORMATION */
+    GI_CHANGED_VERTICES =
+        1u << 4, /* vertex positions/normals (deformation: morph targets at the new
+                    time, or gi_gpu_scene_update_vertices); needs GI_CAP_DEFORMATION */
 };
 
 typedef struct gi_changes {
     uint32_t flags;
-    float time;                     /* the scene time now in effect */
-    uint64_t moved_objects;         /* bit k: object k moved (objects >= 64: see flags) */
+    float time;             /* the scene time now in effect */
+    uint64_t moved_objects; /* bit k: object k moved (objects >= 64: see flags) */
 } gi_changes;
 
 /* One frame to render. Matrices column-major (vecmath.h). */
 typedef struct gi_view {
     uint32_t width, height;
-    float view[16];          /* world -> eye */
-    float proj[16];          /* eye -> clip, GL convention */
+    float view[16]; /* world -> eye */
+    float proj[16]; /* eye -> clip, GL convention */
     float view_proj[16];
     float inv_view_proj[16];
     gi_vec3 eye;
     float yfov, znear, zfar;
-    float time;              /* scene time of this frame, seconds */
-    uint32_t frame_index;    /* frames since the last reset of accumulation */
-    uint32_t seed;           /* per-run seed; frame randomness derives from it */
-    float exposure;          /* display exposure (stops) the report will use */
+    float time;           /* scene time of this frame, seconds */
+    uint32_t frame_index; /* frames since the last reset of accumulation */
+    uint32_t seed;        /* per-run seed; frame randomness derives from it */
+    float exposure;       /* display exposure (stops) the report will use */
 } gi_view;
 
 /* For hosts: the view of camera frame cf on a width x height image at scene
  * time t (view, perspective projection with aspect width / height, their
  * product and its inverse, eye, yfov, znear, zfar); frame_index, seed and
  * exposure are 0, for the caller to set. */
-void gi_view_from_camera(const gi_camera_frame *cf, uint32_t width, uint32_t height, float t, gi_view *v);
+void gi_view_from_camera(const gi_camera_frame *cf, uint32_t width, uint32_t height, float t,
+                         gi_view *v);
 
 /* Where render() writes: linear RGB radiance (alpha ignored) into an
  * RGBA32F 2D texture of view->width x view->height owned by the host.
@@ -193,16 +195,15 @@ struct gi_abi_layout {
     uint32_t gbuffer, depth_view, depth_desc, depth_atlas_desc, kit;
 };
 
-
 typedef struct gi_method {
-    uint32_t struct_size;  /* sizeof(gi_method) the plugin was built with */
-    uint32_t abi_version;  /* GI_ABI_VERSION the plugin was built with */
-    const char *id;        /* short unique name: [a-z0-9_]+, e.g. "csm" */
-    const char *title;     /* "Coherent Shadow Maps" */
-    const char *citation;  /* "Ritschel, Grosch, Kautz, Mueller. EGSR 2007" */
-    const char *version;   /* the plugin's own version string */
-    uint32_t caps;         /* gi_caps */
-    uint32_t max_bounces;  /* indirect bounces it can compute (0 = direct only) */
+    uint32_t struct_size;        /* sizeof(gi_method) the plugin was built with */
+    uint32_t abi_version;        /* GI_ABI_VERSION the plugin was built with */
+    const char *id;              /* short unique name: [a-z0-9_]+, e.g. "csm" */
+    const char *title;           /* "Coherent Shadow Maps" */
+    const char *citation;        /* "Ritschel, Grosch, Kautz, Mueller. EGSR 2007" */
+    const char *version;         /* the plugin's own version string */
+    uint32_t caps;               /* gi_caps */
+    uint32_t max_bounces;        /* indirect bounces it can compute (0 = direct only) */
     const gi_param_desc *params; /* terminated by an entry with name NULL */
 
     gi_result (*create)(const gi_host *host, const gi_params *params, void **instance);
@@ -217,8 +218,6 @@ typedef struct gi_method {
 } gi_method;
 
 typedef const gi_method *(*gi_method_entry_fn)(uint32_t host_abi_version);
-
-
 
 /* The one symbol a plugin defines and exports (declared here so that the
  * definition is checked against it). */

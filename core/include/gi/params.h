@@ -28,7 +28,7 @@ typedef enum gi_param_type {
 } gi_param_type;
 
 typedef struct gi_param_desc {
-    const char *name;    /* [a-z0-9_]+, e.g. "N", "vpls", "filter" */
+    const char *name; /* [a-z0-9_]+, e.g. "N", "vpls", "filter" */
     gi_param_type type;
     double def;          /* default (enum: index into choices) */
     double min, max;     /* inclusive range (int, float) */
@@ -43,9 +43,9 @@ typedef struct gi_param_desc {
 typedef struct gi_params {
     const gi_param_desc *desc; /* the method's table */
     uint32_t count;
-    double *values;            /* count values, desc order */
-    uint32_t *given;           /* 1 where set explicitly */
-    char *undeclared;          /* the first name read that desc does not declare; "" when none */
+    double *values;   /* count values, desc order */
+    uint32_t *given;  /* 1 where set explicitly */
+    char *undeclared; /* the first name read that desc does not declare; "" when none */
 } gi_params;
 
 /* Fills defaults and applies each "name=value" in kv[0..n). `method_id`

@@ -96,10 +96,10 @@ typedef enum gi_depth_metric {
 /* One depth map to render. (Desc structs here follow the zero-means-default
  * rule: a field left 0 asks for the default the comment names.) */
 typedef struct gi_depth_view {
-    float view[16];         /* world (or object-local, see `local`) -> eye */
-    float proj[16];         /* ignored for paraboloid */
+    float view[16]; /* world (or object-local, see `local`) -> eye */
+    float proj[16]; /* ignored for paraboloid */
     gi_projection projection;
-    float znear, zfar;      /* paraboloid clip range (radial) */
+    float znear, zfar; /* paraboloid clip range (radial) */
 } gi_depth_view;
 
 typedef struct gi_depth_desc {
@@ -110,8 +110,9 @@ typedef struct gi_depth_desc {
     int local;              /* 1: ignore object transforms (object-local maps); 0 = world */
     int cull;               /* 0 none, 1 back faces, 2 front faces */
     uint32_t skip_object;   /* 0 = none; k + 1 = every object but k (with only_object 0) */
-    const unsigned char *skip_objects; /* NULL = none; per object, 1: not drawn (with only_object 0);
-                                          read while the renderer draws, so it must outlive it */
+    const unsigned char
+        *skip_objects; /* NULL = none; per object, 1: not drawn (with only_object 0);
+                          read while the renderer draws, so it must outlive it */
 } gi_depth_desc;
 
 typedef struct gi_depth_renderer gi_depth_renderer;
@@ -153,14 +154,15 @@ void gi_depth_atlas_free(gi_depth_atlas *a);
  * projection differs from the atlas', or (paraboloid) a view without
  * 0 <= znear < zfar is GI_ERR_INVALID_ARGUMENT and draws nothing.
  * Leaves the views SSBO bound at GI_SSBO_DEPTH_ATLAS. */
-gi_result gi_depth_atlas_render(gi_depth_atlas *a, const gi_gpu_scene *gs, const gi_depth_view *views,
-                                uint32_t count, gi_error *err);
+gi_result gi_depth_atlas_render(gi_depth_atlas *a, const gi_gpu_scene *gs,
+                                const gi_depth_view *views, uint32_t count, gi_error *err);
 /* Draws the `triangle_count` triangles of index buffer `ibo` (indices into
  * the scene's vertices, e.g. a lower-detail copy, gi/algo/simplify.h) in
  * the renders that follow, through gi_gpu_scene_draw_indices; ibo 0 = the
  * scene's own triangles. The caller keeps the buffer alive while it is set. */
 void gi_depth_atlas_set_geometry(gi_depth_atlas *a, GLuint ibo, uint32_t triangle_count);
-GLuint gi_depth_atlas_texture(const gi_depth_atlas *a);      /* R32F, linear depth, FLT_MAX where empty */
+GLuint
+gi_depth_atlas_texture(const gi_depth_atlas *a); /* R32F, linear depth, FLT_MAX where empty */
 GLuint gi_depth_atlas_views_buffer(const gi_depth_atlas *a); /* SSBO read by depth_atlas.glsl */
 uint32_t gi_depth_atlas_columns(const gi_depth_atlas *a);
 uint32_t gi_depth_atlas_rows(const gi_depth_atlas *a);

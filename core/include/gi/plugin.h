@@ -49,8 +49,8 @@ gi_result gi_method_validate(const gi_method *m, gi_error *err);
  * parameter, in every build type. Any other failure is create()'s result,
  * with "create failed (<result>)" in err (the plugin's own message went to
  * host->log). On failure *instance is NULL. */
-gi_result gi_method_create(const gi_method *m, const gi_host *host, const gi_params *params, void **instance,
-                           gi_error *err);
+gi_result gi_method_create(const gi_method *m, const gi_host *host, const gi_params *params,
+                           void **instance, gi_error *err);
 
 #ifdef __cplusplus
 }

@@ -61,12 +61,12 @@ typedef struct gi_vertex {
 
 typedef struct gi_material {
     char *name;
-    float albedo[3];      /* Lambert reflectance, multiplied by the texture */
-    int albedo_texture;   /* index into gi_scene.textures, -1 if none */
-    float ks[3];          /* Phong lobe reflectance */
-    float exponent;       /* Phong exponent n (0 when ks is 0) */
-    int mirror;           /* ideal specular reflection with reflectance ks */
-    float emission[3];    /* emitted radiance; non-zero makes triangles area lights */
+    float albedo[3];    /* Lambert reflectance, multiplied by the texture */
+    int albedo_texture; /* index into gi_scene.textures, -1 if none */
+    float ks[3];        /* Phong lobe reflectance */
+    float exponent;     /* Phong exponent n (0 when ks is 0) */
+    int mirror;         /* ideal specular reflection with reflectance ks */
+    float emission[3];  /* emitted radiance; non-zero makes triangles area lights */
     int double_sided;
 } gi_material;
 
@@ -108,9 +108,9 @@ typedef struct gi_object {
      * LINEAR or STEP). See gi_scene_object_vertices. */
     uint32_t morph_count;
     float *morph_positions; /* morph_count x vertex_count x 3, object-local displacements */
-    float *morph_normals;   /* same layout; NULL when no target has NORMAL (normals not displaced) */
-    float *morph_weights;   /* morph_count default weights */
-    gi_track morph_track;   /* count 0 when the weights are not animated */
+    float *morph_normals; /* same layout; NULL when no target has NORMAL (normals not displaced) */
+    float *morph_weights; /* morph_count default weights */
+    gi_track morph_track; /* count 0 when the weights are not animated */
 } gi_object;
 
 typedef enum gi_light_type {
@@ -124,8 +124,8 @@ typedef struct gi_light {
     char *name;
     gi_light_type type;
     int node;
-    float intensity[3];  /* colour x intensity: W/sr (point, spot) or W/m^2 (directional) */
-    float range;         /* 0 = infinite */
+    float intensity[3]; /* colour x intensity: W/sr (point, spot) or W/m^2 (directional) */
+    float range;        /* 0 = infinite */
     float inner_cone, outer_cone; /* spot half-angles in radians */
 } gi_light;
 
@@ -139,8 +139,8 @@ typedef struct gi_light_frame {
 typedef struct gi_camera {
     char *name;
     int node;
-    float yfov;   /* radians */
-    float aspect; /* 0 when the file leaves it to the viewport */
+    float yfov;        /* radians */
+    float aspect;      /* 0 when the file leaves it to the viewport */
     float znear, zfar; /* zfar 0 = infinite in glTF; we substitute a bound-based far plane */
 } gi_camera;
 
@@ -152,8 +152,8 @@ typedef struct gi_camera_frame {
 } gi_camera_frame;
 
 typedef struct gi_environment {
-    char *uri;   /* as written in the file, relative to the scene */
-    char *path;  /* resolved path */
+    char *uri;  /* as written in the file, relative to the scene */
+    char *path; /* resolved path */
     float intensity;
     float rotation_deg;
 } gi_environment;

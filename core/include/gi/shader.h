@@ -54,8 +54,8 @@ GLuint gi_program_build_compute(const char *comp, const char *defines, gi_error 
 GLuint gi_program_build_compute_text(const char *label, const char *text, const char *defines,
                                      gi_error *err);
 /* A vertex + fragment program from literal text (without #version). */
-GLuint gi_program_build_text(const char *label, const char *vert_text, const char *frag_text, const char *defines,
-                             gi_error *err);
+GLuint gi_program_build_text(const char *label, const char *vert_text, const char *frag_text,
+                             const char *defines, gi_error *err);
 
 #ifdef __cplusplus
 }

@@ -19,11 +19,12 @@
 #define AVG_TEX_INDIRECT 14
 
 /* SSBOs. */
-#define AVG_SSBO_SLOTS 8       /* avg_trace.comp: one VPL per slot */
-#define AVG_SSBO_VPLS 9        /* avg_shade.comp: the compacted live VPLs */
+#define AVG_SSBO_SLOTS 8        /* avg_trace.comp: one VPL per slot */
+#define AVG_SSBO_VPLS 9         /* avg_shade.comp: the compacted live VPLs */
 #define AVG_SSBO_ATLAS_VIEWS 10 /* avg_shade.comp: the atlas' views (depth_atlas.glsl) */
-#define AVG_SSBO_COLOURS 8     /* avg_vox.geom, avg_vox1.geom: per-material voxel colour */
-#define AVG_SSBO_VOX_SUMS 9    /* avg_vox1.frag, avg_vox_resolve.comp: fixed-point sums, 8 ints a voxel */
+#define AVG_SSBO_COLOURS 8      /* avg_vox.geom, avg_vox1.geom: per-material voxel colour */
+#define AVG_SSBO_VOX_SUMS                                                                          \
+    9 /* avg_vox1.frag, avg_vox_resolve.comp: fixed-point sums, 8 ints a voxel */
 
 /* Fixed-point unit of the single-pass voxeliser's sums: a normal component
  * or colour channel c is added as round(c x AVG_VOX_FIXED), so a sum is

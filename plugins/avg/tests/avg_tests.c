@@ -251,7 +251,8 @@ static int tri_box_clip(const gi_vec3 p[3], gi_vec3 lo, gi_vec3 hi)
 /* CPU counts of triangles overlapping each voxel, boxes grown by `grow`;
  * with `colour`, also the sum of the overlapping triangles' material
  * albedos (the test scenes have no textures). */
-static uint32_t *cpu_voxelise(const gi_scene *s, float t, const avg_grid *g, float grow, float *colour)
+static uint32_t *cpu_voxelise(const gi_scene *s, float t, const avg_grid *g, float grow,
+                              float *colour)
 {
     uint32_t n = g->n;
     uint32_t *count = calloc((size_t)n * n * n, sizeof *count);
@@ -278,13 +279,16 @@ static uint32_t *cpu_voxelise(const gi_scene *s, float t, const avg_grid *g, flo
             for (int y = i0[1]; y <= i1[1]; y++)
                 for (int x = i0[0]; x <= i1[0]; x++) {
                     gi_vec3 blo = gi_v3((float)x - grow, (float)y - grow, (float)z - grow);
-                    gi_vec3 bhi = gi_v3((float)x + 1 + grow, (float)y + 1 + grow, (float)z + 1 + grow);
+                    gi_vec3 bhi =
+                        gi_v3((float)x + 1 + grow, (float)y + 1 + grow, (float)z + 1 + grow);
                     if (tri_box_clip(p, blo, bhi)) {
                         size_t v = ((size_t)z * n + y) * n + x;
                         count[v]++;
                         if (colour)
                             for (int c = 0; c < 3; c++)
-                                colour[3 * v + c] += s->materials[s->vertices[s->indices[3 * tri]].material].albedo[c];
+                                colour[3 * v + c] +=
+                                    s->materials[s->vertices[s->indices[3 * tri]].material]
+                                        .albedo[c];
                     }
                 }
     }
@@ -313,7 +317,8 @@ static void voxel_case(gi_gpu *gpu, const char *scene_path, const float *ts, int
         gi_gpu_scene_set_time(gs, t);
         avg_grid_place(g, gs->bounds);
         float *colour = calloc((size_t)n * n * n * 3, sizeof *colour);
-        uint32_t *inner = cpu_voxelise(s, t, g, -1e-3f, NULL), *exact = cpu_voxelise(s, t, g, 0.0f, colour),
+        uint32_t *inner = cpu_voxelise(s, t, g, -1e-3f, NULL),
+                 *exact = cpu_voxelise(s, t, g, 0.0f, colour),
                  *outer = cpu_voxelise(s, t, g, 1e-3f, NULL);
         size_t total = (size_t)n * n * n, filled_cpu = 0;
         for (size_t i = 0; i < total; i++)
@@ -341,16 +346,22 @@ static void voxel_case(gi_gpu *gpu, const char *scene_path, const float *ts, int
                         if (fabsf(col[4 * i + k] - colour[3 * i + k]) > 1e-4f * (1.0f + c))
                             colour_bad++;
             }
-            printf("voxel %s t=%.2f n=%u %-12s: %zu filled (CPU %zu), %zu missed, %zu false positives (%.3f %%), "
-                   "triangle count different from the CPU's in %zu of %zu voxels (%zu voxels with a triangle within "
+            printf("voxel %s t=%.2f n=%u %-12s: %zu filled (CPU %zu), %zu missed, %zu false "
+                   "positives (%.3f %%), "
+                   "triangle count different from the CPU's in %zu of %zu voxels (%zu voxels with "
+                   "a triangle within "
                    "1e-3 of a face, counted either way)\n",
-                   strrchr(scene_path, '/') + 1, t, n, mode_names[mode], filled, filled_cpu, misses, fp,
-                   100.0 * (double)fp / (double)(filled ? filled : 1), total - count_equal, total, ambiguous);
+                   strrchr(scene_path, '/') + 1, t, n, mode_names[mode], filled, filled_cpu, misses,
+                   fp, 100.0 * (double)fp / (double)(filled ? filled : 1), total - count_equal,
+                   total, ambiguous);
             EXPECT(colour_bad == 0, "%zu voxels with different counts or colour sums", colour_bad);
             if (mode != AVG_VOX_PAPER) {
-                EXPECT(misses == 0, "%s voxeliser missed %zu overlapped voxels", mode_names[mode], misses);
-                EXPECT(fp == 0, "%s voxeliser filled %zu voxels no triangle overlaps", mode_names[mode], fp);
-                EXPECT(count_equal == total, "triangle counts differ in %zu voxels", total - count_equal);
+                EXPECT(misses == 0, "%s voxeliser missed %zu overlapped voxels", mode_names[mode],
+                       misses);
+                EXPECT(fp == 0, "%s voxeliser filled %zu voxels no triangle overlaps",
+                       mode_names[mode], fp);
+                EXPECT(count_equal == total, "triangle counts differ in %zu voxels",
+                       total - count_equal);
             }
             if (mode == AVG_VOX_SINGLE && slices_nrm) {
                 /* The single pass against the per-slice conservative pass:
@@ -370,17 +381,21 @@ static void voxel_case(gi_gpu *gpu, const char *scene_path, const float *ts, int
                         sum_bad += dn > bound || dc > bound;
                     }
                 }
-                printf("voxel %s t=%.2f n=%u single vs conservative: counts differ in %zu of %zu voxels, largest sum "
+                printf("voxel %s t=%.2f n=%u single vs conservative: counts differ in %zu of %zu "
+                       "voxels, largest sum "
                        "difference %.3g (bound per voxel count / %.0f)\n",
-                       strrchr(scene_path, '/') + 1, t, n, count_diff, total, worst, 2.0 * AVG_VOX_FIXED);
-                EXPECT(count_diff == 0, "single-pass counts differ from the per-slice ones in %zu voxels",
+                       strrchr(scene_path, '/') + 1, t, n, count_diff, total, worst,
+                       2.0 * AVG_VOX_FIXED);
+                EXPECT(count_diff == 0,
+                       "single-pass counts differ from the per-slice ones in %zu voxels",
                        count_diff);
                 EXPECT(sum_bad == 0, "%zu sums beyond the fixed-point bound", sum_bad);
             }
             if (mode == AVG_VOX_PAPER) {
                 /* The paper's voxeliser is not conservative at partly covered
                  * voxels; it must still fill most of the surface voxels. */
-                EXPECT(misses * 10 < filled_cpu, "paper voxeliser missed %zu of %zu voxels", misses, filled_cpu);
+                EXPECT(misses * 10 < filled_cpu, "paper voxeliser missed %zu of %zu voxels", misses,
+                       filled_cpu);
             }
             if (mode == AVG_VOX_CONSERVATIVE) {
                 slices_nrm = nrm;
@@ -406,7 +421,8 @@ static void voxel_case(gi_gpu *gpu, const char *scene_path, const float *ts, int
 static void deform_case(gi_gpu *gpu)
 {
     static const float ts[] = {0.0f, 1.0f, 2.0f, 2.5f, 3.0f, 0.0f};
-    voxel_case(gpu, GI_SOURCE_DIR "/scenes/cornell_deform.gltf", ts, (int)(sizeof ts / sizeof ts[0]), 32);
+    voxel_case(gpu, GI_SOURCE_DIR "/scenes/cornell_deform.gltf", ts,
+               (int)(sizeof ts / sizeof ts[0]), 32);
     /* The poses differ in the grid (else the comparison above says nothing):
      * the CPU voxelisations at t = 0 and t = 2 differ in many voxels. */
     gi_error err;
@@ -473,21 +489,22 @@ static float scene_distance(const gi_scene *s, gi_vec3 p)
     return best;
 }
 
-static const char *march_src = "#define AVG_UNIT_NORMAL 8\n"
-                               "#define AVG_UNIT_COLOUR 9\n"
-                               "#include \"avg_grid.glsl\"\n"
-                               "layout(local_size_x = 64) in;\n"
-                               "layout(std430, binding = 8) readonly buffer Rays { vec4 rays[]; };\n"
-                               "layout(std430, binding = 9) writeonly buffer Hits { vec4 hits[]; };\n"
-                               "uniform uint u_count;\n"
-                               "void main() {\n"
-                               "  uint i = gl_GlobalInvocationID.x;\n"
-                               "  if (i >= u_count) return;\n"
-                               "  vec3 o = avg_to_grid(rays[2u * i].xyz), d = rays[2u * i + 1u].xyz;\n"
-                               "  ivec3 c; float t0, t1;\n"
-                               "  if (avg_march(o, d, c, t0, t1)) hits[i] = vec4(vec3(c), t0 * u_grid_h);\n"
-                               "  else hits[i] = vec4(-1.0);\n"
-                               "}\n";
+static const char *march_src =
+    "#define AVG_UNIT_NORMAL 8\n"
+    "#define AVG_UNIT_COLOUR 9\n"
+    "#include \"avg_grid.glsl\"\n"
+    "layout(local_size_x = 64) in;\n"
+    "layout(std430, binding = 8) readonly buffer Rays { vec4 rays[]; };\n"
+    "layout(std430, binding = 9) writeonly buffer Hits { vec4 hits[]; };\n"
+    "uniform uint u_count;\n"
+    "void main() {\n"
+    "  uint i = gl_GlobalInvocationID.x;\n"
+    "  if (i >= u_count) return;\n"
+    "  vec3 o = avg_to_grid(rays[2u * i].xyz), d = rays[2u * i + 1u].xyz;\n"
+    "  ivec3 c; float t0, t1;\n"
+    "  if (avg_march(o, d, c, t0, t1)) hits[i] = vec4(vec3(c), t0 * u_grid_h);\n"
+    "  else hits[i] = vec4(-1.0);\n"
+    "}\n";
 
 static void march_case(gi_gpu *gpu, const char *scene_path, uint32_t n, uint32_t rays)
 {
@@ -514,13 +531,17 @@ static void march_case(gi_gpu *gpu, const char *scene_path, uint32_t n, uint32_t
     while (made < rays) {
         gi_vec3 o;
         for (int a = 0; a < 3; a++)
-            (&o.x)[a] = gs->bounds[a] + (gs->bounds[3 + a] - gs->bounds[a]) * gi_rng_next_float(&rng);
-        int cx = (int)floorf((o.x - g->origin[0]) / g->h), cy = (int)floorf((o.y - g->origin[1]) / g->h),
+            (&o.x)[a] =
+                gs->bounds[a] + (gs->bounds[3 + a] - gs->bounds[a]) * gi_rng_next_float(&rng);
+        int cx = (int)floorf((o.x - g->origin[0]) / g->h),
+            cy = (int)floorf((o.y - g->origin[1]) / g->h),
             cz = (int)floorf((o.z - g->origin[2]) / g->h), free_space = 1;
         for (int dz = -1; dz <= 1; dz++)
             for (int dy = -1; dy <= 1; dy++)
                 for (int dx = -1; dx <= 1; dx++)
-                    free_space &= grid[4 * (((size_t)(cz + dz) * n + (size_t)(cy + dy)) * n + (size_t)(cx + dx)) + 3] == 0.0f;
+                    free_space &= grid[4 * (((size_t)(cz + dz) * n + (size_t)(cy + dy)) * n +
+                                            (size_t)(cx + dx)) +
+                                       3] == 0.0f;
         if (!free_space)
             continue;
         gi_vec3 d = gi_sample_uniform_sphere(gi_rng_next_float(&rng), gi_rng_next_float(&rng));
@@ -532,7 +553,8 @@ static void march_case(gi_gpu *gpu, const char *scene_path, uint32_t n, uint32_t
     GLuint buf[2];
     glCreateBuffers(2, buf);
     glNamedBufferStorage(buf[0], (GLsizeiptr)(rays * 8 * sizeof(float)), ray, 0);
-    glNamedBufferStorage(buf[1], (GLsizeiptr)(rays * 4 * sizeof(float)), NULL, GL_DYNAMIC_STORAGE_BIT);
+    glNamedBufferStorage(buf[1], (GLsizeiptr)(rays * 4 * sizeof(float)), NULL,
+                         GL_DYNAMIC_STORAGE_BIT);
     glUseProgram(prog);
     avg_grid_bind(g, prog, 8, 9);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, buf[0]);
@@ -543,22 +565,27 @@ static void march_case(gi_gpu *gpu, const char *scene_path, uint32_t n, uint32_t
     float *hit = malloc((size_t)rays * 4 * sizeof *hit);
     glGetNamedBufferSubData(buf[1], 0, (GLsizeiptr)(rays * 4 * sizeof(float)), hit);
 
-    uint32_t both = 0, near = 0, avg_only = 0, embree_only = 0, neither = 0, late = 0, steep = 0, steep_near = 0, phantom = 0;
+    uint32_t both = 0, near = 0, avg_only = 0, embree_only = 0, neither = 0, late = 0, steep = 0,
+             steep_near = 0, phantom = 0;
     for (uint32_t i = 0; i < rays; i++) {
         const float *r = &ray[8 * (size_t)i];
         gi_rt_hit h;
-        int eh = gi_rt_intersect(rt, gi_v3(r[0], r[1], r[2]), gi_v3(r[4], r[5], r[6]), 0.0f, INFINITY, &h);
+        int eh = gi_rt_intersect(rt, gi_v3(r[0], r[1], r[2]), gi_v3(r[4], r[5], r[6]), 0.0f,
+                                 INFINITY, &h);
         int ah = hit[4 * i + 3] >= 0.0f;
         if (ah) {
             /* The grid never stops a ray in empty space: some surface lies
              * within two voxel diagonals of where the ray enters the hit voxel. */
-            gi_vec3 p = gi_v3(r[0] + r[4] * hit[4 * i + 3], r[1] + r[5] * hit[4 * i + 3], r[2] + r[6] * hit[4 * i + 3]);
+            gi_vec3 p = gi_v3(r[0] + r[4] * hit[4 * i + 3], r[1] + r[5] * hit[4 * i + 3],
+                              r[2] + r[6] * hit[4 * i + 3]);
             int near_surface = 0;
             for (int k = 0; k < 27 && !near_surface; k++) {
-                gi_vec3 dir = gi_v3((float)(k % 3) - 1.0f, (float)(k / 3 % 3) - 1.0f, (float)(k / 9) - 1.0f);
+                gi_vec3 dir =
+                    gi_v3((float)(k % 3) - 1.0f, (float)(k / 3 % 3) - 1.0f, (float)(k / 9) - 1.0f);
                 if (k == 13)
                     continue;
-                near_surface = gi_rt_occluded(rt, p, gi_v3_normalize(dir), 0.0f, 2.0f * sqrtf(3.0f) * g->h);
+                near_surface =
+                    gi_rt_occluded(rt, p, gi_v3_normalize(dir), 0.0f, 2.0f * sqrtf(3.0f) * g->h);
             }
             if (!near_surface) /* probes can pass beside an edge: measure exactly */
                 near_surface = scene_distance(s, p) <= 2.0f * sqrtf(3.0f) * g->h;
@@ -592,15 +619,19 @@ static void march_case(gi_gpu *gpu, const char *scene_path, uint32_t n, uint32_t
             neither++;
         }
     }
-    printf("march %s n=%u: %u rays: %u hit both (%u = %.2f %% within one voxel; of the %u not grazing (> 15 deg), "
-           "%.2f %%; %u entered late), %u AVG only, %u Embree only (leaks), %u neither; %u AVG hits far from any surface\n",
-           strrchr(scene_path, '/') + 1, n, rays, both, near, 100.0 * near / (both ? both : 1), steep,
-           100.0 * steep_near / (steep ? steep : 1), late, avg_only, embree_only, neither, phantom);
-    EXPECT(embree_only == 0, "%u rays went through the AVG where Embree hits a surface", embree_only);
+    printf("march %s n=%u: %u rays: %u hit both (%u = %.2f %% within one voxel; of the %u not "
+           "grazing (> 15 deg), "
+           "%.2f %%; %u entered late), %u AVG only, %u Embree only (leaks), %u neither; %u AVG "
+           "hits far from any surface\n",
+           strrchr(scene_path, '/') + 1, n, rays, both, near, 100.0 * near / (both ? both : 1),
+           steep, 100.0 * steep_near / (steep ? steep : 1), late, avg_only, embree_only, neither,
+           phantom);
+    EXPECT(embree_only == 0, "%u rays went through the AVG where Embree hits a surface",
+           embree_only);
     /* The rest of the non-grazing hits are rays passing within a voxel of an
      * edge, caught by its conservative voxels (counted, not failed). */
-    EXPECT(steep_near >= steep - steep / 10, "only %u of %u non-grazing hits within one voxel of the real hit",
-           steep_near, steep);
+    EXPECT(steep_near >= steep - steep / 10,
+           "only %u of %u non-grazing hits within one voxel of the real hit", steep_near, steep);
     EXPECT(phantom == 0, "%u AVG hits with no surface within two voxel diagonals", phantom);
     EXPECT(late == 0, "%u AVG hits lie more than a voxel diagonal behind the real surface", late);
     EXPECT(both > rays / 2, "too few hits (%u) for the test to mean anything", both);
@@ -640,9 +671,10 @@ static void vpls_case(gi_gpu *gpu)
     memcpy(first, a->cpu_slots, bytes);
     uint32_t live = a->vpl_count;
     EXPECT(render(a, &v, &t), "frame 2");
-    EXPECT(memcmp(first, a->cpu_slots, bytes) == 0, "the VPL slots differ between two frames of a still scene");
-    EXPECT(a->vpl_count == live && live > a->paths, "live VPLs %u then %u (paths %u)", live, a->vpl_count,
-           a->paths);
+    EXPECT(memcmp(first, a->cpu_slots, bytes) == 0,
+           "the VPL slots differ between two frames of a still scene");
+    EXPECT(a->vpl_count == live && live > a->paths, "live VPLs %u then %u (paths %u)", live,
+           a->vpl_count, a->paths);
     /* The bunny moves: the VPLs that hit it move too; back at t = 0 they return. */
     gi_gpu_scene_set_time(gs, 1.3f);
     gi_changes ch = {GI_CHANGED_TRANSFORMS, 1.3f, ~0ull};
@@ -654,7 +686,8 @@ static void vpls_case(gi_gpu *gpu)
     gi_gpu_scene_set_time(gs, 0.0f);
     make_view(s, 0.0f, 32, 32, &v);
     EXPECT(render(a, &v, &t), "frame back at t = 0");
-    EXPECT(memcmp(first, a->cpu_slots, bytes) == 0, "the VPLs at t = 0 differ after the scene moved and came back");
+    EXPECT(memcmp(first, a->cpu_slots, bytes) == 0,
+           "the VPLs at t = 0 differ after the scene moved and came back");
 
     /* AVG and exact tracing share the light VPLs (slot 0 of every path):
      * same light choice, same quasi-random numbers, same emitter records. */
@@ -666,7 +699,8 @@ static void vpls_case(gi_gpu *gpu)
         float dmax = 0.0f;
         for (int c = 0; c < 3; c++) {
             dmax = fmaxf(dmax, fabsf(va->position[c] - vx->position[c]));
-            dmax = fmaxf(dmax, fabsf(va->power[c] - vx->power[c]) / fmaxf(fabsf(vx->power[c]), 1e-6f) * 1e-2f);
+            dmax = fmaxf(dmax, fabsf(va->power[c] - vx->power[c]) /
+                                   fmaxf(fabsf(vx->power[c]), 1e-6f) * 1e-2f);
         }
         same += dmax < 1e-4f && va->kind == vx->kind;
         for (uint32_t k = 1; k < stride; k++) {
@@ -676,10 +710,13 @@ static void vpls_case(gi_gpu *gpu)
             pow_x += gi_luminance(x->cpu_slots[i * stride + k].power);
         }
     }
-    printf("vpls: %u slots, %u live; light VPLs equal in AVG and exact tracing: %u of %u; bounce VPLs %u (AVG) vs "
+    printf("vpls: %u slots, %u live; light VPLs equal in AVG and exact tracing: %u of %u; bounce "
+           "VPLs %u (AVG) vs "
            "%u (exact), their total power %.4g vs %.4g (%+.1f %%)\n",
-           a->slots, live, same, a->paths, hits_a, hits_x, pow_a, pow_x, 100.0 * (pow_a - pow_x) / pow_x);
-    EXPECT(same == a->paths, "only %u of %u light VPLs agree between AVG and exact tracing", same, a->paths);
+           a->slots, live, same, a->paths, hits_a, hits_x, pow_a, pow_x,
+           100.0 * (pow_a - pow_x) / pow_x);
+    EXPECT(same == a->paths, "only %u of %u light VPLs agree between AVG and exact tracing", same,
+           a->paths);
     EXPECT(fabs(pow_a - pow_x) < 0.25 * pow_x, "bounce VPL power differs by more than 25 %%");
     const gi_method *m = gi_method_entry(GI_ABI_VERSION);
     m->destroy(a);
@@ -742,8 +779,9 @@ static void shade_case(gi_gpu *gpu, int M, int filter)
             lit++;
         }
     }
-    printf("shade M=%d filter=%d: %u pixels, %u VPLs, largest relative difference to the CPU sum %.2e\n", M, filter,
-           lit, a->vpl_count, worst);
+    printf("shade M=%d filter=%d: %u pixels, %u VPLs, largest relative difference to the CPU sum "
+           "%.2e\n",
+           M, filter, lit, a->vpl_count, worst);
     EXPECT(lit > w * h / 2, "only %u pixels hit the scene", lit);
     EXPECT(worst < 1e-3, "GPU shading differs from the CPU sum by %.3g (relative)", worst);
     gi_image_free(img);
@@ -756,8 +794,8 @@ static void shade_case(gi_gpu *gpu, int M, int filter)
 
 /* The shadow-map test of avg_visibility.glsl on the CPU (same offsets and
  * biases as avg.c), given the atlas tiles read back: 1 visible, 0 shadowed. */
-static int map_visible(const avg *a, const float *tiles, uint32_t j, gi_vec3 x, gi_vec3 n, float bias_abs,
-                       float bias_rel)
+static int map_visible(const avg *a, const float *tiles, uint32_t j, gi_vec3 x, gi_vec3 n,
+                       float bias_abs, float bias_rel)
 {
     const gi_depth_atlas_desc *d = gi_depth_atlas_get_desc(a->atlas);
     uint32_t tx, ty;
@@ -796,7 +834,8 @@ static void visibility_case(gi_gpu *gpu, const char *scene, const char *projecti
     float *tiles = malloc((size_t)a->vpl_count * d->tile * d->tile * sizeof *tiles);
     for (uint32_t j = 0; j < a->vpl_count; j++) {
         float *tile = gi_depth_atlas_read_tile(a->atlas, j);
-        memcpy(tiles + (size_t)j * d->tile * d->tile, tile, (size_t)d->tile * d->tile * sizeof *tiles);
+        memcpy(tiles + (size_t)j * d->tile * d->tile, tile,
+               (size_t)d->tile * d->tile * sizeof *tiles);
         free(tile);
     }
     gbuffer_images gb = read_gbuffer(a, w, h);
@@ -807,7 +846,8 @@ static void visibility_case(gi_gpu *gpu, const char *scene, const char *projecti
     for (size_t i = 0; i < (size_t)w * h; i++) {
         if (pos->rgba[4 * i + 3] <= 0.0f)
             continue;
-        gi_vec3 x = gi_v3_load(&pos->rgba[4 * i]), n = gi_v3_normalize(gi_v3_load(&nrm->rgba[4 * i]));
+        gi_vec3 x = gi_v3_load(&pos->rgba[4 * i]),
+                n = gi_v3_normalize(gi_v3_load(&nrm->rgba[4 * i]));
         for (uint32_t j = 0; j < a->vpl_count; j++) {
             float c3[3];
             avg_vpl_contribution(&a->cpu_vpls[j], &pos->rgba[4 * i], &nrm->rgba[4 * i], 0.0f, c3);
@@ -817,8 +857,8 @@ static void visibility_case(gi_gpu *gpu, const char *scene, const char *projecti
             gi_vec3 dir = gi_v3_sub(y, x);
             float dist = gi_v3_length(dir);
             /* Ray from just off the receiver to just short of the VPL. */
-            int blocked = gi_rt_occluded(rt, gi_v3_add(x, gi_v3_scale(n, 1e-3f)), gi_v3_scale(dir, 1.0f / dist),
-                                         0.0f, dist - 1e-2f);
+            int blocked = gi_rt_occluded(rt, gi_v3_add(x, gi_v3_scale(n, 1e-3f)),
+                                         gi_v3_scale(dir, 1.0f / dist), 0.0f, dist - 1e-2f);
             int vis = map_visible(a, tiles, j, x, n, bias_abs, bias_rel);
             pairs++;
             agree += vis == !blocked;
@@ -827,15 +867,21 @@ static void visibility_case(gi_gpu *gpu, const char *scene, const char *projecti
             false_light += vis && blocked;
         }
     }
-    const char *used = gi_depth_atlas_get_desc(a->atlas)->projection == GI_PROJ_PARABOLOID ? "paraboloid" : "perspective";
-    printf("visibility %s %s (%s maps) shadow_lod=%s (%u triangles a map): %u receiver-VPL pairs, shadow maps agree "
+    const char *used = gi_depth_atlas_get_desc(a->atlas)->projection == GI_PROJ_PARABOLOID
+                           ? "paraboloid"
+                           : "perspective";
+    printf("visibility %s %s (%s maps) shadow_lod=%s (%u triangles a map): %u receiver-VPL pairs, "
+           "shadow maps agree "
            "with Embree on %.2f %% (%u falsely shadowed, %u falsely lit)\n",
-           strrchr(scene, '/') + 1, projection, used, lod, a->lod ? a->lod->triangle_count : s->triangle_count, pairs,
+           strrchr(scene, '/') + 1, projection, used, lod,
+           a->lod ? a->lod->triangle_count : s->triangle_count, pairs,
            100.0 * agree / (pairs ? pairs : 1), false_shadow, false_light);
-    EXPECT(agree >= pairs - pairs / 20, "shadow maps agree with ray casting on only %u of %u pairs", agree, pairs);
+    EXPECT(agree >= pairs - pairs / 20, "shadow maps agree with ray casting on only %u of %u pairs",
+           agree, pairs);
     EXPECT(pairs > 10000, "too few pairs (%u)", pairs);
     char what[96];
-    snprintf(what, sizeof what, "visibility %s shadow_lod=%s, light-VPL shadow maps vs Embree", projection, lod);
+    snprintf(what, sizeof what, "visibility %s shadow_lod=%s, light-VPL shadow maps vs Embree",
+             projection, lod);
     gi_test_failed += vis_check(&score, what, VIS_MARGIN, 1000);
     free(tiles);
     free_gbuffer_images(&gb);
@@ -861,7 +907,8 @@ static void punctual_case(gi_gpu *gpu)
         return;
     const gi_scene *s = fx.s;
     gi_gpu_scene *gs = fx.gs;
-    const char *kv[] = {"vpls=4096", "bounces=0", "grid=16", "M=1", "filter=false", "visibility=false"};
+    const char *kv[] = {"vpls=4096", "bounces=0",    "grid=16",
+                        "M=1",       "filter=false", "visibility=false"};
     avg *a = make_avg(&fx.host, gs, kv, 6);
     if (!a) {
         EXPECT(0, "cannot make the avg instance");
@@ -877,9 +924,11 @@ static void punctual_case(gi_gpu *gpu)
     uint32_t lit = 0;
     for (size_t i = 0; i < (size_t)w * h; i++) {
         /* Receivers only: the lamp seen directly is exact either way. */
-        if (pos->rgba[4 * i + 3] <= 0.0f || emi->rgba[4 * i] + emi->rgba[4 * i + 1] + emi->rgba[4 * i + 2] > 0.0f)
+        if (pos->rgba[4 * i + 3] <= 0.0f ||
+            emi->rgba[4 * i] + emi->rgba[4 * i + 1] + emi->rgba[4 * i + 2] > 0.0f)
             continue;
-        gi_vec3 x = gi_v3_load(&pos->rgba[4 * i]), n = gi_v3_normalize(gi_v3_load(&nrm->rgba[4 * i]));
+        gi_vec3 x = gi_v3_load(&pos->rgba[4 * i]),
+                n = gi_v3_normalize(gi_v3_load(&nrm->rgba[4 * i]));
         double S[3] = {0, 0, 0}, P[3] = {0, 0, 0};
         for (uint32_t j = 0; j < a->vpl_count; j++) {
             if ((a->cpu_vpls[j].kind & 0xFFu) != AVG_VPL_DIFFUSE)
@@ -902,7 +951,8 @@ static void punctual_case(gi_gpu *gpu)
                 continue;
             float g = cx / fmaxf(d2, dmin2) * gi_range_window(dist, L->range);
             if (L->type == GI_LIGHT_SPOT)
-                g *= gi_spot_falloff(-gi_v3_dot(wl, f.direction), cosf(L->inner_cone), cosf(L->outer_cone));
+                g *= gi_spot_falloff(-gi_v3_dot(wl, f.direction), cosf(L->inner_cone),
+                                     cosf(L->outer_cone));
             for (int c = 0; c < 3; c++)
                 P[c] += L->intensity[c] * g;
         }
@@ -917,11 +967,13 @@ static void punctual_case(gi_gpu *gpu)
         }
         lit++;
     }
-    printf("punctual: %u receiver pixels, %u VPLs, point and spot lights %.0f %% of their light; image sum %.5g against the "
+    printf("punctual: %u receiver pixels, %u VPLs, point and spot lights %.0f %% of their light; "
+           "image sum %.5g against the "
            "closed form %.5g (%+.3f %%), largest pixel difference %.2f %%\n",
            lit, a->vpl_count, 100.0 * punctual_share / sum_expect, sum_got, sum_expect,
            100.0 * (sum_got - sum_expect) / sum_expect, 100.0 * worst);
-    EXPECT(punctual_share > 0.2 * sum_expect, "the punctual lights carry too little of the light to test them");
+    EXPECT(punctual_share > 0.2 * sum_expect,
+           "the punctual lights carry too little of the light to test them");
     EXPECT(fabs(sum_got - sum_expect) < 0.01 * sum_expect, "image sum off by more than 1 %%");
     EXPECT(worst < 0.03, "a pixel differs by %.3g (relative)", worst);
     gi_image_free(img);

@@ -46,8 +46,8 @@ enum { M_CUBE = 64, NL = 4 };
 
 typedef struct world {
     const gi_scene *s;
-    gi_vec3 *tri;        /* 3 world corners per triangle at t = 0 */
-    float *area;         /* per triangle */
+    gi_vec3 *tri; /* 3 world corners per triangle at t = 0 */
+    float *area;  /* per triangle */
 } world;
 
 static int seg_hits(const world *w, uint32_t k, gi_vec3 o, gi_vec3 d, float hmax)
@@ -55,7 +55,8 @@ static int seg_hits(const world *w, uint32_t k, gi_vec3 o, gi_vec3 d, float hmax
     const gi_object *ob = &w->s->objects[k];
     int n = 0;
     for (uint32_t t = ob->first_triangle; t < ob->first_triangle + ob->triangle_count; t++)
-        n += csm_test_ray_hits_triangle(w->tri[3 * t], w->tri[3 * t + 1], w->tri[3 * t + 2], o, d, hmax);
+        n += csm_test_ray_hits_triangle(w->tri[3 * t], w->tri[3 * t + 1], w->tri[3 * t + 2], o, d,
+                                        hmax);
     return n;
 }
 
@@ -79,8 +80,10 @@ static int inside_closed(const world *w, gi_vec3 x)
 {
     const gi_vec3 d1 = gi_v3(0.31f, 0.87f, 0.38f), d2 = gi_v3(0.11f, 0.07f, -0.99f);
     for (uint32_t k = 0; k < w->s->object_count; k++)
-        if ((seg_hits(w, k, x, d1, FLT_MAX) & 1) && (seg_hits(w, k, x, gi_v3_scale(d1, -1), FLT_MAX) & 1) &&
-            (seg_hits(w, k, x, d2, FLT_MAX) & 1) && (seg_hits(w, k, x, gi_v3_scale(d2, -1), FLT_MAX) & 1))
+        if ((seg_hits(w, k, x, d1, FLT_MAX) & 1) &&
+            (seg_hits(w, k, x, gi_v3_scale(d1, -1), FLT_MAX) & 1) &&
+            (seg_hits(w, k, x, d2, FLT_MAX) & 1) &&
+            (seg_hits(w, k, x, gi_v3_scale(d2, -1), FLT_MAX) & 1))
             return 1;
     return 0;
 }
@@ -107,8 +110,9 @@ static gi_vec3 light_sample(const world *w, const csm_light *l, uint32_t *rng)
     }
     float b[3];
     gi_sample_uniform_triangle(gi_rng_next_float(rng), gi_rng_next_float(rng), b);
-    return gi_v3_add(gi_v3_add(gi_v3_scale(w->tri[3 * tri], b[0]), gi_v3_scale(w->tri[3 * tri + 1], b[1])),
-                     gi_v3_scale(w->tri[3 * tri + 2], b[2]));
+    return gi_v3_add(
+        gi_v3_add(gi_v3_scale(w->tri[3 * tri], b[0]), gi_v3_scale(w->tri[3 * tri + 1], b[1])),
+        gi_v3_scale(w->tri[3 * tri + 2], b[2]));
 }
 
 /* std430 records as plugins/csm/csm.c uploads them. */
@@ -123,9 +127,9 @@ typedef struct setup {
     world w;
     uint32_t light_count;
     csm_light *lights;
-    gi_csm_data *data;     /* light_count x object_count */
-    csm_local_desc *desc;  /* same */
-    float *bias;           /* per object */
+    gi_csm_data *data;    /* light_count x object_count */
+    csm_local_desc *desc; /* same */
+    float *bias;          /* per object */
     float (*local_from_world)[16];
 } setup;
 
@@ -152,8 +156,9 @@ static int setup_scene(gi_gpu *gpu, const char *path, setup *st, int cube_maps)
     st->w.area = malloc(sizeof(float) * s->triangle_count);
     for (uint32_t t = 0; t < s->triangle_count; t++) {
         gi_scene_triangle_world(s, t, 0.0f, &st->w.tri[3 * t]);
-        st->w.area[t] = 0.5f * gi_v3_length(gi_v3_cross(gi_v3_sub(st->w.tri[3 * t + 1], st->w.tri[3 * t]),
-                                                        gi_v3_sub(st->w.tri[3 * t + 2], st->w.tri[3 * t])));
+        st->w.area[t] =
+            0.5f * gi_v3_length(gi_v3_cross(gi_v3_sub(st->w.tri[3 * t + 1], st->w.tri[3 * t]),
+                                            gi_v3_sub(st->w.tri[3 * t + 2], st->w.tri[3 * t])));
     }
     st->light_count = csm_lights_collect(s, 0.0f, NL, 4.0f, &st->lights);
     uint32_t n = s->object_count;
@@ -185,7 +190,8 @@ static int setup_scene(gi_gpu *gpu, const char *path, setup *st, int cube_maps)
                 continue;
             gi_csm_data *cd = &st->data[j * n + k];
             if (csm_build_local(st->gs, k, sphere, d, NULL, 0, 1, cd, &err) != GI_OK) {
-                fprintf(stderr, "set-up failed: %s: cube maps of object %u for light %u: %s\n", path, k, j, err.text);
+                fprintf(stderr, "set-up failed: %s: cube maps of object %u for light %u: %s\n",
+                        path, k, j, err.text);
                 return 0;
             }
             seg += (double)cd->segment_count / (M_CUBE * M_CUBE);
@@ -197,12 +203,14 @@ static int setup_scene(gi_gpu *gpu, const char *path, setup *st, int cube_maps)
     printf("%s: %u light(s)", path, st->light_count);
     for (uint32_t j = 0; j < st->light_count; j++)
         printf(" [%s %ux%u, |e1| %.3f |e2| %.3f]",
-               st->lights[j].kind == CSM_LIGHT_AREA ? "area" : st->lights[j].kind == CSM_LIGHT_LINEAR ? "linear" : "point",
+               st->lights[j].kind == CSM_LIGHT_AREA     ? "area"
+               : st->lights[j].kind == CSM_LIGHT_LINEAR ? "linear"
+                                                        : "point",
                st->lights[j].n_u, st->lights[j].n_v, (double)gi_v3_length(st->lights[j].e1),
                (double)gi_v3_length(st->lights[j].e2));
     if (cube_maps)
-        printf("; %u cube-map CSMs of 6 N maps, M = %u: %.2f segments per texel, %.1f : 1", built, M_CUBE,
-               built ? seg / built : 0.0, bc > 0 ? bu / bc : 0.0);
+        printf("; %u cube-map CSMs of 6 N maps, M = %u: %.2f segments per texel, %.1f : 1", built,
+               M_CUBE, built ? seg / built : 0.0, bc > 0 ? bu / bc : 0.0);
     printf("\n");
     if (st->light_count == 0) {
         fprintf(stderr, "set-up failed: %s: no light found\n", path);
@@ -240,7 +248,8 @@ static int csm_visible(const setup *st, uint32_t j, gi_vec3 x, gi_vec3 y, int *b
         if (l->object == (int)k)
             continue;
         gi_vec3 xl = gi_mat4_point(st->local_from_world[k], x);
-        if (!csm_local_visible_nearest(&st->data[j * n + k], &st->desc[j * n + k], xl, u, v, st->bias[k])) {
+        if (!csm_local_visible_nearest(&st->data[j * n + k], &st->desc[j * n + k], xl, u, v,
+                                       st->bias[k])) {
             if (by)
                 *by = (int)k;
             return 0;
@@ -267,14 +276,16 @@ typedef struct pair {
 } pair;
 
 /* Volume pairs in box [lo, hi] against ray casting; fills pairs for the GPU. */
-static void volume_pairs(const setup *st, const char *name, gi_vec3 lo, gi_vec3 hi, pair *out, int *cpu_out,
-                         double min_agree)
+static void volume_pairs(const setup *st, const char *name, gi_vec3 lo, gi_vec3 hi, pair *out,
+                         int *cpu_out, double min_agree)
 {
     uint32_t rng = gi_rng_init(5, 0, 9);
-    int pairs = 0, agree = 0, agree_snapped = 0, shadowed = 0, inside = 0, silhouette = 0, discretised = 0;
+    int pairs = 0, agree = 0, agree_snapped = 0, shadowed = 0, inside = 0, silhouette = 0,
+        discretised = 0;
     vis_score score = {0}, score_snapped = {0};
     while (pairs < PAIRS) {
-        gi_vec3 x = gi_v3(lo.x + (hi.x - lo.x) * gi_rng_next_float(&rng), lo.y + (hi.y - lo.y) * gi_rng_next_float(&rng),
+        gi_vec3 x = gi_v3(lo.x + (hi.x - lo.x) * gi_rng_next_float(&rng),
+                          lo.y + (hi.y - lo.y) * gi_rng_next_float(&rng),
                           lo.z + (hi.z - lo.z) * gi_rng_next_float(&rng));
         if (inside_closed(&st->w, x)) {
             inside++;
@@ -300,26 +311,31 @@ static void volume_pairs(const setup *st, const char *name, gi_vec3 lo, gi_vec3 
                 discretised++;
             /* near a silhouette: two texels of x's cube map change the answer */
             float step = 2.0f * 2.0f * gi_v3_length(gi_v3_sub(x, ys)) / M_CUBE;
-            static const float dirs[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+            static const float dirs[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                             {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
             int near = 0;
             for (int q = 0; q < 6 && !near; q++)
-                near = exact_visible(&st->w, gi_v3_add(x, gi_v3_scale(gi_v3_load(dirs[q]), step)), ys, l->object,
-                                     NULL) != exact_s;
+                near = exact_visible(&st->w, gi_v3_add(x, gi_v3_scale(gi_v3_load(dirs[q]), step)),
+                                     ys, l->object, NULL) != exact_s;
             silhouette += near;
         }
     }
-    printf("  %d pairs (%d shadowed, %d inside points skipped): %.1f%% agree with the segment to y, %.1f%% with the "
-           "segment to the snapped light point; of the %d disagreements %d are the light's discretisation and %d lie "
+    printf("  %d pairs (%d shadowed, %d inside points skipped): %.1f%% agree with the segment to "
+           "y, %.1f%% with the "
+           "segment to the snapped light point; of the %d disagreements %d are the light's "
+           "discretisation and %d lie "
            "within two texels of a silhouette\n",
-           pairs, shadowed, inside, 100.0 * agree / pairs, 100.0 * agree_snapped / pairs, pairs - agree, discretised,
-           silhouette);
+           pairs, shadowed, inside, 100.0 * agree / pairs, 100.0 * agree_snapped / pairs,
+           pairs - agree, discretised, silhouette);
     EXPECT(agree >= pairs * min_agree, "%d of %d", agree, pairs);
     EXPECT(agree_snapped >= pairs * 0.97, "%d of %d", agree_snapped, pairs);
-    EXPECT(silhouette >= (pairs - agree) * 0.9, "%d of %d disagreements near a silhouette", silhouette, pairs - agree);
+    EXPECT(silhouette >= (pairs - agree) * 0.9, "%d of %d disagreements near a silhouette",
+           silhouette, pairs - agree);
     char what[160];
     snprintf(what, sizeof what, "  %s, volume pairs, cube-map CSM vs the segment x-y", name);
     gi_test_failed += vis_check(&score, what, VIS_MARGIN, 50);
-    snprintf(what, sizeof what, "  %s, volume pairs, cube-map CSM vs the segment to the snapped light point", name);
+    snprintf(what, sizeof what,
+             "  %s, volume pairs, cube-map CSM vs the segment to the snapped light point", name);
     gi_test_failed += vis_check(&score_snapped, what, VIS_MARGIN, 50);
 }
 
@@ -336,11 +352,13 @@ static float w_area_nonemissive(const setup *st, uint32_t t, int only)
 /* Receiver points on the surfaces of csm_cross.glb: per (receiver, caster)
  * the pairs ray casting finds shadowed by that caster, and how many of
  * those and of all pairs the CSM gets right. */
-static void surface_pairs(const setup *st, const char *name, float offset_texels, int cross, int only, double margin)
+static void surface_pairs(const setup *st, const char *name, float offset_texels, int cross,
+                          int only, double margin)
 {
     const gi_scene *s = st->s;
     uint32_t n = s->object_count, rng = gi_rng_init(8, 0, 3);
-    int shadowed_by[8][8] = {{0}}, right_by[8][8] = {{0}}, edge_by[8][8] = {{0}}, total = 0, agree = 0;
+    int shadowed_by[8][8] = {{0}}, right_by[8][8] = {{0}}, edge_by[8][8] = {{0}}, total = 0,
+        agree = 0;
     int false_shadow[8] = {0}, lit_total[8] = {0};
     vis_score score = {0};
     float total_area = 0;
@@ -356,7 +374,8 @@ static void surface_pairs(const setup *st, const char *name, float offset_texels
         float b[3];
         gi_sample_uniform_triangle(gi_rng_next_float(&rng), gi_rng_next_float(&rng), b);
         const gi_vec3 *q = &st->w.tri[3 * t];
-        gi_vec3 x = gi_v3_add(gi_v3_add(gi_v3_scale(q[0], b[0]), gi_v3_scale(q[1], b[1])), gi_v3_scale(q[2], b[2]));
+        gi_vec3 x = gi_v3_add(gi_v3_add(gi_v3_scale(q[0], b[0]), gi_v3_scale(q[1], b[1])),
+                              gi_v3_scale(q[2], b[2]));
         gi_vec3 ng = gi_v3_normalize(gi_v3_cross(gi_v3_sub(q[1], q[0]), gi_v3_sub(q[2], q[0])));
         uint32_t j = gi_rng_next_u32(&rng) % st->light_count;
         const csm_light *l = &st->lights[j];
@@ -365,7 +384,8 @@ static void surface_pairs(const setup *st, const char *name, float offset_texels
             continue;
         uint32_t recv = s->vertices[s->indices[3 * t]].object;
         /* the normal offset, in texels at x's distance */
-        gi_vec3 xo = gi_v3_add(x, gi_v3_scale(ng, offset_texels * 2.0f * gi_v3_length(gi_v3_sub(x, ys)) / M_CUBE));
+        gi_vec3 xo = gi_v3_add(
+            x, gi_v3_scale(ng, offset_texels * 2.0f * gi_v3_length(gi_v3_sub(x, ys)) / M_CUBE));
         /* receivers covered by another object (the ground under a box) are
          * inside it: no surface the camera could see; left out */
         gi_vec3 xe = gi_v3_add(x, gi_v3_scale(ng, 1e-4f));
@@ -381,9 +401,10 @@ static void surface_pairs(const setup *st, const char *name, float offset_texels
             lit_total[recv]++;
             false_shadow[recv] += !lit;
             if (!lit && getenv("CSM_DEBUG"))
-                printf("    false shadow on %s at (%.3f %.3f %.3f) n (%.2f %.2f %.2f) light point (%.3f %.3f %.3f)\n",
-                       s->objects[recv].name, (double)x.x, (double)x.y, (double)x.z, (double)ng.x, (double)ng.y,
-                       (double)ng.z, (double)ys.x, (double)ys.y, (double)ys.z);
+                printf("    false shadow on %s at (%.3f %.3f %.3f) n (%.2f %.2f %.2f) light point "
+                       "(%.3f %.3f %.3f)\n",
+                       s->objects[recv].name, (double)x.x, (double)x.y, (double)x.z, (double)ng.x,
+                       (double)ng.y, (double)ng.z, (double)ys.x, (double)ys.y, (double)ys.z);
         }
         if (!exact && by >= 0 && recv < 8 && by < 8) {
             shadowed_by[recv][by]++;
@@ -391,45 +412,51 @@ static void surface_pairs(const setup *st, const char *name, float offset_texels
             /* a miss within two texels (at x's distance) of the shadow's
              * edge: the normal offset alone moves x by one texel */
             float step = 2.0f * 2.0f * gi_v3_length(gi_v3_sub(x, ys)) / M_CUBE;
-            static const float dirs[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+            static const float dirs[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                             {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
             int near = 0;
             for (int qd = 0; qd < 6 && lit && !near; qd++)
-                near = exact_visible(&st->w, gi_v3_add(xe, gi_v3_scale(gi_v3_load(dirs[qd]), step)), ys, l->object,
-                                     NULL);
+                near = exact_visible(&st->w, gi_v3_add(xe, gi_v3_scale(gi_v3_load(dirs[qd]), step)),
+                                     ys, l->object, NULL);
             edge_by[recv][by] += lit && near;
         }
     }
-    printf("  %d surface pairs (normal offset %.2f texels): %.1f%% agree with ray casting to the snapped light point\n",
+    printf("  %d surface pairs (normal offset %.2f texels): %.1f%% agree with ray casting to the "
+           "snapped light point\n",
            total, (double)offset_texels, 100.0 * agree / total);
     EXPECT(agree >= total * 0.95, "%d of %d", agree, total);
     char what[160];
-    snprintf(what, sizeof what, "  %s, surface pairs (offset %.2f texels), cube-map CSM vs ray casting", name,
+    snprintf(what, sizeof what,
+             "  %s, surface pairs (offset %.2f texels), cube-map CSM vs ray casting", name,
              (double)offset_texels);
     gi_test_failed += vis_check(&score, what, margin, 50);
     for (uint32_t rcv = 0; rcv < n && rcv < 8; rcv++)
         if (lit_total[rcv])
-            printf("  %s: %d lit pairs, CSM shadowed %.1f%% of them\n", s->objects[rcv].name, lit_total[rcv],
-                   100.0 * false_shadow[rcv] / lit_total[rcv]);
+            printf("  %s: %d lit pairs, CSM shadowed %.1f%% of them\n", s->objects[rcv].name,
+                   lit_total[rcv], 100.0 * false_shadow[rcv] / lit_total[rcv]);
     for (uint32_t rcv = 0; rcv < n && rcv < 8; rcv++)
         for (uint32_t c = 0; c < n && c < 8; c++)
             if (shadowed_by[rcv][c])
-                printf("  %s shadowed by %s: %d pairs, CSM shadowed %.1f%%, lit within two texels of the shadow's "
+                printf("  %s shadowed by %s: %d pairs, CSM shadowed %.1f%%, lit within two texels "
+                       "of the shadow's "
                        "edge %.1f%%, lit elsewhere %.1f%%\n",
                        s->objects[rcv].name, s->objects[c].name, shadowed_by[rcv][c],
-                       100.0 * right_by[rcv][c] / shadowed_by[rcv][c], 100.0 * edge_by[rcv][c] / shadowed_by[rcv][c],
-                       100.0 * (shadowed_by[rcv][c] - right_by[rcv][c] - edge_by[rcv][c]) / shadowed_by[rcv][c]);
+                       100.0 * right_by[rcv][c] / shadowed_by[rcv][c],
+                       100.0 * edge_by[rcv][c] / shadowed_by[rcv][c],
+                       100.0 * (shadowed_by[rcv][c] - right_by[rcv][c] - edge_by[rcv][c]) /
+                           shadowed_by[rcv][c]);
     if (!cross)
         return;
     /* objects 0 ground, 1 box_a, 2 box_b (gen_csm_cross.py) */
     int pairs_needed[][2] = {{2, 1}, {1, 2}, {0, 1}, {0, 2}};
     for (int i = 0; i < 4; i++) {
         int rcv = pairs_needed[i][0], c = pairs_needed[i][1];
-        EXPECT(shadowed_by[rcv][c] >= 20, "%s shadowed by %s only %d times", s->objects[rcv].name, s->objects[c].name,
-               shadowed_by[rcv][c]);
+        EXPECT(shadowed_by[rcv][c] >= 20, "%s shadowed by %s only %d times", s->objects[rcv].name,
+               s->objects[c].name, shadowed_by[rcv][c]);
         EXPECT(right_by[rcv][c] + edge_by[rcv][c] >= shadowed_by[rcv][c] * 0.97 &&
                    right_by[rcv][c] >= shadowed_by[rcv][c] * 0.7,
-               "%s by %s: %d (+%d at the edge) of %d", s->objects[rcv].name, s->objects[c].name, right_by[rcv][c],
-               edge_by[rcv][c], shadowed_by[rcv][c]);
+               "%s by %s: %d (+%d at the edge) of %d", s->objects[rcv].name, s->objects[c].name,
+               right_by[rcv][c], edge_by[rcv][c], shadowed_by[rcv][c]);
     }
 }
 
@@ -449,7 +476,8 @@ static const char *kernel =
     "    float pcf = csm_local_visibility_object(j, u_obj, x, vec3(0.0), y, 1, 0.0);\n"
     "    float rr = 0.0;\n"
     "    for (int i = 0; i < 256; i++)\n"
-    "        rr += csm_local_visibility_object(j, u_obj, x, vec3(0.0), y, 2, (float(i) + 0.5) / 256.0);\n"
+    "        rr += csm_local_visibility_object(j, u_obj, x, vec3(0.0), y, 2, (float(i) + 0.5) / "
+    "256.0);\n"
     "    pout[c] = vec4(nearest, pcf, rr / 256.0, 0.0);\n"
     "}\n";
 
@@ -459,7 +487,8 @@ static void gpu_check(const setup *st, const pair *pin, const int *cpu, uint32_t
     const gi_scene *s = st->s;
     uint32_t n = s->object_count, L = st->light_count;
     gi_error err;
-    GLuint prog = gi_program_build_compute_text("plugins/csm/tests/csm_local_kernel.comp", kernel, NULL, &err);
+    GLuint prog = gi_program_build_compute_text("plugins/csm/tests/csm_local_kernel.comp", kernel,
+                                                NULL, &err);
     EXPECT(prog != 0, "%s", err.text);
     if (!prog)
         return;
@@ -488,10 +517,12 @@ static void gpu_check(const setup *st, const pair *pin, const int *cpu, uint32_t
         float l1[4] = {l->e1.x, l->e1.y, l->e1.z, 0}, l2[4] = {l->e2.x, l->e2.y, l->e2.z, 0};
         memcpy(lights[j].o, lo, 16), memcpy(lights[j].e1, l1, 16), memcpy(lights[j].e2, l2, 16);
         lights[j].info[0] = l->n_u, lights[j].info[1] = l->n_v, lights[j].info[2] = base;
-        lights[j].info[3] = l->object >= 0 ? (uint32_t)l->object : 0x80000000u | (uint32_t)l->punctual;
+        lights[j].info[3] =
+            l->object >= 0 ? (uint32_t)l->object : 0x80000000u | (uint32_t)l->punctual;
         for (uint32_t b = 0; b < l->n_v; b++)
             for (uint32_t a = 0; a < l->n_u; a++)
-                cells[base + b * l->n_u + a] = gi_csm_order_index(GI_CSM_ORDER_DIAGONAL, l->n_u, l->n_v, a, b);
+                cells[base + b * l->n_u + a] =
+                    gi_csm_order_index(GI_CSM_ORDER_DIAGONAL, l->n_u, l->n_v, a, b);
         base += l->n_u * l->n_v;
         for (uint32_t k = 0; k < n; k++) {
             const csm_local_desc *d = &st->desc[j * n + k];
@@ -545,7 +576,8 @@ static void gpu_check(const setup *st, const pair *pin, const int *cpu, uint32_t
     }
     double rr_mean, rr_max;
     csm_test_rr_error(gout, PAIRS, &rr_mean, &rr_max);
-    printf("  GLSL cube query: nearest equals the CPU query on %d of %d pairs; %s: PCF strictly between 0 and 1 on %d "
+    printf("  GLSL cube query: nearest equals the CPU query on %d of %d pairs; %s: PCF strictly "
+           "between 0 and 1 on %d "
            "pairs, RR averaged over 256 stratified numbers vs PCF: mean |diff| %.4f, max %.4f\n",
            same, PAIRS, s->objects[obj].name, partial, rr_mean, rr_max);
     EXPECT(same >= PAIRS - 2, "%d of %d", same, PAIRS);
@@ -592,8 +624,9 @@ static int light_box_touches(const setup *st, const csm_light *l, uint32_t k)
     const float *lb = st->s->objects[k].local_bounds;
     float b[6] = {FLT_MAX, FLT_MAX, FLT_MAX, -FLT_MAX, -FLT_MAX, -FLT_MAX};
     for (int corner = 0; corner < 8; corner++) {
-        gi_vec3 p = gi_mat4_point(st->gs->world_from_local[k],
-                                  gi_v3(lb[(corner & 1) ? 3 : 0], lb[(corner & 2) ? 4 : 1], lb[(corner & 4) ? 5 : 2]));
+        gi_vec3 p = gi_mat4_point(
+            st->gs->world_from_local[k],
+            gi_v3(lb[(corner & 1) ? 3 : 0], lb[(corner & 2) ? 4 : 1], lb[(corner & 4) ? 5 : 2]));
         for (int i = 0; i < 3; i++)
             b[i] = fminf(b[i], (&p.x)[i]), b[3 + i] = fmaxf(b[3 + i], (&p.x)[i]);
     }
@@ -626,16 +659,19 @@ static int semi_build(const setup *st, semi *sm)
                             .z3 = CSM_DEPTH_Z2,
                             .shell = 1e-3f * sm->sphere[k][3],
                             .batch = 16};
-        if (csm_build_object(st->gs, k, sm->sphere[k], &d, NULL, 0, 1, &sm->data[k], &err) != GI_OK) {
+        if (csm_build_object(st->gs, k, sm->sphere[k], &d, NULL, 0, 1, &sm->data[k], &err) !=
+            GI_OK) {
             fprintf(stderr, "set-up failed: orthographic CSM of object %u: %s\n", k, err.text);
             return 0;
         }
         for (uint32_t j = 0; j < st->light_count; j++) {
-            int shadows = st->lights[j].object != (int)k && !light_box_touches(st, &st->lights[j], k);
+            int shadows =
+                st->lights[j].object != (int)k && !light_box_touches(st, &st->lights[j], k);
             sm->shadows[j * n + k] = (unsigned char)shadows;
             if (st->lights[j].object != (int)k && !shadows)
-                printf("  semi-local: light %u lies inside the bounds of %s, which casts no shadow of it\n", j,
-                       st->s->objects[k].name);
+                printf("  semi-local: light %u lies inside the bounds of %s, which casts no shadow "
+                       "of it\n",
+                       j, st->s->objects[k].name);
         }
     }
     return 1;
@@ -655,7 +691,8 @@ static void semi_free(const setup *st, semi *sm)
  * casting along each object's nearest map direction (the whole line, as
  * the orthographic map sees it), which isolates the depth and codec path
  * from the angular discretisation of the N x N directions. */
-static int semi_visible(const setup *st, const semi *sm, uint32_t j, gi_vec3 x, gi_vec3 y, int snapped)
+static int semi_visible(const setup *st, const semi *sm, uint32_t j, gi_vec3 x, gi_vec3 y,
+                        int snapped)
 {
     uint32_t n = st->s->object_count;
     for (uint32_t k = 0; k < n; k++) {
@@ -664,8 +701,8 @@ static int semi_visible(const setup *st, const semi *sm, uint32_t j, gi_vec3 x, 
         gi_vec3 xl = gi_mat4_point(st->local_from_world[k], x);
         gi_vec3 wl = gi_v3_normalize(gi_mat4_dir(st->local_from_world[k], gi_v3_sub(y, x)));
         if (!snapped) {
-            if (!gi_csm_dir_visible(&sm->data[k], sm->sphere[k], N_SEMI, N_SEMI, GI_CSM_ORDER_HILBERT, xl, wl,
-                                     0.01f * sm->sphere[k][3]))
+            if (!gi_csm_dir_visible(&sm->data[k], sm->sphere[k], N_SEMI, N_SEMI,
+                                    GI_CSM_ORDER_HILBERT, xl, wl, 0.01f * sm->sphere[k][3]))
                 return 0;
             continue;
         }
@@ -673,7 +710,8 @@ static int semi_visible(const setup *st, const semi *sm, uint32_t j, gi_vec3 x, 
         csm_grid_coords(wl, N_SEMI, N_SEMI, &u, &v);
         int b = (int)floorf(v + 0.5f);
         b = b < 0 ? 0 : b >= N_SEMI ? N_SEMI - 1 : b;
-        csm_cell_angles(N_SEMI, N_SEMI, (uint32_t)floorf(u + 0.5f) % N_SEMI, (uint32_t)b, &theta, &phi);
+        csm_cell_angles(N_SEMI, N_SEMI, (uint32_t)floorf(u + 0.5f) % N_SEMI, (uint32_t)b, &theta,
+                        &phi);
         gi_vec3 d = csm_dir(theta, phi);
         const gi_object *ob = &st->s->objects[k];
         for (uint32_t t = ob->first_triangle; t < ob->first_triangle + ob->triangle_count; t++) {
@@ -704,7 +742,8 @@ static void semilocal_pairs(const setup *st, const char *name, gi_vec3 lo, gi_ve
     vis_score score = {0}, score_snapped = {0};
     int inside = 0;
     while (score.pairs < PAIRS) {
-        gi_vec3 x = gi_v3(lo.x + (hi.x - lo.x) * gi_rng_next_float(&rng), lo.y + (hi.y - lo.y) * gi_rng_next_float(&rng),
+        gi_vec3 x = gi_v3(lo.x + (hi.x - lo.x) * gi_rng_next_float(&rng),
+                          lo.y + (hi.y - lo.y) * gi_rng_next_float(&rng),
                           lo.z + (hi.z - lo.z) * gi_rng_next_float(&rng));
         if (inside_closed(&st->w, x)) {
             inside++;
@@ -718,11 +757,12 @@ static void semilocal_pairs(const setup *st, const char *name, gi_vec3 lo, gi_ve
         vis_add(&score_snapped, semi_visible(st, &sm, j, x, y, 1), lit);
     }
     char what[160];
-    printf("  %s, semi-local (N = %u x %u, M = %u): %d inside points skipped\n", name, N_SEMI, N_SEMI, M_SEMI,
-           inside);
+    printf("  %s, semi-local (N = %u x %u, M = %u): %d inside points skipped\n", name, N_SEMI,
+           N_SEMI, M_SEMI, inside);
     snprintf(what, sizeof what, "  %s, volume pairs, semi-local CSM vs the segment x-y", name);
     gi_test_failed += vis_check(&score, what, VIS_MARGIN, 50);
-    snprintf(what, sizeof what, "  %s, volume pairs, semi-local CSM vs rays along the snapped map directions", name);
+    snprintf(what, sizeof what,
+             "  %s, volume pairs, semi-local CSM vs rays along the snapped map directions", name);
     gi_test_failed += vis_check(&score_snapped, what, VIS_MARGIN, 50);
     semi_free(st, &sm);
 }
@@ -738,13 +778,15 @@ int main(void)
 
     /* The teapot under its area light: x around the teapot, above the ground. */
     if (setup_scene(gpu, GI_SOURCE_DIR "/scenes/teapot_area.glb", &st, 1)) {
-        EXPECT(st.light_count == 1 && st.lights[0].kind == CSM_LIGHT_AREA, "%u lights", st.light_count);
+        EXPECT(st.light_count == 1 && st.lights[0].kind == CSM_LIGHT_AREA, "%u lights",
+               st.light_count);
         uint32_t t = object_named(st.s, "teapot");
         const float *b = st.s->objects[t].local_bounds;
         gi_vec3 lo = gi_mat4_point(st.gs->world_from_local[t], gi_v3(b[0], b[1], b[2]));
         gi_vec3 hi = gi_mat4_point(st.gs->world_from_local[t], gi_v3(b[3], b[4], b[5]));
         gi_vec3 c = gi_v3_scale(gi_v3_add(lo, hi), 0.5f), h = gi_v3_scale(gi_v3_sub(hi, lo), 1.25f);
-        gi_vec3 box_lo = gi_v3(c.x - h.x, 1e-3f, c.z - h.z), box_hi = gi_v3(c.x + h.x, 0.5f * hi.y, c.z + h.z);
+        gi_vec3 box_lo = gi_v3(c.x - h.x, 1e-3f, c.z - h.z),
+                box_hi = gi_v3(c.x + h.x, 0.5f * hi.y, c.z + h.z);
         volume_pairs(&st, "teapot", box_lo, box_hi, pin, cpu, 0.95);
         gpu_check(&st, pin, cpu, t);
         /* Receivers on the teapot, with the plugin's default normal offset
@@ -769,8 +811,10 @@ int main(void)
 
     /* The Cornell box: x in the lower third of the box (outside the blocks). */
     if (setup_scene(gpu, GI_SOURCE_DIR "/scenes/cornell_box.gltf", &st, 1)) {
-        EXPECT(st.light_count == 1 && st.lights[0].kind == CSM_LIGHT_AREA, "%u lights", st.light_count);
-        volume_pairs(&st, "Cornell box", gi_v3(0.01f, 0.01f, 0.01f), gi_v3(5.55f, 1.8f, 5.58f), pin, cpu, 0.95);
+        EXPECT(st.light_count == 1 && st.lights[0].kind == CSM_LIGHT_AREA, "%u lights",
+               st.light_count);
+        volume_pairs(&st, "Cornell box", gi_v3(0.01f, 0.01f, 0.01f), gi_v3(5.55f, 1.8f, 5.58f), pin,
+                     cpu, 0.95);
         gpu_check(&st, pin, cpu, object_named(st.s, "tall_block"));
     } else {
         gi_test_failed++;
@@ -779,11 +823,12 @@ int main(void)
 
     /* Two boxes shadowing each other and the ground (§4.6), a linear and a point light. */
     if (setup_scene(gpu, GI_SOURCE_DIR "/plugins/csm/data/csm_cross.glb", &st, 1)) {
-        EXPECT(st.light_count == 2 && st.lights[0].kind == CSM_LIGHT_LINEAR && st.lights[0].n_v == 1 &&
-                   st.lights[1].kind == CSM_LIGHT_POINT,
+        EXPECT(st.light_count == 2 && st.lights[0].kind == CSM_LIGHT_LINEAR &&
+                   st.lights[0].n_v == 1 && st.lights[1].kind == CSM_LIGHT_POINT,
                "%u lights", st.light_count);
         surface_pairs(&st, "cross", 0.25f, 1, -1, VIS_MARGIN);
-        volume_pairs(&st, "cross", gi_v3(-2.5f, 0.01f, -1.5f), gi_v3(2.5f, 2.2f, 1.5f), pin, cpu, 0.95);
+        volume_pairs(&st, "cross", gi_v3(-2.5f, 0.01f, -1.5f), gi_v3(2.5f, 2.2f, 1.5f), pin, cpu,
+                     0.95);
         gpu_check(&st, pin, cpu, object_named(st.s, "box_a"));
         semilocal_pairs(&st, "cross", gi_v3(-2.5f, 0.01f, -1.5f), gi_v3(2.5f, 2.2f, 1.5f));
     } else {

@@ -13,7 +13,8 @@
 /* Does the ray o + h d meet triangle (p0, p1, p2) at some 0 < h < hmax?
  * Moller-Trumbore on the CPU, independent of Embree and of the plugin; the
  * tests count these hits to tell visibility and inside/outside. */
-static inline int csm_test_ray_hits_triangle(gi_vec3 p0, gi_vec3 p1, gi_vec3 p2, gi_vec3 o, gi_vec3 d, float hmax)
+static inline int csm_test_ray_hits_triangle(gi_vec3 p0, gi_vec3 p1, gi_vec3 p2, gi_vec3 o,
+                                             gi_vec3 d, float hmax)
 {
     gi_vec3 e1 = gi_v3_sub(p1, p0), e2 = gi_v3_sub(p2, p0);
     gi_vec3 pv = gi_v3_cross(d, e2);

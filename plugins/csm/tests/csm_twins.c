@@ -42,7 +42,8 @@ static const char *kernel =
     "    vec3 bt, bb, bd;\n"
     "    csm_basis(theta, phi, bt, bb, bd);\n"
     "    vec3 p = csm_project(sphere, theta, phi, x);\n"
-    "    float v[19] = float[19](ang.x, ang.y, d.x, d.y, d.z, g.x, g.y, bt.x, bt.y, bt.z, bb.x, bb.y, bb.z,\n"
+    "    float v[19] = float[19](ang.x, ang.y, d.x, d.y, d.z, g.x, g.y, bt.x, bt.y, bt.z, bb.x, "
+    "bb.y, bb.z,\n"
     "                            bd.x, bd.y, bd.z, p.x, p.y, p.z);\n"
     "    for (uint i = 0u; i < 19u; i++) o[r + i] = v[i];\n"
     "}\n";
@@ -53,7 +54,8 @@ int main(void)
     if (!gpu)
         return 1;
     gi_error err;
-    GLuint prog = gi_program_build_compute_text("plugins/csm/tests/csm_twins.comp", kernel, NULL, &err);
+    GLuint prog =
+        gi_program_build_compute_text("plugins/csm/tests/csm_twins.comp", kernel, NULL, &err);
     if (!prog) {
         fprintf(stderr, "%s\n", err.text);
         return 1;
@@ -89,7 +91,8 @@ int main(void)
         csm_grid_coords(w, u[0], u[1], &o[5], &o[6]);
         gi_vec3 t, b;
         csm_basis(f[0], f[1], &t, &b, &d);
-        o[7] = t.x, o[8] = t.y, o[9] = t.z, o[10] = b.x, o[11] = b.y, o[12] = b.z, o[13] = d.x, o[14] = d.y, o[15] = d.z;
+        o[7] = t.x, o[8] = t.y, o[9] = t.z, o[10] = b.x, o[11] = b.y, o[12] = b.z, o[13] = d.x,
+        o[14] = d.y, o[15] = d.z;
         gi_vec3 p = csm_project(f + 8, f[0], f[1], gi_v3(f[2], f[3], f[4]));
         o[16] = p.x, o[17] = p.y, o[18] = p.z;
     }
@@ -97,31 +100,36 @@ int main(void)
     glCreateBuffers(3, bufs);
     glNamedBufferStorage(bufs[0], (GLsizeiptr)(sizeof(float) * CASES * IN_F), inf, 0);
     glNamedBufferStorage(bufs[1], (GLsizeiptr)(sizeof(uint32_t) * CASES * IN_U), inu, 0);
-    glNamedBufferStorage(bufs[2], (GLsizeiptr)(sizeof(float) * CASES * OUT_F), NULL, GL_DYNAMIC_STORAGE_BIT);
+    glNamedBufferStorage(bufs[2], (GLsizeiptr)(sizeof(float) * CASES * OUT_F), NULL,
+                         GL_DYNAMIC_STORAGE_BIT);
     for (GLuint i = 0; i < 3; i++)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, i, bufs[i]);
     glUseProgram(prog);
     csm_test_dispatch_read(CASES, bufs[2], (GLsizeiptr)(sizeof(float) * CASES * OUT_F), gpu_out);
-    static const char *names[OUT_F] = {"cell theta", "cell phi", "dir.x", "dir.y", "dir.z", "grid u", "grid v",
-                                       "t.x", "t.y", "t.z", "b.x", "b.y", "b.z", "d.x", "d.y", "d.z",
-                                       "project sx", "project sy", "project depth"};
+    static const char *names[OUT_F] = {
+        "cell theta", "cell phi", "dir.x",      "dir.y",      "dir.z",        "grid u", "grid v",
+        "t.x",        "t.y",      "t.z",        "b.x",        "b.y",          "b.z",    "d.x",
+        "d.y",        "d.z",      "project sx", "project sy", "project depth"};
     int bad = 0;
     double worst = 0;
     for (int c = 0; c < CASES; c++)
         for (int i = 0; i < OUT_F; i++) {
             float want = cpu[c * OUT_F + i], got = gpu_out[c * OUT_F + i];
-            float scale = i >= 16 ? 1.0f + 2.0f / inf[c * IN_F + 11] : 1.0f; /* |x - c| / R up to ~35 */
+            float scale =
+                i >= 16 ? 1.0f + 2.0f / inf[c * IN_F + 11] : 1.0f; /* |x - c| / R up to ~35 */
             float tol = (1e-4f * fabsf(want) + 1e-5f) * scale * (i == 5 || i == 6 ? 256.0f : 1.0f);
             double e = fabs((double)got - want);
             if (e > worst)
                 worst = e;
             if (!(e <= tol)) {
                 if (bad++ < 10)
-                    fprintf(stderr, "case %d %s: cpu %.9g gpu %.9g\n", c, names[i], (double)want, (double)got);
+                    fprintf(stderr, "case %d %s: cpu %.9g gpu %.9g\n", c, names[i], (double)want,
+                            (double)got);
             }
         }
-    printf("csm geometry twins: %d of %d values differ beyond tolerance (largest difference %.3g)\n", bad,
-           CASES * OUT_F, worst);
+    printf(
+        "csm geometry twins: %d of %d values differ beyond tolerance (largest difference %.3g)\n",
+        bad, CASES * OUT_F, worst);
     glDeleteBuffers(3, bufs);
     glDeleteProgram(prog);
     free(inf);

@@ -53,7 +53,8 @@ static int hits(const gi_scene *s, uint32_t k, gi_vec3 o, gi_vec3 d)
     const gi_object *ob = &s->objects[k];
     int n = 0;
     for (uint32_t t = ob->first_triangle; t < ob->first_triangle + ob->triangle_count; t++) {
-        const float *q0 = s->vertices[s->indices[3 * t]].position, *q1 = s->vertices[s->indices[3 * t + 1]].position,
+        const float *q0 = s->vertices[s->indices[3 * t]].position,
+                    *q1 = s->vertices[s->indices[3 * t + 1]].position,
                     *q2 = s->vertices[s->indices[3 * t + 2]].position;
         n += csm_test_ray_hits_triangle(gi_v3(q0[0], q0[1], q0[2]), gi_v3(q1[0], q1[1], q1[2]),
                                         gi_v3(q2[0], q2[1], q2[2]), o, d, INFINITY);
@@ -66,14 +67,15 @@ static int hits(const gi_scene *s, uint32_t k, gi_vec3 o, gi_vec3 d)
 
 /* Visibility of world point x toward world unit w through the CSMs of
  * objects ks[0..n) (nearest filter, bias 0.01 R each): the product of §4.6. */
-static int csm_lit(const gi_gpu_scene *gs, const uint32_t *ks, const gi_csm_data *const *data, float (*spheres)[4],
-                   int n, uint32_t N, gi_vec3 x, gi_vec3 w)
+static int csm_lit(const gi_gpu_scene *gs, const uint32_t *ks, const gi_csm_data *const *data,
+                   float (*spheres)[4], int n, uint32_t N, gi_vec3 x, gi_vec3 w)
 {
     for (int i = 0; i < n; i++) {
         float inv[16];
         gi_mat4_invert(inv, gs->world_from_local[ks[i]]);
         gi_vec3 xl = gi_mat4_point(inv, x), wl = gi_v3_normalize(gi_mat4_dir(inv, w));
-        if (!gi_csm_dir_visible(data[i], spheres[i], N, N, GI_CSM_ORDER_HILBERT, xl, wl, 0.01f * spheres[i][3]))
+        if (!gi_csm_dir_visible(data[i], spheres[i], N, N, GI_CSM_ORDER_HILBERT, xl, wl,
+                                0.01f * spheres[i][3]))
             return 0;
     }
     return 1;
@@ -99,7 +101,8 @@ static int open_surfaces(const gi_scene *s, const gi_gpu_scene *gs, uint32_t kb)
     gi_mesh_object_sphere(s, kg, spheres[1]);
     /* variants: 0 shell (z2), 1 open (z2), 2 shell (z3), 3 shell (z3, spherical far plane) */
     enum { VARIANTS = 4 };
-    static const char *names[VARIANTS] = {"shell, z2", "open, z2", "shell, z3", "shell, z3 + far plane"};
+    static const char *names[VARIANTS] = {"shell, z2", "open, z2", "shell, z3",
+                                          "shell, z3 + far plane"};
     gi_csm_data data[VARIANTS][2];
     memset(data, 0, sizeof data);
     for (int v = 0; v < VARIANTS; v++)
@@ -108,10 +111,13 @@ static int open_surfaces(const gi_scene *s, const gi_gpu_scene *gs, uint32_t kb)
                                 .n_theta = N,
                                 .n_phi = N,
                                 .order = GI_CSM_ORDER_HILBERT,
-                                .z3 = v == 2 ? CSM_DEPTH_Z3 : v == 3 ? CSM_DEPTH_SPHERE : CSM_DEPTH_Z2,
+                                .z3 = v == 2   ? CSM_DEPTH_Z3
+                                      : v == 3 ? CSM_DEPTH_SPHERE
+                                               : CSM_DEPTH_Z2,
                                 .shell = v == 1 ? 0.0f : SHELL * spheres[i][3],
                                 .batch = 16};
-            if (csm_build_object(gs, ks[i], spheres[i], &d, NULL, 0, 1, &data[v][i], &err) != GI_OK) {
+            if (csm_build_object(gs, ks[i], spheres[i], &d, NULL, 0, 1, &data[v][i], &err) !=
+                GI_OK) {
                 fprintf(stderr, "%s\n", err.text);
                 fails++;
             }
@@ -145,10 +151,12 @@ static int open_surfaces(const gi_scene *s, const gi_gpu_scene *gs, uint32_t kb)
     float total = 0;
     for (uint32_t t = 0; t < ob->triangle_count; t++) {
         for (int j = 0; j < 3; j++) {
-            const float *q = s->vertices[s->indices[3 * (ob->first_triangle + t) + (uint32_t)j]].position;
+            const float *q =
+                s->vertices[s->indices[3 * (ob->first_triangle + t) + (uint32_t)j]].position;
             tp[3 * t + (uint32_t)j] = gi_mat4_point(m, gi_v3(q[0], q[1], q[2]));
         }
-        gi_vec3 n = gi_v3_cross(gi_v3_sub(tp[3 * t + 1], tp[3 * t]), gi_v3_sub(tp[3 * t + 2], tp[3 * t]));
+        gi_vec3 n =
+            gi_v3_cross(gi_v3_sub(tp[3 * t + 1], tp[3 * t]), gi_v3_sub(tp[3 * t + 2], tp[3 * t]));
         float len = gi_v3_length(n);
         total += len > 0 && n.y < -0.3f * len ? len : 0.0f;
         cdf[t] = total;
@@ -178,12 +186,14 @@ static int open_surfaces(const gi_scene *s, const gi_gpu_scene *gs, uint32_t kb)
                 gi_sample_uniform_triangle(gi_rng_next_float(&rng), gi_rng_next_float(&rng), b);
                 const gi_vec3 *q = &tp[3 * lo];
                 n = gi_v3_normalize(gi_v3_cross(gi_v3_sub(q[1], q[0]), gi_v3_sub(q[2], q[0])));
-                x = gi_v3_add(gi_v3_add(gi_v3_scale(q[0], b[0]), gi_v3_scale(q[1], b[1])), gi_v3_scale(q[2], b[2]));
+                x = gi_v3_add(gi_v3_add(gi_v3_scale(q[0], b[0]), gi_v3_scale(q[1], b[1])),
+                              gi_v3_scale(q[2], b[2]));
                 x = gi_v3_add(x, gi_v3_scale(n, texel));
                 if (x.y < 0.1f) /* within the ground's bias band */
                     continue;
             } else {
-                x = gi_v3(1.2f * (2.0f * gi_rng_next_float(&rng) - 1.0f), 0.1f + 0.3f * gi_rng_next_float(&rng),
+                x = gi_v3(1.2f * (2.0f * gi_rng_next_float(&rng) - 1.0f),
+                          0.1f + 0.3f * gi_rng_next_float(&rng),
                           1.2f * (2.0f * gi_rng_next_float(&rng) - 1.0f));
                 /* leave out points inside the bunny (odd hits both ways) */
                 gi_rt_hit h1, h2;
@@ -231,15 +241,16 @@ static int open_surfaces(const gi_scene *s, const gi_gpu_scene *gs, uint32_t kb)
             snprintf(what, sizeof what, "open surfaces, %s, %s", kinds[kind], names[v]);
             if (kind == 1) {
                 if (agree[v][kind] < PAIRS * 95 / 100) {
-                    fprintf(stderr, "%s, %s: %d of %d agree\n", kinds[kind], names[v], agree[v][kind], PAIRS);
+                    fprintf(stderr, "%s, %s: %d of %d agree\n", kinds[kind], names[v],
+                            agree[v][kind], PAIRS);
                     fails++;
                 }
                 fails += vis_check(&score[v][kind], what, VIS_MARGIN, 100);
             }
         }
         if (agree_occ[1][kind] > occluded[kind] / 2) {
-            fprintf(stderr, "%s, open: %d of %d occluded pairs shadowed: the leak is gone?\n", kinds[kind],
-                    agree_occ[1][kind], occluded[kind]);
+            fprintf(stderr, "%s, open: %d of %d occluded pairs shadowed: the leak is gone?\n",
+                    kinds[kind], agree_occ[1][kind], occluded[kind]);
             fails++;
         }
     }
@@ -271,21 +282,24 @@ static int open_surfaces(const gi_scene *s, const gi_gpu_scene *gs, uint32_t kb)
         }
         uint32_t r2 = gi_rng_init(12, 0, 1);
         for (int p = 0; p < 500; p++) {
-            gi_vec3 x = gi_v3(2.0f * (2.0f * gi_rng_next_float(&r2) - 1.0f), 0.1f + 0.3f * gi_rng_next_float(&r2),
+            gi_vec3 x = gi_v3(2.0f * (2.0f * gi_rng_next_float(&r2) - 1.0f),
+                              0.1f + 0.3f * gi_rng_next_float(&r2),
                               2.0f * (2.0f * gi_rng_next_float(&r2) - 1.0f));
             gi_vec3 to = gi_v3_sub(light, x);
             if (v == 0)
                 cube_occluded += gi_rt_occluded(rt, x, to, 1e-4f, 1.0f - 1e-4f);
-            cube_shadowed[v] += !csm_local_visible_nearest(&cd, &d, gi_mat4_point(inv, x), 0, 0, 0.01f * gs_[3]);
+            cube_shadowed[v] +=
+                !csm_local_visible_nearest(&cd, &d, gi_mat4_point(inv, x), 0, 0, 0.01f * gs_[3]);
         }
         gi_csm_data_free(&cd);
     }
-    printf("open surfaces, point light below the ground (cube map): %d of 500 pairs occluded; shadowed: shell %d, "
+    printf("open surfaces, point light below the ground (cube map): %d of 500 pairs occluded; "
+           "shadowed: shell %d, "
            "open %d\n",
            cube_occluded, cube_shadowed[0], cube_shadowed[1]);
     if (cube_shadowed[0] < cube_occluded * 95 / 100 || cube_shadowed[1] > cube_occluded / 2) {
-        fprintf(stderr, "cube map: shell %d, open %d of %d occluded\n", cube_shadowed[0], cube_shadowed[1],
-                cube_occluded);
+        fprintf(stderr, "cube map: shell %d, open %d of %d occluded\n", cube_shadowed[0],
+                cube_shadowed[1], cube_occluded);
         fails++;
     }
     for (int v = 0; v < VARIANTS; v++)
@@ -314,7 +328,8 @@ static int sphere_far_plane(const float sphere[4])
     const double R = sphere[3];
     for (uint32_t j = 0; j < M; j++)
         for (uint32_t i = 0; i < M; i++) {
-            double x = ((i + 0.5) / M * 2 - 1) * R, y = ((j + 0.5) / M * 2 - 1) * R, r2 = x * x + y * y;
+            double x = ((i + 0.5) / M * 2 - 1) * R, y = ((j + 0.5) / M * 2 - 1) * R,
+                   r2 = x * x + y * y;
             double want = r2 <= R * R ? 2 * R + sqrt(R * R - r2) : FLT_MAX;
             double got = far[j * M + i];
             if (want == FLT_MAX ? got != FLT_MAX : fabs(got - want) > 1e-4 * R) {
@@ -333,7 +348,8 @@ static int sphere_far_plane(const float sphere[4])
         csm_sphere_far(&cube[face], GI_DEPTH_RADIAL, sphere, M, far);
         for (uint32_t j = 0; j < M; j++)
             for (uint32_t i = 0; i < M; i++) {
-                gi_vec3 d = gi_mat4_dir(inv, gi_v3((i + 0.5f) / M * 2 - 1, (j + 0.5f) / M * 2 - 1, -1.0f));
+                gi_vec3 d =
+                    gi_mat4_dir(inv, gi_v3((i + 0.5f) / M * 2 - 1, (j + 0.5f) / M * 2 - 1, -1.0f));
                 gi_vec3 q = gi_v3_add(p, gi_v3_scale(gi_v3_normalize(d), far[j * M + i]));
                 double off = fabs(gi_v3_length(gi_v3_sub(q, c)) - R) / R;
                 if (off > 1e-4)
@@ -341,8 +357,9 @@ static int sphere_far_plane(const float sphere[4])
                 worst = off > worst ? off : worst;
             }
     }
-    printf("spherical far plane: worst relative error %.2g (orthographic map and 6 cube faces of %u^2)\n", worst,
-           M);
+    printf("spherical far plane: worst relative error %.2g (orthographic map and 6 cube faces of "
+           "%u^2)\n",
+           worst, M);
     if (fails)
         fprintf(stderr, "spherical far plane: %d texels off\n", fails);
     return fails;
@@ -370,18 +387,25 @@ int main(void)
     float sphere[4];
     gi_mesh_object_sphere(s, k, sphere);
     const uint32_t N = 8, M = 64;
-    csm_build_desc desc = {
-        .M = M, .n_theta = N, .n_phi = N, .order = GI_CSM_ORDER_HILBERT, .z3 = 0, .shell = SHELL * sphere[3], .batch = 16};
+    csm_build_desc desc = {.M = M,
+                           .n_theta = N,
+                           .n_phi = N,
+                           .order = GI_CSM_ORDER_HILBERT,
+                           .z3 = 0,
+                           .shell = SHELL * sphere[3],
+                           .batch = 16};
     gi_csm_data data;
     if (csm_build_object(gs, k, sphere, &desc, NULL, 0, 1, &data, &err) != GI_OK) {
         fprintf(stderr, "set-up failed: the bunny's CSM: %s\n", err.text);
         return 1;
     }
-    printf("bunny: R = %.4f, %u maps of %u^2: %.2f segments per texel, %.2f : 1\n", (double)sphere[3], N * N, M,
-           (double)data.segment_count / (M * M), (double)data.bytes_uncompressed / (double)data.bytes_compressed);
+    printf("bunny: R = %.4f, %u maps of %u^2: %.2f segments per texel, %.2f : 1\n",
+           (double)sphere[3], N * N, M, (double)data.segment_count / (M * M),
+           (double)data.bytes_uncompressed / (double)data.bytes_compressed);
 
     /* Lossless on real maps. */
-    gi_depth_desc dd = {.size = M, .surfaces = 2, .metric = GI_DEPTH_EYE_Z, .only_object = k + 1u, .local = 1};
+    gi_depth_desc dd = {
+        .size = M, .surfaces = 2, .metric = GI_DEPTH_EYE_Z, .only_object = k + 1u, .local = 1};
     gi_depth_renderer *dr = gi_depth_renderer_create(&dd, &err);
     if (!dr) {
         fprintf(stderr, "set-up failed: depth renderer: %s\n", err.text);
@@ -408,8 +432,8 @@ int main(void)
         }
         free(map);
     }
-    printf("lossless: %llu of %llu texels violate z1 <= z_avg < z2 (%llu degenerate)\n", (unsigned long long)bad,
-           (unsigned long long)checked, (unsigned long long)degenerate);
+    printf("lossless: %llu of %llu texels violate z1 <= z_avg < z2 (%llu degenerate)\n",
+           (unsigned long long)bad, (unsigned long long)checked, (unsigned long long)degenerate);
     EXPECT(bad == 0, "%llu texels", (unsigned long long)bad);
     glDeleteTextures(1, &tex);
     gi_depth_renderer_free(dr);
@@ -424,7 +448,8 @@ int main(void)
     int pairs = 0, agree = 0, agree_snapped = 0, shadowed = 0, inside = 0;
     vis_score score_w = {0}, score_snapped = {0};
     while (pairs < PAIRS) {
-        gi_vec3 x = gi_v3_add(c, gi_v3_scale(gi_sample_uniform_sphere(gi_rng_next_float(&rng), gi_rng_next_float(&rng)),
+        gi_vec3 x = gi_v3_add(c, gi_v3_scale(gi_sample_uniform_sphere(gi_rng_next_float(&rng),
+                                                                      gi_rng_next_float(&rng)),
                                              1.5f * R * cbrtf(gi_rng_next_float(&rng))));
         gi_vec3 w = gi_sample_uniform_sphere(gi_rng_next_float(&rng), gi_rng_next_float(&rng));
         int hw = hits(s, k, x, w);
@@ -442,7 +467,10 @@ int main(void)
         float u, v, theta, phi;
         csm_grid_coords(w, N, N, &u, &v);
         int bi = (int)floorf(v + 0.5f);
-        csm_cell_angles(N, N, (uint32_t)floorf(u + 0.5f) % N, (uint32_t)(bi < 0 ? 0 : bi >= (int)N ? (int)N - 1 : bi),
+        csm_cell_angles(N, N, (uint32_t)floorf(u + 0.5f) % N,
+                        (uint32_t)(bi < 0         ? 0
+                                   : bi >= (int)N ? (int)N - 1
+                                                  : bi),
                         &theta, &phi);
         int exact_snapped = hits(s, k, x, csm_dir(theta, phi)) == 0;
         shadowed += !exact;
@@ -451,14 +479,16 @@ int main(void)
         vis_add(&score_w, exact, lit);
         vis_add(&score_snapped, exact_snapped, lit);
     }
-    printf("visibility, %d pairs (%d shadowed, %d inside points skipped): %.1f%% agree with rays along w, "
+    printf("visibility, %d pairs (%d shadowed, %d inside points skipped): %.1f%% agree with rays "
+           "along w, "
            "%.1f%% with rays along the snapped map direction\n",
            pairs, shadowed, inside, 100.0 * agree / pairs, 100.0 * agree_snapped / pairs);
     EXPECT(agree >= pairs * 90 / 100, "%d of %d", agree, pairs);
     EXPECT(agree_snapped >= pairs * 97 / 100, "%d of %d", agree_snapped, pairs);
     gi_test_failed += vis_check(&score_w, "bunny, nearest CSM vs rays along w", VIS_MARGIN, 100);
-    gi_test_failed += vis_check(&score_snapped, "bunny, nearest CSM vs rays along the snapped map direction", VIS_MARGIN,
-                                100);
+    gi_test_failed +=
+        vis_check(&score_snapped, "bunny, nearest CSM vs rays along the snapped map direction",
+                  VIS_MARGIN, 100);
 
     /* The GLSL query on the same pairs. */
     EXPECT(gi_shader_register(gi_csm_query_shaders, NULL) == GI_OK, "shader table refused");
@@ -473,18 +503,21 @@ int main(void)
         "    if (c >= u_count) return;\n"
         "    vec3 x = pin[2u * c].xyz, w = pin[2u * c + 1u].xyz;\n"
         "    float rr = 0.0;\n"
-        "    for (int j = 0; j < 256; j++) rr += csm_visibility_object(0u, x, vec3(0.0), w, 2, (float(j) + 0.5) / 256.0);\n"
+        "    for (int j = 0; j < 256; j++) rr += csm_visibility_object(0u, x, vec3(0.0), w, 2, "
+        "(float(j) + 0.5) / 256.0);\n"
         "    pout[c] = vec4(csm_visibility_object(0u, x, vec3(0.0), w, 0, 0.0),\n"
         "                   csm_visibility_object(0u, x, vec3(0.0), w, 1, 0.0), rr / 256.0, 0.0);\n"
         "}\n";
-    GLuint prog = gi_program_build_compute_text("plugins/csm/tests/csm_query_kernel.comp", kernel, NULL, &err);
+    GLuint prog = gi_program_build_compute_text("plugins/csm/tests/csm_query_kernel.comp", kernel,
+                                                NULL, &err);
     EXPECT(prog != 0, "%s", err.text);
     csm_gpu_object obj;
     memset(&obj, 0, sizeof obj);
     /* §4.6: the object moved rigidly (rotation, translation, uniform
      * scale); the pairs go to the GPU in world space and the query takes
      * them back with local_from_world. */
-    const float tr[3] = {0.7f, -0.3f, 2.0f}, q[4] = {0.2f, 0.5f, -0.1f, 0.8f}, sc[3] = {1.5f, 1.5f, 1.5f};
+    const float tr[3] = {0.7f, -0.3f, 2.0f}, q[4] = {0.2f, 0.5f, -0.1f, 0.8f},
+                sc[3] = {1.5f, 1.5f, 1.5f};
     float qn[4];
     memcpy(qn, q, sizeof q);
     gi_quat_normalize(qn);
@@ -510,7 +543,8 @@ int main(void)
     glNamedBufferStorage(bufs[2], (GLsizeiptr)sizeof obj, &obj, 0);
     glNamedBufferStorage(bufs[3], (GLsizeiptr)(sizeof(uint32_t) * (M * M + 1)), data.offsets, 0);
     glNamedBufferStorage(bufs[4], (GLsizeiptr)(sizeof(float) * data.segment_count), data.z_avg, 0);
-    glNamedBufferStorage(bufs[5], (GLsizeiptr)(sizeof(uint32_t) * data.segment_count), data.i_end, 0);
+    glNamedBufferStorage(bufs[5], (GLsizeiptr)(sizeof(uint32_t) * data.segment_count), data.i_end,
+                         0);
     glNamedBufferStorage(bufs[6], (GLsizeiptr)sizeof cells, cells, 0);
     static const GLuint binding[7] = {0, 1, 8, 9, 10, 11, 12};
     for (int i = 0; i < 7; i++)
@@ -535,13 +569,17 @@ int main(void)
     }
     double rr_err_mean, rr_err_max;
     csm_test_rr_error(gout, PAIRS, &rr_err_mean, &rr_err_max);
-    printf("GLSL query (moved object): nearest equals the CPU query on %d of %d pairs; PCF >= 1/2 agrees with ray casting on %.1f%%; "
+    printf("GLSL query (moved object): nearest equals the CPU query on %d of %d pairs; PCF >= 1/2 "
+           "agrees with ray casting on %.1f%%; "
            "RR averaged over 256 stratified numbers vs PCF: mean |diff| %.4f, max %.4f\n",
            gpu_same, PAIRS, 100.0 * pcf_agree / PAIRS, rr_err_mean, rr_err_max);
-    EXPECT(gpu_same >= PAIRS - 2, "%d of %d", gpu_same, PAIRS); /* texel-edge rounding may flip one or two */
+    EXPECT(gpu_same >= PAIRS - 2, "%d of %d", gpu_same,
+           PAIRS); /* texel-edge rounding may flip one or two */
     EXPECT(pcf_agree >= PAIRS * 90 / 100, "%d of %d", pcf_agree, PAIRS);
-    gi_test_failed += vis_check(&score_pcf, "bunny, GLSL PCF >= 1/2 vs rays along w", VIS_MARGIN, 100);
-    EXPECT(rr_err_mean < 0.01 && rr_err_max <= 16.0 / 256.0 + 1e-3, "mean %g max %g", rr_err_mean, rr_err_max);
+    gi_test_failed +=
+        vis_check(&score_pcf, "bunny, GLSL PCF >= 1/2 vs rays along w", VIS_MARGIN, 100);
+    EXPECT(rr_err_mean < 0.01 && rr_err_max <= 16.0 / 256.0 + 1e-3, "mean %g max %g", rr_err_mean,
+           rr_err_max);
     free(gout);
     free(pin);
     free(cpu_lit);

@@ -34,7 +34,7 @@
 #define GI_SOURCE_DIR "."
 #endif
 
-#define POINTS 600     /* surface points scored */
+#define POINTS 600       /* surface points scored */
 #define REF_SAMPLES 4096 /* traced light samples per point (area lights, environment) */
 
 /* The direct irradiance at x (normal n) of every light of s, traced:
@@ -42,8 +42,8 @@
  * emitter table d->em), punctual and directional lights exactly, the
  * environment by K cosine-weighted directions; rt == NULL: nothing is
  * occluded (the unshadowed answer). */
-static void traced(const cssm_csm_direct *d, const gi_scene *s, const gi_rt *rt, gi_vec3 x, gi_vec3 n, uint32_t K,
-                   uint32_t seed, float E[3])
+static void traced(const cssm_csm_direct *d, const gi_scene *s, const gi_rt *rt, gi_vec3 x,
+                   gi_vec3 n, uint32_t K, uint32_t seed, float E[3])
 {
     E[0] = E[1] = E[2] = 0.0f;
     uint32_t rng = gi_rng_init(seed, 1, 0x7e57u);
@@ -59,7 +59,8 @@ static void traced(const cssm_csm_direct *d, const gi_scene *s, const gi_rt *rt,
         gi_vec3 ng = gi_v3_cross(gi_v3_sub(p[1], p[0]), gi_v3_sub(p[2], p[0]));
         float area = 0.5f * gi_v3_length(ng), b[3];
         gi_sample_uniform_triangle(r, u2, b);
-        gi_vec3 y = gi_v3_add(gi_v3_add(gi_v3_scale(p[0], b[0]), gi_v3_scale(p[1], b[1])), gi_v3_scale(p[2], b[2]));
+        gi_vec3 y = gi_v3_add(gi_v3_add(gi_v3_scale(p[0], b[0]), gi_v3_scale(p[1], b[1])),
+                              gi_v3_scale(p[2], b[2]));
         gi_vec3 v = gi_v3_sub(y, x);
         float d2 = gi_v3_dot(v, v), len = sqrtf(d2);
         gi_vec3 w = gi_v3_scale(v, 1.0f / len);
@@ -87,8 +88,9 @@ static void traced(const cssm_csm_direct *d, const gi_scene *s, const gi_rt *rt,
             w = gi_v3_scale(v, 1.0f / dist);
             k = gi_v3_dot(n, w) / (dist * dist) * gi_range_window(dist, l->range);
             if (l->type == GI_LIGHT_SPOT)
-                k *= gi_spot_falloff(gi_v3_dot(gi_v3_normalize(fr.direction), gi_v3_scale(w, -1.0f)),
-                                     cosf(l->inner_cone), cosf(l->outer_cone));
+                k *=
+                    gi_spot_falloff(gi_v3_dot(gi_v3_normalize(fr.direction), gi_v3_scale(w, -1.0f)),
+                                    cosf(l->inner_cone), cosf(l->outer_cone));
             tmax = dist - eps;
         }
         if (!(k > 0.0f) || (rt && gi_rt_occluded(rt, x, w, eps, tmax)))
@@ -146,7 +148,8 @@ static int run(const char *rel, int pixel_estimate, double margin)
         fprintf(stderr, "FAIL: CSMs: %s\n", err.text);
         return 1;
     }
-    const float bias = 0.004f * a.diameter, lift = 2e-3f * a.diameter; /* the plugin's bias and receiver lift */
+    const float bias = 0.004f * a.diameter,
+                lift = 2e-3f * a.diameter; /* the plugin's bias and receiver lift */
     double se_csm = 0, se_pix = 0, se_unsh = 0, se_black = 0, sum_ref = 0, sum_csm = 0;
     uint32_t rng = gi_rng_init(11, 0, 0xd17u), n = 0;
     while (n < POINTS) {
@@ -154,10 +157,12 @@ static int run(const char *rel, int pixel_estimate, double margin)
         gi_vec3 tu, tv;
         gi_onb(t->n, &tu, &tv);
         float side = sqrtf(t->area);
-        gi_vec3 p = gi_v3_add(t->p, gi_v3_add(gi_v3_scale(tu, (gi_rng_next_float(&rng) - 0.5f) * side * 0.9f),
-                                              gi_v3_scale(tv, (gi_rng_next_float(&rng) - 0.5f) * side * 0.9f)));
+        gi_vec3 p = gi_v3_add(
+            t->p, gi_v3_add(gi_v3_scale(tu, (gi_rng_next_float(&rng) - 0.5f) * side * 0.9f),
+                            gi_v3_scale(tv, (gi_rng_next_float(&rng) - 0.5f) * side * 0.9f)));
         gi_vec3 x = gi_v3_add(p, gi_v3_scale(t->n, lift));
-        cssm_receiver rc = {.x = x, .n = t->n, .self = -1, .kd = {GI_PI, GI_PI, GI_PI}}; /* f = 1: irradiance */
+        cssm_receiver rc = {
+            .x = x, .n = t->n, .self = -1, .kd = {GI_PI, GI_PI, GI_PI}}; /* f = 1: irradiance */
         float Ec[3] = {0, 0, 0}, Ep[3] = {0, 0, 0}, Er[3], Eu[3];
         cssm_csm_direct_eval(&d, s, &rc, 0, 1024, n, bias, 0, Ec);
         if (pixel_estimate) /* 16 frames of 16 new points each, averaged */
@@ -179,20 +184,25 @@ static int run(const char *rel, int pixel_estimate, double margin)
         n++;
     }
     const double mean = sum_ref / n;
-    const double e_csm = sqrt(se_csm / n) / mean, e_pix = sqrt(se_pix / n) / mean, e_unsh = sqrt(se_unsh / n) / mean,
-                 e_black = sqrt(se_black / n) / mean;
+    const double e_csm = sqrt(se_csm / n) / mean, e_pix = sqrt(se_pix / n) / mean,
+                 e_unsh = sqrt(se_unsh / n) / mean, e_black = sqrt(se_black / n) / mean;
     const double trivial = e_unsh < e_black ? e_unsh : e_black;
-    printf("%s: %u surface points, %u area-light points (%u cube maps, 6 x 64 x 64, %.0f kB), %s distant CSMs\n", rel,
-           n, d.area_points, d.pts.count, (double)cssm_csm_direct_bytes(&d) / 1e3, d.distant ? "with" : "no");
-    printf("relative RMSE of the direct irradiance against Embree (%d samples): CSM atlas estimate %.4f, "
+    printf("%s: %u surface points, %u area-light points (%u cube maps, 6 x 64 x 64, %.0f kB), %s "
+           "distant CSMs\n",
+           rel, n, d.area_points, d.pts.count, (double)cssm_csm_direct_bytes(&d) / 1e3,
+           d.distant ? "with" : "no");
+    printf("relative RMSE of the direct irradiance against Embree (%d samples): CSM atlas estimate "
+           "%.4f, "
            "per-pixel estimate %s%.4f; unshadowed %.4f, black %.4f; mean %+.2f %%\n",
-           REF_SAMPLES, e_csm, pixel_estimate ? "" : "(not run) ", pixel_estimate ? e_pix : 0.0, e_unsh, e_black,
-           100.0 * (sum_csm / sum_ref - 1.0));
-    CHECK_MSG(e_csm < margin * trivial, "CSM atlas estimate %.4f not below %.1f x the better trivial answer %.4f",
-              e_csm, margin, trivial);
+           REF_SAMPLES, e_csm, pixel_estimate ? "" : "(not run) ", pixel_estimate ? e_pix : 0.0,
+           e_unsh, e_black, 100.0 * (sum_csm / sum_ref - 1.0));
+    CHECK_MSG(e_csm < margin * trivial,
+              "CSM atlas estimate %.4f not below %.1f x the better trivial answer %.4f", e_csm,
+              margin, trivial);
     if (pixel_estimate)
-        CHECK_MSG(e_pix < margin * trivial, "per-pixel estimate %.4f not below %.1f x the better trivial answer %.4f",
-                  e_pix, margin, trivial);
+        CHECK_MSG(e_pix < margin * trivial,
+                  "per-pixel estimate %.4f not below %.1f x the better trivial answer %.4f", e_pix,
+                  margin, trivial);
     CHECK_MSG(fabs(sum_csm / sum_ref - 1.0) < 0.05, "mean irradiance off by %+.2f %%",
               100.0 * (sum_csm / sum_ref - 1.0));
     cssm_csm_direct_free(&d);

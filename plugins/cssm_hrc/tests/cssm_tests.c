@@ -113,13 +113,14 @@ static void check_traversals(const cssm_atlas *a, const char *what)
             missed += !seen[i];
         CHECK_MSG(!twice && !missed, "%s %s: %u visited twice, %u missed", what,
                   cssm_traversal_name((cssm_traversal)how), twice, missed);
-        printf("%s %-7s: %u texels, each once; %u steps leave the chart, %u in-chart steps are not to a "
+        printf("%s %-7s: %u texels, each once; %u steps leave the chart, %u in-chart steps are not "
+               "to a "
                "4-neighbour\n",
                what, cssm_traversal_name((cssm_traversal)how), a->count, chart_changes, jumps);
         /* charts are visited one after the other: each is entered once */
         if (how != CSSM_GREEDY)
-            CHECK_MSG(chart_changes <= a->chart_count, "%s: %u chart changes for %u charts", what, chart_changes,
-                      a->chart_count);
+            CHECK_MSG(chart_changes <= a->chart_count, "%s: %u chart changes for %u charts", what,
+                      chart_changes, a->chart_count);
         /* zig-zag jumps once per row at most (a row broken by a hole); spiral
          * only after stepping back */
         if (how == CSSM_ZIGZAG) {
@@ -129,7 +130,8 @@ static void check_traversals(const cssm_atlas *a, const char *what)
             CHECK_MSG(jumps <= rows, "zig-zag: %u jumps for %u rows", jumps, rows);
         }
         if (how == CSSM_SPIRAL)
-            CHECK_MSG(jumps * 10 <= a->chart_texels, "spiral: %u jumps for %u chart texels (more than 10 %%)", jumps,
+            CHECK_MSG(jumps * 10 <= a->chart_texels,
+                      "spiral: %u jumps for %u chart texels (more than 10 %%)", jumps,
                       a->chart_texels);
         free(seen);
         free(order);
@@ -153,24 +155,27 @@ static int part_traversal(void)
             double texel_area = 0;
             for (uint32_t i = 0; i < a.count; i++)
                 texel_area += a.texels[i].area;
-            printf("%s atlas %u^2: %u texels (%u in %u charts, %u surface samples), coverage %.3f, texel area / "
+            printf("%s atlas %u^2: %u texels (%u in %u charts, %u surface samples), coverage %.3f, "
+                   "texel area / "
                    "surface area %.4f\n",
                    scenes[k], R, a.count, a.chart_texels, a.chart_count, a.count - a.chart_texels,
                    a.covered_area / a.surface_area, texel_area / a.surface_area);
-            CHECK_MSG(fabs(texel_area / a.surface_area - 1.0) < 0.01, "texel areas sum to %.4f of the surface",
-                      texel_area / a.surface_area);
+            CHECK_MSG(fabs(texel_area / a.surface_area - 1.0) < 0.01,
+                      "texel areas sum to %.4f of the surface", texel_area / a.surface_area);
             if (k == 0 && R >= 32)
                 CHECK_MSG(a.chart_count >= 5 && a.chart_texels * 3 > 2 * a.count,
-                          "Cornell box: %u charts, %u of %u texels", a.chart_count, a.chart_texels, a.count);
+                          "Cornell box: %u charts, %u of %u texels", a.chart_count, a.chart_texels,
+                          a.count);
             char what[64];
             snprintf(what, sizeof what, "%s %u^2", k ? "sphere" : "cornell", R);
             check_traversals(&a, what);
             cssm_atlas_free(&a);
             if (k == 0 && R == 32 && cssm_atlas_build(s, 0.0f, R, 1, &a, &err) == GI_OK) {
-                /* no parametrisation: surface samples at the charts' density (the paper's greedy case) */
+                /* no parametrisation: surface samples at the charts' density (the paper's greedy
+                 * case) */
                 printf("%s atlas %u^2, samples only: %u texels\n", scenes[k], R, a.count);
-                CHECK_MSG(a.chart_count == 0 && a.count > 300, "samples only: %u charts, %u texels", a.chart_count,
-                          a.count);
+                CHECK_MSG(a.chart_count == 0 && a.count > 300, "samples only: %u charts, %u texels",
+                          a.chart_count, a.count);
                 check_traversals(&a, "cornell samples");
                 cssm_atlas_free(&a);
             }
@@ -188,7 +193,8 @@ static int decide(uint32_t node, uint32_t salt)
     return (gi_pcg_hash(node * 2654435761u ^ salt) & 3u) != 0;
 }
 
-static void recursive(const cssm_tree *t, int32_t i, uint32_t salt, int full, uint32_t *out, uint32_t *n)
+static void recursive(const cssm_tree *t, int32_t i, uint32_t salt, int full, uint32_t *out,
+                      uint32_t *n)
 {
     const cssm_node *nd = &t->nodes[i];
     if (nd->child >= 0 && (full || decide((uint32_t)i, salt))) {
@@ -224,7 +230,8 @@ static int part_tree(void)
     cssm_atlas a;
     cssm_tree t;
     gi_error err;
-    if (cssm_atlas_build(s, 0.0f, 32, 0, &a, &err) != GI_OK || cssm_tree_build(&a, &t, &err) != GI_OK) {
+    if (cssm_atlas_build(s, 0.0f, 32, 0, &a, &err) != GI_OK ||
+        cssm_tree_build(&a, &t, &err) != GI_OK) {
         fprintf(stderr, "FAIL: %s\n", err.text);
         gi_scene_free(s);
         return 1;
@@ -236,8 +243,8 @@ static int part_tree(void)
         int full = salt == 64;
         recursive(&t, 0, salt, full, x, &nx);
         stackless(&t, salt, full, y, &ny);
-        CHECK_MSG(nx == ny && !memcmp(x, y, nx * sizeof *x), "salt %u: recursive %u nodes, stack-less %u, differ", salt,
-                  nx, ny);
+        CHECK_MSG(nx == ny && !memcmp(x, y, nx * sizeof *x),
+                  "salt %u: recursive %u nodes, stack-less %u, differ", salt, nx, ny);
         if (full)
             CHECK_MSG(nx == a.count, "full traversal: %u leaves of %u", nx, a.count);
     }
@@ -253,8 +260,10 @@ static int part_tree(void)
         }
         area_bad += fabs(area - nd->area) > 1e-4 * area;
     }
-    CHECK_MSG(!outside && !area_bad, "%u texels outside their node's sphere, %u node areas off", outside, area_bad);
-    printf("tree: %u nodes over %u texels; 65 traversals (64 selective, 1 full) equal to the recursive ones\n",
+    CHECK_MSG(!outside && !area_bad, "%u texels outside their node's sphere, %u node areas off",
+              outside, area_bad);
+    printf("tree: %u nodes over %u texels; 65 traversals (64 selective, 1 full) equal to the "
+           "recursive ones\n",
            t.count, a.count);
     free(x);
     free(y);
@@ -333,15 +342,16 @@ static void fixture_close(fixture *f)
 /* A receiver point x on texel i (a random point p of the texel) and the
  * centre of sender j's cube map now: 0 when the two do not face each
  * other (the gathers never ask such pairs). */
-static int fixture_pair(const fixture *f, uint32_t j, uint32_t i, uint32_t *rng, gi_vec3 *p, gi_vec3 *x,
-                        gi_vec3 *eye)
+static int fixture_pair(const fixture *f, uint32_t j, uint32_t i, uint32_t *rng, gi_vec3 *p,
+                        gi_vec3 *x, gi_vec3 *eye)
 {
     const cssm_texel *tj = &f->a.texels[j], *ti = &f->a.texels[i];
     gi_vec3 tu, tv;
     gi_onb(ti->n, &tu, &tv);
     float side = sqrtf(ti->area);
-    *p = gi_v3_add(ti->p, gi_v3_add(gi_v3_scale(tu, (gi_rng_next_float(rng) - 0.5f) * side * 0.9f),
-                                    gi_v3_scale(tv, (gi_rng_next_float(rng) - 0.5f) * side * 0.9f)));
+    *p =
+        gi_v3_add(ti->p, gi_v3_add(gi_v3_scale(tu, (gi_rng_next_float(rng) - 0.5f) * side * 0.9f),
+                                   gi_v3_scale(tv, (gi_rng_next_float(rng) - 0.5f) * side * 0.9f)));
     *x = cssm_receiver_point(&f->m, &f->a, *p, ti->n);
     *eye = cssm_motion_eye(f->m.motion, &f->m, j);
     gi_vec3 d = gi_v3_sub(*x, *eye);
@@ -390,17 +400,21 @@ static int part_visibility(void)
     }
     double rate = (double)agree / tried, rate_pcf = (double)agree_pcf / tried;
     double always = (double)visible / tried, never = 1.0 - always;
-    printf("visibility (Cornell box, atlas 32^2, 6 x 32 x 32, spiral, %d facing pairs): CSSM agrees with Embree on "
-           "%.2f %% (PCF, thresholded at 1/2: %.2f %%); always-visible %.2f %%, never-visible %.2f %%\n",
+    printf("visibility (Cornell box, atlas 32^2, 6 x 32 x 32, spiral, %d facing pairs): CSSM "
+           "agrees with Embree on "
+           "%.2f %% (PCF, thresholded at 1/2: %.2f %%); always-visible %.2f %%, never-visible %.2f "
+           "%%\n",
            tried, 100 * rate, 100 * rate_pcf, 100 * always, 100 * never);
-    printf("errors: %.2f %% lit where Embree finds an occluder, %.2f %% shadowed where it finds none\n",
+    printf("errors: %.2f %% lit where Embree finds an occluder, %.2f %% shadowed where it finds "
+           "none\n",
            100.0 * false_lit / tried, 100.0 * false_shadow / tried);
     double trivial = always > never ? always : never;
     /* measured 95.3 % (PCF 95.9 %) against 68.8 % for always-visible: the
      * misses are split between both kinds, the discretisation of 32 x 32
      * faces and of the atlas (Fig. 14) */
     CHECK_MSG(rate >= 0.94, "CSSM agreement %.4f below 0.94", rate);
-    CHECK_MSG(rate >= trivial + 0.20, "CSSM agreement %.4f not 20 points above the best trivial answer %.4f", rate,
+    CHECK_MSG(rate >= trivial + 0.20,
+              "CSSM agreement %.4f not 20 points above the best trivial answer %.4f", rate,
               trivial);
     CHECK_MSG(rate_pcf >= 0.94, "PCF agreement %.4f below 0.94", rate_pcf);
     fixture_close(&f);
@@ -418,7 +432,8 @@ static void box_points(float h, float *pts)
         pts[3 * k + 1] = (k & 2) ? h : -h;
         pts[3 * k + 2] = (k & 4) ? h : -h;
     }
-    float inner[7][3] = {{0, 0, 0}, {h, 0, 0}, {-h, 0, 0}, {0, h, 0}, {0, -h, 0}, {0, 0, h}, {0, 0, -h}};
+    float inner[7][3] = {{0, 0, 0},  {h, 0, 0}, {-h, 0, 0}, {0, h, 0},
+                         {0, -h, 0}, {0, 0, h}, {0, 0, -h}};
     memcpy(pts + 24, inner, sizeof inner);
 }
 
@@ -438,7 +453,8 @@ static int part_hull(void)
         fprintf(stderr, "FAIL: %s\n", err.text);
         return 1;
     }
-    CHECK_MSG(box.vertex_count == 8, "box hull: %u vertices, expected its 8 corners", box.vertex_count);
+    CHECK_MSG(box.vertex_count == 8, "box hull: %u vertices, expected its 8 corners",
+              box.vertex_count);
     CHECK_MSG(box.face_count == 12, "box hull: %u faces, expected 12 triangles", box.face_count);
     CHECK_MSG(gi_hull_contains(&box, gi_v3(0.49f, -0.49f, 0.2f), 0.0f) &&
                   !gi_hull_contains(&box, gi_v3(0.51f, 0, 0), 0.0f),
@@ -449,18 +465,19 @@ static int part_hull(void)
     struct {
         float dx, dy, dz, gap; /* gap: the exact distance (0 when they overlap or touch) */
         int overlap;
-    } cases[] = {{0.5f, 0.3f, 0.2f, 0.0f, 1},   {0.999f, 0.0f, 0.0f, 0.0f, 1}, {1.0f, 1.0f, 1.0f, 0.0f, 1},
-                 {1.001f, 0.0f, 0.0f, 1e-3f, 0}, {0.0f, -1.001f, 0.5f, 1e-3f, 0}, {2.0f, 0.0f, 0.0f, 1.0f, 0},
+    } cases[] = {{0.5f, 0.3f, 0.2f, 0.0f, 1},          {0.999f, 0.0f, 0.0f, 0.0f, 1},
+                 {1.0f, 1.0f, 1.0f, 0.0f, 1},          {1.001f, 0.0f, 0.0f, 1e-3f, 0},
+                 {0.0f, -1.001f, 0.5f, 1e-3f, 0},      {2.0f, 0.0f, 0.0f, 1.0f, 0},
                  {1.001f, 1.001f, 0.0f, 1.4142e-3f, 0}};
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         translate(M, cases[k].dx, cases[k].dy, cases[k].dz);
         int o = gi_hull_overlap(&box, I, &box, M, 0.0f);
         double d = gi_hull_distance(&box, I, &box, M);
-        CHECK_MSG(o == cases[k].overlap, "boxes at (%g, %g, %g): overlap %d, expected %d", cases[k].dx, cases[k].dy,
-                  cases[k].dz, o, cases[k].overlap);
+        CHECK_MSG(o == cases[k].overlap, "boxes at (%g, %g, %g): overlap %d, expected %d",
+                  cases[k].dx, cases[k].dy, cases[k].dz, o, cases[k].overlap);
         CHECK_MSG(fabs(d - cases[k].gap) <= 1e-5 + 1e-4 * cases[k].gap,
-                  "boxes at (%g, %g, %g): distance %.7g, expected %.7g", cases[k].dx, cases[k].dy, cases[k].dz, d,
-                  cases[k].gap);
+                  "boxes at (%g, %g, %g): distance %.7g, expected %.7g", cases[k].dx, cases[k].dy,
+                  cases[k].dz, d, cases[k].gap);
     }
     /* a box turned 45 degrees about z: its edge reaches 0.5 sqrt(2) from its centre */
     float R[16], T[16];
@@ -470,7 +487,8 @@ static int part_hull(void)
         gi_mat4_trs(T, t, q, one);
         memcpy(R, T, sizeof R);
         int o = gi_hull_overlap(&box, I, &box, R, 0.0f);
-        CHECK_MSG(o == (side < 0), "turned box %s by 1e-3: overlap %d", side < 0 ? "reaching in" : "short", o);
+        CHECK_MSG(o == (side < 0), "turned box %s by 1e-3: overlap %d",
+                  side < 0 ? "reaching in" : "short", o);
     }
     /* a flat set (a quad): qhull is asked again with joggled input */
     float quad[12] = {-1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1};
@@ -483,7 +501,8 @@ static int part_hull(void)
     translate(M, 0.2f, 0.501f, 0.1f);
     CHECK_MSG(!gi_hull_overlap(&flat, I, &box, M, 0.0f), "box 1e-3 above a quad: overlap");
     translate(M, 0.2f, 0.499f, 0.1f);
-    CHECK_MSG(gi_hull_overlap(&flat, I, &box, M, 0.0f), "box reaching 1e-3 through a quad: no overlap");
+    CHECK_MSG(gi_hull_overlap(&flat, I, &box, M, 0.0f),
+              "box reaching 1e-3 through a quad: no overlap");
     /* point clouds on spheres (radii r1, r2): hulls lie inside the spheres and,
      * with 400 points, hold the concentric spheres of 0.9 r */
     uint32_t rng = gi_rng_init(3, 0, 0x411u);
@@ -494,16 +513,20 @@ static int part_hull(void)
         float rr[2] = {r1, r2};
         for (int c = 0; c < 2; c++)
             for (int k = 0; k < 400; k++) {
-                gi_vec3 w = gi_sample_uniform_sphere(gi_rng_next_float(&rng), gi_rng_next_float(&rng));
-                cloud[c][3 * k] = rr[c] * w.x, cloud[c][3 * k + 1] = rr[c] * w.y, cloud[c][3 * k + 2] = rr[c] * w.z;
+                gi_vec3 w =
+                    gi_sample_uniform_sphere(gi_rng_next_float(&rng), gi_rng_next_float(&rng));
+                cloud[c][3 * k] = rr[c] * w.x, cloud[c][3 * k + 1] = rr[c] * w.y,
+                             cloud[c][3 * k + 2] = rr[c] * w.z;
             }
         gi_hull h1, h2;
-        if (gi_hull_build(cloud[0], 400, &h1, &err) != GI_OK || gi_hull_build(cloud[1], 400, &h2, &err) != GI_OK) {
+        if (gi_hull_build(cloud[0], 400, &h1, &err) != GI_OK ||
+            gi_hull_build(cloud[1], 400, &h2, &err) != GI_OK) {
             fprintf(stderr, "FAIL: cloud: %s\n", err.text);
             return 1;
         }
         gi_vec3 dir = gi_sample_uniform_sphere(gi_rng_next_float(&rng), gi_rng_next_float(&rng));
-        /* centres apart by more than r1 + r2 (separated) or less than 0.9 (r1 + r2) (overlapping) */
+        /* centres apart by more than r1 + r2 (separated) or less than 0.9 (r1 + r2) (overlapping)
+         */
         int sep = trial & 1;
         float dist = sep ? (r1 + r2) * (1.0f + 0.001f + 0.3f * gi_rng_next_float(&rng))
                          : 0.9f * (r1 + r2) * (1.0f - 0.001f - 0.9f * gi_rng_next_float(&rng));
@@ -514,20 +537,21 @@ static int part_hull(void)
         gi_hull_free(&h1);
         gi_hull_free(&h2);
     }
-    printf("hull: box 8 vertices / 12 faces; 7 box pairs and 2 turned-box pairs (gaps 1e-3) right; quad +-1e-3 right; "
+    printf("hull: box 8 vertices / 12 faces; 7 box pairs and 2 turned-box pairs (gaps 1e-3) right; "
+           "quad +-1e-3 right; "
            "%d of %d sphere-cloud pairs wrong\n",
            wrong, n);
     CHECK_MSG(wrong == 0, "%d of %d sphere-cloud pairs judged wrong", wrong, n);
     /* bad input: a clear error, no crash */
     float bad[3] = {0.0f, NAN, 0.0f};
     gi_hull none;
-    CHECK_MSG(gi_hull_build(bad, 1, &none, &err) == GI_ERR_INVALID_ARGUMENT, "a NaN point accepted");
+    CHECK_MSG(gi_hull_build(bad, 1, &none, &err) == GI_ERR_INVALID_ARGUMENT,
+              "a NaN point accepted");
     CHECK_MSG(gi_hull_build(NULL, 0, &none, &err) == GI_ERR_INVALID_ARGUMENT, "no points accepted");
     gi_hull_free(&flat);
     gi_hull_free(&box);
     return 0;
 }
-
 
 /* --------------------------------------------------------------- motion */
 
@@ -545,14 +569,16 @@ static int segment_near(gi_vec3 a, gi_vec3 b, gi_vec3 c, float r)
  * prepare() makes at t0 (cssm_hrc.c build_moving: the static CSSM without
  * the movers, each mover's CSSM and CSM); the movers are left at t0.
  * Prints each mover's way under `tag`. 0 on success. */
-static int motion_open(fixture *f, const char *rel, uint32_t movers, float t0, float t1, const char *tag)
+static int motion_open(fixture *f, const char *rel, uint32_t movers, float t0, float t1,
+                       const char *tag)
 {
     if (fixture_open(f, rel, t0, t1))
         return 1;
     uint32_t animated = 0;
     cssm_motion_find(f->s, &animated);
     if (animated != movers || movers > MOTION_MAX_MOVERS) {
-        fprintf(stderr, "FAIL: set-up: %s has %u animated objects, expected %u\n", rel, animated, movers);
+        fprintf(stderr, "FAIL: set-up: %s has %u animated objects, expected %u\n", rel, animated,
+                movers);
         return 1;
     }
     gi_error err = {0};
@@ -580,8 +606,9 @@ static int motion_open(fixture *f, const char *rel, uint32_t movers, float t0, f
         f->c0[k] = gi_mat4_point(T, gi_v3(sph[0], sph[1], sph[2]));
         gi_scene_object_transform(f->s, o, t1, T);
         f->c1[k] = gi_mat4_point(T, gi_v3(sph[0], sph[1], sph[2]));
-        printf("%s: mover %u '%s' moves %.3f (radius %.3f) from t = %g to %g s\n", tag, k, f->s->objects[o].name,
-               gi_v3_length(gi_v3_sub(f->c1[k], f->c0[k])), f->radius[k], t0, t1);
+        printf("%s: mover %u '%s' moves %.3f (radius %.3f) from t = %g to %g s\n", tag, k,
+               f->s->objects[o].name, gi_v3_length(gi_v3_sub(f->c1[k], f->c0[k])), f->radius[k], t0,
+               t1);
     }
     return 0;
 }
@@ -607,7 +634,8 @@ static int motion_near(const fixture *f, gi_vec3 eye, gi_vec3 x)
 {
     int near = 0;
     for (uint32_t k = 0; k < f->mo.mover_count; k++)
-        near |= segment_near(eye, x, f->c1[k], f->radius[k]) || segment_near(eye, x, f->c0[k], f->radius[k]);
+        near |= segment_near(eye, x, f->c1[k], f->radius[k]) ||
+                segment_near(eye, x, f->c0[k], f->radius[k]);
     return near;
 }
 
@@ -615,8 +643,8 @@ static int motion_near(const fixture *f, gi_vec3 eye, gi_vec3 x)
  * other pair as a pixel through its proxy texel, the rest as texel
  * receivers) against Embree on the moved scene, and the unmoved scene's
  * exact visibility. */
-static void motion_judge(const fixture *f, motion_tally *t, int kind, uint32_t j, uint32_t i, gi_vec3 p,
-                         gi_vec3 x, gi_vec3 eye)
+static void motion_judge(const fixture *f, motion_tally *t, int kind, uint32_t j, uint32_t i,
+                         gi_vec3 p, gi_vec3 x, gi_vec3 eye)
 {
     const cssm_texel *ti = &f->a.texels[i];
     const float bias = 0.004f * f->a.diameter;
@@ -650,38 +678,45 @@ static void motion_judge(const fixture *f, motion_tally *t, int kind, uint32_t j
  * the sample reaches 200 times. */
 static void motion_report(const char *tag, const motion_tally *t, int pairs)
 {
-    static const char *const kind_name[MOTION_KINDS] = {"static-static", "mover sender", "mover receiver",
-                                                        "one mover", "two movers"};
-    double rate = (double)t->agree / t->tried, always = (double)t->visible / t->tried, never = 1.0 - always;
+    static const char *const kind_name[MOTION_KINDS] = {
+        "static-static", "mover sender", "mover receiver", "one mover", "two movers"};
+    double rate = (double)t->agree / t->tried, always = (double)t->visible / t->tried,
+           never = 1.0 - always;
     double stale = (double)t->unmoved / t->tried;
     double rate_aff = t->affected ? (double)t->agree_aff / t->affected : 0.0;
     double always_aff = t->affected ? (double)t->vis_aff / t->affected : 0.0;
-    printf("%s: %d facing pairs near a mover: agreement with Embree on the moved scene %.2f %%; always-visible "
+    printf("%s: %d facing pairs near a mover: agreement with Embree on the moved scene %.2f %%; "
+           "always-visible "
            "%.2f %%, never-visible %.2f %%, the unmoved scene's exact visibility %.2f %%\n",
            tag, t->tried, 100 * rate, 100 * always, 100 * never, 100 * stale);
-    printf("%s: on the %d pairs whose visibility the motion changed: %.2f %% (always-visible %.2f %%, "
-           "never-visible %.2f %%, unmoved 0 %%)\n",
-           tag, t->affected, 100 * rate_aff, 100 * always_aff, 100 * (1.0 - always_aff));
+    printf(
+        "%s: on the %d pairs whose visibility the motion changed: %.2f %% (always-visible %.2f %%, "
+        "never-visible %.2f %%, unmoved 0 %%)\n",
+        tag, t->affected, 100 * rate_aff, 100 * always_aff, 100 * (1.0 - always_aff));
     for (int k = 0; k < MOTION_KINDS; k++) {
         if (!t->kinds[k])
             continue;
-        double rk = (double)t->kind_agree[k] / t->kinds[k], ak = (double)t->kind_vis[k] / t->kinds[k];
-        printf("%s: %-14s %5d pairs: %.2f %% (always-visible %.2f %%, never-visible %.2f %%)\n", tag, kind_name[k],
-               t->kinds[k], 100 * rk, 100 * ak, 100 * (1.0 - ak));
+        double rk = (double)t->kind_agree[k] / t->kinds[k],
+               ak = (double)t->kind_vis[k] / t->kinds[k];
+        printf("%s: %-14s %5d pairs: %.2f %% (always-visible %.2f %%, never-visible %.2f %%)\n",
+               tag, kind_name[k], t->kinds[k], 100 * rk, 100 * ak, 100 * (1.0 - ak));
         /* every case of the combination (motion.h) that the sample reaches often enough */
         if (t->kinds[k] >= 200)
-            CHECK_MSG(rk >= fmax(ak, 1.0 - ak) + 0.10, "%s: agreement %.4f not 10 points above the best trivial answer",
+            CHECK_MSG(rk >= fmax(ak, 1.0 - ak) + 0.10,
+                      "%s: agreement %.4f not 10 points above the best trivial answer",
                       kind_name[k], rk);
     }
     double trivial = fmax(fmax(always, never), stale);
     CHECK_MSG(t->tried == pairs, "only %d pairs found", t->tried);
     CHECK_MSG(rate >= 0.90, "agreement %.4f below 0.90", rate);
-    CHECK_MSG(rate >= trivial + MOTION_MARGIN, "agreement %.4f not %.2f above the best trivial answer %.4f", rate,
-              MOTION_MARGIN, trivial);
-    CHECK_MSG(t->affected >= 100, "only %d pairs changed with the motion: the test cannot judge", t->affected);
+    CHECK_MSG(rate >= trivial + MOTION_MARGIN,
+              "agreement %.4f not %.2f above the best trivial answer %.4f", rate, MOTION_MARGIN,
+              trivial);
+    CHECK_MSG(t->affected >= 100, "only %d pairs changed with the motion: the test cannot judge",
+              t->affected);
     CHECK_MSG(rate_aff >= fmax(always_aff, 1.0 - always_aff) + MOTION_MARGIN_AFFECTED,
-              "on the changed pairs agreement %.4f not %.2f above the best trivial answer", rate_aff,
-              MOTION_MARGIN_AFFECTED);
+              "on the changed pairs agreement %.4f not %.2f above the best trivial answer",
+              rate_aff, MOTION_MARGIN_AFFECTED);
 }
 
 /* §3.3 with one mover: the moving Cornell box, everything made at t0, the
@@ -699,8 +734,8 @@ static int part_motion(void)
     }
     cssm_motion_place(&f.mo, f.s, t1, &f.a);
     uint32_t bad = cssm_motion_check(&f.mo, f.s, t1);
-    printf("motion: at t = %g s the bunny's hull overlaps %u hulls, %u objects reach into it%s%s\n", t1,
-           f.mo.overlaps, bad, bad ? ": " : "", f.mo.what);
+    printf("motion: at t = %g s the bunny's hull overlaps %u hulls, %u objects reach into it%s%s\n",
+           t1, f.mo.overlaps, bad, bad ? ": " : "", f.mo.what);
     CHECK_MSG(bad == 0, "the hull condition fails in the test scene: %s", f.mo.what);
     const int pairs = 6000;
     motion_tally t = {0};
@@ -722,10 +757,10 @@ static int part_motion(void)
 }
 
 /* Two moving objects (§3.3 for every object): the bunny and a box of
- * plugins/cssm_hrc/data/cornell_moving2.gltf (plugins/cssm_hrc/data/make_cornell_moving2.py), everything made at t0, both moved to t1
- * by cssm_motion_place alone, facing texel / point pairs that a mover can
- * matter to against Embree on the moved scene; the per-pair hull check,
- * also with the box put onto the bunny. */
+ * plugins/cssm_hrc/data/cornell_moving2.gltf (plugins/cssm_hrc/data/make_cornell_moving2.py),
+ * everything made at t0, both moved to t1 by cssm_motion_place alone, facing texel / point pairs
+ * that a mover can matter to against Embree on the moved scene; the per-pair hull check, also with
+ * the box put onto the bunny. */
 static int part_motion2(void)
 {
     const float t0 = 0.0f, t1 = 1.6f; /* the tall block then hides the box from part of the bunny */
@@ -737,8 +772,8 @@ static int part_motion2(void)
     cssm_motion *mo = &f.mo;
     cssm_motion_place(mo, f.s, t1, &f.a);
     uint32_t bad = cssm_motion_check(mo, f.s, t1);
-    printf("motion2: at t = %g s %u of %u object pairs with a mover overlap, %u intrude%s%s\n", t1, mo->overlaps,
-           mo->pair_count, bad, bad ? ": " : "", mo->what);
+    printf("motion2: at t = %g s %u of %u object pairs with a mover overlap, %u intrude%s%s\n", t1,
+           mo->overlaps, mo->pair_count, bad, bad ? ": " : "", mo->what);
     CHECK_MSG(bad == 0, "the hull condition fails in the test scene: %s", mo->what);
     CHECK_MSG(mo->pair_count == 2 * (f.s->object_count - 2) + 1, "%u pairs", mo->pair_count);
     const int pairs = 6000;
@@ -753,8 +788,10 @@ static int part_motion2(void)
         if (between) {
             uint32_t oj = mo->movers[gi_rng_next_u32(&rng) & 1].object;
             uint32_t oi = mo->movers[0].object + mo->movers[1].object - oj;
-            j = mo->obj_texels[mo->obj_first[oj] + gi_rng_next_u32(&rng) % (mo->obj_first[oj + 1] - mo->obj_first[oj])];
-            i = mo->obj_texels[mo->obj_first[oi] + gi_rng_next_u32(&rng) % (mo->obj_first[oi + 1] - mo->obj_first[oi])];
+            j = mo->obj_texels[mo->obj_first[oj] +
+                               gi_rng_next_u32(&rng) % (mo->obj_first[oj + 1] - mo->obj_first[oj])];
+            i = mo->obj_texels[mo->obj_first[oi] +
+                               gi_rng_next_u32(&rng) % (mo->obj_first[oi + 1] - mo->obj_first[oi])];
         }
         gi_vec3 p, x, eye;
         if (i == j || !fixture_pair(&f, j, i, &rng, &p, &x, &eye))
@@ -775,18 +812,22 @@ static int part_motion2(void)
         if (mo->object_moves[mo->pairs[k].a] && mo->object_moves[mo->pairs[k].b])
             mover_pair = k;
     }
-    CHECK_MSG(mover_pair < np && !mo->pairs[mover_pair].overlap, "the two movers' pair is missing or overlaps at t1");
+    CHECK_MSG(mover_pair < np && !mo->pairs[mover_pair].overlap,
+              "the two movers' pair is missing or overlaps at t1");
     memcpy(mo->movers[1].T, mo->movers[0].T, sizeof mo->movers[1].T);
     bad = cssm_motion_check(mo, f.s, t1);
-    printf("motion2: the box put onto the bunny: %u pairs overlap, %u intrude: %s\n", mo->overlaps, bad, mo->what);
+    printf("motion2: the box put onto the bunny: %u pairs overlap, %u intrude: %s\n", mo->overlaps,
+           bad, mo->what);
     CHECK_MSG(mover_pair < np && mo->pairs[mover_pair].overlap && mo->pairs[mover_pair].intrusion,
               "the overlapping movers are not reported");
     for (uint32_t k = 0; k < np; k++) {
-        if (k == mover_pair || mo->object_moves[mo->pairs[k].a] + mo->object_moves[mo->pairs[k].b] != 1)
+        if (k == mover_pair ||
+            mo->object_moves[mo->pairs[k].a] + mo->object_moves[mo->pairs[k].b] != 1)
             continue;
         /* a pair of a static object and the bunny keeps its state */
         if (mo->mover_of[mo->pairs[k].a] == 0 || mo->mover_of[mo->pairs[k].b] == 0)
-            CHECK_MSG(before_state[k] == (mo->pairs[k].overlap | mo->pairs[k].intrusion << 1), "pair %u changed", k);
+            CHECK_MSG(before_state[k] == (mo->pairs[k].overlap | mo->pairs[k].intrusion << 1),
+                      "pair %u changed", k);
     }
     fixture_close(&f);
     return 0;
@@ -806,7 +847,8 @@ static int part_furnace(int compact)
     cssm_tree t;
     gi_error err;
     cssm_ctree ct = {0};
-    if (cssm_atlas_build(s, 0.0f, 24, 0, &a, &err) != GI_OK || cssm_tree_build(&a, &t, &err) != GI_OK ||
+    if (cssm_atlas_build(s, 0.0f, 24, 0, &a, &err) != GI_OK ||
+        cssm_tree_build(&a, &t, &err) != GI_OK ||
         (compact && cssm_ctree_build(&t, &a, &ct, &err) != GI_OK)) {
         fprintf(stderr, "FAIL: %s\n", err.text);
         return 1;
@@ -819,12 +861,15 @@ static int part_furnace(int compact)
     }
     const double rho = 0.5, Le = 1.0;
     float *L = malloc(3 * a.count * sizeof *L), *NL = malloc(3 * t.count * sizeof *NL);
-    cssm_gather_opts o = {.threshold = 0.1f, .max_cut = 1024, /* the plugin's defaults */ .clamp = 0.02f * a.diameter,
+    cssm_gather_opts o = {.threshold = 0.1f,
+                          .max_cut = 1024,
+                          /* the plugin's defaults */ .clamp = 0.02f * a.diameter,
                           .bias = 0.004f * a.diameter};
     printf("furnace: %u surface samples on the sphere\n", a.count);
     for (uint32_t n = 1; n <= 3; n++) {
         cssm_gather_stats st = {0};
-        if (cssm_solve_ex(&t, compact ? &ct : NULL, &a, &m, &o, n, NULL, NULL, L, NL, &st, &err) != GI_OK) {
+        if (cssm_solve_ex(&t, compact ? &ct : NULL, &a, &m, &o, n, NULL, NULL, L, NL, &st, &err) !=
+            GI_OK) {
             fprintf(stderr, "FAIL: %s\n", err.text);
             return 1;
         }
@@ -845,7 +890,8 @@ static int part_furnace(int compact)
         const int P = 200;
         for (int k = 0; k < P; k++) {
             const cssm_texel *x = &a.texels[gi_rng_next_u32(&rng) % a.count];
-            cssm_receiver rc = {.x = cssm_receiver_point(&m, &a, x->p, x->n), .n = x->n, .self = -1, .glossy = 1};
+            cssm_receiver rc = {
+                .x = cssm_receiver_point(&m, &a, x->p, x->n), .n = x->n, .self = -1, .glossy = 1};
             for (int c = 0; c < 3; c++)
                 rc.kd[c] = (float)rho;
             rc.wo = x->n;
@@ -857,12 +903,15 @@ static int part_furnace(int compact)
             pmean += Le + (out[0] + out[1] + out[2]) / 3.0;
         }
         pmean /= P;
-        printf("furnace%s n = %u: atlas mean %.4f (expected %.4f, %+.2f %%, worst texel %.2f %%), final gather %.4f "
+        printf("furnace%s n = %u: atlas mean %.4f (expected %.4f, %+.2f %%, worst texel %.2f %%), "
+               "final gather %.4f "
                "(expected %.4f, %+.2f %%); emission only %+.1f %%, black -100 %%; mean cut %.1f\n",
-               how, n, mean, atlas_expect, 100 * (mean / atlas_expect - 1), 100 * worst, pmean, pixel_expect,
-               100 * (pmean / pixel_expect - 1), 100 * (Le / pixel_expect - 1), (double)st.nodes / st.receivers);
+               how, n, mean, atlas_expect, 100 * (mean / atlas_expect - 1), 100 * worst, pmean,
+               pixel_expect, 100 * (pmean / pixel_expect - 1), 100 * (Le / pixel_expect - 1),
+               (double)st.nodes / st.receivers);
         CHECK_MSG(fabs(mean / atlas_expect - 1) <= 0.02, "n = %u: atlas off by more than 2 %%", n);
-        CHECK_MSG(fabs(pmean / pixel_expect - 1) <= 0.02, "n = %u: final gather off by more than 2 %%", n);
+        CHECK_MSG(fabs(pmean / pixel_expect - 1) <= 0.02,
+                  "n = %u: final gather off by more than 2 %%", n);
         if (compact) /* the Monte Carlo gather reads no hierarchy */
             continue;
         /* the same final gather by Monte Carlo from the atlas as a pdf (Sec. 4.6) */
@@ -871,7 +920,8 @@ static int part_furnace(int compact)
         cssm_pdf_build(&a, L, cdf);
         for (int k = 0; k < P; k++) {
             const cssm_texel *x = &a.texels[gi_rng_next_u32(&rng) % a.count];
-            cssm_receiver rc = {.x = cssm_receiver_point(&m, &a, x->p, x->n), .n = x->n, .self = -1};
+            cssm_receiver rc = {
+                .x = cssm_receiver_point(&m, &a, x->p, x->n), .n = x->n, .self = -1};
             for (int c = 0; c < 3; c++)
                 rc.kd[c] = (float)rho;
             cssm_gather_opts om = o;
@@ -882,9 +932,11 @@ static int part_furnace(int compact)
         }
         mc /= P;
         free(cdf);
-        printf("furnace n = %u: Monte Carlo final gather (64 texels x %d receivers) %.4f (%+.2f %%)\n", n, P, mc,
-               100 * (mc / pixel_expect - 1));
-        CHECK_MSG(fabs(mc / pixel_expect - 1) <= 0.02, "n = %u: Monte Carlo final gather off by more than 2 %%", n);
+        printf(
+            "furnace n = %u: Monte Carlo final gather (64 texels x %d receivers) %.4f (%+.2f %%)\n",
+            n, P, mc, 100 * (mc / pixel_expect - 1));
+        CHECK_MSG(fabs(mc / pixel_expect - 1) <= 0.02,
+                  "n = %u: Monte Carlo final gather off by more than 2 %%", n);
     }
     cssm_ctree_free(&ct);
     free(L);
@@ -958,13 +1010,17 @@ static int part_texture(void)
         ref_area += A;
     }
     double mean = area > 0 ? sum / area : 0.0, want = ref_area > 0 ? ref / ref_area : 0.0;
-    printf("texture: %u textured texels, albedo (green) %.3f .. %.3f, area mean %.4f; random points %.4f (%+.2f %%); "
+    printf("texture: %u textured texels, albedo (green) %.3f .. %.3f, area mean %.4f; random "
+           "points %.4f (%+.2f %%); "
            "the untextured factor %.3f (%+.1f %%)\n",
-           textured, lo, hi, mean, want, 100.0 * (mean / want - 1.0), factor, 100.0 * (factor / want - 1.0));
+           textured, lo, hi, mean, want, 100.0 * (mean / want - 1.0), factor,
+           100.0 * (factor / want - 1.0));
     CHECK_MSG(textured >= 100, "only %u textured texels", textured);
     CHECK_MSG(hi > lo + 0.2f, "the checker does not show in the atlas (%.3f .. %.3f)", lo, hi);
-    CHECK_MSG(fabs(mean / want - 1.0) <= 0.05, "mean textured albedo %.4f, random points %.4f", mean, want);
-    CHECK_MSG(fabs(factor / want - 1.0) > 0.5, "the test cannot tell: the factor is near the textured mean");
+    CHECK_MSG(fabs(mean / want - 1.0) <= 0.05, "mean textured albedo %.4f, random points %.4f",
+              mean, want);
+    CHECK_MSG(fabs(factor / want - 1.0) > 0.5,
+              "the test cannot tell: the factor is near the textured mean");
     cssm_atlas_free(&a);
     gi_scene_free(s);
     return 0;
@@ -976,14 +1032,23 @@ static int part_texture(void)
 static cssm_node_view float_view(const cssm_tree *t, int32_t i)
 {
     const cssm_node *nd = &t->nodes[i];
-    cssm_node_view v = {.c = nd->c, .r = nd->r, .p = nd->centroid, .n = nd->n, .cos_cone = nd->cos_cone,
-                        .area = nd->area, .child = nd->child, .skip = nd->skip, .first = nd->first,
-                        .count = nd->count, .rep = nd->rep};
+    cssm_node_view v = {.c = nd->c,
+                        .r = nd->r,
+                        .p = nd->centroid,
+                        .n = nd->n,
+                        .cos_cone = nd->cos_cone,
+                        .area = nd->area,
+                        .child = nd->child,
+                        .skip = nd->skip,
+                        .first = nd->first,
+                        .count = nd->count,
+                        .rep = nd->rep};
     return v;
 }
 
 /* The skip-pointer traversal of part_tree over packed nodes. */
-static void stackless_compact(const cssm_ctree *ct, uint32_t salt, int full, uint32_t *out, uint32_t *n)
+static void stackless_compact(const cssm_ctree *ct, uint32_t salt, int full, uint32_t *out,
+                              uint32_t *n)
 {
     int32_t i = 0;
     while (i >= 0) {
@@ -1033,7 +1098,8 @@ static int part_compact(void)
     ct.iscale = 3.0f;
     const float rstep = powf(r_hi / r_lo, 1.0f / 255.0f), astep = logf(a_hi / a_lo) / 255.0f;
     uint32_t rng = gi_rng_init(7, 0, 0xc0au);
-    uint32_t bad_c = 0, bad_r = 0, loose_r = 0, bad_n = 0, bad_k = 0, loose_k = 0, bad_a = 0, bad_i = 0, bad_p = 0;
+    uint32_t bad_c = 0, bad_r = 0, loose_r = 0, bad_n = 0, bad_k = 0, loose_k = 0, bad_a = 0,
+             bad_i = 0, bad_p = 0;
     float max_n = 0.0f, max_i = 0.0f, max_dk = 0.0f;
     double bias_i = 0.0;
     uint32_t bias_n = 0;
@@ -1045,11 +1111,13 @@ static int part_compact(void)
         v.c = gi_v3(p[0], p[1], p[2]);
         v.r = rnd_log(&rng, r_lo, r_hi * 0.5f);
         v.n = gi_sample_uniform_sphere(gi_rng_next_float(&rng), gi_rng_next_float(&rng));
-        v.cos_cone = (i % 7) == 0 ? -1.0f : 1.0f - 2.0f * gi_rng_next_float(&rng) * gi_rng_next_float(&rng);
+        v.cos_cone =
+            (i % 7) == 0 ? -1.0f : 1.0f - 2.0f * gi_rng_next_float(&rng) * gi_rng_next_float(&rng);
         v.area = rnd_log(&rng, a_lo, a_hi);
         float mag = ct.iscale * exp2f(-40.0f + 42.0f * gi_rng_next_float(&rng));
         for (int k = 0; k < 3; k++)
-            v.I[k] = (gi_pcg_hash(i * 3u + (uint32_t)k) % 5u) == 0 ? 0.0f : mag * gi_rng_next_float(&rng);
+            v.I[k] = (gi_pcg_hash(i * 3u + (uint32_t)k) % 5u) == 0 ? 0.0f
+                                                                   : mag * gi_rng_next_float(&rng);
         v.child = (i % 5) == 0 ? -1 : (int32_t)(gi_rng_next_u32(&rng) % CSSM_COMPACT_MAX_NODES);
         v.skip = (i % 3) == 0 ? -1 : (int32_t)(gi_rng_next_u32(&rng) % CSSM_COMPACT_MAX_NODES);
         if (i == 1)
@@ -1090,22 +1158,26 @@ static int part_compact(void)
         bad_p += d.child != v.child || d.skip != v.skip;
     }
     CHECK_MSG(!bad_c, "%u centres off by more than half a step", bad_c);
-    CHECK_MSG(!bad_r && !loose_r, "radius: %u smaller than the true sphere needs, %u more than one code larger", bad_r,
+    CHECK_MSG(!bad_r && !loose_r,
+              "radius: %u smaller than the true sphere needs, %u more than one code larger", bad_r,
               loose_r);
     CHECK_MSG(!bad_n, "%u normals off by more than 1e-3 rad", bad_n);
-    CHECK_MSG(!bad_k && !loose_k, "cone: %u narrower than the true cone, %u more than one code wider", bad_k, loose_k);
+    CHECK_MSG(!bad_k && !loose_k,
+              "cone: %u narrower than the true cone, %u more than one code wider", bad_k, loose_k);
     CHECK_MSG(!bad_a, "%u areas off by more than half a log step", bad_a);
     CHECK_MSG(!bad_i, "%u intensity channels off by more than 1/31.5 of the largest", bad_i);
     CHECK_MSG(!bad_p, "%u pointers changed", bad_p);
     /* the dithered rounding: a mean signed error within a few standard
      * errors of 0 (one step is at most 1/31.5, a uniform error's sd 1/109) */
     bias_i /= bias_n;
-    CHECK_MSG(fabs(bias_i) < 4.0 / (109.0 * sqrt((double)bias_n)) + 1e-4, "intensity rounding biased by %.5f", bias_i);
-    printf(
-        "compact: %u random nodes: normal error at most %.2e rad (%.4f deg), cone widened by at most %.4f rad, "
-        "intensity error at most %.4f of the largest channel (mean signed %+.5f), radius step x%.4f, area step x%.4f\n",
-        N, (double)max_n, (double)max_n * 180.0 / GI_PI, (double)max_dk, (double)max_i, bias_i, (double)rstep,
-        (double)expf(astep));
+    CHECK_MSG(fabs(bias_i) < 4.0 / (109.0 * sqrt((double)bias_n)) + 1e-4,
+              "intensity rounding biased by %.5f", bias_i);
+    printf("compact: %u random nodes: normal error at most %.2e rad (%.4f deg), cone widened by at "
+           "most %.4f rad, "
+           "intensity error at most %.4f of the largest channel (mean signed %+.5f), radius step "
+           "x%.4f, area step x%.4f\n",
+           N, (double)max_n, (double)max_n * 180.0 / GI_PI, (double)max_dk, (double)max_i, bias_i,
+           (double)rstep, (double)expf(astep));
     cssm_ctree_free(&ct);
 
     /* the Cornell box's tree */
@@ -1114,8 +1186,8 @@ static int part_compact(void)
         return 1;
     cssm_atlas a;
     cssm_tree t;
-    if (cssm_atlas_build(s, 0.0f, 32, 0, &a, &err) != GI_OK || cssm_tree_build(&a, &t, &err) != GI_OK ||
-        cssm_ctree_build(&t, &a, &ct, &err) != GI_OK) {
+    if (cssm_atlas_build(s, 0.0f, 32, 0, &a, &err) != GI_OK ||
+        cssm_tree_build(&a, &t, &err) != GI_OK || cssm_ctree_build(&t, &a, &ct, &err) != GI_OK) {
         fprintf(stderr, "FAIL: %s\n", err.text);
         gi_scene_free(s);
         return 1;
@@ -1126,7 +1198,8 @@ static int part_compact(void)
     for (uint32_t i = 0; i < t.count; i++) {
         cssm_node_view f = float_view(&t, (int32_t)i), d;
         cssm_ctree_view(&ct, i, &d);
-        ptr += d.child != f.child || d.skip != f.skip || d.first != f.first || d.count != f.count || d.rep != f.rep;
+        ptr += d.child != f.child || d.skip != f.skip || d.first != f.first || d.count != f.count ||
+               d.rep != f.rep;
         float need = 0.0f;
         for (uint32_t k = f.first; k < f.first + f.count; k++) {
             const cssm_texel *x = &a.texels[t.leaves[k]];
@@ -1144,8 +1217,11 @@ static int part_compact(void)
     over_lin /= t.count;
     CHECK_MSG(!outside, "%u texels outside their node's decoded sphere", outside);
     CHECK_MSG(!out_cone, "%u texel normals outside their node's decoded cone", out_cone);
-    CHECK_MSG(!ptr, "%u nodes whose pointers, leaves or visibility texel differ from the float tree's", ptr);
-    CHECK_MSG(over_log < over_lin, "the log radius code (%.3f) is not tighter than a linear one (%.3f)", over_log,
+    CHECK_MSG(!ptr,
+              "%u nodes whose pointers, leaves or visibility texel differ from the float tree's",
+              ptr);
+    CHECK_MSG(over_log < over_lin,
+              "the log radius code (%.3f) is not tighter than a linear one (%.3f)", over_log,
               over_lin);
     uint32_t *x = malloc(t.count * sizeof *x), *y = malloc(t.count * sizeof *y);
     uint32_t differ = 0;
@@ -1156,7 +1232,10 @@ static int part_compact(void)
         stackless_compact(&ct, salt, full, y, &ny);
         differ += nx != ny || memcmp(x, y, nx * sizeof *x);
     }
-    CHECK_MSG(!differ, "%u of 65 skip-pointer traversals over packed nodes differ from those over float nodes", differ);
+    CHECK_MSG(
+        !differ,
+        "%u of 65 skip-pointer traversals over packed nodes differ from those over float nodes",
+        differ);
     /* the packed pull (re-encoded at each node) against the float pull x area */
     float *tl = malloc(3 * a.count * sizeof *tl), *nl = malloc(3 * t.count * sizeof *nl);
     for (uint32_t i = 0; i < a.count; i++)
@@ -1172,8 +1251,9 @@ static int part_compact(void)
     for (int32_t i = (int32_t)t.count - 1; i >= 0; i--) {
         const cssm_node *nd = &t.nodes[i];
         if (nd->child >= 0)
-            height[i] = 1 + (height[nd->child] > height[t.nodes[nd->child].skip] ? height[nd->child]
-                                                                                  : height[t.nodes[nd->child].skip]);
+            height[i] = 1 + (height[nd->child] > height[t.nodes[nd->child].skip]
+                                 ? height[nd->child]
+                                 : height[t.nodes[nd->child].skip]);
         cssm_node_view d;
         cssm_ctree_view(&ct, (uint32_t)i, &d);
         float mx = 0.0f, sum = 0.0f;
@@ -1190,10 +1270,14 @@ static int part_compact(void)
     }
     free(height);
     CHECK_MSG(!over, "packed pull: %u channels beyond the bound (h + 1) S / 31.5", over);
-    printf("compact: Cornell box 32^2, %u nodes (%zu bytes each as floats + radiance, %zu packed): texels inside "
-           "decoded spheres and cones, pointers exact, 65 traversals equal; radius over-estimate log %.3f, linear "
-           "%.3f (mean); packed pull error mean %.4f, worst %.4f, root %.4f of the largest channel\n",
-           t.count, sizeof(cssm_node) + 3 * sizeof(float), sizeof(cssm_pnode), over_log, over_lin, mean, worst, root);
+    printf(
+        "compact: Cornell box 32^2, %u nodes (%zu bytes each as floats + radiance, %zu packed): "
+        "texels inside "
+        "decoded spheres and cones, pointers exact, 65 traversals equal; radius over-estimate log "
+        "%.3f, linear "
+        "%.3f (mean); packed pull error mean %.4f, worst %.4f, root %.4f of the largest channel\n",
+        t.count, sizeof(cssm_node) + 3 * sizeof(float), sizeof(cssm_pnode), over_log, over_lin,
+        mean, worst, root);
     free(tl);
     free(nl);
     free(x);
@@ -1241,7 +1325,8 @@ static int env_scene(const char *rel, int check)
     const uint32_t M = 16; /* the plugin's default */
     cssm_build_opts eo = {.escape = 1};
     gi_error err = {0};
-    if (fixture_open(&f, rel, 0.0f, 0.0f) || cssm_maps_build(f.gs, &f.a, f.order, M, NULL, &plain, &err) != GI_OK ||
+    if (fixture_open(&f, rel, 0.0f, 0.0f) ||
+        cssm_maps_build(f.gs, &f.a, f.order, M, NULL, &plain, &err) != GI_OK ||
         cssm_maps_build_ex(f.gs, &f.a, f.order, M, &eo, NULL, &f.m, &err) != GI_OK) {
         if (f.order)
             fprintf(stderr, "FAIL: set-up: %s\n", err.text);
@@ -1254,8 +1339,10 @@ static int env_scene(const char *rel, int check)
     const cssm_maps *m = &f.m;
     double rp = (double)cssm_maps_bytes_uncompressed(&plain) / (double)cssm_maps_bytes(&plain);
     double re = (double)cssm_maps_bytes_uncompressed(m) / (double)cssm_maps_bytes(m);
-    double sp = (double)cssm_maps_segments(&plain) / (6.0 * M * M), se = (double)cssm_maps_segments(m) / (6.0 * M * M);
-    printf("%s (atlas 32^2, %u texels, 6 x %u x %u, spiral): compression %.2f : 1 -> %.2f : 1 with escape intervals "
+    double sp = (double)cssm_maps_segments(&plain) / (6.0 * M * M),
+           se = (double)cssm_maps_segments(m) / (6.0 * M * M);
+    printf("%s (atlas 32^2, %u texels, 6 x %u x %u, spiral): compression %.2f : 1 -> %.2f : 1 with "
+           "escape intervals "
            "(segments per texel %.1f -> %.1f, %+.1f %%)\n",
            rel, a->count, M, M, rp, re, sp, se, 100.0 * (se / sp - 1.0));
     CHECK_MSG(se >= sp, "escape intervals cannot merge runs that were apart (%.2f < %.2f)", se, sp);
@@ -1276,17 +1363,19 @@ static int env_scene(const char *rel, int check)
             if (gi_v3_dot(d, a->texels[j].n) <= 0.0f || gi_v3_dot(d, a->texels[i].n) >= 0.0f)
                 continue;
             tried++;
-            int truth = !gi_rt_occluded(f.rt0, m->eye[j], gi_v3_scale(d, 1.0f / len), 1e-4f * a->diameter,
-                                        len * (1.0f - 1e-4f));
+            int truth = !gi_rt_occluded(f.rt0, m->eye[j], gi_v3_scale(d, 1.0f / len),
+                                        1e-4f * a->diameter, len * (1.0f - 1e-4f));
             vis += truth;
             ap += (cssm_visible(&plain, j, x, bias, 0) > 0.5f) == truth;
             ae += (cssm_visible(m, j, x, bias, 0) > 0.5f) == truth;
         }
-        printf("  texel-point visibility (%d facing pairs): %.2f %% agree with Embree, %.2f %% with escape "
+        printf("  texel-point visibility (%d facing pairs): %.2f %% agree with Embree, %.2f %% "
+               "with escape "
                "intervals (always-visible %.2f %%)\n",
                tried, 100.0 * ap / tried, 100.0 * ae / tried, 100.0 * vis / tried);
-        CHECK_MSG(ae >= ap - tried / 100, "escape intervals cost more than 1 point of visibility (%d -> %d of %d)", ap,
-                  ae, tried);
+        CHECK_MSG(ae >= ap - tried / 100,
+                  "escape intervals cost more than 1 point of visibility (%d -> %d of %d)", ap, ae,
+                  tried);
     }
     if (check) {
         /* the escape test: random texel, cosine-weighted direction about its normal */
@@ -1315,15 +1404,21 @@ static int env_scene(const char *rel, int check)
         double r_open = open ? 1.0 - (double)false_block / open : 1.0;
         double r_blocked = blocked ? 1.0 - (double)false_esc / blocked : 1.0;
         double balanced = 0.5 * (r_open + r_blocked);
-        printf("  escape test, %d texel / direction pairs: agrees with Embree on %.2f %% (PCF %.2f %%); always "
-               "escapes %.2f %%, never %.2f %%; errors %.2f %% escape where Embree hits, %.2f %% blocked where it "
-               "does not; balanced %.2f %% (escaping %.2f %%, blocked %.2f %% of %d; trivial answers 50 %%)\n",
-               pairs, 100 * rate, 100.0 * agree_pcf / pairs, 100 * always, 100 * never, 100.0 * false_esc / pairs,
-               100.0 * false_block / pairs, 100 * balanced, 100 * r_open, 100 * r_blocked, blocked);
+        printf("  escape test, %d texel / direction pairs: agrees with Embree on %.2f %% (PCF %.2f "
+               "%%); always "
+               "escapes %.2f %%, never %.2f %%; errors %.2f %% escape where Embree hits, %.2f %% "
+               "blocked where it "
+               "does not; balanced %.2f %% (escaping %.2f %%, blocked %.2f %% of %d; trivial "
+               "answers 50 %%)\n",
+               pairs, 100 * rate, 100.0 * agree_pcf / pairs, 100 * always, 100 * never,
+               100.0 * false_esc / pairs, 100.0 * false_block / pairs, 100 * balanced, 100 * r_open,
+               100 * r_blocked, blocked);
         CHECK_MSG(blocked >= 200, "only %d blocked directions: the test cannot tell", blocked);
-        CHECK_MSG(rate > trivial, "escape agreement %.4f not above the better trivial answer %.4f", rate, trivial);
-        CHECK_MSG(balanced >= 0.5 + ENV_ESCAPE_MARGIN, "balanced escape agreement %.4f not %.0f points above 1/2",
-                  balanced, 100 * ENV_ESCAPE_MARGIN);
+        CHECK_MSG(rate > trivial, "escape agreement %.4f not above the better trivial answer %.4f",
+                  rate, trivial);
+        CHECK_MSG(balanced >= 0.5 + ENV_ESCAPE_MARGIN,
+                  "balanced escape agreement %.4f not %.0f points above 1/2", balanced,
+                  100 * ENV_ESCAPE_MARGIN);
         /* per-texel irradiance: the same directions, visibility by the maps,
          * by Embree, by nothing */
         const uint32_t K = 128; /* the plugin's env_samples */
@@ -1343,13 +1438,15 @@ static int env_scene(const char *rel, int check)
                 sum_c += ec[c];
             }
         }
-        double n3 = 3.0 * a->count, rc = sqrt(se_c / n3), ro = sqrt(se_o / n3), rb = sqrt(se_b / n3);
+        double n3 = 3.0 * a->count, rc = sqrt(se_c / n3), ro = sqrt(se_o / n3),
+               rb = sqrt(se_b / n3);
         double best = ro < rb ? ro : rb;
-        printf("  texel irradiance (%u directions, the same for all): RMSE against the traced estimate %.4f, "
+        printf("  texel irradiance (%u directions, the same for all): RMSE against the traced "
+               "estimate %.4f, "
                "unshadowed %.4f, black %.4f (%.2f x the better); mean %+.2f %%\n",
                K, rc, ro, rb, rc / best, 100.0 * (sum_c / sum_t - 1.0));
-        CHECK_MSG(rc < ENV_IRRADIANCE_RATIO * best, "irradiance RMSE %.4f not below %.2f x %.4f", rc,
-                  ENV_IRRADIANCE_RATIO, best);
+        CHECK_MSG(rc < ENV_IRRADIANCE_RATIO * best, "irradiance RMSE %.4f not below %.2f x %.4f",
+                  rc, ENV_IRRADIANCE_RATIO, best);
     }
     cssm_maps_free(&plain);
     fixture_close(&f);
@@ -1372,7 +1469,8 @@ static int part_compact_limit(void)
             return 1;
         }
         for (uint32_t i = 0; i < a.count; i++) {
-            a.texels[i].p = gi_v3(gi_rng_next_float(&rng), gi_rng_next_float(&rng), gi_rng_next_float(&rng));
+            a.texels[i].p =
+                gi_v3(gi_rng_next_float(&rng), gi_rng_next_float(&rng), gi_rng_next_float(&rng));
             a.texels[i].n = gi_v3(0, 0, 1);
             a.texels[i].area = 1e-4f;
         }
@@ -1395,7 +1493,8 @@ static int part_compact_limit(void)
             CHECK_MSG(!ptr, "%u of %u nodes' pointers differ", ptr, t.count);
             printf("compact_limit: %u nodes packed, pointers exact\n", t.count);
         } else {
-            CHECK_MSG(r == GI_ERR_INVALID_ARGUMENT && strstr(err.text, "at most 65535") && !strchr(err.text, '\n'),
+            CHECK_MSG(r == GI_ERR_INVALID_ARGUMENT && strstr(err.text, "at most 65535") &&
+                          !strchr(err.text, '\n'),
                       "%u nodes: result %d, '%s'", t.count, (int)r, err.text);
             printf("compact_limit: %u nodes refused: %s\n", t.count, err.text);
         }
@@ -1419,7 +1518,8 @@ int main(int argc, char **argv)
     if (argc != 2) {
         fprintf(
             stderr,
-            "usage: cssm_tests traversal|tree|visibility|furnace|hull|motion|motion2|texture|compact|compact_furnace|"
+            "usage: cssm_tests "
+            "traversal|tree|visibility|furnace|hull|motion|motion2|texture|compact|compact_furnace|"
             "compact_limit|escape\n");
         return 2;
     }

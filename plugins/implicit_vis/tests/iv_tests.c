@@ -69,7 +69,8 @@ static gi_gpu *g_gpu = NULL;
 /* The GPU illumination of the links in l (the scene uploaded and its
  * punctual lights bound at t = 0): irradiance in iv_illuminate's layout.
  * Returns 0 (and counts a failure) when a step fails. */
-static int gpu_illuminate(const gi_scene *s, const iv_hier *h, const iv_links *l, uint32_t bounces, float *E)
+static int gpu_illuminate(const gi_scene *s, const iv_hier *h, const iv_links *l, uint32_t bounces,
+                          float *E)
 {
     gi_error err;
     gi_gpu_scene *gs = gi_gpu_scene_upload(g_gpu, s, &err);
@@ -106,7 +107,10 @@ static uint64_t lcg(uint64_t *st)
     *st = *st * 6364136223846793005ull + 1442695040888963407ull;
     return *st >> 11;
 }
-static float urand(uint64_t *st) { return (float)((double)lcg(st) / 9007199254740992.0); }
+static float urand(uint64_t *st)
+{
+    return (float)((double)lcg(st) / 9007199254740992.0);
+}
 
 /* Link modes of the next frame_run / furnace_mean (the plugin's defaults:
  * one bin per link, Eq. 5 covering); the environment (IV_BILINEAR 0 or 1,
@@ -153,7 +157,8 @@ static void test_bins(void)
 
 /* ----------------------------------------------------------- hierarchy */
 
-static void check_hierarchy(const iv_hier *h, const gi_scene *s, float t, const char *what, double area_tol)
+static void check_hierarchy(const iv_hier *h, const gi_scene *s, float t, const char *what,
+                            double area_tol)
 {
     uint32_t *seen = calloc(h->elem_count, sizeof *seen);
     int bad_area = 0, bad_pos = 0, bad_tree = 0;
@@ -174,16 +179,19 @@ static void check_hierarchy(const iv_hier *h, const gi_scene *s, float t, const 
         }
         bad_area += fabs(a - h->area[i]) > 1e-4 * a + 1e-9;
         for (int j = 0; j < 3; j++)
-            bad_pos += a > 0.0 && fabs(p[j] / a - h->pos[3 * i + j]) > 1e-4 * (1.0 + fabs(h->pos[3 * i + j]));
+            bad_pos += a > 0.0 &&
+                       fabs(p[j] / a - h->pos[3 * i + j]) > 1e-4 * (1.0 + fabs(h->pos[3 * i + j]));
     }
     int bad_elem = 0;
     for (uint32_t e = 0; e < h->elem_count; e++)
         bad_elem += seen[e] != 1;
     free(seen);
-    EXPECT(bad_tree == 0 && bad_elem == 0, "%s: %d bad links in the tree, %d elements not in exactly one leaf", what,
-           bad_tree, bad_elem);
-    EXPECT(bad_area == 0 && bad_pos == 0, "%s: %d nodes' areas and %d positions differ from their children's", what,
-           bad_area, bad_pos);
+    EXPECT(bad_tree == 0 && bad_elem == 0,
+           "%s: %d bad links in the tree, %d elements not in exactly one leaf", what, bad_tree,
+           bad_elem);
+    EXPECT(bad_area == 0 && bad_pos == 0,
+           "%s: %d nodes' areas and %d positions differ from their children's", what, bad_area,
+           bad_pos);
     double roots = 0.0, tris = 0.0;
     for (uint32_t r = 0; r < h->root_count; r++)
         roots += h->area[r];
@@ -192,7 +200,8 @@ static void check_hierarchy(const iv_hier *h, const gi_scene *s, float t, const 
     for (uint32_t i = 0; i < s->triangle_count; i++)
         tris += ta[i];
     free(ta);
-    EXPECT(fabs(roots - tris) <= area_tol * tris, "%s: roots' area %.6g, scene surface %.6g", what, roots, tris);
+    EXPECT(fabs(roots - tris) <= area_tol * tris, "%s: roots' area %.6g, scene surface %.6g", what,
+           roots, tris);
     /* leaves sit on their model vertex, placed at t */
     int bad_leaf = 0;
     for (uint32_t e = 0; e < h->elem_count; e++) {
@@ -200,17 +209,19 @@ static void check_hierarchy(const iv_hier *h, const gi_scene *s, float t, const 
         gi_vec3 c[3];
         gi_scene_triangle_world(s, tr, t, c);
         float b1 = h->samp_b[2 * si], b2 = h->samp_b[2 * si + 1];
-        gi_vec3 p = gi_v3_add(gi_v3_scale(c[0], 1.0f - b1 - b2), gi_v3_add(gi_v3_scale(c[1], b1), gi_v3_scale(c[2], b2)));
+        gi_vec3 p = gi_v3_add(gi_v3_scale(c[0], 1.0f - b1 - b2),
+                              gi_v3_add(gi_v3_scale(c[1], b1), gi_v3_scale(c[2], b2)));
         bad_leaf += gi_v3_length(gi_v3_sub(p, gi_v3_load(&h->pos[3 * h->elem_node[e]]))) > 1e-4f;
     }
     EXPECT(bad_leaf == 0, "%s: %d leaves off their vertex", what, bad_leaf);
-    printf("%s: %u elements, %u nodes, %u segments, depth %u\n", what, h->elem_count, h->node_count, h->root_count,
-           h->depth);
+    printf("%s: %u elements, %u nodes, %u segments, depth %u\n", what, h->elem_count, h->node_count,
+           h->root_count, h->depth);
 }
 
 static void test_hierarchy(void)
 {
-    const char *scenes[] = {GI_SOURCE_DIR "/scenes/cornell_box.gltf", GI_SOURCE_DIR "/scenes/cornell_moving.gltf",
+    const char *scenes[] = {GI_SOURCE_DIR "/scenes/cornell_box.gltf",
+                            GI_SOURCE_DIR "/scenes/cornell_moving.gltf",
                             GI_SOURCE_DIR "/scenes/cornell_deform.gltf"};
     for (int k = 0; k < 3; k++) {
         gi_scene *s = load(scenes[k]);
@@ -278,8 +289,9 @@ static void test_links(void)
             not_nearest += fabsf(gi_v3_length(d) - best[b]) > 1e-5f * best[b];
         }
     }
-    EXPECT(wrong_bin == 0 && not_nearest == 0, "brute force: %d links in a wrong bin, %d bins without the nearest",
-           wrong_bin, not_nearest);
+    EXPECT(wrong_bin == 0 && not_nearest == 0,
+           "brute force: %d links in a wrong bin, %d bins without the nearest", wrong_bin,
+           not_nearest);
     /* hierarchical: links in the right bin; after refinement nothing longer
      * than a link on the path to the root */
     iv_links_build(l, h, 1.0f, 0, 0);
@@ -313,11 +325,12 @@ static void test_links(void)
     }
     free(before);
     EXPECT(wrong_bin == 0, "hierarchical: %d links in a wrong bin", wrong_bin);
-    EXPECT(longer == 0 && lost == 0, "refinement: %d leaf bins keep a longer link (or repeat a bin), %d lost one",
-           longer, lost);
+    EXPECT(longer == 0 && lost == 0,
+           "refinement: %d leaf bins keep a longer link (or repeat a bin), %d lost one", longer,
+           lost);
     printf("links: %llu pairs tried, %llu bin entries, %llu receiving links at %u leaves\n",
-           (unsigned long long)l->tries, (unsigned long long)l->created, (unsigned long long)l->receiving,
-           h->elem_count);
+           (unsigned long long)l->tries, (unsigned long long)l->created,
+           (unsigned long long)l->receiving, h->elem_count);
     iv_links_free(l);
     iv_hier_free(h);
     gi_scene_free(s);
@@ -327,7 +340,8 @@ static void test_links(void)
 
 /* Mean radiance (area-weighted) the inside of the sphere shows its centre,
  * for bounces 0..3 (one link structure, four gathers). */
-static int furnace_means(const char *path, uint32_t N, double mean[4], double *rho_out, double *le_out)
+static int furnace_means(const char *path, uint32_t N, double mean[4], double *rho_out,
+                         double *le_out)
 {
     gi_scene *s = load(path);
     if (!s)
@@ -352,7 +366,8 @@ static int furnace_means(const char *path, uint32_t N, double mean[4], double *r
             for (uint32_t e = 0; e < h->elem_count; e++) {
                 uint32_t x = h->elem_node[e];
                 gi_vec3 p = gi_v3_load(&h->pos[3 * x]), nn = gi_v3_load(&h->nrm[3 * x]);
-                int front = gi_v3_dot(nn, gi_v3_scale(p, -1.0f)) >= 0.0f; /* the side facing the centre */
+                int front =
+                    gi_v3_dot(nn, gi_v3_scale(p, -1.0f)) >= 0.0f; /* the side facing the centre */
                 double Le = front || h->elem_two_sided_emit[e] ? h->elem_emit[3 * e] : 0.0;
                 double L = Le + h->elem_albedo[3 * e] / GI_PI * E[6 * e + (front ? 0 : 3)];
                 sum += h->area[x] * L;
@@ -378,8 +393,8 @@ static void test_furnace(void)
     for (int mode = 0; mode < 2; mode++) {
         g_bilinear = mode;
         g_coverage = mode ? 0.7f : 0.0f;
-        printf("links: bilinear %d, coverage %.2g, illumination on the %s\n", g_bilinear, (double)g_coverage,
-               g_gpu ? "GPU" : "CPU");
+        printf("links: bilinear %d, coverage %.2g, illumination on the %s\n", g_bilinear,
+               (double)g_coverage, g_gpu ? "GPU" : "CPU");
         for (int k = 0; k < 2; k++)
             for (int in = 0; in < 2; in++) {
                 double rho = 0.0, le = 0.0, got[4];
@@ -390,10 +405,11 @@ static void test_furnace(void)
                     for (uint32_t j = 0; j <= n + 1; j++)
                         expect += le * pow(rho, (double)j);
                     double dev = got[n] / expect - 1.0;
-                    printf("furnace rho %.2f N %u bounces %u: %.4f, expected %.4f (%+.2f %%)\n", rho, Ns[in], n, got[n],
-                           expect, 100.0 * dev);
-                    EXPECT(fabs(dev) <= 0.02, "furnace rho %.2f N %u bounces %u: %+.2f %% (limit 2 %%)", rho, Ns[in], n,
-                           100.0 * dev);
+                    printf("furnace rho %.2f N %u bounces %u: %.4f, expected %.4f (%+.2f %%)\n",
+                           rho, Ns[in], n, got[n], expect, 100.0 * dev);
+                    EXPECT(fabs(dev) <= 0.02,
+                           "furnace rho %.2f N %u bounces %u: %+.2f %% (limit 2 %%)", rho, Ns[in],
+                           n, 100.0 * dev);
                 }
             }
     }
@@ -413,7 +429,8 @@ typedef struct frame {
 /* How frame_run re-meshes (IV_REMESH_*). */
 static int g_remesher = IV_REMESH_GRID;
 
-static int frame_run(frame *f, const char *path, float edge, uint32_t N, uint32_t bounces, int brute, int splat)
+static int frame_run(frame *f, const char *path, float edge, uint32_t N, uint32_t bounces,
+                     int brute, int splat)
 {
     memset(f, 0, sizeof *f);
     f->s = load(path);
@@ -443,13 +460,16 @@ static void frame_free(frame *f)
     gi_scene_free(f->s);
 }
 
-static double lum(const float *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
+static double lum(const float *c)
+{
+    return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+}
 
 /* Direct irradiance on the normal's side of disc e from the emissive
  * triangles, 8 x 8 stratified points on each, with and without Embree
  * shadow rays. */
-static void exact_direct(const gi_scene *s, const gi_rt *rt, gi_vec3 p, gi_vec3 n, float eps, double *shadowed,
-                         double *unshadowed)
+static void exact_direct(const gi_scene *s, const gi_rt *rt, gi_vec3 p, gi_vec3 n, float eps,
+                         double *shadowed, double *unshadowed)
 {
     const int S = 8;
     *shadowed = *unshadowed = 0.0;
@@ -466,8 +486,9 @@ static void exact_direct(const gi_scene *s, const gi_rt *rt, gi_vec3 p, gi_vec3 
             for (int i = 0; i < S; i++) {
                 float u1 = ((float)i + 0.5f) / (float)S, u2 = ((float)j + 0.5f) / (float)S;
                 float su = sqrtf(u1);
-                gi_vec3 y = gi_v3_add(gi_v3_scale(c[0], 1.0f - su),
-                                      gi_v3_add(gi_v3_scale(c[1], su * (1.0f - u2)), gi_v3_scale(c[2], su * u2)));
+                gi_vec3 y = gi_v3_add(
+                    gi_v3_scale(c[0], 1.0f - su),
+                    gi_v3_add(gi_v3_scale(c[1], su * (1.0f - u2)), gi_v3_scale(c[2], su * u2)));
                 gi_vec3 w = gi_v3_sub(y, p);
                 float r = gi_v3_length(w);
                 w = gi_v3_scale(w, 1.0f / r);
@@ -509,7 +530,8 @@ static void direct_case(const char *scene, float edge_frac, int required)
             continue; /* the light's own discs */
         uint32_t x = h->elem_node[e];
         double sh, un;
-        exact_direct(f.s, rt, gi_v3_load(&h->pos[3 * x]), gi_v3_load(&h->nrm[3 * x]), 1e-4f * ext, &sh, &un);
+        exact_direct(f.s, rt, gi_v3_load(&h->pos[3 * x]), gi_v3_load(&h->nrm[3 * x]), 1e-4f * ext,
+                     &sh, &un);
         double m = lum(&f.E[6 * e]), a = h->area[x];
         ref_sum += a * sh;
         m_err += a * fabs(m - sh);
@@ -519,13 +541,16 @@ static void direct_case(const char *scene, float edge_frac, int required)
             hidden_dark += m == 0.0;
             if (m != 0.0 && getenv("IV_DEBUG") && hidden - hidden_dark < 8) {
                 gi_vec3 pp = gi_v3_load(&h->pos[3 * x]), nn = gi_v3_load(&h->nrm[3 * x]);
-                printf("  lit but hidden: disc %u at (%.3f %.3f %.3f) n (%.2f %.2f %.2f) E %.4g of unshadowed %.4g, area %.4g\n", e,
-                       pp.x, pp.y, pp.z, nn.x, nn.y, nn.z, m, un, h->area[x]);
+                printf("  lit but hidden: disc %u at (%.3f %.3f %.3f) n (%.2f %.2f %.2f) E %.4g of "
+                       "unshadowed %.4g, area %.4g\n",
+                       e, pp.x, pp.y, pp.z, nn.x, nn.y, nn.z, m, un, h->area[x]);
                 for (uint32_t j = f.l->light_off[e]; j < f.l->light_off[e + 1]; j++) {
                     uint32_t src = f.l->light_src[j];
-                    printf("    light link bin %u to node %u at dist %.3f (leaf %d) cover %.3f\n", f.l->light_bin[j], src,
+                    printf("    light link bin %u to node %u at dist %.3f (leaf %d) cover %.3f\n",
+                           f.l->light_bin[j], src,
                            f.l->dist[(size_t)x * f.l->bins + f.l->light_bin[j]], iv_is_leaf(h, src),
-                           f.l->cover[(size_t)x * f.l->bins + f.l->light_bin[j]] / f.l->bin_omega[f.l->light_bin[j]]);
+                           f.l->cover[(size_t)x * f.l->bins + f.l->light_bin[j]] /
+                               f.l->bin_omega[f.l->light_bin[j]]);
                 }
             }
         } else if (sh > 0.5 * un && un > 0.0) {
@@ -534,16 +559,21 @@ static void direct_case(const char *scene, float edge_frac, int required)
         }
     }
     double me = m_err / ref_sum, ue = u_err / ref_sum, be = 1.0;
-    printf("direct light per disc against Embree (%s, N = %u, bilinear %d, coverage %.2g, re-mesh edge %.3g x 5.592, "
+    printf("direct light per disc against Embree (%s, N = %u, bilinear %d, coverage %.2g, re-mesh "
+           "edge %.3g x 5.592, "
            "%u discs): relative L1 error method %.3f, unshadowed %.3f, black %.3f\n",
-           strrchr(scene, '/') + 1, N, f.l->bilinear, (double)f.l->coverage, edge_frac, h->elem_count, me, ue, be);
-    printf("discs hidden from the light (Embree): %ld, of them without light from the method %ld (%.1f %%); "
+           strrchr(scene, '/') + 1, N, f.l->bilinear, (double)f.l->coverage, edge_frac,
+           h->elem_count, me, ue, be);
+    printf("discs hidden from the light (Embree): %ld, of them without light from the method %ld "
+           "(%.1f %%); "
            "discs mostly lit: %ld, of them dark %ld\n",
-           hidden, hidden_dark, 100.0 * (double)hidden_dark / (double)(hidden ? hidden : 1), lit, lit_dark);
+           hidden, hidden_dark, 100.0 * (double)hidden_dark / (double)(hidden ? hidden : 1), lit,
+           lit_dark);
     if (required == 1) {
         /* the occluder test: a disc Embree sees hidden from the light gets no light link */
         EXPECT(hidden >= 100, "only %ld hidden discs: the scene does not test occlusion", hidden);
-        EXPECT(hidden_dark >= 0.9 * hidden, "%ld of %ld hidden discs get light", hidden - hidden_dark, hidden);
+        EXPECT(hidden_dark >= 0.9 * hidden, "%ld of %ld hidden discs get light",
+               hidden - hidden_dark, hidden);
     } else if (required == 2) {
         /* margin: the method removes at least half of black's error (it does not beat the
          * unshadowed answer per disc on this scene: README "Tests") */
@@ -559,7 +589,8 @@ static void test_direct(void)
     const char *e = getenv("IV_TEST_EDGE");
     const char *sc = getenv("IV_TEST_SCENE");
     if (e || sc) {
-        direct_case(sc ? sc : GI_SOURCE_DIR "/scenes/cornell_box.gltf", e ? (float)atof(e) : 0.0f, 0);
+        direct_case(sc ? sc : GI_SOURCE_DIR "/scenes/cornell_box.gltf", e ? (float)atof(e) : 0.0f,
+                    0);
         return;
     }
     /* defaults (Eq. 5): the Cornell box's light lies flush under the ceiling */
@@ -582,7 +613,8 @@ static void test_brute(void)
                            GI_SOURCE_DIR "/tests/data/conformance/one_object_area_point.gltf"};
     for (int k = 0; k < 2; k++) {
         frame a, b;
-        int ok = frame_run(&a, paths[k], 0.0f, 8, 1, 0, 1) && frame_run(&b, paths[k], 0.0f, 8, 1, 1, 1);
+        int ok =
+            frame_run(&a, paths[k], 0.0f, 8, 1, 0, 1) && frame_run(&b, paths[k], 0.0f, 8, 1, 1, 1);
         EXPECT(ok, "set-up failed for %s", paths[k]);
         if (ok) {
             double diff = 0.0, sum = 0.0;
@@ -594,10 +626,13 @@ static void test_brute(void)
                 }
             }
             double rel = sum > 0.0 ? diff / sum : 0.0;
-            printf("%s: hierarchical %llu tries, brute force %llu; irradiance differs by %.3f (relative L1)\n",
-                   strrchr(paths[k], '/') + 1, (unsigned long long)a.l->tries, (unsigned long long)b.l->tries, rel);
+            printf("%s: hierarchical %llu tries, brute force %llu; irradiance differs by %.3f "
+                   "(relative L1)\n",
+                   strrchr(paths[k], '/') + 1, (unsigned long long)a.l->tries,
+                   (unsigned long long)b.l->tries, rel);
             EXPECT(sum > 0.0, "%s: no light at all", paths[k]);
-            EXPECT(rel <= 0.10, "%s: hierarchical and brute force differ by %.3f (limit 0.10)", paths[k], rel);
+            EXPECT(rel <= 0.10, "%s: hierarchical and brute force differ by %.3f (limit 0.10)",
+                   paths[k], rel);
         }
         frame_free(&a);
         frame_free(&b);
@@ -615,7 +650,8 @@ static double leak_case(float edge, uint32_t N, int splat, uint32_t *discs)
 {
     frame f;
     double leaked = -1.0;
-    if (!frame_run(&f, GI_SOURCE_DIR "/scenes/teapot_plane.glb", edge, N, 0, 0, splat) || !f.s->envmap) {
+    if (!frame_run(&f, GI_SOURCE_DIR "/scenes/teapot_plane.glb", edge, N, 0, 0, splat) ||
+        !f.s->envmap) {
         EXPECT(0, "set-up failed (teapot_plane with its environment)");
         frame_free(&f);
         return -1.0;
@@ -641,7 +677,8 @@ static double leak_case(float edge, uint32_t N, int splat, uint32_t *discs)
         double un = 0.0, sh = 0.0;
         for (int j = 0; j < M; j++)
             for (int i = 0; i < M; i++) {
-                gi_vec3 w = gi_to_world(gi_sample_cosine_hemisphere(((float)i + 0.5f) / M, ((float)j + 0.5f) / M), nn);
+                gi_vec3 w = gi_to_world(
+                    gi_sample_cosine_hemisphere(((float)i + 0.5f) / M, ((float)j + 0.5f) / M), nn);
                 float L[3];
                 gi_envmap_eval(f.s->envmap, w, L);
                 double l = lum(L) * GI_PI / (M * M);
@@ -657,10 +694,11 @@ static double leak_case(float edge, uint32_t N, int splat, uint32_t *discs)
         through += a * fmax(0.0, fmin(m, un) - sh);
     }
     leaked = blocked > 0.0 ? through / blocked : 0.0;
-    printf("teapot_plane, N = %u, splat %d, re-mesh edge %.3g (%s): %u shadowed ground discs near the teapot (%u discs in all); "
+    printf("teapot_plane, N = %u, splat %d, re-mesh edge %.3g (%s): %u shadowed ground discs near "
+           "the teapot (%u discs in all); "
            "the method lets through %.1f %% of the irradiance the teapot blocks\n",
-           N, splat, (double)edge, g_remesher == IV_REMESH_GRID ? "grid" : "isotropic", n, h->elem_count,
-           100.0 * leaked);
+           N, splat, (double)edge, g_remesher == IV_REMESH_GRID ? "grid" : "isotropic", n,
+           h->elem_count, 100.0 * leaked);
     *discs = n;
     gi_rt_free(rt);
     frame_free(&f);
@@ -677,29 +715,31 @@ static void test_leak(void)
     double literal_iso = leak_case(0.08f, 12, 0, &n4);
     g_remesher = IV_REMESH_GRID;
     EXPECT(n4 >= 50, "too few shadowed ground discs with isotropic re-meshing (%u)", n4);
-    EXPECT(literal_iso < 0.5 * literal, "without splatting, isotropic re-meshing leaks %.3f, the model %.3f",
-           literal_iso, literal);
+    EXPECT(literal_iso < 0.5 * literal,
+           "without splatting, isotropic re-meshing leaks %.3f, the model %.3f", literal_iso,
+           literal);
     double coarse = leak_case(0.0f, 12, 1, &n0);
     double fine = leak_case(0.08f, 12, 1, &n1);
-    EXPECT(n0 >= 50 && n1 >= 50 && n2 >= 50 && n3 >= 50, "too few shadowed ground discs (%u, %u, %u, %u)", n0, n1, n2,
-           n3);
+    EXPECT(n0 >= 50 && n1 >= 50 && n2 >= 50 && n3 >= 50,
+           "too few shadowed ground discs (%u, %u, %u, %u)", n0, n1, n2, n3);
     /* the paper's Fig. 10(d): the coarse teapot leaks, re-meshed it leaks less */
-    EXPECT(literal_fine < 0.5 * literal, "without splatting, re-meshing leaks %.3f, the model %.3f", literal_fine,
-           literal);
+    EXPECT(literal_fine < 0.5 * literal, "without splatting, re-meshing leaks %.3f, the model %.3f",
+           literal_fine, literal);
     /* splatting near discs closes the leak (measured 0.8 % and 0.3 %) */
-    EXPECT(coarse <= 0.05 && fine <= 0.05, "with splatting the teapot lets %.3f / %.3f through", coarse, fine);
+    EXPECT(coarse <= 0.05 && fine <= 0.05, "with splatting the teapot lets %.3f / %.3f through",
+           coarse, fine);
 }
-
 
 /* ------------------------------------------------------------ re-meshing */
 
 /* The surface the elements span: triangles, elements, edge length mean
  * and spread (coefficient of variation). */
-static void edge_line(const char *what, const iv_hier *h, const gi_scene *s, double *mean, double *cv)
+static void edge_line(const char *what, const iv_hier *h, const gi_scene *s, double *mean,
+                      double *cv)
 {
     iv_hier_edge_stats(h, s, mean, cv);
-    printf("%-34s %7u triangles, %6u elements, edge mean %.4f, spread (sd / mean) %.3f\n", what, h->surf_count,
-           h->elem_count, *mean, *cv);
+    printf("%-34s %7u triangles, %6u elements, edge mean %.4f, spread (sd / mean) %.3f\n", what,
+           h->surf_count, h->elem_count, *mean, *cv);
 }
 
 static void test_remesh(void)
@@ -725,14 +765,16 @@ static void test_remesh(void)
         mx[v % 3] = fmaxf(mx[v % 3], p[v]);
     }
     float ext = fmaxf(mx[0] - mn[0], fmaxf(mx[1] - mn[1], mx[2] - mn[2]));
-    gi_remeshed *r = gi_remesh_isotropic(p, o->vertex_count, ix, o->triangle_count, 0.02f * ext, 3, &err);
+    gi_remeshed *r =
+        gi_remesh_isotropic(p, o->vertex_count, ix, o->triangle_count, 0.02f * ext, 3, &err);
     EXPECT(r != NULL, "teapot: %s", err.text);
     if (r) {
         int bad = 0;
         for (uint32_t v = 0; v < r->vertex_count; v++) {
             const float *w = &r->bary[3 * v];
             const uint32_t *c = &ix[3 * r->face[v]];
-            bad += !(w[0] >= 0.0f && w[1] >= 0.0f && w[2] >= 0.0f && fabsf(w[0] + w[1] + w[2] - 1.0f) < 1e-4f);
+            bad += !(w[0] >= 0.0f && w[1] >= 0.0f && w[2] >= 0.0f &&
+                     fabsf(w[0] + w[1] + w[2] - 1.0f) < 1e-4f);
             double d2 = 0.0;
             for (int k = 0; k < 3; k++) {
                 double q = w[0] * p[3 * c[0] + k] + w[1] * p[3 * c[1] + k] + w[2] * p[3 * c[2] + k];
@@ -740,19 +782,22 @@ static void test_remesh(void)
             }
             bad += sqrt(d2) > 1e-4 * ext;
         }
-        printf("teapot alone: %u triangles -> %u (edge 0.02 x its size), %u vertices, %d off their embedding\n",
+        printf("teapot alone: %u triangles -> %u (edge 0.02 x its size), %u vertices, %d off their "
+               "embedding\n",
                o->triangle_count, r->triangle_count, r->vertex_count, bad);
         EXPECT(bad == 0, "teapot: %d re-meshed vertices off their embedding", bad);
-        EXPECT(r->triangle_count > 4 * o->triangle_count, "teapot: only %u triangles after re-meshing",
-               r->triangle_count);
+        EXPECT(r->triangle_count > 4 * o->triangle_count,
+               "teapot: only %u triangles after re-meshing", r->triangle_count);
         gi_remeshed_free(r);
     }
     ix[5] = o->vertex_count + 7;
     gi_error e2 = {{0}};
-    EXPECT(gi_remesh_isotropic(p, o->vertex_count, ix, o->triangle_count, 0.02f * ext, 3, &e2) == NULL &&
+    EXPECT(gi_remesh_isotropic(p, o->vertex_count, ix, o->triangle_count, 0.02f * ext, 3, &e2) ==
+                   NULL &&
                strstr(e2.text, "out of range"),
            "an index out of range is not refused: '%s'", e2.text);
-    EXPECT(gi_remesh_isotropic(p, o->vertex_count, ix, o->triangle_count, 0.0f, 3, &e2) == NULL && e2.text[0],
+    EXPECT(gi_remesh_isotropic(p, o->vertex_count, ix, o->triangle_count, 0.0f, 3, &e2) == NULL &&
+               e2.text[0],
            "a zero target edge is not refused");
     free(p), free(ix);
 
@@ -769,8 +814,10 @@ static void test_remesh(void)
         edge_line("teapot_plane as it is:", h0, s, &m0, &c0);
         edge_line("teapot_plane, grid, edge 0.08:", hg, s, &mg, &cg);
         edge_line("teapot_plane, isotropic, edge 0.08:", hi, s, &mi, &ci);
-        EXPECT(hi->surf_count > 4 * h0->surf_count, "isotropic: %u triangles from %u", hi->surf_count, h0->surf_count);
-        EXPECT(ci < 0.5 * c0 && ci < cg, "isotropic edge spread %.3f, the model's %.3f, the grid's %.3f", ci, c0, cg);
+        EXPECT(hi->surf_count > 4 * h0->surf_count, "isotropic: %u triangles from %u",
+               hi->surf_count, h0->surf_count);
+        EXPECT(ci < 0.5 * c0 && ci < cg,
+               "isotropic edge spread %.3f, the model's %.3f, the grid's %.3f", ci, c0, cg);
         EXPECT(mi > 0.6 * 0.08 && mi < 1.4 * 0.08, "isotropic mean edge %.4f, target 0.08", mi);
     }
     iv_hier_free(h0), iv_hier_free(hg), iv_hier_free(hi);
@@ -785,7 +832,8 @@ static void test_remesh(void)
      * deforming: the embedding carries rigid motion and morph targets),
      * and the display grid: weights summing to 1, each grid point where
      * its three elements' blend puts it (flat walls: exactly) */
-    const char *scenes[] = {GI_SOURCE_DIR "/scenes/cornell_box.gltf", GI_SOURCE_DIR "/scenes/cornell_moving.gltf",
+    const char *scenes[] = {GI_SOURCE_DIR "/scenes/cornell_box.gltf",
+                            GI_SOURCE_DIR "/scenes/cornell_moving.gltf",
                             GI_SOURCE_DIR "/scenes/cornell_deform.gltf"};
     for (int k = 0; k < 3; k++) {
         s = load(scenes[k]);
@@ -800,8 +848,10 @@ static void test_remesh(void)
             for (int i = 0; i < 2; i++) {
                 iv_hier_update(h, s, ts[i]);
                 char what[600];
-                snprintf(what, sizeof what, "%s isotropic t=%.2f", strrchr(scenes[k], '/') + 1, ts[i]);
-                check_hierarchy(h, s, ts[i], what, 1e-2); /* chords of curved parts: about e^2 / 8R */
+                snprintf(what, sizeof what, "%s isotropic t=%.2f", strrchr(scenes[k], '/') + 1,
+                         ts[i]);
+                check_hierarchy(h, s, ts[i], what,
+                                1e-2); /* chords of curved parts: about e^2 / 8R */
             }
             int bad_w = 0, bad_p = 0;
             /* flat walls and blocks: exactly; the bunny of cornell_moving,
@@ -817,23 +867,29 @@ static void test_remesh(void)
                     for (uint32_t i = 0; i + j <= kk; i++) {
                         uint32_t d = h->tri_grid[t] + iv_grid_index(kk, i, j);
                         const float *w = &h->disp_w[3 * d];
-                        int bw = !(fabsf(w[0] + w[1] + w[2] - 1.0f) < 1e-4f && w[0] >= 0.0f && w[1] >= 0.0f &&
-                                   w[2] >= 0.0f);
+                        int bw = !(fabsf(w[0] + w[1] + w[2] - 1.0f) < 1e-4f && w[0] >= 0.0f &&
+                                   w[1] >= 0.0f && w[2] >= 0.0f);
                         bad_w += bw;
                         float b1 = (float)i / (float)kk, b2 = (float)j / (float)kk;
-                        gi_vec3 want = gi_v3_add(gi_v3_scale(c3[0], 1.0f - b1 - b2),
-                                                 gi_v3_add(gi_v3_scale(c3[1], b1), gi_v3_scale(c3[2], b2)));
+                        gi_vec3 want =
+                            gi_v3_add(gi_v3_scale(c3[0], 1.0f - b1 - b2),
+                                      gi_v3_add(gi_v3_scale(c3[1], b1), gi_v3_scale(c3[2], b2)));
                         gi_vec3 got = gi_v3(0, 0, 0);
                         for (int q = 0; q < 3; q++)
-                            got = gi_v3_add(got, gi_v3_scale(gi_v3_load(&h->pos[3 * h->elem_node[h->disp_elem[3 * d + q]]]),
-                                                             w[q]));
+                            got = gi_v3_add(
+                                got,
+                                gi_v3_scale(
+                                    gi_v3_load(&h->pos[3 * h->elem_node[h->disp_elem[3 * d + q]]]),
+                                    w[q]));
                         float off = gi_v3_length(gi_v3_sub(got, want));
                         worst = fmaxf(worst, off);
                         bad_p += off > tol;
                     }
             }
-            printf("%s: display grid points at most %.3g off their place\n", strrchr(scenes[k], '/') + 1, (double)worst);
-            EXPECT(bad_w == 0 && bad_p == 0, "%s: display grid: %d bad weights, %d points off their place by more than %g",
+            printf("%s: display grid points at most %.3g off their place\n",
+                   strrchr(scenes[k], '/') + 1, (double)worst);
+            EXPECT(bad_w == 0 && bad_p == 0,
+                   "%s: display grid: %d bad weights, %d points off their place by more than %g",
                    scenes[k], bad_w, bad_p, (double)tol);
         }
         iv_hier_free(h);
@@ -854,8 +910,8 @@ static double wall_ms(void)
  * same to the bit (every bin's link, distance and coverage, the counters,
  * the receiving and light links after refinement); then the wall time of
  * the link creation on 1 and on 2 threads, side by side in this run. */
-static void threads_case(const char *path, float edge, int remesher, uint32_t N, int bilinear, int splat, float t,
-                         int timed)
+static void threads_case(const char *path, float edge, int remesher, uint32_t N, int bilinear,
+                         int splat, float t, int timed)
 {
     gi_scene *s = load(path);
     if (!s)
@@ -880,15 +936,21 @@ static void threads_case(const char *path, float edge, int remesher, uint32_t N,
             many->threads = T;
             iv_links_build(many, h, 1.0f, 0, splat);
             iv_links_refine_push(many, h);
-            int same = !memcmp(one->other, many->other, cells * sizeof *one->other) &&
-                       !memcmp(one->dist, many->dist, cells * sizeof *one->dist) &&
-                       !memcmp(one->cover, many->cover, cells * sizeof *one->cover) && one->tries == many->tries &&
-                       one->created == many->created && one->receiving == many->receiving &&
-                       !memcmp(one->leaf_off, many->leaf_off, ((size_t)h->elem_count + 1) * sizeof *one->leaf_off) &&
-                       !memcmp(one->leaf_src, many->leaf_src, one->receiving * sizeof *one->leaf_src) &&
-                       !memcmp(one->leaf_bin, many->leaf_bin, one->receiving * sizeof *one->leaf_bin) &&
-                       !memcmp(one->light_off, many->light_off, ((size_t)h->elem_count + 1) * sizeof *one->light_off);
-            EXPECT(same, "%s: the links on %u threads differ from those on one (tries %llu / %llu, created %llu / %llu)",
+            int same =
+                !memcmp(one->other, many->other, cells * sizeof *one->other) &&
+                !memcmp(one->dist, many->dist, cells * sizeof *one->dist) &&
+                !memcmp(one->cover, many->cover, cells * sizeof *one->cover) &&
+                one->tries == many->tries && one->created == many->created &&
+                one->receiving == many->receiving &&
+                !memcmp(one->leaf_off, many->leaf_off,
+                        ((size_t)h->elem_count + 1) * sizeof *one->leaf_off) &&
+                !memcmp(one->leaf_src, many->leaf_src, one->receiving * sizeof *one->leaf_src) &&
+                !memcmp(one->leaf_bin, many->leaf_bin, one->receiving * sizeof *one->leaf_bin) &&
+                !memcmp(one->light_off, many->light_off,
+                        ((size_t)h->elem_count + 1) * sizeof *one->light_off);
+            EXPECT(same,
+                   "%s: the links on %u threads differ from those on one (tries %llu / %llu, "
+                   "created %llu / %llu)",
                    path, T, (unsigned long long)one->tries, (unsigned long long)many->tries,
                    (unsigned long long)one->created, (unsigned long long)many->created);
         }
@@ -902,11 +964,13 @@ static void threads_case(const char *path, float edge, int remesher, uint32_t N,
                 double dt = wall_ms() - t0;
                 best[k] = dt < best[k] ? dt : best[k];
             }
-        printf("%s (N = %u, %u elements, %llu link tries, %llu bin writes): identical on 1-4 threads\n",
+        printf("%s (N = %u, %u elements, %llu link tries, %llu bin writes): identical on 1-4 "
+               "threads\n",
                strrchr(path, '/') + 1, N, h->elem_count, (unsigned long long)one->tries,
                (unsigned long long)one->created);
         if (timed)
-            printf("  create_links, best of 3, wall: %.1f ms on 1 thread, %.1f ms on 2 (%.2fx; %ld cores online)\n",
+            printf("  create_links, best of 3, wall: %.1f ms on 1 thread, %.1f ms on 2 (%.2fx; %ld "
+                   "cores online)\n",
                    best[0], best[1], best[0] / best[1], sysconf(_SC_NPROCESSORS_ONLN));
     }
     iv_links_free(one), iv_links_free(many);
@@ -916,9 +980,12 @@ static void threads_case(const char *path, float edge, int remesher, uint32_t N,
 
 static void test_threads(void)
 {
-    threads_case(GI_SOURCE_DIR "/scenes/cornell_box_coarse.gltf", 0.0f, IV_REMESH_GRID, 12, 0, 1, 0.0f, 0);
-    threads_case(GI_SOURCE_DIR "/scenes/cornell_deform.gltf", 0.0f, IV_REMESH_GRID, 8, 1, 1, 1.5f, 0);
-    threads_case(GI_SOURCE_DIR "/scenes/teapot_area.glb", 0.3f, IV_REMESH_ISOTROPIC, 12, 0, 1, 0.0f, 0);
+    threads_case(GI_SOURCE_DIR "/scenes/cornell_box_coarse.gltf", 0.0f, IV_REMESH_GRID, 12, 0, 1,
+                 0.0f, 0);
+    threads_case(GI_SOURCE_DIR "/scenes/cornell_deform.gltf", 0.0f, IV_REMESH_GRID, 8, 1, 1, 1.5f,
+                 0);
+    threads_case(GI_SOURCE_DIR "/scenes/teapot_area.glb", 0.3f, IV_REMESH_ISOTROPIC, 12, 0, 1, 0.0f,
+                 0);
     threads_case(GI_SOURCE_DIR "/scenes/teapot_plane.glb", 0.0f, IV_REMESH_GRID, 12, 0, 0, 0.0f, 1);
 }
 
@@ -929,7 +996,8 @@ static void test_threads(void)
  * channel) must stay within `limit` (float summation order), and be far
  * below the difference one bounce makes, so that a missing or extra gather
  * could not pass. */
-static void gpu_case(const char *path, uint32_t N, uint32_t bounces, int bilinear, float coverage, double limit)
+static void gpu_case(const char *path, uint32_t N, uint32_t bounces, int bilinear, float coverage,
+                     double limit)
 {
     g_bilinear = bilinear;
     g_coverage = coverage;
@@ -941,7 +1009,8 @@ static void gpu_case(const char *path, uint32_t N, uint32_t bounces, int bilinea
     if (ok && G && P && gpu_illuminate(f.s, f.h, f.l, bounces, G)) {
         iv_lights li = {f.s, 0.0f, f.s->envmap};
         if (bounces > 0)
-            iv_illuminate(f.l, f.h, &li, bounces - 1, P); /* one gather fewer: the answer to tell apart */
+            iv_illuminate(f.l, f.h, &li, bounces - 1,
+                          P); /* one gather fewer: the answer to tell apart */
         else
             memset(P, 0, (size_t)f.h->elem_count * 6 * sizeof(float));
         double diff = 0.0, fewer = 0.0, sum = 0.0, worst = 0.0;
@@ -956,14 +1025,15 @@ static void gpu_case(const char *path, uint32_t N, uint32_t bounces, int bilinea
             }
         }
         double rel = sum > 0.0 ? diff / sum : 1.0, rel_fewer = sum > 0.0 ? fewer / sum : 0.0;
-        printf("%s (N %u, %u bounces, bilinear %d, coverage %.2g, %u discs): GPU against CPU relative L1 %.2e "
+        printf("%s (N %u, %u bounces, bilinear %d, coverage %.2g, %u discs): GPU against CPU "
+               "relative L1 %.2e "
                "(limit %.0e), worst disc %.2e; one bounce fewer on the CPU %.2e\n",
-               strrchr(path, '/') + 1, N, bounces, bilinear, (double)coverage, f.h->elem_count, rel, limit, worst,
-               rel_fewer);
+               strrchr(path, '/') + 1, N, bounces, bilinear, (double)coverage, f.h->elem_count, rel,
+               limit, worst, rel_fewer);
         EXPECT(sum > 0.0, "%s: no light at all", path);
         EXPECT(rel <= limit, "%s: GPU and CPU differ by %.2e (limit %.0e)", path, rel, limit);
-        EXPECT(rel_fewer >= 10.0 * limit, "%s: one bounce fewer differs by only %.2e: the test cannot tell", path,
-               rel_fewer);
+        EXPECT(rel_fewer >= 10.0 * limit,
+               "%s: one bounce fewer differs by only %.2e: the test cannot tell", path, rel_fewer);
     }
     free(G);
     free(P);
@@ -986,7 +1056,8 @@ static void test_gpu(void)
     gpu_case(GI_SOURCE_DIR "/scenes/cornell_box.gltf", 8, 1, 1, 0.7f, limit);
     gpu_case(GI_SOURCE_DIR "/tests/data/conformance/furnace_050.gltf", 12, 3, 0, 0.0f, limit);
     gpu_case(GI_SOURCE_DIR "/tests/data/conformance/furnace_080.gltf", 8, 2, 0, 0.0f, limit);
-    gpu_case(GI_SOURCE_DIR "/tests/data/conformance/one_object_area_point.gltf", 8, 2, 0, 0.0f, limit);
+    gpu_case(GI_SOURCE_DIR "/tests/data/conformance/one_object_area_point.gltf", 8, 2, 0, 0.0f,
+             limit);
     gpu_case(GI_SOURCE_DIR "/scenes/teapot_plane.glb", 8, 1, 0, 0.0f, limit);
     /* the furnace through the GPU passes: Le sum rho^k within 2 % */
     test_furnace();

@@ -86,9 +86,18 @@ static gi_scene *load(const char *rel)
 
 static vlf_params defaults(void)
 {
-    return (vlf_params){.l = 128, .N = 64, .m = 8, .S = 2, .density = 12, .iterations = 8, .seed = 1,
-                         .order = VLF_ORDER_FACES, .threads = 2, .bsp_levels = 2, .bsp_min = 4096,
-                         .subdivide = 1};
+    return (vlf_params){.l = 128,
+                        .N = 64,
+                        .m = 8,
+                        .S = 2,
+                        .density = 12,
+                        .iterations = 8,
+                        .seed = 1,
+                        .order = VLF_ORDER_FACES,
+                        .threads = 2,
+                        .bsp_levels = 2,
+                        .bsp_min = 4096,
+                        .subdivide = 1};
 }
 
 static float frand(uint32_t *s)
@@ -123,11 +132,13 @@ static void test_dirs(void)
         float mean = (float)(4.0 * GI_PI / n), lo = FLT_MAX, hi = 0;
         for (uint32_t k = 0; k < n; k++)
             lo = fminf(lo, d.solid_angle[k]), hi = fmaxf(hi, d.solid_angle[k]);
-        EXPECT(lo > 0.5f * mean && hi < 2.0f * mean, "l=%u: solid angles %.4g..%.4g, mean %.4g", l, lo, hi, mean);
+        EXPECT(lo > 0.5f * mean && hi < 2.0f * mean, "l=%u: solid angles %.4g..%.4g, mean %.4g", l,
+               lo, hi, mean);
         uint32_t *deg = calloc(n, sizeof *deg);
         int ccw = 1;
         for (uint32_t t = 0; t < d.tri_count; t++) {
-            gi_vec3 a = d.signed_dirs[d.tris[3 * t]], b = d.signed_dirs[d.tris[3 * t + 1]], c = d.signed_dirs[d.tris[3 * t + 2]];
+            gi_vec3 a = d.signed_dirs[d.tris[3 * t]], b = d.signed_dirs[d.tris[3 * t + 1]],
+                    c = d.signed_dirs[d.tris[3 * t + 2]];
             if (gi_v3_dot(gi_v3_cross(gi_v3_sub(b, a), gi_v3_sub(c, a)), a) <= 0.0f)
                 ccw = 0;
             for (int j = 0; j < 3; j++)
@@ -156,13 +167,15 @@ static void test_dirs(void)
             bad_sum = fmaxf(bad_sum, fabsf(s - 1.0f));
             EXPECT(al[0] >= 0 && al[1] >= 0 && al[2] >= 0, "negative weight");
             /* the weights reproduce the direction up to its length */
-            gi_vec3 r = gi_v3_add(gi_v3_add(gi_v3_scale(d.signed_dirs[node[0]], al[0]), gi_v3_scale(d.signed_dirs[node[1]], al[1])),
+            gi_vec3 r = gi_v3_add(gi_v3_add(gi_v3_scale(d.signed_dirs[node[0]], al[0]),
+                                            gi_v3_scale(d.signed_dirs[node[1]], al[1])),
                                   gi_v3_scale(d.signed_dirs[node[2]], al[2]));
             worst_rec = fmaxf(worst_rec, acosf(fminf(1.0f, gi_v3_dot(gi_v3_normalize(r), w))));
         }
         float cap = acosf(1.0f - 2.0f / (float)n);
-        printf("dirs l=%u: %u triangles, largest gap %.2f deg (even-spread cap %.2f deg), solid angles %.4f..%.4f sr\n", l,
-               d.tri_count, worst * 180 / GI_PI, cap * 180 / GI_PI, lo, hi);
+        printf("dirs l=%u: %u triangles, largest gap %.2f deg (even-spread cap %.2f deg), solid "
+               "angles %.4f..%.4f sr\n",
+               l, d.tri_count, worst * 180 / GI_PI, cap * 180 / GI_PI, lo, hi);
         EXPECT(worst < 1.6f * cap, "l=%u: gap %.3g rad > 1.6 x %.3g", l, worst, cap);
         EXPECT(bad_sum < 1e-5f, "l=%u: weights sum off by %.3g", l, bad_sum);
         EXPECT(worst_rec < 1e-3f, "l=%u: interpolated direction off by %.3g rad", l, worst_rec);
@@ -188,7 +201,8 @@ static void test_dirs(void)
  * vertices in one object on node 0, `materials` untextured black
  * materials, `nodes` identity nodes without parents. Freed by
  * gi_scene_free(). */
-static gi_scene *bare_scene(uint32_t triangles, uint32_t vertices, uint32_t materials, uint32_t nodes)
+static gi_scene *bare_scene(uint32_t triangles, uint32_t vertices, uint32_t materials,
+                            uint32_t nodes)
 {
     gi_scene *s = calloc(1, sizeof *s);
     s->triangle_count = triangles;
@@ -268,14 +282,18 @@ static gi_scene *random_triangles(uint32_t single, uint32_t cyclic, uint32_t see
             float d[2] = {p1[0] - p0[0], p1[1] - p0[1]}, len = sqrtf(d[0] * d[0] + d[1] * d[1]);
             d[0] /= len, d[1] /= len;
             float n[2] = {-d[1], d[0]};
-            /* corners: start -hw, start +hw, end +hw, end -hw; height -h at the start, +h at the end */
-            float sx = p0[0] - ext * d[0], sy = p0[1] - ext * d[1], ex = p1[0] + ext * d[0], ey = p1[1] + ext * d[1];
+            /* corners: start -hw, start +hw, end +hw, end -hw; height -h at the start, +h at the
+             * end */
+            float sx = p0[0] - ext * d[0], sy = p0[1] - ext * d[1], ex = p1[0] + ext * d[0],
+                  ey = p1[1] + ext * d[1];
             float qx[4] = {sx - hw * n[0], sx + hw * n[0], ex + hw * n[0], ex - hw * n[0]};
             float qy[4] = {sy - hw * n[1], sy + hw * n[1], ey + hw * n[1], ey - hw * n[1]};
             float qz[4] = {-h, -h, h, h};
             gi_vec3 q[4];
             for (int k = 0; k < 4; k++)
-                q[k] = gi_v3_add(c, gi_v3_add(gi_v3_add(gi_v3_scale(e1, qx[k]), gi_v3_scale(e2, qy[k])), gi_v3_scale(ax, qz[k])));
+                q[k] = gi_v3_add(
+                    c, gi_v3_add(gi_v3_add(gi_v3_scale(e1, qx[k]), gi_v3_scale(e2, qy[k])),
+                                 gi_v3_scale(ax, qz[k])));
             int idx[6] = {0, 1, 2, 0, 2, 3};
             for (int k = 0; k < 6; k++)
                 put(&w, q[idx[k]]);
@@ -290,7 +308,8 @@ static gi_scene *random_triangles(uint32_t single, uint32_t cyclic, uint32_t see
  * fragment list's order, against the faces Embree meets along the same
  * ray one hit after another. Returns the rays that hit something and
  * counts those whose whole sequence agrees. */
-static uint32_t order_against_embree(const vlf_field *f, gi_rt *rt, uint32_t *agree, uint32_t *multi)
+static uint32_t order_against_embree(const vlf_field *f, gi_rt *rt, uint32_t *agree,
+                                     uint32_t *multi)
 {
     uint32_t hits = 0;
     *agree = *multi = 0;
@@ -303,7 +322,8 @@ static uint32_t order_against_embree(const vlf_field *f, gi_rt *rt, uint32_t *ag
             float V = ((float)(c / NS) + 0.5f) / (float)NS * 2.0f - 1.0f;
             for (int sign = -1; sign <= 1; sign += 2) {
                 /* a world ray entering along sign * n from outside the unit sphere */
-                gi_vec3 q = gi_v3_add(gi_v3_add(gi_v3_scale(ps->u, U), gi_v3_scale(ps->v, V)), gi_v3_scale(ps->n, -1.5f * (float)sign));
+                gi_vec3 q = gi_v3_add(gi_v3_add(gi_v3_scale(ps->u, U), gi_v3_scale(ps->v, V)),
+                                      gi_v3_scale(ps->n, -1.5f * (float)sign));
                 gi_vec3 o = gi_v3_add(f->centre, gi_v3_scale(q, f->radius));
                 gi_vec3 d = gi_v3_scale(ps->n, (float)sign);
                 uint32_t want[MAXH], got[MAXH], nw = 0, ng = 0;
@@ -340,7 +360,8 @@ static int same_field(const vlf_field *a, const vlf_field *b)
     uint32_t NS = a->prm.N * a->prm.S;
     for (uint32_t i = 0; i < a->prm.l; i++) {
         const vlf_psf *p = &a->psf[i], *q = &b->psf[i];
-        if (p->frag_count != q->frag_count || memcmp(p->cell_start, q->cell_start, ((size_t)NS * NS + 1) * sizeof *p->cell_start) ||
+        if (p->frag_count != q->frag_count ||
+            memcmp(p->cell_start, q->cell_start, ((size_t)NS * NS + 1) * sizeof *p->cell_start) ||
             memcmp(p->frag, q->frag, (size_t)p->frag_count * sizeof *p->frag))
             return 0;
     }
@@ -353,8 +374,8 @@ static int same_field(const vlf_field *a, const vlf_field *b)
  * must agree on at least 99.5 % of the rays that hit something; the plain
  * sort by nearest depth (the trivial answer) and Newell's order without
  * splitting are scored on the same rays and must miss at least 5 times as
- * many (plus 20). The face order holds with every triangle cut into 9. The face order is the same for 1, 2
- * and 5 threads. */
+ * many (plus 20). The face order holds with every triangle cut into 9. The face order is the same
+ * for 1, 2 and 5 threads. */
 static void test_order(void)
 {
     gi_scene *s = random_triangles(32, 32, 777u);
@@ -397,16 +418,20 @@ static void test_order(void)
         uint32_t hits = order_against_embree(&f, rt, &agree, &multi);
         miss[k] = hits - agree;
         hitc[k] = hits;
-        printf("order %-30s %u rays hit, %u meet 2+ faces; whole sequence agrees with Embree on %u (%.3f %%); "
+        printf("order %-30s %u rays hit, %u meet 2+ faces; whole sequence agrees with Embree on %u "
+               "(%.3f %%); "
                "%llu pieces, %llu cycle splits, %llu BSP cuts, %llu unresolved, %.2f s\n",
-               cfg[k].name, hits, multi, agree, 100.0 * agree / (hits ? hits : 1), (unsigned long long)f.st.sort_pieces,
-               (unsigned long long)f.st.sort_splits, (unsigned long long)f.st.sort_bsp_cuts,
-               (unsigned long long)f.st.sort_unresolved, f.st.sort_s);
-        EXPECT(multi > hits / 10, "too few rays meet two faces (%u of %u): the test set-up is wrong", multi, hits);
+               cfg[k].name, hits, multi, agree, 100.0 * agree / (hits ? hits : 1),
+               (unsigned long long)f.st.sort_pieces, (unsigned long long)f.st.sort_splits,
+               (unsigned long long)f.st.sort_bsp_cuts, (unsigned long long)f.st.sort_unresolved,
+               f.st.sort_s);
+        EXPECT(multi > hits / 10,
+               "too few rays meet two faces (%u of %u): the test set-up is wrong", multi, hits);
         if (cfg[k].order == VLF_ORDER_NOSPLIT)
             EXPECT(f.st.sort_unresolved > 0, "no cycle met: the test set-up is wrong");
         if (cfg[k].order != VLF_ORDER_PLAIN && cfg[k].order != VLF_ORDER_NOSPLIT)
-            EXPECT(agree >= hits - hits / 200, "%s: depth order disagrees with Embree on %u of %u rays", cfg[k].name,
+            EXPECT(agree >= hits - hits / 200,
+                   "%s: depth order disagrees with Embree on %u of %u rays", cfg[k].name,
                    hits - agree, hits);
         if (cfg[k].order == VLF_ORDER_FACES) {
             EXPECT(f.st.sort_splits > 0, "%s: the cycles were not split", cfg[k].name);
@@ -423,7 +448,8 @@ static void test_order(void)
                 q.threads = tc[j];
                 vlf_field g;
                 EXPECT(vlf_field_build(&g, s, 0.0f, &q, err, sizeof err) == 0, "%s", err);
-                EXPECT(same_field(&f, &g), "the face order on %u threads differs from 2 threads", tc[j]);
+                EXPECT(same_field(&f, &g), "the face order on %u threads differs from 2 threads",
+                       tc[j]);
                 EXPECT(g.st.sort_splits == f.st.sort_splits && g.st.sort_pieces == f.st.sort_pieces,
                        "split counts differ across thread counts");
                 vlf_field_free(&g);
@@ -435,10 +461,12 @@ static void test_order(void)
         vlf_field_free(&f);
     }
     EXPECT(miss[3] >= 5 * miss[0] + 20 && miss[3] >= 5 * miss[1] + 20,
-           "the plain sort misses %u of %u rays, Newell %u / %u: the cycles do not matter, the test proves nothing",
+           "the plain sort misses %u of %u rays, Newell %u / %u: the cycles do not matter, the "
+           "test proves nothing",
            miss[3], hitc[3], miss[0], miss[1]);
     /* the cycles need the splits: Newell's order without them fails there */
-    EXPECT(miss[4] >= 5 * miss[0] + 20, "Newell without splitting misses only %u of %u rays (with: %u)", miss[4], hitc[4],
+    EXPECT(miss[4] >= 5 * miss[0] + 20,
+           "Newell without splitting misses only %u of %u rays (with: %u)", miss[4], hitc[4],
            miss[0]);
     if (have_ref)
         vlf_field_free(&ref);
@@ -463,46 +491,58 @@ static void test_energy(void)
     EXPECT(vlf_field_build(&f, s, 0.0f, &p, err, sizeof err) == 0, "%s", err);
     vlf_field_propagate(&f, NULL, NULL);
     const vlf_stats *st = &f.st;
-    printf("energy (closed sphere, 1 iteration): emitted %.6f shot %.6f received %.6f back %.6f escaped %.6f\n",
+    printf("energy (closed sphere, 1 iteration): emitted %.6f shot %.6f received %.6f back %.6f "
+           "escaped %.6f\n",
            st->flux_emitted, st->flux_shot, st->flux_received, st->flux_back, st->flux_escaped);
-    CHECK_NEAR(st->flux_shot, st->flux_received + st->flux_back + st->flux_escaped, 1e-4 * st->flux_shot);
-    EXPECT(st->flux_escaped < 1e-3 * st->flux_shot, "light escaped a closed sphere: %.4g of %.4g", st->flux_escaped,
-           st->flux_shot);
-    EXPECT(st->flux_back < 1e-3 * st->flux_shot, "light met back faces in a closed sphere: %.4g", st->flux_back);
+    CHECK_NEAR(st->flux_shot, st->flux_received + st->flux_back + st->flux_escaped,
+               1e-4 * st->flux_shot);
+    EXPECT(st->flux_escaped < 1e-3 * st->flux_shot, "light escaped a closed sphere: %.4g of %.4g",
+           st->flux_escaped, st->flux_shot);
+    EXPECT(st->flux_back < 1e-3 * st->flux_shot, "light met back faces in a closed sphere: %.4g",
+           st->flux_back);
     /* what is shot in the first iteration is the emission, within the
      * aliasing of the faces' projections onto the rays */
-    EXPECT(fabs(st->flux_shot / st->flux_emitted - 1.0) < 0.02, "shot %.5g vs emitted %.5g", st->flux_shot, st->flux_emitted);
+    EXPECT(fabs(st->flux_shot / st->flux_emitted - 1.0) < 0.02, "shot %.5g vs emitted %.5g",
+           st->flux_shot, st->flux_emitted);
     /* received = sum of E * area over elements */
     double absorbed = 0.0;
     for (uint32_t e = 0; e < f.elem_count; e++)
-        absorbed += (f.E_tot[3 * e] + f.E_tot[3 * e + 1] + f.E_tot[3 * e + 2]) / 3.0 * f.elem_area[e];
-    EXPECT(fabs(absorbed / st->flux_received - 1.0) < 0.02, "irradiance x area %.5g vs received %.5g", absorbed,
-           st->flux_received);
+        absorbed +=
+            (f.E_tot[3 * e] + f.E_tot[3 * e + 1] + f.E_tot[3 * e + 2]) / 3.0 * f.elem_area[e];
+    EXPECT(fabs(absorbed / st->flux_received - 1.0) < 0.02,
+           "irradiance x area %.5g vs received %.5g", absorbed, st->flux_received);
     vlf_field_free(&f);
     /* the same with every triangle cut into 4 (the tessellation sweep's option) */
     p.subdivide = 2;
     EXPECT(vlf_field_build(&f, s, 0.0f, &p, err, sizeof err) == 0, "%s", err);
     vlf_field_propagate(&f, NULL, NULL);
-    printf("energy, triangles cut into 4 (%u triangles): emitted %.6f shot %.6f received %.6f back %.6f escaped %.6f\n",
-           f.tri_count, st->flux_emitted, st->flux_shot, st->flux_received, st->flux_back, st->flux_escaped);
-    CHECK_NEAR(st->flux_shot, st->flux_received + st->flux_back + st->flux_escaped, 1e-4 * st->flux_shot);
+    printf("energy, triangles cut into 4 (%u triangles): emitted %.6f shot %.6f received %.6f back "
+           "%.6f escaped %.6f\n",
+           f.tri_count, st->flux_emitted, st->flux_shot, st->flux_received, st->flux_back,
+           st->flux_escaped);
+    CHECK_NEAR(st->flux_shot, st->flux_received + st->flux_back + st->flux_escaped,
+               1e-4 * st->flux_shot);
     EXPECT(st->flux_escaped < 1e-3 * st->flux_shot && st->flux_back < 1e-3 * st->flux_shot,
-           "subdivided: light escaped (%.4g) or met back faces (%.4g)", st->flux_escaped, st->flux_back);
-    EXPECT(fabs(st->flux_shot / st->flux_emitted - 1.0) < 0.02, "subdivided: shot %.5g vs emitted %.5g", st->flux_shot,
-           st->flux_emitted);
+           "subdivided: light escaped (%.4g) or met back faces (%.4g)", st->flux_escaped,
+           st->flux_back);
+    EXPECT(fabs(st->flux_shot / st->flux_emitted - 1.0) < 0.02,
+           "subdivided: shot %.5g vs emitted %.5g", st->flux_shot, st->flux_emitted);
     vlf_field_free(&f);
     p.subdivide = 1;
     /* the same with 3 perturbed directions per fixed one (§3.5) */
     p.perturbed = 3;
     EXPECT(vlf_field_build(&f, s, 0.0f, &p, err, sizeof err) == 0, "%s", err);
     vlf_field_propagate(&f, NULL, NULL);
-    printf("energy, 3 perturbed directions: emitted %.6f shot %.6f received %.6f back %.6f escaped %.6f\n",
+    printf("energy, 3 perturbed directions: emitted %.6f shot %.6f received %.6f back %.6f escaped "
+           "%.6f\n",
            st->flux_emitted, st->flux_shot, st->flux_received, st->flux_back, st->flux_escaped);
-    CHECK_NEAR(st->flux_shot, st->flux_received + st->flux_back + st->flux_escaped, 1e-4 * st->flux_shot);
+    CHECK_NEAR(st->flux_shot, st->flux_received + st->flux_back + st->flux_escaped,
+               1e-4 * st->flux_shot);
     EXPECT(st->flux_escaped < 1e-3 * st->flux_shot && st->flux_back < 1e-3 * st->flux_shot,
-           "perturbed: light escaped (%.4g) or met back faces (%.4g)", st->flux_escaped, st->flux_back);
-    EXPECT(fabs(st->flux_shot / st->flux_emitted - 1.0) < 0.02, "perturbed: shot %.5g vs emitted %.5g", st->flux_shot,
-           st->flux_emitted);
+           "perturbed: light escaped (%.4g) or met back faces (%.4g)", st->flux_escaped,
+           st->flux_back);
+    EXPECT(fabs(st->flux_shot / st->flux_emitted - 1.0) < 0.02,
+           "perturbed: shot %.5g vs emitted %.5g", st->flux_shot, st->flux_emitted);
     /* the perturbed lists sorted beside the sweeps on 2 threads (above) or
      * in line on 1, or on 5: the same field, bit for bit */
     uint32_t tc[2] = {1, 5};
@@ -524,7 +564,8 @@ static void test_energy(void)
 
 static void test_furnace(void)
 {
-    const char *files[] = {"tests/data/conformance/furnace_050.gltf", "tests/data/conformance/furnace_080.gltf"};
+    const char *files[] = {"tests/data/conformance/furnace_050.gltf",
+                           "tests/data/conformance/furnace_080.gltf"};
     const double rho[] = {0.5, 0.8};
     for (int k = 0; k < 2; k++) {
         gi_scene *s = load(files[k]);
@@ -552,7 +593,8 @@ static void test_furnace(void)
             double want = 0.0;
             for (uint32_t b = 0; b <= its[q]; b++)
                 want += Le * pow(rho[k], b);
-            printf("furnace rho=%.1f iterations %2u: mean radiance %.5f, due Le sum_{k<=%u} rho^k = %.5f (limit %.5f)\n",
+            printf("furnace rho=%.1f iterations %2u: mean radiance %.5f, due Le sum_{k<=%u} rho^k "
+                   "= %.5f (limit %.5f)\n",
                    rho[k], its[q], got, its[q], want, Le / (1.0 - rho[k]));
             EXPECT(fabs(got / want - 1.0) < 0.02, "furnace %.4f vs %.4f", got, want);
             vlf_field_free(&f);
@@ -564,7 +606,8 @@ static void test_furnace(void)
 /* Two quads: an emitter of radiance 1 at height 1 facing down, and below
  * it a mirror (ks 0.8) tilted so that the emitter's light leaves it
  * toward +x. */
-static void add_quad(gi_scene *s, uint32_t q, gi_vec3 a, gi_vec3 b, gi_vec3 c, gi_vec3 d, uint32_t material)
+static void add_quad(gi_scene *s, uint32_t q, gi_vec3 a, gi_vec3 b, gi_vec3 c, gi_vec3 d,
+                     uint32_t material)
 {
     gi_vec3 v[4] = {a, b, c, d};
     for (int k = 0; k < 4; k++) {
@@ -586,7 +629,8 @@ static void test_mirror(void)
     s->materials[1].mirror = 1;
     s->materials[1].exponent = GI_MIRROR_EXPONENT;
     /* emitter at z = 1, normal -z (clockwise seen from above) */
-    add_quad(s, 0, gi_v3(-0.3f, -0.3f, 1.0f), gi_v3(-0.3f, 0.3f, 1.0f), gi_v3(0.3f, 0.3f, 1.0f), gi_v3(0.3f, -0.3f, 1.0f), 0);
+    add_quad(s, 0, gi_v3(-0.3f, -0.3f, 1.0f), gi_v3(-0.3f, 0.3f, 1.0f), gi_v3(0.3f, 0.3f, 1.0f),
+             gi_v3(0.3f, -0.3f, 1.0f), 0);
     /* mirror around the origin, normal (sin 22.5, 0, cos 22.5): light coming
      * down (-z) leaves along (sin 45, 0, cos 45) */
     float c = cosf(GI_PI / 8), sn = sinf(GI_PI / 8);
@@ -599,7 +643,8 @@ static void test_mirror(void)
     float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
     for (uint32_t v = 0; v < 8; v++)
         for (int a = 0; a < 3; a++)
-            lo[a] = fminf(lo[a], s->vertices[v].position[a]), hi[a] = fmaxf(hi[a], s->vertices[v].position[a]);
+            lo[a] = fminf(lo[a], s->vertices[v].position[a]),
+            hi[a] = fmaxf(hi[a], s->vertices[v].position[a]);
     for (int a = 0; a < 3; a++)
         s->objects[0].local_bounds[a] = lo[a], s->objects[0].local_bounds[3 + a] = hi[a];
     vlf_params p = defaults();
@@ -641,9 +686,13 @@ static void test_mirror(void)
          * emitter through it: most of ks Le = 0.8 at the direction nearest
          * the reflection (barycentric weights and the emitter's edges take
          * some), and nothing far from it */
-        printf("mirror: stored radiance %.3f at the direction nearest the reflection (%.3f rad from it; ks Le = 0.8), "
-               "at most %.4f beyond 1 rad from it (the emitter subtends up to 0.54 rad seen from the mirror)\n", best_hit, best_ang, far);
-        EXPECT(best_hit > 0.3 && best_hit < 0.85, "mirror radiance toward the reflection %.3f", best_hit);
+        printf("mirror: stored radiance %.3f at the direction nearest the reflection (%.3f rad "
+               "from it; ks Le = 0.8), "
+               "at most %.4f beyond 1 rad from it (the emitter subtends up to 0.54 rad seen from "
+               "the mirror)\n",
+               best_hit, best_ang, far);
+        EXPECT(best_hit > 0.3 && best_hit < 0.85, "mirror radiance toward the reflection %.3f",
+               best_hit);
         EXPECT(far < 0.01, "mirror radiance away from the reflection %.4f", far);
         vlf_field_free(&f);
     }
@@ -663,8 +712,9 @@ static double mean_E_in(const vlf_field *f, uint32_t fi, float x0, float x1, flo
             uint32_t e = fc->first_elem + iy * fc->W + ix;
             if (f->elem_area[e] < 0.99f * texel)
                 continue;
-            gi_vec3 q = gi_v3_add(fc->origin, gi_v3_add(gi_v3_scale(fc->t, ((float)ix + 0.5f) / f->prm.density),
-                                                        gi_v3_scale(fc->b, ((float)iy + 0.5f) / f->prm.density)));
+            gi_vec3 q = gi_v3_add(
+                fc->origin, gi_v3_add(gi_v3_scale(fc->t, ((float)ix + 0.5f) / f->prm.density),
+                                      gi_v3_scale(fc->b, ((float)iy + 0.5f) / f->prm.density)));
             gi_vec3 w = gi_v3_add(f->centre, gi_v3_scale(q, f->radius));
             if (w.x < x0 || w.x > x1 || w.y < y0 || w.y > y1)
                 continue;
@@ -691,8 +741,8 @@ static void test_sun(void)
         s->nodes[1].rotation[0] = sinf(0.5f * a);
         s->nodes[1].rotation[3] = cosf(0.5f * a);
         add_quad(s, 0, gi_v3(-1, -1, 0), gi_v3(1, -1, 0), gi_v3(1, 1, 0), gi_v3(-1, 1, 0), 0);
-        add_quad(s, 1, gi_v3(-0.25f, -0.25f, 0.5f), gi_v3(0.25f, -0.25f, 0.5f), gi_v3(0.25f, 0.25f, 0.5f),
-                 gi_v3(-0.25f, 0.25f, 0.5f), 0);
+        add_quad(s, 1, gi_v3(-0.25f, -0.25f, 0.5f), gi_v3(0.25f, -0.25f, 0.5f),
+                 gi_v3(0.25f, 0.25f, 0.5f), gi_v3(-0.25f, 0.25f, 0.5f), 0);
         float bounds[6] = {-1, -1, 0, 1, 1, 0.5f};
         memcpy(s->objects[0].local_bounds, bounds, sizeof bounds);
         s->light_count = 1;
@@ -714,8 +764,10 @@ static void test_sun(void)
             double open = mean_E_in(&f, floor, 0.55f, 0.9f, -0.9f, 0.9f);
             double shadow = mean_E_in(&f, floor, -0.1f, 0.1f, (float)ys - 0.1f, (float)ys + 0.1f);
             double mirror = mean_E_in(&f, floor, -0.1f, 0.1f, (float)-ys - 0.1f, (float)-ys + 0.1f);
-            printf("sun %2.0f deg: open floor E = %.4f (due %.4f), shadow centre (0, %.3f) E = %.4f, %s E = %.4f\n",
-                   a * 180.0 / GI_PI, open, want, ys, shadow, k ? "the mirrored spot" : "(same spot)", mirror);
+            printf("sun %2.0f deg: open floor E = %.4f (due %.4f), shadow centre (0, %.3f) E = "
+                   "%.4f, %s E = %.4f\n",
+                   a * 180.0 / GI_PI, open, want, ys, shadow,
+                   k ? "the mirrored spot" : "(same spot)", mirror);
             EXPECT(fabs(open / want - 1.0) < 0.05, "sun: open floor %.4f, due %.4f", open, want);
             EXPECT(shadow >= 0.0 && shadow < 0.05 * want, "sun: the shadow gets %.4f", shadow);
             if (k)
@@ -741,8 +793,8 @@ static void test_point(void)
         s->materials[0].albedo[0] = s->materials[0].albedo[1] = s->materials[0].albedo[2] = 0.5f;
         s->nodes[1].translation[2] = 1.5f; /* -z of the node points down */
         add_quad(s, 0, gi_v3(-1, -1, 0), gi_v3(1, -1, 0), gi_v3(1, 1, 0), gi_v3(-1, 1, 0), 0);
-        add_quad(s, 1, gi_v3(-0.25f, -0.25f, 0.5f), gi_v3(0.25f, -0.25f, 0.5f), gi_v3(0.25f, 0.25f, 0.5f),
-                 gi_v3(-0.25f, 0.25f, 0.5f), 0);
+        add_quad(s, 1, gi_v3(-0.25f, -0.25f, 0.5f), gi_v3(0.25f, -0.25f, 0.5f),
+                 gi_v3(0.25f, 0.25f, 0.5f), gi_v3(-0.25f, 0.25f, 0.5f), 0);
         float bounds[6] = {-1, -1, 0, 1, 1, 0.5f};
         memcpy(s->objects[0].local_bounds, bounds, sizeof bounds);
         s->light_count = 1;
@@ -771,8 +823,9 @@ static void test_point(void)
                     uint32_t e = fc->first_elem + iy * fc->W + ix;
                     if (f.elem_area[e] < 0.99f * texel)
                         continue;
-                    gi_vec3 q = gi_v3_add(fc->origin, gi_v3_add(gi_v3_scale(fc->t, ((float)ix + 0.5f) / p.density),
-                                                                gi_v3_scale(fc->b, ((float)iy + 0.5f) / p.density)));
+                    gi_vec3 q = gi_v3_add(
+                        fc->origin, gi_v3_add(gi_v3_scale(fc->t, ((float)ix + 0.5f) / p.density),
+                                              gi_v3_scale(fc->b, ((float)iy + 0.5f) / p.density)));
                     gi_vec3 w = gi_v3_add(f.centre, gi_v3_scale(q, f.radius));
                     double d2 = (double)w.x * w.x + (double)w.y * w.y + 1.5 * 1.5, d = sqrt(d2);
                     double want = 3.0 * 1.5 / (d2 * d);
@@ -793,14 +846,18 @@ static void test_point(void)
                         n_beyond++;
                     }
                 }
-            printf("%s: %u lit elements, worst %.3f %% off I h / d^3%s; %u in the shadow, at most %.5f; %u beyond the cone, "
-                   "at most %.5f\n", k ? "spot" : "point", n_lit, 100.0 * worst, k ? " x falloff" : "", n_shadow, shadow,
-                   n_beyond, beyond);
-            EXPECT(n_lit > (k ? 8u : 100u) && n_shadow > 20, "point: too few elements lit (%u) or shadowed (%u)", n_lit, n_shadow);
+            printf("%s: %u lit elements, worst %.3f %% off I h / d^3%s; %u in the shadow, at most "
+                   "%.5f; %u beyond the cone, "
+                   "at most %.5f\n",
+                   k ? "spot" : "point", n_lit, 100.0 * worst, k ? " x falloff" : "", n_shadow,
+                   shadow, n_beyond, beyond);
+            EXPECT(n_lit > (k ? 8u : 100u) && n_shadow > 20,
+                   "point: too few elements lit (%u) or shadowed (%u)", n_lit, n_shadow);
             EXPECT(worst < 0.01, "point: lit floor off the inverse square law by %.3g", worst);
             EXPECT(shadow < 1e-3, "point: the shadow gets %.4g", shadow);
             if (k)
-                EXPECT(n_beyond > 50 && beyond < 1e-4, "spot: %u elements beyond the cone get up to %.4g", n_beyond, beyond);
+                EXPECT(n_beyond > 50 && beyond < 1e-4,
+                       "spot: %u elements beyond the cone get up to %.4g", n_beyond, beyond);
             vlf_field_free(&f);
         }
         gi_scene_free(s);
@@ -832,7 +889,8 @@ static void test_point_mirror(void)
     float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
     for (uint32_t v = 0; v < 4; v++)
         for (int a = 0; a < 3; a++)
-            lo[a] = fminf(lo[a], s->vertices[v].position[a]), hi[a] = fmaxf(hi[a], s->vertices[v].position[a]);
+            lo[a] = fminf(lo[a], s->vertices[v].position[a]),
+            hi[a] = fmaxf(hi[a], s->vertices[v].position[a]);
     for (int a = 0; a < 3; a++)
         s->objects[0].local_bounds[a] = lo[a], s->objects[0].local_bounds[3 + a] = hi[a];
     s->light_count = 1;
@@ -884,12 +942,18 @@ static void test_point_mirror(void)
                 far = fmax(far, flux);
         }
         int near = best_sd == node[0] || best_sd == node[1] || best_sd == node[2];
-        printf("point light in a mirror: flux out of the tiles %.4f, ks x flux onto the mirror %.4f (%+.2f %%); the "
-               "largest share (%.0f %%) along %s of the reflection's three directions; at most %.2g beyond 1 rad\n",
-               out, 0.8 * in, 100.0 * (out / (0.8 * in) - 1.0), 100.0 * best / (out > 0 ? out : 1), near ? "one" : "none",
-               far);
-        EXPECT(fabs(out / (0.8 * in) - 1.0) < 0.05, "point light in a mirror: out %.4f, due %.4f", out, 0.8 * in);
-        EXPECT(near, "point light in a mirror: the most light leaves along direction %u, not around the reflection", best_sd);
+        printf("point light in a mirror: flux out of the tiles %.4f, ks x flux onto the mirror "
+               "%.4f (%+.2f %%); the "
+               "largest share (%.0f %%) along %s of the reflection's three directions; at most "
+               "%.2g beyond 1 rad\n",
+               out, 0.8 * in, 100.0 * (out / (0.8 * in) - 1.0), 100.0 * best / (out > 0 ? out : 1),
+               near ? "one" : "none", far);
+        EXPECT(fabs(out / (0.8 * in) - 1.0) < 0.05, "point light in a mirror: out %.4f, due %.4f",
+               out, 0.8 * in);
+        EXPECT(near,
+               "point light in a mirror: the most light leaves along direction %u, not around the "
+               "reflection",
+               best_sd);
         EXPECT(far < 1e-6 * out, "point light in a mirror: %.4g away from the reflection", far);
         vlf_field_free(&f);
     }
@@ -916,16 +980,17 @@ static void test_precision(void)
     float one[3] = {1.0f, 0.5f, 0.25f}, back[3];
     uint16_t h[4];
     vlf_pack(VLF_PREC_16F, one, 1, h);
-    EXPECT(h[0] == 0x3c00 && h[1] == 0x3800 && h[2] == 0x3400 && h[3] == 0, "half of 1, 0.5, 0.25: %04x %04x %04x", h[0],
-           h[1], h[2]);
+    EXPECT(h[0] == 0x3c00 && h[1] == 0x3800 && h[2] == 0x3400 && h[3] == 0,
+           "half of 1, 0.5, 0.25: %04x %04x %04x", h[0], h[1], h[2]);
     uint32_t w;
     vlf_pack(VLF_PREC_RGB9E5, one, 1, &w);
     vlf_unpack(VLF_PREC_RGB9E5, &w, 1, back);
-    EXPECT(back[0] == 1.0f && back[1] == 0.5f && back[2] == 0.25f, "rgb9e5 of 1, 0.5, 0.25: %g %g %g", back[0], back[1],
-           back[2]);
+    EXPECT(back[0] == 1.0f && back[1] == 0.5f && back[2] == 0.25f,
+           "rgb9e5 of 1, 0.5, 0.25: %g %g %g", back[0], back[1], back[2]);
     float big[3] = {1e6f, 70000.0f, 0.0f};
     vlf_quantise(VLF_PREC_16F, big, 1);
-    EXPECT(big[0] == 65504.0f && big[1] == 65504.0f && big[2] == 0.0f, "half clamps to 65504: %g %g", big[0], big[1]);
+    EXPECT(big[0] == 65504.0f && big[1] == 65504.0f && big[2] == 0.0f,
+           "half clamps to 65504: %g %g", big[0], big[1]);
     uint32_t seed = 99u;
     double worst16 = 0.0, worst9 = 0.0;
     for (int q = 0; q < 100000; q++) {
@@ -943,8 +1008,10 @@ static void test_precision(void)
             worst9 = fmax(worst9, fabs(b[k] - v[k]) / mx);
         }
     }
-    printf("precision: largest rounding error, half %.3g of the value (bound 2^-11 = %.3g), rgb9e5 %.3g of the largest "
-           "channel (bound 2^-9 = %.3g)\n", worst16, ldexp(1, -11), worst9, ldexp(1, -9));
+    printf("precision: largest rounding error, half %.3g of the value (bound 2^-11 = %.3g), rgb9e5 "
+           "%.3g of the largest "
+           "channel (bound 2^-9 = %.3g)\n",
+           worst16, ldexp(1, -11), worst9, ldexp(1, -9));
     EXPECT(worst16 <= ldexp(1, -11) * 1.0001, "half rounding %.3g", worst16);
     EXPECT(worst9 <= ldexp(1, -9) * 1.0001, "rgb9e5 rounding %.3g", worst9);
 
@@ -971,28 +1038,34 @@ static void test_precision(void)
         vlf_pack(k, f[k].E_tot, f[k].elem_count, buf);
         vlf_pack(k, f[k].out_tot, f[k].nd_cells, buf + (size_t)f[k].elem_count * bpv);
         vlf_unpack(k, buf, f[k].elem_count, un);
-        vlf_unpack(k, buf + (size_t)f[k].elem_count * bpv, f[k].nd_cells, un + 3 * (size_t)f[k].elem_count);
+        vlf_unpack(k, buf + (size_t)f[k].elem_count * bpv, f[k].nd_cells,
+                   un + 3 * (size_t)f[k].elem_count);
         int exact = memcmp(un, f[k].E_tot, (size_t)f[k].elem_count * 3 * sizeof *un) == 0 &&
-                    memcmp(un + 3 * (size_t)f[k].elem_count, f[k].out_tot, (size_t)f[k].nd_cells * 3 * sizeof *un) == 0;
+                    memcmp(un + 3 * (size_t)f[k].elem_count, f[k].out_tot,
+                           (size_t)f[k].nd_cells * 3 * sizeof *un) == 0;
         EXPECT(exact, "%s: the maps hold values the format cannot store", name[k]);
-        EXPECT(f[k].st.bytes_maps_render == count * bpv, "%s: reported %zu bytes for the maps, packed %zu", name[k],
+        EXPECT(f[k].st.bytes_maps_render == count * bpv,
+               "%s: reported %zu bytes for the maps, packed %zu", name[k],
                f[k].st.bytes_maps_render, count * bpv);
         free(buf);
         free(un);
-        printf("precision %-6s: %u elements + %u tile cells, maps %zu bytes (%zu a value), propagation %zu bytes, "
+        printf("precision %-6s: %u elements + %u tile cells, maps %zu bytes (%zu a value), "
+               "propagation %zu bytes, "
                "rendering %zu bytes, propagate %.2f s",
-               name[k], f[k].elem_count, f[k].nd_cells, f[k].st.bytes_maps_render, bpv, f[k].st.bytes_propagate,
-               f[k].st.bytes_render, f[k].st.propagate_s);
+               name[k], f[k].elem_count, f[k].nd_cells, f[k].st.bytes_maps_render, bpv,
+               f[k].st.bytes_propagate, f[k].st.bytes_render, f[k].st.propagate_s);
         if (k > 0 && ok[0]) {
             double eE = rel_l1(f[k].E_tot, f[0].E_tot, f[k].elem_count);
             double eT = rel_l1(f[k].out_tot, f[0].out_tot, f[k].nd_cells);
             float *zero = calloc((size_t)f[0].elem_count * 3 + 1, sizeof *zero);
             double black = rel_l1(zero, f[0].E_tot, f[0].elem_count);
             free(zero);
-            printf("; against 32f: irradiance %.4f %%, tiles %.4f %% (black: %.0f %%)", 100 * eE, 100 * eT, 100 * black);
+            printf("; against 32f: irradiance %.4f %%, tiles %.4f %% (black: %.0f %%)", 100 * eE,
+                   100 * eT, 100 * black);
             EXPECT(eE < bound_E[k], "%s: irradiance differs from 32f by %.3g", name[k], eE);
             EXPECT(eT < bound_T[k], "%s: tiles differ from 32f by %.3g", name[k], eT);
-            EXPECT(f[k].nd_cells > 0 && f[0].st.bytes_maps_render * bpv == f[k].st.bytes_maps_render * 12,
+            EXPECT(f[k].nd_cells > 0 &&
+                       f[0].st.bytes_maps_render * bpv == f[k].st.bytes_maps_render * 12,
                    "%s: map bytes not in the ratio %zu : 12", name[k], bpv);
         }
         printf("\n");
@@ -1030,12 +1103,15 @@ static void test_albedo(void)
                     sum += fv[0] * fmax(0.0, gi_v3_dot(N, wi)) / pdf;
             }
             double mc = sum / M, q = vlf_phong_albedo(ns[a], cosf(th));
-            printf("albedo n = %2.0f, %2.0f deg: quadrature %.4f, Monte Carlo %.4f\n", ns[a], deg[b], q, mc);
-            EXPECT(fabs(q - mc) < 0.01, "n %g at %g deg: quadrature %.4f, Monte Carlo %.4f", ns[a], deg[b], q, mc);
+            printf("albedo n = %2.0f, %2.0f deg: quadrature %.4f, Monte Carlo %.4f\n", ns[a],
+                   deg[b], q, mc);
+            EXPECT(fabs(q - mc) < 0.01, "n %g at %g deg: quadrature %.4f, Monte Carlo %.4f", ns[a],
+                   deg[b], q, mc);
             if (b == 0)
                 EXPECT(fabs(q - 1.0) < 1e-3, "albedo at normal incidence %.5f", q);
             if (b == 2 && a == 0)
-                EXPECT(fabs(1.0 - mc) > 0.1, "no fall-off at 80 deg (%.4f): the test proves nothing", mc);
+                EXPECT(fabs(1.0 - mc) > 0.1,
+                       "no fall-off at 80 deg (%.4f): the test proves nothing", mc);
         }
 }
 
@@ -1050,8 +1126,9 @@ static void test_albedo(void)
 static void test_texture(void)
 {
     /* floor z = 0 over [-1, 1]^2 facing +z; emitter z = 1 over [-0.5, 0.5]^2 facing -z */
-    const float tri[4 * 9] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, -1, 0, 1, 1, 0, -1, 1, 0,
-                              -0.5f, -0.5f, 1, 0.5f, 0.5f, 1, 0.5f, -0.5f, 1, -0.5f, -0.5f, 1, -0.5f, 0.5f, 1, 0.5f, 0.5f, 1};
+    const float tri[4 * 9] = {-1,   -1,    0, 1,     -1,    0, 1,     1,     0, -1,   -1,   0,
+                              1,    1,     0, -1,    1,     0, -0.5f, -0.5f, 1, 0.5f, 0.5f, 1,
+                              0.5f, -0.5f, 1, -0.5f, -0.5f, 1, -0.5f, 0.5f,  1, 0.5f, 0.5f, 1};
     gi_scene *s = triangle_scene(tri, 4);
     gi_material *m = calloc(2, sizeof *m);
     m[0] = s->materials[0];
@@ -1088,8 +1165,9 @@ static void test_texture(void)
             const vlf_face *fc = &f.faces[f.elem_face[e]];
             if (fc->emission[0] > 0.0f || !(f.elem_area[e] > 0.0f))
                 continue;
-            gi_vec3 q = gi_v3_add(fc->origin, gi_v3_add(gi_v3_scale(fc->t, f.elem_c[2 * e] / p.density),
-                                                        gi_v3_scale(fc->b, f.elem_c[2 * e + 1] / p.density)));
+            gi_vec3 q = gi_v3_add(fc->origin,
+                                  gi_v3_add(gi_v3_scale(fc->t, f.elem_c[2 * e] / p.density),
+                                            gi_v3_scale(fc->b, f.elem_c[2 * e + 1] / p.density)));
             float x = f.centre.x + f.radius * q.x;
             float half = 0.5f / (p.density / f.radius) + 1e-3f; /* half an element, world units */
             float kd = f.elem_kd[3 * e];
@@ -1106,12 +1184,15 @@ static void test_texture(void)
             if (fabsf(kd - want) > 1e-4f)
                 bad++;
         }
-        /* the texture's mean over the floor: u = (x + 1) / 2 over [0, 1] (clamped bilinear or wrapped, the
-         * two halves are symmetric): 0.5 */
+        /* the texture's mean over the floor: u = (x + 1) / 2 over [0, 1] (clamped bilinear or
+         * wrapped, the two halves are symmetric): 0.5 */
         double mean = area > 0.0 ? akd / area : 0.0;
-        printf("texture: %u elements on the black half, %u on the white, %u with the wrong albedo; shot radiance off "
-               "by at most %.2e; mean albedo %.4f (due 0.8 x 0.5 = 0.4)\n", nb, nw, bad, worst, mean);
-        EXPECT(nb > 4 && nw > 4, "too few elements inside the halves (%u, %u): the test set-up is wrong", nb, nw);
+        printf("texture: %u elements on the black half, %u on the white, %u with the wrong albedo; "
+               "shot radiance off "
+               "by at most %.2e; mean albedo %.4f (due 0.8 x 0.5 = 0.4)\n",
+               nb, nw, bad, worst, mean);
+        EXPECT(nb > 4 && nw > 4,
+               "too few elements inside the halves (%u, %u): the test set-up is wrong", nb, nw);
         EXPECT(bad == 0, "%u elements with the wrong albedo", bad);
         EXPECT(worst < 1e-5, "shot radiance differs from albedo E / pi by %.3g", worst);
         EXPECT(fabs(mean - 0.4) < 0.008, "mean albedo %.4f, due 0.4", mean);
@@ -1138,14 +1219,18 @@ static void test_hier(void)
     gi_scene *base = random_triangles(single, cyclic, 777u);
     float *tri = calloc((size_t)count * 9, sizeof *tri), *w = tri;
     for (uint32_t k = 0; k < 3 * (single + 6 * cyclic); k++)
-        put(&w, gi_v3(base->vertices[k].position[0], base->vertices[k].position[1], base->vertices[k].position[2]));
+        put(&w, gi_v3(base->vertices[k].position[0], base->vertices[k].position[1],
+                      base->vertices[k].position[2]));
     gi_scene_free(base);
     /* a cluster: 3 x 3 x 3 cells of 0.25, a random triangle in the ball of
      * radius 0.124 around each cell's centre (so none intersect) */
     for (uint32_t c = 0; c < clusters; c++) {
-        gi_vec3 ctr = gi_v3(4.3f + (float)(c % 3) * 0.9f, 0.2f + (float)(c / 3) * 0.9f, 0.2f + (float)(c % 2) * 0.9f);
+        gi_vec3 ctr = gi_v3(4.3f + (float)(c % 3) * 0.9f, 0.2f + (float)(c / 3) * 0.9f,
+                            0.2f + (float)(c % 2) * 0.9f);
         for (uint32_t t = 0; t < per; t++) {
-            gi_vec3 cell = gi_v3_add(ctr, gi_v3(0.25f * (float)(t % 3), 0.25f * (float)((t / 3) % 3), 0.25f * (float)(t / 9)));
+            gi_vec3 cell =
+                gi_v3_add(ctr, gi_v3(0.25f * (float)(t % 3), 0.25f * (float)((t / 3) % 3),
+                                     0.25f * (float)(t / 9)));
             for (int k = 0; k < 3; k++)
                 put(&w, gi_v3_add(cell, gi_v3_scale(rand_dir(&seed), 0.124f)));
         }
@@ -1193,21 +1278,24 @@ static void test_hier(void)
         miss[k] = hits[k] - agree;
         tests[k] = f.st.sort_tests;
         groups[k] = f.st.sort_groups;
-        printf("hier %-16s %u rays hit, %u meet 2+ faces; agree with Embree on %u (%.3f %%); %llu pairs tested, "
+        printf("hier %-16s %u rays hit, %u meet 2+ faces; agree with Embree on %u (%.3f %%); %llu "
+               "pairs tested, "
                "%llu objects sorted on their own (of %u x %u), %llu fallbacks, %llu cycle splits\n",
-               k ? "shortcut on" : "shortcut off", hits[k], multi, agree, 100.0 * agree / (hits[k] ? hits[k] : 1),
-               (unsigned long long)tests[k], (unsigned long long)groups[k], clusters, p.l,
+               k ? "shortcut on" : "shortcut off", hits[k], multi, agree,
+               100.0 * agree / (hits[k] ? hits[k] : 1), (unsigned long long)tests[k],
+               (unsigned long long)groups[k], clusters, p.l,
                (unsigned long long)f.st.sort_hier_fallbacks, (unsigned long long)f.st.sort_splits);
-        EXPECT(multi > hits[k] / 10, "too few rays meet two faces (%u of %u): the test set-up is wrong", multi, hits[k]);
-        EXPECT(agree >= hits[k] - hits[k] / 200, "depth order disagrees with Embree on %u of %u rays", hits[k] - agree,
-               hits[k]);
+        EXPECT(multi > hits[k] / 10,
+               "too few rays meet two faces (%u of %u): the test set-up is wrong", multi, hits[k]);
+        EXPECT(agree >= hits[k] - hits[k] / 200,
+               "depth order disagrees with Embree on %u of %u rays", hits[k] - agree, hits[k]);
         vlf_field_free(&f);
     }
     EXPECT(groups[1] > 0, "the shortcut was never taken");
     EXPECT(groups[0] == 0, "the shortcut was taken while off");
     EXPECT(miss[1] <= miss[0] + 2, "with the shortcut %u rays miss, without %u", miss[1], miss[0]);
-    EXPECT(tests[1] < tests[0], "the shortcut did not save pair tests (%llu vs %llu)", (unsigned long long)tests[1],
-           (unsigned long long)tests[0]);
+    EXPECT(tests[1] < tests[0], "the shortcut did not save pair tests (%llu vs %llu)",
+           (unsigned long long)tests[1], (unsigned long long)tests[0]);
     gi_rt_free(rt);
     gi_scene_free(s);
 }
@@ -1258,21 +1346,29 @@ static void gpu_case(vlf_gpu *gp, const char *scene, uint32_t prec, double bound
         double sE = rel_l1(shortf.E_tot, cpu.E_tot, cpu.elem_count);
         double sT = cpu.nd_cells ? rel_l1(shortf.out_tot, cpu.out_tot, cpu.nd_cells) : 0.0;
         double dshot = fabs(gpu.st.flux_shot - cpu.st.flux_shot) / fmax(cpu.st.flux_shot, 1e-30);
-        double drecv = fabs(gpu.st.flux_received - cpu.st.flux_received) / fmax(cpu.st.flux_received, 1e-30);
-        printf("gpu %s %-6s: %u elements, %u tile cells; GPU against CPU: irradiance %.2e, tiles %.2e (one iteration "
-               "short: %.2e, %.2e); shot %.2e, received %.2e; propagate CPU %.3f s, GPU %.3f s (set-up %.3f s, "
+        double drecv =
+            fabs(gpu.st.flux_received - cpu.st.flux_received) / fmax(cpu.st.flux_received, 1e-30);
+        printf("gpu %s %-6s: %u elements, %u tile cells; GPU against CPU: irradiance %.2e, tiles "
+               "%.2e (one iteration "
+               "short: %.2e, %.2e); shot %.2e, received %.2e; propagate CPU %.3f s, GPU %.3f s "
+               "(set-up %.3f s, "
                "read-back %.3f s): CPU/GPU %.2f\n",
-               scene, name[prec], cpu.elem_count, cpu.nd_cells, eE, eT, sE, sT, dshot, drecv, cpu.st.propagate_s,
-               gpu.st.propagate_s, g->setup_s, g->readback_s,
+               scene, name[prec], cpu.elem_count, cpu.nd_cells, eE, eT, sE, sT, dshot, drecv,
+               cpu.st.propagate_s, gpu.st.propagate_s, g->setup_s, g->readback_s,
                cpu.st.propagate_s / fmax(gpu.st.propagate_s + g->setup_s, 1e-9));
-        EXPECT(eE < bound && eE * 10.0 < sE, "%s %s: GPU irradiance differs from the CPU's by %.3g (bound %.3g, "
-               "one iteration short %.3g)", scene, name[prec], eE, bound, sE);
+        EXPECT(eE < bound && eE * 10.0 < sE,
+               "%s %s: GPU irradiance differs from the CPU's by %.3g (bound %.3g, "
+               "one iteration short %.3g)",
+               scene, name[prec], eE, bound, sE);
         if (cpu.nd_cells)
-            EXPECT(eT < bound && eT * 10.0 < sT, "%s %s: GPU tiles differ from the CPU's by %.3g (bound %.3g, one "
-                   "iteration short %.3g)", scene, name[prec], eT, bound, sT);
-        EXPECT(dshot < 1e-4 && drecv < 1e-4, "%s: flux counters differ: shot %.3g, received %.3g", scene, dshot, drecv);
-        EXPECT(gpu.st.samples == cpu.st.samples, "samples %llu vs %llu", (unsigned long long)gpu.st.samples,
-               (unsigned long long)cpu.st.samples);
+            EXPECT(eT < bound && eT * 10.0 < sT,
+                   "%s %s: GPU tiles differ from the CPU's by %.3g (bound %.3g, one "
+                   "iteration short %.3g)",
+                   scene, name[prec], eT, bound, sT);
+        EXPECT(dshot < 1e-4 && drecv < 1e-4, "%s: flux counters differ: shot %.3g, received %.3g",
+               scene, dshot, drecv);
+        EXPECT(gpu.st.samples == cpu.st.samples, "samples %llu vs %llu",
+               (unsigned long long)gpu.st.samples, (unsigned long long)cpu.st.samples);
     }
     vlf_field_free(&cpu);
     vlf_field_free(&gpu);
@@ -1316,7 +1412,8 @@ static double panel_light_E(gi_vec3 x, gi_vec3 n)
     for (int j = 0; j < 32; j++)
         for (int i = 0; i < 32; i++) {
             float u = ((float)i + 0.5f) / 32.0f - 0.5f, v = ((float)j + 0.5f) / 32.0f - 0.5f;
-            gi_vec3 y = gi_v3_add(c, gi_v3_add(gi_v3_scale(e1, 0.5f * u), gi_v3_scale(e2, 0.5f * v)));
+            gi_vec3 y =
+                gi_v3_add(c, gi_v3_add(gi_v3_scale(e1, 0.5f * u), gi_v3_scale(e2, 0.5f * v)));
             gi_vec3 d = gi_v3_sub(y, x);
             double r2 = gi_v3_dot(d, d), r = sqrt(r2);
             double cx = gi_v3_dot(n, d) / r, cy = -gi_v3_dot(ln, d) / r;
@@ -1330,13 +1427,15 @@ static double panel_light_E(gi_vec3 x, gi_vec3 n)
  * plugins/vlf/data/panel_double.gltf lit from its back side, 1 iteration. */
 static void test_double(void)
 {
-    const char *names[2] = {"plugins/vlf/data/panel_double.gltf", "plugins/vlf/data/panel_single.gltf"};
+    const char *names[2] = {"plugins/vlf/data/panel_double.gltf",
+                            "plugins/vlf/data/panel_single.gltf"};
     double recv_double = -1.0;
     for (int sc = 0; sc < 2; sc++) {
         gi_scene *s = load(names[sc]);
         if (!s)
             continue;
-        uint32_t orders[3] = {VLF_ORDER_FACES, VLF_ORDER_RAYS, VLF_ORDER_FACES}, perturbed[3] = {0, 0, 3};
+        uint32_t orders[3] = {VLF_ORDER_FACES, VLF_ORDER_RAYS, VLF_ORDER_FACES},
+                 perturbed[3] = {0, 0, 3};
         float *E_faces = NULL;
         for (int run = 0; run < (sc == 0 ? 3 : 1); run++) {
             vlf_params p = defaults();
@@ -1350,7 +1449,8 @@ static void test_double(void)
                 continue;
             vlf_field_propagate(&f, NULL, NULL);
             const vlf_stats *st = &f.st;
-            CHECK_NEAR(st->flux_shot, st->flux_received + st->flux_back + st->flux_escaped, 1e-4 * st->flux_shot);
+            CHECK_NEAR(st->flux_shot, st->flux_received + st->flux_back + st->flux_escaped,
+                       1e-4 * st->flux_shot);
             /* the panel's sides: lit (normal toward the light, +z), dark (-z) */
             int lit = -1, dark = -1;
             for (uint32_t fi = 0; fi < f.face_count; fi++)
@@ -1358,14 +1458,18 @@ static void test_double(void)
                     *(f.faces[fi].n.z > 0.0f ? &lit : &dark) = (int)fi;
             if (sc == 1) {
                 /* single-sided: only the dark side exists; the light lands on its back */
-                EXPECT(lit < 0 && dark >= 0 && f.faces[dark].twin < 0, "single-sided panel: faces %d / %d", lit, dark);
+                EXPECT(lit < 0 && dark >= 0 && f.faces[dark].twin < 0,
+                       "single-sided panel: faces %d / %d", lit, dark);
                 /* the light the double-sided panel's lit side received lands on its back */
-                printf("double: single-sided panel: flux received %.4f, met a back side %.4f (double-sided "
-                       "received %.4f)\n", st->flux_received, st->flux_back, recv_double);
-                EXPECT(st->flux_received < 1e-3 * st->flux_back, "single-sided: received %.4g, back %.4g",
-                       st->flux_received, st->flux_back);
+                printf("double: single-sided panel: flux received %.4f, met a back side %.4f "
+                       "(double-sided "
+                       "received %.4f)\n",
+                       st->flux_received, st->flux_back, recv_double);
+                EXPECT(st->flux_received < 1e-3 * st->flux_back,
+                       "single-sided: received %.4g, back %.4g", st->flux_received, st->flux_back);
                 EXPECT(fabs(st->flux_back - recv_double) < 0.02 * recv_double,
-                       "single-sided back %.4g, double-sided received %.4g", st->flux_back, recv_double);
+                       "single-sided back %.4g, double-sided received %.4g", st->flux_back,
+                       recv_double);
                 vlf_field_free(&f);
                 continue;
             }
@@ -1375,7 +1479,8 @@ static void test_double(void)
                 continue;
             }
             const vlf_face *fl = &f.faces[lit], *fd = &f.faces[dark];
-            EXPECT(fl->twin == dark && fd->twin == lit && fl->back != fd->back && fl->W == fd->W && fl->H == fd->H,
+            EXPECT(fl->twin == dark && fd->twin == lit && fl->back != fd->back && fl->W == fd->W &&
+                       fl->H == fd->H,
                    "the two sides are not each other's twin");
             /* lit side: the mean irradiance of its upper and lower halves (3x apart)
              * (whole elements) each within 5 % of the light's irradiance at
@@ -1391,26 +1496,30 @@ static void test_double(void)
                 dark_max = fmax(dark_max, f.E_tot[3 * (size_t)ed]);
                 if (f.elem_area[el] < 0.99f * texel)
                     continue;
-                gi_vec3 q = gi_v3_add(fl->origin,
-                                      gi_v3_add(gi_v3_scale(fl->t, f.elem_c[2 * (size_t)el] / p.density),
-                                                gi_v3_scale(fl->b, f.elem_c[2 * (size_t)el + 1] / p.density)));
+                gi_vec3 q = gi_v3_add(
+                    fl->origin,
+                    gi_v3_add(gi_v3_scale(fl->t, f.elem_c[2 * (size_t)el] / p.density),
+                              gi_v3_scale(fl->b, f.elem_c[2 * (size_t)el + 1] / p.density)));
                 gi_vec3 x = gi_v3_add(f.centre, gi_v3_scale(q, f.radius));
                 int h = x.y > 0.0f;
                 sum[h] += f.E_tot[3 * (size_t)el];
                 sum_ref[h] += panel_light_E(x, fl->n);
                 n++;
             }
-            printf("double (order %s, perturbed %u): lit side %u whole elements, irradiance lower half %.4f vs %.4f "
-                   "(%+.2f %%), upper %.4f vs %.4f (%+.2f %%); dark side max E %.3g; flux received %.4f, back %.4g\n",
+            printf("double (order %s, perturbed %u): lit side %u whole elements, irradiance lower "
+                   "half %.4f vs %.4f "
+                   "(%+.2f %%), upper %.4f vs %.4f (%+.2f %%); dark side max E %.3g; flux received "
+                   "%.4f, back %.4g\n",
                    p.order == VLF_ORDER_RAYS ? "rays" : "faces", p.perturbed, n, sum[0], sum_ref[0],
-                   100.0 * (sum[0] / sum_ref[0] - 1.0), sum[1], sum_ref[1], 100.0 * (sum[1] / sum_ref[1] - 1.0),
-                   dark_max, st->flux_received, st->flux_back);
+                   100.0 * (sum[0] / sum_ref[0] - 1.0), sum[1], sum_ref[1],
+                   100.0 * (sum[1] / sum_ref[1] - 1.0), dark_max, st->flux_received, st->flux_back);
             EXPECT(n > 100, "only %u whole elements on the lit side", n);
             for (int h = 0; h < 2; h++)
-                EXPECT(fabs(sum[h] / sum_ref[h] - 1.0) < 0.05, "lit side half %d: irradiance %.4f vs %.4f", h, sum[h],
-                       sum_ref[h]);
+                EXPECT(fabs(sum[h] / sum_ref[h] - 1.0) < 0.05,
+                       "lit side half %d: irradiance %.4f vs %.4f", h, sum[h], sum_ref[h]);
             EXPECT(dark_max == 0.0, "light through the panel: %.3g on its dark side", dark_max);
-            EXPECT(st->flux_back < 1e-6 * st->flux_received, "light met a back side: %.4g", st->flux_back);
+            EXPECT(st->flux_back < 1e-6 * st->flux_received, "light met a back side: %.4g",
+                   st->flux_back);
             if (run == 0) {
                 E_faces = malloc((size_t)f.elem_count * 3 * sizeof *E_faces);
                 if (E_faces)
@@ -1462,7 +1571,10 @@ int main(int argc, char **argv)
     if (all || strcmp(part, "double") == 0)
         test_double(), any = 1;
     if (!any) {
-        fprintf(stderr, "vlf_tests: unknown part '%s' (dirs, order, energy, furnace, mirror, precision, sun, point, albedo, texture, hier, gpu, double)\n", part);
+        fprintf(stderr,
+                "vlf_tests: unknown part '%s' (dirs, order, energy, furnace, mirror, precision, "
+                "sun, point, albedo, texture, hier, gpu, double)\n",
+                part);
         return 2;
     }
     return gi_test_finish();

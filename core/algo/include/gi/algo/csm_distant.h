@@ -69,8 +69,8 @@ int gi_csm_distant_blocks(const gi_csm_distant *c, gi_vec3 p, gi_vec3 q, float b
  * §3.2, the nearest filter of §4.5). Points outside the map's footprint
  * are lit. The query of the csm plugin and of cssm_hrc's direct=csm
  * (direct light from directions, receivers on surfaces). */
-int gi_csm_dir_visible(const gi_csm_data *data, const float sphere[4], uint32_t n_theta, uint32_t n_phi,
-                       gi_csm_order order, gi_vec3 x, gi_vec3 w, float bias);
+int gi_csm_dir_visible(const gi_csm_data *data, const float sphere[4], uint32_t n_theta,
+                       uint32_t n_phi, gi_csm_order order, gi_vec3 x, gi_vec3 w, float bias);
 /* The same through gi_csm_distant's maps (scanline order). */
 int gi_csm_distant_visible(const gi_csm_distant *c, gi_vec3 x, gi_vec3 w, float bias);
 

@@ -50,7 +50,8 @@ typedef struct gi_csm_precompute_desc {
     void (*view)(void *ctx, uint32_t q, gi_depth_view *out);
     /* The codec's depths z1, z2 (M * M each) of map q from its read-back
      * layer `map` (M * M * 4 floats, gi_depth_read_layer) and its view. */
-    void (*depths)(void *ctx, uint32_t q, const gi_depth_view *view, const float *map, float *z1, float *z2);
+    void (*depths)(void *ctx, uint32_t q, const gi_depth_view *view, const float *map, float *z1,
+                   float *z2);
     /* Optional (NULL: every map is drawn): nonzero when map q need not be
      * drawn (cssm_hrc: a texel whose cube map sees nothing it is asked
      * about, §3.3). Such a map is neither viewed nor rendered; `depths`
@@ -68,8 +69,8 @@ typedef struct gi_csm_precompute_desc {
  * GI_ERR_INVALID_ARGUMENT for a desc that breaks the rules above, GI_ERR_GL
  * when the depth renderer cannot be made, GI_ERR_OUT_OF_MEMORY, the codec's
  * errors, GI_ERR_CANCELLED. */
-gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc *d, gi_csm_data *out,
-                            gi_error *err);
+gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc *d,
+                            gi_csm_data *out, gi_error *err);
 
 #ifdef __cplusplus
 }

@@ -46,8 +46,8 @@ void gi_hull_free(gi_hull *h);
  * triangulation (vlf's direction set). GI_ERR_INVALID_ARGUMENT with qhull's
  * exit code when qhull fails or returns a facet that is not a triangle;
  * GI_ERR_OUT_OF_MEMORY. On failure *tris is NULL and *tri_count 0. */
-gi_result gi_hull_triangulate(const float *points, uint32_t count, uint32_t **tris, uint32_t *tri_count,
-                              gi_error *err);
+gi_result gi_hull_triangulate(const float *points, uint32_t count, uint32_t **tris,
+                              uint32_t *tri_count, gi_error *err);
 
 /* 1 when the hull holds point p (outside every face plane by at most
  * `margin`). A hull without faces holds nothing. */

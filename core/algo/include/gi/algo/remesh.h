@@ -33,11 +33,11 @@ extern "C" {
 
 typedef struct gi_remeshed {
     uint32_t vertex_count;
-    float *positions;     /* 3 per vertex */
-    uint32_t *face;       /* per vertex: the input triangle it lies on */
-    float *bary;          /* 3 per vertex: its barycentric weights on that triangle's corners */
+    float *positions; /* 3 per vertex */
+    uint32_t *face;   /* per vertex: the input triangle it lies on */
+    float *bary;      /* 3 per vertex: its barycentric weights on that triangle's corners */
     uint32_t triangle_count;
-    uint32_t *indices;    /* 3 per triangle, into the vertices above */
+    uint32_t *indices; /* 3 per triangle, into the vertices above */
 } gi_remeshed;
 
 /* Re-meshes the input (3 floats per vertex, 3 indices per triangle) to
@@ -45,16 +45,17 @@ typedef struct gi_remeshed {
  * flip and tangential smoothing (CGAL's default is 1; 3 to 5 even out a
  * badly shaped mesh). NULL with a one-line message on bad input (an index
  * out of range, no triangle, target_edge <= 0) or when CGAL fails. */
-gi_remeshed *gi_remesh_isotropic(const float *positions, uint32_t vertex_count, const uint32_t *indices,
-                                 uint32_t triangle_count, float target_edge, uint32_t iterations, gi_error *err);
+gi_remeshed *gi_remesh_isotropic(const float *positions, uint32_t vertex_count,
+                                 const uint32_t *indices, uint32_t triangle_count,
+                                 float target_edge, uint32_t iterations, gi_error *err);
 void gi_remeshed_free(gi_remeshed *r);
 
 /* Nearest point on the mesh to each of `count` points: its triangle (face)
  * and barycentric weights there (3 per point, summing to 1). Returns
  * GI_OK, or an error with a message on bad input. */
 gi_result gi_mesh_locate(const float *positions, uint32_t vertex_count, const uint32_t *indices,
-                         uint32_t triangle_count, const float *points, uint32_t count, uint32_t *face, float *bary,
-                         gi_error *err);
+                         uint32_t triangle_count, const float *points, uint32_t count,
+                         uint32_t *face, float *bary, gi_error *err);
 
 #ifdef __cplusplus
 }

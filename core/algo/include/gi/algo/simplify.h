@@ -29,12 +29,12 @@ extern "C" {
 #endif
 
 typedef struct gi_simplified {
-    uint32_t triangle_count;    /* total over all objects */
-    uint32_t *indices;          /* 3 per triangle, into scene->vertices, object by object */
-    uint32_t *object_first;     /* per object: its first triangle in `indices` */
-    uint32_t *object_count;     /* per object: its triangle count */
-    float max_error;            /* largest relative error meshopt reported over the objects */
-    GLuint ibo;                 /* the indices on the GPU (0 until gi_simplified_upload) */
+    uint32_t triangle_count; /* total over all objects */
+    uint32_t *indices;       /* 3 per triangle, into scene->vertices, object by object */
+    uint32_t *object_first;  /* per object: its first triangle in `indices` */
+    uint32_t *object_count;  /* per object: its triangle count */
+    float max_error;         /* largest relative error meshopt reported over the objects */
+    GLuint ibo;              /* the indices on the GPU (0 until gi_simplified_upload) */
 } gi_simplified;
 
 /* NULL with a message for a ratio outside (0, 1], a max_error < 0, or out
