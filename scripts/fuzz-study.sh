@@ -5,8 +5,9 @@
 #
 # usage: scripts/fuzz-study.sh [SECONDS]        (default 60)
 #   BUILD=dir   build directory (default build-fuzz); the corpus grows in
-#               BUILD/fuzz/study_corpus across runs, seeded from
-#               harness/studies/ and tests/fuzz/study_seeds/
+#               BUILD/fuzz/study_corpus across runs, seeded from every
+#               committed study (harness/studies/, plugins/*/study*.json),
+#               tests/fuzz/study_seeds/ and tests/data/studies/
 #
 # Configures a clang build with GIBENCH_FUZZ=ON and ASan + UBSan (the
 # plugins are built too: the reader checks method names against them),
@@ -28,6 +29,10 @@ artifacts=$build/fuzz/study_artifacts
 mkdir -p "$corpus" "$artifacts"
 for f in "$root"/harness/studies/*.json "$root"/tests/fuzz/study_seeds/*.json "$root"/tests/data/studies/*.json; do
     [ -f "$f" ] && cp -n "$f" "$corpus/" 2>/dev/null || true
+done
+# the papers' studies share the name study.json: each gets its plugin's name
+for f in "$root"/plugins/*/study*.json; do
+    [ -f "$f" ] && cp -n "$f" "$corpus/$(basename "$(dirname "$f")")-$(basename "$f")" 2>/dev/null || true
 done
 
 status=0

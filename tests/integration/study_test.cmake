@@ -1,4 +1,5 @@
-# Study files: every file in harness/studies/ loads and expands (--dry-run),
+# Study files: every committed study (harness/studies/*.json and each
+# paper's plugins/<id>/study*.json) loads and expands (--dry-run),
 # malformed entries and charts are refused, and a tiny study with the
 # features of plugins/csm/study.json runs end to end.
 # cmake -DGIB=... -DROOT=... -DOUT=... -P study_test.cmake
@@ -7,7 +8,7 @@ include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
 
 # Every shipped study file is valid: scenes load, methods and parameter
 # values exist, charts are well formed.
-file(GLOB studies ${ROOT}/harness/studies/*.json)
+file(GLOB studies ${ROOT}/harness/studies/*.json ${ROOT}/plugins/*/study*.json)
 foreach(s ${studies})
     run(0 study ${s} --dry-run)
     match("${last_out}" "^study [^\n]*: [1-9][0-9]* runs" "${s}: --dry-run printed no plan:\n${last_out}")
