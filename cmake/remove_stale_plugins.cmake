@@ -3,7 +3,7 @@
 # which the loader would otherwise still find. Included by the top-level
 # CMakeLists.txt at configure time (which a deleted plugin folder triggers,
 # through the glob of plugins/*/CMakeLists.txt), and run by the test
-# layout.stale_plugins as: cmake -DPLUGIN_DIR=... -DIDS=a;b -P remove_stale_plugins.cmake
+# integration.stale_plugins as: cmake -DPLUGIN_DIR=... -DIDS=a;b -P remove_stale_plugins.cmake
 cmake_policy(SET CMP0057 NEW) # if(IN_LIST) in script mode too
 file(GLOB gi_built_plugins ${PLUGIN_DIR}/gimethod_*.so)
 foreach(so ${gi_built_plugins})
