@@ -108,6 +108,275 @@ static int parse(int argc, char **argv, compare_opts *o)
     return EXIT_OK;
 }
 
+/* The "k=v" part of every --param that names method m; returns how many. */
+static uint32_t method_params(const compare_opts *o, const gi_method *m, const char **kv)
+{
+    uint32_t np = 0;
+    size_t idlen = strlen(m->id);
+    for (uint32_t k = 0; k < o->param_count; k++)
+        if (!strncmp(o->params[k], m->id, idlen) && o->params[k][idlen] == '.')
+            kv[np++] = o->params[k] + idlen + 1;
+    return np;
+}
+
+/* --methods: every installed method ("all") or the methods it lists. */
+static int select_methods(const compare_opts *o, gi_plugins *reg, const gi_method **methods,
+                          uint32_t *count)
+{
+    uint32_t n = 0;
+    if (!strcmp(o->methods, "all")) {
+        for (uint32_t i = 0; i < reg->count && n < MAX_METHODS; i++)
+            methods[n++] = reg->items[i].method;
+    } else {
+        /* a comma-separated list of installed ids, none empty, none twice */
+        char list[1024];
+        if (snprintf(list, sizeof list, "%s", o->methods) >= (int)sizeof list)
+            return cli_fail(EXIT_USAGE, "compare: --methods is too long");
+        for (char *id = list, *next; id; id = next) {
+            next = strchr(id, ',');
+            if (next)
+                *next++ = '\0';
+            const gi_method *m = *id ? gi_plugins_find(reg, id) : NULL;
+            int twice = 0;
+            for (uint32_t k = 0; m && k < n; k++)
+                twice |= methods[k] == m;
+            if (!m || twice || n == MAX_METHODS) {
+                if (!*id)
+                    return cli_fail(EXIT_USAGE, "compare: --methods '%s' has an empty method name",
+                                    o->methods);
+                if (twice)
+                    return cli_fail(EXIT_USAGE, "compare: --methods names '%s' twice", id);
+                if (m)
+                    return cli_fail(EXIT_USAGE, "compare: --methods names more than %d methods",
+                                    MAX_METHODS);
+                return cli_fail(EXIT_USAGE, "compare: no method '%s' (see gibench methods)", id);
+            }
+            methods[n++] = m;
+        }
+    }
+    *count = n;
+    if (n == 0)
+        return cli_fail(EXIT_USAGE, "compare: no method is installed (see gibench methods)");
+    return EXIT_OK;
+}
+
+/* Every --param names a method of the comparison and fits its table. */
+static int check_params(const compare_opts *o, const gi_method *const *methods, uint32_t n)
+{
+    for (uint32_t k = 0; k < o->param_count; k++) {
+        size_t len = (size_t)(strchr(o->params[k], '.') - o->params[k]);
+        int found = 0;
+        for (uint32_t i = 0; i < n; i++)
+            found |= strlen(methods[i]->id) == len && !strncmp(methods[i]->id, o->params[k], len);
+        if (!found)
+            return cli_fail(EXIT_USAGE, "compare: --param '%s' names no method of this comparison",
+                            o->params[k]);
+    }
+    /* Each method's parameters against its table, now rather than in a
+     * child process after the references have rendered. */
+    for (uint32_t i = 0; i < n; i++) {
+        const char *kv[MAX_PARAMS];
+        uint32_t np = method_params(o, methods[i], kv);
+        gi_error err;
+        gi_params *p = gi_params_parse(methods[i]->id, methods[i]->params, kv, np, &err);
+        if (!p)
+            return cli_fail(EXIT_USAGE, "compare: --param %s", err.text);
+        gi_params_free(p);
+    }
+    return EXIT_OK;
+}
+
+/* A given reference must be an image of the comparison's size. */
+static int check_reference(const compare_opts *o)
+{
+    if (!o->reference)
+        return EXIT_OK;
+    gi_error err;
+    gi_image *ref = gi_image_read(o->reference, &err);
+    int fits = ref && ref->width == o->width && ref->height == o->height;
+    uint32_t rw = ref ? ref->width : 0, rh = ref ? ref->height : 0;
+    gi_image_free(ref);
+    if (fits)
+        return EXIT_OK;
+    if (!rw)
+        return cli_fail(EXIT_USAGE, "compare: --reference %s", err.text);
+    return cli_fail(EXIT_USAGE,
+                    "compare: --reference %s is %ux%u, the comparison is %ux%u (--size)",
+                    o->reference, rw, rh, o->width, o->height);
+}
+
+/* The full reference: the one given, or path traced into the output folder. */
+static int full_reference(const compare_opts *o, uint64_t scene_hash, char *ref_full, size_t size)
+{
+    char why[1024];
+    if (o->reference) {
+        snprintf(ref_full, size, "%s", o->reference);
+        return EXIT_OK;
+    }
+    snprintf(ref_full, size, "%s/reference_b%u.exr", o->out, o->ref_bounces);
+    fprintf(stderr, "compare: reference (%u spp, %u bounces)\n", o->ref_spp, o->ref_bounces);
+    if (!runner_reference(o->scene, scene_hash, o->camera, o->width, o->height, o->ref_spp,
+                          o->ref_target_se, o->ref_bounces, o->seed, o->time, 0, o->timeout_s,
+                          ref_full, why, sizeof why))
+        return cli_fail(EXIT_RUN, "compare: %s", why);
+    return EXIT_OK;
+}
+
+/* The bounce-matched references made, for the report's viewer. */
+typedef struct matched_refs {
+    uint32_t bounces[MAX_METHODS], n;
+} matched_refs;
+
+/* The reference limited to b bounces, path traced into `path` and listed
+ * in `made`; NULL (after a warning) when it could not be made. */
+static const char *matched_reference(const compare_opts *o, uint64_t scene_hash, uint32_t b,
+                                     char *path, size_t size, matched_refs *made)
+{
+    char why[1024];
+    snprintf(path, size, "%s/reference_b%u.exr", o->out, b);
+    fprintf(stderr, "compare: bounce-matched reference (%u spp, %u bounces)\n", o->ref_spp, b);
+    if (!runner_reference(o->scene, scene_hash, o->camera, o->width, o->height, o->ref_spp,
+                          o->ref_target_se, b, o->seed, o->time, 0, o->timeout_s, path, why,
+                          sizeof why)) {
+        fprintf(stderr, "gibench: warning: %s\n", why);
+        return NULL;
+    }
+    uint32_t k = 0;
+    while (k < made->n && made->bounces[k] != b)
+        k++;
+    if (k == made->n)
+        made->bounces[made->n++] = b;
+    return path;
+}
+
+/* One method's run (or its record as not applicable to the scene). */
+static json_object *run_method(const compare_opts *o, const gi_scene *scene, uint64_t scene_hash,
+                               const gi_method *m, const char *ref_full, matched_refs *made)
+{
+    const char *params[MAX_PARAMS];
+    uint32_t np = method_params(o, m, params);
+    char dir[4096], matched[4096];
+    snprintf(dir, sizeof dir, "%s/%s", o->out, m->id);
+    uint32_t b = m->max_bounces + 1;
+    run_spec spec = {m->id,     o->scene, m->id,    o->camera, o->width,    o->height, o->frames,
+                     o->warmup, o->seed,  o->time,  0.0f,      params,      np,        o->timeout_s,
+                     dir,       m->id,    ref_full, NULL,      o->exposure, 0,         NULL,
+                     0,         NULL,     NULL,     NULL};
+    char reason[256];
+    if (!cli_caps_cover(m, scene, 0, reason, sizeof reason))
+        return runner_not_applicable(&spec, reason);
+    if (b < o->ref_bounces)
+        spec.ref_matched = matched_reference(o, scene_hash, b, matched, sizeof matched, made);
+    else
+        spec.ref_matched = ref_full; /* the full reference is this method's match */
+    double t0 = gi_now();
+    json_object *rec = runner_execute(&spec, !o->fresh);
+    json_object *c;
+    int cached = json_object_object_get_ex(rec, "cached", &c) && json_object_get_boolean(c);
+    json_object_object_del(rec, "cached");
+    fprintf(stderr, "compare: %s %s (%.1f s)\n", m->id, cached ? "cached" : "ran", gi_now() - t0);
+    return rec;
+}
+
+/* Counts and reports a failed run; keeps the first GL renderer named. */
+static void note_outcome(json_object *rec, const gi_method *m, int *failures, char *renderer,
+                         size_t size)
+{
+    json_object *st, *rn;
+    if (json_object_object_get_ex(rec, "status", &st) &&
+        !strcmp(json_object_get_string(st), "failed")) {
+        (*failures)++;
+        json_object *r;
+        json_object_object_get_ex(rec, "reason", &r);
+        fprintf(stderr, "gibench: warning: %s failed: %s\n", m->id, json_object_get_string(r));
+    }
+    if (!renderer[0] && json_object_object_get_ex(rec, "renderer", &rn))
+        snprintf(renderer, size, "%s", json_object_get_string(rn));
+}
+
+/* The viewer's set: the full reference, every bounce-matched one and every run. */
+static json_object *viewer_references(const compare_opts *o, const char *title, json_object *runs,
+                                      const matched_refs *made)
+{
+    json_object *sets = json_object_new_array(), *set = json_object_new_object();
+    json_object *mlist = json_object_new_array(), *ids = json_object_new_array();
+    char img[64];
+    snprintf(img, sizeof img, "reference_b%u.exr", o->ref_bounces);
+    json_object_object_add(set, "name", json_object_new_string(title));
+    json_object_object_add(set, "full", json_object_new_string(img));
+    json_object_object_add(set, "bounces", json_object_new_int((int)o->ref_bounces));
+    for (uint32_t k = 0; k < made->n; k++) {
+        json_object *m = json_object_new_object();
+        snprintf(img, sizeof img, "reference_b%u.exr", made->bounces[k]);
+        json_object_object_add(m, "image", json_object_new_string(img));
+        json_object_object_add(m, "bounces", json_object_new_int((int)made->bounces[k]));
+        json_object_array_add(mlist, m);
+    }
+    json_object_object_add(set, "matched", mlist);
+    for (size_t i = 0; i < json_object_array_length(runs); i++) {
+        json_object *id;
+        if (json_object_object_get_ex(json_object_array_get_idx(runs, i), "run", &id))
+            json_object_array_add(ids, json_object_get(id));
+    }
+    json_object_object_add(set, "runs", ids);
+    json_object_array_add(sets, set);
+    return sets;
+}
+
+/* The report's header, and for a path-traced reference the viewer's set. */
+static json_object *compare_meta(const compare_opts *o, int argc, char **argv, json_object *runs,
+                                 const char *renderer, const matched_refs *made)
+{
+    char title[512], refdesc[512];
+    snprintf(title, sizeof title, "gibench compare: %s at %ux%u", o->scene, o->width, o->height);
+    if (o->reference)
+        snprintf(refdesc, sizeof refdesc, "%s (given); bounce-matched references %u spp",
+                 o->reference, o->ref_spp);
+    else
+        snprintf(refdesc, sizeof refdesc,
+                 "path traced (Embree), %u spp, %u bounces; bounce-matched the same spp",
+                 o->ref_spp, o->ref_bounces);
+    json_object *meta = report_meta_new(title, "compare", argc, argv, renderer, refdesc);
+    if (!o->reference) {
+        char ref_png[64];
+        snprintf(ref_png, sizeof ref_png, "reference_b%u.png", o->ref_bounces);
+        json_object_object_add(meta, "reference_png", json_object_new_string(ref_png));
+        json_object_object_add(meta, "references", viewer_references(o, title, runs, made));
+        json_object_object_add(meta, "exposure", json_object_new_double(o->exposure));
+    }
+    return meta;
+}
+
+/* The references, every method's run and the report; *failures counts the
+ * runs that failed. */
+static int run_comparison(const compare_opts *o, int argc, char **argv, const gi_scene *scene,
+                          uint64_t scene_hash, const gi_method *const *methods, uint32_t n,
+                          int *failures)
+{
+    cli_install_signal_handlers();
+
+    /* References: the full one (given or path traced) and one per bounce
+     * count the methods need. */
+    char ref_full[4096], why[1024];
+    int rc = full_reference(o, scene_hash, ref_full, sizeof ref_full);
+    if (rc != EXIT_OK)
+        return rc;
+    json_object *runs = json_object_new_array();
+    matched_refs made = {{0}, 0};
+    char renderer[256] = "";
+    for (uint32_t i = 0; i < n && !cli_interrupted; i++) {
+        json_object *rec = run_method(o, scene, scene_hash, methods[i], ref_full, &made);
+        note_outcome(rec, methods[i], failures, renderer, sizeof renderer);
+        json_object_array_add(runs, rec);
+    }
+    json_object *meta = compare_meta(o, argc, argv, runs, renderer, &made);
+    rc = report_write(o->out, runs, meta, why, sizeof why) ? EXIT_OK
+                                                           : cli_fail(EXIT_RUN, "compare: %s", why);
+    json_object_put(runs);
+    json_object_put(meta);
+    return rc;
+}
+
 int cmd_compare(int argc, char **argv)
 {
     compare_opts o;
@@ -126,223 +395,16 @@ int cmd_compare(int argc, char **argv)
     gi_plugins *reg = cli_load_plugins(0);
     const gi_method *methods[MAX_METHODS];
     uint32_t n = 0;
-    if (!strcmp(o.methods, "all")) {
-        for (uint32_t i = 0; i < reg->count && n < MAX_METHODS; i++)
-            methods[n++] = reg->items[i].method;
-    } else {
-        /* a comma-separated list of installed ids, none empty, none twice */
-        char list[1024];
-        if (snprintf(list, sizeof list, "%s", o.methods) >= (int)sizeof list) {
-            gi_plugins_free(reg);
-            gi_scene_free(scene);
-            return cli_fail(EXIT_USAGE, "compare: --methods is too long");
-        }
-        for (char *id = list, *next; id; id = next) {
-            next = strchr(id, ',');
-            if (next)
-                *next++ = '\0';
-            const gi_method *m = *id ? gi_plugins_find(reg, id) : NULL;
-            int twice = 0;
-            for (uint32_t k = 0; m && k < n; k++)
-                twice |= methods[k] == m;
-            if (!m || twice || n == MAX_METHODS) {
-                gi_plugins_free(reg);
-                gi_scene_free(scene);
-                if (!*id)
-                    return cli_fail(EXIT_USAGE, "compare: --methods '%s' has an empty method name",
-                                    o.methods);
-                if (twice)
-                    return cli_fail(EXIT_USAGE, "compare: --methods names '%s' twice", id);
-                if (m)
-                    return cli_fail(EXIT_USAGE, "compare: --methods names more than %d methods",
-                                    MAX_METHODS);
-                return cli_fail(EXIT_USAGE, "compare: no method '%s' (see gibench methods)", id);
-            }
-            methods[n++] = m;
-        }
-    }
-    if (n == 0) {
-        gi_plugins_free(reg);
-        gi_scene_free(scene);
-        return cli_fail(EXIT_USAGE, "compare: no method is installed (see gibench methods)");
-    }
-    for (uint32_t k = 0; k < o.param_count; k++) {
-        size_t len = (size_t)(strchr(o.params[k], '.') - o.params[k]);
-        int found = 0;
-        for (uint32_t i = 0; i < n; i++)
-            found |= strlen(methods[i]->id) == len && !strncmp(methods[i]->id, o.params[k], len);
-        if (!found) {
-            gi_plugins_free(reg);
-            gi_scene_free(scene);
-            return cli_fail(EXIT_USAGE, "compare: --param '%s' names no method of this comparison",
-                            o.params[k]);
-        }
-    }
-    /* Each method's parameters against its table, now rather than in a
-     * child process after the references have rendered. */
-    for (uint32_t i = 0; i < n; i++) {
-        const char *kv[MAX_PARAMS];
-        uint32_t np = 0;
-        size_t idlen = strlen(methods[i]->id);
-        for (uint32_t k = 0; k < o.param_count; k++)
-            if (!strncmp(o.params[k], methods[i]->id, idlen) && o.params[k][idlen] == '.')
-                kv[np++] = o.params[k] + idlen + 1;
-        gi_params *p = gi_params_parse(methods[i]->id, methods[i]->params, kv, np, &err);
-        if (!p) {
-            gi_plugins_free(reg);
-            gi_scene_free(scene);
-            return cli_fail(EXIT_USAGE, "compare: --param %s", err.text);
-        }
-        gi_params_free(p);
-    }
-    /* A given reference must be an image of the comparison's size. */
-    if (o.reference) {
-        gi_image *ref = gi_image_read(o.reference, &err);
-        int fits = ref && ref->width == o.width && ref->height == o.height;
-        uint32_t rw = ref ? ref->width : 0, rh = ref ? ref->height : 0;
-        gi_image_free(ref);
-        if (!fits) {
-            gi_plugins_free(reg);
-            gi_scene_free(scene);
-            if (!rw)
-                return cli_fail(EXIT_USAGE, "compare: --reference %s", err.text);
-            return cli_fail(EXIT_USAGE,
-                            "compare: --reference %s is %ux%u, the comparison is %ux%u (--size)",
-                            o.reference, rw, rh, o.width, o.height);
-        }
-    }
-    if (!cli_mkdirs(o.out)) {
-        gi_plugins_free(reg);
-        gi_scene_free(scene);
-        return cli_fail(EXIT_RUN, "compare: cannot create %s", o.out);
-    }
-    cli_install_signal_handlers();
-
-    /* References: the full one (given or path traced) and one per bounce
-     * count the methods need. */
-    char ref_full[4096], why[1024];
-    if (o.reference) {
-        snprintf(ref_full, sizeof ref_full, "%s", o.reference);
-    } else {
-        snprintf(ref_full, sizeof ref_full, "%s/reference_b%u.exr", o.out, o.ref_bounces);
-        fprintf(stderr, "compare: reference (%u spp, %u bounces)\n", o.ref_spp, o.ref_bounces);
-        if (!runner_reference(o.scene, scene_hash, o.camera, o.width, o.height, o.ref_spp,
-                              o.ref_target_se, o.ref_bounces, o.seed, o.time, 0, o.timeout_s,
-                              ref_full, why, sizeof why)) {
-            gi_plugins_free(reg);
-            gi_scene_free(scene);
-            return cli_fail(EXIT_RUN, "compare: %s", why);
-        }
-    }
-    json_object *runs = json_object_new_array();
-    /* the bounce-matched references made, for the report's viewer */
-    uint32_t matched_b[MAX_METHODS], matched_n = 0;
     int failures = 0;
-    char renderer[256] = "";
-    for (uint32_t i = 0; i < n && !cli_interrupted; i++) {
-        const gi_method *m = methods[i];
-        const char *params[MAX_PARAMS];
-        uint32_t np = 0;
-        size_t idlen = strlen(m->id);
-        for (uint32_t k = 0; k < o.param_count; k++)
-            if (!strncmp(o.params[k], m->id, idlen) && o.params[k][idlen] == '.')
-                params[np++] = o.params[k] + idlen + 1;
-        char dir[4096], matched[4096];
-        snprintf(dir, sizeof dir, "%s/%s", o.out, m->id);
-        uint32_t b = m->max_bounces + 1;
-        const char *ref_matched = NULL;
-        run_spec spec = {m->id,    o.scene, m->id,    o.camera, o.width,    o.height, o.frames,
-                         o.warmup, o.seed,  o.time,   0.0f,     params,     np,       o.timeout_s,
-                         dir,      m->id,   ref_full, NULL,     o.exposure, 0,        NULL,
-                         0,        NULL,    NULL,     NULL};
-        char reason[256];
-        json_object *rec;
-        if (!cli_caps_cover(m, scene, 0, reason, sizeof reason)) {
-            rec = runner_not_applicable(&spec, reason);
-        } else {
-            if (b < o.ref_bounces) {
-                snprintf(matched, sizeof matched, "%s/reference_b%u.exr", o.out, b);
-                fprintf(stderr, "compare: bounce-matched reference (%u spp, %u bounces)\n",
-                        o.ref_spp, b);
-                if (runner_reference(o.scene, scene_hash, o.camera, o.width, o.height, o.ref_spp,
-                                     o.ref_target_se, b, o.seed, o.time, 0, o.timeout_s, matched,
-                                     why, sizeof why)) {
-                    ref_matched = matched;
-                    uint32_t k = 0;
-                    while (k < matched_n && matched_b[k] != b)
-                        k++;
-                    if (k == matched_n)
-                        matched_b[matched_n++] = b;
-                } else
-                    fprintf(stderr, "gibench: warning: %s\n", why);
-            } else {
-                ref_matched = ref_full; /* the full reference is this method's match */
-            }
-            spec.ref_matched = ref_matched;
-            double t0 = gi_now();
-            rec = runner_execute(&spec, !o.fresh);
-            json_object *c;
-            int cached = json_object_object_get_ex(rec, "cached", &c) && json_object_get_boolean(c);
-            json_object_object_del(rec, "cached");
-            fprintf(stderr, "compare: %s %s (%.1f s)\n", m->id, cached ? "cached" : "ran",
-                    gi_now() - t0);
-        }
-        json_object *st, *rn;
-        if (json_object_object_get_ex(rec, "status", &st) &&
-            !strcmp(json_object_get_string(st), "failed")) {
-            failures++;
-            json_object *r;
-            json_object_object_get_ex(rec, "reason", &r);
-            fprintf(stderr, "gibench: warning: %s failed: %s\n", m->id, json_object_get_string(r));
-        }
-        if (!renderer[0] && json_object_object_get_ex(rec, "renderer", &rn))
-            snprintf(renderer, sizeof renderer, "%s", json_object_get_string(rn));
-        json_object_array_add(runs, rec);
-    }
-    char title[512], refdesc[512];
-    snprintf(title, sizeof title, "gibench compare: %s at %ux%u", o.scene, o.width, o.height);
-    if (o.reference)
-        snprintf(refdesc, sizeof refdesc, "%s (given); bounce-matched references %u spp",
-                 o.reference, o.ref_spp);
-    else
-        snprintf(refdesc, sizeof refdesc,
-                 "path traced (Embree), %u spp, %u bounces; bounce-matched the same spp", o.ref_spp,
-                 o.ref_bounces);
-    json_object *meta = report_meta_new(title, "compare", argc, argv, renderer, refdesc);
-    if (!o.reference) {
-        char ref_png[64];
-        snprintf(ref_png, sizeof ref_png, "reference_b%u.png", o.ref_bounces);
-        json_object_object_add(meta, "reference_png", json_object_new_string(ref_png));
-        /* the viewer's set: the full reference, every bounce-matched one and every run */
-        json_object *sets = json_object_new_array(), *set = json_object_new_object();
-        json_object *mlist = json_object_new_array(), *ids = json_object_new_array();
-        char img[64];
-        snprintf(img, sizeof img, "reference_b%u.exr", o.ref_bounces);
-        json_object_object_add(set, "name", json_object_new_string(title));
-        json_object_object_add(set, "full", json_object_new_string(img));
-        json_object_object_add(set, "bounces", json_object_new_int((int)o.ref_bounces));
-        for (uint32_t k = 0; k < matched_n; k++) {
-            json_object *m = json_object_new_object();
-            snprintf(img, sizeof img, "reference_b%u.exr", matched_b[k]);
-            json_object_object_add(m, "image", json_object_new_string(img));
-            json_object_object_add(m, "bounces", json_object_new_int((int)matched_b[k]));
-            json_object_array_add(mlist, m);
-        }
-        json_object_object_add(set, "matched", mlist);
-        for (size_t i = 0; i < json_object_array_length(runs); i++) {
-            json_object *id;
-            if (json_object_object_get_ex(json_object_array_get_idx(runs, i), "run", &id))
-                json_object_array_add(ids, json_object_get(id));
-        }
-        json_object_object_add(set, "runs", ids);
-        json_object_array_add(sets, set);
-        json_object_object_add(meta, "references", sets);
-        json_object_object_add(meta, "exposure", json_object_new_double(o.exposure));
-    }
-    rc = report_write(o.out, runs, meta, why, sizeof why) ? EXIT_OK
-                                                          : cli_fail(EXIT_RUN, "compare: %s", why);
-    json_object_put(runs);
-    json_object_put(meta);
+    rc = select_methods(&o, reg, methods, &n);
+    if (rc == EXIT_OK)
+        rc = check_params(&o, methods, n);
+    if (rc == EXIT_OK)
+        rc = check_reference(&o);
+    if (rc == EXIT_OK && !cli_mkdirs(o.out))
+        rc = cli_fail(EXIT_RUN, "compare: cannot create %s", o.out);
+    if (rc == EXIT_OK)
+        rc = run_comparison(&o, argc, argv, scene, scene_hash, methods, n, &failures);
     gi_plugins_free(reg);
     gi_scene_free(scene);
     if (rc == EXIT_OK && cli_interrupted)

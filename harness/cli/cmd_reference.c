@@ -45,6 +45,90 @@ static int is_exr(const char *path)
     return dot && !strcmp(dot, ".exr");
 }
 
+/* The options of how the image is rendered and written: --time-of-scene,
+ * --exposure, --strategy, --pixel, --traversal. */
+static int parse_render_opt(ref_opts *o, const char *a, const char *v)
+{
+    if (!strcmp(a, "--time-of-scene")) {
+        if (!cli_parse_float(v, &o->scene_time) || o->scene_time < 0.0f)
+            return cli_fail(EXIT_USAGE,
+                            "reference: --time-of-scene '%s' is not a non-negative number", v);
+    } else if (!strcmp(a, "--exposure")) {
+        if (!cli_parse_exposure(v, &o->exposure))
+            return cli_fail(EXIT_USAGE,
+                            "reference: --exposure '%s' is not a number of stops in -64..64", v);
+    } else if (!strcmp(a, "--strategy")) {
+        int s = gi_ref_strategy_parse(v);
+        if (s < 0)
+            return cli_fail(EXIT_USAGE, "reference: --strategy '%s' is not mis, light or bsdf", v);
+        o->strategy = (gi_ref_strategy)s;
+    } else if (!strcmp(a, "--pixel")) {
+        if (strcmp(v, "box") && strcmp(v, "center"))
+            return cli_fail(EXIT_USAGE, "reference: --pixel '%s' is not box or center", v);
+        o->pixel_center = !strcmp(v, "center");
+    } else if (!strcmp(a, "--traversal")) {
+        if (strcmp(v, "fast") && strcmp(v, "robust"))
+            return cli_fail(EXIT_USAGE, "reference: --traversal '%s' is not fast or robust", v);
+        o->robust_traversal = !strcmp(v, "robust");
+    }
+    return EXIT_OK;
+}
+
+/* One option with its value. */
+static int parse_opt(ref_opts *o, const char *a, const char *v)
+{
+    unsigned long u;
+    float f;
+    if (!strcmp(a, "--scene"))
+        o->scene = v;
+    else if (!strcmp(a, "--camera"))
+        o->camera = v;
+    else if (!strcmp(a, "--stats"))
+        o->stats = v;
+    else if (!strcmp(a, "--out")) {
+        if (cli_add_out("reference", o->outs, &o->out_count, MAX_OUTS, v))
+            return EXIT_USAGE;
+    } else if (!strcmp(a, "--size")) {
+        if (!cli_parse_size(v, &o->width, &o->height))
+            return cli_fail(EXIT_USAGE, "reference: --size '%s' is not WxH with 1..16384 each", v);
+    } else if (!strcmp(a, "--spp")) {
+        if (!cli_parse_uint(v, 1, 0xFFFFFFFFul, &u))
+            return cli_fail(EXIT_USAGE, "reference: --spp '%s' is not an integer in 1..4294967295",
+                            v);
+        o->spp = u;
+    } else if (!strcmp(a, "--time")) {
+        if (!cli_parse_float(v, &f) || !(f > 0.0f))
+            return cli_fail(EXIT_USAGE,
+                            "reference: --time '%s' is not a positive number of seconds", v);
+        o->time_limit = f;
+    } else if (!strcmp(a, "--target-se")) {
+        if (!cli_parse_float(v, &f) || !(f > 0.0f))
+            return cli_fail(EXIT_USAGE, "reference: --target-se '%s' is not a positive number", v);
+        o->target_se = f;
+    } else if (!strcmp(a, "--max-bounces")) {
+        if (!strcmp(v, "inf") || !strcmp(v, "unlimited") || !strcmp(v, "-1"))
+            o->max_bounces = GI_REF_UNLIMITED;
+        else if (cli_parse_uint(v, 0, 1000000, &u))
+            o->max_bounces = (int)u;
+        else
+            return cli_fail(EXIT_USAGE, "reference: --max-bounces '%s' is not 0..1000000 or 'inf'",
+                            v);
+    } else if (!strcmp(a, "--seed")) {
+        if (!cli_parse_uint(v, 0, 0xFFFFFFFFul, &u))
+            return cli_fail(EXIT_USAGE, "reference: --seed '%s' is not a 32-bit unsigned integer",
+                            v);
+        o->seed = (uint32_t)u;
+    } else if (!strcmp(a, "--threads")) {
+        if (!cli_parse_uint(v, 0, 1024, &u))
+            return cli_fail(EXIT_USAGE, "reference: --threads '%s' is not an integer in 0..1024",
+                            v);
+        o->threads = (uint32_t)u;
+    } else {
+        return parse_render_opt(o, a, v);
+    }
+    return EXIT_OK;
+}
+
 static int parse_opts(int argc, char **argv, ref_opts *o)
 {
     static const char *valued[] = {"--scene",    "--camera",        "--size",        "--spp",
@@ -66,78 +150,9 @@ static int parse_opts(int argc, char **argv, ref_opts *o)
         const char *v = i + 1 < argc ? argv[++i] : NULL;
         if (!v)
             return cli_fail(EXIT_USAGE, "reference: %s needs a value", a);
-        unsigned long u;
-        float f;
-        if (!strcmp(a, "--scene"))
-            o->scene = v;
-        else if (!strcmp(a, "--camera"))
-            o->camera = v;
-        else if (!strcmp(a, "--stats"))
-            o->stats = v;
-        else if (!strcmp(a, "--out")) {
-            if (cli_add_out("reference", o->outs, &o->out_count, MAX_OUTS, v))
-                return EXIT_USAGE;
-        } else if (!strcmp(a, "--size")) {
-            if (!cli_parse_size(v, &o->width, &o->height))
-                return cli_fail(EXIT_USAGE, "reference: --size '%s' is not WxH with 1..16384 each",
-                                v);
-        } else if (!strcmp(a, "--spp")) {
-            if (!cli_parse_uint(v, 1, 0xFFFFFFFFul, &u))
-                return cli_fail(EXIT_USAGE,
-                                "reference: --spp '%s' is not an integer in 1..4294967295", v);
-            o->spp = u;
-        } else if (!strcmp(a, "--time")) {
-            if (!cli_parse_float(v, &f) || !(f > 0.0f))
-                return cli_fail(EXIT_USAGE,
-                                "reference: --time '%s' is not a positive number of seconds", v);
-            o->time_limit = f;
-        } else if (!strcmp(a, "--target-se")) {
-            if (!cli_parse_float(v, &f) || !(f > 0.0f))
-                return cli_fail(EXIT_USAGE, "reference: --target-se '%s' is not a positive number",
-                                v);
-            o->target_se = f;
-        } else if (!strcmp(a, "--max-bounces")) {
-            if (!strcmp(v, "inf") || !strcmp(v, "unlimited") || !strcmp(v, "-1"))
-                o->max_bounces = GI_REF_UNLIMITED;
-            else if (cli_parse_uint(v, 0, 1000000, &u))
-                o->max_bounces = (int)u;
-            else
-                return cli_fail(EXIT_USAGE,
-                                "reference: --max-bounces '%s' is not 0..1000000 or 'inf'", v);
-        } else if (!strcmp(a, "--seed")) {
-            if (!cli_parse_uint(v, 0, 0xFFFFFFFFul, &u))
-                return cli_fail(EXIT_USAGE,
-                                "reference: --seed '%s' is not a 32-bit unsigned integer", v);
-            o->seed = (uint32_t)u;
-        } else if (!strcmp(a, "--threads")) {
-            if (!cli_parse_uint(v, 0, 1024, &u))
-                return cli_fail(EXIT_USAGE,
-                                "reference: --threads '%s' is not an integer in 0..1024", v);
-            o->threads = (uint32_t)u;
-        } else if (!strcmp(a, "--time-of-scene")) {
-            if (!cli_parse_float(v, &o->scene_time) || o->scene_time < 0.0f)
-                return cli_fail(EXIT_USAGE,
-                                "reference: --time-of-scene '%s' is not a non-negative number", v);
-        } else if (!strcmp(a, "--exposure")) {
-            if (!cli_parse_exposure(v, &o->exposure))
-                return cli_fail(EXIT_USAGE,
-                                "reference: --exposure '%s' is not a number of stops in -64..64",
-                                v);
-        } else if (!strcmp(a, "--strategy")) {
-            int s = gi_ref_strategy_parse(v);
-            if (s < 0)
-                return cli_fail(EXIT_USAGE, "reference: --strategy '%s' is not mis, light or bsdf",
-                                v);
-            o->strategy = (gi_ref_strategy)s;
-        } else if (!strcmp(a, "--pixel")) {
-            if (strcmp(v, "box") && strcmp(v, "center"))
-                return cli_fail(EXIT_USAGE, "reference: --pixel '%s' is not box or center", v);
-            o->pixel_center = !strcmp(v, "center");
-        } else if (!strcmp(a, "--traversal")) {
-            if (strcmp(v, "fast") && strcmp(v, "robust"))
-                return cli_fail(EXIT_USAGE, "reference: --traversal '%s' is not fast or robust", v);
-            o->robust_traversal = !strcmp(v, "robust");
-        }
+        int rc = parse_opt(o, a, v);
+        if (rc != EXIT_OK)
+            return rc;
     }
     if (!o->scene)
         return cli_fail(EXIT_USAGE, "reference: --scene is required");
@@ -264,44 +279,49 @@ static json_object *stats_json(const run_state *r, const ref_opts *o, int camera
     return j;
 }
 
-static int run(run_state *r, const ref_opts *o)
+/* The camera: a saved view's (--camera view:FILE.json: its camera, its
+ * moved objects and lights placed; *has_view and *view_cf), the scene's
+ * camera of --camera, or -1 when the scene has none. */
+static int find_camera(run_state *r, const ref_opts *o, int *camera, int *has_view,
+                       gi_camera_frame *view_cf)
 {
-    double t_start = gi_now();
-    gi_error err;
-    r->scene = gi_scene_load(o->scene, &err);
-    if (!r->scene)
-        return cli_fail(EXIT_USAGE, "%s", err.text);
-    int camera = 0;
-    /* --camera view:FILE.json: a saved view's camera, its moved objects and lights placed */
+    *camera = 0;
     view_file view;
     char why[600];
-    int has_view = view_camera_read(o->camera, &view, why, sizeof why);
-    if (has_view < 0)
+    *has_view = view_camera_read(o->camera, &view, why, sizeof why);
+    if (*has_view < 0)
         return cli_fail(EXIT_USAGE, "reference: --camera %s", why);
-    gi_camera_frame view_cf;
-    if (has_view) {
+    if (*has_view) {
         int ok = view_file_check_nodes(&view, r->scene, why, sizeof why);
         if (ok)
             view_file_apply_nodes(&view, r->scene);
-        view_cf = view_file_camera(&view);
+        *view_cf = view_file_camera(&view);
         view_file_free(&view);
         if (!ok)
             return cli_fail(EXIT_USAGE, "reference: --camera %s: %s", o->camera, why);
     } else if (o->camera) {
-        camera = gi_scene_find_camera(r->scene, o->camera);
-        if (camera < 0)
+        *camera = gi_scene_find_camera(r->scene, o->camera);
+        if (*camera < 0)
             return cli_fail(EXIT_USAGE,
                             "reference: %s has no camera '%s' (%u cameras; use a name or #k)",
                             o->scene, o->camera, r->scene->camera_count);
     } else if (r->scene->camera_count == 0) {
-        camera = -1;
+        *camera = -1;
     }
+    return EXIT_OK;
+}
+
+/* The path tracer of the options; view_cf: a saved view's camera, or NULL. */
+static int create_tracer(run_state *r, const ref_opts *o, int camera,
+                         const gi_camera_frame *view_cf)
+{
+    gi_error err;
     gi_ref_desc d;
     gi_ref_desc_init(&d);
     d.scene = r->scene;
     d.camera = camera;
-    if (has_view)
-        d.camera_frame = &view_cf;
+    if (view_cf)
+        d.camera_frame = view_cf;
     d.time = o->scene_time;
     d.width = o->width;
     d.height = o->height;
@@ -314,16 +334,22 @@ static int run(run_state *r, const ref_opts *o)
     gi_result res = gi_ref_create(&d, &r->ref, &err);
     if (res != GI_OK)
         return cli_fail(res == GI_ERR_INVALID_ARGUMENT ? EXIT_USAGE : EXIT_RUN, "%s", err.text);
+    return EXIT_OK;
+}
 
+/* Progressive passes until --spp, --time or --target-se says stop; *stop
+ * names which. */
+static int render_passes(run_state *r, const ref_opts *o, const char **stop)
+{
+    gi_error err;
     progress bar = {isatty(STDERR_FILENO) && gi_log_get_level() >= GI_LOG_WARN};
     const double t_render = gi_now();
     double se = INFINITY, per_spp = 0.0; /* seconds a sample per pixel takes */
     uint64_t se_spp = 0;
-    const char *stop = NULL;
     uint64_t checkpoint = o->target_se > 0.0 ? next_checkpoint(0, se, o->target_se) : o->spp;
     if (o->spp && checkpoint > o->spp)
         checkpoint = o->spp;
-    while (!stop) {
+    while (!*stop) {
         uint64_t spp = gi_ref_spp(r->ref);
         double elapsed = gi_now() - t_render;
         /* Pass size: about PASS_SECONDS of work, never past the checkpoint
@@ -338,7 +364,7 @@ static int run(run_state *r, const ref_opts *o)
         if (k > 0xFFFFFFFFull - spp)
             k = 0xFFFFFFFFull - spp;
         double t0 = gi_now();
-        res = gi_ref_render(r->ref, (uint32_t)k, &err);
+        gi_result res = gi_ref_render(r->ref, (uint32_t)k, &err);
         if (res != GI_OK) {
             progress_end(&bar);
             return cli_fail(EXIT_RUN, "%s", err.text);
@@ -355,25 +381,32 @@ static int run(run_state *r, const ref_opts *o)
             se = gi_ref_mean_rel_se(r->ref);
             se_spp = spp;
             if (se <= o->target_se)
-                stop = "target-se";
+                *stop = "target-se";
             else
                 checkpoint = next_checkpoint(spp, se, o->target_se);
             if (o->spp && checkpoint > o->spp)
                 checkpoint = o->spp;
         }
-        if (!stop && o->spp && spp >= o->spp)
-            stop = "spp";
-        if (!stop && o->time_limit > 0.0 && elapsed >= o->time_limit)
-            stop = "time";
-        if (!stop && spp >= 0xFFFFFFFFull)
-            stop = "spp";
+        if (!*stop && o->spp && spp >= o->spp)
+            *stop = "spp";
+        if (!*stop && o->time_limit > 0.0 && elapsed >= o->time_limit)
+            *stop = "time";
+        if (!*stop && spp >= 0xFFFFFFFFull)
+            *stop = "spp";
         if (bar.on && o->target_se > 0.0)
             progress_show(&bar, o, spp, se, se_spp, elapsed);
         else if (bar.on)
             progress_show(&bar, o, spp, gi_ref_mean_rel_se(r->ref), spp, elapsed);
     }
     progress_end(&bar);
+    return EXIT_OK;
+}
 
+/* The mean into every --out (EXR with a "variance" layer). */
+static int write_images(run_state *r, const ref_opts *o)
+{
+    gi_error err;
+    gi_result res;
     r->mean = gi_ref_mean_image(r->ref);
     r->var = gi_ref_variance_image(r->ref);
     if (!r->mean || !r->var)
@@ -390,6 +423,28 @@ static int run(run_state *r, const ref_opts *o)
         if (res != GI_OK)
             return cli_fail(EXIT_RUN, "%s", err.text);
     }
+    return EXIT_OK;
+}
+
+static int run(run_state *r, const ref_opts *o)
+{
+    double t_start = gi_now();
+    gi_error err;
+    r->scene = gi_scene_load(o->scene, &err);
+    if (!r->scene)
+        return cli_fail(EXIT_USAGE, "%s", err.text);
+    int camera, has_view;
+    gi_camera_frame view_cf;
+    const char *stop = NULL;
+    int rc = find_camera(r, o, &camera, &has_view, &view_cf);
+    if (rc == EXIT_OK)
+        rc = create_tracer(r, o, camera, has_view ? &view_cf : NULL);
+    if (rc == EXIT_OK)
+        rc = render_passes(r, o, &stop);
+    if (rc == EXIT_OK)
+        rc = write_images(r, o);
+    if (rc != EXIT_OK)
+        return rc;
     gi_ref_stats st;
     gi_ref_get_stats(r->ref, &st);
     if (st.nonfinite)

@@ -81,109 +81,122 @@ static int apply_view(render_opts *o)
     return EXIT_OK;
 }
 
-static int parse_opts(int argc, char **argv, render_opts *o)
+/* Whether option `a` takes a value (every option but --no-cache does). */
+static int takes_value(const char *a)
 {
-    memset(o, 0, sizeof *o);
-    o->width = o->height = 256;
-    o->frames = 1;
-    o->seed = 1;
-    for (int i = 0; i < argc; i++) {
-        const char *a = argv[i];
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        unsigned long u;
-        if (!strcmp(a, "--no-cache")) {
-            o->no_cache = 1;
-            continue;
-        }
-        if (!strcmp(a, "--scene") || !strcmp(a, "--method") || !strcmp(a, "--camera") ||
-            !strcmp(a, "--out") || !strcmp(a, "--size") || !strcmp(a, "--param") ||
-            !strcmp(a, "--frames") || !strcmp(a, "--warmup") || !strcmp(a, "--time") ||
-            !strcmp(a, "--animate") || !strcmp(a, "--seed") || !strcmp(a, "--exposure") ||
-            !strcmp(a, "--timings") || !strcmp(a, "--curve-ref") || !strcmp(a, "--view") ||
-            !strcmp(a, "--frames-out")) {
-            if (!v)
-                return cli_fail(EXIT_USAGE, "render: %s needs a value", a);
-            i++;
-        } else {
-            return cli_fail(EXIT_USAGE, "render: unknown argument '%s' (see gibench --help)", a);
-        }
-        if (!strcmp(a, "--scene"))
-            o->scene = v;
-        else if (!strcmp(a, "--method"))
-            o->method = v;
-        else if (!strcmp(a, "--camera"))
-            o->camera = v;
-        else if (!strcmp(a, "--timings"))
-            o->timings = v;
-        else if (!strcmp(a, "--view"))
-            o->view_path = v;
-        else if (!strcmp(a, "--frames-out")) {
-            char probe[4096];
-            if (!cli_frame_path(v, 0, probe, sizeof probe))
-                return cli_fail(EXIT_USAGE,
-                                "render: --frames-out '%s' needs exactly one %%d (or %%0Nd) for "
-                                "the frame index "
-                                "(%%%% for a percent sign)",
-                                v);
-            size_t pl = strlen(probe);
-            if (pl < 5 || (strcmp(probe + pl - 4, ".exr") && strcmp(probe + pl - 4, ".pfm") &&
-                           strcmp(probe + pl - 4, ".png")))
-                return cli_fail(EXIT_USAGE,
-                                "render: --frames-out '%s' must end in .exr, .pfm or .png", v);
-            o->frames_out = v;
-        } else if (!strcmp(a, "--curve-ref")) {
-            const char *eq = strchr(v, '=');
-            if (!eq || eq == v || !eq[1] || eq - v > 31)
-                return cli_fail(
-                    EXIT_USAGE,
-                    "render: --curve-ref '%s' is not NAME=IMAGE (a name of 1..31 characters)", v);
-            if (o->curve_ref_count == MAX_CURVE_REFS)
-                return cli_fail(EXIT_USAGE, "render: at most %d --curve-ref", MAX_CURVE_REFS);
-            o->curve_name[o->curve_ref_count] = v;
-            o->curve_path[o->curve_ref_count++] = eq + 1;
-        } else if (!strcmp(a, "--out")) {
-            if (cli_add_out("render", o->outs, &o->out_count, MAX_OUTS, v))
-                return EXIT_USAGE;
-        } else if (!strcmp(a, "--size")) {
-            if (!cli_parse_size(v, &o->width, &o->height))
-                return cli_fail(EXIT_USAGE, "render: --size '%s' is not WxH with 1..16384 each", v);
-            o->given_size = 1;
-        } else if (!strcmp(a, "--param")) {
-            if (o->param_count == MAX_PARAMS)
-                return cli_fail(EXIT_USAGE, "render: at most %d --param", MAX_PARAMS);
-            o->params[o->param_count++] = v;
-        } else if (!strcmp(a, "--frames")) {
-            if (!cli_parse_uint(v, 1, 1000000, &u))
-                return cli_fail(EXIT_USAGE, "render: --frames '%s' is not an integer in 1..1000000",
-                                v);
-            o->frames = (uint32_t)u;
-            o->given_frames = 1;
-        } else if (!strcmp(a, "--warmup")) {
-            if (!cli_parse_uint(v, 0, 1000, &u))
-                return cli_fail(EXIT_USAGE, "render: --warmup '%s' is not an integer in 0..1000",
-                                v);
-            o->warmup = (uint32_t)u;
-        } else if (!strcmp(a, "--seed")) {
-            if (!cli_parse_uint(v, 0, 0xFFFFFFFFul, &u))
-                return cli_fail(EXIT_USAGE, "render: --seed '%s' is not a 32-bit unsigned integer",
-                                v);
-            o->seed = (uint32_t)u;
-            o->given_seed = 1;
-        } else if (!strcmp(a, "--time")) {
-            if (!cli_parse_float(v, &o->time) || o->time < 0)
-                return cli_fail(EXIT_USAGE, "render: --time '%s' is not a non-negative number", v);
-            o->given_time = 1;
-        } else if (!strcmp(a, "--animate")) {
-            if (!cli_parse_float(v, &o->animate_fps) || o->animate_fps <= 0)
-                return cli_fail(EXIT_USAGE, "render: --animate '%s' is not a positive frame rate",
-                                v);
-        } else if (!strcmp(a, "--exposure")) {
-            if (!cli_parse_exposure(v, &o->exposure))
-                return cli_fail(EXIT_USAGE,
-                                "render: --exposure '%s' is not a number of stops in -64..64", v);
-            o->given_exposure = 1;
-        }
+    return !strcmp(a, "--scene") || !strcmp(a, "--method") || !strcmp(a, "--camera") ||
+           !strcmp(a, "--out") || !strcmp(a, "--size") || !strcmp(a, "--param") ||
+           !strcmp(a, "--frames") || !strcmp(a, "--warmup") || !strcmp(a, "--time") ||
+           !strcmp(a, "--animate") || !strcmp(a, "--seed") || !strcmp(a, "--exposure") ||
+           !strcmp(a, "--timings") || !strcmp(a, "--curve-ref") || !strcmp(a, "--view") ||
+           !strcmp(a, "--frames-out");
+}
+
+/* --frames-out PATTERN: one %d for the frame index and an image file's extension. */
+static int parse_frames_out(render_opts *o, const char *v)
+{
+    char probe[4096];
+    if (!cli_frame_path(v, 0, probe, sizeof probe))
+        return cli_fail(EXIT_USAGE,
+                        "render: --frames-out '%s' needs exactly one %%d (or %%0Nd) for "
+                        "the frame index "
+                        "(%%%% for a percent sign)",
+                        v);
+    size_t pl = strlen(probe);
+    if (pl < 5 || (strcmp(probe + pl - 4, ".exr") && strcmp(probe + pl - 4, ".pfm") &&
+                   strcmp(probe + pl - 4, ".png")))
+        return cli_fail(EXIT_USAGE, "render: --frames-out '%s' must end in .exr, .pfm or .png", v);
+    o->frames_out = v;
+    return EXIT_OK;
+}
+
+/* --curve-ref NAME=PATH */
+static int parse_curve_ref(render_opts *o, const char *v)
+{
+    const char *eq = strchr(v, '=');
+    if (!eq || eq == v || !eq[1] || eq - v > 31)
+        return cli_fail(EXIT_USAGE,
+                        "render: --curve-ref '%s' is not NAME=IMAGE (a name of 1..31 characters)",
+                        v);
+    if (o->curve_ref_count == MAX_CURVE_REFS)
+        return cli_fail(EXIT_USAGE, "render: at most %d --curve-ref", MAX_CURVE_REFS);
+    o->curve_name[o->curve_ref_count] = v;
+    o->curve_path[o->curve_ref_count++] = eq + 1;
+    return EXIT_OK;
+}
+
+/* The options with a number: --frames, --warmup, --seed, --time, --animate, --exposure. */
+static int parse_number_opt(render_opts *o, const char *a, const char *v)
+{
+    unsigned long u;
+    if (!strcmp(a, "--frames")) {
+        if (!cli_parse_uint(v, 1, 1000000, &u))
+            return cli_fail(EXIT_USAGE, "render: --frames '%s' is not an integer in 1..1000000", v);
+        o->frames = (uint32_t)u;
+        o->given_frames = 1;
+    } else if (!strcmp(a, "--warmup")) {
+        if (!cli_parse_uint(v, 0, 1000, &u))
+            return cli_fail(EXIT_USAGE, "render: --warmup '%s' is not an integer in 0..1000", v);
+        o->warmup = (uint32_t)u;
+    } else if (!strcmp(a, "--seed")) {
+        if (!cli_parse_uint(v, 0, 0xFFFFFFFFul, &u))
+            return cli_fail(EXIT_USAGE, "render: --seed '%s' is not a 32-bit unsigned integer", v);
+        o->seed = (uint32_t)u;
+        o->given_seed = 1;
+    } else if (!strcmp(a, "--time")) {
+        if (!cli_parse_float(v, &o->time) || o->time < 0)
+            return cli_fail(EXIT_USAGE, "render: --time '%s' is not a non-negative number", v);
+        o->given_time = 1;
+    } else if (!strcmp(a, "--animate")) {
+        if (!cli_parse_float(v, &o->animate_fps) || o->animate_fps <= 0)
+            return cli_fail(EXIT_USAGE, "render: --animate '%s' is not a positive frame rate", v);
+    } else if (!strcmp(a, "--exposure")) {
+        if (!cli_parse_exposure(v, &o->exposure))
+            return cli_fail(EXIT_USAGE,
+                            "render: --exposure '%s' is not a number of stops in -64..64", v);
+        o->given_exposure = 1;
     }
+    return EXIT_OK;
+}
+
+/* One option with its value. */
+static int parse_opt(render_opts *o, const char *a, const char *v)
+{
+    if (!strcmp(a, "--scene"))
+        o->scene = v;
+    else if (!strcmp(a, "--method"))
+        o->method = v;
+    else if (!strcmp(a, "--camera"))
+        o->camera = v;
+    else if (!strcmp(a, "--timings"))
+        o->timings = v;
+    else if (!strcmp(a, "--view"))
+        o->view_path = v;
+    else if (!strcmp(a, "--frames-out"))
+        return parse_frames_out(o, v);
+    else if (!strcmp(a, "--curve-ref"))
+        return parse_curve_ref(o, v);
+    else if (!strcmp(a, "--out")) {
+        if (cli_add_out("render", o->outs, &o->out_count, MAX_OUTS, v))
+            return EXIT_USAGE;
+    } else if (!strcmp(a, "--size")) {
+        if (!cli_parse_size(v, &o->width, &o->height))
+            return cli_fail(EXIT_USAGE, "render: --size '%s' is not WxH with 1..16384 each", v);
+        o->given_size = 1;
+    } else if (!strcmp(a, "--param")) {
+        if (o->param_count == MAX_PARAMS)
+            return cli_fail(EXIT_USAGE, "render: at most %d --param", MAX_PARAMS);
+        o->params[o->param_count++] = v;
+    } else {
+        return parse_number_opt(o, a, v);
+    }
+    return EXIT_OK;
+}
+
+/* After the options: the saved view (--view, or --camera view:FILE.json)
+ * and what is required. */
+static int finish_opts(render_opts *o)
+{
     if (o->view_path) {
         int rc = apply_view(o);
         if (rc != EXIT_OK)
@@ -206,6 +219,33 @@ static int parse_opts(int argc, char **argv, render_opts *o)
         return cli_fail(EXIT_USAGE, "render: --warmup %u leaves no timed frame of %u", o->warmup,
                         o->frames);
     return EXIT_OK;
+}
+
+static int parse_opts(int argc, char **argv, render_opts *o)
+{
+    memset(o, 0, sizeof *o);
+    o->width = o->height = 256;
+    o->frames = 1;
+    o->seed = 1;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "--no-cache")) {
+            o->no_cache = 1;
+            continue;
+        }
+        if (takes_value(a)) {
+            if (!v)
+                return cli_fail(EXIT_USAGE, "render: %s needs a value", a);
+            i++;
+        } else {
+            return cli_fail(EXIT_USAGE, "render: unknown argument '%s' (see gibench --help)", a);
+        }
+        int rc = parse_opt(o, a, v);
+        if (rc != EXIT_OK)
+            return rc;
+    }
+    return finish_opts(o);
 }
 
 /* The process's peak resident memory so far, in MiB: VmHWM of
@@ -495,9 +535,9 @@ static void print_summary(const run_state *r, const render_opts *o)
            o->timings ? o->timings : "");
 }
 
-static int run(run_state *r, const render_opts *o)
+/* The method of --method among the installed ones. */
+static int find_method(run_state *r, const render_opts *o)
 {
-    gi_error err;
     r->reg = cli_load_plugins(1);
     if (!r->reg)
         return cli_fail(EXIT_RUN, "out of memory");
@@ -512,6 +552,15 @@ static int run(run_state *r, const render_opts *o)
         return cli_fail(EXIT_USAGE, "render: no method '%s' (installed: %s)", o->method,
                         known[0] ? known : "none");
     }
+    return EXIT_OK;
+}
+
+/* The method's parameters and the scene, with what a saved view moves
+ * marked as moving; warns when the method's caps leave part of the scene
+ * out. *moves: the view moves objects or lights. */
+static int load_scene(run_state *r, const render_opts *o, int *moves)
+{
+    gi_error err;
     r->params = gi_params_parse(r->m->id, r->m->params, o->params, o->param_count, &err);
     if (!r->params)
         return cli_fail(EXIT_USAGE, "%s", err.text);
@@ -521,8 +570,8 @@ static int run(run_state *r, const render_opts *o)
     /* A study marks such a cell n/a; a single render runs it but says what
      * the image leaves out. */
     char why[256];
-    int moves = o->has_view && o->view.node_count > 0;
-    if (moves) {
+    *moves = o->has_view && o->view.node_count > 0;
+    if (*moves) {
         /* a saved view with objects or lights moved: the method is prepared
          * with the scene as the file places it, those objects marked as
          * moving, then told of the move by update(), as gibench view did */
@@ -532,11 +581,17 @@ static int run(run_state *r, const render_opts *o)
         for (uint32_t i = 0; i < o->view.node_count; i++)
             view_scene_mark_moving(r->scene, o->view.nodes[i].node);
     }
-    if (!cli_caps_cover(r->m, r->scene, o->animate_fps > 0 || moves, why, sizeof why))
+    if (!cli_caps_cover(r->m, r->scene, o->animate_fps > 0 || *moves, why, sizeof why))
         gi_log(GI_LOG_WARN,
                "render: %s in %s: the image leaves that out (a study marks this cell n/a)", why,
                o->scene);
-    /* references of the convergence curve: read before anything is timed */
+    return EXIT_OK;
+}
+
+/* References of the convergence curve: read before anything is timed. */
+static int read_curve_refs(run_state *r, const render_opts *o)
+{
+    gi_error err;
     for (int c = 0; c < o->curve_ref_count; c++) {
         r->curve_ref[c] = gi_image_read(o->curve_path[c], &err);
         if (!r->curve_ref[c])
@@ -546,16 +601,31 @@ static int run(run_state *r, const render_opts *o)
                             o->curve_path[c], r->curve_ref[c]->width, r->curve_ref[c]->height,
                             o->width, o->height);
     }
-    int camera = 0;
+    return EXIT_OK;
+}
+
+/* The scene camera of --camera (a saved view has its own); -1 when the
+ * scene has none. */
+static int find_camera(const run_state *r, const render_opts *o, int *camera)
+{
+    *camera = 0;
     if (o->camera && !o->has_view) {
-        camera = gi_scene_find_camera(r->scene, o->camera);
-        if (camera < 0)
+        *camera = gi_scene_find_camera(r->scene, o->camera);
+        if (*camera < 0)
             return cli_fail(EXIT_USAGE,
                             "render: %s has no camera '%s' (%u cameras; use a name or #k)",
                             o->scene, o->camera, r->scene->camera_count);
     } else if (r->scene->camera_count == 0) {
-        camera = -1;
+        *camera = -1;
     }
+    return EXIT_OK;
+}
+
+/* The cache, the GL context with the scene uploaded, the timers, the host
+ * services and the render target (cleared to black). */
+static int setup_gpu(run_state *r, const render_opts *o)
+{
+    gi_error err;
     if (!o->no_cache) {
         r->cache_dir = gi_cache_dir(&err);
         if (!r->cache_dir)
@@ -582,8 +652,13 @@ static int run(run_state *r, const render_opts *o)
     glNamedFramebufferTexture(r->target_fbo, GL_COLOR_ATTACHMENT0, r->target_tex, 0);
     const float black[4] = {0, 0, 0, 1};
     glClearNamedFramebufferfv(r->target_fbo, GL_COLOR, 0, black);
-    gi_target target = {r->target_tex, r->target_fbo, o->width, o->height};
+    return EXIT_OK;
+}
 
+/* The method created and prepared (the prepare timer), then told of what
+ * a saved view moves. */
+static int create_and_prepare(run_state *r, const render_opts *o, int moves)
+{
     gi_error cerr;
     gi_result res = gi_method_create(r->m, &r->host.host, r->params, &r->inst, &cerr);
     if (res != GI_OK)
@@ -612,8 +687,45 @@ static int run(run_state *r, const render_opts *o)
         if (res != GI_OK)
             return method_fail(r, "update", res);
     }
-    r->rss_prepare_mib = peak_rss_mib();
+    return EXIT_OK;
+}
 
+/* Frame f (from 0), timed: update() for a step of an animation, then render(). */
+static int render_frame(run_state *r, const render_opts *o, int camera, uint32_t f)
+{
+    gi_target target = {r->target_tex, r->target_fbo, o->width, o->height};
+    float t = o->time + (o->animate_fps > 0 ? (float)f / o->animate_fps : 0.0f);
+    gi_result res;
+    /* A frame of an animation is update() and render(): what an
+     * interactive program pays per frame (a method that rebuilds data
+     * in update() is charged for it; its stages count in the frame). */
+    gi_timer_frame_begin(r->render_timer);
+    if (f > 0 && o->animate_fps > 0) {
+        gi_gpu_scene_set_time(r->gs, t);
+        gi_changes ch = animation_changes(r->scene, r->gs, o->has_view ? -1 : camera);
+        ch.time = t;
+        res = r->m->update(r->inst, r->gs, &ch);
+        if (res != GI_OK) {
+            gi_timer_frame_end(r->render_timer);
+            return method_fail(r, "update", res);
+        }
+    }
+    gi_view view;
+    make_view(r->scene, camera, o, t, o->animate_fps > 0 ? 0 : f, &view);
+    res = r->m->render(r->inst, &view, &target);
+    gi_timer_frame_end(r->render_timer);
+    if (res != GI_OK)
+        return method_fail(r, "render", res);
+    gi_error err;
+    if (gi_gl_check("after render", &err) != GI_OK)
+        return cli_fail(EXIT_RUN, "%s: %s", r->m->id, err.text);
+    return EXIT_OK;
+}
+
+/* Every frame (the render timer), with the convergence curve's points and
+ * --frames-out taken between them, under a progress line. */
+static int render_frames(run_state *r, const render_opts *o, int camera)
+{
     r->host.timer = r->render_timer;
     cli_progress bar;
     char label[64];
@@ -627,30 +739,10 @@ static int run(run_state *r, const render_opts *o)
             return cli_fail(EXIT_RUN, "render: interrupted after %u of %u frames; no image written",
                             f, o->frames);
         }
-        float t = o->time + (o->animate_fps > 0 ? (float)f / o->animate_fps : 0.0f);
-        /* A frame of an animation is update() and render(): what an
-         * interactive program pays per frame (a method that rebuilds data
-         * in update() is charged for it; its stages count in the frame). */
-        gi_timer_frame_begin(r->render_timer);
-        if (f > 0 && o->animate_fps > 0) {
-            gi_gpu_scene_set_time(r->gs, t);
-            gi_changes ch = animation_changes(r->scene, r->gs, o->has_view ? -1 : camera);
-            ch.time = t;
-            res = r->m->update(r->inst, r->gs, &ch);
-            if (res != GI_OK) {
-                gi_timer_frame_end(r->render_timer);
-                return method_fail(r, "update", res);
-            }
-        }
-        gi_view view;
-        make_view(r->scene, camera, o, t, o->animate_fps > 0 ? 0 : f, &view);
-        res = r->m->render(r->inst, &view, &target);
-        gi_timer_frame_end(r->render_timer);
-        if (res != GI_OK)
-            return method_fail(r, "render", res);
-        if (gi_gl_check("after render", &err) != GI_OK)
-            return cli_fail(EXIT_RUN, "%s: %s", r->m->id, err.text);
-        int rc = record_curve_point(r, o, f + 1);
+        int rc = render_frame(r, o, camera, f);
+        if (rc != EXIT_OK)
+            return rc;
+        rc = record_curve_point(r, o, f + 1);
         if (rc == EXIT_OK)
             rc = write_frame(r, o, f);
         if (rc != EXIT_OK) {
@@ -661,6 +753,13 @@ static int run(run_state *r, const render_opts *o)
     if (o->frames > 1)
         cli_progress_show(&bar, 1.0, o->frames, o->frames, "frames");
     cli_progress_end(&bar);
+    return EXIT_OK;
+}
+
+/* The last image (alpha 1) into every --out, the timings file and the summary line. */
+static int write_results(run_state *r, const render_opts *o)
+{
+    gi_error err;
     r->image = gi_gpu_read_texture(r->target_tex, o->width, o->height);
     if (!r->image)
         return cli_fail(EXIT_RUN, "out of memory reading the image back");
@@ -676,6 +775,29 @@ static int run(run_state *r, const render_opts *o)
     int rc = o->timings ? cli_save_json(o->timings, timings_json(r, o)) : EXIT_OK;
     if (rc == EXIT_OK)
         print_summary(r, o);
+    return rc;
+}
+
+static int run(run_state *r, const render_opts *o)
+{
+    int moves = 0, camera = 0;
+    int rc = find_method(r, o);
+    if (rc == EXIT_OK)
+        rc = load_scene(r, o, &moves);
+    if (rc == EXIT_OK)
+        rc = read_curve_refs(r, o);
+    if (rc == EXIT_OK)
+        rc = find_camera(r, o, &camera);
+    if (rc == EXIT_OK)
+        rc = setup_gpu(r, o);
+    if (rc == EXIT_OK)
+        rc = create_and_prepare(r, o, moves);
+    if (rc != EXIT_OK)
+        return rc;
+    r->rss_prepare_mib = peak_rss_mib();
+    rc = render_frames(r, o, camera);
+    if (rc == EXIT_OK)
+        rc = write_results(r, o);
     return rc;
 }
 

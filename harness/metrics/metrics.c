@@ -198,6 +198,87 @@ gi_result gi_metrics_flip_map(const gi_image *test, const gi_image *ref,
 
 /* ---- everything ---- */
 
+/* The sums over the pixels finite in both images. */
+typedef struct pixel_sums {
+    double se, rel, ae, se_t, sum_lx, sum_lr;
+} pixel_sums;
+
+/* One pass over the pixels: the excluded ones counted and masked out, the
+ * sums of the others, and each pixel's tonemapped luminance for SSIM. */
+static void sum_pixels(const gi_image *test, const gi_image *ref, const gi_metrics_opts *o,
+                       size_t n, gi_metrics *out, uint8_t *mask, double *lx, double *lr,
+                       pixel_sums *sums)
+{
+    double se = 0.0, rel = 0.0, ae = 0.0, se_t = 0.0, sum_lx = 0.0, sum_lr = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        const float *x = test->rgba + i * 4, *r = ref->rgba + i * 4;
+        int fx = finite3(x), fr = finite3(r);
+        out->nonfinite_test += !fx;
+        out->nonfinite_ref += !fr;
+        mask[i] = (uint8_t)(fx && fr);
+        if (!mask[i]) {
+            out->excluded++;
+            const float *s = shared_pixel(x, r);
+            lx[i] = lr[i] = s ? gi_tonemap((float)lum(s), o->exposure) : 0.0;
+            continue;
+        }
+        for (int c = 0; c < 3; c++) {
+            double d = (double)x[c] - r[c], q = (double)r[c] + 0.01;
+            se += d * d;
+            rel += d * d / (q * q);
+            ae += fabs(d);
+            double dt = (double)gi_tonemap(x[c], o->exposure) - gi_tonemap(r[c], o->exposure);
+            se_t += dt * dt;
+        }
+        sum_lx += lum(x);
+        sum_lr += lum(r);
+        lx[i] = gi_tonemap((float)lum(x), o->exposure);
+        lr[i] = gi_tonemap((float)lum(r), o->exposure);
+    }
+    *sums = (pixel_sums){se, rel, ae, se_t, sum_lx, sum_lr};
+}
+
+/* The error and luminance metrics from the sums (out->pixels > 0). */
+static void metrics_from_sums(const pixel_sums *sums, gi_metrics *out)
+{
+    double samples = 3.0 * (double)out->pixels;
+    out->mse = sums->se / samples;
+    out->rmse = sqrt(out->mse);
+    out->relmse = sums->rel / samples;
+    out->mae = sums->ae / samples;
+    double mse_t = sums->se_t / samples;
+    out->psnr = mse_t > 0.0 ? 10.0 * log10(1.0 / mse_t) : INFINITY;
+    out->mean_lum_test = sums->sum_lx / (double)out->pixels;
+    out->mean_lum_ref = sums->sum_lr / (double)out->pixels;
+    if (out->mean_lum_ref != 0.0)
+        out->mean_lum_diff_pct =
+            100.0 * (out->mean_lum_test - out->mean_lum_ref) / out->mean_lum_ref;
+    else
+        out->mean_lum_diff_pct = out->mean_lum_test == 0.0 ? 0.0 : NAN;
+}
+
+/* leaked energy: the test's light where the reference is dark */
+static void leaked_energy(const gi_image *test, const gi_image *ref, const uint8_t *mask, size_t n,
+                          double sum_lr, gi_metrics *out)
+{
+    double dark_below = (double)out->dark_threshold * out->mean_lum_ref, leak = 0.0, own = 0.0;
+    uint64_t dark = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (!mask[i])
+            continue;
+        double yr = lum(ref->rgba + i * 4);
+        if (yr < dark_below) {
+            double yx = lum(test->rgba + i * 4);
+            leak += yx > 0.0 ? yx : 0.0;
+            own += yr > 0.0 ? yr : 0.0;
+            dark++;
+        }
+    }
+    out->dark_fraction = (double)dark / (double)out->pixels;
+    out->leaked_energy = sum_lr > 0.0 ? leak / sum_lr : NAN;
+    out->dark_energy_ref = sum_lr > 0.0 ? own / sum_lr : NAN;
+}
+
 gi_result gi_metrics_compute(const gi_image *test, const gi_image *ref, const gi_metrics_opts *opts,
                              gi_metrics *out, gi_error *err)
 {
@@ -227,32 +308,8 @@ gi_result gi_metrics_compute(const gi_image *test, const gi_image *ref, const gi
         goto done;
     }
 
-    double se = 0.0, rel = 0.0, ae = 0.0, se_t = 0.0, sum_lx = 0.0, sum_lr = 0.0;
-    for (size_t i = 0; i < n; i++) {
-        const float *x = test->rgba + i * 4, *r = ref->rgba + i * 4;
-        int fx = finite3(x), fr = finite3(r);
-        out->nonfinite_test += !fx;
-        out->nonfinite_ref += !fr;
-        mask[i] = (uint8_t)(fx && fr);
-        if (!mask[i]) {
-            out->excluded++;
-            const float *s = shared_pixel(x, r);
-            lx[i] = lr[i] = s ? gi_tonemap((float)lum(s), o->exposure) : 0.0;
-            continue;
-        }
-        for (int c = 0; c < 3; c++) {
-            double d = (double)x[c] - r[c], q = (double)r[c] + 0.01;
-            se += d * d;
-            rel += d * d / (q * q);
-            ae += fabs(d);
-            double dt = (double)gi_tonemap(x[c], o->exposure) - gi_tonemap(r[c], o->exposure);
-            se_t += dt * dt;
-        }
-        sum_lx += lum(x);
-        sum_lr += lum(r);
-        lx[i] = gi_tonemap((float)lum(x), o->exposure);
-        lr[i] = gi_tonemap((float)lum(r), o->exposure);
-    }
+    pixel_sums sums;
+    sum_pixels(test, ref, o, n, out, mask, lx, lr, &sums);
     out->pixels = n - out->excluded;
 
     if (out->pixels == 0) {
@@ -261,40 +318,8 @@ gi_result gi_metrics_compute(const gi_image *test, const gi_image *ref, const gi
         out->leaked_energy = out->dark_fraction = out->dark_energy_ref = NAN;
         goto done;
     }
-    double samples = 3.0 * (double)out->pixels;
-    out->mse = se / samples;
-    out->rmse = sqrt(out->mse);
-    out->relmse = rel / samples;
-    out->mae = ae / samples;
-    double mse_t = se_t / samples;
-    out->psnr = mse_t > 0.0 ? 10.0 * log10(1.0 / mse_t) : INFINITY;
-    out->mean_lum_test = sum_lx / (double)out->pixels;
-    out->mean_lum_ref = sum_lr / (double)out->pixels;
-    if (out->mean_lum_ref != 0.0)
-        out->mean_lum_diff_pct =
-            100.0 * (out->mean_lum_test - out->mean_lum_ref) / out->mean_lum_ref;
-    else
-        out->mean_lum_diff_pct = out->mean_lum_test == 0.0 ? 0.0 : NAN;
-
-    /* leaked energy: the test's light where the reference is dark */
-    {
-        double dark_below = (double)out->dark_threshold * out->mean_lum_ref, leak = 0.0, own = 0.0;
-        uint64_t dark = 0;
-        for (size_t i = 0; i < n; i++) {
-            if (!mask[i])
-                continue;
-            double yr = lum(ref->rgba + i * 4);
-            if (yr < dark_below) {
-                double yx = lum(test->rgba + i * 4);
-                leak += yx > 0.0 ? yx : 0.0;
-                own += yr > 0.0 ? yr : 0.0;
-                dark++;
-            }
-        }
-        out->dark_fraction = (double)dark / (double)out->pixels;
-        out->leaked_energy = sum_lr > 0.0 ? leak / sum_lr : NAN;
-        out->dark_energy_ref = sum_lr > 0.0 ? own / sum_lr : NAN;
-    }
+    metrics_from_sums(&sums, out);
+    leaked_energy(test, ref, mask, n, sums.sum_lr, out);
 
     res = gi_metrics_ssim_plane(lx, lr, mask, test->width, test->height, &out->ssim, err);
     if (res)

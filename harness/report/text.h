@@ -1,4 +1,4 @@
-/* A growing text buffer for the report writers (report.c, tradeoff.c):
+/* A growing text buffer for the report writers (report.c and its writers, tradeoff.c):
  * printf-style appends; on an allocation failure the append is dropped and
  * `failed` set, so the caller can refuse to write a partial file. */
 #ifndef GIBENCH_TEXT_H

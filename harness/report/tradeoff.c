@@ -289,6 +289,96 @@ static uint32_t pareto(const setting *set, uint32_t ns, uint32_t method, int mat
     return kept;
 }
 
+/* Method m's series: each of its settings' curves (thin), then its Pareto
+ * front as a staircase into x (and the five arrays after it, `per` values
+ * apart) labelled in `label`. Returns the number of series added. */
+static uint32_t method_series(gi_chart_series *series, const setting *set, uint32_t ns, uint32_t m,
+                              int matched, front_point *fp, double *x, size_t per, char *label,
+                              size_t label_size, const char *method)
+{
+    uint32_t n = 0;
+    for (uint32_t s = 0; s < ns; s++)
+        if (set[s].method_index == m && set[s].n > 1)
+            series[n++] =
+                (gi_chart_series){NULL,     set[s].t,      matched ? set[s].em : set[s].ef,
+                                  set[s].n, GI_CHART_THIN, (int)m + 1,
+                                  NULL,     NULL,          NULL,
+                                  NULL};
+    uint32_t k = pareto(set, ns, m, matched, fp);
+    double *y = x + per, *xl = y + per, *xh = xl + per, *yl = xh + per, *yh = yl + per;
+    /* a staircase: between two settings on the front nothing better is
+     * known than the slower one's error, reached at its own time. Each
+     * front point carries the spread of its repeats as error bars
+     * (time and relMSE, min to max); the corners carry none. */
+    uint32_t c = 0;
+    int spread = 0;
+    for (uint32_t i = 0; i < k; i++) {
+        const setting *g = &set[fp[i].s];
+        uint32_t j = fp[i].k;
+        double e = matched ? g->em[j] : g->ef[j];
+        if (i > 0) {
+            x[c] = g->t[j];
+            y[c] = y[c - 1];
+            xl[c] = xh[c] = yl[c] = yh[c] = NAN;
+            c++;
+        }
+        x[c] = g->t[j];
+        y[c] = e;
+        xl[c] = g->t_lo[j], xh[c] = g->t_hi[j];
+        yl[c] = matched ? g->em_lo[j] : g->ef_lo[j];
+        yh[c] = matched ? g->em_hi[j] : g->ef_hi[j];
+        spread |= g->repeats > 1;
+        c++;
+    }
+    snprintf(label, label_size, "%s (Pareto front%s)", method,
+             spread ? "; bars: min-max of repeats" : "");
+    series[n++] = (gi_chart_series){label,
+                                    x,
+                                    y,
+                                    c,
+                                    GI_CHART_LINE_MARKERS,
+                                    (int)m + 1,
+                                    spread ? xl : NULL,
+                                    spread ? xh : NULL,
+                                    spread ? yl : NULL,
+                                    spread ? yh : NULL};
+    return n;
+}
+
+/* The path tracer's curves from colour `colour` on: full GI, or with
+ * matched every bounce limit (labelled in labels) and then full GI.
+ * Returns the number of series added. */
+static uint32_t path_tracer_series(gi_chart_series *series, int matched,
+                                   const tradeoff_pt_curve *full, const tradeoff_pt_curve *mcurves,
+                                   uint32_t matched_n, char (*labels)[160], int colour)
+{
+    uint32_t n = 0;
+    if (!matched) {
+        series[n++] = (gi_chart_series){"path tracer (Embree, CPU), full GI",
+                                        full->t,
+                                        full->e,
+                                        full->n,
+                                        GI_CHART_DASHED,
+                                        colour,
+                                        NULL,
+                                        NULL,
+                                        NULL,
+                                        NULL};
+    } else {
+        for (uint32_t i = 0; i < matched_n; i++) {
+            snprintf(labels[i], sizeof labels[i], "path tracer, max_bounces %u",
+                     mcurves[i].bounces);
+            series[n++] = (gi_chart_series){
+                labels[i],       mcurves[i].t, mcurves[i].e, mcurves[i].n, GI_CHART_DASHED,
+                colour + (int)i, NULL,         NULL,         NULL,         NULL};
+        }
+        series[n++] =
+            (gi_chart_series){"path tracer, full GI",  full->t, full->e, full->n, GI_CHART_DASHED,
+                              colour + (int)matched_n, NULL,    NULL,    NULL,    NULL};
+    }
+    return n;
+}
+
 static void chart(tradeoff_chart_fn write_chart, const char *out_dir, const char *name, int matched,
                   const tradeoff_pt_curve *full, const tradeoff_pt_curve *mcurves,
                   uint32_t matched_n, const setting *set, uint32_t ns, const char **methods,
@@ -306,78 +396,11 @@ static void chart(tradeoff_chart_fn write_chart, const char *out_dir, const char
         return;
     }
     uint32_t n = 0;
-    for (uint32_t m = 0; m < nm; m++) {
-        for (uint32_t s = 0; s < ns; s++)
-            if (set[s].method_index == m && set[s].n > 1)
-                series[n++] =
-                    (gi_chart_series){NULL,     set[s].t,      matched ? set[s].em : set[s].ef,
-                                      set[s].n, GI_CHART_THIN, (int)m + 1,
-                                      NULL,     NULL,          NULL,
-                                      NULL};
-        uint32_t k = pareto(set, ns, m, matched, fp);
-        double *x = fx + (size_t)m * per * 6, *y = x + per, *xl = y + per, *xh = xl + per,
-               *yl = xh + per, *yh = yl + per;
-        /* a staircase: between two settings on the front nothing better is
-         * known than the slower one's error, reached at its own time. Each
-         * front point carries the spread of its repeats as error bars
-         * (time and relMSE, min to max); the corners carry none. */
-        uint32_t c = 0;
-        int spread = 0;
-        for (uint32_t i = 0; i < k; i++) {
-            const setting *g = &set[fp[i].s];
-            uint32_t j = fp[i].k;
-            double e = matched ? g->em[j] : g->ef[j];
-            if (i > 0) {
-                x[c] = g->t[j];
-                y[c] = y[c - 1];
-                xl[c] = xh[c] = yl[c] = yh[c] = NAN;
-                c++;
-            }
-            x[c] = g->t[j];
-            y[c] = e;
-            xl[c] = g->t_lo[j], xh[c] = g->t_hi[j];
-            yl[c] = matched ? g->em_lo[j] : g->ef_lo[j];
-            yh[c] = matched ? g->em_hi[j] : g->ef_hi[j];
-            spread |= g->repeats > 1;
-            c++;
-        }
-        snprintf(labels[m], sizeof labels[m], "%s (Pareto front%s)", methods[m],
-                 spread ? "; bars: min-max of repeats" : "");
-        series[n++] = (gi_chart_series){labels[m],
-                                        x,
-                                        y,
-                                        c,
-                                        GI_CHART_LINE_MARKERS,
-                                        (int)m + 1,
-                                        spread ? xl : NULL,
-                                        spread ? xh : NULL,
-                                        spread ? yl : NULL,
-                                        spread ? yh : NULL};
-    }
-    int colour = (int)nm + 1;
-    if (!matched) {
-        series[n++] = (gi_chart_series){"path tracer (Embree, CPU), full GI",
-                                        full->t,
-                                        full->e,
-                                        full->n,
-                                        GI_CHART_DASHED,
-                                        colour,
-                                        NULL,
-                                        NULL,
-                                        NULL,
-                                        NULL};
-    } else {
-        for (uint32_t i = 0; i < matched_n; i++) {
-            snprintf(labels[nm + i], sizeof labels[nm + i], "path tracer, max_bounces %u",
-                     mcurves[i].bounces);
-            series[n++] = (gi_chart_series){
-                labels[nm + i],  mcurves[i].t, mcurves[i].e, mcurves[i].n, GI_CHART_DASHED,
-                colour + (int)i, NULL,         NULL,         NULL,         NULL};
-        }
-        series[n++] =
-            (gi_chart_series){"path tracer, full GI",  full->t, full->e, full->n, GI_CHART_DASHED,
-                              colour + (int)matched_n, NULL,    NULL,    NULL,    NULL};
-    }
+    for (uint32_t m = 0; m < nm; m++)
+        n += method_series(series + n, set, ns, m, matched, fp, fx + (size_t)m * per * 6, per,
+                           labels[m], sizeof labels[m], methods[m]);
+    n +=
+        path_tracer_series(series + n, matched, full, mcurves, matched_n, labels + nm, (int)nm + 1);
     char file[512], path[4700], title[512];
     snprintf(file, sizeof file, "chart_%s_error_vs_time%s.png", name, matched ? "_matched" : "");
     snprintf(path, sizeof path, "%s/%s", out_dir, file);

@@ -289,37 +289,177 @@ static json_object *series_json(const double *v, uint32_t n)
     return a;
 }
 
+/* The per-frame series of an animated run, in the record's order. */
+enum {
+    RELMSE_FULL,
+    RELMSE_MATCHED,
+    LEAK_FULL,
+    LUM_DIFF_FULL,
+    FRAME_MS,
+    CHANGE_METHOD,
+    CHANGE_REF_FULL,
+    CHANGE_REF_MATCHED,
+    TEMPORAL_FULL,
+    TEMPORAL_MATCHED,
+    NOISE_FULL,
+    SCENE_TIME,
+    SERIES
+};
+static const char *const series_names[SERIES] = {"relmse_full",
+                                                 "relmse_matched",
+                                                 "leaked_energy_full",
+                                                 "mean_lum_diff_pct_full",
+                                                 "frame_ms",
+                                                 "change_method",
+                                                 "change_ref_full",
+                                                 "change_ref_matched",
+                                                 "temporal_error_full",
+                                                 "temporal_error_matched",
+                                                 "noise_floor_full",
+                                                 "scene_time"};
+
+/* Frame f of the method, its full and matched references and the second
+ * full reference (img[3], when there is one), each of the run's size.
+ * 0 with why when one is missing or of another size. */
+static int read_frame_images(const run_spec *s, const char *frames_pattern, uint32_t f,
+                             gi_image **img, char *why, size_t why_size)
+{
+    int ok = 1;
+    char path[4200];
+    gi_error err;
+    cli_frame_path(frames_pattern, f, path, sizeof path);
+    const char *paths[4] = {path, s->frame_ref_full[f], s->frame_ref_matched[f],
+                            s->frame_ref_alt ? s->frame_ref_alt[f] : NULL};
+    for (int k = 0; k < 4 && ok; k++) {
+        if (!paths[k])
+            continue;
+        img[k] = gi_image_read(paths[k], &err);
+        if (!img[k]) {
+            snprintf(why, why_size, "frame %u: %s", f, err.text);
+            ok = 0;
+        } else if (img[k]->width != s->width || img[k]->height != s->height) {
+            snprintf(why, why_size, "frame %u: %s is %ux%u, not %ux%u", f, paths[k], img[k]->width,
+                     img[k]->height, s->width, s->height);
+            ok = 0;
+        }
+    }
+    return ok;
+}
+
+/* Frame f's error against its full and matched references. */
+static int frame_errors(const run_spec *s, uint32_t f, gi_image *const *img, double **v, char *why,
+                        size_t why_size)
+{
+    int ok = 1;
+    gi_error err;
+    gi_metrics m[2];
+    gi_metrics_opts mo = {s->exposure, 0, 1, 0};
+    for (int k = 0; k < 2 && ok; k++)
+        if (gi_metrics_compute(img[0], img[1 + k], &mo, &m[k], &err) != GI_OK) {
+            snprintf(why, why_size, "frame %u: %s", f, err.text);
+            ok = 0;
+        }
+    if (ok) {
+        v[RELMSE_FULL][f] = m[0].relmse;
+        v[RELMSE_MATCHED][f] = m[1].relmse;
+        v[LEAK_FULL][f] = m[0].leaked_energy;
+        v[LUM_DIFF_FULL][f] = m[0].mean_lum_diff_pct;
+    }
+    return ok;
+}
+
+/* How far the method's change from the frame before is from reference
+ * img[1 + k]'s, pixel by pixel, over the pixels of `mask`; NaN when none. */
+static double temporal_error(gi_image *const *img, gi_image *const *prev, int k,
+                             const uint8_t *mask, size_t np)
+{
+    double sum = 0;
+    uint64_t cnt = 0;
+    for (size_t i = 0; i < np; i++) {
+        if (!mask[i])
+            continue;
+        for (int c = 0; c < 3; c++) {
+            double dm = (double)img[0]->rgba[4 * i + c] - prev[0]->rgba[4 * i + c];
+            double dr = (double)img[1 + k]->rgba[4 * i + c] - prev[1 + k]->rgba[4 * i + c];
+            sum += fabs(dm - dr);
+        }
+        cnt += 3;
+    }
+    return cnt ? sum / (double)cnt : NAN;
+}
+
+/* Frame f's noise floor and its change from the frame before (`prev`):
+ * the method's, the references' and the temporal error. */
+static int frame_changes(const run_spec *s, uint32_t f, gi_image *const *img, gi_image *const *prev,
+                         double **v, char *why, size_t why_size)
+{
+    size_t np = (size_t)s->width * s->height;
+    uint8_t *mask = malloc(np ? np : 1);
+    if (!mask) {
+        snprintf(why, why_size, "out of memory");
+        return 0;
+    }
+    /* the noise floor: two renders of the reference with different seeds */
+    for (size_t i = 0; i < np; i++)
+        mask[i] = (uint8_t)(finite_px(img[1], i) && finite_px(img[3], i));
+    v[NOISE_FULL][f] = img[3] ? mean_abs_diff(img[1], img[3], mask) : NAN;
+    /* frame-to-frame change, over the pixels finite in both frames of all three */
+    v[CHANGE_METHOD][f] = v[CHANGE_REF_FULL][f] = v[CHANGE_REF_MATCHED][f] = NAN;
+    v[TEMPORAL_FULL][f] = v[TEMPORAL_MATCHED][f] = NAN;
+    if (f > 0) {
+        for (size_t i = 0; i < np; i++)
+            mask[i] =
+                (uint8_t)(finite_px(img[0], i) && finite_px(prev[0], i) && finite_px(img[1], i) &&
+                          finite_px(prev[1], i) && finite_px(img[2], i) && finite_px(prev[2], i));
+        v[CHANGE_METHOD][f] = mean_abs_diff(img[0], prev[0], mask);
+        v[CHANGE_REF_FULL][f] = mean_abs_diff(img[1], prev[1], mask);
+        v[CHANGE_REF_MATCHED][f] = mean_abs_diff(img[2], prev[2], mask);
+        /* how far the method's change is from the reference's, pixel by pixel */
+        for (int k = 0; k < 2; k++)
+            v[k ? TEMPORAL_MATCHED : TEMPORAL_FULL][f] = temporal_error(img, prev, k, mask, np);
+    }
+    free(mask);
+    return 1;
+}
+
+/* The record's "animation": every series and their summaries. */
+static json_object *animation_json(const run_spec *s, double *const *v, uint32_t n)
+{
+    json_object *a = json_object_new_object();
+    json_object_object_add(a, "fps", json_object_new_double(s->animate_fps));
+    json_object_object_add(a, "frames", json_object_new_int((int32_t)n));
+    json_object_object_add(a, "time0", json_object_new_double(s->time));
+    for (int k = 0; k < SERIES; k++)
+        json_object_object_add(a, series_names[k], series_json(v[k], n));
+    double cm = mean_finite(v[CHANGE_METHOD], n), cf = mean_finite(v[CHANGE_REF_FULL], n),
+           cmt = mean_finite(v[CHANGE_REF_MATCHED], n);
+    double emax = NAN;
+    for (uint32_t f = 0; f < n; f++)
+        if (isfinite(v[RELMSE_FULL][f]) && !(v[RELMSE_FULL][f] <= emax))
+            emax = v[RELMSE_FULL][f];
+    json_object_object_add(a, "relmse_full_mean", num_or_null(mean_finite(v[RELMSE_FULL], n)));
+    json_object_object_add(a, "relmse_full_max", num_or_null(emax));
+    json_object_object_add(a, "relmse_matched_mean",
+                           num_or_null(mean_finite(v[RELMSE_MATCHED], n)));
+    json_object_object_add(a, "leaked_energy_full_mean", num_or_null(mean_finite(v[LEAK_FULL], n)));
+    json_object_object_add(a, "frame_ms_median", num_or_null(rec_median(v[FRAME_MS], n)));
+    json_object_object_add(a, "change_method_mean", num_or_null(cm));
+    json_object_object_add(a, "change_ref_full_mean", num_or_null(cf));
+    json_object_object_add(a, "change_ref_matched_mean", num_or_null(cmt));
+    json_object_object_add(a, "flicker_full", num_or_null(cm - cf));
+    json_object_object_add(a, "flicker_matched", num_or_null(cm - cmt));
+    json_object_object_add(a, "temporal_error_full_mean",
+                           num_or_null(mean_finite(v[TEMPORAL_FULL], n)));
+    json_object_object_add(a, "temporal_error_matched_mean",
+                           num_or_null(mean_finite(v[TEMPORAL_MATCHED], n)));
+    json_object_object_add(a, "noise_floor_full_mean", num_or_null(mean_finite(v[NOISE_FULL], n)));
+    return a;
+}
+
 json_object *runner_animation_metrics(const run_spec *s, const char *frames_pattern,
                                       json_object *timings, char *why, size_t why_size)
 {
     uint32_t n = s->frame_ref_count;
-    enum {
-        RELMSE_FULL,
-        RELMSE_MATCHED,
-        LEAK_FULL,
-        LUM_DIFF_FULL,
-        FRAME_MS,
-        CHANGE_METHOD,
-        CHANGE_REF_FULL,
-        CHANGE_REF_MATCHED,
-        TEMPORAL_FULL,
-        TEMPORAL_MATCHED,
-        NOISE_FULL,
-        SCENE_TIME,
-        SERIES
-    };
-    static const char *const names[SERIES] = {"relmse_full",
-                                              "relmse_matched",
-                                              "leaked_energy_full",
-                                              "mean_lum_diff_pct_full",
-                                              "frame_ms",
-                                              "change_method",
-                                              "change_ref_full",
-                                              "change_ref_matched",
-                                              "temporal_error_full",
-                                              "temporal_error_matched",
-                                              "noise_floor_full",
-                                              "scene_time"};
     double *v[SERIES] = {0};
     for (int k = 0; k < SERIES; k++)
         v[k] = malloc((n + 1) * sizeof(double));
@@ -341,84 +481,12 @@ json_object *runner_animation_metrics(const run_spec *s, const char *frames_patt
         json_object_object_get_ex(frame, "samples_ms", &samples);
     uint32_t warm = s->warmup < n ? s->warmup : 0;
     for (uint32_t f = 0; f < n && ok; f++) {
-        char path[4200];
-        gi_error err;
-        cli_frame_path(frames_pattern, f, path, sizeof path);
-        const char *paths[4] = {path, s->frame_ref_full[f], s->frame_ref_matched[f],
-                                s->frame_ref_alt ? s->frame_ref_alt[f] : NULL};
         gi_image *img[4] = {0};
-        for (int k = 0; k < 4 && ok; k++) {
-            if (!paths[k])
-                continue;
-            img[k] = gi_image_read(paths[k], &err);
-            if (!img[k]) {
-                snprintf(why, why_size, "frame %u: %s", f, err.text);
-                ok = 0;
-            } else if (img[k]->width != s->width || img[k]->height != s->height) {
-                snprintf(why, why_size, "frame %u: %s is %ux%u, not %ux%u", f, paths[k],
-                         img[k]->width, img[k]->height, s->width, s->height);
-                ok = 0;
-            }
-        }
-        if (ok) {
-            gi_metrics m[2];
-            gi_metrics_opts mo = {s->exposure, 0, 1, 0};
-            for (int k = 0; k < 2 && ok; k++)
-                if (gi_metrics_compute(img[0], img[1 + k], &mo, &m[k], &err) != GI_OK) {
-                    snprintf(why, why_size, "frame %u: %s", f, err.text);
-                    ok = 0;
-                }
-            if (ok) {
-                v[RELMSE_FULL][f] = m[0].relmse;
-                v[RELMSE_MATCHED][f] = m[1].relmse;
-                v[LEAK_FULL][f] = m[0].leaked_energy;
-                v[LUM_DIFF_FULL][f] = m[0].mean_lum_diff_pct;
-            }
-        }
-        if (ok) {
-            size_t np = (size_t)s->width * s->height;
-            uint8_t *mask = malloc(np ? np : 1);
-            if (!mask) {
-                snprintf(why, why_size, "out of memory");
-                ok = 0;
-            } else {
-                /* the noise floor: two renders of the reference with different seeds */
-                for (size_t i = 0; i < np; i++)
-                    mask[i] = (uint8_t)(finite_px(img[1], i) && finite_px(img[3], i));
-                v[NOISE_FULL][f] = img[3] ? mean_abs_diff(img[1], img[3], mask) : NAN;
-                /* frame-to-frame change, over the pixels finite in both frames of all three */
-                v[CHANGE_METHOD][f] = v[CHANGE_REF_FULL][f] = v[CHANGE_REF_MATCHED][f] = NAN;
-                v[TEMPORAL_FULL][f] = v[TEMPORAL_MATCHED][f] = NAN;
-                if (f > 0) {
-                    for (size_t i = 0; i < np; i++)
-                        mask[i] = (uint8_t)(finite_px(img[0], i) && finite_px(prev[0], i) &&
-                                            finite_px(img[1], i) && finite_px(prev[1], i) &&
-                                            finite_px(img[2], i) && finite_px(prev[2], i));
-                    v[CHANGE_METHOD][f] = mean_abs_diff(img[0], prev[0], mask);
-                    v[CHANGE_REF_FULL][f] = mean_abs_diff(img[1], prev[1], mask);
-                    v[CHANGE_REF_MATCHED][f] = mean_abs_diff(img[2], prev[2], mask);
-                    /* how far the method's change is from the reference's, pixel by pixel */
-                    for (int k = 0; k < 2; k++) {
-                        double sum = 0;
-                        uint64_t cnt = 0;
-                        for (size_t i = 0; i < np; i++) {
-                            if (!mask[i])
-                                continue;
-                            for (int c = 0; c < 3; c++) {
-                                double dm =
-                                    (double)img[0]->rgba[4 * i + c] - prev[0]->rgba[4 * i + c];
-                                double dr = (double)img[1 + k]->rgba[4 * i + c] -
-                                            prev[1 + k]->rgba[4 * i + c];
-                                sum += fabs(dm - dr);
-                            }
-                            cnt += 3;
-                        }
-                        v[k ? TEMPORAL_MATCHED : TEMPORAL_FULL][f] = cnt ? sum / (double)cnt : NAN;
-                    }
-                }
-                free(mask);
-            }
-        }
+        ok = read_frame_images(s, frames_pattern, f, img, why, why_size);
+        if (ok)
+            ok = frame_errors(s, f, img, v, why, why_size);
+        if (ok)
+            ok = frame_changes(s, f, img, prev, v, why, why_size);
         v[SCENE_TIME][f] = s->time + (float)f / s->animate_fps; /* as render computes it */
         v[FRAME_MS][f] = NAN;
         if (f >= warm && samples && f - warm < json_object_array_length(samples))
@@ -431,39 +499,7 @@ json_object *runner_animation_metrics(const run_spec *s, const char *frames_patt
     }
     for (int k = 0; k < 3; k++)
         gi_image_free(prev[k]);
-    json_object *a = NULL;
-    if (ok) {
-        a = json_object_new_object();
-        json_object_object_add(a, "fps", json_object_new_double(s->animate_fps));
-        json_object_object_add(a, "frames", json_object_new_int((int32_t)n));
-        json_object_object_add(a, "time0", json_object_new_double(s->time));
-        for (int k = 0; k < SERIES; k++)
-            json_object_object_add(a, names[k], series_json(v[k], n));
-        double cm = mean_finite(v[CHANGE_METHOD], n), cf = mean_finite(v[CHANGE_REF_FULL], n),
-               cmt = mean_finite(v[CHANGE_REF_MATCHED], n);
-        double emax = NAN;
-        for (uint32_t f = 0; f < n; f++)
-            if (isfinite(v[RELMSE_FULL][f]) && !(v[RELMSE_FULL][f] <= emax))
-                emax = v[RELMSE_FULL][f];
-        json_object_object_add(a, "relmse_full_mean", num_or_null(mean_finite(v[RELMSE_FULL], n)));
-        json_object_object_add(a, "relmse_full_max", num_or_null(emax));
-        json_object_object_add(a, "relmse_matched_mean",
-                               num_or_null(mean_finite(v[RELMSE_MATCHED], n)));
-        json_object_object_add(a, "leaked_energy_full_mean",
-                               num_or_null(mean_finite(v[LEAK_FULL], n)));
-        json_object_object_add(a, "frame_ms_median", num_or_null(rec_median(v[FRAME_MS], n)));
-        json_object_object_add(a, "change_method_mean", num_or_null(cm));
-        json_object_object_add(a, "change_ref_full_mean", num_or_null(cf));
-        json_object_object_add(a, "change_ref_matched_mean", num_or_null(cmt));
-        json_object_object_add(a, "flicker_full", num_or_null(cm - cf));
-        json_object_object_add(a, "flicker_matched", num_or_null(cm - cmt));
-        json_object_object_add(a, "temporal_error_full_mean",
-                               num_or_null(mean_finite(v[TEMPORAL_FULL], n)));
-        json_object_object_add(a, "temporal_error_matched_mean",
-                               num_or_null(mean_finite(v[TEMPORAL_MATCHED], n)));
-        json_object_object_add(a, "noise_floor_full_mean",
-                               num_or_null(mean_finite(v[NOISE_FULL], n)));
-    }
+    json_object *a = ok ? animation_json(s, v, n) : NULL;
     for (int k = 0; k < SERIES; k++)
         free(v[k]);
     return a;
@@ -505,71 +541,79 @@ static void add_leak_to_cached(json_object *old, const run_spec *s, const char *
         gi_log(GI_LOG_WARN, "%s", why);
 }
 
-json_object *runner_execute(const run_spec *s, int resume)
-{
-    json_object *rec = base_record(s);
-    if (!cli_mkdirs(s->dir)) {
-        fail_record(rec, "cannot create the run directory");
-        return rec;
-    }
+/* The files of a run's directory. */
+typedef struct run_files {
     char exr[4096], png[4096], timings[4096], log[4096], result[4096], heat[4096], flip[4096];
-    path_in(exr, sizeof exr, s->dir, "image.exr");
-    path_in(png, sizeof png, s->dir, "image.png");
-    path_in(timings, sizeof timings, s->dir, "timings.json");
-    path_in(log, sizeof log, s->dir, "render.log");
-    path_in(result, sizeof result, s->dir, "result.json");
-    path_in(heat, sizeof heat, s->dir, "heatmap.png");
-    path_in(flip, sizeof flip, s->dir, "flip.png");
+    char frames_dir[4200], frames_pattern[4300];
+} run_files;
 
-    argv_builder b = {0};
-    arg(&b, "%s", cli_self_exe());
-    arg(&b, "%s", "render");
-    arg(&b, "%s", "--scene");
-    arg(&b, "%s", s->scene);
-    arg(&b, "%s", "--method");
-    arg(&b, "%s", s->method);
+static void run_files_init(run_files *p, const run_spec *s)
+{
+    path_in(p->exr, sizeof p->exr, s->dir, "image.exr");
+    path_in(p->png, sizeof p->png, s->dir, "image.png");
+    path_in(p->timings, sizeof p->timings, s->dir, "timings.json");
+    path_in(p->log, sizeof p->log, s->dir, "render.log");
+    path_in(p->result, sizeof p->result, s->dir, "result.json");
+    path_in(p->heat, sizeof p->heat, s->dir, "heatmap.png");
+    path_in(p->flip, sizeof p->flip, s->dir, "flip.png");
+    snprintf(p->frames_dir, sizeof p->frames_dir, "%s/frames", s->dir);
+    snprintf(p->frames_pattern, sizeof p->frames_pattern, "%s/frame_%%04d.exr", p->frames_dir);
+}
+
+/* `gibench render` with the run's scene, method, size, frames, time and parameters. */
+static void render_args(argv_builder *b, const run_spec *s)
+{
+    arg(b, "%s", cli_self_exe());
+    arg(b, "%s", "render");
+    arg(b, "%s", "--scene");
+    arg(b, "%s", s->scene);
+    arg(b, "%s", "--method");
+    arg(b, "%s", s->method);
     if (s->camera) {
-        arg(&b, "%s", "--camera");
-        arg(&b, "%s", s->camera);
+        arg(b, "%s", "--camera");
+        arg(b, "%s", s->camera);
     }
     char size[64];
     snprintf(size, sizeof size, "%ux%u", s->width, s->height);
-    arg(&b, "%s", "--size");
-    arg(&b, "%s", size);
-    arg(&b, "%s", "--frames");
-    argu(&b, s->frames);
-    arg(&b, "%s", "--warmup");
-    argu(&b, s->warmup);
-    arg(&b, "%s", "--seed");
-    argu(&b, s->seed);
-    arg(&b, "%s", "--time");
-    argf(&b, s->time);
+    arg(b, "%s", "--size");
+    arg(b, "%s", size);
+    arg(b, "%s", "--frames");
+    argu(b, s->frames);
+    arg(b, "%s", "--warmup");
+    argu(b, s->warmup);
+    arg(b, "%s", "--seed");
+    argu(b, s->seed);
+    arg(b, "%s", "--time");
+    argf(b, s->time);
     if (s->animate_fps > 0) {
-        arg(&b, "%s", "--animate");
-        argf(&b, s->animate_fps);
+        arg(b, "%s", "--animate");
+        argf(b, s->animate_fps);
     }
     if (s->no_cache)
-        arg(&b, "%s", "--no-cache");
-    arg(&b, "%s", "--exposure");
-    argf(&b, s->exposure);
+        arg(b, "%s", "--no-cache");
+    arg(b, "%s", "--exposure");
+    argf(b, s->exposure);
     for (uint32_t i = 0; i < s->param_count; i++) {
-        arg(&b, "%s", "--param");
-        arg(&b, "%s", s->params[i]);
+        arg(b, "%s", "--param");
+        arg(b, "%s", s->params[i]);
     }
-    char config[16384]; /* the whole command line: a cut one could match another run's */
-    join(&b, config, sizeof config);
+}
+
+/* The configuration a result is kept under (the command line so far, the
+ * references and the timer); an animated run also gets --frames-out. */
+static void run_config(argv_builder *b, const run_spec *s, const run_files *p, char *config,
+                       size_t size)
+{
+    join(b, config, size);
     /* The references are part of what the result depends on. */
     size_t used = strlen(config);
     const char *timer = getenv("GIBENCH_TIMER"); /* the timer mode changes every timing */
     /* "curve": results made before render recorded convergence curves are not reused */
-    snprintf(config + used, sizeof config - used, " | full=%s | matched=%s | curve%s%s",
+    snprintf(config + used, size - used, " | full=%s | matched=%s | curve%s%s",
              s->ref_full ? s->ref_full : "-", s->ref_matched ? s->ref_matched : "-",
              timer ? " | timer=" : "", timer ? timer : "");
     /* an animated run compared frame by frame: every frame written, and the
      * references of every frame in the key (by a hash of their names) */
-    char frames_dir[4200], frames_pattern[4300];
-    snprintf(frames_dir, sizeof frames_dir, "%s/frames", s->dir);
-    snprintf(frames_pattern, sizeof frames_pattern, "%s/frame_%%04d.exr", frames_dir);
     if (s->frame_ref_count) {
         uint64_t h = 0;
         for (uint32_t f = 0; f < s->frame_ref_count; f++) {
@@ -579,11 +623,16 @@ json_object *runner_execute(const run_spec *s, int resume)
                 h = gi_hash64(names[k] ? names[k] : "-", strlen(names[k] ? names[k] : "-"), h);
         }
         used = strlen(config);
-        snprintf(config + used, sizeof config - used, " | frame-refs=%u:%016llx",
-                 s->frame_ref_count, (unsigned long long)h);
-        arg(&b, "%s", "--frames-out");
-        arg(&b, "%s", frames_pattern);
+        snprintf(config + used, size - used, " | frame-refs=%u:%016llx", s->frame_ref_count,
+                 (unsigned long long)h);
+        arg(b, "%s", "--frames-out");
+        arg(b, "%s", p->frames_pattern);
     }
+}
+
+/* The convergence curve's references and the output files. */
+static void output_args(argv_builder *b, const run_spec *s, const run_files *p)
+{
     /* the convergence curve against the same references (they are in the
      * config already); an animated run's frames are compared one by one
      * instead (each frame is a new image, not a step of a convergence) */
@@ -591,54 +640,98 @@ json_object *runner_execute(const run_spec *s, int resume)
     const char *cnames[2] = {"full", "matched"};
     for (int k = 0; k < 2 && !s->frame_ref_count; k++)
         if (crefs[k]) {
-            arg(&b, "%s", "--curve-ref");
+            arg(b, "%s", "--curve-ref");
             char kv[4200];
             snprintf(kv, sizeof kv, "%s=%s", cnames[k], crefs[k]);
-            arg(&b, "%s", kv);
+            arg(b, "%s", kv);
         }
-    arg(&b, "%s", "--out");
-    arg(&b, "%s", exr);
-    arg(&b, "%s", "--out");
-    arg(&b, "%s", png);
-    arg(&b, "%s", "--timings");
-    arg(&b, "%s", timings);
+    arg(b, "%s", "--out");
+    arg(b, "%s", p->exr);
+    arg(b, "%s", "--out");
+    arg(b, "%s", p->png);
+    arg(b, "%s", "--timings");
+    arg(b, "%s", p->timings);
+}
 
-    if (resume || collect_only) {
-        json_object *old = cli_read_json(result);
-        json_object *c;
-        json_object *st;
-        if (old && json_object_object_get_ex(old, "config", &c) &&
-            strcmp(json_object_get_string(c), config) == 0 &&
-            !(json_object_object_get_ex(old, "status", &st) &&
-              !strcmp(json_object_get_string(st), "interrupted"))) {
-            json_object_put(rec);
-            args_free(&b);
-            if (!collect_only)
-                add_leak_to_cached(old, s, exr, result);
-            /* for the caller's progress line only; it removes the key */
-            json_object_object_add(old, "cached", json_object_new_boolean(1));
-            return old;
+/* The result kept for the same configuration (not an interrupted one),
+ * marked "cached"; NULL when there is none. */
+static json_object *cached_result(const run_spec *s, const run_files *p, const char *config)
+{
+    json_object *old = cli_read_json(p->result);
+    json_object *c;
+    json_object *st;
+    if (old && json_object_object_get_ex(old, "config", &c) &&
+        strcmp(json_object_get_string(c), config) == 0 &&
+        !(json_object_object_get_ex(old, "status", &st) &&
+          !strcmp(json_object_get_string(st), "interrupted"))) {
+        if (!collect_only)
+            add_leak_to_cached(old, s, p->exr, p->result);
+        /* for the caller's progress line only; it removes the key */
+        json_object_object_add(old, "cached", json_object_new_boolean(1));
+        return old;
+    }
+    json_object_put(old);
+    return NULL;
+}
+
+/* A finished render's record: its timings, the per-frame comparison of an
+ * animated run, the image files and the metrics against each reference. */
+static void take_render(json_object *rec, const run_spec *s, const run_files *p, json_object *t)
+{
+    take_timings(rec, t);
+    char anim_why[1100] = "";
+    if (s->frame_ref_count) {
+        char why[1024];
+        json_object *anim = runner_animation_metrics(s, p->frames_pattern, t, why, sizeof why);
+        if (!anim)
+            snprintf(anim_why, sizeof anim_why, "per-frame comparison: %s", why);
+        if (anim)
+            json_object_object_add(rec, "animation", anim);
+    }
+    json_object_put(t);
+    json_object_object_add(rec, "status", json_object_new_string("ok"));
+    json_object_object_add(rec, "reason", json_object_new_string(""));
+    if (anim_why[0])
+        fail_record(rec, anim_why);
+    char q[4200];
+    snprintf(q, sizeof q, "%s/image.png", s->rel);
+    json_object_object_add(rec, "png", json_object_new_string(q));
+    snprintf(q, sizeof q, "%s/image.exr", s->rel);
+    json_object_object_add(rec, "image", json_object_new_string(q));
+    json_object *metrics = json_object_new_object();
+    const char *refs[2] = {s->ref_full, s->ref_matched};
+    const char *names[2] = {"full", "matched"};
+    for (int k = 0; k < 2; k++) {
+        if (!refs[k])
+            continue;
+        char why[1024];
+        json_object *m = runner_diff(p->exr, refs[k], k == 0 ? p->heat : NULL,
+                                     k == 0 ? p->flip : NULL, s->exposure, why, sizeof why);
+        if (m) {
+            json_object_object_add(metrics, names[k], m);
+        } else {
+            fail_record(rec, why);
+            break;
         }
-        json_object_put(old);
     }
-    json_object_object_add(rec, "config", json_object_new_string(config));
-    if (collect_only) {
-        args_free(&b);
-        fail_record(rec, "no result");
-        return rec;
+    json_object_object_add(rec, "metrics", metrics);
+    if (s->ref_full) {
+        snprintf(q, sizeof q, "%s/heatmap.png", s->rel);
+        json_object_object_add(rec, "heatmap", json_object_new_string(q));
+        snprintf(q, sizeof q, "%s/flip.png", s->rel);
+        json_object_object_add(rec, "flip_map", json_object_new_string(q));
     }
-    unlink(result);
-    if (s->frame_ref_count && !cli_mkdirs(frames_dir)) {
-        args_free(&b);
-        fail_record(rec, "cannot create the frames directory");
-        return rec;
-    }
+}
+
+/* Runs the render in its own process and fills the record from what it wrote. */
+static void run_render(json_object *rec, const run_spec *s, const run_files *p, argv_builder *b)
+{
     cli_proc_result r;
-    int started = cli_run(b.argv, s->timeout_s, log, log, &r) == 0;
-    args_free(&b);
+    int started = cli_run(b->argv, s->timeout_s, p->log, p->log, &r) == 0;
+    args_free(b);
     if (!started) {
         fail_record(rec, r.last_line);
-        return rec;
+        return;
     }
     json_object_object_add(rec, "wall_s", json_object_new_double(r.seconds));
     if (r.timed_out || r.signaled || r.exit_code != 0) {
@@ -646,55 +739,50 @@ json_object *runner_execute(const run_spec *s, int resume)
         cli_proc_describe(&r, d, sizeof d);
         fail_record(rec, d);
     } else {
-        json_object *t = cli_read_json(timings);
-        if (!t) {
+        json_object *t = cli_read_json(p->timings);
+        if (!t)
             fail_record(rec, "the method wrote no timings");
-        } else {
-            take_timings(rec, t);
-            char anim_why[1100] = "";
-            if (s->frame_ref_count) {
-                char why[1024];
-                json_object *anim = runner_animation_metrics(s, frames_pattern, t, why, sizeof why);
-                if (!anim)
-                    snprintf(anim_why, sizeof anim_why, "per-frame comparison: %s", why);
-                if (anim)
-                    json_object_object_add(rec, "animation", anim);
-            }
-            json_object_put(t);
-            json_object_object_add(rec, "status", json_object_new_string("ok"));
-            json_object_object_add(rec, "reason", json_object_new_string(""));
-            if (anim_why[0])
-                fail_record(rec, anim_why);
-            char p[4200];
-            snprintf(p, sizeof p, "%s/image.png", s->rel);
-            json_object_object_add(rec, "png", json_object_new_string(p));
-            snprintf(p, sizeof p, "%s/image.exr", s->rel);
-            json_object_object_add(rec, "image", json_object_new_string(p));
-            json_object *metrics = json_object_new_object();
-            const char *refs[2] = {s->ref_full, s->ref_matched};
-            const char *names[2] = {"full", "matched"};
-            for (int k = 0; k < 2; k++) {
-                if (!refs[k])
-                    continue;
-                char why[1024];
-                json_object *m = runner_diff(exr, refs[k], k == 0 ? heat : NULL,
-                                             k == 0 ? flip : NULL, s->exposure, why, sizeof why);
-                if (m) {
-                    json_object_object_add(metrics, names[k], m);
-                } else {
-                    fail_record(rec, why);
-                    break;
-                }
-            }
-            json_object_object_add(rec, "metrics", metrics);
-            if (s->ref_full) {
-                snprintf(p, sizeof p, "%s/heatmap.png", s->rel);
-                json_object_object_add(rec, "heatmap", json_object_new_string(p));
-                snprintf(p, sizeof p, "%s/flip.png", s->rel);
-                json_object_object_add(rec, "flip_map", json_object_new_string(p));
-            }
+        else
+            take_render(rec, s, p, t);
+    }
+}
+
+json_object *runner_execute(const run_spec *s, int resume)
+{
+    json_object *rec = base_record(s);
+    if (!cli_mkdirs(s->dir)) {
+        fail_record(rec, "cannot create the run directory");
+        return rec;
+    }
+    run_files p;
+    run_files_init(&p, s);
+    argv_builder b = {0};
+    render_args(&b, s);
+    char config[16384]; /* the whole command line: a cut one could match another run's */
+    run_config(&b, s, &p, config, sizeof config);
+    output_args(&b, s, &p);
+
+    if (resume || collect_only) {
+        json_object *old = cached_result(s, &p, config);
+        if (old) {
+            json_object_put(rec);
+            args_free(&b);
+            return old;
         }
     }
+    json_object_object_add(rec, "config", json_object_new_string(config));
+    if (collect_only) {
+        args_free(&b);
+        fail_record(rec, "no result");
+        return rec;
+    }
+    unlink(p.result);
+    if (s->frame_ref_count && !cli_mkdirs(p.frames_dir)) {
+        args_free(&b);
+        fail_record(rec, "cannot create the frames directory");
+        return rec;
+    }
+    run_render(rec, s, &p, &b);
     /* A run that did not finish while gibench was being interrupted is
      * "interrupted": reported, but not recorded, so that resuming redoes it
      * (a failure recorded here would be kept for good). */
@@ -707,7 +795,7 @@ json_object *runner_execute(const run_spec *s, int resume)
         return rec;
     }
     char why[GI_ERROR_MAX];
-    if (!cli_write_json(result, rec, why, sizeof why))
+    if (!cli_write_json(p.result, rec, why, sizeof why))
         gi_log(GI_LOG_WARN, "%s", why);
     return rec;
 }
