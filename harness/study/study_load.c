@@ -201,17 +201,12 @@ static int check_charts(json_object *charts, const char *file)
     return EXIT_OK;
 }
 
-int study_load(study *st, const char *file, const char *out_dir, gi_plugins *reg)
+/* The top-level keys besides "reference" and "methods": the name, the
+ * camera, the run settings every method entry starts from, the seed,
+ * exposure, timeout, timer and the "charts" list. */
+static int load_top_level(study *st, json_object *o, const char *file)
 {
-    st->refs = calloc(MAX_REFS, sizeof *st->refs);
-    if (!st->refs)
-        return cli_fail(EXIT_RUN, "out of memory");
-    st->root = study_read_strict_json(file);
-    if (!st->root)
-        return EXIT_USAGE;
-    json_object *o = st->root, *v;
-    if (!json_object_is_type(o, json_type_object))
-        return study_fail_json(file, "/", "a study is a JSON object");
+    json_object *v;
     static const char *known[] = {"name",    "description", "scenes",  "size",     "frames",
                                   "warmup",  "repeats",     "seed",    "camera",   "time",
                                   "animate", "cache",       "compare", "exposure", "timeout",
@@ -257,51 +252,112 @@ int study_load(study *st, const char *file, const char *out_dir, gi_plugins *reg
             return rc;
         st->charts = v;
     }
+    return EXIT_OK;
+}
 
+/* "reference": the path tracer's settings for the references (defaults
+ * when the study gives none). */
+static int load_reference(study *st, json_object *o, const char *file)
+{
     json_object *ref;
+    int rc;
     st->ref_spp = 256;
     st->ref_bounces = 64;
-    if (json_object_object_get_ex(o, "reference", &ref)) {
-        if (!json_object_is_type(ref, json_type_object))
-            return study_fail_json(file, "/reference", "must be an object {\"spp\": ..., ...}");
-        if ((rc = study_get_uint(ref, "/reference", "spp", 1, 1u << 24, 256, &st->ref_spp, file)) ||
-            (rc = study_get_uint(ref, "/reference", "max_bounces", 0, 1024, 64, &st->ref_bounces,
-                                 file)))
-            return rc;
-        json_object *cs, *tse, *px;
-        static const char *ref_keys[] = {"spp",   "target_se", "max_bounces", "convergence_spp",
-                                         "pixel", NULL};
-        if ((rc = study_check_keys(ref, ref_keys, "/reference", file)))
-            return rc;
-        if (json_object_object_get_ex(ref, "pixel", &px)) {
-            const char *pv = json_object_get_string(px);
-            if (!json_object_is_type(px, json_type_string) ||
-                (strcmp(pv, "box") && strcmp(pv, "center")))
-                return study_fail_json(file, "/reference/pixel",
-                                       "must be \"box\" (the pixel's average) or \"center\"");
-            st->ref_pixel_center = !strcmp(pv, "center");
-        }
-        if (json_object_object_get_ex(ref, "target_se", &tse) &&
-            !json_object_is_type(tse, json_type_null)) {
-            st->ref_target_se = json_object_get_double(tse);
-            if (!(st->ref_target_se > 0))
-                return study_fail_json(file, "/reference/target_se",
-                                       "must be a positive relative standard error");
-        }
-        if (json_object_object_get_ex(ref, "convergence_spp", &cs)) {
-            if (!json_object_is_type(cs, json_type_array) || json_object_array_length(cs) > 32)
+    if (!json_object_object_get_ex(o, "reference", &ref))
+        return EXIT_OK;
+    if (!json_object_is_type(ref, json_type_object))
+        return study_fail_json(file, "/reference", "must be an object {\"spp\": ..., ...}");
+    if ((rc = study_get_uint(ref, "/reference", "spp", 1, 1u << 24, 256, &st->ref_spp, file)) ||
+        (rc =
+             study_get_uint(ref, "/reference", "max_bounces", 0, 1024, 64, &st->ref_bounces, file)))
+        return rc;
+    json_object *cs, *tse, *px;
+    static const char *ref_keys[] = {"spp",   "target_se", "max_bounces", "convergence_spp",
+                                     "pixel", NULL};
+    if ((rc = study_check_keys(ref, ref_keys, "/reference", file)))
+        return rc;
+    if (json_object_object_get_ex(ref, "pixel", &px)) {
+        const char *pv = json_object_get_string(px);
+        if (!json_object_is_type(px, json_type_string) ||
+            (strcmp(pv, "box") && strcmp(pv, "center")))
+            return study_fail_json(file, "/reference/pixel",
+                                   "must be \"box\" (the pixel's average) or \"center\"");
+        st->ref_pixel_center = !strcmp(pv, "center");
+    }
+    if (json_object_object_get_ex(ref, "target_se", &tse) &&
+        !json_object_is_type(tse, json_type_null)) {
+        st->ref_target_se = json_object_get_double(tse);
+        if (!(st->ref_target_se > 0))
+            return study_fail_json(file, "/reference/target_se",
+                                   "must be a positive relative standard error");
+    }
+    if (json_object_object_get_ex(ref, "convergence_spp", &cs)) {
+        if (!json_object_is_type(cs, json_type_array) || json_object_array_length(cs) > 32)
+            return study_fail_json(file, "/reference/convergence_spp",
+                                   "must be a list of at most 32 sample counts");
+        for (size_t i = 0; i < json_object_array_length(cs); i++) {
+            json_object *kj = json_object_array_get_idx(cs, i);
+            int64_t k = json_object_get_int64(kj);
+            if (!json_object_is_type(kj, json_type_int) || k < 1 || (uint64_t)k >= st->ref_spp)
                 return study_fail_json(file, "/reference/convergence_spp",
-                                       "must be a list of at most 32 sample counts");
-            for (size_t i = 0; i < json_object_array_length(cs); i++) {
-                json_object *kj = json_object_array_get_idx(cs, i);
-                int64_t k = json_object_get_int64(kj);
-                if (!json_object_is_type(kj, json_type_int) || k < 1 || (uint64_t)k >= st->ref_spp)
-                    return study_fail_json(file, "/reference/convergence_spp",
-                                           "each count must be 1 .. spp-1");
-                st->conv_spp[st->conv_n++] = (uint32_t)k;
-            }
+                                       "each count must be 1 .. spp-1");
+            st->conv_spp[st->conv_n++] = (uint32_t)k;
         }
     }
+    return EXIT_OK;
+}
+
+/* Entry i of the "methods" list: its settings over the top level's, then
+ * its runs (every installed method's defaults for "method": "all"). */
+static int load_method_entry(study *st, json_object *e, size_t i, const char *file,
+                             const char *out_dir, gi_plugins *reg)
+{
+    static const char *entry_keys[] = {"method", "params",  "label",   "scenes", "size",
+                                       "frames", "warmup",  "repeats", "time",   "animate",
+                                       "cache",  "compare", NULL};
+    json_object *id, *params = NULL;
+    int rc;
+    char mpath[64];
+    snprintf(mpath, sizeof mpath, "/methods/%zu", i);
+    if (!json_object_is_type(e, json_type_object) || !json_object_object_get_ex(e, "method", &id))
+        return study_fail_json(file, mpath, "needs \"method\"");
+    if (!json_object_is_type(id, json_type_string))
+        return study_fail_json(file, mpath, "\"method\" must be a method id (a string) or \"all\"");
+    if ((rc = study_check_keys(e, entry_keys, mpath, file)))
+        return rc;
+    run_settings rs = st->base;
+    if ((rc = parse_settings(st, e, mpath, file, &rs)))
+        return rc;
+    json_object_object_get_ex(e, "params", &params);
+    if (params && !json_object_is_type(params, json_type_object))
+        return study_fail_json(file, mpath, "\"params\" must be an object");
+    const char *mid = json_object_get_string(id);
+    if (!strcmp(mid, "all")) {
+        if (params)
+            return study_fail_json(file, mpath,
+                                   "\"all\" runs every method with its defaults: no \"params\"");
+        for (uint32_t k = 0; k < reg->count; k++)
+            if ((rc = study_expand_method(st, file, out_dir, reg->items[k].method, NULL, mpath,
+                                          &rs)))
+                return rc;
+        return EXIT_OK;
+    }
+    const gi_method *m = gi_plugins_find(reg, mid);
+    if (!m) {
+        char msg[256];
+        snprintf(msg, sizeof msg, "no method '%s' is installed (see gibench methods)", mid);
+        return study_fail_json(file, mpath, msg);
+    }
+    return study_expand_method(st, file, out_dir, m, params, mpath, &rs);
+}
+
+/* "methods": "all" (every installed method with its defaults) or a list
+ * of entries, expanded into the study's runs. */
+static int load_methods(study *st, json_object *o, const char *file, const char *out_dir,
+                        gi_plugins *reg)
+{
+    json_object *v;
+    int rc;
     if (!json_object_object_get_ex(o, "methods", &v))
         return study_fail_json(file, "/methods", "required (\"all\" or a list)");
     st->runs = calloc(MAX_RUNS, sizeof *st->runs);
@@ -310,56 +366,34 @@ int study_load(study *st, const char *file, const char *out_dir, gi_plugins *reg
     if (json_object_is_type(v, json_type_string) && !strcmp(json_object_get_string(v), "all")) {
         for (uint32_t i = 0; i < reg->count; i++)
             if ((rc = study_expand_method(st, file, out_dir, reg->items[i].method, NULL, "/methods",
-                                          b)))
+                                          &st->base)))
                 return rc;
-        study_name_refs(st);
         return EXIT_OK;
     }
     if (!json_object_is_type(v, json_type_array) || json_object_array_length(v) == 0)
         return study_fail_json(
             file, "/methods",
             "must be \"all\" or a non-empty list of {\"method\": id, \"params\": {...}}");
-    static const char *entry_keys[] = {"method", "params",  "label",   "scenes", "size",
-                                       "frames", "warmup",  "repeats", "time",   "animate",
-                                       "cache",  "compare", NULL};
-    for (size_t i = 0; i < json_object_array_length(v); i++) {
-        json_object *e = json_object_array_get_idx(v, i), *id, *params = NULL;
-        char mpath[64];
-        snprintf(mpath, sizeof mpath, "/methods/%zu", i);
-        if (!json_object_is_type(e, json_type_object) ||
-            !json_object_object_get_ex(e, "method", &id))
-            return study_fail_json(file, mpath, "needs \"method\"");
-        if (!json_object_is_type(id, json_type_string))
-            return study_fail_json(file, mpath,
-                                   "\"method\" must be a method id (a string) or \"all\"");
-        if ((rc = study_check_keys(e, entry_keys, mpath, file)))
+    for (size_t i = 0; i < json_object_array_length(v); i++)
+        if ((rc = load_method_entry(st, json_object_array_get_idx(v, i), i, file, out_dir, reg)))
             return rc;
-        run_settings rs = *b;
-        if ((rc = parse_settings(st, e, mpath, file, &rs)))
-            return rc;
-        json_object_object_get_ex(e, "params", &params);
-        if (params && !json_object_is_type(params, json_type_object))
-            return study_fail_json(file, mpath, "\"params\" must be an object");
-        const char *mid = json_object_get_string(id);
-        if (!strcmp(mid, "all")) {
-            if (params)
-                return study_fail_json(
-                    file, mpath, "\"all\" runs every method with its defaults: no \"params\"");
-            for (uint32_t k = 0; k < reg->count; k++)
-                if ((rc = study_expand_method(st, file, out_dir, reg->items[k].method, NULL, mpath,
-                                              &rs)))
-                    return rc;
-            continue;
-        }
-        const gi_method *m = gi_plugins_find(reg, mid);
-        if (!m) {
-            char msg[256];
-            snprintf(msg, sizeof msg, "no method '%s' is installed (see gibench methods)", mid);
-            return study_fail_json(file, mpath, msg);
-        }
-        if ((rc = study_expand_method(st, file, out_dir, m, params, mpath, &rs)))
-            return rc;
-    }
+    return EXIT_OK;
+}
+
+int study_load(study *st, const char *file, const char *out_dir, gi_plugins *reg)
+{
+    st->refs = calloc(MAX_REFS, sizeof *st->refs);
+    if (!st->refs)
+        return cli_fail(EXIT_RUN, "out of memory");
+    st->root = study_read_strict_json(file);
+    if (!st->root)
+        return EXIT_USAGE;
+    if (!json_object_is_type(st->root, json_type_object))
+        return study_fail_json(file, "/", "a study is a JSON object");
+    int rc;
+    if ((rc = load_top_level(st, st->root, file)) || (rc = load_reference(st, st->root, file)) ||
+        (rc = load_methods(st, st->root, file, out_dir, reg)))
+        return rc;
     study_name_refs(st);
     return EXIT_OK;
 }
