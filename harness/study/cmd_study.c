@@ -10,8 +10,6 @@
 #include "study.h"
 #include "study_internal.h"
 
-#include "report.h"
-
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
@@ -117,155 +115,129 @@ static int lock_out_dir(const char *out, int *rc)
     return fd;
 }
 
-int cmd_study(int argc, char **argv)
+/* The command line of gibench study. */
+typedef struct study_args {
+    const char *file, *out;
+    unsigned long jobs;
+    int fresh, dry;
+    slurm_options so;
+} study_args;
+
+/* Reads and checks the options: EXIT_OK, or an exit status after printing
+ * one line. */
+static int parse_args(int argc, char **argv, study_args *a)
 {
-    const char *file = NULL, *out = NULL;
-    unsigned long jobs = 1;
-    int fresh = 0, dry = 0, taken;
-    slurm_options so = {0};
+    int taken;
+    a->jobs = 1;
     for (int i = 0; i < argc; i++) {
-        if ((taken = slurm_take_option(argc, argv, &i, &so)) != 0) {
+        if ((taken = slurm_take_option(argc, argv, &i, &a->so)) != 0) {
             if (taken < 0)
                 return EXIT_USAGE;
         } else if (!strcmp(argv[i], "--out") && i + 1 < argc)
-            out = argv[++i];
+            a->out = argv[++i];
         else if (!strcmp(argv[i], "--jobs") && i + 1 < argc) {
-            if (!cli_parse_uint(argv[++i], 1, 64, &jobs))
+            if (!cli_parse_uint(argv[++i], 1, 64, &a->jobs))
                 return cli_fail(EXIT_USAGE, "study: --jobs '%s' is not an integer in 1..64",
                                 argv[i]);
         } else if (!strcmp(argv[i], "--resume"))
-            fresh = 0;
+            a->fresh = 0;
         else if (!strcmp(argv[i], "--fresh"))
-            fresh = 1;
+            a->fresh = 1;
         else if (!strcmp(argv[i], "--dry-run"))
-            dry = 1;
+            a->dry = 1;
         else if (argv[i][0] == '-')
             return cli_fail(EXIT_USAGE, "study: unknown or incomplete option '%s'", argv[i]);
-        else if (!file)
-            file = argv[i];
+        else if (!a->file)
+            a->file = argv[i];
         else
             return cli_fail(EXIT_USAGE, "study: one study file at a time");
     }
-    if (!file || (!out && !dry))
+    if (!a->file || (!a->out && !a->dry))
         return cli_fail(
             EXIT_USAGE,
             "study: usage: gibench study STUDY.json --out DIR [--jobs N] [--resume|--fresh] "
             "[--dry-run] "
             "[--slurm [--partition P] [--gres G] [--time T] [--array-limit K] [--no-wait]]");
-    if (!out)
-        out = ".";
-    so.dry_run = dry;
-    int src = slurm_check(&so, file, out);
+    if (!a->out)
+        a->out = ".";
+    a->so.dry_run = a->dry;
+    int src = slurm_check(&a->so, a->file, a->out);
     if (src != EXIT_OK)
         return src;
-    if (fresh && (so.enabled || so.cell || so.collect))
+    if (a->fresh && (a->so.enabled || a->so.cell || a->so.collect))
         return cli_fail(EXIT_USAGE,
                         "study: --fresh does not go with --slurm (remove the results to redo)");
+    return EXIT_OK;
+}
+
+/* Slurm: submit the cells, or run one as an array task */
+static int run_on_slurm(study *st, const study_args *a, gi_plugins *reg)
+{
+    int rc = EXIT_OK;
+    if (st->timer)
+        setenv("GIBENCH_TIMER", st->timer, 1);
+    cli_install_signal_handlers();
+    /* a study running locally in DIR refuses the submission; the lock
+     * is given back at once, for the collect job to take */
+    int lock_fd = -1;
+    if (a->so.enabled && !a->dry && cli_mkdirs(a->out))
+        lock_fd = lock_out_dir(a->out, &rc);
+    if (lock_fd >= 0)
+        close(lock_fd);
+    if (rc == EXIT_OK)
+        rc = a->so.cell ? study_slurm_cell(st, a->out, reg, a->so.cell)
+                        : study_slurm_submit(st, a->file, a->out, reg, &a->so);
+    return rc;
+}
+
+/* The study run here, under the lock (*lock_fd, for the caller to close):
+ * its references, its runs (with --slurm-collect, the records that the
+ * array tasks left) and its report; with --dry-run only the plan. */
+static int run_here(study *st, const study_args *a, gi_plugins *reg, int argc, char **argv,
+                    int *lock_fd)
+{
+    int rc = EXIT_OK;
+    if (a->so.collect)
+        runner_set_collect_only(1);
+    if (a->dry) {
+        print_plan(st);
+        return EXIT_OK;
+    }
+    if (!cli_mkdirs(a->out))
+        return cli_fail(EXIT_RUN, "study: cannot create %s", a->out);
+    *lock_fd = lock_out_dir(a->out, &rc);
+    if (rc != EXIT_OK)
+        return rc;
+    if (st->timer)
+        setenv("GIBENCH_TIMER", st->timer, 1);
+    cli_install_signal_handlers();
+    fprintf(stderr, "study: %s: %u runs on %u scenes\n", st->name, st->run_count, st->scene_count);
+    rc = study_build_references(st, a->out, a->so.collect != NULL);
+    if (rc != EXIT_OK)
+        return rc;
+    if (a->so.collect)
+        study_slurm_collect_runs(st, reg, a->out, a->so.collect);
+    else
+        study_execute_runs(st, (uint32_t)a->jobs, a->fresh, reg);
+    return study_write_report(st, a->out, argc, argv);
+}
+
+int cmd_study(int argc, char **argv)
+{
+    study_args a;
+    memset(&a, 0, sizeof a);
+    int rc = parse_args(argc, argv, &a);
+    if (rc != EXIT_OK)
+        return rc;
     gi_plugins *reg = cli_load_plugins(0);
     study st;
     memset(&st, 0, sizeof st);
-    int rc = study_load(&st, file, out, reg);
-    if (rc == EXIT_OK && (so.enabled || so.cell)) {
-        /* Slurm: submit the cells, or run one as an array task */
-        if (st.timer)
-            setenv("GIBENCH_TIMER", st.timer, 1);
-        cli_install_signal_handlers();
-        /* a study running locally in DIR refuses the submission; the lock
-         * is given back at once, for the collect job to take */
-        int lock_fd = -1;
-        if (so.enabled && !dry && cli_mkdirs(out))
-            lock_fd = lock_out_dir(out, &rc);
-        if (lock_fd >= 0)
-            close(lock_fd);
-        if (rc == EXIT_OK)
-            rc = so.cell ? study_slurm_cell(&st, out, reg, so.cell)
-                         : study_slurm_submit(&st, file, out, reg, &so);
-        study_free(&st);
-        gi_plugins_free(reg);
-        return rc;
-    }
-    if (rc == EXIT_OK && so.collect)
-        runner_set_collect_only(1);
-    if (rc == EXIT_OK && dry)
-        print_plan(&st);
-    if (rc == EXIT_OK && !dry && !cli_mkdirs(out))
-        rc = cli_fail(EXIT_RUN, "study: cannot create %s", out);
     int lock_fd = -1;
-    if (rc == EXIT_OK && !dry)
-        lock_fd = lock_out_dir(out, &rc);
-    if (rc == EXIT_OK && !dry && st.timer)
-        setenv("GIBENCH_TIMER", st.timer, 1);
-    if (rc == EXIT_OK && !dry) {
-        cli_install_signal_handlers();
-        fprintf(stderr, "study: %s: %u runs on %u scenes\n", st.name, st.run_count, st.scene_count);
-        rc = study_build_references(&st, out, so.collect != NULL);
-    }
-    if (rc == EXIT_OK && !dry) {
-        if (so.collect)
-            study_slurm_collect_runs(&st, reg, out, so.collect);
-        else
-            study_execute_runs(&st, (uint32_t)jobs, fresh, reg);
-        /* the scene's size, for scale studies (cached records too) */
-        for (uint32_t i = 0; i < st.run_count; i++)
-            if (st.runs[i].record) {
-                const study_scene *sc = &st.scenes[st.runs[i].scene_index];
-                json_object_object_add(st.runs[i].record, "scene_triangles",
-                                       json_object_new_int64(sc->triangles));
-                json_object_object_add(st.runs[i].record, "scene_vertices",
-                                       json_object_new_int64(sc->vertices));
-            }
-        json_object *runs = json_object_new_array();
-        char renderer[256] = "";
-        int failed = 0, interrupted = 0;
-        for (uint32_t i = 0; i < st.run_count; i++) {
-            json_object *v;
-            if (!st.runs[i].record)
-                continue;
-            if (!renderer[0] && json_object_object_get_ex(st.runs[i].record, "renderer", &v))
-                snprintf(renderer, sizeof renderer, "%s", json_object_get_string(v));
-            if (json_object_object_get_ex(st.runs[i].record, "status", &v) &&
-                !strcmp(json_object_get_string(v), "failed"))
-                failed++;
-            if (json_object_object_get_ex(st.runs[i].record, "status", &v) &&
-                !strcmp(json_object_get_string(v), "interrupted"))
-                interrupted++;
-            json_object_array_add(runs, json_object_get(st.runs[i].record));
-        }
-        char title[512], refdesc[256];
-        snprintf(title, sizeof title, "gibench study: %s (%ux%u, %u frames)", st.name,
-                 st.base.width, st.base.height, st.base.frames);
-        snprintf(refdesc, sizeof refdesc,
-                 "path traced (Embree), %u spp, %u bounces; bounce-matched the same spp%s",
-                 st.ref_spp, st.ref_bounces,
-                 st.ref_pixel_center ? "; camera rays through pixel centres" : "");
-        json_object *meta = report_meta_new(title, "study", argc, argv, renderer, refdesc);
-        if (st.ref_count) {
-            char ref_png[512];
-            snprintf(ref_png, sizeof ref_png, "references/%s_b%u_%uspp%s.png", st.refs[0].name,
-                     st.ref_bounces, st.ref_spp, st.ref_pixel_center ? "_center" : "");
-            json_object_object_add(meta, "reference_png", json_object_new_string(ref_png));
-        }
-        study_reference_sets(&st, meta);
-        json_object *chart_list = json_object_new_array();
-        study_charts_and_speedups(&st, out, meta, chart_list);
-        study_animation_report(&st, out, meta, chart_list);
-        study_user_charts(&st, out, runs, chart_list);
-        json_object_object_add(meta, "charts", chart_list);
-        char why[1024];
-        if (!report_write(out, runs, meta, why, sizeof why))
-            rc = cli_fail(EXIT_RUN, "study: %s", why);
-        else
-            fprintf(stderr,
-                    "study: wrote %s/report.md, index.html, runs.csv, frames.csv, curves.csv (%d "
-                    "failed runs)\n",
-                    out, failed);
-        if (rc == EXIT_OK && cli_interrupted)
-            rc = cli_fail(EXIT_RUN,
-                          "study: interrupted (%d runs to redo); rerun the same command to resume",
-                          interrupted);
-        json_object_put(runs);
-        json_object_put(meta);
-    }
+    rc = study_load(&st, a.file, a.out, reg);
+    if (rc == EXIT_OK && (a.so.enabled || a.so.cell))
+        rc = run_on_slurm(&st, &a, reg);
+    else if (rc == EXIT_OK)
+        rc = run_here(&st, &a, reg, argc, argv, &lock_fd);
     study_free(&st);
     gi_plugins_free(reg);
     if (lock_fd >= 0)

@@ -145,6 +145,13 @@ void study_user_charts(study *st, const char *out_dir, json_object *runs, json_o
 void study_animation_report(study *st, const char *out_dir, json_object *meta,
                             json_object *chart_list);
 
+/* ---- the report (study_report.c) ---- */
+
+/* Writes out/report.md, index.html and the CSV files from the runs'
+ * records. EXIT_OK, or EXIT_RUN after printing why (also when the study
+ * was interrupted). */
+int study_write_report(study *st, const char *out, int argc, char **argv);
+
 /* ---- gibench study --slurm (study_slurm.c) ---- */
 
 int study_slurm_cell(study *st, const char *out, gi_plugins *reg, const char *cell);
