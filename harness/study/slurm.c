@@ -374,23 +374,18 @@ static int log_exit(const char *path, char *last, size_t size, int *exists)
     return code;
 }
 
-int slurm_run(const slurm_options *o, const char *file, const char *out, const char *name,
-              uint64_t plan, const slurm_stage *refs, const slurm_stage *runs)
+/* The job ids of one submission: "-" for a stage with no tasks. */
+typedef struct stage_jobs {
+    char ref[64], run[64], col[64];
+} stage_jobs;
+
+/* The three job scripts (texts[k] NULL: the stage has no tasks), printed
+ * for a dry run or else written into dir as paths[k]. */
+static int write_scripts(const slurm_options *o, const char *dir, const char *logs,
+                         char *const texts[3], char paths[3][4400], const slurm_stage *refs,
+                         const slurm_stage *runs)
 {
-    char cwd[4096], dir[4200], logs[4300];
-    if (!getcwd(cwd, sizeof cwd))
-        return cli_fail(EXIT_RUN, "study: cannot read the working directory");
-    if (!chars_in(cwd, "_-.,/+=@%"))
-        return cli_fail(
-            EXIT_USAGE,
-            "study: --slurm needs a working directory without blanks or shell characters");
-    snprintf(dir, sizeof dir, "%s/slurm", out);
-    snprintf(logs, sizeof logs, "%s/logs", dir);
-    char *texts[3] = {refs->n ? stage_script(o, file, out, name, plan, refs, cwd) : NULL,
-                      runs->n ? stage_script(o, file, out, name, plan, runs, cwd) : NULL,
-                      collect_script(o, file, out, name, cwd)};
     const char *names[3] = {"refs.sh", "runs.sh", "collect.sh"};
-    char paths[3][4400];
     int rc = EXIT_OK;
     if (o->dry_run) {
         for (int k = 0; k < 3; k++)
@@ -410,79 +405,120 @@ int slurm_run(const slurm_options *o, const char *file, const char *out, const c
                 rc = EXIT_RUN;
         }
     }
-    char ref_id[64] = "-", run_id[64] = "-", col_id[64] = "", dep[200];
-    if (rc == EXIT_OK && !o->dry_run) {
-        if (refs->n && !submit(out, paths[0], NULL, NULL, NULL, ref_id, sizeof ref_id))
-            rc = EXIT_RUN;
-        snprintf(dep, sizeof dep, "--dependency=afterok:%s", ref_id);
-        if (rc == EXIT_OK && runs->n &&
-            !submit(out, paths[1], refs->n ? dep : NULL, NULL, NULL, run_id, sizeof run_id))
-            rc = EXIT_RUN;
-        if (refs->n && runs->n)
-            snprintf(dep, sizeof dep, "--dependency=afterany:%s:%s", ref_id, run_id);
-        else
-            snprintf(dep, sizeof dep, "--dependency=afterany:%s", refs->n ? ref_id : run_id);
-        if (rc == EXIT_OK && !submit(out, paths[2], refs->n || runs->n ? dep : NULL, ref_id, run_id,
-                                     col_id, sizeof col_id))
-            rc = EXIT_RUN;
-        /* a submitted job whose followers could not be: cancelled, not left behind */
-        if (rc != EXIT_OK) {
-            char *ids[2] = {ref_id, run_id};
-            for (int k = 0; k < 2; k++)
-                if (strcmp(ids[k], "-")) {
-                    char *argv[] = {"scancel", ids[k], NULL};
-                    slurm_cmd(argv, out, NULL, 0, NULL, 0);
-                }
-        }
+    return rc;
+}
+
+/* Submits the references, then the runs after them, then the collect job
+ * after both; the ids into *j. */
+static int submit_stages(const char *out, char paths[3][4400], const slurm_stage *refs,
+                         const slurm_stage *runs, stage_jobs *j)
+{
+    int rc = EXIT_OK;
+    char dep[200];
+    if (refs->n && !submit(out, paths[0], NULL, NULL, NULL, j->ref, sizeof j->ref))
+        rc = EXIT_RUN;
+    snprintf(dep, sizeof dep, "--dependency=afterok:%s", j->ref);
+    if (rc == EXIT_OK && runs->n &&
+        !submit(out, paths[1], refs->n ? dep : NULL, NULL, NULL, j->run, sizeof j->run))
+        rc = EXIT_RUN;
+    if (refs->n && runs->n)
+        snprintf(dep, sizeof dep, "--dependency=afterany:%s:%s", j->ref, j->run);
+    else
+        snprintf(dep, sizeof dep, "--dependency=afterany:%s", refs->n ? j->ref : j->run);
+    if (rc == EXIT_OK && !submit(out, paths[2], refs->n || runs->n ? dep : NULL, j->ref, j->run,
+                                 j->col, sizeof j->col))
+        rc = EXIT_RUN;
+    /* a submitted job whose followers could not be: cancelled, not left behind */
+    if (rc != EXIT_OK) {
+        char *ids[2] = {j->ref, j->run};
+        for (int k = 0; k < 2; k++)
+            if (strcmp(ids[k], "-")) {
+                char *argv[] = {"scancel", ids[k], NULL};
+                slurm_cmd(argv, out, NULL, 0, NULL, 0);
+            }
     }
-    for (int k = 0; k < 3; k++)
-        free(texts[k]);
-    if (rc != EXIT_OK || o->dry_run)
-        return rc;
-    /* every submission, for the record (and for scancel) */
+    return rc;
+}
+
+/* every submission, for the record (and for scancel) */
+static void record_submission(const char *out, const char *dir, const stage_jobs *j,
+                              const slurm_stage *refs, const slurm_stage *runs)
+{
     char jobs[4400], line[300];
     snprintf(jobs, sizeof jobs, "%s/jobs.txt", dir);
     FILE *f = fopen(jobs, "a");
     if (f) {
-        fprintf(f, "%ld refs %s runs %s collect %s\n", (long)time(NULL), ref_id, run_id, col_id);
+        fprintf(f, "%ld refs %s runs %s collect %s\n", (long)time(NULL), j->ref, j->run, j->col);
         fclose(f);
     }
-    snprintf(line, sizeof line, "references %s (%u tasks), runs %s (%u tasks), collect %s", ref_id,
-             refs->n, run_id, runs->n, col_id);
+    snprintf(line, sizeof line, "references %s (%u tasks), runs %s (%u tasks), collect %s", j->ref,
+             refs->n, j->run, runs->n, j->col);
     printf("submitted: %s\n", line);
     fflush(stdout);
     fprintf(stderr, "study: submitted %s; logs in %s/slurm/logs\n", line, out);
-    if (o->no_wait) {
-        fprintf(stderr, "study: not waiting (--no-wait): the collect job %s writes %s/report.md\n",
-                col_id, out);
-        return EXIT_OK;
-    }
-    /* wait for the collect job, which waits for the others */
+}
+
+/* wait for the collect job, which waits for the others */
+static int wait_for_collect(const char *out, const stage_jobs *j)
+{
     int known = 1, unknown_polls = 0;
     for (;;) {
-        int active = job_active(out, col_id, &known);
+        int active = job_active(out, j->col, &known);
         if (!active && known)
             break;
         if (!known && ++unknown_polls > 30)
-            return cli_fail(EXIT_RUN, "study: squeue cannot tell job %s's state: %s", col_id,
+            return cli_fail(EXIT_RUN, "study: squeue cannot tell job %s's state: %s", j->col,
                             "giving up waiting");
         if (cli_interrupted)
             return cli_fail(
                 EXIT_RUN, "study: interrupted while waiting; the jobs go on (scancel %s %s %s)",
-                strcmp(ref_id, "-") ? ref_id : "", strcmp(run_id, "-") ? run_id : "", col_id);
+                strcmp(j->ref, "-") ? j->ref : "", strcmp(j->run, "-") ? j->run : "", j->col);
         struct timespec ts = {2, 0};
         nanosleep(&ts, NULL);
     }
     char log[4500], last[600];
     int exists;
-    snprintf(log, sizeof log, "%s/slurm/logs/collect-%s.log", out, col_id);
+    snprintf(log, sizeof log, "%s/slurm/logs/collect-%s.log", out, j->col);
     int code = log_exit(log, last, sizeof last, &exists);
     if (code != 0)
-        return cli_fail(EXIT_RUN, "study: the collect job %s %s (%s)%s%s", col_id,
+        return cli_fail(EXIT_RUN, "study: the collect job %s %s (%s)%s%s", j->col,
                         code > 0 ? "failed" : "ended without finishing", log, last[0] ? ": " : "",
                         last);
-    fprintf(stderr, "study: collect job %s done: %s\n", col_id, last);
+    fprintf(stderr, "study: collect job %s done: %s\n", j->col, last);
     return EXIT_OK;
+}
+
+int slurm_run(const slurm_options *o, const char *file, const char *out, const char *name,
+              uint64_t plan, const slurm_stage *refs, const slurm_stage *runs)
+{
+    char cwd[4096], dir[4200], logs[4300];
+    if (!getcwd(cwd, sizeof cwd))
+        return cli_fail(EXIT_RUN, "study: cannot read the working directory");
+    if (!chars_in(cwd, "_-.,/+=@%"))
+        return cli_fail(
+            EXIT_USAGE,
+            "study: --slurm needs a working directory without blanks or shell characters");
+    snprintf(dir, sizeof dir, "%s/slurm", out);
+    snprintf(logs, sizeof logs, "%s/logs", dir);
+    char *texts[3] = {refs->n ? stage_script(o, file, out, name, plan, refs, cwd) : NULL,
+                      runs->n ? stage_script(o, file, out, name, plan, runs, cwd) : NULL,
+                      collect_script(o, file, out, name, cwd)};
+    char paths[3][4400];
+    int rc = write_scripts(o, dir, logs, texts, paths, refs, runs);
+    stage_jobs j = {"-", "-", ""};
+    if (rc == EXIT_OK && !o->dry_run)
+        rc = submit_stages(out, paths, refs, runs, &j);
+    for (int k = 0; k < 3; k++)
+        free(texts[k]);
+    if (rc != EXIT_OK || o->dry_run)
+        return rc;
+    record_submission(out, dir, &j, refs, runs);
+    if (o->no_wait) {
+        fprintf(stderr, "study: not waiting (--no-wait): the collect job %s writes %s/report.md\n",
+                j.col, out);
+        return EXIT_OK;
+    }
+    return wait_for_collect(out, &j);
 }
 
 /* ---- the collect job's view of the tasks ---- */

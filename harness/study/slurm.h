@@ -1,5 +1,5 @@
 /* gibench study --slurm: a study's cells as Slurm job arrays. The study
- * runner (cmd_study.c) plans the cells exactly as it does locally; this
+ * runner (study_slurm.c) plans the cells exactly as it does locally; this
  * file writes the job scripts (one array per stage: references, then the
  * method runs with an afterok dependency, then one collect job that writes
  * the report), submits them with sbatch, waits by polling squeue, and

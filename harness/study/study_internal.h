@@ -1,0 +1,162 @@
+/* The study engine's shared definitions (gibench study, README.md
+ * "Studies"): the study as read and planned into runs, its scenes and
+ * reference sets, and the functions that the engine's files call across
+ * each other. Only harness/study/ includes it; study.h is the public entry. */
+#ifndef GIBENCH_STUDY_INTERNAL_H
+#define GIBENCH_STUDY_INTERNAL_H
+
+#include "cli.h"
+#include "runner.h"
+#include "slurm.h"
+#include "tradeoff.h"
+
+#include <json-c/json.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#define MAX_RUNS 4096
+#define MAX_SWEEP 64
+#define MAX_KEYS 64 /* parameters of one entry: as many as render takes (--param) */
+#define MAX_SCENES 16
+#define MAX_REFS 512 /* an animated run compared frame by frame needs a set per frame */
+
+/* What a run is made with: the study's top-level values, overridden per
+ * method entry (README.md, "Studies"). */
+typedef struct run_settings {
+    int scenes[MAX_SCENES]; /* indices into study.scenes */
+    uint32_t scene_n;
+    uint32_t width, height, frames, warmup;
+    uint32_t repeats; /* each with seed + r; an entry's repeats are interleaved */
+    float time, animate_fps;
+    int cache;   /* 0: render --no-cache (precomputation timed afresh) */
+    int compare; /* 0: no references, no metrics (timing-only runs) */
+    const char *label;
+} run_settings;
+
+typedef struct study_run {
+    run_spec spec;
+    char id[512], dir[4096], rel[1024];
+    char *params[MAX_KEYS];
+    int scene_index;
+    int ref_index;    /* -1: not compared */
+    uint32_t bounces; /* the method's max_bounces + 1 */
+    uint64_t setting; /* every input but the seed: runs of one setting are repeats */
+    json_object *record;
+    /* an animated compared run: the reference set of each frame's time, and
+     * the file names handed to the runner (run_spec.frame_ref_*) */
+    int *frame_ref;
+    uint32_t frame_ref_n;
+    const char **fr_full, **fr_matched, **fr_alt;
+} study_run;
+
+typedef struct study_scene {
+    const char *path;
+    char stem[256];
+    uint64_t hash; /* its content: the file, every object's geometry, the environment map */
+    uint32_t triangles, vertices; /* for scale studies (records get scene_triangles) */
+} study_scene;
+
+/* The references of one scene at one size and scene time. */
+typedef struct study_ref {
+    int scene_index;
+    uint32_t width, height;
+    float time;
+    char name[320]; /* the scene's stem, plus size and time where a scene has several */
+    char ref_full[4096];
+    char ref_matched[8][4096];
+    uint32_t matched_bounces[8];
+    uint32_t matched_count;
+    /* the path tracer's convergence: full GI, and for each matched bounce count */
+    tradeoff_pt_curve pt_full, pt_matched[8];
+    char missing[1100]; /* gibench study --slurm-collect: why the set was not made, or "" */
+    int frame_only; /* used only by animated runs' frames: no convergence curve, no tradeoff table
+                     */
+    int want_alt;   /* a frame: also the full-GI reference with another seed (the noise floor) */
+    char ref_alt[4096];
+} study_ref;
+
+typedef struct study {
+    json_object *root;
+    const char *name;
+    uint32_t seed;
+    uint32_t ref_spp, ref_bounces;
+    double ref_target_se; /* 0: none */
+    int ref_pixel_center; /* "pixel": "center": references sample pixel centres */
+    uint32_t conv_spp[32], conv_n;
+    float exposure;
+    const char *camera;
+    double timeout_s;
+    run_settings base;
+    study_scene scenes[MAX_SCENES];
+    uint32_t scene_count;
+    study_ref *refs; /* MAX_REFS of them, on the heap */
+    uint32_t ref_count;
+    json_object *charts; /* the "charts" list, or NULL */
+    const char *timer;   /* "timer": GIBENCH_TIMER for the runs, or NULL */
+    study_run *runs;
+    uint32_t run_count;
+} study;
+
+/* ---- reading the study file (study_json.c) ---- */
+
+/* Prints "FILE: PATH: WHAT" and returns EXIT_USAGE. */
+int study_fail_json(const char *file, const char *path, const char *what);
+int study_get_uint(json_object *o, const char *prefix, const char *key, uint32_t min, uint32_t max,
+                   uint32_t def, uint32_t *out, const char *file);
+int study_get_number(json_object *o, const char *prefix, const char *key, double min, double max,
+                     double def, double *out, const char *file);
+int study_get_string(json_object *o, const char *prefix, const char *key, int null_ok,
+                     const char *def, const char **out, const char *file);
+json_object *study_read_strict_json(const char *file);
+int study_check_keys(json_object *o, const char *const *known, const char *prefix,
+                     const char *file);
+
+/* ---- the study read and planned (study_load.c, study_plan.c) ---- */
+
+/* Reads, validates and plans the study in `file` into st (runs, scenes,
+ * reference sets); run directories lie under out_dir. EXIT_OK, or an exit
+ * status after printing one line. */
+int study_load(study *st, const char *file, const char *out_dir, gi_plugins *reg);
+int study_expand_method(study *st, const char *file, const char *out_dir, const gi_method *m,
+                        json_object *params, const char *mpath, const run_settings *rs);
+void study_name_refs(study *st);
+
+/* ---- references (study_refs.c) ---- */
+
+int study_build_reference_set(study *st, const char *out_dir, uint32_t ri, int curves, char *why,
+                              size_t why_size);
+/* Every reference set. With slurm_collecting (gibench study
+ * --slurm-collect) a missing set is reported with its runs, not fatal. */
+int study_build_references(study *st, const char *out_dir, int slurm_collecting);
+/* Points run r's spec at the reference files of its set(s). */
+void study_attach_refs(study *st, study_run *r);
+void study_reference_sets(study *st, json_object *meta);
+
+/* ---- execution (study_exec.c) ---- */
+
+json_object *study_run_or_skip(study_run *r, gi_plugins *reg, int resume);
+void study_execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg);
+
+/* ---- the report's charts and tables (study_charts.c, study_anim.c) ---- */
+
+void study_charts_and_speedups(study *st, const char *out_dir, json_object *meta,
+                               json_object *chart_list);
+void study_user_charts(study *st, const char *out_dir, json_object *runs, json_object *chart_list);
+void study_animation_report(study *st, const char *out_dir, json_object *meta,
+                            json_object *chart_list);
+
+/* ---- the report (study_report.c) ---- */
+
+/* Writes out/report.md, index.html and the CSV files from the runs'
+ * records. EXIT_OK, or EXIT_RUN after printing why (also when the study
+ * was interrupted). */
+int study_write_report(study *st, const char *out, int argc, char **argv);
+
+/* ---- gibench study --slurm (study_slurm.c) ---- */
+
+int study_slurm_cell(study *st, const char *out, gi_plugins *reg, const char *cell);
+int study_slurm_submit(study *st, const char *file, const char *out, gi_plugins *reg,
+                       const slurm_options *so);
+void study_slurm_collect_runs(study *st, gi_plugins *reg, const char *out, const char *jobs);
+
+#endif
