@@ -1,5 +1,8 @@
-/* gibench view's state, shared by the window code (cmd_view.c) and the
- * script player (view_script.c). */
+/* gibench view's state, shared by its files: the options and main loop
+ * (cmd_view.c), the camera (view_camera.c), the method shown
+ * (view_method.c), the display (view_display.c), screenshots and saved
+ * views (view_save.c), input (view_input.c), moves (view_move.c), the
+ * overlay (view_overlay.c) and the script player (view_script.c). */
 #ifndef GIBENCH_VIEW_H
 #define GIBENCH_VIEW_H
 
@@ -125,6 +128,30 @@ void view_changed(viewer *v);
 gi_vec3 view_eye(const viewer *v);
 gi_camera_frame view_camera(const viewer *v);
 void view_camera_from_scene(viewer *v, int index);
+
+/* The reference runs while it is shown (alone or in split view) and idles otherwise. */
+void view_reference_as_needed(viewer *v);
+
+/* The method shown (view_method.c): unloaded (none shown), a parameter
+ * stepped (keys PAGE_UP and PAGE_DOWN), a frame rendered, the animation
+ * at time t; they return EXIT_OK or an exit code after printing why. */
+void view_unload_method(viewer *v);
+int view_step_param(viewer *v, int dir);
+int view_render_method(viewer *v);
+int view_set_time(viewer *v, float t);
+
+/* The display (view_display.c): its shader made once the context is
+ * current, the window redrawn, the reference's newest image taken in. */
+int view_build_display(viewer *v);
+void view_display(viewer *v);
+void view_poll_reference(viewer *v);
+
+/* The next free name for keys P and V (view_save.c). */
+void view_next_name(viewer *v, char *out, size_t size);
+
+/* The window's input callbacks, which deliver to the functions above
+ * (view_input.c). */
+void view_input_listen(viewer *v);
 
 /* Moving objects and lights (view_move.c). */
 int view_move_init(viewer *v);

@@ -17,9 +17,11 @@
  *     save-view FILE.json     the view, as key V saves it
  *     screenshot PREFIX       PREFIX.exr, PREFIX.png and PREFIX.json (its view)
  *     window-shot FILE.png    the window as shown (split view, divider) at the next redraw
- *     resize W H              the window resized to W x H (the image is rendered again at that
- * size) quit                    exit 0 (so does the end of the file) Blank lines and lines starting
- * with # are skipped. A line runs only once the frame of the line before it has been rendered. */
+ *     resize W H              the window resized to W x H (the image is rendered again at
+ *                             that size)
+ *     quit                    exit 0 (so does the end of the file)
+ * Blank lines and lines starting with # are skipped. A line runs only once
+ * the frame of the line before it has been rendered. */
 #define _POSIX_C_SOURCE 200809L
 #include "view.h"
 
@@ -118,125 +120,184 @@ static int reference_pending(viewer *v, int *rc)
     return 1;
 }
 
+/* A script line split into its first words: the command, up to two
+ * arguments, and n, how many of the three sscanf read. */
+typedef struct script_line {
+    const char *text, *cmd, *a, *b;
+    int n;
+} script_line;
+
+static int key_line(viewer *v, const script_line *s)
+{
+    int k = s->n >= 2 ? key_code(s->a) : -1;
+    if (k < 0)
+        return bad(v, "key: unknown key name (a letter, a digit, SPACE, ESCAPE, LEFT, ...)");
+    int mods = mod_code(s->n == 3 ? s->b : NULL);
+    if (mods < 0)
+        return bad(v, "key NAME [shift|ctrl]");
+    return view_key(v, k, mods);
+}
+
+/* The events of a mouse line at x[0..4) (drag: from x[0], x[1] to x[2], x[3]). */
+static void mouse_events(viewer *v, const char *cmd, const double *x, int bt, int mods)
+{
+    if (!strcmp(cmd, "press")) {
+        view_button(v, bt, 1, x[0], x[1], mods);
+    } else if (!strcmp(cmd, "move")) {
+        view_cursor(v, x[0], x[1]);
+    } else if (!strcmp(cmd, "release")) {
+        view_cursor(v, x[0], x[1]);
+        view_button(v, bt, 0, x[0], x[1], 0);
+    } else {
+        view_cursor(v, x[0], x[1]); /* the mouse is there before the press */
+        view_button(v, bt, 1, x[0], x[1], mods);
+        for (int i = 1; i <= 8; i++)
+            view_cursor(v, x[0] + (x[2] - x[0]) * i / 8.0, x[1] + (x[3] - x[1]) * i / 8.0);
+        view_button(v, bt, 0, x[2], x[3], 0);
+    }
+}
+
+/* drag, press, move and release. */
+static int mouse_line(viewer *v, const script_line *s)
+{
+    const char *cmd = s->cmd, *line = s->text;
+    double x[4];
+    char w1[16] = "", w2[16] = "", extra[16] = "";
+    int need = !strcmp(cmd, "drag") ? 4 : 2, m;
+    if (need == 4)
+        m = sscanf(line, "%*s %lf %lf %lf %lf %15s %15s %15s", &x[0], &x[1], &x[2], &x[3], w1, w2,
+                   extra);
+    else
+        m = sscanf(line, "%*s %lf %lf %15s %15s %15s", &x[0], &x[1], w1, w2, extra);
+    /* the words after the numbers: a button, then a modifier (either may be left out) */
+    int bt = button_code(w1), mods = 0;
+    if (bt < 0) {
+        bt = GLFW_MOUSE_BUTTON_LEFT;
+        mods = mod_code(w1);
+        if (w2[0])
+            mods = -1;
+    } else {
+        mods = mod_code(w2);
+    }
+    int words = m - need;
+    const char *usage = need == 4 ? "drag X0 Y0 X1 Y1 [left|right|middle] [shift|ctrl]"
+                        : !strcmp(cmd, "press") ? "press X Y [left|right|middle] [shift|ctrl]"
+                        : !strcmp(cmd, "move")  ? "move X Y"
+                                                : "release X Y [left|right|middle]";
+    if (m < need || extra[0] || mods < 0 || (!strcmp(cmd, "move") && words > 0) ||
+        (!strcmp(cmd, "release") && (mods != 0 || words > 1)))
+        return bad(v, usage);
+    mouse_events(v, cmd, x, bt, mods);
+    return v->exit_code;
+}
+
+static int scroll_line(viewer *v, const script_line *s)
+{
+    double dy;
+    if (sscanf(s->text, "%*s %lf", &dy) != 1)
+        return bad(v, "scroll DY");
+    view_scroll(v, dy);
+    return EXIT_OK;
+}
+
+static int method_line(viewer *v, const script_line *s)
+{
+    int idx = s->n >= 2 ? method_by_id(v, s->a) : -2;
+    if (idx < -1)
+        return bad(v, "method: no such method (see gibench methods; or reference)");
+    if (idx >= 0)
+        v->last_method = idx;
+    return view_select(v, idx);
+}
+
+static int wait_line(viewer *v, const script_line *s)
+{
+    unsigned long k;
+    if (s->n != 2 || !cli_parse_uint(s->a, 1, 100000, &k))
+        return bad(v, "wait N (frames, 1..100000)");
+    v->wait_left = (uint32_t)k;
+    v->wait_spp = view_ref_spp(&v->ref) + k;
+    v->wait_deadline = gi_now() + REF_WAIT_S;
+    return EXIT_OK;
+}
+
+static int save_view_line(viewer *v, const script_line *s)
+{
+    return s->n == 2 ? view_save(v, s->a) : bad(v, "save-view FILE.json");
+}
+
+static int screenshot_line(viewer *v, const script_line *s)
+{
+    return s->n == 2 ? view_screenshot(v, s->a) : bad(v, "screenshot PREFIX");
+}
+
+static int window_shot_line(viewer *v, const script_line *s)
+{
+    if (s->n != 2)
+        return bad(v, "window-shot FILE.png");
+    free(v->window_shot_buf);
+    v->window_shot_buf = strdup(s->a);
+    if (!v->window_shot_buf)
+        return cli_fail(EXIT_RUN, "out of memory");
+    v->window_shot = v->window_shot_buf;
+    v->need_display = 1;
+    return EXIT_OK;
+}
+
+static int resize_line(viewer *v, const script_line *s)
+{
+    unsigned long w, h;
+    if (s->n != 3 || !cli_parse_uint(s->a, 1, 16384, &w) || !cli_parse_uint(s->b, 1, 16384, &h))
+        return bad(v, "resize W H (1..16384 each)");
+    glfwSetWindowSize(v->win, (int)w, (int)h);
+    /* the X server answers asynchronously: wait for the new size (up to 5 s) */
+    double until = gi_now() + 5.0;
+    int fw = 0, fh = 0;
+    do {
+        glfwPollEvents();
+        glfwGetFramebufferSize(v->win, &fw, &fh);
+    } while (((unsigned long)fw != w || (unsigned long)fh != h) && gi_now() < until);
+    if ((unsigned long)fw != w || (unsigned long)fh != h)
+        return bad(v, "resize: the window did not take the size");
+    v->need_render = 1;
+    return EXIT_OK;
+}
+
+static int quit_line(viewer *v, const script_line *s)
+{
+    v->quit = 1;
+    return EXIT_OK;
+}
+
+static const struct {
+    const char *name;
+    int (*run)(viewer *v, const script_line *s);
+} commands[] = {
+    {"key", key_line},
+    {"drag", mouse_line},
+    {"press", mouse_line},
+    {"move", mouse_line},
+    {"release", mouse_line},
+    {"scroll", scroll_line},
+    {"method", method_line},
+    {"wait", wait_line},
+    {"save-view", save_view_line},
+    {"screenshot", screenshot_line},
+    {"window-shot", window_shot_line},
+    {"resize", resize_line},
+    {"quit", quit_line},
+};
+
 static int run_line(viewer *v, char *line)
 {
     char cmd[32] = "", a[4096] = "", b[32] = "";
     int n = sscanf(line, "%31s %4095s %31s", cmd, a, b);
     if (n < 1)
         return EXIT_OK;
-    if (!strcmp(cmd, "key")) {
-        int k = n >= 2 ? key_code(a) : -1;
-        if (k < 0)
-            return bad(v, "key: unknown key name (a letter, a digit, SPACE, ESCAPE, LEFT, ...)");
-        int mods = mod_code(n == 3 ? b : NULL);
-        if (mods < 0)
-            return bad(v, "key NAME [shift|ctrl]");
-        return view_key(v, k, mods);
-    }
-    if (!strcmp(cmd, "drag") || !strcmp(cmd, "press") || !strcmp(cmd, "move") ||
-        !strcmp(cmd, "release")) {
-        double x[4];
-        char w1[16] = "", w2[16] = "", extra[16] = "";
-        int need = !strcmp(cmd, "drag") ? 4 : 2, m;
-        if (need == 4)
-            m = sscanf(line, "%*s %lf %lf %lf %lf %15s %15s %15s", &x[0], &x[1], &x[2], &x[3], w1,
-                       w2, extra);
-        else
-            m = sscanf(line, "%*s %lf %lf %15s %15s %15s", &x[0], &x[1], w1, w2, extra);
-        /* the words after the numbers: a button, then a modifier (either may be left out) */
-        int bt = button_code(w1), mods = 0;
-        if (bt < 0) {
-            bt = GLFW_MOUSE_BUTTON_LEFT;
-            mods = mod_code(w1);
-            if (w2[0])
-                mods = -1;
-        } else {
-            mods = mod_code(w2);
-        }
-        int words = m - need;
-        const char *usage = need == 4 ? "drag X0 Y0 X1 Y1 [left|right|middle] [shift|ctrl]"
-                            : !strcmp(cmd, "press") ? "press X Y [left|right|middle] [shift|ctrl]"
-                            : !strcmp(cmd, "move")  ? "move X Y"
-                                                    : "release X Y [left|right|middle]";
-        if (m < need || extra[0] || mods < 0 || (!strcmp(cmd, "move") && words > 0) ||
-            (!strcmp(cmd, "release") && (mods != 0 || words > 1)))
-            return bad(v, usage);
-        if (!strcmp(cmd, "press")) {
-            view_button(v, bt, 1, x[0], x[1], mods);
-        } else if (!strcmp(cmd, "move")) {
-            view_cursor(v, x[0], x[1]);
-        } else if (!strcmp(cmd, "release")) {
-            view_cursor(v, x[0], x[1]);
-            view_button(v, bt, 0, x[0], x[1], 0);
-        } else {
-            view_cursor(v, x[0], x[1]); /* the mouse is there before the press */
-            view_button(v, bt, 1, x[0], x[1], mods);
-            for (int i = 1; i <= 8; i++)
-                view_cursor(v, x[0] + (x[2] - x[0]) * i / 8.0, x[1] + (x[3] - x[1]) * i / 8.0);
-            view_button(v, bt, 0, x[2], x[3], 0);
-        }
-        return v->exit_code;
-    }
-    if (!strcmp(cmd, "scroll")) {
-        double dy;
-        if (sscanf(line, "%*s %lf", &dy) != 1)
-            return bad(v, "scroll DY");
-        view_scroll(v, dy);
-        return EXIT_OK;
-    }
-    if (!strcmp(cmd, "method")) {
-        int idx = n >= 2 ? method_by_id(v, a) : -2;
-        if (idx < -1)
-            return bad(v, "method: no such method (see gibench methods; or reference)");
-        if (idx >= 0)
-            v->last_method = idx;
-        return view_select(v, idx);
-    }
-    if (!strcmp(cmd, "wait")) {
-        unsigned long k;
-        if (n != 2 || !cli_parse_uint(a, 1, 100000, &k))
-            return bad(v, "wait N (frames, 1..100000)");
-        v->wait_left = (uint32_t)k;
-        v->wait_spp = view_ref_spp(&v->ref) + k;
-        v->wait_deadline = gi_now() + REF_WAIT_S;
-        return EXIT_OK;
-    }
-    if (!strcmp(cmd, "save-view"))
-        return n == 2 ? view_save(v, a) : bad(v, "save-view FILE.json");
-    if (!strcmp(cmd, "screenshot"))
-        return n == 2 ? view_screenshot(v, a) : bad(v, "screenshot PREFIX");
-    if (!strcmp(cmd, "window-shot")) {
-        if (n != 2)
-            return bad(v, "window-shot FILE.png");
-        free(v->window_shot_buf);
-        v->window_shot_buf = strdup(a);
-        if (!v->window_shot_buf)
-            return cli_fail(EXIT_RUN, "out of memory");
-        v->window_shot = v->window_shot_buf;
-        v->need_display = 1;
-        return EXIT_OK;
-    }
-    if (!strcmp(cmd, "resize")) {
-        unsigned long w, h;
-        if (n != 3 || !cli_parse_uint(a, 1, 16384, &w) || !cli_parse_uint(b, 1, 16384, &h))
-            return bad(v, "resize W H (1..16384 each)");
-        glfwSetWindowSize(v->win, (int)w, (int)h);
-        /* the X server answers asynchronously: wait for the new size (up to 5 s) */
-        double until = gi_now() + 5.0;
-        int fw = 0, fh = 0;
-        do {
-            glfwPollEvents();
-            glfwGetFramebufferSize(v->win, &fw, &fh);
-        } while (((unsigned long)fw != w || (unsigned long)fh != h) && gi_now() < until);
-        if ((unsigned long)fw != w || (unsigned long)fh != h)
-            return bad(v, "resize: the window did not take the size");
-        v->need_render = 1;
-        return EXIT_OK;
-    }
-    if (!strcmp(cmd, "quit")) {
-        v->quit = 1;
-        return EXIT_OK;
-    }
+    script_line s = {line, cmd, a, b, n};
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        if (!strcmp(cmd, commands[i].name))
+            return commands[i].run(v, &s);
     return bad(v, "unknown command (key, drag, press, move, release, scroll, resize, method, wait, "
                   "save-view, screenshot, window-shot, quit)");
 }
