@@ -1,6 +1,5 @@
-/* The `example_env` method: the complete plugin that README.md's "Adding a
- * method plugin" walks through (the README shows this file verbatim and a
- * test keeps the two equal).
+/* The `example_env` method: the complete plugin that docs/plugins.md walks
+ * through (it shows this file verbatim, and a test keeps the two equal).
  *
  * Unshadowed environment light on Lambertian surfaces: per G-buffer pixel,
  * `samples` cosine-weighted directions a frame, each weighted by the
@@ -99,7 +98,8 @@ static const char *example_env_last_error(void *inst)
 
 GI_METHOD_EXPORT(
     example_env, .id = "example_env",
-    .title = "Unshadowed environment light by cosine sampling (the README's example plugin)",
+    .title =
+        "Unshadowed environment light by cosine sampling (the example plugin of docs/plugins.md)",
     .citation = "gibench example", .version = "1.0",
     .caps = GI_CAP_DIRECT | GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION | GI_CAP_DEFORMATION |
             GI_CAP_PROGRESSIVE | GI_CAP_TEXTURES,

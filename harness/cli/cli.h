@@ -11,7 +11,7 @@
 #include <signal.h>
 #include <stdio.h>
 
-/* Exit codes (ARCHITECTURE.md): 0 ok, 1 failure while running, 2 bad usage or input. */
+/* Exit codes (docs/ARCHITECTURE.md): 0 ok, 1 failure while running, 2 bad usage or input. */
 enum { EXIT_OK = 0, EXIT_RUN = 1, EXIT_USAGE = 2 };
 
 /* Prints "gibench: <message>" on stderr and returns `code`. */

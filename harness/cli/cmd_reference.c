@@ -262,7 +262,7 @@ static json_object *stats_json(const run_state *r, const ref_opts *o, int camera
                                                       : 0.0));
     json_object_object_add(j, "nonfinite_samples", json_object_new_int64((int64_t)st.nonfinite));
     /* Mean over pixels of the standard error of the mean luminance, absolute
-     * and relative (the --target-se statistic, README "Reference path tracer"). */
+     * and relative (the --target-se statistic, docs/commands.md "gibench reference"). */
     size_t n = (size_t)o->width * o->height;
     double se_sum = 0.0;
     for (size_t i = 0; i < n; i++)

@@ -1,5 +1,5 @@
 /* The help of every command: `gibench help CMD` and `gibench CMD --help`
- * (README.md, "Command line", says the same at length). */
+ * (docs/commands.md, says the same at length). */
 #include "cli.h"
 
 #include <string.h>
@@ -89,7 +89,8 @@ static const command_help helps[] = {
     {"study",
      "usage: gibench study STUDY.json --out DIR [--jobs N] [--resume|--fresh] [--dry-run]\n"
      "         [--slurm [--partition P] [--gres G] [--time T] [--array-limit K] [--no-wait]]\n"
-     "Run a declarative experiment (README.md, \"Studies\"): every method setting x scene x repeat "
+     "Run a declarative experiment (docs/studies.md, \"gibench study\"): every method setting x "
+     "scene x repeat "
      "in\n"
      "its own process, against the references, with convergence curves, Pareto fronts and the\n"
      "equal-error and equal-time tables; cached runs are not run again.\n"
@@ -99,8 +100,8 @@ static const command_help helps[] = {
      "  --fresh       run everything again\n"
      "  --dry-run     check the file and print the plan; run nothing (with --slurm: print the job "
      "scripts)\n"
-     "  --slurm       run the cells as Slurm job arrays (README.md, \"Studies on a Slurm "
-     "cluster\"):\n"
+     "  --slurm       run the cells as Slurm job arrays (docs/studies.md, \"Studies on a "
+     "Slurm cluster\"):\n"
      "                references, then method runs (afterok), then a collect job that writes the "
      "report\n"
      "  --partition P --gres G --time T   sbatch's options for the cells' tasks\n"
@@ -122,8 +123,8 @@ static const command_help helps[] = {
      "  --camera NAME|#k       the scene's camera to start from\n"
      "  --exposure EV  --time T  --seed N\n"
      "  --screenshot-dir DIR   where keys P (screenshot) and V (save view) write (default .)\n"
-     "  --script FILE          replay key and mouse events from FILE, then exit (README \"gibench "
-     "view\")\n"
+     "  --script FILE          replay key and mouse events from FILE, then exit (docs/commands.md, "
+     "\"Scripts\")\n"
      "Keys: M/N next/previous method, R reference, mouse left orbit, right dolly, middle pan, "
      "wheel zoom,\n"
      "Shift+left drag move the object under the mouse, Ctrl+left drag rotate it, L select a light\n"

@@ -1,4 +1,4 @@
-/* gibench: the command-line front door (ARCHITECTURE.md "Command line"). */
+/* gibench: the command-line front door (docs/commands.md). */
 #include "cli.h"
 
 #include "gi/gpu.h"

@@ -1,4 +1,4 @@
-/* A saved view of gibench view ("save view", README.md "gibench view"):
+/* A saved view of gibench view ("save view", docs/commands.md "gibench view"):
  * scene, camera, time, method and its parameters, image size, exposure and
  * the frames accumulated, as a small JSON file that `gibench render --view
  * FILE` reproduces in batch. */

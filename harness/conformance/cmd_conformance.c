@@ -1,5 +1,5 @@
 /* gibench conformance: the same checks for every method plugin, with no
- * code of its own for any of them (README "Conformance suite").
+ * code of its own for any of them (docs/conformance.md).
  *
  * The checks of one method form a fixed list of items (furnace, the shipped
  * scenes, determinism, resize and second prepare, updates, parameters,

@@ -1,10 +1,8 @@
-/* gibench conformance's internals, shared by its files (README
- * "Conformance suite"): the items of a method's check list (conf_items.c),
- * the child's sessions on the GPU (conf_session.c), image measures
- * (conf_measure.c), the checks (conf_checks.c), the child process that
- * runs them (conf_child.c) and the parent that starts children and prints
- * the table (cmd_conformance.c). Not a public header: only the .c files
- * beside it include it. */
+/* gibench conformance's internals, shared by its files (docs/conformance.md): the items of a
+ * method's check list (conf_items.c), the child's sessions on the GPU (conf_session.c), image
+ * measures (conf_measure.c), the checks (conf_checks.c), the child process that runs them
+ * (conf_child.c) and the parent that starts children and prints the table (cmd_conformance.c). Not
+ * a public header: only the .c files beside it include it. */
 #ifndef GIBENCH_CONF_H
 #define GIBENCH_CONF_H
 

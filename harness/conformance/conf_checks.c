@@ -1,7 +1,6 @@
-/* gibench conformance: the checks, one per item (README "Conformance
- * suite"): the furnace against its closed form, every shipped scene,
- * determinism, resize and a second prepare, updates against a fresh
- * instance, parameter values, refused settings and each light type. */
+/* gibench conformance: the checks, one per item (docs/conformance.md): the furnace against its
+ * closed form, every shipped scene, determinism, resize and a second prepare, updates against a
+ * fresh instance, parameter values, refused settings and each light type. */
 #include "conf.h"
 
 #include <math.h>

@@ -1,6 +1,6 @@
-/* gibench conformance --run-items, the child process (README "Conformance
- * suite"): runs a method's items from --from on, each in its own session
- * under an alarm, and prints the lines that the parent reads back. */
+/* gibench conformance --run-items, the child process (docs/conformance.md): runs a method's items
+ * from --from on, each in its own session under an alarm, and prints the lines that the parent
+ * reads back. */
 #define _POSIX_C_SOURCE 200809L
 #include "conf.h"
 

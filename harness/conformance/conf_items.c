@@ -1,6 +1,5 @@
-/* gibench conformance: the items of one method's check list (README
- * "Conformance suite"): the furnace, every shipped scene, determinism,
- * resize and second prepare, updates, parameter values, unknown
+/* gibench conformance: the items of one method's check list (docs/conformance.md): the furnace,
+ * every shipped scene, determinism, resize and second prepare, updates, parameter values, unknown
  * parameters and light types, in a fixed order that the child's --from
  * counts in; the parent groups them into the table's checks. */
 #define _POSIX_C_SOURCE 200809L

@@ -1,6 +1,5 @@
-/* gibench conformance: what the checks measure in an image (README
- * "Conformance suite"): its mean, NaN, Inf and negative pixels, and the
- * relative difference of two images. */
+/* gibench conformance: what the checks measure in an image (docs/conformance.md): its mean, NaN,
+ * Inf and negative pixels, and the relative difference of two images. */
 #include "conf.h"
 
 #include <math.h>

@@ -1,5 +1,5 @@
 /* gibench conformance, the child's side: a session on the GPU for one item
- * (README "Conformance suite"): the scene loaded and uploaded, a fresh
+ * (docs/conformance.md): the scene loaded and uploaded, a fresh
  * instance of the method made and prepared as `gibench render` does it,
  * frames rendered into a target of the asked size and read back. */
 #define _POSIX_C_SOURCE 200809L

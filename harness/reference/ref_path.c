@@ -3,7 +3,7 @@
  * (Veach 1997, ch. 9: one light sample and one BSDF sample per vertex,
  * power heuristic with beta = 2), Russian roulette after the third bounce.
  *
- * Conventions shared with every GPU method (README.md "Scene conventions"):
+ * Conventions shared with every GPU method (docs/scenes.md "Scene conventions"):
  *  - the shading normal is the interpolated vertex normal turned to the
  *    side of wo (reflection is two-sided); the geometric normal decides
  *    which side a ray leaves from: a sampled direction on the other

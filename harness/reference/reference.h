@@ -1,6 +1,6 @@
 /* The reference: a CPU path tracer on Embree 3 over the core's scene, the
- * ground truth every GPU method is measured against (ARCHITECTURE.md "The
- * reference"; README.md "Reference path tracer").
+ * ground truth every GPU method is measured against (docs/ARCHITECTURE.md "The reference";
+ * docs/commands.md "gibench reference").
  *
  * Use:
  *     gi_ref_desc d;
@@ -140,8 +140,8 @@ typedef struct gi_ref_stats {
     double build_seconds;      /* scene validation + BVH build in gi_ref_create */
     double render_seconds;     /* wall time inside gi_ref_render, summed */
     double render_cpu_seconds; /* the process's CPU time (every thread) inside gi_ref_render,
-                                  summed: what studies timed by CPU time compare with (README "Speed
-                                  against accuracy") */
+                                  summed: what studies timed by CPU time compare with
+                                  (docs/studies.md "Speed against accuracy") */
 } gi_ref_stats;
 void gi_ref_get_stats(const gi_ref *r, gi_ref_stats *out);
 

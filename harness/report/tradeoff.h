@@ -5,8 +5,8 @@
  * for each bounce limit in use. From them: the error-against-time charts,
  * the equal-error table (speed-up over the full and the bounce-matched
  * path tracer), and the equal-time table (each method's error at the time
- * the path tracer needs for fixed error levels). README.md, "Speed against
- * accuracy", defines every column. */
+ * the path tracer needs for fixed error levels). docs/studies.md, "Speed against accuracy", defines
+ * every column. */
 #ifndef GIBENCH_TRADEOFF_H
 #define GIBENCH_TRADEOFF_H
 

@@ -32,7 +32,7 @@ typedef struct run_spec {
      * seed (the reference's noise floor; may be NULL). frame_ref_count is
      * 0 or `frames`; with it the run writes every frame
      * (render --frames-out DIR/frames/frame_%04d.exr) and the record gets
-     * "animation" (README.md, "Animated runs"). */
+     * "animation" (docs/studies.md, "Animated runs, frame by frame"). */
     uint32_t frame_ref_count;
     const char *const *frame_ref_full, *const *frame_ref_matched, *const *frame_ref_alt;
 } run_spec;

@@ -177,7 +177,7 @@ def main():
       "1 % of the final error. Precompute: `prepare` (in these runs "
       "csm and cssm_hrc, the methods that cache precomputation, run with `\"cache\": false`, so it is measured). Memory: the "
       "method's own data as it reports it (stat `data_bytes`, what it "
-      "counts is in README \"Memory\") and the render process's peak "
+      "counts is in docs/measurement.md \"Memory\") and the render process's peak "
       "resident memory (on llvmpipe GPU buffers are process memory).\n")
     for s in scenes:
         w("### %s\n" % s)

@@ -2,7 +2,7 @@
  * expanded into independent runs, executed in child processes by a worker
  * pool, cached by the hash of each run's configuration, and reported with
  * tables and error-against-time charts that include the path tracer's own
- * convergence curve. The file format is documented in README.md ("Studies").
+ * convergence curve. The file format is documented in docs/studies.md ("gibench study").
  * This file is the command: its options, the lock on the output directory,
  * the plan that --dry-run prints, and the order of the steps, which the
  * study_*.c files carry out (study_internal.h). */

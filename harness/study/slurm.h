@@ -4,7 +4,7 @@
  * method runs with an afterok dependency, then one collect job that writes
  * the report), submits them with sbatch, waits by polling squeue, and
  * tells the collect job how each missing cell's task ended (sacct, else
- * scontrol, else the task's log). README.md, "Studies on a Slurm cluster". */
+ * scontrol, else the task's log). docs/studies.md, "Studies on a Slurm cluster". */
 #ifndef GIBENCH_SLURM_H
 #define GIBENCH_SLURM_H
 

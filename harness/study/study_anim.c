@@ -1,5 +1,5 @@
 /* The report's section on animated runs compared frame by frame
- * (README.md, "Animated runs"): a table of every such run and, per scene,
+ * (docs/studies.md, "Animated runs, frame by frame"): a table of every such run and, per scene,
  * charts of relMSE, frame time and frame-to-frame change per frame. */
 #define _POSIX_C_SOURCE 200809L
 #include "study_internal.h"
@@ -219,7 +219,7 @@ static void anim_chart(const study *st, const char *out_dir, uint32_t sc, int c,
     }
 }
 
-/* Animated runs compared frame by frame (README.md, "Animated runs"): a
+/* Animated runs compared frame by frame (docs/studies.md, "Animated runs, frame by frame"): a
  * table of every such run (markdown, into meta "animation_markdown") and,
  * per scene, charts of relMSE, frame time and frame-to-frame change
  * against the frame index, one series per run. */

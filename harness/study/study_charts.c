@@ -1,7 +1,7 @@
 /* A study's charts: per reference set the error-against-time charts, the
  * speed-ups against the path tracer and the equal-error and equal-time
  * tables (tradeoff.h), and the study's own "charts" (y against x over the
- * finished runs' records, README.md "Studies"). */
+ * finished runs' records, docs/studies.md "gibench study"). */
 #define _POSIX_C_SOURCE 200809L
 #include "study_internal.h"
 

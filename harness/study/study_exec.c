@@ -1,4 +1,4 @@
-/* A study's runs executed (README.md, "Studies"): each run in a child
+/* A study's runs executed (docs/studies.md, "gibench study"): each run in a child
  * process (runner.h), by a pool of worker processes or one after another,
  * cached by its configuration's hash, with a progress line per run. */
 #define _POSIX_C_SOURCE 200809L

@@ -1,5 +1,5 @@
-/* The study engine's shared definitions (gibench study, README.md
- * "Studies"): the study as read and planned into runs, its scenes and
+/* The study engine's shared definitions (gibench study, docs/studies.md
+ * "gibench study"): the study as read and planned into runs, its scenes and
  * reference sets, and the functions that the engine's files call across
  * each other. Only harness/study/ includes it; study.h is the public entry. */
 #ifndef GIBENCH_STUDY_INTERNAL_H
@@ -21,7 +21,7 @@
 #define MAX_REFS 512 /* an animated run compared frame by frame needs a set per frame */
 
 /* What a run is made with: the study's top-level values, overridden per
- * method entry (README.md, "Studies"). */
+ * method entry (docs/studies.md, "gibench study"). */
 typedef struct run_settings {
     int scenes[MAX_SCENES]; /* indices into study.scenes */
     uint32_t scene_n;

@@ -1,4 +1,4 @@
-/* The study file as strict JSON (gibench study, README.md "Studies"):
+/* The study file as strict JSON (gibench study, docs/studies.md "gibench study"):
  * the reader that refuses trailing commas, comments and keys given twice,
  * and the typed reads of its values whose messages name the value's JSON
  * path. */

@@ -1,4 +1,4 @@
-/* The study file read and checked (README.md, "Studies"): the top-level
+/* The study file read and checked (docs/studies.md, "gibench study"): the top-level
  * keys, the reference settings, the method entries, the run settings that
  * either may give (scenes, size, frames, time, animate, ...), each scene
  * loaded once, and the "charts" list. The runs are planned in study_plan.c. */

@@ -1,4 +1,4 @@
-/* A study expanded into runs (README.md, "Studies"): each parameter's
+/* A study expanded into runs (docs/studies.md, "gibench study"): each parameter's
  * sweep (a value, a list or a range), the Cartesian product of an entry's
  * sweeps over its scenes and repeats, each run's identity (the hash of
  * every input that changes its result), and the reference sets (scene,

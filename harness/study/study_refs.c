@@ -1,4 +1,4 @@
-/* A study's references (README.md, "Studies"): per reference set the
+/* A study's references (docs/studies.md, "gibench study"): per reference set the
  * path-traced full-GI reference, the bounce-matched ones for the methods'
  * bounce counts, the noise-floor reference of animation frames and the
  * path tracer's own convergence curve; the runs pointed at them, and the

@@ -2,7 +2,7 @@
  * sizes that scale studies chart, the report's description of the study
  * and its references, the charts and tables of study_charts.c and
  * study_anim.c, and report.md, index.html and the CSV files written from
- * them. README.md, "Studies". */
+ * them. docs/studies.md, "gibench study". */
 #define _POSIX_C_SOURCE 200809L
 #include "study_internal.h"
 

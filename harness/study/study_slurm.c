@@ -1,8 +1,7 @@
 /* gibench study --slurm (slurm.h): the same cells as Slurm array tasks.
  * The cells are planned exactly as the local runner plans them; this file
  * submits those not yet done, runs one cell as an array task (--cell), and
- * collects the records (--slurm-collect). README.md, "Studies on a Slurm
- * cluster". */
+ * collects the records (--slurm-collect). docs/studies.md, "Studies on a Slurm cluster". */
 #define _POSIX_C_SOURCE 200809L
 #include "study_internal.h"
 

@@ -1,4 +1,4 @@
-/* gibench view: the interactive viewer (README.md "gibench view"). A GLFW
+/* gibench view: the interactive viewer (docs/commands.md "gibench view"). A GLFW
  * window with an OpenGL 4.5 core context, adopted by the core (gi_gpu_desc
  * .adopt_current), so that the methods render through the same plugin path
  * as `gibench render` and their image is shown without a copy; the

@@ -1,4 +1,4 @@
-/* gibench view: the orbit camera (README.md "gibench view"): the eye at a
+/* gibench view: the orbit camera (docs/commands.md "gibench view"): the eye at a
  * distance from a centre, at a yaw and a pitch, placed from the scene's
  * cameras; any change restarts the accumulation and the reference. */
 #include "view.h"

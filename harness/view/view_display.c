@@ -1,4 +1,4 @@
-/* gibench view: the window's redraw (README.md "gibench view"): the
+/* gibench view: the window's redraw (docs/commands.md "gibench view"): the
  * display shader (exposure and sRGB; in split view the reference or the
  * method's error right of the divider), the overlay, the title line, the
  * window written to a PNG on request, and the reference's newest image. */

@@ -1,4 +1,4 @@
-/* gibench view: input (README.md "gibench view"): keys, mouse buttons,
+/* gibench view: input (docs/commands.md "gibench view"): keys, mouse buttons,
  * mouse motion and the wheel, from the window's callbacks or, in a
  * scripted run, from the script alone (view_script.c). */
 #include "view.h"

@@ -1,4 +1,4 @@
-/* gibench view: the method shown (README.md "gibench view"): created and
+/* gibench view: the method shown (docs/commands.md "gibench view"): created and
  * prepared as `gibench render` does it, made again when a parameter key
  * changes a value, one frame rendered and timed per call, and told of the
  * animation's time through update(). */

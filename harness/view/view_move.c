@@ -1,6 +1,6 @@
 /* gibench view: objects picked with the mouse and moved or rotated, lights
  * selected with key L and moved with keys or dragged with the mouse
- * (README.md "gibench view", "Moving objects and lights").
+ * (docs/commands.md "gibench view", "Moving objects and lights").
  * A move writes the node's translation and rotation into the viewer's own
  * copy of the scene, places the GPU scene again (gi_gpu_scene_set_time, as
  * the animation does) and tells the method through update() with the

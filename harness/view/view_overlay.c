@@ -1,9 +1,8 @@
-/* gibench view's overlay, drawn with GL over the image (README.md "gibench
- * view", "Overlay"): the method, its parameters, the GL renderer, frames
- * accumulated, exposure, the last frame's per-stage times as a bar chart,
- * the method's message when it cannot follow a change, and a progress bar
- * while a method precomputes. Text is stb_easy_font's (Debian libstb-dev):
- * quads of a small vector font, turned into triangles here. */
+/* gibench view's overlay, drawn with GL over the image (docs/commands.md "gibench view",
+ * "Overlay"): the method, its parameters, the GL renderer, frames accumulated, exposure, the last
+ * frame's per-stage times as a bar chart, the method's message when it cannot follow a change, and
+ * a progress bar while a method precomputes. Text is stb_easy_font's (Debian libstb-dev): quads of
+ * a small vector font, turned into triangles here. */
 #define _POSIX_C_SOURCE 200809L
 #include "view.h"
 

@@ -1,4 +1,4 @@
-/* gibench view: screenshots and saved views (README.md "gibench view"):
+/* gibench view: screenshots and saved views (docs/commands.md "gibench view"):
  * PREFIX.exr, PREFIX.png and PREFIX.json, and the view file that
  * `gibench render --view` reproduces (keys P and V, script lines
  * screenshot and save-view). */

@@ -1,5 +1,5 @@
 /* gibench view --script FILE: replays input, one event per line, so that
- * the viewer can be driven and tested without a person (README.md
+ * the viewer can be driven and tested without a person (docs/commands.md
  * "gibench view", "Scripts"). Lines:
  *     key NAME [shift|ctrl]   a key press: a letter, a digit, SPACE, ESCAPE, LEFT, RIGHT, UP,
  *                             DOWN, MINUS, EQUAL, LEFT_BRACKET, RIGHT_BRACKET, COMMA, PERIOD,

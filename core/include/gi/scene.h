@@ -11,7 +11,7 @@
  * it. Time-dependent state (animated objects, lights, cameras) is computed
  * on demand by the gi_scene_*_at(t) functions.
  *
- * Conventions (fixed; see README.md "Scene conventions"):
+ * Conventions (fixed; see docs/scenes.md "Scene conventions"):
  *  - +Y up, right-handed, unit-free lengths. All quantities radiometric:
  *    emission is radiance, a point/spot light's intensity x colour is
  *    radiant intensity, a directional light's is irradiance.

@@ -1,7 +1,7 @@
 # docs/plugins.md shows the example plugin's files verbatim: each fenced
 # block that follows a line "<!-- example: PATH -->" must equal the file PATH
 # (relative to the repository), and at least the plugin's C file and its
-# shader must be shown. Run as: cmake -DROOT=<repo> -P readme_in_step.cmake
+# shader must be shown. Run as: cmake -DROOT=<repo> -P docs_in_step.cmake
 set(doc docs/plugins.md)
 file(READ ${ROOT}/${doc} text)
 set(failures 0)
