@@ -13,6 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* ------------------------------------------------------------ furnace */
+
 /* Mean radiance (area-weighted) the inside of the sphere shows its centre,
  * for bounces 0..3 (one link structure, four gathers). */
 static int furnace_means(const char *path, uint32_t N, double mean[4], double *rho_out,
@@ -91,6 +93,8 @@ void iv_test_furnace(void)
     iv_test_bilinear = 0;
     iv_test_coverage = 0.0f;
 }
+
+/* ------------------------------------------------------ direct vs Embree */
 
 static double lum(const float *c)
 {

@@ -22,6 +22,8 @@ static float urand(uint64_t *st)
     return (float)((double)lcg(st) / 9007199254740992.0);
 }
 
+/* ---------------------------------------------------------------- bins */
+
 void iv_test_bins(void)
 {
     for (uint32_t n = 1; n <= 16; n++) {
