@@ -104,6 +104,104 @@ bool check_input(const float *positions, uint32_t nv, const uint32_t *indices, u
     return true;
 }
 
+/* The input as a polygon soup without its degenerate triangles (points
+ * are not merged: a caller's split vertices stay split), oriented
+ * (non-manifold vertices cut apart), then a halfedge mesh. false when
+ * every triangle is degenerate. */
+bool soup_to_mesh(const float *positions, uint32_t vertex_count, const uint32_t *indices,
+                  uint32_t triangle_count, Mesh &mesh)
+{
+    std::vector<Point> pts;
+    pts.reserve(vertex_count);
+    for (uint32_t v = 0; v < vertex_count; v++)
+        pts.emplace_back(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
+    std::vector<std::vector<std::size_t>> polys;
+    polys.reserve(triangle_count);
+    for (uint32_t t = 0; t < triangle_count; t++) {
+        uint32_t a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
+        if (a == b || b == c || a == c || CGAL::collinear(pts[a], pts[b], pts[c]))
+            continue;
+        polys.push_back({a, b, c});
+    }
+    if (polys.empty())
+        return false;
+    PMP::orient_polygon_soup(pts, polys);
+    PMP::polygon_soup_to_polygon_mesh(pts, polys, mesh);
+    return true;
+}
+
+/* CGAL's isotropic re-meshing of the whole mesh toward target_edge, its
+ * borders and sharp creases kept. */
+void remesh_features_kept(Mesh &mesh, double target_edge, uint32_t iterations)
+{
+    /* the input's border vertices stay (a border's corners with them):
+     * the border keeps its shape and the surface its area */
+    auto fixed = mesh.add_property_map<Mesh::Vertex_index, bool>("v:gi_fixed", false).first;
+    for (Mesh::Halfedge_index h : mesh.halfedges())
+        if (mesh.is_border(h))
+            fixed[mesh.target(h)] = true;
+    /* creases sharper than 60 degrees inside a patch: their edges are
+     * split but not flipped, their vertices stay */
+    auto sharp = mesh.add_property_map<Mesh::Edge_index, bool>("e:gi_sharp", false).first;
+    PMP::detect_sharp_edges(mesh, 60.0, sharp);
+    for (Mesh::Edge_index e : mesh.edges())
+        if (sharp[e]) {
+            fixed[mesh.vertex(e, 0)] = true;
+            fixed[mesh.vertex(e, 1)] = true;
+        }
+    PMP::isotropic_remeshing(faces(mesh), target_edge, mesh,
+                             CGAL::parameters::number_of_iterations(iterations)
+                                 .vertex_is_constrained_map(fixed)
+                                 .edge_is_constrained_map(sharp));
+}
+
+/* The re-meshed surface into r: compact vertex numbering, then each
+ * vertex located on the input (its triangle and barycentric weights).
+ * false, with err set, when out of memory or a face is no triangle. */
+bool copy_remeshed(const Mesh &mesh, const float *positions, const uint32_t *indices,
+                   uint32_t triangle_count, gi_remeshed *r, gi_error *err)
+{
+    std::vector<uint32_t> id(mesh.number_of_vertices() + mesh.number_of_removed_vertices(),
+                             UINT32_MAX);
+    uint32_t nv = 0;
+    for (Mesh::Vertex_index v : mesh.vertices())
+        id[(size_t)v] = nv++;
+    uint32_t nf = (uint32_t)mesh.number_of_faces();
+    r->vertex_count = nv;
+    r->triangle_count = nf;
+    r->positions = (float *)malloc(((size_t)nv * 3 + 1) * sizeof(float));
+    r->face = (uint32_t *)malloc(((size_t)nv + 1) * sizeof(uint32_t));
+    r->bary = (float *)malloc(((size_t)nv * 3 + 1) * sizeof(float));
+    r->indices = (uint32_t *)malloc(((size_t)nf * 3 + 1) * sizeof(uint32_t));
+    if (!r->positions || !r->face || !r->bary || !r->indices) {
+        gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "remesh: out of memory for %u vertices", nv);
+        return false;
+    }
+    Locator loc(positions, indices, triangle_count);
+    for (Mesh::Vertex_index v : mesh.vertices()) {
+        uint32_t i = id[(size_t)v];
+        const Point &p = mesh.point(v);
+        r->positions[3 * i] = (float)p.x();
+        r->positions[3 * i + 1] = (float)p.y();
+        r->positions[3 * i + 2] = (float)p.z();
+        loc.locate(p.x(), p.y(), p.z(), &r->face[i], &r->bary[3 * i]);
+    }
+    uint32_t f = 0;
+    for (Mesh::Face_index fi : mesh.faces()) {
+        int c = 0;
+        for (Mesh::Vertex_index v : vertices_around_face(mesh.halfedge(fi), mesh))
+            if (c < 3)
+                r->indices[3 * f + c++] = id[(size_t)v];
+        if (c != 3) {
+            gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                         "remesh: CGAL returned a face with %d corners", c);
+            return false;
+        }
+        f++;
+    }
+    return true;
+}
+
 } // namespace
 
 extern "C" gi_remeshed *gi_remesh_isotropic(const float *positions, uint32_t vertex_count,
@@ -125,88 +223,16 @@ extern "C" gi_remeshed *gi_remesh_isotropic(const float *positions, uint32_t ver
         return NULL;
     }
     try {
-        /* the input as a polygon soup without its degenerate triangles
-         * (points are not merged: a caller's split vertices stay split),
-         * oriented (non-manifold vertices cut apart), then a halfedge mesh */
-        std::vector<Point> pts;
-        pts.reserve(vertex_count);
-        for (uint32_t v = 0; v < vertex_count; v++)
-            pts.emplace_back(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
-        std::vector<std::vector<std::size_t>> polys;
-        polys.reserve(triangle_count);
-        for (uint32_t t = 0; t < triangle_count; t++) {
-            uint32_t a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
-            if (a == b || b == c || a == c || CGAL::collinear(pts[a], pts[b], pts[c]))
-                continue;
-            polys.push_back({a, b, c});
-        }
-        if (polys.empty()) {
+        Mesh mesh;
+        if (!soup_to_mesh(positions, vertex_count, indices, triangle_count, mesh)) {
             gi_remeshed_free(r);
             gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "remesh: every triangle is degenerate");
             return NULL;
         }
-        PMP::orient_polygon_soup(pts, polys);
-        Mesh mesh;
-        PMP::polygon_soup_to_polygon_mesh(pts, polys, mesh);
-        /* the input's border vertices stay (a border's corners with them):
-         * the border keeps its shape and the surface its area */
-        auto fixed = mesh.add_property_map<Mesh::Vertex_index, bool>("v:gi_fixed", false).first;
-        for (Mesh::Halfedge_index h : mesh.halfedges())
-            if (mesh.is_border(h))
-                fixed[mesh.target(h)] = true;
-        /* creases sharper than 60 degrees inside a patch: their edges are
-         * split but not flipped, their vertices stay */
-        auto sharp = mesh.add_property_map<Mesh::Edge_index, bool>("e:gi_sharp", false).first;
-        PMP::detect_sharp_edges(mesh, 60.0, sharp);
-        for (Mesh::Edge_index e : mesh.edges())
-            if (sharp[e]) {
-                fixed[mesh.vertex(e, 0)] = true;
-                fixed[mesh.vertex(e, 1)] = true;
-            }
-        PMP::isotropic_remeshing(faces(mesh), (double)target_edge, mesh,
-                                 CGAL::parameters::number_of_iterations(iterations)
-                                     .vertex_is_constrained_map(fixed)
-                                     .edge_is_constrained_map(sharp));
-        /* compact vertex numbering, then each vertex located on the input */
-        std::vector<uint32_t> id(mesh.number_of_vertices() + mesh.number_of_removed_vertices(),
-                                 UINT32_MAX);
-        uint32_t nv = 0;
-        for (Mesh::Vertex_index v : mesh.vertices())
-            id[(size_t)v] = nv++;
-        uint32_t nf = (uint32_t)mesh.number_of_faces();
-        r->vertex_count = nv;
-        r->triangle_count = nf;
-        r->positions = (float *)malloc(((size_t)nv * 3 + 1) * sizeof(float));
-        r->face = (uint32_t *)malloc(((size_t)nv + 1) * sizeof(uint32_t));
-        r->bary = (float *)malloc(((size_t)nv * 3 + 1) * sizeof(float));
-        r->indices = (uint32_t *)malloc(((size_t)nf * 3 + 1) * sizeof(uint32_t));
-        if (!r->positions || !r->face || !r->bary || !r->indices) {
+        remesh_features_kept(mesh, (double)target_edge, iterations);
+        if (!copy_remeshed(mesh, positions, indices, triangle_count, r, err)) {
             gi_remeshed_free(r);
-            gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "remesh: out of memory for %u vertices", nv);
             return NULL;
-        }
-        Locator loc(positions, indices, triangle_count);
-        for (Mesh::Vertex_index v : mesh.vertices()) {
-            uint32_t i = id[(size_t)v];
-            const Point &p = mesh.point(v);
-            r->positions[3 * i] = (float)p.x();
-            r->positions[3 * i + 1] = (float)p.y();
-            r->positions[3 * i + 2] = (float)p.z();
-            loc.locate(p.x(), p.y(), p.z(), &r->face[i], &r->bary[3 * i]);
-        }
-        uint32_t f = 0;
-        for (Mesh::Face_index fi : mesh.faces()) {
-            int c = 0;
-            for (Mesh::Vertex_index v : vertices_around_face(mesh.halfedge(fi), mesh))
-                if (c < 3)
-                    r->indices[3 * f + c++] = id[(size_t)v];
-            if (c != 3) {
-                gi_remeshed_free(r);
-                gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                             "remesh: CGAL returned a face with %d corners", c);
-                return NULL;
-            }
-            f++;
         }
         return r;
     } catch (const std::exception &e) {

@@ -2,8 +2,8 @@
  * Visibility (Dong, Kautz, Theobalt, Seidel, PG 2007).
  *
  * prepare(): surface elements and the geometric hierarchy (Algorithm 1,
- * lines 1-2; iv_core.c). Every frame (lines 3-11), each a stage timer named
- * as the paper's Table 1:
+ * lines 1-2; elements.c, hierarchy.c). Every frame (lines 3-11), each a
+ * stage timer named as the paper's Table 1:
  *   update_elements  positions, normals, areas at the frame's time, bottom-up;
  *   create_links     the hierarchical links in world-aligned 6 x N x N bins,
  *                    the shortest per bin (implicit visibility);
@@ -12,14 +12,15 @@
  *                    through empty bins, punctual lights through their bin,
  *                    then `bounces` gathers and pull-ups: compute shaders
  *                    over the flattened links (iv_gpu.c, Sec. 4.3.1), or
- *                    with `illum=cpu` the same on one CPU thread;
+ *                    with `illum=cpu` the same on one CPU thread
+ *                    (illuminate.c);
  *   display          the G-buffer and the per-vertex irradiance
  *                    interpolated per pixel (shaders/iv_display.comp), plus,
  *                    on glossy materials, the BRDF-weighted sum of the
  *                    direct light over the elements' bins (Sec. 4.3).
- * The hierarchy and the links are built on the CPU (the links on
- * `threads` threads); the gathering and pull-up and the display run on
- * the GPU. */
+ * The hierarchy and the links are built on the CPU (hierarchy.c,
+ * links.c; the links on `threads` threads, links_threads.c); the
+ * gathering and pull-up and the display run on the GPU. */
 #define _POSIX_C_SOURCE 200809L
 #include "iv.h"
 #include "iv_gpu.h"
@@ -141,22 +142,10 @@ static void release_prepared(implicit_vis *m)
     m->ssbo_light = m->ssbo_tri = m->ssbo_grid = m->prog_display = 0;
 }
 
-static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
+/* The links' memory (bins x nodes x 12 bytes) and brute force's element
+ * count, refused above their limits. */
+static gi_result check_limits(implicit_vis *m)
 {
-    implicit_vis *m = inst;
-    gi_error err;
-    release_prepared(m);
-    gi_kit_prepare(&m->kit, gs);
-    const gi_scene *s = gs->scene;
-    const gi_host *host = m->kit.host;
-    host->stage_begin(host, "hierarchy");
-    float ext = 0.0f;
-    for (int c = 0; c < 3; c++)
-        ext = fmaxf(ext, s->bounds[3 + c] - s->bounds[c]);
-    m->hier = iv_hier_create(s, m->remesh * ext, m->remesher, &err);
-    host->stage_end(host, "hierarchy");
-    if (!m->hier)
-        return gi_kit_fail_with(&m->kit, GI_ERR_INVALID_ARGUMENT, &err);
     unsigned long long bytes =
         6ull * (unsigned long long)m->N * (unsigned long long)m->N * m->hier->node_count * 12ull;
     if (bytes > IV_MAX_LINK_BYTES)
@@ -169,25 +158,15 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
                            "implicit_vis: links=brute compares every two of %u elements (limit "
                            "%u): use links=hierarchical",
                            m->hier->elem_count, IV_MAX_BRUTE_ELEMENTS);
-    m->links = iv_links_create(m->hier, (uint32_t)m->N);
-    if (m->links) {
-        m->links->bilinear = m->bilinear;
-        m->links->coverage = m->coverage;
-        m->links->threads = (uint32_t)m->threads;
-    }
-    m->irr = calloc((size_t)m->hier->elem_count * 6, sizeof(float));
-    m->elem_light = calloc((size_t)m->hier->elem_count * 12, sizeof(float));
+    return GI_OK;
+}
+
+/* The display's look-up: triangle -> (k, first grid point), grid point
+ * -> three elements and their weights (uvec4, vec4), filled into tri and
+ * grid (freed here) and uploaded. */
+static void upload_display_grid(implicit_vis *m, const gi_scene *s, uint32_t *tri, uint32_t *grid)
+{
     const iv_hier *h = m->hier;
-    uint32_t *tri = malloc(((size_t)s->triangle_count * 2 + 1) * sizeof(uint32_t));
-    uint32_t *grid = malloc(((size_t)h->disp_count * 8 + 1) * sizeof(uint32_t));
-    if (!m->links || !m->irr || !m->elem_light || !tri || !grid) {
-        free(tri), free(grid);
-        return gi_kit_fail(&m->kit, GI_ERR_OUT_OF_MEMORY,
-                           "implicit_vis: out of memory for the links of %u nodes",
-                           m->hier->node_count);
-    }
-    /* the display's look-up: triangle -> (k, first grid point), grid point
-     * -> three elements and their weights (uvec4, vec4) */
     for (uint32_t t = 0; t < s->triangle_count; t++) {
         tri[2 * t] = h->tri_k[t];
         tri[2 * t + 1] = h->tri_grid[t];
@@ -205,18 +184,78 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
     glNamedBufferStorage(m->ssbo_grid, (GLsizeiptr)((size_t)h->disp_count * 8 * sizeof(uint32_t)),
                          grid, 0);
     free(tri), free(grid);
-    glCreateBuffers(1, &m->ssbo_light);
-    glNamedBufferStorage(m->ssbo_light,
-                         (GLsizeiptr)((size_t)m->hier->elem_count * 12 * sizeof(float)), NULL,
-                         GL_DYNAMIC_STORAGE_BIT);
-    /* glossy: a Phong material (a mirror's delta lobe is not handled: no GI_CAP_MIRROR) */
+}
+
+/* Whether the scene has a glossy material: a Phong lobe (a mirror's delta
+ * lobe is not handled: no GI_CAP_MIRROR). */
+static int scene_glossy(const gi_scene *s)
+{
     int glossy = 0;
     for (uint32_t i = 0; i < s->material_count; i++) {
         const gi_material *mat = &s->materials[i];
         glossy |= mat->ks[0] + mat->ks[1] + mat->ks[2] > 0.0f && !mat->mirror &&
                   mat->exponent < GI_MIRROR_EXPONENT;
     }
-    m->glossy = m->glossy != 0 && glossy;
+    return glossy;
+}
+
+/* The hierarchy's sizes and the surface's edge lengths, as stats. */
+static void report_hierarchy(const implicit_vis *m, const gi_scene *s)
+{
+    const gi_host *host = m->kit.host;
+    host->stat(host, "elements", (double)m->hier->elem_count);
+    host->stat(host, "nodes", (double)m->hier->node_count);
+    host->stat(host, "segments", (double)m->hier->segment_count);
+    host->stat(host, "link_threads", (double)m->threads);
+    host->stat(host, "surface_points", (double)m->hier->sample_count);
+    host->stat(host, "surface_triangles", (double)m->hier->surf_count);
+    double edge_mean, edge_cv;
+    iv_hier_edge_stats(m->hier, s, &edge_mean, &edge_cv);
+    host->stat(host, "edge_mean", edge_mean);
+    host->stat(host, "edge_cv", edge_cv);
+}
+
+static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
+{
+    implicit_vis *m = inst;
+    gi_error err;
+    release_prepared(m);
+    gi_kit_prepare(&m->kit, gs);
+    const gi_scene *s = gs->scene;
+    const gi_host *host = m->kit.host;
+    host->stage_begin(host, "hierarchy");
+    float ext = 0.0f;
+    for (int c = 0; c < 3; c++)
+        ext = fmaxf(ext, s->bounds[3 + c] - s->bounds[c]);
+    m->hier = iv_hier_create(s, m->remesh * ext, m->remesher, &err);
+    host->stage_end(host, "hierarchy");
+    if (!m->hier)
+        return gi_kit_fail_with(&m->kit, GI_ERR_INVALID_ARGUMENT, &err);
+    gi_result r = check_limits(m);
+    if (r != GI_OK)
+        return r;
+    m->links = iv_links_create(m->hier, (uint32_t)m->N);
+    if (m->links) {
+        m->links->bilinear = m->bilinear;
+        m->links->coverage = m->coverage;
+        m->links->threads = (uint32_t)m->threads;
+    }
+    m->irr = calloc((size_t)m->hier->elem_count * 6, sizeof(float));
+    m->elem_light = calloc((size_t)m->hier->elem_count * 12, sizeof(float));
+    uint32_t *tri = malloc(((size_t)s->triangle_count * 2 + 1) * sizeof(uint32_t));
+    uint32_t *grid = malloc(((size_t)m->hier->disp_count * 8 + 1) * sizeof(uint32_t));
+    if (!m->links || !m->irr || !m->elem_light || !tri || !grid) {
+        free(tri), free(grid);
+        return gi_kit_fail(&m->kit, GI_ERR_OUT_OF_MEMORY,
+                           "implicit_vis: out of memory for the links of %u nodes",
+                           m->hier->node_count);
+    }
+    upload_display_grid(m, s, tri, grid);
+    glCreateBuffers(1, &m->ssbo_light);
+    glNamedBufferStorage(m->ssbo_light,
+                         (GLsizeiptr)((size_t)m->hier->elem_count * 12 * sizeof(float)), NULL,
+                         GL_DYNAMIC_STORAGE_BIT);
+    m->glossy = m->glossy != 0 && scene_glossy(s);
     if (m->glossy && m->cpu_illum)
         return gi_kit_fail(&m->kit, GI_ERR_UNSUPPORTED,
                            "implicit_vis: glossy materials need illum=gpu (the display reads the "
@@ -232,16 +271,7 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
             return gi_kit_fail_with(&m->kit, GI_ERR_GL, &err);
         m->gpu->keep_emit = m->glossy;
     }
-    host->stat(host, "elements", (double)m->hier->elem_count);
-    host->stat(host, "nodes", (double)m->hier->node_count);
-    host->stat(host, "segments", (double)m->hier->segment_count);
-    host->stat(host, "link_threads", (double)m->threads);
-    host->stat(host, "surface_points", (double)m->hier->sample_count);
-    host->stat(host, "surface_triangles", (double)m->hier->surf_count);
-    double edge_mean, edge_cv;
-    iv_hier_edge_stats(m->hier, s, &edge_mean, &edge_cv);
-    host->stat(host, "edge_mean", edge_mean);
-    host->stat(host, "edge_cv", edge_cv);
+    report_hierarchy(m, s);
     if (gi_gl_check("implicit_vis: prepare", &err) != GI_OK)
         return gi_kit_fail_with(&m->kit, GI_ERR_GL, &err);
     return GI_OK;

@@ -2,15 +2,22 @@
  * surface elements, the geometric hierarchy, the cube-map bins, the
  * hierarchical link structure with implicit visibility and the gathering
  * of light along its links. No GL here, so that the tests can drive every
- * stage on its own.
+ * stage on its own. Names: prefix iv_ for implicit_vis.
+ *
+ * Files: bins.c (Sec. 4.2.2 "Discretization"), elements.c (Sec. 4.1, 5.1),
+ * hierarchy.c (Sec. 4.1, 4.2.1), links.c and links_threads.c (Sec.
+ * 4.2.2-4.2.4), illuminate.c (Sec. 4.3, 4.4); iv_internal.h holds what
+ * they share among themselves.
  *
  * Use (Algorithm 1):
- *     iv_hier *h = iv_hier_create(scene, edge, IV_REMESH_ISOTROPIC, &err); // CreateSurfels +
- * CreateGeometricHierarchy iv_links *l = iv_links_create(h, N); per frame: iv_hier_update(h, scene,
- * t);               // UpdateElements (Sec. 4.2.1) iv_links_build(l, h, subdiv, brute, splat); //
- * CreateHierarchicalLinks (Sec. 4.2.2) iv_links_refine_push(l, h);                 // Refine +
- * PushDownLinks (Sec. 4.2.3-4.2.4) iv_illuminate(l, h, &lights, bounces, E);   // ComputeIlluminate
- * + PullupEnergy (Sec. 4.3)
+ *     iv_hier *h = iv_hier_create(scene, edge, IV_REMESH_ISOTROPIC, &err);
+ *                                                 // CreateSurfels + CreateGeometricHierarchy
+ *     iv_links *l = iv_links_create(h, N);
+ *   per frame:
+ *     iv_hier_update(h, scene, t);                // UpdateElements (Sec. 4.2.1)
+ *     iv_links_build(l, h, subdiv, brute, splat); // CreateHierarchicalLinks (Sec. 4.2.2)
+ *     iv_links_refine_push(l, h);                 // Refine + PushDownLinks (Sec. 4.2.3-4.2.4)
+ *     iv_illuminate(l, h, &lights, bounces, E);   // ComputeIlluminate + PullupEnergy (Sec. 4.3)
  */
 #ifndef IV_H
 #define IV_H

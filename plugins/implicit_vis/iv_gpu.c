@@ -45,64 +45,52 @@ void iv_gpu_free(iv_gpu *g)
     free(g);
 }
 
-iv_gpu *iv_gpu_create(const iv_hier *h, const iv_links *l, const gi_envmap *env, gi_error *err)
+/* The levels: breadth-first order puts each depth in one run of nodes,
+ * the first of depth d at level_off[d]. */
+static gi_result find_levels(iv_gpu *g, const iv_hier *h, gi_error *err)
 {
-    iv_gpu *g = calloc(1, sizeof *g);
-    if (!g) {
-        gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
-                     "implicit_vis: out of memory for the GPU illumination");
-        return NULL;
-    }
-    g->nodes = h->node_count;
-    g->elems = h->elem_count;
-    g->bins = l->bins;
-    g->n = l->n;
-    g->env = env != NULL;
-    if (h->node_count >= (1u << 30)) { /* iv_weights.comp keeps a node's side in the top two bits */
-        gi_error_set(err, GI_ERR_UNSUPPORTED,
-                     "implicit_vis: %u nodes are too many for the GPU illumination (limit 2^30)",
-                     h->node_count);
-        free(g);
-        return NULL;
-    }
-    /* the levels: breadth-first order puts each depth in one run of nodes */
     uint8_t *depth = calloc(h->node_count, 1);
     g->level_off = calloc((size_t)h->depth + 2, sizeof *g->level_off);
-    uint32_t *elem = NULL, *children = NULL;
-    float *bins = NULL;
-    int ok = depth && g->level_off;
-    for (uint32_t i = 0; ok && i < h->node_count; i++) {
+    if (!depth || !g->level_off) {
+        free(depth);
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                            "implicit_vis: out of memory for the GPU illumination");
+    }
+    for (uint32_t i = 0; i < h->node_count; i++) {
         depth[i] = h->parent[i] < 0 ? 0 : (uint8_t)(depth[h->parent[i]] + 1);
         if (depth[i] >= h->depth || (i > 0 && depth[i] < depth[i - 1])) {
-            gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                         "implicit_vis: the hierarchy's nodes are not in breadth-first order");
             free(depth);
-            iv_gpu_free(g);
-            return NULL;
+            return gi_error_set(
+                err, GI_ERR_INVALID_ARGUMENT,
+                "implicit_vis: the hierarchy's nodes are not in breadth-first order");
         }
     }
-    if (ok) {
-        g->levels = h->node_count ? depth[h->node_count - 1] + 1u : 0u;
-        for (uint32_t d = 0, i = 0; d <= g->levels; d++) {
-            while (i < h->node_count && depth[i] < d)
-                i++;
-            g->level_off[d] = i;
-        }
+    g->levels = h->node_count ? depth[h->node_count - 1] + 1u : 0u;
+    for (uint32_t d = 0, i = 0; d <= g->levels; d++) {
+        while (i < h->node_count && depth[i] < d)
+            i++;
+        g->level_off[d] = i;
     }
     free(depth);
-    /* per element: albedo, emission, leaf, two-sided emission (IvElem) */
-    elem = ok ? calloc((size_t)h->elem_count * 12 + 1, sizeof(uint32_t)) : NULL;
-    children = ok ? calloc((size_t)h->node_count * 2 + 1, sizeof(uint32_t)) : NULL;
-    bins = ok ? calloc((size_t)l->bins * 8, sizeof(float)) : NULL;
-    g->geom = ok ? malloc((size_t)h->node_count * 8 * sizeof(float) + 1) : NULL;
-    g->off = ok ? malloc(((size_t)h->elem_count + 1) * 2 * sizeof(uint32_t)) : NULL;
-    ok = ok && elem && children && bins && g->geom && g->off;
-    if (!ok) {
+    return GI_OK;
+}
+
+/* What stays the same every frame, uploaded: per element its albedo,
+ * emission, leaf and two-sided emission (IvElem), per node its children,
+ * per bin its direction, solid angle and the environment through it; and
+ * the staging of the frame's geometry and link offsets. */
+static gi_result upload_static(iv_gpu *g, const iv_hier *h, const iv_links *l, const gi_envmap *env,
+                               gi_error *err)
+{
+    uint32_t *elem = calloc((size_t)h->elem_count * 12 + 1, sizeof(uint32_t));
+    uint32_t *children = calloc((size_t)h->node_count * 2 + 1, sizeof(uint32_t));
+    float *bins = calloc((size_t)l->bins * 8, sizeof(float));
+    g->geom = malloc((size_t)h->node_count * 8 * sizeof(float) + 1);
+    g->off = malloc(((size_t)h->elem_count + 1) * 2 * sizeof(uint32_t));
+    if (!elem || !children || !bins || !g->geom || !g->off) {
         free(elem), free(children), free(bins);
-        gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
-                     "implicit_vis: out of memory for the GPU illumination");
-        iv_gpu_free(g);
-        return NULL;
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                            "implicit_vis: out of memory for the GPU illumination");
     }
     for (uint32_t e = 0; e < h->elem_count; e++) {
         float f[8];
@@ -129,6 +117,13 @@ iv_gpu *iv_gpu_create(const iv_hier *h, const iv_links *l, const gi_envmap *env,
     g->ssbo_children = make_static(children, (size_t)h->node_count * 2 * sizeof(uint32_t));
     g->ssbo_bins = make_static(bins, (size_t)l->bins * 8 * sizeof(float));
     free(elem), free(children), free(bins);
+    return GI_OK;
+}
+
+/* The buffers written every frame (the links' grow as needed), and the
+ * largest shader storage block this GL allows. */
+static void make_frame_buffers(iv_gpu *g, const iv_hier *h)
+{
     g->ssbo_geom = make_dynamic((size_t)h->node_count * 8 * sizeof(float));
     g->ssbo_off = make_dynamic(((size_t)h->elem_count + 1) * 2 * sizeof(uint32_t));
     g->ssbo_links = make_dynamic(16);
@@ -142,6 +137,33 @@ iv_gpu *iv_gpu_create(const iv_hier *h, const iv_links *l, const gi_envmap *env,
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
     g->max_block =
         max_block > 0 ? (size_t)max_block : (size_t)1 << 27; /* GL's minimum: 2^27 bytes */
+}
+
+iv_gpu *iv_gpu_create(const iv_hier *h, const iv_links *l, const gi_envmap *env, gi_error *err)
+{
+    iv_gpu *g = calloc(1, sizeof *g);
+    if (!g) {
+        gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                     "implicit_vis: out of memory for the GPU illumination");
+        return NULL;
+    }
+    g->nodes = h->node_count;
+    g->elems = h->elem_count;
+    g->bins = l->bins;
+    g->n = l->n;
+    g->env = env != NULL;
+    if (h->node_count >= (1u << 30)) { /* iv_weights.comp keeps a node's side in the top two bits */
+        gi_error_set(err, GI_ERR_UNSUPPORTED,
+                     "implicit_vis: %u nodes are too many for the GPU illumination (limit 2^30)",
+                     h->node_count);
+        free(g);
+        return NULL;
+    }
+    if (find_levels(g, h, err) != GI_OK || upload_static(g, h, l, env, err) != GI_OK) {
+        iv_gpu_free(g);
+        return NULL;
+    }
+    make_frame_buffers(g, h);
     g->prog_emit = gi_program_build_compute("iv_emit.comp", NULL, err);
     g->prog_weights = g->prog_emit ? gi_program_build_compute("iv_weights.comp", NULL, err) : 0;
     g->prog_pull = g->prog_weights ? gi_program_build_compute("iv_pull.comp", NULL, err) : 0;

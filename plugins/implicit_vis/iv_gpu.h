@@ -2,15 +2,17 @@
  * gather at the leaves with Eq. 5 and the area-weighted pull-up, iterated
  * for the bounces, as compute shaders over the flattened hierarchy and the
  * leaves' receiving links (iv_links_pack). The same computation as
- * iv_illuminate (iv_core.c) in single precision; the links are built on
+ * iv_illuminate (illuminate.c) in single precision; the links are built on
  * the CPU.
  *
  * Use (a GL context current, the plugin's shader table registered):
- *     iv_gpu *g = iv_gpu_create(h, l, scene->envmap, &err);  // after iv_hier_create,
- * iv_links_create per frame, after iv_links_refine_push, the scene's punctual lights bound
- * (gi_gpu_scene_bind) at the frame's time: iv_gpu_illuminate(g, l, h, bounces, light_count, &err);
- *         the result: g->ssbo_out (iv_display.comp's IvElemLight), or
- *         iv_gpu_read(g, e_out) in iv_illuminate's layout. */
+ *   after iv_hier_create and iv_links_create:
+ *     iv_gpu *g = iv_gpu_create(h, l, scene->envmap, &err);
+ *   per frame, after iv_links_refine_push, the scene's punctual lights
+ *   bound (gi_gpu_scene_bind) at the frame's time:
+ *     iv_gpu_illuminate(g, l, h, bounces, light_count, &err);
+ *   the result: g->ssbo_out (iv_display.comp's IvElemLight), or
+ *   iv_gpu_read(g, e_out) in iv_illuminate's layout. */
 #ifndef IV_GPU_H
 #define IV_GPU_H
 
@@ -21,9 +23,9 @@
 typedef struct iv_gpu {
     uint32_t nodes, elems, bins, n;
     uint32_t levels; /* depth of the deepest tree */
-    uint32_t *
-        level_off; /* levels + 1: nodes of each depth (breadth-first order keeps them contiguous) */
-    int env;       /* the scene has an environment */
+    /* levels + 1: the first node of each depth (breadth-first order keeps them contiguous) */
+    uint32_t *level_off;
+    int env; /* the scene has an environment */
     GLuint prog_emit, prog_weights, prog_pull, prog_gather;
     GLuint ssbo_elem, ssbo_children, ssbo_bins; /* built once */
     GLuint ssbo_geom, ssbo_links, ssbo_off;     /* every frame */

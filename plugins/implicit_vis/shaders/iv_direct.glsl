@@ -11,7 +11,7 @@ uniform uint u_n; // bins per cube side
 
 const float IV_FLT_MAX = 3.402823466e38;
 
-// Bin of direction d (iv_bin_of in iv_core.c).
+// Bin of direction d (iv_bin_of in bins.c).
 uint iv_bin_of(vec3 d)
 {
     int ax = 0;

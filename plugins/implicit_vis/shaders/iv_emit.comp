@@ -1,7 +1,7 @@
 // GPU illumination, first pass (Sec. 4.3.1): per element, the emission as
 // the leaf's outgoing radiance (bounce 0), its irradiance cleared, and the
 // normalisation of its bins (cosine-weighted solid angles summing to pi
-// over a hemisphere, as iv_illuminate in iv_core.c).
+// over a hemisphere, as iv_illuminate in illuminate.c).
 #include "iv_gpu.glsl"
 
 layout(local_size_x = IV_GROUP) in;

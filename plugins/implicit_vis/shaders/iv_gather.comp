@@ -6,7 +6,7 @@
 // the empty bins and the punctual lights through the bin toward them. The
 // irradiance is added to the element's total, and times albedo / pi becomes
 // the leaf's outgoing radiance for the next bounce. The GLSL twin of
-// iv_illuminate's loop in iv_core.c.
+// iv_illuminate's loop in illuminate.c.
 #include "iv_gpu.glsl"
 
 layout(local_size_x = IV_GROUP) in;

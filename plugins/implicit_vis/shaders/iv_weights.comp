@@ -4,7 +4,7 @@
 // seen from the disc, normalised, times the share of the bin the link
 // covers; its sign the side of the disc it falls on) and which side of the
 // node at the other end faces the element (front, back, or both averaged
-// for a cluster facing every way; node_radiance in iv_core.c). The
+// for a cluster facing every way; node_radiance in illuminate.c). The
 // gathers then read one record and one radiance per link.
 #include "iv_gpu.glsl"
 

@@ -1,0 +1,43 @@
+/* Declarations that the implicit_vis CPU files share among themselves,
+ * not used by the lifecycle (implicit_vis.c) or the tests: the surface
+ * elements (elements.c, Sec. 4.1 and 5.1) that the hierarchy
+ * (hierarchy.c) is built on, and the steps of link creation (Sec. 4.2.2)
+ * that the single-threaded build (links.c) and the multi-threaded one
+ * (links_threads.c) share. The plugin's interface is iv.h. */
+#ifndef IV_INTERNAL_H
+#define IV_INTERNAL_H
+
+#include "iv.h"
+
+/* ---- surface elements (elements.c, hierarchy.c) ---- */
+
+/* The surface points of s (re-meshed to `target` by `remesher` when
+ * target > 0; see iv_hier_create) and their elements, into h's point,
+ * surface, display-grid and element arrays. */
+gi_result iv_elements_make(iv_hier *h, const gi_scene *s, float target, int remesher,
+                           gi_error *err);
+/* The error of a hierarchy that cannot be built, `reason` in brackets
+ * ("no triangles", "out of memory"). */
+gi_result iv_hier_fail(const char *reason, gi_error *err);
+
+/* ---- link creation (links.c, links_threads.c) ---- */
+
+/* What Sec. 4.2.2 does with the pair (A, B): nothing, link them, or try
+ * B's children, or A's. Depends on the geometry only, never on the links
+ * made so far, so pairs can be enumerated in any order or in parallel. */
+enum { IV_PAIR_NONE, IV_PAIR_LINK, IV_PAIR_SPLIT_B, IV_PAIR_SPLIT_A };
+
+/* The IV_PAIR_* for (A, B); d = B - A and r2 = |d|^2 are set unless it
+ * is IV_PAIR_NONE. */
+int iv_pair_decide(const iv_links *l, const iv_hier *h, float subdiv, uint32_t A, uint32_t B,
+                   gi_vec3 *dout, float *r2out);
+/* Receiver A's side of the link A-B (d = B - A, r = |d|): B written into
+ * A's bin toward it, or with `splat` into every bin a near disc covers. */
+void iv_put_side(iv_links *l, const iv_hier *h, uint32_t A, uint32_t B, gi_vec3 d, float r,
+                 int splat);
+/* The hierarchical links on `threads` threads (each node's bins emptied
+ * first); 0 when it could not (out of memory, no thread), and the caller
+ * builds them on one. */
+int iv_links_build_parallel(iv_links *l, const iv_hier *h, float subdiv, int splat, int threads);
+
+#endif

@@ -1,0 +1,271 @@
+/* The implicit_vis method's link creation on several threads (Sec. 4.2.2;
+ * README "Multi-threaded link creation"): the same links, to the bit, as
+ * link_self / link_pair make on one thread (links.c).
+ * 1. The recursion of link_self / link_pair is unrolled into an ordered
+ *    list of tasks (calls in the order one thread would make them).
+ * 2. Threads take tasks and list the pairs each task links, in order.
+ * 3. Threads write the links: each owns the receiving nodes x with
+ *    x mod threads = its index, and goes through all pairs in task order,
+ *    writing only its own nodes' sides. Every node's bins see the same
+ *    writes in the same order as on one thread, so the result (shortest
+ *    links, ties, coverage sums) is the same to the bit. */
+#include "iv_internal.h"
+
+#include <float.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+
+typedef struct link_task {
+    uint32_t A, B;   /* B == UINT32_MAX: link_self(A) */
+    uint32_t *pairs; /* 2 per pair linked, in order */
+    size_t n, cap;
+    uint64_t tries;
+} link_task;
+
+typedef struct link_par {
+    iv_links *l;
+    const iv_hier *h;
+    float subdiv;
+    int splat;
+    link_task *tasks;
+    size_t ntasks;
+    atomic_size_t next;
+    int threads;
+    int fail;
+} link_par;
+
+static int task_push(link_task *t, uint32_t A, uint32_t B)
+{
+    if (t->n == t->cap) {
+        size_t c = t->cap ? 2 * t->cap : 256;
+        uint32_t *p = realloc(t->pairs, c * 2 * sizeof *p);
+        if (!p)
+            return 0;
+        t->pairs = p;
+        t->cap = c;
+    }
+    t->pairs[2 * t->n] = A;
+    t->pairs[2 * t->n + 1] = B;
+    t->n++;
+    return 1;
+}
+
+static int collect_pair(link_par *p, link_task *t, uint32_t A, uint32_t B)
+{
+    const iv_hier *h = p->h;
+    t->tries++;
+    gi_vec3 d;
+    float r2;
+    switch (iv_pair_decide(p->l, h, p->subdiv, A, B, &d, &r2)) {
+    case IV_PAIR_SPLIT_B:
+        for (uint32_t k = 0; k < h->child_count[B]; k++)
+            if (!collect_pair(p, t, A, h->first_child[B] + k))
+                return 0;
+        return 1;
+    case IV_PAIR_SPLIT_A:
+        for (uint32_t k = 0; k < h->child_count[A]; k++)
+            if (!collect_pair(p, t, h->first_child[A] + k, B))
+                return 0;
+        return 1;
+    case IV_PAIR_LINK:
+        return task_push(t, A, B);
+    default:
+        return 1;
+    }
+}
+
+static int collect_self(link_par *p, link_task *t, uint32_t A)
+{
+    const iv_hier *h = p->h;
+    uint32_t f = h->first_child[A], n = h->child_count[A];
+    for (uint32_t i = 0; i < n; i++)
+        if (!collect_self(p, t, f + i))
+            return 0;
+    for (uint32_t i = 0; i < n; i++)
+        for (uint32_t j = i + 1; j < n; j++)
+            if (!collect_pair(p, t, f + i, f + j))
+                return 0;
+    return 1;
+}
+
+/* Replaces every task by the calls it makes (in order) until there are
+ * at least `want` or none can be unrolled; a link found while unrolling
+ * stays a one-pair task. tries counts the calls unrolled. */
+static link_task *unroll_tasks(link_par *p, link_task *tasks, size_t *count, size_t want,
+                               uint64_t *tries)
+{
+    const iv_hier *h = p->h;
+    for (int pass = 0; pass < 12 && *count < want; pass++) {
+        size_t n = *count, cap = 0, m = 0;
+        for (size_t i = 0; i < n; i++) {
+            uint32_t A = tasks[i].A, B = tasks[i].B;
+            uint32_t ca = h->child_count[A];
+            cap += B == UINT32_MAX ? ca + (size_t)ca * ca / 2 : 4;
+        }
+        link_task *out = calloc(cap + 1, sizeof *out);
+        if (!out)
+            return tasks;
+        int grew = 0;
+        for (size_t i = 0; i < n; i++) {
+            uint32_t A = tasks[i].A, B = tasks[i].B;
+            if (tasks[i].n > 0) { /* a link found while unrolling: kept as it is */
+                out[m++] = tasks[i];
+                continue;
+            }
+            if (B == UINT32_MAX) {
+                uint32_t f = h->first_child[A], c = h->child_count[A];
+                for (uint32_t k = 0; k < c; k++)
+                    out[m++] = (link_task){.A = f + k, .B = UINT32_MAX};
+                for (uint32_t x = 0; x < c; x++)
+                    for (uint32_t y = x + 1; y < c; y++)
+                        out[m++] = (link_task){.A = f + x, .B = f + y};
+                grew = 1;
+                continue;
+            }
+            (*tries)++;
+            gi_vec3 d;
+            float r2;
+            int what = iv_pair_decide(p->l, h, p->subdiv, A, B, &d, &r2);
+            if (what == IV_PAIR_SPLIT_B) {
+                for (uint32_t k = 0; k < h->child_count[B]; k++)
+                    out[m++] = (link_task){.A = A, .B = h->first_child[B] + k};
+                grew = 1;
+            } else if (what == IV_PAIR_SPLIT_A) {
+                for (uint32_t k = 0; k < h->child_count[A]; k++)
+                    out[m++] = (link_task){.A = h->first_child[A] + k, .B = B};
+                grew = 1;
+            } else if (what == IV_PAIR_LINK) {
+                out[m] = (link_task){.A = A, .B = B};
+                if (!task_push(&out[m], A, B)) {
+                    free(out);
+                    return tasks;
+                }
+                m++;
+            }
+        }
+        free(tasks);
+        tasks = out;
+        *count = m;
+        if (!grew)
+            break;
+    }
+    return tasks;
+}
+
+static void *collect_worker(void *arg)
+{
+    link_par *p = arg;
+    for (;;) {
+        size_t i = atomic_fetch_add(&p->next, 1);
+        if (i >= p->ntasks)
+            break;
+        link_task *t = &p->tasks[i];
+        if (t->n > 0)
+            continue; /* a link found while unrolling */
+        int ok = t->B == UINT32_MAX ? collect_self(p, t, t->A) : collect_pair(p, t, t->A, t->B);
+        if (!ok)
+            p->fail = 1;
+    }
+    return NULL;
+}
+
+typedef struct write_arg {
+    link_par *p;
+    uint32_t index;
+    uint64_t created;
+} write_arg;
+
+static void *write_worker(void *arg)
+{
+    write_arg *w = arg;
+    link_par *p = w->p;
+    const iv_hier *h = p->h;
+    uint32_t T = (uint32_t)p->threads, me = w->index;
+    /* a private copy of the counters: `created` is summed afterwards */
+    iv_links mine = *p->l;
+    mine.created = 0;
+    for (uint32_t x = me; x < p->l->nodes; x += T) { /* its nodes' bins emptied */
+        size_t base = (size_t)x * p->l->bins;
+        for (uint32_t b = 0; b < p->l->bins; b++) {
+            p->l->other[base + b] = -1;
+            p->l->dist[base + b] = FLT_MAX;
+            p->l->cover[base + b] = 0.0f;
+        }
+    }
+    for (size_t i = 0; i < p->ntasks; i++) {
+        const link_task *t = &p->tasks[i];
+        for (size_t k = 0; k < t->n; k++) {
+            uint32_t A = t->pairs[2 * k], B = t->pairs[2 * k + 1];
+            int a = A % T == me, b = B % T == me;
+            if (!a && !b)
+                continue;
+            gi_vec3 d = gi_v3_sub(gi_v3_load(&h->pos[3 * B]), gi_v3_load(&h->pos[3 * A]));
+            float r = sqrtf(gi_v3_dot(d, d));
+            if (a)
+                iv_put_side(&mine, h, A, B, d, r, p->splat);
+            if (b)
+                iv_put_side(&mine, h, B, A, gi_v3_scale(d, -1.0f), r, p->splat);
+        }
+    }
+    w->created = mine.created;
+    return NULL;
+}
+
+int iv_links_build_parallel(iv_links *l, const iv_hier *h, float subdiv, int splat, int threads)
+{
+    link_par p = {.l = l, .h = h, .subdiv = subdiv, .splat = splat, .threads = threads};
+    size_t n = h->root_count + (size_t)h->root_count * (h->root_count - 1) / 2;
+    link_task *tasks = calloc(n + 1, sizeof *tasks);
+    if (!tasks)
+        return 0;
+    size_t m = 0;
+    for (uint32_t i = 0; i < h->root_count; i++)
+        tasks[m++] = (link_task){.A = i, .B = UINT32_MAX};
+    for (uint32_t i = 0; i < h->root_count; i++)
+        for (uint32_t j = i + 1; j < h->root_count; j++)
+            tasks[m++] = (link_task){.A = i, .B = j};
+    uint64_t tries = 0;
+    tasks = unroll_tasks(&p, tasks, &m, (size_t)64 * (size_t)threads, &tries);
+    p.tasks = tasks;
+    p.ntasks = m;
+    atomic_init(&p.next, 0);
+    pthread_t *tid = malloc((size_t)threads * sizeof *tid);
+    uint8_t *made = calloc((size_t)threads, 1);
+    write_arg *wa = calloc((size_t)threads, sizeof *wa);
+    int ok = tid && made && wa;
+    if (ok) {
+        /* this thread works too; a thread that cannot start is not needed */
+        for (int i = 1; i < threads; i++)
+            made[i] = pthread_create(&tid[i], NULL, collect_worker, &p) == 0;
+        collect_worker(&p);
+        for (int i = 1; i < threads; i++)
+            if (made[i])
+                pthread_join(tid[i], NULL);
+        ok = !p.fail;
+    }
+    if (ok) {
+        for (size_t i = 0; i < m; i++)
+            tries += tasks[i].tries;
+        /* each writer owns its nodes: one that cannot start runs here afterwards */
+        for (int i = 0; i < threads; i++)
+            wa[i] = (write_arg){.p = &p, .index = (uint32_t)i};
+        for (int i = 1; i < threads; i++)
+            made[i] = pthread_create(&tid[i], NULL, write_worker, &wa[i]) == 0;
+        write_worker(&wa[0]);
+        for (int i = 1; i < threads; i++) {
+            if (made[i])
+                pthread_join(tid[i], NULL);
+            else
+                write_worker(&wa[i]);
+        }
+        for (int i = 0; i < threads; i++)
+            l->created += wa[i].created;
+        l->tries = tries;
+    }
+    for (size_t i = 0; i < m; i++)
+        free(tasks[i].pairs);
+    free(tasks), free(tid), free(made), free(wa);
+    return ok;
+}
