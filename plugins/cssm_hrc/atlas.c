@@ -8,7 +8,6 @@
 
 #include <float.h>
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -119,308 +118,389 @@ static int pack(rect *r, uint32_t n, uint32_t R, uint32_t *x0, uint32_t *y0)
     return ok;
 }
 
-gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_only,
-                           cssm_atlas *out, gi_error *err)
+/* What cssm_atlas_build works with between its steps: the scene's
+ * triangles in world space, their planar groups, the charts' frames and
+ * packing, the surface samples per object. */
+typedef struct atlas_build {
+    const gi_scene *s;
+    uint32_t T;                    /* triangles */
+    gi_vec3 *P, *Nf;               /* world corners (3 per triangle), unit normals */
+    float *A;                      /* triangle areas */
+    int32_t *tri_group, *next_tri; /* per triangle: its group (-1: none), the group's next */
+    group *g;                      /* planar groups */
+    uint32_t ng, cap;
+    rect *rects;          /* the charts' rectangles (sorted by pack) */
+    uint32_t nr;          /* charts */
+    uint32_t *x0, *y0;    /* per group: its chart's corner in the atlas */
+    gi_vec3 *U, *V;       /* per group: the chart's axes */
+    float *umin;          /* per group: 2, the smallest coordinates along U and V */
+    float h;              /* texel edge */
+    double chart_area;    /* of the groups with a chart */
+    double *rest;         /* per object: area left to surface samples */
+    uint32_t *per_object; /* per object: its surface samples */
+    uint32_t samples;     /* surface samples in all */
+    uint32_t cap_texels;  /* texels allocated */
+} atlas_build;
+
+static void atlas_build_free(atlas_build *b)
 {
-    memset(out, 0, sizeof *out);
-    out->R = R;
-    const uint32_t T = s->triangle_count;
-    gi_vec3 *P = malloc((size_t)T * 3 * sizeof *P), *Nf = malloc((size_t)T * sizeof *Nf);
-    float *A = malloc((size_t)T * sizeof *A);
-    int32_t *tri_group = malloc((size_t)T * sizeof *tri_group),
-            *next_tri = malloc((size_t)T * sizeof *next_tri);
-    group *g = NULL;
-    uint32_t ng = 0, cap = 0;
-    gi_result r = GI_ERR_OUT_OF_MEMORY;
-    if (!P || !Nf || !A || !tri_group || !next_tri) {
-        snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for the atlas");
-        goto fail;
-    }
+    free(b->rest), free(b->per_object);
+    free(b->rects), free(b->x0), free(b->y0), free(b->U), free(b->V), free(b->umin);
+    free(b->P), free(b->Nf), free(b->A), free(b->tri_group), free(b->next_tri), free(b->g);
+}
+
+/* The triangles at time t in world space: corners, normals, areas; the
+ * surface area and the diameter of the scene. */
+static gi_result atlas_triangles(atlas_build *b, float t, cssm_atlas *out, gi_error *err)
+{
+    const uint32_t T = b->T;
+    b->P = malloc((size_t)T * 3 * sizeof *b->P), b->Nf = malloc((size_t)T * sizeof *b->Nf);
+    b->A = malloc((size_t)T * sizeof *b->A);
+    b->tri_group = malloc((size_t)T * sizeof *b->tri_group),
+    b->next_tri = malloc((size_t)T * sizeof *b->next_tri);
+    if (!b->P || !b->Nf || !b->A || !b->tri_group || !b->next_tri)
+        return GI_ERR_OUT_OF_MEMORY;
+    gi_vec3 *P = b->P;
     float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
     for (uint32_t i = 0; i < T; i++) {
-        gi_scene_triangle_world(s, i, t, &P[3 * i]);
-        A[i] = tri_area(&P[3 * i], &Nf[i]);
-        out->surface_area += A[i];
+        gi_scene_triangle_world(b->s, i, t, &P[3 * i]);
+        b->A[i] = tri_area(&P[3 * i], &b->Nf[i]);
+        out->surface_area += b->A[i];
         for (int k = 0; k < 3; k++) {
             float q[3] = {P[3 * i + k].x, P[3 * i + k].y, P[3 * i + k].z};
             for (int j = 0; j < 3; j++)
                 lo[j] = fminf(lo[j], q[j]), hi[j] = fmaxf(hi[j], q[j]);
         }
     }
-    if (!(out->surface_area > 0.0)) {
-        r = GI_ERR_INVALID_ARGUMENT;
-        snprintf(err->text, sizeof err->text,
-                 "cssm_hrc: the scene has no surface area to build an atlas on");
-        goto fail;
-    }
+    if (!(out->surface_area > 0.0))
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "cssm_hrc: the scene has no surface area to build an atlas on");
     out->diameter = gi_v3_length(gi_v3(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]));
-    /* planar groups per object */
+    return GI_OK;
+}
+
+/* Planar groups per object: the triangles of one object in one plane
+ * (normal and offset within tolerance); an object of more than
+ * MAX_GROUPS_PER_OBJECT planes gets none. */
+static gi_result atlas_group_planes(atlas_build *b, float diameter)
+{
+    const gi_scene *s = b->s;
+    const gi_vec3 *P = b->P, *Nf = b->Nf;
+    int32_t *tri_group = b->tri_group, *next_tri = b->next_tri;
     for (uint32_t o = 0; o < s->object_count; o++) {
         const gi_object *ob = &s->objects[o];
-        uint32_t first_group = ng;
+        uint32_t first_group = b->ng;
         int overflow = 0;
         for (uint32_t i = ob->first_triangle; i < ob->first_triangle + ob->triangle_count; i++) {
             tri_group[i] = -1;
             next_tri[i] = -1;
-            if (!(A[i] > 0.0f) || overflow)
+            if (!(b->A[i] > 0.0f) || overflow)
                 continue;
             float d = gi_v3_dot(Nf[i], P[3 * i]);
             uint32_t k = first_group;
-            for (; k < ng; k++)
-                if (gi_v3_dot(g[k].n, Nf[i]) > 0.9999f && fabsf(g[k].d - d) < 1e-4f * out->diameter)
+            for (; k < b->ng; k++)
+                if (gi_v3_dot(b->g[k].n, Nf[i]) > 0.9999f &&
+                    fabsf(b->g[k].d - d) < 1e-4f * diameter)
                     break;
-            if (k == ng) {
-                if (ng - first_group >= MAX_GROUPS_PER_OBJECT) {
+            if (k == b->ng) {
+                if (b->ng - first_group >= MAX_GROUPS_PER_OBJECT) {
                     overflow = 1; /* a curved mesh: surface samples for the whole object */
                     continue;
                 }
-                if (ng == cap) {
-                    cap = cap ? 2 * cap : 64;
-                    group *ng_ = realloc(g, cap * sizeof *g);
+                if (b->ng == b->cap) {
+                    b->cap = b->cap ? 2 * b->cap : 64;
+                    group *ng_ = realloc(b->g, b->cap * sizeof *b->g);
                     if (!ng_)
-                        goto fail;
-                    g = ng_;
+                        return GI_ERR_OUT_OF_MEMORY;
+                    b->g = ng_;
                 }
-                g[ng] = (group){.object = o,
-                                .n = Nf[i],
-                                .d = d,
-                                .area = 0,
-                                .first_tri = UINT32_MAX,
-                                .chart = -1};
-                ng++;
+                b->g[b->ng] = (group){.object = o,
+                                      .n = Nf[i],
+                                      .d = d,
+                                      .area = 0,
+                                      .first_tri = UINT32_MAX,
+                                      .chart = -1};
+                b->ng++;
             }
-            g[k].area += A[i];
-            next_tri[i] = (int32_t)g[k].first_tri;
-            g[k].first_tri = i;
+            b->g[k].area += b->A[i];
+            next_tri[i] = (int32_t)b->g[k].first_tri;
+            b->g[k].first_tri = i;
             tri_group[i] = (int32_t)k;
         }
         if (overflow)
             for (uint32_t i = ob->first_triangle; i < ob->first_triangle + ob->triangle_count; i++)
                 tri_group[i] = -1;
         if (overflow)
-            ng = first_group;
+            b->ng = first_group;
     }
-    /* texel size: start at 90 % fill and grow until the charts pack */
-    double chart_area = 0.0;
-    float h = (float)sqrt(out->surface_area / (0.9 * (double)R * (double)R));
-    rect *rects = malloc((ng ? ng : 1) * sizeof *rects);
-    uint32_t *x0 = malloc((ng ? ng : 1) * sizeof *x0), *y0 = malloc((ng ? ng : 1) * sizeof *y0);
-    gi_vec3 *U = malloc((ng ? ng : 1) * sizeof *U), *V = malloc((ng ? ng : 1) * sizeof *V);
-    float *umin = malloc((ng ? ng : 1) * 2 * sizeof *umin);
-    if (!rects || !x0 || !y0 || !U || !V || !umin) {
-        free(rects), free(x0), free(y0), free(U), free(V), free(umin);
-        goto fail;
-    }
+    return GI_OK;
+}
+
+/* Each group's chart axes (an orthonormal basis of its plane) and the
+ * smallest coordinates of its corners along them. */
+static gi_result atlas_chart_frames(atlas_build *b)
+{
+    const uint32_t ng = b->ng;
+    b->rects = malloc((ng ? ng : 1) * sizeof *b->rects);
+    b->x0 = malloc((ng ? ng : 1) * sizeof *b->x0), b->y0 = malloc((ng ? ng : 1) * sizeof *b->y0);
+    b->U = malloc((ng ? ng : 1) * sizeof *b->U), b->V = malloc((ng ? ng : 1) * sizeof *b->V);
+    b->umin = malloc((ng ? ng : 1) * 2 * sizeof *b->umin);
+    if (!b->rects || !b->x0 || !b->y0 || !b->U || !b->V || !b->umin)
+        return GI_ERR_OUT_OF_MEMORY;
     for (uint32_t k = 0; k < ng; k++) {
-        gi_onb(g[k].n, &U[k], &V[k]);
+        gi_onb(b->g[k].n, &b->U[k], &b->V[k]);
         float a0 = FLT_MAX, b0 = FLT_MAX;
-        for (int32_t i = (int32_t)g[k].first_tri; i >= 0; i = next_tri[i])
+        for (int32_t i = (int32_t)b->g[k].first_tri; i >= 0; i = b->next_tri[i])
             for (int j = 0; j < 3; j++)
-                a0 = fminf(a0, gi_v3_dot(P[3 * i + j], U[k])),
-                b0 = fminf(b0, gi_v3_dot(P[3 * i + j], V[k]));
-        umin[2 * k] = a0, umin[2 * k + 1] = b0;
+                a0 = fminf(a0, gi_v3_dot(b->P[3 * i + j], b->U[k])),
+                b0 = fminf(b0, gi_v3_dot(b->P[3 * i + j], b->V[k]));
+        b->umin[2 * k] = a0, b->umin[2 * k + 1] = b0;
     }
-    uint32_t nr = 0;
+    return GI_OK;
+}
+
+/* The texel size: start at 90 % fill and grow until the charts (groups
+ * of at least MIN_CHART_TEXELS texels) pack into the R x R atlas. */
+static gi_result atlas_pack_charts(atlas_build *b, uint32_t R, double surface_area, gi_error *err)
+{
+    group *g = b->g;
+    float h = (float)sqrt(surface_area / (0.9 * (double)R * (double)R));
     for (int attempt = 0; attempt < 400; attempt++, h *= 1.02f) {
-        nr = 0;
-        chart_area = 0.0;
-        for (uint32_t k = 0; k < ng; k++) {
+        b->nr = 0;
+        b->chart_area = 0.0;
+        for (uint32_t k = 0; k < b->ng; k++) {
             g[k].chart = -1;
             if (g[k].area / ((double)h * h) < MIN_CHART_TEXELS)
                 continue;
             float a1 = -FLT_MAX, b1 = -FLT_MAX;
-            for (int32_t i = (int32_t)g[k].first_tri; i >= 0; i = next_tri[i])
+            for (int32_t i = (int32_t)g[k].first_tri; i >= 0; i = b->next_tri[i])
                 for (int j = 0; j < 3; j++)
-                    a1 = fmaxf(a1, gi_v3_dot(P[3 * i + j], U[k])),
-                    b1 = fmaxf(b1, gi_v3_dot(P[3 * i + j], V[k]));
-            rects[nr].w = (uint32_t)ceilf((a1 - umin[2 * k]) / h);
-            rects[nr].h = (uint32_t)ceilf((b1 - umin[2 * k + 1]) / h);
-            rects[nr].g = k;
-            g[k].chart = (int)nr;
-            chart_area += g[k].area;
-            nr++;
+                    a1 = fmaxf(a1, gi_v3_dot(b->P[3 * i + j], b->U[k])),
+                    b1 = fmaxf(b1, gi_v3_dot(b->P[3 * i + j], b->V[k]));
+            b->rects[b->nr].w = (uint32_t)ceilf((a1 - b->umin[2 * k]) / h);
+            b->rects[b->nr].h = (uint32_t)ceilf((b1 - b->umin[2 * k + 1]) / h);
+            b->rects[b->nr].g = k;
+            g[k].chart = (int)b->nr;
+            b->chart_area += g[k].area;
+            b->nr++;
         }
-        if (pack(rects, nr, R, x0, y0))
+        if (pack(b->rects, b->nr, R, b->x0, b->y0))
             break;
-        if (attempt == 399) {
-            free(rects), free(x0), free(y0), free(U), free(V), free(umin);
-            r = GI_ERR_INVALID_ARGUMENT;
-            snprintf(err->text, sizeof err->text,
-                     "cssm_hrc: the charts do not pack into a %u x %u atlas", R, R);
-            goto fail;
-        }
+        if (attempt == 399)
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "cssm_hrc: the charts do not pack into a %u x %u atlas", R, R);
     }
-    if (samples_only) { /* the charts' texel size, no parametrisation */
-        for (uint32_t k = 0; k < ng; k++)
-            g[k].chart = -1;
-        nr = 0;
-        chart_area = 0.0;
-    }
-    out->h = h;
-    out->chart_area = chart_area;
+    b->h = h;
+    return GI_OK;
+}
+
+/* The atlas' grid and charts allocated, and the surface samples of each
+ * object: its area outside charts at the charts' density. */
+static gi_result atlas_sample_counts(atlas_build *b, cssm_atlas *out)
+{
+    const gi_scene *s = b->s;
+    const uint32_t R = out->R;
+    const float h = b->h;
     out->grid = malloc((size_t)R * R * sizeof *out->grid);
-    out->charts = calloc(nr ? nr : 1, sizeof *out->charts);
+    out->charts = calloc(b->nr ? b->nr : 1, sizeof *out->charts);
     /* sample counts of the objects without charts */
-    double *rest = calloc(s->object_count ? s->object_count : 1, sizeof *rest);
-    uint32_t samples = 0;
-    if (!out->grid || !out->charts || !rest) {
-        free(rest);
-        free(rects), free(x0), free(y0), free(U), free(V), free(umin);
-        goto fail;
-    }
-    for (uint32_t i = 0; i < T; i++)
-        if (tri_group[i] < 0 || g[tri_group[i]].chart < 0)
-            rest[s->vertices[s->indices[3 * i]].object] += A[i];
-    uint32_t *per_object = calloc(s->object_count ? s->object_count : 1, sizeof *per_object);
-    if (!per_object) {
-        free(rest);
-        free(rects), free(x0), free(y0), free(U), free(V), free(umin);
-        goto fail;
-    }
+    b->rest = calloc(s->object_count ? s->object_count : 1, sizeof *b->rest);
+    b->samples = 0;
+    if (!out->grid || !out->charts || !b->rest)
+        return GI_ERR_OUT_OF_MEMORY;
+    for (uint32_t i = 0; i < b->T; i++)
+        if (b->tri_group[i] < 0 || b->g[b->tri_group[i]].chart < 0)
+            b->rest[s->vertices[s->indices[3 * i]].object] += b->A[i];
+    b->per_object = calloc(s->object_count ? s->object_count : 1, sizeof *b->per_object);
+    if (!b->per_object)
+        return GI_ERR_OUT_OF_MEMORY;
     for (uint32_t o = 0; o < s->object_count; o++) {
-        per_object[o] =
-            rest[o] > 0.0 ? (uint32_t)fmax(1.0, floor(rest[o] / ((double)h * h) + 0.5)) : 0u;
-        samples += per_object[o];
+        b->per_object[o] =
+            b->rest[o] > 0.0 ? (uint32_t)fmax(1.0, floor(b->rest[o] / ((double)h * h) + 0.5)) : 0u;
+        b->samples += b->per_object[o];
     }
     for (size_t i = 0; i < (size_t)R * R; i++)
         out->grid[i] = -1;
-    /* rasterise the charts: a texel whose centre lies in a triangle of the chart */
-    uint32_t cap_texels = samples + 1024;
-    out->texels = malloc(cap_texels * sizeof *out->texels);
-    if (!out->texels) {
-        free(rest), free(per_object);
-        free(rects), free(x0), free(y0), free(U), free(V), free(umin);
-        goto fail;
-    }
-    out->chart_count = nr;
-    for (uint32_t k = 0; k < ng; k++) {
-        if (g[k].chart < 0)
-            continue;
-        cssm_chart *c = &out->charts[g[k].chart];
-        uint32_t ci = (uint32_t)g[k].chart;
-        c->object = g[k].object;
-        c->x0 = x0[k], c->y0 = y0[k];
-        for (uint32_t q = 0; q < nr; q++)
-            if (rects[q].g == k)
-                c->w = rects[q].w, c->h = rects[q].h;
-        c->normal = g[k].n;
-        c->u = gi_v3_scale(U[k], h);
-        c->v = gi_v3_scale(V[k], h);
-        /* the plane point at (umin, vmin) */
-        c->origin =
-            gi_v3_add(gi_v3_scale(g[k].n, g[k].d), gi_v3_add(gi_v3_scale(U[k], umin[2 * k]),
-                                                             gi_v3_scale(V[k], umin[2 * k + 1])));
-        uint32_t first = out->count;
-        for (uint32_t yy = 0; yy < c->h; yy++)
-            for (uint32_t xx = 0; xx < c->w; xx++) {
-                float pu = ((float)xx + 0.5f) * h, pv = ((float)yy + 0.5f) * h;
-                int32_t hit = -1;
-                for (int32_t i = (int32_t)g[k].first_tri; i >= 0 && hit < 0; i = next_tri[i]) {
-                    float tr[6];
-                    for (int j = 0; j < 3; j++) {
-                        tr[2 * j] = gi_v3_dot(P[3 * i + j], U[k]) - umin[2 * k];
-                        tr[2 * j + 1] = gi_v3_dot(P[3 * i + j], V[k]) - umin[2 * k + 1];
-                    }
-                    if (inside(pu, pv, tr))
-                        hit = i;
+    b->cap_texels = b->samples + 1024;
+    out->texels = malloc(b->cap_texels * sizeof *out->texels);
+    if (!out->texels)
+        return GI_ERR_OUT_OF_MEMORY;
+    return GI_OK;
+}
+
+/* Group k's chart rasterised: a texel whose centre lies in a triangle of
+ * the chart; the texel areas add up to the group's. */
+static gi_result atlas_rasterise_chart(atlas_build *b, uint32_t k, cssm_atlas *out)
+{
+    const group *g = b->g;
+    const gi_vec3 *P = b->P, *U = b->U, *V = b->V;
+    const float *umin = b->umin;
+    const float h = b->h;
+    const uint32_t R = out->R;
+    cssm_chart *c = &out->charts[g[k].chart];
+    uint32_t ci = (uint32_t)g[k].chart;
+    c->object = g[k].object;
+    c->x0 = b->x0[k], c->y0 = b->y0[k];
+    for (uint32_t q = 0; q < b->nr; q++)
+        if (b->rects[q].g == k)
+            c->w = b->rects[q].w, c->h = b->rects[q].h;
+    c->normal = g[k].n;
+    c->u = gi_v3_scale(U[k], h);
+    c->v = gi_v3_scale(V[k], h);
+    /* the plane point at (umin, vmin) */
+    c->origin =
+        gi_v3_add(gi_v3_scale(g[k].n, g[k].d),
+                  gi_v3_add(gi_v3_scale(U[k], umin[2 * k]), gi_v3_scale(V[k], umin[2 * k + 1])));
+    uint32_t first = out->count;
+    for (uint32_t yy = 0; yy < c->h; yy++)
+        for (uint32_t xx = 0; xx < c->w; xx++) {
+            float pu = ((float)xx + 0.5f) * h, pv = ((float)yy + 0.5f) * h;
+            int32_t hit = -1;
+            for (int32_t i = (int32_t)g[k].first_tri; i >= 0 && hit < 0; i = b->next_tri[i]) {
+                float tr[6];
+                for (int j = 0; j < 3; j++) {
+                    tr[2 * j] = gi_v3_dot(P[3 * i + j], U[k]) - umin[2 * k];
+                    tr[2 * j + 1] = gi_v3_dot(P[3 * i + j], V[k]) - umin[2 * k + 1];
                 }
-                if (hit < 0)
-                    continue;
-                if (out->count == cap_texels) {
-                    cap_texels *= 2;
-                    cssm_texel *nt = realloc(out->texels, cap_texels * sizeof *nt);
-                    if (!nt) {
-                        free(rest), free(per_object);
-                        free(rects), free(x0), free(y0), free(U), free(V), free(umin);
-                        goto fail;
-                    }
-                    out->texels = nt;
-                }
-                cssm_texel *x = &out->texels[out->count];
-                memset(x, 0, sizeof *x);
-                x->p =
-                    gi_v3_add(c->origin, gi_v3_add(gi_v3_scale(U[k], pu), gi_v3_scale(V[k], pv)));
-                x->n = g[k].n;
-                x->chart = (int32_t)ci;
-                x->x = c->x0 + xx, x->y = c->y0 + yy;
-                x->triangle = (uint32_t)hit;
-                material_of(s, (uint32_t)hit, &P[3 * (size_t)hit], x);
-                out->grid[(size_t)x->y * R + x->x] = (int32_t)out->count;
-                out->count++;
+                if (inside(pu, pv, tr))
+                    hit = i;
             }
-        uint32_t n_in = out->count - first;
-        out->covered_area += (double)n_in * h * h;
-        for (uint32_t i = first; i < out->count; i++)
-            out->texels[i].area = (float)(g[k].area / (n_in ? n_in : 1));
-        /* a chart without a texel centre inside: its area is lost (reported by coverage) */
+            if (hit < 0)
+                continue;
+            if (out->count == b->cap_texels) {
+                b->cap_texels *= 2;
+                cssm_texel *nt = realloc(out->texels, b->cap_texels * sizeof *nt);
+                if (!nt)
+                    return GI_ERR_OUT_OF_MEMORY;
+                out->texels = nt;
+            }
+            cssm_texel *x = &out->texels[out->count];
+            memset(x, 0, sizeof *x);
+            x->p = gi_v3_add(c->origin, gi_v3_add(gi_v3_scale(U[k], pu), gi_v3_scale(V[k], pv)));
+            x->n = g[k].n;
+            x->chart = (int32_t)ci;
+            x->x = c->x0 + xx, x->y = c->y0 + yy;
+            x->triangle = (uint32_t)hit;
+            material_of(b->s, (uint32_t)hit, &P[3 * (size_t)hit], x);
+            out->grid[(size_t)x->y * R + x->x] = (int32_t)out->count;
+            out->count++;
+        }
+    uint32_t n_in = out->count - first;
+    out->covered_area += (double)n_in * h * h;
+    for (uint32_t i = first; i < out->count; i++)
+        out->texels[i].area = (float)(g[k].area / (n_in ? n_in : 1));
+    /* a chart without a texel centre inside: its area is lost (reported by coverage) */
+    return GI_OK;
+}
+
+/* Every chart rasterised, then each triangle's chart (-1: none). */
+static gi_result atlas_rasterise_charts(atlas_build *b, cssm_atlas *out)
+{
+    out->chart_count = b->nr;
+    for (uint32_t k = 0; k < b->ng; k++) {
+        if (b->g[k].chart < 0)
+            continue;
+        gi_result r = atlas_rasterise_chart(b, k, out);
+        if (r != GI_OK)
+            return r;
     }
     out->chart_texels = out->count;
-    out->tri_chart = malloc((size_t)T * sizeof *out->tri_chart);
-    if (!out->tri_chart) {
-        free(rest), free(per_object);
-        free(rects), free(x0), free(y0), free(U), free(V), free(umin);
-        goto fail;
-    }
-    for (uint32_t i = 0; i < T; i++)
-        out->tri_chart[i] = tri_group[i] >= 0 ? g[tri_group[i]].chart : -1;
-    /* surface samples: systematic sampling of each object's remaining area */
-    if (out->count + samples > cap_texels) {
-        cssm_texel *nt = realloc(out->texels, (out->count + samples + 1) * sizeof *nt);
-        if (!nt) {
-            free(rest), free(per_object);
-            free(rects), free(x0), free(y0), free(U), free(V), free(umin);
-            goto fail;
-        }
+    out->tri_chart = malloc((size_t)b->T * sizeof *out->tri_chart);
+    if (!out->tri_chart)
+        return GI_ERR_OUT_OF_MEMORY;
+    for (uint32_t i = 0; i < b->T; i++)
+        out->tri_chart[i] = b->tri_group[i] >= 0 ? b->g[b->tri_group[i]].chart : -1;
+    return GI_OK;
+}
+
+/* Surface samples: systematic sampling of each object's remaining area
+ * (§3.2.3, last paragraph). */
+static gi_result atlas_surface_samples(atlas_build *b, cssm_atlas *out)
+{
+    const gi_scene *s = b->s;
+    if (out->count + b->samples > b->cap_texels) {
+        cssm_texel *nt = realloc(out->texels, (out->count + b->samples + 1) * sizeof *nt);
+        if (!nt)
+            return GI_ERR_OUT_OF_MEMORY;
         out->texels = nt;
     }
     for (uint32_t o = 0; o < s->object_count; o++) {
-        if (!per_object[o])
+        const uint32_t want = b->per_object[o];
+        if (!want)
             continue;
         const gi_object *ob = &s->objects[o];
         uint32_t rng = gi_rng_init(o, 0, 0xa71a5u);
-        double step = rest[o] / per_object[o], acc = 0.0, target = step * gi_rng_next_float(&rng);
+        double step = b->rest[o] / want, acc = 0.0, target = step * gi_rng_next_float(&rng);
         uint32_t made = 0;
         for (uint32_t i = ob->first_triangle;
-             i < ob->first_triangle + ob->triangle_count && made < per_object[o]; i++) {
-            if (tri_group[i] >= 0 && g[tri_group[i]].chart >= 0)
+             i < ob->first_triangle + ob->triangle_count && made < want; i++) {
+            if (b->tri_group[i] >= 0 && b->g[b->tri_group[i]].chart >= 0)
                 continue;
-            acc += A[i];
-            while (target < acc && made < per_object[o]) {
+            acc += b->A[i];
+            while (target < acc && made < want) {
                 float u1 = gi_rng_next_float(&rng), u2 = gi_rng_next_float(&rng);
                 if (u1 + u2 > 1.0f)
                     u1 = 1.0f - u1, u2 = 1.0f - u2;
                 cssm_texel *x = &out->texels[out->count++];
                 memset(x, 0, sizeof *x);
-                gi_vec3 *p = &P[3 * i];
+                gi_vec3 *p = &b->P[3 * i];
                 x->p = gi_v3_add(p[0], gi_v3_add(gi_v3_scale(gi_v3_sub(p[1], p[0]), u1),
                                                  gi_v3_scale(gi_v3_sub(p[2], p[0]), u2)));
-                x->n = Nf[i];
+                x->n = b->Nf[i];
                 x->area = (float)step;
                 x->chart = -1;
                 x->x = x->y = CSSM_NO_XY;
                 x->triangle = i;
-                material_of(s, i, &P[3 * (size_t)i], x);
+                material_of(s, i, &b->P[3 * (size_t)i], x);
                 made++;
                 target += step;
             }
         }
         out->covered_area += step * made;
     }
-    free(rest), free(per_object);
-    free(rects), free(x0), free(y0), free(U), free(V), free(umin);
-    free(P), free(Nf), free(A), free(tri_group), free(next_tri), free(g);
+    return GI_OK;
+}
+
+gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_only,
+                           cssm_atlas *out, gi_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->R = R;
+    atlas_build b = {.s = s, .T = s->triangle_count};
+    gi_result r = atlas_triangles(&b, t, out, err);
+    if (r == GI_OK)
+        r = atlas_group_planes(&b, out->diameter);
+    if (r == GI_OK)
+        r = atlas_chart_frames(&b);
+    if (r == GI_OK)
+        r = atlas_pack_charts(&b, R, out->surface_area, err);
+    if (r == GI_OK) {
+        if (samples_only) { /* the charts' texel size, no parametrisation */
+            for (uint32_t k = 0; k < b.ng; k++)
+                b.g[k].chart = -1;
+            b.nr = 0;
+            b.chart_area = 0.0;
+        }
+        out->h = b.h;
+        out->chart_area = b.chart_area;
+        r = atlas_sample_counts(&b, out);
+    }
+    if (r == GI_OK)
+        r = atlas_rasterise_charts(&b, out);
+    if (r == GI_OK)
+        r = atlas_surface_samples(&b, out);
+    atlas_build_free(&b);
+    if (r != GI_OK) {
+        if (r == GI_ERR_OUT_OF_MEMORY)
+            gi_error_set(err, r, "cssm_hrc: out of memory for the atlas");
+        cssm_atlas_free(out);
+        return r;
+    }
     if (!out->count) {
         cssm_atlas_free(out);
-        snprintf(err->text, sizeof err->text, "cssm_hrc: the atlas has no texel");
-        return GI_ERR_INVALID_ARGUMENT;
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "cssm_hrc: the atlas has no texel");
     }
     return GI_OK;
-fail:
-    if (r == GI_ERR_OUT_OF_MEMORY)
-        snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for the atlas");
-    free(P), free(Nf), free(A), free(tri_group), free(next_tri), free(g);
-    cssm_atlas_free(out);
-    return r;
 }
 
 void cssm_atlas_free(cssm_atlas *a)

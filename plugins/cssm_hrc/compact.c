@@ -23,7 +23,6 @@
 
 #include <float.h>
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -211,12 +210,11 @@ gi_result cssm_ctree_check(uint32_t texels, gi_error *err)
     uint64_t count = texels ? 2ull * texels - 1 : 0;
     if (count <= CSSM_COMPACT_MAX_NODES)
         return GI_OK;
-    snprintf(err->text, sizeof err->text,
-             "cssm_hrc: nodes=compact holds at most %u nodes (16-bit pointers, Sec. 4.2.1), this "
-             "hierarchy has %llu "
-             "(%u texels): lower atlas or use nodes=float",
-             CSSM_COMPACT_MAX_NODES, (unsigned long long)count, texels);
-    return GI_ERR_INVALID_ARGUMENT;
+    return gi_error_set(
+        err, GI_ERR_INVALID_ARGUMENT,
+        "cssm_hrc: nodes=compact holds at most %u nodes (16-bit pointers, Sec. "
+        "4.2.1), this hierarchy has %llu (%u texels): lower atlas or use nodes=float",
+        CSSM_COMPACT_MAX_NODES, (unsigned long long)count, texels);
 }
 
 gi_result cssm_ctree_setup(cssm_ctree *ct, uint32_t count, const float lo[3], const float hi[3],
@@ -230,8 +228,8 @@ gi_result cssm_ctree_setup(cssm_ctree *ct, uint32_t count, const float lo[3], co
     ct->leaves = calloc((size_t)count / 2 + 1, sizeof *ct->leaves);
     if (!ct->nodes || !ct->side || !ct->leaves) {
         cssm_ctree_free(ct);
-        snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for the compact hierarchy");
-        return GI_ERR_OUT_OF_MEMORY;
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                            "cssm_hrc: out of memory for the compact hierarchy");
     }
     ct->count = count;
     for (int k = 0; k < 3; k++) {

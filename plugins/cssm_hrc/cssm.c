@@ -9,7 +9,6 @@
 
 #include <float.h>
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -47,8 +46,8 @@ gi_result cssm_maps_setup(const cssm_atlas *a, const uint32_t *order, uint32_t M
     out->eye = malloc(N * sizeof *out->eye);
     if (!out->seq || !out->eye) {
         cssm_maps_free(out);
-        snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for %u cube maps", N);
-        return GI_ERR_OUT_OF_MEMORY;
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for %u cube maps",
+                            N);
     }
     /* the eye sits just above the surface so that its own plane is not seen */
     for (uint32_t k = 0; k < N; k++) {
@@ -146,8 +145,8 @@ gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const 
     if (!corners || !mask) {
         free(corners), free(mask);
         cssm_maps_free(out);
-        snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for %u cube maps", N);
-        return GI_ERR_OUT_OF_MEMORY;
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for %u cube maps",
+                            N);
     }
     for (int f = 0; f < 6; f++) {
         gi_vec3 s, t, fw;

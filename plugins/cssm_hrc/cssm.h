@@ -1,6 +1,8 @@
-/* CPU side of the cssm_hrc plugin (Ritschel, Grosch, Kautz, Seidel,
- * "Interactive Illumination with Coherent Surface Shadow Maps", GI 2008):
+/* prefix cssm_ for cssm_hrc: every non-static function and type of the
+ * plugin's files starts with cssm_, and its parameter table is cssm_params.
  *
+ * CPU side of the cssm_hrc plugin (Ritschel, Grosch, Kautz, Seidel,
+ * "Interactive Illumination with Coherent Surface Shadow Maps", GI 2008):
  *  - the illumination atlas (§3.2.3, Fig. 5): texels with world position,
  *    normal, area and material (atlas.c);
  *  - the coherent traversals of the atlas (§3.2.3, Fig. 6/7): greedy,
@@ -85,15 +87,6 @@ void cssm_atlas_free(cssm_atlas *a);
  * gi_scene_albedo), emission, Phong lobe. */
 void cssm_texel_material(const gi_scene *s, uint32_t tri, const gi_vec3 p[3], cssm_texel *x);
 
-/* The order in which the texels' cube maps are rendered and compressed:
- * order[k] = texel visited k-th (a permutation of 0 .. count-1). Greedy:
- * nearest unvisited texel in 3D from texel 0 on, over all texels. Zig-zag
- * and spiral: chart after chart, the next chart the one whose first texel
- * is nearest (3D) to the last texel visited; inside a chart the rows of
- * its rectangle alternately left to right and right to left (zig-zag) or
- * a left-hand walk along the border of the unvisited region, stepping back
- * along the path when stuck (spiral); surface samples follow, greedily.
- * Returns a malloc'd array or NULL on no memory. */
 /* Continuous texel coordinates (texel centres at x + 1/2) of world point p
  * in chart c's rectangle. */
 void cssm_chart_coords(const cssm_atlas *a, uint32_t chart, gi_vec3 p, float *u, float *v);
@@ -104,6 +97,15 @@ void cssm_chart_coords(const cssm_atlas *a, uint32_t chart, gi_vec3 p, float *u,
 int cssm_chart_bicubic(const cssm_atlas *a, uint32_t chart, float u, float v, const float *values,
                        float out[3]);
 
+/* The order in which the texels' cube maps are rendered and compressed:
+ * order[k] = texel visited k-th (a permutation of 0 .. count-1). Greedy:
+ * nearest unvisited texel in 3D from texel 0 on, over all texels. Zig-zag
+ * and spiral: chart after chart, the next chart the one whose first texel
+ * is nearest (3D) to the last texel visited; inside a chart the rows of
+ * its rectangle alternately left to right and right to left (zig-zag) or
+ * a left-hand walk along the border of the unvisited region, stepping back
+ * along the path when stuck (spiral); surface samples follow, greedily.
+ * Returns a malloc'd array or NULL on no memory. */
 uint32_t *cssm_traverse(const cssm_atlas *a, cssm_traversal how);
 const char *cssm_traversal_name(cssm_traversal how);
 

@@ -11,7 +11,6 @@
 
 #include <float.h>
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -76,6 +75,139 @@ static int triangle_double_sided(const gi_scene *s, uint32_t tri)
     return s->materials[s->vertices[s->indices[3 * tri]].material].double_sided;
 }
 
+static gi_result out_of_memory(gi_error *err)
+{
+    return gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                        "cssm_hrc: out of memory for the direct light's CSMs");
+}
+
+/* The core's emitter table read back: power CDF over the emitting
+ * triangles. */
+static gi_result read_emitters(const gi_gpu_scene *gs, cssm_csm_direct *out, gi_error *err)
+{
+    out->em_count = gs->emitter_count;
+    if (out->em_count) {
+        out->em = malloc(out->em_count * sizeof *out->em);
+        if (!out->em)
+            return out_of_memory(err);
+        glGetNamedBufferSubData(gs->ssbo_emitters, 0, (GLsizeiptr)(out->em_count * sizeof *out->em),
+                                out->em);
+    }
+    return GI_OK;
+}
+
+/* Per scene light its point: point and spot lights one each after the NA
+ * area points, directional lights none; counts both kinds. */
+static gi_result light_points(const gi_scene *s, uint32_t NA, cssm_csm_direct *out,
+                              uint32_t *punctual, uint32_t *directional, gi_error *err)
+{
+    out->light_point = malloc((s->light_count ? s->light_count : 1) * sizeof *out->light_point);
+    if (!out->light_point)
+        return out_of_memory(err);
+    for (uint32_t i = 0; i < s->light_count; i++) {
+        if (s->lights[i].type == GI_LIGHT_DIRECTIONAL) {
+            out->light_point[i] = UINT32_MAX;
+            (*directional)++;
+        } else {
+            out->light_point[i] = NA + (*punctual)++;
+        }
+    }
+    return GI_OK;
+}
+
+/* The NA points on the area lights: a Hammersley set through the power
+ * CDF, stratified by power, with their radiance and weights. */
+static void area_points(const gi_scene *s, uint32_t NA, cssm_csm_direct *out)
+{
+    for (uint32_t i = 0; i < NA; i++) {
+        float h[2];
+        gi_hammersley(i, NA, h);
+        h[0] = ((float)i + 0.5f) / (float)NA;
+        uint32_t e = emitter_find(out, &h[0]);
+        gi_vec3 n;
+        float pdf;
+        cssm_texel *x = &out->pts.texels[i];
+        x->p = emitter_point(out, s, e, h[0], h[1], &n, &pdf);
+        x->n = n;
+        x->chart = -1;
+        x->x = x->y = CSSM_NO_XY;
+        x->triangle = out->em[e].triangle;
+        memcpy(&out->pt_Le[3 * i], gi_scene_triangle_emission(s, out->em[e].triangle),
+               3 * sizeof(float));
+        out->pt_w[i] = pdf > 0.0f ? 1.0f / ((float)NA * pdf) : 0.0f;
+        out->pt_ds[i] = (unsigned char)triangle_double_sided(s, out->em[e].triangle);
+        if (out->pt_ds[i]) /* a double-sided emitter lights both sides: its whole cube map
+                              counts */
+            x->n = gi_v3(0, 0, 0);
+    }
+}
+
+/* The P light points (NA on the area lights, then the punctual lights)
+ * and a depth cube map at each, compressed in a greedy order. */
+static gi_result point_maps(const gi_gpu_scene *gs, uint32_t NA, uint32_t P, uint32_t M,
+                            const gi_host *host, cssm_csm_direct *out, gi_error *err)
+{
+    const gi_scene *s = gs->scene;
+    out->pts.texels = calloc(P, sizeof *out->pts.texels);
+    out->pt_Le = malloc(3 * (size_t)(NA ? NA : 1) * sizeof *out->pt_Le);
+    out->pt_w = malloc((NA ? NA : 1) * sizeof *out->pt_w);
+    out->pt_ds = malloc(NA ? NA : 1);
+    if (!out->pts.texels || !out->pt_Le || !out->pt_w || !out->pt_ds)
+        return out_of_memory(err);
+    out->pts.count = P;
+    out->pts.diameter = out->diameter;
+    area_points(s, NA, out);
+    for (uint32_t i = 0; i < s->light_count; i++)
+        if (out->light_point[i] != UINT32_MAX) {
+            cssm_texel *x = &out->pts.texels[out->light_point[i]];
+            x->p = gi_scene_light_at(s, i, gs->time).position;
+            x->n = gi_v3(0, 0, 0); /* no "don't care" half */
+            x->chart = -1;
+            x->x = x->y = CSSM_NO_XY;
+        }
+    out->order = cssm_traverse(&out->pts, CSSM_GREEDY);
+    if (!out->order)
+        return out_of_memory(err);
+    cssm_build_opts o = {.render_stage = "csm_render"};
+    return cssm_maps_build_ex(gs, &out->pts, out->order, M, &o, host, &out->maps, err);
+}
+
+/* Distant light (directional lights, the environment): per object its
+ * CSM over directions, its frame and world bounding sphere. */
+static gi_result distant_maps(const gi_gpu_scene *gs, const gi_host *host, cssm_csm_direct *out,
+                              gi_error *err)
+{
+    const gi_scene *s = gs->scene;
+    const uint32_t K = s->object_count;
+    out->distant = calloc(K ? K : 1, sizeof *out->distant);
+    out->local_from_world = malloc((K ? K : 1) * sizeof *out->local_from_world);
+    out->scale = malloc((K ? K : 1) * sizeof *out->scale);
+    out->sphere_w = malloc(4 * (size_t)(K ? K : 1) * sizeof *out->sphere_w);
+    if (!out->distant || !out->local_from_world || !out->scale || !out->sphere_w)
+        return out_of_memory(err);
+    out->object_count = K;
+    for (uint32_t k = 0; k < K; k++) {
+        if (host && host->cancelled && host->cancelled(host))
+            return gi_error_set(err, GI_ERR_CANCELLED, "cssm_hrc: cancelled");
+        float T[16];
+        gi_scene_object_transform(s, k, gs->time, T);
+        if (!gi_mat4_invert(out->local_from_world[k], T))
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "cssm_hrc: object %u has a singular transform", k);
+        float sc = gi_v3_length(gi_mat4_dir(T, gi_v3(1, 0, 0)));
+        out->scale[k] = sc > 0.0f ? sc : 1.0f;
+        gi_csm_distant_desc dd = {.M = 32, .n_theta = 32};
+        gi_result r = gi_csm_distant_build(gs, k, &dd, &out->distant[k], err);
+        if (r != GI_OK)
+            return r;
+        const float *sp = out->distant[k].sphere;
+        gi_vec3 c = gi_mat4_point(T, gi_v3(sp[0], sp[1], sp[2]));
+        out->sphere_w[4 * k] = c.x, out->sphere_w[4 * k + 1] = c.y, out->sphere_w[4 * k + 2] = c.z;
+        out->sphere_w[4 * k + 3] = sp[3] * out->scale[k];
+    }
+    return GI_OK;
+}
+
 gi_result cssm_csm_direct_build(const gi_gpu_scene *gs, float diameter, uint32_t N, uint32_t M,
                                 const gi_host *host, cssm_csm_direct *out, gi_error *err)
 {
@@ -84,122 +216,19 @@ gi_result cssm_csm_direct_build(const gi_gpu_scene *gs, float diameter, uint32_t
     out->diameter = diameter;
     out->time = gs->time;
     /* the core's emitter table: power CDF over the emitting triangles */
-    out->em_count = gs->emitter_count;
-    if (out->em_count) {
-        out->em = malloc(out->em_count * sizeof *out->em);
-        if (!out->em)
-            goto oom;
-        glGetNamedBufferSubData(gs->ssbo_emitters, 0, (GLsizeiptr)(out->em_count * sizeof *out->em),
-                                out->em);
-    }
+    gi_result r = read_emitters(gs, out, err);
     const uint32_t NA = out->em_count ? N : 0;
     uint32_t punctual = 0, directional = 0;
-    out->light_point = malloc((s->light_count ? s->light_count : 1) * sizeof *out->light_point);
-    if (!out->light_point)
-        goto oom;
-    for (uint32_t i = 0; i < s->light_count; i++) {
-        if (s->lights[i].type == GI_LIGHT_DIRECTIONAL) {
-            out->light_point[i] = UINT32_MAX;
-            directional++;
-        } else {
-            out->light_point[i] = NA + punctual++;
-        }
-    }
+    if (r == GI_OK)
+        r = light_points(s, NA, out, &punctual, &directional, err);
     out->area_points = NA;
-    const uint32_t P = NA + punctual;
-    if (P) {
-        out->pts.texels = calloc(P, sizeof *out->pts.texels);
-        out->pt_Le = malloc(3 * (size_t)(NA ? NA : 1) * sizeof *out->pt_Le);
-        out->pt_w = malloc((NA ? NA : 1) * sizeof *out->pt_w);
-        out->pt_ds = malloc(NA ? NA : 1);
-        if (!out->pts.texels || !out->pt_Le || !out->pt_w || !out->pt_ds)
-            goto oom;
-        out->pts.count = P;
-        out->pts.diameter = diameter;
-        /* a Hammersley set through the power CDF: stratified by power */
-        for (uint32_t i = 0; i < NA; i++) {
-            float h[2];
-            gi_hammersley(i, NA, h);
-            h[0] = ((float)i + 0.5f) / (float)NA;
-            uint32_t e = emitter_find(out, &h[0]);
-            gi_vec3 n;
-            float pdf;
-            cssm_texel *x = &out->pts.texels[i];
-            x->p = emitter_point(out, s, e, h[0], h[1], &n, &pdf);
-            x->n = n;
-            x->chart = -1;
-            x->x = x->y = CSSM_NO_XY;
-            x->triangle = out->em[e].triangle;
-            memcpy(&out->pt_Le[3 * i], gi_scene_triangle_emission(s, out->em[e].triangle),
-                   3 * sizeof(float));
-            out->pt_w[i] = pdf > 0.0f ? 1.0f / ((float)NA * pdf) : 0.0f;
-            out->pt_ds[i] = (unsigned char)triangle_double_sided(s, out->em[e].triangle);
-            if (out->pt_ds[i]) /* a double-sided emitter lights both sides: its whole cube map
-                                  counts */
-                x->n = gi_v3(0, 0, 0);
-        }
-        for (uint32_t i = 0; i < s->light_count; i++)
-            if (out->light_point[i] != UINT32_MAX) {
-                cssm_texel *x = &out->pts.texels[out->light_point[i]];
-                x->p = gi_scene_light_at(s, i, gs->time).position;
-                x->n = gi_v3(0, 0, 0); /* no "don't care" half */
-                x->chart = -1;
-                x->x = x->y = CSSM_NO_XY;
-            }
-        out->order = cssm_traverse(&out->pts, CSSM_GREEDY);
-        if (!out->order)
-            goto oom;
-        cssm_build_opts o = {.render_stage = "csm_render"};
-        gi_result r = cssm_maps_build_ex(gs, &out->pts, out->order, M, &o, host, &out->maps, err);
-        if (r != GI_OK) {
-            cssm_csm_direct_free(out);
-            return r;
-        }
-    }
-    /* distant light: per object its CSM over directions */
-    if (directional || (s->has_environment && s->envmap)) {
-        const uint32_t K = s->object_count;
-        out->distant = calloc(K ? K : 1, sizeof *out->distant);
-        out->local_from_world = malloc((K ? K : 1) * sizeof *out->local_from_world);
-        out->scale = malloc((K ? K : 1) * sizeof *out->scale);
-        out->sphere_w = malloc(4 * (size_t)(K ? K : 1) * sizeof *out->sphere_w);
-        if (!out->distant || !out->local_from_world || !out->scale || !out->sphere_w)
-            goto oom;
-        out->object_count = K;
-        for (uint32_t k = 0; k < K; k++) {
-            if (host && host->cancelled && host->cancelled(host)) {
-                cssm_csm_direct_free(out);
-                snprintf(err->text, sizeof err->text, "cssm_hrc: cancelled");
-                return GI_ERR_CANCELLED;
-            }
-            float T[16];
-            gi_scene_object_transform(s, k, gs->time, T);
-            if (!gi_mat4_invert(out->local_from_world[k], T)) {
-                cssm_csm_direct_free(out);
-                snprintf(err->text, sizeof err->text,
-                         "cssm_hrc: object %u has a singular transform", k);
-                return GI_ERR_INVALID_ARGUMENT;
-            }
-            float sc = gi_v3_length(gi_mat4_dir(T, gi_v3(1, 0, 0)));
-            out->scale[k] = sc > 0.0f ? sc : 1.0f;
-            gi_csm_distant_desc dd = {.M = 32, .n_theta = 32};
-            gi_result r = gi_csm_distant_build(gs, k, &dd, &out->distant[k], err);
-            if (r != GI_OK) {
-                cssm_csm_direct_free(out);
-                return r;
-            }
-            const float *sp = out->distant[k].sphere;
-            gi_vec3 c = gi_mat4_point(T, gi_v3(sp[0], sp[1], sp[2]));
-            out->sphere_w[4 * k] = c.x, out->sphere_w[4 * k + 1] = c.y,
-                              out->sphere_w[4 * k + 2] = c.z;
-            out->sphere_w[4 * k + 3] = sp[3] * out->scale[k];
-        }
-    }
-    return GI_OK;
-oom:
-    cssm_csm_direct_free(out);
-    snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for the direct light's CSMs");
-    return GI_ERR_OUT_OF_MEMORY;
+    if (r == GI_OK && NA + punctual)
+        r = point_maps(gs, NA, NA + punctual, M, host, out, err);
+    if (r == GI_OK && (directional || (s->has_environment && s->envmap)))
+        r = distant_maps(gs, host, out, err);
+    if (r != GI_OK)
+        cssm_csm_direct_free(out);
+    return r;
 }
 
 int cssm_csm_direct_open(const cssm_csm_direct *d, gi_vec3 x, gi_vec3 n, gi_vec3 w, float bias)

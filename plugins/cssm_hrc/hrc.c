@@ -8,7 +8,6 @@
 
 #include <float.h>
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -133,8 +132,7 @@ gi_result cssm_tree_build(const cssm_atlas *a, cssm_tree *out, gi_error *err)
     out->leaf_node = malloc(n * sizeof *out->leaf_node);
     if (!n || !out->nodes || !out->leaves || !out->leaf_node) {
         cssm_tree_free(out);
-        snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for the hierarchy");
-        return GI_ERR_OUT_OF_MEMORY;
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the hierarchy");
     }
     for (uint32_t i = 0; i < n; i++)
         out->leaves[i] = i;
@@ -422,8 +420,7 @@ gi_result cssm_solve_ex(const cssm_tree *t, cssm_ctree *ct, const cssm_atlas *a,
           *nodes = calloc(3 * (size_t)t->count, sizeof *nodes);
     if (!Le || !Rk || !Rn || !nodes) {
         free(Le), free(Rk), free(Rn), free(nodes);
-        snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for the lighting");
-        return GI_ERR_OUT_OF_MEMORY;
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the lighting");
     }
     for (uint32_t i = 0; i < N; i++)
         memcpy(&Le[3 * i], a->texels[i].emission, 3 * sizeof(float));

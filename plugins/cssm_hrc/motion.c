@@ -64,22 +64,19 @@ static float transform_scale(const float T[16])
     return cbrtf(fabsf(det));
 }
 
+/* Frees m and sets the error of a failed allocation for `what`. */
 static gi_result oom(cssm_motion *m, gi_error *err, const char *what)
 {
     cssm_motion_free(m);
-    snprintf(err->text, sizeof err->text, "cssm_hrc: out of memory for %s", what);
-    return GI_ERR_OUT_OF_MEMORY;
+    return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for %s", what);
 }
 
-gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, cssm_motion *out,
-                           gi_error *err)
+/* The per-texel, per-object and per-mover arrays of a motion of N
+ * texels, O objects and K movers, zeroed. */
+static gi_result motion_alloc(const cssm_atlas *a, uint32_t O, uint32_t K, cssm_motion *out,
+                              gi_error *err)
 {
-    memset(out, 0, sizeof *out);
-    uint32_t K = 0;
-    out->moving = cssm_motion_find(s, &K);
-    const uint32_t N = a->count, O = s->object_count;
-    out->object_count = O;
-    out->mover_count = K;
+    const uint32_t N = a->count;
     out->on_moving = calloc(N ? N : 1, 1);
     out->on_static = calloc(N ? N : 1, 1);
     out->local_p = calloc(N ? N : 1, sizeof *out->local_p);
@@ -100,16 +97,22 @@ gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, cssm
         !out->movers || !out->obj_first || !out->obj_texels || !out->hulls || !out->static_csm ||
         !out->static_Tinv || !out->static_scale)
         return oom(out, err, "the moving objects");
-    for (uint32_t k = 0, i = 0; k < O; k++) {
+    return GI_OK;
+}
+
+/* Every object's frame at prepare time t (its inverse and scale), and a
+ * mover for each animated object. */
+static gi_result motion_frames(const gi_scene *s, float t, cssm_motion *out, gi_error *err)
+{
+    for (uint32_t k = 0, i = 0; k < out->object_count; k++) {
         out->mover_of[k] = -1;
         float T0[16], *Ti = &out->static_Tinv[16 * (size_t)k];
         gi_scene_object_transform(s, k, t, T0);
         if (!gi_mat4_invert(Ti, T0)) {
             const char *name = s->objects[k].name ? s->objects[k].name : "?";
             cssm_motion_free(out);
-            snprintf(err->text, sizeof err->text,
-                     "cssm_hrc: the object '%.100s' has a singular transform", name);
-            return GI_ERR_INVALID_ARGUMENT;
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "cssm_hrc: the object '%.100s' has a singular transform", name);
         }
         out->static_scale[k] = transform_scale(T0);
         if (!s->objects[k].animated)
@@ -123,6 +126,16 @@ gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, cssm
         out->mover_of[k] = (int32_t)i++;
         out->object_moves[k] = 1;
     }
+    return GI_OK;
+}
+
+/* Per texel its object and whether it moves (then its position and
+ * normal in the mover's frame); the texels of each object; the charts of
+ * movers in their frames. */
+static gi_result motion_texels(const gi_scene *s, const cssm_atlas *a, cssm_motion *out,
+                               gi_error *err)
+{
+    const uint32_t N = a->count, O = out->object_count;
     for (uint32_t i = 0; i < N; i++) {
         const cssm_texel *x = &a->texels[i];
         uint32_t o = s->vertices[s->indices[3 * x->triangle]].object;
@@ -157,7 +170,14 @@ gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, cssm
         }
         out->local_charts[c] = ch;
     }
-    /* the pairs of objects with a mover in it */
+    return GI_OK;
+}
+
+/* The pairs of objects with a mover in it, and the convex hull of each
+ * object's vertices, local frame, once. */
+static gi_result motion_hulls(const gi_scene *s, cssm_motion *out, gi_error *err)
+{
+    const uint32_t O = out->object_count;
     out->pairs = calloc(O ? (size_t)O * O / 2 + 1 : 1, sizeof *out->pairs);
     if (!out->pairs)
         return oom(out, err, "the hull pairs");
@@ -165,7 +185,6 @@ gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, cssm
         for (uint32_t q = p + 1; q < O; q++)
             if (out->object_moves[p] || out->object_moves[q])
                 out->pairs[out->pair_count++] = (cssm_hull_pair){.a = p, .b = q};
-    /* the convex hull of each object's vertices, local frame, once */
     for (uint32_t k = 0; k < O; k++) {
         const gi_object *ob = &s->objects[k];
         float *pts = malloc((size_t)(ob->vertex_count ? ob->vertex_count : 1) * 3 * sizeof *pts);
@@ -187,16 +206,32 @@ gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, cssm
     return GI_OK;
 }
 
+gi_result cssm_motion_init(const gi_scene *s, float t, const cssm_atlas *a, cssm_motion *out,
+                           gi_error *err)
+{
+    memset(out, 0, sizeof *out);
+    uint32_t K = 0;
+    out->moving = cssm_motion_find(s, &K);
+    out->object_count = s->object_count;
+    out->mover_count = K;
+    gi_result r = motion_alloc(a, s->object_count, K, out, err);
+    if (r == GI_OK)
+        r = motion_frames(s, t, out, err);
+    if (r == GI_OK)
+        r = motion_texels(s, a, out, err);
+    if (r == GI_OK)
+        r = motion_hulls(s, out, err);
+    return r;
+}
+
 gi_result cssm_motion_build_maps(cssm_motion *m, const gi_gpu_scene *gs, const cssm_atlas *a,
                                  const uint32_t *order, uint32_t M, const gi_host *host,
                                  gi_error *err)
 {
     unsigned char *elsewhere = malloc(a->count ? a->count : 1);
-    if (!elsewhere) {
-        snprintf(err->text, sizeof err->text,
-                 "cssm_hrc: out of memory for the moving objects' maps");
-        return GI_ERR_OUT_OF_MEMORY;
-    }
+    if (!elsewhere)
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                            "cssm_hrc: out of memory for the moving objects' maps");
     gi_result r = GI_OK;
     for (uint32_t k = 0; k < m->mover_count && r == GI_OK; k++) {
         cssm_mover *mv = &m->movers[k];

@@ -1,0 +1,147 @@
+/* The cssm_hrc plugin's instance and what its files share (Ritschel,
+ * Grosch, Kautz, Seidel, GI 2008):
+ *   cssm_hrc.c       the descriptor, the parameter table cssm_params and
+ *                    the lifecycle functions;
+ *   direct_light.c   the direct light of the punctual lights and the
+ *                    environment (§4.7 "Direct Light"), or direct=csm;
+ *   lighting.c       the hierarchy's packed nodes (§4.2.1) and the atlas'
+ *                    lighting (§4.1, Fig. 8);
+ *   maps_cache.c     the CSSM (§3.2) of a static scene, cached on disk;
+ *   motion_update.c  moving rigid objects (§3.3) at prepare and update;
+ *   final_gather.c   the per-pixel final gather (§4.4, §4.5) and shading;
+ *   stats.c          the stats the plugin reports.
+ * The parts of the paper these call (atlas, CSSM, hierarchy) are in
+ * cssm.h, motion.h, env_cssm.h and direct_csm.h. */
+#ifndef CSSM_HRC_H
+#define CSSM_HRC_H
+
+#include "cssm.h"
+#include "direct_csm.h"
+#include "motion.h"
+
+#include "gi/envmap.h"
+#include "gi/kit.h"
+#include "gi/raytrace.h"
+
+typedef struct cssm_shadow_map {
+    int type; /* GI_LIGHT_* */
+    uint32_t size;
+    gi_vec3 pos, dir; /* light frame */
+    float view[16];   /* directional: world -> eye */
+    float half;       /* directional: half extent of the orthographic map */
+    float *depth;     /* 6 faces (point, spot) or 1 map, size^2 floats each */
+} cssm_shadow_map;
+
+typedef struct cssm_hrc {
+    gi_kit kit;
+    int R, M, traversal, bounces, max_cut, jitter, pcf, shadow_size;
+    float threshold, clamp_f, bias_f;
+    cssm_atlas atlas;
+    uint32_t *order;
+    cssm_maps maps;
+    cssm_tree tree;
+    float *texel_L; /* emission + reflected, 3 per texel */
+    float *node_L;  /* pulled texel_L */
+    float *node_Le; /* pulled emission (texel mode: direct light per pixel) */
+    float *node_B;  /* pulled reflected light (texel mode: indirect) */
+    float *texel_T; /* texel mode: view-dependent indirect light per texel, 3 per texel */
+    uint32_t *ids;  /* G-buffer ids read-back (texel mode) */
+    int mode;
+    int indirect, mc_samples;  /* §4.6 alternative: Monte Carlo from the atlas as a pdf */
+    float *texel_Le, *texel_B; /* emission and reflected light per texel */
+    double *cdf[3];            /* pdf tables of texel_L, texel_Le, texel_B */
+    cssm_shadow_map *shadows;
+    uint32_t shadow_count;
+    int env_samples; /* environment light: directions per texel (or pixel) */
+    int env_pixel;  /* 1: environment light traced per pixel; 0: the texels' irradiance looked up */
+    int env_mode;   /* environment visibility: 0 ray tracer, 1 the texels' own CSSMs (env_cssm.c) */
+    gi_rt *rt;      /* the scene for the environment's occlusion, NULL without environment */
+    float *texel_E; /* environment irradiance per texel, 3 per texel; NULL: no environment */
+    float *accum;   /* running average, 4 per pixel */
+    float *gb[5];   /* G-buffer read-back: position, normal, albedo, phong, emission */
+    uint32_t acc_w, acc_h;
+    cssm_motion motion; /* §3.3: moving rigid objects (motion.h); motion.moving < 0: static scene */
+    int nodes; /* 1: nodes=compact, the gathers read packed 128-bit nodes (§4.2.1, compact.c) */
+    cssm_ctree ct[3]; /* nodes=compact: the packed hierarchy with the intensity of texel_L,
+                         emission, reflected */
+    int direct, csm_points, csm_samples, csm_M; /* §4.7 "Direct Light": direct=csm (direct_csm.h) */
+    cssm_csm_direct *csm;                       /* its CSMs, NULL with direct=maps */
+    int prepared;
+} cssm_hrc;
+
+/* ------------------------------------------------------ direct_light.c */
+
+void cssm_release_shadows(cssm_hrc *c);
+/* The direct light's maps: the punctual lights' shadow maps (direct=maps),
+ * or the CSMs of direct=csm (§4.7, direct_csm.h), made again when the
+ * lights or materials change. Stage timer csm_precompute; stats
+ * csm_bytes, csm_points, csm_maps. */
+gi_result cssm_make_direct(cssm_hrc *c, const gi_gpu_scene *gs, gi_error *err);
+/* Irradiance-like factor of punctual light i at point x with normal n
+ * (E / colour: intensity x cos / d^2 x spot x range, or E cos), shadowed by
+ * its shadow map. Returns the light's irradiance in e[3]. */
+void cssm_punctual(const cssm_hrc *c, const gi_scene *s, uint32_t i, gi_vec3 x, gi_vec3 n,
+                   float e[3]);
+/* Environment irradiance at x with normal n (any direct-light method will
+ * do, §4.7 "Direct Light"): the estimator of env_cssm.c, each direction
+ * counted when the core's ray tracer finds nothing along it. */
+void cssm_env_irradiance(const gi_envmap *env, const gi_rt *rt, gi_vec3 x, gi_vec3 n, uint32_t K,
+                         uint32_t seed, const cssm_receiver *brdf, float e[3]);
+
+/* ---------------------------------------------------------- lighting.c */
+
+/* The gathers' options from the parameters. */
+cssm_gather_opts cssm_hrc_gather_opts(const cssm_hrc *c, float exposure, uint32_t *rng);
+/* The receiver position of surface point p (cssm_receiver_point). */
+gi_vec3 cssm_hrc_offset(const cssm_hrc *c, gi_vec3 p, gi_vec3 n);
+/* nodes=compact: the packed hierarchy (§4.2.1), one per light set, after
+ * the float one was built; stats of the node memory either way. */
+gi_result cssm_make_compact(cssm_hrc *c, gi_error *err);
+/* The atlas' lighting (§4.1, Fig. 8) with the punctual lights' direct
+ * light per texel added to the first bounce. Fails through the kit. */
+gi_result cssm_lighting(cssm_hrc *c, const gi_gpu_scene *gs);
+
+/* -------------------------------------------------------- maps_cache.c */
+
+/* The static scene's CSSM: read from the cache, or made and stored. */
+gi_result cssm_load_or_build_maps(cssm_hrc *c, const gi_gpu_scene *gs, gi_error *err);
+
+/* ----------------------------------------------------- motion_update.c */
+
+/* §3.3 with moving objects, made in prepare(): the static CSSM, each
+ * mover's own CSSM and CSM, the static objects' CSMs (motion.c). */
+gi_result cssm_build_moving(cssm_hrc *c, const gi_gpu_scene *gs, gi_error *err);
+/* §3.3 in update(): the movers placed at the scene's time, the hierarchy
+ * made again, the hulls checked. Fails through the kit (unprepared). */
+gi_result cssm_place_movers(cssm_hrc *c, const gi_gpu_scene *gs);
+
+/* ------------------------------------------------------ final_gather.c */
+
+/* The G-buffer read back into c->gb (and the ids, the image). Fails
+ * through the kit. */
+gi_result cssm_read_gbuffer(cssm_hrc *c, uint32_t w, uint32_t h);
+/* Texel mode (Fig. 17 right): the glossy gather of the indirect light per
+ * atlas texel toward the eye, into c->texel_T. Stage timer texel_gather. */
+void cssm_texel_gather(cssm_hrc *c, const gi_view *view, uint32_t frame, int random,
+                       cssm_gather_stats *st);
+/* Every pixel's radiance averaged into c->accum. Stage timer
+ * final_gather. */
+void cssm_final_gather(cssm_hrc *c, const gi_view *view, uint32_t frame, int random,
+                       cssm_gather_stats *st);
+
+/* ------------------------------------------------------------- stats.c */
+
+/* atlas_texels, atlas_chart_texels, atlas_charts, atlas_coverage. */
+void cssm_stats_atlas(const cssm_hrc *c);
+/* The CSSM's size and compression. */
+void cssm_stats_maps(const cssm_hrc *c);
+/* The moving objects' maps (cssm_build_moving). */
+void cssm_stats_moving(const cssm_hrc *c);
+/* data_bytes: the compressed visibility maps. */
+void cssm_stats_data_bytes(const cssm_hrc *c);
+/* The last hull check, in all and per pair of objects with a mover. */
+void cssm_stats_hulls(const cssm_hrc *c, const gi_scene *s);
+/* Cut size and clamped share of a frame's gathers. */
+void cssm_stats_cuts(const cssm_hrc *c, const cssm_gather_stats *st);
+
+#endif
