@@ -1,7 +1,7 @@
 /* The `vlf` method: Light Field Propagation and Rendering on the GPU
  * (Mortensen, Khanna, Slater, Afrigraph 2007), the GPU Virtual Light Field.
  *
- * prepare(): the light field is built on the CPU (vlf_core.c: stage
+ * prepare(): the light field is built on the CPU (field.c: stage
  * `sort`), propagated on the CPU or, with propagate = gpu, by compute
  * passes (vlf_gpu.c; stage `propagate`), then uploaded (`gpu_init`);
  * render(): the G-buffer and one compute pass reading the irradiance atlas
@@ -15,7 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "vlf_core.h"
+#include "vlf_field.h"
 #include "vlf_gpu.h"
 
 extern const gi_shader_source gi_vlf_shaders[];
@@ -71,7 +71,7 @@ static const gi_param_desc vlf_params_desc[] = {
      "surfaces as more "
      "faces (the tessellation sweep of propagation time against faces)"},
     {"propagate", GI_PARAM_ENUM, 0, 0, 0, "cpu|gpu", "propagation (Sec. 3.2-3.4)",
-     "where propagation runs: cpu: the sweeps in C (vlf_core.c); gpu: GL compute passes over the "
+     "where propagation runs: cpu: the sweeps in C (propagate.c); gpu: GL compute passes over the "
      "same depth order "
      "(vlf_gpu.c), the same maps within float rounding; gpu needs perturbed = 0"},
     {"hier_min", GI_PARAM_INT, 0, 0, 1000000, NULL, "hierarchical sort (Sec. 3.2)",

@@ -219,7 +219,7 @@ int vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, char *err, size_t err_size)
         }
         g->g_count[i] = (uint32_t)gath.n - g->g_first[i];
         fbase += ps->frag_count;
-        /* scatter jobs of subfield i (§3.4, as scatter() in vlf_core.c) */
+        /* scatter jobs of subfield i (§3.4, as vlf_scatter() in scatter.c) */
         g->j_first[i] = (uint32_t)jobs.n;
         uint32_t cells = 0;
         for (uint32_t fi = 0; ok && fi < f->face_count; fi++) {

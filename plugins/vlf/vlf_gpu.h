@@ -12,7 +12,7 @@
 
 #include <epoxy/gl.h>
 
-#include "vlf_core.h"
+#include "vlf_field.h"
 
 enum { VLF_GPU_PASSES = 4, VLF_GPU_BUFFERS = 16 };
 

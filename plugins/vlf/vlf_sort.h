@@ -4,8 +4,8 @@
  * another's plane where a cycle of overlaps makes any plain order wrong,
  * and the scene cut first by planes orthogonal to the direction through
  * its centre of mass (the paper's BSP split for large scenes). No GL, no
- * threads here: vlf_core.c runs one sorter per thread, one direction at a
- * time. */
+ * threads here: subfields.c and perturbed.c run one sorter per thread, one
+ * direction at a time. */
 #ifndef VLF_SORT_H
 #define VLF_SORT_H
 

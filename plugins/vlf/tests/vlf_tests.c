@@ -52,7 +52,7 @@
  *                      nothing through the panel, the per-ray sort and
  *                      perturbed directions agree; single-sided, the same
  *                      light lands on its back. */
-#include "vlf_core.h"
+#include "vlf_field.h"
 #include "vlf_gpu.h"
 
 #include "gi/brdf.h"

@@ -1,12 +1,14 @@
 /* The CPU side of the vlf method (Mortensen, Khanna, Slater, Afrigraph 2007):
- * the direction set with its spherical triangulation (§2.1), the parallel
- * subfields and their per-ray depth order (§3.2), the storage of diffuse
- * elements and sparse non-diffuse tiles (§3.1), and the propagation of
- * unshot radiance through radiance interfaces (§3.2-§3.4). No GL here: the
- * plugin (vlf.c) uploads the result for rendering (§4), and the tests drive
- * these functions directly. */
-#ifndef VLF_CORE_H
-#define VLF_CORE_H
+ * the direction set with its spherical triangulation (§2.1, directions.c),
+ * the parallel subfields and their per-ray depth order (§3.2, subfields.c,
+ * vlf_sort.c), the faces and their elements (§3.1, faces.c, field.c), the
+ * storage of diffuse elements and sparse non-diffuse tiles (§3.1, §6,
+ * precision.c), and the propagation of unshot radiance through radiance
+ * interfaces (§3.2-§3.5, propagate.c, scatter.c, perturbed.c, lights.c).
+ * No GL here: the plugin (vlf.c) uploads the result for rendering (§4),
+ * and the tests drive these functions directly. */
+#ifndef VLF_FIELD_H
+#define VLF_FIELD_H
 
 #include <stddef.h>
 #include <stdint.h>

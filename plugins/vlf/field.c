@@ -1,0 +1,279 @@
+/* The light field of the vlf method built for a scene (paper §2.1,
+ * §3.1, §3.2): the settings checked, the scene scaled into the unit
+ * sphere, its lights, faces and elements, every subfield's depth order,
+ * the tile storage of the non-diffuse faces and the memory it takes; and
+ * the field freed. */
+#define _POSIX_C_SOURCE 200809L
+#include "field_internal.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gi/lights.h"
+#include "gi/raytrace.h"
+
+int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *p, char *err,
+                    size_t err_size)
+{
+    memset(f, 0, sizeof *f);
+    f->prm = *p;
+    double t0 = vlf_now_s();
+    if (p->precision > VLF_PREC_RGB9E5) {
+        snprintf(err, err_size, "vlf: storage precision %u unknown", p->precision);
+        return -1;
+    }
+    if (p->S < 1 || p->S > 8) {
+        snprintf(err, err_size, "vlf: supersampling S = %u outside 1..8", p->S);
+        return -1;
+    }
+    if (p->N < 4 || p->m < 1 || p->N % p->m != 0) {
+        snprintf(err, err_size, "vlf: N = %u must be a multiple of the tile size m = %u", p->N,
+                 p->m);
+        return -1;
+    }
+    double ray_bytes =
+        (double)p->l * (double)(p->N * p->S) * (double)(p->N * p->S) * sizeof(uint32_t);
+    if (ray_bytes > 2.0 * 1024 * 1024 * 1024) {
+        snprintf(err, err_size,
+                 "vlf: l (N S)^2 = %.3g rays need %.1f GB of depth lists alone; lower l, N or S",
+                 ray_bytes / sizeof(uint32_t), ray_bytes / (1024.0 * 1024 * 1024));
+        return -1;
+    }
+    if (vlf_dirs_build(&f->dirs, p->l, err, err_size) != 0)
+        return -1;
+    if (s->triangle_count == 0) {
+        snprintf(err, err_size, "vlf: the scene has no triangles");
+        return -1;
+    }
+    float b[6];
+    gi_scene_bounds_at(s, t, b);
+    f->centre = gi_v3(0.5f * (b[0] + b[3]), 0.5f * (b[1] + b[4]), 0.5f * (b[2] + b[5]));
+    f->radius = 0.5f * sqrtf((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) +
+                             (b[5] - b[2]) * (b[5] - b[2]));
+    f->radius *= 1.001f;
+    if (!(f->radius > 0.0f) || !isfinite(f->radius)) {
+        snprintf(err, err_size, "vlf: the scene's bounds are empty or not finite");
+        return -1;
+    }
+    f->env = s->envmap;
+    /* Directional lights (not in the paper, which has emissive faces and
+     * sky): parallel light, so it enters like the sky of Fig. 6, into the
+     * interfaces of the three directions around the light's with their
+     * barycentric weights, radiance alpha E / dOmega, so that each carries
+     * alpha E through a unit of area across it. */
+    f->sun = calloc((size_t)p->l * 2 * 3, sizeof *f->sun);
+    if (!f->sun)
+        goto oom;
+    for (uint32_t li = 0; li < s->light_count; li++) {
+        if (s->lights[li].type != GI_LIGHT_DIRECTIONAL)
+            continue;
+        gi_light_frame fr = gi_scene_light_at(s, li, t);
+        float len = gi_v3_length(fr.direction);
+        if (!(len > 0.0f))
+            continue;
+        uint32_t node[3];
+        float al[3];
+        vlf_dirs_locate(&f->dirs, gi_v3_scale(fr.direction, 1.0f / len), node, al);
+        for (int k = 0; k < 3; k++)
+            for (int q = 0; q < 3; q++)
+                f->sun[3 * node[k] + (uint32_t)q] +=
+                    al[k] * s->lights[li].intensity[q] / f->dirs.solid_angle[node[k]];
+        f->sun_count++;
+    }
+    /* Point and spot lights: a first shot by shadow rays (punctual_first_shot). */
+    for (uint32_t li = 0; li < s->light_count; li++)
+        f->punctual_count += s->lights[li].type != GI_LIGHT_DIRECTIONAL;
+    if (f->punctual_count) {
+        f->punctual = calloc(f->punctual_count, sizeof *f->punctual);
+        if (!f->punctual)
+            goto oom;
+        uint32_t k = 0;
+        for (uint32_t li = 0; li < s->light_count; li++) {
+            const gi_light *L = &s->lights[li];
+            if (L->type == GI_LIGHT_DIRECTIONAL)
+                continue;
+            gi_light_frame fr = gi_scene_light_at(s, li, t);
+            vlf_punctual *P = &f->punctual[k++];
+            P->spot = L->type == GI_LIGHT_SPOT;
+            P->pos = fr.position;
+            P->dir = fr.direction;
+            memcpy(P->I, L->intensity, sizeof P->I);
+            P->range = L->range;
+            P->cos_inner = cosf(L->inner_cone);
+            P->cos_outer = cosf(L->outer_cone);
+        }
+        gi_error e;
+        if (gi_rt_create(s, t, &f->rt, &e) != GI_OK) {
+            snprintf(err, err_size, "vlf: shadow rays for the point lights: %s", e.text);
+            return -1;
+        }
+    }
+    if (!vlf_group_faces(f, s, t))
+        goto oom;
+    uint32_t elems = 0;
+    for (uint32_t fi = 0; fi < f->face_count; fi++) {
+        vlf_face *fc = &f->faces[fi];
+        fc->first_elem = elems;
+        elems += fc->W * fc->H;
+        fc->nd = (fc->ks[0] > 0.0f || fc->ks[1] > 0.0f || fc->ks[2] > 0.0f) ? (int32_t)f->nd_count++
+                                                                            : -1;
+        /* Diffuse emission normalised so that the discrete directions carry
+         * exactly pi L per unit area out of the face. */
+        double sum = 0.0;
+        for (uint32_t sd = 0; sd < 2 * p->l; sd++) {
+            float c2 = gi_v3_dot(fc->n, f->dirs.signed_dirs[sd]);
+            if (c2 > 0.0f)
+                sum += c2 * f->dirs.solid_angle[sd];
+        }
+        fc->send_scale = sum > 0.0 ? (float)(GI_PI / sum) : 1.0f;
+    }
+    f->elem_count = elems;
+    f->elem_face = malloc((size_t)elems * sizeof *f->elem_face);
+    f->elem_area = calloc((size_t)elems, sizeof *f->elem_area);
+    f->elem_c = calloc((size_t)elems * 2 + 2, sizeof *f->elem_c);
+    f->E_tot = calloc((size_t)elems * 3, sizeof(float));
+    f->E_next = calloc((size_t)elems * 3, sizeof(float));
+    f->L_cur = calloc((size_t)elems * 3, sizeof(float));
+    f->psf = calloc(p->l, sizeof *f->psf);
+    f->rects = calloc((size_t)f->nd_count * p->l + 1, sizeof *f->rects);
+    if (!f->elem_face || !f->elem_area || !f->elem_c || !f->E_tot || !f->E_next || !f->L_cur ||
+        !f->psf || !f->rects)
+        goto oom;
+    for (uint32_t fi = 0; fi < f->face_count; fi++) {
+        vlf_face *fc = &f->faces[fi];
+        for (uint32_t e = 0; e < fc->W * fc->H; e++)
+            f->elem_face[fc->first_elem + e] = fi;
+    }
+    f->elem_kd = calloc((size_t)elems * 3 + 3, sizeof *f->elem_kd);
+    if (!f->elem_kd)
+        goto oom;
+    vlf_element_areas(f, s);
+    /* a back side's elements are its front's texels: the same areas,
+     * centroids and (textured) albedo sums */
+    for (uint32_t fi = 0; fi < f->face_count; fi++) {
+        const vlf_face *fc = &f->faces[fi];
+        if (!fc->back)
+            continue;
+        const vlf_face *fr = &f->faces[fc->twin];
+        for (uint32_t e = 0; e < fc->W * fc->H; e++) {
+            size_t d = fc->first_elem + e, o = fr->first_elem + e;
+            f->elem_area[d] = f->elem_area[o];
+            memcpy(f->elem_c + 2 * d, f->elem_c + 2 * o, 2 * sizeof *f->elem_c);
+            memcpy(f->elem_kd + 3 * d, f->elem_kd + 3 * o, 3 * sizeof *f->elem_kd);
+        }
+    }
+    /* each element's albedo: the material's, or on textured faces the
+     * texture averaged over the element's part of the face */
+    for (uint32_t e = 0; e < elems; e++) {
+        const vlf_face *fc = &f->faces[f->elem_face[e]];
+        for (int c = 0; c < 3; c++) {
+            float *kd = &f->elem_kd[3 * (size_t)e + (size_t)c];
+            *kd = fc->textured && f->elem_area[e] > 0.0f ? *kd / f->elem_area[e] : fc->kd[c];
+        }
+    }
+    for (uint32_t e = 0; e < elems; e++) {
+        if (f->elem_area[e] > 0.0f) {
+            f->elem_c[2 * (size_t)e] /= f->elem_area[e];
+            f->elem_c[2 * (size_t)e + 1] /= f->elem_area[e];
+        }
+    }
+    if ((uint64_t)s->triangle_count * p->subdivide * p->subdivide > 50000000u) {
+        snprintf(err, err_size, "vlf: %u triangles cut into %u^2 each are too many",
+                 s->triangle_count, p->subdivide);
+        return -1;
+    }
+    if (!vlf_subdivide_triangles(f, p->subdivide < 1 ? 1 : p->subdivide) || !vlf_build_subfields(f))
+        goto oom;
+    /* Tile storage offsets, then coverage of each stored cell. */
+    size_t cells = 0;
+    uint32_t tiles = 0;
+    for (size_t r = 0; r < (size_t)f->nd_count * p->l; r++) {
+        f->rects[r].offset = (uint32_t)cells;
+        cells += (size_t)f->rects[r].w * f->rects[r].h;
+        tiles += f->rects[r].w * f->rects[r].h / (p->m * p->m);
+    }
+    if (cells > 0x7fffffffu) {
+        snprintf(err, err_size, "vlf: %zu non-diffuse cells do not fit (lower N or l)", cells);
+        return -1;
+    }
+    f->nd_cells = (uint32_t)cells;
+    size_t nc = cells ? cells : 1;
+    f->nd_cover = calloc(nc, 1);
+    f->out_cur = calloc(nc * 3, sizeof(float));
+    f->out_next = calloc(nc * 3, sizeof(float));
+    f->out_tot = calloc(nc * 3, sizeof(float));
+    f->in = calloc(nc * 3, sizeof(float));
+    if (!f->nd_cover || !f->out_cur || !f->out_next || !f->out_tot || !f->in)
+        goto oom;
+    size_t frags = 0;
+    for (uint32_t i = 0; i < p->l; i++) {
+        const vlf_psf *ps = &f->psf[i];
+        frags += ps->frag_count;
+        uint32_t NS = p->N * p->S;
+        for (uint32_t c = 0; c < NS * NS; c++)
+            for (uint32_t k = ps->cell_start[c]; k < ps->cell_start[c + 1]; k++) {
+                const vlf_face *fc = &f->faces[f->elem_face[ps->frag[k]]];
+                if (fc->nd >= 0)
+                    f->nd_cover[vlf_rect_slot(&f->rects[(size_t)fc->nd * p->l + i], (c % NS) / p->S,
+                                              (c / NS) / p->S)] = 1;
+            }
+    }
+    uint32_t ndel = 0;
+    for (size_t c = 0; c < cells; c++)
+        ndel += f->nd_cover[c];
+    f->st.diffuse_elements = elems;
+    f->st.nondiffuse_elements = ndel;
+    f->st.tiles = tiles;
+    /* Memory as the paper counts it: current, next and total ir/radiance
+     * maps in the storage format for both kinds (and the incoming tiles),
+     * plus the depth order; rendering keeps the totals and the tile index
+     * only (vlf.c uploads exactly these maps). */
+    size_t bpv = vlf_precision_bytes(p->precision);
+    f->st.bytes_maps_render = ((size_t)elems + cells) * bpv;
+    f->st.bytes_propagate =
+        (size_t)elems * bpv * 3 + cells * bpv * 4 + cells + frags * sizeof(uint32_t) +
+        (size_t)p->l * ((size_t)p->N * p->S * p->N * p->S + 1) * sizeof(uint32_t);
+    f->st.bytes_render = f->st.bytes_maps_render + (size_t)f->nd_count * p->l * sizeof(vlf_rect);
+    f->st.sort_s = vlf_now_s() - t0;
+    return 0;
+oom:
+    snprintf(err, err_size, "vlf: out of memory building the light field (N = %u, l = %u)", p->N,
+             p->l);
+    return -1;
+}
+
+void vlf_field_free(vlf_field *f)
+{
+    if (f->psf)
+        for (uint32_t i = 0; i < f->prm.l; i++) {
+            free(f->psf[i].cell_start);
+            free(f->psf[i].frag);
+        }
+    free(f->psf);
+    vlf_dirs_free(&f->dirs);
+    free(f->faces);
+    free(f->tri_face);
+    free(f->tri_group);
+    free(f->tri_p);
+    free(f->elem_face);
+    free(f->elem_area);
+    free(f->elem_kd);
+    free(f->rects);
+    free(f->nd_cover);
+    free(f->E_tot);
+    free(f->E_next);
+    free(f->L_cur);
+    free(f->out_cur);
+    free(f->out_next);
+    free(f->out_tot);
+    free(f->in);
+    free(f->sun);
+    free(f->punctual);
+    free(f->elem_c);
+    if (f->rt)
+        gi_rt_free(f->rt);
+    memset(f, 0, sizeof *f);
+}
