@@ -9,7 +9,6 @@
 
 #include <float.h>
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -41,13 +40,12 @@ static float spherical_area(gi_vec3 a, gi_vec3 b, gi_vec3 c)
     return 2.0f * fabsf(atan2f(num, den));
 }
 
-int vlf_dirs_build(vlf_dirs *d, uint32_t l, char *err, size_t err_size)
+gi_result vlf_dirs_build(vlf_dirs *d, uint32_t l, gi_error *err)
 {
     memset(d, 0, sizeof *d);
-    if (l < 4) {
-        snprintf(err, err_size, "vlf: l = %u directions, at least 4 needed", l);
-        return -1;
-    }
+    if (l < 4)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "vlf: l = %u directions, at least 4 needed", l);
     d->l = l;
     uint32_t n = 2 * l;
     d->signed_dirs = calloc(n, sizeof *d->signed_dirs);
@@ -56,8 +54,7 @@ int vlf_dirs_build(vlf_dirs *d, uint32_t l, char *err, size_t err_size)
     if (!d->signed_dirs || !d->solid_angle || !pts) {
         free(pts);
         vlf_dirs_free(d);
-        snprintf(err, err_size, "vlf: out of memory for %u directions", l);
-        return -1;
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "vlf: out of memory for %u directions", l);
     }
     /* Spherical Fibonacci points on the upper hemisphere: equal-area bands in
      * z, golden-angle steps in phi. */
@@ -79,17 +76,16 @@ int vlf_dirs_build(vlf_dirs *d, uint32_t l, char *err, size_t err_size)
      * triangulation (gi/algo/hull.h). */
     uint32_t *raw = NULL, count = 0;
     gi_error hull_err;
-    int ok = gi_hull_triangulate(pts, n, &raw, &count, &hull_err) == GI_OK;
+    gi_result r = gi_hull_triangulate(pts, n, &raw, &count, &hull_err);
     free(pts);
-    if (ok) {
+    if (r == GI_OK) {
         d->tris = calloc((size_t)count * 3, sizeof *d->tris);
         d->tri_inv = calloc((size_t)count * 9, sizeof *d->tri_inv);
-        ok = d->tris && d->tri_inv;
-        if (!ok)
-            snprintf(hull_err.text, sizeof hull_err.text, "out of memory");
+        if (!d->tris || !d->tri_inv)
+            r = gi_error_set(&hull_err, GI_ERR_OUT_OF_MEMORY, "out of memory");
     }
     uint32_t t = 0;
-    for (; ok && t < count; t++) {
+    for (; r == GI_OK && t < count; t++) {
         uint32_t v[3] = {raw[3 * t], raw[3 * t + 1], raw[3 * t + 2]};
         gi_vec3 a = d->signed_dirs[v[0]], b = d->signed_dirs[v[1]], c = d->signed_dirs[v[2]];
         gi_vec3 nrm = gi_v3_cross(gi_v3_sub(b, a), gi_v3_sub(c, a));
@@ -103,8 +99,7 @@ int vlf_dirs_build(vlf_dirs *d, uint32_t l, char *err, size_t err_size)
         }
         float m[9] = {a.x, b.x, c.x, a.y, b.y, c.y, a.z, b.z, c.z};
         if (!inv3(m, d->tri_inv + 9 * t)) {
-            ok = 0;
-            snprintf(hull_err.text, sizeof hull_err.text, "a degenerate spherical triangle");
+            r = gi_error_set(&hull_err, GI_ERR_INVALID_ARGUMENT, "a degenerate spherical triangle");
             break;
         }
         memcpy(d->tris + 3 * t, v, sizeof v);
@@ -114,12 +109,12 @@ int vlf_dirs_build(vlf_dirs *d, uint32_t l, char *err, size_t err_size)
     }
     d->tri_count = t;
     free(raw);
-    if (!ok) {
+    if (r != GI_OK) {
         vlf_dirs_free(d);
-        snprintf(err, err_size, "vlf: could not triangulate %u directions: %s", l, hull_err.text);
-        return -1;
+        return gi_error_set(err, r, "vlf: could not triangulate %u directions: %s", l,
+                            hull_err.text);
     }
-    return 0;
+    return GI_OK;
 }
 
 void vlf_dirs_free(vlf_dirs *d)

@@ -28,7 +28,7 @@ static int key_cmp(const void *a, const void *b)
     return x->tri < y->tri ? -1 : (x->tri > y->tri);
 }
 
-int vlf_group_faces(vlf_field *f, const gi_scene *s, float t)
+gi_result vlf_group_faces(vlf_field *f, const gi_scene *s, float t)
 {
     uint32_t T = s->triangle_count;
     f->tri_count = T;
@@ -41,7 +41,7 @@ int vlf_group_faces(vlf_field *f, const gi_scene *s, float t)
     if (!f->tri_face || !f->tri_group || !f->tri_p || !keys || !nrm || !f->faces) {
         free(keys);
         free(nrm);
-        return 0;
+        return GI_ERR_OUT_OF_MEMORY;
     }
     for (uint32_t ti = 0; ti < T; ti++) {
         gi_vec3 w[3];
@@ -128,7 +128,7 @@ int vlf_group_faces(vlf_field *f, const gi_scene *s, float t)
     f->face_count = nf;
     free(keys);
     free(nrm);
-    return 1;
+    return GI_OK;
 }
 
 /* Clips polygon (x, y)[n] to the half-plane s * (coord k) <= c; returns
@@ -217,17 +217,17 @@ void vlf_element_areas(vlf_field *f, const gi_scene *s)
     }
 }
 
-int vlf_subdivide_triangles(vlf_field *f, uint32_t k)
+gi_result vlf_subdivide_triangles(vlf_field *f, uint32_t k)
 {
     f->tri_sub = k * k;
     if (k <= 1)
-        return 1;
+        return GI_OK;
     size_t T = (size_t)f->tri_count * k * k;
     gi_vec3 *P = malloc(T * 3 * sizeof *P);
     uint32_t *F = malloc(T * sizeof *F), *Gr = malloc(T * sizeof *Gr);
     if (!P || !F || !Gr) {
         free(P), free(F), free(Gr);
-        return 0;
+        return GI_ERR_OUT_OF_MEMORY;
     }
     size_t n = 0;
     float inv = 1.0f / (float)k;
@@ -258,5 +258,5 @@ int vlf_subdivide_triangles(vlf_field *f, uint32_t k)
     f->tri_face = F;
     f->tri_group = Gr;
     f->tri_count = (uint32_t)n;
-    return 1;
+    return GI_OK;
 }

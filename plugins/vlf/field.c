@@ -8,56 +8,48 @@
 
 #include <math.h>
 #include <stdint.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "gi/lights.h"
 #include "gi/raytrace.h"
 
-int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *p, char *err,
-                    size_t err_size)
+gi_result vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_settings *p,
+                          gi_error *err)
 {
     memset(f, 0, sizeof *f);
     f->prm = *p;
     double t0 = vlf_now_s();
-    if (p->precision > VLF_PREC_RGB9E5) {
-        snprintf(err, err_size, "vlf: storage precision %u unknown", p->precision);
-        return -1;
-    }
-    if (p->S < 1 || p->S > 8) {
-        snprintf(err, err_size, "vlf: supersampling S = %u outside 1..8", p->S);
-        return -1;
-    }
-    if (p->N < 4 || p->m < 1 || p->N % p->m != 0) {
-        snprintf(err, err_size, "vlf: N = %u must be a multiple of the tile size m = %u", p->N,
-                 p->m);
-        return -1;
-    }
+    if (p->precision > VLF_PREC_RGB9E5)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "vlf: storage precision %u unknown",
+                            p->precision);
+    if (p->S < 1 || p->S > 8)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "vlf: supersampling S = %u outside 1..8",
+                            p->S);
+    if (p->N < 4 || p->m < 1 || p->N % p->m != 0)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "vlf: N = %u must be a multiple of the tile size m = %u", p->N, p->m);
     double ray_bytes =
         (double)p->l * (double)(p->N * p->S) * (double)(p->N * p->S) * sizeof(uint32_t);
-    if (ray_bytes > 2.0 * 1024 * 1024 * 1024) {
-        snprintf(err, err_size,
-                 "vlf: l (N S)^2 = %.3g rays need %.1f GB of depth lists alone; lower l, N or S",
-                 ray_bytes / sizeof(uint32_t), ray_bytes / (1024.0 * 1024 * 1024));
-        return -1;
-    }
-    if (vlf_dirs_build(&f->dirs, p->l, err, err_size) != 0)
-        return -1;
-    if (s->triangle_count == 0) {
-        snprintf(err, err_size, "vlf: the scene has no triangles");
-        return -1;
-    }
+    if (ray_bytes > 2.0 * 1024 * 1024 * 1024)
+        return gi_error_set(
+            err, GI_ERR_INVALID_ARGUMENT,
+            "vlf: l (N S)^2 = %.3g rays need %.1f GB of depth lists alone; lower l, N or S",
+            ray_bytes / sizeof(uint32_t), ray_bytes / (1024.0 * 1024 * 1024));
+    gi_result rc = vlf_dirs_build(&f->dirs, p->l, err);
+    if (rc != GI_OK)
+        return rc;
+    if (s->triangle_count == 0)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "vlf: the scene has no triangles");
     float b[6];
     gi_scene_bounds_at(s, t, b);
     f->centre = gi_v3(0.5f * (b[0] + b[3]), 0.5f * (b[1] + b[4]), 0.5f * (b[2] + b[5]));
     f->radius = 0.5f * sqrtf((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) +
                              (b[5] - b[2]) * (b[5] - b[2]));
     f->radius *= 1.001f;
-    if (!(f->radius > 0.0f) || !isfinite(f->radius)) {
-        snprintf(err, err_size, "vlf: the scene's bounds are empty or not finite");
-        return -1;
-    }
+    if (!(f->radius > 0.0f) || !isfinite(f->radius))
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "vlf: the scene's bounds are empty or not finite");
     f->env = s->envmap;
     /* Directional lights (not in the paper, which has emissive faces and
      * sky): parallel light, so it enters like the sky of Fig. 6, into the
@@ -106,12 +98,11 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
             P->cos_outer = cosf(L->outer_cone);
         }
         gi_error e;
-        if (gi_rt_create(s, t, &f->rt, &e) != GI_OK) {
-            snprintf(err, err_size, "vlf: shadow rays for the point lights: %s", e.text);
-            return -1;
-        }
+        rc = gi_rt_create(s, t, &f->rt, &e);
+        if (rc != GI_OK)
+            return gi_error_set(err, rc, "vlf: shadow rays for the point lights: %s", e.text);
     }
-    if (!vlf_group_faces(f, s, t))
+    if (vlf_group_faces(f, s, t) != GI_OK)
         goto oom;
     uint32_t elems = 0;
     for (uint32_t fi = 0; fi < f->face_count; fi++) {
@@ -180,12 +171,12 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
             f->elem_c[2 * (size_t)e + 1] /= f->elem_area[e];
         }
     }
-    if ((uint64_t)s->triangle_count * p->subdivide * p->subdivide > 50000000u) {
-        snprintf(err, err_size, "vlf: %u triangles cut into %u^2 each are too many",
-                 s->triangle_count, p->subdivide);
-        return -1;
-    }
-    if (!vlf_subdivide_triangles(f, p->subdivide < 1 ? 1 : p->subdivide) || !vlf_build_subfields(f))
+    if ((uint64_t)s->triangle_count * p->subdivide * p->subdivide > 50000000u)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "vlf: %u triangles cut into %u^2 each are too many", s->triangle_count,
+                            p->subdivide);
+    if (vlf_subdivide_triangles(f, p->subdivide < 1 ? 1 : p->subdivide) != GI_OK ||
+        vlf_build_subfields(f) != GI_OK)
         goto oom;
     /* Tile storage offsets, then coverage of each stored cell. */
     size_t cells = 0;
@@ -195,10 +186,9 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
         cells += (size_t)f->rects[r].w * f->rects[r].h;
         tiles += f->rects[r].w * f->rects[r].h / (p->m * p->m);
     }
-    if (cells > 0x7fffffffu) {
-        snprintf(err, err_size, "vlf: %zu non-diffuse cells do not fit (lower N or l)", cells);
-        return -1;
-    }
+    if (cells > 0x7fffffffu)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "vlf: %zu non-diffuse cells do not fit (lower N or l)", cells);
     f->nd_cells = (uint32_t)cells;
     size_t nc = cells ? cells : 1;
     f->nd_cover = calloc(nc, 1);
@@ -238,11 +228,10 @@ int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *
         (size_t)p->l * ((size_t)p->N * p->S * p->N * p->S + 1) * sizeof(uint32_t);
     f->st.bytes_render = f->st.bytes_maps_render + (size_t)f->nd_count * p->l * sizeof(vlf_rect);
     f->st.sort_s = vlf_now_s() - t0;
-    return 0;
+    return GI_OK;
 oom:
-    snprintf(err, err_size, "vlf: out of memory building the light field (N = %u, l = %u)", p->N,
-             p->l);
-    return -1;
+    return gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                        "vlf: out of memory building the light field (N = %u, l = %u)", p->N, p->l);
 }
 
 void vlf_field_free(vlf_field *f)

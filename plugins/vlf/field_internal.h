@@ -3,7 +3,11 @@
  * (§3.2, subfields.c), the steps that build the field (faces.c,
  * subfields.c, used by field.c), and the steps of propagation kept in files
  * of their own (lights.c, scatter.c, perturbed.c, used by propagate.c). A
- * file including it defines _POSIX_C_SOURCE first (clock_gettime). */
+ * file including it defines _POSIX_C_SOURCE first (clock_gettime).
+ *
+ * These steps fail only for lack of memory: they return
+ * GI_ERR_OUT_OF_MEMORY (or NULL) without a message, and the function of
+ * vlf_field.h that runs them words it (it knows what was being built). */
 #ifndef VLF_FIELD_INTERNAL_H
 #define VLF_FIELD_INTERNAL_H
 
@@ -50,12 +54,13 @@ typedef struct vlf_sort_counts {
  * that order, each ray's fragments then kept in the order they came
  * (a stable bucket sort by cell); rays order: all fragments sorted by cell
  * and depth. bbox (4 per face, may be NULL) grows by the subfield cells
- * each face covers. 1, or 0 out of memory. */
-int vlf_list_fragments(const vlf_field *f, const vlf_psf *fr, vlf_frag_buf *buf, vlf_frag_buf *tmp,
-                       vlf_sorter *so, int32_t *bbox, vlf_sort_counts *cnt);
+ * each face covers. */
+gi_result vlf_list_fragments(const vlf_field *f, const vlf_psf *fr, vlf_frag_buf *buf,
+                             vlf_frag_buf *tmp, vlf_sorter *so, int32_t *bbox,
+                             vlf_sort_counts *cnt);
 /* The sort stage on f->prm.threads threads (the calling one among them):
- * every subfield's depth order and tile rectangles. 1, or 0 out of memory. */
-int vlf_build_subfields(vlf_field *f);
+ * every subfield's depth order and tile rectangles. */
+gi_result vlf_build_subfields(vlf_field *f);
 
 /* The slot of subfield cell (cx, cy) in the tile storage of rectangle r. */
 static inline size_t vlf_rect_slot(const vlf_rect *r, uint32_t cx, uint32_t cy)
@@ -68,23 +73,20 @@ static inline size_t vlf_rect_slot(const vlf_rect *r, uint32_t cx, uint32_t cy)
 /* Faces: the scene's triangles grouped by material and plane (normal and
  * offset to 1e-3), each group one face with a chart of density texels per
  * unit length over its bounding rectangle in the plane (§3.1: one
- * irradiance texture per face; the charts are the atlas). 1, or 0 out of
- * memory. */
-int vlf_group_faces(vlf_field *f, const gi_scene *s, float t);
+ * irradiance texture per face; the charts are the atlas). */
+gi_result vlf_group_faces(vlf_field *f, const gi_scene *s, float t);
 /* Area of each element inside its face: every triangle clipped exactly
  * against the texels of its bounding box. */
 void vlf_element_areas(vlf_field *f, const gi_scene *s);
 /* Cuts every triangle into k^2 (a regular grid of its barycentric
  * coordinates, the winding kept): the same surfaces as more faces, for the
- * paper's claim that propagation is linear in the number of faces. 1, or 0
- * out of memory. */
-int vlf_subdivide_triangles(vlf_field *f, uint32_t k);
+ * paper's claim that propagation is linear in the number of faces. */
+gi_result vlf_subdivide_triangles(vlf_field *f, uint32_t k);
 
 /* ---- Propagation (§3.2-§3.5) ---------------------------------------------- */
 
-/* The point and spot lights' first shot into the next maps (lights.c). 1,
- * or 0 out of memory. */
-int vlf_punctual_first_shot(vlf_field *f);
+/* The point and spot lights' first shot into the next maps (lights.c). */
+gi_result vlf_punctual_first_shot(vlf_field *f);
 /* Non-diffuse scattering (§3.4) of what subfield i brought (scatter.c). */
 void vlf_scatter(vlf_field *f, uint32_t i);
 
@@ -94,8 +96,8 @@ void vlf_scatter(vlf_field *f, uint32_t i);
 typedef struct vlf_perturbed vlf_perturbed;
 vlf_perturbed *vlf_perturbed_create(vlf_field *f);
 /* The sweeps of every perturbed direction of fixed direction i, both ways,
- * standing in for the fixed direction's. 1, or 0 out of memory. */
-int vlf_perturbed_sweeps(vlf_perturbed *pt, uint32_t i, int first_iteration);
+ * standing in for the fixed direction's. */
+gi_result vlf_perturbed_sweeps(vlf_perturbed *pt, uint32_t i, int first_iteration);
 void vlf_perturbed_free(vlf_perturbed *pt); /* NULL is fine */
 
 #endif

@@ -48,14 +48,14 @@ static void punctual_at(const vlf_field *f, gi_vec3 x, gi_vec3 n, float *E, gi_v
  * face, reflected as §3.4 reflects the interface's light), added to the
  * next maps of the first iteration: shot on from there like received
  * light. */
-int vlf_punctual_first_shot(vlf_field *f)
+gi_result vlf_punctual_first_shot(vlf_field *f)
 {
     uint32_t P = f->punctual_count, l = f->prm.l;
     float *E = malloc((size_t)P * 3 * sizeof *E), *g = malloc((size_t)2 * l * sizeof *g);
     gi_vec3 *w = malloc((size_t)P * sizeof *w);
     if (!E || !g || !w) {
         free(E), free(g), free(w);
-        return 0;
+        return GI_ERR_OUT_OF_MEMORY;
     }
     for (uint32_t e = 0; e < f->elem_count; e++) {
         if (!(f->elem_area[e] > 0.0f))
@@ -111,5 +111,5 @@ int vlf_punctual_first_shot(vlf_field *f)
         }
     }
     free(E), free(g), free(w);
-    return 1;
+    return GI_OK;
 }

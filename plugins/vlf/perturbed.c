@@ -17,8 +17,8 @@
 /* Fragments of all faces along a perturbed direction (frame fr), sorted
  * per ray front to back; kept with their depths (§3.5: perturbed
  * directions are sorted like fixed ones, used for transport, discarded). */
-static int perturbed_list(vlf_field *f, const vlf_psf *fr, vlf_frag_buf *buf, vlf_frag_buf *tmp,
-                          vlf_sorter *so)
+static gi_result perturbed_list(vlf_field *f, const vlf_psf *fr, vlf_frag_buf *buf,
+                                vlf_frag_buf *tmp, vlf_sorter *so)
 {
     vlf_sort_counts cnt = {0, 0, 0, 0, 0, 0, 0};
     return vlf_list_fragments(f, fr, buf, tmp, so, NULL, &cnt);
@@ -175,7 +175,7 @@ static void *pert_thread(void *arg)
             vlf_psf *fr = &pp->frame[k];
             fr->n = perturbed_dir(pp->f, pp->i, k);
             gi_onb(fr->n, &fr->u, &fr->v);
-            ok = perturbed_list(pp->f, fr, &pp->slot[k], &w->tmp, &w->so);
+            ok = perturbed_list(pp->f, fr, &pp->slot[k], &w->tmp, &w->so) == GI_OK;
         }
         pthread_mutex_lock(&pp->mu);
         pp->ready[k] = ok ? 1 : 2;
@@ -202,9 +202,9 @@ static void pipe_free(pert_pipe *pp, pert_worker *wk)
 }
 
 /* The perturbed sweeps of fixed direction i with the lists sorted beside
- * them on T threads; 0 out of memory. */
-static int perturbed_pipelined(vlf_field *f, uint32_t i, int first_iteration, pert_pipe *pp,
-                               pert_worker *wk)
+ * them on T threads. */
+static gi_result perturbed_pipelined(vlf_field *f, uint32_t i, int first_iteration, pert_pipe *pp,
+                                     pert_worker *wk)
 {
     uint32_t T = pp->T, P = pp->P, l = f->prm.l, prec = f->prm.precision;
     pp->i = i;
@@ -213,7 +213,7 @@ static int perturbed_pipelined(vlf_field *f, uint32_t i, int first_iteration, pe
     uint8_t *started = calloc(T, 1);
     if (!th || !started) {
         free(th), free(started);
-        return 0;
+        return GI_ERR_OUT_OF_MEMORY;
     }
     for (uint32_t t = 0; t < T; t++)
         started[t] = pthread_create(&th[t], NULL, pert_thread, &wk[t]) == 0;
@@ -241,7 +241,7 @@ static int perturbed_pipelined(vlf_field *f, uint32_t i, int first_iteration, pe
         if (started[t])
             pthread_join(th[t], NULL);
     free(th), free(started);
-    return ok;
+    return ok ? GI_OK : GI_ERR_OUT_OF_MEMORY;
 }
 
 /* Sets up the pipe of P = f->prm.perturbed lists sorted on
@@ -272,8 +272,8 @@ static int pipe_init(pert_pipe *pp, pert_worker **wk, vlf_field *f)
 }
 
 /* The perturbed sweeps of fixed direction i with each list sorted just
- * before its sweeps on the propagating thread; 0 out of memory. */
-static int perturbed_in_line(vlf_perturbed *pt, uint32_t i, int first_iteration)
+ * before its sweeps on the propagating thread. */
+static gi_result perturbed_in_line(vlf_perturbed *pt, uint32_t i, int first_iteration)
 {
     vlf_field *f = pt->f;
     uint32_t l = f->prm.l, prec = f->prm.precision;
@@ -281,8 +281,8 @@ static int perturbed_in_line(vlf_perturbed *pt, uint32_t i, int first_iteration)
         vlf_psf fr;
         fr.n = perturbed_dir(f, i, k);
         gi_onb(fr.n, &fr.u, &fr.v);
-        if (!perturbed_list(f, &fr, &pt->buf, &pt->tmp, &pt->so))
-            return 0;
+        if (perturbed_list(f, &fr, &pt->buf, &pt->tmp, &pt->so) != GI_OK)
+            return GI_ERR_OUT_OF_MEMORY;
         /* each sign's solid angle: the fixed direction's, shared */
         sweep_perturbed(f, i, &fr, &pt->buf, +1, f->dirs.solid_angle[i] / (float)f->prm.perturbed,
                         first_iteration);
@@ -291,7 +291,7 @@ static int perturbed_in_line(vlf_perturbed *pt, uint32_t i, int first_iteration)
                         f->dirs.solid_angle[i + l] / (float)f->prm.perturbed, first_iteration);
         vlf_quantise(prec, f->E_next, f->elem_count);
     }
-    return 1;
+    return GI_OK;
 }
 
 vlf_perturbed *vlf_perturbed_create(vlf_field *f)
@@ -308,7 +308,7 @@ vlf_perturbed *vlf_perturbed_create(vlf_field *f)
     return pt;
 }
 
-int vlf_perturbed_sweeps(vlf_perturbed *pt, uint32_t i, int first_iteration)
+gi_result vlf_perturbed_sweeps(vlf_perturbed *pt, uint32_t i, int first_iteration)
 {
     return pt->pipelined ? perturbed_pipelined(pt->f, i, first_iteration, &pt->pp, pt->wk)
                          : perturbed_in_line(pt, i, first_iteration);

@@ -93,7 +93,7 @@ static void sweep(vlf_field *f, uint32_t i, int sign, int first_iteration)
     f->st.flux_escaped += esc * w;
 }
 
-int vlf_propagate_init(vlf_field *f)
+gi_result vlf_propagate_init(vlf_field *f, gi_error *err)
 {
     uint32_t prec = f->prm.precision;
     size_t ne = (size_t)f->elem_count * 3, nc = (size_t)f->nd_cells * 3;
@@ -112,22 +112,24 @@ int vlf_propagate_init(vlf_field *f)
     }
     vlf_quantise(prec, f->L_cur, f->elem_count);
     if (f->punctual_count) {
-        if (!vlf_punctual_first_shot(f))
-            return -1;
+        if (vlf_punctual_first_shot(f) != GI_OK)
+            return gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                                "vlf: out of memory starting propagation");
         vlf_quantise(prec, f->E_next, f->elem_count);
         vlf_quantise(prec, f->out_next, f->nd_cells);
     }
     f->st.flux_shot = f->st.flux_received = f->st.flux_back = f->st.flux_escaped = 0;
     f->st.samples = 0;
-    return 0;
+    return GI_OK;
 }
 
 /* The transport of fixed direction i in one iteration: the incoming
  * radiance of its tiles cleared, the sweeps along +w_i and -w_i (or along
  * the perturbed directions standing in for it, §3.5), the incoming
  * radiance written in the storage format, then the non-diffuse faces'
- * scattering (§3.4). 1, or 0 out of memory. */
-static int propagate_direction(vlf_field *f, vlf_perturbed *pt, uint32_t i, int first_iteration)
+ * scattering (§3.4). */
+static gi_result propagate_direction(vlf_field *f, vlf_perturbed *pt, uint32_t i,
+                                     int first_iteration)
 {
     uint32_t l = f->prm.l, prec = f->prm.precision;
     for (uint32_t fi = 0; fi < f->face_count; fi++)
@@ -140,8 +142,8 @@ static int propagate_direction(vlf_field *f, vlf_perturbed *pt, uint32_t i, int 
         vlf_quantise(prec, f->E_next, f->elem_count);
         sweep(f, i, -1, first_iteration);
         vlf_quantise(prec, f->E_next, f->elem_count);
-    } else if (!vlf_perturbed_sweeps(pt, i, first_iteration)) {
-        return 0;
+    } else if (vlf_perturbed_sweeps(pt, i, first_iteration) != GI_OK) {
+        return GI_ERR_OUT_OF_MEMORY;
     }
     if (prec != VLF_PREC_32F)
         for (uint32_t fi = 0; fi < f->face_count; fi++)
@@ -151,7 +153,7 @@ static int propagate_direction(vlf_field *f, vlf_perturbed *pt, uint32_t i, int 
             }
     if (f->nd_count)
         vlf_scatter(f, i);
-    return 1;
+    return GI_OK;
 }
 
 /* The end of a shooting iteration: what was received is added to the
@@ -177,25 +179,31 @@ static void end_iteration(vlf_field *f)
     vlf_quantise(prec, f->out_tot, f->nd_cells);
 }
 
-int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user)
+gi_result vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user, gi_error *err)
 {
     double t0 = vlf_now_s();
-    if (vlf_propagate_init(f) != 0)
-        return -1;
+    gi_result r = vlf_propagate_init(f, err);
+    if (r != GI_OK)
+        return r;
     /* perturbed directions: sorted on `threads` threads beside the sweeps */
     vlf_perturbed *pt = NULL;
     if (f->prm.perturbed > 0 && !(pt = vlf_perturbed_create(f)))
-        return -1;
-    int ok = 1;
-    for (uint32_t it = 0; it < f->prm.iterations && ok; it++) {
-        for (uint32_t i = 0; i < f->prm.l && ok; i++)
-            ok = !(cancelled && cancelled(user)) && propagate_direction(f, pt, i, it == 0);
-        if (ok)
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                            "vlf: out of memory propagating the light field");
+    for (uint32_t it = 0; it < f->prm.iterations && r == GI_OK; it++) {
+        for (uint32_t i = 0; i < f->prm.l && r == GI_OK; i++) {
+            if (cancelled && cancelled(user))
+                r = gi_error_set(err, GI_ERR_CANCELLED, "vlf: propagation cancelled");
+            else if (propagate_direction(f, pt, i, it == 0) != GI_OK)
+                r = gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                                 "vlf: out of memory propagating the light field");
+        }
+        if (r == GI_OK)
             end_iteration(f);
     }
     vlf_perturbed_free(pt);
-    if (!ok)
-        return -1;
+    if (r != GI_OK)
+        return r;
     f->st.propagate_s = vlf_now_s() - t0;
-    return 0;
+    return GI_OK;
 }

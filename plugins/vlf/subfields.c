@@ -155,8 +155,8 @@ static int frag_cmp(const void *a, const void *b)
     return x->elem < y->elem ? -1 : (x->elem > y->elem);
 }
 
-int vlf_list_fragments(const vlf_field *f, const vlf_psf *fr, vlf_frag_buf *buf, vlf_frag_buf *tmp,
-                       vlf_sorter *so, int32_t *bbox, vlf_sort_counts *cnt)
+gi_result vlf_list_fragments(const vlf_field *f, const vlf_psf *fr, vlf_frag_buf *buf,
+                             vlf_frag_buf *tmp, vlf_sorter *so, int32_t *bbox, vlf_sort_counts *cnt)
 {
     uint32_t N = f->prm.N * f->prm.S;
     int32_t dummy[4];
@@ -166,17 +166,17 @@ int vlf_list_fragments(const vlf_field *f, const vlf_psf *fr, vlf_frag_buf *buf,
             uint32_t fi = f->tri_face[ti];
             sort_ctx c = {buf, f, fr, &f->faces[fi], N, bbox ? bbox + 4 * fi : dummy};
             if (!raster_tri(f, fr, f->tri_p + 3 * (size_t)ti, emit_frag, &c))
-                return 0;
+                return GI_ERR_OUT_OF_MEMORY;
         }
         qsort(buf->v, buf->n, sizeof *buf->v, frag_cmp);
-        return 1;
+        return GI_OK;
     }
     int mode = f->prm.order == VLF_ORDER_PLAIN     ? VLF_SORT_PLAIN
                : f->prm.order == VLF_ORDER_NOSPLIT ? VLF_SORT_NOSPLIT
                                                    : VLF_SORT_NEWELL;
     if (vlf_sort_faces(so, f->tri_p, f->tri_count, f->tri_group, f->prm.hier_min, fr->u, fr->v,
-                       fr->n, mode, f->prm.bsp_levels, f->prm.bsp_min) != 0)
-        return 0;
+                       fr->n, mode, f->prm.bsp_levels, f->prm.bsp_min) != GI_OK)
+        return GI_ERR_OUT_OF_MEMORY;
     cnt->pieces += so->nout;
     cnt->splits += so->splits;
     cnt->bsp_cuts += so->bsp_cuts;
@@ -198,18 +198,18 @@ int vlf_list_fragments(const vlf_field *f, const vlf_psf *fr, vlf_frag_buf *buf,
                     gi_v3_add(gi_v3_add(gi_v3_scale(fr->u, w[a]->x), gi_v3_scale(fr->v, w[a]->y)),
                               gi_v3_scale(fr->n, w[a]->z));
             if (!raster_tri(f, fr, q, emit_frag, &c))
-                return 0;
+                return GI_ERR_OUT_OF_MEMORY;
         }
     }
     /* stable bucket sort by cell: each ray keeps the faces' order */
     uint32_t *start = calloc((size_t)N * N + 1, sizeof *start);
     if (!start)
-        return 0;
+        return GI_ERR_OUT_OF_MEMORY;
     if (tmp->cap < buf->n) {
         vlf_frag *t = realloc(tmp->v, (buf->n ? buf->n : 1) * sizeof *t);
         if (!t) {
             free(start);
-            return 0;
+            return GI_ERR_OUT_OF_MEMORY;
         }
         tmp->v = t;
         tmp->cap = buf->n ? buf->n : 1;
@@ -225,7 +225,7 @@ int vlf_list_fragments(const vlf_field *f, const vlf_psf *fr, vlf_frag_buf *buf,
     vlf_frag_buf sw = *buf;
     *buf = *tmp;
     *tmp = sw;
-    return 1;
+    return GI_OK;
 }
 
 /* Depth order of subfield i (the "sort" stage, §3.2): the fragments of
@@ -248,7 +248,7 @@ static int build_psf(vlf_field *f, uint32_t i, vlf_frag_buf *buf, vlf_frag_buf *
         bbox[4 * fi] = bbox[4 * fi + 1] = INT32_MAX;
         bbox[4 * fi + 2] = bbox[4 * fi + 3] = -1;
     }
-    if (!vlf_list_fragments(f, p, buf, tmp, so, bbox, cnt)) {
+    if (vlf_list_fragments(f, p, buf, tmp, so, bbox, cnt) != GI_OK) {
         free(bbox);
         return 0;
     }
@@ -309,7 +309,7 @@ static void *sort_thread(void *arg)
     return NULL;
 }
 
-int vlf_build_subfields(vlf_field *f)
+gi_result vlf_build_subfields(vlf_field *f)
 {
     uint32_t T = f->prm.threads < 1 ? 1 : f->prm.threads;
     if (T > f->prm.l)
@@ -319,7 +319,7 @@ int vlf_build_subfields(vlf_field *f)
     uint8_t *started = calloc(T, 1);
     if (!jobs || !th || !started) {
         free(jobs), free(th), free(started);
-        return 0;
+        return GI_ERR_OUT_OF_MEMORY;
     }
     for (uint32_t t = 0; t < T; t++) {
         jobs[t] = (sort_job){f, t, T, 0, {0, 0, 0, 0, 0, 0, 0}};
@@ -345,5 +345,5 @@ int vlf_build_subfields(vlf_field *f)
         f->st.sort_hier_fallbacks += jobs[t].cnt.fallbacks;
     }
     free(jobs), free(th), free(started);
-    return ok;
+    return ok ? GI_OK : GI_ERR_OUT_OF_MEMORY;
 }

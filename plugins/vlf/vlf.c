@@ -24,7 +24,7 @@ enum { VLF_LOOKUP_W = 512, VLF_LOOKUP_H = 256, VLF_BUFFERS = 7 };
 
 typedef struct vlf {
     gi_kit kit;
-    vlf_params prm;
+    vlf_settings prm;
     vlf_field field;
     int have_field;
     int gpu_propagate; /* propagate = gpu: the compute passes of vlf_gpu.c */
@@ -36,7 +36,7 @@ typedef struct vlf {
     size_t gpu_map_bytes; /* bytes of the light-field maps uploaded for rendering */
 } vlf;
 
-static const gi_param_desc vlf_params_desc[] = {
+static const gi_param_desc vlf_params[] = {
     {"l", GI_PARAM_INT, 128, 8, 1024, NULL, "l (Sec. 2.1)",
      "bi-directional directions spread over the hemisphere"},
     {"N", GI_PARAM_INT, 64, 8, 256, NULL, "N (Sec. 2.1)",
@@ -264,13 +264,13 @@ static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
     if (v->have_field)
         vlf_field_free(&v->field);
     v->have_field = 0;
-    char err[256];
+    gi_error err;
     host->stage_begin(host, "sort");
-    int rc = vlf_field_build(&v->field, gs->scene, gs->time, &v->prm, err, sizeof err);
+    gi_result rc = vlf_field_build(&v->field, gs->scene, gs->time, &v->prm, &err);
     host->stage_end(host, "sort");
-    if (rc != 0) {
+    if (rc != GI_OK) {
         vlf_field_free(&v->field);
-        return gi_kit_fail(&v->kit, GI_ERR_INVALID_ARGUMENT, "%s", err);
+        return gi_kit_fail_with(&v->kit, GI_ERR_INVALID_ARGUMENT, &err);
     }
     v->have_field = 1;
     host->stage_begin(host, "propagate");
@@ -278,20 +278,20 @@ static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
         /* the depth order and the gather lists uploaded (propagate_setup),
          * then the passes; the maps read back for the upload below */
         host->stage_begin(host, "propagate_setup");
-        rc = vlf_gpu_setup(&v->gpu, &v->field, err, sizeof err);
+        rc = vlf_gpu_setup(&v->gpu, &v->field, &err);
         host->stage_end(host, "propagate_setup");
-        if (rc == 0)
-            rc =
-                vlf_gpu_propagate(&v->gpu, &v->field, vlf_cancelled, (void *)host, err, sizeof err);
+        if (rc == GI_OK)
+            rc = vlf_gpu_propagate(&v->gpu, &v->field, vlf_cancelled, (void *)host, &err);
         host->stage_end(host, "propagate");
-        if (rc != 0)
-            return gi_kit_fail(
+        if (rc != GI_OK)
+            return gi_kit_fail_with(
                 &v->kit, host->cancelled && host->cancelled(host) ? GI_ERR_CANCELLED : GI_ERR_GL,
-                "%s", err);
+                &err);
     } else {
-        rc = vlf_field_propagate(&v->field, vlf_cancelled, (void *)host);
+        /* any failure here has been reported as a cancellation */
+        rc = vlf_field_propagate(&v->field, vlf_cancelled, (void *)host, NULL);
         host->stage_end(host, "propagate");
-        if (rc != 0)
+        if (rc != GI_OK)
             return gi_kit_fail(&v->kit, GI_ERR_CANCELLED, "vlf: propagation cancelled");
     }
     host->stage_begin(host, "gpu_init");
@@ -337,9 +337,9 @@ static gi_result vlf_prepare(void *inst, const gi_gpu_scene *gs)
             return gi_kit_fail_with(&v->kit, GI_ERR_GL, &err);
     }
     if (v->gpu_propagate && !v->have_gpu) {
-        char e[256];
-        if (vlf_gpu_init(&v->gpu, e, sizeof e) != 0)
-            return gi_kit_fail(&v->kit, GI_ERR_GL, "%s", e);
+        gi_error err;
+        if (vlf_gpu_init(&v->gpu, &err) != GI_OK)
+            return gi_kit_fail_with(&v->kit, GI_ERR_GL, &err);
         v->have_gpu = 1;
     }
     return vlf_build(v, gs);
@@ -428,4 +428,4 @@ GI_METHOD_EXPORT(
     .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_GLOSSY | GI_CAP_MIRROR | GI_CAP_AREA_LIGHTS |
             GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION |
             GI_CAP_PRECOMPUTE | GI_CAP_VISIBILITY | GI_CAP_TEXTURES,
-    .max_bounces = 7, .params = vlf_params_desc);
+    .max_bounces = 7, .params = vlf_params);

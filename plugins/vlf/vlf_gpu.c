@@ -42,7 +42,7 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-int vlf_gpu_init(vlf_gpu *g, char *err, size_t err_size)
+gi_result vlf_gpu_init(vlf_gpu *g, gi_error *err)
 {
     memset(g, 0, sizeof *g);
     for (int p = 0; p < VLF_GPU_PASSES; p++) {
@@ -51,12 +51,11 @@ int vlf_gpu_init(vlf_gpu *g, char *err, size_t err_size)
         gi_error e;
         g->prog[p] = gi_program_build_compute("vlf_propagate.comp", defines, &e);
         if (!g->prog[p]) {
-            snprintf(err, err_size, "vlf: propagation pass %d: %s", p, e.text);
             vlf_gpu_free(g);
-            return -1;
+            return gi_error_set(err, GI_ERR_GL, "vlf: propagation pass %d: %s", p, e.text);
         }
     }
-    return 0;
+    return GI_OK;
 }
 
 void vlf_gpu_free(vlf_gpu *g)
@@ -106,15 +105,13 @@ static void *grow_push(grow *a)
     return (char *)a->v + a->size * a->n++;
 }
 
-int vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, char *err, size_t err_size)
+gi_result vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, gi_error *err)
 {
     double t0 = now_s();
     uint32_t l = f->prm.l, S = f->prm.S, NS = f->prm.N * S, n2 = NS * NS;
-    if (f->prm.perturbed > 0) {
-        snprintf(err, err_size,
-                 "vlf: propagate = gpu runs the fixed directions only (perturbed = 0)");
-        return -1;
-    }
+    if (f->prm.perturbed > 0)
+        return gi_error_set(err, GI_ERR_UNSUPPORTED,
+                            "vlf: propagate = gpu runs the fixed directions only (perturbed = 0)");
     if (!g->buf[0])
         glCreateBuffers(VLF_GPU_BUFFERS, g->buf);
     free(g->start_base), free(g->frag_base), free(g->g_first), free(g->g_elem), free(g->g_count);
@@ -141,13 +138,11 @@ int vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, char *err, size_t err_size)
         largest = (size_t)f->elem_count * 9 * sizeof(float);
     if ((size_t)f->nd_cells * 12 * sizeof(float) > largest)
         largest = (size_t)f->nd_cells * 12 * sizeof(float);
-    if (max_block > 0 && largest > (size_t)max_block) {
-        snprintf(
-            err, err_size,
+    if (max_block > 0 && largest > (size_t)max_block)
+        return gi_error_set(
+            err, GI_ERR_UNSUPPORTED,
             "vlf: propagate = gpu needs a %zu-byte buffer, the GL allows %lld (lower l, N or S)",
             largest, (long long)max_block);
-        return -1;
-    }
     uint32_t *start = malloc(((size_t)l * (n2 + 1)) * sizeof *start);
     uint32_t *frag = malloc((frags + 1) * sizeof *frag);
     uint32_t *slot = malloc((frags + 1) * sizeof *slot);
@@ -308,17 +303,14 @@ int vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, char *err, size_t err_size)
     }
     free(start), free(frag), free(slot), free(perm), free(cnt), free(pos), free(touched);
     free(faces), free(rects), free(frames), free(wg), free(cover), free(gath.v), free(jobs.v);
-    if (!ok) {
-        snprintf(err, err_size, "vlf: out of memory setting up the GPU propagation");
-        return -1;
-    }
-    gi_error e;
-    if (gi_gl_check("vlf: GPU propagation set-up", &e) != GI_OK) {
-        snprintf(err, err_size, "%s", e.text);
-        return -1;
-    }
+    if (!ok)
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                            "vlf: out of memory setting up the GPU propagation");
+    gi_result r = gi_gl_check("vlf: GPU propagation set-up", err);
+    if (r != GI_OK)
+        return r;
     g->setup_s = now_s() - t0;
-    return 0;
+    return GI_OK;
 }
 
 /* Dispatches `count` invocations of 64 (x, then y past 65535 groups), z
@@ -343,15 +335,14 @@ static void set_f(GLuint p, const char *name, float v)
     glProgramUniform1f(p, glGetUniformLocation(p, name), v);
 }
 
-int vlf_gpu_propagate(vlf_gpu *g, vlf_field *f, int (*cancelled)(void *), void *user, char *err,
-                      size_t err_size)
+gi_result vlf_gpu_propagate(vlf_gpu *g, vlf_field *f, int (*cancelled)(void *), void *user,
+                            gi_error *err)
 {
     double t0 = now_s();
     uint32_t l = f->prm.l, S = f->prm.S, NS = f->prm.N * S, n2 = NS * NS;
-    if (vlf_propagate_init(f) != 0) {
-        snprintf(err, err_size, "vlf: out of memory starting propagation");
-        return -1;
-    }
+    gi_result rc = vlf_propagate_init(f, err);
+    if (rc != GI_OK)
+        return rc;
     size_t ne = (size_t)f->elem_count * 3, nc = (size_t)f->nd_cells * 3;
     /* the maps as vlf_propagate_init left them */
     glNamedBufferData(g->buf[B_EMAP], (GLsizeiptr)((3 * ne + 3) * sizeof(float)), NULL,
@@ -383,12 +374,10 @@ int vlf_gpu_propagate(vlf_gpu *g, vlf_field *f, int (*cancelled)(void *), void *
         set_f(P, "u_min_area", 1.0f / (64.0f * f->prm.density * f->prm.density));
         set_f(P, "u_inv_s2", 1.0f / (float)(S * S));
     }
-    int rc = 0;
-    for (uint32_t it = 0; it < f->prm.iterations && rc == 0; it++) {
+    for (uint32_t it = 0; it < f->prm.iterations && rc == GI_OK; it++) {
         for (uint32_t i = 0; i < l; i++) {
             if (cancelled && cancelled(user)) {
-                snprintf(err, err_size, "vlf: propagation cancelled");
-                rc = -1;
+                rc = gi_error_set(err, GI_ERR_CANCELLED, "vlf: propagation cancelled");
                 break;
             }
             float t[6], sky[6], w[2], dW[2];
@@ -431,7 +420,7 @@ int vlf_gpu_propagate(vlf_gpu *g, vlf_field *f, int (*cancelled)(void *), void *
             }
             f->st.samples += 2 * (uint64_t)f->psf[i].frag_count;
         }
-        if (rc != 0)
+        if (rc != GI_OK)
             break;
         GLuint P = g->prog[P_FINISH];
         glUseProgram(P);
@@ -441,7 +430,7 @@ int vlf_gpu_propagate(vlf_gpu *g, vlf_field *f, int (*cancelled)(void *), void *
     }
     glUseProgram(0);
     double t1 = now_s();
-    if (rc == 0) {
+    if (rc == GI_OK) {
         /* the maps and the flux counters back into the field */
         glGetNamedBufferSubData(g->buf[B_EMAP], 0, (GLsizeiptr)(ne * sizeof(float)), f->E_next);
         glGetNamedBufferSubData(g->buf[B_EMAP], (GLintptr)(ne * sizeof(float)),
@@ -456,10 +445,9 @@ int vlf_gpu_propagate(vlf_gpu *g, vlf_field *f, int (*cancelled)(void *), void *
         glGetNamedBufferSubData(g->buf[B_TMAP], (GLintptr)(3 * nc * sizeof(float)),
                                 (GLsizeiptr)(nc * sizeof(float)), f->in);
         float *st = malloc((size_t)2 * n2 * 4 * sizeof *st);
-        if (!st) {
-            snprintf(err, err_size, "vlf: out of memory reading the GPU's counters");
-            return -1;
-        }
+        if (!st)
+            return gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                                "vlf: out of memory reading the GPU's counters");
         glGetNamedBufferSubData(g->buf[B_STATS], 0, (GLsizeiptr)((size_t)2 * n2 * 4 * sizeof *st),
                                 st);
         double sum[4] = {0, 0, 0, 0};
@@ -470,11 +458,8 @@ int vlf_gpu_propagate(vlf_gpu *g, vlf_field *f, int (*cancelled)(void *), void *
         f->st.flux_shot = sum[0], f->st.flux_received = sum[1], f->st.flux_back = sum[2],
         f->st.flux_escaped = sum[3];
     }
-    gi_error e;
-    if (rc == 0 && gi_gl_check("vlf: GPU propagation", &e) != GI_OK) {
-        snprintf(err, err_size, "%s", e.text);
-        rc = -1;
-    }
+    if (rc == GI_OK)
+        rc = gi_gl_check("vlf: GPU propagation", err);
     g->readback_s = now_s() - t1;
     f->st.propagate_s = now_s() - t0;
     return rc;

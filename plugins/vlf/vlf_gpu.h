@@ -25,17 +25,17 @@ typedef struct vlf_gpu {
     double setup_s, readback_s; /* the upload of the depth order and the read-back of the maps */
 } vlf_gpu;
 
-/* Builds the passes' programs. 0, or -1 with a message in err. */
-int vlf_gpu_init(vlf_gpu *g, char *err, size_t err_size);
+/* Builds the passes' programs. */
+gi_result vlf_gpu_init(vlf_gpu *g, gi_error *err);
 /* Uploads field f's depth order, gather lists, tiles and scatter jobs
- * (the paper keeps them on the GPU for the iterations). 0 or -1 with err. */
-int vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, char *err, size_t err_size);
+ * (the paper keeps them on the GPU for the iterations). */
+gi_result vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, gi_error *err);
 /* Propagates f for f->prm.iterations iterations on the GPU (after
  * vlf_gpu_setup on the same field) and reads the maps back into f (the
  * same arrays and counters as vlf_field_propagate). `cancelled` (may be
- * NULL) is polled between directions. 0, or -1 with err. */
-int vlf_gpu_propagate(vlf_gpu *g, vlf_field *f, int (*cancelled)(void *), void *user, char *err,
-                      size_t err_size);
+ * NULL) is polled between directions; returns GI_ERR_CANCELLED then. */
+gi_result vlf_gpu_propagate(vlf_gpu *g, vlf_field *f, int (*cancelled)(void *), void *user,
+                            gi_error *err);
 void vlf_gpu_free(vlf_gpu *g);
 
 #endif

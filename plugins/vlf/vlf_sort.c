@@ -708,9 +708,9 @@ done:
     return rc;
 }
 
-int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, const uint32_t *group,
-                   uint32_t hier_min, gi_vec3 u, gi_vec3 v, gi_vec3 n, int mode,
-                   uint32_t bsp_levels, uint32_t bsp_min)
+gi_result vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count,
+                         const uint32_t *group, uint32_t hier_min, gi_vec3 u, gi_vec3 v, gi_vec3 n,
+                         int mode, uint32_t bsp_levels, uint32_t bsp_min)
 {
     s->tests = 0;
     s->splits = s->bsp_cuts = s->unresolved = 0;
@@ -718,7 +718,7 @@ int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, cons
     if (group && hier_min > 0) {
         int r = sort_hier(s, tri_p, tri_count, group, hier_min, u, v, n, mode, bsp_levels, bsp_min);
         if (r <= 0)
-            return r;
+            return r == 0 ? GI_OK : GI_ERR_OUT_OF_MEMORY;
         if (s->nout > 0) /* it ran and a stand-in was split: again without the shortcut */
             s->hier_fallbacks++;
         s->tests = 0;
@@ -726,10 +726,10 @@ int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, cons
         s->groups = 0;
     }
     if (load_triangles(s, tri_p, tri_count, u, v, n, 0) != 0)
-        return -1;
+        return GI_ERR_OUT_OF_MEMORY;
     uint32_t *items = malloc((size_t)(tri_count ? tri_count : 1) * sizeof *items);
     if (!items)
-        return -1;
+        return GI_ERR_OUT_OF_MEMORY;
     for (uint32_t t = 0; t < tri_count; t++)
         items[t] = t;
     /* splitting stops at 8 pieces per triangle on average (cycles then
@@ -738,7 +738,7 @@ int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, cons
     int rc =
         order_bsp(s, items, tri_count, mode, 0, bsp_levels, bsp_min ? bsp_min : 2, split_limit);
     free(items);
-    return rc;
+    return rc == 0 ? GI_OK : GI_ERR_OUT_OF_MEMORY;
 }
 
 void vlf_sorter_free(vlf_sorter *s)

@@ -84,20 +84,20 @@ static gi_scene *load(const char *rel)
     return s;
 }
 
-static vlf_params defaults(void)
+static vlf_settings defaults(void)
 {
-    return (vlf_params){.l = 128,
-                        .N = 64,
-                        .m = 8,
-                        .S = 2,
-                        .density = 12,
-                        .iterations = 8,
-                        .seed = 1,
-                        .order = VLF_ORDER_FACES,
-                        .threads = 2,
-                        .bsp_levels = 2,
-                        .bsp_min = 4096,
-                        .subdivide = 1};
+    return (vlf_settings){.l = 128,
+                          .N = 64,
+                          .m = 8,
+                          .S = 2,
+                          .density = 12,
+                          .iterations = 8,
+                          .seed = 1,
+                          .order = VLF_ORDER_FACES,
+                          .threads = 2,
+                          .bsp_levels = 2,
+                          .bsp_min = 4096,
+                          .subdivide = 1};
 }
 
 static float frand(uint32_t *s)
@@ -118,9 +118,9 @@ static void test_dirs(void)
     uint32_t ls[] = {8, 32, 128, 512};
     for (size_t li = 0; li < sizeof ls / sizeof ls[0]; li++) {
         vlf_dirs d;
-        char err[256];
+        gi_error err;
         uint32_t l = ls[li];
-        EXPECT(vlf_dirs_build(&d, l, err, sizeof err) == 0, "%s", err);
+        EXPECT(vlf_dirs_build(&d, l, &err) == GI_OK, "%s", err.text);
         uint32_t n = 2 * l;
         /* closed triangulated sphere: V - E + F = 2 with E = 3F/2 */
         EXPECT(d.tri_count == 2 * n - 4, "l=%u: %u triangles for %u nodes", l, d.tri_count, n);
@@ -399,7 +399,7 @@ static void test_order(void)
     vlf_field ref;
     int have_ref = 0;
     for (int k = 0; k < 6; k++) {
-        vlf_params p = defaults();
+        vlf_settings p = defaults();
         p.l = 16;
         p.subdivide = k == 5 ? 3 : 1;
         p.N = 64;
@@ -409,10 +409,10 @@ static void test_order(void)
         p.bsp_min = cfg[k].bsp_min;
         p.threads = cfg[k].threads;
         vlf_field f;
-        char err[256];
-        int rc = vlf_field_build(&f, s, 0.0f, &p, err, sizeof err);
-        EXPECT(rc == 0, "%s", err);
-        if (rc != 0)
+        gi_error err;
+        gi_result rc = vlf_field_build(&f, s, 0.0f, &p, &err);
+        EXPECT(rc == GI_OK, "%s", err.text);
+        if (rc != GI_OK)
             continue;
         uint32_t agree, multi;
         uint32_t hits = order_against_embree(&f, rt, &agree, &multi);
@@ -444,10 +444,10 @@ static void test_order(void)
             /* the same order on 1 and 5 threads */
             uint32_t tc[2] = {1, 5};
             for (int j = 0; j < 2; j++) {
-                vlf_params q = p;
+                vlf_settings q = p;
                 q.threads = tc[j];
                 vlf_field g;
-                EXPECT(vlf_field_build(&g, s, 0.0f, &q, err, sizeof err) == 0, "%s", err);
+                EXPECT(vlf_field_build(&g, s, 0.0f, &q, &err) == GI_OK, "%s", err.text);
                 EXPECT(same_field(&f, &g), "the face order on %u threads differs from 2 threads",
                        tc[j]);
                 EXPECT(g.st.sort_splits == f.st.sort_splits && g.st.sort_pieces == f.st.sort_pieces,
@@ -479,7 +479,7 @@ static void test_energy(void)
     gi_scene *s = load("tests/data/conformance/furnace_050.gltf");
     if (!s)
         return;
-    vlf_params p = defaults();
+    vlf_settings p = defaults();
     p.l = 64;
     p.N = 48;
     p.density = 6;
@@ -487,9 +487,9 @@ static void test_energy(void)
     if (getenv("VLF_N"))
         p.N = (uint32_t)atoi(getenv("VLF_N"));
     vlf_field f;
-    char err[256];
-    EXPECT(vlf_field_build(&f, s, 0.0f, &p, err, sizeof err) == 0, "%s", err);
-    vlf_field_propagate(&f, NULL, NULL);
+    gi_error err;
+    EXPECT(vlf_field_build(&f, s, 0.0f, &p, &err) == GI_OK, "%s", err.text);
+    vlf_field_propagate(&f, NULL, NULL, NULL);
     const vlf_stats *st = &f.st;
     printf("energy (closed sphere, 1 iteration): emitted %.6f shot %.6f received %.6f back %.6f "
            "escaped %.6f\n",
@@ -514,8 +514,8 @@ static void test_energy(void)
     vlf_field_free(&f);
     /* the same with every triangle cut into 4 (the tessellation sweep's option) */
     p.subdivide = 2;
-    EXPECT(vlf_field_build(&f, s, 0.0f, &p, err, sizeof err) == 0, "%s", err);
-    vlf_field_propagate(&f, NULL, NULL);
+    EXPECT(vlf_field_build(&f, s, 0.0f, &p, &err) == GI_OK, "%s", err.text);
+    vlf_field_propagate(&f, NULL, NULL, NULL);
     printf("energy, triangles cut into 4 (%u triangles): emitted %.6f shot %.6f received %.6f back "
            "%.6f escaped %.6f\n",
            f.tri_count, st->flux_emitted, st->flux_shot, st->flux_received, st->flux_back,
@@ -531,8 +531,8 @@ static void test_energy(void)
     p.subdivide = 1;
     /* the same with 3 perturbed directions per fixed one (§3.5) */
     p.perturbed = 3;
-    EXPECT(vlf_field_build(&f, s, 0.0f, &p, err, sizeof err) == 0, "%s", err);
-    vlf_field_propagate(&f, NULL, NULL);
+    EXPECT(vlf_field_build(&f, s, 0.0f, &p, &err) == GI_OK, "%s", err.text);
+    vlf_field_propagate(&f, NULL, NULL, NULL);
     printf("energy, 3 perturbed directions: emitted %.6f shot %.6f received %.6f back %.6f escaped "
            "%.6f\n",
            st->flux_emitted, st->flux_shot, st->flux_received, st->flux_back, st->flux_escaped);
@@ -547,11 +547,11 @@ static void test_energy(void)
      * in line on 1, or on 5: the same field, bit for bit */
     uint32_t tc[2] = {1, 5};
     for (int k = 0; k < 2; k++) {
-        vlf_params q = p;
+        vlf_settings q = p;
         q.threads = tc[k];
         vlf_field g;
-        EXPECT(vlf_field_build(&g, s, 0.0f, &q, err, sizeof err) == 0, "%s", err);
-        vlf_field_propagate(&g, NULL, NULL);
+        EXPECT(vlf_field_build(&g, s, 0.0f, &q, &err) == GI_OK, "%s", err.text);
+        vlf_field_propagate(&g, NULL, NULL, NULL);
         int same = g.elem_count == f.elem_count &&
                    memcmp(g.E_tot, f.E_tot, (size_t)f.elem_count * 3 * sizeof *f.E_tot) == 0 &&
                    g.st.flux_shot == f.st.flux_shot && g.st.samples == f.st.samples;
@@ -573,14 +573,14 @@ static void test_furnace(void)
             return;
         uint32_t its[] = {1, 8, 16};
         for (int q = 0; q < 3; q++) {
-            vlf_params p = defaults();
+            vlf_settings p = defaults();
             if (!getenv("VLF_FULL"))
                 p.l = 64, p.N = 48, p.density = 6;
             p.iterations = its[q];
             vlf_field f;
-            char err[256];
-            EXPECT(vlf_field_build(&f, s, 0.0f, &p, err, sizeof err) == 0, "%s", err);
-            vlf_field_propagate(&f, NULL, NULL);
+            gi_error err;
+            EXPECT(vlf_field_build(&f, s, 0.0f, &p, &err) == GI_OK, "%s", err.text);
+            vlf_field_propagate(&f, NULL, NULL, NULL);
             /* radiance of the surface = Le + rho E / pi, area-weighted mean */
             double num = 0.0, den = 0.0;
             for (uint32_t e = 0; e < f.elem_count; e++) {
@@ -647,14 +647,14 @@ static void test_mirror(void)
             hi[a] = fmaxf(hi[a], s->vertices[v].position[a]);
     for (int a = 0; a < 3; a++)
         s->objects[0].local_bounds[a] = lo[a], s->objects[0].local_bounds[3 + a] = hi[a];
-    vlf_params p = defaults();
+    vlf_settings p = defaults();
     p.iterations = 2;
     vlf_field f;
-    char err[256];
-    int rc = vlf_field_build(&f, s, 0.0f, &p, err, sizeof err);
-    EXPECT(rc == 0, "%s", err);
-    if (rc == 0) {
-        vlf_field_propagate(&f, NULL, NULL);
+    gi_error err;
+    gi_result rc = vlf_field_build(&f, s, 0.0f, &p, &err);
+    EXPECT(rc == GI_OK, "%s", err.text);
+    if (rc == GI_OK) {
+        vlf_field_propagate(&f, NULL, NULL, NULL);
         int mf = -1;
         for (uint32_t fi = 0; fi < f.face_count; fi++)
             if (f.faces[fi].nd >= 0)
@@ -750,15 +750,15 @@ static void test_sun(void)
         s->lights[0].type = GI_LIGHT_DIRECTIONAL;
         s->lights[0].node = 1;
         s->lights[0].intensity[0] = s->lights[0].intensity[1] = s->lights[0].intensity[2] = 2.0f;
-        vlf_params p = defaults();
+        vlf_settings p = defaults();
         p.iterations = 1;
         p.density = 16;
         vlf_field f;
-        char err[256];
-        int rc = vlf_field_build(&f, s, 0.0f, &p, err, sizeof err);
-        EXPECT(rc == 0, "%s", err);
-        if (rc == 0) {
-            vlf_field_propagate(&f, NULL, NULL);
+        gi_error err;
+        gi_result rc = vlf_field_build(&f, s, 0.0f, &p, &err);
+        EXPECT(rc == GI_OK, "%s", err.text);
+        if (rc == GI_OK) {
+            vlf_field_propagate(&f, NULL, NULL, NULL);
             uint32_t floor = f.tri_face[0];
             double want = 2.0 * cos(a), ys = 0.5 * tan(a);
             double open = mean_E_in(&f, floor, 0.55f, 0.9f, -0.9f, 0.9f);
@@ -804,15 +804,15 @@ static void test_point(void)
         s->lights[0].inner_cone = 0.3f;
         s->lights[0].outer_cone = 0.35f;
         s->lights[0].intensity[0] = s->lights[0].intensity[1] = s->lights[0].intensity[2] = 3.0f;
-        vlf_params p = defaults();
+        vlf_settings p = defaults();
         p.iterations = 1;
         p.density = 16;
         vlf_field f;
-        char err[256];
-        int rc = vlf_field_build(&f, s, 0.0f, &p, err, sizeof err);
-        EXPECT(rc == 0, "%s", err);
-        if (rc == 0) {
-            vlf_field_propagate(&f, NULL, NULL);
+        gi_error err;
+        gi_result rc = vlf_field_build(&f, s, 0.0f, &p, &err);
+        EXPECT(rc == GI_OK, "%s", err.text);
+        if (rc == GI_OK) {
+            vlf_field_propagate(&f, NULL, NULL, NULL);
             const vlf_face *fc = &f.faces[f.tri_face[0]];
             float texel = 1.0f / (p.density * p.density);
             double worst = 0.0, shadow = 0.0, beyond = 0.0, lit = 0.0;
@@ -898,14 +898,14 @@ static void test_point_mirror(void)
     s->lights[0].type = GI_LIGHT_POINT;
     s->lights[0].node = 1;
     s->lights[0].intensity[0] = s->lights[0].intensity[1] = s->lights[0].intensity[2] = 3.0f;
-    vlf_params p = defaults();
+    vlf_settings p = defaults();
     p.iterations = 1;
     vlf_field f;
-    char err[256];
-    int rc = vlf_field_build(&f, s, 0.0f, &p, err, sizeof err);
-    EXPECT(rc == 0, "%s", err);
-    if (rc == 0) {
-        vlf_field_propagate(&f, NULL, NULL);
+    gi_error err;
+    gi_result rc = vlf_field_build(&f, s, 0.0f, &p, &err);
+    EXPECT(rc == GI_OK, "%s", err.text);
+    if (rc == GI_OK) {
+        vlf_field_propagate(&f, NULL, NULL, NULL);
         const vlf_face *fc = &f.faces[0];
         gi_vec3 refl = gi_v3_normalize(gi_v3(1, 0, 1));
         uint32_t node[3];
@@ -1019,18 +1019,18 @@ static void test_precision(void)
     if (!s)
         return;
     vlf_field f[3];
-    char err[256];
+    gi_error err;
     const char *name[3] = {"32f", "16f", "rgb9e5"};
     const double bound_E[3] = {0.0, 0.002, 0.01}, bound_T[3] = {0.0, 0.002, 0.01};
     int ok[3] = {0, 0, 0};
     for (uint32_t k = 0; k < 3; k++) {
-        vlf_params p = defaults();
+        vlf_settings p = defaults();
         p.l = 32, p.N = 32, p.density = 8, p.iterations = 4, p.precision = k;
-        ok[k] = vlf_field_build(&f[k], s, 0.0f, &p, err, sizeof err) == 0;
-        EXPECT(ok[k], "%s", err);
+        ok[k] = vlf_field_build(&f[k], s, 0.0f, &p, &err) == GI_OK;
+        EXPECT(ok[k], "%s", err.text);
         if (!ok[k])
             continue;
-        vlf_field_propagate(&f[k], NULL, NULL);
+        vlf_field_propagate(&f[k], NULL, NULL, NULL);
         size_t bpv = vlf_precision_bytes(k), count = (size_t)f[k].elem_count + f[k].nd_cells;
         /* the maps as packed for rendering: the reported bytes, and nothing lost */
         uint8_t *buf = malloc(count * bpv + 1);
@@ -1151,14 +1151,14 @@ static void test_texture(void)
         v->uv[0] = 0.5f * (v->position[0] + 1.0f);
         v->uv[1] = 0.5f * (v->position[1] + 1.0f);
     }
-    vlf_params p = defaults();
+    vlf_settings p = defaults();
     p.l = 32, p.N = 32, p.density = 8, p.iterations = 1;
     vlf_field f;
-    char err[256];
-    int ok = vlf_field_build(&f, s, 0.0f, &p, err, sizeof err) == 0;
-    EXPECT(ok, "%s", err);
+    gi_error err;
+    int ok = vlf_field_build(&f, s, 0.0f, &p, &err) == GI_OK;
+    EXPECT(ok, "%s", err.text);
     if (ok) {
-        vlf_field_propagate(&f, NULL, NULL);
+        vlf_field_propagate(&f, NULL, NULL, NULL);
         uint32_t nb = 0, nw = 0, bad = 0;
         double akd = 0.0, area = 0.0, worst = 0.0;
         for (uint32_t e = 0; e < f.elem_count; e++) {
@@ -1264,14 +1264,14 @@ static void test_hier(void)
     uint32_t miss[2] = {0, 0}, hits[2] = {0, 0};
     uint64_t tests[2] = {0, 0}, groups[2] = {0, 0};
     for (int k = 0; k < 2; k++) {
-        vlf_params p = defaults();
+        vlf_settings p = defaults();
         p.l = 16, p.N = 64, p.density = 8, p.bsp_levels = 0;
         p.hier_min = k ? 4 : 0;
         vlf_field f;
-        char err[256];
-        int rc = vlf_field_build(&f, s, 0.0f, &p, err, sizeof err);
-        EXPECT(rc == 0, "%s", err);
-        if (rc != 0)
+        gi_error err;
+        gi_result rc = vlf_field_build(&f, s, 0.0f, &p, &err);
+        EXPECT(rc == GI_OK, "%s", err.text);
+        if (rc != GI_OK)
             continue;
         uint32_t agree, multi;
         hits[k] = order_against_embree(&f, rt, &agree, &multi);
@@ -1315,30 +1315,30 @@ static void gpu_case(vlf_gpu *gp, const char *scene, uint32_t prec, double bound
     if (!s)
         return;
     static const char *name[3] = {"32f", "16f", "rgb9e5"};
-    vlf_params p = defaults();
+    vlf_settings p = defaults();
     p.l = 32, p.N = 32, p.density = 8, p.iterations = 4, p.precision = prec;
     vlf_field cpu, gpu, shortf;
-    char err[256];
-    int ok = vlf_field_build(&cpu, s, 0.0f, &p, err, sizeof err) == 0;
-    EXPECT(ok, "%s", err);
-    ok = ok && vlf_field_build(&gpu, s, 0.0f, &p, err, sizeof err) == 0;
-    EXPECT(ok, "%s", err);
-    vlf_params ps = p;
+    gi_error err;
+    int ok = vlf_field_build(&cpu, s, 0.0f, &p, &err) == GI_OK;
+    EXPECT(ok, "%s", err.text);
+    ok = ok && vlf_field_build(&gpu, s, 0.0f, &p, &err) == GI_OK;
+    EXPECT(ok, "%s", err.text);
+    vlf_settings ps = p;
     ps.iterations = p.iterations - 1;
-    ok = ok && vlf_field_build(&shortf, s, 0.0f, &ps, err, sizeof err) == 0;
-    EXPECT(ok, "%s", err);
+    ok = ok && vlf_field_build(&shortf, s, 0.0f, &ps, &err) == GI_OK;
+    EXPECT(ok, "%s", err.text);
     if (!ok) {
         gi_scene_free(s);
         return;
     }
-    EXPECT(vlf_field_propagate(&cpu, NULL, NULL) == 0, "CPU propagation failed");
-    EXPECT(vlf_field_propagate(&shortf, NULL, NULL) == 0, "CPU propagation failed");
+    EXPECT(vlf_field_propagate(&cpu, NULL, NULL, NULL) == GI_OK, "CPU propagation failed");
+    EXPECT(vlf_field_propagate(&shortf, NULL, NULL, NULL) == GI_OK, "CPU propagation failed");
     vlf_gpu *g = gp;
-    int gok = vlf_gpu_setup(g, &gpu, err, sizeof err) == 0;
-    EXPECT(gok, "%s", err);
+    int gok = vlf_gpu_setup(g, &gpu, &err) == GI_OK;
+    EXPECT(gok, "%s", err.text);
     if (gok) {
-        gok = vlf_gpu_propagate(g, &gpu, NULL, NULL, err, sizeof err) == 0;
-        EXPECT(gok, "%s", err);
+        gok = vlf_gpu_propagate(g, &gpu, NULL, NULL, &err) == GI_OK;
+        EXPECT(gok, "%s", err.text);
     }
     if (gok) {
         double eE = rel_l1(gpu.E_tot, cpu.E_tot, cpu.elem_count);
@@ -1386,9 +1386,9 @@ static void test_gpu(void)
     EXPECT(gi_shader_register(gi_vlf_shaders, &e) == GI_OK, "shaders: %s", e.text);
     printf("gpu: GL renderer %s\n", gi_gpu_renderer(ctx));
     vlf_gpu g;
-    char err[256];
-    int ok = vlf_gpu_init(&g, err, sizeof err) == 0;
-    EXPECT(ok, "%s", err);
+    gi_error err;
+    int ok = vlf_gpu_init(&g, &err) == GI_OK;
+    EXPECT(ok, "%s", err.text);
     if (ok) {
         gpu_case(&g, "scenes/cornell_glossy.gltf", VLF_PREC_32F, 1e-4);
         gpu_case(&g, "scenes/cornell_glossy.gltf", VLF_PREC_16F, 2e-3);
@@ -1438,16 +1438,16 @@ static void test_double(void)
                  perturbed[3] = {0, 0, 3};
         float *E_faces = NULL;
         for (int run = 0; run < (sc == 0 ? 3 : 1); run++) {
-            vlf_params p = defaults();
+            vlf_settings p = defaults();
             p.iterations = 1;
             p.order = orders[run], p.perturbed = perturbed[run];
             vlf_field f;
-            char err[256];
-            int rc = vlf_field_build(&f, s, 0.0f, &p, err, sizeof err);
-            EXPECT(rc == 0, "%s", err);
-            if (rc != 0)
+            gi_error err;
+            gi_result rc = vlf_field_build(&f, s, 0.0f, &p, &err);
+            EXPECT(rc == GI_OK, "%s", err.text);
+            if (rc != GI_OK)
                 continue;
-            vlf_field_propagate(&f, NULL, NULL);
+            vlf_field_propagate(&f, NULL, NULL, NULL);
             const vlf_stats *st = &f.st;
             CHECK_NEAR(st->flux_shot, st->flux_received + st->flux_back + st->flux_escaped,
                        1e-4 * st->flux_shot);
