@@ -28,22 +28,19 @@ static int key_cmp(const void *a, const void *b)
     return x->tri < y->tri ? -1 : (x->tri > y->tri);
 }
 
-gi_result vlf_group_faces(vlf_field *f, const gi_scene *s, float t)
+/* 1 if triangles x and y have the same material and plane (their keys
+ * but the triangle). */
+static int same_face(const tri_key *x, const tri_key *y)
 {
-    uint32_t T = s->triangle_count;
-    f->tri_count = T;
-    f->tri_face = malloc((size_t)T * sizeof *f->tri_face);
-    f->tri_group = malloc((size_t)T * sizeof *f->tri_group);
-    f->tri_p = malloc((size_t)T * 3 * sizeof *f->tri_p);
-    tri_key *keys = malloc((size_t)T * sizeof *keys);
-    gi_vec3 *nrm = malloc((size_t)T * sizeof *nrm);
-    f->faces = calloc((size_t)T * 2, sizeof *f->faces); /* double-sided faces take two */
-    if (!f->tri_face || !f->tri_group || !f->tri_p || !keys || !nrm || !f->faces) {
-        free(keys);
-        free(nrm);
-        return GI_ERR_OUT_OF_MEMORY;
-    }
-    for (uint32_t ti = 0; ti < T; ti++) {
+    return key_cmp(&(tri_key){0, x->material, x->nx, x->ny, x->nz, x->d},
+                   &(tri_key){0, y->material, y->nx, y->ny, y->nz, y->d}) == 0;
+}
+
+/* The scene's triangles at time t in VLF coordinates (f->tri_p), each
+ * one's scene object (f->tri_group), unit normal (nrm) and key. */
+static void key_triangles(vlf_field *f, const gi_scene *s, float t, tri_key *keys, gi_vec3 *nrm)
+{
+    for (uint32_t ti = 0; ti < s->triangle_count; ti++) {
         gi_vec3 w[3];
         gi_scene_triangle_world(s, ti, t, w);
         gi_vec3 *p = f->tri_p + 3 * (size_t)ti;
@@ -59,58 +56,95 @@ gi_result vlf_group_faces(vlf_field *f, const gi_scene *s, float t)
                              (int32_t)lrintf(n.z * 1000.0f),
                              (int32_t)lrintf(gi_v3_dot(n, p[0]) * 1000.0f)};
     }
+}
+
+/* Face fi of the triangles keys[0 .. n): their summed area, the normal of
+ * their summed cross products (the first triangle's where that vanishes)
+ * and the chart axes in the plane; the triangles marked as the face's. */
+static void face_plane(vlf_field *f, uint32_t fi, const tri_key *keys, uint32_t n,
+                       const gi_vec3 *nrm)
+{
+    vlf_face *fc = &f->faces[fi];
+    gi_vec3 sum = gi_v3(0, 0, 0);
+    for (uint32_t k = 0; k < n; k++) {
+        const gi_vec3 *p = f->tri_p + 3 * (size_t)keys[k].tri;
+        gi_vec3 c = gi_v3_cross(gi_v3_sub(p[1], p[0]), gi_v3_sub(p[2], p[0]));
+        sum = gi_v3_add(sum, c);
+        fc->area += 0.5f * gi_v3_length(c);
+        f->tri_face[keys[k].tri] = fi;
+    }
+    fc->n = gi_v3_length(sum) > 0.0f ? gi_v3_normalize(sum) : nrm[keys[0].tri];
+    gi_onb(fc->n, &fc->t, &fc->b);
+}
+
+/* Face fc's chart: the bounding rectangle in its plane of the triangles
+ * keys[0 .. n), density texels per unit length (1 to 1024 a side). */
+static void face_chart(const vlf_field *f, vlf_face *fc, const tri_key *keys, uint32_t n)
+{
+    float lo[2] = {FLT_MAX, FLT_MAX}, hi[2] = {-FLT_MAX, -FLT_MAX};
+    gi_vec3 p0 = f->tri_p[3 * (size_t)keys[0].tri];
+    for (uint32_t k = 0; k < n; k++)
+        for (int c = 0; c < 3; c++) {
+            gi_vec3 d = gi_v3_sub(f->tri_p[3 * (size_t)keys[k].tri + (size_t)c], p0);
+            float x = gi_v3_dot(d, fc->t), y = gi_v3_dot(d, fc->b);
+            lo[0] = fminf(lo[0], x), lo[1] = fminf(lo[1], y);
+            hi[0] = fmaxf(hi[0], x), hi[1] = fmaxf(hi[1], y);
+        }
+    fc->origin = gi_v3_add(p0, gi_v3_add(gi_v3_scale(fc->t, lo[0]), gi_v3_scale(fc->b, lo[1])));
+    float W = ceilf((hi[0] - lo[0]) * f->prm.density), H = ceilf((hi[1] - lo[1]) * f->prm.density);
+    fc->W = W < 1.0f ? 1u : W > 1024.0f ? 1024u : (uint32_t)W;
+    fc->H = H < 1.0f ? 1u : H > 1024.0f ? 1024u : (uint32_t)H;
+}
+
+/* Face fc's material (the scene's material m) with its lobe's albedo
+ * table, and the emission of its triangle t0. */
+static void face_material(vlf_face *fc, const gi_scene *s, uint32_t m, uint32_t t0)
+{
+    const gi_material *mt = &s->materials[m];
+    memcpy(fc->kd, mt->albedo, sizeof fc->kd);
+    memcpy(fc->ks, mt->ks, sizeof fc->ks);
+    fc->exponent = mt->exponent;
+    fc->material = m;
+    fc->textured = mt->albedo_texture >= 0 && (uint32_t)mt->albedo_texture < s->texture_count;
+    fc->mirror = mt->mirror || mt->exponent >= GI_MIRROR_EXPONENT;
+    for (int k = 0; k < VLF_ALBEDO_TABLE; k++)
+        fc->albedo[k] =
+            fc->mirror
+                ? 1.0f
+                : (float)vlf_phong_albedo(fc->exponent, (float)k / (float)(VLF_ALBEDO_TABLE - 1));
+    const float *le = gi_scene_triangle_emission(s, t0);
+    for (int k = 0; k < 3; k++)
+        fc->emission[k] = le ? le[k] : 0.0f;
+}
+
+gi_result vlf_group_faces(vlf_field *f, const gi_scene *s, float t)
+{
+    uint32_t T = s->triangle_count;
+    f->tri_count = T;
+    f->tri_face = malloc((size_t)T * sizeof *f->tri_face);
+    f->tri_group = malloc((size_t)T * sizeof *f->tri_group);
+    f->tri_p = malloc((size_t)T * 3 * sizeof *f->tri_p);
+    tri_key *keys = malloc((size_t)T * sizeof *keys);
+    gi_vec3 *nrm = malloc((size_t)T * sizeof *nrm);
+    f->faces = calloc((size_t)T * 2, sizeof *f->faces); /* double-sided faces take two */
+    if (!f->tri_face || !f->tri_group || !f->tri_p || !keys || !nrm || !f->faces) {
+        free(keys);
+        free(nrm);
+        return GI_ERR_OUT_OF_MEMORY;
+    }
+    key_triangles(f, s, t, keys, nrm);
     qsort(keys, T, sizeof *keys, key_cmp);
     uint32_t nf = 0;
     for (uint32_t a = 0; a < T;) {
         uint32_t b = a + 1;
-        while (b < T && key_cmp(&(tri_key){0, keys[a].material, keys[a].nx, keys[a].ny, keys[a].nz,
-                                           keys[a].d},
-                                &(tri_key){0, keys[b].material, keys[b].nx, keys[b].ny, keys[b].nz,
-                                           keys[b].d}) == 0)
+        while (b < T && same_face(&keys[a], &keys[b]))
             b++;
         vlf_face *fc = &f->faces[nf];
-        uint32_t t0 = keys[a].tri;
-        gi_vec3 n = gi_v3(0, 0, 0);
-        for (uint32_t k = a; k < b; k++) {
-            const gi_vec3 *p = f->tri_p + 3 * (size_t)keys[k].tri;
-            gi_vec3 c = gi_v3_cross(gi_v3_sub(p[1], p[0]), gi_v3_sub(p[2], p[0]));
-            n = gi_v3_add(n, c);
-            fc->area += 0.5f * gi_v3_length(c);
-            f->tri_face[keys[k].tri] = nf;
-        }
-        fc->n = gi_v3_length(n) > 0.0f ? gi_v3_normalize(n) : nrm[t0];
-        gi_onb(fc->n, &fc->t, &fc->b);
-        float lo[2] = {FLT_MAX, FLT_MAX}, hi[2] = {-FLT_MAX, -FLT_MAX};
-        gi_vec3 p0 = f->tri_p[3 * (size_t)t0];
-        for (uint32_t k = a; k < b; k++)
-            for (int c = 0; c < 3; c++) {
-                gi_vec3 d = gi_v3_sub(f->tri_p[3 * (size_t)keys[k].tri + (size_t)c], p0);
-                float x = gi_v3_dot(d, fc->t), y = gi_v3_dot(d, fc->b);
-                lo[0] = fminf(lo[0], x), lo[1] = fminf(lo[1], y);
-                hi[0] = fmaxf(hi[0], x), hi[1] = fmaxf(hi[1], y);
-            }
-        fc->origin = gi_v3_add(p0, gi_v3_add(gi_v3_scale(fc->t, lo[0]), gi_v3_scale(fc->b, lo[1])));
-        float W = ceilf((hi[0] - lo[0]) * f->prm.density),
-              H = ceilf((hi[1] - lo[1]) * f->prm.density);
-        fc->W = W < 1.0f ? 1u : W > 1024.0f ? 1024u : (uint32_t)W;
-        fc->H = H < 1.0f ? 1u : H > 1024.0f ? 1024u : (uint32_t)H;
-        const gi_material *mt = &s->materials[keys[a].material];
-        memcpy(fc->kd, mt->albedo, sizeof fc->kd);
-        memcpy(fc->ks, mt->ks, sizeof fc->ks);
-        fc->exponent = mt->exponent;
-        fc->material = keys[a].material;
-        fc->textured = mt->albedo_texture >= 0 && (uint32_t)mt->albedo_texture < s->texture_count;
-        fc->mirror = mt->mirror || mt->exponent >= GI_MIRROR_EXPONENT;
-        for (int k = 0; k < VLF_ALBEDO_TABLE; k++)
-            fc->albedo[k] = fc->mirror
-                                ? 1.0f
-                                : (float)vlf_phong_albedo(fc->exponent,
-                                                          (float)k / (float)(VLF_ALBEDO_TABLE - 1));
-        const float *le = gi_scene_triangle_emission(s, t0);
-        for (int k = 0; k < 3; k++)
-            fc->emission[k] = le ? le[k] : 0.0f;
+        face_plane(f, nf, keys + a, b - a, nrm);
+        face_chart(f, fc, keys + a, b - a);
+        face_material(fc, s, keys[a].material, keys[a].tri);
         fc->twin = -1;
-        if (mt->double_sided) {
+        if (s->materials[keys[a].material].double_sided) {
             /* the back side (§3.1: receiver faces store values for both
              * sides): the same plane and chart, the normal reversed; it
              * emits too (glTF doubleSided) */

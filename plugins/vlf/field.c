@@ -11,15 +11,19 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "gi/lights.h"
 #include "gi/raytrace.h"
 
-gi_result vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_settings *p,
-                          gi_error *err)
+gi_result vlf_build_out_of_memory(const vlf_field *f, gi_error *err)
 {
-    memset(f, 0, sizeof *f);
-    f->prm = *p;
-    double t0 = vlf_now_s();
+    return gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                        "vlf: out of memory building the light field (N = %u, l = %u)", f->prm.N,
+                        f->prm.l);
+}
+
+/* The settings a field can be built with (the parameter table's bounds
+ * leave some combinations out of reach of the storage). */
+static gi_result check_settings(const vlf_settings *p, gi_error *err)
+{
     if (p->precision > VLF_PREC_RGB9E5)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "vlf: storage precision %u unknown",
                             p->precision);
@@ -36,9 +40,13 @@ gi_result vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_se
             err, GI_ERR_INVALID_ARGUMENT,
             "vlf: l (N S)^2 = %.3g rays need %.1f GB of depth lists alone; lower l, N or S",
             ray_bytes / sizeof(uint32_t), ray_bytes / (1024.0 * 1024 * 1024));
-    gi_result rc = vlf_dirs_build(&f->dirs, p->l, err);
-    if (rc != GI_OK)
-        return rc;
+    return GI_OK;
+}
+
+/* The VLF coordinates of scene s at time t: its bounds' centre and half
+ * diagonal (a little more) make the unit sphere. */
+static gi_result place_scene(vlf_field *f, const gi_scene *s, float t, gi_error *err)
+{
     if (s->triangle_count == 0)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "vlf: the scene has no triangles");
     float b[6];
@@ -51,60 +59,15 @@ gi_result vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_se
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
                             "vlf: the scene's bounds are empty or not finite");
     f->env = s->envmap;
-    /* Directional lights (not in the paper, which has emissive faces and
-     * sky): parallel light, so it enters like the sky of Fig. 6, into the
-     * interfaces of the three directions around the light's with their
-     * barycentric weights, radiance alpha E / dOmega, so that each carries
-     * alpha E through a unit of area across it. */
-    f->sun = calloc((size_t)p->l * 2 * 3, sizeof *f->sun);
-    if (!f->sun)
-        goto oom;
-    for (uint32_t li = 0; li < s->light_count; li++) {
-        if (s->lights[li].type != GI_LIGHT_DIRECTIONAL)
-            continue;
-        gi_light_frame fr = gi_scene_light_at(s, li, t);
-        float len = gi_v3_length(fr.direction);
-        if (!(len > 0.0f))
-            continue;
-        uint32_t node[3];
-        float al[3];
-        vlf_dirs_locate(&f->dirs, gi_v3_scale(fr.direction, 1.0f / len), node, al);
-        for (int k = 0; k < 3; k++)
-            for (int q = 0; q < 3; q++)
-                f->sun[3 * node[k] + (uint32_t)q] +=
-                    al[k] * s->lights[li].intensity[q] / f->dirs.solid_angle[node[k]];
-        f->sun_count++;
-    }
-    /* Point and spot lights: a first shot by shadow rays (punctual_first_shot). */
-    for (uint32_t li = 0; li < s->light_count; li++)
-        f->punctual_count += s->lights[li].type != GI_LIGHT_DIRECTIONAL;
-    if (f->punctual_count) {
-        f->punctual = calloc(f->punctual_count, sizeof *f->punctual);
-        if (!f->punctual)
-            goto oom;
-        uint32_t k = 0;
-        for (uint32_t li = 0; li < s->light_count; li++) {
-            const gi_light *L = &s->lights[li];
-            if (L->type == GI_LIGHT_DIRECTIONAL)
-                continue;
-            gi_light_frame fr = gi_scene_light_at(s, li, t);
-            vlf_punctual *P = &f->punctual[k++];
-            P->spot = L->type == GI_LIGHT_SPOT;
-            P->pos = fr.position;
-            P->dir = fr.direction;
-            memcpy(P->I, L->intensity, sizeof P->I);
-            P->range = L->range;
-            P->cos_inner = cosf(L->inner_cone);
-            P->cos_outer = cosf(L->outer_cone);
-        }
-        gi_error e;
-        rc = gi_rt_create(s, t, &f->rt, &e);
-        if (rc != GI_OK)
-            return gi_error_set(err, rc, "vlf: shadow rays for the point lights: %s", e.text);
-    }
-    if (vlf_group_faces(f, s, t) != GI_OK)
-        goto oom;
-    uint32_t elems = 0;
+    return GI_OK;
+}
+
+/* Each face's first element in the atlas, its index among the non-diffuse
+ * faces and its emission normaliser; the per-element maps, the subfields
+ * and the tile rectangles allocated. */
+static gi_result lay_out_elements(vlf_field *f)
+{
+    uint32_t elems = 0, l = f->prm.l;
     for (uint32_t fi = 0; fi < f->face_count; fi++) {
         vlf_face *fc = &f->faces[fi];
         fc->first_elem = elems;
@@ -114,7 +77,7 @@ gi_result vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_se
         /* Diffuse emission normalised so that the discrete directions carry
          * exactly pi L per unit area out of the face. */
         double sum = 0.0;
-        for (uint32_t sd = 0; sd < 2 * p->l; sd++) {
+        for (uint32_t sd = 0; sd < 2 * l; sd++) {
             float c2 = gi_v3_dot(fc->n, f->dirs.signed_dirs[sd]);
             if (c2 > 0.0f)
                 sum += c2 * f->dirs.solid_angle[sd];
@@ -128,19 +91,25 @@ gi_result vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_se
     f->E_tot = calloc((size_t)elems * 3, sizeof(float));
     f->E_next = calloc((size_t)elems * 3, sizeof(float));
     f->L_cur = calloc((size_t)elems * 3, sizeof(float));
-    f->psf = calloc(p->l, sizeof *f->psf);
-    f->rects = calloc((size_t)f->nd_count * p->l + 1, sizeof *f->rects);
+    f->psf = calloc(l, sizeof *f->psf);
+    f->rects = calloc((size_t)f->nd_count * l + 1, sizeof *f->rects);
     if (!f->elem_face || !f->elem_area || !f->elem_c || !f->E_tot || !f->E_next || !f->L_cur ||
         !f->psf || !f->rects)
-        goto oom;
+        return GI_ERR_OUT_OF_MEMORY;
     for (uint32_t fi = 0; fi < f->face_count; fi++) {
         vlf_face *fc = &f->faces[fi];
         for (uint32_t e = 0; e < fc->W * fc->H; e++)
             f->elem_face[fc->first_elem + e] = fi;
     }
     f->elem_kd = calloc((size_t)elems * 3 + 3, sizeof *f->elem_kd);
-    if (!f->elem_kd)
-        goto oom;
+    return f->elem_kd ? GI_OK : GI_ERR_OUT_OF_MEMORY;
+}
+
+/* Each element's area on its face, the centroid of its part of the face
+ * and its albedo (§3.1). */
+static void element_values(vlf_field *f, const gi_scene *s)
+{
+    uint32_t elems = f->elem_count;
     vlf_element_areas(f, s);
     /* a back side's elements are its front's texels: the same areas,
      * centroids and (textured) albedo sums */
@@ -171,14 +140,13 @@ gi_result vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_se
             f->elem_c[2 * (size_t)e + 1] /= f->elem_area[e];
         }
     }
-    if ((uint64_t)s->triangle_count * p->subdivide * p->subdivide > 50000000u)
-        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                            "vlf: %u triangles cut into %u^2 each are too many", s->triangle_count,
-                            p->subdivide);
-    if (vlf_subdivide_triangles(f, p->subdivide < 1 ? 1 : p->subdivide) != GI_OK ||
-        vlf_build_subfields(f) != GI_OK)
-        goto oom;
-    /* Tile storage offsets, then coverage of each stored cell. */
+}
+
+/* Tile storage offsets of the rectangles the sort recorded, then the
+ * non-diffuse maps allocated. */
+static gi_result allocate_tiles(vlf_field *f, gi_error *err)
+{
+    const vlf_settings *p = &f->prm;
     size_t cells = 0;
     uint32_t tiles = 0;
     for (size_t r = 0; r < (size_t)f->nd_count * p->l; r++) {
@@ -190,6 +158,7 @@ gi_result vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_se
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
                             "vlf: %zu non-diffuse cells do not fit (lower N or l)", cells);
     f->nd_cells = (uint32_t)cells;
+    f->st.tiles = tiles;
     size_t nc = cells ? cells : 1;
     f->nd_cover = calloc(nc, 1);
     f->out_cur = calloc(nc * 3, sizeof(float));
@@ -197,11 +166,17 @@ gi_result vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_se
     f->out_tot = calloc(nc * 3, sizeof(float));
     f->in = calloc(nc * 3, sizeof(float));
     if (!f->nd_cover || !f->out_cur || !f->out_next || !f->out_tot || !f->in)
-        goto oom;
-    size_t frags = 0;
+        return vlf_build_out_of_memory(f, err);
+    return GI_OK;
+}
+
+/* Coverage of each stored tile cell: the cells some ray of the subfield
+ * meets the face in. */
+static void mark_coverage(vlf_field *f)
+{
+    const vlf_settings *p = &f->prm;
     for (uint32_t i = 0; i < p->l; i++) {
         const vlf_psf *ps = &f->psf[i];
-        frags += ps->frag_count;
         uint32_t NS = p->N * p->S;
         for (uint32_t c = 0; c < NS * NS; c++)
             for (uint32_t k = ps->cell_start[c]; k < ps->cell_start[c + 1]; k++) {
@@ -212,26 +187,62 @@ gi_result vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_se
             }
     }
     uint32_t ndel = 0;
-    for (size_t c = 0; c < cells; c++)
+    for (size_t c = 0; c < f->nd_cells; c++)
         ndel += f->nd_cover[c];
-    f->st.diffuse_elements = elems;
     f->st.nondiffuse_elements = ndel;
-    f->st.tiles = tiles;
-    /* Memory as the paper counts it: current, next and total ir/radiance
-     * maps in the storage format for both kinds (and the incoming tiles),
-     * plus the depth order; rendering keeps the totals and the tile index
-     * only (vlf.c uploads exactly these maps). */
+}
+
+/* Memory as the paper counts it: current, next and total ir/radiance
+ * maps in the storage format for both kinds (and the incoming tiles),
+ * plus the depth order; rendering keeps the totals and the tile index
+ * only (vlf.c uploads exactly these maps). */
+static void count_memory(vlf_field *f)
+{
+    const vlf_settings *p = &f->prm;
+    size_t elems = f->elem_count, cells = f->nd_cells, frags = 0;
+    for (uint32_t i = 0; i < p->l; i++)
+        frags += f->psf[i].frag_count;
+    f->st.diffuse_elements = f->elem_count;
     size_t bpv = vlf_precision_bytes(p->precision);
-    f->st.bytes_maps_render = ((size_t)elems + cells) * bpv;
+    f->st.bytes_maps_render = (elems + cells) * bpv;
     f->st.bytes_propagate =
-        (size_t)elems * bpv * 3 + cells * bpv * 4 + cells + frags * sizeof(uint32_t) +
+        elems * bpv * 3 + cells * bpv * 4 + cells + frags * sizeof(uint32_t) +
         (size_t)p->l * ((size_t)p->N * p->S * p->N * p->S + 1) * sizeof(uint32_t);
     f->st.bytes_render = f->st.bytes_maps_render + (size_t)f->nd_count * p->l * sizeof(vlf_rect);
+}
+
+gi_result vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_settings *p,
+                          gi_error *err)
+{
+    memset(f, 0, sizeof *f);
+    f->prm = *p;
+    double t0 = vlf_now_s();
+    gi_result rc = check_settings(p, err);
+    if (rc == GI_OK)
+        rc = vlf_dirs_build(&f->dirs, p->l, err);
+    if (rc == GI_OK)
+        rc = place_scene(f, s, t, err);
+    if (rc == GI_OK)
+        rc = vlf_add_lights(f, s, t, err);
+    if (rc != GI_OK)
+        return rc;
+    if (vlf_group_faces(f, s, t) != GI_OK || lay_out_elements(f) != GI_OK)
+        return vlf_build_out_of_memory(f, err);
+    element_values(f, s);
+    if ((uint64_t)s->triangle_count * p->subdivide * p->subdivide > 50000000u)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "vlf: %u triangles cut into %u^2 each are too many", s->triangle_count,
+                            p->subdivide);
+    if (vlf_subdivide_triangles(f, p->subdivide < 1 ? 1 : p->subdivide) != GI_OK ||
+        vlf_build_subfields(f) != GI_OK)
+        return vlf_build_out_of_memory(f, err);
+    rc = allocate_tiles(f, err);
+    if (rc != GI_OK)
+        return rc;
+    mark_coverage(f);
+    count_memory(f);
     f->st.sort_s = vlf_now_s() - t0;
     return GI_OK;
-oom:
-    return gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
-                        "vlf: out of memory building the light field (N = %u, l = %u)", p->N, p->l);
 }
 
 void vlf_field_free(vlf_field *f)

@@ -5,7 +5,7 @@
  * of their own (lights.c, scatter.c, perturbed.c, used by propagate.c). A
  * file including it defines _POSIX_C_SOURCE first (clock_gettime).
  *
- * These steps fail only for lack of memory: they return
+ * The steps without a gi_error fail only for lack of memory: they return
  * GI_ERR_OUT_OF_MEMORY (or NULL) without a message, and the function of
  * vlf_field.h that runs them words it (it knows what was being built). */
 #ifndef VLF_FIELD_INTERNAL_H
@@ -67,6 +67,17 @@ static inline size_t vlf_rect_slot(const vlf_rect *r, uint32_t cx, uint32_t cy)
 {
     return r->offset + (size_t)((int32_t)cy - r->y0) * r->w + (size_t)((int32_t)cx - r->x0);
 }
+
+/* ---- Building the field (field.c, lights.c) ------------------------------- */
+
+/* Sets the message of a build that ran out of memory; returns
+ * GI_ERR_OUT_OF_MEMORY. */
+gi_result vlf_build_out_of_memory(const vlf_field *f, gi_error *err);
+/* The scene's lights at time t other than emission and sky (lights.c):
+ * the directional lights' radiance into the interfaces (f->sun), the
+ * point and spot lights (f->punctual) with the scene for their shadow rays
+ * (f->rt). */
+gi_result vlf_add_lights(vlf_field *f, const gi_scene *s, float t, gi_error *err);
 
 /* ---- Faces and elements (§3.1, faces.c) ----------------------------------- */
 

@@ -1,15 +1,86 @@
-/* The scene's point and spot lights in the vlf method (not in the paper,
- * which has emissive faces and sky): their irradiance by shadow rays and
- * their first shot into the maps, from where propagation carries it on. */
+/* The scene's lights in the vlf method other than emissive faces and sky
+ * (not in the paper, which has only those): directional lights entering
+ * the radiance interfaces like the sky, point and spot lights by shadow
+ * rays, their irradiance and first shot into the maps, from where
+ * propagation carries it on. */
 #define _POSIX_C_SOURCE 200809L
 #include "field_internal.h"
 
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "gi/lights.h"
 #include "gi/raytrace.h"
+
+/* Directional lights: parallel light, so it enters like the sky of Fig.
+ * 6, into the interfaces of the three directions around the light's with
+ * their barycentric weights, radiance alpha E / dOmega, so that each
+ * carries alpha E through a unit of area across it. */
+static gi_result add_suns(vlf_field *f, const gi_scene *s, float t)
+{
+    f->sun = calloc((size_t)f->prm.l * 2 * 3, sizeof *f->sun);
+    if (!f->sun)
+        return GI_ERR_OUT_OF_MEMORY;
+    for (uint32_t li = 0; li < s->light_count; li++) {
+        if (s->lights[li].type != GI_LIGHT_DIRECTIONAL)
+            continue;
+        gi_light_frame fr = gi_scene_light_at(s, li, t);
+        float len = gi_v3_length(fr.direction);
+        if (!(len > 0.0f))
+            continue;
+        uint32_t node[3];
+        float al[3];
+        vlf_dirs_locate(&f->dirs, gi_v3_scale(fr.direction, 1.0f / len), node, al);
+        for (int k = 0; k < 3; k++)
+            for (int q = 0; q < 3; q++)
+                f->sun[3 * node[k] + (uint32_t)q] +=
+                    al[k] * s->lights[li].intensity[q] / f->dirs.solid_angle[node[k]];
+        f->sun_count++;
+    }
+    return GI_OK;
+}
+
+/* Point and spot lights at time t, with the scene for their shadow rays:
+ * a first shot by shadow rays (vlf_punctual_first_shot). */
+static gi_result add_punctual(vlf_field *f, const gi_scene *s, float t, gi_error *err)
+{
+    for (uint32_t li = 0; li < s->light_count; li++)
+        f->punctual_count += s->lights[li].type != GI_LIGHT_DIRECTIONAL;
+    if (!f->punctual_count)
+        return GI_OK;
+    f->punctual = calloc(f->punctual_count, sizeof *f->punctual);
+    if (!f->punctual)
+        return vlf_build_out_of_memory(f, err);
+    uint32_t k = 0;
+    for (uint32_t li = 0; li < s->light_count; li++) {
+        const gi_light *L = &s->lights[li];
+        if (L->type == GI_LIGHT_DIRECTIONAL)
+            continue;
+        gi_light_frame fr = gi_scene_light_at(s, li, t);
+        vlf_punctual *P = &f->punctual[k++];
+        P->spot = L->type == GI_LIGHT_SPOT;
+        P->pos = fr.position;
+        P->dir = fr.direction;
+        memcpy(P->I, L->intensity, sizeof P->I);
+        P->range = L->range;
+        P->cos_inner = cosf(L->inner_cone);
+        P->cos_outer = cosf(L->outer_cone);
+    }
+    gi_error e;
+    gi_result rc = gi_rt_create(s, t, &f->rt, &e);
+    if (rc != GI_OK)
+        return gi_error_set(err, rc, "vlf: shadow rays for the point lights: %s", e.text);
+    return GI_OK;
+}
+
+gi_result vlf_add_lights(vlf_field *f, const gi_scene *s, float t, gi_error *err)
+{
+    if (add_suns(f, s, t) != GI_OK)
+        return vlf_build_out_of_memory(f, err);
+    return add_punctual(f, s, t, err);
+}
 
 /* Irradiance at world point x of surface normal n from the point and spot
  * lights, each through a shadow ray (Embree, core raytrace.h); per light
