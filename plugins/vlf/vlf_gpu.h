@@ -3,8 +3,8 @@
  * scattering and the shooting iterations run as GL 4.5 compute passes
  * (shaders/vlf_propagate.comp) on the depth order the CPU's sort stage
  * built, giving the maps the CPU's vlf_field_propagate gives (within
- * float rounding; tests: vlf_tests gpu). Needs a current GL 4.5 context
- * and the plugin's shaders registered. */
+ * float rounding; tests: vlf_storage_tests gpu). Needs a current GL 4.5
+ * context and the plugin's shaders registered. */
 #ifndef VLF_GPU_H
 #define VLF_GPU_H
 
