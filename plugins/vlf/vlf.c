@@ -1,7 +1,7 @@
 /* The `vlf` method: Light Field Propagation and Rendering on the GPU
  * (Mortensen, Khanna, Slater, Afrigraph 2007), the GPU Virtual Light Field.
  *
- * prepare(): the light field is built on the CPU (vlf_core.c: stage
+ * prepare(): the light field is built on the CPU (field.c: stage
  * `sort`), propagated on the CPU or, with propagate = gpu, by compute
  * passes (vlf_gpu.c; stage `propagate`), then uploaded (`gpu_init`);
  * render(): the G-buffer and one compute pass reading the irradiance atlas
@@ -15,7 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "vlf_core.h"
+#include "vlf_field.h"
 #include "vlf_gpu.h"
 
 extern const gi_shader_source gi_vlf_shaders[];
@@ -24,7 +24,7 @@ enum { VLF_LOOKUP_W = 512, VLF_LOOKUP_H = 256, VLF_BUFFERS = 7 };
 
 typedef struct vlf {
     gi_kit kit;
-    vlf_params prm;
+    vlf_settings prm;
     vlf_field field;
     int have_field;
     int gpu_propagate; /* propagate = gpu: the compute passes of vlf_gpu.c */
@@ -36,7 +36,7 @@ typedef struct vlf {
     size_t gpu_map_bytes; /* bytes of the light-field maps uploaded for rendering */
 } vlf;
 
-static const gi_param_desc vlf_params_desc[] = {
+static const gi_param_desc vlf_params[] = {
     {"l", GI_PARAM_INT, 128, 8, 1024, NULL, "l (Sec. 2.1)",
      "bi-directional directions spread over the hemisphere"},
     {"N", GI_PARAM_INT, 64, 8, 256, NULL, "N (Sec. 2.1)",
@@ -71,7 +71,7 @@ static const gi_param_desc vlf_params_desc[] = {
      "surfaces as more "
      "faces (the tessellation sweep of propagation time against faces)"},
     {"propagate", GI_PARAM_ENUM, 0, 0, 0, "cpu|gpu", "propagation (Sec. 3.2-3.4)",
-     "where propagation runs: cpu: the sweeps in C (vlf_core.c); gpu: GL compute passes over the "
+     "where propagation runs: cpu: the sweeps in C (propagate.c); gpu: GL compute passes over the "
      "same depth order "
      "(vlf_gpu.c), the same maps within float rounding; gpu needs perturbed = 0"},
     {"hier_min", GI_PARAM_INT, 0, 0, 1000000, NULL, "hierarchical sort (Sec. 3.2)",
@@ -144,31 +144,10 @@ static void upload(GLuint b, const void *data, size_t bytes)
                       GL_STATIC_DRAW);
 }
 
-/* Uploads the propagated field: faces, irradiance atlas, tiles, their
- * index, the subfield frames (the WC -> PSF matrices' rows) and the
- * triangulation with its lat-long lookup ("gpu_init"). */
-static gi_result vlf_upload(vlf *v)
+/* Per face: chart origin and the back side's face, axes scaled to texels,
+ * then W, H, first element, nd (16 words). */
+static void pack_faces(const vlf_field *f, float *faces)
 {
-    vlf_field *f = &v->field;
-    uint32_t l = f->prm.l, T = f->dirs.tri_count;
-    if (!v->buf[0])
-        glCreateBuffers(VLF_BUFFERS, v->buf);
-    float *faces = calloc((size_t)f->face_count * 16, sizeof *faces);
-    uint32_t prec = f->prm.precision;
-    size_t bpv = vlf_precision_bytes(prec), e_words = (size_t)f->elem_count * bpv / 4;
-    uint32_t *irr = calloc(e_words + f->elem_count + 4, sizeof *irr);
-    void *tiles = calloc((size_t)f->nd_cells * bpv + 4, 1);
-    float *dirs = calloc(((size_t)3 * l + 3 * T + 2 * l) * 4, sizeof *dirs);
-    int32_t *rects = calloc((size_t)f->nd_count * l * 8 + 8, sizeof *rects);
-    uint32_t *tris = calloc((size_t)T * 4, sizeof *tris);
-    uint32_t *lut = calloc((size_t)VLF_LOOKUP_W * VLF_LOOKUP_H, sizeof *lut);
-    if (!faces || !irr || !tiles || !dirs || !rects || !tris || !lut) {
-        free(faces), free(irr), free(tiles), free(dirs), free(rects), free(tris), free(lut);
-        return gi_kit_fail(&v->kit, GI_ERR_OUT_OF_MEMORY,
-                           "vlf: out of memory uploading the light field");
-    }
-    /* faces: chart origin and the back side's face, axes scaled to texels, then W, H, first
-     * element, nd */
     for (uint32_t i = 0; i < f->face_count; i++) {
         const vlf_face *fc = &f->faces[i];
         gi_vec3 o = gi_v3_add(f->centre, gi_v3_scale(fc->origin, f->radius));
@@ -184,10 +163,15 @@ static gi_result vlf_upload(vlf *v)
             (uint32_t)fc->twin; /* the other side of a double-sided face, ~0u for none */
         memcpy(F + 3, &twin, sizeof twin);
     }
-    /* the irradiance atlas in the storage format, then per element the part
-     * of the texel that lies on its face (the filter's weight, so that
-     * slivers at a face's border, hit by few rays, count little); the
-     * tiles in the storage format */
+}
+
+/* The irradiance atlas in the storage format, then per element the part
+ * of the texel that lies on its face (the filter's weight, so that
+ * slivers at a face's border, hit by few rays, count little); the tiles in
+ * the storage format. */
+static void pack_maps(const vlf_field *f, uint32_t *irr, size_t e_words, void *tiles)
+{
+    uint32_t prec = f->prm.precision;
     float texel = 1.0f / (f->prm.density * f->prm.density);
     vlf_pack(prec, f->E_tot, f->elem_count, irr);
     for (uint32_t e = 0; e < f->elem_count; e++) {
@@ -195,6 +179,14 @@ static gi_result vlf_upload(vlf *v)
         memcpy(irr + e_words + e, &w, sizeof w);
     }
     vlf_pack(prec, f->out_tot, f->nd_cells, tiles);
+}
+
+/* The subfield frames (the WC -> PSF matrices' rows), the inverse vertex
+ * matrices of the spherical triangles and the signed directions, 4 floats
+ * each, into dirs; the triangles' nodes into tris. */
+static void pack_directions(const vlf_field *f, float *dirs, uint32_t *tris)
+{
+    uint32_t l = f->prm.l, T = f->dirs.tri_count;
     for (uint32_t i = 0; i < l; i++) {
         const vlf_psf *p = &f->psf[i];
         gi_vec3 fr[3] = {p->u, p->v, p->n};
@@ -209,7 +201,12 @@ static gi_result vlf_upload(vlf *v)
     }
     for (uint32_t s = 0; s < 2 * l; s++)
         memcpy(dirs + 4 * (3 * l + 3 * T + s), &f->dirs.signed_dirs[s], 3 * sizeof(float));
-    for (size_t r = 0; r < (size_t)f->nd_count * l; r++) {
+}
+
+/* The tile index: per (face, direction) its rectangle (8 words). */
+static void pack_rects(const vlf_field *f, int32_t *rects)
+{
+    for (size_t r = 0; r < (size_t)f->nd_count * f->prm.l; r++) {
         const vlf_rect *R = &f->rects[r];
         rects[8 * r] = R->x0;
         rects[8 * r + 1] = R->y0;
@@ -217,6 +214,11 @@ static gi_result vlf_upload(vlf *v)
         rects[8 * r + 3] = (int32_t)R->h;
         rects[8 * r + 4] = (int32_t)R->offset;
     }
+}
+
+/* The lat-long lookup: the spherical triangle of each texel's direction. */
+static void fill_lookup(const vlf_field *f, uint32_t *lut)
+{
     for (uint32_t y = 0; y < VLF_LOOKUP_H; y++)
         for (uint32_t x = 0; x < VLF_LOOKUP_W; x++) {
             float phi = ((float)x + 0.5f) / VLF_LOOKUP_W * 2.0f * GI_PI - GI_PI;
@@ -226,30 +228,66 @@ static gi_result vlf_upload(vlf *v)
             float al[3];
             lut[y * VLF_LOOKUP_W + x] = vlf_dirs_locate(&f->dirs, w, node, al);
         }
-    upload(v->buf[0], faces, (size_t)f->face_count * 16 * sizeof *faces);
-    upload(v->buf[1], irr, (e_words + f->elem_count) * sizeof *irr);
-    /* the face of each scene triangle (the G-buffer's ids) */
+}
+
+/* The face of each scene triangle (the G-buffer's ids) into buffer b. 1,
+ * or 0 out of memory. */
+static int upload_scene_faces(const vlf_field *f, GLuint b)
+{
     uint32_t scene_tris = f->tri_count / f->tri_sub;
     uint32_t *scene_face = malloc((size_t)scene_tris * sizeof *scene_face + 4);
-    if (!scene_face) {
-        free(faces), free(irr), free(tiles), free(dirs), free(rects), free(tris), free(lut);
-        return gi_kit_fail(&v->kit, GI_ERR_OUT_OF_MEMORY,
-                           "vlf: out of memory uploading the light field");
-    }
+    if (!scene_face)
+        return 0;
     for (uint32_t t = 0; t < scene_tris; t++)
         scene_face[t] = f->tri_face[(size_t)t * f->tri_sub];
-    upload(v->buf[6], scene_face, (size_t)scene_tris * sizeof *scene_face);
+    upload(b, scene_face, (size_t)scene_tris * sizeof *scene_face);
     free(scene_face);
-    upload(v->buf[2], tiles, (size_t)f->nd_cells * bpv);
-    v->gpu_map_bytes = e_words * sizeof *irr + (size_t)f->nd_cells * bpv;
-    upload(v->buf[3], rects, (size_t)f->nd_count * l * 8 * sizeof *rects);
-    upload(v->buf[4], dirs, ((size_t)3 * l + 3 * T + 2 * l) * 4 * sizeof *dirs);
-    upload(v->buf[5], tris, (size_t)T * 4 * sizeof *tris);
-    if (!v->lookup)
-        v->lookup = gi_gpu_texture_2d(GL_R32UI, VLF_LOOKUP_W, VLF_LOOKUP_H);
-    glTextureSubImage2D(v->lookup, 0, 0, 0, VLF_LOOKUP_W, VLF_LOOKUP_H, GL_RED_INTEGER,
-                        GL_UNSIGNED_INT, lut);
+    return 1;
+}
+
+/* Uploads the propagated field: faces, irradiance atlas, tiles, their
+ * index, the subfield frames (the WC -> PSF matrices' rows) and the
+ * triangulation with its lat-long lookup ("gpu_init"). */
+static gi_result vlf_upload(vlf *v)
+{
+    vlf_field *f = &v->field;
+    uint32_t l = f->prm.l, T = f->dirs.tri_count;
+    if (!v->buf[0])
+        glCreateBuffers(VLF_BUFFERS, v->buf);
+    float *faces = calloc((size_t)f->face_count * 16, sizeof *faces);
+    size_t bpv = vlf_precision_bytes(f->prm.precision), e_words = (size_t)f->elem_count * bpv / 4;
+    uint32_t *irr = calloc(e_words + f->elem_count + 4, sizeof *irr);
+    void *tiles = calloc((size_t)f->nd_cells * bpv + 4, 1);
+    float *dirs = calloc(((size_t)3 * l + 3 * T + 2 * l) * 4, sizeof *dirs);
+    int32_t *rects = calloc((size_t)f->nd_count * l * 8 + 8, sizeof *rects);
+    uint32_t *tris = calloc((size_t)T * 4, sizeof *tris);
+    uint32_t *lut = calloc((size_t)VLF_LOOKUP_W * VLF_LOOKUP_H, sizeof *lut);
+    int ok = faces && irr && tiles && dirs && rects && tris && lut;
+    if (ok) {
+        pack_faces(f, faces);
+        pack_maps(f, irr, e_words, tiles);
+        pack_directions(f, dirs, tris);
+        pack_rects(f, rects);
+        fill_lookup(f, lut);
+        upload(v->buf[0], faces, (size_t)f->face_count * 16 * sizeof *faces);
+        upload(v->buf[1], irr, (e_words + f->elem_count) * sizeof *irr);
+        ok = upload_scene_faces(f, v->buf[6]);
+    }
+    if (ok) {
+        upload(v->buf[2], tiles, (size_t)f->nd_cells * bpv);
+        v->gpu_map_bytes = e_words * sizeof *irr + (size_t)f->nd_cells * bpv;
+        upload(v->buf[3], rects, (size_t)f->nd_count * l * 8 * sizeof *rects);
+        upload(v->buf[4], dirs, ((size_t)3 * l + 3 * T + 2 * l) * 4 * sizeof *dirs);
+        upload(v->buf[5], tris, (size_t)T * 4 * sizeof *tris);
+        if (!v->lookup)
+            v->lookup = gi_gpu_texture_2d(GL_R32UI, VLF_LOOKUP_W, VLF_LOOKUP_H);
+        glTextureSubImage2D(v->lookup, 0, 0, 0, VLF_LOOKUP_W, VLF_LOOKUP_H, GL_RED_INTEGER,
+                            GL_UNSIGNED_INT, lut);
+    }
     free(faces), free(irr), free(tiles), free(dirs), free(rects), free(tris), free(lut);
+    if (!ok)
+        return gi_kit_fail(&v->kit, GI_ERR_OUT_OF_MEMORY,
+                           "vlf: out of memory uploading the light field");
     gi_error err;
     if (gi_gl_check("vlf: upload", &err) != GI_OK)
         return gi_kit_fail_with(&v->kit, GI_ERR_GL, &err);
@@ -264,13 +302,13 @@ static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
     if (v->have_field)
         vlf_field_free(&v->field);
     v->have_field = 0;
-    char err[256];
+    gi_error err;
     host->stage_begin(host, "sort");
-    int rc = vlf_field_build(&v->field, gs->scene, gs->time, &v->prm, err, sizeof err);
+    gi_result rc = vlf_field_build(&v->field, gs->scene, gs->time, &v->prm, &err);
     host->stage_end(host, "sort");
-    if (rc != 0) {
+    if (rc != GI_OK) {
         vlf_field_free(&v->field);
-        return gi_kit_fail(&v->kit, GI_ERR_INVALID_ARGUMENT, "%s", err);
+        return gi_kit_fail_with(&v->kit, GI_ERR_INVALID_ARGUMENT, &err);
     }
     v->have_field = 1;
     host->stage_begin(host, "propagate");
@@ -278,20 +316,20 @@ static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
         /* the depth order and the gather lists uploaded (propagate_setup),
          * then the passes; the maps read back for the upload below */
         host->stage_begin(host, "propagate_setup");
-        rc = vlf_gpu_setup(&v->gpu, &v->field, err, sizeof err);
+        rc = vlf_gpu_setup(&v->gpu, &v->field, &err);
         host->stage_end(host, "propagate_setup");
-        if (rc == 0)
-            rc =
-                vlf_gpu_propagate(&v->gpu, &v->field, vlf_cancelled, (void *)host, err, sizeof err);
+        if (rc == GI_OK)
+            rc = vlf_gpu_propagate(&v->gpu, &v->field, vlf_cancelled, (void *)host, &err);
         host->stage_end(host, "propagate");
-        if (rc != 0)
-            return gi_kit_fail(
+        if (rc != GI_OK)
+            return gi_kit_fail_with(
                 &v->kit, host->cancelled && host->cancelled(host) ? GI_ERR_CANCELLED : GI_ERR_GL,
-                "%s", err);
+                &err);
     } else {
-        rc = vlf_field_propagate(&v->field, vlf_cancelled, (void *)host);
+        /* any failure here has been reported as a cancellation */
+        rc = vlf_field_propagate(&v->field, vlf_cancelled, (void *)host, NULL);
         host->stage_end(host, "propagate");
-        if (rc != 0)
+        if (rc != GI_OK)
             return gi_kit_fail(&v->kit, GI_ERR_CANCELLED, "vlf: propagation cancelled");
     }
     host->stage_begin(host, "gpu_init");
@@ -337,9 +375,9 @@ static gi_result vlf_prepare(void *inst, const gi_gpu_scene *gs)
             return gi_kit_fail_with(&v->kit, GI_ERR_GL, &err);
     }
     if (v->gpu_propagate && !v->have_gpu) {
-        char e[256];
-        if (vlf_gpu_init(&v->gpu, e, sizeof e) != 0)
-            return gi_kit_fail(&v->kit, GI_ERR_GL, "%s", e);
+        gi_error err;
+        if (vlf_gpu_init(&v->gpu, &err) != GI_OK)
+            return gi_kit_fail_with(&v->kit, GI_ERR_GL, &err);
         v->have_gpu = 1;
     }
     return vlf_build(v, gs);
@@ -428,4 +466,4 @@ GI_METHOD_EXPORT(
     .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_GLOSSY | GI_CAP_MIRROR | GI_CAP_AREA_LIGHTS |
             GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION |
             GI_CAP_PRECOMPUTE | GI_CAP_VISIBILITY | GI_CAP_TEXTURES,
-    .max_bounces = 7, .params = vlf_params_desc);
+    .max_bounces = 7, .params = vlf_params);

@@ -567,6 +567,126 @@ static int load_triangles(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_coun
     return 0;
 }
 
+enum { MAX_GROUPS = 64 };
+
+/* The groups of the hierarchical shortcut in one frame: every group's
+ * triangle count and bounding box, and the candidates (groups of at least
+ * hier_min triangles but not all, at most MAX_GROUPS): which group each
+ * is, whether it is isolated, its stand-in and where its own order lies
+ * in s->out. */
+typedef struct hier_groups {
+    uint32_t G, *gcount;
+    float *gb;     /* 6 per group: lower and upper corner of its box in the frame */
+    int32_t *cand; /* candidate slot of each group, -1 none */
+    uint32_t nc, niso;
+    uint32_t gid[MAX_GROUPS], proxy[MAX_GROUPS], first_out[MAX_GROUPS], end_out[MAX_GROUPS];
+    uint8_t iso[MAX_GROUPS];
+} hier_groups;
+
+/* Every group's triangle count and bounding box (pieces 0 .. tri_count - 1
+ * are the triangles in the frame). */
+static void group_boxes(const vlf_sorter *s, hier_groups *h, uint32_t tri_count,
+                        const uint32_t *group)
+{
+    for (uint32_t g = 0; g < h->G; g++)
+        for (int a = 0; a < 3; a++)
+            h->gb[6 * g + (uint32_t)a] = INFINITY, h->gb[6 * g + 3 + (uint32_t)a] = -INFINITY;
+    for (uint32_t t = 0; t < tri_count; t++) {
+        const vlf_piece *p = &s->poly[t];
+        float *b = h->gb + 6 * (size_t)group[t];
+        h->gcount[group[t]]++;
+        for (int a = 0; a < 3; a++)
+            b[a] = fminf(b[a], p->lo[a]), b[3 + a] = fmaxf(b[3 + a], p->hi[a]);
+    }
+}
+
+/* The candidates, isolated until shown otherwise. */
+static void find_candidates(hier_groups *h, uint32_t tri_count, uint32_t hier_min)
+{
+    h->nc = 0;
+    for (uint32_t g = 0; g < h->G; g++) {
+        h->cand[g] = -1;
+        if (h->gcount[g] >= hier_min && h->gcount[g] < tri_count && h->nc < MAX_GROUPS) {
+            h->cand[g] = (int32_t)h->nc;
+            h->gid[h->nc] = g;
+            h->iso[h->nc++] = 1;
+        }
+    }
+}
+
+/* A candidate is isolated when no other group's triangle reaches into its
+ * box; counts the isolated ones. */
+static void isolate(const vlf_sorter *s, hier_groups *h, uint32_t tri_count, const uint32_t *group)
+{
+    for (uint32_t t = 0; t < tri_count; t++) {
+        const vlf_piece *p = &s->poly[t];
+        for (uint32_t c = 0; c < h->nc; c++) {
+            if (!h->iso[c] || h->gid[c] == group[t])
+                continue;
+            const float *b = h->gb + 6 * (size_t)h->gid[c];
+            int inside = 1;
+            for (int a = 0; a < 3 && inside; a++)
+                inside = p->lo[a] < b[3 + a] - EPS && p->hi[a] > b[a] + EPS;
+            if (inside)
+                h->iso[c] = 0;
+        }
+    }
+    h->niso = 0;
+    for (uint32_t c = 0; c < h->nc; c++)
+        h->niso += h->iso[c];
+}
+
+/* The stand-ins: the isolated groups' front rectangles, planes z =
+ * nearest depth (pieces of triangles tri_count + c). 0, or -1 out of
+ * memory. */
+static int add_stand_ins(vlf_sorter *s, hier_groups *h, uint32_t tri_count)
+{
+    for (uint32_t c = 0; c < h->nc; c++) {
+        if (!h->iso[c])
+            continue;
+        const float *b = h->gb + 6 * (size_t)h->gid[c];
+        gi_vec3 q[4] = {gi_v3(b[0], b[1], b[2]), gi_v3(b[3], b[1], b[2]), gi_v3(b[3], b[4], b[2]),
+                        gi_v3(b[0], b[4], b[2])};
+        float *pl = s->plane + 4 * (size_t)(tri_count + c);
+        pl[0] = 0.0f, pl[1] = 0.0f, pl[2] = 1.0f, pl[3] = b[2];
+        h->proxy[c] = add_piece(s, tri_count + c, q, 4);
+        if (h->proxy[c] == UINT32_MAX)
+            return -1;
+    }
+    return 0;
+}
+
+/* Each group's list spliced into the order s->out[global_first ..) at its
+ * stand-in's place, the result becoming s->out. 0, 1 when a stand-in was
+ * split by a cycle, -1 out of memory. */
+static int splice_groups(vlf_sorter *s, const hier_groups *h, uint32_t tri_count,
+                         uint32_t global_first)
+{
+    uint32_t *order = malloc(((size_t)s->nout + 1) * sizeof *order);
+    if (!order)
+        return -1;
+    uint32_t no = 0;
+    for (uint32_t k = global_first; k < s->nout; k++) {
+        uint32_t idx = s->out[k], tri = s->poly[idx].tri;
+        if (tri < tri_count) {
+            order[no++] = idx;
+            continue;
+        }
+        uint32_t c = tri - tri_count;
+        if (idx != h->proxy[c]) {
+            free(order);
+            return 1; /* the stand-in was split by a cycle */
+        }
+        for (uint32_t j = h->first_out[c]; j < h->end_out[c]; j++)
+            order[no++] = s->out[j];
+    }
+    memcpy(s->out, order, (size_t)no * sizeof *order);
+    s->nout = no;
+    s->groups += h->niso;
+    free(order);
+    return 0;
+}
+
 /* The hierarchical shortcut of §3.2: "objects enclosed by a bounding volume
  * not intersected by any other object in the scene can be taken out of the
  * scene and sorted separately", the volume sorted in their place, their
@@ -583,134 +703,65 @@ static int sort_hier(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, co
                      uint32_t hier_min, gi_vec3 u, gi_vec3 v, gi_vec3 n, int mode,
                      uint32_t bsp_levels, uint32_t bsp_min)
 {
-    enum { MAX_GROUPS = 64 };
-    uint32_t G = 0;
+    hier_groups h;
+    h.G = 0;
     for (uint32_t t = 0; t < tri_count; t++)
-        if (group[t] + 1 > G)
-            G = group[t] + 1;
-    uint32_t *gcount = calloc((size_t)G + 1, sizeof *gcount);
-    float *gb = malloc(((size_t)G + 1) * 6 * sizeof *gb);
-    int32_t *cand =
-        malloc(((size_t)G + 1) * sizeof *cand); /* candidate slot of each group, -1 none */
+        if (group[t] + 1 > h.G)
+            h.G = group[t] + 1;
+    h.gcount = calloc((size_t)h.G + 1, sizeof *h.gcount);
+    h.gb = malloc(((size_t)h.G + 1) * 6 * sizeof *h.gb);
+    h.cand = malloc(((size_t)h.G + 1) * sizeof *h.cand);
     uint32_t *items = malloc(((size_t)tri_count + MAX_GROUPS + 1) * sizeof *items);
-    uint32_t *order = NULL;
     int rc = -1;
-    if (!gcount || !gb || !cand || !items)
+    if (!h.gcount || !h.gb || !h.cand || !items)
         goto done;
     if (load_triangles(s, tri_p, tri_count, u, v, n, MAX_GROUPS) != 0)
         goto done;
-    for (uint32_t g = 0; g < G; g++)
-        for (int a = 0; a < 3; a++)
-            gb[6 * g + (uint32_t)a] = INFINITY, gb[6 * g + 3 + (uint32_t)a] = -INFINITY;
-    for (uint32_t t = 0; t < tri_count; t++) {
-        const vlf_piece *p = &s->poly[t];
-        float *b = gb + 6 * (size_t)group[t];
-        gcount[group[t]]++;
-        for (int a = 0; a < 3; a++)
-            b[a] = fminf(b[a], p->lo[a]), b[3 + a] = fmaxf(b[3 + a], p->hi[a]);
-    }
-    uint32_t nc = 0, gid[MAX_GROUPS];
-    uint8_t iso[MAX_GROUPS];
-    for (uint32_t g = 0; g < G; g++) {
-        cand[g] = -1;
-        if (gcount[g] >= hier_min && gcount[g] < tri_count && nc < MAX_GROUPS) {
-            cand[g] = (int32_t)nc;
-            gid[nc] = g;
-            iso[nc++] = 1;
-        }
-    }
+    group_boxes(s, &h, tri_count, group);
+    find_candidates(&h, tri_count, hier_min);
     rc = 1;
-    if (nc == 0)
+    if (h.nc == 0)
         goto done;
-    /* a group is isolated when no other group's triangle reaches into its box */
-    for (uint32_t t = 0; t < tri_count; t++) {
-        const vlf_piece *p = &s->poly[t];
-        for (uint32_t c = 0; c < nc; c++) {
-            if (!iso[c] || gid[c] == group[t])
-                continue;
-            const float *b = gb + 6 * (size_t)gid[c];
-            int inside = 1;
-            for (int a = 0; a < 3 && inside; a++)
-                inside = p->lo[a] < b[3 + a] - EPS && p->hi[a] > b[a] + EPS;
-            if (inside)
-                iso[c] = 0;
-        }
-    }
-    uint32_t niso = 0;
-    for (uint32_t c = 0; c < nc; c++)
-        niso += iso[c];
-    if (niso == 0)
+    isolate(s, &h, tri_count, group);
+    if (h.niso == 0)
         goto done;
     rc = -1;
-    /* the stand-ins: the front rectangles, planes z = nearest depth */
-    uint32_t proxy[MAX_GROUPS], first_out[MAX_GROUPS], end_out[MAX_GROUPS];
-    for (uint32_t c = 0; c < nc; c++) {
-        if (!iso[c])
-            continue;
-        const float *b = gb + 6 * (size_t)gid[c];
-        gi_vec3 q[4] = {gi_v3(b[0], b[1], b[2]), gi_v3(b[3], b[1], b[2]), gi_v3(b[3], b[4], b[2]),
-                        gi_v3(b[0], b[4], b[2])};
-        float *pl = s->plane + 4 * (size_t)(tri_count + c);
-        pl[0] = 0.0f, pl[1] = 0.0f, pl[2] = 1.0f, pl[3] = b[2];
-        proxy[c] = add_piece(s, tri_count + c, q, 4);
-        if (proxy[c] == UINT32_MAX)
-            goto done;
-    }
+    if (add_stand_ins(s, &h, tri_count) != 0)
+        goto done;
     uint32_t split_limit = tri_count > UINT32_MAX / 8 - 4096 ? UINT32_MAX : 8 * tri_count + 4096;
     /* each isolated group on its own */
-    for (uint32_t c = 0; c < nc; c++) {
-        if (!iso[c])
+    for (uint32_t c = 0; c < h.nc; c++) {
+        if (!h.iso[c])
             continue;
         uint32_t ni = 0;
         for (uint32_t t = 0; t < tri_count; t++)
-            if (group[t] == gid[c])
+            if (group[t] == h.gid[c])
                 items[ni++] = t;
-        first_out[c] = s->nout;
+        h.first_out[c] = s->nout;
         if (order_bsp(s, items, ni, mode, 0, bsp_levels, bsp_min ? bsp_min : 2, split_limit) != 0)
             goto done;
-        end_out[c] = s->nout;
+        h.end_out[c] = s->nout;
     }
     /* the rest with the stand-ins */
     uint32_t ni = 0;
     for (uint32_t t = 0; t < tri_count; t++)
-        if (cand[group[t]] < 0 || !iso[cand[group[t]]])
+        if (h.cand[group[t]] < 0 || !h.iso[h.cand[group[t]]])
             items[ni++] = t;
-    for (uint32_t c = 0; c < nc; c++)
-        if (iso[c])
-            items[ni++] = proxy[c];
+    for (uint32_t c = 0; c < h.nc; c++)
+        if (h.iso[c])
+            items[ni++] = h.proxy[c];
     uint32_t global_first = s->nout;
     if (order_bsp(s, items, ni, mode, 0, bsp_levels, bsp_min ? bsp_min : 2, split_limit) != 0)
         goto done;
-    /* each group's list spliced in at its stand-in's place */
-    order = malloc(((size_t)s->nout + 1) * sizeof *order);
-    if (!order)
-        goto done;
-    uint32_t no = 0;
-    rc = 1;
-    for (uint32_t k = global_first; k < s->nout; k++) {
-        uint32_t idx = s->out[k], tri = s->poly[idx].tri;
-        if (tri < tri_count) {
-            order[no++] = idx;
-            continue;
-        }
-        uint32_t c = tri - tri_count;
-        if (idx != proxy[c])
-            goto done; /* the stand-in was split by a cycle */
-        for (uint32_t j = first_out[c]; j < end_out[c]; j++)
-            order[no++] = s->out[j];
-    }
-    memcpy(s->out, order, (size_t)no * sizeof *order);
-    s->nout = no;
-    s->groups += niso;
-    rc = 0;
+    rc = splice_groups(s, &h, tri_count, global_first);
 done:
-    free(gcount), free(gb), free(cand), free(items), free(order);
+    free(h.gcount), free(h.gb), free(h.cand), free(items);
     return rc;
 }
 
-int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, const uint32_t *group,
-                   uint32_t hier_min, gi_vec3 u, gi_vec3 v, gi_vec3 n, int mode,
-                   uint32_t bsp_levels, uint32_t bsp_min)
+gi_result vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count,
+                         const uint32_t *group, uint32_t hier_min, gi_vec3 u, gi_vec3 v, gi_vec3 n,
+                         int mode, uint32_t bsp_levels, uint32_t bsp_min)
 {
     s->tests = 0;
     s->splits = s->bsp_cuts = s->unresolved = 0;
@@ -718,7 +769,7 @@ int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, cons
     if (group && hier_min > 0) {
         int r = sort_hier(s, tri_p, tri_count, group, hier_min, u, v, n, mode, bsp_levels, bsp_min);
         if (r <= 0)
-            return r;
+            return r == 0 ? GI_OK : GI_ERR_OUT_OF_MEMORY;
         if (s->nout > 0) /* it ran and a stand-in was split: again without the shortcut */
             s->hier_fallbacks++;
         s->tests = 0;
@@ -726,10 +777,10 @@ int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, cons
         s->groups = 0;
     }
     if (load_triangles(s, tri_p, tri_count, u, v, n, 0) != 0)
-        return -1;
+        return GI_ERR_OUT_OF_MEMORY;
     uint32_t *items = malloc((size_t)(tri_count ? tri_count : 1) * sizeof *items);
     if (!items)
-        return -1;
+        return GI_ERR_OUT_OF_MEMORY;
     for (uint32_t t = 0; t < tri_count; t++)
         items[t] = t;
     /* splitting stops at 8 pieces per triangle on average (cycles then
@@ -738,7 +789,7 @@ int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, cons
     int rc =
         order_bsp(s, items, tri_count, mode, 0, bsp_levels, bsp_min ? bsp_min : 2, split_limit);
     free(items);
-    return rc;
+    return rc == 0 ? GI_OK : GI_ERR_OUT_OF_MEMORY;
 }
 
 void vlf_sorter_free(vlf_sorter *s)

@@ -4,13 +4,14 @@
  * another's plane where a cycle of overlaps makes any plain order wrong,
  * and the scene cut first by planes orthogonal to the direction through
  * its centre of mass (the paper's BSP split for large scenes). No GL, no
- * threads here: vlf_core.c runs one sorter per thread, one direction at a
- * time. */
+ * threads here: subfields.c and perturbed.c run one sorter per thread, one
+ * direction at a time. */
 #ifndef VLF_SORT_H
 #define VLF_SORT_H
 
 #include <stdint.h>
 
+#include "gi/common.h"
 #include "gi/vecmath.h"
 
 /* A convex polygon: a scene triangle or a piece of one after splitting,
@@ -70,10 +71,11 @@ enum { VLF_SORT_NEWELL = 0, VLF_SORT_PLAIN = 1, VLF_SORT_NOSPLIT = 2 };
  * triangles whose bounding box in the frame no other triangle reaches into
  * are sorted on their own and spliced in where their box's front face
  * falls in the order of the rest (the hierarchical shortcut of §3.2).
- * Returns 0 on success, -1 out of memory. */
-int vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count, const uint32_t *group,
-                   uint32_t hier_min, gi_vec3 u, gi_vec3 v, gi_vec3 n, int mode,
-                   uint32_t bsp_levels, uint32_t bsp_min);
+ * Fails only out of memory (GI_ERR_OUT_OF_MEMORY, no message: the caller
+ * words it). */
+gi_result vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count,
+                         const uint32_t *group, uint32_t hier_min, gi_vec3 u, gi_vec3 v, gi_vec3 n,
+                         int mode, uint32_t bsp_levels, uint32_t bsp_min);
 void vlf_sorter_free(vlf_sorter *s);
 
 #endif

@@ -1,6 +1,7 @@
 // Propagation of the light field on the GPU (plugins/vlf/vlf_gpu.c, paper
-// §3.2-§3.4): the same transport as the CPU's sweep(), scatter() and the
-// end of an iteration in vlf_core.c, one pass per define VLF_PASS:
+// §3.2-§3.4): the same transport as the CPU's sweep(), vlf_scatter() and
+// the end of an iteration in propagate.c and scatter.c, one pass per
+// define VLF_PASS:
 //   0 sweep:   one invocation per radiance-interface ray and sign (y = 0:
 //              along +w_i, 1: along -w_i), through the ray's fragments;
 //              receivers record the interface's radiance per fragment,
@@ -66,7 +67,7 @@ uint vlf_index()
 }
 
 // IEEE half of a float, rounded to nearest even, clamped at 65504
-// (float_to_half in vlf_core.c).
+// (float_to_half in precision.c).
 uint vlf_f2h(float f)
 {
     uint x = floatBitsToUint(f);
@@ -99,7 +100,7 @@ float vlf_h2f(uint h)
     return (h & 0x8000u) != 0u ? -f : f;
 }
 
-// RGB9E5 as GL packs it and back (pack_9e5 / unpack_9e5 in vlf_core.c);
+// RGB9E5 as GL packs it and back (pack_9e5 / unpack_9e5 in precision.c);
 // the scales are powers of two, so ldexp keeps the divisions exact.
 vec3 vlf_9e5(vec3 c)
 {
@@ -203,7 +204,7 @@ void main()
 bool covered(uint slot) { return ((cover[slot >> 2] >> (8u * (slot & 3u))) & 0xffu) != 0u; }
 
 // Bilinear read of the incoming tile rect r at cell position (x, y) over
-// its covered cells (read_in in vlf_core.c).
+// its covered cells (read_in in scatter.c).
 bool read_in(VlfRect r, float x, float y, out vec3 o)
 {
     float fx = x - 0.5 - float(r.r.x), fy = y - 0.5 - float(r.r.y);

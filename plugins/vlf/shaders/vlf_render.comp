@@ -36,7 +36,7 @@ uniform uint u_tri_count;
 uniform uint u_precision; // 0: three float32, 1: RGBA16F (4 halves), 2: RGB9E5
 uniform uint u_weight_offset; // first weight in vlf_E (uints)
 
-// A value of a map in the storage format (vlf_pack in vlf_core.c) from its
+// A value of a map in the storage format (vlf_pack in precision.c) from its
 // words: three float32, RGBA16F (two words) or RGB9E5 (one word).
 uint vlf_stride() { return u_precision == 1u ? 2u : u_precision == 2u ? 1u : 3u; }
 vec3 vlf_decode(uint w0, uint w1, uint w2)

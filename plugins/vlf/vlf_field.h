@@ -1,16 +1,19 @@
 /* The CPU side of the vlf method (Mortensen, Khanna, Slater, Afrigraph 2007):
- * the direction set with its spherical triangulation (§2.1), the parallel
- * subfields and their per-ray depth order (§3.2), the storage of diffuse
- * elements and sparse non-diffuse tiles (§3.1), and the propagation of
- * unshot radiance through radiance interfaces (§3.2-§3.4). No GL here: the
- * plugin (vlf.c) uploads the result for rendering (§4), and the tests drive
- * these functions directly. */
-#ifndef VLF_CORE_H
-#define VLF_CORE_H
+ * the direction set with its spherical triangulation (§2.1, directions.c),
+ * the parallel subfields and their per-ray depth order (§3.2, subfields.c,
+ * vlf_sort.c), the faces and their elements (§3.1, faces.c, field.c), the
+ * storage of diffuse elements and sparse non-diffuse tiles (§3.1, §6,
+ * precision.c), and the propagation of unshot radiance through radiance
+ * interfaces (§3.2-§3.5, propagate.c, scatter.c, perturbed.c, lights.c).
+ * No GL here: the plugin (vlf.c) uploads the result for rendering (§4),
+ * and the tests drive these functions directly. */
+#ifndef VLF_FIELD_H
+#define VLF_FIELD_H
 
 #include <stddef.h>
 #include <stdint.h>
 
+#include "gi/common.h"
 #include "gi/scene.h"
 #include "gi/vecmath.h"
 
@@ -25,16 +28,16 @@ typedef struct vlf_dirs {
     float *tri_inv; /* 9 per triangle: inverse of the matrix with columns a, b, c (row-major) */
 } vlf_dirs;
 
-/* Builds the set with qhull. 0 on success, else -1 with a message in err. */
-int vlf_dirs_build(vlf_dirs *d, uint32_t l, char *err, size_t err_size);
+/* Builds the set with qhull. */
+gi_result vlf_dirs_build(vlf_dirs *d, uint32_t l, gi_error *err);
 void vlf_dirs_free(vlf_dirs *d);
 /* The spherical triangle holding unit direction w and its barycentric
  * weights (non-negative, summing to 1) of its three nodes; returns the
  * triangle index. */
 uint32_t vlf_dirs_locate(const vlf_dirs *d, gi_vec3 w, uint32_t node[3], float alpha[3]);
 
-/* Parameters (names of the paper where it has them). */
-typedef struct vlf_params {
+/* Settings: the parameters' values (names of the paper where it has them). */
+typedef struct vlf_settings {
     uint32_t l; /* bi-directional directions */
     uint32_t N; /* cells per side of a parallel subfield */
     uint32_t m; /* cells per side of a tile of non-diffuse storage */
@@ -54,7 +57,7 @@ typedef struct vlf_params {
                             (tessellation sweep) */
     uint32_t hier_min; /* hierarchical shortcut (§3.2): objects of at least this many triangles in a
                         * box no other triangle reaches into are sorted on their own; 0: off */
-} vlf_params;
+} vlf_settings;
 
 /* Storage formats of the light-field maps (§3.1, §6): three float32 (12
  * bytes a value), RGBA16F (the paper's 64-bit format: three halves and an
@@ -149,7 +152,7 @@ typedef struct vlf_punctual {
 } vlf_punctual;
 
 typedef struct vlf_field {
-    vlf_params prm;
+    vlf_settings prm;
     vlf_dirs dirs;
     gi_vec3 centre;
     float radius; /* world = centre + radius * vlf */
@@ -183,19 +186,20 @@ typedef struct vlf_field {
 } vlf_field;
 
 /* Builds the field for scene s at time t: faces, elements, directions and
- * the per-ray depth order of every subfield ("sort"). 0 or -1 with err. */
-int vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_params *p, char *err,
-                    size_t err_size);
+ * the per-ray depth order of every subfield ("sort"). */
+gi_result vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_settings *p,
+                          gi_error *err);
 /* Shoots unshot radiance for p->iterations iterations ("propagate").
- * `cancelled` (may be NULL) is polled between directions; returns -1 then. */
-int vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user);
+ * `cancelled` (may be NULL) is polled between directions; returns
+ * GI_ERR_CANCELLED then. */
+gi_result vlf_field_propagate(vlf_field *f, int (*cancelled)(void *), void *user, gi_error *err);
 void vlf_field_free(vlf_field *f);
 
 /* The start of propagation shared by the CPU and the GPU paths: the maps
  * cleared, emission as the first unshot radiance, the point and spot
- * lights' first shot into the next maps, the counters zeroed. 0 or -1
- * (out of memory). */
-int vlf_propagate_init(vlf_field *f);
+ * lights' first shot into the next maps, the counters zeroed. Fails only
+ * out of memory. */
+gi_result vlf_propagate_init(vlf_field *f, gi_error *err);
 /* The radiance the interface of fixed direction i starts a sweep with
  * along sign * w_i: the sky's and the directional lights' (first
  * iteration only). */
