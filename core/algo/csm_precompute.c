@@ -7,6 +7,63 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* One precomputation's renderer, layered texture, scratch and codecs. */
+typedef struct precompute_run {
+    const gi_gpu_scene *gs;
+    const gi_csm_precompute_desc *d;
+    uint32_t S, M;
+    const char *who, *what, *render_stage;
+    gi_depth_renderer *dr;
+    GLuint tex;
+    gi_depth_view *views;
+    uint32_t *slot; /* map k of a batch: its layer, UINT32_MAX not drawn */
+    float *z1, *z2;
+    gi_csm_codec *enc[GI_CSM_MAX_STREAMS];
+} precompute_run;
+
+/* Maps first .. first + count - 1: those not skipped drawn in one
+ * gi_depth_render call, then each read back and added to its stream's
+ * codec. */
+static gi_result encode_batch(precompute_run *pr, uint32_t first, uint32_t count, gi_error *err)
+{
+    const gi_csm_precompute_desc *d = pr->d;
+    const gi_host *host = d->host;
+    uint32_t drawn = 0; /* maps of this batch to draw: layers 0 .. drawn-1 */
+    for (uint32_t k = 0; k < count; k++) {
+        pr->slot[k] = d->skip && d->skip(d->ctx, first + k) ? UINT32_MAX : drawn;
+        if (pr->slot[k] != UINT32_MAX)
+            d->view(d->ctx, first + k, &pr->views[drawn++]);
+    }
+    gi_host_stage(host, pr->render_stage, 1);
+    gi_result r =
+        drawn ? gi_depth_render(pr->dr, pr->gs, pr->views, drawn, pr->tex, 0, err) : GI_OK;
+    gi_host_stage(host, pr->render_stage, 0);
+    if (r != GI_OK)
+        return r;
+    for (uint32_t k = 0; k < count; k++) {
+        const uint32_t q = first + k;
+        float *map = NULL;
+        if (pr->slot[k] != UINT32_MAX) {
+            gi_host_stage(host, pr->render_stage, 1);
+            map = gi_depth_read_layer(pr->tex, pr->M, pr->slot[k]);
+            gi_host_stage(host, pr->render_stage, 0);
+            if (!map) {
+                snprintf(err->text, sizeof err->text, "%s: reading %s %u failed", pr->who, pr->what,
+                         q);
+                return GI_ERR_OUT_OF_MEMORY;
+            }
+        }
+        gi_host_stage(host, "compress", 1);
+        d->depths(d->ctx, q, map ? &pr->views[pr->slot[k]] : NULL, map, pr->z1, pr->z2);
+        free(map);
+        r = gi_csm_codec_add_map(pr->enc[q % pr->S], q / pr->S, pr->z1, pr->z2, err);
+        gi_host_stage(host, "compress", 0);
+        if (r != GI_OK)
+            return r;
+    }
+    return GI_OK;
+}
+
 gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc *d,
                             gi_csm_data *out, gi_error *err)
 {
@@ -27,22 +84,23 @@ gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc
                  what, S);
         return GI_ERR_INVALID_ARGUMENT;
     }
-    gi_depth_renderer *dr = gi_depth_renderer_create(&d->depth, err);
-    if (!dr)
+    precompute_run pr = {
+        .gs = gs, .d = d, .S = S, .M = M, .who = who, .what = what, .render_stage = render_stage};
+    pr.dr = gi_depth_renderer_create(&d->depth, err);
+    if (!pr.dr)
         return GI_ERR_GL;
-    GLuint tex = gi_depth_texture_create(dr, batch);
-    gi_depth_view *views = calloc(batch, sizeof *views);
-    uint32_t *slot =
-        calloc(batch, sizeof *slot); /* map k of a batch: its layer, UINT32_MAX not drawn */
-    float *z1 = malloc((size_t)M * M * sizeof *z1), *z2 = malloc((size_t)M * M * sizeof *z2);
-    gi_csm_codec *enc[GI_CSM_MAX_STREAMS] = {0};
+    pr.tex = gi_depth_texture_create(pr.dr, batch);
+    pr.views = calloc(batch, sizeof *pr.views);
+    pr.slot = calloc(batch, sizeof *pr.slot);
+    pr.z1 = malloc((size_t)M * M * sizeof *pr.z1);
+    pr.z2 = malloc((size_t)M * M * sizeof *pr.z2);
     gi_result r = GI_ERR_OUT_OF_MEMORY;
-    if (!views || !slot || !z1 || !z2) {
+    if (!pr.views || !pr.slot || !pr.z1 || !pr.z2) {
         snprintf(err->text, sizeof err->text, "%s: out of memory for %u x %u %s", who, M, M, what);
         goto done;
     }
     for (uint32_t s = 0; s < S; s++)
-        if ((r = gi_csm_codec_begin(M, N / S, &enc[s], err)) != GI_OK)
+        if ((r = gi_csm_codec_begin(M, N / S, &pr.enc[s], err)) != GI_OK)
             goto done;
     for (uint32_t first = 0; first < N; first += batch) {
         if (host && host->cancelled(host)) {
@@ -51,38 +109,8 @@ gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc
             goto done;
         }
         uint32_t count = N - first < batch ? N - first : batch;
-        uint32_t drawn = 0; /* maps of this batch to draw: layers 0 .. drawn-1 */
-        for (uint32_t k = 0; k < count; k++) {
-            slot[k] = d->skip && d->skip(d->ctx, first + k) ? UINT32_MAX : drawn;
-            if (slot[k] != UINT32_MAX)
-                d->view(d->ctx, first + k, &views[drawn++]);
-        }
-        gi_host_stage(host, render_stage, 1);
-        r = drawn ? gi_depth_render(dr, gs, views, drawn, tex, 0, err) : GI_OK;
-        gi_host_stage(host, render_stage, 0);
-        if (r != GI_OK)
+        if ((r = encode_batch(&pr, first, count, err)) != GI_OK)
             goto done;
-        for (uint32_t k = 0; k < count; k++) {
-            const uint32_t q = first + k;
-            float *map = NULL;
-            if (slot[k] != UINT32_MAX) {
-                gi_host_stage(host, render_stage, 1);
-                map = gi_depth_read_layer(tex, M, slot[k]);
-                gi_host_stage(host, render_stage, 0);
-                if (!map) {
-                    r = GI_ERR_OUT_OF_MEMORY;
-                    snprintf(err->text, sizeof err->text, "%s: reading %s %u failed", who, what, q);
-                    goto done;
-                }
-            }
-            gi_host_stage(host, "compress", 1);
-            d->depths(d->ctx, q, map ? &views[slot[k]] : NULL, map, z1, z2);
-            free(map);
-            r = gi_csm_codec_add_map(enc[q % S], q / S, z1, z2, err);
-            gi_host_stage(host, "compress", 0);
-            if (r != GI_OK)
-                goto done;
-        }
         if (host) {
             char label[96];
             snprintf(label, sizeof label, "%s: %s", who, what);
@@ -91,21 +119,21 @@ gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc
     }
     gi_host_stage(host, "compress", 1);
     for (uint32_t s = 0; s < S && r == GI_OK; s++) {
-        r = gi_csm_codec_finish(enc[s], &out[s], err);
-        enc[s] = NULL;
+        r = gi_csm_codec_finish(pr.enc[s], &out[s], err);
+        pr.enc[s] = NULL;
     }
     gi_host_stage(host, "compress", 0);
 done:
     for (uint32_t s = 0; s < S; s++) {
-        gi_csm_codec_free(enc[s]);
+        gi_csm_codec_free(pr.enc[s]);
         if (r != GI_OK)
             gi_csm_data_free(&out[s]);
     }
-    free(views);
-    free(slot);
-    free(z1);
-    free(z2);
-    glDeleteTextures(1, &tex);
-    gi_depth_renderer_free(dr);
+    free(pr.views);
+    free(pr.slot);
+    free(pr.z1);
+    free(pr.z2);
+    glDeleteTextures(1, &pr.tex);
+    gi_depth_renderer_free(pr.dr);
     return r;
 }

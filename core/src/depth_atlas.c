@@ -32,34 +32,34 @@ struct gi_depth_atlas {
     uint32_t geometry_count; /* their triangles */
 };
 
-gi_depth_atlas *gi_depth_atlas_create(const gi_depth_atlas_desc *d, gi_error *err)
+/* Rejects a desc the atlas cannot draw. */
+static gi_result check_desc(const gi_depth_atlas_desc *d, gi_error *err)
 {
-    if (!d) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth atlas: the desc is NULL");
-        return NULL;
-    }
-    if (d->tile == 0 || d->tile > ATLAS_MAX_TILE || d->capacity == 0) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                     "depth atlas: tile %u (1..%u) or capacity %u (>= 1) invalid", d->tile,
-                     ATLAS_MAX_TILE, d->capacity);
-        return NULL;
-    }
-    if (d->projection != GI_PROJ_PERSPECTIVE && d->projection != GI_PROJ_PARABOLOID) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                     "depth atlas: projection %d is not perspective or paraboloid",
-                     (int)d->projection);
-        return NULL;
-    }
-    if (d->metric != GI_DEPTH_EYE_Z && d->metric != GI_DEPTH_RADIAL) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth atlas: metric %d invalid",
-                     (int)d->metric);
-        return NULL;
-    }
-    if (d->cull < 0 || d->cull > 2) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth atlas: cull %d is not 0, 1 or 2",
-                     d->cull);
-        return NULL;
-    }
+    if (!d)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth atlas: the desc is NULL");
+    if (d->tile == 0 || d->tile > ATLAS_MAX_TILE || d->capacity == 0)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "depth atlas: tile %u (1..%u) or capacity %u (>= 1) invalid", d->tile,
+                            ATLAS_MAX_TILE, d->capacity);
+    if (d->projection != GI_PROJ_PERSPECTIVE && d->projection != GI_PROJ_PARABOLOID)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "depth atlas: projection %d is not perspective or paraboloid",
+                            (int)d->projection);
+    if (d->metric != GI_DEPTH_EYE_Z && d->metric != GI_DEPTH_RADIAL)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth atlas: metric %d invalid",
+                            (int)d->metric);
+    if (d->cull < 0 || d->cull > 2)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth atlas: cull %d is not 0, 1 or 2",
+                            d->cull);
+    return GI_OK;
+}
+
+/* The grid of tiles: the smallest square number of columns that holds
+ * capacity tiles, as many rows as they fill; refused when the texture
+ * would exceed this GL's limits. */
+static gi_result atlas_grid(const gi_depth_atlas_desc *d, uint32_t *columns_out, uint32_t *rows_out,
+                            gi_error *err)
+{
     uint32_t columns = (uint32_t)ceil(sqrt((double)d->capacity));
     while ((uint64_t)columns * columns < d->capacity) /* guard sqrt rounding */
         columns++;
@@ -70,14 +70,47 @@ gi_depth_atlas *gi_depth_atlas_create(const gi_depth_atlas_desc *d, gi_error *er
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
     glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_rb);
     uint64_t limit = (uint64_t)(max_tex < max_rb ? max_tex : max_rb);
-    if ((uint64_t)columns * d->tile > limit || (uint64_t)rows * d->tile > limit) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                     "depth atlas: %u maps of %u^2 need a %llu x %llu texture, more than this GL "
-                     "allows (%llu)",
-                     d->capacity, d->tile, (unsigned long long)columns * d->tile,
-                     (unsigned long long)rows * d->tile, (unsigned long long)limit);
+    if ((uint64_t)columns * d->tile > limit || (uint64_t)rows * d->tile > limit)
+        return gi_error_set(
+            err, GI_ERR_INVALID_ARGUMENT,
+            "depth atlas: %u maps of %u^2 need a %llu x %llu texture, more than this GL "
+            "allows (%llu)",
+            d->capacity, d->tile, (unsigned long long)columns * d->tile,
+            (unsigned long long)rows * d->tile, (unsigned long long)limit);
+    *columns_out = columns;
+    *rows_out = rows;
+    return GI_OK;
+}
+
+/* The texture, its depth buffer and framebuffer, and the views' buffer
+ * (the info header, then capacity views), bound as a texture buffer too. */
+static void create_targets(gi_depth_atlas *a)
+{
+    const gi_depth_atlas_desc *d = &a->desc;
+    a->tex = gi_gpu_texture_2d(GL_R32F, a->width, a->height);
+    glCreateRenderbuffers(1, &a->depth_rb);
+    glNamedRenderbufferStorage(a->depth_rb, GL_DEPTH_COMPONENT32F, (GLsizei)a->width,
+                               (GLsizei)a->height);
+    glCreateFramebuffers(1, &a->fbo);
+    glNamedFramebufferTexture(a->fbo, GL_COLOR_ATTACHMENT0, a->tex, 0);
+    glNamedFramebufferRenderbuffer(a->fbo, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, a->depth_rb);
+    glNamedFramebufferDrawBuffer(a->fbo, GL_COLOR_ATTACHMENT0);
+    /* The SSBO: the info header, then capacity views. */
+    atlas_info_gpu info = {d->tile, a->columns, (uint32_t)d->projection, (uint32_t)d->metric};
+    GLsizeiptr size = (GLsizeiptr)(sizeof info + (size_t)d->capacity * sizeof(atlas_view_gpu));
+    glCreateBuffers(1, &a->ssbo);
+    glNamedBufferStorage(a->ssbo, size, NULL, GL_DYNAMIC_STORAGE_BIT);
+    glNamedBufferSubData(a->ssbo, 0, sizeof info, &info);
+    /* The vertex stage reads the same buffer as a texture buffer (see depth_atlas.vert). */
+    glCreateTextures(GL_TEXTURE_BUFFER, 1, &a->ssbo_tex);
+    glTextureBuffer(a->ssbo_tex, GL_RGBA32F, a->ssbo);
+}
+
+gi_depth_atlas *gi_depth_atlas_create(const gi_depth_atlas_desc *d, gi_error *err)
+{
+    uint32_t columns = 0, rows = 0;
+    if (check_desc(d, err) != GI_OK || atlas_grid(d, &columns, &rows, err) != GI_OK)
         return NULL;
-    }
     gi_depth_atlas *a = calloc(1, sizeof *a);
     if (a)
         a->staging = malloc((size_t)d->capacity * sizeof *a->staging);
@@ -101,23 +134,7 @@ gi_depth_atlas *gi_depth_atlas_create(const gi_depth_atlas_desc *d, gi_error *er
     a->loc_views = glGetUniformLocation(a->program, "u_views");
     a->loc_projection = glGetUniformLocation(a->program, "u_projection");
     a->loc_metric = glGetUniformLocation(a->program, "u_metric");
-    a->tex = gi_gpu_texture_2d(GL_R32F, a->width, a->height);
-    glCreateRenderbuffers(1, &a->depth_rb);
-    glNamedRenderbufferStorage(a->depth_rb, GL_DEPTH_COMPONENT32F, (GLsizei)a->width,
-                               (GLsizei)a->height);
-    glCreateFramebuffers(1, &a->fbo);
-    glNamedFramebufferTexture(a->fbo, GL_COLOR_ATTACHMENT0, a->tex, 0);
-    glNamedFramebufferRenderbuffer(a->fbo, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, a->depth_rb);
-    glNamedFramebufferDrawBuffer(a->fbo, GL_COLOR_ATTACHMENT0);
-    /* The SSBO: the info header, then capacity views. */
-    atlas_info_gpu info = {d->tile, columns, (uint32_t)d->projection, (uint32_t)d->metric};
-    GLsizeiptr size = (GLsizeiptr)(sizeof info + (size_t)d->capacity * sizeof(atlas_view_gpu));
-    glCreateBuffers(1, &a->ssbo);
-    glNamedBufferStorage(a->ssbo, size, NULL, GL_DYNAMIC_STORAGE_BIT);
-    glNamedBufferSubData(a->ssbo, 0, sizeof info, &info);
-    /* The vertex stage reads the same buffer as a texture buffer (see depth_atlas.vert). */
-    glCreateTextures(GL_TEXTURE_BUFFER, 1, &a->ssbo_tex);
-    glTextureBuffer(a->ssbo_tex, GL_RGBA32F, a->ssbo);
+    create_targets(a);
     if (glCheckNamedFramebufferStatus(a->fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
         gi_error_set(err, GI_ERR_GL, "depth atlas: the %ux%u framebuffer is incomplete", a->width,
                      a->height);

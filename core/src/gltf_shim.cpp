@@ -877,6 +877,14 @@ class Converter
     void convert_animations();
     void convert_channel(size_t a, size_t k);
     void read_environment();
+    void copy_geometry(gi_scene *s) const;
+    void copy_materials(gi_scene *s) const;
+    void copy_textures(gi_scene *s) const;
+    void copy_nodes(gi_scene *s) const;
+    void copy_objects(gi_scene *s) const;
+    void copy_lights(gi_scene *s) const;
+    void copy_cameras(gi_scene *s) const;
+    void copy_emitters_and_environment(gi_scene *s) const;
     gi_scene *build() const;
 };
 
@@ -2073,6 +2081,135 @@ void fill_track(gi_track *dst, const Track &src)
     dst->values = copy_array(src.values);
 }
 
+/* The output's arrays, each filled by one of these from build() (a throw
+ * leaves what is already there to gi_scene_free). */
+void Converter::copy_geometry(gi_scene *s) const
+{
+    s->vertices = copy_array(vertices);
+    s->vertex_count = static_cast<uint32_t>(vertices.size());
+    s->indices = copy_array(indices);
+    s->triangle_count = static_cast<uint32_t>(indices.size() / 3);
+}
+
+void Converter::copy_materials(gi_scene *s) const
+{
+    s->materials = static_cast<gi_material *>(calloc(materials.size() + 1, sizeof(gi_material)));
+    if (!s->materials)
+        throw std::bad_alloc();
+    s->material_count = static_cast<uint32_t>(materials.size());
+    for (size_t i = 0; i < materials.size(); i++) {
+        s->materials[i] = materials[i];
+        s->materials[i].name = nullptr;
+        s->materials[i].name = copy_string(material_names[i]);
+    }
+}
+
+void Converter::copy_textures(gi_scene *s) const
+{
+    s->textures = static_cast<gi_texture *>(calloc(textures.size() + 1, sizeof(gi_texture)));
+    if (!s->textures)
+        throw std::bad_alloc();
+    s->texture_count = static_cast<uint32_t>(textures.size());
+    for (size_t i = 0; i < textures.size(); i++) {
+        s->textures[i].width = textures[i].width;
+        s->textures[i].height = textures[i].height;
+        s->textures[i].name = copy_string(textures[i].name);
+        s->textures[i].rgba = copy_array(textures[i].rgba);
+    }
+}
+
+void Converter::copy_nodes(gi_scene *s) const
+{
+    s->nodes = static_cast<gi_node *>(calloc(nodes.size() + 1, sizeof(gi_node)));
+    if (!s->nodes)
+        throw std::bad_alloc();
+    s->node_count = static_cast<uint32_t>(nodes.size());
+    for (size_t i = 0; i < nodes.size(); i++) {
+        gi_node &g = s->nodes[i];
+        g.parent = parents[i];
+        memcpy(g.translation, nodes[i].t, sizeof g.translation);
+        memcpy(g.rotation, nodes[i].r, sizeof g.rotation);
+        memcpy(g.scale, nodes[i].s, sizeof g.scale);
+        g.name = copy_string(m.nodes[i].name);
+        fill_track(&g.anim_t, nodes[i].anim[0]);
+        fill_track(&g.anim_r, nodes[i].anim[1]);
+        fill_track(&g.anim_s, nodes[i].anim[2]);
+    }
+}
+
+void Converter::copy_objects(gi_scene *s) const
+{
+    s->objects = static_cast<gi_object *>(calloc(objects.size() + 1, sizeof(gi_object)));
+    if (!s->objects)
+        throw std::bad_alloc();
+    s->object_count = static_cast<uint32_t>(objects.size());
+    for (size_t i = 0; i < objects.size(); i++) {
+        s->objects[i] = objects[i];
+        s->objects[i].name = nullptr;
+        s->objects[i].name = copy_string(object_names[i]);
+        s->objects[i].morph_positions = nullptr;
+        s->objects[i].morph_normals = nullptr;
+        s->objects[i].morph_weights = nullptr;
+        s->objects[i].morph_track = gi_track();
+        if (objects[i].morph_count) {
+            const ObjectMorph &om = object_morphs[i];
+            s->objects[i].morph_positions = copy_array(om.pos);
+            s->objects[i].morph_normals = copy_array(om.nrm);
+            s->objects[i].morph_weights = copy_array(om.weights);
+            fill_track(&s->objects[i].morph_track,
+                       nodes[static_cast<size_t>(objects[i].node)].weights);
+        }
+    }
+}
+
+void Converter::copy_lights(gi_scene *s) const
+{
+    s->lights = static_cast<gi_light *>(calloc(lights.size() + 1, sizeof(gi_light)));
+    if (!s->lights)
+        throw std::bad_alloc();
+    s->light_count = static_cast<uint32_t>(lights.size());
+    for (size_t i = 0; i < lights.size(); i++) {
+        s->lights[i] = lights[i];
+        s->lights[i].name = nullptr;
+        s->lights[i].name = copy_string(light_names[i]);
+    }
+}
+
+void Converter::copy_cameras(gi_scene *s) const
+{
+    s->cameras = static_cast<gi_camera *>(calloc(cameras.size() + 1, sizeof(gi_camera)));
+    if (!s->cameras)
+        throw std::bad_alloc();
+    s->camera_count = static_cast<uint32_t>(cameras.size());
+    for (size_t i = 0; i < cameras.size(); i++) {
+        s->cameras[i] = cameras[i];
+        s->cameras[i].name = nullptr;
+        s->cameras[i].name = copy_string(camera_names[i]);
+    }
+}
+
+/* The emissive triangles (after copy_geometry), the animation's length
+ * and the environment. */
+void Converter::copy_emitters_and_environment(gi_scene *s) const
+{
+    std::vector<uint32_t> emitters;
+    for (uint32_t t = 0; t < s->triangle_count; t++) {
+        const float *e = materials[vertices[indices[t * 3]].material].emission;
+        if (e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f)
+            emitters.push_back(t);
+    }
+    s->emitters = copy_array(emitters);
+    s->emitter_count = static_cast<uint32_t>(emitters.size());
+    s->animation_length = animation_length;
+    if (has_env) {
+        s->has_environment = 1;
+        s->environment.uri = copy_string(env_uri);
+        s->environment.path = copy_string(env_path);
+        s->environment.intensity = env_intensity;
+        s->environment.rotation_deg = env_rotation;
+    }
+}
+
 /* Moves everything into malloc'd C arrays (gi_scene_free's ownership). */
 gi_scene *Converter::build() const
 {
@@ -2080,100 +2217,14 @@ gi_scene *Converter::build() const
     if (!s)
         throw std::bad_alloc();
     try {
-        s->vertices = copy_array(vertices);
-        s->vertex_count = static_cast<uint32_t>(vertices.size());
-        s->indices = copy_array(indices);
-        s->triangle_count = static_cast<uint32_t>(indices.size() / 3);
-        s->materials =
-            static_cast<gi_material *>(calloc(materials.size() + 1, sizeof(gi_material)));
-        if (!s->materials)
-            throw std::bad_alloc();
-        s->material_count = static_cast<uint32_t>(materials.size());
-        for (size_t i = 0; i < materials.size(); i++) {
-            s->materials[i] = materials[i];
-            s->materials[i].name = nullptr;
-            s->materials[i].name = copy_string(material_names[i]);
-        }
-        s->textures = static_cast<gi_texture *>(calloc(textures.size() + 1, sizeof(gi_texture)));
-        if (!s->textures)
-            throw std::bad_alloc();
-        s->texture_count = static_cast<uint32_t>(textures.size());
-        for (size_t i = 0; i < textures.size(); i++) {
-            s->textures[i].width = textures[i].width;
-            s->textures[i].height = textures[i].height;
-            s->textures[i].name = copy_string(textures[i].name);
-            s->textures[i].rgba = copy_array(textures[i].rgba);
-        }
-        s->nodes = static_cast<gi_node *>(calloc(nodes.size() + 1, sizeof(gi_node)));
-        if (!s->nodes)
-            throw std::bad_alloc();
-        s->node_count = static_cast<uint32_t>(nodes.size());
-        for (size_t i = 0; i < nodes.size(); i++) {
-            gi_node &g = s->nodes[i];
-            g.parent = parents[i];
-            memcpy(g.translation, nodes[i].t, sizeof g.translation);
-            memcpy(g.rotation, nodes[i].r, sizeof g.rotation);
-            memcpy(g.scale, nodes[i].s, sizeof g.scale);
-            g.name = copy_string(m.nodes[i].name);
-            fill_track(&g.anim_t, nodes[i].anim[0]);
-            fill_track(&g.anim_r, nodes[i].anim[1]);
-            fill_track(&g.anim_s, nodes[i].anim[2]);
-        }
-        s->objects = static_cast<gi_object *>(calloc(objects.size() + 1, sizeof(gi_object)));
-        if (!s->objects)
-            throw std::bad_alloc();
-        s->object_count = static_cast<uint32_t>(objects.size());
-        for (size_t i = 0; i < objects.size(); i++) {
-            s->objects[i] = objects[i];
-            s->objects[i].name = nullptr;
-            s->objects[i].name = copy_string(object_names[i]);
-            s->objects[i].morph_positions = nullptr;
-            s->objects[i].morph_normals = nullptr;
-            s->objects[i].morph_weights = nullptr;
-            s->objects[i].morph_track = gi_track();
-            if (objects[i].morph_count) {
-                const ObjectMorph &om = object_morphs[i];
-                s->objects[i].morph_positions = copy_array(om.pos);
-                s->objects[i].morph_normals = copy_array(om.nrm);
-                s->objects[i].morph_weights = copy_array(om.weights);
-                fill_track(&s->objects[i].morph_track,
-                           nodes[static_cast<size_t>(objects[i].node)].weights);
-            }
-        }
-        s->lights = static_cast<gi_light *>(calloc(lights.size() + 1, sizeof(gi_light)));
-        if (!s->lights)
-            throw std::bad_alloc();
-        s->light_count = static_cast<uint32_t>(lights.size());
-        for (size_t i = 0; i < lights.size(); i++) {
-            s->lights[i] = lights[i];
-            s->lights[i].name = nullptr;
-            s->lights[i].name = copy_string(light_names[i]);
-        }
-        s->cameras = static_cast<gi_camera *>(calloc(cameras.size() + 1, sizeof(gi_camera)));
-        if (!s->cameras)
-            throw std::bad_alloc();
-        s->camera_count = static_cast<uint32_t>(cameras.size());
-        for (size_t i = 0; i < cameras.size(); i++) {
-            s->cameras[i] = cameras[i];
-            s->cameras[i].name = nullptr;
-            s->cameras[i].name = copy_string(camera_names[i]);
-        }
-        std::vector<uint32_t> emitters;
-        for (uint32_t t = 0; t < s->triangle_count; t++) {
-            const float *e = materials[vertices[indices[t * 3]].material].emission;
-            if (e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f)
-                emitters.push_back(t);
-        }
-        s->emitters = copy_array(emitters);
-        s->emitter_count = static_cast<uint32_t>(emitters.size());
-        s->animation_length = animation_length;
-        if (has_env) {
-            s->has_environment = 1;
-            s->environment.uri = copy_string(env_uri);
-            s->environment.path = copy_string(env_path);
-            s->environment.intensity = env_intensity;
-            s->environment.rotation_deg = env_rotation;
-        }
+        copy_geometry(s);
+        copy_materials(s);
+        copy_textures(s);
+        copy_nodes(s);
+        copy_objects(s);
+        copy_lights(s);
+        copy_cameras(s);
+        copy_emitters_and_environment(s);
     } catch (...) {
         gi_scene_free(s);
         throw;

@@ -208,7 +208,8 @@ gi_gpu_scene *gi_gpu_scene_upload(gi_gpu *gpu, const gi_scene *s, gi_error *err)
     return gs;
 }
 
-void gi_gpu_scene_set_time(gi_gpu_scene *gs, float t)
+/* The objects' transforms at t and their normal matrices. */
+static void upload_transforms(gi_gpu_scene *gs, float t)
 {
     const gi_scene *s = gs->scene;
     float ubo[GI_MAX_OBJECTS][32];
@@ -225,82 +226,91 @@ void gi_gpu_scene_set_time(gi_gpu_scene *gs, float t)
     }
     glNamedBufferSubData(gs->ubo_objects, 0, (GLsizeiptr)(s->object_count * 32 * sizeof(float)),
                          ubo);
+}
 
-    /* Morphing objects: their vertices at t into the vertex buffer (one
-     * upload per object; the rest of the buffer is untouched). */
-    if (gs->deforming) {
-        gi_vertex *v = NULL;
-        size_t cap = 0;
-        for (uint32_t o = 0; o < s->object_count; o++) {
-            const gi_object *obj = &s->objects[o];
-            if (!obj->morph_count || !obj->vertex_count)
-                continue;
-            if (obj->vertex_count > cap) {
-                free(v);
-                cap = obj->vertex_count;
-                v = malloc(cap * sizeof *v);
-                if (!v) {
-                    gi_log(GI_LOG_ERROR, "gpu scene: out of memory morphing object %u", o);
-                    break;
-                }
+/* Morphing objects: their vertices at t into the vertex buffer (one
+ * upload per object; the rest of the buffer is untouched). */
+static void upload_morphed_vertices(gi_gpu_scene *gs, float t)
+{
+    const gi_scene *s = gs->scene;
+    gi_vertex *v = NULL;
+    size_t cap = 0;
+    for (uint32_t o = 0; o < s->object_count; o++) {
+        const gi_object *obj = &s->objects[o];
+        if (!obj->morph_count || !obj->vertex_count)
+            continue;
+        if (obj->vertex_count > cap) {
+            free(v);
+            cap = obj->vertex_count;
+            v = malloc(cap * sizeof *v);
+            if (!v) {
+                gi_log(GI_LOG_ERROR, "gpu scene: out of memory morphing object %u", o);
+                break;
             }
-            gi_scene_object_vertices(s, o, t, v);
-            glNamedBufferSubData(gs->vbo, (GLintptr)((size_t)obj->first_vertex * sizeof *v),
-                                 (GLsizeiptr)((size_t)obj->vertex_count * sizeof *v), v);
         }
-        free(v);
+        gi_scene_object_vertices(s, o, t, v);
+        glNamedBufferSubData(gs->vbo, (GLintptr)((size_t)obj->first_vertex * sizeof *v),
+                             (GLsizeiptr)((size_t)obj->vertex_count * sizeof *v), v);
     }
+    free(v);
+}
 
-    if (s->light_count) {
-        gi_gpu_light *lights = calloc(s->light_count, sizeof *lights);
-        for (uint32_t i = 0; lights && i < s->light_count; i++) {
-            const gi_light *l = &s->lights[i];
-            gi_light_frame f = gi_scene_light_at(s, i, t);
-            gi_v3_store(f.position, lights[i].position);
-            gi_v3_store(f.direction, lights[i].direction);
-            lights[i].type = (uint32_t)l->type;
-            lights[i].range = l->range;
-            memcpy(lights[i].intensity, l->intensity, sizeof lights[i].intensity);
-            lights[i].cos_inner = cosf(l->inner_cone);
-            lights[i].cos_outer = cosf(l->outer_cone);
-        }
-        if (lights)
-            glNamedBufferSubData(gs->ssbo_lights, 0, (GLsizeiptr)(s->light_count * sizeof *lights),
-                                 lights);
-        free(lights);
+/* The punctual lights at t. */
+static void upload_lights(gi_gpu_scene *gs, float t)
+{
+    const gi_scene *s = gs->scene;
+    gi_gpu_light *lights = calloc(s->light_count, sizeof *lights);
+    for (uint32_t i = 0; lights && i < s->light_count; i++) {
+        const gi_light *l = &s->lights[i];
+        gi_light_frame f = gi_scene_light_at(s, i, t);
+        gi_v3_store(f.position, lights[i].position);
+        gi_v3_store(f.direction, lights[i].direction);
+        lights[i].type = (uint32_t)l->type;
+        lights[i].range = l->range;
+        memcpy(lights[i].intensity, l->intensity, sizeof lights[i].intensity);
+        lights[i].cos_inner = cosf(l->inner_cone);
+        lights[i].cos_outer = cosf(l->outer_cone);
     }
+    if (lights)
+        glNamedBufferSubData(gs->ssbo_lights, 0, (GLsizeiptr)(s->light_count * sizeof *lights),
+                             lights);
+    free(lights);
+}
 
-    gs->emitter_power = 0.0f;
-    if (s->emitter_count) {
-        gi_gpu_emitter *em = calloc(s->emitter_count, sizeof *em);
-        double total = 0.0;
-        for (uint32_t i = 0; em && i < s->emitter_count; i++) {
-            gi_vec3 p[3];
-            gi_scene_triangle_world(s, s->emitters[i], t, p);
-            float area =
-                0.5f * gi_v3_length(gi_v3_cross(gi_v3_sub(p[1], p[0]), gi_v3_sub(p[2], p[0])));
-            float power =
-                area * gi_luminance(gi_scene_triangle_emission(s, s->emitters[i])) * GI_PI;
-            em[i].triangle = s->emitters[i];
-            em[i].area = area;
-            em[i].pdf = power;
-            total += power;
-            em[i].cdf = (float)total;
-        }
-        for (uint32_t i = 0; em && i < s->emitter_count; i++) {
-            em[i].cdf = total > 0 ? (float)(em[i].cdf / total) : (float)(i + 1) / s->emitter_count;
-            em[i].pdf = total > 0 ? (float)(em[i].pdf / total) : 1.0f / s->emitter_count;
-        }
-        if (em) {
-            em[s->emitter_count - 1].cdf = 1.0f;
-            glNamedBufferSubData(gs->ssbo_emitters, 0, (GLsizeiptr)(s->emitter_count * sizeof *em),
-                                 em);
-        }
-        free(em);
-        gs->emitter_power = (float)total;
+/* The emissive triangles at t with their areas and the CDF of their power;
+ * sets gs->emitter_power. */
+static void upload_emitters(gi_gpu_scene *gs, float t)
+{
+    const gi_scene *s = gs->scene;
+    gi_gpu_emitter *em = calloc(s->emitter_count, sizeof *em);
+    double total = 0.0;
+    for (uint32_t i = 0; em && i < s->emitter_count; i++) {
+        gi_vec3 p[3];
+        gi_scene_triangle_world(s, s->emitters[i], t, p);
+        float area = 0.5f * gi_v3_length(gi_v3_cross(gi_v3_sub(p[1], p[0]), gi_v3_sub(p[2], p[0])));
+        float power = area * gi_luminance(gi_scene_triangle_emission(s, s->emitters[i])) * GI_PI;
+        em[i].triangle = s->emitters[i];
+        em[i].area = area;
+        em[i].pdf = power;
+        total += power;
+        em[i].cdf = (float)total;
     }
+    for (uint32_t i = 0; em && i < s->emitter_count; i++) {
+        em[i].cdf = total > 0 ? (float)(em[i].cdf / total) : (float)(i + 1) / s->emitter_count;
+        em[i].pdf = total > 0 ? (float)(em[i].pdf / total) : 1.0f / s->emitter_count;
+    }
+    if (em) {
+        em[s->emitter_count - 1].cdf = 1.0f;
+        glNamedBufferSubData(gs->ssbo_emitters, 0, (GLsizeiptr)(s->emitter_count * sizeof *em), em);
+    }
+    free(em);
+    gs->emitter_power = (float)total;
+}
 
-    gi_scene_bounds_at(s, t, gs->bounds);
+/* The scene-info block at t (scene.glsl GiSceneInfo), made on first use. */
+static void upload_info(gi_gpu_scene *gs, float t)
+{
+    const gi_scene *s = gs->scene;
     scene_info info = {{s->triangle_count, s->light_count, s->emitter_count, s->envmap ? 1u : 0u},
                        {gs->emitter_power,
                         s->envmap ? gi_envmap_average_radiance(s->envmap) * 4.0f * GI_PI : 0.0f, t,
@@ -310,6 +320,21 @@ void gi_gpu_scene_set_time(gi_gpu_scene *gs, float t)
     if (!gs->ubo_info)
         gs->ubo_info = make_buffer(NULL, sizeof info, GL_DYNAMIC_STORAGE_BIT);
     glNamedBufferSubData(gs->ubo_info, 0, sizeof info, &info);
+}
+
+void gi_gpu_scene_set_time(gi_gpu_scene *gs, float t)
+{
+    const gi_scene *s = gs->scene;
+    upload_transforms(gs, t);
+    if (gs->deforming)
+        upload_morphed_vertices(gs, t);
+    if (s->light_count)
+        upload_lights(gs, t);
+    gs->emitter_power = 0.0f;
+    if (s->emitter_count)
+        upload_emitters(gs, t);
+    gi_scene_bounds_at(s, t, gs->bounds);
+    upload_info(gs, t);
     gs->time = t;
 }
 

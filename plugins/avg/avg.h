@@ -1,6 +1,7 @@
 /* Approximate Visibility Grids (Bashford-Rogers, Debattista, Harvey,
  * Chalmers): the plugin's internal interface, shared by avg.c and the tests
- * (tests/avg_tests.c compiles the plugin's sources in).
+ * (the avg_tests program, tests/avg_test*.c, compiles the plugin's sources
+ * in).
  *
  *   avg_grid   the AVG itself (§III-A): two 3D textures (summed normals and
  *              summed colours, a count in alpha), rebuilt by the rasteriser

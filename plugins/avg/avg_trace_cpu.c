@@ -117,11 +117,84 @@ static void set_v3(float *dst, gi_vec3 v)
     dst[2] = v.z;
 }
 
+/* A path's light vertex: the VPL of slot 0 and the path's first ray. */
+typedef struct path_start {
+    avg_vpl v;
+    gi_vec3 origin, dir, flux;
+} path_start;
+
+/* On the area lights: a point on the emitter triangle that ue picks, its
+ * VPL, and a cosine-distributed ray about the triangle's normal. 0 for a
+ * degenerate triangle or emitter. */
+static int start_on_emitter(const avg_exact *x, const gi_scene *s, float ue, float pl, float N,
+                            const float q0[2], const float q1[2], float eps, path_start *ps)
+{
+    const float *pos = gi_rt_positions(x->rt);
+    const gi_gpu_emitter *em = &x->emitters[gi_emitter_find_cpu(x->emitters, x->emitter_count, ue)];
+    uint32_t tri = em->triangle;
+    gi_vec3 p0 = vertex(pos, s->indices[3 * tri]), p1 = vertex(pos, s->indices[3 * tri + 1]),
+            p2 = vertex(pos, s->indices[3 * tri + 2]);
+    float bc[3];
+    gi_sample_uniform_triangle(q0[0], q0[1], bc);
+    gi_vec3 ng = gi_v3_cross(gi_v3_sub(p1, p0), gi_v3_sub(p2, p0));
+    float area = 0.5f * gi_v3_length(ng);
+    if (!(area > 0.0f) || !(em->pdf > 0.0f))
+        return 0;
+    const gi_material *m = &s->materials[s->vertices[s->indices[3 * tri]].material];
+    gi_vec3 axis = gi_v3_scale(ng, 1.0f / (2.0f * area));
+    float pdf_area = pl * em->pdf / area;
+    gi_vec3 y = gi_v3_add(gi_v3_add(gi_v3_scale(p0, bc[0]), gi_v3_scale(p1, bc[1])),
+                          gi_v3_scale(p2, bc[2]));
+    set_v3(ps->v.position, y);
+    ps->v.kind = AVG_VPL_DIFFUSE | (m->double_sided ? 0x10000u : 0u);
+    set_v3(ps->v.normal, axis);
+    ps->flux =
+        gi_v3_scale(gi_v3(m->emission[0], m->emission[1], m->emission[2]), GI_PI / (pdf_area * N));
+    set_v3(ps->v.power, ps->flux);
+    ps->dir = gi_to_world(gi_sample_cosine_hemisphere(q1[0], q1[1]), axis);
+    ps->origin = gi_v3_add(y, gi_v3_scale(axis, eps));
+    return 1;
+}
+
+/* At point or spot light L (path i): its VPL and a ray uniform in the
+ * spot's cone or over the sphere. */
+static void start_at_light(const gi_gpu_light *L, float pl, float N, uint32_t i, const float q1[2],
+                           path_start *ps)
+{
+    gi_vec3 I =
+        gi_v3_scale(gi_v3(L->intensity[0], L->intensity[1], L->intensity[2]), 1.0f / (pl * N));
+    gi_vec3 ldir = gi_v3(L->direction[0], L->direction[1], L->direction[2]);
+    memcpy(ps->v.position, L->position, sizeof ps->v.position);
+    ps->v.range = L->range;
+    memcpy(ps->v.spot_dir, L->direction, sizeof ps->v.spot_dir);
+    int spot = L->type == GI_LIGHT_SPOT;
+    ps->v.kind = spot ? AVG_VPL_SPOT : AVG_VPL_POINT;
+    ps->v.cos_inner = L->cos_inner;
+    ps->v.cos_outer = L->cos_outer;
+    if (spot && L->cos_outer >= 0.0f) {
+        set_v3(ps->v.normal, ldir);
+        set_v3(ps->v.power, I);
+    } else {
+        gi_vec3 a = spot ? ldir : gi_v3(0, 1, 0);
+        set_v3(ps->v.normal, (i & 1u) == 0 ? a : gi_v3_scale(a, -1.0f));
+        set_v3(ps->v.power, gi_v3_scale(I, 2.0f));
+    }
+    if (spot) {
+        ps->dir = gi_to_world(gi_sample_uniform_cone(q1[0], q1[1], L->cos_outer), ldir);
+        ps->flux =
+            gi_v3_scale(I, gi_spot_falloff(gi_v3_dot(ps->dir, ldir), L->cos_inner, L->cos_outer) /
+                               gi_uniform_cone_pdf(L->cos_outer));
+    } else {
+        ps->dir = gi_sample_uniform_sphere(q1[0], q1[1]);
+        ps->flux = gi_v3_scale(I, 1.0f / gi_uniform_sphere_pdf());
+    }
+    ps->origin = gi_v3_load(L->position);
+}
+
 static void trace_path(const avg_exact *x, const gi_scene *s, const avg_light_table *lt,
                        const avg_trace_desc *d, uint32_t mask, float eps, uint32_t i,
                        avg_vpl *slots)
 {
-    const float *pos = gi_rt_positions(x->rt);
     float N = (float)d->paths;
     float u = ((float)i + 0.5f) / N;
     uint32_t l = 0;
@@ -134,68 +207,18 @@ static void trace_path(const avg_exact *x, const gi_scene *s, const avg_light_ta
     float q0[2], q1[2];
     avg_qr(i, 0, mask, d->seed, q0);
     avg_qr(i, 1, mask, d->seed, q1);
-    avg_vpl v;
-    memset(&v, 0, sizeof v);
-    gi_vec3 origin, dir, flux;
+    path_start ps;
+    memset(&ps.v, 0, sizeof ps.v);
     if (l == 0) {
         float ue = (u - lo) / pl;
         ue = ue < 0.0f ? 0.0f : (ue > GI_ONE_MINUS_EPSILON ? GI_ONE_MINUS_EPSILON : ue);
-        const gi_gpu_emitter *em =
-            &x->emitters[gi_emitter_find_cpu(x->emitters, x->emitter_count, ue)];
-        uint32_t tri = em->triangle;
-        gi_vec3 p0 = vertex(pos, s->indices[3 * tri]), p1 = vertex(pos, s->indices[3 * tri + 1]),
-                p2 = vertex(pos, s->indices[3 * tri + 2]);
-        float bc[3];
-        gi_sample_uniform_triangle(q0[0], q0[1], bc);
-        gi_vec3 ng = gi_v3_cross(gi_v3_sub(p1, p0), gi_v3_sub(p2, p0));
-        float area = 0.5f * gi_v3_length(ng);
-        if (!(area > 0.0f) || !(em->pdf > 0.0f))
+        if (!start_on_emitter(x, s, ue, pl, N, q0, q1, eps, &ps))
             return;
-        const gi_material *m = &s->materials[s->vertices[s->indices[3 * tri]].material];
-        gi_vec3 axis = gi_v3_scale(ng, 1.0f / (2.0f * area));
-        float pdf_area = pl * em->pdf / area;
-        gi_vec3 y = gi_v3_add(gi_v3_add(gi_v3_scale(p0, bc[0]), gi_v3_scale(p1, bc[1])),
-                              gi_v3_scale(p2, bc[2]));
-        set_v3(v.position, y);
-        v.kind = AVG_VPL_DIFFUSE | (m->double_sided ? 0x10000u : 0u);
-        set_v3(v.normal, axis);
-        flux = gi_v3_scale(gi_v3(m->emission[0], m->emission[1], m->emission[2]),
-                           GI_PI / (pdf_area * N));
-        set_v3(v.power, flux);
-        dir = gi_to_world(gi_sample_cosine_hemisphere(q1[0], q1[1]), axis);
-        origin = gi_v3_add(y, gi_v3_scale(axis, eps));
     } else {
-        const gi_gpu_light *L = &x->lights[l - 1];
-        gi_vec3 I =
-            gi_v3_scale(gi_v3(L->intensity[0], L->intensity[1], L->intensity[2]), 1.0f / (pl * N));
-        gi_vec3 ldir = gi_v3(L->direction[0], L->direction[1], L->direction[2]);
-        memcpy(v.position, L->position, sizeof v.position);
-        v.range = L->range;
-        memcpy(v.spot_dir, L->direction, sizeof v.spot_dir);
-        int spot = L->type == GI_LIGHT_SPOT;
-        v.kind = spot ? AVG_VPL_SPOT : AVG_VPL_POINT;
-        v.cos_inner = L->cos_inner;
-        v.cos_outer = L->cos_outer;
-        if (spot && L->cos_outer >= 0.0f) {
-            set_v3(v.normal, ldir);
-            set_v3(v.power, I);
-        } else {
-            gi_vec3 a = spot ? ldir : gi_v3(0, 1, 0);
-            set_v3(v.normal, (i & 1u) == 0 ? a : gi_v3_scale(a, -1.0f));
-            set_v3(v.power, gi_v3_scale(I, 2.0f));
-        }
-        if (spot) {
-            dir = gi_to_world(gi_sample_uniform_cone(q1[0], q1[1], L->cos_outer), ldir);
-            flux =
-                gi_v3_scale(I, gi_spot_falloff(gi_v3_dot(dir, ldir), L->cos_inner, L->cos_outer) /
-                                   gi_uniform_cone_pdf(L->cos_outer));
-        } else {
-            dir = gi_sample_uniform_sphere(q1[0], q1[1]);
-            flux = gi_v3_scale(I, 1.0f / gi_uniform_sphere_pdf());
-        }
-        origin = gi_v3_load(L->position);
+        start_at_light(&x->lights[l - 1], pl, N, i, q1, &ps);
     }
-    slots[0] = v;
+    slots[0] = ps.v;
+    gi_vec3 origin = ps.origin, dir = ps.dir, flux = ps.flux;
 
     for (uint32_t k = 1; k <= d->bounces; k++) {
         gi_rt_hit hit;

@@ -445,65 +445,97 @@ static void release_prepared(csm *c)
     c->warned_moved = 0;
 }
 
-static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
+/* What prepare() gathers before the upload: the codec data of every
+ * object's distant maps and of every (light, object) pair's cube maps, and
+ * the running totals of the concatenated buffers and of the stats. */
+typedef struct csm_prep {
+    uint32_t n;           /* objects, at least 1 (the arrays' size) */
+    uint32_t n_pairs;     /* light_count x n */
+    gi_csm_data *data;    /* per object: its distant maps */
+    gi_csm_data *ldata;   /* per pair (light j, object k) at j n + k: its cube maps */
+    csm_gpu_rect *pairs;  /* per pair: the record the GPU reads */
+    int semilocal, local; /* lights=semilocal; fixed local lights that need cube maps */
+    uint32_t casters;     /* objects with CSMs (not receiver-only) */
+    uint32_t done;        /* builds so far (progress) */
+    float share;          /* the progress share of one build */
+    int hits, tries;      /* builds that came from the cache, builds in all */
+    uint64_t offsets_total, segments_total, bytes_u, bytes_c, maps_local;
+    uint64_t local_segments, local_texels;
+} csm_prep;
+
+static void free_prep(const csm *c, csm_prep *p)
 {
-    csm *c = inst;
-    release_prepared(c);
-    const gi_host *host = c->kit.host;
+    for (uint32_t k = 0; p->data && k < c->object_count; k++)
+        gi_csm_data_free(&p->data[k]);
+    for (uint32_t q = 0; p->ldata && q < p->n_pairs; q++)
+        gi_csm_data_free(&p->ldata[q]);
+    free(p->data);
+    free(p->ldata);
+    free(p->pairs);
+}
+
+/* The per-object arrays, and the transforms at prepare time (update()
+ * compares against them). */
+static gi_result alloc_objects(csm *c, const gi_gpu_scene *gs, csm_prep *p)
+{
     const gi_scene *s = gs->scene;
-    gi_error err;
-    gi_kit_prepare(&c->kit, gs);
-    c->program = gi_program_build_compute("csm.comp", NULL, &err);
-    if (!c->program)
-        return gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
     c->object_count = s->object_count;
-    uint32_t n = s->object_count ? s->object_count : 1u;
-    c->objects = calloc(n, sizeof *c->objects);
-    c->casts = calloc(n, 1);
-    c->prepare_transforms = malloc((size_t)n * 16 * sizeof(float));
+    p->n = s->object_count ? s->object_count : 1u;
+    c->objects = calloc(p->n, sizeof *c->objects);
+    c->casts = calloc(p->n, 1);
+    c->prepare_transforms = malloc((size_t)p->n * 16 * sizeof(float));
     if (c->prepare_transforms)
         for (uint32_t k = 0; k < c->object_count && k < GI_MAX_OBJECTS; k++)
             memcpy(c->prepare_transforms + 16 * k, gs->world_from_local[k], 16 * sizeof(float));
-    gi_csm_data *data = calloc(n, sizeof *data);
-    if (!c->objects || !c->casts || !c->prepare_transforms || !data) {
-        free(data);
+    p->data = calloc(p->n, sizeof *p->data);
+    if (!c->objects || !c->casts || !c->prepare_transforms || !p->data)
         return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "csm: out of memory");
-    }
-    /* Lights (§4.2) at the current time; directional lights stay distant. */
+    return GI_OK;
+}
+
+/* Lights (§4.2) at the current time; directional lights stay distant. */
+static gi_result collect_lights(csm *c, const gi_gpu_scene *gs, csm_prep *p)
+{
+    const gi_scene *s = gs->scene;
     c->light_count =
         csm_lights_collect(s, gs->time, (uint32_t)c->n_local, c->linear_aspect, &c->lights);
     int directional = 0;
     for (uint32_t i = 0; i < s->light_count; i++)
         directional |= s->lights[i].type == GI_LIGHT_DIRECTIONAL;
-    int semilocal = c->lights_mode == LIGHTS_SEMILOCAL;
-    c->distant = s->has_environment || directional || (semilocal && c->light_count > 0);
-    int local = !semilocal && c->light_count > 0;
-    uint32_t n_pairs = c->light_count * n;
-    gi_csm_data *ldata = calloc(n_pairs ? n_pairs : 1, sizeof *ldata);
-    csm_gpu_rect *pairs = calloc(n_pairs ? n_pairs : 1, sizeof *pairs);
-    if (!ldata || !pairs) {
-        free(data);
-        free(ldata);
-        free(pairs);
+    p->semilocal = c->lights_mode == LIGHTS_SEMILOCAL;
+    c->distant = s->has_environment || directional || (p->semilocal && c->light_count > 0);
+    p->local = !p->semilocal && c->light_count > 0;
+    p->n_pairs = c->light_count * p->n;
+    p->ldata = calloc(p->n_pairs ? p->n_pairs : 1, sizeof *p->ldata);
+    p->pairs = calloc(p->n_pairs ? p->n_pairs : 1, sizeof *p->pairs);
+    if (!p->ldata || !p->pairs)
         return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "csm: out of memory");
-    }
-    uint32_t casters = 0;
+    return GI_OK;
+}
+
+/* Which objects cast (§4.6, receiver-only objects), and the progress
+ * share of one build. */
+static void mark_casters(csm *c, const gi_scene *s, csm_prep *p)
+{
+    const gi_host *host = c->kit.host;
     for (uint32_t k = 0; k < c->object_count; k++) {
         c->casts[k] = !(c->receivers == RECEIVERS_PLANAR && object_is_planar(s, k));
-        casters += c->casts[k];
+        p->casters += c->casts[k];
         if (!c->casts[k])
             host->log(host, GI_LOG_INFO, "object %s is receiver-only (planar)", s->objects[k].name);
     }
     /* progress: every build counts as one share */
-    uint32_t builds = (c->distant ? casters : 0) + (local ? casters * c->light_count : 0), done = 0;
-    float share = builds ? 1.0f / (float)builds : 1.0f;
-    gi_result r = GI_OK;
-    int hits = 0, tries = 0;
-    uint64_t offsets_total = 0, segments_total = 0, bytes_u = 0, bytes_c = 0, maps_local = 0;
-    uint64_t local_segments = 0, local_texels = 0;
-    for (uint32_t k = 0; k < c->object_count && r == GI_OK; k++) {
+    uint32_t builds = (c->distant ? p->casters : 0) + (p->local ? p->casters * c->light_count : 0);
+    p->share = builds ? 1.0f / (float)builds : 1.0f;
+}
+
+/* Every object's sphere and bias, and the casters' orthographic CSMs when
+ * distant or semi-local light needs them (§4.1, §3.1). */
+static gi_result build_distant(csm *c, const gi_gpu_scene *gs, csm_prep *p)
+{
+    for (uint32_t k = 0; k < c->object_count; k++) {
         float sphere[4];
-        gi_mesh_object_sphere(s, k, sphere);
+        gi_mesh_object_sphere(gs->scene, k, sphere);
         if (!(sphere[3] > 0.0f))
             sphere[3] = 1e-6f; /* a degenerate object: a point; its maps are empty */
         csm_gpu_object *o = &c->objects[k];
@@ -513,199 +545,291 @@ static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
         if (!c->distant || !c->casts[k])
             continue; /* M = 0: no orthographic CSM */
         int hit = 0;
-        r = load_or_build(c, gs, k, sphere, share * (float)done++, share, &data[k], &hit);
+        gi_result r = load_or_build(c, gs, k, sphere, p->share * (float)p->done++, p->share,
+                                    &p->data[k], &hit);
         if (r != GI_OK)
-            break;
-        hits += hit;
-        tries++;
+            return r;
+        p->hits += hit;
+        p->tries++;
         o->M = (uint32_t)c->M;
-        o->offsets_base = (uint32_t)offsets_total;
-        o->segments_base = (uint32_t)segments_total;
-        offsets_total += (uint64_t)c->M * (uint64_t)c->M + 1u;
-        segments_total += data[k].segment_count;
-        bytes_u += data[k].bytes_uncompressed;
-        bytes_c += data[k].bytes_compressed;
+        o->offsets_base = (uint32_t)p->offsets_total;
+        o->segments_base = (uint32_t)p->segments_total;
+        p->offsets_total += (uint64_t)c->M * (uint64_t)c->M + 1u;
+        p->segments_total += p->data[k].segment_count;
+        p->bytes_u += p->data[k].bytes_uncompressed;
+        p->bytes_c += p->data[k].bytes_compressed;
     }
-    /* Cube-map CSMs per (light, object) (§4.2, §4.6), or the semi-local
-     * validity flags (§4.3). */
-    for (uint32_t j = 0; j < c->light_count && r == GI_OK; j++) {
-        const csm_light *l = &c->lights[j];
-        for (uint32_t k = 0; k < c->object_count && r == GI_OK; k++) {
-            csm_gpu_rect *pr = &pairs[j * n + k];
-            int shadows = c->casts[k] && l->object != (int)k;
-            if (shadows && semilocal) {
-                float wb[6];
-                object_world_bounds(gs, k, wb);
-                if (light_in_bounds(l, wb)) {
-                    host->log(host, GI_LOG_WARN,
-                              "semi-local light %u lies inside the bounds of object %s, which then "
-                              "casts no "
-                              "shadow of it (semi-local lights are valid outside an object's "
-                              "convex hull only)",
-                              j, s->objects[k].name);
-                    shadows = 0;
-                }
-            }
-            float local_from_world[16];
-            if (!gi_mat4_invert(local_from_world, gs->world_from_local[k]))
-                gi_mat4_identity(local_from_world);
-            csm_local_desc desc = {.M = (uint32_t)c->m_local,
-                                   .o = gi_mat4_point(local_from_world, l->origin),
-                                   .e1 = gi_mat4_dir(local_from_world, l->e1),
-                                   .e2 = gi_mat4_dir(local_from_world, l->e2),
-                                   .n_u = l->n_u,
-                                   .n_v = l->n_v,
-                                   .order = c->light_order,
-                                   .z3 = c->z3,
-                                   .shell = shell_depth(c, c->objects[k].sphere[3]),
-                                   .batch = batch_for(c->m_local)};
+    return GI_OK;
+}
+
+/* Does object k cast shadows of light j: not of its own light, not as a
+ * receiver-only object, and a semi-local light must lie outside its
+ * bounds (warned about). */
+static int pair_shadows(const csm *c, const gi_gpu_scene *gs, const csm_prep *p, uint32_t j,
+                        uint32_t k)
+{
+    const csm_light *l = &c->lights[j];
+    int shadows = c->casts[k] && l->object != (int)k;
+    if (shadows && p->semilocal) {
+        float wb[6];
+        object_world_bounds(gs, k, wb);
+        if (light_in_bounds(l, wb)) {
+            const gi_host *host = c->kit.host;
+            host->log(host, GI_LOG_WARN,
+                      "semi-local light %u lies inside the bounds of object %s, which then "
+                      "casts no "
+                      "shadow of it (semi-local lights are valid outside an object's "
+                      "convex hull only)",
+                      j, gs->scene->objects[k].name);
+            shadows = 0;
+        }
+    }
+    return shadows;
+}
+
+/* Light l's rectangle and grid in object k's local space (§4.6). */
+static csm_local_desc pair_desc(const csm *c, const gi_gpu_scene *gs, const csm_light *l,
+                                uint32_t k)
+{
+    float local_from_world[16];
+    if (!gi_mat4_invert(local_from_world, gs->world_from_local[k]))
+        gi_mat4_identity(local_from_world);
+    csm_local_desc desc = {.M = (uint32_t)c->m_local,
+                           .o = gi_mat4_point(local_from_world, l->origin),
+                           .e1 = gi_mat4_dir(local_from_world, l->e1),
+                           .e2 = gi_mat4_dir(local_from_world, l->e2),
+                           .n_u = l->n_u,
+                           .n_v = l->n_v,
+                           .order = c->light_order,
+                           .z3 = c->z3,
+                           .shell = shell_depth(c, c->objects[k].sphere[3]),
+                           .batch = batch_for(c->m_local)};
+    return desc;
+}
+
+/* Cube-map CSMs per (light, object) (§4.2, §4.6), or the semi-local
+ * validity flags (§4.3). */
+static gi_result build_light_pairs(csm *c, const gi_gpu_scene *gs, csm_prep *p)
+{
+    for (uint32_t j = 0; j < c->light_count; j++) {
+        for (uint32_t k = 0; k < c->object_count; k++) {
+            csm_gpu_rect *pr = &p->pairs[j * p->n + k];
+            int shadows = pair_shadows(c, gs, p, j, k);
+            csm_local_desc desc = pair_desc(c, gs, &c->lights[j], k);
             rect_store(pr->o, desc.o, shadows ? 1.0f : 0.0f);
             rect_store(pr->e1, desc.e1, 0.0f);
             rect_store(pr->e2, desc.e2, 0.0f);
             memcpy(&pr->info[3], &c->objects[k].bias_bits, 4);
-            if (!shadows || !local)
+            if (!shadows || !p->local)
                 continue;
-            gi_csm_data *d = &ldata[j * n + k];
+            gi_csm_data *d = &p->ldata[j * p->n + k];
             int hit = 0;
-            r = load_or_build_local(c, gs, k, c->objects[k].sphere, &desc, share * (float)done++,
-                                    share, d, &hit);
+            gi_result r = load_or_build_local(c, gs, k, c->objects[k].sphere, &desc,
+                                              p->share * (float)p->done++, p->share, d, &hit);
             if (r != GI_OK)
-                break;
-            hits += hit;
-            tries++;
+                return r;
+            p->hits += hit;
+            p->tries++;
             pr->info[0] = desc.M;
-            pr->info[1] = (uint32_t)offsets_total;
-            pr->info[2] = (uint32_t)segments_total;
-            offsets_total += (uint64_t)desc.M * desc.M + 1u;
-            segments_total += d->segment_count;
-            local_segments += d->segment_count;
-            local_texels += (uint64_t)desc.M * desc.M;
-            maps_local += d->N;
-            bytes_u += d->bytes_uncompressed;
-            bytes_c += d->bytes_compressed;
+            pr->info[1] = (uint32_t)p->offsets_total;
+            pr->info[2] = (uint32_t)p->segments_total;
+            p->offsets_total += (uint64_t)desc.M * desc.M + 1u;
+            p->segments_total += d->segment_count;
+            p->local_segments += d->segment_count;
+            p->local_texels += (uint64_t)desc.M * desc.M;
+            p->maps_local += d->N;
+            p->bytes_u += d->bytes_uncompressed;
+            p->bytes_c += d->bytes_compressed;
         }
     }
-    if (r == GI_OK && (offsets_total > UINT32_MAX || segments_total > UINT32_MAX))
-        r = gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED, "csm: more than 2^32 segments in all");
+    return GI_OK;
+}
+
+/* The host copies of the buffers upload() makes. */
+typedef struct csm_arrays {
+    uint32_t *offsets, *iend;
+    float *z;
+    uint32_t cells_n, *cells; /* distant grid cell -> enumeration index */
+    float *patterns;
+    uint32_t lcells_n, *lcells; /* object -> light, then the lights' cells */
+    csm_gpu_rect *lrec;         /* per light */
+} csm_arrays;
+
+/* The objects' distant data and the pairs' cube-map data, one after the
+ * other at the bases prepare() gave them. */
+static void concatenate_segments(const csm *c, const csm_prep *p, csm_arrays *a)
+{
+    for (uint32_t k = 0; k < c->object_count; k++) {
+        if (!c->objects[k].M)
+            continue;
+        size_t m2 = (size_t)c->M * (size_t)c->M + 1u;
+        memcpy(a->offsets + c->objects[k].offsets_base, p->data[k].offsets,
+               m2 * sizeof *a->offsets);
+        memcpy(a->z + c->objects[k].segments_base, p->data[k].z_avg,
+               p->data[k].segment_count * sizeof *a->z);
+        memcpy(a->iend + c->objects[k].segments_base, p->data[k].i_end,
+               p->data[k].segment_count * sizeof *a->iend);
+    }
+    for (uint32_t q = 0; q < p->n_pairs; q++) {
+        if (!p->pairs[q].info[0])
+            continue;
+        size_t m2 = (size_t)p->pairs[q].info[0] * p->pairs[q].info[0] + 1u;
+        memcpy(a->offsets + p->pairs[q].info[1], p->ldata[q].offsets, m2 * sizeof *a->offsets);
+        memcpy(a->z + p->pairs[q].info[2], p->ldata[q].z_avg,
+               p->ldata[q].segment_count * sizeof *a->z);
+        memcpy(a->iend + p->pairs[q].info[2], p->ldata[q].i_end,
+               p->ldata[q].segment_count * sizeof *a->iend);
+    }
+}
+
+/* The cell tables, so that the GLSL side needs no enumeration code, and
+ * the light records. */
+static void fill_cells(const csm *c, const csm_prep *p, csm_arrays *a)
+{
+    for (uint32_t b = 0; b < (uint32_t)c->N; b++)
+        for (uint32_t i = 0; i < (uint32_t)c->N; i++)
+            a->cells[b * (uint32_t)c->N + i] =
+                gi_csm_order_index(c->order, (uint32_t)c->N, (uint32_t)c->N, i, b);
+    /* object -> light, then each light's grid cells -> enumeration index */
+    for (uint32_t k = 0; k < p->n; k++)
+        a->lcells[k] = 0xFFFFFFFFu;
+    uint32_t base = p->n;
+    for (uint32_t j = 0; j < c->light_count; j++) {
+        const csm_light *l = &c->lights[j];
+        if (l->object >= 0)
+            a->lcells[l->object] = j;
+        rect_store(a->lrec[j].o, l->origin, (float)l->kind);
+        rect_store(a->lrec[j].e1, l->e1, 0.0f);
+        rect_store(a->lrec[j].e2, l->e2, 0.0f);
+        a->lrec[j].info[0] = l->n_u;
+        a->lrec[j].info[1] = l->n_v;
+        a->lrec[j].info[2] = base;
+        a->lrec[j].info[3] =
+            l->object >= 0 ? (uint32_t)l->object : 0x80000000u | (uint32_t)l->punctual;
+        for (uint32_t b = 0; b < l->n_v; b++)
+            for (uint32_t i = 0; i < l->n_u; i++)
+                a->lcells[base + b * l->n_u + i] =
+                    gi_csm_order_index(c->light_order, l->n_u, l->n_v, i, b);
+        base += l->n_u * l->n_v;
+    }
+}
+
+static gi_result upload_buffers(csm *c, const csm_prep *p, const csm_arrays *a)
+{
+    gi_error err;
+    glCreateBuffers(9, c->ssbo);
+    glCreateBuffers(1, &c->count);
+    glNamedBufferStorage(c->count, 4, NULL, GL_DYNAMIC_STORAGE_BIT);
+    glNamedBufferStorage(c->ssbo[0], (GLsizeiptr)(p->n * sizeof *c->objects), c->objects,
+                         GL_DYNAMIC_STORAGE_BIT);
+    glNamedBufferStorage(c->ssbo[1], (GLsizeiptr)((p->offsets_total ? p->offsets_total : 1) * 4),
+                         a->offsets, 0);
+    glNamedBufferStorage(c->ssbo[2], (GLsizeiptr)((p->segments_total ? p->segments_total : 1) * 4),
+                         a->z, 0);
+    glNamedBufferStorage(c->ssbo[3], (GLsizeiptr)((p->segments_total ? p->segments_total : 1) * 4),
+                         a->iend, 0);
+    glNamedBufferStorage(c->ssbo[4], (GLsizeiptr)(a->cells_n * 4), a->cells, 0);
+    glNamedBufferStorage(c->ssbo[5], (GLsizeiptr)(CSM_PATTERNS * (size_t)c->S * 8), a->patterns, 0);
+    glNamedBufferStorage(c->ssbo[6],
+                         (GLsizeiptr)((c->light_count ? c->light_count : 1) * sizeof *a->lrec),
+                         a->lrec, 0);
+    glNamedBufferStorage(c->ssbo[7], (GLsizeiptr)((p->n_pairs ? p->n_pairs : 1) * sizeof *p->pairs),
+                         p->pairs, 0);
+    glNamedBufferStorage(c->ssbo[8], (GLsizeiptr)(a->lcells_n * 4), a->lcells, 0);
+    if (gi_gl_check("csm: upload", &err) != GI_OK)
+        return gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
+    return GI_OK;
+}
+
+/* Stage "upload": one concatenated set of offsets, z_avg and i_end with
+ * per-object and per-pair bases, the records, the cell tables and the
+ * sampling patterns (§5.1). */
+static gi_result upload(csm *c, const csm_prep *p)
+{
+    const gi_host *host = c->kit.host;
+    gi_result r = GI_OK;
+    host->stage_begin(host, "upload");
+    csm_arrays a;
+    a.offsets = malloc((p->offsets_total ? p->offsets_total : 1) * sizeof *a.offsets);
+    a.z = malloc((p->segments_total ? p->segments_total : 1) * sizeof *a.z);
+    a.iend = malloc((p->segments_total ? p->segments_total : 1) * sizeof *a.iend);
+    a.cells_n = (uint32_t)(c->N * c->N);
+    a.cells = malloc(a.cells_n * sizeof *a.cells);
+    a.patterns = make_patterns(c->S);
+    a.lcells_n = p->n;
+    for (uint32_t j = 0; j < c->light_count; j++)
+        a.lcells_n += c->lights[j].n_u * c->lights[j].n_v;
+    a.lcells = malloc(a.lcells_n * sizeof *a.lcells);
+    a.lrec = calloc(c->light_count ? c->light_count : 1, sizeof *a.lrec);
+    if (!a.offsets || !a.z || !a.iend || !a.cells || !a.patterns || !a.lcells || !a.lrec)
+        r = gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "csm: out of memory for the upload");
     if (r == GI_OK) {
-        host->stage_begin(host, "upload");
-        uint32_t *offsets = malloc((offsets_total ? offsets_total : 1) * sizeof *offsets);
-        float *z = malloc((segments_total ? segments_total : 1) * sizeof *z);
-        uint32_t *iend = malloc((segments_total ? segments_total : 1) * sizeof *iend);
-        uint32_t cells_n = (uint32_t)(c->N * c->N);
-        uint32_t *cells = malloc(cells_n * sizeof *cells);
-        float *patterns = make_patterns(c->S);
-        uint32_t lcells_n = n;
-        for (uint32_t j = 0; j < c->light_count; j++)
-            lcells_n += c->lights[j].n_u * c->lights[j].n_v;
-        uint32_t *lcells = malloc(lcells_n * sizeof *lcells);
-        csm_gpu_rect *lrec = calloc(c->light_count ? c->light_count : 1, sizeof *lrec);
-        if (!offsets || !z || !iend || !cells || !patterns || !lcells || !lrec)
-            r = gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "csm: out of memory for the upload");
-        for (uint32_t k = 0; r == GI_OK && k < c->object_count; k++) {
-            if (!c->objects[k].M)
-                continue;
-            size_t m2 = (size_t)c->M * (size_t)c->M + 1u;
-            memcpy(offsets + c->objects[k].offsets_base, data[k].offsets, m2 * sizeof *offsets);
-            memcpy(z + c->objects[k].segments_base, data[k].z_avg,
-                   data[k].segment_count * sizeof *z);
-            memcpy(iend + c->objects[k].segments_base, data[k].i_end,
-                   data[k].segment_count * sizeof *iend);
-        }
-        for (uint32_t q = 0; r == GI_OK && q < n_pairs; q++) {
-            if (!pairs[q].info[0])
-                continue;
-            size_t m2 = (size_t)pairs[q].info[0] * pairs[q].info[0] + 1u;
-            memcpy(offsets + pairs[q].info[1], ldata[q].offsets, m2 * sizeof *offsets);
-            memcpy(z + pairs[q].info[2], ldata[q].z_avg, ldata[q].segment_count * sizeof *z);
-            memcpy(iend + pairs[q].info[2], ldata[q].i_end, ldata[q].segment_count * sizeof *iend);
-        }
-        for (uint32_t b = 0; r == GI_OK && b < (uint32_t)c->N; b++)
-            for (uint32_t a = 0; a < (uint32_t)c->N; a++)
-                cells[b * (uint32_t)c->N + a] =
-                    gi_csm_order_index(c->order, (uint32_t)c->N, (uint32_t)c->N, a, b);
-        if (r == GI_OK) {
-            /* object -> light, then each light's grid cells -> enumeration index */
-            for (uint32_t k = 0; k < n; k++)
-                lcells[k] = 0xFFFFFFFFu;
-            uint32_t base = n;
-            for (uint32_t j = 0; j < c->light_count; j++) {
-                const csm_light *l = &c->lights[j];
-                if (l->object >= 0)
-                    lcells[l->object] = j;
-                rect_store(lrec[j].o, l->origin, (float)l->kind);
-                rect_store(lrec[j].e1, l->e1, 0.0f);
-                rect_store(lrec[j].e2, l->e2, 0.0f);
-                lrec[j].info[0] = l->n_u;
-                lrec[j].info[1] = l->n_v;
-                lrec[j].info[2] = base;
-                lrec[j].info[3] =
-                    l->object >= 0 ? (uint32_t)l->object : 0x80000000u | (uint32_t)l->punctual;
-                for (uint32_t b = 0; b < l->n_v; b++)
-                    for (uint32_t a = 0; a < l->n_u; a++)
-                        lcells[base + b * l->n_u + a] =
-                            gi_csm_order_index(c->light_order, l->n_u, l->n_v, a, b);
-                base += l->n_u * l->n_v;
-            }
-            glCreateBuffers(9, c->ssbo);
-            glCreateBuffers(1, &c->count);
-            glNamedBufferStorage(c->count, 4, NULL, GL_DYNAMIC_STORAGE_BIT);
-            glNamedBufferStorage(c->ssbo[0], (GLsizeiptr)(n * sizeof *c->objects), c->objects,
-                                 GL_DYNAMIC_STORAGE_BIT);
-            glNamedBufferStorage(c->ssbo[1], (GLsizeiptr)((offsets_total ? offsets_total : 1) * 4),
-                                 offsets, 0);
-            glNamedBufferStorage(c->ssbo[2],
-                                 (GLsizeiptr)((segments_total ? segments_total : 1) * 4), z, 0);
-            glNamedBufferStorage(c->ssbo[3],
-                                 (GLsizeiptr)((segments_total ? segments_total : 1) * 4), iend, 0);
-            glNamedBufferStorage(c->ssbo[4], (GLsizeiptr)(cells_n * 4), cells, 0);
-            glNamedBufferStorage(c->ssbo[5], (GLsizeiptr)(CSM_PATTERNS * (size_t)c->S * 8),
-                                 patterns, 0);
-            glNamedBufferStorage(c->ssbo[6],
-                                 (GLsizeiptr)((c->light_count ? c->light_count : 1) * sizeof *lrec),
-                                 lrec, 0);
-            glNamedBufferStorage(c->ssbo[7], (GLsizeiptr)((n_pairs ? n_pairs : 1) * sizeof *pairs),
-                                 pairs, 0);
-            glNamedBufferStorage(c->ssbo[8], (GLsizeiptr)(lcells_n * 4), lcells, 0);
-            if (gi_gl_check("csm: upload", &err) != GI_OK)
-                r = gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
-        }
-        free(offsets);
-        free(z);
-        free(iend);
-        free(cells);
-        free(patterns);
-        free(lcells);
-        free(lrec);
-        host->stage_end(host, "upload");
+        concatenate_segments(c, p, &a);
+        fill_cells(c, p, &a);
+        r = upload_buffers(c, p, &a);
     }
-    for (uint32_t k = 0; k < c->object_count; k++)
-        gi_csm_data_free(&data[k]);
-    for (uint32_t q = 0; q < n_pairs; q++)
-        gi_csm_data_free(&ldata[q]);
-    free(data);
-    free(ldata);
-    free(pairs);
-    if (r != GI_OK)
-        return r;
+    free(a.offsets);
+    free(a.z);
+    free(a.iend);
+    free(a.cells);
+    free(a.patterns);
+    free(a.lcells);
+    free(a.lrec);
+    host->stage_end(host, "upload");
+    return r;
+}
+
+static void report_stats(const csm *c, const csm_prep *p)
+{
+    const gi_host *host = c->kit.host;
     uint32_t distant_objects = 0;
     for (uint32_t k = 0; k < c->object_count; k++)
         distant_objects += c->objects[k].M != 0;
     double texels = (double)distant_objects * (double)c->M * (double)c->M;
-    uint64_t distant_segments = segments_total - local_segments;
-    host->stat(host, "bytes_uncompressed", (double)bytes_u);
-    host->stat(host, "bytes_compressed", (double)bytes_c);
+    uint64_t distant_segments = p->segments_total - p->local_segments;
+    host->stat(host, "bytes_uncompressed", (double)p->bytes_u);
+    host->stat(host, "bytes_compressed", (double)p->bytes_c);
     host->stat(host, "data_bytes",
-               (double)bytes_c); /* the compressed maps are what render() reads */
-    host->stat(host, "ratio", bytes_c ? (double)bytes_u / (double)bytes_c : 0.0);
+               (double)p->bytes_c); /* the compressed maps are what render() reads */
+    host->stat(host, "ratio", p->bytes_c ? (double)p->bytes_u / (double)p->bytes_c : 0.0);
     host->stat(host, "segments_per_texel", texels > 0 ? (double)distant_segments / texels : 0.0);
     host->stat(host, "maps", (double)distant_objects * c->N * c->N);
-    host->stat(host, "maps_local", (double)maps_local);
+    host->stat(host, "maps_local", (double)p->maps_local);
     host->stat(host, "segments_per_texel_local",
-               local_texels ? (double)local_segments / (double)local_texels : 0.0);
+               p->local_texels ? (double)p->local_segments / (double)p->local_texels : 0.0);
     host->stat(host, "lights", (double)c->light_count);
-    host->stat(host, "receiver_only_objects", (double)(c->object_count - casters));
-    host->stat(host, "cache_hit", tries > 0 && hits == tries ? 1.0 : 0.0);
+    host->stat(host, "receiver_only_objects", (double)(c->object_count - p->casters));
+    host->stat(host, "cache_hit", p->tries > 0 && p->hits == p->tries ? 1.0 : 0.0);
+}
+
+static gi_result csm_prepare(void *inst, const gi_gpu_scene *gs)
+{
+    csm *c = inst;
+    release_prepared(c);
+    gi_error err;
+    gi_kit_prepare(&c->kit, gs);
+    c->program = gi_program_build_compute("csm.comp", NULL, &err);
+    if (!c->program)
+        return gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
+    csm_prep p;
+    memset(&p, 0, sizeof p);
+    gi_result r = alloc_objects(c, gs, &p);
+    if (r == GI_OK)
+        r = collect_lights(c, gs, &p);
+    if (r == GI_OK) {
+        mark_casters(c, gs->scene, &p);
+        r = build_distant(c, gs, &p);
+    }
+    if (r == GI_OK)
+        r = build_light_pairs(c, gs, &p);
+    if (r == GI_OK && (p.offsets_total > UINT32_MAX || p.segments_total > UINT32_MAX))
+        r = gi_kit_fail(&c->kit, GI_ERR_UNSUPPORTED, "csm: more than 2^32 segments in all");
+    if (r == GI_OK)
+        r = upload(c, &p);
+    free_prep(c, &p);
+    if (r != GI_OK)
+        return r;
+    report_stats(c, &p);
     return GI_OK;
 }
 

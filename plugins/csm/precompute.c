@@ -7,7 +7,6 @@
 
 #include "gi/algo/csm_precompute.h"
 
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -43,11 +42,9 @@ gi_result csm_encode_maps(const gi_gpu_scene *gs, const csm_encode_desc *desc, c
     encode_depths e = {desc, NULL};
     if (desc->z3 == CSM_DEPTH_SPHERE) {
         e.far = desc->sphere ? malloc((size_t)M * M * sizeof *e.far) : NULL;
-        if (!e.far) {
-            snprintf(err->text, sizeof err->text, "csm: out of memory for %u x %u %s", M, M,
-                     desc->what);
-            return GI_ERR_OUT_OF_MEMORY;
-        }
+        if (!e.far)
+            return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "csm: out of memory for %u x %u %s", M,
+                                M, desc->what);
     }
     gi_csm_precompute_desc d = {.depth = {.size = M,
                                           .surfaces = desc->z3 ? 3u : 2u,

@@ -349,115 +349,145 @@ static float w_area_nonemissive(const setup *st, uint32_t t, int only)
     return e[0] > 0 || e[1] > 0 || e[2] > 0 ? 0.0f : st->w.area[t];
 }
 
+/* surface_pairs' counts: per (receiver, caster), objects 0..7, the pairs
+ * ray casting finds shadowed by that caster, those the CSM shadows too and
+ * those it lights within two texels of the shadow's edge; per receiver the
+ * lit pairs and those the CSM shadows. */
+typedef struct surface_tally {
+    int shadowed_by[8][8], right_by[8][8], edge_by[8][8], total, agree;
+    int false_shadow[8], lit_total[8];
+    vis_score score;
+} surface_tally;
+
+/* One receiver pair toward a point on a random light, counted into *c
+ * unless the receiver faces away from it or lies inside an object. */
+static void surface_pair(const setup *st, float offset_texels, int only, float total_area,
+                         uint32_t *rng, surface_tally *c)
+{
+    const gi_scene *s = st->s;
+    /* a triangle by area, a point on it, offset along its normal */
+    float r = gi_rng_next_float(rng) * total_area;
+    uint32_t t = 0;
+    for (; t + 1 < s->triangle_count; t++)
+        if ((r -= w_area_nonemissive(st, t, only)) < 0)
+            break;
+    float b[3];
+    gi_sample_uniform_triangle(gi_rng_next_float(rng), gi_rng_next_float(rng), b);
+    const gi_vec3 *q = &st->w.tri[3 * t];
+    gi_vec3 x = gi_v3_add(gi_v3_add(gi_v3_scale(q[0], b[0]), gi_v3_scale(q[1], b[1])),
+                          gi_v3_scale(q[2], b[2]));
+    gi_vec3 ng = gi_v3_normalize(gi_v3_cross(gi_v3_sub(q[1], q[0]), gi_v3_sub(q[2], q[0])));
+    uint32_t j = gi_rng_next_u32(rng) % st->light_count;
+    const csm_light *l = &st->lights[j];
+    gi_vec3 y = light_sample(&st->w, l, rng), ys = snapped(l, y);
+    if (gi_v3_dot(ng, gi_v3_sub(y, x)) <= 0 || gi_v3_dot(ng, gi_v3_sub(ys, x)) <= 0)
+        return;
+    uint32_t recv = s->vertices[s->indices[3 * t]].object;
+    /* the normal offset, in texels at x's distance */
+    gi_vec3 xo = gi_v3_add(
+        x, gi_v3_scale(ng, offset_texels * 2.0f * gi_v3_length(gi_v3_sub(x, ys)) / M_CUBE));
+    /* receivers covered by another object (the ground under a box) are
+     * inside it: no surface the camera could see; left out */
+    gi_vec3 xe = gi_v3_add(x, gi_v3_scale(ng, 1e-4f));
+    if (inside_closed(&st->w, xe) || inside_closed(&st->w, xo))
+        return;
+    int by = -1;
+    int exact = exact_visible(&st->w, xe, ys, l->object, &by);
+    int lit = csm_visible(st, j, xo, y, NULL);
+    c->total++;
+    c->agree += lit == exact;
+    vis_add(&c->score, exact, lit);
+    if (exact && recv < 8) {
+        c->lit_total[recv]++;
+        c->false_shadow[recv] += !lit;
+        if (!lit && getenv("CSM_DEBUG"))
+            printf("    false shadow on %s at (%.3f %.3f %.3f) n (%.2f %.2f %.2f) light point "
+                   "(%.3f %.3f %.3f)\n",
+                   s->objects[recv].name, (double)x.x, (double)x.y, (double)x.z, (double)ng.x,
+                   (double)ng.y, (double)ng.z, (double)ys.x, (double)ys.y, (double)ys.z);
+    }
+    if (!exact && by >= 0 && recv < 8 && by < 8) {
+        c->shadowed_by[recv][by]++;
+        c->right_by[recv][by] += !lit;
+        /* a miss within two texels (at x's distance) of the shadow's
+         * edge: the normal offset alone moves x by one texel */
+        float step = 2.0f * 2.0f * gi_v3_length(gi_v3_sub(x, ys)) / M_CUBE;
+        static const float dirs[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                         {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+        int near = 0;
+        for (int qd = 0; qd < 6 && lit && !near; qd++)
+            near = exact_visible(&st->w, gi_v3_add(xe, gi_v3_scale(gi_v3_load(dirs[qd]), step)), ys,
+                                 l->object, NULL);
+        c->edge_by[recv][by] += lit && near;
+    }
+}
+
+static void report_surface_pairs(const setup *st, const char *name, float offset_texels,
+                                 double margin, const surface_tally *c)
+{
+    const gi_scene *s = st->s;
+    uint32_t n = s->object_count;
+    printf("  %d surface pairs (normal offset %.2f texels): %.1f%% agree with ray casting to the "
+           "snapped light point\n",
+           c->total, (double)offset_texels, 100.0 * c->agree / c->total);
+    EXPECT(c->agree >= c->total * 0.95, "%d of %d", c->agree, c->total);
+    char what[160];
+    snprintf(what, sizeof what,
+             "  %s, surface pairs (offset %.2f texels), cube-map CSM vs ray casting", name,
+             (double)offset_texels);
+    gi_test_failed += vis_check(&c->score, what, margin, 50);
+    for (uint32_t rcv = 0; rcv < n && rcv < 8; rcv++)
+        if (c->lit_total[rcv])
+            printf("  %s: %d lit pairs, CSM shadowed %.1f%% of them\n", s->objects[rcv].name,
+                   c->lit_total[rcv], 100.0 * c->false_shadow[rcv] / c->lit_total[rcv]);
+    for (uint32_t rcv = 0; rcv < n && rcv < 8; rcv++)
+        for (uint32_t k = 0; k < n && k < 8; k++)
+            if (c->shadowed_by[rcv][k])
+                printf("  %s shadowed by %s: %d pairs, CSM shadowed %.1f%%, lit within two texels "
+                       "of the shadow's "
+                       "edge %.1f%%, lit elsewhere %.1f%%\n",
+                       s->objects[rcv].name, s->objects[k].name, c->shadowed_by[rcv][k],
+                       100.0 * c->right_by[rcv][k] / c->shadowed_by[rcv][k],
+                       100.0 * c->edge_by[rcv][k] / c->shadowed_by[rcv][k],
+                       100.0 * (c->shadowed_by[rcv][k] - c->right_by[rcv][k] - c->edge_by[rcv][k]) /
+                           c->shadowed_by[rcv][k]);
+}
+
+/* csm_cross.glb: the CSM agrees with ray casting where box A shadows box
+ * B, B shadows A, and the boxes shadow the ground. */
+static void check_cross(const setup *st, const surface_tally *c)
+{
+    const gi_scene *s = st->s;
+    /* objects 0 ground, 1 box_a, 2 box_b (gen_csm_cross.py) */
+    int pairs_needed[][2] = {{2, 1}, {1, 2}, {0, 1}, {0, 2}};
+    for (int i = 0; i < 4; i++) {
+        int rcv = pairs_needed[i][0], k = pairs_needed[i][1];
+        EXPECT(c->shadowed_by[rcv][k] >= 20, "%s shadowed by %s only %d times",
+               s->objects[rcv].name, s->objects[k].name, c->shadowed_by[rcv][k]);
+        EXPECT(c->right_by[rcv][k] + c->edge_by[rcv][k] >= c->shadowed_by[rcv][k] * 0.97 &&
+                   c->right_by[rcv][k] >= c->shadowed_by[rcv][k] * 0.7,
+               "%s by %s: %d (+%d at the edge) of %d", s->objects[rcv].name, s->objects[k].name,
+               c->right_by[rcv][k], c->edge_by[rcv][k], c->shadowed_by[rcv][k]);
+    }
+}
+
 /* Receiver points on the surfaces of csm_cross.glb: per (receiver, caster)
  * the pairs ray casting finds shadowed by that caster, and how many of
  * those and of all pairs the CSM gets right. */
 static void surface_pairs(const setup *st, const char *name, float offset_texels, int cross,
                           int only, double margin)
 {
-    const gi_scene *s = st->s;
-    uint32_t n = s->object_count, rng = gi_rng_init(8, 0, 3);
-    int shadowed_by[8][8] = {{0}}, right_by[8][8] = {{0}}, edge_by[8][8] = {{0}}, total = 0,
-        agree = 0;
-    int false_shadow[8] = {0}, lit_total[8] = {0};
-    vis_score score = {0};
+    uint32_t rng = gi_rng_init(8, 0, 3);
+    surface_tally c;
+    memset(&c, 0, sizeof c);
     float total_area = 0;
-    for (uint32_t t = 0; t < s->triangle_count; t++)
+    for (uint32_t t = 0; t < st->s->triangle_count; t++)
         total_area += w_area_nonemissive(st, t, only);
-    for (int p = 0; p < 6000; p++) {
-        /* a triangle by area, a point on it, offset along its normal */
-        float r = gi_rng_next_float(&rng) * total_area;
-        uint32_t t = 0;
-        for (; t + 1 < s->triangle_count; t++)
-            if ((r -= w_area_nonemissive(st, t, only)) < 0)
-                break;
-        float b[3];
-        gi_sample_uniform_triangle(gi_rng_next_float(&rng), gi_rng_next_float(&rng), b);
-        const gi_vec3 *q = &st->w.tri[3 * t];
-        gi_vec3 x = gi_v3_add(gi_v3_add(gi_v3_scale(q[0], b[0]), gi_v3_scale(q[1], b[1])),
-                              gi_v3_scale(q[2], b[2]));
-        gi_vec3 ng = gi_v3_normalize(gi_v3_cross(gi_v3_sub(q[1], q[0]), gi_v3_sub(q[2], q[0])));
-        uint32_t j = gi_rng_next_u32(&rng) % st->light_count;
-        const csm_light *l = &st->lights[j];
-        gi_vec3 y = light_sample(&st->w, l, &rng), ys = snapped(l, y);
-        if (gi_v3_dot(ng, gi_v3_sub(y, x)) <= 0 || gi_v3_dot(ng, gi_v3_sub(ys, x)) <= 0)
-            continue;
-        uint32_t recv = s->vertices[s->indices[3 * t]].object;
-        /* the normal offset, in texels at x's distance */
-        gi_vec3 xo = gi_v3_add(
-            x, gi_v3_scale(ng, offset_texels * 2.0f * gi_v3_length(gi_v3_sub(x, ys)) / M_CUBE));
-        /* receivers covered by another object (the ground under a box) are
-         * inside it: no surface the camera could see; left out */
-        gi_vec3 xe = gi_v3_add(x, gi_v3_scale(ng, 1e-4f));
-        if (inside_closed(&st->w, xe) || inside_closed(&st->w, xo))
-            continue;
-        int by = -1;
-        int exact = exact_visible(&st->w, xe, ys, l->object, &by);
-        int lit = csm_visible(st, j, xo, y, NULL);
-        total++;
-        agree += lit == exact;
-        vis_add(&score, exact, lit);
-        if (exact && recv < 8) {
-            lit_total[recv]++;
-            false_shadow[recv] += !lit;
-            if (!lit && getenv("CSM_DEBUG"))
-                printf("    false shadow on %s at (%.3f %.3f %.3f) n (%.2f %.2f %.2f) light point "
-                       "(%.3f %.3f %.3f)\n",
-                       s->objects[recv].name, (double)x.x, (double)x.y, (double)x.z, (double)ng.x,
-                       (double)ng.y, (double)ng.z, (double)ys.x, (double)ys.y, (double)ys.z);
-        }
-        if (!exact && by >= 0 && recv < 8 && by < 8) {
-            shadowed_by[recv][by]++;
-            right_by[recv][by] += !lit;
-            /* a miss within two texels (at x's distance) of the shadow's
-             * edge: the normal offset alone moves x by one texel */
-            float step = 2.0f * 2.0f * gi_v3_length(gi_v3_sub(x, ys)) / M_CUBE;
-            static const float dirs[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
-                                             {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
-            int near = 0;
-            for (int qd = 0; qd < 6 && lit && !near; qd++)
-                near = exact_visible(&st->w, gi_v3_add(xe, gi_v3_scale(gi_v3_load(dirs[qd]), step)),
-                                     ys, l->object, NULL);
-            edge_by[recv][by] += lit && near;
-        }
-    }
-    printf("  %d surface pairs (normal offset %.2f texels): %.1f%% agree with ray casting to the "
-           "snapped light point\n",
-           total, (double)offset_texels, 100.0 * agree / total);
-    EXPECT(agree >= total * 0.95, "%d of %d", agree, total);
-    char what[160];
-    snprintf(what, sizeof what,
-             "  %s, surface pairs (offset %.2f texels), cube-map CSM vs ray casting", name,
-             (double)offset_texels);
-    gi_test_failed += vis_check(&score, what, margin, 50);
-    for (uint32_t rcv = 0; rcv < n && rcv < 8; rcv++)
-        if (lit_total[rcv])
-            printf("  %s: %d lit pairs, CSM shadowed %.1f%% of them\n", s->objects[rcv].name,
-                   lit_total[rcv], 100.0 * false_shadow[rcv] / lit_total[rcv]);
-    for (uint32_t rcv = 0; rcv < n && rcv < 8; rcv++)
-        for (uint32_t c = 0; c < n && c < 8; c++)
-            if (shadowed_by[rcv][c])
-                printf("  %s shadowed by %s: %d pairs, CSM shadowed %.1f%%, lit within two texels "
-                       "of the shadow's "
-                       "edge %.1f%%, lit elsewhere %.1f%%\n",
-                       s->objects[rcv].name, s->objects[c].name, shadowed_by[rcv][c],
-                       100.0 * right_by[rcv][c] / shadowed_by[rcv][c],
-                       100.0 * edge_by[rcv][c] / shadowed_by[rcv][c],
-                       100.0 * (shadowed_by[rcv][c] - right_by[rcv][c] - edge_by[rcv][c]) /
-                           shadowed_by[rcv][c]);
-    if (!cross)
-        return;
-    /* objects 0 ground, 1 box_a, 2 box_b (gen_csm_cross.py) */
-    int pairs_needed[][2] = {{2, 1}, {1, 2}, {0, 1}, {0, 2}};
-    for (int i = 0; i < 4; i++) {
-        int rcv = pairs_needed[i][0], c = pairs_needed[i][1];
-        EXPECT(shadowed_by[rcv][c] >= 20, "%s shadowed by %s only %d times", s->objects[rcv].name,
-               s->objects[c].name, shadowed_by[rcv][c]);
-        EXPECT(right_by[rcv][c] + edge_by[rcv][c] >= shadowed_by[rcv][c] * 0.97 &&
-                   right_by[rcv][c] >= shadowed_by[rcv][c] * 0.7,
-               "%s by %s: %d (+%d at the edge) of %d", s->objects[rcv].name, s->objects[c].name,
-               right_by[rcv][c], edge_by[rcv][c], shadowed_by[rcv][c]);
-    }
+    for (int p = 0; p < 6000; p++)
+        surface_pair(st, offset_texels, only, total_area, &rng, &c);
+    report_surface_pairs(st, name, offset_texels, margin, &c);
+    if (cross)
+        check_cross(st, &c);
 }
 
 static const char *kernel =
@@ -481,78 +511,110 @@ static const char *kernel =
     "    pout[c] = vec4(nearest, pcf, rr / 256.0, 0.0);\n"
     "}\n";
 
-/* The GLSL query on the plugin's buffer layout (csm.c, csm_local.glsl). */
-static void gpu_check(const setup *st, const pair *pin, const int *cpu, uint32_t obj)
+/* The set-up's lights and cube maps in the plugin's buffer layout (csm.c),
+ * host side. */
+typedef struct packed {
+    csm_gpu_object *objs;
+    rect *pairs, *lights;
+    uint32_t *offsets, *iend, *cells;
+    float *z;
+    uint64_t offs, segs, cells_n;
+} packed;
+
+/* Light j's record and cells, and its pairs' records and data. */
+static void pack_light(const setup *st, uint32_t j, uint32_t *base, packed *pk)
 {
-    const gi_scene *s = st->s;
-    uint32_t n = s->object_count, L = st->light_count;
-    gi_error err;
-    GLuint prog = gi_program_build_compute_text("plugins/csm/tests/csm_local_kernel.comp", kernel,
-                                                NULL, &err);
-    EXPECT(prog != 0, "%s", err.text);
-    if (!prog)
-        return;
-    csm_gpu_object *objs = calloc(n, sizeof *objs);
-    rect *pairs = calloc((size_t)L * n, sizeof *pairs), *lights = calloc(L, sizeof *lights);
-    uint64_t offs = 0, segs = 0, cells_n = n;
+    uint32_t n = st->s->object_count;
+    const csm_light *l = &st->lights[j];
+    if (l->object >= 0)
+        pk->cells[l->object] = j;
+    float lo[4] = {l->origin.x, l->origin.y, l->origin.z, (float)l->kind};
+    float l1[4] = {l->e1.x, l->e1.y, l->e1.z, 0}, l2[4] = {l->e2.x, l->e2.y, l->e2.z, 0};
+    rect *lr = &pk->lights[j];
+    memcpy(lr->o, lo, 16), memcpy(lr->e1, l1, 16), memcpy(lr->e2, l2, 16);
+    lr->info[0] = l->n_u, lr->info[1] = l->n_v, lr->info[2] = *base;
+    lr->info[3] = l->object >= 0 ? (uint32_t)l->object : 0x80000000u | (uint32_t)l->punctual;
+    for (uint32_t b = 0; b < l->n_v; b++)
+        for (uint32_t a = 0; a < l->n_u; a++)
+            pk->cells[*base + b * l->n_u + a] =
+                gi_csm_order_index(GI_CSM_ORDER_DIAGONAL, l->n_u, l->n_v, a, b);
+    *base += l->n_u * l->n_v;
+    for (uint32_t k = 0; k < n; k++) {
+        const csm_local_desc *d = &st->desc[j * n + k];
+        const gi_csm_data *cd = &st->data[j * n + k];
+        rect *r = &pk->pairs[j * n + k];
+        float po[4] = {d->o.x, d->o.y, d->o.z, cd->M ? 1.0f : 0.0f};
+        float p1[4] = {d->e1.x, d->e1.y, d->e1.z, 0}, p2[4] = {d->e2.x, d->e2.y, d->e2.z, 0};
+        memcpy(r->o, po, 16), memcpy(r->e1, p1, 16), memcpy(r->e2, p2, 16);
+        memcpy(&r->info[3], &st->bias[k], 4);
+        if (!cd->M)
+            continue;
+        r->info[0] = M_CUBE, r->info[1] = (uint32_t)pk->offs, r->info[2] = (uint32_t)pk->segs;
+        memcpy(pk->offsets + pk->offs, cd->offsets, ((size_t)M_CUBE * M_CUBE + 1) * 4);
+        memcpy(pk->z + pk->segs, cd->z_avg, cd->segment_count * 4);
+        memcpy(pk->iend + pk->segs, cd->i_end, cd->segment_count * 4);
+        pk->offs += (uint64_t)M_CUBE * M_CUBE + 1;
+        pk->segs += cd->segment_count;
+    }
+}
+
+static packed pack_buffers(const setup *st)
+{
+    uint32_t n = st->s->object_count, L = st->light_count;
+    packed pk;
+    pk.objs = calloc(n, sizeof *pk.objs);
+    pk.pairs = calloc((size_t)L * n, sizeof *pk.pairs);
+    pk.lights = calloc(L, sizeof *pk.lights);
+    pk.offs = 0, pk.segs = 0, pk.cells_n = n;
     for (uint32_t j = 0; j < L; j++)
-        cells_n += st->lights[j].n_u * st->lights[j].n_v;
+        pk.cells_n += st->lights[j].n_u * st->lights[j].n_v;
     for (uint32_t q = 0; q < L * n; q++)
         if (st->data[q].M)
-            offs += (uint64_t)M_CUBE * M_CUBE + 1, segs += st->data[q].segment_count;
-    uint32_t *offsets = malloc(offs * 4), *iend = malloc(segs * 4), *cells = malloc(cells_n * 4);
-    float *z = malloc(segs * 4);
-    offs = segs = 0;
+            pk.offs += (uint64_t)M_CUBE * M_CUBE + 1, pk.segs += st->data[q].segment_count;
+    pk.offsets = malloc(pk.offs * 4);
+    pk.iend = malloc(pk.segs * 4);
+    pk.cells = malloc(pk.cells_n * 4);
+    pk.z = malloc(pk.segs * 4);
+    pk.offs = pk.segs = 0;
     for (uint32_t k = 0; k < n; k++) {
-        memcpy(objs[k].local_from_world, st->local_from_world[k], 64);
-        memcpy(objs[k].world_from_local, st->gs->world_from_local[k], 64);
-        cells[k] = 0xFFFFFFFFu;
+        memcpy(pk.objs[k].local_from_world, st->local_from_world[k], 64);
+        memcpy(pk.objs[k].world_from_local, st->gs->world_from_local[k], 64);
+        pk.cells[k] = 0xFFFFFFFFu;
     }
     uint32_t base = n;
-    for (uint32_t j = 0; j < L; j++) {
-        const csm_light *l = &st->lights[j];
-        if (l->object >= 0)
-            cells[l->object] = j;
-        float lo[4] = {l->origin.x, l->origin.y, l->origin.z, (float)l->kind};
-        float l1[4] = {l->e1.x, l->e1.y, l->e1.z, 0}, l2[4] = {l->e2.x, l->e2.y, l->e2.z, 0};
-        memcpy(lights[j].o, lo, 16), memcpy(lights[j].e1, l1, 16), memcpy(lights[j].e2, l2, 16);
-        lights[j].info[0] = l->n_u, lights[j].info[1] = l->n_v, lights[j].info[2] = base;
-        lights[j].info[3] =
-            l->object >= 0 ? (uint32_t)l->object : 0x80000000u | (uint32_t)l->punctual;
-        for (uint32_t b = 0; b < l->n_v; b++)
-            for (uint32_t a = 0; a < l->n_u; a++)
-                cells[base + b * l->n_u + a] =
-                    gi_csm_order_index(GI_CSM_ORDER_DIAGONAL, l->n_u, l->n_v, a, b);
-        base += l->n_u * l->n_v;
-        for (uint32_t k = 0; k < n; k++) {
-            const csm_local_desc *d = &st->desc[j * n + k];
-            const gi_csm_data *cd = &st->data[j * n + k];
-            rect *r = &pairs[j * n + k];
-            float po[4] = {d->o.x, d->o.y, d->o.z, cd->M ? 1.0f : 0.0f};
-            float p1[4] = {d->e1.x, d->e1.y, d->e1.z, 0}, p2[4] = {d->e2.x, d->e2.y, d->e2.z, 0};
-            memcpy(r->o, po, 16), memcpy(r->e1, p1, 16), memcpy(r->e2, p2, 16);
-            memcpy(&r->info[3], &st->bias[k], 4);
-            if (!cd->M)
-                continue;
-            r->info[0] = M_CUBE, r->info[1] = (uint32_t)offs, r->info[2] = (uint32_t)segs;
-            memcpy(offsets + offs, cd->offsets, ((size_t)M_CUBE * M_CUBE + 1) * 4);
-            memcpy(z + segs, cd->z_avg, cd->segment_count * 4);
-            memcpy(iend + segs, cd->i_end, cd->segment_count * 4);
-            offs += (uint64_t)M_CUBE * M_CUBE + 1;
-            segs += cd->segment_count;
-        }
-    }
+    for (uint32_t j = 0; j < L; j++)
+        pack_light(st, j, &base, &pk);
+    return pk;
+}
+
+static void free_packed(packed *pk)
+{
+    free(pk->objs);
+    free(pk->pairs);
+    free(pk->lights);
+    free(pk->offsets);
+    free(pk->z);
+    free(pk->iend);
+    free(pk->cells);
+}
+
+/* Runs the kernel (then deleted) on the pairs over the packed buffers;
+ * returns its results, 4 floats a pair. */
+static float *run_kernel(GLuint prog, const setup *st, const packed *pk, const pair *pin,
+                         uint32_t obj)
+{
+    uint32_t n = st->s->object_count, L = st->light_count;
     GLuint bufs[9];
     glCreateBuffers(9, bufs);
     glNamedBufferStorage(bufs[0], (GLsizeiptr)(sizeof(pair) * PAIRS), pin, 0);
     glNamedBufferStorage(bufs[1], (GLsizeiptr)(16 * PAIRS), NULL, 0);
-    glNamedBufferStorage(bufs[2], (GLsizeiptr)(n * sizeof *objs), objs, 0);
-    glNamedBufferStorage(bufs[3], (GLsizeiptr)(offs * 4), offsets, 0);
-    glNamedBufferStorage(bufs[4], (GLsizeiptr)(segs * 4), z, 0);
-    glNamedBufferStorage(bufs[5], (GLsizeiptr)(segs * 4), iend, 0);
-    glNamedBufferStorage(bufs[6], (GLsizeiptr)(L * sizeof *lights), lights, 0);
-    glNamedBufferStorage(bufs[7], (GLsizeiptr)((size_t)L * n * sizeof *pairs), pairs, 0);
-    glNamedBufferStorage(bufs[8], (GLsizeiptr)(cells_n * 4), cells, 0);
+    glNamedBufferStorage(bufs[2], (GLsizeiptr)(n * sizeof *pk->objs), pk->objs, 0);
+    glNamedBufferStorage(bufs[3], (GLsizeiptr)(pk->offs * 4), pk->offsets, 0);
+    glNamedBufferStorage(bufs[4], (GLsizeiptr)(pk->segs * 4), pk->z, 0);
+    glNamedBufferStorage(bufs[5], (GLsizeiptr)(pk->segs * 4), pk->iend, 0);
+    glNamedBufferStorage(bufs[6], (GLsizeiptr)(L * sizeof *pk->lights), pk->lights, 0);
+    glNamedBufferStorage(bufs[7], (GLsizeiptr)((size_t)L * n * sizeof *pk->pairs), pk->pairs, 0);
+    glNamedBufferStorage(bufs[8], (GLsizeiptr)(pk->cells_n * 4), pk->cells, 0);
     static const GLuint binding[9] = {0, 1, 8, 9, 10, 11, 14, 15, 16};
     for (int i = 0; i < 9; i++)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding[i], bufs[i]);
@@ -569,6 +631,21 @@ static void gpu_check(const setup *st, const pair *pin, const int *cpu, uint32_t
     glUseProgram(0);
     glDeleteProgram(prog);
     glDeleteBuffers(9, bufs);
+    return gout;
+}
+
+/* The GLSL query on the plugin's buffer layout (csm.c, csm_local.glsl). */
+static void gpu_check(const setup *st, const pair *pin, const int *cpu, uint32_t obj)
+{
+    const gi_scene *s = st->s;
+    gi_error err;
+    GLuint prog = gi_program_build_compute_text("plugins/csm/tests/csm_local_kernel.comp", kernel,
+                                                NULL, &err);
+    EXPECT(prog != 0, "%s", err.text);
+    if (!prog)
+        return;
+    packed pk = pack_buffers(st);
+    float *gout = run_kernel(prog, st, &pk, pin, obj);
     int same = 0, partial = 0;
     for (int p = 0; p < PAIRS; p++) {
         same += (gout[4 * p] > 0.5f) == (cpu[p] != 0);
@@ -584,13 +661,7 @@ static void gpu_check(const setup *st, const pair *pin, const int *cpu, uint32_t
     EXPECT(partial > 0, "PCF never fractional");
     EXPECT(rr_mean < 0.01 && rr_max <= 16.0 / 256.0 + 1e-3, "mean %g max %g", rr_mean, rr_max);
     free(gout);
-    free(objs);
-    free(pairs);
-    free(lights);
-    free(offsets);
-    free(z);
-    free(iend);
-    free(cells);
+    free_packed(&pk);
 }
 
 /* The object called `name`; a scene without it fails the test. */
