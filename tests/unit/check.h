@@ -1,13 +1,15 @@
 /* Minimal test assertions for the unit tests: each CHECK prints the failing
  * expression with file:line and counts; gi_test_finish prints
- * "N passed, N failed" and returns the exit status. */
+ * "N passed, N failed" and returns the exit status. A test program made of
+ * several files has one pair of counters: they are weak definitions, which
+ * the linker merges into one, so a CHECK in any file counts. */
 #ifndef GI_TEST_CHECK_H
 #define GI_TEST_CHECK_H
 
 #include <math.h>
 #include <stdio.h>
 
-static int gi_test_passed, gi_test_failed;
+__attribute__((weak)) int gi_test_passed, gi_test_failed;
 
 #define CHECK(cond)                                                                                \
     do {                                                                                           \

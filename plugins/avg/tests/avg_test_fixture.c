@@ -157,8 +157,3 @@ void avg_test_free_gbuffer(avg_test_gbuffer *g)
     gi_image_free(g->alb);
     gi_image_free(g->emi);
 }
-
-int avg_test_fixture_failures(void)
-{
-    return gi_test_failed;
-}

@@ -1,9 +1,7 @@
 /* What the files of avg_tests share (avg_tests.c lists the subjects): a
  * minimal host and the fixtures that drive the method in-process
- * (avg_test_fixture.c), and each subject's entry point. check.h keeps its
- * failure counts per file (its counters are static), so each entry point
- * returns the failures of its own file, and avg_test_fixture_failures()
- * those of the fixtures. */
+ * (avg_test_fixture.c), and each subject's entry point. check.h's counters
+ * are shared by all the files. */
 #ifndef AVG_TESTS_H
 #define AVG_TESTS_H
 
@@ -12,7 +10,7 @@
 #include "gi/image.h"
 
 /* Subjects (the ctest names integration.avg_<subject>): each runs its
- * cases and returns its file's failure count. */
+ * cases and returns the failed checks so far (gi_test_failed). */
 int avg_test_voxel(gi_gpu *gpu);
 int avg_test_deform(gi_gpu *gpu);
 int avg_test_march(gi_gpu *gpu);
@@ -20,8 +18,6 @@ int avg_test_vpls(gi_gpu *gpu);
 int avg_test_shade(gi_gpu *gpu);
 int avg_test_visibility(gi_gpu *gpu);
 int avg_test_punctual(gi_gpu *gpu);
-/* Failures counted by the fixtures below. */
-int avg_test_fixture_failures(void);
 
 /* The view of the scene's first camera (or the default view) at time t,
  * seed 1. */

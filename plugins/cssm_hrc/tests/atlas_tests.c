@@ -191,8 +191,3 @@ int cssm_test_texture(void)
     gi_scene_free(s);
     return 0;
 }
-
-int cssm_test_failed_atlas(void)
-{
-    return gi_test_failed;
-}

@@ -392,8 +392,3 @@ int cssm_test_compact_limit(void)
     }
     return 0;
 }
-
-int cssm_test_failed_compact(void)
-{
-    return gi_test_failed;
-}

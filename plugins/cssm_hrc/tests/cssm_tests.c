@@ -67,14 +67,6 @@ int cssm_test_load_gpu(const char *rel, gi_gpu **gpu, gi_scene **s, gi_gpu_scene
     return gpu_fixture_load(path, gpu, s, gs) && *gs;
 }
 
-/* Failed checks over the files (check.h counts per file). */
-static int failed_checks(void)
-{
-    return cssm_test_failed_atlas() + cssm_test_failed_tree() + cssm_test_failed_compact() +
-           cssm_test_failed_visibility() + cssm_test_failed_furnace() + cssm_test_failed_motion() +
-           cssm_test_failed_env();
-}
-
 int main(int argc, char **argv)
 {
     if (argc != 2) {
@@ -114,7 +106,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "cssm_tests: unknown part '%s'\n", argv[1]);
         return 2;
     }
-    const int failed = failed_checks();
+    const int failed = gi_test_failed; /* every file's checks (check.h) */
     if (r || failed) {
         fprintf(stderr, "cssm_tests %s: %d check(s) failed\n", argv[1], failed + r);
         return 1;

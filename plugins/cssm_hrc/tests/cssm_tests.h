@@ -1,8 +1,8 @@
 /* What the files of cssm_tests share (cssm_tests.c lists the parts):
  * the scenes, the GL fixture of the visibility, motion and escape parts
  * (fixture.c), the tree traversals of the tree and compact parts
- * (tree_tests.c), and each file's parts. check.h counts failed checks per
- * file, so each file that checks reports its count for main. */
+ * (tree_tests.c), and each file's parts. check.h's counters are shared by
+ * all the files. */
 #ifndef CSSM_TESTS_H
 #define CSSM_TESTS_H
 
@@ -77,14 +77,5 @@ int cssm_test_hull(void);           /* motion_tests.c */
 int cssm_test_motion(void);         /* motion_tests.c */
 int cssm_test_motion2(void);        /* motion_tests.c */
 int cssm_test_env(void);            /* env_tests.c */
-
-/* Failed checks of each file. */
-int cssm_test_failed_atlas(void);
-int cssm_test_failed_tree(void);
-int cssm_test_failed_compact(void);
-int cssm_test_failed_visibility(void);
-int cssm_test_failed_furnace(void);
-int cssm_test_failed_motion(void);
-int cssm_test_failed_env(void);
 
 #endif

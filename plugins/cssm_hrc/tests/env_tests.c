@@ -214,8 +214,3 @@ int cssm_test_env(void)
     r |= env_scene("scenes/cornell_box.gltf", 0);
     return r;
 }
-
-int cssm_test_failed_env(void)
-{
-    return gi_test_failed;
-}

@@ -181,8 +181,3 @@ int cssm_test_furnace(int compact)
     furnace_close(&f);
     return 0;
 }
-
-int cssm_test_failed_furnace(void)
-{
-    return gi_test_failed;
-}

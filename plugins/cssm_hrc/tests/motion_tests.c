@@ -479,8 +479,3 @@ int cssm_test_motion2(void)
     cssm_fixture_close(&f);
     return 0;
 }
-
-int cssm_test_failed_motion(void)
-{
-    return gi_test_failed;
-}

@@ -98,8 +98,3 @@ int cssm_test_tree(void)
     gi_scene_free(s);
     return 0;
 }
-
-int cssm_test_failed_tree(void)
-{
-    return gi_test_failed;
-}

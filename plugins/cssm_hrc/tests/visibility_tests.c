@@ -63,8 +63,3 @@ int cssm_test_visibility(void)
     cssm_fixture_close(&f);
     return 0;
 }
-
-int cssm_test_failed_visibility(void)
-{
-    return gi_test_failed;
-}

@@ -59,12 +59,4 @@ void iv_test_remesh(void);
 void iv_test_threads(void);
 void iv_test_gpu(void);
 
-/* check.h counts in each file: the failures of each file's checks, summed
- * by main(). */
-int iv_tests_structure_failed(void);
-int iv_tests_light_failed(void);
-int iv_tests_remesh_failed(void);
-int iv_tests_threads_failed(void);
-int iv_tests_gpu_failed(void);
-
 #endif

@@ -117,8 +117,3 @@ void iv_test_gpu(void)
     gi_gpu_destroy(iv_test_gl);
     iv_test_gl = NULL;
 }
-
-int iv_tests_gpu_failed(void)
-{
-    return gi_test_failed;
-}

@@ -365,8 +365,3 @@ void iv_test_leak(void)
     EXPECT(coarse <= 0.05 && fine <= 0.05, "with splatting the teapot lets %.3f / %.3f through",
            coarse, fine);
 }
-
-int iv_tests_light_failed(void)
-{
-    return gi_test_failed;
-}

@@ -196,8 +196,3 @@ void iv_test_remesh(void)
     for (int k = 0; k < 3; k++)
         remesh_cornell(scenes[k], k);
 }
-
-int iv_tests_remesh_failed(void)
-{
-    return gi_test_failed;
-}

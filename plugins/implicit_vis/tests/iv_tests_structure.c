@@ -236,8 +236,3 @@ void iv_test_links(void)
     iv_hier_free(h);
     gi_scene_free(s);
 }
-
-int iv_tests_structure_failed(void)
-{
-    return gi_test_failed;
-}

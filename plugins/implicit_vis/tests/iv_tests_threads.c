@@ -99,8 +99,3 @@ void iv_test_threads(void)
                  0);
     threads_case(GI_SOURCE_DIR "/scenes/teapot_plane.glb", 0.0f, IV_REMESH_GRID, 12, 0, 0, 0.0f, 1);
 }
-
-int iv_tests_threads_failed(void)
-{
-    return gi_test_failed;
-}
