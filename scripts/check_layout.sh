@@ -8,8 +8,9 @@
 #     docs/ARCHITECTURE.md's table "Long functions" with its reason;
 #   - at most one source file of more than 1,000 lines, the glTF loader;
 #   - README.md at most 500 lines;
-#   - libgicore.so (given as $1, optional) needs none of CGAL's GMP/MPFR,
-#     qhull or meshoptimizer: those link into libgi_algo.so only.
+#   - libgicore.so (given as $1, optional) loads none of CGAL's GMP/MPFR,
+#     qhull or meshoptimizer, directly or through another library (ldd):
+#     those link into libgi_algo.so only.
 # Usage: scripts/check_layout.sh [path/to/libgicore.so]
 # Exit 0 when every rule holds; 1 with one line per broken rule.
 set -uo pipefail
@@ -47,9 +48,9 @@ readme=$(wc -l < README.md)
 (( readme <= 500 )) || fail "README.md has $readme lines (at most 500: the rest belongs in docs/)"
 
 if [[ -n ${1:-} ]]; then
-    needed=$(readelf -d "$1" | grep NEEDED || true)
-    bad=$(grep -i -E 'cgal|gmp|mpfr|qhull|meshopt' <<< "$needed" || true)
-    [[ -z $bad ]] || fail "$1 needs $bad (core/algo/ is the only place these link)"
+    needed=$(ldd "$1") || fail "ldd $1 failed"
+    bad=$(grep -i -E 'cgal|gmp|mpfr|qhull|meshopt' <<< "$needed" | awk '{print $1}' | paste -sd' ' || true)
+    [[ -z $bad ]] || fail "ldd $1 lists $bad (core/algo/ is the only place these link)"
 fi
 (( fails == 0 )) && echo "check_layout: the tree has the shape docs/ARCHITECTURE.md describes"
 exit $(( fails > 0 ))

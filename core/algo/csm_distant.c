@@ -77,9 +77,9 @@ gi_result gi_csm_distant_build(const gi_gpu_scene *gs, uint32_t object,
     memset(out, 0, sizeof *out);
     const gi_scene *s = gs->scene;
     if (object >= s->object_count) {
-        snprintf(err->text, sizeof err->text, "csm_distant: object %u out of range (%u objects)",
-                 object, s->object_count);
-        return GI_ERR_INVALID_ARGUMENT;
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "csm_distant: object %u out of range (%u objects)", object,
+                            s->object_count);
     }
     const uint32_t M = desc && desc->M ? desc->M : 32u;
     out->n_theta = desc && desc->n_theta ? desc->n_theta : 32u;
@@ -100,7 +100,8 @@ gi_result gi_csm_distant_build(const gi_gpu_scene *gs, uint32_t object,
     gi_csm_codec *enc = NULL;
     gi_result r = GI_ERR_OUT_OF_MEMORY;
     if (!z1 || !z2) {
-        snprintf(err->text, sizeof err->text, "csm_distant: out of memory for %u x %u maps", M, M);
+        r = gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "csm_distant: out of memory for %u x %u maps",
+                         M, M);
         goto done;
     }
     if ((r = gi_csm_codec_begin(M, N, &enc, err)) != GI_OK)
@@ -114,9 +115,8 @@ gi_result gi_csm_distant_build(const gi_gpu_scene *gs, uint32_t object,
         for (uint32_t k = 0; k < count && r == GI_OK; k++) {
             float *map = gi_depth_read_layer(tex, M, k);
             if (!map) {
-                r = GI_ERR_OUT_OF_MEMORY;
-                snprintf(err->text, sizeof err->text, "csm_distant: reading map %u failed",
-                         first + k);
+                r = gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "csm_distant: reading map %u failed",
+                                 first + k);
                 break;
             }
             for (size_t t = 0; t < (size_t)M * M; t++) {

@@ -48,9 +48,8 @@ static gi_result encode_batch(precompute_run *pr, uint32_t first, uint32_t count
             map = gi_depth_read_layer(pr->tex, pr->M, pr->slot[k]);
             gi_host_stage(host, pr->render_stage, 0);
             if (!map) {
-                snprintf(err->text, sizeof err->text, "%s: reading %s %u failed", pr->who, pr->what,
-                         q);
-                return GI_ERR_OUT_OF_MEMORY;
+                return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "%s: reading %s %u failed", pr->who,
+                                    pr->what, q);
             }
         }
         gi_host_stage(host, "compress", 1);
@@ -74,15 +73,13 @@ gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc
     const char *render_stage = d->render_stage ? d->render_stage : "depth_render";
     const gi_host *host = d->host;
     if (S > GI_CSM_MAX_STREAMS) {
-        snprintf(err->text, sizeof err->text, "%s: %u codec streams (at most %u)", who, S,
-                 GI_CSM_MAX_STREAMS);
-        return GI_ERR_INVALID_ARGUMENT;
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: %u codec streams (at most %u)", who,
+                            S, GI_CSM_MAX_STREAMS);
     }
     memset(out, 0, S * sizeof *out);
     if (N == 0 || N % S != 0 || !d->view || !d->depths) {
-        snprintf(err->text, sizeof err->text, "%s: %u %s do not make %u codec streams", who, N,
-                 what, S);
-        return GI_ERR_INVALID_ARGUMENT;
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: %u %s do not make %u codec streams",
+                            who, N, what, S);
     }
     precompute_run pr = {
         .gs = gs, .d = d, .S = S, .M = M, .who = who, .what = what, .render_stage = render_stage};
@@ -96,7 +93,8 @@ gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc
     pr.z2 = malloc((size_t)M * M * sizeof *pr.z2);
     gi_result r = GI_ERR_OUT_OF_MEMORY;
     if (!pr.views || !pr.slot || !pr.z1 || !pr.z2) {
-        snprintf(err->text, sizeof err->text, "%s: out of memory for %u x %u %s", who, M, M, what);
+        r = gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "%s: out of memory for %u x %u %s", who, M, M,
+                         what);
         goto done;
     }
     for (uint32_t s = 0; s < S; s++)
@@ -104,8 +102,7 @@ gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc
             goto done;
     for (uint32_t first = 0; first < N; first += batch) {
         if (host && host->cancelled(host)) {
-            r = GI_ERR_CANCELLED;
-            snprintf(err->text, sizeof err->text, "%s: precomputation cancelled", who);
+            r = gi_error_set(err, GI_ERR_CANCELLED, "%s: precomputation cancelled", who);
             goto done;
         }
         uint32_t count = N - first < batch ? N - first : batch;

@@ -130,20 +130,18 @@ gi_result gi_hull_build(const float *points, uint32_t count, gi_hull *out, gi_er
 {
     memset(out, 0, sizeof *out);
     if (!count || !points) {
-        snprintf(err->text, sizeof err->text, "hull: no points");
-        return GI_ERR_INVALID_ARGUMENT;
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "hull: no points");
     }
     coordT *pts = malloc((size_t)count * 3 * sizeof *pts);
     if (!pts) {
-        snprintf(err->text, sizeof err->text, "hull: out of memory for %u points", count);
-        return GI_ERR_OUT_OF_MEMORY;
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "hull: out of memory for %u points", count);
     }
     int distinct = 0;
     for (uint32_t i = 0; i < 3 * count; i++) {
         if (!isfinite(points[i])) {
             free(pts);
-            snprintf(err->text, sizeof err->text, "hull: point %u is not finite", i / 3);
-            return GI_ERR_INVALID_ARGUMENT;
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "hull: point %u is not finite",
+                                i / 3);
         }
         pts[i] = points[i];
         distinct |= points[i] != points[i % 3];
@@ -173,14 +171,12 @@ gi_result gi_hull_build(const float *points, uint32_t count, gi_hull *out, gi_er
     }
     free(pts);
     if (rc == -1) {
-        snprintf(err->text, sizeof err->text, "hull: out of memory for the hull of %u points",
-                 count);
-        return GI_ERR_OUT_OF_MEMORY;
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
+                            "hull: out of memory for the hull of %u points", count);
     }
     if (rc != 0) {
-        snprintf(err->text, sizeof err->text, "hull: qhull failed on %u points (exit code %d)",
-                 count, rc);
-        return GI_ERR_INVALID_ARGUMENT;
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "hull: qhull failed on %u points (exit code %d)", count, rc);
     }
     return GI_OK;
 }
