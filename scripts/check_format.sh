@@ -17,10 +17,15 @@ if [[ ${1:-} == --fix ]]; then
     "$cf" -i "${files[@]}"
     exit 0
 fi
-bad=()
-for f in "${files[@]}"; do
-    "$cf" --dry-run -Werror "$f" >/dev/null 2>&1 || bad+=("$f")
-done
+# One clang-format process for all files (a process per file costs 40 s);
+# the files that differ are read back from its diagnostics.
+out=$("$cf" --dry-run -Werror "${files[@]}" 2>&1 >/dev/null)
+rc=$?
+mapfile -t bad < <(grep -oE '^[^:]+:[0-9]+:[0-9]+: error' <<<"$out" | cut -d: -f1 | sort -u)
+if (( rc != 0 && ${#bad[@]} == 0 )); then
+    echo "check_format: clang-format-14 failed: ${out%%$'\n'*}" >&2
+    exit 1
+fi
 if (( ${#bad[@]} > 0 )); then
     echo "check_format: ${#bad[@]} of ${#files[@]} files differ from .clang-format (scripts/check_format.sh --fix):"
     printf '  %s\n' "${bad[@]}"
