@@ -2,7 +2,9 @@
  * times with one FAKE_* macro defined (tests/CMakeLists.txt). The FAKE_CONF_*
  * kinds render something (a constant per pixel) for the conformance suite's
  * own tests: each breaks one rule the suite must catch. FAKE_ENTRY_CRASH and
- * FAKE_CTOR_CRASH crash while loading (in gi_method_entry, in a constructor).
+ * FAKE_CTOR_CRASH crash while loading (in gi_method_entry, in a constructor);
+ * FAKE_DTOR_CRASH loads fine and crashes in its destructor, when unloaded or
+ * at the exit of the process that loaded it.
  * FAKE_BAKED renders a constant grey, lacks GI_CAP_RIGID_MOTION and refuses
  * moved lights in update(), as a method that bakes its lights at prepare
  * would: the viewer's tests of a method that cannot follow a change. */
@@ -157,6 +159,13 @@ static const gi_method fake_method = {
 
 #if defined(FAKE_CTOR_CRASH) /* crashes as it is mapped, before any symbol is looked up */
 __attribute__((constructor)) static void fake_ctor(void)
+{
+    raise(SIGSEGV);
+}
+#endif
+
+#if defined(FAKE_DTOR_CRASH) /* crashes as it is unloaded: at dlclose, or at exit */
+__attribute__((destructor)) static void fake_dtor(void)
 {
     raise(SIGSEGV);
 }
