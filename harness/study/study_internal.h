@@ -135,7 +135,8 @@ void study_reference_sets(study *st, json_object *meta);
 /* ---- execution (study_exec.c) ---- */
 
 json_object *study_run_or_skip(study_run *r, gi_plugins *reg, int resume);
-void study_execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg);
+/* mode: RUNNER_FRESH (--fresh), RUNNER_RESUME, RUNNER_RETRY_FAILED (--retry-failed). */
+void study_execute_runs(study *st, uint32_t jobs, int mode, gi_plugins *reg);
 
 /* ---- the report's charts and tables (study_charts.c, study_anim.c) ---- */
 
