@@ -231,7 +231,7 @@ static int run_here(study *st, const study_args *a, gi_plugins *reg, int argc, c
                            : a->retry_failed ? RUNNER_RETRY_FAILED
                                              : RUNNER_RESUME,
                            reg);
-    return study_write_report(st, a->out, argc, argv);
+    return study_write_report(st, a->out, argc, argv, a->so.collect != NULL);
 }
 
 int cmd_study(int argc, char **argv)

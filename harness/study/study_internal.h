@@ -150,8 +150,10 @@ void study_animation_report(study *st, const char *out_dir, json_object *meta,
 
 /* Writes out/report.md, index.html and the CSV files from the runs'
  * records. EXIT_OK, or EXIT_RUN after printing why (also when the study
- * was interrupted). */
-int study_write_report(study *st, const char *out, int argc, char **argv);
+ * was interrupted, and when a run failed, unless `slurm_collect`: the
+ * collect job names the failed runs but ends completed, its report being
+ * its work). */
+int study_write_report(study *st, const char *out, int argc, char **argv, int slurm_collect);
 
 /* ---- gibench study --slurm (study_slurm.c) ---- */
 

@@ -96,7 +96,7 @@ static int report_failures(const study *st, int failed)
                     st->run_count);
 }
 
-int study_write_report(study *st, const char *out, int argc, char **argv)
+int study_write_report(study *st, const char *out, int argc, char **argv, int slurm_collect)
 {
     int rc = EXIT_OK;
     add_scene_sizes(st);
@@ -122,8 +122,8 @@ int study_write_report(study *st, const char *out, int argc, char **argv)
         rc = cli_fail(EXIT_RUN,
                       "study: interrupted (%d runs to redo); rerun the same command to resume",
                       interrupted);
-    else if (rc == EXIT_OK && failed)
-        rc = report_failures(st, failed);
+    else if (rc == EXIT_OK && failed && report_failures(st, failed) != EXIT_OK && !slurm_collect)
+        rc = EXIT_RUN;
     json_object_put(runs);
     json_object_put(meta);
     return rc;
