@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 /* runner_set_collect_only: nothing is run, cached results are taken */
@@ -807,9 +808,16 @@ static void run_render(json_object *rec, const run_spec *s, const run_files *p, 
     }
     json_object_object_add(rec, "wall_s", json_object_new_double(r.seconds));
     if (!cli_proc_ok(&r)) {
-        char d[700];
+        char d[700], full[900];
         cli_proc_describe(&r, d, sizeof d);
-        fail_record(rec, d);
+        /* a full disk may have swallowed the child's own words (its log
+         * lies on the same disk): say so, for the summary's "external" */
+        struct statvfs fs;
+        if (statvfs(s->dir, &fs) == 0 && fs.f_bavail == 0 && !strstr(d, "No space left"))
+            snprintf(full, sizeof full, "%s (No space left on device in %s)", d, s->dir);
+        else
+            snprintf(full, sizeof full, "%s", d);
+        fail_record(rec, full);
     } else {
         json_object *t = cli_read_json(p->timings);
         if (!t)
