@@ -273,3 +273,107 @@ gi_result gi_file_write_atomic(const char *path, const void *data, size_t size, 
     }
     return gi_atomic_commit(&f, 1, err);
 }
+
+/* The cache entry's header (cache.h): magic, version, name length, name,
+ * payload size, payload hash, all little-endian as the host writes them
+ * (a cache directory is not shared between machines of other byte order:
+ * such an entry fails its checks and is recomputed). */
+static const char cache_magic[8] = {'G', 'I', 'C', 'A', 'C', 'H', 'E', '\n'};
+#define CACHE_HEADER_VERSION 1u
+#define CACHE_NAME_MAX 255u
+
+static const char *entry_name(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    return slash ? slash + 1 : path;
+}
+
+gi_result gi_cache_store(const char *path, const void *data, size_t size, gi_error *err)
+{
+    assert(path && (data || size == 0));
+    const char *name = entry_name(path);
+    uint32_t head[2] = {CACHE_HEADER_VERSION, (uint32_t)strlen(name)};
+    if (head[1] > CACHE_NAME_MAX)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%.200s: cache entry name too long",
+                            path);
+    uint64_t tail[2] = {(uint64_t)size, gi_hash64(data, size, 0)};
+    size_t header = sizeof cache_magic + sizeof head + head[1] + sizeof tail;
+    unsigned char *buf = malloc(header + size);
+    if (!buf)
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+    unsigned char *q = buf;
+    memcpy(q, cache_magic, sizeof cache_magic);
+    q += sizeof cache_magic;
+    memcpy(q, head, sizeof head);
+    q += sizeof head;
+    memcpy(q, name, head[1]);
+    q += head[1];
+    memcpy(q, tail, sizeof tail);
+    q += sizeof tail;
+    if (size)
+        memcpy(q, data, size);
+    gi_result r = gi_file_write_atomic(path, buf, header + size, err);
+    free(buf);
+    return r;
+}
+
+/* Checks the header of an entry of n bytes read from `path`: GI_OK with the
+ * payload's offset and size, or why not. */
+static gi_result check_entry(const char *path, const unsigned char *p, size_t n, size_t *at,
+                             size_t *size, gi_error *err)
+{
+    const char *name = entry_name(path);
+    uint32_t head[2];
+    uint64_t tail[2];
+    size_t fixed = sizeof cache_magic + sizeof head;
+    if (n < fixed || memcmp(p, cache_magic, sizeof cache_magic) != 0)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "no gibench cache header (damaged, or written by an older gibench)");
+    memcpy(head, p + sizeof cache_magic, sizeof head);
+    if (head[0] != CACHE_HEADER_VERSION || head[1] > CACHE_NAME_MAX ||
+        n < fixed + head[1] + sizeof tail)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "bad cache header (version %u)", head[0]);
+    if (head[1] != strlen(name) || memcmp(p + fixed, name, head[1]) != 0) {
+        /* the name it was made as, when it is printable (one line) */
+        int shown = 1;
+        for (uint32_t i = 0; i < head[1]; i++)
+            shown &= p[fixed + i] >= 0x20 && p[fixed + i] < 0x7f;
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "made as %.*s, not %s: copied from another scene or other settings",
+                            shown ? (int)head[1] : 9, shown ? (const char *)(p + fixed) : "another",
+                            name);
+    }
+    memcpy(tail, p + fixed + head[1], sizeof tail);
+    *at = fixed + head[1] + sizeof tail;
+    if (tail[0] != n - *at)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "%zu bytes of data, the header says %llu (truncated or padded)",
+                            n - *at, (unsigned long long)tail[0]);
+    if (gi_hash64(p + *at, n - *at, 0) != tail[1])
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "checksum mismatch (damaged)");
+    *size = n - *at;
+    return GI_OK;
+}
+
+gi_result gi_cache_load(const char *path, void **data, size_t *size, gi_error *err)
+{
+    assert(path && data && size);
+    *data = NULL;
+    *size = 0;
+    size_t n = 0, at = 0, payload = 0;
+    errno = 0;
+    unsigned char *p = gi_file_read_all(path, &n);
+    if (!p)
+        return errno == ENOENT ? GI_OK
+                               : gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "cannot read it: %s",
+                                              strerror(errno));
+    gi_result r = check_entry(path, p, n, &at, &payload, err);
+    if (r != GI_OK) {
+        free(p);
+        return r;
+    }
+    memmove(p, p + at, payload);
+    *data = p;
+    *size = payload;
+    return GI_OK;
+}

@@ -100,6 +100,22 @@ gi_envmap *gi_envmap_create(const float *rgba, uint32_t width, uint32_t height, 
     return env;
 }
 
+uint64_t gi_envmap_count_nonfinite(const float *rgba, uint32_t width, uint32_t height, uint32_t *x,
+                                   uint32_t *y)
+{
+    uint64_t bad = 0;
+    for (size_t i = 0; rgba && i < (size_t)width * height; i++) {
+        const float *p = rgba + 4 * i;
+        if (isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))
+            continue;
+        if (!bad++) {
+            *x = (uint32_t)(i % width);
+            *y = (uint32_t)(i / width);
+        }
+    }
+    return bad;
+}
+
 void gi_envmap_free(gi_envmap *env)
 {
     if (!env)

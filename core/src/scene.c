@@ -88,6 +88,16 @@ static int load_environment(gi_scene *s, const char *name, const char *pointer, 
                      s->environment.uri, ierr.text);
         return 0;
     }
+    uint32_t bx = 0, by = 0;
+    uint64_t bad = gi_envmap_count_nonfinite(img->rgba, img->width, img->height, &bx, &by);
+    if (bad) {
+        gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                     "%s: %s: environment map '%.100s' has %llu NaN or infinite texels (the first "
+                     "at x %u, y %u)",
+                     name, pointer, s->environment.uri, (unsigned long long)bad, bx, by);
+        gi_image_free(img);
+        return 0;
+    }
     s->envmap = gi_envmap_create(img->rgba, img->width, img->height, s->environment.intensity,
                                  s->environment.rotation_deg);
     gi_image_free(img);

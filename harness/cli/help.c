@@ -87,7 +87,8 @@ static const command_help helps[] = {
      "  --fresh                rerun methods even when a result for the same configuration "
      "exists\n"},
     {"study",
-     "usage: gibench study STUDY.json --out DIR [--jobs N] [--resume|--fresh] [--dry-run]\n"
+     "usage: gibench study STUDY.json --out DIR [--jobs N] [--resume|--fresh|--retry-failed]\n"
+     "         [--dry-run]\n"
      "         [--slurm [--partition P] [--gres G] [--time T] [--array-limit K] [--no-wait]]\n"
      "Run a declarative experiment (docs/studies.md, \"gibench study\"): every method setting x "
      "scene x repeat "
@@ -98,6 +99,11 @@ static const command_help helps[] = {
      "  --jobs N      worker processes\n"
      "  --resume      keep earlier results of the same configuration (the default)\n"
      "  --fresh       run everything again\n"
+     "  --retry-failed  run the failed runs again (a run killed from outside, a full disk), keep "
+     "the rest\n"
+     "Exit status: 0 every run ok or n/a, 1 a run failed or the study was interrupted (the report "
+     "is\n"
+     "written all the same), 2 a bad study file or option.\n"
      "  --dry-run     check the file and print the plan; run nothing (with --slurm: print the job "
      "scripts)\n"
      "  --slurm       run the cells as Slurm job arrays (docs/studies.md, \"Studies on a "

@@ -65,6 +65,7 @@ int cli_run(char *const argv[], double timeout_s, const char *out_path, const ch
     memset(r, 0, sizeof *r);
     if (cli_interrupted) { /* nothing new starts once gibench is interrupted */
         r->interrupted = 1;
+        r->exit_code = -1; /* not done: no caller may read it as success */
         snprintf(r->last_line, sizeof r->last_line, "not started: interrupted");
         return 0;
     }
@@ -139,6 +140,9 @@ int cli_run(char *const argv[], double timeout_s, const char *out_path, const ch
     if (term_sent > 0.0 && !r->timed_out && !(WIFEXITED(status) && WEXITSTATUS(status) == 0)) {
         kill(-pid, SIGKILL); /* whatever of the group is left */
         r->interrupted = 1;
+        /* the child's own status (never 0 here), so that a caller reading
+         * exit_code alone cannot take the unfinished work as done */
+        r->exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     } else if (!r->timed_out) {
         if (WIFSIGNALED(status)) {
             r->signaled = 1;
@@ -151,6 +155,21 @@ int cli_run(char *const argv[], double timeout_s, const char *out_path, const ch
     return 0;
 }
 
+int cli_proc_ok(const cli_proc_result *r)
+{
+    return !r->interrupted && !r->timed_out && !r->signaled && r->exit_code == 0;
+}
+
+int cli_reason_external(const char *reason)
+{
+    static const char *const marks[] = {"killed (signal", "(signal 9:", "No space left on device",
+                                        "Disk quota exceeded", "Input/output error"};
+    for (size_t i = 0; reason && i < sizeof marks / sizeof marks[0]; i++)
+        if (strstr(reason, marks[i]))
+            return 1;
+    return 0;
+}
+
 void cli_proc_describe(const cli_proc_result *r, char *buf, size_t size)
 {
     if (r->interrupted)
@@ -158,8 +177,12 @@ void cli_proc_describe(const cli_proc_result *r, char *buf, size_t size)
     else if (r->timed_out)
         snprintf(buf, size, "timed out after %.0f s", r->seconds);
     else if (r->signaled)
-        snprintf(buf, size, "crashed (signal %d: %s)%s%s", r->signal, strsignal(r->signal),
-                 r->last_line[0] ? ": " : "", r->last_line);
+        /* SIGKILL, SIGTERM and SIGHUP come from outside (the out-of-memory
+         * killer, an administrator, a scheduler), not from the method */
+        snprintf(buf, size, "%s (signal %d: %s)%s%s",
+                 r->signal == SIGKILL || r->signal == SIGTERM || r->signal == SIGHUP ? "killed"
+                                                                                     : "crashed",
+                 r->signal, strsignal(r->signal), r->last_line[0] ? ": " : "", r->last_line);
     else if (r->exit_code != 0)
         snprintf(buf, size, "exit %d%s%s", r->exit_code, r->last_line[0] ? ": " : "", r->last_line);
     else

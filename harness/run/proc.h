@@ -7,7 +7,7 @@
 #include <stddef.h>
 
 typedef struct cli_proc_result {
-    int exit_code; /* valid when !signaled && !timed_out */
+    int exit_code; /* valid when !signaled && !timed_out; never 0 when interrupted */
     int signaled;  /* killed by a signal (crash) */
     int signal;
     int timed_out;       /* killed by us at the time limit */
@@ -35,9 +35,24 @@ int cli_run(char *const argv[], double timeout_s, const char *out_path, const ch
  * also gets SIGKILL when gibench dies (PR_SET_PDEATHSIG, Linux).
  *
  * One-line description of how a run ended: "ok", "exit 2: <line>",
- * "crashed (signal 11: Segmentation fault): <line>", "timed out after 30 s",
+ * "crashed (signal 11: Segmentation fault): <line>", "killed (signal 9: Killed)",
+ * "timed out after 30 s",
  * "interrupted". */
 void cli_proc_describe(const cli_proc_result *r, char *buf, size_t size);
+
+/* 1 when the child ran to its end and exited 0: started, not interrupted,
+ * not timed out, not killed. Every caller of a child asks this, never
+ * exit_code alone: an interrupted child has not done its work, whatever
+ * its status. */
+int cli_proc_ok(const cli_proc_result *r);
+
+/* 1 when a failure, as cli_proc_describe words it (a run record's
+ * "reason"), looks external, not the method's own: the child was killed by
+ * a signal it does not raise itself (SIGKILL, as the out-of-memory killer
+ * sends, SIGTERM or SIGHUP from outside: "killed (signal 9: ...)"), or its
+ * last line reports a full disk, a quota or an I/O error (ENOSPC, EDQUOT,
+ * EIO). Such a run may well succeed when retried (study --retry-failed). */
+int cli_reason_external(const char *reason);
 
 /* Absolute path of the running gibench executable. */
 const char *cli_self_exe(void);

@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 /* runner_set_collect_only: nothing is run, cached results are taken */
@@ -115,6 +116,37 @@ static void fail_record(json_object *o, const char *reason)
     json_object_object_add(o, "reason", json_object_new_string(reason));
 }
 
+/* A run whose image holds NaN or infinite pixels has failed, however
+ * small its error over the others (the metrics leave such pixels out):
+ * 1 and why when `exr` has any; 0 when it has none or cannot be read (the
+ * comparison reports an unreadable image itself). */
+static int nonfinite_output(const char *exr, char *why, size_t why_size)
+{
+    gi_error err;
+    gi_image *img = gi_image_read(exr, &err);
+    if (!img)
+        return 0;
+    size_t n = (size_t)img->width * img->height, bad = 0;
+    for (size_t i = 0; i < n; i++)
+        bad += !(isfinite(img->rgba[4 * i]) && isfinite(img->rgba[4 * i + 1]) &&
+                 isfinite(img->rgba[4 * i + 2]));
+    gi_image_free(img);
+    if (bad)
+        snprintf(why, why_size, "non-finite output: %zu of %zu pixels are NaN or infinite", bad, n);
+    return bad != 0;
+}
+
+/* The number of non-finite pixels that `gibench diff --json` counted in
+ * image `which` ("test" or "reference"). */
+static int64_t diff_nonfinite(json_object *m, const char *which)
+{
+    json_object *img, *v;
+    if (json_object_object_get_ex(m, which, &img) &&
+        json_object_object_get_ex(img, "nonfinite_pixels", &v))
+        return json_object_get_int64(v);
+    return 0;
+}
+
 json_object *runner_diff(const char *image, const char *reference, const char *heatmap,
                          const char *flip_map, float exposure, char *why, size_t why_size)
 {
@@ -140,7 +172,7 @@ json_object *runner_diff(const char *image, const char *reference, const char *h
     cli_proc_result r;
     int started = cli_run(b.argv, 300, out, err, &r) == 0;
     args_free(&b);
-    if (!started || r.timed_out || r.signaled || r.exit_code) {
+    if (!started || !cli_proc_ok(&r)) {
         char d[600];
         cli_proc_describe(&r, d, sizeof d);
         snprintf(why, why_size, "diff against %s: %s", reference, d);
@@ -357,6 +389,15 @@ static int frame_errors(const run_spec *s, uint32_t f, gi_image *const *img, dou
     for (int k = 0; k < 2 && ok; k++)
         if (gi_metrics_compute(img[0], img[1 + k], &mo, &m[k], &err) != GI_OK) {
             snprintf(why, why_size, "frame %u: %s", f, err.text);
+            ok = 0;
+        } else if (m[k].nonfinite_test || m[k].nonfinite_ref) {
+            /* the metrics leave such pixels out: the frame is not judged on the rest */
+            snprintf(why, why_size,
+                     "frame %u: non-finite %s: %llu of %u pixels are NaN or infinite", f,
+                     m[k].nonfinite_test ? "output" : "reference",
+                     (unsigned long long)(m[k].nonfinite_test ? m[k].nonfinite_test
+                                                              : m[k].nonfinite_ref),
+                     s->width * s->height);
             ok = 0;
         }
     if (ok) {
@@ -653,19 +694,43 @@ static void output_args(argv_builder *b, const run_spec *s, const run_files *p)
     arg(b, "%s", p->timings);
 }
 
+/* Whether a cached record's metrics counted non-finite pixels in its image
+ * (the image itself may be gone: committed results keep PNGs only). */
+static int cached_nonfinite(json_object *rec, char *why, size_t why_size)
+{
+    json_object *metrics, *m;
+    if (!json_object_object_get_ex(rec, "metrics", &metrics) ||
+        !json_object_object_get_ex(metrics, "full", &m) || diff_nonfinite(m, "test") <= 0)
+        return 0;
+    snprintf(why, why_size, "non-finite output: %lld pixels are NaN or infinite",
+             (long long)diff_nonfinite(m, "test"));
+    return 1;
+}
+
 /* The result kept for the same configuration (not an interrupted one),
  * marked "cached"; NULL when there is none. */
-static json_object *cached_result(const run_spec *s, const run_files *p, const char *config)
+static json_object *cached_result(const run_spec *s, const run_files *p, const char *config,
+                                  int resume)
 {
     json_object *old = cli_read_json(p->result);
     json_object *c;
-    json_object *st;
+    json_object *st = NULL;
     if (old && json_object_object_get_ex(old, "config", &c) &&
         strcmp(json_object_get_string(c), config) == 0 &&
         !(json_object_object_get_ex(old, "status", &st) &&
           !strcmp(json_object_get_string(st), "interrupted"))) {
         if (!collect_only)
             add_leak_to_cached(old, s, p->exr, p->result);
+        /* a result recorded "ok" before non-finite output failed a run */
+        char why[256];
+        const char *status = st ? json_object_get_string(st) : "";
+        if (!strcmp(status, "ok") &&
+            (nonfinite_output(p->exr, why, sizeof why) || cached_nonfinite(old, why, sizeof why)))
+            fail_record(old, why);
+        if (resume == RUNNER_RETRY_FAILED && strcmp(status, "ok")) {
+            json_object_put(old); /* --retry-failed: run it again */
+            return NULL;
+        }
         /* for the caller's progress line only; it removes the key */
         json_object_object_add(old, "cached", json_object_new_boolean(1));
         return old;
@@ -691,8 +756,11 @@ static void take_render(json_object *rec, const run_spec *s, const run_files *p,
     json_object_put(t);
     json_object_object_add(rec, "status", json_object_new_string("ok"));
     json_object_object_add(rec, "reason", json_object_new_string(""));
+    char nf_why[256];
     if (anim_why[0])
         fail_record(rec, anim_why);
+    else if (nonfinite_output(p->exr, nf_why, sizeof nf_why))
+        fail_record(rec, nf_why);
     char q[4200];
     snprintf(q, sizeof q, "%s/image.png", s->rel);
     json_object_object_add(rec, "png", json_object_new_string(q));
@@ -707,6 +775,11 @@ static void take_render(json_object *rec, const run_spec *s, const run_files *p,
         char why[1024];
         json_object *m = runner_diff(p->exr, refs[k], k == 0 ? p->heat : NULL,
                                      k == 0 ? p->flip : NULL, s->exposure, why, sizeof why);
+        if (m && diff_nonfinite(m, "reference") > 0) {
+            snprintf(why, sizeof why, "reference %s has %lld NaN or infinite pixels", refs[k],
+                     (long long)diff_nonfinite(m, "reference"));
+            fail_record(rec, why);
+        }
         if (m) {
             json_object_object_add(metrics, names[k], m);
         } else {
@@ -734,10 +807,17 @@ static void run_render(json_object *rec, const run_spec *s, const run_files *p, 
         return;
     }
     json_object_object_add(rec, "wall_s", json_object_new_double(r.seconds));
-    if (r.timed_out || r.signaled || r.exit_code != 0) {
-        char d[700];
+    if (!cli_proc_ok(&r)) {
+        char d[700], full[900];
         cli_proc_describe(&r, d, sizeof d);
-        fail_record(rec, d);
+        /* a full disk may have swallowed the child's own words (its log
+         * lies on the same disk): say so, for the summary's "external" */
+        struct statvfs fs;
+        if (statvfs(s->dir, &fs) == 0 && fs.f_bavail == 0 && !strstr(d, "No space left"))
+            snprintf(full, sizeof full, "%s (No space left on device in %s)", d, s->dir);
+        else
+            snprintf(full, sizeof full, "%s", d);
+        fail_record(rec, full);
     } else {
         json_object *t = cli_read_json(p->timings);
         if (!t)
@@ -763,7 +843,7 @@ json_object *runner_execute(const run_spec *s, int resume)
     output_args(&b, s, &p);
 
     if (resume || collect_only) {
-        json_object *old = cached_result(s, &p, config);
+        json_object *old = cached_result(s, &p, config, collect_only ? RUNNER_RESUME : resume);
         if (old) {
             json_object_put(rec);
             args_free(&b);
@@ -776,7 +856,11 @@ json_object *runner_execute(const run_spec *s, int resume)
         fail_record(rec, "no result");
         return rec;
     }
-    unlink(p.result);
+    /* nothing of an earlier run may be read as this run's output (an
+     * interrupted or failed render leaves the old files otherwise) */
+    const char *outputs[] = {p.result, p.exr, p.png, p.timings, p.heat, p.flip};
+    for (size_t k = 0; k < sizeof outputs / sizeof outputs[0]; k++)
+        unlink(outputs[k]);
     if (s->frame_ref_count && !cli_mkdirs(p.frames_dir)) {
         args_free(&b);
         fail_record(rec, "cannot create the frames directory");
@@ -865,9 +949,12 @@ int runner_reference(const char *scene, uint64_t scene_hash, const char *camera,
     arg(&b, "%s", "--stats");
     arg(&b, "%s", stats);
     cli_proc_result r;
+    /* The old key goes first: until the new image is complete and its key
+     * written, neither the old nor a half-made image passes as this one. */
+    unlink(cfg_path);
     int started = cli_run(b.argv, timeout_s, log, log, &r) == 0;
     args_free(&b);
-    if (!started || r.timed_out || r.signaled || r.exit_code != 0) {
+    if (!started || !cli_proc_ok(&r)) {
         char d[700];
         cli_proc_describe(&r, d, sizeof d);
         snprintf(why, why_size, "reference for %s: %s", scene, d);

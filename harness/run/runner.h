@@ -37,8 +37,17 @@ typedef struct run_spec {
     const char *const *frame_ref_full, *const *frame_ref_matched, *const *frame_ref_alt;
 } run_spec;
 
-/* Runs (or resumes) a run; never fails as a whole: failures are records
- * with status "failed" and the child's own message. Caller owns the result. */
+/* How runner_execute treats a result already in the run's directory. */
+enum {
+    RUNNER_FRESH = 0,       /* run again whatever is there */
+    RUNNER_RESUME = 1,      /* keep a result of the same configuration, failed or not */
+    RUNNER_RETRY_FAILED = 2 /* keep an "ok" result, run a failed one again */
+};
+/* Runs (or resumes, per `resume`, a RUNNER_* mode) a run; never fails as a
+ * whole: failures are records with status "failed" and the child's own
+ * message (cli_reason_external tells which look external). A run whose
+ * image holds NaN or infinite pixels has failed ("non-finite output: N of
+ * M pixels are NaN or infinite"). Caller owns the result. */
 json_object *runner_execute(const run_spec *spec, int resume);
 /* Collect-only mode (on: 1), for gibench study --slurm, whose cells run
  * elsewhere: runner_execute runs nothing and writes nothing, returning the

@@ -119,7 +119,7 @@ static int lock_out_dir(const char *out, int *rc)
 typedef struct study_args {
     const char *file, *out;
     unsigned long jobs;
-    int fresh, dry;
+    int fresh, dry, retry_failed;
     slurm_options so;
 } study_args;
 
@@ -143,6 +143,8 @@ static int parse_args(int argc, char **argv, study_args *a)
             a->fresh = 0;
         else if (!strcmp(argv[i], "--fresh"))
             a->fresh = 1;
+        else if (!strcmp(argv[i], "--retry-failed"))
+            a->retry_failed = 1;
         else if (!strcmp(argv[i], "--dry-run"))
             a->dry = 1;
         else if (argv[i][0] == '-')
@@ -155,8 +157,8 @@ static int parse_args(int argc, char **argv, study_args *a)
     if (!a->file || (!a->out && !a->dry))
         return cli_fail(
             EXIT_USAGE,
-            "study: usage: gibench study STUDY.json --out DIR [--jobs N] [--resume|--fresh] "
-            "[--dry-run] "
+            "study: usage: gibench study STUDY.json --out DIR [--jobs N] "
+            "[--resume|--fresh|--retry-failed] [--dry-run] "
             "[--slurm [--partition P] [--gres G] [--time T] [--array-limit K] [--no-wait]]");
     if (!a->out)
         a->out = ".";
@@ -167,6 +169,12 @@ static int parse_args(int argc, char **argv, study_args *a)
     if (a->fresh && (a->so.enabled || a->so.cell || a->so.collect))
         return cli_fail(EXIT_USAGE,
                         "study: --fresh does not go with --slurm (remove the results to redo)");
+    if (a->retry_failed && a->fresh)
+        return cli_fail(EXIT_USAGE, "study: --retry-failed does not go with --fresh (which "
+                                    "redoes every run)");
+    if (a->retry_failed && (a->so.enabled || a->so.cell || a->so.collect))
+        return cli_fail(EXIT_USAGE, "study: --retry-failed does not go with --slurm (remove the "
+                                    "failed runs' result.json to redo them)");
     return EXIT_OK;
 }
 
@@ -218,8 +226,12 @@ static int run_here(study *st, const study_args *a, gi_plugins *reg, int argc, c
     if (a->so.collect)
         study_slurm_collect_runs(st, reg, a->out, a->so.collect);
     else
-        study_execute_runs(st, (uint32_t)a->jobs, a->fresh, reg);
-    return study_write_report(st, a->out, argc, argv);
+        study_execute_runs(st, (uint32_t)a->jobs,
+                           a->fresh          ? RUNNER_FRESH
+                           : a->retry_failed ? RUNNER_RETRY_FAILED
+                                             : RUNNER_RESUME,
+                           reg);
+    return study_write_report(st, a->out, argc, argv, a->so.collect != NULL);
 }
 
 int cmd_study(int argc, char **argv)

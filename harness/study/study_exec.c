@@ -70,7 +70,7 @@ static void report_run(run_progress *p, const study *st, uint32_t i, json_object
 
 /* Runs every run not yet done: `jobs` worker processes, each taking runs
  * i, i+jobs, ...; results land in each run's result.json. */
-void study_execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg)
+void study_execute_runs(study *st, uint32_t jobs, int mode, gi_plugins *reg)
 {
     for (uint32_t i = 0; i < st->run_count; i++)
         study_attach_refs(st, &st->runs[i]);
@@ -80,7 +80,8 @@ void study_execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg)
         run_progress p = {gi_now(), 0, 0, st->run_count};
         for (uint32_t i = 0; i < st->run_count; i++) {
             double t0 = gi_now();
-            st->runs[i].record = study_run_or_skip(&st->runs[i], reg, !fresh || cli_interrupted);
+            st->runs[i].record =
+                study_run_or_skip(&st->runs[i], reg, cli_interrupted ? RUNNER_RESUME : mode);
             if (!cli_interrupted)
                 report_run(&p, st, i, st->runs[i].record, gi_now() - t0, "");
             else
@@ -97,7 +98,7 @@ void study_execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg)
             snprintf(who, sizeof who, "worker %u ", j);
             for (uint32_t i = j; i < st->run_count && !cli_interrupted; i += jobs) {
                 double t0 = gi_now();
-                json_object *rec = study_run_or_skip(&st->runs[i], reg, !fresh);
+                json_object *rec = study_run_or_skip(&st->runs[i], reg, mode);
                 if (!cli_interrupted)
                     report_run(&p, st, i, rec, gi_now() - t0, who);
                 json_object_put(rec);
@@ -123,7 +124,7 @@ void study_execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg)
     free(pids);
     /* collect: every worker wrote result.json; resume picks them up */
     for (uint32_t i = 0; i < st->run_count; i++) {
-        st->runs[i].record = study_run_or_skip(&st->runs[i], reg, 1);
+        st->runs[i].record = study_run_or_skip(&st->runs[i], reg, RUNNER_RESUME);
         json_object_object_del(st->runs[i].record, "cached");
     }
 }

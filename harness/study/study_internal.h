@@ -135,7 +135,8 @@ void study_reference_sets(study *st, json_object *meta);
 /* ---- execution (study_exec.c) ---- */
 
 json_object *study_run_or_skip(study_run *r, gi_plugins *reg, int resume);
-void study_execute_runs(study *st, uint32_t jobs, int fresh, gi_plugins *reg);
+/* mode: RUNNER_FRESH (--fresh), RUNNER_RESUME, RUNNER_RETRY_FAILED (--retry-failed). */
+void study_execute_runs(study *st, uint32_t jobs, int mode, gi_plugins *reg);
 
 /* ---- the report's charts and tables (study_charts.c, study_anim.c) ---- */
 
@@ -149,8 +150,10 @@ void study_animation_report(study *st, const char *out_dir, json_object *meta,
 
 /* Writes out/report.md, index.html and the CSV files from the runs'
  * records. EXIT_OK, or EXIT_RUN after printing why (also when the study
- * was interrupted). */
-int study_write_report(study *st, const char *out, int argc, char **argv);
+ * was interrupted, and when a run failed, unless `slurm_collect`: the
+ * collect job names the failed runs but ends completed, its report being
+ * its work). */
+int study_write_report(study *st, const char *out, int argc, char **argv, int slurm_collect);
 
 /* ---- gibench study --slurm (study_slurm.c) ---- */
 

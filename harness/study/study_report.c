@@ -6,6 +6,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "study_internal.h"
 
+#include "proc.h"
 #include "report.h"
 
 #include <stdio.h>
@@ -67,7 +68,35 @@ static json_object *meta_of_study(const study *st, int argc, char **argv, const 
     return meta;
 }
 
-int study_write_report(study *st, const char *out, int argc, char **argv)
+/* The failed runs, a line each (the first 20), saying which look external
+ * (killed by a signal from outside, a full disk, an I/O error: worth a
+ * retry), then the verdict: a study with failed runs exits 1. */
+static int report_failures(const study *st, int failed)
+{
+    int external = 0, listed = 0;
+    for (uint32_t i = 0; i < st->run_count; i++) {
+        json_object *v, *rec = st->runs[i].record;
+        if (!rec || !json_object_object_get_ex(rec, "status", &v) ||
+            strcmp(json_object_get_string(v), "failed"))
+            continue;
+        const char *why =
+            json_object_object_get_ex(rec, "reason", &v) ? json_object_get_string(v) : "";
+        int ext = cli_reason_external(why);
+        external += ext;
+        if (listed++ < 20)
+            fprintf(stderr, "study: failed%s: %s: %s\n", ext ? " (looks external)" : "",
+                    st->runs[i].id, why);
+    }
+    if (external)
+        return cli_fail(EXIT_RUN,
+                        "study: %d of %u runs failed, %d of them look external (killed, disk "
+                        "full, I/O error); --retry-failed redoes the failed runs",
+                        failed, st->run_count, external);
+    return cli_fail(EXIT_RUN, "study: %d of %u runs failed; --retry-failed redoes them", failed,
+                    st->run_count);
+}
+
+int study_write_report(study *st, const char *out, int argc, char **argv, int slurm_collect)
 {
     int rc = EXIT_OK;
     add_scene_sizes(st);
@@ -93,6 +122,8 @@ int study_write_report(study *st, const char *out, int argc, char **argv)
         rc = cli_fail(EXIT_RUN,
                       "study: interrupted (%d runs to redo); rerun the same command to resume",
                       interrupted);
+    else if (rc == EXIT_OK && failed && report_failures(st, failed) != EXIT_OK && !slurm_collect)
+        rc = EXIT_RUN;
     json_object_put(runs);
     json_object_put(meta);
     return rc;

@@ -229,11 +229,16 @@ static int cache_load(csm *c, const char *name, uint32_t M, uint32_t N, gi_csm_d
     if (!*path)
         return 0;
     size_t size = 0;
-    void *bytes = gi_file_read_all(*path, &size);
-    if (!bytes)
-        return 0;
+    void *bytes = NULL;
     gi_error err;
     int hit = 0;
+    /* the entry's header names what it was made for (gi_cache_load) */
+    if (gi_cache_load(*path, &bytes, &size, &err) != GI_OK) {
+        host->log(host, GI_LOG_WARN, "%s: unusable cache file (%s); recomputing", *path, err.text);
+        return 0;
+    }
+    if (!bytes)
+        return 0;
     if (gi_csm_data_read(bytes, size, data, &err) == GI_OK && data->M == M && data->N == N)
         hit = 1;
     else {
@@ -253,7 +258,7 @@ static void cache_store(csm *c, const char *path, const gi_csm_data *data)
     void *bytes = NULL;
     size_t size = 0;
     if (gi_csm_data_write(data, &bytes, &size, &err) != GI_OK ||
-        gi_file_write_atomic(path, bytes, size, &err) != GI_OK)
+        gi_cache_store(path, bytes, size, &err) != GI_OK)
         c->kit.host->log(c->kit.host, GI_LOG_WARN, "csm: not cached: %s", err.text);
     free(bytes);
 }

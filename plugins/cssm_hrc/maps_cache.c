@@ -39,7 +39,15 @@ static void cache_name(const cssm_hrc *c, const gi_gpu_scene *gs, char *name, si
 static int cache_load(cssm_hrc *c, const char *path)
 {
     size_t size = 0;
-    unsigned char *bytes = gi_file_read_all(path, &size);
+    void *data = NULL;
+    gi_error lerr;
+    /* the entry's header names what it was made for (gi_cache_load) */
+    if (gi_cache_load(path, &data, &size, &lerr) != GI_OK) {
+        c->kit.host->log(c->kit.host, GI_LOG_WARN, "%s: unusable cache file (%s); recomputing",
+                         path, lerr.text);
+        return 0;
+    }
+    unsigned char *bytes = data;
     if (!bytes)
         return 0;
     int ok = size >= 16 && !memcmp(bytes, cache_magic, 8);
@@ -90,7 +98,7 @@ static void cache_store(cssm_hrc *c, const char *path)
             memcpy(buf + at + 8, part[f], sz[f]);
             at += 8 + sz[f];
         }
-        if (gi_file_write_atomic(path, buf, total, &err) != GI_OK)
+        if (gi_cache_store(path, buf, total, &err) != GI_OK)
             ok = 0;
     }
     if (!ok || !buf)

@@ -91,7 +91,9 @@ run(2 compare --scene scenes/cornell_box_coarse.gltf --methods direct --param ot
 # study
 set(S ${OUT}/study)
 file(REMOVE_RECURSE ${S})
-run(0 study tests/data/studies/tiny.json --out ${S})
+# a study with a failed run (fake_crash) exits 1, after writing its report
+run(1 study tests/data/studies/tiny.json --out ${S})
+match("${last_err}" "gibench: study: 1 of 4 runs failed" "the failed run is not the verdict:\n${last_err}")
 file(READ ${S}/runs.csv csv)
 match_count("${csv}" "\n[^\n]+" 4 "tiny study: runs")
 match("${csv}" "light_samples=8" "sweep value missing")

@@ -28,6 +28,22 @@ char *gi_cache_path(const char *dir, const char *name);
 void *gi_file_read_all(const char *path, size_t *size);
 gi_result gi_file_write_atomic(const char *path, const void *data, size_t size, gi_error *err);
 
+/* Cache entries carry what they were made for. gi_cache_store writes
+ * `data` to `path` atomically behind a header: the magic "GICACHE\n", the
+ * header's version, the entry's own name (the last part of `path`, whose
+ * hex digits are the hash of everything the data depends on: scene
+ * content, method, the parameters that change the data, the data's format
+ * version), the payload's size and its XXH64. gi_cache_load reads it back
+ * and checks all of it against `path`: GI_OK with *data (malloc'd, yours
+ * to free) and *size when the entry is whole and was made under this very
+ * name; GI_OK with *data NULL when there is no file; else
+ * GI_ERR_INVALID_ARGUMENT and one line saying why (made for another entry:
+ * copied from another scene or other settings; truncated, padded or
+ * damaged; no header: written by an older gibench), for the caller to
+ * recompute with a warning. */
+gi_result gi_cache_store(const char *path, const void *data, size_t size, gi_error *err);
+gi_result gi_cache_load(const char *path, void **data, size_t *size, gi_error *err);
+
 /* Atomic replacement for writers that open the file by name themselves
  * (OpenImageIO, VTK). gi_atomic_begin creates an empty temporary file beside
  * `path`, named ".<stem>.tmp-<pid>-XXXXXX<ext>" so that the real extension

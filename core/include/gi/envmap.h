@@ -45,6 +45,13 @@ typedef struct gi_envmap {
 gi_envmap *gi_envmap_create(const float *rgba, uint32_t width, uint32_t height, float intensity,
                             float rotation_deg);
 void gi_envmap_free(gi_envmap *env);
+/* The texels of an RGBA image (rgba, row 0 = top) whose R, G or B is NaN
+ * or infinite, with the first one's column and row in *x, *y (when the
+ * count is not 0). A scene's loader refuses a map with any: one such texel
+ * turns every pixel that sees it, and every estimate that samples the map,
+ * into NaN, which the metrics would then leave out. */
+uint64_t gi_envmap_count_nonfinite(const float *rgba, uint32_t width, uint32_t height, uint32_t *x,
+                                   uint32_t *y);
 
 /* Direction <-> (u, v) in [0,1)^2, with the rotation applied. */
 void gi_envmap_dir_to_uv(const gi_envmap *env, gi_vec3 d, float *u, float *v);

@@ -1,0 +1,48 @@
+# Issue 32, item 6: a run killed from outside (SIGKILL, as the out-of-memory
+# killer sends) is a failed run that the summary calls external; a study
+# with failed runs exits 1; resuming keeps the failure, --retry-failed
+# redoes the failed run alone (the run that was ok stays cached).
+# cmake -DGIB=... -DROOT=... -DOUT=... -P study_retry_failed.cmake
+set(failures 0)
+include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
+set(D ${OUT}/study_retry_failed)
+file(REMOVE_RECURSE ${D})
+file(MAKE_DIRECTORY ${D})
+# a quick run, then one slow enough to be killed while it renders
+file(WRITE ${D}/s.json "{\"name\": \"retry\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
+  \"size\": [16, 16], \"frames\": 1, \"warmup\": 0, \"compare\": false,
+  \"methods\": [{\"method\": \"direct\", \"params\": {\"light_samples\": 2}},
+               {\"method\": \"direct\", \"params\": {\"light_samples\": 1}, \"frames\": 400}]}")
+set(S ${D}/out)
+# start the study, wait for the slow run's render, SIGKILL that render alone
+execute_process(COMMAND sh -c "\"$0\" study \"$2\" --out \"$1\" >\"$1.log\" 2>&1 & p=$!
+                               i=0; k=''
+                               while [ -z \"$k\" ] && [ $i -lt 600 ]; do sleep 0.05; i=$((i+1))
+                                 k=$(ps -eo pid=,args= | grep -F \"$1/runs/\" | grep -F -- '--frames 400' | grep -v grep | awk '{print $1}'); done
+                               kill -KILL $k; wait $p; echo $?"
+                        ${GIB} ${S} ${D}/s.json
+                WORKING_DIRECTORY ${ROOT} TIMEOUT 120 RESULT_VARIABLE rc OUTPUT_VARIABLE code)
+string(STRIP "${code}" code)
+file(READ ${S}.log log)
+if(NOT rc EQUAL 0 OR NOT code STREQUAL "1")
+    fail("the study with a killed run exited ${code} (expected 1):\n${log}")
+endif()
+match("${log}" "study: failed \\(looks external\\): [^\n]*: killed \\(signal 9" "the killed run is not called external:\n${log}")
+match("${log}" "gibench: study: 1 of 2 runs failed, 1 of them look external" "no verdict line:\n${log}")
+file(READ ${S}/runs.csv csv)
+match_count("${csv}" ",failed,killed \\(signal 9" 1 "killed runs in runs.csv")
+# resuming keeps the failure (and exits 1 again)
+run(1 study ${D}/s.json --out ${S})
+match("${last_err}" "\\[2/2\\] failed " "resuming did not keep the failed run:\n${last_err}")
+# --retry-failed redoes it, and only it
+run(0 study ${D}/s.json --out ${S} --retry-failed)
+match("${last_err}" "\\[1/2\\] cached " "--retry-failed redid a run that was ok:\n${last_err}")
+match("${last_err}" "\\[2/2\\] ran " "--retry-failed did not redo the failed run:\n${last_err}")
+file(READ ${S}/runs.csv csv)
+match_count("${csv}" ",ok," 2 "runs ok after --retry-failed")
+run(2 study ${D}/s.json --out ${S} --retry-failed --fresh)
+
+if(failures GREATER 0)
+    message(FATAL_ERROR "${failures} retry-failed expectation(s) failed")
+endif()
+message(STATUS "a killed run is an external failure; --retry-failed redoes it")
