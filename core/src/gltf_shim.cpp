@@ -125,6 +125,7 @@ struct Context {
     /* First refusal by a callback that tinygltf calls (its own text would not
      * say which JSON element it was). */
     std::string refused_pointer, refused;
+    uint64_t image_texels = 0; /* decoded so far, against GI_MAX_TEXTURE_TEXELS */
 };
 
 bool uri_scheme(const std::string &uri, std::string *scheme)
@@ -361,9 +362,11 @@ bool is_png_or_jpeg(const unsigned char *b, size_t n)
 }
 
 /* Decodes PNG/JPEG bytes into image->image (RGBA, 8 or 16 bits) after
- * checking the format and the size in the header. */
+ * checking the format and the size in the header, and the texels decoded so
+ * far (*texels, updated) against the scene's limit: one small PNG listed as
+ * many images must not decode into many GiB. */
 bool decode_image(tinygltf::Image *image, int index, const unsigned char *bytes, size_t size,
-                  std::string *why)
+                  uint64_t *texels, std::string *why)
 {
     int w = 0, h = 0, comp = 0;
     if (size > INT_MAX) {
@@ -380,6 +383,11 @@ bool decode_image(tinygltf::Image *image, int index, const unsigned char *bytes,
     }
     if (w < 1 || h < 1 || w > GI_MAX_TEXTURE_SIZE || h > GI_MAX_TEXTURE_SIZE) {
         *why = fmt("image size %dx%d outside 1..%d", w, h, GI_MAX_TEXTURE_SIZE);
+        return false;
+    }
+    *texels += static_cast<uint64_t>(w) * static_cast<uint64_t>(h);
+    if (*texels > GI_MAX_TEXTURE_TEXELS) {
+        *why = fmt("images exceed the limit of %u texels in all", GI_MAX_TEXTURE_TEXELS);
         return false;
     }
     std::string err, warn;
@@ -406,7 +414,8 @@ bool load_image_callback(tinygltf::Image *image, const int index, std::string *e
     if (image->bufferView >= 0)
         return true; /* decoded by the converter once the view's bounds are checked */
     std::string why;
-    if (size >= 0 && decode_image(image, index, bytes, static_cast<size_t>(size), &why))
+    if (size >= 0 &&
+        decode_image(image, index, bytes, static_cast<size_t>(size), &c.image_texels, &why))
         return true;
     if (c.refused.empty()) {
         c.refused_pointer = fmt("/images/%d", index);
@@ -818,6 +827,7 @@ class Converter
     std::vector<std::string> material_names;
     int default_material = -1;
     std::vector<TextureData> textures;
+    uint64_t texture_texels = 0;              /* in textures, against GI_MAX_TEXTURE_TEXELS */
     std::map<int, int> texture_of;            /* glTF texture -> textures index */
     std::vector<tinygltf::Image> view_images; /* decoded images stored in buffer views */
     std::vector<int> parents;
@@ -1106,7 +1116,7 @@ void Converter::check_images()
             tinygltf::Image &d = view_images[i];
             d.name = img.name;
             if (!decode_image(&d, static_cast<int>(i), b.data.data() + bv.byteOffset, bv.byteLength,
-                              &why))
+                              &c.image_texels, &why))
                 fail(p, why);
         } else if (img.image.empty()) {
             fail(p, "image data could not be read" +
@@ -1140,6 +1150,11 @@ void Converter::convert_texture(int index)
     td.name = !t.name.empty() ? t.name : !img->name.empty() ? img->name : img->uri;
     td.width = static_cast<uint32_t>(img->width);
     td.height = static_cast<uint32_t>(img->height);
+    texture_texels += static_cast<uint64_t>(td.width) * td.height;
+    if (texture_texels > GI_MAX_TEXTURE_TEXELS)
+        fail(fmt("/textures/%d", index),
+             fmt("textures exceed the limit of %u texels in all (1 GiB as float RGBA)",
+                 GI_MAX_TEXTURE_TEXELS));
     size_t n = static_cast<size_t>(td.width) * td.height * 4;
     td.rgba.resize(n);
     float lut[256];

@@ -6,14 +6,10 @@
 
 #include "gi/image.h"
 
-/* Largest image we allocate (4 floats a pixel => 4 GiB); anything bigger is
- * a corrupt header or a bug, not a render. */
-#define GI_IMAGE_MAX_PIXELS (1ull << 28)
-
 gi_image *gi_image_create(uint32_t width, uint32_t height)
 {
     uint64_t pixels = (uint64_t)width * height;
-    if (width == 0 || height == 0 || pixels > GI_IMAGE_MAX_PIXELS)
+    if (width == 0 || height == 0 || pixels > GI_MAX_IMAGE_ALLOC_PIXELS)
         return NULL;
     gi_image *img = malloc(sizeof *img);
     if (!img)

@@ -10,7 +10,9 @@
 #include <ImfOutputFile.h>
 #include <ImfPartType.h>
 #include <ImfStdIO.h>
+#include <ImfVersion.h>
 
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -58,9 +60,37 @@ gi_result gi_exr_write(const char *path, const gi_image *rgba, const gi_image *c
     });
 }
 
+/* The first header's windows and channel count checked against the limits
+ * of gi/limits.h before the library opens the file (the display window
+ * only places the data, gi_channels_place): Imf::InputFile sizes
+ * its line buffers from the header, so a 600-byte file declaring
+ * 8,000,000 x 32 pixels cost gigabytes before any check of ours ran. A
+ * header the library cannot parse is left to it (its message says why). */
+static gi_result check_exr_header(const char *path, gi_error *err)
+{
+    std::ifstream f(path, std::ios::binary);
+    char mv[8];
+    if (!f.read(mv, sizeof mv) || !Imf::isImfMagic(mv))
+        return GI_OK;
+    int version = (int)((unsigned char)mv[4] | (unsigned char)mv[5] << 8 |
+                        (unsigned char)mv[6] << 16 | (unsigned)(unsigned char)mv[7] << 24);
+    Imf::StdIFStream is(f, path);
+    Imf::Header h;
+    h.readFrom(is, version);
+    const Imath::Box2i dw = h.dataWindow();
+    int nc = 0;
+    for (Imf::ChannelList::ConstIterator it = h.channels().begin(); it != h.channels().end(); ++it)
+        nc++;
+    return gi_channels_check(path, (int64_t)dw.max.x - dw.min.x + 1,
+                             (int64_t)dw.max.y - dw.min.y + 1, nc, err);
+}
+
 gi_result gi_exr_read_channels(const char *path, gi_channels *out, gi_error *err)
 {
     return guarded_read(path, "OpenEXR", out, err, [&]() -> gi_result {
+        gi_result checked = check_exr_header(path, err);
+        if (checked != GI_OK)
+            return checked;
         Imf::InputFile file(path, 1);
         const Imf::Header &h = file.header();
         if (h.hasType() && Imf::isDeepData(h.type()))

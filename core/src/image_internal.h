@@ -13,9 +13,6 @@
 extern "C" {
 #endif
 
-/* Same bound as gi_image_create (image.c). */
-#define GI_IMAGE_FILE_MAX_PIXELS (1ull << 28)
-
 typedef struct gi_channels {
     uint32_t width, height;
     int count;
@@ -26,9 +23,11 @@ typedef struct gi_channels {
 /* Frees what the names and data hold (free()), zeroes the struct. */
 void gi_channels_release(gi_channels *c);
 
-/* The readers' size check before decoding (image_io.c): GI_OK for w x h
- * pixels (1 .. GI_IMAGE_FILE_MAX_PIXELS) of nc channels (1 .. 1024), else
- * GI_ERR_INVALID_ARGUMENT "<path>: unsupported image size ...". */
+/* The readers' size check before decoding (image_io.c), against the limits
+ * of gi/limits.h: GI_OK for a data window of w x h pixels of nc channels
+ * (1 .. GI_MAX_IMAGE_FILE_CHANNELS) within GI_MAX_IMAGE_FILE_PIXELS and
+ * GI_MAX_IMAGE_FILE_VALUES, else GI_ERR_INVALID_ARGUMENT "<path>: image
+ * size WxH with N channels exceeds the limit of ...". */
 gi_result gi_channels_check(const char *path, int64_t w, int64_t h, int nc, gi_error *err);
 
 /* Where a file's data window lies in its display window (both in the
@@ -42,7 +41,7 @@ typedef struct gi_channels_window {
  * holds w x h pixels of nc floats, row 0 at the top; names[c] is channel
  * c's name (NULL: ""). The pixels are placed inside the display window,
  * zeros around them, or make the image alone when the display window is
- * absurd (empty or over GI_IMAGE_FILE_MAX_PIXELS). GI_ERR_OUT_OF_MEMORY
+ * absurd (empty or over GI_MAX_IMAGE_FILE_PIXELS). GI_ERR_OUT_OF_MEMORY
  * leaves what was allocated in `out` for gi_channels_release. */
 gi_result gi_channels_place(const char *path, const float *buf, int64_t w, int64_t h, int nc,
                             const char *const *names, const gi_channels_window *win,

@@ -40,11 +40,18 @@ void gi_channels_release(gi_channels *c)
 
 gi_result gi_channels_check(const char *path, int64_t w, int64_t h, int nc, gi_error *err)
 {
-    if (w <= 0 || h <= 0 || nc <= 0 || nc > 1024 ||
-        (uint64_t)w * (uint64_t)h > GI_IMAGE_FILE_MAX_PIXELS)
+    if (w <= 0 || h <= 0 || nc <= 0 || nc > GI_MAX_IMAGE_FILE_CHANNELS)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                            "%s: unsupported image size %lldx%lld with %d channels", path,
-                            (long long)w, (long long)h, nc);
+                            "%s: unsupported image size %lldx%lld with %d channels (1..%d)", path,
+                            (long long)w, (long long)h, nc, GI_MAX_IMAGE_FILE_CHANNELS);
+    const uint64_t pixels = (uint64_t)w * (uint64_t)h;
+    if (pixels > GI_MAX_IMAGE_FILE_PIXELS || pixels * (uint64_t)nc > GI_MAX_IMAGE_FILE_VALUES)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "%s: image size %lldx%lld with %d channels exceeds the limit of %llu "
+                            "pixels and %llu values (pixels x channels)",
+                            path, (long long)w, (long long)h, nc,
+                            (unsigned long long)GI_MAX_IMAGE_FILE_PIXELS,
+                            (unsigned long long)GI_MAX_IMAGE_FILE_VALUES);
     return GI_OK;
 }
 
@@ -52,8 +59,10 @@ gi_result gi_channels_place(const char *path, const float *buf, int64_t w, int64
                             const char *const *names, const gi_channels_window *win,
                             gi_channels *out, gi_error *err)
 {
-    const int use_full = win->full_w > 0 && win->full_h > 0 &&
-                         (uint64_t)win->full_w * (uint64_t)win->full_h <= GI_IMAGE_FILE_MAX_PIXELS;
+    const int use_full =
+        win->full_w > 0 && win->full_h > 0 &&
+        (uint64_t)win->full_w * (uint64_t)win->full_h <= GI_MAX_IMAGE_FILE_PIXELS &&
+        (uint64_t)win->full_w * (uint64_t)win->full_h * (uint64_t)nc <= GI_MAX_IMAGE_FILE_VALUES;
     const int64_t fw = use_full ? win->full_w : w, fh = use_full ? win->full_h : h;
     const int64_t ox = use_full ? win->x - win->full_x : 0,
                   oy = use_full ? win->y - win->full_y : 0;
@@ -88,7 +97,7 @@ gi_result gi_channels_place(const char *path, const float *buf, int64_t w, int64
 static int image_ok(const gi_image *img)
 {
     return img && img->rgba && img->width > 0 && img->height > 0 &&
-           (uint64_t)img->width * img->height <= GI_IMAGE_FILE_MAX_PIXELS;
+           (uint64_t)img->width * img->height <= GI_MAX_IMAGE_ALLOC_PIXELS;
 }
 
 /* The extension of the last path component including the dot, or "" (a

@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -393,12 +394,26 @@ typedef struct path_list {
     size_t n;
 } path_list;
 
-/* Appends the folder's plugin files to `list`, sorted by name. */
-static void scan_dir(path_list *list, const char *dir)
+/* Appends the folder's plugin files to `list`, sorted by name. A folder
+ * that anyone may write to is refused whole (anyone could place code that
+ * every gibench process then runs); an entry that is not a regular file
+ * (a FIFO, a device, a folder) is refused without being opened: dlopen of
+ * a FIFO blocks until the probe's time limit. Both land in reg->errors. */
+static void scan_dir(gi_plugins *reg, path_list *list, const char *dir)
 {
     DIR *d = opendir(dir);
     if (!d)
         return;
+    struct stat st;
+    char why[4400]; /* a path and its reason */
+    if (fstat(dirfd(d), &st) == 0 && (st.st_mode & S_IWOTH)) {
+        snprintf(why, sizeof why,
+                 "%s: folder is world-writable: its plugins are not loaded (chmod o-w %s)", dir,
+                 dir);
+        push_error(reg, why);
+        closedir(d);
+        return;
+    }
     char **names = NULL;
     size_t n = 0;
     struct dirent *e;
@@ -407,6 +422,12 @@ static void scan_dir(path_list *list, const char *dir)
         if (strncmp(e->d_name, "gimethod_", 9) != 0 || len < 12 ||
             strcmp(e->d_name + len - 3, ".so") != 0)
             continue;
+        if (fstatat(dirfd(d), e->d_name, &st, 0) != 0 || !S_ISREG(st.st_mode)) {
+            snprintf(why, sizeof why, "%s/%s: not a regular file (skipped unopened)", dir,
+                     e->d_name);
+            push_error(reg, why);
+            continue;
+        }
         char **grown = realloc(names, (n + 1) * sizeof *names);
         if (!grown)
             break;
@@ -443,14 +464,14 @@ gi_plugins *gi_plugins_scan(const char *build_dir)
         return NULL;
     path_list list = {NULL, 0};
     if (build_dir)
-        scan_dir(&list, build_dir);
+        scan_dir(reg, &list, build_dir);
     const char *env = getenv("GIBENCH_PLUGIN_PATH");
     if (env) {
         char *copy = dup_str(env), *save = NULL;
         for (char *tok = copy ? strtok_r(copy, ":", &save) : NULL; tok;
              tok = strtok_r(NULL, ":", &save))
             if (*tok && (!build_dir || strcmp(tok, build_dir) != 0))
-                scan_dir(&list, tok);
+                scan_dir(reg, &list, tok);
         free(copy);
     }
     /* every plugin is tried in a child first; only those it found valid

@@ -90,6 +90,15 @@ gi_timer_mode gi_timer_mode_for(int gl_is_software)
     return gl_is_software ? GI_TIMER_CPU_FINISH : GI_TIMER_GL_QUERY;
 }
 
+gi_result gi_timer_env_check(gi_error *err)
+{
+    const char *env = getenv("GIBENCH_TIMER");
+    if (!env || !*env || !strcmp(env, "query") || !strcmp(env, "finish") || !strcmp(env, "cputime"))
+        return GI_OK;
+    return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                        "GIBENCH_TIMER='%.64s' is not a timer mode: query, finish or cputime", env);
+}
+
 gi_timer *gi_timer_create(gi_timer_mode mode, uint32_t warmup)
 {
     gi_timer *t = calloc(1, sizeof *t);

@@ -138,16 +138,35 @@ int cli_parse_size(const char *s, uint32_t *w, uint32_t *h)
     memcpy(buf, s, n);
     buf[n] = '\0';
     unsigned long a, b;
-    if (!cli_parse_uint(buf, 1, 16384, &a) || !cli_parse_uint(x + 1, 1, 16384, &b))
+    if (!cli_parse_uint(buf, 1, GI_MAX_IMAGE_SIDE, &a) ||
+        !cli_parse_uint(x + 1, 1, GI_MAX_IMAGE_SIDE, &b) || !gi_image_size_ok(a, b))
         return 0;
     *w = (uint32_t)a;
     *h = (uint32_t)b;
     return 1;
 }
 
+const char *cli_plugin_dir(void)
+{
+    const char *dir = getenv("GIBENCH_PLUGIN_DIR");
+    return !dir ? GIBENCH_PLUGIN_DIR : *dir ? dir : NULL;
+}
+
 gi_plugins *cli_load_plugins(int quiet)
 {
-    gi_plugins *reg = gi_plugins_scan(GIBENCH_PLUGIN_DIR);
+    /* A plugin's constructors run at dlopen, and what they print must not
+     * land in our stdout (methods --json, diff --json): while the plugins
+     * load, stdout is a copy of stderr. */
+    fflush(stdout);
+    int saved = dup(STDOUT_FILENO);
+    if (saved >= 0)
+        dup2(STDERR_FILENO, STDOUT_FILENO);
+    gi_plugins *reg = gi_plugins_scan(cli_plugin_dir());
+    if (saved >= 0) {
+        fflush(stdout);
+        dup2(saved, STDOUT_FILENO);
+        close(saved);
+    }
     if (reg && !quiet)
         for (uint32_t i = 0; i < reg->error_count; i++)
             fprintf(stderr, "gibench: warning: plugin refused: %s\n", reg->errors[i]);

@@ -3,6 +3,7 @@
 #ifndef GIBENCH_CLI_H
 #define GIBENCH_CLI_H
 
+#include "gi/limits.h"
 #include "gi/method.h"
 #include "gi/plugin.h"
 #include "gi/timer.h"
@@ -21,7 +22,8 @@ int cli_fail(int code, const char *fmt, ...)
 #endif
     ;
 
-/* Parses "WxH" into positive sizes (<= 16384); 0 on malformed text. */
+/* Parses "WxH" into a size that keeps gi/limits.h's GI_IMAGE_SIZE_RULE; 0
+ * on malformed text or a size beyond it. */
 int cli_parse_size(const char *s, uint32_t *w, uint32_t *h);
 /* The file name of frame `index` from a printf-style PATTERN with exactly
  * one %d, %Nd or %0Nd (N < 10) and %% for a percent sign (render
@@ -43,9 +45,21 @@ int cli_add_out(const char *cmd, const char **outs, int *count, int max, const c
 int cli_mkdirs(const char *path);
 /* Reads a JSON file (NULL if absent or malformed). */
 json_object *cli_read_json(const char *path);
+/* Reads a JSON file a user wrote (a study, a saved view) strictly
+ * (json_strict.c): a regular file of at most GI_MAX_JSON_BYTES, strict
+ * JSON (no trailing comma, comment or text after the value), no object
+ * giving a key twice, keys compared unescaped ("fr\u0061mes" is
+ * "frames"). NULL with the one-line reason in `why` ("FILE: /json/path:
+ * key given twice (line N)", "FILE: line N: not valid JSON: ..."). */
+json_object *cli_read_json_strict(const char *path, char *why, size_t why_size);
 
-/* The plugin registry of this build plus $GIBENCH_PLUGIN_PATH; loader
- * refusals are printed as warnings. */
+/* The folder of the build's own plugins: $GIBENCH_PLUGIN_DIR when set
+ * (empty: none), else the folder compiled in (GIBENCH_PLUGIN_DIR); NULL
+ * for none. */
+const char *cli_plugin_dir(void);
+/* The plugin registry of cli_plugin_dir() plus $GIBENCH_PLUGIN_PATH; loader
+ * refusals are printed as warnings. Whatever plugins print while they load
+ * goes to stderr. */
 gi_plugins *cli_load_plugins(int quiet);
 /* The caps as a list of words ("direct area-lights ..."). */
 void cli_caps_string(uint32_t caps, char *buf, size_t size);

@@ -90,7 +90,7 @@ int cmd_methods(int argc, char **argv)
     } else {
         if (reg->count == 0)
             printf("no method plugins found (build directory %s, GIBENCH_PLUGIN_PATH)\n",
-                   GIBENCH_PLUGIN_DIR);
+                   cli_plugin_dir() ? cli_plugin_dir() : "none");
         for (uint32_t i = 0; i < reg->count; i++) {
             const gi_method *m = reg->items[i].method;
             char caps[256];

@@ -90,7 +90,8 @@ static int parse_opt(ref_opts *o, const char *a, const char *v)
             return EXIT_USAGE;
     } else if (!strcmp(a, "--size")) {
         if (!cli_parse_size(v, &o->width, &o->height))
-            return cli_fail(EXIT_USAGE, "reference: --size '%s' is not WxH with 1..16384 each", v);
+            return cli_fail(EXIT_USAGE,
+                            "reference: --size '%s' is not WxH with " GI_IMAGE_SIZE_RULE, v);
     } else if (!strcmp(a, "--spp")) {
         if (!cli_parse_uint(v, 1, 0xFFFFFFFFul, &u))
             return cli_fail(EXIT_USAGE, "reference: --spp '%s' is not an integer in 1..4294967295",

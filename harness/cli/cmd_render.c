@@ -181,7 +181,8 @@ static int parse_opt(render_opts *o, const char *a, const char *v)
             return EXIT_USAGE;
     } else if (!strcmp(a, "--size")) {
         if (!cli_parse_size(v, &o->width, &o->height))
-            return cli_fail(EXIT_USAGE, "render: --size '%s' is not WxH with 1..16384 each", v);
+            return cli_fail(EXIT_USAGE, "render: --size '%s' is not WxH with " GI_IMAGE_SIZE_RULE,
+                            v);
         o->given_size = 1;
     } else if (!strcmp(a, "--param")) {
         if (o->param_count == MAX_PARAMS)

@@ -115,6 +115,10 @@ int main(int argc, char **argv)
             return cli_fail(EXIT_USAGE, "unknown command '%s' (see gibench --help)", cmd);
         return EXIT_OK;
     }
+    /* every command times or passes the mode to its children */
+    gi_error terr;
+    if (gi_timer_env_check(&terr) != GI_OK)
+        return cli_fail(EXIT_USAGE, "%s", terr.text);
     if (!strcmp(cmd, "methods"))
         return cmd_methods(sub_argc, sub_argv);
     if (!strcmp(cmd, "info"))

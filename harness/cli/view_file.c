@@ -229,9 +229,11 @@ static int get_str(json_object *o, const char *key, char *out, size_t size)
 int view_file_read(const char *path, view_file *v, char *why, size_t why_size)
 {
     memset(v, 0, sizeof *v);
-    json_object *j = cli_read_json(path);
-    if (!j || !json_object_is_type(j, json_type_object)) {
-        snprintf(why, why_size, "%s: not a readable JSON view file", path);
+    json_object *j = cli_read_json_strict(path, why, why_size);
+    if (!j)
+        return 0;
+    if (!json_object_is_type(j, json_type_object)) {
+        snprintf(why, why_size, "%s: not a JSON view file (an object)", path);
         json_object_put(j);
         return 0;
     }
@@ -244,10 +246,11 @@ int view_file_read(const char *path, view_file *v, char *why, size_t why_size)
         bad = "scene";
     else if (!get_str(j, "method", v->method, sizeof v->method))
         bad = "method";
-    else if (!get_num(j, "width", 1, 16384, &d) || (v->width = (uint32_t)d) != d)
-        bad = "width (1..16384)";
-    else if (!get_num(j, "height", 1, 16384, &d) || (v->height = (uint32_t)d) != d)
-        bad = "height (1..16384)";
+    else if (!get_num(j, "width", 1, GI_MAX_IMAGE_SIDE, &d) || (v->width = (uint32_t)d) != d)
+        bad = "width (" GI_IMAGE_SIZE_RULE ")";
+    else if (!get_num(j, "height", 1, GI_MAX_IMAGE_SIDE, &d) || (v->height = (uint32_t)d) != d ||
+             !gi_image_size_ok(v->width, v->height))
+        bad = "height (" GI_IMAGE_SIZE_RULE ")";
     else if (!get_num(j, "frames", 1, 1000000, &d) || (v->frames = (uint32_t)d) != d)
         bad = "frames (1..1000000)";
     else if (!get_num(j, "seed", 0, 4294967295.0, &d) || (v->seed = (uint32_t)d) != d)

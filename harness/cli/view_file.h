@@ -43,7 +43,7 @@ int view_file_set_params(view_file *v, const char *canonical);
 gi_camera_frame view_file_camera(const view_file *v);
 /* Writes the view as JSON; 1 on success, else 0 with why. */
 int view_file_write(const char *path, const view_file *v, char *why, size_t why_size);
-/* Reads and checks a view (finite camera, sizes 1..16384, known keys);
+/* Reads and checks a view (finite camera, sizes gi_image_size_ok, known keys);
  * 1 on success, else 0 with a one-line why. Free with view_file_free. */
 int view_file_read(const char *path, view_file *v, char *why, size_t why_size);
 void view_file_free(view_file *v);

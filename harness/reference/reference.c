@@ -7,6 +7,7 @@
  * own stream gi_rng_init(pixel, sample, seed). The sums after N samples are
  * thus the same bits for any thread count and any split into passes. */
 #define _POSIX_C_SOURCE 200809L
+#include "gi/limits.h"
 #include "ref_internal.h"
 
 #include "gi/timer.h"
@@ -81,9 +82,10 @@ gi_result gi_ref_create(const gi_ref_desc *d, gi_ref **out, gi_error *err)
     *out = NULL;
     if (!d->scene)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "reference: no scene");
-    if (d->width < 1 || d->height < 1 || d->width > 16384 || d->height > 16384)
+    if (!gi_image_size_ok(d->width, d->height))
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                            "reference: size %ux%u is not 1..16384 each", d->width, d->height);
+                            "reference: size %ux%u is not " GI_IMAGE_SIZE_RULE, d->width,
+                            d->height);
     if (d->max_bounces < GI_REF_UNLIMITED)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
                             "reference: max_bounces %d is below -1 (unlimited)", d->max_bounces);

@@ -75,7 +75,7 @@ typedef struct gi_ref_desc {
      * a free camera, e.g. gibench view's orbit camera or a saved view. */
     const gi_camera_frame *camera_frame;
     float time;             /* scene time t: object, light and camera placement */
-    uint32_t width, height; /* required, 1..16384 each */
+    uint32_t width, height; /* required, gi_image_size_ok (gi/limits.h) */
     uint32_t seed;
     /* Scattering events a path may have: 0 = emitters and the environment
      * seen directly, 1 = plus direct light at the first hit, k = up to k

@@ -5,6 +5,65 @@
 
 #include <string.h>
 
+/* Names from users (the study's title, scene and run names, parameters,
+ * failure reasons) as report.md text that shows them as written: HTML's
+ * specials become entities, so a name cannot put markup (a <script>, an
+ * <img onerror=...>) into report.md or the page a viewer makes of it; '|'
+ * is escaped in table cells and line breaks become spaces. */
+static void md_text(text *t, const char *s)
+{
+    for (; *s; s++) {
+        if (*s == '<')
+            put(t, "&lt;");
+        else if (*s == '>')
+            put(t, "&gt;");
+        else if (*s == '&')
+            put(t, "&amp;");
+        else if (*s == '|')
+            put(t, "\\|");
+        else
+            put(t, "%c", *s == '\n' || *s == '\r' ? ' ' : *s);
+    }
+}
+
+/* The same inside a code span (`...`), where HTML is not read: a backtick
+ * would end the span, so it is shown as a quote. */
+static void md_code(text *t, const char *s)
+{
+    put(t, "`");
+    for (; *s; s++) {
+        if (*s == '|')
+            put(t, "\\|");
+        else
+            put(t, "%c", *s == '`' ? '\'' : *s == '\n' || *s == '\r' ? ' ' : *s);
+    }
+    put(t, "`");
+}
+
+/* A file name as a link target: anything but [A-Za-z0-9._~/-] as %XX, so
+ * that a name cannot close the link or open markup. */
+static void md_url(text *t, const char *s)
+{
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+            strchr("._~/-", c))
+            put(t, "%c", c);
+        else
+            put(t, "%%%02X", c);
+    }
+}
+
+/* ![alt](file) with both escaped. */
+static void md_image(text *t, const char *alt, const char *file)
+{
+    put(t, "![");
+    md_text(t, alt);
+    put(t, "](");
+    md_url(t, file);
+    put(t, ")");
+}
+
 static void md_num(text *t, double v)
 {
     if (v == v)
@@ -13,14 +72,62 @@ static void md_num(text *t, double v)
         put(t, " – |");
 }
 
+/* The title and the list of what the report was made with. */
+static void md_header(text *t, json_object *meta)
+{
+    static const char *const head[][2] = {{"- GL renderer: ", "renderer"},
+                                          {"- reference: ", "reference"},
+                                          {"- machine: ", "machine"},
+                                          {"- date: ", "date"}};
+    put(t, "# ");
+    md_text(t, report_str(meta, "title"));
+    put(t, "\n\n- command: ");
+    md_code(t, report_str(meta, "command"));
+    put(t, "\n");
+    for (size_t k = 0; k < sizeof head / sizeof head[0]; k++) {
+        put(t, "%s", head[k][0]);
+        md_text(t, report_str(meta, head[k][1]));
+        put(t, "\n");
+    }
+    put(t, "\n");
+}
+
+/* The reference and each run's image and error map, as links. */
+static void md_images(text *t, const char *dir, json_object *runs, json_object *meta)
+{
+    size_t count = json_object_array_length(runs);
+    put(t, "\nImages (tonemapped at the report's exposure) and relative error against the full "
+           "reference "
+           "(log scale, colour bar in each map):\n\n");
+    const char *ref_png = report_str(meta, "reference_png");
+    if (report_exists_in(dir, ref_png)) {
+        put(t, "reference: ");
+        md_image(t, "reference", ref_png);
+        put(t, "\n\n");
+    }
+    for (size_t i = 0; i < count; i++) {
+        json_object *o = json_object_array_get_idx(runs, i);
+        int png = report_exists_in(dir, report_str(o, "png")),
+            heat = report_exists_in(dir, report_str(o, "heatmap"));
+        if (!png && !heat)
+            continue;
+        md_text(t, report_str(o, "run"));
+        put(t, ":");
+        if (png) {
+            put(t, " ");
+            md_image(t, report_str(o, "run"), report_str(o, "png"));
+        }
+        if (heat) {
+            put(t, " ");
+            md_image(t, "error", report_str(o, "heatmap"));
+        }
+        put(t, "\n\n");
+    }
+}
+
 void report_write_md(text *t, const char *dir, json_object *runs, json_object *meta)
 {
-    put(t, "# %s\n\n", report_str(meta, "title"));
-    put(t, "- command: `%s`\n", report_str(meta, "command"));
-    put(t, "- GL renderer: %s\n", report_str(meta, "renderer"));
-    put(t, "- reference: %s\n", report_str(meta, "reference"));
-    put(t, "- machine: %s\n", report_str(meta, "machine"));
-    put(t, "- date: %s\n\n", report_str(meta, "date"));
+    md_header(t, meta);
     put(t, "Errors are against the full-GI reference (\"full\") and against the reference limited "
            "to the "
            "method's own bounce count (\"matched\"), so that method error and missing light are "
@@ -36,9 +143,19 @@ void report_write_md(text *t, const char *dir, json_object *runs, json_object *m
     for (size_t i = 0; i < count; i++) {
         json_object *o = json_object_array_get_idx(runs, i);
         const char *status = report_str(o, "status");
-        put(t, "| %s | %s | `%s` | %s%s%s |", report_str(o, "run"), report_str(o, "method"),
-            report_str(o, "params"), status, strcmp(status, "ok") ? ": " : "",
-            strcmp(status, "ok") ? report_str(o, "reason") : "");
+        put(t, "| ");
+        md_text(t, report_str(o, "run"));
+        put(t, " | ");
+        md_text(t, report_str(o, "method"));
+        put(t, " | ");
+        md_code(t, report_str(o, "params"));
+        put(t, " | ");
+        md_text(t, status);
+        if (strcmp(status, "ok")) {
+            put(t, ": ");
+            md_text(t, report_str(o, "reason"));
+        }
+        put(t, " |");
         md_num(t, report_num(o, "frame_ms", "median", NULL));
         md_num(t, report_num(o, "prepare_ms", NULL, NULL));
         md_num(t, report_num(o, "metrics", "full", "relmse"));
@@ -62,7 +179,9 @@ void report_write_md(text *t, const char *dir, json_object *runs, json_object *m
             json_object *o = json_object_array_get_idx(runs, i);
             if (strcmp(report_str(o, "status"), "ok"))
                 continue;
-            put(t, "| %s |", report_str(o, "run"));
+            put(t, "| ");
+            md_text(t, report_str(o, "run"));
+            put(t, " |");
             for (int k = 0; k <= ns; k++) {
                 const char *k1 = k < ns ? "stages" : "frame_ms", *k2 = k < ns ? stages[k] : NULL;
                 double med =
@@ -77,32 +196,16 @@ void report_write_md(text *t, const char *dir, json_object *runs, json_object *m
             put(t, "\n");
         }
     }
-    put(t, "\nImages (tonemapped at the report's exposure) and relative error against the full "
-           "reference "
-           "(log scale, colour bar in each map):\n\n");
-    const char *ref_png = report_str(meta, "reference_png");
-    if (report_exists_in(dir, ref_png))
-        put(t, "reference: ![reference](%s)\n\n", ref_png);
-    for (size_t i = 0; i < count; i++) {
-        json_object *o = json_object_array_get_idx(runs, i);
-        int png = report_exists_in(dir, report_str(o, "png")),
-            heat = report_exists_in(dir, report_str(o, "heatmap"));
-        if (!png && !heat)
-            continue;
-        put(t, "%s:", report_str(o, "run"));
-        if (png)
-            put(t, " ![%s](%s)", report_str(o, "run"), report_str(o, "png"));
-        if (heat)
-            put(t, " ![error](%s)", report_str(o, "heatmap"));
-        put(t, "\n\n");
-    }
+    md_images(t, dir, runs, meta);
     json_object *charts;
     if (json_object_object_get_ex(meta, "charts", &charts)) {
         put(t, "\n");
         for (size_t i = 0; i < json_object_array_length(charts); i++) {
             const char *c = json_object_get_string(json_object_array_get_idx(charts, i));
-            if (report_exists_in(dir, c))
-                put(t, "![%s](%s)\n\n", c, c);
+            if (report_exists_in(dir, c)) {
+                md_image(t, c, c);
+                put(t, "\n\n");
+            }
         }
     }
     json_object *extra;

@@ -68,6 +68,12 @@ static int scene_index(study *st, const char *file, const char *jpath, const cha
     }
     if (!has_camera)
         return cli_fail(EXIT_USAGE, "%s: /camera: %s has no camera '%s'", file, path, st->camera);
+    /* run ids are keyed on the content: two names of one scene would give
+     * two runs of one id (and run at once under --jobs) */
+    for (uint32_t i = 0; i < st->scene_count; i++)
+        if (st->scenes[i].hash == hash)
+            return cli_fail(EXIT_USAGE, "%s: %s: %s has the same content as %s, listed already",
+                            file, jpath, path, st->scenes[i].path);
     study_scene *sc = &st->scenes[st->scene_count];
     sc->path = path;
     sc->hash = hash;
@@ -100,6 +106,9 @@ static int parse_settings(study *st, json_object *o, const char *prefix, const c
             int rc = scene_index(st, file, ep, json_object_get_string(e), &rs->scenes[rs->scene_n]);
             if (rc != EXIT_OK)
                 return rc;
+            for (uint32_t k = 0; k < rs->scene_n; k++)
+                if (rs->scenes[k] == rs->scenes[rs->scene_n])
+                    return study_fail_json(file, ep, "scene listed twice (one run id for both)");
             rs->scene_n++;
         }
     }
@@ -110,8 +119,9 @@ static int parse_settings(study *st, json_object *o, const char *prefix, const c
         json_object *jw = json_object_array_get_idx(v, 0), *jh = json_object_array_get_idx(v, 1);
         int64_t w = json_object_get_int64(jw), h = json_object_get_int64(jh);
         if (!json_object_is_type(jw, json_type_int) || !json_object_is_type(jh, json_type_int) ||
-            w < 1 || h < 1 || w > 16384 || h > 16384)
-            return study_fail_json(file, path, "width and height must be integers in 1..16384");
+            !gi_image_size_ok((unsigned long long)w, (unsigned long long)h) || w < 1 || h < 1)
+            return study_fail_json(file, path,
+                                   "width and height must be integers, " GI_IMAGE_SIZE_RULE);
         rs->width = (uint32_t)w;
         rs->height = (uint32_t)h;
     }

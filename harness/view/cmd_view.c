@@ -58,7 +58,8 @@ static int parse_opts(int argc, char **argv, viewer *v)
             v->camera_name = val;
         else if (!strcmp(a, "--size")) {
             if (!cli_parse_size(val, &v->width, &v->height))
-                return cli_fail(EXIT_USAGE, "view: --size '%s' is not WxH with 1..16384 each", val);
+                return cli_fail(EXIT_USAGE, "view: --size '%s' is not WxH with " GI_IMAGE_SIZE_RULE,
+                                val);
         } else if (!strcmp(a, "--param")) {
             if (v->opt_param_count == VIEW_FILE_MAX_PARAMS)
                 return cli_fail(EXIT_USAGE, "view: at most %d --param", VIEW_FILE_MAX_PARAMS);
@@ -310,7 +311,7 @@ static int loop(viewer *v)
         int fw = 0, fh = 0;
         glfwGetFramebufferSize(v->win, &fw, &fh);
         if (fw > 0 && fh > 0 && ((uint32_t)fw != v->width || (uint32_t)fh != v->height) &&
-            fw <= 16384 && fh <= 16384)
+            gi_image_size_ok((unsigned)fw, (unsigned)fh))
             resize_targets(v, (uint32_t)fw, (uint32_t)fh);
         if (v->playing) {
             double now = gi_now();

@@ -247,8 +247,9 @@ static int window_shot_line(viewer *v, const script_line *s)
 static int resize_line(viewer *v, const script_line *s)
 {
     unsigned long w, h;
-    if (s->n != 3 || !cli_parse_uint(s->a, 1, 16384, &w) || !cli_parse_uint(s->b, 1, 16384, &h))
-        return bad(v, "resize W H (1..16384 each)");
+    if (s->n != 3 || !cli_parse_uint(s->a, 1, GI_MAX_IMAGE_SIDE, &w) ||
+        !cli_parse_uint(s->b, 1, GI_MAX_IMAGE_SIDE, &h) || !gi_image_size_ok(w, h))
+        return bad(v, "resize W H (" GI_IMAGE_SIZE_RULE ")");
     glfwSetWindowSize(v->win, (int)w, (int)h);
     /* the X server answers asynchronously: wait for the new size (up to 5 s) */
     double until = gi_now() + 5.0;

@@ -2,7 +2,8 @@
  * times with one FAKE_* macro defined (tests/CMakeLists.txt). The FAKE_CONF_*
  * kinds render something (a constant per pixel) for the conformance suite's
  * own tests: each breaks one rule the suite must catch. FAKE_ENTRY_CRASH and
- * FAKE_CTOR_CRASH crash while loading (in gi_method_entry, in a constructor).
+ * FAKE_CTOR_CRASH crash while loading (in gi_method_entry, in a constructor);
+ * FAKE_CTOR_PRINT prints to stdout from a constructor.
  * FAKE_BAKED renders a constant grey, lacks GI_CAP_RIGID_MOTION and refuses
  * moved lights in update(), as a method that bakes its lights at prepare
  * would: the viewer's tests of a method that cannot follow a change. */
@@ -10,6 +11,7 @@
 #include "gi/kit.h" /* GI_ABI_LAYOUT */
 
 #include <math.h>
+#include <stdio.h>
 #include <signal.h>
 #include <stddef.h>
 #include <unistd.h>
@@ -159,6 +161,14 @@ static const gi_method fake_method = {
 __attribute__((constructor)) static void fake_ctor(void)
 {
     raise(SIGSEGV);
+}
+#endif
+
+#if defined(FAKE_CTOR_PRINT) /* chatters on stdout as it is mapped (and again, unbuffered) */
+__attribute__((constructor)) static void fake_ctor(void)
+{
+    printf("fake_ctor_print: hello from a constructor\n");
+    (void)!write(STDOUT_FILENO, "fake_ctor_print: raw\n", 21);
 }
 #endif
 

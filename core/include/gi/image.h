@@ -16,6 +16,7 @@
 #define GI_IMAGE_H
 
 #include "gi/common.h"
+#include "gi/limits.h"
 
 #ifdef __cplusplus
 extern "C" {

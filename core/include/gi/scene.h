@@ -41,12 +41,7 @@ extern "C" {
 
 #define GI_MIRROR_EXPONENT 10000.0f
 /* Limits that validation enforces ("absurd counts or sizes"). */
-#include "gi/glsl_shared.h" /* GI_MAX_OBJECTS: the object-transform UBO holds this many */
-#define GI_MAX_TRIANGLES (16u * 1024u * 1024u)
-#define GI_MAX_VERTICES (48u * 1024u * 1024u)
-#define GI_MAX_MATERIALS 4096
-#define GI_MAX_TEXTURE_SIZE 8192
-#define GI_MAX_FILE_BYTES (1024ull * 1024ull * 1024ull)
+#include "gi/limits.h"
 
 /* 48 bytes; this exact layout is uploaded as an SSBO (std430, see
  * core/shaders/scene.glsl) and used as the vertex buffer. */

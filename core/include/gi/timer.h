@@ -50,6 +50,10 @@ const char *gi_timer_mode_name(gi_timer_mode mode);
 /* Picks GI_TIMER_CPU_FINISH for software renderers, GL queries otherwise;
  * GIBENCH_TIMER=query|finish|cputime overrides. */
 gi_timer_mode gi_timer_mode_for(int gl_is_software);
+/* GI_OK when GIBENCH_TIMER is unset, empty or one of query, finish,
+ * cputime; else GI_ERR_INVALID_ARGUMENT with a message listing them (a
+ * misspelt mode would otherwise be ignored and time with the default). */
+gi_result gi_timer_env_check(gi_error *err);
 
 void gi_timer_frame_begin(gi_timer *t);
 void gi_timer_frame_end(gi_timer *t);
