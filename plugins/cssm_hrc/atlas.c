@@ -461,6 +461,57 @@ static gi_result atlas_surface_samples(atlas_build *b, cssm_atlas *out)
     return GI_OK;
 }
 
+static int tri_double_sided(const gi_scene *s, uint32_t tri)
+{
+    return s->materials[s->vertices[s->indices[3 * (size_t)tri]].material].double_sided != 0;
+}
+
+/* The back sides of double-sided materials (glTF 2.0 doubleSided: back
+ * faces are lit with reversed normals, an emitter emits from both sides).
+ * A texel of the paper's atlas holds one position, one normal and one
+ * radiance (§3.2.3: "3D position, normal, area, radiance and BRDF
+ * parameters"), and the two sides of a sheet receive different light (a
+ * panel lit from one side), so the back side gets texels of its own: a
+ * copy of each front texel with the normal reversed, its own cube map
+ * (the eye on the back side), its own radiance and leaf. The copies have
+ * no chart (the atlas grid holds the front sides; a chart mirrored into
+ * the grid would halve every chart's resolution): they are surface samples
+ * (§3.2.3, last paragraph), walked greedily after the charts, and a pixel
+ * on a back side gathers its light itself (cssm_side_chart). Single-sided
+ * back faces get no texel: they do not exist (issue 28's one rule). */
+static gi_result atlas_back_sides(const gi_scene *s, cssm_atlas *out)
+{
+    const uint32_t n = out->count;
+    uint32_t extra = 0;
+    for (uint32_t i = 0; i < n; i++)
+        extra += (uint32_t)tri_double_sided(s, out->texels[i].triangle);
+    if (!extra)
+        return GI_OK;
+    cssm_texel *nt = realloc(out->texels, ((size_t)n + extra) * sizeof *nt);
+    if (!nt)
+        return GI_ERR_OUT_OF_MEMORY;
+    out->texels = nt;
+    for (uint32_t i = 0; i < n; i++) {
+        if (!tri_double_sided(s, nt[i].triangle))
+            continue;
+        cssm_texel *x = &nt[out->count++];
+        *x = nt[i];
+        x->n = gi_v3_scale(nt[i].n, -1.0f);
+        x->chart = -1;
+        x->x = x->y = CSSM_NO_XY;
+    }
+    out->back_texels = extra;
+    return GI_OK;
+}
+
+int32_t cssm_side_chart(const cssm_atlas *a, uint32_t tri, gi_vec3 n)
+{
+    int32_t chart = a->tri_chart[tri];
+    if (chart >= 0 && gi_v3_dot(a->charts[chart].normal, n) < 0.0f)
+        return -1; /* the back side of a double-sided chart: its texels are surface samples */
+    return chart;
+}
+
 gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_only,
                            cssm_atlas *out, gi_error *err)
 {
@@ -489,6 +540,8 @@ gi_result cssm_atlas_build(const gi_scene *s, float t, uint32_t R, int samples_o
         r = atlas_rasterise_charts(&b, out);
     if (r == GI_OK)
         r = atlas_surface_samples(&b, out);
+    if (r == GI_OK)
+        r = atlas_back_sides(s, out);
     atlas_build_free(&b);
     if (r != GI_OK) {
         if (r == GI_ERR_OUT_OF_MEMORY)

@@ -62,12 +62,13 @@ typedef struct cssm_atlas {
     uint32_t chart_texels; /* texels inside charts */
     cssm_chart *charts;
     uint32_t chart_count;
-    float h;             /* texel edge length in world units */
-    float diameter;      /* scene bounding-box diagonal */
-    double surface_area; /* of every triangle */
-    double chart_area;   /* of the triangles in charts */
-    double covered_area; /* chart texels x h^2: the share of chart_area the texel grid covers */
-    int32_t *tri_chart;  /* per scene triangle: its chart, -1 for none */
+    float h;              /* texel edge length in world units */
+    float diameter;       /* scene bounding-box diagonal */
+    double surface_area;  /* of every triangle */
+    double chart_area;    /* of the triangles in charts */
+    double covered_area;  /* chart texels x h^2: the share of chart_area the texel grid covers */
+    int32_t *tri_chart;   /* per scene triangle: its chart, -1 for none */
+    uint32_t back_texels; /* the last back_texels texels: back sides of double-sided materials */
 } cssm_atlas;
 
 /* Builds the atlas of the scene at time t (world space, every object):
@@ -75,7 +76,9 @@ typedef struct cssm_atlas {
  * scenes' walls and blocks) packed into the R x R atlas; triangles of no
  * chart large enough (curved meshes) get evenly distributed surface
  * samples of the same density (§3.2.3, last paragraph). Texel areas sum to
- * each chart's / object's area. samples_only: the texel size the charts
+ * each chart's / object's area. The triangles of double-sided materials
+ * get a second texel per front texel, normal reversed, no chart, after
+ * the surface samples (atlas.c, atlas_back_sides). samples_only: the texel size the charts
  * would get, but surface samples everywhere (no parametrisation: the
  * paper's greedy case). GI_ERR_INVALID_ARGUMENT when the scene has no
  * area. */
@@ -86,6 +89,11 @@ void cssm_atlas_free(cssm_atlas *a);
  * it): albedo factor x albedo texture at x->p (the mesh uvs interpolated,
  * gi_scene_albedo), emission, Phong lobe. */
 void cssm_texel_material(const gi_scene *s, uint32_t tri, const gi_vec3 p[3], cssm_texel *x);
+
+/* The chart of scene triangle tri for a point whose (eye-facing) normal is
+ * n: tri_chart, or -1 when n faces away from the chart's normal (the back
+ * side of a double-sided triangle, whose texels are surface samples). */
+int32_t cssm_side_chart(const cssm_atlas *a, uint32_t tri, gi_vec3 n);
 
 /* Continuous texel coordinates (texel centres at x + 1/2) of world point p
  * in chart c's rectangle. */
@@ -217,7 +225,12 @@ typedef struct cssm_node_view {
 } cssm_node_view;
 
 /* Median cut over the texel positions (§4.2): split at the median of the
- * longest axis of the box until one texel is left. */
+ * longest axis of the box until one texel is left. With back-side texels
+ * (double-sided materials) the root's children are the front texels and
+ * the back texels, each median cut: a front and a back texel share a
+ * position, so a median cut alone would keep them together down to the
+ * leaves and every cluster of a double-sided surface would have a mean
+ * normal of zero. */
 gi_result cssm_tree_build(const cssm_atlas *a, cssm_tree *out, gi_error *err);
 void cssm_tree_free(cssm_tree *t);
 /* Pull (§4.1.1): per node the area-weighted mean of per-texel radiance
@@ -308,7 +321,10 @@ typedef struct cssm_gather_opts {
     float clamp;      /* distances below it count as it (§5 "Quality") */
     float bias;       /* CSSM depth bias, world units */
     int pcf;
-    uint32_t *rng;   /* non-NULL: jitter each gathered node inside its area (§4.5) */
+    uint32_t *rng;    /* non-NULL: jitter each gathered node inside its area (§4.5) */
+    int rep_centroid; /* 1: a node's visibility from the texel nearest its centroid, jitter over
+                       * uniform leaves (rep=centroid); 0: the leaf picked by intensity
+                       * (lightcuts' representative, hrc.c pick_leaf) */
     int no_emission; /* cssm_solve: R_1 = direct only, the emitting texels not gathered (their light
                       * comes from the direct light of direct=csm, §4.7) */
 } cssm_gather_opts;

@@ -50,6 +50,11 @@ static const gi_param_desc cssm_params[] = {
     {"jitter", GI_PARAM_BOOL, 1, 0, 1, NULL, "jittering (Sec. 4.5)",
      "final gather: each node's position drawn inside its area every frame, averaged "
      "progressively"},
+    {"rep", GI_PARAM_ENUM, 0, 0, 0, "intensity|centroid", "representative (Sec. 4.4, 4.5)",
+     "texel whose CSSM gives a gathered node's visibility (and, with jitter, where it sends "
+     "from): intensity, lightcuts' representative drawn by radiant intensity (the paper's "
+     "lightcuts); centroid, the texel nearest the node's centroid and uniform leaves with "
+     "jitter (the area rule of before, for comparison)"},
     {"clamp", GI_PARAM_FLOAT, 0.02, 0.0, 1.0, NULL, "clamping (Sec. 5 Quality)",
      "distances below clamp x scene diameter count as that distance"},
     {"bias", GI_PARAM_FLOAT, 0.004, 0.0, 0.1, NULL, "depth bias (Fig. 14)",
@@ -124,6 +129,7 @@ static gi_result cssm_create(const gi_host *host, const gi_params *params, void 
     c->threshold = gi_params_float(params, "threshold");
     c->max_cut = gi_params_int(params, "max_cut");
     c->jitter = gi_params_bool(params, "jitter");
+    c->rep_centroid = gi_params_enum(params, "rep");
     c->clamp_f = gi_params_float(params, "clamp");
     c->bias_f = gi_params_float(params, "bias");
     c->env_samples = gi_params_int(params, "env_samples");

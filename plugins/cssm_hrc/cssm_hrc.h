@@ -35,6 +35,7 @@ typedef struct cssm_shadow_map {
 typedef struct cssm_hrc {
     gi_kit kit;
     int R, M, traversal, bounces, max_cut, jitter, pcf, shadow_size;
+    int rep_centroid; /* rep=centroid: the area rule of representatives (hrc.c pick_leaf) */
     float threshold, clamp_f, bias_f;
     cssm_atlas atlas;
     uint32_t *order;

@@ -117,7 +117,7 @@ void cssm_env_proxies(const cssm_atlas *a, const cssm_maps *m, const gi_scene *s
     out->count = 0;
     if (tri >= s->triangle_count)
         return;
-    int32_t chart = a->tri_chart[tri];
+    int32_t chart = cssm_side_chart(a, tri, n);
     if (chart >= 0) { /* the 2 x 2 chart texels around P, bilinear weights */
         const cssm_chart *c = &a->charts[chart];
         float u, v;

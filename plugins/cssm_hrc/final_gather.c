@@ -162,7 +162,7 @@ static void pixel_indirect(const cssm_hrc *c, const frame_ctx *f, size_t p, gi_v
     if (!c->csm)
         gather(c, 1, rc, o, out, NULL);
     uint32_t tri = c->ids[4 * p + 2];
-    int32_t chart = tri < f->s->triangle_count ? c->atlas.tri_chart[tri] : -1;
+    int32_t chart = tri < f->s->triangle_count ? cssm_side_chart(&c->atlas, tri, rc->n) : -1;
     float ind[3] = {0, 0, 0}, u, v;
     int ok = 0;
     if (chart >= 0) {
@@ -205,7 +205,7 @@ static void pixel_environment(const cssm_hrc *c, const frame_ctx *f, size_t p,
 {
     const gi_scene *s = f->s;
     uint32_t tri = c->ids[4 * p + 2];
-    int32_t chart = tri < s->triangle_count ? c->atlas.tri_chart[tri] : -1;
+    int32_t chart = tri < s->triangle_count ? cssm_side_chart(&c->atlas, tri, Nn) : -1;
     float e[3] = {0, 0, 0}, u, v;
     int ok = 0;
     if (c->env_pixel && c->maps.escape) { /* env=cssm: the maps of the texels around it */

@@ -76,9 +76,10 @@ static void node_fill(const cssm_atlas *a, const cssm_tree *t, cssm_node *nd, fl
 }
 
 /* Builds the subtree over leaves[first, first + count) at node index *next;
- * returns its index. */
+ * returns its index. split: the size of the left child (0: the median cut
+ * decides). */
 static int32_t build(const cssm_atlas *a, cssm_tree *t, uint32_t first, uint32_t count,
-                     uint32_t *next)
+                     uint32_t split, uint32_t *next)
 {
     int32_t me = (int32_t)(*next)++;
     cssm_node *nd = &t->nodes[me];
@@ -92,16 +93,19 @@ static int32_t build(const cssm_atlas *a, cssm_tree *t, uint32_t first, uint32_t
         t->leaf_node[t->leaves[first]] = (uint32_t)me;
         return me;
     }
-    int axis = 0;
-    for (int j = 1; j < 3; j++)
-        if (hi[j] - lo[j] > hi[axis] - lo[axis])
-            axis = j;
-    sort_atlas = a;
-    sort_axis = axis;
-    qsort(t->leaves + first, count, sizeof *t->leaves, cmp_axis);
-    uint32_t half = count / 2;
-    int32_t left = build(a, t, first, half, next);
-    int32_t right = build(a, t, first + half, count - half, next);
+    uint32_t half = split;
+    if (!half) {
+        int axis = 0;
+        for (int j = 1; j < 3; j++)
+            if (hi[j] - lo[j] > hi[axis] - lo[axis])
+                axis = j;
+        sort_atlas = a;
+        sort_axis = axis;
+        qsort(t->leaves + first, count, sizeof *t->leaves, cmp_axis);
+        half = count / 2;
+    }
+    int32_t left = build(a, t, first, half, 0, next);
+    int32_t right = build(a, t, first + half, count - half, 0, next);
     t->nodes[me].child = left;
     t->nodes[left].skip = right;
     (void)right;
@@ -137,7 +141,9 @@ gi_result cssm_tree_build(const cssm_atlas *a, cssm_tree *out, gi_error *err)
     for (uint32_t i = 0; i < n; i++)
         out->leaves[i] = i;
     uint32_t next = 0;
-    build(a, out, 0, n, &next);
+    /* the back sides (the last back_texels texels) in a subtree of their own */
+    uint32_t front = a->back_texels < n ? n - a->back_texels : 0;
+    build(a, out, 0, n, a->back_texels ? front : 0, &next);
     out->count = next;
     fix_skips(out, 0, -1);
     return GI_OK;
@@ -256,28 +262,77 @@ float cssm_bound(const cssm_node *S, const float L[3], const cssm_receiver *rc)
     return bound_view(&v, rc);
 }
 
+/* The leaf (its rank in leaves[]) that stands for node S in a gather:
+ * lightcuts' representative, which this paper's final gather and
+ * refinement oracle build on (§4.4: "Recently, Walter et al. [24]
+ * introduced lightcuts ... a hierarchy of VPLs"; §4.3: "The same upper
+ * bound computation as presented in [24] is used here"). A node is a VPL
+ * carrying the "radiant intensity" of §4.2.1, and lightcuts picks a
+ * cluster's representative among its children with probability
+ * proportional to their intensity, so that the cluster's light is sent from
+ * where its light is: the walk goes down from S, at each node to the left
+ * or right child with probability I_left / (I_left + I_right) (luminance).
+ * An unlit texel is never picked while a lit one is below S, and the
+ * gather, I_S G V at the picked leaf, has the expectation
+ * sum_k I_k G_k V_k over the leaves. Jitter (§4.5, "we pick a random
+ * location" inside the VPL's area) draws the walk's numbers from the
+ * frame's generator; without jitter they come from a hash of the node's
+ * index, a fixed choice per node and light set as in lightcuts. As in
+ * lightcuts the node's light leaves from the representative's position
+ * and normal (a mean normal of a cluster that holds the light and the
+ * walls beside it points nowhere the light does). The area
+ * rule of before (the texel nearest the centroid, uniform leaves with
+ * jitter) is rep=centroid. */
+static uint32_t pick_leaf(const cssm_tree *t, const float *node_L, const cssm_ctree *ct,
+                          const cssm_node_view *S, int32_t index, uint32_t *rng)
+{
+    uint32_t fixed = gi_rng_init((uint32_t)index, 0, 0x2e9u);
+    uint32_t *g = rng ? rng : &fixed;
+    cssm_node_view v = *S;
+    while (v.child >= 0) {
+        cssm_node_view l, r;
+        fetch(t, node_L, ct, v.child, &l);
+        fetch(t, node_L, ct, l.skip, &r);
+        float il = fmaxf(0.0f, gi_luminance(l.I)), ir = fmaxf(0.0f, gi_luminance(r.I));
+        float pl = il + ir > 0.0f ? il / (il + ir) : l.area / fmaxf(l.area + r.area, FLT_MIN);
+        v = gi_rng_next_float(g) < pl ? l : r;
+    }
+    return v.first;
+}
+
 /* One gathered node: sample position (the node's gather position, or with
- * jitter a random point of a random texel below it, §4.5), visibility
- * through that texel's CSSM. leaves: leaf rank -> texel. */
-static void transfer(const uint32_t *leaves, const cssm_atlas *a, const cssm_maps *maps,
-                     const cssm_node_view *S, const cssm_receiver *rc, const cssm_gather_opts *o,
+ * jitter a random point of a leaf texel below it, §4.5), visibility
+ * through that texel's CSSM (the leaf: pick_leaf). leaves: leaf rank ->
+ * texel. */
+static void transfer(const cssm_tree *t, const float *node_L, const cssm_ctree *ct,
+                     const cssm_atlas *a, const cssm_maps *maps, const cssm_node_view *S,
+                     int32_t index, const cssm_receiver *rc, const cssm_gather_opts *o,
                      float out[3], cssm_gather_stats *st)
 {
+    const uint32_t *leaves = ct ? ct->leaves : t->leaves;
     gi_vec3 y = S->p, ny = S->n;
     uint32_t vis_texel = S->rep;
-    if (o->rng) {
+    if (!o->rep_centroid) {
+        /* lightcuts: the cluster's intensity sent from its representative's
+         * position and orientation (jitter: a random point of it) */
+        vis_texel = leaves[pick_leaf(t, node_L, ct, S, index, o->rng)];
+        y = a->texels[vis_texel].p;
+        ny = a->texels[vis_texel].n;
+    } else if (o->rng) { /* a uniform leaf below S */
         uint32_t k = S->first + (uint32_t)(gi_rng_next_float(o->rng) * (float)S->count);
         if (k >= S->first + S->count)
             k = S->first + S->count - 1;
-        const cssm_texel *x = &a->texels[leaves[k]];
+        vis_texel = leaves[k];
+        if (S->count == 1)
+            ny = a->texels[vis_texel].n;
+    }
+    if (o->rng) {
+        const cssm_texel *x = &a->texels[vis_texel];
         gi_vec3 tu, tv;
         gi_onb(x->n, &tu, &tv);
         float side = sqrtf(x->area);
         float u1 = gi_rng_next_float(o->rng) - 0.5f, u2 = gi_rng_next_float(o->rng) - 0.5f;
         y = gi_v3_add(x->p, gi_v3_add(gi_v3_scale(tu, u1 * side), gi_v3_scale(tv, u2 * side)));
-        if (S->count == 1)
-            ny = x->n;
-        vis_texel = leaves[k];
     }
     gi_vec3 w = gi_v3_sub(y, rc->x);
     float d2 = gi_v3_dot(w, w);
@@ -345,7 +400,7 @@ static void gather_any(const cssm_tree *t, const float *node_L, const cssm_ctree
             continue;
         }
         if (lit)
-            transfer(leaves, a, maps, &S, rc, o, out, st);
+            transfer(t, node_L, ct, a, maps, &S, i, rc, o, out, st);
         gathered++;
         pending--;
         i = S.skip;

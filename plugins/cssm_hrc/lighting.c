@@ -23,7 +23,8 @@ cssm_gather_opts cssm_hrc_gather_opts(const cssm_hrc *c, float exposure, uint32_
                           .clamp = c->clamp_f * c->atlas.diameter,
                           .bias = c->bias_f * c->atlas.diameter,
                           .pcf = c->pcf,
-                          .rng = rng};
+                          .rng = rng,
+                          .rep_centroid = c->rep_centroid};
     return o;
 }
 

@@ -74,7 +74,7 @@ int main(int argc, char **argv)
             stderr,
             "usage: cssm_tests "
             "traversal|tree|visibility|furnace|hull|motion|motion2|texture|compact|compact_furnace|"
-            "compact_limit|escape\n");
+            "compact_limit|escape|representative\n");
         return 2;
     }
     int r;
@@ -102,6 +102,8 @@ int main(int argc, char **argv)
         r = cssm_test_texture();
     else if (!strcmp(argv[1], "escape"))
         r = cssm_test_env();
+    else if (!strcmp(argv[1], "representative"))
+        r = cssm_test_representative();
     else {
         fprintf(stderr, "cssm_tests: unknown part '%s'\n", argv[1]);
         return 2;

@@ -73,6 +73,7 @@ int cssm_test_compact(void);        /* compact_tests.c */
 int cssm_test_compact_limit(void);  /* compact_tests.c */
 int cssm_test_visibility(void);     /* visibility_tests.c */
 int cssm_test_furnace(int compact); /* furnace_tests.c */
+int cssm_test_representative(void); /* furnace_tests.c */
 int cssm_test_hull(void);           /* motion_tests.c */
 int cssm_test_motion(void);         /* motion_tests.c */
 int cssm_test_motion2(void);        /* motion_tests.c */
