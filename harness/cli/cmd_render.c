@@ -669,6 +669,8 @@ static int create_and_prepare(run_state *r, const render_opts *o, int moves)
                                                                                     : EXIT_RUN,
                         "%s: %s", r->m->id, cerr.text);
     r->host.timer = r->prep_timer;
+    /* -v: the moment precomputation starts (the cancellation test waits for it) */
+    gi_log(GI_LOG_INFO, "%s: prepare begins", r->m->id);
     gi_timer_frame_begin(r->prep_timer);
     res = r->m->prepare(r->inst, r->gs);
     gi_timer_frame_end(r->prep_timer);

@@ -53,9 +53,6 @@ study_file broken scenes/cornell_box_coarse.gltf 4 '[{"method": "direct"}]' ', "
 "$GIB" study "$D/broken.json" --out "$D/broken" >"$D/broken.log" 2>&1
 st=$(status "$D/broken/runs.csv" direct)
 [ "$st" = ok ] || fail "broken plugin: the direct run is '$st' (expected ok): $(tail -n 3 "$D/broken.log")"
-grep -q "gimethod_fake_dtor_crash.so: crashed while unloading" "$D/broken.log" "$D/methods.err" 2>/dev/null ||
-    grep -rq "crashed while unloading" "$D/broken" 2>/dev/null ||
-    echo "note: the study's log does not name the refused plugin"
 echo "broken plugin: methods --json whole (rc $rc), direct run: $st"
 unset GIBENCH_PLUGIN_PATH
 
