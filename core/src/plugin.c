@@ -159,8 +159,10 @@ static int push_error(gi_plugins *reg, const char *text)
     return 1;
 }
 
-/* dlopen, entry and validation, with the descriptor returned (no registry). */
-static gi_result open_and_check(const char *path, const gi_method **out, gi_error *err)
+/* dlopen, entry and validation, with the descriptor returned (no registry);
+ * the library handle into *handle when it is not NULL. */
+static gi_result open_and_check(const char *path, const gi_method **out, void **handle,
+                                gi_error *err)
 {
     /* Never dlclose: see plugin.h. A refused library stays mapped too; it is
      * rare and closing it would run its destructors. */
@@ -186,14 +188,21 @@ static gi_result open_and_check(const char *path, const gi_method **out, gi_erro
     if (gi_method_validate(m, &verr) != GI_OK)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "%s: %s", path, verr.text);
     *out = m;
+    if (handle)
+        *handle = lib;
     return GI_OK;
 }
 
 /* Plugins are loaded in a forked child first (dlopen with its
- * constructors, gi_method_entry, validation), so that a plugin that
- * crashes, exits or hangs while loading is refused with one line instead of
- * taking the command down; the parent then maps only the plugins the child
- * found valid. One child checks a whole batch in order and reports a line
+ * constructors, gi_method_entry, validation, then dlclose with its
+ * destructors: the library's whole life but create and destroy, which need
+ * a GL context and run in each render's own process), so that a plugin that
+ * crashes, exits or hangs while loading or unloading is refused with one
+ * line instead of taking the command down (a destructor that crashes would
+ * otherwise kill every gibench process at exit, after its work, with its
+ * output unflushed); the parent then maps only the plugins the child found
+ * valid. Before dlclose the child reports "<index> -1" (unloading), so that
+ * a death there is named as such. One child checks a whole batch in order and reports a line
  * "<index> <code> <message>" per plugin through a pipe; when it dies, the
  * first plugin it did not report is the culprit, and a new child goes on
  * with the next. The child leaves with _exit (no atexit handlers, no stdio
@@ -203,7 +212,21 @@ static gi_result open_and_check(const char *path, const gi_method **out, gi_erro
 typedef struct probe_result {
     gi_result code; /* GI_OK: load it in the parent */
     gi_error err;   /* the refusal, "path: reason" */
+    int unloading;  /* the child reported it loaded and was unloading it */
 } probe_result;
+
+/* Writes all of line[0..len) to fd; a failed write ends the child. */
+static void write_line(int fd, const char *line, int len)
+{
+    for (int done = 0; done < len;) {
+        ssize_t w = write(fd, line + done, (size_t)(len - done));
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0)
+            _exit(3);
+        done += (int)w;
+    }
+}
 
 static void probe_child(char *const *paths, size_t from, size_t n, int fd)
 {
@@ -217,7 +240,13 @@ static void probe_child(char *const *paths, size_t from, size_t n, int fd)
     for (size_t i = from; i < n; i++) {
         gi_error cerr = {{0}};
         const gi_method *m = NULL;
-        gi_result r = open_and_check(paths[i], &m, &cerr);
+        void *lib = NULL;
+        gi_result r = open_and_check(paths[i], &m, &lib, &cerr);
+        if (r == GI_OK) {
+            char mark[48];
+            write_line(fd, mark, snprintf(mark, sizeof mark, "%zu -1\n", i));
+            dlclose(lib); /* its destructors run here */
+        }
         for (char *c = cerr.text; *c; c++)
             if (*c == '\n' || *c == '\r')
                 *c = ' ';
@@ -228,14 +257,7 @@ static void probe_child(char *const *paths, size_t from, size_t n, int fd)
             len = (int)sizeof line - 1;
             line[len - 1] = '\n';
         }
-        for (int done = 0; done < len;) {
-            ssize_t w = write(fd, line + done, (size_t)(len - done));
-            if (w < 0 && errno == EINTR)
-                continue;
-            if (w <= 0)
-                _exit(3);
-            done += (int)w;
-        }
+        write_line(fd, line, len);
     }
     _exit(0);
 }
@@ -304,7 +326,9 @@ static size_t probe_from(char *const *paths, size_t from, size_t n, probe_result
             *nl = '\0';
             char *rest = NULL;
             unsigned long long idx = strtoull(buf, &rest, 10);
-            long code = rest && *rest == ' ' ? strtol(rest + 1, &rest, 10) : -1;
+            long code = rest && *rest == ' ' ? strtol(rest + 1, &rest, 10) : -2;
+            if (idx == next && idx < n && code == -1)
+                out[idx].unloading = 1;
             if (idx == next && idx < n && code >= 0) {
                 out[idx].code = code <= GI_ERR_IO ? (gi_result)code : GI_ERR_INVALID_ARGUMENT;
                 if (out[idx].code != GI_OK)
@@ -331,13 +355,14 @@ static size_t probe_from(char *const *paths, size_t from, size_t n, probe_result
     probe_result *bad = &out[next];
     bad->code = GI_ERR_UNSUPPORTED;
     if (hung)
-        gi_error_set(&bad->err, bad->code, "%s: still loading after %d s (killed)", paths[next],
-                     GI_PROBE_SECONDS);
+        gi_error_set(&bad->err, bad->code, "%s: still %s after %d s (killed)", paths[next],
+                     bad->unloading ? "unloading" : "loading", GI_PROBE_SECONDS);
     else if (WIFSIGNALED(status))
-        gi_error_set(&bad->err, bad->code, "%s: crashed while loading (signal %d)", paths[next],
-                     WTERMSIG(status));
+        gi_error_set(&bad->err, bad->code, "%s: crashed while %s (signal %d)", paths[next],
+                     bad->unloading ? "unloading" : "loading", WTERMSIG(status));
     else
-        gi_error_set(&bad->err, bad->code, "%s: exited while loading (status %d)", paths[next],
+        gi_error_set(&bad->err, bad->code, "%s: exited while %s (status %d)", paths[next],
+                     bad->unloading ? "unloading" : "loading",
                      WIFEXITED(status) ? WEXITSTATUS(status) : -1);
     return next + 1;
 }
@@ -352,7 +377,7 @@ static void probe_all(char *const *paths, size_t n, probe_result *out)
 static gi_result add_probed(gi_plugins *reg, const char *path, gi_error *err)
 {
     const gi_method *m = NULL;
-    gi_result r = open_and_check(path, &m, err);
+    gi_result r = open_and_check(path, &m, NULL, err);
     if (r != GI_OK)
         return r;
     if (!reg)
@@ -374,7 +399,7 @@ static gi_result add_probed(gi_plugins *reg, const char *path, gi_error *err)
 
 gi_result gi_plugins_add(gi_plugins *reg, const char *path, gi_error *err)
 {
-    probe_result pr = {GI_OK, {{0}}};
+    probe_result pr = {GI_OK, {{0}}, 0};
     char *paths[1] = {(char *)path};
     probe_all(paths, 1, &pr);
     if (pr.code != GI_OK) {

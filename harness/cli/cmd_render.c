@@ -484,7 +484,7 @@ static json_object *timings_json(const run_state *r, const render_opts *o)
     json_object_object_add(j, "seed", json_object_new_int64(o->seed));
     json_object_object_add(j, "time", json_object_new_double(o->time));
     json_object_object_add(j, "animate_fps", json_object_new_double(o->animate_fps));
-    json_object_object_add(j, "cache", json_object_new_boolean(!o->no_cache));
+    json_object_object_add(j, "cache", json_object_new_boolean(r->cache_dir != NULL));
     json_object_object_add(j, "gl_renderer", json_object_new_string(gi_gpu_renderer(r->gpu)));
     json_object_object_add(j, "gl_version", json_object_new_string(gi_gpu_version(r->gpu)));
     json_object_object_add(j, "egl_platform", json_object_new_string(gi_gpu_platform(r->gpu)));
@@ -627,10 +627,13 @@ static int find_camera(const run_state *r, const render_opts *o, int *camera)
 static int setup_gpu(run_state *r, const render_opts *o)
 {
     gi_error err;
+    /* The cache only saves time: with no usable directory (HOME unset or
+     * read-only, as on many batch nodes) the method precomputes afresh, as
+     * with --no-cache, after one warning. */
     if (!o->no_cache) {
         r->cache_dir = gi_cache_dir(&err);
         if (!r->cache_dir)
-            return cli_fail(EXIT_RUN, "%s", err.text);
+            fprintf(stderr, "gibench: warning: %s; rendering without the cache\n", err.text);
     }
     r->gpu = gi_gpu_create(NULL, &err);
     if (!r->gpu)
@@ -667,6 +670,8 @@ static int create_and_prepare(run_state *r, const render_opts *o, int moves)
                                                                                     : EXIT_RUN,
                         "%s: %s", r->m->id, cerr.text);
     r->host.timer = r->prep_timer;
+    /* -v: the moment precomputation starts (the cancellation test waits for it) */
+    gi_log(GI_LOG_INFO, "%s: prepare begins", r->m->id);
     gi_timer_frame_begin(r->prep_timer);
     res = r->m->prepare(r->inst, r->gs);
     gi_timer_frame_end(r->prep_timer);

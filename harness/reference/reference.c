@@ -76,6 +76,19 @@ int gi_ref_strategy_parse(const char *name)
     return -1;
 }
 
+/* Worker threads when none are asked for: the CPUs a Slurm job was given
+ * (SLURM_CPUS_PER_TASK; a batch node has more cores than the job may use),
+ * else every online CPU. */
+static uint32_t default_threads(void)
+{
+    const char *slurm = getenv("SLURM_CPUS_PER_TASK");
+    char *end = NULL;
+    long n = slurm && *slurm ? strtol(slurm, &end, 10) : 0;
+    if (!end || *end != '\0' || n <= 0)
+        n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n > 0 ? (uint32_t)(n < MAX_THREADS ? n : MAX_THREADS) : 1u;
+}
+
 gi_result gi_ref_create(const gi_ref_desc *d, gi_ref **out, gi_error *err)
 {
     assert(d && out);
@@ -111,11 +124,7 @@ gi_result gi_ref_create(const gi_ref_desc *d, gi_ref **out, gi_error *err)
         gi_ref_free(r);
         return res;
     }
-    r->threads = d->threads;
-    if (r->threads == 0) {
-        long n = sysconf(_SC_NPROCESSORS_ONLN);
-        r->threads = n > 0 ? (uint32_t)(n < MAX_THREADS ? n : MAX_THREADS) : 1u;
-    }
+    r->threads = d->threads ? d->threads : default_threads();
     snprintf(r->renderer, sizeof r->renderer, "%s cpu", gi_rt_version(r->rs.rt));
     r->build_seconds = gi_now() - t0;
     *out = r;

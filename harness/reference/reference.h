@@ -82,7 +82,7 @@ typedef struct gi_ref_desc {
      * bounces; GI_REF_UNLIMITED = all. NOT zero-means-default: a zeroed
      * desc renders emitters only; start from gi_ref_desc_init. */
     int max_bounces;
-    uint32_t threads; /* worker threads; 0 = the number of online CPUs */
+    uint32_t threads; /* worker threads; 0 = $SLURM_CPUS_PER_TASK, else the online CPUs */
     gi_ref_strategy strategy;
     /* 0: each camera sample uniform in its pixel (box filter, the pixel's
      * exact average); 1: every sample through the pixel's centre, as the

@@ -242,7 +242,10 @@ static char *stage_script(const slurm_options *o, const char *file, const char *
         name, !strcmp(s->kind, "ref") ? "reference" : "method-run");
     char log[64];
     snprintf(log, sizeof log, "%s-%%A_%%a.log", s->kind);
-    common_lines(&t, o, name, !strcmp(s->kind, "ref") ? "refs" : "runs", out, log, cwd);
+    slurm_options own = *o;
+    if (!strcmp(s->kind, "ref"))
+        own.gres = NULL; /* the reference renders on the CPU (Embree): --gres is for the runs */
+    common_lines(&t, &own, name, !strcmp(s->kind, "ref") ? "refs" : "runs", out, log, cwd);
     gi_text_put(&t, "#SBATCH --array=%s\n", spec);
     gi_text_put(&t,
                 "'%s' study '%s' --out '%s' --cell %s:\"$SLURM_ARRAY_TASK_ID\":%016llx\n"
@@ -393,7 +396,7 @@ static int write_scripts(const slurm_options *o, const char *dir, const char *lo
                 printf("==> %s/%s <==\n%s\n", dir, names[k], texts[k]);
         printf("# %u reference cells and %u method-run cells to submit; then: sbatch --parsable "
                "refs.sh; "
-               "sbatch --parsable --dependency=afterok:REFS runs.sh; "
+               "sbatch --parsable --dependency=afterany:REFS runs.sh; "
                "sbatch --parsable --dependency=afterany:REFS:RUNS collect.sh REFS RUNS\n",
                refs->n, runs->n);
     } else if (!cli_mkdirs(logs)) {
@@ -409,7 +412,10 @@ static int write_scripts(const slurm_options *o, const char *dir, const char *lo
 }
 
 /* Submits the references, then the runs after them, then the collect job
- * after both; the ids into *j. */
+ * after both; the ids into *j. The runs wait for the whole reference array
+ * to end (afterany, not afterok): a run task checks its own reference and
+ * fails alone when that one is missing, so one failed reference costs its
+ * scene's runs, not every run of the study. */
 static int submit_stages(const char *out, char paths[3][4400], const slurm_stage *refs,
                          const slurm_stage *runs, stage_jobs *j)
 {
@@ -417,7 +423,7 @@ static int submit_stages(const char *out, char paths[3][4400], const slurm_stage
     char dep[200];
     if (refs->n && !submit(out, paths[0], NULL, NULL, NULL, j->ref, sizeof j->ref))
         rc = EXIT_RUN;
-    snprintf(dep, sizeof dep, "--dependency=afterok:%s", j->ref);
+    snprintf(dep, sizeof dep, "--dependency=afterany:%s", j->ref);
     if (rc == EXIT_OK && runs->n &&
         !submit(out, paths[1], refs->n ? dep : NULL, NULL, NULL, j->run, sizeof j->run))
         rc = EXIT_RUN;

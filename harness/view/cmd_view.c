@@ -137,9 +137,9 @@ static int load_inputs(viewer *v, int *camera)
                             "view: %s has no camera '%s' (%u cameras; use a name or #k)",
                             v->scene_path, v->camera_name, v->scene->camera_count);
     }
-    v->cache_dir = gi_cache_dir(&err);
+    v->cache_dir = gi_cache_dir(&err); /* optional, as for render */
     if (!v->cache_dir)
-        return cli_fail(EXIT_RUN, "%s", err.text);
+        fprintf(stderr, "gibench: warning: %s; rendering without the cache\n", err.text);
     if (!view_move_init(v))
         return cli_fail(EXIT_RUN, "out of memory");
     return EXIT_OK;

@@ -211,6 +211,12 @@ static void count_memory(vlf_field *f)
     f->st.bytes_render = f->st.bytes_maps_render + (size_t)f->nd_count * p->l * sizeof(vlf_rect);
 }
 
+/* Whether the caller asked to stop (vlf_settings.cancelled). */
+static int build_cancelled(const vlf_field *f)
+{
+    return f->prm.cancelled && f->prm.cancelled(f->prm.cancel_user);
+}
+
 gi_result vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_settings *p,
                           gi_error *err)
 {
@@ -226,8 +232,15 @@ gi_result vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_se
         rc = vlf_add_lights(f, s, t, err);
     if (rc != GI_OK)
         return rc;
-    if (vlf_group_faces(f, s, t) != GI_OK || lay_out_elements(f) != GI_OK)
+    if (build_cancelled(f))
+        return gi_error_set(err, GI_ERR_CANCELLED, "vlf: build cancelled");
+    rc = vlf_group_faces(f, s, t);
+    if (rc == GI_ERR_CANCELLED)
+        return gi_error_set(err, GI_ERR_CANCELLED, "vlf: build cancelled");
+    if (rc != GI_OK || lay_out_elements(f) != GI_OK)
         return vlf_build_out_of_memory(f, err);
+    if (build_cancelled(f))
+        return gi_error_set(err, GI_ERR_CANCELLED, "vlf: build cancelled");
     element_values(f, s);
     if ((uint64_t)s->triangle_count * p->subdivide * p->subdivide > 50000000u)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
@@ -235,7 +248,8 @@ gi_result vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_se
                             p->subdivide);
     if (vlf_subdivide_triangles(f, p->subdivide < 1 ? 1 : p->subdivide) != GI_OK ||
         vlf_build_subfields(f) != GI_OK)
-        return vlf_build_out_of_memory(f, err);
+        return build_cancelled(f) ? gi_error_set(err, GI_ERR_CANCELLED, "vlf: build cancelled")
+                                  : vlf_build_out_of_memory(f, err);
     rc = allocate_tiles(f, err);
     if (rc != GI_OK)
         return rc;

@@ -85,7 +85,7 @@ gi_result vlf_add_lights(vlf_field *f, const gi_scene *s, float t, gi_error *err
  * offset to 1e-3), each group one face with a chart of density texels per
  * unit length over its bounding rectangle in the plane (§3.1: one
  * irradiance texture per face; the charts are the atlas). */
-gi_result vlf_group_faces(vlf_field *f, const gi_scene *s, float t);
+gi_result vlf_group_faces(vlf_field *f, const gi_scene *s, float t); /* or GI_ERR_CANCELLED */
 /* Area of each element inside its face: every triangle clipped exactly
  * against the texels of its bounding box. */
 void vlf_element_areas(vlf_field *f, const gi_scene *s);

@@ -301,8 +301,13 @@ static void *sort_thread(void *arg)
     vlf_sorter so;
     memset(&so, 0, sizeof so);
     j->ok = 1;
-    for (uint32_t i = j->t; i < j->f->prm.l && j->ok; i += j->T)
+    for (uint32_t i = j->t; i < j->f->prm.l && j->ok; i += j->T) {
+        if (j->f->prm.cancelled && j->f->prm.cancelled(j->f->prm.cancel_user)) {
+            j->ok = 0;
+            break;
+        }
         j->ok = build_psf(j->f, i, &buf, &tmp, &so, &j->cnt);
+    }
     free(buf.v);
     free(tmp.v);
     vlf_sorter_free(&so);

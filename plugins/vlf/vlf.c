@@ -303,12 +303,15 @@ static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
         vlf_field_free(&v->field);
     v->have_field = 0;
     gi_error err;
+    v->prm.cancelled = vlf_cancelled; /* polled in the build's long loops */
+    v->prm.cancel_user = (void *)host;
     host->stage_begin(host, "sort");
     gi_result rc = vlf_field_build(&v->field, gs->scene, gs->time, &v->prm, &err);
     host->stage_end(host, "sort");
     if (rc != GI_OK) {
         vlf_field_free(&v->field);
-        return gi_kit_fail_with(&v->kit, GI_ERR_INVALID_ARGUMENT, &err);
+        return gi_kit_fail_with(
+            &v->kit, rc == GI_ERR_CANCELLED ? GI_ERR_CANCELLED : GI_ERR_INVALID_ARGUMENT, &err);
     }
     v->have_field = 1;
     host->stage_begin(host, "propagate");

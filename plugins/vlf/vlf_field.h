@@ -57,6 +57,11 @@ typedef struct vlf_settings {
                             (tessellation sweep) */
     uint32_t hier_min; /* hierarchical shortcut (§3.2): objects of at least this many triangles in a
                         * box no other triangle reaches into are sorted on their own; 0: off */
+    /* Polled between the build's steps and between directions of the sort
+     * (also from its worker threads): non-zero stops the build with
+     * GI_ERR_CANCELLED. NULL: never. */
+    int (*cancelled)(void *user);
+    void *cancel_user;
 } vlf_settings;
 
 /* Storage formats of the light-field maps (§3.1, §6): three float32 (12

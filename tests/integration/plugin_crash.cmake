@@ -1,10 +1,11 @@
 # A plugin that crashes while loading (in gi_method_entry or a constructor)
-# is refused with one warning naming it; every command goes on with the
-# other plugins (it used to die with signal 11 and no message).
+# or unloading (a destructor) is refused with one warning naming it; every
+# command goes on with the other plugins (it used to die with signal 11 and
+# no message; a destructor's crash at exit cut `methods --json` short).
 # cmake -DGIB=... -DFAKE_PLUGINS=... -DOUT=... -P plugin_crash.cmake
 set(failures 0)
 include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
-foreach(kind entry_crash ctor_crash)
+foreach(kind entry_crash ctor_crash dtor_crash)
     set(D ${OUT}/plugin_crash_${kind})
     file(REMOVE_RECURSE ${D})
     file(MAKE_DIRECTORY ${D})
@@ -17,8 +18,22 @@ foreach(kind entry_crash ctor_crash)
     foreach(id direct fake_good)
         match("${out}" "${id}" "${kind}: method ${id} not listed:\n${out}")
     endforeach()
-    match("${err}" "^gibench: warning: plugin refused: ${D}/gimethod_fake_${kind}\\.so: crashed while loading \\(signal 11\\)\n$"
+    set(phase loading)
+    if(kind STREQUAL dtor_crash)
+        set(phase unloading)
+    endif()
+    match("${err}" "^gibench: warning: plugin refused: ${D}/gimethod_fake_${kind}\\.so: crashed while ${phase} \\(signal 11\\)\n$"
           "${kind}: not exactly one warning naming the plugin and its signal:\n${err}")
+    # methods --json is whole (a destructor that crashes at exit cut it short)
+    execute_process(COMMAND ${GIB} -q methods --json TIMEOUT 120 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    if(NOT rc EQUAL 0)
+        fail("${kind}: gibench methods --json exited ${rc}:\n${err}")
+    else()
+        string(JSON n ERROR_VARIABLE jerr LENGTH "${out}")
+        if(jerr)
+            fail("${kind}: methods --json is not JSON (${jerr}):\n${out}")
+        endif()
+    endif()
 endforeach()
 unset(ENV{GIBENCH_PLUGIN_PATH})
 if(failures GREATER 0)

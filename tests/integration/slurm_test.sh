@@ -8,14 +8,27 @@
 #   2. one method-run task cancelled on purpose: only its cell is marked
 #      failed, with the task's Slurm state; the others are done;
 #   3. resubmitting runs that cell alone and completes the study;
-#   4. the reference stage cancelled: no run starts, and the report marks
-#      every run with the reference task's fate.
+#   4. the reference stage cancelled: the report marks every run with the
+#      reference task's fate;
+#   5. one scene's reference task cancelled: that scene's runs alone are
+#      marked (the other scene's runs are done).
+# Before the cluster (no Slurm needed): --dry-run gives --gres to runs.sh
+# only, never to the CPU-only references.
 # Skipped ("SKIPPED: why") when not root or when the daemons cannot start.
 # usage: slurm_test.sh GIBENCH ROOT OUT
 set -u
 GIB=$1 ROOT=$2 OUT=$3
 skip() { echo "SKIPPED: $*"; exit 0; }
 fail() { echo "FAIL: $*" >&2; exit 1; }
+
+# --gres: the runs' script has it, the references' does not
+dry=$(cd "$ROOT" && "$GIB" study tests/data/studies/slurm_tiny.json --out "$OUT/slurm_dry" --slurm --gres gpu:1 --dry-run 2>&1) ||
+    fail "--dry-run failed: $dry"
+refs_part=$(printf '%s\n' "$dry" | sed -n '/refs\.sh <==/,/<==/p')
+runs_part=$(printf '%s\n' "$dry" | sed -n '/runs\.sh <==/,/<==/p')
+printf '%s\n' "$runs_part" | grep -q '^#SBATCH --gres=gpu:1$' || fail "runs.sh lacks --gres: $dry"
+printf '%s\n' "$refs_part" | grep -q -- '--gres' && fail "refs.sh (CPU only) has --gres: $refs_part"
+echo "--gres: runs.sh only"
 
 [ "$(id -u)" = 0 ] || skip "not running as root (munged, slurmctld and slurmd are started as root)"
 for d in munged slurmctld slurmd sbatch squeue sinfo scontrol scancel python3; do
@@ -178,8 +191,8 @@ grep -q "(0 to make), 3 runs (2 done before, 0 not applicable, 1 to run)" "$T/re
     fail "resubmitting did not run the one missing cell alone: $(cat "$T/resume.out")"
 same=$(csv_same "$L/runs.csv" "$F/runs.csv") || fail "after resubmitting, results differ from the local run: $same"
 echo "resubmitted: $same"
-# 4. the reference stage cancelled: no run starts (afterok), the collect job
-# still reports, every run marked with the reference task's fate
+# 4. the reference stage cancelled: the collect job still reports, every
+# run marked with the reference task's fate
 R=$OUT/slurm_noref
 rm -rf "$R"
 "$GIB" study "$STUDY" --out "$R" --slurm --no-wait >"$T/noref.out" 2>&1 || fail "--no-wait failed: $(cat "$T/noref.out")"
@@ -199,5 +212,35 @@ for r in rows:
     assert r["status"] == "failed" and r["reason"].startswith("no reference") and \
         ("Slurm task %s_0: CANCELLED" % sys.argv[2]) in r["reason"], (r["run"], r["status"], r["reason"])
 print("no references:", rows[0]["reason"])
+PY
+# 5. two scenes, the references one at a time (--array-limit 1), the first
+# slow enough (spp 2048) that the second is still pending when cancelled:
+# only the second scene's runs fail
+P=$OUT/slurm_onescene
+rm -rf "$P"
+cat > "$T/two.json" <<'JSON'
+{"name": "slurm_two", "scenes": ["scenes/cornell_box_coarse.gltf", "scenes/bunny_env.glb"],
+ "size": [16, 16], "frames": 1, "warmup": 0, "timeout": 60,
+ "methods": [{"method": "direct"}], "reference": {"spp": 2048, "max_bounces": 2}}
+JSON
+"$GIB" study "$T/two.json" --out "$P" --slurm --no-wait --array-limit 1 >"$T/two.out" 2>&1 || fail "--no-wait failed: $(cat "$T/two.out")"
+read -r refs_job collect_job < <(sed -n 's/^submitted: references \([0-9]*\) .*collect \([0-9]*\)$/\1 \2/p' "$T/two.out")
+[ -n "${collect_job:-}" ] || fail "--no-wait printed no job ids: $(cat "$T/two.out")"
+scancel "${refs_job}_1" || fail "scancel ${refs_job}_1 failed"
+for _ in $(seq 300); do
+    st=$(squeue -h -t all -j "$collect_job" -o %T 2>/dev/null)
+    case "$st" in PENDING|RUNNING|CONFIGURING|COMPLETING) sleep 0.5 ;; *) break ;; esac
+done
+[ "$st" = COMPLETED ] || fail "the collect job ended $st after one reference was cancelled"
+python3 - "$P/runs.csv" "$refs_job" <<'PY' || fail "one failed reference did not cost its scene's runs alone"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert len(rows) == 2, rows
+by = {r["scene"].split("/")[-1]: r for r in rows}
+ok, bad = by["cornell_box_coarse.gltf"], by["bunny_env.glb"]
+assert ok["status"] == "ok", (ok["run"], ok["status"], ok["reason"])
+assert bad["status"] == "failed" and bad["reason"].startswith("no reference") and \
+    ("Slurm task %s_1: CANCELLED" % sys.argv[2]) in bad["reason"], (bad["run"], bad["status"], bad["reason"])
+print("one reference cancelled:", bad["run"], "-", bad["reason"])
 PY
 echo "slurm: all checks passed"

@@ -4,6 +4,8 @@
  * own tests: each breaks one rule the suite must catch. FAKE_ENTRY_CRASH and
  * FAKE_CTOR_CRASH crash while loading (in gi_method_entry, in a constructor);
  * FAKE_CTOR_PRINT prints to stdout from a constructor.
+ * FAKE_DTOR_CRASH loads fine and crashes in its destructor, when unloaded or
+ * at the exit of the process that loaded it.
  * FAKE_BAKED renders a constant grey, lacks GI_CAP_RIGID_MOTION and refuses
  * moved lights in update(), as a method that bakes its lights at prepare
  * would: the viewer's tests of a method that cannot follow a change. */
@@ -169,6 +171,13 @@ __attribute__((constructor)) static void fake_ctor(void)
 {
     printf("fake_ctor_print: hello from a constructor\n");
     (void)!write(STDOUT_FILENO, "fake_ctor_print: raw\n", 21);
+}
+#endif
+
+#if defined(FAKE_DTOR_CRASH) /* crashes as it is unloaded: at dlclose, or at exit */
+__attribute__((destructor)) static void fake_dtor(void)
+{
+    raise(SIGSEGV);
 }
 #endif
 

@@ -39,6 +39,9 @@ int main(void)
      * caught in a probe child: one line, and this process goes on. */
     expect_refused("entry_crash", "crashed while loading (signal 11)");
     expect_refused("ctor_crash", "crashed while loading (signal 11)");
+    /* ... and in a destructor, which the probe runs by unloading it (else
+     * every process that mapped it would crash at exit). */
+    expect_refused("dtor_crash", "crashed while unloading (signal 11)");
     /* Built against other data layouts: refused with the struct named. */
     char msg[160];
     snprintf(msg, sizeof msg,
@@ -66,7 +69,7 @@ int main(void)
     for (uint32_t i = 0; i < reg->error_count; i++)
         dup += strstr(reg->errors[i], "duplicate method id 'fake_good'") != NULL;
     CHECK(dup == 1);
-    CHECK(reg->error_count == 12);
+    CHECK(reg->error_count == 13);
     const gi_method *m = gi_plugins_find(reg, "fake_good");
     CHECK(m && m->params && strcmp(m->params[1].choices, "a|b|c") == 0);
     gi_plugins_free(reg);

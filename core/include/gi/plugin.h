@@ -7,7 +7,9 @@
  * descriptor checked: entry present, non-NULL result, ABI major equal,
  * struct_size at least the 1.0 size, every required function inside
  * struct_size and non-NULL, a valid id, a valid parameter table, no
- * duplicate id (the first found wins). A refused plugin gives one line
+ * duplicate id (the first found wins). All of this, and unloading it
+ * (dlclose: its destructors), is first tried in a child process, so that a
+ * plugin that crashes or hangs there is refused. A refused plugin gives one line
  * "path: reason" in the registry's error list and is skipped.
  * Libraries are never dlclose'd (shims with C++/TLS destructors crash
  * after unload); gi_plugins_free releases only the registry.
