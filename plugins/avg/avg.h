@@ -66,7 +66,7 @@ void avg_grid_bind(const avg_grid *g, GLuint program, GLuint unit_normal, GLuint
 enum { AVG_VPL_DIFFUSE = 0, AVG_VPL_POINT = 1, AVG_VPL_SPOT = 2 };
 typedef struct avg_vpl {
     float position[3];
-    uint32_t kind;   /* AVG_VPL_* | bounce << 8 | double-sided << 16 */
+    uint32_t kind;   /* AVG_VPL_* | bounce << 8 | double-sided emitter << 16 */
     float normal[3]; /* surface normal (diffuse) or spot axis */
     float cos_inner;
     float power[3]; /* diffuse: flux, radiant intensity = power cos / pi; point/spot: intensity */

@@ -124,10 +124,12 @@ typedef struct path_start {
 } path_start;
 
 /* On the area lights: a point on the emitter triangle that ue picks, its
- * VPL, and a cosine-distributed ray about the triangle's normal. 0 for a
+ * VPL, and a cosine-distributed ray about the triangle's normal (for a
+ * double-sided emitter, about the face path i's parity picks). 0 for a
  * degenerate triangle or emitter. */
 static int start_on_emitter(const avg_exact *x, const gi_scene *s, float ue, float pl, float N,
-                            const float q0[2], const float q1[2], float eps, path_start *ps)
+                            uint32_t i, const float q0[2], const float q1[2], float eps,
+                            path_start *ps)
 {
     const float *pos = gi_rt_positions(x->rt);
     const gi_gpu_emitter *em = &x->emitters[gi_emitter_find_cpu(x->emitters, x->emitter_count, ue)];
@@ -147,9 +149,14 @@ static int start_on_emitter(const avg_exact *x, const gi_scene *s, float ue, flo
                           gi_v3_scale(p2, bc[2]));
     set_v3(ps->v.position, y);
     ps->v.kind = AVG_VPL_DIFFUSE | (m->double_sided ? 0x10000u : 0u);
-    set_v3(ps->v.normal, axis);
     ps->flux =
         gi_v3_scale(gi_v3(m->emission[0], m->emission[1], m->emission[2]), GI_PI / (pdf_area * N));
+    if (m->double_sided) { /* both faces emit: the path's parity picks one, at twice the power */
+        ps->flux = gi_v3_scale(ps->flux, 2.0f);
+        if (i & 1u)
+            axis = gi_v3_scale(axis, -1.0f);
+    }
+    set_v3(ps->v.normal, axis);
     set_v3(ps->v.power, ps->flux);
     ps->dir = gi_to_world(gi_sample_cosine_hemisphere(q1[0], q1[1]), axis);
     ps->origin = gi_v3_add(y, gi_v3_scale(axis, eps));
@@ -212,7 +219,7 @@ static void trace_path(const avg_exact *x, const gi_scene *s, const avg_light_ta
     if (l == 0) {
         float ue = (u - lo) / pl;
         ue = ue < 0.0f ? 0.0f : (ue > GI_ONE_MINUS_EPSILON ? GI_ONE_MINUS_EPSILON : ue);
-        if (!start_on_emitter(x, s, ue, pl, N, q0, q1, eps, &ps))
+        if (!start_on_emitter(x, s, ue, pl, N, i, q0, q1, eps, &ps))
             return;
     } else {
         start_at_light(&x->lights[l - 1], pl, N, i, q1, &ps);
@@ -305,8 +312,6 @@ void avg_vpl_contribution(const avg_vpl *v, const float x[3], const float n[3], 
     uint32_t kind = v->kind & 0xFFu;
     float f;
     if (kind == AVG_VPL_DIFFUSE) {
-        if (v->kind & 0x10000u)
-            cos_v = fabsf(cos_v);
         if (cos_v <= 0.0f)
             return;
         f = cos_v * GI_INV_PI * cos_x / fmaxf(d2, dmin2);

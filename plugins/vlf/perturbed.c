@@ -86,13 +86,17 @@ static void sweep_perturbed(vlf_field *f, uint32_t i, const vlf_psf *fr, const v
                 recv += lum;
                 L[0] = L[1] = L[2] = 0.0f;
             } else if (cs > 0.0f) {
+                /* as in propagate.c's sweep: a single-sided back lets it through */
                 back += lum;
+                float own[3];
                 for (int q = 0; q < 3; q++)
-                    L[q] = f->L_cur[3 * (size_t)el + q] * fc->send_scale;
+                    own[q] = f->L_cur[3 * (size_t)el + q] * fc->send_scale;
                 if (slot != SIZE_MAX)
                     for (int q = 0; q < 3; q++)
-                        L[q] += f->out_cur[3 * slot + q];
-                shot += L[0] + L[1] + L[2];
+                        own[q] += f->out_cur[3 * slot + q];
+                for (int q = 0; q < 3; q++)
+                    L[q] += own[q];
+                shot += own[0] + own[1] + own[2];
             }
             f->st.samples++;
         }

@@ -31,7 +31,8 @@ void vlf_sweep_sky(const vlf_field *f, uint32_t i, int sign, int first_iteration
 /* One sweep of subfield i along travel direction t = sign * w_i, front to
  * back along t through every ray's fragments with the radiance interface:
  * receivers (front side facing against t) take the interface's radiance,
- * senders (front side along t) overwrite it with their unshot radiance. */
+ * senders (front side along t) add their unshot radiance to it (what
+ * crossed their back goes on: flux_back counts it, nothing is lost). */
 static void sweep(vlf_field *f, uint32_t i, int sign, int first_iteration)
 {
     const vlf_psf *p = &f->psf[i];
@@ -71,16 +72,24 @@ static void sweep(vlf_field *f, uint32_t i, int sign, int first_iteration)
                 recv += lum;
                 L[0] = L[1] = L[2] = 0.0f;
             } else if (cs > 0.0f) {
-                /* sender: what arrived on its back side is absorbed */
+                /* sender: its front adds its unshot radiance; what arrived
+                 * on its back goes on through it, since a single-sided
+                 * face seen from its back does not exist (glTF
+                 * doubleSided = false, the rule of gi/scene.h; a
+                 * double-sided face's receiver side, just before, has
+                 * taken it all) */
                 back += lum;
+                float own[3];
                 for (int q = 0; q < 3; q++)
-                    L[q] = f->L_cur[3 * (size_t)el + q] * fc->send_scale;
+                    own[q] = f->L_cur[3 * (size_t)el + q] * fc->send_scale;
                 if (fc->nd >= 0) {
                     size_t slot = vlf_rect_slot(&f->rects[(size_t)fc->nd * l + i], cx, cy);
                     for (int q = 0; q < 3; q++)
-                        L[q] += f->out_cur[3 * slot + q];
+                        own[q] += f->out_cur[3 * slot + q];
                 }
-                shot += L[0] + L[1] + L[2];
+                for (int q = 0; q < 3; q++)
+                    L[q] += own[q];
+                shot += own[0] + own[1] + own[2];
             }
             f->st.samples++;
         }

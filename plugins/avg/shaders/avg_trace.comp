@@ -5,7 +5,9 @@
 //  - light choice: the stratified number (i + 0.5) / paths in the CDF of the
 //    lights' power (area lights as one group, the emitter CDF inside it);
 //  - area lights: a point uniform on the chosen emissive triangle and a
-//    cosine-distributed direction (quasi-random pairs 0 and 1);
+//    cosine-distributed direction (quasi-random pairs 0 and 1) about its
+//    front normal, or for a double-sided emitter about the face the path's
+//    parity picks;
 //  - point lights: a uniform direction; spot lights: uniform in the cone;
 //  - marching through the grid to the first voxel holding a normal; the
 //    VPL's colour is the voxel's average colour, its normal the voxel's
@@ -75,9 +77,19 @@ void main()
         axis = ng / (2.0 * area);
         float pdf_area = pl * em.pdf / area;
         v.position = bc.x * p0 + bc.y * p1 + bc.z * p2;
-        v.kind = AVG_VPL_DIFFUSE | (((lm.flags & GI_MATERIAL_DOUBLE_SIDED) != 0u) ? 0x10000u : 0u);
-        v.normal = axis;
         v.power = lm.emission * GI_PI / (pdf_area * N);
+        // A double-sided emitter emits from both faces (glTF doubleSided):
+        // the path leaves from the face its parity picks, at twice the
+        // power, so that its VPL (one hemisphere, one shadow map) and its
+        // bounces cover both sides, as for point lights below.
+        bool two = (lm.flags & GI_MATERIAL_DOUBLE_SIDED) != 0u;
+        if (two) {
+            v.power *= 2.0;
+            if ((i & 1u) != 0u)
+                axis = -axis;
+        }
+        v.kind = AVG_VPL_DIFFUSE | (two ? 0x10000u : 0u);
+        v.normal = axis;
         flux = v.power;
         dir = gi_to_world(gi_sample_cosine_hemisphere(q1.x, q1.y), axis);
         origin = avg_to_grid(v.position) + axis * u_offset;

@@ -13,7 +13,7 @@ const uint AVG_VPL_POINT = 1u;
 const uint AVG_VPL_SPOT = 2u;
 
 struct AvgVpl {
-    vec3 position; uint kind;   // kind | bounce << 8 | double-sided << 16
+    vec3 position; uint kind;   // kind | bounce << 8 | double-sided emitter << 16
     vec3 normal; float cos_inner; // surface normal, or the hemisphere a light VPL covers
     vec3 power; float cos_outer;  // diffuse: flux (intensity = power cos / pi); point/spot: intensity
     vec3 spot_dir; float range;
@@ -75,8 +75,6 @@ vec3 avg_vpl_contribution(AvgVpl v, vec3 x, vec3 n, float dmin2)
         return vec3(0.0);
     uint kind = v.kind & 0xFFu;
     if (kind == AVG_VPL_DIFFUSE) {
-        if ((v.kind & 0x10000u) != 0u)
-            cos_v = abs(cos_v);
         if (cos_v <= 0.0)
             return vec3(0.0);
         return v.power * (cos_v * GI_INV_PI * cos_x / max(d2, dmin2));

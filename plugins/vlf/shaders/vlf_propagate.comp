@@ -5,7 +5,8 @@
 //   0 sweep:   one invocation per radiance-interface ray and sign (y = 0:
 //              along +w_i, 1: along -w_i), through the ray's fragments;
 //              receivers record the interface's radiance per fragment,
-//              senders put their unshot radiance on it;
+//              senders add their unshot radiance to it (what crossed a
+//              single-sided face's back goes on through it);
 //   1 gather:  per element (and per non-diffuse tile cell) of subfield i,
 //              the recorded radiance of its fragments summed in the CPU's
 //              order into the next irradiance map (and the incoming tile);
@@ -160,12 +161,15 @@ void main()
             rcv += lum;
             L = vec3(0.0);
         } else if (cs > 0.0) {
+            // sender: adds its unshot radiance; what crossed its back goes
+            // on (a single-sided face seen from its back does not exist)
             back += lum;
-            L = e_get(L_CUR, el) * fc.send_scale;
+            vec3 own = e_get(L_CUR, el) * fc.send_scale;
             uint slot = frag_slot[u_frag_base + k];
             if (slot != 0xffffffffu)
-                L += t_get(OUT_CUR, slot);
-            shot += L.x + L.y + L.z;
+                own += t_get(OUT_CUR, slot);
+            L += own;
+            shot += own.x + own.y + own.z;
         } else if (s == 0u) {
             recv[3u * k] = 0.0, recv[3u * k + 1u] = 0.0, recv[3u * k + 2u] = 0.0;
         }
