@@ -125,7 +125,7 @@ static int read_manifest(const conf_opts *o, ho_run *h)
         h->count++;
     }
     json_object_put(root);
-    if (h->count == 0)
+    if (h->count == 0 && !wanted(o->variants, "furnace_in") && !wanted(o->variants, "furnace_out"))
         return cli_fail(EXIT_USAGE, "conformance: no variant of %s matches --variants '%s'", mf,
                         o->variants ? o->variants : "");
     return EXIT_OK;
@@ -302,8 +302,11 @@ int conf_held_out(const conf_opts *o, const gi_method *const *ms, uint32_t count
     }
     cli_install_signal_handlers();
     for (uint32_t i = 0; i < count; i++) {
-        run_child(o, &h, ms[i], "furnace_in", "furnace_in");
-        run_child(o, &h, ms[i], "furnace_out", "furnace_out");
+        /* the furnaces belong to no seed: --variants names them to run them */
+        if (wanted(o->variants, "furnace_in"))
+            run_child(o, &h, ms[i], "furnace_in", "furnace_in");
+        if (wanted(o->variants, "furnace_out"))
+            run_child(o, &h, ms[i], "furnace_out", "furnace_out");
         for (uint32_t v = 0; v < h.count; v++)
             run_child(o, &h, ms[i], h.name[v], h.file[v]);
     }
