@@ -268,6 +268,16 @@ int gi_param_quality_of(const gi_param_desc *d, gi_param_quality *q)
         return 0;
     const char *s = d->choices;
     int dir = 0;
+    if (!strncmp(s, "quality:none:", 13)) {
+        if (!s[13])
+            return -1; /* a knob that does not converge says why */
+        if (q) {
+            q->dir = 0;
+            q->factor = 1.0;
+            q->reason = s + 13;
+        }
+        return 1;
+    }
     if (!strncmp(s, "quality:up:", 11))
         dir = 1;
     else if (!strncmp(s, "quality:down:", 13))
@@ -282,6 +292,7 @@ int gi_param_quality_of(const gi_param_desc *d, gi_param_quality *q)
     if (q) {
         q->dir = dir;
         q->factor = factor;
+        q->reason = NULL;
     }
     return 1;
 }
@@ -289,7 +300,7 @@ int gi_param_quality_of(const gi_param_desc *d, gi_param_quality *q)
 double gi_param_quality_step(const gi_param_desc *d, double from, int steps)
 {
     gi_param_quality q;
-    if (gi_param_quality_of(d, &q) != 1)
+    if (gi_param_quality_of(d, &q) != 1 || q.dir == 0)
         return from;
     double v = from;
     for (int k = 0; k < steps; k++) {

@@ -28,7 +28,12 @@ static json_object *param_json(const gi_param_desc *d)
     gi_param_quality q;
     if (gi_param_quality_of(d, &q) == 1) { /* a quality knob (params.h) */
         json_object *qo = json_object_new_object();
-        json_object_object_add(qo, "more_is", json_object_new_string(q.dir > 0 ? "up" : "down"));
+        json_object_object_add(qo, "more_is",
+                               json_object_new_string(q.dir > 0   ? "up"
+                                                      : q.dir < 0 ? "down"
+                                                                  : "none"));
+        if (q.reason)
+            json_object_object_add(qo, "does_not_converge", json_object_new_string(q.reason));
         json_object_object_add(qo, "factor", json_object_new_double(q.factor));
         json_object *steps = json_object_new_array();
         for (int k = 1; k <= 3; k++)
@@ -61,7 +66,9 @@ static void print_param(const gi_param_desc *d)
     }
     gi_param_quality q;
     char mark[64] = "";
-    if (gi_param_quality_of(d, &q) == 1)
+    if (gi_param_quality_of(d, &q) == 1 && q.dir == 0)
+        snprintf(mark, sizeof mark, " [does not converge: %.40s]", q.reason);
+    else if (gi_param_quality_of(d, &q) == 1)
         snprintf(mark, sizeof mark, " [quality: %s is better, x%g a step]",
                  q.dir > 0 ? "more" : "less", q.factor);
     printf("    %-12s %-5s default %-8s %-18s %s%s%s%s%s\n", d->name, cli_param_type_name(d->type),

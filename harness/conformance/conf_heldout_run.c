@@ -222,6 +222,10 @@ static void check_knob(conf_session *S, const conf_scene *sc, uint32_t size, con
         result_line(check, R_FAIL, NAN, NAN, "malformed quality mark '%s'", d->choices);
         return;
     }
+    if (q.dir == 0) { /* the method says it does not converge in this knob, and why */
+        result_line(check, R_NA, NAN, NAN, "does not converge in %s: %s", d->name, q.reason);
+        return;
+    }
     double worst = e0, prev = d->def;
     int used = snprintf(text, sizeof text, "%s %g: %.4g", d->name, d->def, e0);
     for (int k = 1; k <= 3; k++) {

@@ -83,6 +83,8 @@ static void check_quality(void)
         {"bad", GI_PARAM_INT, 1, 1, 64, "quality:up:1", NULL, "factor 1"},
         {"odd", GI_PARAM_FLOAT, 1, 1, 64, "more", NULL, "no mark"},
         {"filter", GI_PARAM_ENUM, 0, 0, 0, "quality:up:2", NULL, "an enum's choices"},
+        {"r", GI_PARAM_INT, 4, 1, 64, GI_QUALITY_NONE("bias grows with r"), NULL, "no converge"},
+        {"r2", GI_PARAM_INT, 4, 1, 64, "quality:none:", NULL, "no reason"},
         {0},
     };
     gi_param_quality m;
@@ -95,6 +97,9 @@ static void check_quality(void)
     CHECK(gi_param_quality_of(&q[3], &m) == -1 && gi_param_quality_step(&q[3], 5, 2) == 5);
     CHECK(gi_param_quality_of(&q[4], &m) == -1);
     CHECK(gi_param_quality_of(&q[5], &m) == 0 && gi_param_quality_of(&desc[0], &m) == 0);
+    CHECK(gi_param_quality_of(&q[6], &m) == 1 && m.dir == 0 &&
+          !strcmp(m.reason, "bias grows with r"));
+    CHECK(gi_param_quality_step(&q[6], 4, 3) == 4 && gi_param_quality_of(&q[7], &m) == -1);
     gi_error err;
     const char *kv[1] = {"N=20"};
     gi_params *p = gi_params_parse("iv", q, kv, 1, &err);

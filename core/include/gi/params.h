@@ -51,18 +51,22 @@ typedef struct gi_param_desc {
  *     {"N", GI_PARAM_INT, 16, 2, 256, GI_QUALITY_UP(2), "N (Sec. 4.1)", "..."},
  * `gibench conformance --held-out` raises every marked knob three steps
  * from its default and requires that the error does not grow beyond its
- * noise; `gibench methods` shows the marks. A method that cannot converge
- * in a knob leaves it unmarked and says why in its caps text. */
+ * noise; `gibench methods` shows the marks. A knob the method cannot
+ * converge in is marked GI_QUALITY_NONE("the reason"): the suite reports it
+ * n/a with that reason instead of sweeping it (never a silent pass). */
 #define GI_QUALITY_UP(factor) "quality:up:" #factor
 #define GI_QUALITY_DOWN(factor) "quality:down:" #factor
+#define GI_QUALITY_NONE(reason) "quality:none:" reason
 
 typedef struct gi_param_quality {
-    int dir;       /* +1: larger is better; -1: smaller is better */
-    double factor; /* > 1: the ratio of one step */
+    int dir;            /* +1: larger is better; -1: smaller is better; 0: does not converge */
+    double factor;      /* > 1: the ratio of one step (1 when dir is 0) */
+    const char *reason; /* dir 0: why it does not converge; else NULL */
 } gi_param_quality;
 
 /* 1 and *q when d is a marked int/float parameter, 0 when it carries no
- * mark, -1 when its mark is malformed (not "quality:up|down:F", F > 1). */
+ * mark, -1 when its mark is malformed (not "quality:up|down:F" with F > 1,
+ * nor "quality:none:" with a reason). */
 int gi_param_quality_of(const gi_param_desc *d, gi_param_quality *q);
 /* The value `steps` quality steps better than `from` (from itself when
  * steps is 0), clamped to the range; ints change by at least 1 a step.
