@@ -67,7 +67,7 @@ expect(2 "matches --variants" conformance --held-out ${OUT}/held_out/a --variant
 # the trivial-answer check can fail: a black image is no better than black
 set(ENV{GIBENCH_PLUGIN_PATH} ${FAKES})
 execute_process(COMMAND ${GIB} -q conformance --held-out ${OUT}/held_out/a --method fake_conf_liar
-                        --variants ceiling --no-converge --json --size 32
+                        --variants furnace_in,furnace_out,ceiling --no-converge --json --size 32
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 file(WRITE ${OUT}/held_out/liar.json "${out}")
 if(NOT rc EQUAL 1)
