@@ -261,3 +261,55 @@ char *gi_params_to_string(const gi_params *p)
     }
     return s;
 }
+
+int gi_param_quality_of(const gi_param_desc *d, gi_param_quality *q)
+{
+    if (!d || (d->type != GI_PARAM_INT && d->type != GI_PARAM_FLOAT) || !d->choices)
+        return 0;
+    const char *s = d->choices;
+    int dir = 0;
+    if (!strncmp(s, "quality:none:", 13)) {
+        if (!s[13])
+            return -1; /* a knob that does not converge says why */
+        if (q) {
+            q->dir = 0;
+            q->factor = 1.0;
+            q->reason = s + 13;
+        }
+        return 1;
+    }
+    if (!strncmp(s, "quality:up:", 11))
+        dir = 1;
+    else if (!strncmp(s, "quality:down:", 13))
+        dir = -1;
+    else
+        return -1;
+    const char *f = s + (dir > 0 ? 11 : 13);
+    char *end = NULL;
+    double factor = strtod(f, &end);
+    if (end == f || *end || !(factor > 1.0) || !isfinite(factor))
+        return -1;
+    if (q) {
+        q->dir = dir;
+        q->factor = factor;
+        q->reason = NULL;
+    }
+    return 1;
+}
+
+double gi_param_quality_step(const gi_param_desc *d, double from, int steps)
+{
+    gi_param_quality q;
+    if (gi_param_quality_of(d, &q) != 1 || q.dir == 0)
+        return from;
+    double v = from;
+    for (int k = 0; k < steps; k++) {
+        double next = q.dir > 0 ? v * q.factor : v / q.factor;
+        if (d->type == GI_PARAM_INT) {
+            /* an int step moves by at least one, so a small default still rises */
+            next = q.dir > 0 ? fmax(round(next), v + 1.0) : fmin(round(next), v - 1.0);
+        }
+        v = fmin(fmax(next, d->min), d->max);
+    }
+    return v;
+}

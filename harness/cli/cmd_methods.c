@@ -25,6 +25,23 @@ static json_object *param_json(const gi_param_desc *d)
         json_object_object_add(p, "min", json_object_new_double(d->min));
         json_object_object_add(p, "max", json_object_new_double(d->max));
     }
+    gi_param_quality q;
+    if (gi_param_quality_of(d, &q) == 1) { /* a quality knob (params.h) */
+        json_object *qo = json_object_new_object();
+        json_object_object_add(qo, "more_is",
+                               json_object_new_string(q.dir > 0   ? "up"
+                                                      : q.dir < 0 ? "down"
+                                                                  : "none"));
+        if (q.reason)
+            json_object_object_add(qo, "does_not_converge", json_object_new_string(q.reason));
+        json_object_object_add(qo, "factor", json_object_new_double(q.factor));
+        json_object *steps = json_object_new_array();
+        for (int k = 1; k <= 3; k++)
+            json_object_array_add(steps,
+                                  json_object_new_double(gi_param_quality_step(d, d->def, k)));
+        json_object_object_add(qo, "steps", steps);
+        json_object_object_add(p, "quality", qo);
+    }
     json_object_object_add(p, "symbol", json_object_new_string(d->symbol ? d->symbol : ""));
     json_object_object_add(p, "help", json_object_new_string(d->help ? d->help : ""));
     return p;
@@ -47,9 +64,16 @@ static void print_param(const gi_param_desc *d)
         snprintf(range, sizeof range, "[%g, %g]", d->min, d->max);
         break;
     }
-    printf("    %-12s %-5s default %-8s %-18s %s%s%s%s\n", d->name, cli_param_type_name(d->type),
+    gi_param_quality q;
+    char mark[64] = "";
+    if (gi_param_quality_of(d, &q) == 1 && q.dir == 0)
+        snprintf(mark, sizeof mark, " [does not converge: %.40s]", q.reason);
+    else if (gi_param_quality_of(d, &q) == 1)
+        snprintf(mark, sizeof mark, " [quality: %s is better, x%g a step]",
+                 q.dir > 0 ? "more" : "less", q.factor);
+    printf("    %-12s %-5s default %-8s %-18s %s%s%s%s%s\n", d->name, cli_param_type_name(d->type),
            def, range, d->help ? d->help : "", d->symbol ? " (" : "", d->symbol ? d->symbol : "",
-           d->symbol ? ")" : "");
+           d->symbol ? ")" : "", mark);
 }
 
 int cmd_methods(int argc, char **argv)

@@ -118,7 +118,12 @@ static const command_help helps[] = {
      "The conformance suite on every method (or M): closed emitting sphere = Le * sum rho^k for "
      "its\n"
      "bounce count, finiteness, determinism, caps honesty, parameter checks.\n"
-     "  --json   as JSON   --size N   image size   --item-timeout S   seconds per check\n"},
+     "  --json   as JSON   --size N   image size   --item-timeout S   seconds per check\n"
+     "  --held-out SEED|DIR   the held-out family of SEED (scripts/held_out.py) or of a folder it\n"
+     "                        made: both furnaces, beats black and direct by 2x, converges in "
+     "its\n"
+     "                        quality knobs\n"
+     "  --variants a,b        held-out variants to run   --no-converge   skip the knob sweeps\n"},
     {"view",
      "usage: gibench view --scene S [--method M|reference] [options]\n"
      "The interactive viewer: a window (GLFW, OpenGL 4.5 core) showing a method's image of the "

@@ -261,7 +261,8 @@ static json_object *table_json(const gi_method *const *ms, uint32_t count,
 
 /* The command line into o; child and from for --run-items and --from.
  * EXIT_OK, or an exit code after printing why. */
-static int parse_args(int argc, char **argv, conf_opts *o, int *child, unsigned long *from)
+static int parse_args(int argc, char **argv, conf_opts *o, int *child, unsigned long *from,
+                      const char **item)
 {
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -270,6 +271,21 @@ static int parse_args(int argc, char **argv, conf_opts *o, int *child, unsigned 
             o->json = 1;
         } else if (!strcmp(a, "--run-items")) {
             *child = 1;
+        } else if (!strcmp(a, "--no-converge")) {
+            o->no_converge = 1;
+        } else if (!strcmp(a, "--held-out-item")) { /* the held-out child: DIR FILE */
+            if (i + 2 >= argc)
+                return cli_fail(EXIT_USAGE, "conformance: %s needs a folder and a file", a);
+            o->held_out = argv[++i];
+            *item = argv[++i];
+        } else if (!strcmp(a, "--held-out") || !strcmp(a, "--variants")) {
+            if (!v)
+                return cli_fail(EXIT_USAGE, "conformance: %s needs a value", a);
+            i++;
+            if (!strcmp(a, "--held-out"))
+                o->held_out = v;
+            else
+                o->variants = v;
         } else if (!strcmp(a, "--method") || !strcmp(a, "--size") || !strcmp(a, "--item-timeout") ||
                    !strcmp(a, "--from")) {
             if (!v)
@@ -380,12 +396,18 @@ static int check_methods(const conf_opts *o, const gi_method *const *ms, uint32_
 
 int cmd_conformance(int argc, char **argv)
 {
-    conf_opts o = {NULL, 32, 60.0, 0};
+    conf_opts o = {NULL, 32, 60.0, 0, NULL, NULL, 0};
     int child = 0;
     unsigned long from = 0;
-    int rc = parse_args(argc, argv, &o, &child, &from);
+    const char *item = NULL;
+    int rc = parse_args(argc, argv, &o, &child, &from, &item);
     if (rc != EXIT_OK)
         return rc;
+    if (item) {
+        if (!o.method)
+            return cli_fail(EXIT_USAGE, "conformance: --held-out-item needs --method");
+        return conf_held_out_item(&o, o.held_out, item);
+    }
     if (child) {
         if (!o.method)
             return cli_fail(EXIT_USAGE, "conformance: --run-items needs --method");
@@ -398,7 +420,7 @@ int cmd_conformance(int argc, char **argv)
     uint32_t count = 0;
     rc = pick_methods(&o, reg, ms, &count);
     if (rc == EXIT_OK)
-        rc = check_methods(&o, ms, count);
+        rc = o.held_out ? conf_held_out(&o, ms, count) : check_methods(&o, ms, count);
     gi_plugins_free(reg);
     return rc;
 }

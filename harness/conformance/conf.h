@@ -33,6 +33,9 @@ typedef struct conf_opts {
     uint32_t size;
     double item_timeout;
     int json;
+    const char *held_out; /* --held-out SEED or folder; NULL: the shipped suite */
+    const char *variants; /* --variants a,b: the held-out variants to run; NULL: all */
+    int no_converge;      /* --no-converge: skip the knob sweeps */
 } conf_opts;
 
 /* The items of method m, in the fixed order that --from counts in;
@@ -100,6 +103,22 @@ conf_status conf_set(conf_result *r, conf_status s, const char *fmt, ...);
 /* Runs item `it` in session S (which holds a GPU, except for
  * unknown_params) into r. */
 conf_status conf_run_item(conf_session *S, const conf_opts *o, const conf_item *it, conf_result *r);
+
+/* The furnace check on the closed emitting sphere at `path` (albedo rho,
+ * Le = 1, camera at its centre), as the furnace_* rows run it. */
+conf_status conf_check_furnace_file(conf_session *S, const conf_opts *o, const char *path,
+                                    double rho, conf_result *r);
+
+/* ---- the held-out family (conf_heldout.c, conf_heldout_run.c) */
+
+#define CONF_TRUTH GIBENCH_SOURCE_DIR "/tests/data/truth"
+#define CONF_HELD_OUT_SCRIPT GIBENCH_SOURCE_DIR "/scripts/held_out.py"
+#define CONF_MAX_KNOBS 16
+
+/* gibench conformance --held-out SEED|DIR: the family's checks for ms[0..count). */
+int conf_held_out(const conf_opts *o, const gi_method *const *ms, uint32_t count);
+/* The child of one (method, scene): --held-out-item DIR FILE. */
+int conf_held_out_item(const conf_opts *o, const char *dir, const char *file);
 
 /* ---- the child (conf_child.c) */
 

@@ -79,9 +79,16 @@ static int pick_scene(conf_session *S, char *path, size_t size, conf_scene *sc, 
 static conf_status check_furnace(conf_session *S, const conf_opts *o, const char *arg,
                                  conf_result *r)
 {
-    char path[512], why[256];
+    char path[512];
     snprintf(path, sizeof path, "%s/furnace_%s.gltf", CONF_DATA, arg);
-    double rho = atof(arg) / 100.0, Le = 1.0;
+    return conf_check_furnace_file(S, o, path, atof(arg) / 100.0, r);
+}
+
+conf_status conf_check_furnace_file(conf_session *S, const conf_opts *o, const char *path,
+                                    double rho, conf_result *r)
+{
+    char why[256];
+    double Le = 1.0;
     conf_scene sc;
     if (!conf_scene_open(S, path, 0.0f, &sc))
         return fail_why(r, S);

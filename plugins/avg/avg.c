@@ -33,9 +33,9 @@
 #define AVG_LOD_ERROR 0.02f
 
 static const gi_param_desc avg_params[] = {
-    {"grid", GI_PARAM_INT, 64, 4, 512, NULL, "AVG resolution (Sec. III-A, 64^3)",
+    {"grid", GI_PARAM_INT, 64, 4, 512, GI_QUALITY_UP(1.5), "AVG resolution (Sec. III-A, 64^3)",
      "voxels per axis of the grid"},
-    {"vpls", GI_PARAM_INT, 1024, 1, 65536, NULL, "N_VPL (Sec. IV, 1024)",
+    {"vpls", GI_PARAM_INT, 1024, 1, 65536, GI_QUALITY_UP(2), "N_VPL (Sec. IV, 1024)",
      "VPL slots: N_VPL / (B + 1) light paths, each with a VPL on the light and at up to B hits"},
     {"bounces", GI_PARAM_INT, 3, 0, 3, NULL, "bounces (Sec. IV, 3)",
      "indirect bounces B (VPLs at hits 1..B)"},

@@ -81,9 +81,9 @@ typedef struct csm {
 } csm;
 
 static const gi_param_desc csm_params[] = {
-    {"N", GI_PARAM_INT, 16, 2, 256, NULL, "N (Sec. 4.1)",
+    {"N", GI_PARAM_INT, 16, 2, 256, GI_QUALITY_UP(1.5), "N (Sec. 4.1)",
      "directions per dimension of the lat-long grid: N_theta = N_phi = N, N^2 maps per object"},
-    {"M", GI_PARAM_INT, 128, 8, 1024, NULL, "M (Sec. 3)", "depth map size M x M"},
+    {"M", GI_PARAM_INT, 128, 8, 1024, GI_QUALITY_UP(1.5), "M (Sec. 3)", "depth map size M x M"},
     {"enumeration", GI_PARAM_ENUM, 2, 0, 0, "scanline|zigzag|hilbert|diagonal", "Sec. 4.4",
      "order of the maps in the codec"},
     {"depth", GI_PARAM_ENUM, 0, 0, 0, "z2|z3|sphere", "Sec. 3.1",
@@ -99,7 +99,7 @@ static const gi_param_desc csm_params[] = {
      "thickness of that shell as a fraction of the object's bounding-sphere radius"},
     {"filter", GI_PARAM_ENUM, 0, 0, 0, "nearest|pcf|rr", "Sec. 4.5",
      "nearest map and texel; generalised PCF (4 maps x 4 texels); Russian roulette over those 16"},
-    {"S", GI_PARAM_INT, 16, 1, 1024, NULL, "S (Sec. 5.1)",
+    {"S", GI_PARAM_INT, 16, 1, 1024, GI_QUALITY_UP(2), "S (Sec. 5.1)",
      "environment samples per pixel and frame"},
     {"bias", GI_PARAM_FLOAT, 0.01, 0, 1, NULL, "bias (Sec. 6)",
      "depth bias as a fraction of the bounding-sphere radius"},

@@ -29,10 +29,10 @@
 #include <stdlib.h>
 
 static const gi_param_desc cssm_params[] = {
-    {"atlas", GI_PARAM_INT, 32, 8, 128, NULL, "atlas resolution (Sec. 3.2.3, Table 2)",
+    {"atlas", GI_PARAM_INT, 32, 8, 128, GI_QUALITY_UP(2), "atlas resolution (Sec. 3.2.3, Table 2)",
      "the illumination atlas is atlas x atlas texels; each texel is a surface sample, a cube map "
      "and a leaf"},
-    {"M", GI_PARAM_INT, 16, 4, 64, NULL, "6 x M x M (Sec. 3.2.1, Table 2)",
+    {"M", GI_PARAM_INT, 16, 4, 64, GI_QUALITY_UP(2), "6 x M x M (Sec. 3.2.1, Table 2)",
      "cube face size of the CSSM depth cube maps"},
     {"traversal", GI_PARAM_ENUM, 2, 0, 0, "greedy|zigzag|spiral|greedy_atlas",
      "Sec. 3.2.3, Fig. 6/7",

@@ -28,9 +28,9 @@ typedef struct direct {
 } direct;
 
 static const gi_param_desc direct_params[] = {
-    {"light_samples", GI_PARAM_INT, 16, 1, 4096, NULL, "S (area lights)",
+    {"light_samples", GI_PARAM_INT, 16, 1, 4096, GI_QUALITY_UP(2), "S (area lights)",
      "area-light samples per pixel and frame"},
-    {"env_samples", GI_PARAM_INT, 16, 0, 4096, NULL, "S (environment)",
+    {"env_samples", GI_PARAM_INT, 16, 0, 4096, GI_QUALITY_UP(2), "S (environment)",
      "environment-map samples per pixel and frame (and as many BRDF samples with mis)"},
     {"mis", GI_PARAM_BOOL, 1, 0, 1, NULL, NULL,
      "combine environment and BRDF sampling (power heuristic)"},

@@ -43,11 +43,11 @@
 extern const gi_shader_source gi_implicit_vis_shaders[];
 
 static const gi_param_desc iv_params[] = {
-    {"N", GI_PARAM_INT, 12, 1, 32, NULL, "N (Sec. 4.2.2, 6 x N x N bins; Table 1: 8, 12, 16)",
-     "bins per cube-map side of every node"},
+    {"N", GI_PARAM_INT, 12, 1, 32, GI_QUALITY_UP(1.5),
+     "N (Sec. 4.2.2, 6 x N x N bins; Table 1: 8, 12, 16)", "bins per cube-map side of every node"},
     {"bounces", GI_PARAM_INT, 3, 0, 3, NULL, "light bounces (Algorithm 1, line 8)",
      "indirect bounces after the direct light (Table 1: 1)"},
-    {"subdiv", GI_PARAM_FLOAT, 1.0, 0.01, 100.0, NULL, "Sec. 4.2.2",
+    {"subdiv", GI_PARAM_FLOAT, 1.0, 0.01, 100.0, GI_QUALITY_DOWN(2), "Sec. 4.2.2",
      "a node is subdivided while its solid angle seen from the other end exceeds this many bins' "
      "solid angle"},
     {"links", GI_PARAM_ENUM, 0, 0, 0, "hierarchical|brute", "Sec. 4.2 / 3.1 (Fig. 10 b, c)",

@@ -37,15 +37,15 @@ typedef struct vlf {
 } vlf;
 
 static const gi_param_desc vlf_params[] = {
-    {"l", GI_PARAM_INT, 128, 8, 1024, NULL, "l (Sec. 2.1)",
+    {"l", GI_PARAM_INT, 128, 8, 1024, GI_QUALITY_UP(2), "l (Sec. 2.1)",
      "bi-directional directions spread over the hemisphere"},
-    {"N", GI_PARAM_INT, 64, 8, 256, NULL, "N (Sec. 2.1)",
+    {"N", GI_PARAM_INT, 64, 8, 256, GI_QUALITY_UP(2), "N (Sec. 2.1)",
      "rays per side of each parallel subfield (N x N)"},
     {"m", GI_PARAM_INT, 8, 1, 64, NULL, "m (Sec. 2.1)",
      "cells per side of a tile of non-diffuse storage; N must be a multiple"},
     {"S", GI_PARAM_INT, 2, 1, 8, NULL, "RI super-sampling (Sec. 3.3)",
      "radiance interface cells per subfield cell and side: transport on (N S)^2 rays"},
-    {"density", GI_PARAM_FLOAT, 12, 1, 64, NULL, "texel density",
+    {"density", GI_PARAM_FLOAT, 12, 1, 64, GI_QUALITY_UP(1.5), "texel density",
      "diffuse elements per unit length, the scene scaled into the unit sphere (faces get k x k "
      "elements, k <= 64)"},
     {"iterations", GI_PARAM_INT, 8, 1, 64, NULL, "iterations (Sec. 6)",

@@ -71,9 +71,46 @@ static void check_undeclared(void)
     gi_params_free(p);
 }
 
+/* Quality marks (params.h): direction and factor read back, three steps
+ * rounded and clamped, an int step at least one, a malformed mark refused,
+ * and a marked row still parses as before. */
+static void check_quality(void)
+{
+    static const gi_param_desc q[] = {
+        {"N", GI_PARAM_INT, 12, 1, 32, GI_QUALITY_UP(1.5), NULL, "bins"},
+        {"subdiv", GI_PARAM_FLOAT, 1.0, 0.01, 100.0, GI_QUALITY_DOWN(2), NULL, "threshold"},
+        {"k", GI_PARAM_INT, 1, 1, 64, GI_QUALITY_UP(1.2), NULL, "small"},
+        {"bad", GI_PARAM_INT, 1, 1, 64, "quality:up:1", NULL, "factor 1"},
+        {"odd", GI_PARAM_FLOAT, 1, 1, 64, "more", NULL, "no mark"},
+        {"filter", GI_PARAM_ENUM, 0, 0, 0, "quality:up:2", NULL, "an enum's choices"},
+        {"r", GI_PARAM_INT, 4, 1, 64, GI_QUALITY_NONE("bias grows with r"), NULL, "no converge"},
+        {"r2", GI_PARAM_INT, 4, 1, 64, "quality:none:", NULL, "no reason"},
+        {0},
+    };
+    gi_param_quality m;
+    CHECK(gi_param_quality_of(&q[0], &m) == 1 && m.dir == 1 && m.factor == 1.5);
+    CHECK(gi_param_quality_step(&q[0], 12, 1) == 18 && gi_param_quality_step(&q[0], 12, 2) == 27);
+    CHECK(gi_param_quality_step(&q[0], 12, 3) == 32); /* 40.5 clamped to max */
+    CHECK(gi_param_quality_of(&q[1], &m) == 1 && m.dir == -1 && m.factor == 2.0);
+    CHECK_NEAR(gi_param_quality_step(&q[1], 1.0, 3), 0.125, 1e-12);
+    CHECK(gi_param_quality_step(&q[2], 1, 3) == 4); /* 1.2 rounds to 1: one more a step */
+    CHECK(gi_param_quality_of(&q[3], &m) == -1 && gi_param_quality_step(&q[3], 5, 2) == 5);
+    CHECK(gi_param_quality_of(&q[4], &m) == -1);
+    CHECK(gi_param_quality_of(&q[5], &m) == 0 && gi_param_quality_of(&desc[0], &m) == 0);
+    CHECK(gi_param_quality_of(&q[6], &m) == 1 && m.dir == 0 &&
+          !strcmp(m.reason, "bias grows with r"));
+    CHECK(gi_param_quality_step(&q[6], 4, 3) == 4 && gi_param_quality_of(&q[7], &m) == -1);
+    gi_error err;
+    const char *kv[1] = {"N=20"};
+    gi_params *p = gi_params_parse("iv", q, kv, 1, &err);
+    CHECK(p && gi_params_int(p, "N") == 20);
+    gi_params_free(p);
+}
+
 int main(void)
 {
     check_undeclared();
+    check_quality();
     gi_error err;
     gi_params *p = parse(NULL, NULL, &err);
     CHECK(p != NULL);

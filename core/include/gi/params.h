@@ -30,12 +30,48 @@ typedef enum gi_param_type {
 typedef struct gi_param_desc {
     const char *name; /* [a-z0-9_]+, e.g. "N", "vpls", "filter" */
     gi_param_type type;
-    double def;          /* default (enum: index into choices) */
-    double min, max;     /* inclusive range (int, float) */
-    const char *choices; /* enum only: "nearest|pcf|rr" */
-    const char *symbol;  /* the paper's symbol or section, e.g. "N (Sec. 4.1)" */
-    const char *help;    /* one line */
+    double def;      /* default (enum: index into choices) */
+    double min, max; /* inclusive range (int, float) */
+    /* enum: the choices, "nearest|pcf|rr". int and float: NULL, or the
+     * parameter's quality mark (GI_QUALITY_UP / GI_QUALITY_DOWN below). */
+    const char *choices;
+    const char *symbol; /* the paper's symbol or section, e.g. "N (Sec. 4.1)" */
+    const char *help;   /* one line */
 } gi_param_desc;
+
+/* Quality marks (issue 28; docs/conformance.md "Converges"). A quality knob
+ * is an int or float parameter along which the method should get closer to
+ * the truth: sample counts, bins, atlas or grid resolution, direction
+ * counts. Its mark, written in the `choices` slot of its row (unused by
+ * numbers, so the table's layout and every unmarked row stay as they are),
+ * says which way is "more" and the step: one step multiplies the value by
+ * `factor` (UP, factor > 1) or divides it by `factor` (DOWN: smaller is
+ * finer, e.g. a subdivision threshold), rounded for ints to at least one
+ * more (or less) than before and clamped to [min, max].
+ *     {"N", GI_PARAM_INT, 16, 2, 256, GI_QUALITY_UP(2), "N (Sec. 4.1)", "..."},
+ * `gibench conformance --held-out` raises every marked knob three steps
+ * from its default and requires that the error does not grow beyond its
+ * noise; `gibench methods` shows the marks. A knob the method cannot
+ * converge in is marked GI_QUALITY_NONE("the reason"): the suite reports it
+ * n/a with that reason instead of sweeping it (never a silent pass). */
+#define GI_QUALITY_UP(factor) "quality:up:" #factor
+#define GI_QUALITY_DOWN(factor) "quality:down:" #factor
+#define GI_QUALITY_NONE(reason) "quality:none:" reason
+
+typedef struct gi_param_quality {
+    int dir;            /* +1: larger is better; -1: smaller is better; 0: does not converge */
+    double factor;      /* > 1: the ratio of one step (1 when dir is 0) */
+    const char *reason; /* dir 0: why it does not converge; else NULL */
+} gi_param_quality;
+
+/* 1 and *q when d is a marked int/float parameter, 0 when it carries no
+ * mark, -1 when its mark is malformed (not "quality:up|down:F" with F > 1,
+ * nor "quality:none:" with a reason). */
+int gi_param_quality_of(const gi_param_desc *d, gi_param_quality *q);
+/* The value `steps` quality steps better than `from` (from itself when
+ * steps is 0), clamped to the range; ints change by at least 1 a step.
+ * from when d carries no valid mark. */
+double gi_param_quality_step(const gi_param_desc *d, double from, int steps);
 
 /* The longest parameter name kept by gi_params_check's message, with its NUL. */
 #define GI_PARAM_NAME_MAX 64
