@@ -56,6 +56,8 @@ uint64_t gi_scene_object_hash(const gi_scene *s, uint32_t object)
         if (o->morph_normals)
             XXH64_update(st, o->morph_normals, n * sizeof(float));
         XXH64_update(st, o->morph_weights, o->morph_count * sizeof(float));
+        if (o->morph_flat)
+            XXH64_update(st, o->morph_flat, o->triangle_count);
         if (o->morph_track.count) {
             XXH64_update(st, o->morph_track.times, o->morph_track.count * sizeof(float));
             XXH64_update(st, o->morph_track.values,

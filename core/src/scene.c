@@ -7,6 +7,8 @@
 
 #include "gi/scene.h"
 
+#include "gi/log.h"
+
 #include "gi/envmap.h"
 #include "gi/image.h"
 #include "gltf_shim.h"
@@ -121,6 +123,11 @@ gi_scene *gi_scene_load_memory(const void *data, size_t size, int binary, const 
         return NULL;
     }
     gi_scene_bounds_at(s, 0.0f, s->bounds);
+    if (s->camera_count == 0) /* said once, where the scene is loaded (issue 28) */
+        gi_log(GI_LOG_WARN,
+               "%s: no camera; using the default camera (looking down -Z at the centre of the "
+               "bounds, the bounding sphere filling its 45-degree field of view)",
+               name);
     return s;
 }
 
@@ -178,6 +185,7 @@ void gi_scene_free(gi_scene *s)
         free(s->objects[i].morph_positions);
         free(s->objects[i].morph_normals);
         free(s->objects[i].morph_weights);
+        free(s->objects[i].morph_flat);
         free_track(&s->objects[i].morph_track);
     }
     free(s->objects);
@@ -474,6 +482,33 @@ gi_vec3 gi_scene_vertex_position(const gi_scene *s, uint32_t vertex, float t)
     return gi_v3((float)p[0], (float)p[1], (float)p[2]);
 }
 
+/* A primitive without NORMAL has flat normals at every weight (glTF 2.0
+ * §3.7.2.1): the face normal of the morphed triangle, on its three own
+ * vertices (the loader unshared them). */
+static void flat_face_normals(const gi_scene *s, const gi_object *o, gi_vertex *out)
+{
+    for (uint32_t t = 0; t < o->triangle_count; t++) {
+        if (!o->morph_flat[t])
+            continue;
+        const uint32_t *idx = s->indices + 3 * ((size_t)o->first_triangle + t);
+        gi_vertex *v[3] = {&out[idx[0] - o->first_vertex], &out[idx[1] - o->first_vertex],
+                           &out[idx[2] - o->first_vertex]};
+        double e1[3], e2[3];
+        for (int c = 0; c < 3; c++) {
+            e1[c] = (double)v[1]->position[c] - v[0]->position[c];
+            e2[c] = (double)v[2]->position[c] - v[0]->position[c];
+        }
+        double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                       e1[0] * e2[1] - e1[1] * e2[0]};
+        double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(l > 0.0) || !isfinite(l))
+            continue; /* degenerate at these weights: the rest normal stays */
+        for (int j = 0; j < 3; j++)
+            for (int c = 0; c < 3; c++)
+                v[j]->normal[c] = (float)(n[c] / l);
+    }
+}
+
 void gi_scene_object_vertices(const gi_scene *s, uint32_t object, float t, gi_vertex *out)
 {
     assert(s && object < s->object_count && out);
@@ -511,6 +546,8 @@ void gi_scene_object_vertices(const gi_scene *s, uint32_t object, float t, gi_ve
     }
     if (w != wbuf)
         free(w);
+    if (o->morph_flat)
+        flat_face_normals(s, o, out);
 }
 
 void gi_scene_triangle_world(const gi_scene *s, uint32_t tri, float t, gi_vec3 p[3])
