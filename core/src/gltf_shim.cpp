@@ -1050,8 +1050,8 @@ void Converter::warn_reduced(size_t i, const std::string &name) const
     const tinygltf::PbrMetallicRoughness &pbr = mt.pbrMetallicRoughness;
     std::vector<std::string> dropped;
     if (pbr.metallicFactor > 0.0)
-        dropped.push_back(fmt("metallicFactor %g (rendered as metallic 0: diffuse)",
-                              pbr.metallicFactor));
+        dropped.push_back(
+            fmt("metallicFactor %g (rendered as metallic 0: diffuse)", pbr.metallicFactor));
     if (pbr.metallicRoughnessTexture.index >= 0)
         dropped.push_back("metallicRoughnessTexture (ignored)");
     if (mt.normalTexture.index >= 0)
