@@ -771,7 +771,7 @@ struct MeshData {
 /* An object's morph data, moved into the gi_object by build(). */
 struct ObjectMorph {
     std::vector<float> pos, nrm, weights; /* target-major; nrm empty if none */
-    std::vector<uint8_t> flat;            /* MeshData::flat of a morphing mesh */
+    std::vector<uint8_t> flat;            /* MeshData::flat: flat-normal triangles */
 };
 
 struct Track {
@@ -1938,8 +1938,7 @@ void Converter::add_object(int node)
         if (md.morph_normals)
             om.nrm.insert(om.nrm.end(), md.tnrm[k].begin(), md.tnrm[k].end());
     }
-    if (md.morph_count)
-        om.flat = md.flat;
+    om.flat = md.flat;
     objects.push_back(o);
     object_morphs.push_back(std::move(om));
     const std::string &mesh_name = m.meshes[static_cast<size_t>(nd.mesh)].name;
@@ -2240,14 +2239,13 @@ void Converter::copy_objects(gi_scene *s) const
         s->objects[i].morph_positions = nullptr;
         s->objects[i].morph_normals = nullptr;
         s->objects[i].morph_weights = nullptr;
-        s->objects[i].morph_flat = nullptr;
         s->objects[i].morph_track = gi_track();
+        s->objects[i].flat_triangles = copy_array(object_morphs[i].flat);
         if (objects[i].morph_count) {
             const ObjectMorph &om = object_morphs[i];
             s->objects[i].morph_positions = copy_array(om.pos);
             s->objects[i].morph_normals = copy_array(om.nrm);
             s->objects[i].morph_weights = copy_array(om.weights);
-            s->objects[i].morph_flat = copy_array(om.flat);
             fill_track(&s->objects[i].morph_track,
                        nodes[static_cast<size_t>(objects[i].node)].weights);
         }

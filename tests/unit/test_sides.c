@@ -12,7 +12,11 @@
  *    G-buffer's normal facing the eye. With GI_RT_ALL_FACES the near half
  *    is hit, as the old code hit it always;
  *  - sphere_out_ds.gltf: a double-sided sphere wound outward is hit from
- *    its centre, gi_side says GI_SIDE_BACK and reverses the normal. */
+ *    its centre, gi_side says GI_SIDE_BACK and reverses the normal;
+ *  - a triangle without NORMAL under a mirroring node (scale z = -1): its
+ *    flat normal points out of the front in world space (glTF: a negative
+ *    determinant reverses the winding), and a morphing one gets the face
+ *    normal of its morphed corners. */
 #include "check.h"
 #include "gpu_fixture.h"
 #include "gi/gpu.h"
@@ -170,8 +174,79 @@ static void test_raster_single_sided(const gi_scene *s, gi_gpu_scene *gs, const 
     gi_depth_renderer_free(dr);
 }
 
+/* Standard base64 of n bytes into out (4 (n + 2) / 3 characters + NUL). */
+static void base64(const unsigned char *d, size_t n, char *out)
+{
+    static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    for (size_t i = 0; i < n; i += 3) {
+        uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0) |
+                     (i + 2 < n ? d[i + 2] : 0);
+        *out++ = tab[v >> 18 & 63];
+        *out++ = tab[v >> 12 & 63];
+        *out++ = i + 1 < n ? tab[v >> 6 & 63] : '=';
+        *out++ = i + 2 < n ? tab[v & 63] : '=';
+    }
+    *out = '\0';
+}
+
+static void test_mirrored_and_morphed_flat(void)
+{
+    /* One triangle (0,0,0) (1,0,0) (0,1,0) without NORMAL; a morph target
+     * lifting corner 2 by +Z. Node 0 mirrors it (scale z = -1), node 1
+     * morphs it at weight 1. */
+    const float data[18] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1};
+    char b64[128], json[2048];
+    base64((const unsigned char *)data, sizeof data, b64);
+    snprintf(json, sizeof json,
+             "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}],"
+             "\"nodes\":[{\"mesh\":0,\"scale\":[1,1,-1]},{\"mesh\":1,\"translation\":[3,0,0]}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]},"
+             "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"targets\":[{\"POSITION\":1}]}],"
+             "\"weights\":[1]}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":"
+             "\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,"
+             "\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[0,0,1]}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,"
+             "\"byteLength\":36}],\"buffers\":[{\"byteLength\":72,\"uri\":"
+             "\"data:application/octet-stream;base64,%s\"}]}",
+             b64);
+    gi_error err;
+    gi_scene *s = gi_scene_load_memory(json, strlen(json), 0, NULL, "mirror.gltf", &err);
+    CHECK_MSG(s != NULL, "%s", err.text);
+    if (!s)
+        return;
+    CHECK(s->object_count == 2);
+    gi_rt *rt = NULL;
+    CHECK_MSG(gi_rt_create(s, 0.0f, &rt, &err) == GI_OK, "%s", err.text);
+    if (rt) {
+        /* The mirrored triangle: world corners wind counter-clockwise seen
+         * from +Z, so its front and its world shading normal are +Z. */
+        gi_rt_hit h;
+        CHECK(gi_rt_intersect(rt, gi_v3(0.2f, 0.2f, 1.0f), gi_v3(0, 0, -1), 0, INFINITY, &h) &&
+              h.object == 0 && h.ng.z > 0.99f);
+        CHECK(!gi_rt_intersect(rt, gi_v3(0.2f, 0.2f, -1.0f), gi_v3(0, 0, 1), 0, INFINITY, &h));
+        const float *n = gi_rt_normals(rt);
+        uint32_t v0 = s->objects[0].first_vertex;
+        printf("mirrored flat triangle: world shading normal %.3f %.3f %.3f\n", n[3 * v0],
+               n[3 * v0 + 1], n[3 * v0 + 2]);
+        CHECK(n[3 * v0 + 2] > 0.99f);
+    }
+    gi_rt_free(rt);
+    gi_vertex out[3];
+    CHECK(s->objects[1].vertex_count == 3);
+    gi_scene_object_vertices(s, 1, 0.0f, out);
+    const float r = 0.70710678f; /* cross((1,0,0), (0,1,1)) / sqrt 2 */
+    printf("morphed flat triangle: normal %.3f %.3f %.3f\n", out[0].normal[0], out[0].normal[1],
+           out[0].normal[2]);
+    for (int k = 0; k < 3; k++)
+        CHECK(fabsf(out[k].normal[0]) < 1e-5f && fabsf(out[k].normal[1] + r) < 1e-5f &&
+              fabsf(out[k].normal[2] - r) < 1e-5f);
+    gi_scene_free(s);
+}
+
 int main(void)
 {
+    test_mirrored_and_morphed_flat();
     test_flat_normals();
     test_rt_double_sided();
     gi_gpu *gpu;

@@ -130,9 +130,12 @@ typedef struct gi_object {
     float *morph_normals; /* same layout; NULL when no target has NORMAL (normals not displaced) */
     float *morph_weights; /* morph_count default weights */
     /* Per triangle, 1 where the primitive had no NORMAL (flat normals): such
-     * a triangle owns its three vertices and gi_scene_object_vertices gives
-     * them the face normal of the morphed positions. NULL when none. */
-    uint8_t *morph_flat;
+     * a triangle owns its three vertices, which carry its front face normal
+     * (reversed in object-local space when the node's determinant is
+     * negative, so that the world normal points out of the front); with
+     * morph targets gi_scene_object_vertices recomputes it from the morphed
+     * corners. NULL when the object has none. */
+    uint8_t *flat_triangles;
     gi_track morph_track; /* count 0 when the weights are not animated */
 } gi_object;
 
