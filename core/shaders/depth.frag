@@ -3,6 +3,7 @@
 // linear depth into channel k of the map (colour mask) and into u_prev's
 // successor for the next pass.
 in vec3 v_eye;
+flat in uint v_cull; // depth.vert: 0 both sides, 1 cull back faces, 2 cull front (mirrored)
 
 uniform int u_metric;   // 0 eye z, 1 radial
 uniform int u_peel;     // 0 for the first surface
@@ -13,6 +14,10 @@ layout(location = 1) out float o_next;  // this pass's depth, read by the next
 
 void main()
 {
+    // The one rule for sides (gi/scene.h): a single-sided back face is no
+    // surface, so it casts no shadow and hides nothing.
+    if (v_cull != 0u && gl_FrontFacing == (v_cull == 2u))
+        discard;
     float d = u_metric == 1 ? length(v_eye) : -v_eye.z;
     if (u_peel > 0) {
         float prev = texelFetch(u_prev, ivec2(gl_FragCoord.xy), 0).r;
