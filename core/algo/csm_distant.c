@@ -89,8 +89,12 @@ gi_result gi_csm_distant_build(const gi_gpu_scene *gs, uint32_t object,
         out->sphere[3] = 1e-6f;
     const float shell = (desc && desc->shell > 0.0f ? desc->shell : 0.01f) * out->sphere[3];
     const uint32_t N = out->n_theta * out->n_phi;
-    gi_depth_desc dd = {
-        .size = M, .surfaces = 2, .metric = GI_DEPTH_EYE_Z, .only_object = object + 1u, .local = 1};
+    gi_depth_desc dd = {.size = M,
+                        .surfaces = 2,
+                        .metric = GI_DEPTH_EYE_Z,
+                        .only_object = object + 1u,
+                        .local = 1,
+                        .receiver_side = 1 /* the maps answer rays cast from the receivers */};
     gi_depth_renderer *dr = gi_depth_renderer_create(&dd, err);
     if (!dr)
         return GI_ERR_GL;

@@ -51,7 +51,10 @@ gi_result csm_encode_maps(const gi_gpu_scene *gs, const csm_encode_desc *desc, c
                                           .metric = desc->metric,
                                           .only_object = desc->object + 1u,
                                           .local = 1,
-                                          .cull = 0},
+                                          .cull = 0,
+                                          /* the maps answer rays cast from
+                                             the receivers toward the light */
+                                          .receiver_side = 1},
                                 .count = desc->count,
                                 .streams = 1,
                                 .batch = desc->batch,
