@@ -120,7 +120,10 @@ typedef struct gi_depth_desc {
      * and the reference cast them): such a ray meets a single-sided triangle
      * only when its front faces the receiver, i.e. faces away from the eye,
      * so the map keeps the faces the eye sees from behind and drops those it
-     * sees from the front. Double-sided triangles are drawn either way. */
+     * sees from the front. Double-sided triangles are drawn either way.
+     * 2: both sides of every triangle (raw geometry), for a caller that
+     * needs the entry and exit depths of closed objects and applies the
+     * rule itself or states where it does not. */
     int receiver_side;
 } gi_depth_desc;
 
