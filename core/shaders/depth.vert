@@ -4,6 +4,7 @@
 
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in uint a_object;
+layout(location = 3) in uint a_material;
 
 uniform mat4 u_view;
 uniform mat4 u_proj;
@@ -12,6 +13,10 @@ uniform int u_local;      // 1: object-local space, transforms ignored
 uniform vec2 u_range;     // paraboloid near, far
 
 out vec3 v_eye;
+// The one rule for sides (gi/scene.h): 1 when a back face is no surface
+// (single-sided), 2 when in addition the local winding is mirrored (u_local
+// draws object-local corners, so a negative determinant is not applied).
+flat out uint v_cull;
 out float gl_ClipDistance[1];
 
 void main()
@@ -20,6 +25,9 @@ void main()
                               : gi_objects[a_object].world_from_local * vec4(a_position, 1.0);
     vec4 eye = u_view * world;
     v_eye = eye.xyz;
+    v_cull = gi_material_double_sided(a_material) ? 0u : 1u;
+    if (v_cull != 0u && u_local != 0 && determinant(mat3(gi_objects[a_object].world_from_local)) < 0.0)
+        v_cull = 2u;
     gl_ClipDistance[0] = 1.0;
     if (u_projection == 2) {
         // Paraboloid around -Z (Brabec et al. 2002): the hemisphere in front.

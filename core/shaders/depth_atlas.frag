@@ -3,10 +3,13 @@
 uniform int u_metric; // 0 eye z, 1 radial
 
 in vec3 v_eye;
+flat in uint v_single; // 1: single-sided material, its back faces are no surface (gi/scene.h)
 
 layout(location = 0) out float o_depth;
 
 void main()
 {
+    if (v_single != 0u && !gl_FrontFacing)
+        discard;
     o_depth = u_metric == 1 ? length(v_eye) : -v_eye.z;
 }

@@ -9,6 +9,7 @@
 
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in uint a_object;
+layout(location = 3) in uint a_material;
 
 uniform uvec2 u_grid;      // columns, rows
 uniform int u_projection;  // 1 perspective, 2 paraboloid
@@ -25,6 +26,7 @@ mat4 fetch_mat(int at)
 }
 
 out vec3 v_eye;
+flat out uint v_single; // the one rule for sides (gi/scene.h): back faces are no surface
 out float gl_ClipDistance[5];
 
 void main()
@@ -34,6 +36,7 @@ void main()
     int base = 1 + 9 * int(view); // vec4s: the info header, then 9 per view
     vec4 eye = fetch_mat(base) * world;
     v_eye = eye.xyz;
+    v_single = gi_material_double_sided(a_material) ? 0u : 1u;
     vec4 clip;
     float hemisphere = 1.0;
     if (u_projection == 2) {

@@ -20,13 +20,20 @@ layout(location = 5) out uvec4 o_ids;
 void main()
 {
     GiMaterial m = gi_materials[v_material];
-    vec3 n = normalize(v_normal);
-    // Shade the side the eye sees: walls seen from inside, thin sheets.
+    // The one rule for sides (gi/scene.h): the back of a single-sided
+    // triangle is no surface; the eye sees what lies behind it.
+    int side = gi_side_of(v_material, gl_FrontFacing);
+    if (side == 0)
+        discard;
+    // The back of a double-sided one has reversed normals; a shading normal
+    // that still faces away (smooth normals at a silhouette, a file whose
+    // normals disagree with its winding) is turned to the eye as well.
+    vec3 n = normalize(v_normal) * float(side);
     if (dot(n, u_eye - v_world) < 0.0)
         n = -n;
     bool mirror = (m.flags & GI_MATERIAL_MIRROR) != 0u;
-    // Emitters radiate from their front face (CCW), both faces if double-sided.
-    bool emits = gl_FrontFacing || (m.flags & GI_MATERIAL_DOUBLE_SIDED) != 0u;
+    // Front faces emit; back faces exist only when double-sided, and emit.
+    bool emits = true;
     o_position = vec4(v_world, v_eye_depth);
     o_normal = vec4(n, 0.0);
     o_albedo = vec4(gi_material_albedo(v_material, v_uv), mirror ? 1.0 : 0.0);

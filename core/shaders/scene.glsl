@@ -72,6 +72,17 @@ void gi_triangle_world(uint tri, out vec3 p0, out vec3 p1, out vec3 p2)
 // Does material m emit from both sides (glTF doubleSided)?
 bool gi_material_double_sided(uint m) { return (gi_materials[m].flags & GI_MATERIAL_DOUBLE_SIDED) != 0u; }
 
+// The one rule for sides (gi/scene.h) in a rasterised view or at a ray hit:
+// 1 the front, -1 the back of a double-sided material (normals reversed
+// before lighting), 0 the back of a single-sided one (no surface: discard,
+// or let the ray go on). `front` is gl_FrontFacing, or dot(ng, wo) > 0.
+int gi_side_of(uint m, bool front)
+{
+    if (front)
+        return 1;
+    return gi_material_double_sided(m) ? -1 : 0;
+}
+
 uint gi_triangle_material(uint tri) { return gi_vertices[gi_indices[3u * tri]].material; }
 
 // Lambert albedo of a material at texture coordinate uv.

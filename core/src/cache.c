@@ -49,6 +49,8 @@ uint64_t gi_scene_object_hash(const gi_scene *s, uint32_t object)
         uint32_t rel = s->indices[k] - o->first_vertex;
         XXH64_update(st, &rel, sizeof rel);
     }
+    if (o->flat_triangles) /* flat normals: recomputed under morphing */
+        XXH64_update(st, o->flat_triangles, o->triangle_count);
     if (o->morph_count) { /* the morph targets and their weights shape it too */
         size_t n = (size_t)o->morph_count * o->vertex_count * 3;
         XXH64_update(st, &o->morph_count, sizeof o->morph_count);

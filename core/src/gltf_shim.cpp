@@ -19,6 +19,7 @@
  */
 #include "gltf_shim.h"
 
+#include "gi/log.h"
 #include "gi/tonemap.h"
 
 #include <algorithm>
@@ -771,11 +772,15 @@ struct MeshData {
     bool morph_normals = false;
     std::vector<std::vector<float>> tpos, tnrm;
     std::vector<float> weights; /* mesh.weights, or zeros */
+    /* Per triangle: 1 when its primitive had no NORMAL (flat normals, own
+     * vertices); empty while every primitive had NORMAL. */
+    std::vector<uint8_t> flat;
 };
 
 /* An object's morph data, moved into the gi_object by build(). */
 struct ObjectMorph {
     std::vector<float> pos, nrm, weights; /* target-major; nrm empty if none */
+    std::vector<uint8_t> flat;            /* MeshData::flat: flat-normal triangles */
 };
 
 struct Track {
@@ -858,6 +863,7 @@ class Converter
     void convert_materials();
     void convert_material(size_t i);
     void read_phong(size_t i, gi_material *g);
+    void warn_reduced(size_t i, const std::string &name) const;
     int texture(int index, const std::string &pointer);
     void convert_texture(int index);
     void check_textures() const;
@@ -1041,6 +1047,36 @@ void Converter::convert_material(size_t i)
     read_phong(i, &g);
     materials.push_back(g);
     material_names.push_back(mt.name.empty() ? fmt("material%zu", i) : mt.name);
+    warn_reduced(i, material_names.back());
+}
+
+/* The material model is Lambert + an optional Phong lobe (gi/scene.h);
+ * whatever else a glTF material asks for is dropped, and said so, once per
+ * material and feature, so that a researcher's own scene is not silently
+ * rendered as something else (issue 28). */
+void Converter::warn_reduced(size_t i, const std::string &name) const
+{
+    const tinygltf::Material &mt = m.materials[i];
+    const tinygltf::PbrMetallicRoughness &pbr = mt.pbrMetallicRoughness;
+    std::vector<std::string> dropped;
+    if (pbr.metallicFactor > 0.0)
+        dropped.push_back(
+            fmt("metallicFactor %g (rendered as metallic 0: diffuse)", pbr.metallicFactor));
+    if (pbr.metallicRoughnessTexture.index >= 0)
+        dropped.push_back("metallicRoughnessTexture (ignored)");
+    if (mt.normalTexture.index >= 0)
+        dropped.push_back("normalTexture (ignored: vertex normals only)");
+    if (mt.occlusionTexture.index >= 0)
+        dropped.push_back("occlusionTexture (ignored)");
+    if (mt.emissiveTexture.index >= 0)
+        dropped.push_back("emissiveTexture (ignored: emissiveFactor only)");
+    if (mt.alphaMode == "BLEND" || mt.alphaMode == "MASK")
+        dropped.push_back("alphaMode " + mt.alphaMode + " (rendered opaque)");
+    for (const auto &e : mt.extensions)
+        if (e.first != "KHR_materials_emissive_strength")
+            dropped.push_back(e.first + " (ignored)");
+    for (const std::string &d : dropped)
+        gi_log(GI_LOG_WARN, "%s: material '%s': %s", c.name.c_str(), name.c_str(), d.c_str());
 }
 
 /* extras {"gibench": {"phong": {"ks": [r,g,b], "exponent": n}, "mirror": b}} */
@@ -1500,8 +1536,9 @@ void Converter::read_positions(const std::string &pp, int acc, std::vector<gi_ve
         }
 }
 
-/* Normals as given, normalised; missing or zero ones become the area-
- * weighted average of the adjacent faces' normals in this primitive. */
+/* Normals as given, normalised; zero ones in a NORMAL accessor (no
+ * direction given) become the area-weighted average of the adjacent faces'
+ * normals in this primitive. A primitive without NORMAL gets flat_normals. */
 void smooth_normals(std::vector<gi_vertex> *v, const std::vector<uint32_t> &idx,
                     const std::vector<bool> &need)
 {
@@ -1535,6 +1572,49 @@ void smooth_normals(std::vector<gi_vertex> *v, const std::vector<uint32_t> &idx,
             out[2] = 1.0f;
         }
     }
+}
+
+/* glTF 2.0 §3.7.2.1: "When normals are not specified, client
+ * implementations MUST calculate flat normals". Every triangle gets its own
+ * three vertices carrying its face normal (cross(p1 - p0, p2 - p0), the
+ * front of a counter-clockwise triangle); a degenerate one gets +Z. The
+ * morph displacements of the primitive (appended at first_vertex by
+ * read_targets) are unshared the same way. */
+void flat_normals(std::vector<gi_vertex> *v, std::vector<uint32_t> *idx, size_t first_vertex,
+                  MeshData *out)
+{
+    std::vector<gi_vertex> flat(idx->size());
+    for (size_t t = 0; t + 2 < idx->size(); t += 3) {
+        const float *a = (*v)[(*idx)[t]].position, *b = (*v)[(*idx)[t + 1]].position,
+                    *c = (*v)[(*idx)[t + 2]].position;
+        double e1[3], e2[3];
+        for (int k = 0; k < 3; k++) {
+            e1[k] = double(b[k]) - a[k];
+            e2[k] = double(c[k]) - a[k];
+        }
+        double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                       e1[0] * e2[1] - e1[1] * e2[0]};
+        double l = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (size_t j = 0; j < 3; j++) {
+            gi_vertex x = (*v)[(*idx)[t + j]];
+            for (int k = 0; k < 3; k++)
+                x.normal[k] = l > 0.0 && std::isfinite(l) ? static_cast<float>(n[k] / l)
+                                                          : (k == 2 ? 1.0f : 0.0f);
+            flat[t + j] = x;
+        }
+    }
+    for (size_t k = 0; k < out->morph_count; k++)
+        for (std::vector<float> *d : {&out->tpos[k], &out->tnrm[k]}) {
+            std::vector<float> seg(idx->size() * 3, 0.0f);
+            for (size_t i = 0; i < idx->size(); i++)
+                for (size_t c = 0; c < 3; c++)
+                    seg[i * 3 + c] = (*d)[(first_vertex + (*idx)[i]) * 3 + c];
+            d->resize(first_vertex * 3);
+            d->insert(d->end(), seg.begin(), seg.end());
+        }
+    *v = std::move(flat);
+    for (size_t i = 0; i < idx->size(); i++)
+        (*idx)[i] = static_cast<uint32_t>(i);
 }
 
 void Converter::read_normals(const std::string &pp, int acc, std::vector<gi_vertex> *v)
@@ -1728,8 +1808,16 @@ void Converter::convert_primitive(size_t mi, size_t k, MeshData *out)
     if (tex != -1)
         read_uvs(pp, tex, &v);
     read_indices(pp, prim, v.size(), &idx);
-    smooth_normals(&v, idx, need);
+    size_t first_vertex = out->vertices.size();
     read_targets(pp, prim, v.size(), k == 0, out);
+    if (nrm == -1)
+        flat_normals(&v, &idx, first_vertex, out);
+    else
+        smooth_normals(&v, idx, need);
+    if (nrm == -1 || !out->flat.empty()) {
+        out->flat.resize(out->indices.size() / 3, 0);
+        out->flat.resize((out->indices.size() + idx.size()) / 3, nrm == -1 ? 1 : 0);
+    }
 
     if (out->vertices.size() + v.size() > GI_MAX_VERTICES)
         fail(pp, fmt("mesh exceeds the limit of %u vertices", GI_MAX_VERTICES));
@@ -1865,6 +1953,7 @@ void Converter::add_object(int node)
         if (md.morph_normals)
             om.nrm.insert(om.nrm.end(), md.tnrm[k].begin(), md.tnrm[k].end());
     }
+    om.flat = md.flat;
     objects.push_back(o);
     object_morphs.push_back(std::move(om));
     const std::string &mesh_name = m.meshes[static_cast<size_t>(nd.mesh)].name;
@@ -2166,6 +2255,7 @@ void Converter::copy_objects(gi_scene *s) const
         s->objects[i].morph_normals = nullptr;
         s->objects[i].morph_weights = nullptr;
         s->objects[i].morph_track = gi_track();
+        s->objects[i].flat_triangles = copy_array(object_morphs[i].flat);
         if (objects[i].morph_count) {
             const ObjectMorph &om = object_morphs[i];
             s->objects[i].morph_positions = copy_array(om.pos);

@@ -198,6 +198,7 @@ gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi
     }
     glUniform1i(glGetUniformLocation(p, "u_metric"), (GLint)d->metric);
     glUniform1i(glGetUniformLocation(p, "u_local"), d->local);
+    glUniform1i(glGetUniformLocation(p, "u_receiver_side"), d->receiver_side);
     glUniform1i(glGetUniformLocation(p, "u_prev"), GI_TEX_CORE_DEPTH_PEEL);
     GLint loc_view = glGetUniformLocation(p, "u_view"),
           loc_proj = glGetUniformLocation(p, "u_proj");

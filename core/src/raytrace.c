@@ -21,6 +21,7 @@ struct gi_rt {
     RTCGeometry geom; /* NULL for a scene without triangles */
     float *pos;       /* Embree's vertex buffer: world positions, 3 floats a vertex */
     float *nrm;       /* world unit shading normals, 3 floats a vertex */
+    uint8_t *single;  /* per triangle: 1 when its material is single-sided (culled from behind) */
     float time;
     int moving; /* some object is animated or has morph targets */
     char version[32];
@@ -127,6 +128,62 @@ done:
     return res;
 }
 
+/* The one rule for sides (gi/scene.h): a single-sided triangle seen from
+ * its back does not exist for any ray. Embree calls this for every
+ * candidate hit of rtcIntersect* and rtcOccluded*; the front is the
+ * counter-clockwise side of the world-space corners (a node with a negative
+ * determinant mirrors them, which is the winding flip glTF asks for). */
+static void cull_back_faces(const struct RTCFilterFunctionNArguments *args)
+{
+    const gi_rt *rt = args->geometryUserPtr;
+    const gi_scene *s = rt->scene;
+    /* SOA packets of N lanes (rtcore_ray.h's RTCRayN_* / RTCHitN_* layout;
+     * those accessors are C++ only): ray dir_x, y, z at 4N, 5N, 6N floats,
+     * hit primID at 5N words. */
+    const unsigned n = args->N;
+    const float *ray = (const float *)args->ray;
+    const unsigned *hit = (const unsigned *)args->hit;
+    for (unsigned i = 0; i < n; i++) {
+        if (args->valid[i] != -1)
+            continue;
+        unsigned prim = hit[5 * n + i];
+        if (!rt->single[prim])
+            continue;
+        const uint32_t *idx = s->indices + 3 * (size_t)prim;
+        gi_vec3 p0 = gi_v3_load(rt->pos + 3 * (size_t)idx[0]);
+        gi_vec3 ng = gi_v3_cross(gi_v3_sub(gi_v3_load(rt->pos + 3 * (size_t)idx[1]), p0),
+                                 gi_v3_sub(gi_v3_load(rt->pos + 3 * (size_t)idx[2]), p0));
+        gi_vec3 d = gi_v3(ray[4 * n + i], ray[5 * n + i], ray[6 * n + i]);
+        if (gi_v3_dot(ng, d) >= 0.0f)
+            args->valid[i] = 0;
+    }
+}
+
+/* Per-triangle single-sided flags and the filter, unless GI_RT_ALL_FACES. */
+static gi_result set_culling(gi_rt *rt, unsigned flags, gi_error *err)
+{
+    const gi_scene *s = rt->scene;
+    if (flags & GI_RT_ALL_FACES)
+        return GI_OK;
+    int any = 0;
+    for (uint32_t m = 0; m < s->material_count; m++)
+        any |= !s->materials[m].double_sided;
+    if (!any)
+        return GI_OK;
+    rt->single = malloc(s->triangle_count);
+    if (!rt->single)
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "raytrace: out of memory (%u triangles)",
+                            s->triangle_count);
+    for (uint32_t t = 0; t < s->triangle_count; t++) {
+        uint32_t m = s->vertices[s->indices[3 * (size_t)t]].material;
+        rt->single[t] = m < s->material_count && !s->materials[m].double_sided;
+    }
+    rtcSetGeometryUserData(rt->geom, rt);
+    rtcSetGeometryIntersectFilterFunction(rt->geom, cull_back_faces);
+    rtcSetGeometryOccludedFilterFunction(rt->geom, cull_back_faces);
+    return GI_OK;
+}
+
 static gi_result commit(gi_rt *rt, gi_error *err)
 {
     if (rt->geom)
@@ -146,9 +203,10 @@ gi_result gi_rt_create_ex(const gi_scene *s, float time, unsigned flags, gi_rt *
 {
     if (out)
         *out = NULL;
-    if (flags & ~(unsigned)GI_RT_FAST_TRAVERSAL)
+    const unsigned known = (unsigned)GI_RT_FAST_TRAVERSAL | (unsigned)GI_RT_ALL_FACES;
+    if (flags & ~known)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "raytrace: unknown option bits 0x%x",
-                            flags & ~(unsigned)GI_RT_FAST_TRAVERSAL);
+                            flags & ~known);
     if (!s || !out)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "raytrace: %s is NULL",
                             !s ? "the scene" : "the output pointer");
@@ -207,6 +265,9 @@ gi_result gi_rt_create_ex(const gi_scene *s, float time, unsigned flags, gi_rt *
         if (res != GI_OK)
             goto fail;
         memcpy(ib, s->indices, (size_t)s->triangle_count * 3 * sizeof(unsigned));
+        res = set_culling(rt, flags, err);
+        if (res != GI_OK)
+            goto fail;
         rtcAttachGeometryByID(rt->rtc, rt->geom, 0);
     }
     res = commit(rt, err);
@@ -276,6 +337,7 @@ void gi_rt_free(gi_rt *rt)
     if (rt->device)
         rtcReleaseDevice(rt->device);
     free(rt->nrm);
+    free(rt->single);
     free(rt);
 }
 

@@ -7,6 +7,8 @@
 
 #include "gi/scene.h"
 
+#include "gi/log.h"
+
 #include "gi/envmap.h"
 #include "gi/image.h"
 #include "gltf_shim.h"
@@ -109,6 +111,28 @@ static int load_environment(gi_scene *s, const char *name, const char *pointer, 
     return 1;
 }
 
+static float object_handedness(const gi_scene *s, uint32_t object, float t);
+
+/* The loader computed flat normals in object-local space as
+ * cross(p1 - p0, p2 - p0); under a mirroring node transform the front is
+ * the other side (glTF: a negative determinant reverses the winding). */
+static void orient_flat_normals(gi_scene *s)
+{
+    for (uint32_t o = 0; o < s->object_count; o++) {
+        const gi_object *ob = &s->objects[o];
+        if (!ob->flat_triangles || object_handedness(s, o, 0.0f) > 0.0f)
+            continue;
+        for (uint32_t t = 0; t < ob->triangle_count; t++) {
+            if (!ob->flat_triangles[t])
+                continue;
+            for (int k = 0; k < 3; k++) {
+                float *n = s->vertices[s->indices[3 * ((size_t)ob->first_triangle + t) + k]].normal;
+                n[0] = -n[0], n[1] = -n[1], n[2] = -n[2];
+            }
+        }
+    }
+}
+
 gi_scene *gi_scene_load_memory(const void *data, size_t size, int binary, const char *base_dir,
                                const char *name, gi_error *err)
 {
@@ -131,6 +155,12 @@ gi_scene *gi_scene_load_memory(const void *data, size_t size, int binary, const 
         return NULL;
     }
     gi_scene_bounds_at(s, 0.0f, s->bounds);
+    orient_flat_normals(s);
+    if (s->camera_count == 0) /* said once, where the scene is loaded (issue 28) */
+        gi_log(GI_LOG_WARN,
+               "%s: no camera; using the default camera (looking down -Z at the centre of the "
+               "bounds, the bounding sphere filling its 45-degree field of view)",
+               name);
     return s;
 }
 
@@ -188,6 +218,7 @@ void gi_scene_free(gi_scene *s)
         free(s->objects[i].morph_positions);
         free(s->objects[i].morph_normals);
         free(s->objects[i].morph_weights);
+        free(s->objects[i].flat_triangles);
         free_track(&s->objects[i].morph_track);
     }
     free(s->objects);
@@ -484,6 +515,47 @@ gi_vec3 gi_scene_vertex_position(const gi_scene *s, uint32_t vertex, float t)
     return gi_v3((float)p[0], (float)p[1], (float)p[2]);
 }
 
+/* -1 when the object's world transform at t mirrors (negative
+ * determinant): glTF then reverses the winding, so the front face normal
+ * in object-local space is minus cross(p1 - p0, p2 - p0). */
+static float object_handedness(const gi_scene *s, uint32_t object, float t)
+{
+    float m[16];
+    gi_scene_object_transform(s, object, t, m);
+    float det = m[0] * (m[5] * m[10] - m[6] * m[9]) - m[4] * (m[1] * m[10] - m[2] * m[9]) +
+                m[8] * (m[1] * m[6] - m[2] * m[5]);
+    return det < 0.0f ? -1.0f : 1.0f;
+}
+
+/* A primitive without NORMAL has flat normals at every weight (glTF 2.0
+ * §3.7.2.1): the front face normal of the morphed triangle, on its three
+ * own vertices (the loader unshared them). */
+static void flat_face_normals(const gi_scene *s, uint32_t object, float time, gi_vertex *out)
+{
+    const gi_object *o = &s->objects[object];
+    float sign = object_handedness(s, object, time);
+    for (uint32_t t = 0; t < o->triangle_count; t++) {
+        if (!o->flat_triangles[t])
+            continue;
+        const uint32_t *idx = s->indices + 3 * ((size_t)o->first_triangle + t);
+        gi_vertex *v[3] = {&out[idx[0] - o->first_vertex], &out[idx[1] - o->first_vertex],
+                           &out[idx[2] - o->first_vertex]};
+        double e1[3], e2[3];
+        for (int c = 0; c < 3; c++) {
+            e1[c] = (double)v[1]->position[c] - v[0]->position[c];
+            e2[c] = (double)v[2]->position[c] - v[0]->position[c];
+        }
+        double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                       e1[0] * e2[1] - e1[1] * e2[0]};
+        double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(l > 0.0) || !isfinite(l))
+            continue; /* degenerate at these weights: the rest normal stays */
+        for (int j = 0; j < 3; j++)
+            for (int c = 0; c < 3; c++)
+                v[j]->normal[c] = sign * (float)(n[c] / l);
+    }
+}
+
 void gi_scene_object_vertices(const gi_scene *s, uint32_t object, float t, gi_vertex *out)
 {
     assert(s && object < s->object_count && out);
@@ -521,6 +593,8 @@ void gi_scene_object_vertices(const gi_scene *s, uint32_t object, float t, gi_ve
     }
     if (w != wbuf)
         free(w);
+    if (o->flat_triangles)
+        flat_face_normals(s, object, t, out);
 }
 
 void gi_scene_triangle_world(const gi_scene *s, uint32_t tri, float t, gi_vec3 p[3])

@@ -8,7 +8,10 @@
  *    side of wo (reflection is two-sided); the geometric normal decides
  *    which side a ray leaves from: a sampled direction on the other
  *    geometric side than wo carries nothing (no light through surfaces);
- *  - emitters radiate from their front face (CCW) only unless double-sided;
+ *  - the one rule for sides (gi/scene.h): gi_rt never reports the back of
+ *    a single-sided triangle (camera, bounce and shadow rays pass through
+ *    it), so a hit seen from behind is double-sided: its normals are turned
+ *    to wo and it emits (front and back) like its front;
  *  - gi_brdf (brdf.h) is the material, its mirror lobe a delta lobe.
  *
  * Path vertex d (d = 1 at the first hit) adds its emission (a path of

@@ -59,7 +59,7 @@ static void test_weights(const gi_scene *s)
 static void test_vertices(const gi_scene *s)
 {
     static const float quad[4][3] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
-    gi_vertex v[4];
+    gi_vertex v[6]; /* 'rigid' has no NORMAL: flat, 3 vertices a triangle */
     gi_scene_object_vertices(s, 0, 1.0f, v);
     float nl = sqrtf(0.25f * 0.25f + 1.0f);
     for (int i = 0; i < 4; i++) {
@@ -79,8 +79,9 @@ static void test_vertices(const gi_scene *s)
     CHECK_NEAR(v[0].position[2], 0.0f, 0.0);
     CHECK(s->vertices[s->objects[1].first_vertex + 2].position[0] == 1.0f);
     /* the rigid object is a plain copy */
+    CHECK(s->objects[2].vertex_count == 6);
     gi_scene_object_vertices(s, 2, 1.0f, v);
-    CHECK(memcmp(v, s->vertices + s->objects[2].first_vertex, sizeof v) == 0);
+    CHECK(memcmp(v, s->vertices + s->objects[2].first_vertex, 6 * sizeof *v) == 0);
     /* world triangle of 'posed' (translation 0, 0, -3): triangle 2 = (0, 1, 2) */
     gi_vec3 p[3];
     gi_scene_triangle_world(s, s->objects[1].first_triangle, 5.0f, p);

@@ -11,7 +11,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* All hit distances along a ray, sorted, up to max. */
+/* All hit distances along a ray, sorted, up to max: the surfaces the one
+ * rule for sides leaves (single-sided triangles seen from the front). */
 static int cast_all(const gi_scene *s, gi_vec3 o, gi_vec3 d, float *out, int max,
                     uint32_t *first_tri)
 {
@@ -24,6 +25,10 @@ static int cast_all(const gi_scene *s, gi_vec3 o, gi_vec3 d, float *out, int max
         gi_vec3 pv = gi_v3_cross(d, e2);
         float det = gi_v3_dot(e1, pv);
         if (fabsf(det) < 1e-12f)
+            continue;
+        /* The one rule for sides (gi/scene.h): det > 0 is the front (d
+         * against cross(e1, e2)); a single-sided back face is no surface. */
+        if (det < 0.0f && !s->materials[s->vertices[s->indices[3 * t]].material].double_sided)
             continue;
         gi_vec3 tv = gi_v3_sub(o, p[0]);
         float u = gi_v3_dot(tv, pv) / det;

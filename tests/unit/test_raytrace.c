@@ -42,12 +42,15 @@ typedef struct bf_hit {
 typedef struct bf_scene {
     uint32_t n;
     double (*p)[9];
+    uint8_t *single; /* the material is single-sided: culled from behind (gi/scene.h) */
 } bf_scene;
 
 static bf_scene bf_place(const gi_scene *s, float time)
 {
-    bf_scene b = {s->triangle_count, malloc((size_t)s->triangle_count * sizeof(double[9]))};
+    bf_scene b = {s->triangle_count, malloc((size_t)s->triangle_count * sizeof(double[9])),
+                  malloc(s->triangle_count ? s->triangle_count : 1)};
     for (uint32_t t = 0; t < s->triangle_count; t++) {
+        b.single[t] = !s->materials[s->vertices[s->indices[3 * (size_t)t]].material].double_sided;
         gi_vec3 p[3];
         gi_scene_triangle_world(s, t, time, p);
         for (int k = 0; k < 3; k++) {
@@ -61,8 +64,9 @@ static bf_scene bf_place(const gi_scene *s, float time)
 
 /* Moller-Trumbore in double on one triangle: t, or -1 for no hit. Also the
  * smallest barycentric (how close the ray passes to an edge), even for a
- * miss (negative then). */
-static double mt(const double *p, const double o[3], const double d[3], double *edge)
+ * miss (negative then). A single-sided triangle seen from its back (det <=
+ * 0: d along cross(e1, e2)) is no surface (gi/scene.h). */
+static double mt(const double *p, const double o[3], const double d[3], int single, double *edge)
 {
     double e1[3], e2[3], pv[3], tv[3], qv[3];
     for (int k = 0; k < 3; k++) {
@@ -75,7 +79,7 @@ static double mt(const double *p, const double o[3], const double d[3], double *
     pv[2] = d[0] * e2[1] - d[1] * e2[0];
     double det = e1[0] * pv[0] + e1[1] * pv[1] + e1[2] * pv[2];
     *edge = -1.0;
-    if (fabs(det) < 1e-300)
+    if (fabs(det) < 1e-300 || (single && det < 0.0))
         return -1.0;
     double u = (tv[0] * pv[0] + tv[1] * pv[1] + tv[2] * pv[2]) / det;
     qv[0] = tv[1] * e1[2] - tv[2] * e1[1];
@@ -99,7 +103,7 @@ static int bf_intersect(const bf_scene *b, gi_vec3 of, gi_vec3 df, double tmin, 
     *near_edge = 0;
     for (uint32_t i = 0; i < b->n; i++) {
         double edge;
-        double t = mt(b->p[i], o, d, &edge);
+        double t = mt(b->p[i], o, d, b->single[i], &edge);
         if (fabs(edge) < EDGE_EPS)
             *near_edge = 1;
         if (t >= tmin && t <= tmax && t < h->t) {
@@ -166,7 +170,8 @@ static void compare_ray(const gi_rt *rt, const gi_scene *s, const bf_scene *b, g
     if (h.triangle != bh.tri) {
         /* A tie: Embree's triangle is hit by the brute force too, at the same t. */
         double edge, o3[3] = {o.x, o.y, o.z}, d3[3] = {d.x, d.y, d.z};
-        double t2 = h.triangle < b->n ? mt(b->p[h.triangle], o3, d3, &edge) : -1.0;
+        double t2 =
+            h.triangle < b->n ? mt(b->p[h.triangle], o3, d3, b->single[h.triangle], &edge) : -1.0;
         if (t2 >= 0.0 && fabs(t2 - bh.t) <= 1e-4 * bh.t + 1e-6)
             st->ties++;
         else if (near_edge)
@@ -325,6 +330,7 @@ static void test_scene(const char *path, int rays)
         report(path, &st);
         test_threads(rt, s);
         free(b.p);
+        free(b.single);
     }
     gi_rt_free(rt);
     gi_scene_free(s);
@@ -376,6 +382,7 @@ static void test_handmade(void)
     CHECK(!gi_rt_occluded(rt, gi_v3(0, 0.2f, 0), gi_v3(1, 0, 0), 10.0f, INFINITY));
     CHECK(!gi_rt_intersect(rt, gi_v3(0, 0.2f, 0), gi_v3(1, 0, 0), 0.0f, 1.0f, &h));
     free(b.p);
+    free(b.single);
     gi_rt_free(rt);
     gi_scene_free(s);
 }
@@ -449,6 +456,7 @@ static void test_moving(void)
     random_rays(rt, s, &b, t1, 1000, 3, &st);
     report("cornell_moving after set_time", &st);
     free(b.p);
+    free(b.single);
     /* Back to t0: the very same hits as a BVH built at t0. */
     CHECK(gi_rt_set_time(rt, t0, &err) == GI_OK);
     uint32_t rng = gi_rng_init(11, 0, 1);
@@ -502,6 +510,7 @@ static void test_fast_traversal(void)
         random_rays(rt, s, &b, 0.0f, 3000, 7, &st);
         report("cornell_box.gltf, fast traversal", &st);
         free(b.p);
+        free(b.single);
     }
     gi_rt_free(rt);
     gi_scene_free(s);

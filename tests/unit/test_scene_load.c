@@ -33,16 +33,18 @@ static void test_quad(void)
     gi_scene *s = load(VALID "quad.gltf");
     if (!s)
         return;
-    CHECK(s->vertex_count == 4 && s->triangle_count == 2 && s->object_count == 1);
+    /* No NORMAL in the file: flat normals, so each triangle owns its three
+     * vertices (glTF 2.0 §3.7.2.1; issue 28). */
+    CHECK(s->vertex_count == 6 && s->triangle_count == 2 && s->object_count == 1);
     CHECK(s->material_count == 1 && s->node_count == 2 && s->camera_count == 1);
     CHECK(s->light_count == 0 && s->emitter_count == 0 && s->texture_count == 0);
     CHECK(s->animation_length == 0.0f && !s->objects[0].animated && !s->has_environment);
     CHECK(strcmp(s->objects[0].name, "quad") == 0 && strcmp(s->materials[0].name, "white") == 0);
     CHECK(strcmp(s->path, VALID "quad.gltf") == 0);
     const gi_object *o = &s->objects[0];
-    CHECK(o->first_vertex == 0 && o->vertex_count == 4 && o->first_triangle == 0 &&
+    CHECK(o->first_vertex == 0 && o->vertex_count == 6 && o->first_triangle == 0 &&
           o->triangle_count == 2 && o->node == 0);
-    for (uint32_t i = 0; i < 4; i++) { /* no NORMAL in the file: computed, +Z */
+    for (uint32_t i = 0; i < 6; i++) { /* no NORMAL in the file: the face normal, +Z */
         const gi_vertex *v = &s->vertices[i];
         CHECK(v->object == 0 && v->material == 0);
         CHECK_NEAR(v->normal[0], 0, TOL);
@@ -50,7 +52,9 @@ static void test_quad(void)
         CHECK_NEAR(v->normal[2], 1, TOL);
         CHECK(v->uv[0] == 0.0f && v->uv[1] == 0.0f);
     }
-    CHECK(s->indices[3] == 0 && s->indices[4] == 2 && s->indices[5] == 3);
+    CHECK(s->indices[3] == 3 && s->indices[4] == 4 && s->indices[5] == 5);
+    CHECK(memcmp(s->vertices[3].position, s->vertices[0].position, sizeof(float[3])) == 0 &&
+          memcmp(s->vertices[4].position, s->vertices[2].position, sizeof(float[3])) == 0);
     CHECK_NEAR(s->materials[0].albedo[1], 0.8, TOL);
     CHECK(s->materials[0].albedo_texture == -1 && s->materials[0].exponent == 0.0f &&
           !s->materials[0].mirror && !s->materials[0].double_sided);

@@ -113,6 +113,18 @@ typedef struct gi_depth_desc {
     const unsigned char
         *skip_objects; /* NULL = none; per object, 1: not drawn (with only_object 0);
                           read while the renderer draws, so it must outlive it */
+    /* Which side of a single-sided triangle exists (the one rule, gi/scene.h).
+     * 0: the side seen from the eye (a camera's view: a back face is no
+     * surface). 1: the side seen from the receivers, for a map that stands
+     * for shadow rays cast from the shaded points toward the eye (as gi_rt
+     * and the reference cast them): such a ray meets a single-sided triangle
+     * only when its front faces the receiver, i.e. faces away from the eye,
+     * so the map keeps the faces the eye sees from behind and drops those it
+     * sees from the front. Double-sided triangles are drawn either way.
+     * 2: both sides of every triangle (raw geometry), for a caller that
+     * needs the entry and exit depths of closed objects and applies the
+     * rule itself or states where it does not. */
+    int receiver_side;
 } gi_depth_desc;
 
 typedef struct gi_depth_renderer gi_depth_renderer;

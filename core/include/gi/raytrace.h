@@ -27,6 +27,13 @@
  * finite at t = ..."), because Embree silently drops such triangles and the scene
  * would show holes instead of failing.
  *
+ * Sides: the one rule of gi/scene.h. A triangle whose material is not
+ * doubleSided does not exist for a ray that reaches its back (the side its
+ * world-space corners wind clockwise): gi_rt_intersect* pass through it and
+ * gi_rt_occluded ignores it. A double-sided one is hit from both sides;
+ * gi_side (gi/scene.h) then says which side and turns the normals.
+ * GI_RT_ALL_FACES turns culling off.
+ *
  * Queries: gi_rt_intersect and gi_rt_occluded only read the committed BVH,
  * so any number of threads may query one gi_rt at once. gi_rt_set_time
  * rewrites the BVH and must not run while queries are in flight. The ray
@@ -75,7 +82,12 @@ enum {
      * neighboring primitives"). Hits otherwise agree to float rounding.
      * What Embree's own tutorial path tracer uses; the reference path
      * tracer's default (harness/reference/reference.h). */
-    GI_RT_FAST_TRAVERSAL = 1u << 0
+    GI_RT_FAST_TRAVERSAL = 1u << 0,
+    /* Every triangle is hit from both sides, whatever its material's
+     * doubleSided: raw geometry, for a caller that applies its own rule.
+     * Without it the one rule for sides (gi/scene.h) holds: a single-sided
+     * triangle is invisible to every ray that reaches its back. */
+    GI_RT_ALL_FACES = 1u << 1
 };
 /* gi_rt_create with options (GI_RT_*; 0 = gi_rt_create). An unknown bit is
  * GI_ERR_INVALID_ARGUMENT. */

@@ -11,6 +11,25 @@
  * it. Time-dependent state (animated objects, lights, cameras) is computed
  * on demand by the gi_scene_*_at(t) functions.
  *
+ * ==== THE ONE RULE FOR SIDES (glTF 2.0; every pass and every method) ====
+ * The front face of a triangle is the one whose world-space corners wind
+ * counter-clockwise (cross(p1 - p0, p2 - p0) points out of the front). A
+ * node with a negative determinant mirrors its corners, which reverses the
+ * local winding exactly as glTF asks: test facing on world-space corners.
+ *  - Material not doubleSided: a triangle seen from its back DOES NOT EXIST.
+ *    Camera, shadow, visibility and bounce rays and every rasterised view
+ *    (G-buffer, depth/shadow/cube maps, atlases, voxelisations used for
+ *    visibility) pass through it. It reflects and emits on its front only.
+ *  - Material doubleSided: both sides are the same surface. Seen from the
+ *    back, the geometric and shading normals are reversed before lighting;
+ *    an emissive double-sided triangle emits from both sides.
+ *  - A primitive without NORMAL has flat normals (the face normal).
+ * The core follows it everywhere: gi_rt culls (gi/raytrace.h), the
+ * G-buffer, depth maps and the depth atlas discard culled fragments, the
+ * reference path tracer applies it. Methods use gi_side / gi_side_normal
+ * below (C) or gi_side_of in core/shaders/scene.glsl (GLSL).
+ * =========================================================================
+ *
  * Conventions (fixed; see docs/scenes.md "Scene conventions"):
  *  - +Y up, right-handed, unit-free lengths. All quantities radiometric:
  *    emission is radiance, a point/spot light's intensity x colour is
@@ -105,6 +124,13 @@ typedef struct gi_object {
     float *morph_positions; /* morph_count x vertex_count x 3, object-local displacements */
     float *morph_normals; /* same layout; NULL when no target has NORMAL (normals not displaced) */
     float *morph_weights; /* morph_count default weights */
+    /* Per triangle, 1 where the primitive had no NORMAL (flat normals): such
+     * a triangle owns its three vertices, which carry its front face normal
+     * (reversed in object-local space when the node's determinant is
+     * negative, so that the world normal points out of the front); with
+     * morph targets gi_scene_object_vertices recomputes it from the morphed
+     * corners. NULL when the object has none. */
+    uint8_t *flat_triangles;
     gi_track morph_track; /* count 0 when the weights are not animated */
 } gi_object;
 
@@ -181,6 +207,29 @@ typedef struct gi_scene {
     float bounds[6];          /* world bounds at t = 0 */
 } gi_scene;
 
+/* The one rule for sides at one hit (see the top of this file). */
+typedef enum gi_side_kind {
+    GI_SIDE_NONE = 0,  /* single-sided seen from the back: no hit, the ray goes on */
+    GI_SIDE_FRONT = 1, /* the front: normals as they are */
+    GI_SIDE_BACK = -1, /* the back of a double-sided triangle: normals reversed */
+} gi_side_kind;
+
+/* Which side of a triangle with front geometric normal ng (any length) is
+ * seen along direction wo (from the surface towards the viewer, the
+ * previous path vertex or the light; any length). */
+static inline gi_side_kind gi_side(int double_sided, gi_vec3 ng, gi_vec3 wo)
+{
+    if (gi_v3_dot(ng, wo) > 0.0f)
+        return GI_SIDE_FRONT;
+    return double_sided ? GI_SIDE_BACK : GI_SIDE_NONE;
+}
+
+/* A normal (geometric or shading) as lighting must use it on that side. */
+static inline gi_vec3 gi_side_normal(gi_side_kind side, gi_vec3 n)
+{
+    return side == GI_SIDE_BACK ? gi_v3_scale(n, -1.0f) : n;
+}
+
 /* Loads and validates a .gltf or .glb file. On failure returns NULL and
  * writes "file: /json/path: reason" into err. */
 gi_scene *gi_scene_load(const char *path, gi_error *err);
@@ -206,8 +255,10 @@ int gi_scene_camera_animated(const gi_scene *s, int camera);
 int gi_scene_lights_animated(const gi_scene *s);
 /* World-space frame of punctual light i at time t. */
 gi_light_frame gi_scene_light_at(const gi_scene *s, uint32_t light, float t);
-/* Camera i at time t. With no camera in the file, camera -1 gives a default
- * view of the scene bounds from +Z. */
+/* Camera i at time t. Camera -1 is the default view (what a scene without
+ * a camera renders; the loader warns once): from +Z towards -Z, aimed at
+ * the centre of the bounds at t = 0, far enough that the bounding sphere fits
+ * the 45-degree vertical field of view. */
 gi_camera_frame gi_scene_camera_at(const gi_scene *s, int camera, float t);
 /* Index of the camera named `name`, or of "#k", or -1 when none matches. */
 int gi_scene_find_camera(const gi_scene *s, const char *name);

@@ -450,8 +450,13 @@ static int check_lossless(const bunny *bn)
 {
     const uint32_t N = bn->desc.n_theta, M = bn->desc.M;
     gi_error err;
-    gi_depth_desc dd = {
-        .size = M, .surfaces = 2, .metric = GI_DEPTH_EYE_Z, .only_object = bn->k + 1u, .local = 1};
+    /* the maps as plugins/csm/precompute.c renders them (receiver_side) */
+    gi_depth_desc dd = {.size = M,
+                        .surfaces = 2,
+                        .metric = GI_DEPTH_EYE_Z,
+                        .only_object = bn->k + 1u,
+                        .local = 1,
+                        .receiver_side = 2};
     gi_depth_renderer *dr = gi_depth_renderer_create(&dd, &err);
     if (!dr) {
         fprintf(stderr, "set-up failed: depth renderer: %s\n", err.text);
