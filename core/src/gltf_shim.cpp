@@ -1868,10 +1868,12 @@ void Converter::check_totals()
         const MeshData &md = mesh(nd.mesh);
         verts += md.vertices.size();
         tris += md.indices.size() / 3;
-        if (verts > GI_MAX_VERTICES)
-            fail(p, fmt("scene exceeds the limit of %u vertices", GI_MAX_VERTICES));
+        /* Triangles first: flat normals give every triangle its own three
+         * vertices, so the vertex limit (three per triangle) follows it. */
         if (tris > GI_MAX_TRIANGLES)
             fail(p, fmt("scene exceeds the limit of %u triangles", GI_MAX_TRIANGLES));
+        if (verts > GI_MAX_VERTICES)
+            fail(p, fmt("scene exceeds the limit of %u vertices", GI_MAX_VERTICES));
     }
     vertices.reserve(verts);
     indices.reserve(tris * 3);

@@ -120,6 +120,27 @@ static double lum(const float *e)
     return 0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2];
 }
 
+/* A random point in a random atlas texel, lifted off the surface; 0 for a
+ * point inside a closed object (a floor texel under a block): the first
+ * surface along the normal, both sides counted, is a back face. The truth
+ * lets shadow rays out of such points through the single-sided walls
+ * (gi/scene.h), and no renderer shades them, so they are left out. */
+static int pick_point(const cssm_atlas *a, gi_rt *raw, float lift, uint32_t *rng, gi_vec3 *x,
+                      gi_vec3 *n)
+{
+    const cssm_texel *t = &a->texels[gi_rng_next_u32(rng) % a->count];
+    gi_vec3 tu, tv;
+    gi_onb(t->n, &tu, &tv);
+    float side = sqrtf(t->area);
+    gi_vec3 p =
+        gi_v3_add(t->p, gi_v3_add(gi_v3_scale(tu, (gi_rng_next_float(rng) - 0.5f) * side * 0.9f),
+                                  gi_v3_scale(tv, (gi_rng_next_float(rng) - 0.5f) * side * 0.9f)));
+    *x = gi_v3_add(p, gi_v3_scale(t->n, lift));
+    *n = t->n;
+    gi_rt_hit h;
+    return !(gi_rt_intersect(raw, *x, t->n, 0.0f, INFINITY, &h) && gi_v3_dot(h.ng, t->n) > 0.0f);
+}
+
 /* The CSMs' error must be below `margin` x the better trivial answer's
  * (measured: cornell 0.15, all 0.40, env 0.50; the margins leave room for
  * the Monte Carlo noise of other seeds). */
@@ -154,25 +175,13 @@ static int run(const char *rel, int pixel_estimate, double margin)
     double se_csm = 0, se_pix = 0, se_unsh = 0, se_black = 0, sum_ref = 0, sum_csm = 0;
     uint32_t rng = gi_rng_init(11, 0, 0xd17u), n = 0, inside = 0;
     while (n < POINTS) {
-        const cssm_texel *t = &a.texels[gi_rng_next_u32(&rng) % a.count];
-        gi_vec3 tu, tv;
-        gi_onb(t->n, &tu, &tv);
-        float side = sqrtf(t->area);
-        gi_vec3 p = gi_v3_add(
-            t->p, gi_v3_add(gi_v3_scale(tu, (gi_rng_next_float(&rng) - 0.5f) * side * 0.9f),
-                            gi_v3_scale(tv, (gi_rng_next_float(&rng) - 0.5f) * side * 0.9f)));
-        gi_vec3 x = gi_v3_add(p, gi_v3_scale(t->n, lift));
-        /* Leave out points inside closed objects (floor texels under a
-         * block): the first surface along the normal, both sides counted,
-         * is a back face. The truth lets shadow rays out of them through
-         * the single-sided walls (gi/scene.h), and no renderer shades them. */
-        gi_rt_hit h;
-        if (gi_rt_intersect(raw, x, t->n, 0.0f, INFINITY, &h) && gi_v3_dot(h.ng, t->n) > 0.0f) {
+        gi_vec3 x, nrm;
+        if (!pick_point(&a, raw, lift, &rng, &x, &nrm)) {
             inside++;
             continue;
         }
         cssm_receiver rc = {
-            .x = x, .n = t->n, .self = -1, .kd = {GI_PI, GI_PI, GI_PI}}; /* f = 1: irradiance */
+            .x = x, .n = nrm, .self = -1, .kd = {GI_PI, GI_PI, GI_PI}}; /* f = 1: irradiance */
         float Ec[3] = {0, 0, 0}, Ep[3] = {0, 0, 0}, Er[3], Eu[3];
         cssm_csm_direct_eval(&d, s, &rc, 0, 1024, n, bias, 0, Ec);
         if (pixel_estimate) /* 16 frames of 16 new points each, averaged */
@@ -182,8 +191,8 @@ static int run(const char *rel, int pixel_estimate, double margin)
                 for (int j = 0; j < 3; j++)
                     Ep[j] += e[j] / 16.0f;
             }
-        traced(&d, s, rt, x, t->n, REF_SAMPLES, n, Er);
-        traced(&d, s, NULL, x, t->n, REF_SAMPLES, n + 7919u, Eu); /* its own samples */
+        traced(&d, s, rt, x, nrm, REF_SAMPLES, n, Er);
+        traced(&d, s, NULL, x, nrm, REF_SAMPLES, n + 7919u, Eu); /* its own samples */
         double r = lum(Er);
         se_csm += (lum(Ec) - r) * (lum(Ec) - r);
         se_pix += (lum(Ep) - r) * (lum(Ep) - r);
