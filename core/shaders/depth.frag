@@ -20,8 +20,12 @@ void main()
     // or with u_receiver_side from the receivers behind the map's surfaces
     // (a shadow ray cast toward the eye meets the face the eye sees from
     // behind).
+    // Mode 3: the first surface by the eye's rule, the later ones of both
+    // sides, so a closed object's exit (a back face from the eye) follows
+    // its entry and the pair is a closed interval.
     bool front = gl_FrontFacing != (v_cull == 2u);
-    if (v_cull != 0u && u_receiver_side != 2 && front == (u_receiver_side != 0))
+    bool both = u_receiver_side == 2 || (u_receiver_side == 3 && u_peel > 0);
+    if (v_cull != 0u && !both && front == (u_receiver_side == 1))
         discard;
     float d = u_metric == 1 ? length(v_eye) : -v_eye.z;
     if (u_peel > 0) {

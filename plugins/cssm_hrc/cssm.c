@@ -167,6 +167,10 @@ gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const 
                                           .only_object = opts->only_object,
                                           .local = opts->local,
                                           .cull = 0,
+                                          /* the entry by the eye's rule, then both
+                                           * sides: a closed object's dual depth lies
+                                           * between its entry and exit */
+                                          .receiver_side = 3,
                                           .skip_objects = opts->skip_objects},
                                 .count = 6 * N,
                                 .streams = 6,

@@ -172,6 +172,27 @@ static void test_raster_single_sided(const gi_scene *s, gi_gpu_scene *gs, const 
     free(map);
     glDeleteTextures(1, &tex);
     gi_depth_renderer_free(dr);
+
+    /* Mode 3 (dual depth): the first surface by the eye's rule (the far
+     * half), the second of either side; mode 2 starts at the near half. */
+    for (int mode = 2; mode <= 3; mode++) {
+        gi_depth_desc d2 = {
+            .size = W, .surfaces = 2, .metric = GI_DEPTH_EYE_Z, .receiver_side = mode};
+        gi_depth_renderer *r2 = gi_depth_renderer_create(&d2, &err);
+        CHECK_MSG(r2 != NULL, "%s", err.text);
+        if (!r2)
+            return;
+        GLuint t2 = gi_depth_texture_create(r2, 1);
+        CHECK(gi_depth_render(r2, gs, &dv, 1, t2, 0, &err) == GI_OK);
+        float *m2 = gi_depth_read_layer(t2, W, 0);
+        const float want = mode == 3 ? b->dist + b->radius : b->dist - b->radius;
+        printf("depth map, receiver_side %d: first surface %.4f (want %.4f)\n", mode,
+               m2 ? m2[i] : -1.0f, want);
+        CHECK(m2 && fabsf(m2[i] - want) < 0.05f * b->radius);
+        free(m2);
+        glDeleteTextures(1, &t2);
+        gi_depth_renderer_free(r2);
+    }
 }
 
 /* Standard base64 of n bytes into out (4 (n + 2) / 3 characters + NUL). */

@@ -123,7 +123,11 @@ typedef struct gi_depth_desc {
      * sees from the front. Double-sided triangles are drawn either way.
      * 2: both sides of every triangle (raw geometry), for a caller that
      * needs the entry and exit depths of closed objects and applies the
-     * rule itself or states where it does not. */
+     * rule itself or states where it does not.
+     * 3: the first surface as 0 (seen from the eye), every later peeled
+     * surface of both sides: a closed object's entry and exit bound a closed
+     * interval (dual depth), and a single-sided face the eye sees from
+     * behind still hides nothing in front of the first surface. */
     int receiver_side;
 } gi_depth_desc;
 
