@@ -113,22 +113,27 @@ static int load_environment(gi_scene *s, const char *name, const char *pointer, 
 
 static float object_handedness(const gi_scene *s, uint32_t object, float t);
 
-/* The loader computed flat normals in object-local space as
- * cross(p1 - p0, p2 - p0); under a mirroring node transform the front is
- * the other side (glTF: a negative determinant reverses the winding). */
-static void orient_flat_normals(gi_scene *s)
+/* glTF 2.0 (meshes): the determinant of a node's global transform defines
+ * the winding: counter-clockwise where it is positive, clockwise where it is
+ * negative, so a mirrored instance keeps its front where the mesh has it
+ * (Unity and Unreal do the same). Every pass tests facing on world-space
+ * corners (gi/scene.h), so the corners of each triangle of a mirroring
+ * object are stored in the reverse order: its world-space counter-clockwise
+ * side is then its front. Normals stay as they are: the normal matrix takes
+ * a local front normal (flat normals are computed on the file's order, in
+ * object-local space) to the world front. The handedness at t = 0 decides;
+ * an animation that changes it later is not followed. */
+static void mirror_winding(gi_scene *s)
 {
     for (uint32_t o = 0; o < s->object_count; o++) {
         const gi_object *ob = &s->objects[o];
-        if (!ob->flat_triangles || object_handedness(s, o, 0.0f) > 0.0f)
+        if (object_handedness(s, o, 0.0f) > 0.0f)
             continue;
         for (uint32_t t = 0; t < ob->triangle_count; t++) {
-            if (!ob->flat_triangles[t])
-                continue;
-            for (int k = 0; k < 3; k++) {
-                float *n = s->vertices[s->indices[3 * ((size_t)ob->first_triangle + t) + k]].normal;
-                n[0] = -n[0], n[1] = -n[1], n[2] = -n[2];
-            }
+            uint32_t *idx = s->indices + 3 * ((size_t)ob->first_triangle + t);
+            uint32_t k = idx[1];
+            idx[1] = idx[2];
+            idx[2] = k;
         }
     }
 }
@@ -155,7 +160,7 @@ gi_scene *gi_scene_load_memory(const void *data, size_t size, int binary, const 
         return NULL;
     }
     gi_scene_bounds_at(s, 0.0f, s->bounds);
-    orient_flat_normals(s);
+    mirror_winding(s);
     if (s->camera_count == 0) /* said once, where the scene is loaded (issue 28) */
         gi_log(GI_LOG_WARN,
                "%s: no camera; using the default camera (looking down -Z at the centre of the "
@@ -516,8 +521,7 @@ gi_vec3 gi_scene_vertex_position(const gi_scene *s, uint32_t vertex, float t)
 }
 
 /* -1 when the object's world transform at t mirrors (negative
- * determinant): glTF then reverses the winding, so the front face normal
- * in object-local space is minus cross(p1 - p0, p2 - p0). */
+ * determinant): glTF then reverses the winding (mirror_winding). */
 static float object_handedness(const gi_scene *s, uint32_t object, float t)
 {
     float m[16];
@@ -530,10 +534,12 @@ static float object_handedness(const gi_scene *s, uint32_t object, float t)
 /* A primitive without NORMAL has flat normals at every weight (glTF 2.0
  * §3.7.2.1): the front face normal of the morphed triangle, on its three
  * own vertices (the loader unshared them). */
-static void flat_face_normals(const gi_scene *s, uint32_t object, float time, gi_vertex *out)
+static void flat_face_normals(const gi_scene *s, uint32_t object, gi_vertex *out)
 {
     const gi_object *o = &s->objects[object];
-    float sign = object_handedness(s, object, time);
+    /* the corners of a mirroring object are stored reversed (mirror_winding):
+     * their cross product is minus the file's, the local front normal */
+    float sign = object_handedness(s, object, 0.0f);
     for (uint32_t t = 0; t < o->triangle_count; t++) {
         if (!o->flat_triangles[t])
             continue;
@@ -594,7 +600,7 @@ void gi_scene_object_vertices(const gi_scene *s, uint32_t object, float t, gi_ve
     if (w != wbuf)
         free(w);
     if (o->flat_triangles)
-        flat_face_normals(s, object, t, out);
+        flat_face_normals(s, object, out);
 }
 
 void gi_scene_triangle_world(const gi_scene *s, uint32_t tri, float t, gi_vec3 p[3])

@@ -240,17 +240,19 @@ static void test_mirrored_and_morphed_flat(void)
     gi_rt *rt = NULL;
     CHECK_MSG(gi_rt_create(s, 0.0f, &rt, &err) == GI_OK, "%s", err.text);
     if (rt) {
-        /* The mirrored triangle: world corners wind counter-clockwise seen
-         * from +Z, so its front and its world shading normal are +Z. */
+        /* The mirrored triangle: its local front is +Z; the node mirrors z, and
+         * glTF makes the winding clockwise under a negative determinant, so the
+         * front stays where the mesh has it, mirrored: -Z (world corners wind
+         * counter-clockwise seen from +Z, but that is now the back). */
         gi_rt_hit h;
-        CHECK(gi_rt_intersect(rt, gi_v3(0.2f, 0.2f, 1.0f), gi_v3(0, 0, -1), 0, INFINITY, &h) &&
-              h.object == 0 && h.ng.z > 0.99f);
-        CHECK(!gi_rt_intersect(rt, gi_v3(0.2f, 0.2f, -1.0f), gi_v3(0, 0, 1), 0, INFINITY, &h));
+        CHECK(gi_rt_intersect(rt, gi_v3(0.2f, 0.2f, -1.0f), gi_v3(0, 0, 1), 0, INFINITY, &h) &&
+              h.object == 0 && h.ng.z < -0.99f);
+        CHECK(!gi_rt_intersect(rt, gi_v3(0.2f, 0.2f, 1.0f), gi_v3(0, 0, -1), 0, INFINITY, &h));
         const float *n = gi_rt_normals(rt);
         uint32_t v0 = s->objects[0].first_vertex;
         printf("mirrored flat triangle: world shading normal %.3f %.3f %.3f\n", n[3 * v0],
                n[3 * v0 + 1], n[3 * v0 + 2]);
-        CHECK(n[3 * v0 + 2] > 0.99f);
+        CHECK(n[3 * v0 + 2] < -0.99f);
     }
     gi_rt_free(rt);
     gi_vertex out[3];

@@ -12,10 +12,14 @@
  * on demand by the gi_scene_*_at(t) functions.
  *
  * ==== THE ONE RULE FOR SIDES (glTF 2.0; every pass and every method) ====
- * The front face of a triangle is the one whose world-space corners wind
- * counter-clockwise (cross(p1 - p0, p2 - p0) points out of the front). A
- * node with a negative determinant mirrors its corners, which reverses the
- * local winding exactly as glTF asks: test facing on world-space corners.
+ * The front face of a triangle is the one whose corners, in the file's
+ * order, wind counter-clockwise in object-local space. A node whose global
+ * transform has a negative determinant makes the winding clockwise (glTF),
+ * so a mirrored instance keeps its front where the mesh has it. The loader
+ * stores the corners of such an object in the reverse order, so in every
+ * pass the front is the side where the stored world-space corners wind
+ * counter-clockwise (cross(p1 - p0, p2 - p0) points out of it): test facing
+ * on world-space corners.
  *  - Material not doubleSided: a triangle seen from its back DOES NOT EXIST.
  *    Camera, shadow, visibility and bounce rays and every rasterised view
  *    (G-buffer, depth/shadow/cube maps, atlases, voxelisations used for
