@@ -37,3 +37,47 @@ void gi_text_put(gi_text *t, const char *fmt, ...)
     gi_text_vput(t, fmt, ap);
     va_end(ap);
 }
+
+void gi_text_md(gi_text *t, const char *s)
+{
+    for (; *s; s++) {
+        if (*s == '<')
+            gi_text_put(t, "&lt;");
+        else if (*s == '>')
+            gi_text_put(t, "&gt;");
+        else if (*s == '&')
+            gi_text_put(t, "&amp;");
+        else if (*s == '|' || *s == '`' || *s == '\\')
+            gi_text_put(t, "\\%c", *s);
+        else
+            gi_text_put(t, "%c", *s == '\n' || *s == '\r' ? ' ' : *s);
+    }
+}
+
+void gi_text_md_code(gi_text *t, const char *s)
+{
+    gi_text_put(t, "`");
+    for (; *s; s++) {
+        if (*s == '|')
+            gi_text_put(t, "\\|");
+        else
+            gi_text_put(t, "%c", *s == '`' ? '\'' : *s == '\n' || *s == '\r' ? ' ' : *s);
+    }
+    gi_text_put(t, "`");
+}
+
+void gi_text_html(gi_text *t, const char *s)
+{
+    for (; *s; s++) {
+        if (*s == '<')
+            gi_text_put(t, "&lt;");
+        else if (*s == '>')
+            gi_text_put(t, "&gt;");
+        else if (*s == '&')
+            gi_text_put(t, "&amp;");
+        else if (*s == '"')
+            gi_text_put(t, "&quot;");
+        else
+            gi_text_put(t, "%c", *s == '\n' || *s == '\r' ? ' ' : *s);
+    }
+}
