@@ -6,14 +6,9 @@
 set(failures 0)
 include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
 include(${CMAKE_CURRENT_LIST_DIR}/study_signal.cmake)
-set(D ${OUT}/study_fresh_interrupt)
-file(REMOVE_RECURSE ${D})
-file(MAKE_DIRECTORY ${D})
+fresh_study_dir(study_fresh_interrupt)
 # enough frames that the render is still going when the signal comes
-file(WRITE ${D}/s.json "{\"name\": \"fresh\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
-  \"size\": [16, 16], \"frames\": 400, \"warmup\": 0, \"compare\": false,
-  \"methods\": [{\"method\": \"direct\", \"params\": {\"light_samples\": 1}}]}")
-set(S ${D}/out)
+coarse_study(${D}/s.json fresh 400 "[{\"method\": \"direct\", \"params\": {\"light_samples\": 1}}]")
 execute_process(COMMAND ${GIB} -q study ${D}/s.json --out ${S} WORKING_DIRECTORY ${ROOT}
                 RESULT_VARIABLE rc ERROR_VARIABLE err)
 file(GLOB results ${S}/runs/*/result.json)

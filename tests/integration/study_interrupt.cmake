@@ -7,9 +7,7 @@ set(failures 0)
 include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
 include(${CMAKE_CURRENT_LIST_DIR}/study_signal.cmake)
 set(ENV{GIBENCH_PLUGIN_PATH} "${FAKE_RUN}")
-set(D ${OUT}/study_interrupt)
-file(REMOVE_RECURSE ${D})
-file(MAKE_DIRECTORY ${D})
+fresh_study_dir(study_interrupt)
 # two hanging runs and one that is never reached before the signal
 function(study_file timeout)
     file(WRITE ${D}/hang.json "{\"name\": \"hang\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],

@@ -6,15 +6,10 @@
 set(failures 0)
 include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
 include(${CMAKE_CURRENT_LIST_DIR}/study_signal.cmake)
-set(D ${OUT}/study_retry_failed)
-file(REMOVE_RECURSE ${D})
-file(MAKE_DIRECTORY ${D})
+fresh_study_dir(study_retry_failed)
 # a quick run, then one slow enough to be killed while it renders
-file(WRITE ${D}/s.json "{\"name\": \"retry\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
-  \"size\": [16, 16], \"frames\": 1, \"warmup\": 0, \"compare\": false,
-  \"methods\": [{\"method\": \"direct\", \"params\": {\"light_samples\": 2}},
-               {\"method\": \"direct\", \"params\": {\"light_samples\": 1}, \"frames\": 400}]}")
-set(S ${D}/out)
+coarse_study(${D}/s.json retry 1 "[{\"method\": \"direct\", \"params\": {\"light_samples\": 2}},
+               {\"method\": \"direct\", \"params\": {\"light_samples\": 1}, \"frames\": 400}]")
 # start the study, wait for the slow run's render, SIGKILL that render alone
 signal_study("the study with a killed run" ${S} ${D}/s.json
              "k=$(ps -eo pid=,args= | grep -F \"$o/runs/\" | grep -F -- '--frames 400' | grep -v grep | awk '{print $1}'); [ -n \"$k\" ]"

@@ -26,3 +26,21 @@ endfunction()
 
 # The `ready` test of a study whose first run has started: a render log.
 set(RUN_STARTED "ls \"$o\"/runs/*/render.log >/dev/null 2>&1")
+
+# fresh_study_dir(<name>): D = ${OUT}/<name>, emptied; S = ${D}/out, the
+# study's output folder.
+macro(fresh_study_dir name)
+    set(D ${OUT}/${name})
+    file(REMOVE_RECURSE ${D})
+    file(MAKE_DIRECTORY ${D})
+    set(S ${D}/out)
+endmacro()
+
+# coarse_study(<file> <name> <frames> <methods>): writes a study of the
+# coarse Cornell box at 16 x 16, no warm-up, not compared, with `methods`
+# (its JSON list).
+function(coarse_study file name frames methods)
+    file(WRITE ${file} "{\"name\": \"${name}\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
+  \"size\": [16, 16], \"frames\": ${frames}, \"warmup\": 0, \"compare\": false,
+  \"methods\": ${methods}}")
+endfunction()
