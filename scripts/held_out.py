@@ -48,7 +48,7 @@ sys.path.insert(0, os.path.join(HERE, "..", "tests", "data"))
 sys.path.insert(0, os.path.join(HERE, "..", "tests", "data", "truth"))
 from gltf_writer import Mesh  # noqa: E402
 from gen_conformance import Writer, box, quad  # noqa: E402
-from gen_truth import block_flat, block_shared, drop_normals, room_walls  # noqa: E402
+from gen_truth import block_flat, block_shared, drop_normals, outward, room_walls  # noqa: E402
 
 GEN = "gibench scripts/held_out.py"
 VARIANTS = ("ceiling", "hanging", "flat", "inside_out", "punctual", "sky")
@@ -106,15 +106,6 @@ def tilted_quad(half, tilt_deg):
         out.add_vertex((x, y * c - z * s, y * s + z * c), (nx, ny * c - nz * s, ny * s + nz * c))
     out.idx = list(m.idx)
     return out
-
-
-def outward(m):
-    """m wound and normalled the other way."""
-    o = Mesh()
-    o.pos, o.nrm = list(m.pos), [-c for c in m.nrm]
-    for t in range(0, len(m.idx), 3):
-        o.idx += [m.idx[t], m.idx[t + 2], m.idx[t + 1]]
-    return o
 
 
 def mirrored_x(m):

@@ -19,6 +19,7 @@
  */
 #include "gltf_shim.h"
 
+#include "gi/json_keys.h"
 #include "gi/log.h"
 #include "gi/tonemap.h"
 
@@ -592,6 +593,15 @@ void check_before_tinygltf(const Context &c, const char *text, size_t n)
     Json j = Json::parse(text, text + n, nullptr, false);
     if (j.is_discarded() || !j.is_object())
         return; /* tinygltf reports the syntax error in its words */
+    /* tinygltf keeps the last of two equal keys without a word: refused, as
+     * a study's are (gi/json_keys.h) */
+    char path[512], key[256];
+    size_t line = 0;
+    int dup = gi_json_duplicate_key(text, n, path, sizeof path, key, sizeof key, &line);
+    if (dup < 0)
+        fail("/", "out of memory");
+    if (dup > 0)
+        fail(path, fmt("duplicate key '%s' (line %zu)", key, line));
     check_asset(j);
     check_required_extensions(j);
     check_uris(c, j, "buffers");

@@ -499,6 +499,24 @@ int cli_mkdirs(const char *path)
     return mkdir(buf, 0755) == 0 || errno == EEXIST;
 }
 
+int cli_temp_dir(const char *stem, char *out, size_t size)
+{
+    const char *dir = getenv("TMPDIR");
+    if (!dir || !dir[0])
+        dir = "/tmp";
+    int n = snprintf(out, size, "%s/%s-XXXXXX", dir, stem);
+    if (n < 0 || (size_t)n >= size) {
+        errno = ENAMETOOLONG;
+        return 0;
+    }
+    if (mkdtemp(out))
+        return 1;
+    int e = errno; /* glibc leaves its last guess in out: name the template */
+    snprintf(out, size, "%s/%s-XXXXXX", dir, stem);
+    errno = e;
+    return 0;
+}
+
 json_object *cli_read_json(const char *path)
 {
     size_t n;

@@ -43,6 +43,11 @@ int cli_add_out(const char *cmd, const char **outs, int *count, int max, const c
 
 /* mkdir -p; 1 on success. */
 int cli_mkdirs(const char *path);
+/* Makes a fresh private folder "$TMPDIR/<stem>-XXXXXX" (/tmp when TMPDIR is
+ * unset or empty, as mktemp(1) does) and writes its path to out. 1 on
+ * success; 0 with errno set and out holding the template that failed, for
+ * the caller's error message. */
+int cli_temp_dir(const char *stem, char *out, size_t size);
 /* Reads a JSON file (NULL if absent or malformed). */
 json_object *cli_read_json(const char *path);
 /* Reads a JSON file a user wrote (a study, a saved view) strictly

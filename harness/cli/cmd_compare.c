@@ -13,6 +13,8 @@
 #include <unistd.h>
 
 #define MAX_METHODS 32
+/* the failed methods' ids, ", "-separated: room for MAX_METHODS ids of 64 bytes */
+#define FAILED_LIST (MAX_METHODS * 66)
 #define MAX_PARAMS 64
 
 typedef struct compare_opts {
@@ -278,9 +280,10 @@ static json_object *run_method(const compare_opts *o, const gi_scene *scene, uin
     return rec;
 }
 
-/* Counts and reports a failed run; keeps the first GL renderer named. */
-static void note_outcome(json_object *rec, const gi_method *m, int *failures, char *renderer,
-                         size_t size)
+/* Counts and reports a failed run, adding its method to the failed list
+ * (the one-line verdict names them); keeps the first GL renderer named. */
+static void note_outcome(json_object *rec, const gi_method *m, int *failures, char *failed,
+                         size_t failed_size, char *renderer, size_t size)
 {
     json_object *st, *rn;
     if (json_object_object_get_ex(rec, "status", &st) &&
@@ -289,6 +292,8 @@ static void note_outcome(json_object *rec, const gi_method *m, int *failures, ch
         json_object *r;
         json_object_object_get_ex(rec, "reason", &r);
         fprintf(stderr, "gibench: warning: %s failed: %s\n", m->id, json_object_get_string(r));
+        size_t used = strlen(failed);
+        snprintf(failed + used, failed_size - used, "%s%s", used ? ", " : "", m->id);
     }
     if (!renderer[0] && json_object_object_get_ex(rec, "renderer", &rn))
         snprintf(renderer, size, "%s", json_object_get_string(rn));
@@ -348,10 +353,10 @@ static json_object *compare_meta(const compare_opts *o, int argc, char **argv, j
 }
 
 /* The references, every method's run and the report; *failures counts the
- * runs that failed. */
+ * runs that failed and failed (FAILED_LIST bytes) lists their methods. */
 static int run_comparison(const compare_opts *o, int argc, char **argv, const gi_scene *scene,
                           uint64_t scene_hash, const gi_method *const *methods, uint32_t n,
-                          int *failures)
+                          int *failures, char *failed)
 {
     cli_install_signal_handlers();
 
@@ -366,7 +371,7 @@ static int run_comparison(const compare_opts *o, int argc, char **argv, const gi
     char renderer[256] = "";
     for (uint32_t i = 0; i < n && !cli_interrupted; i++) {
         json_object *rec = run_method(o, scene, scene_hash, methods[i], ref_full, &made);
-        note_outcome(rec, methods[i], failures, renderer, sizeof renderer);
+        note_outcome(rec, methods[i], failures, failed, FAILED_LIST, renderer, sizeof renderer);
         json_object_array_add(runs, rec);
     }
     json_object *meta = compare_meta(o, argc, argv, runs, renderer, &made);
@@ -396,6 +401,7 @@ int cmd_compare(int argc, char **argv)
     const gi_method *methods[MAX_METHODS];
     uint32_t n = 0;
     int failures = 0;
+    char failed[FAILED_LIST] = "";
     rc = select_methods(&o, reg, methods, &n);
     if (rc == EXIT_OK)
         rc = check_params(&o, methods, n);
@@ -404,13 +410,15 @@ int cmd_compare(int argc, char **argv)
     if (rc == EXIT_OK && !cli_mkdirs(o.out))
         rc = cli_fail(EXIT_RUN, "compare: cannot create %s", o.out);
     if (rc == EXIT_OK)
-        rc = run_comparison(&o, argc, argv, scene, scene_hash, methods, n, &failures);
+        rc = run_comparison(&o, argc, argv, scene, scene_hash, methods, n, &failures, failed);
     gi_plugins_free(reg);
     gi_scene_free(scene);
     if (rc == EXIT_OK && cli_interrupted)
         return cli_fail(EXIT_RUN, "compare: interrupted; rerun the same command to resume");
+    /* as study does: a comparison with a failed run is a failure, though
+     * its report is written (docs/commands.md "Exit status") */
     if (rc == EXIT_OK && failures)
-        fprintf(stderr, "gibench: compare: %d of %u methods failed (see %s/report.md)\n", failures,
-                n, o.out);
+        return cli_fail(EXIT_RUN, "compare: %d of %u methods failed: %s (see %s/report.md)",
+                        failures, n, failed, o.out);
     return rc;
 }

@@ -18,6 +18,7 @@
 #include "proc.h"
 
 #include <dirent.h>
+#include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -365,9 +366,10 @@ static void remove_logs(const char *tmpdir, int failed)
  * its JSON). EXIT_OK when every check passed or does not apply. */
 static int check_methods(const conf_opts *o, const gi_method *const *ms, uint32_t count)
 {
-    char tmpdir[] = "/tmp/gibench-conformance-XXXXXX";
-    if (!mkdtemp(tmpdir))
-        return cli_fail(EXIT_RUN, "conformance: cannot make a temporary directory");
+    char tmpdir[1024];
+    if (!cli_temp_dir("gibench-conformance", tmpdir, sizeof tmpdir))
+        return cli_fail(EXIT_RUN, "conformance: cannot make a temporary folder %s: %s", tmpdir,
+                        strerror(errno));
     cli_install_signal_handlers();
     cell(*cells)[CHECK_COUNT] = calloc(count, sizeof *cells);
     if (!cells)

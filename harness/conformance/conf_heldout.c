@@ -8,6 +8,7 @@
 #include "conf.h"
 #include "proc.h"
 
+#include <errno.h>
 #include <ftw.h>
 #include <math.h>
 #include <stdio.h>
@@ -67,9 +68,9 @@ static int family_folder(const char *arg, ho_run *h)
                         "conformance: --held-out '%s' is neither a seed (an integer in "
                         "0..4294967295) nor a folder made by scripts/held_out.py",
                         arg);
-    snprintf(h->dir, sizeof h->dir, "/tmp/gibench-held-out-XXXXXX");
-    if (!mkdtemp(h->dir))
-        return cli_fail(EXIT_RUN, "conformance: cannot make a temporary folder");
+    if (!cli_temp_dir("gibench-held-out", h->dir, sizeof h->dir))
+        return cli_fail(EXIT_RUN, "conformance: cannot make a temporary folder %s: %s", h->dir,
+                        strerror(errno));
     h->made = 1;
     char seed_s[32], log[1100];
     snprintf(seed_s, sizeof seed_s, "%lu", seed);

@@ -5,29 +5,10 @@
 
 #include "gi/shader.h"
 
+#include <ctype.h>
 #include <string.h>
 
-static void html_escape(text *t, const char *s)
-{
-    for (; *s; s++) {
-        switch (*s) {
-        case '<':
-            put(t, "&lt;");
-            break;
-        case '>':
-            put(t, "&gt;");
-            break;
-        case '&':
-            put(t, "&amp;");
-            break;
-        case '"':
-            put(t, "&quot;");
-            break;
-        default:
-            put(t, "%c", *s);
-        }
-    }
-}
+#define html_escape gi_text_html /* text.h */
 
 /* The page's script and style, embedded at build time (harness/report/CMakeLists.txt). */
 extern const gi_shader_source gi_report_assets[];
@@ -48,16 +29,40 @@ static void html_num(text *t, double v)
         put(t, "<td data-v=\"\">–</td>");
 }
 
-/* Inline markdown: `code` spans, the rest escaped. */
+/* The entity at s (at most n bytes) that gi_text_md writes; its length, or 0. */
+static size_t md_entity(const char *s, size_t n)
+{
+    static const char *const known[] = {"&lt;", "&gt;", "&amp;", "&quot;"};
+    for (size_t k = 0; k < sizeof known / sizeof known[0]; k++) {
+        size_t len = strlen(known[k]);
+        if (len <= n && !strncmp(s, known[k], len))
+            return len;
+    }
+    return 0;
+}
+
+/* Inline markdown as gi_text_md and gi_text_md_code write it (text.h):
+ * `code` spans, backslash escapes and the entities of HTML's specials
+ * (kept as they are: the page shows the character), the rest escaped. In a
+ * code span only "\|" is an escape (a table's, as GitHub reads it). */
 static void md_inline(text *t, const char *s, size_t n)
 {
     int code = 0;
     char buf[2];
     buf[1] = '\0';
     for (size_t i = 0; i < n; i++) {
+        size_t ent;
         if (s[i] == '`') {
             put(t, code ? "</code>" : "<code>");
             code = !code;
+            continue;
+        }
+        if (s[i] == '\\' && i + 1 < n &&
+            (s[i + 1] == '|' || (!code && ispunct((unsigned char)s[i + 1]))))
+            i++;
+        else if (!code && (ent = md_entity(s + i, n - i))) {
+            put(t, "%.*s", (int)ent, s + i);
+            i += ent - 1;
             continue;
         }
         buf[0] = s[i];
@@ -65,6 +70,18 @@ static void md_inline(text *t, const char *s, size_t n)
     }
     if (code)
         put(t, "</code>");
+}
+
+/* The next cell separator of a table row in [c, stop): a '|' not escaped. */
+static const char *md_cell_end(const char *c, const char *stop)
+{
+    for (; c < stop; c++) {
+        if (*c == '\\' && c + 1 < stop)
+            c++;
+        else if (*c == '|')
+            return c;
+    }
+    return stop;
 }
 
 /* The speed-against-accuracy text of tradeoff.c (markdown: headings,
@@ -102,9 +119,7 @@ static void md_to_html(text *t, const char *md)
             put(t, "<tr>");
             const char *c = md + 1, *stop = md + n;
             while (c < stop) {
-                const char *bar = memchr(c, '|', (size_t)(stop - c));
-                if (!bar)
-                    bar = stop;
+                const char *bar = md_cell_end(c, stop);
                 const char *a = c, *b = bar;
                 while (a < b && *a == ' ')
                     a++;
@@ -352,11 +367,17 @@ void report_write_html(text *t, const char *dir, json_object *runs, json_object 
     html_tradeoff(t, meta);
     html_charts(t, dir, meta);
 
-    /* the viewer's data; json-c escapes '/', so no "</script>" can occur */
+    /* the viewer's data; json-c escapes '/', so no "</script>" can occur, */
     put(t, "<script type=\"application/json\" id=\"gib-data\">");
     json_object *data = json_object_new_object();
     json_object_object_add(data, "sets", sets);
-    put(t, "%s", json_object_to_json_string_ext(data, JSON_C_TO_STRING_PLAIN));
+    /* and '<' as \u003c (the same string to JSON.parse): a name holding
+     * "<!--<script>" would otherwise keep the element open past its end */
+    for (const char *j = json_object_to_json_string_ext(data, JSON_C_TO_STRING_PLAIN); *j; j++)
+        if (*j == '<')
+            put(t, "\\u003c");
+        else
+            put(t, "%c", *j);
     json_object_put(data);
     put(t, "</script>\n<script>\n%s</script>\n</body></html>\n", asset("viewer.js"));
 }

@@ -5,40 +5,9 @@
 
 #include <string.h>
 
-/* Names from users (the study's title, scene and run names, parameters,
- * failure reasons) as report.md text that shows them as written: HTML's
- * specials become entities, so a name cannot put markup (a <script>, an
- * <img onerror=...>) into report.md or the page a viewer makes of it; '|'
- * is escaped in table cells and line breaks become spaces. */
-static void md_text(text *t, const char *s)
-{
-    for (; *s; s++) {
-        if (*s == '<')
-            put(t, "&lt;");
-        else if (*s == '>')
-            put(t, "&gt;");
-        else if (*s == '&')
-            put(t, "&amp;");
-        else if (*s == '|')
-            put(t, "\\|");
-        else
-            put(t, "%c", *s == '\n' || *s == '\r' ? ' ' : *s);
-    }
-}
-
-/* The same inside a code span (`...`), where HTML is not read: a backtick
- * would end the span, so it is shown as a quote. */
-static void md_code(text *t, const char *s)
-{
-    put(t, "`");
-    for (; *s; s++) {
-        if (*s == '|')
-            put(t, "\\|");
-        else
-            put(t, "%c", *s == '`' ? '\'' : *s == '\n' || *s == '\r' ? ' ' : *s);
-    }
-    put(t, "`");
-}
+/* Names from users as report.md text and code spans (text.h). */
+#define md_text gi_text_md
+#define md_code gi_text_md_code
 
 /* A file name as a link target: anything but [A-Za-z0-9._~/-] as %XX, so
  * that a name cannot close the link or open markup. */
@@ -169,8 +138,11 @@ void report_write_md(text *t, const char *dir, json_object *runs, json_object *m
     int ns = report_stage_names(runs, stages, 32);
     if (ns > 0) {
         put(t, "\nStage timings in ms, median (min – max) over the timed frames:\n\n| run |");
-        for (int k = 0; k < ns; k++)
-            put(t, " %s |", stages[k]);
+        for (int k = 0; k < ns; k++) {
+            put(t, " ");
+            md_text(t, stages[k]);
+            put(t, " |");
+        }
         put(t, " frame |\n|---|");
         for (int k = 0; k <= ns; k++)
             put(t, "---:|");

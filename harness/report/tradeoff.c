@@ -438,7 +438,9 @@ static void put_error(gi_text *md, const setting *g, uint32_t k)
 static void params_cell(gi_text *md, json_object *rec)
 {
     const char *p = str(rec, "params");
-    gi_text_put(md, " `%s` |", *p ? p : "(defaults)");
+    gi_text_put(md, " ");
+    gi_text_md_code(md, *p ? p : "(defaults)");
+    gi_text_put(md, " |");
 }
 
 /* Per record: the earliest recorded frame whose error is within 1 % of the
@@ -484,9 +486,11 @@ static void equal_error_table(gi_text *md, const char *name, const tradeoff_pt_c
                               const setting *set, uint32_t ns, const char **methods, uint32_t nm,
                               front_point *fp)
 {
+    gi_text_put(md, "#### ");
+    gi_text_md(md, name);
     gi_text_put(
         md,
-        "#### %s: equal error (each method's Pareto front against the full-GI reference)\n\n"
+        ": equal error (each method's Pareto front against the full-GI reference)\n\n"
         "Speed-up = the path tracer's time to the same relMSE ÷ the method's time to its image; "
         "\"matched\" compares the method's error against the reference of its own bounce count "
         "with "
@@ -497,8 +501,7 @@ static void equal_error_table(gi_text *md, const char *name, const tradeoff_pt_c
         "on a hardware GPU they do not) and the size of the method's own precomputed data (its "
         "`data_bytes` statistic; \"–\" where it reports none), medians over repeats. "
         "\"*\": the path tracer's time is extrapolated beyond its measured curve (slope −1). "
-        "relMSE over repeats: median [min–max].\n\n",
-        name);
+        "relMSE over repeats: median [min–max].\n\n");
     gi_text_put(
         md,
         "| method | params | frames | time to image (s) | relMSE full | path tracer, same error "
@@ -516,7 +519,9 @@ static void equal_error_table(gi_text *md, const char *name, const tradeoff_pt_c
             const tradeoff_pt_curve *mc = curve_for(full, matched, matched_n, g->bounces);
             double tptm = tradeoff_pt_time_at(mc, g->em[p], &exm);
             double prep = isfinite(g->prep_s) ? g->prep_s : 0.0;
-            gi_text_put(md, "| %s |", methods[m]);
+            gi_text_put(md, "| ");
+            gi_text_md(md, methods[m]);
+            gi_text_put(md, " |");
             params_cell(md, g->first);
             gi_text_put(md, " %u | %.4g |", g->frame[p], g->t[p]);
             put_error(md, g, p);
@@ -559,9 +564,11 @@ static void equal_time_table(gi_text *md, const char *name, const tradeoff_pt_cu
 {
     if (full->n == 0)
         return;
+    gi_text_put(md, "#### ");
+    gi_text_md(md, name);
     gi_text_put(
         md,
-        "#### %s: equal time (each method's best relMSE within the time the path tracer needs for "
+        ": equal time (each method's best relMSE within the time the path tracer needs for "
         "its "
         "error levels)\n\n"
         "A column per image of the path tracer's convergence run (time, its relMSE). A cell: the "
@@ -572,8 +579,7 @@ static void equal_time_table(gi_text *md, const char *name, const tradeoff_pt_cu
         "that fast. \"matched\" rows: against the reference of the method's bounce count, the path "
         "tracer limited to it (its own time and error at that image). The last three columns: the "
         "precomputation time, peak resident memory and data size of the settings behind the row's "
-        "cells (min–max when they differ).\n\n",
-        name);
+        "cells (min–max when they differ).\n\n");
     gi_text_put(md, "| method |");
     for (uint32_t i = 0; i < full->n; i++)
         gi_text_put(md, " %.3g s (PT %.3g) |", full->t[i], full->e[i]);
@@ -591,7 +597,9 @@ static void equal_time_table(gi_text *md, const char *name, const tradeoff_pt_cu
                 matched_row ? curve_for(full, matched, matched_n, b) : full;
             if (matched_row && c == full)
                 continue; /* the method is full GI: the row above says it */
-            gi_text_put(md, "| %s%s |", methods[m], matched_row ? " (matched)" : "");
+            gi_text_put(md, "| ");
+            gi_text_md(md, methods[m]);
+            gi_text_put(md, "%s |", matched_row ? " (matched)" : "");
             /* the range of the costs of the settings behind the cells */
             double lo[3] = {INFINITY, INFINITY, INFINITY},
                    hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -651,8 +659,9 @@ void tradeoff_report(const char *out_dir, const char *name, const tradeoff_pt_cu
     if (write_chart && any_matched)
         chart(write_chart, out_dir, name, 1, full, matched, matched_n, set, ns, methods, nm,
               chart_list);
-    gi_text_put(
-        md, "Path tracer convergence on %s (relMSE against the reference, another seed):", name);
+    gi_text_put(md, "Path tracer convergence on ");
+    gi_text_md(md, name);
+    gi_text_put(md, " (relMSE against the reference, another seed):");
     const tradeoff_pt_curve *curves[9] = {full};
     uint32_t nc = 1;
     for (uint32_t i = 0; i < matched_n && nc < 9; i++)

@@ -107,12 +107,24 @@ static void anim_table_row(gi_text *md, const study_run *r)
         size_t used = strlen(params);
         snprintf(params + used, sizeof params - used, "%s%s", k ? "," : "", r->spec.params[k]);
     }
-    gi_text_put(md, "| %s | %s | `%s` | %s |", r->id, r->spec.method,
-                params[0] ? params : "(defaults)", r->spec.label ? r->spec.label : "");
+    /* names, labels and reasons come from users: escaped (text.h) */
+    gi_text_put(md, "| ");
+    gi_text_md(md, r->id);
+    gi_text_put(md, " | ");
+    gi_text_md(md, r->spec.method);
+    gi_text_put(md, " | ");
+    gi_text_md_code(md, params[0] ? params : "(defaults)");
+    gi_text_put(md, " | ");
+    gi_text_md(md, r->spec.label ? r->spec.label : "");
+    gi_text_put(md, " |");
     if (strcmp(status, "ok")) {
         const char *reason =
             json_object_object_get_ex(r->record, "reason", &v) ? json_object_get_string(v) : "";
-        gi_text_put(md, " %s: %s | | | | | | | | | | | | |\n", status, reason);
+        gi_text_put(md, " ");
+        gi_text_md(md, status);
+        gi_text_put(md, ": ");
+        gi_text_md(md, reason);
+        gi_text_put(md, " | | | | | | | | | | | | |\n");
         return;
     }
     gi_text_put(md, " %u | %g |", r->frame_ref_n, (double)r->spec.animate_fps);

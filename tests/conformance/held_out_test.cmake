@@ -64,6 +64,16 @@ expect(2 "neither a seed" conformance --held-out -3)
 expect(2 "has no manifest.json" conformance --held-out ${OUT}/held_out)
 expect(2 "matches --variants" conformance --held-out ${OUT}/held_out/a --variants nosuch)
 
+# temporary folders go under $TMPDIR (issue 32): one that cannot be made is
+# one line naming the folder and why, for the seed's family and for the
+# children's logs alike
+set(ENV{TMPDIR} ${OUT}/held_out/no_such_dir)
+expect(1 "cannot make a temporary folder ${OUT}/held_out/no_such_dir/gibench-held-out-XXXXXX: No such file"
+       conformance --held-out 7 --method direct)
+expect(1 "cannot make a temporary folder ${OUT}/held_out/no_such_dir/gibench-conformance-XXXXXX: No such file"
+       conformance --method direct)
+unset(ENV{TMPDIR})
+
 # the trivial-answer check can fail: a black image is no better than black
 set(ENV{GIBENCH_PLUGIN_PATH} ${FAKES})
 execute_process(COMMAND ${GIB} -q conformance --held-out ${OUT}/held_out/a --method fake_conf_liar

@@ -396,6 +396,18 @@ def mutate(fn, with_mesh=True):
     return make
 
 
+def duplicate_key(second):
+    """The base scene with doubleSided on its material, followed by `second`
+    (the same key again, in some spelling) in the same object."""
+    def make():
+        doc = base().finish()
+        doc["materials"][0]["doubleSided"] = True
+        text = pretty(doc) + "\n"
+        assert text.count('"doubleSided": true') == 1
+        return text.replace('"doubleSided": true', '"doubleSided": true, ' + second).encode()
+    return make
+
+
 def rebuilt(fn):
     """Like mutate, but the mutation adds data: the buffer is written after."""
     def make():
@@ -878,6 +890,12 @@ CORPUS = [
     ("env-intensity.gltf", "/scenes/0/extras/gibench/environment/intensity: must be a number >= 0",
      mutate(set_path(["scenes", 0, "extras"], {"gibench": {"environment": {
          "uri": "sky.pfm", "intensity": "bright"}}}))),
+    # a key given twice (tinygltf would keep the last): refused, also when
+    # the second is spelt with an escape (json.dumps cannot write either)
+    ("json-duplicate-key.gltf", "/materials/0/doubleSided: duplicate key 'doubleSided'",
+     duplicate_key('"doubleSided": false')),
+    ("json-duplicate-key-escaped.gltf", "/materials/0/doubleSided: duplicate key 'doubleSided'",
+     duplicate_key('"double\\u0053ided": false')),
     # tinygltf's own errors, passed through
     ("json-syntax.gltf", "parse error", lambda: b'{"asset": {"version": "2.0"}, "nodes": [,]}\n'),
     ("json-not-object.gltf", "Root element is not a JSON object", lambda: b"[1, 2, 3]\n"),

@@ -7,8 +7,11 @@ include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
 set(ENV{GIBENCH_PLUGIN_PATH} "${FAKE_RUN}")
 set(C ${OUT}/compare)
 file(REMOVE_RECURSE ${C})
-run(0 compare --scene scenes/cornell_box_coarse.gltf --methods direct,fake_crash,fake_hang,fake_narrow
+run(1 compare --scene scenes/cornell_box_coarse.gltf --methods direct,fake_crash,fake_hang,fake_narrow
        --out ${C} --size 16x16 --frames 2 --ref-spp 16 --ref-bounces 8 --timeout 8)
+# failed runs fail the command (exit 1, as study), its last line naming them
+match("${last_err}" "gibench: compare: 2 of 4 methods failed: fake_crash, fake_hang \\(see [^\n]*/report.md\\)\n$"
+      "compare's verdict line:\n${last_err}")
 file(READ ${C}/runs.csv csv)
 match("${csv}" "\ndirect,[^\n]*,ok," "direct did not run ok:\n${csv}")
 match("${csv}" "fake_crash,[^\n]*failed,\"?crashed \\(signal" "the crash was not isolated and reported:\n${csv}")

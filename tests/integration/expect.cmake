@@ -37,6 +37,14 @@ function(fail msg)
     set(failures ${f} PARENT_SCOPE)
 endfunction()
 
+# end_checks(): the end of a script: FATAL_ERROR with the count when an
+# expectation failed (a macro, so that it reads the script's `failures`).
+macro(end_checks)
+    if(failures GREATER 0)
+        message(FATAL_ERROR "${failures} check(s) failed")
+    endif()
+endmacro()
+
 # match(<text> <regex> <message>): text must match regex.
 function(match text regex msg)
     if(NOT text MATCHES "${regex}")

@@ -5,21 +5,12 @@
 # cmake -DGIB=... -DROOT=... -DOUT=... -P full_disk.cmake
 set(failures 0)
 include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
-execute_process(COMMAND id -u OUTPUT_VARIABLE uid OUTPUT_STRIP_TRAILING_WHITESPACE)
-if(NOT uid STREQUAL "0")
-    message(STATUS "SKIPPED: not running as root (uid ${uid}), so no tmpfs can be mounted to fill")
-    return()
-endif()
+include(${CMAKE_CURRENT_LIST_DIR}/tmpfs.cmake)
 set(M ${OUT}/full_disk)
 set(SRC ${OUT}/full_disk_src)
-execute_process(COMMAND umount ${M} RESULT_VARIABLE ignored ERROR_QUIET)
-file(REMOVE_RECURSE ${M} ${SRC})
-file(MAKE_DIRECTORY ${M} ${SRC})
-execute_process(COMMAND mount -t tmpfs -o size=256k tmpfs ${M} RESULT_VARIABLE rc ERROR_VARIABLE err)
-if(NOT rc EQUAL 0)
-    message(STATUS "SKIPPED: cannot mount a tmpfs (${err})")
-    return()
-endif()
+small_tmpfs(${M})
+file(REMOVE_RECURSE ${SRC})
+file(MAKE_DIRECTORY ${SRC})
 
 # Inputs on the ordinary disk.
 execute_process(COMMAND ${GIB} reference --scene ${ROOT}/scenes/cornell_box_coarse.gltf --size 32x32 --spp 4

@@ -5,14 +5,10 @@
 # cmake -DGIB=... -DROOT=... -DOUT=... -P study_fresh_interrupt.cmake
 set(failures 0)
 include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
-set(D ${OUT}/study_fresh_interrupt)
-file(REMOVE_RECURSE ${D})
-file(MAKE_DIRECTORY ${D})
+include(${CMAKE_CURRENT_LIST_DIR}/study_signal.cmake)
+fresh_study_dir(study_fresh_interrupt)
 # enough frames that the render is still going when the signal comes
-file(WRITE ${D}/s.json "{\"name\": \"fresh\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
-  \"size\": [16, 16], \"frames\": 400, \"warmup\": 0, \"compare\": false,
-  \"methods\": [{\"method\": \"direct\", \"params\": {\"light_samples\": 1}}]}")
-set(S ${D}/out)
+coarse_study(${D}/s.json fresh 400 "[{\"method\": \"direct\", \"params\": {\"light_samples\": 1}}]")
 execute_process(COMMAND ${GIB} -q study ${D}/s.json --out ${S} WORKING_DIRECTORY ${ROOT}
                 RESULT_VARIABLE rc ERROR_VARIABLE err)
 file(GLOB results ${S}/runs/*/result.json)
@@ -22,16 +18,8 @@ endif()
 file(GLOB logs ${S}/runs/*/render.log)
 file(REMOVE ${logs})
 # --fresh: start the study, wait for the run's child (its log), SIGTERM the study
-execute_process(COMMAND sh -c "\"$0\" study \"$2\" --out \"$1\" --fresh >\"$1.log\" 2>&1 & p=$!
-                               i=0; while ! ls \"$1\"/runs/*/render.log >/dev/null 2>&1 && [ $i -lt 600 ]; do sleep 0.05; i=$((i+1)); done
-                               kill -TERM $p; wait $p; echo $?"
-                        ${GIB} ${S} ${D}/s.json
-                WORKING_DIRECTORY ${ROOT} TIMEOUT 120 RESULT_VARIABLE rc OUTPUT_VARIABLE code)
-string(STRIP "${code}" code)
-file(READ ${S}.log log)
-if(NOT rc EQUAL 0 OR NOT code STREQUAL "1")
-    fail("the interrupted study exited ${code} (expected 1):\n${log}")
-endif()
+signal_study("the interrupted study" ${S} ${D}/s.json "${RUN_STARTED}" "kill -TERM $p" --fresh)
+set(log "${study_log}")
 match("${log}" "study: interrupted \\(1 runs to redo\\)" "the run was not reported interrupted:\n${log}")
 file(READ ${S}/runs.csv csv)
 match_count("${csv}" ",interrupted," 1 "interrupted runs in runs.csv")

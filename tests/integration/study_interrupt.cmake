@@ -5,10 +5,9 @@
 # cmake -DGIB=... -DROOT=... -DOUT=... -DFAKE_RUN=... -P study_interrupt.cmake
 set(failures 0)
 include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
+include(${CMAKE_CURRENT_LIST_DIR}/study_signal.cmake)
 set(ENV{GIBENCH_PLUGIN_PATH} "${FAKE_RUN}")
-set(D ${OUT}/study_interrupt)
-file(REMOVE_RECURSE ${D})
-file(MAKE_DIRECTORY ${D})
+fresh_study_dir(study_interrupt)
 # two hanging runs and one that is never reached before the signal
 function(study_file timeout)
     file(WRITE ${D}/hang.json "{\"name\": \"hang\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
@@ -21,16 +20,9 @@ foreach(jobs 1 2)
     set(S ${D}/out${jobs})
     study_file(600)
     # start the study, wait for its first run's log, SIGTERM the study alone
-    execute_process(COMMAND sh -c "\"$0\" study \"$3\" --out \"$1\" --jobs $2 >\"$1.log\" 2>&1 & p=$!
-                                   i=0; while ! ls \"$1\"/runs/*/render.log >/dev/null 2>&1 && [ $i -lt 600 ]; do sleep 0.1; i=$((i+1)); done
-                                   sleep 1; kill -TERM $p; wait $p; echo $?"
-                            ${GIB} ${S} ${jobs} ${D}/hang.json
-                    WORKING_DIRECTORY ${ROOT} TIMEOUT 120 RESULT_VARIABLE rc OUTPUT_VARIABLE code)
-    string(STRIP "${code}" code)
-    file(READ ${S}.log log)
-    if(NOT rc EQUAL 0 OR NOT code STREQUAL "1")
-        fail("--jobs ${jobs}: the interrupted study exited ${code} (expected 1):\n${log}")
-    endif()
+    signal_study("--jobs ${jobs}: the interrupted study" ${S} ${D}/hang.json "${RUN_STARTED}"
+                 "sleep 1; kill -TERM $p" --jobs ${jobs})
+    set(log "${study_log}")
     match("${log}" "study: interrupted \\(3 runs to redo\\)" "--jobs ${jobs}: no 'interrupted' line:\n${log}")
     # no render of this study is left running
     execute_process(COMMAND sh -c "ps -eo args | grep -F \"$0/runs/\" | grep -v grep" ${S} OUTPUT_VARIABLE left)

@@ -5,28 +5,16 @@
 # cmake -DGIB=... -DROOT=... -DOUT=... -P study_retry_failed.cmake
 set(failures 0)
 include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
-set(D ${OUT}/study_retry_failed)
-file(REMOVE_RECURSE ${D})
-file(MAKE_DIRECTORY ${D})
+include(${CMAKE_CURRENT_LIST_DIR}/study_signal.cmake)
+fresh_study_dir(study_retry_failed)
 # a quick run, then one slow enough to be killed while it renders
-file(WRITE ${D}/s.json "{\"name\": \"retry\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
-  \"size\": [16, 16], \"frames\": 1, \"warmup\": 0, \"compare\": false,
-  \"methods\": [{\"method\": \"direct\", \"params\": {\"light_samples\": 2}},
-               {\"method\": \"direct\", \"params\": {\"light_samples\": 1}, \"frames\": 400}]}")
-set(S ${D}/out)
+coarse_study(${D}/s.json retry 1 "[{\"method\": \"direct\", \"params\": {\"light_samples\": 2}},
+               {\"method\": \"direct\", \"params\": {\"light_samples\": 1}, \"frames\": 400}]")
 # start the study, wait for the slow run's render, SIGKILL that render alone
-execute_process(COMMAND sh -c "\"$0\" study \"$2\" --out \"$1\" >\"$1.log\" 2>&1 & p=$!
-                               i=0; k=''
-                               while [ -z \"$k\" ] && [ $i -lt 600 ]; do sleep 0.05; i=$((i+1))
-                                 k=$(ps -eo pid=,args= | grep -F \"$1/runs/\" | grep -F -- '--frames 400' | grep -v grep | awk '{print $1}'); done
-                               kill -KILL $k; wait $p; echo $?"
-                        ${GIB} ${S} ${D}/s.json
-                WORKING_DIRECTORY ${ROOT} TIMEOUT 120 RESULT_VARIABLE rc OUTPUT_VARIABLE code)
-string(STRIP "${code}" code)
-file(READ ${S}.log log)
-if(NOT rc EQUAL 0 OR NOT code STREQUAL "1")
-    fail("the study with a killed run exited ${code} (expected 1):\n${log}")
-endif()
+signal_study("the study with a killed run" ${S} ${D}/s.json
+             "k=$(ps -eo pid=,args= | grep -F \"$o/runs/\" | grep -F -- '--frames 400' | grep -v grep | awk '{print $1}'); [ -n \"$k\" ]"
+             "kill -KILL $k")
+set(log "${study_log}")
 match("${log}" "study: failed \\(looks external\\): [^\n]*: killed \\(signal 9" "the killed run is not called external:\n${log}")
 match("${log}" "gibench: study: 1 of 2 runs failed, 1 of them look external" "no verdict line:\n${log}")
 file(READ ${S}/runs.csv csv)

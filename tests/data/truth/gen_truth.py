@@ -107,7 +107,8 @@ def box_light(name, flat):
 
 
 def outward(m):
-    """The inward furnace sphere wound and normalled the other way."""
+    """m wound and normalled the other way (the inward furnace sphere made
+    outward here; scripts/held_out.py imports it)."""
     o = Mesh()
     o.pos, o.nrm = list(m.pos), [-c for c in m.nrm]
     for t in range(0, len(m.idx), 3):
