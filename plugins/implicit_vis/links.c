@@ -132,9 +132,10 @@ void iv_put_side(iv_links *l, const iv_hier *h, uint32_t A, uint32_t B, gi_vec3 
     gi_vec3 n = gi_v3_load(&h->nrm[3 * B]);
     /* the one rule for sides (gi/scene.h): a single-sided node (every disc
      * below it facing one way) seen from behind is not there, and hides
-     * nothing; A looks at B along d, so B is seen along -d */
-    if (l->one_sided[B] && gi_v3_dot(n, n) > 0.98f &&
-        gi_side(0, n, gi_v3_scale(d, -1.0f)) == GI_SIDE_NONE)
+     * nothing. A looks at B along d. Unlike gi_side, a node seen exactly
+     * edge-on (a disc of the same plane) stays: it is a neighbour of A's
+     * surface, not its back, and the nearest-node rule needs it. */
+    if (l->one_sided[B] && gi_v3_dot(n, n) > 0.98f && gi_v3_dot(n, d) > 0.0f)
         return;
     /* B's solid angle seen from A: its area foreshortened by its mean
      * normal; a cluster whose discs face many ways (short mean normal)
