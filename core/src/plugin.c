@@ -100,6 +100,66 @@ gi_result gi_method_create(const gi_method *m, const gi_host *host, const gi_par
     return r;
 }
 
+const gi_departure *gi_method_departure(const gi_method *m, const char *check)
+{
+    if (!m || !check || !GI_HAS_FIELD(m, gi_method, departures) || !m->departures)
+        return NULL;
+    for (const gi_departure *d = m->departures; d->check; d++)
+        if (!strcmp(d->check, check))
+            return d;
+    return NULL;
+}
+
+int gi_departure_remedy_args(const gi_departure *d, char *buf, size_t size, const char **kv,
+                             uint32_t max)
+{
+    if (!d || !d->remedy || strlen(d->remedy) >= size)
+        return -1;
+    snprintf(buf, size, "%s", d->remedy);
+    uint32_t n = 0;
+    char *save = NULL;
+    for (char *tok = strtok_r(buf, " ", &save); tok; tok = strtok_r(NULL, " ", &save)) {
+        if (n == max)
+            return -1;
+        kv[n++] = tok;
+    }
+    return (int)n;
+}
+
+/* Departures (ABI 1.2): each names a check the suite knows, gives a
+ * one-line reason and a remedy its own parameter table accepts, once per
+ * check; a declaration the suite could not act on is refused at load. */
+static gi_result validate_departures(const gi_method *m, gi_error *err)
+{
+    if (!GI_HAS_FIELD(m, gi_method, departures) || !m->departures)
+        return GI_OK;
+    for (const gi_departure *d = m->departures; d->check; d++) {
+        if (strcmp(d->check, "furnace") && strcmp(d->check, "held_out"))
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "departure for unknown check '%s' (furnace, held_out)", d->check);
+        if (gi_method_departure(m, d->check) != d)
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "departure '%s' declared twice",
+                                d->check);
+        if (!d->reason || !*d->reason || strchr(d->reason, '\n'))
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "departure '%s' needs a one-line reason", d->check);
+        char buf[512];
+        const char *kv[16];
+        int n = gi_departure_remedy_args(d, buf, sizeof buf, kv, 16);
+        if (n <= 0)
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "departure '%s' needs a remedy: up to 16 \"k=v\" parameters",
+                                d->check);
+        gi_error perr;
+        gi_params *p = gi_params_parse(m->id, m->params, kv, (uint32_t)n, &perr);
+        if (!p)
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "departure '%s' remedy: %s", d->check,
+                                perr.text);
+        gi_params_free(p);
+    }
+    return GI_OK;
+}
+
 gi_result gi_method_validate(const gi_method *m, gi_error *err)
 {
     if (GI_ABI_VERSION_MAJOR(m->abi_version) != GI_ABI_MAJOR)
@@ -143,6 +203,8 @@ gi_result gi_method_validate(const gi_method *m, gi_error *err)
         return gi_error_set(err, GI_ERR_UNSUPPORTED, "method '%s' %s", m->id, lerr.text);
     gi_error perr;
     if (validate_params(m, &perr) != GI_OK)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "method '%s': %s", m->id, perr.text);
+    if (validate_departures(m, &perr) != GI_OK)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "method '%s': %s", m->id, perr.text);
     return GI_OK;
 }

@@ -76,6 +76,57 @@ static void print_param(const gi_param_desc *d)
            d->symbol ? ")" : "", mark);
 }
 
+/* The method's declared departures (gi_departure, ABI 1.2): the checks where the paper's
+ * method, at its defaults, is known to fail, why, and the remedy the conformance suite checks. */
+static json_object *departures_json(const gi_method *m)
+{
+    json_object *arr = json_object_new_array();
+    static const char *const checks[] = {"furnace", "held_out"};
+    for (size_t k = 0; k < sizeof checks / sizeof checks[0]; k++) {
+        const gi_departure *d = gi_method_departure(m, checks[k]);
+        if (!d)
+            continue;
+        json_object *o = json_object_new_object();
+        json_object_object_add(o, "check", json_object_new_string(d->check));
+        json_object_object_add(o, "reason", json_object_new_string(d->reason));
+        json_object_object_add(o, "remedy", json_object_new_string(d->remedy));
+        json_object_array_add(arr, o);
+    }
+    return arr;
+}
+
+static void print_departures(const gi_method *m)
+{
+    static const char *const checks[] = {"furnace", "held_out"};
+    for (size_t k = 0; k < sizeof checks / sizeof checks[0]; k++) {
+        const gi_departure *d = gi_method_departure(m, checks[k]);
+        if (d)
+            printf("  declared departure (%s): %s\n    remedy checked instead: %s\n", d->check,
+                   d->reason, d->remedy);
+    }
+}
+
+static json_object *method_json(const gi_plugin *it)
+{
+    const gi_method *m = it->method;
+    json_object *o = json_object_new_object();
+    char caps[256];
+    cli_caps_string(m->caps, caps, sizeof caps);
+    json_object_object_add(o, "id", json_object_new_string(m->id));
+    json_object_object_add(o, "title", json_object_new_string(m->title));
+    json_object_object_add(o, "citation", json_object_new_string(m->citation));
+    json_object_object_add(o, "version", json_object_new_string(m->version));
+    json_object_object_add(o, "caps", json_object_new_string(caps));
+    json_object_object_add(o, "max_bounces", json_object_new_int((int32_t)m->max_bounces));
+    json_object_object_add(o, "path", json_object_new_string(it->path));
+    json_object *ps = json_object_new_array();
+    for (const gi_param_desc *d = m->params; d && d->name; d++)
+        json_object_array_add(ps, param_json(d));
+    json_object_object_add(o, "params", ps);
+    json_object_object_add(o, "departures", departures_json(m));
+    return o;
+}
+
 int cmd_methods(int argc, char **argv)
 {
     int json = 0;
@@ -90,24 +141,8 @@ int cmd_methods(int argc, char **argv)
         return cli_fail(EXIT_RUN, "out of memory");
     if (json) {
         json_object *arr = json_object_new_array();
-        for (uint32_t i = 0; i < reg->count; i++) {
-            const gi_method *m = reg->items[i].method;
-            json_object *o = json_object_new_object();
-            char caps[256];
-            cli_caps_string(m->caps, caps, sizeof caps);
-            json_object_object_add(o, "id", json_object_new_string(m->id));
-            json_object_object_add(o, "title", json_object_new_string(m->title));
-            json_object_object_add(o, "citation", json_object_new_string(m->citation));
-            json_object_object_add(o, "version", json_object_new_string(m->version));
-            json_object_object_add(o, "caps", json_object_new_string(caps));
-            json_object_object_add(o, "max_bounces", json_object_new_int((int32_t)m->max_bounces));
-            json_object_object_add(o, "path", json_object_new_string(reg->items[i].path));
-            json_object *ps = json_object_new_array();
-            for (const gi_param_desc *d = m->params; d && d->name; d++)
-                json_object_array_add(ps, param_json(d));
-            json_object_object_add(o, "params", ps);
-            json_object_array_add(arr, o);
-        }
+        for (uint32_t i = 0; i < reg->count; i++)
+            json_object_array_add(arr, method_json(&reg->items[i]));
         puts(json_object_to_json_string_ext(arr, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_SPACED |
                                                      JSON_C_TO_STRING_NOSLASHESCAPE));
         json_object_put(arr);
@@ -126,6 +161,7 @@ int cmd_methods(int argc, char **argv)
                 for (const gi_param_desc *d = m->params; d->name; d++)
                     print_param(d);
             }
+            print_departures(m);
         }
     }
     gi_plugins_free(reg);

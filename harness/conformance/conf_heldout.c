@@ -253,8 +253,11 @@ static void print_rows(const ho_run *h, const gi_method *const *ms, uint32_t cou
            "limit", "detail");
     for (uint32_t k = 0; k < h->nrows; k++) {
         const ho_row *r = &h->rows[k];
-        printf("%-14s %-12s %-22s %-5s %10.4g %10.4g  %s\n", r->method, r->variant, r->check,
-               conf_status_name[r->status], r->value, r->limit, r->detail);
+        char st[16]; /* "*": a declared departure, scored at its remedy (the detail says) */
+        snprintf(st, sizeof st, "%s%s", conf_status_name[r->status],
+                 strncmp(r->detail, "declared departure: ", 20) ? "" : "*");
+        printf("%-14s %-12s %-22s %-5s %10.4g %10.4g  %s\n", r->method, r->variant, r->check, st,
+               r->value, r->limit, r->detail);
     }
     print_summary(h, ms, count);
 }
@@ -281,6 +284,9 @@ static json_object *rows_json(const ho_run *h, const conf_opts *o, int failed)
         json_object_object_add(jo, "limit", num(r->limit));
         json_object_object_add(jo, "seconds", json_object_new_double(r->seconds));
         json_object_object_add(jo, "detail", json_object_new_string(r->detail));
+        json_object_object_add(
+            jo, "departure",
+            json_object_new_boolean(!strncmp(r->detail, "declared departure: ", 20)));
         json_object_array_add(arr, jo);
     }
     json_object_object_add(root, "rows", arr);

@@ -14,14 +14,60 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Fraction of bin b of leaf x that its links cover (their solid angles
- * summed over the leaf's path to the root, at most the bin's). */
-static float covered(const iv_links *l, uint32_t x, uint32_t b)
+/* Solid angle of node y seen from leaf x, Eq. 5's (n_y . -w) A_y / r^2:
+ * its area foreshortened by its mean normal (a cluster facing many ways,
+ * short mean normal, shows more than its mean normal says; as links.c
+ * counts coverage), taken as the solid angle of a disc of that projected
+ * area (Sec. 4.1: elements are discs), 2 pi (1 - 1 / sqrt(1 + a / (pi r^2))),
+ * which is a / r^2 for the small elements Eq. 5 assumes and stays below a
+ * hemisphere for a disc nearer than its size. */
+static float node_omega(const iv_hier *h, uint32_t x, uint32_t y)
 {
-    if (!(l->coverage > 0.0f)) /* Eq. 5: the nearest element covers its bin */
-        return l->other[(size_t)x * l->bins + b] >= 0 ? 1.0f : 0.0f;
-    float f = l->cover[(size_t)x * l->bins + b] / (l->coverage * l->bin_omega[b]);
-    return f < 1.0f ? f : 1.0f;
+    gi_vec3 d = gi_v3_sub(gi_v3_load(&h->pos[3 * y]), gi_v3_load(&h->pos[3 * x]));
+    float r2 = gi_v3_dot(d, d);
+    if (!(r2 > 0.0f))
+        return 0.0f;
+    gi_vec3 n = gi_v3_load(&h->nrm[3 * y]);
+    float c = fabsf(gi_v3_dot(n, d)) / sqrtf(r2), len = gi_v3_length(n);
+    double a = (double)h->area[y] * fmaxf(c, 1.0f - len) / ((double)GI_PI * r2);
+    /* 2 pi (1 - 1 / sqrt(1 + a)), written to keep its precision for small a */
+    double q = sqrt(1.0 + a);
+    return (float)(2.0 * GI_PI * a / (q * (q + 1.0)));
+}
+
+float iv_link_share(const iv_links *l, const iv_hier *h, uint32_t x, uint32_t b)
+{
+    size_t i = (size_t)x * l->bins + b;
+    int32_t y = l->other[i];
+    if (y < 0)
+        return 0.0f;
+    if (l->coverage > 0.0f) { /* README "Deviations": the share the links' solid angles cover */
+        float f = l->cover[i] / (l->coverage * l->bin_omega[b]);
+        return f < 1.0f ? f : 1.0f;
+    }
+    switch (l->weight) {
+    case IV_WEIGHT_BIN: /* the nearest covers its bin */
+        return 1.0f;
+    case IV_WEIGHT_SURFACE: /* Eq. 4 over the nearest surface's nodes in the bin */
+        return l->cover[i] / l->bin_omega[b];
+    default: /* Eq. 5 as printed: (n_y . -w) A_y / r^2 of the nearest */
+        return node_omega(h, x, (uint32_t)y) / l->bin_omega[b];
+    }
+}
+
+int iv_env_partial(const iv_links *l)
+{
+    return l->coverage > 0.0f || l->weight == IV_WEIGHT_SURFACE;
+}
+
+float iv_env_open(const iv_links *l, const iv_hier *h, uint32_t x, uint32_t b)
+{
+    if (l->other[(size_t)x * l->bins + b] < 0)
+        return 1.0f;
+    if (!iv_env_partial(l))
+        return 0.0f;
+    float f = iv_link_share(l, h, x, b);
+    return f < 1.0f ? 1.0f - f : 0.0f;
 }
 
 static uint32_t float_bits(float f)
@@ -48,7 +94,7 @@ void iv_links_pack(const iv_links *l, const iv_hier *h, uint32_t *links, uint32_
                 uint32_t *w = &links[4 * ((light ? light_base : 0) + j)];
                 w[0] = bin[j];
                 w[1] = src[j];
-                w[2] = float_bits(covered(l, x, bin[j]));
+                w[2] = float_bits(iv_link_share(l, h, x, bin[j]));
                 w[3] = float_bits(l->dist[(size_t)x * l->bins + bin[j]]);
             }
         }
@@ -190,13 +236,13 @@ void iv_illuminate(const iv_links *l, iv_hier *h, const iv_lights *li, uint32_t 
             for (uint32_t j = off[e]; j < off[e + 1]; j++) {
                 float L[3];
                 node_radiance(h, sp, sm, src[j], p, L);
-                add_bin(l, bin[j], n, norm[e], covered(l, x, bin[j]), L, ep, em);
+                add_bin(l, bin[j], n, norm[e], iv_link_share(l, h, x, bin[j]), L, ep, em);
             }
             if (direct) {
                 if (li->env) { /* Sec. 4.4: an empty bin (or what its links leave uncovered) sees
                                   the environment */
                     for (uint32_t b = 0; b < l->bins; b++) {
-                        float open = 1.0f - covered(l, x, b);
+                        float open = iv_env_open(l, h, x, b);
                         if (open > 0.0f) {
                             float L[3];
                             gi_envmap_eval(li->env, gi_v3_load(&l->bin_dir[3 * b]), L);
@@ -207,9 +253,9 @@ void iv_illuminate(const iv_links *l, iv_hier *h, const iv_lights *li, uint32_t 
                 if (li->scene && li->scene->light_count)
                     punctual(l, h, li, x, ep, em);
             }
-            for (int c = 0; c < 3; c++) {
+            for (int c = 0; c < 3; c++) { /* single-sided: lit on its front only */
                 ek[6 * e + c] = ep[c];
-                ek[6 * e + 3 + c] = em[c];
+                ek[6 * e + 3 + c] = h->elem_two_sided_emit[e] ? em[c] : 0.0;
             }
         }
         /* the gathered light, reflected: the next bounce's source */

@@ -88,11 +88,12 @@ typedef struct iv_hier {
     /* Elements: one oriented disc per distinct point (points equal in
      * position and normal merged). */
     uint32_t elem_count;
-    uint32_t *elem_rep; /* element -> one of its points */
-    float *elem_albedo; /* 3 per element: mean albedo of its points */
-    float *elem_emit;   /* 3 per element: emitted radiance */
-    uint8_t *elem_two_sided_emit;
-    uint32_t segment_count; /* connected parts of each object: the roots */
+    uint32_t *elem_rep;           /* element -> one of its points */
+    float *elem_albedo;           /* 3 per element: mean albedo of its points */
+    float *elem_emit;             /* 3 per element: emitted radiance */
+    uint8_t *elem_two_sided_emit; /* material doubleSided: emits, receives and reflects on both
+                                     sides (else on the normal's side only) */
+    uint32_t segment_count;       /* connected parts of each object: the roots */
     /* Nodes in breadth-first order: the roots first, children contiguous
      * and after their parent, so bottom-up is a backward sweep. */
     uint32_t node_count;
@@ -133,6 +134,14 @@ static inline int iv_is_leaf(const iv_hier *h, uint32_t node)
 
 /* ---- the hierarchical link structure (Sec. 4.2) ---- */
 
+/* How a link weighs in its bin (Sec. 3, Eq. 4 and 5; README "Weights"). */
+enum {
+    IV_WEIGHT_EQ5 = 0,     /* Eq. 5 as printed: the linked node's own solid angle, A cos / r^2 */
+    IV_WEIGHT_BIN = 1,     /* the nearest node covers its whole bin (the bin's solid angle) */
+    IV_WEIGHT_SURFACE = 2, /* Eq. 4 over the nearest surface: the solid angles of every node of
+                              the nearest node's segment that falls in the bin, summed */
+};
+
 typedef struct iv_links {
     uint32_t n;    /* bins per cube side (the paper's N) */
     uint32_t bins; /* 6 n n */
@@ -146,10 +155,15 @@ typedef struct iv_links {
     float coverage; /* > 0: a bin whose links' solid angles sum to less than this share of it is lit
                        through that part only (README "Deviations"); 0: Eq. 5, the nearest covers
                        all */
-    float *cover; /* nodes x bins: solid angle of every node linked in the bin (Eq. 4's sum); after
-                     refinement summed down each leaf's path */
-    float *bin_dir;   /* 3 per bin: centre direction */
-    float *bin_omega; /* per bin: solid angle */
+    int weight;     /* IV_WEIGHT_*: how a link weighs in its bin */
+    float *cover;   /* nodes x bins: solid angle of every node linked in the bin (Eq. 4's sum; with
+                       IV_WEIGHT_SURFACE only the nodes of the nearest node's segment); after
+                       refinement summed down each leaf's path */
+    uint32_t *root; /* per node: the root of its tree (its segment) */
+    uint8_t *one_sided; /* per node: every disc below it is single-sided (seen from behind it is
+                           not there: the one rule for sides) */
+    float *bin_dir;     /* 3 per bin: centre direction */
+    float *bin_omega;   /* per bin: solid angle */
     /* After iv_links_refine_push: the receiving links of each leaf
      * (unidirectional), and the light links among them (Sec. 4.3.1 "Speedup"). */
     uint32_t *leaf_off;  /* elements + 1 */
@@ -190,6 +204,20 @@ void iv_links_pack(const iv_links *l, const iv_hier *h, uint32_t *links, uint32_
 
 /* ---- illumination (Sec. 4.3, 4.4) ---- */
 
+/* The weight of leaf x's link in bin b as a multiple of the bin's solid
+ * angle (IV_WEIGHT_*, or with coverage > 0 the share its links cover):
+ * the link's Eq. 5 weight is this times the bin's cosine-weighted solid
+ * angle. 0 for an empty bin. */
+float iv_link_share(const iv_links *l, const iv_hier *h, uint32_t x, uint32_t b);
+/* The share of bin b of leaf x through which the environment is seen
+ * (Sec. 4.4): 1 for an empty bin; for a linked one 0 under Eq. 5 and the
+ * bin rule ("any empty bin can see the lighting environment"), else what
+ * its share leaves open. */
+float iv_env_open(const iv_links *l, const iv_hier *h, uint32_t x, uint32_t b);
+/* Whether a linked bin passes the environment through what its share
+ * leaves open (coverage > 0 or IV_WEIGHT_SURFACE); the GPU's u_env_share. */
+int iv_env_partial(const iv_links *l);
+
 typedef struct iv_lights {
     const gi_scene *scene;
     float t;              /* punctual lights placed at this time */
@@ -198,10 +226,11 @@ typedef struct iv_lights {
 
 /* Gathers the direct light (light links, punctual lights through their bin,
  * the environment through empty bins) and `bounces` indirect bounces at the
- * leaves with Eq. 5 (each linked node covering its bin), pulling the
+ * leaves with Eq. 5 (each link weighted by iv_link_share), pulling the
  * reflected radiance up after each gather. Out: per element the irradiance
  * on both sides of its disc, e_out[6 e + 0..2] on the normal's side,
- * [6 e + 3..5] on the other. */
+ * [6 e + 3..5] on the other (0 for a single-sided disc: lit on its front
+ * only). */
 void iv_illuminate(const iv_links *l, iv_hier *h, const iv_lights *lights, uint32_t bounces,
                    float *e_out);
 

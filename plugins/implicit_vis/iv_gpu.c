@@ -280,6 +280,7 @@ gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint
         glUniform1i(glGetUniformLocation(p, "u_direct"), k == 0);
         glUniform1ui(glGetUniformLocation(p, "u_light_base"), l->leaf_off[g->elems]);
         glUniform1i(glGetUniformLocation(p, "u_env"), g->env);
+        glUniform1i(glGetUniformLocation(p, "u_env_share"), iv_env_partial(l));
         glUniform1ui(glGetUniformLocation(p, "u_punctual"), k == 0 ? punctual : 0u);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_RAD_SRC, g->ssbo_rad[cur]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_RAD_DST, g->ssbo_rad[1 - cur]);

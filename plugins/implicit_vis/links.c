@@ -26,12 +26,27 @@ iv_links *iv_links_create(const iv_hier *h, uint32_t n)
     l->cover = malloc(cells * sizeof *l->cover);
     l->bin_dir = malloc((size_t)l->bins * 3 * sizeof(float));
     l->bin_omega = malloc(l->bins * sizeof(float));
+    l->root = malloc((size_t)l->nodes * sizeof *l->root);
+    l->one_sided = calloc(l->nodes ? l->nodes : 1, 1);
     l->leaf_off = calloc((size_t)h->elem_count + 1, sizeof *l->leaf_off);
     l->light_off = calloc((size_t)h->elem_count + 1, sizeof *l->light_off);
     if (!l->other || !l->dist || !l->cover || !l->bin_dir || !l->bin_omega || !l->leaf_off ||
-        !l->light_off) {
+        !l->light_off || !l->root || !l->one_sided) {
         iv_links_free(l);
         return NULL;
+    }
+    /* breadth-first: a parent comes before its children */
+    for (uint32_t i = 0; i < l->nodes; i++)
+        l->root[i] = h->parent[i] < 0 ? i : l->root[h->parent[i]];
+    for (uint32_t i = l->nodes; i-- > 0;) {
+        if (iv_is_leaf(h, i)) {
+            l->one_sided[i] = !h->elem_two_sided_emit[h->node_elem[i]];
+            continue;
+        }
+        uint8_t all = 1;
+        for (uint32_t k = 0; k < h->child_count[i]; k++)
+            all &= l->one_sided[h->first_child[i] + k];
+        l->one_sided[i] = all;
     }
     for (uint32_t b = 0; b < l->bins; b++) {
         gi_v3_store(iv_bin_centre(b, n), &l->bin_dir[3 * b]);
@@ -47,16 +62,24 @@ void iv_links_free(iv_links *l)
     free(l->other), free(l->dist), free(l->cover), free(l->bin_dir), free(l->bin_omega);
     free(l->leaf_off), free(l->leaf_bin), free(l->leaf_src);
     free(l->light_off), free(l->light_bin), free(l->light_src);
+    free(l->root), free(l->one_sided);
     free(l);
 }
 
 /* Writes node B into bin b of node A where it is nearer than what the bin
  * holds (the implicit visibility), and adds its solid angle `omega` to the
- * bin's coverage. */
+ * bin's coverage: every node's, or with IV_WEIGHT_SURFACE only those of
+ * the nearest node's segment (a nearer node of another segment starts the
+ * sum afresh, a farther one is hidden). */
 static void put(iv_links *l, uint32_t A, uint32_t b, uint32_t B, float r, float omega)
 {
     size_t i = (size_t)A * l->bins + b;
-    l->cover[i] += omega;
+    if (l->weight != IV_WEIGHT_SURFACE)
+        l->cover[i] += omega;
+    else if (l->other[i] < 0 || l->root[l->other[i]] == l->root[B])
+        l->cover[i] += omega;
+    else if (r < l->dist[i])
+        l->cover[i] = omega;
     if (r < l->dist[i]) {
         l->dist[i] = r;
         l->other[i] = (int32_t)B;
@@ -106,10 +129,17 @@ void iv_put_side(iv_links *l, const iv_hier *h, uint32_t A, uint32_t B, gi_vec3 
 {
     uint32_t b = iv_bin_of(d, l->n);
     float cover = h->area[B] / (r * r) / l->bin_omega[b];
+    gi_vec3 n = gi_v3_load(&h->nrm[3 * B]);
+    /* the one rule for sides (gi/scene.h): a single-sided node (every disc
+     * below it facing one way) seen from behind is not there, and hides
+     * nothing. A looks at B along d. Unlike gi_side, a node seen exactly
+     * edge-on (a disc of the same plane) stays: it is a neighbour of A's
+     * surface, not its back, and the nearest-node rule needs it. */
+    if (l->one_sided[B] && gi_v3_dot(n, n) > 0.98f && gi_v3_dot(n, d) > 0.0f)
+        return;
     /* B's solid angle seen from A: its area foreshortened by its mean
      * normal; a cluster whose discs face many ways (short mean normal)
      * shows more than its mean normal says */
-    gi_vec3 n = gi_v3_load(&h->nrm[3 * B]);
     float c = fabsf(gi_v3_dot(n, d)) / r, len = gi_v3_length(n);
     float omega = h->area[B] * fmaxf(c, 1.0f - len) / (r * r);
     if (!splat || cover <= 1.0f || !iv_is_leaf(h, B)) {
@@ -307,7 +337,13 @@ void iv_links_refine_push(iv_links *l, const iv_hier *h)
     for (uint32_t i = h->root_count; i < h->node_count; i++) {
         size_t p = (size_t)h->parent[i] * nb, c = (size_t)i * nb;
         for (uint32_t b = 0; b < nb; b++) {
-            l->cover[c + b] += l->cover[p + b]; /* the pairs linked higher up lie in this bin too */
+            /* the pairs linked higher up lie in this bin too (with
+             * IV_WEIGHT_SURFACE: where they are of the nearer link's segment) */
+            int32_t op = l->other[p + b], oc = l->other[c + b];
+            if (l->weight != IV_WEIGHT_SURFACE || op < 0 || oc < 0 || l->root[op] == l->root[oc])
+                l->cover[c + b] += l->cover[p + b];
+            else if (l->dist[p + b] < l->dist[c + b])
+                l->cover[c + b] = l->cover[p + b];
             if (l->dist[p + b] < l->dist[c + b]) {
                 l->dist[c + b] = l->dist[p + b];
                 l->other[c + b] = l->other[p + b];

@@ -6,6 +6,10 @@
  * FAKE_CTOR_PRINT prints to stdout from a constructor.
  * FAKE_DTOR_CRASH loads fine and crashes in its destructor, when unloaded or
  * at the exit of the process that loaded it.
+ * FAKE_CONF_DEPART declares a furnace departure (gi_departure) whose remedy
+ * fix=true renders the furnace's closed form; at its defaults it renders
+ * the emission alone, as FAKE_CONF_WRONG does. FAKE_CONF_DEPART_NOFIX
+ * declares the same, but its remedy changes nothing: the suite must fail it.
  * FAKE_BAKED renders a constant grey, lacks GI_CAP_RIGID_MOTION and refuses
  * moved lights in update(), as a method that bakes its lights at prepare
  * would: the viewer's tests of a method that cannot follow a change. */
@@ -23,9 +27,19 @@ static const gi_host *fake_host;
 static uint32_t fake_flags_seen, fake_updates;
 #endif
 
+#if defined(FAKE_CONF_DEPART) || defined(FAKE_CONF_DEPART_NOFIX)
+#define FAKE_DEPART 1
+static int fake_fix;      /* the remedy's parameter */
+static float fake_rho;    /* the first material's albedo (the furnace's rho) */
+static int fake_emitters; /* the scene has an area light */
+#endif
+
 static gi_result fake_create(const gi_host *host, const gi_params *params, void **inst)
 {
     (void)host, (void)params;
+#if defined(FAKE_DEPART)
+    fake_fix = gi_params_bool(params, "fix");
+#endif
 #if defined(FAKE_CHANGES)
     fake_host = host;
 #endif
@@ -36,6 +50,10 @@ static gi_result fake_create(const gi_host *host, const gi_params *params, void 
 static gi_result fake_prepare(void *inst, const gi_gpu_scene *s)
 {
     (void)inst, (void)s;
+#if defined(FAKE_DEPART)
+    fake_rho = s->scene->material_count ? s->scene->materials[0].albedo[0] : 0.0f;
+    fake_emitters = s->scene->emitter_count > 0;
+#endif
     return GI_OK;
 }
 static gi_result fake_update(void *inst, const gi_gpu_scene *s, const gi_changes *c)
@@ -79,6 +97,15 @@ static gi_result fake_render(void *inst, const gi_view *v, const gi_target *t)
 #endif
     fake_renders++;
     glClearNamedFramebufferfv(t->fbo, GL_COLOR, 0, c);
+#elif defined(FAKE_DEPART)
+    /* the emission alone at the defaults; with the remedy Le (1 + rho), the furnace's closed
+     * form at max_bounces 0 (B = 1); black without an area light */
+    float e = !fake_emitters ? 0.0f : fake_fix ? 1.0f + fake_rho : 1.0f;
+#if defined(FAKE_CONF_DEPART_NOFIX)
+    e = fake_emitters ? 1.0f : 0.0f;
+#endif
+    const float c[4] = {e, e, e, 1.0f};
+    glClearNamedFramebufferfv(t->fbo, GL_COLOR, 0, c);
 #elif defined(FAKE_BAKED)
     const float grey[4] = {0.5f, 0.5f, 0.5f, 1.0f};
     glClearNamedFramebufferfv(t->fbo, GL_COLOR, 0, grey);
@@ -111,8 +138,19 @@ static const gi_param_desc fake_params[] = {
     {"n", GI_PARAM_INT, 4, 1, 64, NULL, "N", "a count"},
     {"mode", GI_PARAM_ENUM, 1, 0, 0, "a|b|c", NULL, "a choice"},
 #endif
+#if defined(FAKE_DEPART)
+    {"fix", GI_PARAM_BOOL, 0, 0, 1, NULL, NULL, "the remedy: render the furnace right"},
+#endif
     {0},
 };
+
+#if defined(FAKE_DEPART)
+static const gi_departure fake_departures[] = {
+    {"furnace", "the fake's paper renders the emission alone", "fix=true"},
+    {"held_out", "the fake's paper renders a constant", "fix=true"},
+    {NULL, NULL, NULL},
+};
+#endif
 
 static const gi_method fake_method = {
 #if defined(FAKE_SMALL_STRUCT)
@@ -136,7 +174,7 @@ static const gi_method fake_method = {
     .citation = "none",
     .version = "0",
 #if defined(FAKE_CRASH) || defined(FAKE_HANG) || defined(FAKE_CONF_WRONG) ||                       \
-    defined(FAKE_CONF_NAN) || defined(FAKE_CONF_NONDET)
+    defined(FAKE_CONF_NAN) || defined(FAKE_CONF_NONDET) || defined(FAKE_DEPART)
     .caps = GI_CAP_DIRECT | GI_CAP_AREA_LIGHTS,
 #elif defined(FAKE_CONF_LIAR)
     .caps = GI_CAP_DIRECT | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL |
@@ -157,6 +195,9 @@ static const gi_method fake_method = {
     .destroy = fake_destroy,
     .last_error = fake_last_error,
     .layout = GI_ABI_LAYOUT,
+#if defined(FAKE_DEPART)
+    .departures = fake_departures,
+#endif
 };
 
 #if defined(FAKE_CTOR_CRASH) /* crashes as it is mapped, before any symbol is looked up */

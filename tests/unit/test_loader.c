@@ -29,7 +29,7 @@ static void expect_refused(const char *kind, const char *substring)
 
 int main(void)
 {
-    expect_refused("wrong_abi", "built for plugin ABI 2.0, this gibench speaks 1.1");
+    expect_refused("wrong_abi", "built for plugin ABI 2.0, this gibench speaks 1.2");
     expect_refused("missing_fn", "lacks the required function render()");
     expect_refused("bad_id", "method id 'Bad Id!' is not [a-z0-9_]{1,31}");
     expect_refused("null_entry", "gi_method_entry returned NULL");
@@ -99,6 +99,40 @@ int main(void)
     bad.struct_size = (uint32_t)offsetof(gi_method, layout);
     CHECK(gi_method_validate(&bad, &err) == GI_ERR_UNSUPPORTED &&
           strstr(err.text, "has no data layout"));
+    /* Declared departures (ABI 1.2): a valid one is found by its check; one
+     * the conformance suite could not act on is refused with the reason. */
+    static const gi_departure ok_dep[] = {{"furnace", "why", "n=8 mode=c"}, {NULL, NULL, NULL}};
+    bad = *m;
+    bad.departures = ok_dep;
+    CHECK(gi_method_validate(&bad, &err) == GI_OK);
+    CHECK(gi_method_departure(&bad, "furnace") == &ok_dep[0]);
+    CHECK(gi_method_departure(&bad, "held_out") == NULL);
+    char buf[64];
+    const char *kv[4];
+    CHECK(gi_departure_remedy_args(&ok_dep[0], buf, sizeof buf, kv, 4) == 2 &&
+          strcmp(kv[0], "n=8") == 0 && strcmp(kv[1], "mode=c") == 0);
+    CHECK(gi_departure_remedy_args(&ok_dep[0], buf, sizeof buf, kv, 1) == -1);
+    /* a 1.1 descriptor ends before the field: none declared, whatever lies beyond */
+    bad.struct_size = (uint32_t)offsetof(gi_method, departures);
+    CHECK(gi_method_validate(&bad, &err) == GI_OK && gi_method_departure(&bad, "furnace") == NULL);
+    static const struct {
+        gi_departure d[3];
+        const char *error;
+    } refused[] = {
+        {{{"nosuch", "why", "n=8"}, {NULL, NULL, NULL}}, "unknown check 'nosuch'"},
+        {{{"furnace", "", "n=8"}, {NULL, NULL, NULL}}, "one-line reason"},
+        {{{"furnace", "two\nlines", "n=8"}, {NULL, NULL, NULL}}, "one-line reason"},
+        {{{"furnace", "why", ""}, {NULL, NULL, NULL}}, "needs a remedy"},
+        {{{"furnace", "why", "nosuch=1"}, {NULL, NULL, NULL}}, "remedy"},
+        {{{"furnace", "why", "n=999"}, {NULL, NULL, NULL}}, "remedy"},
+        {{{"furnace", "a", "n=8"}, {"furnace", "b", "n=9"}, {NULL, NULL, NULL}}, "declared twice"},
+    };
+    for (size_t i = 0; i < sizeof refused / sizeof refused[0]; i++) {
+        bad = *m;
+        bad.departures = refused[i].d;
+        CHECK(gi_method_validate(&bad, &err) == GI_ERR_INVALID_ARGUMENT &&
+              strstr(err.text, refused[i].error));
+    }
     /* A plugin built against the current headers passes the check. */
     static const gi_abi_layout current = GI_ABI_LAYOUT;
     CHECK(gi_abi_layout_check(&current, &err) == GI_OK);

@@ -6,13 +6,13 @@
  * dlopen(RTLD_NOW | RTLD_LOCAL), its gi_method_entry called, and its
  * descriptor checked: entry present, non-NULL result, ABI major equal,
  * struct_size at least the 1.0 size, every required function inside
- * struct_size and non-NULL, a valid id, a valid parameter table, no
- * duplicate id (the first found wins). All of this, and unloading it
- * (dlclose: its destructors), is first tried in a child process, so that a
- * plugin that crashes or hangs there is refused. A refused plugin gives one line
- * "path: reason" in the registry's error list and is skipped.
- * Libraries are never dlclose'd (shims with C++/TLS destructors crash
- * after unload); gi_plugins_free releases only the registry.
+ * struct_size and non-NULL, a valid id, a valid parameter table, valid
+ * declared departures (a known check, a one-line reason, a remedy that
+ * parses against the parameter table), no duplicate id (the first found wins). All of this, and
+ * unloading it (dlclose: its destructors), is first tried in a child process, so that a plugin that
+ * crashes or hangs there is refused. A refused plugin gives one line "path: reason" in the
+ * registry's error list and is skipped. Libraries are never dlclose'd (shims with C++/TLS
+ * destructors crash after unload); gi_plugins_free releases only the registry.
  */
 #ifndef GI_PLUGIN_H
 #define GI_PLUGIN_H
@@ -45,6 +45,14 @@ const gi_method *gi_plugins_find(const gi_plugins *reg, const char *id);
 void gi_plugins_free(gi_plugins *reg);
 /* Checks a descriptor as the loader does (exposed for tests). */
 gi_result gi_method_validate(const gi_method *m, gi_error *err);
+/* The departure method m declares for `check` ("furnace", "held_out"), or
+ * NULL when it declares none (or was built before ABI 1.2). */
+const gi_departure *gi_method_departure(const gi_method *m, const char *check);
+/* Splits d->remedy into at most `max` "k=v" strings kv[], pointing into
+ * buf (size bytes); returns how many, or -1 when it does not fit. */
+int gi_departure_remedy_args(const gi_departure *d, char *buf, size_t size, const char **kv,
+                             uint32_t max);
+
 /* m->create(host, params, instance), and then the parameter contract
  * (gi/params.h): an instance that read a parameter its table does not
  * declare is destroyed and refused with GI_ERR_INVALID_ARGUMENT naming the

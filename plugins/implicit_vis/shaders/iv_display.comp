@@ -6,7 +6,8 @@
 // re-meshing the point's own element; isotropic: the corners of the
 // re-meshed triangle it lies on), on the side of
 // the disc the pixel's surface faces, times the pixel's albedo / pi, plus
-// the emission seen directly.
+// the emission seen directly; where the camera ray misses, the background
+// (the environment seen directly, view.glsl), as the other methods draw it.
 // With IV_GLOSSY (a scene with glossy materials, Sec. 4.3 and Fig. 11): a
 // pixel of a glossy (Phong) material adds the Phong lobe of the direct
 // light, the BRDF-weighted sum over the bins of its elements (blended as
@@ -18,6 +19,7 @@
 #include "common.glsl"
 #include "scene.glsl"
 #include "gbuffer_read.glsl"
+#include "view.glsl"
 #include "iv_gpu.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -31,8 +33,6 @@ struct IvDisp {
 layout(std430, binding = IV_SSBO_GRID) readonly buffer IvGrid { IvDisp iv_grid[]; }; // grid point
 layout(rgba32f, binding = GI_IMAGE_TARGET) uniform writeonly image2D u_target;
 
-uniform ivec2 u_size;
-
 #ifdef IV_GLOSSY
 layout(std430, binding = IV_SSBO_ELEM) readonly buffer IvElems { IvElem iv_elem[]; };
 layout(std430, binding = IV_SSBO_BINS) readonly buffer IvBins { IvBin iv_bin[]; };
@@ -43,10 +43,10 @@ layout(std430, binding = IV_SSBO_LINK_OFF) readonly buffer IvLinkOff { uvec2 iv_
 layout(std430, binding = IV_SSBO_WLINKS) readonly buffer IvWLinks { uvec2 iv_wl[]; }; // node | side << 30, weight
 #include "iv_direct.glsl"
 
-uniform vec3 u_eye;
 uniform uint u_bins;       // 6 n n
 uniform uint u_light_base; // the light links' first record in iv_link
 uniform int u_env;         // 1: the scene has an environment
+uniform int u_env_share;   // as iv_gather.comp
 
 // The glossy part of Eq. 2 for the direct light reaching element e on the
 // side `front`, seen at pixel x (normal N, toward the eye wo) through the
@@ -73,10 +73,11 @@ vec3 glossy_direct(uint e, bool front, gi_brdf b, vec3 x, vec3 N, vec3 wo)
     if (u_env != 0) { // Sec. 4.4: the environment through what the links leave open of each bin
         uint j = o0.x;
         for (uint bn = 0u; bn < u_bins; bn++) {
-            float frac = 0.0;
-            if (j < o1.x && iv_link[j].x == bn)
-                frac = uintBitsToFloat(iv_link[j++].z);
-            float open = 1.0 - frac;
+            float open = 1.0;
+            if (j < o1.x && iv_link[j].x == bn) { // as iv_gather.comp
+                open = u_env_share != 0 ? max(1.0 - uintBitsToFloat(iv_link[j].z), 0.0) : 0.0;
+                j++;
+            }
             if (!(open > 0.0))
                 continue;
             vec3 d = iv_bin[bn].dir.xyz;
@@ -129,7 +130,7 @@ void main()
     if (any(greaterThanEqual(px, u_size)))
         return;
     GiSurface s = gi_gbuffer_surface(px);
-    vec3 L = vec3(0.0);
+    vec3 L = gi_background(px); // a camera ray that misses sees the environment, as every method draws it
 #ifdef IV_GLOSSY
     vec3 G = vec3(0.0);
 #endif

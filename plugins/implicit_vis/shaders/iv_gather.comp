@@ -35,6 +35,7 @@ uniform uint u_bins;        // 6 n n
 uniform int u_direct;       // 1: the direct light (light links, environment, punctual lights)
 uniform uint u_light_base;  // the light links' first record in iv_link
 uniform int u_env;          // 1: the scene has an environment
+uniform int u_env_share;    // 1: a linked bin passes the environment through what its share leaves open (iv_env_partial)
 uniform uint u_punctual;    // number of punctual lights
 
 // Radiance node `src` sends from its side `side` (iv_weights.comp).
@@ -80,10 +81,11 @@ void main()
         if (u_env != 0) { // Sec. 4.4: what the links leave open of each bin sees the environment
             uint j = o0.x;
             for (uint b = 0u; b < u_bins; b++) {
-                float frac = 0.0;
-                if (j < o1.x && iv_link[j].x == b)
-                    frac = uintBitsToFloat(iv_link[j++].z);
-                float open = 1.0 - frac;
+                float open = 1.0;
+                if (j < o1.x && iv_link[j].x == b) { // linked: closed, or open where its share leaves it
+                    open = u_env_share != 0 ? max(1.0 - uintBitsToFloat(iv_link[j].z), 0.0) : 0.0;
+                    j++;
+                }
                 if (open > 0.0)
                     add_bin(b, n, norm, open, iv_bin[b].env.rgb, ep, em);
             }
@@ -102,6 +104,8 @@ void main()
                 em += abs(c) * scale * lt.intensity;
         }
     }
+    if (iv_elem[e].info.y == 0u) // single-sided: lit on its front only (the one rule for sides)
+        em = vec3(0.0);
     iv_out[e].e_front += vec4(ep, 0.0);
     iv_out[e].e_back += vec4(em, 0.0);
     vec3 rho = iv_elem[e].albedo.rgb / GI_PI;

@@ -5,14 +5,14 @@
 # area light (glossy_floor), a point and a spot light (glossy_punctual),
 # an environment (glossy_env), at 64x64, direct light only (bounces=0)
 # against the 1-bounce reference (256 spp); the area light with the remedy
-# for small emitters the README describes (bilinear + coverage 1).
+# for small emitters the README describes (bilinear + coverage 1), all
+# with splatting (README "Deviations"; off by default since issue 28).
 # Beside it, on the same reference, the trivial answers: black, the
 # unshadowed `direct` plugin, and the plugin's own diffuse-only image
 # (glossy=false). The method must stay under LIMIT while every trivial
 # answer exceeds TRIVIAL (the stated margin), and its image mean within
-# MEAN %. The paper's own Eq. 5 (the default: the nearest element covers
-# its bin) is scored and printed, not asserted (README "Deviations": small
-# lights are too bright). Then: with no glossy material (the Cornell box)
+# MEAN %. The paper's own Eq. 5 as printed (the default) is scored and
+# printed, not asserted (README "Weights"). Then: with no glossy material (the Cornell box)
 # glossy=true and glossy=false give the same image to the bit, and
 # illum=cpu refuses a glossy scene with one line.
 # Run by ctest as: cmake -DGIB=... -DSCENES=... -DDATA=... -DOUT=... -DEXPECT=... -P iv_glossy.cmake
@@ -45,20 +45,21 @@ endfunction()
 # the area light (the light links); measured: method 0.033 (mean +4.4 %);
 # diffuse-only 0.16, direct 0.22, black 0.39
 set(scene ${DATA}/glossy_floor.gltf)
-set(args --param bounces=0 --param bilinear=true --param coverage=1)
+set(args --param bounces=0 --param bilinear=true --param coverage=1 --param splat=true)
 expect_beats_reference(implicit_vis ${scene} LIMIT 0.08 TRIVIAL 0.12 MEAN 10 SPP 256 BOUNCES 1 SIZE 64x64 BLACK
                        METHOD_ARGS ${args} DIRECT_ARGS --frames 4)
 expect_beats_diffuse(glossy_floor 0.12 ${args})
-# the point and spot light (through their bins); default settings;
+# the point and spot light (through their bins); splatting on (without it
+# the floor's near discs leave bins open and the shadow leaks: 0.33);
 # measured: method 0.016 (mean -1.4 %); diffuse-only 0.16, direct 0.58, black 0.44
 expect_beats_reference(implicit_vis ${DATA}/glossy_punctual.gltf LIMIT 0.06 TRIVIAL 0.12 MEAN 10 SPP 256
-                       BOUNCES 1 SIZE 64x64 BLACK METHOD_ARGS --param bounces=0 DIRECT_ARGS --frames 4)
-expect_beats_diffuse(glossy_punctual 0.12 --param bounces=0)
-# the environment (through the open bins); default settings; measured:
+                       BOUNCES 1 SIZE 64x64 BLACK METHOD_ARGS --param bounces=0 --param splat=true DIRECT_ARGS --frames 4)
+expect_beats_diffuse(glossy_punctual 0.12 --param bounces=0 --param splat=true)
+# the environment (through the open bins); splatting on (without it 0.18); measured:
 # method 0.035 (mean -14 %); diffuse-only 0.44, direct 0.33, black 0.96
 expect_beats_reference(implicit_vis ${DATA}/glossy_env.gltf LIMIT 0.1 TRIVIAL 0.2 MEAN 20 SPP 256
-                       BOUNCES 1 SIZE 64x64 BLACK METHOD_ARGS --param bounces=0 DIRECT_ARGS --frames 4)
-expect_beats_diffuse(glossy_env 0.2 --param bounces=0)
+                       BOUNCES 1 SIZE 64x64 BLACK METHOD_ARGS --param bounces=0 --param splat=true DIRECT_ARGS --frames 4)
+expect_beats_diffuse(glossy_env 0.2 --param bounces=0 --param splat=true)
 
 # the paper's Eq. 5 as written (the default settings): printed only
 set(ref ${OUT}/implicit_vis_ref_glossy_floor.exr)
@@ -66,7 +67,7 @@ set(eq5 ${OUT}/implicit_vis_eq5_glossy_floor.exr)
 expect(0 "" render --scene ${scene} --method implicit_vis --size 64x64 --param bounces=0 --out ${eq5})
 diff_metric(${eq5} ${ref} relmse e_relmse)
 diff_metric(${eq5} ${ref} mean_lum_diff_pct e_mean)
-message(STATUS "glossy_floor: default settings (Eq. 5, splatting) relMSE ${e_relmse}, mean ${e_mean} % (not asserted)")
+message(STATUS "glossy_floor: default settings (Eq. 5 as printed, no splatting) relMSE ${e_relmse}, mean ${e_mean} % (not asserted)")
 
 # no glossy material: the glossy code must not change a pixel
 foreach(g true false)

@@ -62,11 +62,13 @@ gi_scene *iv_test_load(const char *path)
  * IV_COVERAGE a share) overrides them, for exploring. */
 int iv_test_bilinear = 0;
 float iv_test_coverage = 0.0f;
+int iv_test_weight = IV_WEIGHT_EQ5;
 void iv_test_modes(iv_links *l)
 {
-    const char *b = getenv("IV_BILINEAR"), *c = getenv("IV_COVERAGE");
+    const char *b = getenv("IV_BILINEAR"), *c = getenv("IV_COVERAGE"), *w = getenv("IV_WEIGHT");
     l->bilinear = b ? atoi(b) : iv_test_bilinear;
     l->coverage = c ? (float)atof(c) : iv_test_coverage;
+    l->weight = w ? atoi(w) : iv_test_weight;
 }
 
 /* How iv_test_frame_run re-meshes (IV_REMESH_*). */

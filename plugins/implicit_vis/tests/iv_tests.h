@@ -18,6 +18,7 @@ gi_scene *iv_test_load(const char *path);
 
 /* The link modes iv_test_modes sets (iv_tests.c). */
 extern int iv_test_bilinear;
+extern int iv_test_weight; /* IV_WEIGHT_* */
 extern float iv_test_coverage;
 void iv_test_modes(iv_links *l);
 

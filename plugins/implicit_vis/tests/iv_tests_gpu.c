@@ -78,11 +78,11 @@ static void gpu_case(const char *path, uint32_t N, uint32_t bounces, int bilinea
             }
         }
         double rel = sum > 0.0 ? diff / sum : 1.0, rel_fewer = sum > 0.0 ? fewer / sum : 0.0;
-        printf("%s (N %u, %u bounces, bilinear %d, coverage %.2g, %u discs): GPU against CPU "
-               "relative L1 %.2e "
+        printf("%s (N %u, %u bounces, weight %d, bilinear %d, coverage %.2g, %u discs): GPU "
+               "against CPU relative L1 %.2e "
                "(limit %.0e), worst disc %.2e; one bounce fewer on the CPU %.2e\n",
-               strrchr(path, '/') + 1, N, bounces, bilinear, (double)coverage, f.h->elem_count, rel,
-               limit, worst, rel_fewer);
+               strrchr(path, '/') + 1, N, bounces, f.l->weight, bilinear, (double)coverage,
+               f.h->elem_count, rel, limit, worst, rel_fewer);
         EXPECT(sum > 0.0, "%s: no light at all", path);
         EXPECT(rel <= limit, "%s: GPU and CPU differ by %.2e (limit %.0e)", path, rel, limit);
         EXPECT(rel_fewer >= 10.0 * limit,
@@ -108,9 +108,15 @@ void iv_test_gpu(void)
     gpu_case(GI_SOURCE_DIR "/scenes/cornell_box.gltf", 12, 3, 0, 0.0f, limit);
     gpu_case(GI_SOURCE_DIR "/scenes/cornell_box.gltf", 8, 1, 1, 0.7f, limit);
     gpu_case(GI_SOURCE_DIR "/tests/data/conformance/furnace_050.gltf", 12, 3, 0, 0.0f, limit);
-    gpu_case(GI_SOURCE_DIR "/tests/data/conformance/furnace_080.gltf", 8, 2, 0, 0.0f, limit);
-    gpu_case(GI_SOURCE_DIR "/tests/data/conformance/one_object_area_point.gltf", 8, 2, 0, 0.0f,
+    /* the other weights (README "Weights"): the bin rule, and Eq. 4 over the
+     * nearest surface, whose open share of a bin passes the environment */
+    iv_test_weight = IV_WEIGHT_BIN;
+    gpu_case(GI_SOURCE_DIR "/tests/data/conformance/one_object_area_point.gltf", 8, 1, 0, 0.0f,
              limit);
+    iv_test_weight = IV_WEIGHT_SURFACE;
+    gpu_case(GI_SOURCE_DIR "/tests/data/conformance/furnace_080.gltf", 8, 2, 0, 0.0f, limit);
+    gpu_case(GI_SOURCE_DIR "/scenes/teapot_plane.glb", 8, 1, 0, 0.0f, limit);
+    iv_test_weight = IV_WEIGHT_EQ5;
     gpu_case(GI_SOURCE_DIR "/scenes/teapot_plane.glb", 8, 1, 0, 0.0f, limit);
     /* the furnace through the GPU passes: Le sum rho^k within 2 % */
     iv_test_furnace();

@@ -174,7 +174,10 @@ void iv_test_links(void)
         for (uint32_t f = 0; f < h->elem_count; f++) {
             gi_vec3 d = gi_v3_sub(gi_v3_load(&h->pos[3 * h->elem_node[f]]), pa);
             float r = gi_v3_length(d);
-            if (f != e && r > 1e-10f) {
+            /* the one rule for sides: a single-sided disc seen from behind is not there */
+            gi_vec3 nf = gi_v3_load(&h->nrm[3 * h->elem_node[f]]);
+            int behind = !h->elem_two_sided_emit[f] && gi_v3_dot(nf, d) > 0.0f;
+            if (f != e && r > 1e-10f && !behind) {
                 uint32_t b = iv_bin_of(d, n);
                 best[b] = fminf(best[b], r);
             }
