@@ -26,7 +26,7 @@ struct gi_depth_atlas {
     gi_depth_atlas_desc desc;
     uint32_t columns, rows, width, height, count;
     GLuint program, fbo, tex, depth_rb, ssbo, ssbo_tex;
-    GLint loc_grid, loc_views, loc_projection, loc_metric;
+    GLint loc_grid, loc_views, loc_projection, loc_metric, loc_receiver_side;
     atlas_view_gpu *staging; /* capacity entries */
     GLuint geometry_ibo;     /* indices drawn instead of the scene's triangles when not 0 */
     uint32_t geometry_count; /* their triangles */
@@ -51,6 +51,9 @@ static gi_result check_desc(const gi_depth_atlas_desc *d, gi_error *err)
     if (d->cull < 0 || d->cull > 2)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth atlas: cull %d is not 0, 1 or 2",
                             d->cull);
+    if (d->receiver_side < 0 || d->receiver_side > 1)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "depth atlas: receiver_side %d is not 0 or 1", d->receiver_side);
     return GI_OK;
 }
 
@@ -134,6 +137,7 @@ gi_depth_atlas *gi_depth_atlas_create(const gi_depth_atlas_desc *d, gi_error *er
     a->loc_views = glGetUniformLocation(a->program, "u_views");
     a->loc_projection = glGetUniformLocation(a->program, "u_projection");
     a->loc_metric = glGetUniformLocation(a->program, "u_metric");
+    a->loc_receiver_side = glGetUniformLocation(a->program, "u_receiver_side");
     create_targets(a);
     if (glCheckNamedFramebufferStatus(a->fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
         gi_error_set(err, GI_ERR_GL, "depth atlas: the %ux%u framebuffer is incomplete", a->width,
@@ -226,6 +230,7 @@ gi_result gi_depth_atlas_render(gi_depth_atlas *a, const gi_gpu_scene *gs,
         glUniform1i(a->loc_views, ATLAS_VIEWS_UNIT);
         glUniform1i(a->loc_projection, (GLint)d->projection);
         glUniform1i(a->loc_metric, (GLint)d->metric);
+        glUniform1i(a->loc_receiver_side, d->receiver_side);
         glBindTextureUnit(ATLAS_VIEWS_UNIT, a->ssbo_tex);
         if (a->geometry_ibo)
             gi_gpu_scene_draw_indices(gs, a->geometry_ibo, a->geometry_count * 3, (GLsizei)count);

@@ -257,8 +257,16 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
         gi_result r = build_lod(a, scene->scene, &err);
         if (r != GI_OK)
             return gi_kit_fail_with(&a->kit, r, &err);
-        gi_depth_atlas_desc d = {(uint32_t)a->tile, a->slots, choose_projection(a, scene->scene),
-                                 GI_DEPTH_RADIAL, 1};
+        /* No culling, and single-sided faces as the receivers see them (the
+         * one rule for sides, gi/scene.h): a VPL's light reaches a point
+         * unless a ray from the point toward the VPL meets a surface, as the
+         * reference traces it; a closed object's map holds its far side. */
+        gi_depth_atlas_desc d = {.tile = (uint32_t)a->tile,
+                                 .capacity = a->slots,
+                                 .projection = choose_projection(a, scene->scene),
+                                 .metric = GI_DEPTH_RADIAL,
+                                 .cull = 0,
+                                 .receiver_side = 1};
         if (a->lod && a->projection == 1)
             a->kit.host->log(a->kit.host, GI_LOG_WARN,
                              "shadow_lod=%g with projection=paraboloid: the warp bends the "

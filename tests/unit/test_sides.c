@@ -193,6 +193,28 @@ static void test_raster_single_sided(const gi_scene *s, gi_gpu_scene *gs, const 
         glDeleteTextures(1, &t2);
         gi_depth_renderer_free(r2);
     }
+
+    /* The depth atlas: seen from the eye (0) the far half, seen from the
+     * receivers (1: inside the ball, behind the near half) the near half. */
+    for (int mode = 0; mode <= 1; mode++) {
+        gi_depth_atlas_desc ad = {.tile = W,
+                                  .capacity = 1,
+                                  .projection = GI_PROJ_PERSPECTIVE,
+                                  .metric = GI_DEPTH_EYE_Z,
+                                  .receiver_side = mode};
+        gi_depth_atlas *at = gi_depth_atlas_create(&ad, &err);
+        CHECK_MSG(at != NULL, "%s", err.text);
+        if (!at)
+            return;
+        CHECK(gi_depth_atlas_render(at, gs, &dv, 1, &err) == GI_OK);
+        float *tile = gi_depth_atlas_read_tile(at, 0);
+        const float want = mode == 0 ? b->dist + b->radius : b->dist - b->radius;
+        const float got = tile ? tile[(W / 2) * W + W / 2] : -1.0f;
+        printf("depth atlas, receiver_side %d: centre %.4f (want %.4f)\n", mode, got, want);
+        CHECK(fabsf(got - want) < 0.05f * b->radius);
+        free(tile);
+        gi_depth_atlas_free(at);
+    }
 }
 
 /* Standard base64 of n bytes into out (4 (n + 2) / 3 characters + NUL). */

@@ -220,7 +220,7 @@ static void atlas_case(gi_gpu_scene *gs, gi_projection proj, const gi_simplified
                        const gi_simplified *low, size_t *differ_full, size_t *differ_low)
 {
     gi_error err;
-    gi_depth_atlas_desc d = {32, 4, proj, GI_DEPTH_RADIAL, 0};
+    gi_depth_atlas_desc d = {32, 4, proj, GI_DEPTH_RADIAL, 0, 0};
     gi_depth_atlas *a = gi_depth_atlas_create(&d, &err);
     CHECK_MSG(a != NULL, "%s", err.text);
     if (!a)

@@ -156,6 +156,11 @@ typedef struct gi_depth_atlas_desc {
     gi_projection projection; /* GI_PROJ_PERSPECTIVE or GI_PROJ_PARABOLOID */
     gi_depth_metric metric;   /* GI_DEPTH_EYE_Z or GI_DEPTH_RADIAL */
     int cull;                 /* 0 none, 1 back faces, 2 front faces */
+    /* Which side of a single-sided triangle exists, as gi_depth_desc's
+     * receiver_side: 0 the side the eye sees, 1 the side the receivers see
+     * (maps that stand for visibility rays cast from the receivers toward
+     * the eye, as the reference casts them). */
+    int receiver_side;
 } gi_depth_atlas_desc;
 
 typedef struct gi_depth_atlas gi_depth_atlas;
