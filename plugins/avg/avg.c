@@ -257,16 +257,18 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
         gi_result r = build_lod(a, scene->scene, &err);
         if (r != GI_OK)
             return gi_kit_fail_with(&a->kit, r, &err);
-        /* No culling, and single-sided faces as the receivers see them (the
-         * one rule for sides, gi/scene.h): a VPL's light reaches a point
-         * unless a ray from the point toward the VPL meets a surface, as the
-         * reference traces it; a closed object's map holds its far side. */
+        /* Back faces culled: the faces each VPL sees (receiver_side 0). The
+         * maps as the receivers see them (receiver_side 1, the rule the
+         * reference follows for a ray from the receiver) fix a single-sided
+         * panel facing away from a VPL (held-out seed 2 ceiling: relMSE 0.396
+         * -> 0.144) but lose 12 % of box_light's light, for a reason not yet
+         * found (README, "Sides"), so they are not the default. */
         gi_depth_atlas_desc d = {.tile = (uint32_t)a->tile,
                                  .capacity = a->slots,
                                  .projection = choose_projection(a, scene->scene),
                                  .metric = GI_DEPTH_RADIAL,
-                                 .cull = 0,
-                                 .receiver_side = 1};
+                                 .cull = 1,
+                                 .receiver_side = 0};
         if (a->lod && a->projection == 1)
             a->kit.host->log(a->kit.host, GI_LOG_WARN,
                              "shadow_lod=%g with projection=paraboloid: the warp bends the "
