@@ -239,6 +239,7 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
         m->links->bilinear = m->bilinear;
         m->links->coverage = m->coverage;
         m->links->threads = (uint32_t)m->threads;
+        m->links->host = host; /* link creation stops on a cancel (issue 32) */
     }
     m->irr = calloc((size_t)m->hier->elem_count * 6, sizeof(float));
     m->elem_light = calloc((size_t)m->hier->elem_count * 12, sizeof(float));
@@ -317,6 +318,8 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
     host->stage_begin(host, "create_links");
     iv_links_build(m->links, m->hier, m->subdiv, m->brute, m->splat);
     host->stage_end(host, "create_links");
+    if (m->links->stopped)
+        return gi_kit_fail(&m->kit, GI_ERR_CANCELLED, "implicit_vis: link creation cancelled");
 
     host->stage_begin(host, "refine_push");
     iv_links_refine_push(m->links, m->hier);
