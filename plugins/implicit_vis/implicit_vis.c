@@ -324,6 +324,8 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
     host->stage_begin(host, "refine_push");
     iv_links_refine_push(m->links, m->hier);
     host->stage_end(host, "refine_push");
+    if (host->cancelled && host->cancelled(host)) /* before the gathers (issue 32) */
+        return gi_kit_fail(&m->kit, GI_ERR_CANCELLED, "implicit_vis: cancelled");
 
     host->stage_begin(host, "illumination");
     if (m->gpu) { /* Sec. 4.3.1: the punctual lights at the frame's time come from the scene's

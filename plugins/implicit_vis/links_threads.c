@@ -172,6 +172,8 @@ static void *collect_worker(void *arg)
         size_t i = atomic_fetch_add(&p->next, 1);
         if (i >= p->ntasks)
             break;
+        if (par_stop(p, 0)) /* the host asked before each task, and every 64 k pairs in it */
+            break;
         link_task *t = &p->tasks[i];
         if (t->n > 0)
             continue; /* a link found while unrolling */
