@@ -68,7 +68,12 @@ gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc
 {
     const uint32_t S = d->streams ? d->streams : 1u;
     const uint32_t M = d->depth.size, N = d->count;
-    const uint32_t batch = d->batch ? d->batch : 16u;
+    /* Maps per gi_depth_render call: d->batch, fewer on a large scene (about
+     * 2^20 triangles a call) so that the cancel asked between calls is seen
+     * within a fraction of a second (issue 32); the maps are the same. */
+    const uint32_t tris = gs->scene->triangle_count, fit = (1u << 20) / (tris ? tris : 1u);
+    uint32_t batch = d->batch ? d->batch : 16u;
+    batch = fit < batch ? (fit ? fit : 1u) : batch;
     const char *who = d->who ? d->who : "csm", *what = d->what ? d->what : "maps";
     const char *render_stage = d->render_stage ? d->render_stage : "depth_render";
     const gi_host *host = d->host;

@@ -13,6 +13,7 @@ layout(location = 3) in uint a_material;
 
 uniform uvec2 u_grid;      // columns, rows
 uniform int u_projection;  // 1 perspective, 2 paraboloid
+uniform uint u_first;      // the first view of this draw (the draw may be split in batches)
 // The views SSBO of depth_atlas.glsl, read as a texture buffer of vec4s
 // (the info header, then 9 a view: view, proj, range): llvmpipe turns SSBO
 // loads into a loop over the SIMD lanes, a texel fetch into one gather;
@@ -31,7 +32,7 @@ out float gl_ClipDistance[5];
 
 void main()
 {
-    uint view = uint(gl_InstanceID);
+    uint view = u_first + uint(gl_InstanceID);
     vec4 world = gi_objects[a_object].world_from_local * vec4(a_position, 1.0);
     int base = 1 + 9 * int(view); // vec4s: the info header, then 9 per view
     vec4 eye = fetch_mat(base) * world;

@@ -3,6 +3,8 @@
  * C twin of the GLSL lookup (depth_atlas.glsl). */
 #include "gi/passes.h"
 
+#include "gi/method.h"
+
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -26,11 +28,17 @@ struct gi_depth_atlas {
     gi_depth_atlas_desc desc;
     uint32_t columns, rows, width, height, count;
     GLuint program, fbo, tex, depth_rb, ssbo, ssbo_tex;
-    GLint loc_grid, loc_views, loc_projection, loc_metric, loc_receiver_side;
+    GLint loc_grid, loc_views, loc_projection, loc_metric, loc_receiver_side, loc_first;
     atlas_view_gpu *staging; /* capacity entries */
     GLuint geometry_ibo;     /* indices drawn instead of the scene's triangles when not 0 */
     uint32_t geometry_count; /* their triangles */
+    const gi_host *host;     /* polled for cancellation between batches of views; NULL: never */
 };
+
+/* Triangles (times views) one batch of the draw holds when a host is set:
+ * about a tenth of a second on llvmpipe, so that a cancel is seen soon
+ * while a draw of a few thousand views is still only a few calls. */
+#define ATLAS_BATCH_TRIANGLES (1u << 20)
 
 /* Rejects a desc the atlas cannot draw. */
 static gi_result check_desc(const gi_depth_atlas_desc *d, gi_error *err)
@@ -138,6 +146,7 @@ gi_depth_atlas *gi_depth_atlas_create(const gi_depth_atlas_desc *d, gi_error *er
     a->loc_projection = glGetUniformLocation(a->program, "u_projection");
     a->loc_metric = glGetUniformLocation(a->program, "u_metric");
     a->loc_receiver_side = glGetUniformLocation(a->program, "u_receiver_side");
+    a->loc_first = glGetUniformLocation(a->program, "u_first");
     create_targets(a);
     if (glCheckNamedFramebufferStatus(a->fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
         gi_error_set(err, GI_ERR_GL, "depth atlas: the %ux%u framebuffer is incomplete", a->width,
@@ -167,6 +176,33 @@ void gi_depth_atlas_free(gi_depth_atlas *a)
     glDeleteBuffers(1, &a->ssbo);
     free(a->staging);
     free(a);
+}
+
+/* The instanced draw of views 0..count-1 (u_first + gl_InstanceID is the
+ * view): in one call without a host, else in batches of about
+ * ATLAS_BATCH_TRIANGLES with host->cancelled() asked before each (llvmpipe
+ * runs a draw's vertex work inside the call, so a batch is the longest a
+ * cancel waits). */
+static gi_result draw_batches(gi_depth_atlas *a, const gi_gpu_scene *gs, uint32_t count,
+                              gi_error *err)
+{
+    uint32_t tris = a->geometry_ibo ? a->geometry_count : gs->scene->triangle_count;
+    uint32_t step = count;
+    if (a->host && a->host->cancelled) {
+        step = ATLAS_BATCH_TRIANGLES / (tris ? tris : 1);
+        step = step ? step : 1;
+    }
+    for (uint32_t first = 0; first < count; first += step) {
+        if (a->host && a->host->cancelled && a->host->cancelled(a->host))
+            return gi_error_set(err, GI_ERR_CANCELLED, "depth atlas: cancelled");
+        uint32_t n = count - first < step ? count - first : step;
+        glUniform1ui(a->loc_first, first);
+        if (a->geometry_ibo)
+            gi_gpu_scene_draw_indices(gs, a->geometry_ibo, a->geometry_count * 3, (GLsizei)n);
+        else
+            gi_gpu_scene_draw(gs, -1, (GLsizei)n);
+    }
+    return GI_OK;
 }
 
 gi_result gi_depth_atlas_render(gi_depth_atlas *a, const gi_gpu_scene *gs,
@@ -232,19 +268,26 @@ gi_result gi_depth_atlas_render(gi_depth_atlas *a, const gi_gpu_scene *gs,
         glUniform1i(a->loc_metric, (GLint)d->metric);
         glUniform1i(a->loc_receiver_side, d->receiver_side);
         glBindTextureUnit(ATLAS_VIEWS_UNIT, a->ssbo_tex);
-        if (a->geometry_ibo)
-            gi_gpu_scene_draw_indices(gs, a->geometry_ibo, a->geometry_count * 3, (GLsizei)count);
-        else
-            gi_gpu_scene_draw(gs, -1, (GLsizei)count);
+        gi_result r = draw_batches(a, gs, count, err);
         for (GLenum k = 0; k < 5; k++)
             glDisable(GL_CLIP_DISTANCE0 + k);
         glDisable(GL_CULL_FACE);
         glBindTextureUnit(ATLAS_VIEWS_UNIT, 0);
         glUseProgram(0);
+        if (r != GI_OK) { /* cancelled: the atlas holds no complete set of views */
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+            a->count = 0;
+            return r;
+        }
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     a->count = count;
     return gi_gl_check("depth atlas: render", err);
+}
+
+void gi_depth_atlas_set_host(gi_depth_atlas *a, const gi_host *host)
+{
+    a->host = host;
 }
 
 void gi_depth_atlas_set_geometry(gi_depth_atlas *a, GLuint ibo, uint32_t triangle_count)

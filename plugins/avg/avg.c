@@ -251,6 +251,7 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
     a->grid = avg_grid_create((uint32_t)a->grid_n, &err);
     if (!a->grid)
         return gi_kit_fail_with(&a->kit, GI_ERR_GL, &err);
+    a->grid->host = a->kit.host; /* the long draws stop on a cancel (issue 32) */
     if (build_programs(a, &err) != GI_OK)
         return gi_kit_fail_with(&a->kit, GI_ERR_GL, &err);
     if (a->visibility) {
@@ -280,6 +281,7 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
             return gi_kit_fail_with(&a->kit, GI_ERR_INVALID_ARGUMENT, &err);
         gi_depth_atlas_set_geometry(a->atlas, a->lod ? a->lod->ibo : 0,
                                     a->lod ? a->lod->triangle_count : 0);
+        gi_depth_atlas_set_host(a->atlas, a->kit.host);
         a->views = calloc(a->slots, sizeof *a->views);
         if (!a->views)
             return gi_kit_fail(&a->kit, GI_ERR_OUT_OF_MEMORY,

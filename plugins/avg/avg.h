@@ -44,6 +44,7 @@ typedef struct avg_grid {
     GLuint ssbo_sums;             /* the single pass: 8 ints a voxel (avg_vox1.frag) */
     GLuint ssbo_colours;          /* per material: albedo x mean texture colour */
     const gi_scene *colour_scene; /* the scene ssbo_colours was made for */
+    const gi_host *host;          /* polled between batches of slices (issue 32); NULL: never */
 } avg_grid;
 
 avg_grid *avg_grid_create(uint32_t n, gi_error *err);

@@ -217,6 +217,28 @@ static gi_result voxelise_single(avg_grid *g, const gi_gpu_scene *gs, gi_error *
     return gi_gl_check("avg: single-pass voxelisation", err);
 }
 
+/* The per-slice passes (§III-A) as instanced draws of the scene: all n
+ * slices in one draw without a host, else batches of about AVG_VOX_BATCH
+ * triangles (times slices) with host->cancelled() asked before each
+ * (llvmpipe runs a draw's vertex and geometry work inside the call). */
+#define AVG_VOX_BATCH (1u << 19)
+static gi_result draw_slices(const avg_grid *g, const gi_gpu_scene *gs, GLuint p, gi_error *err)
+{
+    uint32_t tris = gs->scene->triangle_count, step = g->n;
+    if (g->host && g->host->cancelled) {
+        step = AVG_VOX_BATCH / (tris ? tris : 1);
+        step = step ? step : 1;
+    }
+    GLint loc = glGetUniformLocation(p, "u_first_slice");
+    for (uint32_t first = 0; first < g->n; first += step) {
+        if (g->host && g->host->cancelled && g->host->cancelled(g->host))
+            return gi_error_set(err, GI_ERR_CANCELLED, "avg: voxelisation cancelled");
+        glUniform1i(loc, (GLint)first);
+        gi_gpu_scene_draw(gs, -1, (GLsizei)(g->n - first < step ? g->n - first : step));
+    }
+    return GI_OK;
+}
+
 gi_result avg_grid_voxelise(avg_grid *g, const gi_gpu_scene *gs, avg_vox_mode mode, gi_error *err)
 {
     if (g->colour_scene != gs->scene && upload_material_colours(g, gs->scene, err) != GI_OK)
@@ -242,12 +264,12 @@ gi_result avg_grid_voxelise(avg_grid *g, const gi_gpu_scene *gs, avg_vox_mode mo
     glUniform1f(glGetUniformLocation(p, "u_epsilon"), 0.5f);
     gi_gpu_scene_bind(gs);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, AVG_SSBO_COLOURS, g->ssbo_colours);
-    gi_gpu_scene_draw(gs, -1, (GLsizei)g->n);
+    gi_result r = draw_slices(g, gs, p, err);
     glUseProgram(0);
     glDisable(GL_BLEND);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
-    return gi_gl_check("avg: voxelisation", err);
+    return r != GI_OK ? r : gi_gl_check("avg: voxelisation", err);
 }
 
 float *avg_grid_read(const avg_grid *g, int colour)

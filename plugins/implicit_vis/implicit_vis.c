@@ -249,6 +249,7 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
         m->links->coverage = m->coverage;
         m->links->weight = m->weight;
         m->links->threads = (uint32_t)m->threads;
+        m->links->host = host; /* link creation stops on a cancel (issue 32) */
     }
     m->irr = calloc((size_t)m->hier->elem_count * 6, sizeof(float));
     m->elem_light = calloc((size_t)m->hier->elem_count * 12, sizeof(float));
@@ -327,10 +328,14 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
     host->stage_begin(host, "create_links");
     iv_links_build(m->links, m->hier, m->subdiv, m->brute, m->splat);
     host->stage_end(host, "create_links");
+    if (m->links->stopped)
+        return gi_kit_fail(&m->kit, GI_ERR_CANCELLED, "implicit_vis: link creation cancelled");
 
     host->stage_begin(host, "refine_push");
     iv_links_refine_push(m->links, m->hier);
     host->stage_end(host, "refine_push");
+    if (host->cancelled && host->cancelled(host)) /* before the gathers (issue 32) */
+        return gi_kit_fail(&m->kit, GI_ERR_CANCELLED, "implicit_vis: cancelled");
 
     host->stage_begin(host, "illumination");
     if (m->gpu) { /* Sec. 4.3.1: the punctual lights at the frame's time come from the scene's

@@ -27,6 +27,8 @@
 
 #include <stdint.h>
 
+struct gi_host;
+
 /* ---- cube-map bins (Sec. 4.2.2 "Discretization") ---- */
 
 /* Bin of direction d (any length > 0) in a 6 x n x n world-aligned cube map:
@@ -176,6 +178,11 @@ typedef struct iv_links {
     uint64_t tries;     /* node pairs considered */
     uint64_t created;   /* bin entries written (a shorter link replacing one counts) */
     uint64_t receiving; /* leaf links after refinement and push-down */
+    /* Asked for a cancel every 64 k node pairs of link creation (issue 32);
+     * NULL: never. `stopped`: the last build stopped on it, its links are
+     * incomplete. */
+    const struct gi_host *host;
+    int stopped;
 } iv_links;
 
 iv_links *iv_links_create(const iv_hier *h, uint32_t n);

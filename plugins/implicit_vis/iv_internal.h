@@ -39,5 +39,8 @@ void iv_put_side(iv_links *l, const iv_hier *h, uint32_t A, uint32_t B, gi_vec3 
  * first); 0 when it could not (out of memory, no thread), and the caller
  * builds them on one. */
 int iv_links_build_parallel(iv_links *l, const iv_hier *h, float subdiv, int splat, int threads);
+/* Whether l->host asks to stop (issue 32); thread-safe as the host's
+ * cancelled() is (a flag set by a signal handler). */
+int iv_links_cancelled(const iv_links *l);
 
 #endif

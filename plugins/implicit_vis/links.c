@@ -7,6 +7,8 @@
  * See iv.h. */
 #include "iv_internal.h"
 
+#include "gi/method.h"
+
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -238,10 +240,17 @@ int iv_pair_decide(const iv_links *l, const iv_hier *h, float subdiv, uint32_t A
 
 /* Sec. 4.2.2: link A and B, or their children where one looks bigger than
  * a bin from the other. */
+int iv_links_cancelled(const iv_links *l)
+{
+    return l->host && l->host->cancelled && l->host->cancelled(l->host);
+}
+
 static void link_pair(link_ctx *c, uint32_t A, uint32_t B)
 {
     const iv_hier *h = c->h;
-    c->l->tries++;
+    if (c->l->stopped ||
+        ((++c->l->tries & 0xFFFF) == 0 && (c->l->stopped = iv_links_cancelled(c->l))))
+        return; /* a cancel: the recursion unwinds */
     gi_vec3 d;
     float r2;
     switch (iv_pair_decide(c->l, h, c->subdiv, A, B, &d, &r2)) {
@@ -286,9 +295,12 @@ static void links_clear(iv_links *l)
 
 void iv_links_build(iv_links *l, const iv_hier *h, float subdiv, int brute, int splat)
 {
+    l->stopped = 0;
     if (brute) {
         links_clear(l);
-        for (uint32_t i = 0; i < h->elem_count; i++)
+        for (uint32_t i = 0; i < h->elem_count && !l->stopped; i++) {
+            if ((i & 63) == 63)
+                l->stopped = iv_links_cancelled(l);
             for (uint32_t j = i + 1; j < h->elem_count; j++) {
                 uint32_t A = h->elem_node[i], B = h->elem_node[j];
                 gi_vec3 d = gi_v3_sub(gi_v3_load(&h->pos[3 * B]), gi_v3_load(&h->pos[3 * A]));
@@ -297,6 +309,7 @@ void iv_links_build(iv_links *l, const iv_hier *h, float subdiv, int brute, int 
                 if (r2 > 1e-20f)
                     insert(l, h, A, B, d, sqrtf(r2), splat);
             }
+        }
         return;
     }
     l->tries = l->created = 0;

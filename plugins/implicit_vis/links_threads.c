@@ -34,7 +34,17 @@ typedef struct link_par {
     atomic_size_t next;
     int threads;
     int fail;
+    atomic_int stop; /* a cancel seen by any thread (issue 32) */
 } link_par;
+
+/* Whether to stop: the host is asked every 64 k steps of `count`, and a
+ * cancel seen by one thread stops them all. */
+static int par_stop(link_par *p, uint64_t count)
+{
+    if ((count & 0xFFFF) == 0 && iv_links_cancelled(p->l))
+        atomic_store(&p->stop, 1);
+    return atomic_load_explicit(&p->stop, memory_order_relaxed);
+}
 
 static int task_push(link_task *t, uint32_t A, uint32_t B)
 {
@@ -55,7 +65,8 @@ static int task_push(link_task *t, uint32_t A, uint32_t B)
 static int collect_pair(link_par *p, link_task *t, uint32_t A, uint32_t B)
 {
     const iv_hier *h = p->h;
-    t->tries++;
+    if (par_stop(p, ++t->tries))
+        return 0;
     gi_vec3 d;
     float r2;
     switch (iv_pair_decide(p->l, h, p->subdiv, A, B, &d, &r2)) {
@@ -161,6 +172,8 @@ static void *collect_worker(void *arg)
         size_t i = atomic_fetch_add(&p->next, 1);
         if (i >= p->ntasks)
             break;
+        if (par_stop(p, 0)) /* the host asked before each task, and every 64 k pairs in it */
+            break;
         link_task *t = &p->tasks[i];
         if (t->n > 0)
             continue; /* a link found while unrolling */
@@ -194,9 +207,12 @@ static void *write_worker(void *arg)
             p->l->cover[base + b] = 0.0f;
         }
     }
+    uint64_t steps = 0;
     for (size_t i = 0; i < p->ntasks; i++) {
         const link_task *t = &p->tasks[i];
         for (size_t k = 0; k < t->n; k++) {
+            if (par_stop(p, ++steps))
+                return NULL;
             uint32_t A = t->pairs[2 * k], B = t->pairs[2 * k + 1];
             int a = A % T == me, b = B % T == me;
             if (!a && !b)
@@ -231,6 +247,7 @@ int iv_links_build_parallel(iv_links *l, const iv_hier *h, float subdiv, int spl
     p.tasks = tasks;
     p.ntasks = m;
     atomic_init(&p.next, 0);
+    atomic_init(&p.stop, 0);
     pthread_t *tid = malloc((size_t)threads * sizeof *tid);
     uint8_t *made = calloc((size_t)threads, 1);
     write_arg *wa = calloc((size_t)threads, sizeof *wa);
@@ -245,7 +262,7 @@ int iv_links_build_parallel(iv_links *l, const iv_hier *h, float subdiv, int spl
                 pthread_join(tid[i], NULL);
         ok = !p.fail;
     }
-    if (ok) {
+    if (ok && !atomic_load(&p.stop)) {
         for (size_t i = 0; i < m; i++)
             tries += tasks[i].tries;
         /* each writer owns its nodes: one that cannot start runs here afterwards */
@@ -267,5 +284,9 @@ int iv_links_build_parallel(iv_links *l, const iv_hier *h, float subdiv, int spl
     for (size_t i = 0; i < m; i++)
         free(tasks[i].pairs);
     free(tasks), free(tid), free(made), free(wa);
+    if (atomic_load(&p.stop)) { /* cancelled: no build on one thread follows */
+        l->stopped = 1;
+        return 1;
+    }
     return ok;
 }

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""A large scene for the cancellation test (tests/integration/cancel.cmake):
+"""A large scene for the cancellation test (tests/integration/cancel_test.sh):
 the Cornell box (scenes/cornell_box_coarse.gltf) with a bumpy heightfield of
 2 * n * n triangles over its floor. The bumps make every triangle's plane
 its own (methods that merge coplanar triangles get no shortcut).

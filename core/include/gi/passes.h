@@ -182,6 +182,12 @@ gi_result gi_depth_atlas_render(gi_depth_atlas *a, const gi_gpu_scene *gs,
  * the renders that follow, through gi_gpu_scene_draw_indices; ibo 0 = the
  * scene's own triangles. The caller keeps the buffer alive while it is set. */
 void gi_depth_atlas_set_geometry(gi_depth_atlas *a, GLuint ibo, uint32_t triangle_count);
+struct gi_host;
+/* With a host set, gi_depth_atlas_render draws in batches of about a
+ * million triangles (times views) and asks host->cancelled() before each:
+ * GI_ERR_CANCELLED, count 0, when it says stop (issue 32: a few thousand
+ * maps of a large scene are one long draw). NULL (the default): one draw. */
+void gi_depth_atlas_set_host(gi_depth_atlas *a, const struct gi_host *host);
 GLuint
 gi_depth_atlas_texture(const gi_depth_atlas *a); /* R32F, linear depth, FLT_MAX where empty */
 GLuint gi_depth_atlas_views_buffer(const gi_depth_atlas *a); /* SSBO read by depth_atlas.glsl */
