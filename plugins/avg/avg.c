@@ -26,6 +26,10 @@
 
 #define AVG_BIAS_VOXELS 0.5f /* receiver offset and constant depth bias, in voxel edges */
 #define AVG_BIAS_TEXELS 1.0f /* depth bias per unit of distance and slope, in texels of the map */
+/* How far a bounce VPL's shadow-map eye moves out along its normal, in
+ * voxel edges: the voxel's diagonal. */
+#define AVG_EYE_LIFT 1.7320508f
+
 /* Largest surface move the shadow maps' lower-detail copy may make, as a
  * share of each object's extent (meshopt's relative error): half a texel
  * of a 32^2 map seen from one extent away with the 120 degree field of
@@ -186,6 +190,19 @@ static gi_result shadow_maps(avg *a, gi_error *err)
     for (uint32_t j = 0; j < a->vpl_count; j++) {
         const avg_vpl *v = &a->cpu_vpls[j];
         gi_vec3 eye = gi_v3_load(v->position), n = gi_v3_load(v->normal);
+        /* A bounce VPL lies up to a voxel diagonal past its surface (its
+         * position is pushed into the hit voxel, avg_trace.comp); maps kept
+         * as the receivers see them (receiver_side 1) would hold that
+         * surface's back at its eye and shadow everything. Their eye moves
+         * out along the normal by the diagonal. */
+        if ((v->kind >> 8 & 0xFFu) != 0)
+            eye = gi_v3_add(eye, gi_v3_scale(n, AVG_EYE_LIFT * a->grid->h));
+        /* A VPL on an area light lies on the light's plane: a paraboloid map
+         * would draw the light's own triangles (their corners on the
+         * horizon) across the disc. A hundredth of a voxel puts that plane
+         * behind the eye, where the hemisphere clips it. */
+        else if ((v->kind & 0xFFu) == AVG_VPL_DIFFUSE)
+            eye = gi_v3_add(eye, gi_v3_scale(n, 0.01f * a->grid->h));
         gi_vec3 up = fabsf(n.y) < 0.9f ? gi_v3(0, 1, 0) : gi_v3(1, 0, 0);
         gi_depth_view *dv = &a->views[j];
         gi_mat4_look_at(dv->view, eye, gi_v3_add(eye, n), up);
@@ -258,18 +275,16 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
         gi_result r = build_lod(a, scene->scene, &err);
         if (r != GI_OK)
             return gi_kit_fail_with(&a->kit, r, &err);
-        /* Back faces culled: the faces each VPL sees (receiver_side 0). The
-         * maps as the receivers see them (receiver_side 1, the rule the
-         * reference follows for a ray from the receiver) fix a single-sided
-         * panel facing away from a VPL (held-out seed 2 ceiling: relMSE 0.396
-         * -> 0.144) but lose 12 % of box_light's light, for a reason not yet
-         * found (README, "Sides"), so they are not the default. */
+        /* No culling, and single-sided faces as the receivers see them (the
+         * one rule for sides, gi/scene.h): a VPL's light reaches a point
+         * unless a ray from the point toward the VPL meets a surface, as the
+         * reference traces it; a closed object's map holds its far side. */
         gi_depth_atlas_desc d = {.tile = (uint32_t)a->tile,
                                  .capacity = a->slots,
                                  .projection = choose_projection(a, scene->scene),
                                  .metric = GI_DEPTH_RADIAL,
-                                 .cull = 1,
-                                 .receiver_side = 0};
+                                 .cull = 0,
+                                 .receiver_side = 1};
         if (a->lod && a->projection == 1)
             a->kit.host->log(a->kit.host, GI_LOG_WARN,
                              "shadow_lod=%g with projection=paraboloid: the warp bends the "
