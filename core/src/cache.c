@@ -43,6 +43,9 @@ uint64_t gi_scene_object_hash(const gi_scene *s, uint32_t object)
         XXH64_update(st, v->position, sizeof v->position);
         XXH64_update(st, v->normal, sizeof v->normal);
         XXH64_update(st, v->uv, sizeof v->uv);
+        /* the one rule for sides (gi/scene.h): which faces exist in a map */
+        unsigned char ds = (unsigned char)(s->materials[v->material].double_sided != 0);
+        XXH64_update(st, &ds, 1);
     }
     for (size_t k = (size_t)o->first_triangle * 3;
          k < ((size_t)o->first_triangle + o->triangle_count) * 3; k++) {

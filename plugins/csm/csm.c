@@ -36,8 +36,8 @@
 
 extern const gi_shader_source gi_csm_shaders[];
 
-#define CSM_FORMAT_VERSION 2u
-#define CSM_LOCAL_FORMAT_VERSION 1u
+#define CSM_FORMAT_VERSION 3u       /* 3: maps drawn by the one rule for sides (issue 28) */
+#define CSM_LOCAL_FORMAT_VERSION 2u /* 2: the one rule for sides (issue 28) */
 #define CSM_PATTERNS 256u
 
 enum {

@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define CSSM_FORMAT_VERSION 3u /* 3: back-side texels of double-sided materials */
+#define CSSM_FORMAT_VERSION 4u /* 4: cube maps by the rule for sides (receiver_side 3) */
 static const char cache_magic[8] = {'G', 'I', 'C', 'S', 'S', 'M', '\r', '\n'};
 
 /* Cache name: the meshes, their placement at prepare time and every

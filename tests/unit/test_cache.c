@@ -5,6 +5,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "check.h"
 #include "gi/cache.h"
+#include "gi/scene.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -49,8 +50,28 @@ static unsigned char *read_raw(const char *name, size_t *n)
     return b;
 }
 
+/* The object hash that cache names start from changes with a material's
+ * doubleSided: under the rule for sides (gi/scene.h) it decides which faces
+ * a map holds (issue 28). */
+static void test_hash_sides(void)
+{
+    gi_error err;
+    gi_scene *s = gi_scene_load(GI_TEST_DATA "/truth/box_light.gltf", &err);
+    CHECK_MSG(s != NULL, "%s", err.text);
+    if (!s)
+        return;
+    uint64_t h0 = gi_scene_object_hash(s, 0);
+    uint32_t m = s->vertices[s->objects[0].first_vertex].material;
+    s->materials[m].double_sided = !s->materials[m].double_sided;
+    CHECK(gi_scene_object_hash(s, 0) != h0);
+    s->materials[m].double_sided = !s->materials[m].double_sided;
+    CHECK(gi_scene_object_hash(s, 0) == h0);
+    gi_scene_free(s);
+}
+
 int main(void)
 {
+    test_hash_sides();
     CHECK(mkdtemp(dir) != NULL);
     const char payload[] = "precomputed maps of one object, 37 bytes";
     const char *a = "m-0123456789abcdef.bin", *b = "m-fedcba9876543210.bin";

@@ -17,7 +17,8 @@ extern "C" {
 
 /* 64-bit hash (XXH64) of a byte range, continuing from `seed`. */
 uint64_t gi_hash64(const void *data, size_t size, uint64_t seed);
-/* Hash of one object's mesh in local space (positions, normals, uvs, indices). */
+/* Hash of one object's mesh in local space (positions, normals, uvs, indices,
+ * each vertex's material doubleSided: which faces exist under the rule for sides). */
 uint64_t gi_scene_object_hash(const gi_scene *s, uint32_t object);
 /* Resolves (and creates) the cache directory; returns a malloc'd path or
  * NULL + err. */
