@@ -84,10 +84,11 @@ static void sweep_perturbed(vlf_field *f, uint32_t i, const vlf_psf *fr, const v
                     for (int q = 0; q < 3; q++)
                         f->in[3 * slot + q] += L[q] * inv_s2 / (float)f->prm.perturbed;
                 recv += lum;
-                L[0] = L[1] = L[2] = 0.0f;
+                /* as in propagate.c's sweep: it goes on past a face lit
+                 * on its front, and stops at a face met on its back */
             } else if (cs > 0.0f) {
-                /* as in propagate.c's sweep: a single-sided back lets it through */
                 back += lum;
+                L[0] = L[1] = L[2] = 0.0f;
                 float own[3];
                 for (int q = 0; q < 3; q++)
                     own[q] = f->L_cur[3 * (size_t)el + q] * fc->send_scale;

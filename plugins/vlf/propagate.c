@@ -30,9 +30,12 @@ void vlf_sweep_sky(const vlf_field *f, uint32_t i, int sign, int first_iteration
 
 /* One sweep of subfield i along travel direction t = sign * w_i, front to
  * back along t through every ray's fragments with the radiance interface:
- * receivers (front side facing against t) take the interface's radiance,
- * senders (front side along t) add their unshot radiance to it (what
- * crossed their back goes on: flux_back counts it, nothing is lost). */
+ * receivers (front side facing against t) take the interface's radiance
+ * and let it go on, senders (front side along t) stop what arrived on their
+ * back (flux_back counts it) and send their unshot radiance on. This is the
+ * one rule for sides (gi/scene.h) as the reference applies it to a ray cast
+ * from a point back toward the light: it meets a single-sided face only on
+ * its front. A closed surface receives at its entry and stops at its exit. */
 static void sweep(vlf_field *f, uint32_t i, int sign, int first_iteration)
 {
     const vlf_psf *p = &f->psf[i];
@@ -70,15 +73,17 @@ static void sweep(vlf_field *f, uint32_t i, int sign, int first_iteration)
                         f->in[3 * slot + q] += L[q] * inv_s2;
                 }
                 recv += lum;
-                L[0] = L[1] = L[2] = 0.0f;
+                /* and it goes on: a ray from a point further along back
+                 * toward the light meets this face's back, which does not
+                 * exist (the one rule for sides, gi/scene.h, as the
+                 * reference casts that ray); a closed surface's exit face
+                 * stops it below */
             } else if (cs > 0.0f) {
-                /* sender: its front adds its unshot radiance; what arrived
-                 * on its back goes on through it, since a single-sided
-                 * face seen from its back does not exist (glTF
-                 * doubleSided = false, the rule of gi/scene.h; a
-                 * double-sided face's receiver side, just before, has
-                 * taken it all) */
+                /* sender: a ray from downstream meets its front, so what
+                 * arrived on its back stops here (flux_back), and its
+                 * front sends its unshot radiance on */
                 back += lum;
+                L[0] = L[1] = L[2] = 0.0f;
                 float own[3];
                 for (int q = 0; q < 3; q++)
                     own[q] = f->L_cur[3 * (size_t)el + q] * fc->send_scale;

@@ -4,9 +4,9 @@
 // define VLF_PASS:
 //   0 sweep:   one invocation per radiance-interface ray and sign (y = 0:
 //              along +w_i, 1: along -w_i), through the ray's fragments;
-//              receivers record the interface's radiance per fragment,
-//              senders add their unshot radiance to it (what crossed a
-//              single-sided face's back goes on through it);
+//              receivers record the interface's radiance per fragment
+//              and let it go on, senders stop what reached their back and
+//              send their unshot radiance on (the rule for sides);
 //   1 gather:  per element (and per non-diffuse tile cell) of subfield i,
 //              the recorded radiance of its fragments summed in the CPU's
 //              order into the next irradiance map (and the incoming tile);
@@ -158,12 +158,12 @@ void main()
         float lum = L.x + L.y + L.z;
         if (cs < 0.0) {
             recv[3u * k] = L.x, recv[3u * k + 1u] = L.y, recv[3u * k + 2u] = L.z;
-            rcv += lum;
-            L = vec3(0.0);
+            rcv += lum; // and it goes on (propagate.c: the rule for sides)
         } else if (cs > 0.0) {
-            // sender: adds its unshot radiance; what crossed its back goes
-            // on (a single-sided face seen from its back does not exist)
+            // sender: what arrived on its back stops (a ray from downstream
+            // meets its front); it sends its unshot radiance on
             back += lum;
+            L = vec3(0.0);
             vec3 own = e_get(L_CUR, el) * fc.send_scale;
             uint slot = frag_slot[u_frag_base + k];
             if (slot != 0xffffffffu)

@@ -62,8 +62,10 @@ static void test_sun(void)
         s->nodes[1].rotation[0] = sinf(0.5f * a);
         s->nodes[1].rotation[3] = cosf(0.5f * a);
         add_quad(s, 0, gi_v3(-1, -1, 0), gi_v3(1, -1, 0), gi_v3(1, 1, 0), gi_v3(-1, 1, 0), 0);
-        add_quad(s, 1, gi_v3(-0.25f, -0.25f, 0.5f), gi_v3(0.25f, -0.25f, 0.5f),
-                 gi_v3(0.25f, 0.25f, 0.5f), gi_v3(-0.25f, 0.25f, 0.5f), 0);
+        /* the occluder faces the floor: a ray from the floor toward the sun
+         * meets its front (the rule for sides, gi/scene.h) */
+        add_quad(s, 1, gi_v3(-0.25f, -0.25f, 0.5f), gi_v3(-0.25f, 0.25f, 0.5f),
+                 gi_v3(0.25f, 0.25f, 0.5f), gi_v3(0.25f, -0.25f, 0.5f), 0);
         float bounds[6] = {-1, -1, 0, 1, 1, 0.5f};
         memcpy(s->objects[0].local_bounds, bounds, sizeof bounds);
         s->light_count = 1;

@@ -67,10 +67,13 @@ static void test_energy(void)
     printf("energy (closed sphere, 1 iteration): emitted %.6f shot %.6f received %.6f back %.6f "
            "escaped %.6f\n",
            st->flux_emitted, st->flux_shot, st->flux_received, st->flux_back, st->flux_escaped);
-    CHECK_NEAR(st->flux_shot, st->flux_received + st->flux_escaped, /* a back lets it through */
-               1e-4 * st->flux_shot);
-    EXPECT(st->flux_escaped < 1e-3 * st->flux_shot, "light escaped a closed sphere: %.4g of %.4g",
-           st->flux_escaped, st->flux_shot);
+    /* The rule for sides from the receiver's side (propagate.c): every
+     * packet ends at a back or escapes; inside the inward-wound sphere each
+     * reaches the far wall once, which takes it and lets it go on (a point
+     * outside sees the inside through the walls' backs). */
+    CHECK_NEAR(st->flux_shot, st->flux_back + st->flux_escaped, 1e-4 * st->flux_shot);
+    EXPECT(fabs(st->flux_received / st->flux_shot - 1.0) < 1e-3,
+           "the far wall received %.4g of %.4g shot", st->flux_received, st->flux_shot);
     EXPECT(st->flux_back < 1e-3 * st->flux_shot, "light met back faces in a closed sphere: %.4g",
            st->flux_back);
     /* what is shot in the first iteration is the emission, within the
@@ -93,11 +96,11 @@ static void test_energy(void)
            "%.6f escaped %.6f\n",
            f.tri_count, st->flux_emitted, st->flux_shot, st->flux_received, st->flux_back,
            st->flux_escaped);
-    CHECK_NEAR(st->flux_shot, st->flux_received + st->flux_escaped, /* a back lets it through */
-               1e-4 * st->flux_shot);
-    EXPECT(st->flux_escaped < 1e-3 * st->flux_shot && st->flux_back < 1e-3 * st->flux_shot,
-           "subdivided: light escaped (%.4g) or met back faces (%.4g)", st->flux_escaped,
-           st->flux_back);
+    CHECK_NEAR(st->flux_shot, st->flux_back + st->flux_escaped, 1e-4 * st->flux_shot);
+    EXPECT(fabs(st->flux_received / st->flux_shot - 1.0) < 1e-3 &&
+               st->flux_back < 1e-3 * st->flux_shot,
+           "subdivided: received %.4g of %.4g shot, %.4g met back faces", st->flux_received,
+           st->flux_shot, st->flux_back);
     EXPECT(fabs(st->flux_shot / st->flux_emitted - 1.0) < 0.02,
            "subdivided: shot %.5g vs emitted %.5g", st->flux_shot, st->flux_emitted);
     vlf_field_free(&f);
@@ -109,11 +112,11 @@ static void test_energy(void)
     printf("energy, 3 perturbed directions: emitted %.6f shot %.6f received %.6f back %.6f escaped "
            "%.6f\n",
            st->flux_emitted, st->flux_shot, st->flux_received, st->flux_back, st->flux_escaped);
-    CHECK_NEAR(st->flux_shot, st->flux_received + st->flux_escaped, /* a back lets it through */
-               1e-4 * st->flux_shot);
-    EXPECT(st->flux_escaped < 1e-3 * st->flux_shot && st->flux_back < 1e-3 * st->flux_shot,
-           "perturbed: light escaped (%.4g) or met back faces (%.4g)", st->flux_escaped,
-           st->flux_back);
+    CHECK_NEAR(st->flux_shot, st->flux_back + st->flux_escaped, 1e-4 * st->flux_shot);
+    EXPECT(fabs(st->flux_received / st->flux_shot - 1.0) < 1e-3 &&
+               st->flux_back < 1e-3 * st->flux_shot,
+           "perturbed: received %.4g of %.4g shot, %.4g met back faces", st->flux_received,
+           st->flux_shot, st->flux_back);
     EXPECT(fabs(st->flux_shot / st->flux_emitted - 1.0) < 0.02,
            "perturbed: shot %.5g vs emitted %.5g", st->flux_shot, st->flux_emitted);
     /* the perturbed lists sorted beside the sweeps on 2 threads (above) or
@@ -409,10 +412,11 @@ static double panel_light_E(gi_vec3 x, gi_vec3 n)
 }
 
 /* The single-sided panel (faces lit and dark of field f): only the dark
- * side exists. Seen from its back (the light's side) it does not exist
- * (glTF doubleSided = false; the rule of gi/scene.h), so the light the
- * double-sided panel's lit side received (recv_double) crosses it and
- * escapes: nothing received, nothing absorbed. */
+ * side exists. The light meets its back: it receives nothing (glTF
+ * doubleSided = false), but a ray from a point behind it back toward the
+ * light meets its front (the rule of gi/scene.h as the reference casts it),
+ * so the light the double-sided panel's lit side received (recv_double)
+ * stops there: it casts its shadow. */
 static void check_single_sided(const vlf_field *f, int lit, int dark, double recv_double)
 {
     const vlf_stats *st = &f->st;
@@ -425,10 +429,9 @@ static void check_single_sided(const vlf_field *f, int lit, int dark, double rec
            st->flux_received, st->flux_back);
     EXPECT(fabs(st->flux_back - recv_double) < 0.02 * recv_double,
            "single-sided back %.4g, double-sided received %.4g", st->flux_back, recv_double);
-    /* the old sweep absorbed at the back: escaped was shot - back */
-    EXPECT(st->flux_escaped > 0.999 * st->flux_shot,
-           "single-sided panel: escaped %.4g of %.4g shot (absorbed by a back side)",
-           st->flux_escaped, st->flux_shot);
+    EXPECT(fabs(st->flux_escaped - (st->flux_shot - st->flux_back)) < 1e-3 * st->flux_shot,
+           "single-sided panel: escaped %.4g of %.4g shot, %.4g stopped at its back",
+           st->flux_escaped, st->flux_shot, st->flux_back);
 }
 
 /* The double-sided panel's sides (faces lit and dark of field f, built
@@ -476,7 +479,11 @@ static void check_double_sided(const vlf_field *f, const vlf_settings *p, int li
         EXPECT(fabs(sum[h] / sum_ref[h] - 1.0) < 0.05, "lit side half %d: irradiance %.4f vs %.4f",
                h, sum[h], sum_ref[h]);
     EXPECT(dark_max == 0.0, "light through the panel: %.3g on its dark side", dark_max);
-    EXPECT(st->flux_back < 1e-6 * st->flux_received, "light met a back side: %.4g", st->flux_back);
+    /* the lit side takes the light and lets it go on; its twin, met on
+     * its back, stops it (propagate.c) */
+    EXPECT(fabs(st->flux_back / st->flux_received - 1.0) < 0.01,
+           "the dark side stopped %.4g of the %.4g the lit side took", st->flux_back,
+           st->flux_received);
 }
 
 /* Irradiance at world point x (unit normal n) from sphere_in_ss.gltf's
@@ -500,11 +507,12 @@ static double ball_lamp_E(gi_vec3 x, gi_vec3 n)
 
 /* The one rule for sides (gi/scene.h, glTF doubleSided = false): a
  * single-sided face seen from its back does not exist for any ray. The
- * inward-wound ball of tests/data/truth/sphere_in_ss.gltf under a lamp:
- * the lamp's light crosses the ball's upper half (seen from its back) and
- * lands on the inside of its lower half (their fronts face up), 1
- * iteration: the irradiance there against the lamp's, unoccluded (the old
- * sweep absorbed it at the upper half: 0). */
+ * inward-wound ball of tests/data/truth/sphere_in_ss.gltf under a lamp: a
+ * ray from the inside of its lower half (fronts facing up) toward the lamp
+ * meets the upper half's front (it faces down, into the ball), so, as in
+ * the reference, no direct light lands there, 1 iteration: the irradiance
+ * against the lamp's unoccluded one (the light-side sweep of the first
+ * issue 28 change let 98.5 % of it through). */
 static void test_sides(void)
 {
     gi_scene *s = load("tests/data/truth/sphere_in_ss.gltf");
@@ -534,11 +542,11 @@ static void test_sides(void)
             n++;
         }
         printf("sides: inward single-sided ball, inside of its lower half (%u elements): "
-               "irradiance x area %.5f, the lamp's through the culled upper half %.5f (%+.1f %%); "
+               "irradiance x area %.5f, the lamp's unoccluded %.5f (%+.1f %%); "
                "flux across back sides %.4f\n",
                n, got, want, want > 0.0 ? 100.0 * (got / want - 1.0) : 0.0, f.st.flux_back);
         EXPECT(n > 20 && want > 0.0, "ball's lower half: %u elements", n);
-        EXPECT(fabs(got / want - 1.0) < 0.1, "inside of the ball: %.4g vs %.4g", got, want);
+        EXPECT(got < 0.01 * want, "inside of the ball: %.4g (unoccluded %.4g)", got, want);
         vlf_field_free(&f);
     }
     gi_scene_free(s);
@@ -581,9 +589,8 @@ static void test_double(void)
                 continue;
             vlf_field_propagate(&f, NULL, NULL, NULL);
             const vlf_stats *st = &f.st;
-            CHECK_NEAR(st->flux_shot,
-                       st->flux_received + st->flux_escaped, /* a back lets it through */
-                       1e-4 * st->flux_shot);
+            /* every packet stops at a back or escapes (propagate.c) */
+            CHECK_NEAR(st->flux_shot, st->flux_back + st->flux_escaped, 1e-4 * st->flux_shot);
             /* the panel's sides: lit (normal toward the light, +z), dark (-z) */
             int lit = -1, dark = -1;
             for (uint32_t fi = 0; fi < f.face_count; fi++)
