@@ -17,6 +17,18 @@ match("${csv}" "\ndirect,[^\n]*,ok," "direct did not run ok:\n${csv}")
 match("${csv}" "fake_crash,[^\n]*failed,\"?crashed \\(signal" "the crash was not isolated and reported:\n${csv}")
 match("${csv}" "fake_hang,[^\n]*failed,timed out after" "the hang was not cut off:\n${csv}")
 match("${csv}" "fake_narrow,[^\n]*n/a,fake_narrow does not handle area lights" "n/a cell missing:\n${csv}")
+# issue 32 item 5: a method whose destroy() crashes is listed and costs its
+# own runs only (the other method of the same compare is ok)
+run(0 methods --json)
+match("${last_out}" "\"fake_destroy_crash\"" "methods does not list fake_destroy_crash:\n${last_out}")
+set(CD ${OUT}/compare_destroy)
+file(REMOVE_RECURSE ${CD})
+run(1 compare --scene scenes/cornell_box_coarse.gltf --methods direct,fake_destroy_crash
+       --out ${CD} --size 16x16 --frames 1 --ref-spp 16 --ref-bounces 8 --timeout 20)
+file(READ ${CD}/runs.csv csv_d)
+match("${csv_d}" "\ndirect,[^\n]*,ok," "direct did not run ok beside a crashing destroy():\n${csv_d}")
+match("${csv_d}" "fake_destroy_crash,[^\n]*failed,\"?crashed \\(signal"
+      "the crash in destroy() was not isolated and reported:\n${csv_d}")
 # render --animate tells update() what the animation moves: vertices on a
 # deforming scene, transforms when objects move, lights when a light moves,
 # the camera when the view's camera node is animated, and nothing else.

@@ -120,6 +120,9 @@ static gi_result fake_render(void *inst, const gi_view *v, const gi_target *t)
 static void fake_destroy(void *inst)
 {
     (void)inst;
+#if defined(FAKE_DESTROY_CRASH)
+    raise(SIGSEGV); /* renders, then crashes in destroy(): costs its own runs only */
+#endif
 }
 static const char *fake_last_error(void *inst)
 {
@@ -173,8 +176,9 @@ static const gi_method fake_method = {
     .title = "Fake method",
     .citation = "none",
     .version = "0",
-#if defined(FAKE_CRASH) || defined(FAKE_HANG) || defined(FAKE_CONF_WRONG) ||                       \
-    defined(FAKE_CONF_NAN) || defined(FAKE_CONF_NONDET) || defined(FAKE_DEPART)
+#if defined(FAKE_CRASH) || defined(FAKE_HANG) || defined(FAKE_DESTROY_CRASH) ||                    \
+    defined(FAKE_CONF_WRONG) || defined(FAKE_CONF_NAN) || defined(FAKE_CONF_NONDET) ||             \
+    defined(FAKE_DEPART)
     .caps = GI_CAP_DIRECT | GI_CAP_AREA_LIGHTS,
 #elif defined(FAKE_CONF_LIAR)
     .caps = GI_CAP_DIRECT | GI_CAP_AREA_LIGHTS | GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL |
