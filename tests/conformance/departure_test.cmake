@@ -24,16 +24,8 @@ function(check json check status dep re)
     set(failures ${failures} PARENT_SCOPE)
 endfunction()
 
-function(conf method code)
-    execute_process(COMMAND ${GIB} -q conformance --method ${method} --json --item-timeout 30
-                    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-    file(WRITE ${OUT}/departure/${method}.json "${out}")
-    if(NOT rc EQUAL code)
-        fail("conformance --method ${method}: exit ${rc}, expected ${code}\n${out}\n${err}")
-    endif()
-    set(table "${out}" PARENT_SCOPE)
-    set(failures ${failures} PARENT_SCOPE)
-endfunction()
+set(CONF_JSON_PREFIX ${OUT}/departure/)
+include(${CMAKE_CURRENT_LIST_DIR}/conf_run.cmake)
 
 set(paper "declared departure: the fake's paper renders the emission alone; paper default \\(reported, not gated\\) fails: rho 0.5, B = 1: mean 1.0000, expected 1.5000")
 # the remedy passes: the check passes, the paper's failure reported beside it (exit 1 all the

@@ -8,18 +8,8 @@ set(failures 0)
 set(ENV{GIBENCH_PLUGIN_PATH} ${FAKES})
 file(MAKE_DIRECTORY ${OUT})
 
-# conf(<method> <expected exit>): runs the suite on one method with --json;
-# the table lands in the variable `table`.
-function(conf method code)
-    execute_process(COMMAND ${GIB} -q conformance --method ${method} --json --item-timeout 30
-                    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-    file(WRITE ${OUT}/suite_${method}.json "${out}")
-    if(NOT rc EQUAL code)
-        fail("conformance --method ${method}: exit ${rc}, expected ${code}\n${out}\n${err}")
-    endif()
-    set(table "${out}" PARENT_SCOPE)
-    set(failures ${failures} PARENT_SCOPE)
-endfunction()
+set(CONF_JSON_PREFIX ${OUT}/suite_)
+include(${CMAKE_CURRENT_LIST_DIR}/conf_run.cmake)
 
 # cell(<check> <status> <regex of the detail>)
 function(cell check status re)
