@@ -97,7 +97,7 @@ gi_result gi_csm_distant_build(const gi_gpu_scene *gs, uint32_t object,
                         /* Both sides of every triangle: the first two surfaces of a closed
                          * object are its entry and exit, and the stored depth lies between
                          * them (the dual depth of csm_cpu.h), away from receivers beside it. Only
-                         * the sides a shadow ray from the receiver meets (receiver_side 1)
+                         * the sides a shadow ray from the receiver meets (GI_SIDES_RECEIVERS)
                          * would leave the exit alone, where the object touches the ground:
                          * bunny_env's direct light by cssm_direct_tests env, relMSE 0.037
                          * (one side) against 0.024 (both; unshadowed 0.052), the error on
@@ -105,7 +105,7 @@ gi_result gi_csm_distant_build(const gi_gpu_scene *gs, uint32_t object,
                          * get wrong: a receiver that sees a single-sided triangle's back
                          * along w is shadowed by it (gi/scene.h lets that ray through);
                          * no receiver of the shipped scenes lies there. */
-                        .receiver_side = 2};
+                        .receiver_side = GI_SIDES_BOTH};
     gi_depth_renderer *dr = gi_depth_renderer_create(&dd, err);
     if (!dr)
         return GI_ERR_GL;

@@ -59,9 +59,10 @@ static gi_result check_desc(const gi_depth_atlas_desc *d, gi_error *err)
     if (d->cull < 0 || d->cull > 2)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth atlas: cull %d is not 0, 1 or 2",
                             d->cull);
-    if (d->receiver_side < 0 || d->receiver_side > 1)
+    if ((int)d->receiver_side != GI_SIDES_EYE && (int)d->receiver_side != GI_SIDES_RECEIVERS)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                            "depth atlas: receiver_side %d is not 0 or 1", d->receiver_side);
+                            "depth atlas: receiver_side %d is not 0 (eye) or 1 (receivers)",
+                            (int)d->receiver_side);
     return GI_OK;
 }
 
@@ -266,7 +267,7 @@ gi_result gi_depth_atlas_render(gi_depth_atlas *a, const gi_gpu_scene *gs,
         glUniform1i(a->loc_views, ATLAS_VIEWS_UNIT);
         glUniform1i(a->loc_projection, (GLint)d->projection);
         glUniform1i(a->loc_metric, (GLint)d->metric);
-        glUniform1i(a->loc_receiver_side, d->receiver_side);
+        glUniform1i(a->loc_receiver_side, (GLint)d->receiver_side);
         glBindTextureUnit(ATLAS_VIEWS_UNIT, a->ssbo_tex);
         gi_result r = draw_batches(a, gs, count, err);
         for (GLenum k = 0; k < 5; k++)

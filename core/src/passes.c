@@ -118,6 +118,11 @@ gi_depth_renderer *gi_depth_renderer_create(const gi_depth_desc *desc, gi_error 
                      d.surfaces);
         return NULL;
     }
+    if ((int)d.receiver_side < GI_SIDES_EYE || (int)d.receiver_side > GI_SIDES_ANY_THEN_RECEIVERS) {
+        gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "depth maps: receiver_side %d is not a gi_sides",
+                     (int)d.receiver_side);
+        return NULL;
+    }
     gi_depth_renderer *r = calloc(1, sizeof *r);
     if (!r) {
         gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory");
@@ -198,7 +203,7 @@ gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi
     }
     glUniform1i(glGetUniformLocation(p, "u_metric"), (GLint)d->metric);
     glUniform1i(glGetUniformLocation(p, "u_local"), d->local);
-    glUniform1i(glGetUniformLocation(p, "u_receiver_side"), d->receiver_side);
+    glUniform1i(glGetUniformLocation(p, "u_receiver_side"), (GLint)d->receiver_side);
     glUniform1i(glGetUniformLocation(p, "u_prev"), GI_TEX_CORE_DEPTH_PEEL);
     GLint loc_view = glGetUniformLocation(p, "u_view"),
           loc_proj = glGetUniformLocation(p, "u_proj");

@@ -192,7 +192,7 @@ static gi_result shadow_maps(avg *a, gi_error *err)
         gi_vec3 eye = gi_v3_load(v->position), n = gi_v3_load(v->normal);
         /* A bounce VPL lies up to a voxel diagonal past its surface (its
          * position is pushed into the hit voxel, avg_trace.comp); maps kept
-         * as the receivers see them (receiver_side 1) would hold that
+         * as the receivers see them (GI_SIDES_RECEIVERS) would hold that
          * surface's back at its eye and shadow everything. Their eye moves
          * out along the normal by the diagonal. */
         if ((v->kind >> 8 & 0xFFu) != 0)
@@ -284,7 +284,7 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
                                  .projection = choose_projection(a, scene->scene),
                                  .metric = GI_DEPTH_RADIAL,
                                  .cull = 0,
-                                 .receiver_side = 1};
+                                 .receiver_side = GI_SIDES_RECEIVERS};
         if (a->lod && a->projection == 1)
             a->kit.host->log(a->kit.host, GI_LOG_WARN,
                              "shadow_lod=%g with projection=paraboloid: the warp bends the "

@@ -35,12 +35,12 @@ static void encode_texel_depths(void *ctx, uint32_t q, const gi_depth_view *v, c
 }
 
 /* The maps draw both sides of every triangle (gi_depth_desc.receiver_side
- * 2), whatever the rule for sides (gi/scene.h) says of single-sided ones:
+ * GI_SIDES_BOTH), whatever the rule for sides (gi/scene.h) says of single-sided ones:
  * the dual depth of a closed object must lie between its entry and its exit
  * (§3.1), and only both sides give both. A single-sided open surface then
  * blocks from both sides, where the rule lets a ray from a receiver that
  * sees its back through; no receiver of the shipped scenes lies there. The
- * sides a shadow ray meets alone (receiver_side 1) keep only the exit of a
+ * sides a shadow ray meets alone (GI_SIDES_RECEIVERS) keep only the exit of a
  * closed object: csm_local's cube-map test then fails (41 of 47
  * disagreements near a silhouette, 90 % required). */
 gi_result csm_encode_maps(const gi_gpu_scene *gs, const csm_encode_desc *desc, const gi_host *host,
@@ -62,7 +62,7 @@ gi_result csm_encode_maps(const gi_gpu_scene *gs, const csm_encode_desc *desc, c
                                           .local = 1,
                                           .cull = 0,
                                           /* both sides: see below */
-                                          .receiver_side = 2},
+                                          .receiver_side = GI_SIDES_BOTH},
                                 .count = desc->count,
                                 .streams = 1,
                                 .batch = desc->batch,

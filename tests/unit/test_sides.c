@@ -23,6 +23,7 @@
 #include "gi/passes.h"
 #include "gi/raytrace.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -130,6 +131,82 @@ static void test_rt_double_sided(void)
     gi_scene_free(s);
 }
 
+/* The first two peeled surfaces of one view at the centre texel
+ * (FLT_MAX: none). 0 when the renderer fails (a check says so). */
+static int depth_two(gi_gpu_scene *gs, gi_sides mode, const gi_depth_view *dv, uint32_t W,
+                     float out[2])
+{
+    gi_error err;
+    gi_depth_desc d2 = {.size = W, .surfaces = 2, .metric = GI_DEPTH_EYE_Z, .receiver_side = mode};
+    gi_depth_renderer *r2 = gi_depth_renderer_create(&d2, &err);
+    CHECK_MSG(r2 != NULL, "%s", err.text);
+    if (!r2)
+        return 0;
+    GLuint t2 = gi_depth_texture_create(r2, 1);
+    CHECK(gi_depth_render(r2, gs, dv, 1, t2, 0, &err) == GI_OK);
+    float *m2 = gi_depth_read_layer(t2, W, 0);
+    const size_t i = ((size_t)(W / 2) * W + W / 2) * 4;
+    out[0] = m2 ? m2[i] : NAN;
+    out[1] = m2 ? m2[i + 1] : NAN;
+    free(m2);
+    glDeleteTextures(1, &t2);
+    gi_depth_renderer_free(r2);
+    return 1;
+}
+
+/* The dual-depth modes of gi_sides on the inward single-sided ball. From
+ * outside, along the axis: its near half is seen from behind (a surface
+ * for rays cast from the receivers inside it toward the eye), its far half
+ * from the front. BOTH: near, far. EYE_THEN_BOTH: far, then what lies
+ * behind the ball. RECEIVERS_THEN_BOTH: near, far. ANY_THEN_RECEIVERS:
+ * near (a surface for the receivers, so not negated), far. From the centre
+ * every face is seen from the front and none is a surface for the
+ * receivers: ANY_THEN_RECEIVERS gives -r (marked) and no second surface,
+ * RECEIVERS_THEN_BOTH nothing. A mode beyond the enum is refused. */
+static void test_depth_modes(gi_gpu_scene *gs, const ball_ray *b, const gi_depth_view *dv,
+                             uint32_t W)
+{
+    const float nr = b->dist - b->radius, fr = b->dist + b->radius, tol = 0.05f * b->radius;
+    const struct {
+        gi_sides mode;
+        float want0, want1; /* FLT_MAX: none; NAN: anything behind the ball */
+    } outside[] = {{GI_SIDES_BOTH, nr, fr},
+                   {GI_SIDES_EYE_THEN_BOTH, fr, NAN},
+                   {GI_SIDES_RECEIVERS_THEN_BOTH, nr, fr},
+                   {GI_SIDES_ANY_THEN_RECEIVERS, nr, fr}};
+    for (size_t k = 0; k < sizeof outside / sizeof outside[0]; k++) {
+        float z[2];
+        if (!depth_two(gs, outside[k].mode, dv, W, z))
+            return;
+        printf("depth map, receiver_side %d: surfaces %.4f, %.4g (want %.4f, %.4g)\n",
+               (int)outside[k].mode, z[0], z[1], outside[k].want0, outside[k].want1);
+        CHECK(fabsf(z[0] - outside[k].want0) < tol);
+        CHECK(isnan(outside[k].want1)       ? z[1] > fr + tol
+              : outside[k].want1 == FLT_MAX ? z[1] == FLT_MAX
+                                            : fabsf(z[1] - outside[k].want1) < tol);
+    }
+    gi_depth_view c = {.projection = GI_PROJ_PERSPECTIVE};
+    gi_mat4_look_at(c.view, b->centre, gi_v3_add(b->centre, b->d), gi_v3(0, 1, 0));
+    gi_mat4_perspective(c.proj, 1.0f, 1.0f, 0.01f * b->radius, 10.0f * b->radius);
+    float z[2];
+    if (!depth_two(gs, GI_SIDES_ANY_THEN_RECEIVERS, &c, W, z))
+        return;
+    printf("depth map from the centre, receiver_side %d: %.4f, %.4g (want %.4f, none)\n",
+           GI_SIDES_ANY_THEN_RECEIVERS, z[0], z[1], -b->radius);
+    CHECK(fabsf(z[0] + b->radius) < tol && z[1] == FLT_MAX);
+    if (!depth_two(gs, GI_SIDES_RECEIVERS_THEN_BOTH, &c, W, z))
+        return;
+    printf("depth map from the centre, receiver_side %d: %.4g (want none)\n",
+           GI_SIDES_RECEIVERS_THEN_BOTH, z[0]);
+    CHECK(z[0] == FLT_MAX);
+    gi_error err;
+    gi_depth_desc bad = {.size = W, .receiver_side = (gi_sides)(GI_SIDES_ANY_THEN_RECEIVERS + 1)};
+    gi_depth_renderer *r = gi_depth_renderer_create(&bad, &err);
+    printf("receiver_side %d: %s\n", (int)bad.receiver_side, r ? "accepted" : err.text);
+    CHECK(r == NULL);
+    gi_depth_renderer_free(r);
+}
+
 /* The G-buffer and a depth map through the file's camera: the centre pixel
  * shows the ball's far half. */
 static void test_raster_single_sided(const gi_scene *s, gi_gpu_scene *gs, const ball_ray *b)
@@ -173,42 +250,23 @@ static void test_raster_single_sided(const gi_scene *s, gi_gpu_scene *gs, const 
     glDeleteTextures(1, &tex);
     gi_depth_renderer_free(dr);
 
-    /* Mode 3 (dual depth): the first surface by the eye's rule (the far
-     * half), the second of either side; mode 2 starts at the near half. */
-    for (int mode = 2; mode <= 3; mode++) {
-        gi_depth_desc d2 = {
-            .size = W, .surfaces = 2, .metric = GI_DEPTH_EYE_Z, .receiver_side = mode};
-        gi_depth_renderer *r2 = gi_depth_renderer_create(&d2, &err);
-        CHECK_MSG(r2 != NULL, "%s", err.text);
-        if (!r2)
-            return;
-        GLuint t2 = gi_depth_texture_create(r2, 1);
-        CHECK(gi_depth_render(r2, gs, &dv, 1, t2, 0, &err) == GI_OK);
-        float *m2 = gi_depth_read_layer(t2, W, 0);
-        const float want = mode == 3 ? b->dist + b->radius : b->dist - b->radius;
-        printf("depth map, receiver_side %d: first surface %.4f (want %.4f)\n", mode,
-               m2 ? m2[i] : -1.0f, want);
-        CHECK(m2 && fabsf(m2[i] - want) < 0.05f * b->radius);
-        free(m2);
-        glDeleteTextures(1, &t2);
-        gi_depth_renderer_free(r2);
-    }
+    test_depth_modes(gs, b, &dv, W);
 
-    /* The depth atlas: seen from the eye (0) the far half, seen from the
-     * receivers (1: inside the ball, behind the near half) the near half. */
-    for (int mode = 0; mode <= 1; mode++) {
+    /* The depth atlas: seen from the eye the far half, seen from the
+     * receivers (inside the ball, behind the near half) the near half. */
+    for (int mode = GI_SIDES_EYE; mode <= GI_SIDES_RECEIVERS; mode++) {
         gi_depth_atlas_desc ad = {.tile = W,
                                   .capacity = 1,
                                   .projection = GI_PROJ_PERSPECTIVE,
                                   .metric = GI_DEPTH_EYE_Z,
-                                  .receiver_side = mode};
+                                  .receiver_side = (gi_sides)mode};
         gi_depth_atlas *at = gi_depth_atlas_create(&ad, &err);
         CHECK_MSG(at != NULL, "%s", err.text);
         if (!at)
             return;
         CHECK(gi_depth_atlas_render(at, gs, &dv, 1, &err) == GI_OK);
         float *tile = gi_depth_atlas_read_tile(at, 0);
-        const float want = mode == 0 ? b->dist + b->radius : b->dist - b->radius;
+        const float want = mode == GI_SIDES_EYE ? b->dist + b->radius : b->dist - b->radius;
         const float got = tile ? tile[(W / 2) * W + W / 2] : -1.0f;
         printf("depth atlas, receiver_side %d: centre %.4f (want %.4f)\n", mode, got, want);
         CHECK(fabsf(got - want) < 0.05f * b->radius);

@@ -102,6 +102,49 @@ typedef struct gi_depth_view {
     float znear, zfar; /* paraboloid clip range (radial) */
 } gi_depth_view;
 
+/* Which side of a single-sided triangle is a surface in a depth map or
+ * atlas (the one rule for sides, gi/scene.h). Double-sided triangles are
+ * drawn in every mode. core/shaders/depth.frag and depth_atlas.frag use the
+ * same numbers.
+ * EYE: the side seen from the eye (a camera's view, or a map that stands
+ * for rays cast from its eye: a back face is no surface).
+ * RECEIVERS: the side seen from the receivers, for a map that stands for
+ * shadow rays cast from the shaded points toward the eye (as gi_rt and the
+ * reference cast them): such a ray meets a single-sided triangle only when
+ * its front faces the receiver, i.e. faces away from the eye, so the map
+ * keeps the faces the eye sees from behind and drops those it sees from
+ * the front.
+ * BOTH: both sides of every triangle (raw geometry), for a caller that
+ * needs the entry and exit depths of closed objects and applies the rule
+ * itself or states where it does not.
+ * EYE_THEN_BOTH: the first surface as EYE, every later peeled surface of
+ * both sides: a closed object's entry and exit bound a closed interval
+ * (dual depth), and a single-sided face the eye sees from behind still
+ * hides nothing in front of the first surface (rays cast from the eye).
+ * RECEIVERS_THEN_BOTH: as EYE_THEN_BOTH with the first surface as
+ * RECEIVERS; a closed object's first surface is then its exit and the
+ * second the receiver behind it, so a dual-depth midpoint lies between
+ * the two (light leaks where an object touches its receiver).
+ * ANY_THEN_RECEIVERS: the first surface of either side; the second, when
+ * the first is no surface for the receivers (a single-sided face the eye
+ * sees from the front), the first surface behind it that is one for them,
+ * else the next of either side; later ones of both sides. The map's first
+ * channel holds that first depth negated when the first surface is none
+ * for the receivers, so a caller tells a face the eye sees from the front
+ * with nothing behind it that the receivers see (it hides nothing from
+ * them) from a surface without a second one. For dual-depth maps that
+ * stand for rays cast from the receivers: a closed object's entry and exit
+ * bound it, a face the eye sees from behind (a caster for the receivers)
+ * starts an interval, and one it sees from the front alone casts nothing. */
+typedef enum gi_sides {
+    GI_SIDES_EYE = 0,
+    GI_SIDES_RECEIVERS = 1,
+    GI_SIDES_BOTH = 2,
+    GI_SIDES_EYE_THEN_BOTH = 3,
+    GI_SIDES_RECEIVERS_THEN_BOTH = 4,
+    GI_SIDES_ANY_THEN_RECEIVERS = 5,
+} gi_sides;
+
 typedef struct gi_depth_desc {
     uint32_t size;          /* maps are size x size */
     uint32_t surfaces;      /* 1..4 peeled layers (2 = dual depth, 3 = z3); 0 = 1 */
@@ -113,22 +156,8 @@ typedef struct gi_depth_desc {
     const unsigned char
         *skip_objects; /* NULL = none; per object, 1: not drawn (with only_object 0);
                           read while the renderer draws, so it must outlive it */
-    /* Which side of a single-sided triangle exists (the one rule, gi/scene.h).
-     * 0: the side seen from the eye (a camera's view: a back face is no
-     * surface). 1: the side seen from the receivers, for a map that stands
-     * for shadow rays cast from the shaded points toward the eye (as gi_rt
-     * and the reference cast them): such a ray meets a single-sided triangle
-     * only when its front faces the receiver, i.e. faces away from the eye,
-     * so the map keeps the faces the eye sees from behind and drops those it
-     * sees from the front. Double-sided triangles are drawn either way.
-     * 2: both sides of every triangle (raw geometry), for a caller that
-     * needs the entry and exit depths of closed objects and applies the
-     * rule itself or states where it does not.
-     * 3: the first surface as 0 (seen from the eye), every later peeled
-     * surface of both sides: a closed object's entry and exit bound a closed
-     * interval (dual depth), and a single-sided face the eye sees from
-     * behind still hides nothing in front of the first surface. */
-    int receiver_side;
+    /* Which side of a single-sided triangle exists (gi_sides above). */
+    gi_sides receiver_side;
 } gi_depth_desc;
 
 typedef struct gi_depth_renderer gi_depth_renderer;
@@ -156,11 +185,11 @@ typedef struct gi_depth_atlas_desc {
     gi_projection projection; /* GI_PROJ_PERSPECTIVE or GI_PROJ_PARABOLOID */
     gi_depth_metric metric;   /* GI_DEPTH_EYE_Z or GI_DEPTH_RADIAL */
     int cull;                 /* 0 none, 1 back faces, 2 front faces */
-    /* Which side of a single-sided triangle exists, as gi_depth_desc's
-     * receiver_side: 0 the side the eye sees, 1 the side the receivers see
-     * (maps that stand for visibility rays cast from the receivers toward
-     * the eye, as the reference casts them). */
-    int receiver_side;
+    /* Which side of a single-sided triangle exists: GI_SIDES_EYE or
+     * GI_SIDES_RECEIVERS (maps that stand for visibility rays cast from the
+     * receivers toward the eye, as the reference casts them); the atlas
+     * keeps one surface, so no other mode. */
+    gi_sides receiver_side;
 } gi_depth_atlas_desc;
 
 typedef struct gi_depth_atlas gi_depth_atlas;

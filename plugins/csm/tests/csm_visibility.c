@@ -456,7 +456,7 @@ static int check_lossless(const bunny *bn)
                         .metric = GI_DEPTH_EYE_Z,
                         .only_object = bn->k + 1u,
                         .local = 1,
-                        .receiver_side = 2};
+                        .receiver_side = GI_SIDES_BOTH};
     gi_depth_renderer *dr = gi_depth_renderer_create(&dd, &err);
     if (!dr) {
         fprintf(stderr, "set-up failed: depth renderer: %s\n", err.text);
