@@ -120,6 +120,9 @@ static void build_depths(void *ctx, uint32_t q, const gi_depth_view *view, const
             z2[t] = a1 >= far ? FLT_MAX : fminf(fmaxf(a2, a1), far);
             continue;
         }
+        if (a1 < 0.0f) /* GI_SIDES_ANY_THEN_RECEIVERS: a first surface the receivers do
+                          not see, a caster only with one they see behind it */
+            a1 = a2 >= FLT_MAX ? FLT_MAX : -a1;
         z1[t] = a1 >= FLT_MAX ? FLT_MAX : a1;
         z2[t] = a1 >= FLT_MAX || a2 >= FLT_MAX ? FLT_MAX : fmaxf(a2, z1[t]);
     }
@@ -132,6 +135,9 @@ gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const 
     static const cssm_build_opts none = {0};
     if (!opts)
         opts = &none;
+    if (opts->escape && !opts->from_eye)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "cssm_hrc: escape intervals answer rays cast from the eye (from_eye)");
     gi_result r = cssm_maps_setup(a, order, M, out, err);
     if (r != GI_OK)
         return r;
@@ -161,30 +167,30 @@ gi_result cssm_maps_build_ex(const gi_gpu_scene *gs, const cssm_atlas *a, const 
     }
     build_ctx b = {
         .a = a, .order = order, .opts = opts, .out = out, .corners = corners, .mask = mask};
-    gi_csm_precompute_desc d = {.depth = {.size = M,
-                                          .surfaces = 2,
-                                          .metric = GI_DEPTH_RADIAL,
-                                          .only_object = opts->only_object,
-                                          .local = opts->local,
-                                          .cull = 0,
-                                          /* the entry by the eye's rule, then both
-                                           * sides: a closed object's dual depth lies
-                                           * between its entry and exit */
-                                          .receiver_side = 3,
-                                          .skip_objects = opts->skip_objects},
-                                .count = 6 * N,
-                                .streams = 6,
-                                .batch = 6 * CSSM_BATCH,
-                                .view = build_view,
-                                .depths = build_depths,
-                                .skip = opts->dont_care ? build_skip : NULL,
-                                .ctx = &b,
-                                .host = host,
-                                .p1 = 1.0f,
-                                .who = "cssm_hrc",
-                                .what = "cube maps",
-                                .render_stage =
-                                    opts->render_stage ? opts->render_stage : "cssm_render"};
+    gi_csm_precompute_desc d = {
+        .depth = {.size = M,
+                  .surfaces = 2,
+                  .metric = GI_DEPTH_RADIAL,
+                  .only_object = opts->only_object,
+                  .local = opts->local,
+                  .cull = 0,
+                  /* dual depth by the rule for the
+                   * rays the maps answer (cssm.h) */
+                  .receiver_side =
+                      opts->from_eye ? GI_SIDES_EYE_THEN_BOTH : GI_SIDES_ANY_THEN_RECEIVERS,
+                  .skip_objects = opts->skip_objects},
+        .count = 6 * N,
+        .streams = 6,
+        .batch = 6 * CSSM_BATCH,
+        .view = build_view,
+        .depths = build_depths,
+        .skip = opts->dont_care ? build_skip : NULL,
+        .ctx = &b,
+        .host = host,
+        .p1 = 1.0f,
+        .who = "cssm_hrc",
+        .what = "cube maps",
+        .render_stage = opts->render_stage ? opts->render_stage : "cssm_render"};
     r = gi_csm_precompute(gs, &d, out->face, err);
     free(corners), free(mask);
     if (r != GI_OK)

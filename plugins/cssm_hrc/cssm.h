@@ -147,6 +147,13 @@ typedef struct cssm_build_opts {
                        one that saw none as [far, inf): z_avg >= far tells the direction escapes
                        (env=cssm, env_cssm.h); 0: [z1, z2), none as (inf, inf) */
     const char *render_stage; /* stage timer of rendering and read-back; NULL: "cssm_render" */
+    /* Which rays the maps answer, so which rule for sides they are drawn by
+     * (gi/scene.h; gi_sides, gi/passes.h). 0: rays cast from a receiver
+     * toward the map's eye, as the reference casts them (the visibility of
+     * a sender texel or of a light point): GI_SIDES_ANY_THEN_RECEIVERS.
+     * 1: rays cast from the eye (the escape test of env=cssm, which needs
+     * it: `escape` without it is an error): GI_SIDES_EYE_THEN_BOTH. */
+    int from_eye;
 } cssm_build_opts;
 
 /* Renders (the core's precomputation loop gi/algo/csm_precompute.h with its

@@ -53,7 +53,8 @@ static gi_result make_shadows(cssm_hrc *c, const gi_gpu_scene *gs, gi_error *err
         gi_depth_desc dd = {.size = S,
                             .surfaces = 1,
                             .metric = directional ? GI_DEPTH_EYE_Z : GI_DEPTH_RADIAL,
-                            .receiver_side = 1 /* shadow rays are cast from the receivers */};
+                            .receiver_side =
+                                GI_SIDES_RECEIVERS /* shadow rays are cast from the receivers */};
         gi_depth_renderer *dr = gi_depth_renderer_create(&dd, err);
         if (!dr) {
             cssm_release_shadows(c);

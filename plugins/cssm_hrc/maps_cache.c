@@ -11,7 +11,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define CSSM_FORMAT_VERSION 4u /* 4: cube maps by the rule for sides (receiver_side 3) */
+#define CSSM_FORMAT_VERSION                                                                        \
+    7u /* 7: maps by the rays they answer (GI_SIDES_ANY_THEN_RECEIVERS;                            \
+           GI_SIDES_EYE_THEN_BOTH with escape) */
 static const char cache_magic[8] = {'G', 'I', 'C', 'S', 'S', 'M', '\r', '\n'};
 
 /* Cache name: the meshes, their placement at prepare time and every
@@ -130,7 +132,7 @@ gi_result cssm_load_or_build_maps(cssm_hrc *c, const gi_gpu_scene *gs, gi_error 
         return GI_OK;
     }
     cssm_maps_free(&c->maps);
-    cssm_build_opts bo = {.escape = escape};
+    cssm_build_opts bo = {.escape = escape, .from_eye = escape};
     r = cssm_maps_build_ex(gs, &c->atlas, c->order, (uint32_t)c->M, &bo, host, &c->maps, err);
     if (r == GI_OK && path)
         cache_store(c, path);

@@ -185,10 +185,12 @@ static int env_scene(const char *rel, int check)
     cssm_fixture f;
     cssm_maps plain = {0};
     const uint32_t M = 16; /* the plugin's default */
-    cssm_build_opts eo = {.escape = 1};
+    /* both sets answer rays cast from the eye (the escape test's), so the
+     * two differ by the escape intervals alone */
+    cssm_build_opts eo = {.escape = 1, .from_eye = 1}, po = {.from_eye = 1};
     gi_error err = {0};
     if (cssm_fixture_open(&f, rel, 0.0f, 0.0f) ||
-        cssm_maps_build(f.gs, &f.a, f.order, M, NULL, &plain, &err) != GI_OK ||
+        cssm_maps_build_ex(f.gs, &f.a, f.order, M, &po, NULL, &plain, &err) != GI_OK ||
         cssm_maps_build_ex(f.gs, &f.a, f.order, M, &eo, NULL, &f.m, &err) != GI_OK) {
         if (f.order)
             fprintf(stderr, "FAIL: set-up: %s\n", err.text);

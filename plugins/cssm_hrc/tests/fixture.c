@@ -65,8 +65,11 @@ int cssm_fixture_pair(const cssm_fixture *f, uint32_t j, uint32_t i, uint32_t *r
 
 int cssm_fixture_truth(const cssm_fixture *f, const gi_rt *rt, gi_vec3 eye, gi_vec3 x)
 {
-    gi_vec3 d = gi_v3_sub(x, eye);
+    /* cast from x toward the eye, as the reference casts a ray from a
+     * receiver toward the light it gathers (the rule for sides, gi/scene.h,
+     * makes visibility depend on the direction) */
+    gi_vec3 d = gi_v3_sub(eye, x);
     float len = gi_v3_length(d);
     d = gi_v3_scale(d, 1.0f / len);
-    return !gi_rt_occluded(rt, eye, d, 1e-4f * f->a.diameter, len * (1.0f - 1e-4f));
+    return !gi_rt_occluded(rt, x, d, 1e-4f * f->a.diameter, len * (1.0f - 1e-4f));
 }
