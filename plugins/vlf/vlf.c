@@ -37,7 +37,7 @@ typedef struct vlf {
 } vlf;
 
 static const gi_param_desc vlf_params[] = {
-    {"l", GI_PARAM_INT, 128, 8, 1024, GI_QUALITY_UP(2), "l (Sec. 2.1)",
+    {"l", GI_PARAM_INT, 512, 8, 1024, GI_QUALITY_UP(2), "l (Sec. 2.1)",
      "bi-directional directions spread over the hemisphere"},
     {"N", GI_PARAM_INT, 64, 8, 256, GI_QUALITY_UP(2), "N (Sec. 2.1)",
      "rays per side of each parallel subfield (N x N)"},

@@ -39,7 +39,8 @@ endforeach()
 # the rounds
 foreach(round 1 2 3)
     foreach(cam ${views})
-        set(args --scene ${SCENE} --method vlf --size 128x128 --frames 10 --warmup 2
+        # l = 128, not the default 512: the frame time read here does not depend on l, the propagation does (speed)
+        set(args --scene ${SCENE} --method vlf --param l=128 --size 128x128 --frames 10 --warmup 2
                  --timings ${W}/${cam}.timings.json --out ${W}/${cam}.exr)
         if(NOT cam STREQUAL "scene")
             list(APPEND args --camera view:${W}/${cam}.json)
