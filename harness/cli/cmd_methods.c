@@ -35,10 +35,17 @@ static json_object *param_json(const gi_param_desc *d)
         if (q.reason)
             json_object_object_add(qo, "does_not_converge", json_object_new_string(q.reason));
         json_object_object_add(qo, "factor", json_object_new_double(q.factor));
+        /* the values the held-out sweep runs: it stops where the range clamps a step
+         * (conf_heldout_run.c), so a repeated value is not listed */
         json_object *steps = json_object_new_array();
-        for (int k = 1; k <= 3; k++)
-            json_object_array_add(steps,
-                                  json_object_new_double(gi_param_quality_step(d, d->def, k)));
+        double prev = d->def;
+        for (int k = 1; k <= 3; k++) {
+            double v = gi_param_quality_step(d, d->def, k);
+            if (v == prev)
+                break;
+            json_object_array_add(steps, json_object_new_double(v));
+            prev = v;
+        }
         json_object_object_add(qo, "steps", steps);
         json_object_object_add(p, "quality", qo);
     }
