@@ -8,8 +8,8 @@ it must still fail at least one check (so the list cannot outlive the
 failure it records), and its failures are printed, not counted. Every other
 method's failed check fails the gate; so does a run that gives no JSON.
 
-usage: held_out_gate.py GIBENCH --run SEED:VARIANTS [--run ...]
-                        [--known-fail METHOD ...] [--size N]
+usage: held_out_gate.py GIBENCH --run SEED|DIR:VARIANTS [--run ...]
+                        [--known-fail METHOD ...] [--size N] [--method M]
 """
 import argparse
 import json
@@ -17,9 +17,9 @@ import subprocess
 import sys
 
 
-def run_one(gib, seed, variants, size):
+def run_one(gib, seed, variants, size, method):
     cmd = [gib, "-q", "conformance", "--held-out", seed, "--variants", variants,
-           "--size", str(size), "--no-converge", "--json"]
+           "--size", str(size), "--no-converge", "--json"] + (["--method", method] if method else [])
     p = subprocess.run(cmd, capture_output=True, text=True)
     try:
         doc = json.loads(p.stdout)
@@ -37,12 +37,13 @@ def main():
     ap.add_argument("--run", action="append", required=True, help="SEED:VARIANTS")
     ap.add_argument("--known-fail", action="append", default=[])
     ap.add_argument("--size", type=int, default=32)
+    ap.add_argument("--method", help="one method only (the gate's own test)")
     a = ap.parse_args()
     failures, known_fails, broken = [], {m: 0 for m in a.known_fail}, 0
     seen = set()
     for r in a.run:
-        seed, _, variants = r.partition(":")
-        rows = run_one(a.gibench, seed, variants, a.size)
+        seed, _, variants = r.rpartition(":")
+        rows = run_one(a.gibench, seed, variants, a.size, a.method)
         if rows is None:
             broken += 1
             continue
