@@ -173,8 +173,12 @@ static void exact_direct(const gi_scene *s, const gi_rt *rt, gi_vec3 p, gi_vec3 
 static void direct_case(const char *scene, float edge_frac, int required)
 {
     iv_test_frame f;
-    uint32_t N = 12;
-    if (!iv_test_frame_run(&f, scene, edge_frac * 5.592f, N, 0, getenv("IV_BRUTE") ? 1 : 0, 1)) {
+    /* IV_N, IV_SPLAT: the bins and splatting of a scene given by IV_TEST_SCENE (exploring) */
+    const char *en = getenv("IV_N"), *es = getenv("IV_SPLAT");
+    uint32_t N = en ? (uint32_t)atoi(en) : 12u;
+    int splat = es ? atoi(es) : 1;
+    if (!iv_test_frame_run(&f, scene, edge_frac * 5.592f, N, 0, getenv("IV_BRUTE") ? 1 : 0,
+                           splat)) {
         EXPECT(0, "set-up failed");
         iv_test_frame_free(&f);
         return;
@@ -189,7 +193,7 @@ static void direct_case(const char *scene, float edge_frac, int required)
     float ext = 0.0f;
     for (int i = 0; i < 3; i++)
         ext = fmaxf(ext, f.s->bounds[3 + i] - f.s->bounds[i]);
-    double ref_sum = 0.0, m_err = 0.0, u_err = 0.0;
+    double ref_sum = 0.0, m_sum = 0.0, m_err = 0.0, u_err = 0.0;
     long hidden = 0, hidden_dark = 0, lit = 0, lit_dark = 0;
     const iv_hier *h = f.h;
     for (uint32_t e = 0; e < h->elem_count; e++) {
@@ -201,6 +205,7 @@ static void direct_case(const char *scene, float edge_frac, int required)
                      &sh, &un);
         double m = lum(&f.E[6 * e]), a = h->area[x];
         ref_sum += a * sh;
+        m_sum += a * m;
         m_err += a * fabs(m - sh);
         u_err += a * fabs(un - sh);
         if (un > 0.0 && sh == 0.0) {
@@ -228,9 +233,10 @@ static void direct_case(const char *scene, float edge_frac, int required)
     double me = m_err / ref_sum, ue = u_err / ref_sum, be = 1.0;
     printf("direct light per disc against Embree (%s, N = %u, bilinear %d, coverage %.2g, re-mesh "
            "edge %.3g x 5.592, "
-           "%u discs): relative L1 error method %.3f, unshadowed %.3f, black %.3f\n",
+           "%u discs): relative L1 error method %.3f, unshadowed %.3f, black %.3f; method's "
+           "light / exact %.3f\n",
            strrchr(scene, '/') + 1, N, f.l->bilinear, (double)f.l->coverage, edge_frac,
-           h->elem_count, me, ue, be);
+           h->elem_count, me, ue, be, m_sum / ref_sum);
     printf("discs hidden from the light (Embree): %ld, of them without light from the method %ld "
            "(%.1f %%); "
            "discs mostly lit: %ld, of them dark %ld\n",
