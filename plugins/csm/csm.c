@@ -128,9 +128,9 @@ static const gi_param_desc csm_params[] = {
      "update, stage 'rebuild'), or keep the first placement's (the paper's fixed lights; shadows "
      "then stale)"},
     {"occluders", GI_PARAM_ENUM, 0, 0, 0, "nearest|dilated", NULL,
-     "local lights: other objects' cube maps tested at the nearest texel (the paper's), or "
-     "dilated: lit only where all 4 texels around the receiver are, so occluders narrower than a "
-     "texel still shadow (not the paper's)"},
+     "point and spot lights: other objects' cube maps tested at the nearest texel (the paper's), "
+     "or dilated: lit only where all 4 texels around the receiver are, so occluders narrower than "
+     "a texel still shadow (not the paper's)"},
     {"receivers", GI_PARAM_ENUM, 0, 0, 0, "none|planar", "Sec. 4.6",
      "receiver-only objects without CSMs: none, or every planar object"},
     {"mode", GI_PARAM_ENUM, 0, 0, 0, "shade|random|coherent", "Table 2",

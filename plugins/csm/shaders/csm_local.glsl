@@ -185,7 +185,10 @@ float csm_local_visibility_object(uint j, uint k, vec3 x, vec3 n, vec3 y, int mo
 // k is not the receiver's own object; with csm_dilate_local its cube maps
 // then take mode 3 (a receiver's own surface is left to the paper's test:
 // its neighbouring texels hold the receiver's own surface at other depths,
-// and the 4-texel minimum would shadow it at grazing angles).
+// and the 4-texel minimum would shadow it at grazing angles). Only point
+// and spot lights (kind 2) are dilated: their shadows are hard, so one
+// missed texel gives a pixel the light's full contribution, while an area
+// light averages its points and the grown shadows cost more than they save.
 float csm_light_visibility_object(uint j, uint k, vec3 x, vec3 n, vec3 y, float u_rr, bool other)
 {
     if (csm_semilocal != 0) {
@@ -193,7 +196,8 @@ float csm_light_visibility_object(uint j, uint k, vec3 x, vec3 n, vec3 y, float 
             return 1.0;
         return csm_visibility_object(k, x, n, normalize(y - x), csm_filter, u_rr);
     }
-    return csm_local_visibility_object(j, k, x, n, y, other && csm_dilate_local != 0 ? 3 : csm_filter, u_rr);
+    bool dilate = other && csm_dilate_local != 0 && csm_lights[j].o.w == 2.0;
+    return csm_local_visibility_object(j, k, x, n, y, dilate ? 3 : csm_filter, u_rr);
 }
 
 // Visibility of light point y from x on object `own` (0xFFFFFFFF: none):
