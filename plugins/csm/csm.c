@@ -67,6 +67,7 @@ typedef struct csm {
     gi_csm_order order;
     float bias, normal_offset, normal_offset_local, shell_thickness;
     int lights_mode, n_local, m_local, receivers, distant, warned_moved, local_motion;
+    int dilate_local;  /* occluders=dilated: README "Sub-texel occluders" */
     uint32_t rebuilds; /* local-light precomputations redone in update() (local_motion=rebuild) */
     float *prepare_transforms; /* 16 per object: world_from_local at prepare time */
     gi_csm_order light_order;
@@ -126,6 +127,10 @@ static const gi_param_desc csm_params[] = {
      "precomputation in that frame's "
      "update, stage 'rebuild'), or keep the first placement's (the paper's fixed lights; shadows "
      "then stale)"},
+    {"occluders", GI_PARAM_ENUM, 0, 0, 0, "nearest|dilated", NULL,
+     "point and spot lights: other objects' cube maps tested at the nearest texel (the paper's), "
+     "or dilated: lit only where all 4 texels around the receiver are, so occluders narrower than "
+     "a texel still shadow (not the paper's)"},
     {"receivers", GI_PARAM_ENUM, 0, 0, 0, "none|planar", "Sec. 4.6",
      "receiver-only objects without CSMs: none, or every planar object"},
     {"mode", GI_PARAM_ENUM, 0, 0, 0, "shade|random|coherent", "Table 2",
@@ -162,6 +167,7 @@ static gi_result csm_create(const gi_host *host, const gi_params *params, void *
     c->light_order = (gi_csm_order)gi_params_enum(params, "light_enumeration");
     c->linear_aspect = gi_params_float(params, "linear_aspect");
     c->receivers = gi_params_enum(params, "receivers");
+    c->dilate_local = gi_params_enum(params, "occluders");
     c->mode = gi_params_enum(params, "mode");
     c->local_motion = gi_params_enum(params, "local_motion");
     *out = c;
@@ -928,6 +934,7 @@ static gi_result csm_render(void *inst, const gi_view *view, const gi_target *ta
     glUniform1ui(glGetUniformLocation(p, "csm_light_count"), c->light_count);
     glUniform1i(glGetUniformLocation(p, "csm_semilocal"), c->lights_mode == LIGHTS_SEMILOCAL);
     glUniform1f(glGetUniformLocation(p, "csm_normal_offset_local"), c->normal_offset_local);
+    glUniform1i(glGetUniformLocation(p, "csm_dilate_local"), c->dilate_local);
     glUniform1i(glGetUniformLocation(p, "u_distant"), c->distant);
     gi_kit_dispatch_8x8(view->width, view->height);
     glUseProgram(0);
@@ -960,6 +967,21 @@ static const char *csm_last_error(void *inst)
     return inst ? gi_kit_last_error(&((csm *)inst)->kit) : "";
 }
 
+/* Declared departure (docs/conformance.md): the nearest-texel test of §3.2
+ * misses occluders narrower than a cube-map texel (a panel seen edge-on, a
+ * corner clipped by millimetres), and a pixel that both point lights of the
+ * held-out `punctual` room leave dark then gets full light, which relMSE
+ * (epsilon 0.01) weighs 10^4 times; which pixels leak changes with M_local
+ * (README "Sub-texel occluders"). occluders=dilated is the remedy. */
+static const gi_departure csm_departures[] = {
+    {"held_out",
+     "nearest cube-map texels miss sub-texel occluders, leaking light into pixels the truth leaves "
+     "dark (punctual, 64^2: relMSE 0.82 seed 3, 2.01 seed 5; M_local 64..384 each fail one; "
+     "README \"Sub-texel occluders\")",
+     "occluders=dilated"},
+    {NULL, NULL, NULL},
+};
+
 GI_METHOD_EXPORT(csm, .id = "csm", .title = "Coherent Shadow Maps",
                  .citation = "Ritschel, Grosch, Kautz, Mueller. Interactive Illumination with "
                              "Coherent Shadow Maps. EGSR 2007",
@@ -968,4 +990,4 @@ GI_METHOD_EXPORT(csm, .id = "csm", .title = "Coherent Shadow Maps",
                          GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_GLOSSY |
                          GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE | GI_CAP_PRECOMPUTE |
                          GI_CAP_RIGID_MOTION | GI_CAP_TEXTURES,
-                 .max_bounces = 0, .params = csm_params);
+                 .max_bounces = 0, .params = csm_params, .departures = csm_departures);

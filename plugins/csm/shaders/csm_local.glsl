@@ -16,7 +16,8 @@
 //                            (0xFFFFFFFF none); then per light the enumeration
 //                            index of grid cell (a, b) at cells base + b n_u + a
 // Uniforms: csm_light_count, csm_semilocal (1: the orthographic maps with
-// d = l - p, §4.3), csm_normal_offset_local.
+// d = l - p, §4.3), csm_normal_offset_local, csm_dilate_local (1: the other
+// objects' cube maps are tested with mode 3 below, occluders=dilated).
 #ifndef CSM_LOCAL_GLSL
 #define CSM_LOCAL_GLSL
 #include "csm_query.glsl"
@@ -36,6 +37,7 @@ layout(std430, binding = 16) readonly buffer CsmLightCells { uint csm_light_cell
 uniform uint csm_light_count;
 uniform int csm_semilocal;
 uniform float csm_normal_offset_local; // texels of the cube face at x's distance
+uniform int csm_dilate_local;          // 1: occluders=dilated (README "Sub-texel occluders")
 
 vec3 csm_light_point(vec3 o, vec3 e1, vec3 e2, uint n_u, uint n_v, uint a, uint b)
 {
@@ -80,9 +82,11 @@ vec2 csm_cube_project(int face, vec3 d)
     return vec2(dot(s, d) / z, dot(t, d) / z);
 }
 
-// One depth test of local point x against cube map (a, b) of pair p; with
-// `pcf`, the 4 texels around x bilinearly weighted (clamped to the face),
-// else the nearest texel, or with rr >= 0 one of the 4 chosen by rr.
+// One depth test of local point x against cube map (a, b) of pair p: mode 0
+// the nearest texel; 1 the 4 texels around x bilinearly weighted (clamped
+// to the face); 2 one of those 4 chosen by rr; 3 (occluders=dilated, not
+// the paper's) lit only where all 4 are, so that an occluder narrower than
+// a texel, which the texel centres can miss, still shadows.
 float csm_cube_test(CsmPair p, CsmLight l, uint a, uint b, vec3 x, int mode, float rr)
 {
     uint n_u = l.info.x, n_v = l.info.y, M = p.info.x;
@@ -110,6 +114,14 @@ float csm_cube_test(CsmPair p, CsmLight l, uint a, uint b, vec3 x, int mode, flo
         ivec2 tex = clamp(i0 + ivec2(ix, iy), ivec2(0), ivec2(last));
         return depth <= csm_lookup_at(p.info.y, p.info.z, M, tex, i) + z_bias ? 1.0 : 0.0;
     }
+    if (mode == 3) {
+        for (int j = 0; j < 4; j++) {
+            ivec2 tex = clamp(i0 + ivec2(j & 1, j >> 1), ivec2(0), ivec2(last));
+            if (!(depth <= csm_lookup_at(p.info.y, p.info.z, M, tex, i) + z_bias))
+                return 0.0;
+        }
+        return 1.0;
+    }
     float v = 0.0;
     for (int j = 0; j < 4; j++) {
         ivec2 o = ivec2(j & 1, j >> 1);
@@ -126,7 +138,7 @@ float csm_cube_test(CsmPair p, CsmLight l, uint a, uint b, vec3 x, int mode, flo
 // point y on light j through object k's cube-map CSM (§4.2), with filter
 // `mode` (0 nearest grid point and texel; 1 generalised PCF over the 2^d
 // nearest grid points x 4 texels; 2 Russian roulette over those, driven by
-// u_rr in [0, 1)).
+// u_rr in [0, 1); 3 the nearest grid point, lit where all 4 texels are).
 float csm_local_visibility_object(uint j, uint k, vec3 x, vec3 n, vec3 y, int mode, float u_rr)
 {
     CsmPair p = csm_pairs[j * csm_object_count + k];
@@ -145,9 +157,9 @@ float csm_local_visibility_object(uint j, uint k, vec3 x, vec3 n, vec3 y, int mo
         vec3 nl = normalize(n * mat3(ob.world_from_local));
         xl += nl * (csm_normal_offset_local * 2.0 * length(xl - lc) / float(p.info.x));
     }
-    if (mode == 0) {
+    if (mode == 0 || mode == 3) {
         uint a = uint(clamp(int(floor(g.x + 0.5)), 0, nu - 1)), b = uint(clamp(int(floor(g.y + 0.5)), 0, nv - 1));
-        return csm_cube_test(p, l, a, b, xl, 0, 0.0);
+        return csm_cube_test(p, l, a, b, xl, mode, 0.0);
     }
     vec2 g0 = floor(g), fg = g - g0;
     uint as[2] = uint[2](uint(clamp(int(g0.x), 0, nu - 1)), uint(clamp(int(g0.x) + 1, 0, nu - 1)));
@@ -169,15 +181,23 @@ float csm_local_visibility_object(uint j, uint k, vec3 x, vec3 n, vec3 y, int mo
 }
 
 // Visibility through one object for light j: its cube maps (local), or
-// with csm_semilocal its orthographic maps along y - x (§4.3).
-float csm_light_visibility_object(uint j, uint k, vec3 x, vec3 n, vec3 y, float u_rr)
+// with csm_semilocal its orthographic maps along y - x (§4.3). `other`:
+// k is not the receiver's own object; with csm_dilate_local its cube maps
+// then take mode 3 (a receiver's own surface is left to the paper's test:
+// its neighbouring texels hold the receiver's own surface at other depths,
+// and the 4-texel minimum would shadow it at grazing angles). Only point
+// and spot lights (kind 2) are dilated: their shadows are hard, so one
+// missed texel gives a pixel the light's full contribution, while an area
+// light averages its points and the grown shadows cost more than they save.
+float csm_light_visibility_object(uint j, uint k, vec3 x, vec3 n, vec3 y, float u_rr, bool other)
 {
     if (csm_semilocal != 0) {
         if (csm_pairs[j * csm_object_count + k].o.w == 0.0)
             return 1.0;
         return csm_visibility_object(k, x, n, normalize(y - x), csm_filter, u_rr);
     }
-    return csm_local_visibility_object(j, k, x, n, y, csm_filter, u_rr);
+    bool dilate = other && csm_dilate_local != 0 && csm_lights[j].o.w == 2.0;
+    return csm_local_visibility_object(j, k, x, n, y, dilate ? 3 : csm_filter, u_rr);
 }
 
 // Visibility of light point y from x on object `own` (0xFFFFFFFF: none):
@@ -186,10 +206,10 @@ float csm_light_visibility(uint j, vec3 x, vec3 n, vec3 y, uint own, inout uint 
 {
     float v = 1.0;
     if (own < csm_object_count)
-        v = csm_light_visibility_object(j, own, x, n, y, csm_filter == 2 ? gi_rng_next_float(rng) : 0.0);
+        v = csm_light_visibility_object(j, own, x, n, y, csm_filter == 2 ? gi_rng_next_float(rng) : 0.0, false);
     for (uint k = 0u; k < csm_object_count && v > 0.0; k++)
         if (k != own)
-            v *= csm_light_visibility_object(j, k, x, n, y, csm_filter == 2 ? gi_rng_next_float(rng) : 0.0);
+            v *= csm_light_visibility_object(j, k, x, n, y, csm_filter == 2 ? gi_rng_next_float(rng) : 0.0, true);
     return v;
 }
 
