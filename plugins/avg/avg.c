@@ -238,13 +238,14 @@ static void release_prepared(avg *a)
         glDeleteBuffers(1, &a->ssbo_vpls);
     free(a->cpu_slots);
     free(a->cpu_vpls);
+    free(a->cpu_order);
     a->grid = NULL;
     a->exact = NULL;
     a->atlas = NULL;
     a->views = NULL;
     a->prog_trace = a->prog_split = a->prog_shade = a->prog_assemble = a->prog_final = 0;
     a->ssbo_slots = a->ssbo_vpls = 0;
-    a->cpu_slots = a->cpu_vpls = NULL;
+    a->cpu_slots = a->cpu_vpls = a->cpu_order = NULL;
     a->vpl_count = 0;
 }
 
@@ -313,7 +314,8 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
     }
     a->cpu_slots = calloc(a->slots, sizeof *a->cpu_slots);
     a->cpu_vpls = calloc(a->slots, sizeof *a->cpu_vpls);
-    if (!a->cpu_slots || !a->cpu_vpls)
+    a->cpu_order = calloc(a->slots, sizeof *a->cpu_order);
+    if (!a->cpu_slots || !a->cpu_vpls || !a->cpu_order)
         return gi_kit_fail(&a->kit, GI_ERR_OUT_OF_MEMORY, "avg: out of memory for the VPL slots");
     glCreateBuffers(1, &a->ssbo_slots);
     glNamedBufferStorage(a->ssbo_slots, (GLsizeiptr)(a->slots * sizeof(avg_vpl)), NULL,
@@ -478,16 +480,16 @@ static void punctual_parts(avg *a)
                 v->normal[k] = -v->normal[k];
         }
     }
-    /* Stable partition through the slots' read-back buffer (free until the
-     * next frame's tracing). */
+    /* Stable partition (the read-back slots stay as the tracer wrote them). */
     uint32_t at[3] = {0, n_whole, a->vpl_count - n_dead};
     for (uint32_t j = 0; j < a->vpl_count; j++) {
         const avg_vpl *v = &a->cpu_vpls[j];
         int dead = !(v->power[0] > 0.0f || v->power[1] > 0.0f || v->power[2] > 0.0f);
         int group = (v->kind & AVG_VPL_WHOLE) ? 0 : (dead && (v->kind >> 24) != 0 ? 2 : 1);
-        a->cpu_slots[at[group]++] = *v;
+        a->cpu_order[at[group]++] = *v;
     }
-    memcpy(a->cpu_vpls, a->cpu_slots, a->vpl_count * sizeof *a->cpu_vpls);
+    if (n_whole + n_dead > 0)
+        memcpy(a->cpu_vpls, a->cpu_order, a->vpl_count * sizeof *a->cpu_vpls);
     a->vpl_whole = n_whole;
     a->vpl_shaded = a->vpl_count - n_dead;
     if (a->vpl_count)

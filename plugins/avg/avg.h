@@ -147,6 +147,7 @@ typedef struct avg {
     uint32_t slots, paths;
     avg_vpl *cpu_slots; /* readback of the slots */
     avg_vpl *cpu_vpls;  /* compacted live VPLs, in slot order */
+    avg_vpl *cpu_order; /* punctual_parts' reordering (avg.c) */
     uint32_t vpl_count;
     uint32_t vpl_whole;    /* the first vpl_whole: punctual lights' covers, shaded at every pixel */
     uint32_t vpl_shaded;   /* the first vpl_shaded have power and maps; the rest repeat a cover */

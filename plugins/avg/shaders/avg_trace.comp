@@ -82,7 +82,7 @@ void main()
         // A double-sided emitter emits from both faces (glTF doubleSided):
         // the path leaves from the face its parity picks, at twice the
         // power, so that its VPL (one hemisphere, one shadow map) and its
-        // bounces cover both sides, as for point lights below.
+        // bounces cover both sides.
         bool two = (lm.flags & GI_MATERIAL_DOUBLE_SIDED) != 0u;
         if (two) {
             v.power *= 2.0;
