@@ -206,7 +206,7 @@ static gi_result shadow_maps(avg *a, gi_error *err)
         gi_vec3 up = fabsf(n.y) < 0.9f ? gi_v3(0, 1, 0) : gi_v3(1, 0, 0);
         gi_depth_view *dv = &a->views[j];
         gi_mat4_look_at(dv->view, eye, gi_v3_add(eye, n), up);
-        /* A cube-face VPL of a punctual light (avg_trace.comp): its face is
+        /* A cube-face VPL of a punctual light (punctual_parts): its face is
          * the 90 degree frustum about the axis n, whose sides the up vector
          * above aligns with the other two axes. */
         float fov = (v->kind & AVG_VPL_FACE) ? 90.0f : a->fov;
