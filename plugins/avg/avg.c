@@ -187,7 +187,7 @@ static gi_result shadow_maps(avg *a, gi_error *err)
     float diag = sqrtf((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) +
                        (b[5] - b[2]) * (b[5] - b[2]));
     float zfar = 2.0f * diag + 1e-6f, znear = 1e-3f * a->grid->h;
-    for (uint32_t j = 0; j < a->vpl_count; j++) {
+    for (uint32_t j = 0; j < a->vpl_shaded; j++) {
         const avg_vpl *v = &a->cpu_vpls[j];
         gi_vec3 eye = gi_v3_load(v->position), n = gi_v3_load(v->normal);
         /* A bounce VPL lies up to a voxel diagonal past its surface (its
@@ -206,12 +206,16 @@ static gi_result shadow_maps(avg *a, gi_error *err)
         gi_vec3 up = fabsf(n.y) < 0.9f ? gi_v3(0, 1, 0) : gi_v3(1, 0, 0);
         gi_depth_view *dv = &a->views[j];
         gi_mat4_look_at(dv->view, eye, gi_v3_add(eye, n), up);
-        gi_mat4_perspective(dv->proj, a->fov * GI_PI / 180.0f, 1.0f, znear, zfar);
+        /* A cube-face VPL of a punctual light (punctual_parts): its face is
+         * the 90 degree frustum about the axis n, whose sides the up vector
+         * above aligns with the other two axes. */
+        float fov = (v->kind & AVG_VPL_FACE) ? 90.0f : a->fov;
+        gi_mat4_perspective(dv->proj, fov * GI_PI / 180.0f, 1.0f, znear, zfar);
         dv->projection = d->projection;
         dv->znear = 0.0f;
         dv->zfar = zfar;
     }
-    return gi_depth_atlas_render(a->atlas, a->kit.scene, a->views, a->vpl_count, err);
+    return gi_depth_atlas_render(a->atlas, a->kit.scene, a->views, a->vpl_shaded, err);
 }
 
 /* Everything prepare() makes, released before a second prepare() and by destroy(). */
@@ -234,13 +238,14 @@ static void release_prepared(avg *a)
         glDeleteBuffers(1, &a->ssbo_vpls);
     free(a->cpu_slots);
     free(a->cpu_vpls);
+    free(a->cpu_order);
     a->grid = NULL;
     a->exact = NULL;
     a->atlas = NULL;
     a->views = NULL;
     a->prog_trace = a->prog_split = a->prog_shade = a->prog_assemble = a->prog_final = 0;
     a->ssbo_slots = a->ssbo_vpls = 0;
-    a->cpu_slots = a->cpu_vpls = NULL;
+    a->cpu_slots = a->cpu_vpls = a->cpu_order = NULL;
     a->vpl_count = 0;
 }
 
@@ -309,7 +314,8 @@ static gi_result avg_prepare(void *inst, const gi_gpu_scene *scene)
     }
     a->cpu_slots = calloc(a->slots, sizeof *a->cpu_slots);
     a->cpu_vpls = calloc(a->slots, sizeof *a->cpu_vpls);
-    if (!a->cpu_slots || !a->cpu_vpls)
+    a->cpu_order = calloc(a->slots, sizeof *a->cpu_order);
+    if (!a->cpu_slots || !a->cpu_vpls || !a->cpu_order)
         return gi_kit_fail(&a->kit, GI_ERR_OUT_OF_MEMORY, "avg: out of memory for the VPL slots");
     glCreateBuffers(1, &a->ssbo_slots);
     glNamedBufferStorage(a->ssbo_slots, (GLsizeiptr)(a->slots * sizeof(avg_vpl)), NULL,
@@ -412,12 +418,80 @@ static gi_result trace_avg(avg *a, const avg_light_table *lt, uint32_t seed, gi_
  * the same scene. */
 static void compact(avg *a)
 {
-    a->vpl_count = 0;
+    a->vpl_count = a->vpl_whole = a->vpl_shaded = 0;
     for (uint32_t s = 0; s < a->slots; s++) {
         const float *pw = a->cpu_slots[s].power;
         if (pw[0] > 0.0f || pw[1] > 0.0f || pw[2] > 0.0f)
             a->cpu_vpls[a->vpl_count++] = a->cpu_slots[s];
     }
+}
+
+/* What one VPL's shadow map covers of a punctual light's directions, F
+ * parts of the sphere: 1 for a spot whose cone the map holds, else 2
+ * hemispheres (paraboloid maps, or no maps) or 6 cube faces (perspective
+ * maps of 90 degrees). The paper's VPLs lie on area lights and shine
+ * through a cosine, so a perspective map that misses the edge of their
+ * hemisphere loses little (§IV: "lack of visibility information at the
+ * edges ... not too noticeable due to the reduction in radiance from the
+ * cosine"); a point light has no cosine, and every direction outside its
+ * VPLs' maps passed every occluder (issue 28). */
+static uint32_t punctual_cover(const avg *a, const avg_vpl *v)
+{
+    int perspective =
+        a->atlas && gi_depth_atlas_get_desc(a->atlas)->projection == GI_PROJ_PERSPECTIVE;
+    float half = perspective ? 0.5f * a->fov * GI_PI / 180.0f : 0.5f * GI_PI;
+    if ((v->kind & 0xFFu) == AVG_VPL_SPOT && v->cos_outer >= cosf(half))
+        return 1;
+    return perspective ? 6 : 2;
+}
+
+/* The VPLs on punctual lights (kind's entry, written by the tracers with the
+ * light's intensity I). All of a light's VPLs lie at the light, so its n
+ * maps hold F distinct pictures (punctual_cover): the light's first F VPLs
+ * take parts 0 .. F-1 of its directions, each with the whole intensity I,
+ * and are shaded at every pixel, outside the interleaving and the filter
+ * (AVG_VPL_WHOLE; §III-C's subsets and filter average out the differences
+ * between VPL subsets, and these add up to the light's direct light
+ * exactly); its other VPLs would repeat them and get no power. The list is
+ * reordered: the whole VPLs first (vpl_whole), then the rest in slot order
+ * (interleaved, vpl_shaded in all with maps), then the powerless ones. */
+static void punctual_parts(avg *a)
+{
+    uint32_t seen[1 + AVG_MAX_PUNCTUAL] = {0}, n_whole = 0, n_dead = 0;
+    for (uint32_t j = 0; j < a->vpl_count; j++) {
+        avg_vpl *v = &a->cpu_vpls[j];
+        uint32_t l = v->kind >> 24;
+        if (l == 0 || l > AVG_MAX_PUNCTUAL)
+            continue;
+        uint32_t F = punctual_cover(a, v), part = seen[l]++;
+        if (part >= F) {
+            memset(v->power, 0, sizeof v->power);
+            n_dead++;
+            continue;
+        }
+        v->kind |= AVG_VPL_WHOLE;
+        n_whole++;
+        if (F == 6) {
+            memset(v->normal, 0, sizeof v->normal);
+            v->normal[part / 2] = (part & 1u) ? -1.0f : 1.0f;
+            v->kind |= AVG_VPL_FACE;
+        } else if (F == 2 && part == 1) {
+            for (int k = 0; k < 3; k++)
+                v->normal[k] = -v->normal[k];
+        }
+    }
+    /* Stable partition (the read-back slots stay as the tracer wrote them). */
+    uint32_t at[3] = {0, n_whole, a->vpl_count - n_dead};
+    for (uint32_t j = 0; j < a->vpl_count; j++) {
+        const avg_vpl *v = &a->cpu_vpls[j];
+        int dead = !(v->power[0] > 0.0f || v->power[1] > 0.0f || v->power[2] > 0.0f);
+        int group = (v->kind & AVG_VPL_WHOLE) ? 0 : (dead && (v->kind >> 24) != 0 ? 2 : 1);
+        a->cpu_order[at[group]++] = *v;
+    }
+    if (n_whole + n_dead > 0)
+        memcpy(a->cpu_vpls, a->cpu_order, a->vpl_count * sizeof *a->cpu_vpls);
+    a->vpl_whole = n_whole;
+    a->vpl_shaded = a->vpl_count - n_dead;
     if (a->vpl_count)
         glNamedBufferSubData(a->ssbo_vpls, 0, (GLsizeiptr)(a->vpl_count * sizeof(avg_vpl)),
                              a->cpu_vpls);
@@ -463,6 +537,9 @@ static void size_scratch(avg *a, uint32_t w, uint32_t h)
     a->tex_split_out =
         gi_kit_scratch_texture(&a->kit, 2, GL_RGBA32F, a->split_w * mx, a->split_h * mx);
     a->tex_indirect = gi_kit_scratch_texture(&a->kit, 3, GL_RGBA32F, w, h);
+    a->tex_split_whole =
+        gi_kit_scratch_texture(&a->kit, 4, GL_RGBA32F, a->split_w * mx, a->split_h * mx);
+    a->tex_whole = gi_kit_scratch_texture(&a->kit, 5, GL_RGBA32F, w, h);
 }
 
 /* §III-C: split, shade per subset, reassemble, filter, albedo. */
@@ -491,10 +568,12 @@ static gi_result illuminate(avg *a, const gi_view *view, const gi_target *target
     glBindTextureUnit(AVG_TEX_SPLIT_POS, a->tex_split_pos);
     glBindTextureUnit(AVG_TEX_SPLIT_NRM, a->tex_split_nrm);
     glBindImageTexture(0, a->tex_split_out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(1, a->tex_split_whole, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, AVG_SSBO_VPLS, a->ssbo_vpls);
     glUniform2iv(glGetUniformLocation(p, "u_sub"), 1, sub);
     glUniform1i(glGetUniformLocation(p, "u_mx"), a->mx);
-    glUniform1ui(glGetUniformLocation(p, "u_count"), a->vpl_count);
+    glUniform1ui(glGetUniformLocation(p, "u_count"), a->vpl_shaded);
+    glUniform1ui(glGetUniformLocation(p, "u_whole"), a->vpl_whole);
     float dmin = a->clamp * a->grid->h;
     glUniform1f(glGetUniformLocation(p, "u_dmin2"), dmin * dmin);
     glUniform1i(glGetUniformLocation(p, "u_visibility"), a->atlas != NULL);
@@ -514,7 +593,9 @@ static gi_result illuminate(avg *a, const gi_view *view, const gi_target *target
     p = a->prog_assemble;
     glUseProgram(p);
     glBindTextureUnit(AVG_TEX_SPLIT_OUT, a->tex_split_out);
+    glBindTextureUnit(AVG_TEX_SPLIT_WHOLE, a->tex_split_whole);
     glBindImageTexture(0, a->tex_indirect, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(1, a->tex_whole, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glUniform2iv(glGetUniformLocation(p, "u_size"), 1, size);
     glUniform2iv(glGetUniformLocation(p, "u_sub"), 1, sub);
     glUniform1i(glGetUniformLocation(p, "u_mx"), a->mx);
@@ -525,6 +606,7 @@ static gi_result illuminate(avg *a, const gi_view *view, const gi_target *target
     glUseProgram(p);
     gi_gbuffer_bind(a->kit.gbuffer, GI_TEX_GBUFFER_POSITION);
     glBindTextureUnit(AVG_TEX_INDIRECT, a->tex_indirect);
+    glBindTextureUnit(AVG_TEX_WHOLE, a->tex_whole);
     glBindImageTexture(1, target->texture, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glUniform2iv(glGetUniformLocation(p, "u_size"), 1, size);
     glUniform1i(glGetUniformLocation(p, "u_mx"), a->mx);
@@ -571,6 +653,7 @@ static gi_result avg_render(void *inst, const gi_view *view, const gi_target *ta
     }
     if (r == GI_OK) {
         compact(a);
+        punctual_parts(a);
         dump_vpls(a);
     }
     host->stage_end(host, "tra");
@@ -592,6 +675,7 @@ static gi_result avg_render(void *inst, const gi_view *view, const gi_target *ta
         return gi_kit_fail_with(&a->kit, r, &err);
 
     host->stat(host, "vpls_live", (double)a->vpl_count);
+    host->stat(host, "vpls_shaded", (double)a->vpl_shaded);
     host->stat(host, "light_paths", (double)a->paths);
     host->stat(host, "voxel_size", (double)a->grid->h);
     /* Kept for rendering: the grid's two RGBA32F 3D textures, the live VPLs

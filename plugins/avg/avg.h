@@ -65,9 +65,16 @@ void avg_grid_bind(const avg_grid *g, GLuint program, GLuint unit_normal, GLuint
 
 /* A VPL, std430 (64 bytes), mirrored in shaders/avg_vpl.glsl. */
 enum { AVG_VPL_DIFFUSE = 0, AVG_VPL_POINT = 1, AVG_VPL_SPOT = 2 };
+/* kind flag: a punctual light's VPL covering the cube face whose axis is its
+ * normal, not a hemisphere (avg.c, punctual_parts) */
+#define AVG_VPL_FACE 0x20000u
+/* kind flag: one of a punctual light's cover VPLs, shaded at every pixel
+ * outside the interleaving and the filter (avg.c, punctual_parts) */
+#define AVG_VPL_WHOLE 0x40000u
 typedef struct avg_vpl {
     float position[3];
-    uint32_t kind;   /* AVG_VPL_* | bounce << 8 | double-sided emitter << 16 */
+    uint32_t kind;   /* AVG_VPL_* | bounce << 8 | double-sided emitter << 16 | AVG_VPL_FACE |
+                       punctual light's entry (1 + light) << 24 */
     float normal[3]; /* surface normal (diffuse) or spot axis */
     float cos_inner;
     float power[3]; /* diffuse: flux, radiant intensity = power cos / pi; point/spot: intensity */
@@ -84,6 +91,11 @@ typedef struct avg_trace_desc {
     uint32_t seed; /* the run's seed (gi_view.seed); 1, the default, gives the sequence of earlier
                       versions */
 } avg_trace_desc;
+
+/* The face of the cube about a punctual light through which direction o
+ * leaves it: 2 a + (o[a] < 0), a the axis of o's largest component (the
+ * lowest on a tie). Twin of avg_vpl.glsl's avg_cube_face. */
+uint32_t avg_cube_face(const float o[3]);
 
 /* Light choice of the tracers: the area lights as one group (emitter CDF
  * inside) followed by the punctual lights, by power (§III-B "weighted by the
@@ -129,15 +141,19 @@ typedef struct avg {
     GLuint prog_trace, prog_split, prog_shade, prog_assemble, prog_final;
     GLuint ssbo_slots, ssbo_vpls, ubo_lights;
     GLuint tex_split_pos, tex_split_nrm, tex_split_out,
-        tex_indirect; /* the kit's scratch textures 0-3 */
+        tex_indirect;                  /* the kit's scratch textures 0-3 */
+    GLuint tex_split_whole, tex_whole; /* 4-5: punctual lights' unfiltered part */
     uint32_t split_w, split_h;
     uint32_t slots, paths;
     avg_vpl *cpu_slots; /* readback of the slots */
     avg_vpl *cpu_vpls;  /* compacted live VPLs, in slot order */
+    avg_vpl *cpu_order; /* punctual_parts' reordering (avg.c) */
     uint32_t vpl_count;
-    avg_exact *exact;          /* the CPU tracer (avg_trace_cpu.c), NULL for avg tracing */
-    gi_depth_atlas *atlas;     /* the VPLs' shadow maps when visibility is on */
-    gi_depth_view *views;      /* one per VPL slot */
+    uint32_t vpl_whole;    /* the first vpl_whole: punctual lights' covers, shaded at every pixel */
+    uint32_t vpl_shaded;   /* the first vpl_shaded have power and maps; the rest repeat a cover */
+    avg_exact *exact;      /* the CPU tracer (avg_trace_cpu.c), NULL for avg tracing */
+    gi_depth_atlas *atlas; /* the VPLs' shadow maps when visibility is on */
+    gi_depth_view *views;  /* one per VPL slot */
     struct gi_simplified *lod; /* the shadow maps' lower-detail copy (shadow_lod < 1), else NULL */
 } avg;
 

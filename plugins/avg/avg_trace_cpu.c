@@ -163,9 +163,9 @@ static int start_on_emitter(const avg_exact *x, const gi_scene *s, float ue, flo
     return 1;
 }
 
-/* At point or spot light L (path i): its VPL and a ray uniform in the
+/* At point or spot light L (entry l): its VPL and a ray uniform in the
  * spot's cone or over the sphere. */
-static void start_at_light(const gi_gpu_light *L, float pl, float N, uint32_t i, const float q1[2],
+static void start_at_light(const gi_gpu_light *L, uint32_t l, float pl, float N, const float q1[2],
                            path_start *ps)
 {
     gi_vec3 I =
@@ -178,14 +178,11 @@ static void start_at_light(const gi_gpu_light *L, float pl, float N, uint32_t i,
     ps->v.kind = spot ? AVG_VPL_SPOT : AVG_VPL_POINT;
     ps->v.cos_inner = L->cos_inner;
     ps->v.cos_outer = L->cos_outer;
-    if (spot && L->cos_outer >= 0.0f) {
-        set_v3(ps->v.normal, ldir);
-        set_v3(ps->v.power, I);
-    } else {
-        gi_vec3 a = spot ? ldir : gi_v3(0, 1, 0);
-        set_v3(ps->v.normal, (i & 1u) == 0 ? a : gi_v3_scale(a, -1.0f));
-        set_v3(ps->v.power, gi_v3_scale(I, 2.0f));
-    }
+    /* the light's intensity and entry, as avg_trace.comp (avg.c's
+     * punctual_parts gives the VPL its cover and share) */
+    set_v3(ps->v.normal, spot ? ldir : gi_v3(0, 1, 0));
+    memcpy(ps->v.power, L->intensity, sizeof ps->v.power);
+    ps->v.kind |= l << 24;
     if (spot) {
         ps->dir = gi_to_world(gi_sample_uniform_cone(q1[0], q1[1], L->cos_outer), ldir);
         ps->flux =
@@ -222,7 +219,7 @@ static void trace_path(const avg_exact *x, const gi_scene *s, const avg_light_ta
         if (!start_on_emitter(x, s, ue, pl, N, i, q0, q1, eps, &ps))
             return;
     } else {
-        start_at_light(&x->lights[l - 1], pl, N, i, q1, &ps);
+        start_at_light(&x->lights[l - 1], l, pl, N, q1, &ps);
     }
     slots[0] = ps.v;
     gi_vec3 origin = ps.origin, dir = ps.dir, flux = ps.flux;
@@ -296,6 +293,13 @@ gi_result avg_exact_trace(avg_exact *x, const gi_gpu_scene *gs, const avg_light_
     return GI_OK;
 }
 
+uint32_t avg_cube_face(const float o[3])
+{
+    float m[3] = {fabsf(o[0]), fabsf(o[1]), fabsf(o[2])};
+    uint32_t a = (m[0] >= m[1] && m[0] >= m[2]) ? 0u : (m[1] >= m[2] ? 1u : 2u);
+    return 2u * a + (o[a] < 0.0f ? 1u : 0u);
+}
+
 void avg_vpl_contribution(const avg_vpl *v, const float x[3], const float n[3], float dmin2,
                           float out[3])
 {
@@ -316,7 +320,9 @@ void avg_vpl_contribution(const avg_vpl *v, const float x[3], const float n[3], 
             return;
         f = cos_v * GI_INV_PI * cos_x / fmaxf(d2, dmin2);
     } else {
-        if (cos_v <= 0.0f)
+        /* a hemisphere about the normal, or the cube face whose axis it is */
+        float o[3] = {-w.x, -w.y, -w.z};
+        if ((v->kind & AVG_VPL_FACE) ? avg_cube_face(o) != avg_cube_face(v->normal) : cos_v <= 0.0f)
             return;
         f = cos_x / fmaxf(d2, dmin2) * gi_range_window(sqrtf(d2), v->range);
         if (kind == AVG_VPL_SPOT)

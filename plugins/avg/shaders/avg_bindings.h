@@ -15,8 +15,10 @@
 #define AVG_TEX_ATLAS 16
 /* avg_assemble.comp: the shaded sub-images. */
 #define AVG_TEX_SPLIT_OUT 14
+#define AVG_TEX_SPLIT_WHOLE 15
 /* avg_final.comp: the reassembled indirect light S. */
 #define AVG_TEX_INDIRECT 14
+#define AVG_TEX_WHOLE 15
 
 /* SSBOs. */
 #define AVG_SSBO_SLOTS 8        /* avg_trace.comp: one VPL per slot */

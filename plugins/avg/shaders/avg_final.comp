@@ -4,7 +4,8 @@
 // fly: normals differing (dot < u_normal_dot) or world positions farther
 // apart than u_max_dist x the pixel's eye depth (that is, more than a fixed
 // multiple of the window's footprint on a surface facing the camera); the
-// remaining weights are renormalised. Then
+// remaining weights are renormalised; the punctual lights' part that every
+// subset holds whole (avg_shade.comp) is added after the filter. Then
 // times albedo / pi (Lambert), plus the emission seen directly.
 #include "common.glsl"
 #include "gbuffer_read.glsl"
@@ -13,6 +14,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = AVG_TEX_INDIRECT) uniform sampler2D u_indirect;
+layout(binding = AVG_TEX_WHOLE) uniform sampler2D u_whole; // punctual lights' exact part, unfiltered
 layout(rgba32f, binding = GI_IMAGE_TARGET) uniform writeonly image2D u_target;
 
 uniform ivec2 u_size;
@@ -53,6 +55,7 @@ void main()
             }
             S = wsum > 0.0 ? sum / wsum : S; // the pixel itself always passes
         }
+        S += texelFetch(u_whole, p, 0).rgb;
         L = texelFetch(gi_gbuffer_emission, p, 0).rgb + texelFetch(gi_gbuffer_albedo, p, 0).rgb * GI_INV_PI * S;
     }
     imageStore(u_target, p, vec4(L, 1.0));

@@ -8,7 +8,8 @@
 //    cosine-distributed direction (quasi-random pairs 0 and 1) about its
 //    front normal, or for a double-sided emitter about the face the path's
 //    parity picks;
-//  - point lights: a uniform direction; spot lights: uniform in the cone;
+//  - point lights: a uniform direction; spot lights: uniform in the cone
+//    (their VPLs' cover and share are set on the CPU, avg.c punctual_parts);
 //  - marching through the grid to the first voxel holding a normal; the
 //    VPL's colour is the voxel's average colour, its normal the voxel's
 //    average normal turned toward the ray, its position a random distance
@@ -81,7 +82,7 @@ void main()
         // A double-sided emitter emits from both faces (glTF doubleSided):
         // the path leaves from the face its parity picks, at twice the
         // power, so that its VPL (one hemisphere, one shadow map) and its
-        // bounces cover both sides, as for point lights below.
+        // bounces cover both sides.
         bool two = (lm.flags & GI_MATERIAL_DOUBLE_SIDED) != 0u;
         if (two) {
             v.power *= 2.0;
@@ -103,17 +104,12 @@ void main()
         v.kind = spot ? AVG_VPL_SPOT : AVG_VPL_POINT;
         v.cos_inner = L.cos_inner;
         v.cos_outer = L.cos_outer;
-        // One hemisphere per VPL (one shadow map each): a spot's cone when
-        // it fits in one, else the half chosen by the path's parity, at
-        // twice the intensity.
-        if (spot && L.cos_outer >= 0.0) {
-            v.normal = L.direction;
-            v.power = I;
-        } else {
-            vec3 a = spot ? L.direction : vec3(0.0, 1.0, 0.0);
-            v.normal = (i & 1u) == 0u ? a : -a;
-            v.power = 2.0 * I;
-        }
+        // The light's own intensity and its entry in the kind: the CPU
+        // (avg.c, punctual_parts) gives each VPL of the light the part of
+        // its directions that one shadow map covers and its share.
+        v.normal = spot ? L.direction : vec3(0.0, 1.0, 0.0);
+        v.power = L.intensity;
+        v.kind |= uint(l) << 24;
         if (spot) {
             vec3 w = gi_to_world(gi_sample_uniform_cone(q1.x, q1.y, L.cos_outer), L.direction);
             dir = w;
