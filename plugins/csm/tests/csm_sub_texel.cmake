@@ -7,11 +7,14 @@
 # the departure `held_out` with remedy occluders=dilated, so the suite
 # scores the remedy and reports the paper's nearest texel beside it
 # (0.82 and 2.01, failing: light leaks into pixels both lights leave dark).
+# Seed 10's room fails with occluders=dilated alone (0.0166, limit 0.0084:
+# acne from normal_offset_local 0.25 on the thin panel); the remedy's
+# normal_offset_local=0.5 passes it (README "Local-light acne").
 # Run by ctest as:
 #   cmake -DGIB=... -DOUT=... -DPY=python3 -DSCRIPT=.../held_out.py -P csm_sub_texel.cmake
 set(failures 0)
 set(ENV{GIBENCH_PLUGIN_PATH} "")
-foreach(seed 3 5)
+foreach(seed 3 5 10)
     set(dir ${OUT}/csm_sub_texel_s${seed})
     file(REMOVE_RECURSE ${dir})
     execute_process(COMMAND ${PY} ${SCRIPT} --seed ${seed} --out ${dir}
