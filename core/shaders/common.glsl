@@ -17,4 +17,17 @@ float gi_luminance(vec3 rgb)
 {
     return 0.2126 * rgb.r + 0.7152 * rgb.g + 0.0722 * rgb.b;
 }
+
+// The face of the core's cube maps a direction d from the centre falls into
+// (+x, -x, +y, -y, +z, -z = 0..5; the lowest axis on a tie, so every
+// direction belongs to exactly one face). C twin: gi_cube_face, gi/algo/cubemap.h.
+int gi_cube_face(vec3 d)
+{
+    vec3 a = abs(d);
+    if (a.x >= a.y && a.x >= a.z)
+        return d.x >= 0.0 ? 0 : 1;
+    if (a.y >= a.z)
+        return d.y >= 0.0 ? 2 : 3;
+    return d.z >= 0.0 ? 4 : 5;
+}
 #endif

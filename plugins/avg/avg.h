@@ -92,11 +92,6 @@ typedef struct avg_trace_desc {
                       versions */
 } avg_trace_desc;
 
-/* The face of the cube about a punctual light through which direction o
- * leaves it: 2 a + (o[a] < 0), a the axis of o's largest component (the
- * lowest on a tie). Twin of avg_vpl.glsl's avg_cube_face. */
-uint32_t avg_cube_face(const float o[3]);
-
 /* Light choice of the tracers: the area lights as one group (emitter CDF
  * inside) followed by the punctual lights, by power (§III-B "weighted by the
  * power of the light source"). */

@@ -11,6 +11,7 @@
 #include "gi/rng.h"
 #include "gi/sampling.h"
 #include "gi/sequences.h"
+#include "gi/algo/cubemap.h"
 #include "gi/lights.h"
 
 #include <float.h>
@@ -293,13 +294,6 @@ gi_result avg_exact_trace(avg_exact *x, const gi_gpu_scene *gs, const avg_light_
     return GI_OK;
 }
 
-uint32_t avg_cube_face(const float o[3])
-{
-    float m[3] = {fabsf(o[0]), fabsf(o[1]), fabsf(o[2])};
-    uint32_t a = (m[0] >= m[1] && m[0] >= m[2]) ? 0u : (m[1] >= m[2] ? 1u : 2u);
-    return 2u * a + (o[a] < 0.0f ? 1u : 0u);
-}
-
 void avg_vpl_contribution(const avg_vpl *v, const float x[3], const float n[3], float dmin2,
                           float out[3])
 {
@@ -322,7 +316,9 @@ void avg_vpl_contribution(const avg_vpl *v, const float x[3], const float n[3], 
     } else {
         /* a hemisphere about the normal, or the cube face whose axis it is */
         float o[3] = {-w.x, -w.y, -w.z};
-        if ((v->kind & AVG_VPL_FACE) ? avg_cube_face(o) != avg_cube_face(v->normal) : cos_v <= 0.0f)
+        if ((v->kind & AVG_VPL_FACE)
+                ? gi_cube_face(gi_v3_load(o)) != gi_cube_face(gi_v3_load(v->normal))
+                : cos_v <= 0.0f)
             return;
         f = cos_x / fmaxf(d2, dmin2) * gi_range_window(sqrtf(d2), v->range);
         if (kind == AVG_VPL_SPOT)

@@ -18,17 +18,6 @@ const uint AVG_VPL_FACE = 0x20000u;
 // shaded at every pixel, outside the interleaving and the filter
 const uint AVG_VPL_WHOLE = 0x40000u;
 
-// The face of the cube about a punctual light through which direction o
-// leaves it: 2 a + (o[a] < 0) with a the axis of o's largest component, the
-// lowest axis on a tie, so that every direction belongs to exactly one face.
-// C twin: avg_cube_face in avg_trace_cpu.c.
-uint avg_cube_face(vec3 o)
-{
-    vec3 m = abs(o);
-    uint a = (m.x >= m.y && m.x >= m.z) ? 0u : (m.y >= m.z ? 1u : 2u);
-    return 2u * a + (o[a] < 0.0 ? 1u : 0u);
-}
-
 struct AvgVpl {
     vec3 position; uint kind;   // kind | bounce << 8 | double-sided emitter << 16 | AVG_VPL_FACE | light entry << 24
     vec3 normal; float cos_inner; // surface normal, or the hemisphere (cube face) a light VPL covers
@@ -98,7 +87,7 @@ vec3 avg_vpl_contribution(AvgVpl v, vec3 x, vec3 n, float dmin2)
     }
     // A punctual light's VPL covers one hemisphere about `normal`, or with
     // the face flag the cube face whose axis `normal` is.
-    if ((v.kind & AVG_VPL_FACE) != 0u ? avg_cube_face(-w) != avg_cube_face(v.normal) : cos_v <= 0.0)
+    if ((v.kind & AVG_VPL_FACE) != 0u ? gi_cube_face(-w) != gi_cube_face(v.normal) : cos_v <= 0.0)
         return vec3(0.0);
     float f = cos_x / max(d2, dmin2) * gi_range_window(sqrt(d2), v.range);
     if (kind == AVG_VPL_SPOT)
