@@ -20,6 +20,7 @@
 // objects' cube maps are tested with mode 3 below, occluders=dilated).
 #ifndef CSM_LOCAL_GLSL
 #define CSM_LOCAL_GLSL
+#include "common.glsl" // gi_cube_face: the faces and tie rule of gi/algo/cubemap.h
 #include "csm_query.glsl"
 
 struct CsmLight {
@@ -51,16 +52,6 @@ vec2 csm_light_grid(vec3 o, vec3 e1, vec3 e2, uint n_u, uint n_v, vec3 y)
     float l1 = dot(e1, e1), l2 = dot(e2, e2);
     return vec2(n_u > 1u && l1 > 0.0 ? dot(q, e1) / l1 * float(n_u) - 0.5 : 0.0,
                 n_v > 1u && l2 > 0.0 ? dot(q, e2) / l2 * float(n_v) - 0.5 : 0.0);
-}
-
-int csm_cube_face(vec3 d)
-{
-    vec3 a = abs(d);
-    if (a.x >= a.y && a.x >= a.z)
-        return d.x >= 0.0 ? 0 : 1;
-    if (a.y >= a.z)
-        return d.y >= 0.0 ? 2 : 3;
-    return d.z >= 0.0 ? 4 : 5;
 }
 
 void csm_cube_basis(int face, out vec3 s, out vec3 t, out vec3 f)
@@ -95,7 +86,7 @@ float csm_cube_test(CsmPair p, CsmLight l, uint a, uint b, vec3 x, int mode, flo
     float depth = length(d);
     if (!(depth > 0.0))
         return 1.0;
-    int face = csm_cube_face(d);
+    int face = gi_cube_face(d);
     vec2 sc = csm_cube_project(face, d);
     uint i = uint(face) * n_u * n_v + csm_light_cells[l.info.z + b * n_u + a];
     float z_bias = uintBitsToFloat(p.info.w);
