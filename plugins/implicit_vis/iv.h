@@ -229,10 +229,15 @@ typedef struct iv_lights {
     const gi_scene *scene;
     float t;              /* punctual lights placed at this time */
     const gi_envmap *env; /* NULL: black */
+    /* NULL: the paper's direct light along the links. Else 6 per element,
+     * the direct irradiance on both sides as iv_illuminate's out (traced,
+     * README "Traced direct light"): it replaces the first gather, and
+     * e_out then holds the indirect bounces only. */
+    const float *direct;
 } iv_lights;
 
 /* Gathers the direct light (light links, punctual lights through their bin,
- * the environment through empty bins) and `bounces` indirect bounces at the
+ * the environment through empty bins; or lights->direct) and `bounces` indirect bounces at the
  * leaves with Eq. 5 (each link weighted by iv_link_share), pulling the
  * reflected radiance up after each gather. Out: per element the irradiance
  * on both sides of its disc, e_out[6 e + 0..2] on the normal's side,

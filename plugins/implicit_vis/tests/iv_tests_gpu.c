@@ -33,7 +33,7 @@ int iv_test_gpu_illuminate(const gi_scene *s, const iv_hier *h, const iv_links *
     EXPECT(g != NULL, "GPU illumination: %s", err.text);
     int ok = g != NULL;
     if (g) {
-        gi_result r = iv_gpu_illuminate(g, l, h, bounces, s->light_count, &err);
+        gi_result r = iv_gpu_illuminate(g, l, h, bounces, s->light_count, NULL, &err);
         EXPECT(r == GI_OK, "GPU illumination: %s", err.text);
         ok = r == GI_OK;
         if (ok)
@@ -60,7 +60,7 @@ static void gpu_case(const char *path, uint32_t N, uint32_t bounces, int bilinea
     float *G = ok ? malloc((size_t)f.h->elem_count * 6 * sizeof(float)) : NULL;
     float *P = ok ? malloc((size_t)f.h->elem_count * 6 * sizeof(float)) : NULL;
     if (ok && G && P && iv_test_gpu_illuminate(f.s, f.h, f.l, bounces, G)) {
-        iv_lights li = {f.s, 0.0f, f.s->envmap};
+        iv_lights li = {f.s, 0.0f, f.s->envmap, NULL};
         if (bounces > 0)
             iv_illuminate(f.l, f.h, &li, bounces - 1,
                           P); /* one gather fewer: the answer to tell apart */
