@@ -22,10 +22,9 @@ struct gi_direct_rays {
     const gi_rt *rt;
     const gi_scene *scene;
     float time;
-    /* 1e-4 of the scene's size: rays start this far off the surface along
-     * its normal, and ignore hits nearer than this, so that a point on an
-     * edge or in a corner (an element at a mesh vertex) is not shadowed by
-     * the neighbouring face it touches */
+    /* 1e-4 of the scene's size: hits nearer than this are ignored, so that
+     * a point is not shadowed by its own surface nor, on an edge or in a
+     * corner (an element at a mesh vertex), by the face beside it */
     float eps;
     uint32_t count;
     emitter *em;
@@ -122,25 +121,28 @@ static void stratified(uint32_t k, const float r[2], float u[2])
     u[1] = gi_cp_rotate(u[1], r[1]);
 }
 
-/* Area lights: K points; the first coordinate of a stratified point picks
- * the triangle in the power CDF and, rescaled within its interval, with
- * the second places the point on it. */
+/* Area lights: K points, the k-th triangle from the k-th of K strata of
+ * the power CDF (one random shift for all), its point on the triangle from
+ * the k-th stratified 2D point. (Not the first coordinate rescaled within
+ * the triangle's interval: with K strata on a lattice that rescaled value
+ * is the same for every k.) */
 static void area_lights(const gi_direct_rays *d, gi_vec3 o, gi_vec3 n, uint32_t K, uint32_t *rng,
                         double E[3])
 {
     if (!d->count || !K)
         return;
-    float r[2] = {gi_rng_next_float(rng), gi_rng_next_float(rng)}, u[2];
+    float r0 = gi_rng_next_float(rng), r[2] = {gi_rng_next_float(rng), gi_rng_next_float(rng)},
+          u[2];
     for (uint32_t k = 0; k < K; k++) {
-        stratified(k, r, u);
-        uint32_t i = gi_cdf_find_interval(d->cdf, d->count, u[0]);
+        float u0 = ((float)k + r0) / (float)K;
+        uint32_t i = gi_cdf_find_interval(d->cdf, d->count, u0 < 1.0f ? u0 : GI_ONE_MINUS_EPSILON);
         const emitter *e = &d->em[i];
         float pick = d->cdf[i + 1] - d->cdf[i];
         if (!(pick > 0.0f) || !(e->area > 0.0f))
             continue;
-        float bc[3], u1 = (u[0] - d->cdf[i]) / pick;
-        gi_sample_uniform_triangle(u1 < 0.0f ? 0.0f : (u1 < 1.0f ? u1 : GI_ONE_MINUS_EPSILON), u[1],
-                                   bc);
+        float bc[3];
+        stratified(k, r, u);
+        gi_sample_uniform_triangle(u[0], u[1], bc);
         gi_vec3 y = gi_v3_add(gi_v3_add(gi_v3_scale(e->p[0], bc[0]), gi_v3_scale(e->p[1], bc[1])),
                               gi_v3_scale(e->p[2], bc[2]));
         gi_vec3 dv = gi_v3_sub(y, o);
@@ -221,7 +223,8 @@ void gi_direct_rays_irradiance(const gi_direct_rays *d, gi_vec3 x, gi_vec3 n, ui
                                uint32_t env_samples, uint32_t seed, float E[3])
 {
     double acc[3] = {0.0, 0.0, 0.0};
-    gi_vec3 o = gi_v3_add(x, gi_v3_scale(n, d->eps));
+    gi_vec3 o = x; /* hits nearer than eps are ignored instead of moving the origin, which would
+                      change the distance to a near light */
     uint32_t rng = gi_rng_init(seed, 0, 0xd1ec7u);
     area_lights(d, o, n, area_samples, &rng, acc);
     environment(d, o, n, env_samples, &rng, acc);

@@ -43,9 +43,9 @@ uint32_t gi_direct_rays_emitters(const gi_direct_rays *d);
  * lights from area_samples points (stratified in the power CDF), the
  * environment from env_samples directions, each punctual light exactly
  * with one shadow ray. `seed` picks the random numbers (the same seed
- * gives the same E). Rays start 1e-4 of the scene's size off the surface
- * along n and ignore hits nearer than that (a point in a corner is not
- * shadowed by the face it touches). An unbiased estimate: its mean over seeds converges to the
+ * gives the same E). Rays start at x and ignore hits nearer than 1e-4 of
+ * the scene's size (a point is not shadowed by its own surface, nor in a
+ * corner by the face beside it). An unbiased estimate: its mean over seeds converges to the
  * direct irradiance. */
 void gi_direct_rays_irradiance(const gi_direct_rays *d, gi_vec3 x, gi_vec3 n, uint32_t area_samples,
                                uint32_t env_samples, uint32_t seed, float E[3]);
