@@ -102,6 +102,7 @@ typedef struct implicit_vis {
     int glossy; /* the display adds the glossy direct light (a glossy material, glossy=true) */
     int traced; /* direct=traced: the direct light by shadow rays (iv_traced.h) */
     int direct_samples;
+    int warned_cpu; /* the links outgrew one GL storage block once: warned */
     float subdiv, remesh, coverage;
     iv_hier *hier;
     iv_links *links;
@@ -374,12 +375,23 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
     }
 
     host->stage_begin(host, "illumination");
+    int on_cpu = m->gpu == NULL;
     if (m->gpu) { /* Sec. 4.3.1: the punctual lights at the frame's time come from the scene's
                      buffer */
         gi_gpu_scene_bind(gs);
         r = iv_gpu_illuminate(m->gpu, m->links, m->hier, (uint32_t)m->bounces, s->light_count,
                               direct, &err);
-    } else {
+        if (r == GI_ERR_UNSUPPORTED && !m->glossy) { /* more links than one GL storage block holds
+                                                        (llvmpipe: 128 MiB): the same gather on
+                                                        the CPU */
+            if (!m->warned_cpu)
+                gi_log(GI_LOG_WARN, "%s; gathering on the CPU (illum=cpu) instead", err.text);
+            m->warned_cpu = 1;
+            on_cpu = 1;
+            r = GI_OK;
+        }
+    }
+    if (on_cpu) {
         iv_lights li = {s, gs->time, s->envmap, direct};
         iv_illuminate(m->links, m->hier, &li, (uint32_t)m->bounces, m->irr);
         upload_elem_light(m);
@@ -397,7 +409,7 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
         glUseProgram(p);
         gi_kit_bind(&m->kit, p, view, target);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_ELEM_LIGHT,
-                         m->gpu ? m->gpu->ssbo_out : m->ssbo_light);
+                         on_cpu ? m->ssbo_light : m->gpu->ssbo_out);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_TRI, m->ssbo_tri);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_GRID, m->ssbo_grid);
         if (m->traced_direct)
