@@ -483,7 +483,7 @@ static const gi_departure iv_departures[] = {
      "the direct light along implicit-visibility links misses small and flush emitters, and "
      "elements at mesh vertices cannot draw shadows between them (held-out family: relMSE 1.9 to "
      "4.9 times the limit on every variant but the furnaces; README \"Held-out family\")",
-     "direct=traced weight=surface remesh=0.03"},
+     "direct=traced weight=surface remesh=0.03 splat=true"},
     {NULL, NULL, NULL},
 };
 
