@@ -29,10 +29,7 @@ static float node_omega(const iv_hier *h, uint32_t x, uint32_t y)
         return 0.0f;
     gi_vec3 n = gi_v3_load(&h->nrm[3 * y]);
     float c = fabsf(gi_v3_dot(n, d)) / sqrtf(r2), len = gi_v3_length(n);
-    double a = (double)h->area[y] * fmaxf(c, 1.0f - len) / ((double)GI_PI * r2);
-    /* 2 pi (1 - 1 / sqrt(1 + a)), written to keep its precision for small a */
-    double q = sqrt(1.0 + a);
-    return (float)(2.0 * GI_PI * a / (q * (q + 1.0)));
+    return iv_disc_solid_angle((double)h->area[y] * fmaxf(c, 1.0f - len), r2);
 }
 
 float iv_link_share(const iv_links *l, const iv_hier *h, uint32_t x, uint32_t b)

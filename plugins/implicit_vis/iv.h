@@ -25,6 +25,7 @@
 #include "gi/envmap.h"
 #include "gi/scene.h"
 
+#include <math.h>
 #include <stdint.h>
 
 struct gi_host;
@@ -132,6 +133,18 @@ void iv_hier_edge_stats(const iv_hier *h, const gi_scene *s, double *mean, doubl
 static inline int iv_is_leaf(const iv_hier *h, uint32_t node)
 {
     return h->child_count[node] == 0;
+}
+
+/* Solid angle of a disc of (projected) area a seen on its axis from
+ * distance sqrt(r2): 2 pi (1 - 1 / sqrt(1 + a / (pi r2))), which is
+ * a / r2 for a small disc and stays below a hemisphere for a near one.
+ * Written to keep its precision for small a. */
+static inline float iv_disc_solid_angle(double a, double r2)
+{
+    if (!(r2 > 0.0))
+        return 0.0f;
+    double x = a / (3.14159265358979323846 * r2), q = sqrt(1.0 + x);
+    return (float)(2.0 * 3.14159265358979323846 * x / (q * (q + 1.0)));
 }
 
 /* ---- the hierarchical link structure (Sec. 4.2) ---- */
