@@ -140,14 +140,10 @@ void iv_put_side(iv_links *l, const iv_hier *h, uint32_t A, uint32_t B, gi_vec3 
     if (l->one_sided[B] && gi_v3_dot(n, n) > 0.98f && gi_v3_dot(n, d) > 0.0f)
         return;
     /* B's solid angle seen from A: its area foreshortened by its mean
-     * normal (a cluster whose discs face many ways, short mean normal,
-     * shows more than its mean normal says), as a disc's, below a
-     * hemisphere however near: a / r^2 alone grows without bound for a
-     * disc nearer than its size (the foot of a thin panel standing on a
-     * floor), and Eq. 4's sum over a bin with it, so that light grew from
-     * bounce to bounce (held-out seed 10 sky, README "Traced direct light") */
+     * normal; a cluster whose discs face many ways (short mean normal)
+     * shows more than its mean normal says */
     float c = fabsf(gi_v3_dot(n, d)) / r, len = gi_v3_length(n);
-    float omega = iv_disc_solid_angle((double)h->area[B] * fmaxf(c, 1.0f - len), (double)r * r);
+    float omega = h->area[B] * fmaxf(c, 1.0f - len) / (r * r);
     if (!splat || cover <= 1.0f || !iv_is_leaf(h, B)) {
         if (l->bilinear)
             put_bilinear(l, A, d, B, r, omega);
@@ -169,6 +165,12 @@ void iv_put_side(iv_links *l, const iv_hier *h, uint32_t A, uint32_t B, gi_vec3 
                   y = (2.0f * ((float)j + 0.5f) / (float)g - 1.0f);
             inside += x * x + y * y <= 1.0f;
         }
+    /* the near disc's own solid angle, spread over the bins it spans: a
+     * disc's, below a hemisphere however near. a / r^2 grows without bound
+     * for a disc nearer than its size (the foot of a thin panel standing
+     * on a floor), and Eq. 4's sums with it, so that light grew from
+     * bounce to bounce (held-out seed 10 sky; README "Traced direct light") */
+    omega = iv_disc_solid_angle((double)h->area[B] * fmaxf(c, 1.0f - len), (double)r * r);
     put(l, A, b, B, r, 0.0f);
     for (int j = 0; j < g; j++)
         for (int i = 0; i < g; i++) {
