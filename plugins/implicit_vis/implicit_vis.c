@@ -52,7 +52,7 @@ static const gi_param_desc iv_params[] = {
      "surfaces lose what its neighbours in the bin would add (furnace -35/-27/-17/-3 % at N "
      "8/12/16/24); weight=surface converges (README \"Weights\"). At the held-out remedy the error "
      "rises with N along a room's edges where a lamp is flush under the ceiling (held-out seed 1 "
-     "ceiling, 32^2: 0.0037 at 12, 0.0068 at 32; README \"Traced direct light\")"},
+     "ceiling, 32^2: 0.0033 at 12, 0.0058 at 32; README \"Traced direct light\")"},
     {"bounces", GI_PARAM_INT, 3, 0, 3, NULL, "light bounces (Algorithm 1, line 8)",
      "indirect bounces after the direct light (Table 1: 1)"},
     {"subdiv", GI_PARAM_FLOAT, 1.0, 0.01, 100.0, GI_QUALITY_DOWN(2), "Sec. 4.2.2",
