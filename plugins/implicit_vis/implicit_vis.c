@@ -339,6 +339,51 @@ static void upload_elem_light(implicit_vis *m)
                          m->elem_light);
 }
 
+/* The frame's light at the elements (Algorithm 1, lines 7-10): with
+ * direct=traced first the elements' direct light by shadow rays (stage
+ * traced_direct), then the gathers and pull-ups on the GPU (Sec. 4.3.1) or
+ * the CPU; *on_cpu says where the result is (ssbo_light, or the GPU's
+ * ssbo_out). */
+static gi_result illuminate(implicit_vis *m, const gi_gpu_scene *gs, int *on_cpu, gi_error *err)
+{
+    const gi_host *host = m->kit.host;
+    const gi_scene *s = gs->scene;
+    const float *direct = NULL;
+    gi_result r = GI_OK;
+    if (m->traced_direct) { /* README "Traced direct light" */
+        host->stage_begin(host, "traced_direct");
+        r = iv_traced_elements(m->traced_direct, m->hier, gs->time, err);
+        host->stage_end(host, "traced_direct");
+        if (r != GI_OK)
+            return r;
+        direct = m->traced_direct->elem;
+    }
+    host->stage_begin(host, "illumination");
+    *on_cpu = m->gpu == NULL;
+    if (m->gpu) { /* Sec. 4.3.1: the punctual lights at the frame's time come from the scene's
+                     buffer */
+        gi_gpu_scene_bind(gs);
+        r = iv_gpu_illuminate(m->gpu, m->links, m->hier, (uint32_t)m->bounces, s->light_count,
+                              direct, err);
+        if (r == GI_ERR_UNSUPPORTED && !m->glossy) { /* more links than one GL storage block holds
+                                                        (llvmpipe: 128 MiB): the same gather on
+                                                        the CPU */
+            if (!m->warned_cpu)
+                gi_log(GI_LOG_WARN, "%s; gathering on the CPU (illum=cpu) instead", err->text);
+            m->warned_cpu = 1;
+            *on_cpu = 1;
+            r = GI_OK;
+        }
+    }
+    if (*on_cpu && r == GI_OK) {
+        iv_lights li = {s, gs->time, s->envmap, direct};
+        iv_illuminate(m->links, m->hier, &li, (uint32_t)m->bounces, m->irr);
+        upload_elem_light(m);
+    }
+    host->stage_end(host, "illumination");
+    return r;
+}
+
 static gi_result iv_render(void *inst, const gi_view *view, const gi_target *target)
 {
     implicit_vis *m = inst;
@@ -366,39 +411,8 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
     if (host->cancelled && host->cancelled(host)) /* before the gathers (issue 32) */
         return gi_kit_fail(&m->kit, GI_ERR_CANCELLED, "implicit_vis: cancelled");
 
-    const float *direct = NULL;
-    if (m->traced_direct) { /* README "Traced direct light" */
-        host->stage_begin(host, "traced_direct");
-        r = iv_traced_elements(m->traced_direct, m->hier, gs->time, &err);
-        host->stage_end(host, "traced_direct");
-        if (r != GI_OK)
-            return gi_kit_fail_with(&m->kit, r, &err);
-        direct = m->traced_direct->elem;
-    }
-
-    host->stage_begin(host, "illumination");
-    int on_cpu = m->gpu == NULL;
-    if (m->gpu) { /* Sec. 4.3.1: the punctual lights at the frame's time come from the scene's
-                     buffer */
-        gi_gpu_scene_bind(gs);
-        r = iv_gpu_illuminate(m->gpu, m->links, m->hier, (uint32_t)m->bounces, s->light_count,
-                              direct, &err);
-        if (r == GI_ERR_UNSUPPORTED && !m->glossy) { /* more links than one GL storage block holds
-                                                        (llvmpipe: 128 MiB): the same gather on
-                                                        the CPU */
-            if (!m->warned_cpu)
-                gi_log(GI_LOG_WARN, "%s; gathering on the CPU (illum=cpu) instead", err.text);
-            m->warned_cpu = 1;
-            on_cpu = 1;
-            r = GI_OK;
-        }
-    }
-    if (on_cpu) {
-        iv_lights li = {s, gs->time, s->envmap, direct};
-        iv_illuminate(m->links, m->hier, &li, (uint32_t)m->bounces, m->irr);
-        upload_elem_light(m);
-    }
-    host->stage_end(host, "illumination");
+    int on_cpu = 0;
+    r = illuminate(m, gs, &on_cpu, &err);
     if (r != GI_OK)
         return gi_kit_fail_with(&m->kit, r, &err);
 
