@@ -29,10 +29,7 @@ static float node_omega(const iv_hier *h, uint32_t x, uint32_t y)
         return 0.0f;
     gi_vec3 n = gi_v3_load(&h->nrm[3 * y]);
     float c = fabsf(gi_v3_dot(n, d)) / sqrtf(r2), len = gi_v3_length(n);
-    double a = (double)h->area[y] * fmaxf(c, 1.0f - len) / ((double)GI_PI * r2);
-    /* 2 pi (1 - 1 / sqrt(1 + a)), written to keep its precision for small a */
-    double q = sqrt(1.0 + a);
-    return (float)(2.0 * GI_PI * a / (q * (q + 1.0)));
+    return iv_disc_solid_angle((double)h->area[y] * fmaxf(c, 1.0f - len), r2);
 }
 
 float iv_link_share(const iv_links *l, const iv_hier *h, uint32_t x, uint32_t b)
@@ -233,12 +230,19 @@ void iv_illuminate(const iv_links *l, iv_hier *h, const iv_lights *li, uint32_t 
             uint32_t x = h->elem_node[e];
             gi_vec3 p = gi_v3_load(&h->pos[3 * x]), n = gi_v3_load(&h->nrm[3 * x]);
             double ep[3] = {0, 0, 0}, em[3] = {0, 0, 0};
-            for (uint32_t j = off[e]; j < off[e + 1]; j++) {
+            if (direct && li->direct) { /* traced (README "Traced direct light") */
+                for (int c = 0; c < 3; c++) {
+                    ep[c] = li->direct[6 * (size_t)e + (size_t)c];
+                    em[c] = li->direct[6 * (size_t)e + 3 + (size_t)c];
+                }
+            }
+            uint32_t j1 = direct && li->direct ? off[e] : off[e + 1];
+            for (uint32_t j = off[e]; j < j1; j++) {
                 float L[3];
                 node_radiance(h, sp, sm, src[j], p, L);
                 add_bin(l, bin[j], n, norm[e], iv_link_share(l, h, x, bin[j]), L, ep, em);
             }
-            if (direct) {
+            if (direct && !li->direct) {
                 if (li->env) { /* Sec. 4.4: an empty bin (or what its links leave uncovered) sees
                                   the environment */
                     for (uint32_t b = 0; b < l->bins; b++) {
@@ -262,8 +266,10 @@ void iv_illuminate(const iv_links *l, iv_hier *h, const iv_lights *li, uint32_t 
         for (uint32_t e = 0; e < ne; e++) {
             uint32_t x = h->elem_node[e];
             for (int c = 0; c < 3; c++) {
-                e_out[6 * e + c] += (float)ek[6 * e + c];
-                e_out[6 * e + 3 + c] += (float)ek[6 * e + 3 + c];
+                if (!(direct && li->direct)) { /* traced direct light: the display adds its own */
+                    e_out[6 * e + c] += (float)ek[6 * e + c];
+                    e_out[6 * e + 3 + c] += (float)ek[6 * e + 3 + c];
+                }
                 float rho = h->elem_albedo[3 * e + c] / (float)GI_PI;
                 sp[3 * x + c] = rho * (float)ek[6 * e + c];
                 sm[3 * x + c] = rho * (float)ek[6 * e + 3 + c];

@@ -25,6 +25,7 @@
 #include "gi/envmap.h"
 #include "gi/scene.h"
 
+#include <math.h>
 #include <stdint.h>
 
 struct gi_host;
@@ -134,6 +135,18 @@ static inline int iv_is_leaf(const iv_hier *h, uint32_t node)
     return h->child_count[node] == 0;
 }
 
+/* Solid angle of a disc of (projected) area a seen on its axis from
+ * distance sqrt(r2): 2 pi (1 - 1 / sqrt(1 + a / (pi r2))), which is
+ * a / r2 for a small disc and stays below a hemisphere for a near one.
+ * Written to keep its precision for small a. */
+static inline float iv_disc_solid_angle(double a, double r2)
+{
+    if (!(r2 > 0.0))
+        return 0.0f;
+    double x = a / (3.14159265358979323846 * r2), q = sqrt(1.0 + x);
+    return (float)(2.0 * 3.14159265358979323846 * x / (q * (q + 1.0)));
+}
+
 /* ---- the hierarchical link structure (Sec. 4.2) ---- */
 
 /* How a link weighs in its bin (Sec. 3, Eq. 4 and 5; README "Weights"). */
@@ -229,10 +242,15 @@ typedef struct iv_lights {
     const gi_scene *scene;
     float t;              /* punctual lights placed at this time */
     const gi_envmap *env; /* NULL: black */
+    /* NULL: the paper's direct light along the links. Else 6 per element,
+     * the direct irradiance on both sides as iv_illuminate's out (traced,
+     * README "Traced direct light"): it replaces the first gather, and
+     * e_out then holds the indirect bounces only. */
+    const float *direct;
 } iv_lights;
 
 /* Gathers the direct light (light links, punctual lights through their bin,
- * the environment through empty bins) and `bounces` indirect bounces at the
+ * the environment through empty bins; or lights->direct) and `bounces` indirect bounces at the
  * leaves with Eq. 5 (each link weighted by iv_link_share), pulling the
  * reflected radiance up after each gather. Out: per element the irradiance
  * on both sides of its disc, e_out[6 e + 0..2] on the normal's side,

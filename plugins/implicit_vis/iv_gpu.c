@@ -33,7 +33,7 @@ void iv_gpu_free(iv_gpu *g)
         return;
     GLuint bufs[] = {g->ssbo_elem,   g->ssbo_children, g->ssbo_bins,   g->ssbo_geom,
                      g->ssbo_links,  g->ssbo_off,      g->ssbo_wlinks, g->ssbo_rad[0],
-                     g->ssbo_rad[1], g->ssbo_out,      g->ssbo_emit};
+                     g->ssbo_rad[1], g->ssbo_out,      g->ssbo_emit,   g->ssbo_direct};
     for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++)
         if (bufs[i])
             glDeleteBuffers(1, &bufs[i]);
@@ -133,6 +133,7 @@ static void make_frame_buffers(iv_gpu *g, const iv_hier *h)
         g->ssbo_rad[i] = make_dynamic((size_t)h->node_count * 8 * sizeof(float));
     g->ssbo_out = make_dynamic((size_t)h->elem_count * 12 * sizeof(float));
     g->ssbo_emit = make_dynamic((size_t)h->node_count * 8 * sizeof(float));
+    g->ssbo_direct = make_dynamic((size_t)h->elem_count * 8 * sizeof(float));
     GLint64 max_block = 0;
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
     g->max_block =
@@ -207,9 +208,29 @@ static void pull_up(const iv_gpu *g, GLuint rad)
             dispatch(g->prog_pull, g->level_off[d], g->level_off[d + 1] - g->level_off[d]);
 }
 
-gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint32_t bounces,
-                            uint32_t punctual, gi_error *err)
+/* The traced direct irradiance (6 per element) as IvRad records (front, back). */
+static gi_result upload_direct(iv_gpu *g, const float *direct, gi_error *err)
 {
+    float *o = calloc((size_t)g->elems * 8 + 1, sizeof(float));
+    if (!o)
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "implicit_vis: out of memory");
+    for (uint32_t e = 0; e < g->elems; e++) {
+        memcpy(&o[8 * (size_t)e], &direct[6 * (size_t)e], 3 * sizeof(float));
+        memcpy(&o[8 * (size_t)e + 4], &direct[6 * (size_t)e + 3], 3 * sizeof(float));
+    }
+    glNamedBufferSubData(g->ssbo_direct, 0, (GLsizeiptr)((size_t)g->elems * 8 * sizeof(float)), o);
+    free(o);
+    return GI_OK;
+}
+
+gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint32_t bounces,
+                            uint32_t punctual, const float *direct, gi_error *err)
+{
+    if (direct) {
+        gi_result r = upload_direct(g, direct, err);
+        if (r != GI_OK)
+            return r;
+    }
     /* the frame's geometry: position and area, mean normal */
     for (uint32_t i = 0; i < g->nodes; i++) {
         float *o = &g->geom[8 * (size_t)i];
@@ -256,6 +277,7 @@ gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_LINK_OFF, g->ssbo_off);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_WLINKS, g->ssbo_wlinks);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_ELEM_LIGHT, g->ssbo_out);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_DIRECT, g->ssbo_direct);
 
     /* bounce 0: the emission, pulled up */
     int cur = 0;
@@ -282,6 +304,7 @@ gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint
         glUniform1i(glGetUniformLocation(p, "u_env"), g->env);
         glUniform1i(glGetUniformLocation(p, "u_env_share"), iv_env_partial(l));
         glUniform1ui(glGetUniformLocation(p, "u_punctual"), k == 0 ? punctual : 0u);
+        glUniform1i(glGetUniformLocation(p, "u_traced"), direct != NULL);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_RAD_SRC, g->ssbo_rad[cur]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_RAD_DST, g->ssbo_rad[1 - cur]);
         dispatch(p, 0, g->elems);

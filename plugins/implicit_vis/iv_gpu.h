@@ -33,6 +33,7 @@ typedef struct iv_gpu {
     GLuint ssbo_rad[2];    /* outgoing radiance per node, this bounce's and the previous one's */
     GLuint ssbo_out;       /* per element: irradiance on both sides, normal (IV_SSBO_ELEM_LIGHT) */
     GLuint ssbo_emit;      /* per node: the emission pulled up (bounce 0), kept when keep_emit */
+    GLuint ssbo_direct;    /* per element: the traced direct irradiance (made on first use) */
     int keep_emit;         /* set by the caller: keep the emission for the glossy display */
     float *geom;           /* staging: 8 per node */
     uint32_t *links, *off; /* staging for iv_links_pack */
@@ -46,9 +47,11 @@ void iv_gpu_free(iv_gpu *g);
 /* Uploads the frame's node positions, normals and areas and the links,
  * then runs the passes: emission, the links' weights, pull-up, and
  * bounces + 1 gathers each followed by a pull-up (the last one needs none). punctual: the number of
- * the scene's punctual lights (bound at GI_SSBO_LIGHTS). */
+ * the scene's punctual lights (bound at GI_SSBO_LIGHTS). direct: NULL for the paper's direct
+ * light along the links, else iv_lights.direct's traced irradiance (6 per element), which then
+ * replaces the first gather and is left out of ssbo_out (iv_illuminate's rule). */
 gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint32_t bounces,
-                            uint32_t punctual, gi_error *err);
+                            uint32_t punctual, const float *direct, gi_error *err);
 /* Binds what the glossy display reads of the frame's direct light (after
  * iv_gpu_illuminate with keep_emit): the elements, bins, node geometry,
  * receiving links, their offsets and weights, and the pulled-up emission

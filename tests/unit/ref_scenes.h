@@ -29,7 +29,7 @@ typedef struct tg_str {
     size_t n, cap;
 } tg_str;
 
-static void tg_reserve(tg_str *s, size_t more)
+static inline void tg_reserve(tg_str *s, size_t more)
 {
     if (s->n + more + 1 <= s->cap)
         return;
@@ -44,7 +44,7 @@ static void tg_reserve(tg_str *s, size_t more)
     s->cap = cap;
 }
 
-static void tg_bytes(tg_str *s, const void *data, size_t n)
+static inline void tg_bytes(tg_str *s, const void *data, size_t n)
 {
     tg_reserve(s, n);
     memcpy(s->p + s->n, data, n);
@@ -55,7 +55,7 @@ static void tg_bytes(tg_str *s, const void *data, size_t n)
 #if defined(__GNUC__)
 __attribute__((format(printf, 2, 3)))
 #endif
-static void
+static inline void
 tg_printf(tg_str *s, const char *fmt, ...)
 {
     va_list ap;
@@ -75,12 +75,12 @@ typedef struct tg_scene {
     tg_str camera_node, camera;
 } tg_scene;
 
-static void tg_init(tg_scene *b)
+static inline void tg_init(tg_scene *b)
 {
     memset(b, 0, sizeof *b);
 }
 
-static void tg_free(tg_scene *b)
+static inline void tg_free(tg_scene *b)
 {
     tg_str *all[] = {&b->bin,       &b->meshes, &b->accessors, &b->views,       &b->nodes,
                      &b->materials, &b->lights, &b->extras,    &b->camera_node, &b->camera};
@@ -90,8 +90,8 @@ static void tg_free(tg_scene *b)
 }
 
 /* A material; emission is radiance (split into factor x strength). */
-static int tg_material(tg_scene *b, const float albedo[3], const float emission[3],
-                       int double_sided)
+static inline int tg_material(tg_scene *b, const float albedo[3], const float emission[3],
+                              int double_sided)
 {
     float e = fmaxf(emission[0], fmaxf(emission[1], emission[2]));
     float f[3] = {0, 0, 0};
@@ -108,7 +108,7 @@ static int tg_material(tg_scene *b, const float albedo[3], const float emission[
 }
 
 /* Appends data to the buffer as one buffer view; returns the view index. */
-static int tg_view(tg_scene *b, const void *data, size_t size)
+static inline int tg_view(tg_scene *b, const void *data, size_t size)
 {
     size_t off = b->bin.n;
     tg_bytes(&b->bin, data, size);
@@ -117,7 +117,7 @@ static int tg_view(tg_scene *b, const void *data, size_t size)
     return b->n_views++;
 }
 
-static int tg_accessor_vec3(tg_scene *b, const float *v, uint32_t n)
+static inline int tg_accessor_vec3(tg_scene *b, const float *v, uint32_t n)
 {
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (uint32_t i = 0; i < n; i++)
@@ -135,8 +135,8 @@ static int tg_accessor_vec3(tg_scene *b, const float *v, uint32_t n)
 
 /* One object: a node holding a mesh of one triangle primitive. nrm may be
  * NULL (the loader then computes normals from the faces). */
-static void tg_mesh(tg_scene *b, const float *pos, const float *nrm, uint32_t nverts,
-                    const uint32_t *idx, uint32_t ntris, int material)
+static inline void tg_mesh(tg_scene *b, const float *pos, const float *nrm, uint32_t nverts,
+                           const uint32_t *idx, uint32_t ntris, int material)
 {
     int ap = tg_accessor_vec3(b, pos, nverts);
     int an = nrm ? tg_accessor_vec3(b, nrm, nverts) : -1;
@@ -165,7 +165,7 @@ static void tg_mesh(tg_scene *b, const float *pos, const float *nrm, uint32_t nv
  * triangles), corners on the sphere of radius r about the origin, front
  * faces (CCW) inside. smooth: radial normals pointing inward; otherwise no
  * normals (flat faces: vertices are not shared). */
-static void tg_icosphere(tg_scene *b, float r, int level, int smooth, int material)
+static inline void tg_icosphere(tg_scene *b, float r, int level, int smooth, int material)
 {
     const float t = 1.6180339887f;
     const float ico_v[12][3] = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
@@ -243,7 +243,7 @@ static void tg_icosphere(tg_scene *b, float r, int level, int smooth, int materi
 }
 
 /* Square of side 2 * half in the plane y = height, front face up (+Y). */
-static void tg_plane(tg_scene *b, float half, float height, int material)
+static inline void tg_plane(tg_scene *b, float half, float height, int material)
 {
     const float pos[12] = {-half, height, -half, -half, height, half,
                            half,  height, half,  half,  height, -half};
@@ -254,7 +254,7 @@ static void tg_plane(tg_scene *b, float half, float height, int material)
 
 /* Regular `segments`-gon of circumradius r in the plane y = height, centred
  * on the Y axis, front face down (-Y): a fan about the centre. */
-static void tg_disk(tg_scene *b, float r, float height, uint32_t segments, int material)
+static inline void tg_disk(tg_scene *b, float r, float height, uint32_t segments, int material)
 {
     float *pos = malloc((size_t)(segments + 1) * 3 * sizeof(float));
     float *nrm = malloc((size_t)(segments + 1) * 3 * sizeof(float));
@@ -288,7 +288,7 @@ static void tg_disk(tg_scene *b, float r, float height, uint32_t segments, int m
 
 /* Rotation (x, y, z, w) that turns -Z to the unit direction of f (+Y up
  * unless f is along it, then +Z up): how glTF orients cameras and lights. */
-static void tg_look_quat(const float fwd[3], double q[4])
+static inline void tg_look_quat(const float fwd[3], double q[4])
 {
     double f[3] = {fwd[0], fwd[1], fwd[2]};
     double len = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
@@ -338,8 +338,8 @@ static void tg_look_quat(const float fwd[3], double q[4])
 }
 
 /* A perspective camera at eye looking at target. */
-static void tg_camera(tg_scene *b, const float eye[3], const float target[3], float yfov_deg,
-                      float znear)
+static inline void tg_camera(tg_scene *b, const float eye[3], const float target[3], float yfov_deg,
+                             float znear)
 {
     float f[3] = {target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]};
     double q[4];
@@ -356,7 +356,8 @@ static void tg_camera(tg_scene *b, const float eye[3], const float target[3], fl
 
 /* A KHR_lights_punctual light: `type_json` is the light object's body
  * without braces; placed at p pointing along dir. */
-static void tg_light(tg_scene *b, const char *type_json, const float p[3], const float dir[3])
+static inline void tg_light(tg_scene *b, const char *type_json, const float p[3],
+                            const float dir[3])
 {
     double q[4];
     tg_look_quat(dir, q);
@@ -370,7 +371,7 @@ static void tg_light(tg_scene *b, const char *type_json, const float p[3], const
 }
 
 /* A point light of radiant intensity I (white) at p. */
-static void tg_point_light(tg_scene *b, const float p[3], float intensity)
+static inline void tg_point_light(tg_scene *b, const float p[3], float intensity)
 {
     char body[64];
     const float down[3] = {0, -1, 0};
@@ -379,7 +380,7 @@ static void tg_point_light(tg_scene *b, const float p[3], float intensity)
 }
 
 /* The scene's environment map (a file name relative to the base dir). */
-static void tg_environment(tg_scene *b, const char *uri, float intensity, float rotation_deg)
+static inline void tg_environment(tg_scene *b, const char *uri, float intensity, float rotation_deg)
 {
     tg_printf(&b->extras,
               "\"extras\":{\"gibench\":{\"environment\":{\"uri\":\"%s\",\"intensity\":%.9g,"
@@ -387,7 +388,7 @@ static void tg_environment(tg_scene *b, const char *uri, float intensity, float 
               uri, intensity, rotation_deg);
 }
 
-static void tg_base64(tg_str *out, const unsigned char *d, size_t n)
+static inline void tg_base64(tg_str *out, const unsigned char *d, size_t n)
 {
     static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     tg_reserve(out, (n + 2) / 3 * 4);
@@ -401,7 +402,7 @@ static void tg_base64(tg_str *out, const unsigned char *d, size_t n)
 }
 
 /* The glTF text of the scene built so far. */
-static char *tg_json(tg_scene *b)
+static inline char *tg_json(tg_scene *b)
 {
     tg_str j = {0};
     tg_printf(&j,
@@ -433,7 +434,7 @@ static char *tg_json(tg_scene *b)
 
 /* Loads the scene (external files from base_dir, NULL for none) and frees
  * the builder. */
-static gi_scene *tg_load(tg_scene *b, const char *base_dir, gi_error *err)
+static inline gi_scene *tg_load(tg_scene *b, const char *base_dir, gi_error *err)
 {
     char *json = tg_json(b);
     gi_scene *s = gi_scene_load_memory(json, strlen(json), 0, base_dir, "test-scene.gltf", err);

@@ -20,6 +20,10 @@
 #define IV_SSBO_LINK_OFF 18 /* per element + 1: its first receiving link, its first light link */
 /* per receiving link, per frame: node at the other end and its side, Eq. 5's weight */
 #define IV_SSBO_WLINKS 19
+/* per element: the traced direct irradiance on both sides (direct=traced; iv_gather.comp) */
+#define IV_SSBO_DIRECT 20
+/* per pixel: the traced direct irradiance (direct=traced; iv_display.comp) */
+#define IV_SSBO_PIXEL_DIRECT 21
 #define IV_SSBO_PUNCTUAL 3 /* the scene's punctual lights (GI_SSBO_LIGHTS) */
 /* work-group width of the three passes */
 #define IV_GROUP 64

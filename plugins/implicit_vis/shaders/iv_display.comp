@@ -32,6 +32,11 @@ struct IvDisp {
 };
 layout(std430, binding = IV_SSBO_GRID) readonly buffer IvGrid { IvDisp iv_grid[]; }; // grid point
 layout(rgba32f, binding = GI_IMAGE_TARGET) uniform writeonly image2D u_target;
+#ifdef IV_TRACED
+// direct=traced (README "Traced direct light"): the direct irradiance at each pixel, by shadow rays
+// on the CPU; the elements then hold the indirect bounces only
+layout(std430, binding = IV_SSBO_PIXEL_DIRECT) readonly buffer IvPixelDirect { vec4 iv_pixel_direct[]; };
+#endif
 
 #ifdef IV_GLOSSY
 layout(std430, binding = IV_SSBO_ELEM) readonly buffer IvElems { IvElem iv_elem[]; };
@@ -183,6 +188,9 @@ void main()
             }
 #endif
         }
+#ifdef IV_TRACED
+        E += iv_pixel_direct[px.y * u_size.x + px.x].rgb;
+#endif
         L = s.emission + s.brdf.kd * GI_INV_PI * E;
 #ifdef IV_GLOSSY
         L += G;

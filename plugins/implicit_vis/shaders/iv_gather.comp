@@ -30,6 +30,8 @@ struct IvPunctual { // the scene's GiLight (scene.glsl, gpu.h gi_gpu_light)
 };
 layout(std430, binding = IV_SSBO_PUNCTUAL) readonly buffer IvPunctuals { IvPunctual iv_punctual[]; };
 #include "iv_direct.glsl"
+// direct=traced (README "Traced direct light"): the first gather's irradiance, traced on the CPU
+layout(std430, binding = IV_SSBO_DIRECT) readonly buffer IvTraced { IvRad iv_traced[]; };
 
 uniform uint u_bins;        // 6 n n
 uniform int u_direct;       // 1: the direct light (light links, environment, punctual lights)
@@ -37,6 +39,7 @@ uniform uint u_light_base;  // the light links' first record in iv_link
 uniform int u_env;          // 1: the scene has an environment
 uniform int u_env_share;    // 1: a linked bin passes the environment through what its share leaves open (iv_env_partial)
 uniform uint u_punctual;    // number of punctual lights
+uniform int u_traced;       // 1: the direct light is iv_traced's, and the display adds its own per pixel
 
 // Radiance node `src` sends from its side `side` (iv_weights.comp).
 vec3 node_radiance(uint src, uint side)
@@ -65,9 +68,10 @@ void main()
     vec3 p = iv_node[leaf].pos.xyz, n = iv_node[leaf].nrm.xyz;
     float norm = iv_out[e].normal.w;
     uvec2 o0 = iv_off[e], o1 = iv_off[e + 1u];
+    bool traced = u_direct != 0 && u_traced != 0;
     uint j0 = u_direct != 0 ? u_light_base + o0.y : o0.x;
-    uint j1 = u_direct != 0 ? u_light_base + o1.y : o1.x;
-    vec3 ep = vec3(0.0), em = vec3(0.0);
+    uint j1 = traced ? j0 : (u_direct != 0 ? u_light_base + o1.y : o1.x);
+    vec3 ep = traced ? iv_traced[e].front.rgb : vec3(0.0), em = traced ? iv_traced[e].back.rgb : vec3(0.0);
     for (uint j = j0; j < j1; j++) { // Eq. 5 with the weights of iv_weights.comp
         uvec2 l = iv_wl[j];
         float w = uintBitsToFloat(l.y);
@@ -77,7 +81,7 @@ void main()
         else
             em += -w * L;
     }
-    if (u_direct != 0) {
+    if (u_direct != 0 && !traced) {
         if (u_env != 0) { // Sec. 4.4: what the links leave open of each bin sees the environment
             uint j = o0.x;
             for (uint b = 0u; b < u_bins; b++) {
@@ -106,8 +110,10 @@ void main()
     }
     if (iv_elem[e].info.y == 0u) // single-sided: lit on its front only (the one rule for sides)
         em = vec3(0.0);
-    iv_out[e].e_front += vec4(ep, 0.0);
-    iv_out[e].e_back += vec4(em, 0.0);
+    if (!traced) { // traced: the display adds the direct light per pixel
+        iv_out[e].e_front += vec4(ep, 0.0);
+        iv_out[e].e_back += vec4(em, 0.0);
+    }
     vec3 rho = iv_elem[e].albedo.rgb / GI_PI;
     iv_dst[leaf].front = vec4(rho * ep, 0.0);
     iv_dst[leaf].back = vec4(rho * em, 0.0);

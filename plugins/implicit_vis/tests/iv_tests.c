@@ -92,7 +92,7 @@ int iv_test_frame_run(iv_test_frame *f, const char *path, float edge, uint32_t N
     f->E = malloc((size_t)f->h->elem_count * 6 * sizeof(float));
     iv_links_build(f->l, f->h, 1.0f, brute, splat);
     iv_links_refine_push(f->l, f->h);
-    iv_lights li = {f->s, 0.0f, f->s->envmap};
+    iv_lights li = {f->s, 0.0f, f->s->envmap, NULL};
     iv_illuminate(f->l, f->h, &li, bounces, f->E);
     return 1;
 }

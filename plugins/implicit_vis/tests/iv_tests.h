@@ -40,7 +40,7 @@ void iv_test_frame_free(iv_test_frame *f);
 
 extern gi_gpu *iv_test_gl;
 int iv_test_gpu_illuminate(const gi_scene *s, const iv_hier *h, const iv_links *l, uint32_t bounces,
-                           float *E);
+                           const float *direct, float *E);
 
 /* ---- iv_tests_structure.c ---- */
 

@@ -33,10 +33,10 @@ static int furnace_means(const char *path, uint32_t N, int splat, double mean[4]
         float *E = malloc((size_t)h->elem_count * 6 * sizeof(float));
         iv_links_build(l, h, 1.0f, 0, splat);
         iv_links_refine_push(l, h);
-        iv_lights li = {s, 0.0f, NULL};
+        iv_lights li = {s, 0.0f, NULL, NULL};
         for (uint32_t n = 0; n <= 3; n++) {
             if (iv_test_gl)
-                iv_test_gpu_illuminate(s, h, l, n, E);
+                iv_test_gpu_illuminate(s, h, l, n, NULL, E);
             else
                 iv_illuminate(l, h, &li, n, E);
             double sum = 0.0, area = 0.0;

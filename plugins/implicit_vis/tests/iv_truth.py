@@ -4,11 +4,13 @@ the environment-lit bunny, against the Embree reference and the trivial
 answers (plugins/implicit_vis/README.md "Weights" and "Tests").
 
   box      box_light (32 x 32, full GI: 4-bounce reference, 256 spp):
-           weight=surface with splatting, re-meshed to 0.15 of the room
-           (README "Weights"), at N = 8, 12, 16: its relMSE must not rise
-           with N by more than NOISE, and at N = 16 be at most half of the
-           better of black and the unshadowed `direct` plugin. (The default
-           settings, Eq. 5 as printed, score 0.61 here: README.)
+           the held-out remedy (direct=traced weight=surface remesh=0.03
+           splat=true; README "Traced direct light"), at N = 8, 12, 16: its
+           relMSE must not rise with N by more than NOISE, and at N = 16 be
+           at most a tenth of the better of black and the unshadowed
+           `direct` plugin. (The default settings, Eq. 5 as printed, score
+           0.61 here; the paper's transport at its best setting tried,
+           weight=surface splat=true remesh=0.15, about 0.05: README.)
   env      bunny_env (32 x 32): the pixels where the camera sees the sky
            (those the `direct` plugin with env_samples=0 leaves non-black:
            the background the core draws for every method) must match the
@@ -30,8 +32,8 @@ import os
 import subprocess
 import sys
 
-NOISE = 0.01  # relMSE: the reference's own noise at 256 spp is common to all N; 0.01 is ~15 % of N = 16
-REMEDY = ["weight=surface", "splat=true", "remesh=0.15"]
+NOISE = 0.002  # relMSE: the reference's noise is common to all N; the traced light's, 64 rays, ~3e-4
+REMEDY = ["direct=traced", "weight=surface", "remesh=0.03", "splat=true"]
 
 
 class Check:
@@ -107,10 +109,10 @@ def box(k, src):
         print("box_light: implicit_vis %s N=%d relMSE %.4f" % (" ".join(REMEDY), n, e))
         errs.append((n, e))
     for (n0, e0), (n1, e1) in zip(errs, errs[1:]):
-        k.expect(e1 <= e0 + NOISE, "N %d -> %d: relMSE %.4f -> %.4f does not rise by more than %.2f"
+        k.expect(e1 <= e0 + NOISE, "N %d -> %d: relMSE %.4f -> %.4f does not rise by more than %.3f"
                  % (n0, n1, e0, e1, NOISE))
-    gate = 0.5 * min(black, direct)
-    k.expect(errs[-1][1] <= gate, "N 16: relMSE %.4f <= half the better trivial answer (%.4f)"
+    gate = 0.1 * min(black, direct)
+    k.expect(errs[-1][1] <= gate, "N 16: relMSE %.4f <= a tenth of the better trivial answer (%.4f)"
              % (errs[-1][1], gate))
 
 
