@@ -195,22 +195,10 @@ static void punctual(const gi_direct_rays *d, gi_vec3 o, gi_vec3 n, double E[3])
         const gi_light *lt = &s->lights[i];
         gi_light_frame f = gi_scene_light_at(s, i, d->time);
         gi_vec3 w;
-        float scale, tfar = INFINITY;
-        if (lt->type == GI_LIGHT_DIRECTIONAL) {
-            w = gi_v3_normalize(gi_v3_scale(f.direction, -1.0f));
-            scale = 1.0f;
-        } else {
-            gi_vec3 dv = gi_v3_sub(f.position, o);
-            float r = gi_v3_length(dv);
-            if (!(r > 0.0f))
-                continue;
-            w = gi_v3_scale(dv, 1.0f / r);
-            scale = gi_range_window(r, lt->range) / (r * r);
-            if (lt->type == GI_LIGHT_SPOT)
-                scale *= gi_spot_falloff(-gi_v3_dot(w, gi_v3_normalize(f.direction)),
-                                         cosf(lt->inner_cone), cosf(lt->outer_cone));
-            tfar = r * (1.0f - 1e-5f);
-        }
+        float scale, r;
+        if (!gi_punctual_toward(lt, f, o, &w, &r, &scale))
+            continue;
+        float tfar = isinf(r) ? INFINITY : r * (1.0f - 1e-5f);
         float c = gi_v3_dot(n, w);
         if (c <= 0.0f || !(scale > 0.0f) || gi_rt_occluded(d->rt, o, w, d->eps, tfar))
             continue;

@@ -166,21 +166,9 @@ static void punctual(const iv_links *l, const iv_hier *h, const iv_lights *li, u
         const gi_light *lt = &s->lights[i];
         gi_light_frame f = gi_scene_light_at(s, i, li->t);
         gi_vec3 wl;
-        float scale, r = FLT_MAX;
-        if (lt->type == GI_LIGHT_DIRECTIONAL) {
-            wl = gi_v3_normalize(gi_v3_scale(f.direction, -1.0f));
-            scale = 1.0f;
-        } else {
-            gi_vec3 d = gi_v3_sub(f.position, x);
-            r = gi_v3_length(d);
-            if (!(r > 0.0f))
-                continue;
-            wl = gi_v3_scale(d, 1.0f / r);
-            scale = gi_range_window(r, lt->range) / (r * r);
-            if (lt->type == GI_LIGHT_SPOT)
-                scale *= gi_spot_falloff(-gi_v3_dot(wl, gi_v3_normalize(f.direction)),
-                                         cosf(lt->inner_cone), cosf(lt->outer_cone));
-        }
+        float scale, r;
+        if (!gi_punctual_toward(lt, f, x, &wl, &r, &scale))
+            continue;
         size_t k = base + iv_bin_of(wl, l->n);
         if (l->other[k] >= 0 && l->dist[k] < r)
             continue;

@@ -15,6 +15,7 @@
 #ifndef GI_LIGHTS_H
 #define GI_LIGHTS_H
 
+#include "gi/scene.h"
 #include "gi/vecmath.h"
 
 #ifdef __cplusplus
@@ -53,6 +54,34 @@ static inline float gi_emitter_cos(gi_vec3 ng_unit, gi_vec3 w_to_light, int doub
     if (double_sided)
         return fabsf(c);
     return c > 0.0f ? c : 0.0f;
+}
+
+/* Toward KHR punctual light `lt` placed at `f` (gi_scene_light_at) from
+ * world point x: the unit direction *w, the distance *dist (INFINITY for a
+ * directional light) and *scale, such that the irradiance on a surface of
+ * normal n is intensity x max(n . w, 0) x scale (1 / d^2 with the range
+ * window and the spot cone; 1 for a directional light). Returns 0 when x
+ * is at the light's position (no direction). */
+static inline int gi_punctual_toward(const gi_light *lt, gi_light_frame f, gi_vec3 x, gi_vec3 *w,
+                                     float *dist, float *scale)
+{
+    if (lt->type == GI_LIGHT_DIRECTIONAL) {
+        *w = gi_v3_normalize(gi_v3_scale(f.direction, -1.0f));
+        *dist = INFINITY;
+        *scale = 1.0f;
+        return 1;
+    }
+    gi_vec3 d = gi_v3_sub(f.position, x);
+    float r = gi_v3_length(d);
+    if (!(r > 0.0f))
+        return 0;
+    *w = gi_v3_scale(d, 1.0f / r);
+    *dist = r;
+    *scale = gi_range_window(r, lt->range) / (r * r);
+    if (lt->type == GI_LIGHT_SPOT)
+        *scale *= gi_spot_falloff(-gi_v3_dot(*w, gi_v3_normalize(f.direction)),
+                                  cosf(lt->inner_cone), cosf(lt->outer_cone));
+    return 1;
 }
 
 #ifdef __cplusplus
