@@ -45,14 +45,16 @@
 extern const gi_shader_source gi_implicit_vis_shaders[];
 
 static const gi_param_desc iv_params[] = {
-    {"N", GI_PARAM_INT, 12, 1, 32, GI_QUALITY_UP(1.5),
+    {"N", GI_PARAM_INT, 12, 1, 32,
+     GI_QUALITY_NONE(
+         "the error need not fall with N: under Eq. 5 as printed (the default) a bin "
+         "counts only its nearest node (README \"Weights\"); at the held-out remedy it "
+         "rises along a room's edges where a lamp is flush under the ceiling (seed 1 "
+         "ceiling, 32^2: 0.0033 at N 12, 0.0058 at 32; README \"Traced direct light\")"),
      "N (Sec. 4.2.2, 6 x N x N bins; Table 1: 8, 12, 16)",
-     "bins per cube-map side of every node (quality, more = finer). Under Eq. 5 as printed (the "
-     "default) the error need not fall with N: a bin counts only its nearest node, and closed "
-     "surfaces lose what its neighbours in the bin would add (furnace -35/-27/-17/-3 % at N "
-     "8/12/16/24); weight=surface converges (README \"Weights\"). At the held-out remedy the error "
-     "rises with N along a room's edges where a lamp is flush under the ceiling (held-out seed 1 "
-     "ceiling, 32^2: 0.0033 at 12, 0.0058 at 32; README \"Traced direct light\")"},
+     "bins per cube-map side of every node (more = finer bins; the error does not always fall: "
+     "README \"Weights\", \"Traced direct light\"; furnace -35/-27/-17/-3 % at N 8/12/16/24 "
+     "under Eq. 5 as printed, weight=surface converges there)"},
     {"bounces", GI_PARAM_INT, 3, 0, 3, NULL, "light bounces (Algorithm 1, line 8)",
      "indirect bounces after the direct light (Table 1: 1)"},
     {"subdiv", GI_PARAM_FLOAT, 1.0, 0.01, 100.0, GI_QUALITY_DOWN(2), "Sec. 4.2.2",
