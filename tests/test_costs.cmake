@@ -22,12 +22,12 @@
 # its end.
 set(GI_TEST_COSTS
     # conformance suites (tests/conformance/CMakeLists.txt, one per plugin)
-    conformance.vlf 510
-    conformance.cssm_hrc 320
-    conformance.csm 240
+    conformance.vlf 1198
+    conformance.cssm_hrc 484
+    conformance.csm 356
     conformance.avg 245
-    conformance.held_out 140
-    conformance.implicit_vis 60
+    conformance.held_out 209
+    conformance.implicit_vis 116
     # tests/integration/CMakeLists.txt
     integration.view_drag 152
     integration.slurm 143
