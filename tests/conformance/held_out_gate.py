@@ -10,6 +10,7 @@ method's failed check fails the gate; so does a run that gives no JSON.
 
 usage: held_out_gate.py GIBENCH --run SEED|DIR:VARIANTS [--run ...]
                         [--known-fail METHOD ...] [--size N] [--method M]
+                        [--item-timeout S]
 """
 import argparse
 import json
@@ -17,9 +18,11 @@ import subprocess
 import sys
 
 
-def run_one(gib, seed, variants, size, method):
+def run_one(gib, seed, variants, size, method, item_timeout):
     cmd = [gib, "-q", "conformance", "--held-out", seed, "--variants", variants,
            "--size", str(size), "--no-converge", "--json"] + (["--method", method] if method else [])
+    if item_timeout:
+        cmd += ["--item-timeout", str(item_timeout)]
     p = subprocess.run(cmd, capture_output=True, text=True)
     try:
         doc = json.loads(p.stdout)
@@ -38,12 +41,14 @@ def main():
     ap.add_argument("--known-fail", action="append", default=[])
     ap.add_argument("--size", type=int, default=32)
     ap.add_argument("--method", help="one method only (the gate's own test)")
+    ap.add_argument("--item-timeout", type=float,
+                    help="each child's time limit (gibench's default 60 s when not given)")
     a = ap.parse_args()
     failures, known_fails, broken = [], {m: 0 for m in a.known_fail}, 0
     seen = set()
     for r in a.run:
         seed, _, variants = r.rpartition(":")
-        rows = run_one(a.gibench, seed, variants, a.size, a.method)
+        rows = run_one(a.gibench, seed, variants, a.size, a.method, a.item_timeout)
         if rows is None:
             broken += 1
             continue
