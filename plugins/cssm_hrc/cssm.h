@@ -354,6 +354,10 @@ void cssm_gather(const cssm_tree *t, const cssm_atlas *a, const cssm_maps *maps,
 void cssm_cgather(const cssm_ctree *ct, const cssm_atlas *a, const cssm_maps *maps,
                   const cssm_receiver *rc, const cssm_gather_opts *o, float out[3],
                   cssm_gather_stats *st);
+/* §4.3's refinement test without a powf per node: the largest value y with
+ * (y)^(1/2.2) <= thr, so that "refine when (b·exposure)^(1/2.2) > thr" is
+ * exactly "refine when b·exposure > limit". */
+float cssm_refine_limit(float thr);
 /* Upper bound of what node S sends to the receiver (the oracle's L_max),
  * luminance. */
 float cssm_bound(const cssm_node *S, const float L[3], const cssm_receiver *rc);

@@ -367,6 +367,26 @@ static void transfer(const cssm_tree *t, const float *node_L, const cssm_ctree *
 }
 
 /* Fig. 10 over either layout (ct NULL: the float nodes with node_L). */
+/* §4.3's refinement test compares the tone-mapped bound, (b·scale)^(1/2.2),
+ * with the threshold. powf is monotone, so the test equals b·scale > lim for
+ * the largest lim whose tone-mapped value is still not above the threshold:
+ * found once per receiver instead of one powf per visited node (the powf was
+ * 15 % of the gather). The search steps to the exact float boundary, so the
+ * cut, and the image, are the same bit for bit. */
+float cssm_refine_limit(float thr)
+{
+    const float e = 1.0f / 2.2f;
+    if (!(thr > 0.0f))
+        return thr < 0.0f ? -1.0f : 0.0f; /* every positive bound refines */
+    float lim = powf(thr, 2.2f);
+    while (lim > 0.0f && powf(lim, e) > thr)
+        lim = nextafterf(lim, 0.0f);
+    for (float up = nextafterf(lim, INFINITY); up < INFINITY && powf(up, e) <= thr;
+         up = nextafterf(lim, INFINITY))
+        lim = up;
+    return lim;
+}
+
 static void gather_any(const cssm_tree *t, const float *node_L, const cssm_ctree *ct,
                        const cssm_atlas *a, const cssm_maps *maps, const cssm_receiver *rc,
                        const cssm_gather_opts *o, float out[3], cssm_gather_stats *st)
@@ -376,7 +396,7 @@ static void gather_any(const cssm_tree *t, const float *node_L, const cssm_ctree
     /* Fig. 10: refine by the child pointer, gather and leave by the skip
      * pointer. `pending` counts the subtrees still to be visited, so that
      * gathered + pending is the size the cut reaches at least. */
-    const float thr = o->threshold;
+    const float lim = cssm_refine_limit(o->threshold);
     const float scale = exp2f(o->exposure);
     uint32_t gathered = 0, pending = 1;
     int32_t i = 0;
@@ -392,7 +412,7 @@ static void gather_any(const cssm_tree *t, const float *node_L, const cssm_ctree
         int refine = 0;
         if (S.child >= 0 && gathered + pending + 1 <= o->max_cut && lit) {
             float b = bound_view(&S, rc);
-            refine = b >= FLT_MAX || powf(b * scale, 1.0f / 2.2f) > thr;
+            refine = b >= FLT_MAX || b * scale > lim;
         }
         if (refine) {
             pending++;

@@ -74,7 +74,7 @@ int main(int argc, char **argv)
             stderr,
             "usage: cssm_tests "
             "traversal|tree|visibility|furnace|hull|motion|motion2|texture|compact|compact_furnace|"
-            "compact_limit|escape|representative\n");
+            "compact_limit|escape|representative|refine_limit\n");
         return 2;
     }
     int r;
@@ -82,6 +82,8 @@ int main(int argc, char **argv)
         r = cssm_test_traversal();
     else if (!strcmp(argv[1], "tree"))
         r = cssm_test_tree();
+    else if (!strcmp(argv[1], "refine_limit"))
+        r = cssm_test_refine_limit();
     else if (!strcmp(argv[1], "visibility"))
         r = cssm_test_visibility();
     else if (!strcmp(argv[1], "furnace"))

@@ -69,6 +69,7 @@ int cssm_test_decide(uint32_t node, uint32_t salt);
 int cssm_test_traversal(void);      /* atlas_tests.c */
 int cssm_test_texture(void);        /* atlas_tests.c */
 int cssm_test_tree(void);           /* tree_tests.c */
+int cssm_test_refine_limit(void);   /* tree_tests.c */
 int cssm_test_compact(void);        /* compact_tests.c */
 int cssm_test_compact_limit(void);  /* compact_tests.c */
 int cssm_test_visibility(void);     /* visibility_tests.c */

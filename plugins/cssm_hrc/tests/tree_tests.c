@@ -2,7 +2,10 @@
  *   tree  the skip-pointer traversal equals a recursive depth-first
  *         traversal, for full traversals and for selective ones with
  *         pseudo-random refine decisions; spheres hold their texels,
- *         areas add up */
+ *         areas add up
+ *   refine_limit  the precomputed limit of the refinement test decides as
+ *         the tone-mapped comparison does (§4.3), at the float boundary and
+ *         on random bounds */
 #include "cssm_tests.h"
 
 #include "check.h"
@@ -97,4 +100,36 @@ int cssm_test_tree(void)
     cssm_atlas_free(&a);
     gi_scene_free(s);
     return 0;
+}
+
+/* One threshold: the limit agrees with powf(y, 1/2.2) > thr at the limit,
+ * its float neighbours and at random bounds spread over many octaves. */
+static int refine_limit_agrees(float thr, uint32_t *rng)
+{
+    const float e = 1.0f / 2.2f, lim = cssm_refine_limit(thr);
+    int bad = 0;
+    float y = lim;
+    for (int k = 0; k < 4; k++)
+        y = nextafterf(y, 0.0f);
+    for (int k = 0; k < 9; k++, y = nextafterf(y, INFINITY))
+        bad += y >= 0.0f && (y > lim) != (powf(y, e) > thr);
+    for (int k = 0; k < 100000; k++) {
+        float r = ldexpf(gi_rng_next_float(rng), (int)(gi_rng_next_u32(rng) % 60u) - 40);
+        bad += (r > lim) != (powf(r, e) > thr);
+    }
+    CHECK_MSG(bad == 0, "threshold %g: %d bounds decided otherwise than powf", (double)thr, bad);
+    return bad;
+}
+
+int cssm_test_refine_limit(void)
+{
+    const float thr[] = {0.1f, 0.02f, 0.5f, 1.0f, 0.0f, -0.1f, 0.3333f, 1e-6f};
+    uint32_t rng = 7u;
+    int bad = 0;
+    for (size_t i = 0; i < sizeof thr / sizeof thr[0]; i++)
+        bad += refine_limit_agrees(thr[i], &rng) != 0;
+    printf("refine_limit: %zu thresholds, the limit decides as powf at the boundary and on 100000 "
+           "random bounds each\n",
+           sizeof thr / sizeof thr[0]);
+    return bad != 0;
 }
