@@ -96,6 +96,10 @@ static const gi_param_desc iv_params[] = {
     {"direct_samples", GI_PARAM_INT, 64, 1, 4096, GI_QUALITY_UP(2), "(direct=traced only)",
      "shadow rays per element and per pixel for the area lights, as many for the environment "
      "(direct=traced)"},
+    {"relink", GI_PARAM_ENUM, 0, 0, 0, "moved|always", "Algorithm 1, lines 3-6",
+     "when the elements are updated and the links created and pushed down: moved, on a frame "
+     "where something moved or changed (the same image; a still frame reuses them); always, "
+     "every frame as Algorithm 1 (the timing of Table 1)"},
     {0},
 };
 
@@ -106,7 +110,13 @@ typedef struct implicit_vis {
     int glossy; /* the display adds the glossy direct light (a glossy material, glossy=true) */
     int traced; /* direct=traced: the direct light by shadow rays (iv_traced.h) */
     int direct_samples;
-    int warned_cpu; /* the links outgrew one GL storage block once: warned */
+    int warned_cpu;    /* the links outgrew one GL storage block once: warned */
+    int relink_always; /* relink=always: Algorithm 1 lines 3-6 on every frame */
+    int scene_static;  /* nothing in the scene moves with time */
+    int links_valid;   /* the links were made for links_time and nothing changed since */
+    float links_time;
+    int light_valid; /* the elements' light of the last frame still holds (relink=moved) */
+    int light_on_cpu; /* where that light is (illuminate's on_cpu) */
     float subdiv, remesh, coverage;
     iv_hier *hier;
     iv_links *links;
@@ -142,12 +152,26 @@ static gi_result iv_create(const gi_host *host, const gi_params *params, void **
     m->glossy = gi_params_bool(params, "glossy");
     m->traced = gi_params_enum(params, "direct") == 1;
     m->direct_samples = gi_params_int(params, "direct_samples");
+    m->relink_always = gi_params_enum(params, "relink") == 1;
     if (m->threads == 0) {
         long n = sysconf(_SC_NPROCESSORS_ONLN);
         m->threads = n > 0 ? (n > 256 ? 256 : (int)n) : 1;
     }
     *out = m;
     return GI_OK;
+}
+
+/* Whether nothing in the scene moves with time: then links made at one
+ * time hold at every other. */
+static int scene_is_static(const gi_gpu_scene *gs)
+{
+    const gi_scene *s = gs->scene;
+    if (gs->deforming || gi_scene_lights_animated(s))
+        return 0;
+    for (uint32_t k = 0; k < s->object_count; k++)
+        if (s->objects[k].animated || s->objects[k].morph_track.count)
+            return 0;
+    return 1;
 }
 
 static void release_prepared(implicit_vis *m)
@@ -313,6 +337,8 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
         if (!m->traced_direct)
             return gi_kit_fail_with(&m->kit, GI_ERR_INVALID_ARGUMENT, &err);
     }
+    m->scene_static = scene_is_static(gs);
+    m->links_valid = m->light_valid = 0;
     report_hierarchy(m, s);
     if (gi_gl_check("implicit_vis: prepare", &err) != GI_OK)
         return gi_kit_fail_with(&m->kit, GI_ERR_GL, &err);
@@ -321,8 +347,49 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
 
 static gi_result iv_update(void *inst, const gi_gpu_scene *gs, const gi_changes *changes)
 {
-    /* everything but the hierarchy is rebuilt every frame (Algorithm 1) */
-    gi_kit_update(&((implicit_vis *)inst)->kit, gs, changes);
+    /* Algorithm 1 rebuilds everything but the hierarchy every frame; the
+     * links depend only on where the elements and emitters are, so a change
+     * of anything but the camera makes them stale (iv_render rebuilds). */
+    implicit_vis *m = inst;
+    if (changes->flags & ~(uint32_t)GI_CHANGED_CAMERA)
+        m->links_valid = 0;
+    gi_kit_update(&m->kit, gs, changes);
+    return GI_OK;
+}
+
+/* Algorithm 1, lines 3-6: the elements at the frame's time, the
+ * hierarchical links and their push-down, each a stage of Table 1. With
+ * relink=moved they are kept from the last frame when nothing moved since
+ * (stat links_reused); the stages are still recorded, near zero. */
+static gi_result update_links(implicit_vis *m, const gi_gpu_scene *gs)
+{
+    const gi_host *host = m->kit.host;
+    int reuse =
+        !m->relink_always && m->links_valid && (m->scene_static || m->links_time == gs->time);
+    host->stage_begin(host, "update_elements");
+    if (!reuse)
+        iv_hier_update(m->hier, gs->scene, gs->time);
+    host->stage_end(host, "update_elements");
+
+    host->stage_begin(host, "create_links");
+    if (!reuse)
+        iv_links_build(m->links, m->hier, m->subdiv, m->brute, m->splat);
+    host->stage_end(host, "create_links");
+    if (m->links->stopped) {
+        m->links_valid = 0;
+        return gi_kit_fail(&m->kit, GI_ERR_CANCELLED, "implicit_vis: link creation cancelled");
+    }
+    host->stage_begin(host, "refine_push");
+    if (!reuse)
+        iv_links_refine_push(m->links, m->hier);
+    host->stage_end(host, "refine_push");
+    if (!reuse && m->gpu)
+        m->gpu->links_current = 0;
+    if (!reuse)
+        m->light_valid = 0;
+    m->links_valid = 1;
+    m->links_time = gs->time;
+    host->stat(host, "links_reused", reuse ? 1.0 : 0.0);
     return GI_OK;
 }
 
@@ -391,32 +458,30 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
     implicit_vis *m = inst;
     const gi_host *host = m->kit.host;
     const gi_gpu_scene *gs = m->kit.scene;
-    const gi_scene *s = gs->scene;
     gi_error err;
     gi_result r = gi_kit_frame_begin(&m->kit, view, GI_KIT_GBUFFER);
     if (r != GI_OK)
         return r;
 
-    host->stage_begin(host, "update_elements");
-    iv_hier_update(m->hier, s, gs->time);
-    host->stage_end(host, "update_elements");
-
-    host->stage_begin(host, "create_links");
-    iv_links_build(m->links, m->hier, m->subdiv, m->brute, m->splat);
-    host->stage_end(host, "create_links");
-    if (m->links->stopped)
-        return gi_kit_fail(&m->kit, GI_ERR_CANCELLED, "implicit_vis: link creation cancelled");
-
-    host->stage_begin(host, "refine_push");
-    iv_links_refine_push(m->links, m->hier);
-    host->stage_end(host, "refine_push");
+    r = update_links(m, gs);
+    if (r != GI_OK)
+        return r;
     if (host->cancelled && host->cancelled(host)) /* before the gathers (issue 32) */
         return gi_kit_fail(&m->kit, GI_ERR_CANCELLED, "implicit_vis: cancelled");
 
-    int on_cpu = 0;
-    r = illuminate(m, gs, &on_cpu, &err);
-    if (r != GI_OK)
-        return gi_kit_fail_with(&m->kit, r, &err);
+    /* With the links kept and the direct light along them (deterministic),
+     * the elements' light is the last frame's: only the display runs. */
+    int on_cpu = m->light_on_cpu;
+    if (m->light_valid) {
+        host->stage_begin(host, "illumination");
+        host->stage_end(host, "illumination");
+    } else {
+        r = illuminate(m, gs, &on_cpu, &err);
+        if (r != GI_OK)
+            return gi_kit_fail_with(&m->kit, r, &err);
+        m->light_valid = !m->traced && !m->relink_always;
+        m->light_on_cpu = on_cpu;
+    }
 
     host->stage_begin(host, "display");
     r = gi_kit_render_gbuffer(&m->kit, view, NULL);

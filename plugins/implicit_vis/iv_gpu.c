@@ -223,14 +223,10 @@ static gi_result upload_direct(iv_gpu *g, const float *direct, gi_error *err)
     return GI_OK;
 }
 
-gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint32_t bounces,
-                            uint32_t punctual, const float *direct, gi_error *err)
+/* The frame's node geometry and the flattened links, to the GPU: only
+ * when the links were rebuilt (links_current). */
+static gi_result upload_links(iv_gpu *g, const iv_links *l, const iv_hier *h, gi_error *err)
 {
-    if (direct) {
-        gi_result r = upload_direct(g, direct, err);
-        if (r != GI_OK)
-            return r;
-    }
     /* the frame's geometry: position and area, mean normal */
     for (uint32_t i = 0; i < g->nodes; i++) {
         float *o = &g->geom[8 * (size_t)i];
@@ -268,6 +264,23 @@ gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint
     glNamedBufferSubData(g->ssbo_links, 0, (GLsizeiptr)(words * sizeof(uint32_t)), g->links);
     glNamedBufferSubData(g->ssbo_off, 0,
                          (GLsizeiptr)(((size_t)g->elems + 1) * 2 * sizeof(uint32_t)), g->off);
+    return GI_OK;
+}
+
+gi_result iv_gpu_illuminate(iv_gpu *g, const iv_links *l, const iv_hier *h, uint32_t bounces,
+                            uint32_t punctual, const float *direct, gi_error *err)
+{
+    if (direct) {
+        gi_result r = upload_direct(g, direct, err);
+        if (r != GI_OK)
+            return r;
+    }
+    if (!g->links_current) {
+        gi_result r = upload_links(g, l, h, err);
+        if (r != GI_OK)
+            return r;
+        g->links_current = 1;
+    }
 
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_ELEM, g->ssbo_elem);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IV_SSBO_CHILDREN, g->ssbo_children);

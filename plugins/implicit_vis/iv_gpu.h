@@ -35,6 +35,8 @@ typedef struct iv_gpu {
     GLuint ssbo_emit;      /* per node: the emission pulled up (bounce 0), kept when keep_emit */
     GLuint ssbo_direct;    /* per element: the traced direct irradiance (made on first use) */
     int keep_emit;         /* set by the caller: keep the emission for the glossy display */
+    int links_current;     /* ssbo_geom and ssbo_links hold the links given last; the caller
+                              clears it when it rebuilds them */
     float *geom;           /* staging: 8 per node */
     uint32_t *links, *off; /* staging for iv_links_pack */
     size_t links_cap;      /* words */
