@@ -115,7 +115,7 @@ typedef struct implicit_vis {
     int scene_static;  /* nothing in the scene moves with time */
     int links_valid;   /* the links were made for links_time and nothing changed since */
     float links_time;
-    int light_valid; /* the elements' light of the last frame still holds (relink=moved) */
+    int light_valid;  /* the elements' light of the last frame still holds (relink=moved) */
     int light_on_cpu; /* where that light is (illuminate's on_cpu) */
     float subdiv, remesh, coverage;
     iv_hier *hier;
