@@ -27,6 +27,14 @@ match("${last_err}" "/charts/0: \"file\" must be a plain file name" "a chart esc
 set(S ${OUT}/study_csm_tiny)
 file(REMOVE_RECURSE ${S})
 run(0 study tests/data/studies/csm_tiny.json --out ${S})
+# the reference stage reports each reference as it is done (issue 33: it was
+# silent for a minute at the demo's size)
+match("${last_err}" "study: reference bunny_env \\(4 bounces\\): 16 spp in [0-9.]+ s\n"
+      "no progress line for the full-GI reference:\n${last_err}")
+match("${last_err}" "study: bounce-matched reference bunny_env \\(1 bounces\\): 16 spp in [0-9.]+ s\n"
+      "no progress line for the bounce-matched reference:\n${last_err}")
+match("${last_err}" "study: convergence bunny_env \\(1 bounces, 4 spp\\): 4 spp in [0-9.]+ s\n"
+      "no progress line for the convergence images:\n${last_err}")
 file(READ ${S}/runs.csv csv)
 match_count("${csv}" "\n[^\n]+" 6 "csm_tiny: runs")
 match("${csv}" "^run,[^\n]*,label,width,height,prepare_depth_render_ms,prepare_compress_ms[^\n]*,stat_ratio,"
