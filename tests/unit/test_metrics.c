@@ -4,9 +4,11 @@
 #include "flip.h"
 #include "metrics.h"
 
+#include "gi/cache.h"
 #include "gi/tonemap.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -698,6 +700,64 @@ static void test_leaked_energy(void)
     gi_image_free(lit);
 }
 
+/* The mean of pair `name` in section `section` ("ldr"/"hdr") of
+ * tests/data/flip/reference.json, NaN when absent. */
+static double nvidia_mean(const char *json, const char *section, const char *name)
+{
+    char key[64];
+    snprintf(key, sizeof key, "\"%s\": {", section);
+    const char *p = strstr(json, key);
+    snprintf(key, sizeof key, "\"%s\": {", name);
+    p = p ? strstr(p, key) : NULL;
+    p = p ? strstr(p, "\"mean\": ") : NULL;
+    return p ? strtod(p + 8, NULL) : NAN;
+}
+
+/* LDR-FLIP against NVIDIA's own implementation (FLIP v1.6, its C++ tool;
+ * tests/data/flip/PROVENANCE.md): the mean of three 32x32 pairs (a noisy
+ * gradient, shifted edges, dark noise) within 5e-5 (the tool prints six
+ * decimals), and the per-pixel map of the edge pair within 0.004 (the
+ * tool's map is an 8-bit PNG: half a step is 0.002). */
+static void test_flip_nvidia(void)
+{
+    size_t n = 0;
+    char *json = gi_file_read_all(GI_TEST_DATA "/flip/reference.json", &n);
+    CHECK_MSG(json != NULL, "tests/data/flip/reference.json not readable");
+    if (!json)
+        return;
+    const char *pairs[] = {"noise", "edges", "dark"};
+    for (int k = 0; k < 3; k++) {
+        char path[1024];
+        gi_error err;
+        snprintf(path, sizeof path, GI_TEST_DATA "/flip/%s_ref.pfm", pairs[k]);
+        gi_image *ref = gi_image_read(path, &err);
+        snprintf(path, sizeof path, GI_TEST_DATA "/flip/%s_test.pfm", pairs[k]);
+        gi_image *test = gi_image_read(path, &err);
+        CHECK_MSG(ref && test, "%s: %s", pairs[k], err.text);
+        double want = nvidia_mean(json, "ldr", pairs[k]), mean = NAN;
+        CHECK_MSG(isfinite(want), "%s: no mean in reference.json", pairs[k]);
+        float *map = ref ? malloc((size_t)ref->width * ref->height * sizeof *map) : NULL;
+        gi_metrics_opts o = {0};
+        if (ref && test && map)
+            CHECK(gi_metrics_flip_map(test, ref, &o, map, &mean, &err) == GI_OK);
+        CHECK_MSG(fabs(mean - want) <= 5e-5, "%s: gibench %.6f, NVIDIA %.6f", pairs[k], mean, want);
+        gi_image *nv = k == 1 ? gi_image_read(GI_TEST_DATA "/flip/edges_flip_map.pfm", &err) : NULL;
+        if (k == 1) {
+            CHECK_MSG(nv && ref && nv->width == ref->width && nv->height == ref->height, "%s",
+                      err.text);
+            double worst = 0.0;
+            for (size_t i = 0; nv && map && i < (size_t)nv->width * nv->height; i++)
+                worst = fmax(worst, fabs(map[i] - nv->rgba[i * 4]));
+            CHECK_MSG(worst <= 0.004, "edges: per-pixel FLIP differs by up to %.4f", worst);
+        }
+        gi_image_free(nv);
+        free(map);
+        gi_image_free(ref);
+        gi_image_free(test);
+    }
+    free(json);
+}
+
 int main(void)
 {
     test_single_pixel();
@@ -710,6 +770,7 @@ int main(void)
     test_flip_kernels();
     test_flip_values();
     test_flip_against_direct();
+    test_flip_nvidia();
     test_leaked_energy();
     return gi_test_finish();
 }
