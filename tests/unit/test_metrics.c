@@ -758,6 +758,58 @@ static void test_flip_nvidia(void)
     free(json);
 }
 
+/* HDR-FLIP against NVIDIA's tool (FLIP v1.6, EXR inputs, its defaults: ACES,
+ * exposures from the reference) on a gibench render and its reference: the
+ * exposure range within 1e-3 stops and the mean within 5e-4. */
+static void test_flip_hdr_nvidia(void)
+{
+    size_t n = 0;
+    char *json = gi_file_read_all(GI_TEST_DATA "/flip/reference.json", &n);
+    CHECK_MSG(json != NULL, "tests/data/flip/reference.json not readable");
+    gi_error err;
+    gi_image *ref = gi_image_read(GI_TEST_DATA "/flip/render_ref.exr", &err);
+    gi_image *test = gi_image_read(GI_TEST_DATA "/flip/render_test.exr", &err);
+    CHECK_MSG(ref && test, "%s", err.text);
+    if (!json || !ref || !test) {
+        free(json);
+        gi_image_free(ref);
+        gi_image_free(test);
+        return;
+    }
+    size_t px = (size_t)ref->width * ref->height;
+    float *r3 = malloc(px * 3 * sizeof *r3), *t3 = malloc(px * 3 * sizeof *t3);
+    float *map = malloc(px * sizeof *map);
+    for (size_t i = 0; r3 && t3 && i < px; i++)
+        for (int c = 0; c < 3; c++) {
+            r3[i * 3 + c] = ref->rgba[i * 4 + c];
+            t3[i * 3 + c] = test->rgba[i * 4 + c];
+        }
+    gi_flip_hdr_info info = {0};
+    double mean = NAN;
+    if (r3 && t3 && map &&
+        gi_flip_hdr_map(t3, r3, ref->width, ref->height, GI_FLIP_PPD_DEFAULT, map, &info, &err) ==
+            GI_OK) {
+        mean = 0.0;
+        for (size_t i = 0; i < px; i++)
+            mean += map[i];
+        mean /= (double)px;
+    }
+    const char *e = strstr(json, "\"Start exposure\": \"");
+    double start = e ? strtod(e + 19, NULL) : NAN;
+    e = strstr(json, "\"Stop exposure\": \"");
+    double stop = e ? strtod(e + 18, NULL) : NAN, want = nvidia_mean(json, "hdr", "render");
+    CHECK_MSG(fabs(info.start - start) <= 1e-3 && fabs(info.stop - stop) <= 1e-3,
+              "exposures %.4f..%.4f, NVIDIA %.4f..%.4f", info.start, info.stop, start, stop);
+    CHECK_MSG(info.count == 10, "%d exposures, NVIDIA 10", info.count);
+    CHECK_MSG(fabs(mean - want) <= 5e-5, "HDR-FLIP: gibench %.6f, NVIDIA %.6f", mean, want);
+    free(r3);
+    free(t3);
+    free(map);
+    gi_image_free(ref);
+    gi_image_free(test);
+    free(json);
+}
+
 int main(void)
 {
     test_single_pixel();
@@ -771,6 +823,7 @@ int main(void)
     test_flip_values();
     test_flip_against_direct();
     test_flip_nvidia();
+    test_flip_hdr_nvidia();
     test_leaked_energy();
     return gi_test_finish();
 }
