@@ -700,6 +700,34 @@ static void test_leaked_energy(void)
     gi_image_free(lit);
 }
 
+/* A PFM of tests/data/flip/ ("PF", little-endian, rows bottom first, as
+ * make_flip_data.py writes it), read here so that the test needs no image
+ * module; NULL when it is not one. */
+static gi_image *read_pfm(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    unsigned w = 0, h = 0;
+    float scale = 0.0f;
+    gi_image *img = NULL;
+    if (f && fscanf(f, "PF %u %u %f", &w, &h, &scale) == 3 && scale < 0.0f && fgetc(f) == '\n' &&
+        w > 0 && h > 0 && w <= 4096 && h <= 4096 && (img = gi_image_create(w, h)) != NULL) {
+        for (unsigned y = 0; y < h; y++)
+            for (unsigned x = 0; x < w; x++) {
+                float *p = img->rgba + ((size_t)(h - 1 - y) * w + x) * 4;
+                if (fread(p, sizeof(float), 3, f) != 3) {
+                    gi_image_free(img);
+                    img = NULL;
+                    y = h;
+                    break;
+                }
+                p[3] = 1.0f;
+            }
+    }
+    if (f)
+        fclose(f);
+    return img;
+}
+
 /* The mean of pair `name` in section `section` ("ldr"/"hdr") of
  * tests/data/flip/reference.json, NaN when absent. */
 static double nvidia_mean(const char *json, const char *section, const char *name)
@@ -730,10 +758,10 @@ static void test_flip_nvidia(void)
         char path[1024];
         gi_error err;
         snprintf(path, sizeof path, GI_TEST_DATA "/flip/%s_ref.pfm", pairs[k]);
-        gi_image *ref = gi_image_read(path, &err);
+        gi_image *ref = read_pfm(path);
         snprintf(path, sizeof path, GI_TEST_DATA "/flip/%s_test.pfm", pairs[k]);
-        gi_image *test = gi_image_read(path, &err);
-        CHECK_MSG(ref && test, "%s: %s", pairs[k], err.text);
+        gi_image *test = read_pfm(path);
+        CHECK_MSG(ref && test, "%s: the pair's PFMs are not readable", pairs[k]);
         double want = nvidia_mean(json, "ldr", pairs[k]), mean = NAN;
         CHECK_MSG(isfinite(want), "%s: no mean in reference.json", pairs[k]);
         float *map = ref ? malloc((size_t)ref->width * ref->height * sizeof *map) : NULL;
@@ -741,10 +769,10 @@ static void test_flip_nvidia(void)
         if (ref && test && map)
             CHECK(gi_metrics_flip_map(test, ref, &o, map, &mean, &err) == GI_OK);
         CHECK_MSG(fabs(mean - want) <= 5e-5, "%s: gibench %.6f, NVIDIA %.6f", pairs[k], mean, want);
-        gi_image *nv = k == 1 ? gi_image_read(GI_TEST_DATA "/flip/edges_flip_map.pfm", &err) : NULL;
+        gi_image *nv = k == 1 ? read_pfm(GI_TEST_DATA "/flip/edges_flip_map.pfm") : NULL;
         if (k == 1) {
-            CHECK_MSG(nv && ref && nv->width == ref->width && nv->height == ref->height, "%s",
-                      err.text);
+            CHECK_MSG(nv && ref && nv->width == ref->width && nv->height == ref->height,
+                      "edges_flip_map.pfm: not readable or not the pair's size");
             double worst = 0.0;
             for (size_t i = 0; nv && map && i < (size_t)nv->width * nv->height; i++)
                 worst = fmax(worst, fabs(map[i] - nv->rgba[i * 4]));
