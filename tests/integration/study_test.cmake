@@ -18,6 +18,20 @@ match("${last_out}" "label=table1 N=128 M=128 enumeration=hilbert" "csm.json: no
 match("${last_out}" "no-cache not-compared label=table1" "csm.json: Table 1 runs must skip the cache and the references")
 match("${last_out}" "animate not-compared label=moving" "csm.json: no animated run")
 
+# The demo (make demo) runs the baseline and every method of the five
+# papers, and times csm's and cssm_hrc's precomputation cold in both
+# repeats (no cache: a repeat would otherwise read the first one's maps)
+run(0 study harness/studies/demo.json --dry-run)
+foreach(mn direct:8 csm:4 cssm_hrc:4 implicit_vis:2 vlf:2 avg:4)
+    string(REPLACE ":" ";" mn "${mn}")
+    list(GET mn 0 m)
+    list(GET mn 1 n)
+    match_count("${last_out}" "\nrun cornell_box-${m}-" ${n} "demo.json: runs of ${m}")
+endforeach()
+foreach(m csm cssm_hrc)
+    match("${last_out}" "\nrun cornell_box-${m}-[^\n]* no-cache " "demo.json: ${m} runs with the cache:\n${last_out}")
+endforeach()
+
 run(2 study tests/data/studies/bad_entry_key.json --dry-run)
 match("${last_err}" "/methods/0/frame: unknown key" "an unknown method-entry key was not named:\n${last_err}")
 run(2 study tests/data/studies/bad_chart.json --dry-run)
