@@ -3,9 +3,11 @@
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
 
+#include "gi/cache.h"
 #include "gi/image.h"
 #include "report.h"
 #include "runner.h"
+#include "view_file.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -121,6 +123,47 @@ static uint32_t method_params(const compare_opts *o, const gi_method *m, const c
     return np;
 }
 
+/* An id that is no installed method: one line listing those that are, as render's. */
+static int unknown_method(const gi_plugins *reg, const char *id)
+{
+    char known[1024] = "";
+    for (uint32_t i = 0; i < reg->count; i++) {
+        size_t used = strlen(known);
+        snprintf(known + used, sizeof known - used, "%s%s", i ? ", " : "",
+                 reg->items[i].method->id);
+    }
+    return cli_fail(EXIT_USAGE, "compare: no method '%s' (installed: %s)", id,
+                    known[0] ? known : "none");
+}
+
+/* --camera: a camera of the scene, or a view saved by gibench view
+ * (view:FILE.json, as render, reference and studies take it: its camera and
+ * moved objects). A view's bytes join the scene's content in *scene_hash,
+ * so that results made under another view are not reused. */
+static int check_camera(const compare_opts *o, const gi_scene *scene, uint64_t *scene_hash)
+{
+    view_file view;
+    char why[600];
+    int is_view = view_camera_read(o->camera, &view, why, sizeof why);
+    if (is_view < 0)
+        return cli_fail(EXIT_USAGE, "compare: --camera %s", why);
+    if (is_view) {
+        int ok = view_file_check_nodes(&view, scene, why, sizeof why);
+        view_file_free(&view);
+        if (!ok)
+            return cli_fail(EXIT_USAGE, "compare: --camera %s: %s", o->camera, why);
+        size_t n = 0;
+        unsigned char *bytes = (unsigned char *)gi_file_read_all(o->camera + 5, &n);
+        for (size_t i = 0; bytes && i < n; i++)
+            *scene_hash = (*scene_hash ^ bytes[i]) * 0x100000001b3ull; /* FNV-1a, as a study's */
+        free(bytes);
+        return EXIT_OK;
+    }
+    if (o->camera && gi_scene_find_camera(scene, o->camera) < 0)
+        return cli_fail(EXIT_USAGE, "compare: %s has no camera '%s'", o->scene, o->camera);
+    return EXIT_OK;
+}
+
 /* --methods: every installed method ("all") or the methods it lists. */
 static int select_methods(const compare_opts *o, gi_plugins *reg, const gi_method **methods,
                           uint32_t *count)
@@ -151,7 +194,7 @@ static int select_methods(const compare_opts *o, gi_plugins *reg, const gi_metho
                 if (m)
                     return cli_fail(EXIT_USAGE, "compare: --methods names more than %d methods",
                                     MAX_METHODS);
-                return cli_fail(EXIT_USAGE, "compare: no method '%s' (see gibench methods)", id);
+                return unknown_method(reg, id);
             }
             methods[n++] = m;
         }
@@ -393,9 +436,10 @@ int cmd_compare(int argc, char **argv)
     uint64_t scene_hash = scene ? cli_scene_content_hash(scene, o.scene) : 0;
     if (!scene)
         return cli_fail(EXIT_USAGE, "%s", err.text);
-    if (o.camera && gi_scene_find_camera(scene, o.camera) < 0) {
+    rc = check_camera(&o, scene, &scene_hash);
+    if (rc != EXIT_OK) {
         gi_scene_free(scene);
-        return cli_fail(EXIT_USAGE, "compare: %s has no camera '%s'", o.scene, o.camera);
+        return rc;
     }
     gi_plugins *reg = cli_load_plugins(0);
     const gi_method *methods[MAX_METHODS];

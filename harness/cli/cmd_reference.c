@@ -344,6 +344,10 @@ static int render_passes(run_state *r, const ref_opts *o, const char **stop)
 {
     gi_error err;
     progress bar = {isatty(STDERR_FILENO) && gi_log_get_level() >= GI_LOG_WARN};
+    /* a caller that reads the log (gibench study) asks for a plain line
+     * every S seconds instead of the terminal's bar */
+    const char *every_env = getenv("GIBENCH_PROGRESS_EVERY");
+    double every = every_env && !bar.on ? atof(every_env) : 0.0, last_line = 0.0;
     const double t_render = gi_now();
     double se = INFINITY, per_spp = 0.0; /* seconds a sample per pixel takes */
     uint64_t se_spp = 0;
@@ -398,6 +402,11 @@ static int render_passes(run_state *r, const ref_opts *o, const char **stop)
             progress_show(&bar, o, spp, se, se_spp, elapsed);
         else if (bar.on)
             progress_show(&bar, o, spp, gi_ref_mean_rel_se(r->ref), spp, elapsed);
+        if (every > 0.0 && (elapsed - last_line >= every || *stop)) {
+            fprintf(stderr, "reference: %llu/%llu spp, %.1f s\n", (unsigned long long)spp,
+                    (unsigned long long)o->spp, elapsed);
+            last_line = elapsed;
+        }
     }
     progress_end(&bar);
     return EXIT_OK;

@@ -57,6 +57,33 @@ extern const gi_flip_csf gi_flip_csf_params[3];
 gi_result gi_flip_map(const float *test_srgb, const float *ref_srgb, uint32_t w, uint32_t h,
                       double ppd, float *out, gi_error *err);
 
+/* HDR-FLIP (Andersson, Nilsson, Shirley, Akenine-Möller: "Visualizing
+ * Errors in Rendered High Dynamic Range Images", Eurographics 2021 short
+ * papers), written from the paper: both linear images are exposed by 2^c
+ * for `count` exposures c evenly spaced from `start` to `stop`, tone mapped
+ * by the ACES fit of Narkowicz (2015) after a pre-exposure of 0.6, clamped
+ * to [0, 1], and compared by LDR-FLIP; a pixel's HDR-FLIP is its largest
+ * LDR-FLIP over the exposures. The range comes from the reference: with
+ * x_max the radiance the tone curve maps to 0.85, start = log2(x_max /
+ * Y_max) and stop = log2(x_max / Y_median) (Y the luminance, Rec. 709
+ * weights; the median the (n/2)-th smallest of the n pixels), and count =
+ * max(2, ceil(stop - start)). A black reference gives start = stop = 0;
+ * a median of 0 gives stop = start. */
+typedef struct gi_flip_hdr_info {
+    double start, stop; /* exposures in stops */
+    int count;
+} gi_flip_hdr_info;
+
+/* Per-pixel HDR-FLIP of test against ref (w*h pixels, 3 linear floats each;
+ * a non-finite value counts as 0) into out[w*h]; info (may be NULL) gets the
+ * exposures used. GI_ERR_INVALID_ARGUMENT for a bad ppd, GI_ERR_OUT_OF_MEMORY. */
+gi_result gi_flip_hdr_map(const float *test_linear, const float *ref_linear, uint32_t w, uint32_t h,
+                          double ppd, float *out, gi_flip_hdr_info *info, gi_error *err);
+/* The exposure range of HDR-FLIP for a reference (as gi_flip_hdr_map uses it). */
+gi_flip_hdr_info gi_flip_hdr_exposures(const float *ref_linear, uint32_t w, uint32_t h);
+/* The tone curve: ACES (Narkowicz) of 0.6 x, not clamped. */
+double gi_flip_hdr_tonemap(double x);
+
 /* --- building blocks --- */
 
 /* Radius in pixels of the colour kernels: ceil(3 sqrt(b_max / (2 pi^2)) ppd),

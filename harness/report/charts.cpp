@@ -84,6 +84,14 @@ const unsigned char palette[][3] = {
     {240, 228, 66},  /* yellow */
 };
 constexpr size_t palette_size = sizeof palette / sizeof palette[0];
+/* Reference curves (GI_CHART_REFERENCE): greys, none in the palette (its
+ * black excepted, they are grey), each with its own dash pattern, so that a
+ * reference is never read as a method. */
+const unsigned char reference_greys[][3] = {
+    {90, 90, 90}, {125, 125, 125}, {155, 155, 155}, {180, 180, 180}};
+const int reference_dashes[] = {vtkPen::DASH_LINE, vtkPen::DASH_DOT_LINE, vtkPen::DOT_LINE,
+                                vtkPen::DASH_DOT_DOT_LINE};
+constexpr size_t reference_looks = sizeof reference_greys / sizeof reference_greys[0];
 /* Five shapes against eight colours: series k and k + 8 still differ. */
 const int markers[] = {vtkPlotPoints::CIRCLE, vtkPlotPoints::SQUARE, vtkPlotPoints::DIAMOND,
                        vtkPlotPoints::CROSS, vtkPlotPoints::PLUS};
@@ -441,7 +449,7 @@ void add_bars(vtkChartXY *chart, const gi_chart_desc &d, const gi_chart_series &
 /* Adds series k to the chart: its own two-column table, colour, marker.
  * `name` (the title, else the file) identifies the chart in warnings. */
 void add_series(vtkChartXY *chart, const gi_chart_desc &d, const gi_chart_series &s, uint32_t k,
-                const char *name)
+                uint32_t reference_index, const char *name)
 {
     vtkNew<vtkTable> table;
     vtkNew<vtkDoubleArray> xs, ys;
@@ -472,9 +480,13 @@ void add_series(vtkChartXY *chart, const gi_chart_desc &d, const gi_chart_series
     chart->AddPlot(plot);
     plot->SetInputData(table, 0, 1);
     plot->SetLabel(label_of(s, k));
-    /* colour and marker by position, or by the series' own colour index */
+    /* colour and marker by position, or by the series' own colour index;
+     * a reference by its own index among the reference looks */
     uint32_t look = s.color > 0 ? (uint32_t)s.color - 1 : k;
-    const unsigned char *c = palette[look % palette_size];
+    if (s.style == GI_CHART_REFERENCE && s.color == 0)
+        look = reference_index;
+    const unsigned char *c = s.style == GI_CHART_REFERENCE ? reference_greys[look % reference_looks]
+                                                           : palette[look % palette_size];
     plot->SetColor(c[0], c[1], c[2], s.style == GI_CHART_THIN ? 150 : 255);
     plot->SetWidth(s.style == GI_CHART_THIN ? 1.0f : 2.0f);
     if (s.style == GI_CHART_THIN) {
@@ -483,6 +495,9 @@ void add_series(vtkChartXY *chart, const gi_chart_desc &d, const gi_chart_series
         plot->SetMarkerSize(4.0f);
     } else if (s.style == GI_CHART_DASHED) {
         plot->GetPen()->SetLineType(vtkPen::DASH_LINE);
+        plot->SetMarkerStyle(vtkPlotPoints::NONE);
+    } else if (s.style == GI_CHART_REFERENCE) {
+        plot->GetPen()->SetLineType(reference_dashes[look % reference_looks]);
         plot->SetMarkerStyle(vtkPlotPoints::NONE);
     } else {
         plot->SetMarkerStyle(markers[look % marker_count]);
@@ -698,8 +713,10 @@ gi_result render(const gi_chart_desc &d, const gi_chart_series *series, uint32_t
     set_axis(chart->GetAxis(vtkAxis::BOTTOM), d.x_label, d.log_x, xr, dejavu, d.x_ticks,
              d.x_tick_count);
     set_axis(chart->GetAxis(vtkAxis::LEFT), d.y_label, d.log_y, yr, dejavu, nullptr, 0);
-    for (uint32_t k = 0; k < n; k++)
-        add_series(chart, d, series[k], k, *title ? title : what);
+    for (uint32_t k = 0, refs = 0; k < n; k++) {
+        add_series(chart, d, series[k], k, refs, *title ? title : what);
+        refs += series[k].style == GI_CHART_REFERENCE;
+    }
     chart->SetRenderEmpty(true); /* axes and title even without a point */
     chart->SetAutoAxes(false);
     chart->GetAxis(vtkAxis::TOP)->SetVisible(false);
@@ -773,7 +790,7 @@ gi_result validate(const gi_chart_desc &d, const gi_chart_series *series, uint32
     for (uint32_t k = 0; k < n; k++) {
         const gi_chart_series &s = series[k];
         if (s.style != GI_CHART_LINE_MARKERS && s.style != GI_CHART_MARKERS &&
-            s.style != GI_CHART_DASHED && s.style != GI_CHART_THIN)
+            s.style != GI_CHART_DASHED && s.style != GI_CHART_THIN && s.style != GI_CHART_REFERENCE)
             return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
                                 "%s: series %u ('%s'): unknown style %d", what, k + 1,
                                 label_of(s, k).c_str(), s.style);

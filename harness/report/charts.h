@@ -47,6 +47,10 @@ enum {
     GI_CHART_DASHED = 2,       /* dashed line, no markers (reference curves) */
     GI_CHART_THIN = 3,         /* thin, faint line with small markers and no legend entry
                                   (the many runs behind a series that carries the legend) */
+    GI_CHART_REFERENCE = 4,    /* a reference curve (the path tracer's): grey, no markers, in
+                                  greys and dash patterns of its own that no palette colour
+                                  shares; `color` k > 0 picks the k-th of them (dark to light),
+                                  0 the position among the chart's reference series */
 };
 
 typedef struct gi_chart_series {

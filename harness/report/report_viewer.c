@@ -133,17 +133,31 @@ static json_object *find_run(json_object *runs, const char *id)
     return NULL;
 }
 
+/* Whether an image labelled `have` shows the setting labelled `label`:
+ * the label itself, or it with a repeat's number (" #2", " #3", ...). */
+static int same_setting(const char *have, const char *label)
+{
+    size_t n = strlen(label);
+    if (strncmp(have, label, n))
+        return 0;
+    if (!have[n])
+        return 1;
+    if (strncmp(have + n, " #", 2) || !have[n + 2])
+        return 0;
+    return strspn(have + n + 2, "0123456789") == strlen(have + n + 2);
+}
+
 static void add_run_image(const char *dir, json_object *images, json_object *o)
 {
     if (strcmp(report_raw(o, "status"), "ok"))
         return;
     char label[600], title[8192], info[8192];
     run_label(o, label, sizeof label);
-    /* repeats of one setting: numbered */
+    /* repeats of one setting: numbered among themselves only (a prefix
+     * match would count "light_samples=16" as a repeat of "light_samples=1") */
     int same = 0;
     for (size_t k = 0; k < json_object_array_length(images); k++)
-        same += !strncmp(report_raw(json_object_array_get_idx(images, k), "label"), label,
-                         strlen(label));
+        same += same_setting(report_raw(json_object_array_get_idx(images, k), "label"), label);
     if (same) {
         size_t used = strlen(label);
         snprintf(label + used, sizeof label - used, " #%d", same + 1);

@@ -345,12 +345,12 @@ static uint32_t method_series(gi_chart_series *series, const setting *set, uint3
     return n;
 }
 
-/* The path tracer's curves from colour `colour` on: full GI, or with
- * matched every bounce limit (labelled in labels) and then full GI.
- * Returns the number of series added. */
+/* The path tracer's curves, in the reference looks (greys, none a
+ * method's colour): full GI, or with matched every bounce limit (labelled
+ * in labels) and then full GI. Returns the number of series added. */
 static uint32_t path_tracer_series(gi_chart_series *series, int matched,
                                    const tradeoff_pt_curve *full, const tradeoff_pt_curve *mcurves,
-                                   uint32_t matched_n, char (*labels)[160], int colour)
+                                   uint32_t matched_n, char (*labels)[160])
 {
     uint32_t n = 0;
     if (!matched) {
@@ -358,23 +358,31 @@ static uint32_t path_tracer_series(gi_chart_series *series, int matched,
                                         full->t,
                                         full->e,
                                         full->n,
-                                        GI_CHART_DASHED,
-                                        colour,
+                                        GI_CHART_REFERENCE,
+                                        1,
                                         NULL,
                                         NULL,
                                         NULL,
                                         NULL};
     } else {
+        /* full GI keeps the first look in both charts; the bounce limits follow */
         for (uint32_t i = 0; i < matched_n; i++) {
             snprintf(labels[i], sizeof labels[i], "path tracer, max_bounces %u",
                      mcurves[i].bounces);
             series[n++] = (gi_chart_series){
-                labels[i],       mcurves[i].t, mcurves[i].e, mcurves[i].n, GI_CHART_DASHED,
-                colour + (int)i, NULL,         NULL,         NULL,         NULL};
+                labels[i],  mcurves[i].t, mcurves[i].e, mcurves[i].n, GI_CHART_REFERENCE,
+                (int)i + 2, NULL,         NULL,         NULL,         NULL};
         }
-        series[n++] =
-            (gi_chart_series){"path tracer, full GI",  full->t, full->e, full->n, GI_CHART_DASHED,
-                              colour + (int)matched_n, NULL,    NULL,    NULL,    NULL};
+        series[n++] = (gi_chart_series){"path tracer, full GI",
+                                        full->t,
+                                        full->e,
+                                        full->n,
+                                        GI_CHART_REFERENCE,
+                                        1,
+                                        NULL,
+                                        NULL,
+                                        NULL,
+                                        NULL};
     }
     return n;
 }
@@ -399,8 +407,7 @@ static void chart(tradeoff_chart_fn write_chart, const char *out_dir, const char
     for (uint32_t m = 0; m < nm; m++)
         n += method_series(series + n, set, ns, m, matched, fp, fx + (size_t)m * per * 6, per,
                            labels[m], sizeof labels[m], methods[m]);
-    n +=
-        path_tracer_series(series + n, matched, full, mcurves, matched_n, labels + nm, (int)nm + 1);
+    n += path_tracer_series(series + n, matched, full, mcurves, matched_n, labels + nm);
     char file[512], path[4700], title[512];
     snprintf(file, sizeof file, "chart_%s_error_vs_time%s.png", name, matched ? "_matched" : "");
     snprintf(path, sizeof path, "%s/%s", out_dir, file);

@@ -6,9 +6,18 @@
 #define _POSIX_C_SOURCE 200809L
 #include "study_internal.h"
 
+#include "gi/cache.h"
+#include "gi/log.h"
+#include "gi/timer.h"
+
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <time.h>
+#include <unistd.h>
 
 static double rec_num(json_object *o, const char *k1, const char *k2, const char *k3)
 {
@@ -20,6 +29,96 @@ static double rec_num(json_object *o, const char *k1, const char *k2, const char
         o = v;
     }
     return json_object_get_double(o);
+}
+
+/* ---- progress of a reference --------------------------------------------
+ * A reference renders in a child process for up to minutes; its progress
+ * ("reference: 256/1024 spp, 12.0 s", asked for by GIBENCH_PROGRESS_EVERY)
+ * goes to its log. A watcher thread shows the latest of those lines while
+ * the child runs, at most every 10 s in a log, in place on a terminal; a
+ * line with the samples and seconds follows when it is done. Nothing
+ * under -q. */
+typedef struct ref_watch {
+    pthread_t thread;
+    atomic_int done;
+    int started, tty;
+    char label[400], log[4200], stats[4200];
+    double t0;
+} ref_watch;
+
+static void watch_line(const ref_watch *w, char *line, size_t size)
+{
+    line[0] = '\0';
+    size_t n = 0;
+    char *text = gi_file_read_all(w->log, &n);
+    char *last = NULL;
+    for (char *p = text; p && (p = strstr(p, "reference: ")); p++)
+        last = p;
+    if (last) {
+        last += strlen("reference: ");
+        size_t k = strcspn(last, "\n");
+        if (last[k] == '\n') /* a whole line only */
+            snprintf(line, size, "%.*s", (int)k, last);
+    }
+    free(text);
+}
+
+static void *watch_main(void *arg)
+{
+    ref_watch *w = arg;
+    double shown = w->t0;
+    char line[256], prev[256] = "";
+    while (!atomic_load(&w->done)) {
+        struct timespec ts = {0, 200 * 1000 * 1000};
+        nanosleep(&ts, NULL);
+        double now = gi_now();
+        if (now - shown < (w->tty ? 1.0 : 10.0))
+            continue;
+        watch_line(w, line, sizeof line);
+        if (!line[0] || !strcmp(line, prev))
+            continue;
+        snprintf(prev, sizeof prev, "%s", line);
+        char el[32];
+        cli_format_duration(now - w->t0, el, sizeof el);
+        fprintf(stderr, "%sstudy: %s: %s; elapsed %s%s", w->tty ? "\r" : "", w->label, line, el,
+                w->tty ? "\033[K" : "\n");
+        shown = now;
+    }
+    return NULL;
+}
+
+static void watch_start(ref_watch *w, const char *label, const char *out_exr)
+{
+    memset(w, 0, sizeof *w);
+    if (gi_log_get_level() < GI_LOG_WARN) /* -q */
+        return;
+    snprintf(w->label, sizeof w->label, "%s", label);
+    snprintf(w->log, sizeof w->log, "%s.log", out_exr);
+    snprintf(w->stats, sizeof w->stats, "%s.json", out_exr);
+    w->tty = isatty(STDERR_FILENO);
+    w->t0 = gi_now();
+    /* the reference child's progress lines, every 2 s, into its log */
+    setenv("GIBENCH_PROGRESS_EVERY", "2", 1);
+    w->started = pthread_create(&w->thread, NULL, watch_main, w) == 0;
+}
+
+/* Stops the watcher; when the reference exists, a line with its samples
+ * and render time (from its statistics). */
+static void watch_stop(ref_watch *w, int ok)
+{
+    if (w->started) {
+        atomic_store(&w->done, 1);
+        pthread_join(w->thread, NULL);
+        if (w->tty)
+            fputs("\r\033[K", stderr);
+    }
+    if (!ok || !w->label[0])
+        return;
+    json_object *sj = cli_read_json(w->stats);
+    double spp = rec_num(sj, "spp", NULL, NULL), t = rec_num(sj, "render_seconds", NULL, NULL);
+    json_object_put(sj);
+    if (isfinite(spp) && isfinite(t))
+        fprintf(stderr, "study: %s: %.0f spp in %.2f s\n", w->label, spp, t);
 }
 
 /* The path tracer's convergence curve at one bounce limit: an image of
@@ -40,9 +139,17 @@ static int pt_convergence(study *st, const char *out_dir, const study_ref *sc, c
         snprintf(stem, sizeof stem, "%s", sc->name);
         snprintf(img, sizeof img, "%s/references/%s_conv_%s%uspp%s.exr", out_dir, stem, b,
                  st->conv_spp[c], px);
-        if (!runner_reference(scene, st->scenes[sc->scene_index].hash, st->camera, sc->width,
-                              sc->height, st->conv_spp[c], 0.0, bounces, st->seed + 7919, sc->time,
-                              st->ref_pixel_center, st->timeout_s, img, why, why_size))
+        char label[400];
+        snprintf(label, sizeof label, "convergence %s (%u bounces, %u spp)", stem, bounces,
+                 st->conv_spp[c]);
+        ref_watch w;
+        watch_start(&w, label, img);
+        int ok =
+            runner_reference(scene, st->scenes[sc->scene_index].hash, st->camera, sc->width,
+                             sc->height, st->conv_spp[c], 0.0, bounces, st->seed + 7919, sc->time,
+                             st->ref_pixel_center, st->timeout_s, img, why, why_size);
+        watch_stop(&w, ok);
+        if (!ok)
             return 0;
         snprintf(stats, sizeof stats, "%s.json", img);
         json_object *sj = cli_read_json(stats);
@@ -101,9 +208,16 @@ int study_build_reference_set(study *st, const char *out_dir, uint32_t ri, int c
              st->ref_spp, px);
     fprintf(stderr, "study: reference %s (%ux%u, %u spp, %u bounces)\n", stem, sc->width,
             sc->height, st->ref_spp, st->ref_bounces);
-    if (!runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width, sc->height,
-                          st->ref_spp, st->ref_target_se, st->ref_bounces, st->seed, sc->time,
-                          st->ref_pixel_center, st->timeout_s * 10, sc->ref_full, why, why_size))
+    char label[400];
+    snprintf(label, sizeof label, "reference %s (%u bounces)", stem, st->ref_bounces);
+    ref_watch w;
+    watch_start(&w, label, sc->ref_full);
+    int ok =
+        runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width, sc->height,
+                         st->ref_spp, st->ref_target_se, st->ref_bounces, st->seed, sc->time,
+                         st->ref_pixel_center, st->timeout_s * 10, sc->ref_full, why, why_size);
+    watch_stop(&w, ok);
+    if (!ok)
         return 0;
     /* the noise floor of an animation frame: the same reference with another seed */
     if (sc->want_alt) {
@@ -128,10 +242,14 @@ int study_build_reference_set(study *st, const char *out_dir, uint32_t ri, int c
             snprintf(sc->ref_matched[k], sizeof sc->ref_matched[k], "%s/%s_b%u_%uspp%s.exr", dir,
                      stem, b, st->ref_spp, px);
             fprintf(stderr, "study: bounce-matched reference %s (%u bounces)\n", stem, b);
-            if (!runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width,
+            snprintf(label, sizeof label, "bounce-matched reference %s (%u bounces)", stem, b);
+            watch_start(&w, label, sc->ref_matched[k]);
+            ok = runner_reference(path, st->scenes[sc->scene_index].hash, st->camera, sc->width,
                                   sc->height, st->ref_spp, st->ref_target_se, b, st->seed, sc->time,
                                   st->ref_pixel_center, st->timeout_s * 10, sc->ref_matched[k], why,
-                                  why_size))
+                                  why_size);
+            watch_stop(&w, ok);
+            if (!ok)
                 return 0;
             sc->matched_count++;
         }

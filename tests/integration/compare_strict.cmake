@@ -37,7 +37,18 @@ if(NOT rc STREQUAL "2" OR NOT err MATCHES "--methods '' has an empty method name
 endif()
 refuse(empty_in_list "has an empty method name" --methods "direct,")
 refuse(twice "--methods names 'direct' twice" --methods "direct,direct")
-refuse(unknown_method "no method 'nope'" --methods "direct,nope")
+# an unknown method: the line lists the installed ones, as render's does
+refuse(unknown_method "no method 'nope' \\(installed: [^)]*direct" --methods "direct,nope")
+# --camera view:FILE (a view saved by gibench view) is taken as render,
+# reference and studies take it: past the camera check, the next fault is
+# the parameter's; a view that cannot be read is refused in one line
+file(WRITE ${D}/view.json "{\"gibench_view\": 1, \"scene\": \"${SCENE}\", \"method\": \"direct\", \"params\": [],
+  \"width\": 32, \"height\": 32, \"frames\": 1, \"seed\": 1, \"time\": 0, \"exposure\": 0,
+  \"camera\": {\"eye\": [0, 1, 3.5], \"forward\": [0, 0, -1], \"up\": [0, 1, 0], \"yfov\": 0.7,
+              \"znear\": 0.01, \"zfar\": 100}, \"nodes\": []}")
+refuse(view_camera "--param direct: unknown parameter 'foo'" --methods direct
+       --camera view:${D}/view.json --param direct.foo=1)
+refuse(view_missing "compare: --camera .*none\\.json" --methods direct --camera view:${D}/none.json)
 refuse(unknown_param "--param direct: unknown parameter 'foo'" --methods direct --param direct.foo=1)
 refuse(param_range "light_samples=0 is outside" --methods direct --param direct.light_samples=0)
 refuse(missing_reference "--reference ${D}/none.exr" --methods direct --reference ${D}/none.exr)

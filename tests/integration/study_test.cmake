@@ -18,6 +18,20 @@ match("${last_out}" "label=table1 N=128 M=128 enumeration=hilbert" "csm.json: no
 match("${last_out}" "no-cache not-compared label=table1" "csm.json: Table 1 runs must skip the cache and the references")
 match("${last_out}" "animate not-compared label=moving" "csm.json: no animated run")
 
+# The demo (make demo) runs the baseline and every method of the five
+# papers, and times csm's and cssm_hrc's precomputation cold in both
+# repeats (no cache: a repeat would otherwise read the first one's maps)
+run(0 study harness/studies/demo.json --dry-run)
+foreach(mn direct:8 csm:4 cssm_hrc:4 implicit_vis:2 vlf:2 avg:4)
+    string(REPLACE ":" ";" mn "${mn}")
+    list(GET mn 0 m)
+    list(GET mn 1 n)
+    match_count("${last_out}" "\nrun cornell_box-${m}-" ${n} "demo.json: runs of ${m}")
+endforeach()
+foreach(m csm cssm_hrc)
+    match("${last_out}" "\nrun cornell_box-${m}-[^\n]* no-cache " "demo.json: ${m} runs with the cache:\n${last_out}")
+endforeach()
+
 run(2 study tests/data/studies/bad_entry_key.json --dry-run)
 match("${last_err}" "/methods/0/frame: unknown key" "an unknown method-entry key was not named:\n${last_err}")
 run(2 study tests/data/studies/bad_chart.json --dry-run)
@@ -27,6 +41,14 @@ match("${last_err}" "/charts/0: \"file\" must be a plain file name" "a chart esc
 set(S ${OUT}/study_csm_tiny)
 file(REMOVE_RECURSE ${S})
 run(0 study tests/data/studies/csm_tiny.json --out ${S})
+# the reference stage reports each reference as it is done (issue 33: it was
+# silent for a minute at the demo's size)
+match("${last_err}" "study: reference bunny_env \\(4 bounces\\): 16 spp in [0-9.]+ s\n"
+      "no progress line for the full-GI reference:\n${last_err}")
+match("${last_err}" "study: bounce-matched reference bunny_env \\(1 bounces\\): 16 spp in [0-9.]+ s\n"
+      "no progress line for the bounce-matched reference:\n${last_err}")
+match("${last_err}" "study: convergence bunny_env \\(1 bounces, 4 spp\\): 4 spp in [0-9.]+ s\n"
+      "no progress line for the convergence images:\n${last_err}")
 file(READ ${S}/runs.csv csv)
 match_count("${csv}" "\n[^\n]+" 6 "csm_tiny: runs")
 match("${csv}" "^run,[^\n]*,label,width,height,prepare_depth_render_ms,prepare_compress_ms[^\n]*,stat_ratio,"

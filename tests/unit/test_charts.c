@@ -342,6 +342,38 @@ static void test_colour_index(void)
     gi_image_free(img);
 }
 
+/* A reference curve (GI_CHART_REFERENCE, the path tracer's) is drawn in
+ * a grey of its own: even first in the chart it takes no palette colour. */
+static void test_reference_look(void)
+{
+    double x[4] = {0, 1, 2, 3}, y[4] = {3, 2, 1, 0};
+    size_t grey_px[2] = {0, 0}, blue_px = 0;
+    /* without and with the curve: antialiased axis text has greys too */
+    for (uint32_t with = 0; with < 2; with++) {
+        gi_chart_series s[1] = {
+            {"path tracer", x, y, 4 * with, GI_CHART_REFERENCE, 0, NULL, NULL, NULL, NULL}};
+        gi_chart_desc d = {"reference look", "x", "y", 0, 0, 500, 400, NULL, 0};
+        char path[600];
+        snprintf(path, sizeof path, "%s/reference_look_%u.png", dir, with);
+        gi_error err = {{0}};
+        CHECK_MSG(gi_chart_write_png(path, &d, s, 1, &err) == GI_OK, "%s", err.text);
+        gi_image *img = gi_image_read(path, &err);
+        CHECK_MSG(img != NULL, "%s", err.text);
+        static const int blue[3] = {0, 114, 178}, grey[3] = {90, 90, 90};
+        for (uint32_t yy = 0; img && yy < img->height; yy++)
+            for (uint32_t xx = 0; xx < img->width; xx++) {
+                int rgb[3];
+                px(img, xx, yy, rgb);
+                blue_px += near_colour(rgb, blue, 24);
+                grey_px[with] += near_colour(rgb, grey, 6);
+            }
+        gi_image_free(img);
+    }
+    CHECK_MSG(grey_px[1] > grey_px[0] + 100 && blue_px == 0,
+              "%zu grey pixels with the curve, %zu without; %zu blue", grey_px[1], grey_px[0],
+              blue_px);
+}
+
 /* Axis ranges (charts.h): a short span is widened so that noise does not
  * fill the y axis; a wide one is only padded; error bars count. */
 static void test_noise_ranges(void)
@@ -526,6 +558,7 @@ int main(void)
     test_points_kept();
     test_ranges();
     test_colour_index();
+    test_reference_look();
     test_noise_ranges();
     test_error_bars();
     test_custom_ticks();

@@ -4,9 +4,11 @@
 #include "flip.h"
 #include "metrics.h"
 
+#include "gi/cache.h"
 #include "gi/tonemap.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -698,6 +700,144 @@ static void test_leaked_energy(void)
     gi_image_free(lit);
 }
 
+/* A PFM of tests/data/flip/ ("PF", little-endian, rows bottom first, as
+ * make_flip_data.py writes it), read here so that the test needs no image
+ * module; NULL when it is not one. */
+static gi_image *read_pfm(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    unsigned w = 0, h = 0;
+    float scale = 0.0f;
+    gi_image *img = NULL;
+    if (f && fscanf(f, "PF %u %u %f", &w, &h, &scale) == 3 && scale < 0.0f && fgetc(f) == '\n' &&
+        w > 0 && h > 0 && w <= 4096 && h <= 4096 && (img = gi_image_create(w, h)) != NULL) {
+        for (unsigned y = 0; y < h; y++)
+            for (unsigned x = 0; x < w; x++) {
+                float *p = img->rgba + ((size_t)(h - 1 - y) * w + x) * 4;
+                if (fread(p, sizeof(float), 3, f) != 3) {
+                    gi_image_free(img);
+                    img = NULL;
+                    y = h;
+                    break;
+                }
+                p[3] = 1.0f;
+            }
+    }
+    if (f)
+        fclose(f);
+    return img;
+}
+
+/* The mean of pair `name` in section `section` ("ldr"/"hdr") of
+ * tests/data/flip/reference.json, NaN when absent. */
+static double nvidia_mean(const char *json, const char *section, const char *name)
+{
+    char key[64];
+    snprintf(key, sizeof key, "\"%s\": {", section);
+    const char *p = strstr(json, key);
+    snprintf(key, sizeof key, "\"%s\": {", name);
+    p = p ? strstr(p, key) : NULL;
+    p = p ? strstr(p, "\"mean\": ") : NULL;
+    return p ? strtod(p + 8, NULL) : NAN;
+}
+
+/* LDR-FLIP against NVIDIA's own implementation (FLIP v1.6, its C++ tool;
+ * tests/data/flip/PROVENANCE.md): the mean of three 32x32 pairs (a noisy
+ * gradient, shifted edges, dark noise) within 5e-5 (the tool prints six
+ * decimals), and the per-pixel map of the edge pair within 0.004 (the
+ * tool's map is an 8-bit PNG: half a step is 0.002). */
+static void test_flip_nvidia(void)
+{
+    size_t n = 0;
+    char *json = gi_file_read_all(GI_TEST_DATA "/flip/reference.json", &n);
+    CHECK_MSG(json != NULL, "tests/data/flip/reference.json not readable");
+    if (!json)
+        return;
+    const char *pairs[] = {"noise", "edges", "dark"};
+    for (int k = 0; k < 3; k++) {
+        char path[1024];
+        gi_error err;
+        snprintf(path, sizeof path, GI_TEST_DATA "/flip/%s_ref.pfm", pairs[k]);
+        gi_image *ref = read_pfm(path);
+        snprintf(path, sizeof path, GI_TEST_DATA "/flip/%s_test.pfm", pairs[k]);
+        gi_image *test = read_pfm(path);
+        CHECK_MSG(ref && test, "%s: the pair's PFMs are not readable", pairs[k]);
+        double want = nvidia_mean(json, "ldr", pairs[k]), mean = NAN;
+        CHECK_MSG(isfinite(want), "%s: no mean in reference.json", pairs[k]);
+        float *map = ref ? malloc((size_t)ref->width * ref->height * sizeof *map) : NULL;
+        gi_metrics_opts o = {0};
+        if (ref && test && map)
+            CHECK(gi_metrics_flip_map(test, ref, &o, map, &mean, &err) == GI_OK);
+        CHECK_MSG(fabs(mean - want) <= 5e-5, "%s: gibench %.6f, NVIDIA %.6f", pairs[k], mean, want);
+        gi_image *nv = k == 1 ? read_pfm(GI_TEST_DATA "/flip/edges_flip_map.pfm") : NULL;
+        if (k == 1) {
+            CHECK_MSG(nv && ref && nv->width == ref->width && nv->height == ref->height,
+                      "edges_flip_map.pfm: not readable or not the pair's size");
+            double worst = 0.0;
+            for (size_t i = 0; nv && map && i < (size_t)nv->width * nv->height; i++)
+                worst = fmax(worst, fabs(map[i] - nv->rgba[i * 4]));
+            CHECK_MSG(worst <= 0.004, "edges: per-pixel FLIP differs by up to %.4f", worst);
+        }
+        gi_image_free(nv);
+        free(map);
+        gi_image_free(ref);
+        gi_image_free(test);
+    }
+    free(json);
+}
+
+/* HDR-FLIP against NVIDIA's tool (FLIP v1.6, EXR inputs, its defaults: ACES,
+ * exposures from the reference) on a gibench render and its reference: the
+ * exposure range within 1e-3 stops and the mean within 5e-5 (six decimals). */
+static void test_flip_hdr_nvidia(void)
+{
+    size_t n = 0;
+    char *json = gi_file_read_all(GI_TEST_DATA "/flip/reference.json", &n);
+    CHECK_MSG(json != NULL, "tests/data/flip/reference.json not readable");
+    gi_error err;
+    gi_image *ref = gi_image_read(GI_TEST_DATA "/flip/render_ref.exr", &err);
+    gi_image *test = gi_image_read(GI_TEST_DATA "/flip/render_test.exr", &err);
+    CHECK_MSG(ref && test, "%s", err.text);
+    if (!json || !ref || !test) {
+        free(json);
+        gi_image_free(ref);
+        gi_image_free(test);
+        return;
+    }
+    size_t px = (size_t)ref->width * ref->height;
+    float *r3 = malloc(px * 3 * sizeof *r3), *t3 = malloc(px * 3 * sizeof *t3);
+    float *map = malloc(px * sizeof *map);
+    for (size_t i = 0; r3 && t3 && i < px; i++)
+        for (int c = 0; c < 3; c++) {
+            r3[i * 3 + c] = ref->rgba[i * 4 + c];
+            t3[i * 3 + c] = test->rgba[i * 4 + c];
+        }
+    gi_flip_hdr_info info = {0};
+    double mean = NAN;
+    if (r3 && t3 && map &&
+        gi_flip_hdr_map(t3, r3, ref->width, ref->height, GI_FLIP_PPD_DEFAULT, map, &info, &err) ==
+            GI_OK) {
+        mean = 0.0;
+        for (size_t i = 0; i < px; i++)
+            mean += map[i];
+        mean /= (double)px;
+    }
+    const char *e = strstr(json, "\"Start exposure\": \"");
+    double start = e ? strtod(e + 19, NULL) : NAN;
+    e = strstr(json, "\"Stop exposure\": \"");
+    double stop = e ? strtod(e + 18, NULL) : NAN, want = nvidia_mean(json, "hdr", "render");
+    CHECK_MSG(fabs(info.start - start) <= 1e-3 && fabs(info.stop - stop) <= 1e-3,
+              "exposures %.4f..%.4f, NVIDIA %.4f..%.4f", info.start, info.stop, start, stop);
+    CHECK_MSG(info.count == 10, "%d exposures, NVIDIA 10", info.count);
+    CHECK_MSG(fabs(mean - want) <= 5e-5, "HDR-FLIP: gibench %.6f, NVIDIA %.6f", mean, want);
+    free(r3);
+    free(t3);
+    free(map);
+    gi_image_free(ref);
+    gi_image_free(test);
+    free(json);
+}
+
 int main(void)
 {
     test_single_pixel();
@@ -710,6 +850,8 @@ int main(void)
     test_flip_kernels();
     test_flip_values();
     test_flip_against_direct();
+    test_flip_nvidia();
+    test_flip_hdr_nvidia();
     test_leaked_energy();
     return gi_test_finish();
 }

@@ -45,7 +45,7 @@ static struct {
     char last_path[512];
     uint32_t front_count[2];
     double front_x[2][16], front_y[2][16];
-    uint32_t thin, dashed;
+    uint32_t thin, reference, pt_not_reference, pt_colour_twice;
 } seen;
 
 static gi_result fake_chart(const char *path, const gi_chart_desc *desc, const gi_chart_series *s,
@@ -54,13 +54,22 @@ static gi_result fake_chart(const char *path, const gi_chart_desc *desc, const g
     (void)desc, (void)err;
     seen.calls++;
     snprintf(seen.last_path, sizeof seen.last_path, "%s", path);
+    /* the path tracer's curves: in the reference looks (never a method's
+     * colour, issue 33), each bounce limit a look of its own */
+    int used[64] = {0};
+    for (uint32_t i = 0; i < n; i++)
+        if (s[i].label && !strncmp(s[i].label, "path tracer", 11)) {
+            seen.pt_not_reference += s[i].style != GI_CHART_REFERENCE;
+            if (s[i].color >= 0 && s[i].color < 64)
+                seen.pt_colour_twice += used[s[i].color]++ > 0;
+        }
     if (seen.calls > 1)
         return GI_OK; /* the matched chart: counted only */
     for (uint32_t i = 0; i < n; i++) {
         if (s[i].style == GI_CHART_THIN)
             seen.thin++;
-        if (s[i].style == GI_CHART_DASHED)
-            seen.dashed++;
+        if (s[i].style == GI_CHART_REFERENCE)
+            seen.reference++;
         int m = s[i].label && !strncmp(s[i].label, "fast", 4)   ? 0
                 : s[i].label && !strncmp(s[i].label, "prog", 4) ? 1
                                                                 : -1;
@@ -155,8 +164,11 @@ static void test_report(void)
     /* charts: full and matched; the fronts are staircases */
     CHECK(seen.calls == 2);
     CHECK(strstr(seen.last_path, "chart_box_error_vs_time_matched.png") != NULL);
-    CHECK(seen.thin == 3);   /* every setting's own curve */
-    CHECK(seen.dashed == 1); /* the full-GI path tracer */
+    CHECK(seen.thin == 3);      /* every setting's own curve */
+    CHECK(seen.reference == 1); /* the full-GI path tracer */
+    CHECK_MSG(seen.pt_not_reference == 0, "%u path tracer curves drawn as a method's",
+              seen.pt_not_reference);
+    CHECK(seen.pt_colour_twice == 0);
     CHECK(seen.front_count[0] == 1);
     CHECK(seen.front_count[1] == 5);
     double want_x[5] = {1, 2, 2, 4, 4}, want_y[5] = {0.2, 0.2, 0.1, 0.1, 0.05};
