@@ -1,0 +1,202 @@
+"""gibench from Python: methods, scenes and renders in one process, images as numpy arrays.
+
+    import gibench
+    scene = gibench.Scene("scenes/cornell_box.gltf")
+    img = scene.render("csm", size=(128, 128), frames=8, seed=1)
+    img.shape, img.dtype      # (128, 128, 3) float32, rows top to bottom
+    img.timings["render"]     # the run's stage timings, as gibench render --timings
+
+The names and defaults are the CLI's (docs/commands.md); the render is the
+same code as `gibench render`, so the images are the same bit for bit.
+One process keeps one GL context (made on first use, on the calling
+thread: use gibench from one thread) and the installed plugins; a Scene
+keeps its loaded scene and GPU upload. docs/python.md has the whole API.
+"""
+import ctypes
+import json
+import os
+import subprocess
+import tempfile
+
+import numpy as np
+
+from . import _build
+from ._lib import Error, RunError, UsageError, GiError, RenderOpts, check, lib, take_string
+
+__all__ = ["Error", "RunError", "UsageError", "Image", "Scene", "methods", "read", "write"]
+
+
+class Image(np.ndarray):
+    """A float32 H x W x 3 numpy array with the run's `timings` (a dict: method,
+    params, prepare and render stage statistics in ms, stats; None for an image
+    that was not rendered)."""
+
+    def __new__(cls, array, timings=None):
+        obj = np.asarray(array, dtype=np.float32).view(cls)
+        obj.timings = timings
+        return obj
+
+    def __array_finalize__(self, obj):
+        self.timings = getattr(obj, "timings", None)
+
+
+def methods():
+    """The installed methods as `gibench methods --json` lists them: dicts with
+    id, title, citation, caps, max_bounces and params (name, type, default,
+    min/max or choices, and "quality" for a quality knob)."""
+    out = ctypes.c_void_p()
+    err = GiError()
+    check(lib.gibench_methods_json(ctypes.byref(out), ctypes.byref(err)), err)
+    return json.loads(take_string(out))
+
+
+def _param_text(value):
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return str(value)
+
+
+def _size(size):
+    try:
+        w, h = (int(v) for v in size)
+    except (TypeError, ValueError):
+        raise UsageError("render: size %r is not (width, height)" % (size,)) from None
+    if w < 0 or h < 0 or w > 0xFFFFFFFF or h > 0xFFFFFFFF:
+        raise UsageError("render: --size '%dx%d' is not a size" % (w, h))
+    return w, h
+
+
+def _uint(name, value, lo, hi):
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not lo <= value <= hi:
+        raise UsageError("render: --%s '%s' is not an integer in %d..%d" % (name, value, lo, hi))
+    return int(value)
+
+
+class Scene:
+    """A loaded scene and its GPU upload (gibench render --scene PATH).
+
+    cameras: the scene's camera names (camera= takes a name or "#k");
+    duration: the animation's length in seconds (0 for a static scene)."""
+
+    def __init__(self, path):
+        self.path = os.fspath(path)
+        self._handle = ctypes.c_void_p()
+        err = GiError()
+        check(lib.gibench_scene_open(self.path.encode(), ctypes.byref(self._handle),
+                                     ctypes.byref(err)), err)
+        out = ctypes.c_void_p()
+        check(lib.gibench_scene_info_json(self._handle, ctypes.byref(out), ctypes.byref(err)), err)
+        info = json.loads(take_string(out))
+        self.cameras = info["cameras"]
+        self.duration = info["duration"]
+        self.info = info
+
+    def close(self):
+        """Releases the scene and its upload now (also when the object goes)."""
+        if getattr(self, "_handle", None) and self._handle.value:
+            lib.gibench_scene_close(self._handle)
+            self._handle = ctypes.c_void_p()
+
+    def __del__(self):
+        self.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def _alive(self):
+        if not self._handle.value:
+            raise UsageError("render: the scene %s is closed" % self.path)
+
+    def render(self, method, size=(256, 256), frames=1, seed=1, params=None, camera=None,
+               time=0.0, warmup=0, exposure=0.0, no_cache=False, isolate=False):
+        """One render as `gibench render --scene S --method M`: an Image (H x W x 3
+        float32, the last frame) with .timings. isolate=True runs it in a child
+        `gibench render` process, so that a crashing plugin raises RunError
+        instead of taking the interpreter down."""
+        w, h = _size(size)
+        frames = _uint("frames", frames, 1, 1000000)
+        seed = _uint("seed", seed, 0, 0xFFFFFFFF)
+        warmup = _uint("warmup", warmup, 0, 1000)
+        texts = ["%s=%s" % (k, _param_text(v)) for k, v in (params or {}).items()]
+        if isolate:
+            return self._render_child(method, w, h, frames, seed, texts, camera, time, warmup,
+                                      exposure, no_cache)
+        self._alive()
+        arr = (ctypes.c_char_p * max(1, len(texts)))(*[t.encode() for t in texts])
+        o = RenderOpts(method=str(method).encode(), camera=None if camera is None else
+                       str(camera).encode(), params=arr, param_count=len(texts), width=w, height=h,
+                       frames=frames, warmup=warmup, seed=seed, time=float(time),
+                       exposure=float(exposure), no_cache=1 if no_cache else 0)
+        if w * h > (1 << 28):
+            raise UsageError("render: --size '%dx%d' is too large" % (w, h))
+        img = np.empty((h, w, 3), dtype=np.float32)
+        out = ctypes.c_void_p()
+        err = GiError()
+        res = lib.gibench_render(self._handle, ctypes.byref(o),
+                                 img.ctypes.data_as(ctypes.POINTER(ctypes.c_float)),
+                                 ctypes.byref(out), ctypes.byref(err))
+        check(res, err)
+        return Image(img, json.loads(take_string(out)))
+
+    def _render_child(self, method, w, h, frames, seed, texts, camera, time, warmup, exposure,
+                      no_cache):
+        with tempfile.TemporaryDirectory(prefix="gibench-py-") as tmp:
+            out = os.path.join(tmp, "image.exr")
+            timings = os.path.join(tmp, "timings.json")
+            cmd = [os.environ.get("GIBENCH_BIN") or _build.COMMAND, "-q", "render",
+                   "--scene", self.path, "--method", str(method), "--out", out,
+                   "--size", "%dx%d" % (w, h), "--frames", str(frames), "--seed", str(seed),
+                   "--warmup", str(warmup), "--time", repr(float(time)),
+                   "--exposure", repr(float(exposure)), "--timings", timings]
+            for t in texts:
+                cmd += ["--param", t]
+            if camera is not None:
+                cmd += ["--camera", str(camera)]
+            if no_cache:
+                cmd.append("--no-cache")
+            p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            if p.returncode != 0:
+                raise _child_error(p)
+            img = read(out)
+            with open(timings) as f:
+                return Image(img, json.load(f))
+
+
+def _child_error(p):
+    """The exception of a failed child gibench: its last 'gibench: ' line."""
+    lines = [ln[len("gibench: "):] for ln in p.stderr.splitlines() if ln.startswith("gibench: ")]
+    if p.returncode < 0:
+        return RunError("render: the child process died of signal %d%s" %
+                        (-p.returncode, (" (" + lines[-1] + ")") if lines else ""))
+    msg = lines[-1] if lines else (p.stderr.strip().splitlines() or ["exit status %d" % p.returncode])[-1]
+    return UsageError(msg) if p.returncode == 2 else RunError(msg)
+
+
+def read(path):
+    """An image file (EXR, PFM, PNG) read by gibench's own reader: H x W x 3 float32."""
+    rgba = ctypes.POINTER(ctypes.c_float)()
+    w, h = ctypes.c_uint32(), ctypes.c_uint32()
+    err = GiError()
+    res = lib.gibench_image_read(os.fspath(path).encode(), ctypes.byref(rgba), ctypes.byref(w),
+                                 ctypes.byref(h), ctypes.byref(err))
+    check(res, err)
+    try:
+        a = np.ctypeslib.as_array(rgba, shape=(h.value, w.value, 4))[:, :, :3].copy()
+    finally:
+        lib.gibench_free(ctypes.cast(rgba, ctypes.c_void_p))
+    return Image(a)
+
+
+def write(path, img, exposure=0.0):
+    """Writes an H x W x 3 image as gibench render writes its --out (EXR/PFM
+    linear; PNG with the exposure in stops, sRGB)."""
+    a = np.ascontiguousarray(np.asarray(img, dtype=np.float32))
+    if a.ndim != 3 or a.shape[2] != 3 or a.shape[0] == 0 or a.shape[1] == 0:
+        raise UsageError("write: the image is not H x W x 3 (shape %s)" % (a.shape,))
+    err = GiError()
+    check(lib.gibench_image_write(os.fspath(path).encode(),
+                                  a.ctypes.data_as(ctypes.POINTER(ctypes.c_float)),
+                                  a.shape[1], a.shape[0], float(exposure), ctypes.byref(err)), err)
