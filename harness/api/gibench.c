@@ -3,6 +3,7 @@
 #include "gi/gibench.h"
 
 #include "cli.h"
+#include "gibench_internal.h"
 #include "gi/cache.h"
 #include "gi/image.h"
 #include "gi/log.h"
@@ -42,7 +43,7 @@ static gi_result ensure_plugins(gi_error *err)
     return g_reg ? GI_OK : gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory");
 }
 
-static gi_result json_out(json_object *j, char **out, gi_error *err)
+gi_result gibench_json_out(json_object *j, char **out, gi_error *err)
 {
     const char *text =
         json_object_to_json_string_ext(j, JSON_C_TO_STRING_PLAIN | JSON_C_TO_STRING_NOSLASHESCAPE);
@@ -73,7 +74,7 @@ gi_result gibench_methods_json(char **out, gi_error *err)
     json_object *arr = json_object_new_array();
     for (uint32_t i = 0; i < g_reg->count; i++)
         json_object_array_add(arr, cli_method_json(&g_reg->items[i]));
-    return json_out(arr, out, err);
+    return gibench_json_out(arr, out, err);
 }
 
 gi_result gibench_scene_open(const char *path, gibench_scene **out, gi_error *err)
@@ -100,6 +101,11 @@ gi_result gibench_scene_open(const char *path, gibench_scene **out, gi_error *er
     return GI_OK;
 }
 
+const gi_scene *gibench_scene_of(const gibench_scene *s)
+{
+    return s->scene;
+}
+
 void gibench_scene_close(gibench_scene *s)
 {
     if (!s)
@@ -123,7 +129,7 @@ gi_result gibench_scene_info_json(const gibench_scene *s, char **out, gi_error *
     json_object_object_add(j, "objects", json_object_new_int64(sc->object_count));
     json_object_object_add(j, "lights", json_object_new_int64(sc->light_count));
     json_object_object_add(j, "triangles", json_object_new_int64(sc->triangle_count));
-    return json_out(j, out, err);
+    return gibench_json_out(j, out, err);
 }
 
 /* The method, its parameters and the camera, checked as gibench render
@@ -259,7 +265,7 @@ gi_result gibench_render(gibench_scene *s, const gibench_render_opts *o, float *
     l.camera = camera;
     res = run_loop(&l, params, o->frames, rgb, err);
     if (res == GI_OK && timings)
-        res = json_out(timings_json(&l, params, &host), timings, err);
+        res = gibench_json_out(timings_json(&l, params, &host), timings, err);
     render_loop_free(&l);
     gi_timer_free(l.prep_timer);
     gi_timer_free(l.render_timer);

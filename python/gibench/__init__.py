@@ -21,9 +21,11 @@ import tempfile
 import numpy as np
 
 from . import _build
-from ._lib import Error, RunError, UsageError, GiError, RenderOpts, check, lib, take_string
+from ._lib import (Error, GiError, ReferenceOpts, RenderOpts, RunError, UsageError, check, lib,
+                   take_string)
 
-__all__ = ["Error", "RunError", "UsageError", "Image", "Scene", "methods", "read", "write"]
+__all__ = ["Error", "RunError", "UsageError", "Image", "Scene", "methods", "metrics", "read",
+           "write"]
 
 
 class Image(np.ndarray):
@@ -56,19 +58,19 @@ def _param_text(value):
     return str(value)
 
 
-def _size(size):
+def _size(size, cmd="render"):
     try:
         w, h = (int(v) for v in size)
     except (TypeError, ValueError):
-        raise UsageError("render: size %r is not (width, height)" % (size,)) from None
+        raise UsageError("%s: size %r is not (width, height)" % (cmd, size)) from None
     if w < 0 or h < 0 or w > 0xFFFFFFFF or h > 0xFFFFFFFF:
-        raise UsageError("render: --size '%dx%d' is not a size" % (w, h))
+        raise UsageError("%s: --size '%dx%d' is not a size" % (cmd, w, h))
     return w, h
 
 
-def _uint(name, value, lo, hi):
+def _uint(name, value, lo, hi, cmd="render"):
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not lo <= value <= hi:
-        raise UsageError("render: --%s '%s' is not an integer in %d..%d" % (name, value, lo, hi))
+        raise UsageError("%s: --%s '%s' is not an integer in %d..%d" % (cmd, name, value, lo, hi))
     return int(value)
 
 
@@ -141,6 +143,45 @@ class Scene:
         check(res, err)
         return Image(img, json.loads(take_string(out)))
 
+    def reference(self, spp=None, seconds=None, target_se=None, max_bounces=None,
+                  size=(256, 256), seed=1, camera=None, time=0.0, threads=0, pixel="box",
+                  traversal="fast"):
+        """The path-traced reference as `gibench reference`: (mean, variance), two
+        H x W x 3 float32 arrays; mean.timings holds the run's stats (spp, stop,
+        render_seconds, mean_rel_se, ...). Progressive: it stops at spp samples per
+        pixel, after `seconds`, or at the mean relative standard error target_se
+        (--target-se), whichever comes first; with none given, 256 spp.
+        max_bounces None is unlimited; time is the scene's time (--time-of-scene)."""
+        self._alive()
+        w, h = _size(size, "reference")
+        if pixel not in ("box", "center"):
+            raise UsageError("reference: --pixel '%s' is not box or center" % pixel)
+        if traversal not in ("fast", "robust"):
+            raise UsageError("reference: --traversal '%s' is not fast or robust" % traversal)
+        o = ReferenceOpts(camera=None if camera is None else str(camera).encode(), width=w,
+                          height=h, seed=_uint("seed", seed, 0, 0xFFFFFFFF, "reference"),
+                          threads=_uint("threads", threads, 0, 1024, "reference"),
+                          time=float(time), pixel_center=pixel == "center",
+                          robust_traversal=traversal == "robust")
+        o.max_bounces = -1 if max_bounces is None else _uint("max-bounces", max_bounces, 0,
+                                                             1000000, "reference")
+        if spp is not None:
+            o.spp = _uint("spp", spp, 1, 0xFFFFFFFF, "reference")
+        for name, v in (("time", seconds), ("target-se", target_se)):
+            if v is not None and not (isinstance(v, (int, float)) and v > 0 and v < float("inf")):
+                raise UsageError("reference: --%s '%s' is not a positive number" % (name, v))
+        o.seconds = float(seconds or 0.0)
+        o.target_se = float(target_se or 0.0)
+        mean = np.empty((h, w, 3), dtype=np.float32)
+        var = np.empty((h, w, 3), dtype=np.float32)
+        out = ctypes.c_void_p()
+        err = GiError()
+        fp = ctypes.POINTER(ctypes.c_float)
+        check(lib.gibench_reference(self._handle, ctypes.byref(o), mean.ctypes.data_as(fp),
+                                    var.ctypes.data_as(fp), ctypes.byref(out), ctypes.byref(err)),
+              err)
+        return Image(mean, json.loads(take_string(out))), var
+
     def _render_child(self, method, w, h, frames, seed, texts, camera, time, warmup, exposure,
                       no_cache):
         with tempfile.TemporaryDirectory(prefix="gibench-py-") as tmp:
@@ -173,6 +214,36 @@ def _child_error(p):
                         (-p.returncode, (" (" + lines[-1] + ")") if lines else ""))
     msg = lines[-1] if lines else (p.stderr.strip().splitlines() or ["exit status %d" % p.returncode])[-1]
     return UsageError(msg) if p.returncode == 2 else RunError(msg)
+
+
+def metrics(test, ref, exposure=0.0, ppd=0.0, maps=False):
+    """gibench diff TEST REF: a dict under diff --json's names (relmse, rmse, mse,
+    mae, psnr, ssim, flip, mean_lum_*, leaked_energy, ...; None where undefined).
+    maps=True adds the per-pixel maps as H x W float32 arrays: "relerr_map"
+    (what diff --heatmap draws) and "flip_map" (diff --flip-map)."""
+    a = np.ascontiguousarray(np.asarray(test, dtype=np.float32))
+    b = np.ascontiguousarray(np.asarray(ref, dtype=np.float32))
+    for x in (a, b):
+        if x.ndim != 3 or x.shape[2] != 3 or x.size == 0:
+            raise UsageError("metrics: an image is not H x W x 3 (shape %s)" % (x.shape,))
+    if a.shape != b.shape:
+        raise UsageError("image sizes differ: test %dx%d, reference %dx%d" %
+                         (a.shape[1], a.shape[0], b.shape[1], b.shape[0]))
+    h, w = a.shape[:2]
+    fp = ctypes.POINTER(ctypes.c_float)
+    rel = np.empty((h, w), dtype=np.float32) if maps else None
+    flip = np.empty((h, w), dtype=np.float32) if maps else None
+    out = ctypes.c_void_p()
+    err = GiError()
+    check(lib.gibench_metrics(a.ctypes.data_as(fp), b.ctypes.data_as(fp), w, h, float(exposure),
+                              float(ppd), rel.ctypes.data_as(fp) if maps else None,
+                              flip.ctypes.data_as(fp) if maps else None, ctypes.byref(out),
+                              ctypes.byref(err)), err)
+    m = json.loads(take_string(out))
+    if maps:
+        m["relerr_map"] = rel
+        m["flip_map"] = flip
+    return m
 
 
 def read(path):

@@ -42,6 +42,24 @@ class RenderOpts(ctypes.Structure):
     ]
 
 
+class ReferenceOpts(ctypes.Structure):
+    """gibench_reference_opts, field for field."""
+    _fields_ = [
+        ("camera", ctypes.c_char_p),
+        ("width", ctypes.c_uint32),
+        ("height", ctypes.c_uint32),
+        ("spp", ctypes.c_uint64),
+        ("seconds", ctypes.c_double),
+        ("target_se", ctypes.c_double),
+        ("max_bounces", ctypes.c_int),
+        ("seed", ctypes.c_uint32),
+        ("threads", ctypes.c_uint32),
+        ("time", ctypes.c_float),
+        ("pixel_center", ctypes.c_int),
+        ("robust_traversal", ctypes.c_int),
+    ]
+
+
 def _load():
     path = os.environ.get("GIBENCH_LIBRARY") or _build.LIBRARY
     lib = ctypes.CDLL(path)
@@ -59,6 +77,13 @@ def _load():
                                 err], ctypes.c_int),
         "gibench_image_write": ([ctypes.c_char_p, ctypes.POINTER(ctypes.c_float), ctypes.c_uint32,
                                  ctypes.c_uint32, ctypes.c_float, err], ctypes.c_int),
+        "gibench_reference": ([P, ctypes.POINTER(ReferenceOpts), ctypes.POINTER(ctypes.c_float),
+                               ctypes.POINTER(ctypes.c_float), ctypes.POINTER(P), err],
+                              ctypes.c_int),
+        "gibench_metrics": ([ctypes.POINTER(ctypes.c_float), ctypes.POINTER(ctypes.c_float),
+                             ctypes.c_uint32, ctypes.c_uint32, ctypes.c_float, ctypes.c_float,
+                             ctypes.POINTER(ctypes.c_float), ctypes.POINTER(ctypes.c_float),
+                             ctypes.POINTER(P), err], ctypes.c_int),
         "gibench_free": ([P], None),
     }
     for name, (args, res) in sigs.items():

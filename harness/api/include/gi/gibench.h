@@ -75,6 +75,40 @@ gi_result gibench_scene_info_json(const gibench_scene *s, char **out, gi_error *
 gi_result gibench_render(gibench_scene *s, const gibench_render_opts *o, float *rgb, char **timings,
                          gi_error *err);
 
+/* The options of gibench reference, with its defaults
+ * (gibench_reference_defaults): 256x256, seed 1, unlimited bounces. With
+ * none of spp, seconds and target_se, 256 samples per pixel. */
+typedef struct gibench_reference_opts {
+    const char *camera; /* a camera name or "#k"; NULL for the first */
+    uint32_t width, height;
+    uint64_t spp;         /* --spp: stop at this many samples per pixel (0: no limit) */
+    double seconds;       /* --time: stop after this long (0: none) */
+    double target_se;     /* --target-se: stop at this mean relative standard error */
+    int max_bounces;      /* --max-bounces; -1 unlimited */
+    uint32_t seed;        /* --seed */
+    uint32_t threads;     /* --threads; 0 every core */
+    float time;           /* --time-of-scene */
+    int pixel_center;     /* --pixel center (1) or box (0) */
+    int robust_traversal; /* --traversal robust (1) or fast (0) */
+} gibench_reference_opts;
+
+gibench_reference_opts gibench_reference_defaults(void);
+
+/* The path-traced reference as gibench reference renders it (the same
+ * progressive loop, gi_ref_progressive): the mean into mean and, when not
+ * NULL, the variance of the mean into variance (width * height * 3 each);
+ * stats: {"spp", "stop", "render_seconds", "mean_rel_se", ...}. */
+gi_result gibench_reference(gibench_scene *s, const gibench_reference_opts *o, float *mean,
+                            float *variance, char **stats, gi_error *err);
+
+/* gibench diff of test against ref (RGB, width * height * 3 each): the
+ * metrics under gibench diff --json's names into *out; when not NULL, the
+ * per-pixel relative error and FLIP maps (width * height each). flip_ppd 0
+ * is FLIP's default. */
+gi_result gibench_metrics(const float *test, const float *ref, uint32_t width, uint32_t height,
+                          float exposure, float flip_ppd, float *relerr_map, float *flip_map,
+                          char **out, gi_error *err);
+
 /* Reads an image file (EXR, PFM, PNG) with gibench's reader: *rgba holds
  * width * height * 4 floats (gibench_free). */
 gi_result gibench_image_read(const char *path, float **rgba, uint32_t *width, uint32_t *height,
