@@ -55,6 +55,9 @@ def methods():
 def _param_text(value):
     if isinstance(value, bool):
         return "true" if value else "false"
+    # 32.0 as "32": the knob steps of gibench.methods() are numbers, an int knob's too
+    if isinstance(value, float) and value.is_integer():
+        return str(int(value))
     return str(value)
 
 

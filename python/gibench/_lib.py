@@ -20,6 +20,10 @@ class RunError(Error, RuntimeError):
     """A failure while running (the CLI's exit status 1), or a crashed child."""
 
 
+for _cls in (Error, UsageError, RunError):
+    _cls.__module__ = "gibench"
+
+
 class GiError(ctypes.Structure):
     _fields_ = [("text", ctypes.c_char * 512)]
 
