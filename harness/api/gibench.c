@@ -204,14 +204,132 @@ static json_object *timings_json(const render_loop *l, const gi_params *params,
     return j;
 }
 
-/* Every frame, then the last one's RGB into rgb. */
-static gi_result run_loop(render_loop *l, const gi_params *params, uint32_t frames, float *rgb,
-                          gi_error *err)
+struct gibench_method {
+    gibench_scene *s;
+    gi_params *params;
+    char *cache_dir;
+    cli_host host;
+    int host_ready;
+    render_loop l;
+    uint32_t next_frame; /* the frame_index of the next frame: 0 after an update */
+    uint32_t warmup;
+    gi_timer_mode mode;
+};
+
+void gibench_method_close(gibench_method *m)
 {
+    if (!m)
+        return;
+    render_loop_free(&m->l);
+    gi_timer_free(m->l.prep_timer);
+    gi_timer_free(m->l.render_timer);
+    if (m->host_ready)
+        cli_host_free(&m->host);
+    free(m->cache_dir);
+    gi_params_free(m->params);
+    free(m);
+}
+
+/* The instance's loop, host and timers, as gibench render sets them up. */
+static void method_setup(gibench_method *m, const gi_method *gm, const gibench_render_opts *o,
+                         int camera)
+{
+    gi_error cerr;
+    gibench_scene *s = m->s;
+    /* as gibench render: without a usable cache folder, precompute afresh */
+    m->cache_dir = o->no_cache ? NULL : gi_cache_dir(&cerr);
+    gi_gpu_scene_set_time(s->gs, o->time);
+    m->mode = gi_timer_mode_for(gi_gpu_is_software(g_gpu));
+    cli_host_init(&m->host, gm->id, m->cache_dir, s->gs, gi_gpu_renderer(g_gpu),
+                  gi_gpu_is_software(g_gpu));
+    m->host_ready = 1;
+    m->warmup = o->warmup;
+    render_loop *l = &m->l;
+    l->m = gm;
+    l->scene = s->scene;
+    l->gs = s->gs;
+    l->host = &m->host;
+    l->prep_timer = gi_timer_create(m->mode, 0);
+    l->width = o->width;
+    l->height = o->height;
+    l->seed = o->seed;
+    l->time = o->time;
+    l->exposure = o->exposure;
+    l->camera = camera;
     render_loop_target(l);
-    gi_result res = render_loop_prepare(l, params, err);
+}
+
+gi_result gibench_method_open(gibench_scene *s, const gibench_render_opts *o, gibench_method **out,
+                              gi_error *err)
+{
+    *out = NULL;
+    const gi_method *gm = NULL;
+    gi_params *params = NULL;
+    int camera = 0;
+    gi_result res = resolve(s, o, &gm, &params, &camera, err);
+    if (res != GI_OK) {
+        gi_params_free(params);
+        return res;
+    }
+    char why[256];
+    if (!cli_caps_cover(gm, s->scene, 0, why, sizeof why))
+        gi_log(GI_LOG_WARN,
+               "render: %s in %s: the image leaves that out (a study marks this cell n/a)", why,
+               s->scene->path);
+    gibench_method *m = calloc(1, sizeof *m);
+    if (!m) {
+        gi_params_free(params);
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory");
+    }
+    m->s = s;
+    m->params = params;
+    method_setup(m, gm, o, camera);
+    res = render_loop_prepare(&m->l, params, err);
+    if (res != GI_OK) {
+        gibench_method_close(m);
+        return res;
+    }
+    *out = m;
+    return GI_OK;
+}
+
+gi_result gibench_method_update(gibench_method *m, float time, const char *camera, gi_error *err)
+{
+    uint32_t flags = 0;
+    if (camera) {
+        int c = gi_scene_find_camera(m->s->scene, camera);
+        if (c < 0)
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "render: %s has no camera '%s' (%u cameras; use a name or #k)",
+                                m->s->scene->path, camera, m->s->scene->camera_count);
+        flags = c != m->l.camera ? GI_CHANGED_CAMERA : 0u;
+        m->l.camera = c;
+    }
+    if (!(time >= 0) || time > 3.4e38f)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "render: --time '%g' is not a non-negative number", (double)time);
+    m->l.time = time;
+    m->next_frame = 0;
+    return render_loop_update(&m->l, time, flags, err);
+}
+
+gi_result gibench_method_render(gibench_method *m, uint32_t frames, float *rgb, char **timings,
+                                gi_error *err)
+{
+    if (timings)
+        *timings = NULL;
+    if (frames < 1 || frames > 1000000)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "render: --frames '%u' is not an integer in 1..1000000", frames);
+    render_loop *l = &m->l;
+    /* every call's frames timed afresh; the scene at this instance's time
+     * (another instance on the same scene may have moved it) */
+    gi_timer_free(l->render_timer);
+    l->render_timer = gi_timer_create(m->mode, m->warmup < frames ? m->warmup : 0);
+    gi_gpu_scene_set_time(l->gs, l->time);
+    gi_result res = GI_OK;
     for (uint32_t f = 0; res == GI_OK && f < frames; f++)
-        res = render_loop_frame(l, f, err);
+        res = render_loop_frame(l, m->next_frame++, err);
     if (res != GI_OK)
         return res;
     gi_image *img = render_loop_image(l);
@@ -220,58 +338,17 @@ static gi_result run_loop(render_loop *l, const gi_params *params, uint32_t fram
     for (size_t i = 0; i < (size_t)l->width * l->height; i++)
         memcpy(rgb + 3 * i, img->rgba + 4 * i, 3 * sizeof(float));
     gi_image_free(img);
-    return GI_OK;
+    return timings ? gibench_json_out(timings_json(l, m->params, &m->host), timings, err) : GI_OK;
 }
 
 gi_result gibench_render(gibench_scene *s, const gibench_render_opts *o, float *rgb, char **timings,
                          gi_error *err)
 {
-    if (timings)
-        *timings = NULL;
-    const gi_method *m = NULL;
-    gi_params *params = NULL;
-    int camera = 0;
-    gi_result res = resolve(s, o, &m, &params, &camera, err);
-    if (res != GI_OK) {
-        gi_params_free(params);
-        return res;
-    }
-    char why[256];
-    if (!cli_caps_cover(m, s->scene, 0, why, sizeof why))
-        gi_log(GI_LOG_WARN,
-               "render: %s in %s: the image leaves that out (a study marks this cell n/a)", why,
-               s->scene->path);
-    gi_error cerr;
-    /* as gibench render: without a usable cache folder, precompute afresh */
-    char *cache_dir = o->no_cache ? NULL : gi_cache_dir(&cerr);
-    gi_gpu_scene_set_time(s->gs, o->time);
-    gi_timer_mode mode = gi_timer_mode_for(gi_gpu_is_software(g_gpu));
-    cli_host host;
-    cli_host_init(&host, m->id, cache_dir, s->gs, gi_gpu_renderer(g_gpu),
-                  gi_gpu_is_software(g_gpu));
-    render_loop l;
-    memset(&l, 0, sizeof l);
-    l.m = m;
-    l.scene = s->scene;
-    l.gs = s->gs;
-    l.host = &host;
-    l.prep_timer = gi_timer_create(mode, 0);
-    l.render_timer = gi_timer_create(mode, o->warmup);
-    l.width = o->width;
-    l.height = o->height;
-    l.seed = o->seed;
-    l.time = o->time;
-    l.exposure = o->exposure;
-    l.camera = camera;
-    res = run_loop(&l, params, o->frames, rgb, err);
-    if (res == GI_OK && timings)
-        res = gibench_json_out(timings_json(&l, params, &host), timings, err);
-    render_loop_free(&l);
-    gi_timer_free(l.prep_timer);
-    gi_timer_free(l.render_timer);
-    cli_host_free(&host);
-    free(cache_dir);
-    gi_params_free(params);
+    gibench_method *m = NULL;
+    gi_result res = gibench_method_open(s, o, &m, err);
+    if (res == GI_OK)
+        res = gibench_method_render(m, o->frames, rgb, timings, err);
+    gibench_method_close(m);
     return res;
 }
 

@@ -67,6 +67,18 @@ static gi_changes animation_changes(const gi_scene *s, const gi_gpu_scene *gs, i
     return ch;
 }
 
+gi_result render_loop_update(render_loop *r, float t, uint32_t flags, gi_error *err)
+{
+    gi_gpu_scene_set_time(r->gs, t);
+    gi_changes ch = animation_changes(r->scene, r->gs, r->fixed_camera ? -1 : r->camera);
+    ch.flags |= flags;
+    ch.time = t;
+    gi_result res = r->m->update(r->inst, r->gs, &ch);
+    if (res != GI_OK)
+        return render_loop_method_error(r, "update", res, err);
+    return GI_OK;
+}
+
 gi_result render_loop_frame(render_loop *r, uint32_t f, gi_error *err)
 {
     gi_target target = {r->target_tex, r->target_fbo, r->width, r->height};
@@ -78,13 +90,10 @@ gi_result render_loop_frame(render_loop *r, uint32_t f, gi_error *err)
      * in update() is charged for it; its stages count in the frame). */
     gi_timer_frame_begin(r->render_timer);
     if (f > 0 && r->animate_fps > 0) {
-        gi_gpu_scene_set_time(r->gs, t);
-        gi_changes ch = animation_changes(r->scene, r->gs, r->fixed_camera ? -1 : r->camera);
-        ch.time = t;
-        res = r->m->update(r->inst, r->gs, &ch);
+        res = render_loop_update(r, t, 0, err);
         if (res != GI_OK) {
             gi_timer_frame_end(r->render_timer);
-            return render_loop_method_error(r, "update", res, err);
+            return res;
         }
     }
     gi_camera_frame cf =

@@ -32,6 +32,10 @@ void render_loop_target(render_loop *r);
  * err; the result says usage (GI_ERR_INVALID_ARGUMENT, GI_ERR_UNSUPPORTED)
  * or a failure while running. */
 gi_result render_loop_prepare(render_loop *r, const gi_params *params, gi_error *err);
+/* The scene moved to time t (its animation: transforms, lights, camera,
+ * deformation) and the method told by update() of what that changes, and
+ * of `flags` besides (GI_CHANGED_CAMERA for another camera). */
+gi_result render_loop_update(render_loop *r, float t, uint32_t flags, gi_error *err);
 /* Frame f (from 0), timed: update() for a step of an animation (animate_fps
  * > 0), then render(), then a GL error check. */
 gi_result render_loop_frame(render_loop *r, uint32_t f, gi_error *err);

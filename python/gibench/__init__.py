@@ -17,6 +17,7 @@ import json
 import os
 import subprocess
 import tempfile
+import weakref
 
 import numpy as np
 
@@ -24,8 +25,8 @@ from . import _build
 from ._lib import (Error, GiError, ReferenceOpts, RenderOpts, RunError, UsageError, check, lib,
                    take_string)
 
-__all__ = ["Error", "RunError", "UsageError", "Image", "Scene", "methods", "metrics", "read",
-           "write"]
+__all__ = ["Error", "RunError", "UsageError", "Image", "Method", "Scene", "methods", "metrics", "read",
+           "study", "write"]
 
 
 class Image(np.ndarray):
@@ -95,9 +96,13 @@ class Scene:
         self.cameras = info["cameras"]
         self.duration = info["duration"]
         self.info = info
+        self._methods = weakref.WeakSet()
 
     def close(self):
-        """Releases the scene and its upload now (also when the object goes)."""
+        """Releases the scene and its upload now (also when the object goes),
+        and every Method instance made on it."""
+        for m in list(getattr(self, "_methods", ())):
+            m.close()
         if getattr(self, "_handle", None) and self._handle.value:
             lib.gibench_scene_close(self._handle)
             self._handle = ctypes.c_void_p()
@@ -130,21 +135,24 @@ class Scene:
             return self._render_child(method, w, h, frames, seed, texts, camera, time, warmup,
                                       exposure, no_cache)
         self._alive()
-        arr = (ctypes.c_char_p * max(1, len(texts)))(*[t.encode() for t in texts])
-        o = RenderOpts(method=str(method).encode(), camera=None if camera is None else
-                       str(camera).encode(), params=arr, param_count=len(texts), width=w, height=h,
-                       frames=frames, warmup=warmup, seed=seed, time=float(time),
-                       exposure=float(exposure), no_cache=1 if no_cache else 0)
-        if w * h > (1 << 28):
-            raise UsageError("render: --size '%dx%d' is too large" % (w, h))
+        o, keep = _render_opts(method, w, h, frames, seed, texts, camera, time, warmup, exposure,
+                               no_cache)
         img = np.empty((h, w, 3), dtype=np.float32)
         out = ctypes.c_void_p()
         err = GiError()
         res = lib.gibench_render(self._handle, ctypes.byref(o),
                                  img.ctypes.data_as(ctypes.POINTER(ctypes.c_float)),
                                  ctypes.byref(out), ctypes.byref(err))
+        del keep
         check(res, err)
         return Image(img, json.loads(take_string(out)))
+
+    def method(self, method, size=(256, 256), seed=1, params=None, camera=None, time=0.0,
+               warmup=0, exposure=0.0, no_cache=False):
+        """A Method: the instance created and prepared once (the options of
+        render), then updated and rendered frame after frame."""
+        self._alive()
+        return Method(self, method, size, seed, params, camera, time, warmup, exposure, no_cache)
 
     def reference(self, spp=None, seconds=None, target_se=None, max_bounces=None,
                   size=(256, 256), seed=1, camera=None, time=0.0, threads=0, pixel="box",
@@ -209,12 +217,133 @@ class Scene:
                 return Image(img, json.load(f))
 
 
-def _child_error(p):
+def study(study, out, jobs=None, resume=False, fresh=False, dry_run=False):
+    """Runs a study as `gibench study STUDY --out OUT` (each run in its own
+    process, as the CLI does) and returns its runs: the records of OUT/runs.json
+    as a list of dicts, or a pandas DataFrame (nested keys flattened, e.g.
+    "metrics.full.relmse") when pandas is installed. study is a study file's
+    path or the study itself as a dict (paths in it are relative to the current
+    folder, as in a file)."""
+    with tempfile.TemporaryDirectory(prefix="gibench-py-") as tmp:
+        path = study
+        if isinstance(study, dict):
+            path = os.path.join(tmp, "%s.json" % study.get("name", "study"))
+            with open(path, "w") as f:
+                json.dump(study, f, indent=1)
+        cmd = [os.environ.get("GIBENCH_BIN") or _build.COMMAND, "-q", "study", os.fspath(path),
+               "--out", os.fspath(out)]
+        if jobs is not None:
+            cmd += ["--jobs", str(jobs)]
+        cmd += (["--resume"] if resume else []) + (["--fresh"] if fresh else [])
+        cmd += ["--dry-run"] if dry_run else []
+        p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    if p.returncode != 0:
+        raise _child_error(p, "study")
+    if dry_run:
+        return p.stdout
+    with open(os.path.join(os.fspath(out), "runs.json")) as f:
+        runs = json.load(f)
+    try:
+        import pandas
+    except ImportError:
+        return runs
+    return pandas.json_normalize(runs)
+
+
+def _render_opts(method, w, h, frames, seed, texts, camera, time, warmup, exposure, no_cache):
+    """The RenderOpts of render(), and what must stay alive while it is used."""
+    if w * h > (1 << 28):
+        raise UsageError("render: --size '%dx%d' is too large" % (w, h))
+    arr = (ctypes.c_char_p * max(1, len(texts)))(*[t.encode() for t in texts])
+    o = RenderOpts(method=str(method).encode(), camera=None if camera is None else
+                   str(camera).encode(), params=arr, param_count=len(texts), width=w, height=h,
+                   frames=frames, warmup=warmup, seed=seed, time=float(time),
+                   exposure=float(exposure), no_cache=1 if no_cache else 0)
+    return o, arr
+
+
+class Method:
+    """A method instance that stays alive across frames (Scene.method): one
+    create() and prepare(), then update() when the scene's time or the camera
+    changes and render() for more frames. What `gibench render --animate FPS`
+    does between frames, driven from Python:
+
+        m = scene.method("csm", size=(64, 64))
+        for k in range(10):
+            if k:
+                m.update(time=k / 30)
+            img = m.render()
+    """
+
+    def __init__(self, scene, method, size, seed, params, camera, time, warmup, exposure,
+                 no_cache):
+        w, h = _size(size)
+        texts = ["%s=%s" % (k, _param_text(v)) for k, v in (params or {}).items()]
+        o, keep = _render_opts(method, w, h, 1, _uint("seed", seed, 0, 0xFFFFFFFF), texts,
+                               camera, time, _uint("warmup", warmup, 0, 1000), exposure,
+                               no_cache)
+        self.scene = scene  # the scene outlives the instance
+        self.id = str(method)
+        self.size = (w, h)
+        self.time = float(time)
+        self._handle = ctypes.c_void_p()
+        err = GiError()
+        check(lib.gibench_method_open(scene._handle, ctypes.byref(o), ctypes.byref(self._handle),
+                                      ctypes.byref(err)), err)
+        del keep
+        scene._methods.add(self)
+
+    def _alive(self):
+        if not self._handle.value:
+            raise UsageError("render: the %s instance is closed" % self.id)
+
+    def update(self, time=None, camera=None):
+        """Moves the scene to `time` (its animated objects, lights and camera)
+        and/or switches to `camera`; the method's update() is told what changed.
+        The next frame starts a still view's accumulation again."""
+        self._alive()
+        if time is not None:
+            self.time = float(time)
+        err = GiError()
+        check(lib.gibench_method_update(self._handle, self.time,
+                                        None if camera is None else str(camera).encode(),
+                                        ctypes.byref(err)), err)
+
+    def render(self, frames=1):
+        """`frames` more frames; the last one as an Image with .timings."""
+        self._alive()
+        frames = _uint("frames", frames, 1, 1000000)
+        w, h = self.size
+        img = np.empty((h, w, 3), dtype=np.float32)
+        out = ctypes.c_void_p()
+        err = GiError()
+        check(lib.gibench_method_render(self._handle, frames,
+                                        img.ctypes.data_as(ctypes.POINTER(ctypes.c_float)),
+                                        ctypes.byref(out), ctypes.byref(err)), err)
+        return Image(img, json.loads(take_string(out)))
+
+    def close(self):
+        """Destroys the instance now (also when the object goes or its scene closes)."""
+        if getattr(self, "_handle", None) and self._handle.value:
+            lib.gibench_method_close(self._handle)
+            self._handle = ctypes.c_void_p()
+
+    def __del__(self):
+        self.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def _child_error(p, cmd="render"):
     """The exception of a failed child gibench: its last 'gibench: ' line."""
     lines = [ln[len("gibench: "):] for ln in p.stderr.splitlines() if ln.startswith("gibench: ")]
     if p.returncode < 0:
-        return RunError("render: the child process died of signal %d%s" %
-                        (-p.returncode, (" (" + lines[-1] + ")") if lines else ""))
+        return RunError("%s: the child process died of signal %d%s" %
+                        (cmd, -p.returncode, (" (" + lines[-1] + ")") if lines else ""))
     msg = lines[-1] if lines else (p.stderr.strip().splitlines() or ["exit status %d" % p.returncode])[-1]
     return UsageError(msg) if p.returncode == 2 else RunError(msg)
 

@@ -88,6 +88,12 @@ def _load():
                              ctypes.c_uint32, ctypes.c_uint32, ctypes.c_float, ctypes.c_float,
                              ctypes.POINTER(ctypes.c_float), ctypes.POINTER(ctypes.c_float),
                              ctypes.POINTER(P), err], ctypes.c_int),
+        "gibench_method_open": ([P, ctypes.POINTER(RenderOpts), ctypes.POINTER(P), err],
+                                ctypes.c_int),
+        "gibench_method_update": ([P, ctypes.c_float, ctypes.c_char_p, err], ctypes.c_int),
+        "gibench_method_render": ([P, ctypes.c_uint32, ctypes.POINTER(ctypes.c_float),
+                                   ctypes.POINTER(P), err], ctypes.c_int),
+        "gibench_method_close": ([P], None),
         "gibench_free": ([P], None),
     }
     for name, (args, res) in sigs.items():

@@ -75,6 +75,24 @@ gi_result gibench_scene_info_json(const gibench_scene *s, char **out, gi_error *
 gi_result gibench_render(gibench_scene *s, const gibench_render_opts *o, float *rgb, char **timings,
                          gi_error *err);
 
+/* A method instance that stays alive across calls (an animation, or more
+ * frames of a still view): created and prepared once with o (o->frames
+ * unused), then any number of update and render calls. */
+typedef struct gibench_method gibench_method;
+gi_result gibench_method_open(gibench_scene *s, const gibench_render_opts *o, gibench_method **out,
+                              gi_error *err);
+/* The scene moved to `time` (its animation: transforms, lights, camera,
+ * deformation), and, when camera is not NULL, another camera; the method's
+ * update() told what that changes, as gibench render --animate tells it
+ * between frames. The next frame is frame_index 0 again. */
+gi_result gibench_method_update(gibench_method *m, float time, const char *camera, gi_error *err);
+/* `frames` more frames (frame_index counting on from the last update) and
+ * the last one's RGB into rgb, timings as for gibench_render. */
+gi_result gibench_method_render(gibench_method *m, uint32_t frames, float *rgb, char **timings,
+                                gi_error *err);
+/* The instance destroyed; the scene must outlive it. */
+void gibench_method_close(gibench_method *m);
+
 /* The options of gibench reference, with its defaults
  * (gibench_reference_defaults): 256x256, seed 1, unlimited bounces. With
  * none of spp, seconds and target_se, 256 samples per pixel. */
