@@ -34,6 +34,13 @@ pkgs=(
   # scripts/*.py (the results tables, their test integration.results_tables;
   # the bash completion, scripts/gen-completion.py, which `make` installs)
   python3 bash-completion
+  # The Python API (python/gibench, docs/python.md): numpy for Debian's /usr/bin/python3
+  python3-numpy
+  # its tests under pytest (tests/python, ctest python.*)
+  python3-pytest
+  # the tutorial notebook (examples/python) run by its test: plots (Agg) and nbclient
+  python3-matplotlib
+  python3-nbformat python3-nbclient python3-ipykernel
   # The report page in a real browser (tests/integration/report_browser.cmake):
   # Debian's Chromium, driven by playwright-core from npm (tests/browser/).
   chromium

@@ -126,6 +126,10 @@ uint64_t cli_scene_content_hash(const gi_scene *s, const char *path);
  * ("avg does not handle directional lights or environment light"). */
 int cli_caps_cover(const gi_method *m, const gi_scene *s, int animated, char *why, size_t size);
 
+/* One installed method as gibench methods --json lists it (id, title,
+ * caps, parameters with ranges and quality knobs); also the Python API's. */
+json_object *cli_method_json(const gi_plugin *it);
+
 /* The help of one command (gibench help CMD, CMD --help): 0 when known. */
 int cli_command_help(const char *cmd, FILE *to);
 

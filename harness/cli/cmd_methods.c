@@ -113,7 +113,7 @@ static void print_departures(const gi_method *m)
     }
 }
 
-static json_object *method_json(const gi_plugin *it)
+json_object *cli_method_json(const gi_plugin *it)
 {
     const gi_method *m = it->method;
     json_object *o = json_object_new_object();
@@ -149,7 +149,7 @@ int cmd_methods(int argc, char **argv)
     if (json) {
         json_object *arr = json_object_new_array();
         for (uint32_t i = 0; i < reg->count; i++)
-            json_object_array_add(arr, method_json(&reg->items[i]));
+            json_object_array_add(arr, cli_method_json(&reg->items[i]));
         puts(json_object_to_json_string_ext(arr, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_SPACED |
                                                      JSON_C_TO_STRING_NOSLASHESCAPE));
         json_object_put(arr);

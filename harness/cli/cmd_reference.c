@@ -21,8 +21,6 @@
 
 #define MAX_OUTS 4
 #define DEFAULT_SPP 256
-/* Passes between progress updates and stop checks last about this long. */
-#define PASS_SECONDS 0.5
 
 typedef struct ref_opts {
     const char *scene, *camera, *stats;
@@ -213,20 +211,6 @@ typedef struct run_state {
     gi_image *mean, *var;
 } run_state;
 
-/* Next sample count at which --target-se is checked: a function of the
- * image alone (never of timing), so that the stopping point and the image
- * are reproducible. Aim 10% past the count the 1/sqrt(spp) law predicts,
- * at most doubling. */
-static uint64_t next_checkpoint(uint64_t spp, double se, double target)
-{
-    if (spp < 4)
-        return 4;
-    double want =
-        isfinite(se) ? 1.1 * (double)spp * (se / target) * (se / target) : 2.0 * (double)spp;
-    uint64_t n = want > 2.0 * (double)spp ? 2 * spp : (uint64_t)ceil(want);
-    return n > spp ? n : spp + 1;
-}
-
 static json_object *stats_json(const run_state *r, const ref_opts *o, int camera, double wall,
                                const char *stop)
 {
@@ -338,77 +322,54 @@ static int create_tracer(run_state *r, const ref_opts *o, int camera,
     return EXIT_OK;
 }
 
+/* The progress line after a pass; a pending interrupt cancels. */
+typedef struct pass_state {
+    progress bar;
+    const ref_opts *o;
+    double every, last_line; /* GIBENCH_PROGRESS_EVERY: a plain line every `every` s */
+} pass_state;
+
+/* A plain progress line for a caller that reads the log (gibench study). */
+static void progress_line(pass_state *ps, uint64_t spp, double elapsed)
+{
+    fprintf(stderr, "reference: %llu/%llu spp, %.1f s\n", (unsigned long long)spp,
+            (unsigned long long)ps->o->spp, elapsed);
+    ps->last_line = elapsed;
+}
+
+static int after_pass(void *user, uint64_t spp, double se, uint64_t se_spp, double elapsed)
+{
+    pass_state *ps = user;
+    if (cli_interrupted)
+        return 1;
+    if (ps->bar.on)
+        progress_show(&ps->bar, ps->o, spp, se, se_spp, elapsed);
+    if (ps->every > 0.0 && elapsed - ps->last_line >= ps->every)
+        progress_line(ps, spp, elapsed);
+    return 0;
+}
+
 /* Progressive passes until --spp, --time or --target-se says stop; *stop
  * names which. */
 static int render_passes(run_state *r, const ref_opts *o, const char **stop)
 {
     gi_error err;
-    progress bar = {isatty(STDERR_FILENO) && gi_log_get_level() >= GI_LOG_WARN};
+    pass_state ps = {{isatty(STDERR_FILENO) && gi_log_get_level() >= GI_LOG_WARN}, o, 0.0, 0.0};
     /* a caller that reads the log (gibench study) asks for a plain line
      * every S seconds instead of the terminal's bar */
     const char *every_env = getenv("GIBENCH_PROGRESS_EVERY");
-    double every = every_env && !bar.on ? atof(every_env) : 0.0, last_line = 0.0;
+    ps.every = every_env && !ps.bar.on ? atof(every_env) : 0.0;
     const double t_render = gi_now();
-    double se = INFINITY, per_spp = 0.0; /* seconds a sample per pixel takes */
-    uint64_t se_spp = 0;
-    uint64_t checkpoint = o->target_se > 0.0 ? next_checkpoint(0, se, o->target_se) : o->spp;
-    if (o->spp && checkpoint > o->spp)
-        checkpoint = o->spp;
-    while (!*stop) {
-        uint64_t spp = gi_ref_spp(r->ref);
-        double elapsed = gi_now() - t_render;
-        /* Pass size: about PASS_SECONDS of work, never past the checkpoint
-         * or the sample limit, nor (much) past the time budget. */
-        double budget = PASS_SECONDS;
-        if (o->time_limit > 0.0)
-            budget = fmin(budget, o->time_limit - elapsed);
-        uint64_t k = per_spp > 0.0 ? (uint64_t)(budget / per_spp) : 1;
-        k = k < 1 ? 1 : k;
-        if (checkpoint && k > checkpoint - spp)
-            k = checkpoint - spp;
-        if (k > 0xFFFFFFFFull - spp)
-            k = 0xFFFFFFFFull - spp;
-        double t0 = gi_now();
-        gi_result res = gi_ref_render(r->ref, (uint32_t)k, &err);
-        if (res != GI_OK) {
-            progress_end(&bar);
-            return cli_fail(EXIT_RUN, "%s", err.text);
-        }
-        per_spp = (gi_now() - t0) / (double)k;
-        spp = gi_ref_spp(r->ref);
-        elapsed = gi_now() - t_render;
-        if (cli_interrupted) {
-            progress_end(&bar);
-            return cli_fail(EXIT_RUN, "reference: interrupted after %llu spp; no image written",
-                            (unsigned long long)spp);
-        }
-        if (o->target_se > 0.0 && spp == checkpoint) {
-            se = gi_ref_mean_rel_se(r->ref);
-            se_spp = spp;
-            if (se <= o->target_se)
-                *stop = "target-se";
-            else
-                checkpoint = next_checkpoint(spp, se, o->target_se);
-            if (o->spp && checkpoint > o->spp)
-                checkpoint = o->spp;
-        }
-        if (!*stop && o->spp && spp >= o->spp)
-            *stop = "spp";
-        if (!*stop && o->time_limit > 0.0 && elapsed >= o->time_limit)
-            *stop = "time";
-        if (!*stop && spp >= 0xFFFFFFFFull)
-            *stop = "spp";
-        if (bar.on && o->target_se > 0.0)
-            progress_show(&bar, o, spp, se, se_spp, elapsed);
-        else if (bar.on)
-            progress_show(&bar, o, spp, gi_ref_mean_rel_se(r->ref), spp, elapsed);
-        if (every > 0.0 && (elapsed - last_line >= every || *stop)) {
-            fprintf(stderr, "reference: %llu/%llu spp, %.1f s\n", (unsigned long long)spp,
-                    (unsigned long long)o->spp, elapsed);
-            last_line = elapsed;
-        }
-    }
-    progress_end(&bar);
+    gi_ref_until u = {o->spp, o->time_limit, o->target_se};
+    gi_result res = gi_ref_progressive(r->ref, &u, after_pass, &ps, stop, &err);
+    progress_end(&ps.bar);
+    if (res == GI_OK && ps.every > 0.0)
+        progress_line(&ps, gi_ref_spp(r->ref), gi_now() - t_render);
+    if (res == GI_ERR_CANCELLED)
+        return cli_fail(EXIT_RUN, "reference: interrupted after %llu spp; no image written",
+                        (unsigned long long)gi_ref_spp(r->ref));
+    if (res != GI_OK)
+        return cli_fail(EXIT_RUN, "%s", err.text);
     return EXIT_OK;
 }
 

@@ -6,6 +6,7 @@
 #include "gi/log.h"
 #include "gi/passes.h"
 #include "metrics.h"
+#include "render_loop.h"
 #include "view_file.h"
 
 #include <math.h>
@@ -275,41 +276,6 @@ static double peak_rss_mib(void)
     return kib / 1024.0;
 }
 
-static void make_view(const gi_scene *s, int camera, const render_opts *o, float t, uint32_t frame,
-                      gi_view *v)
-{
-    gi_camera_frame cf =
-        o->has_view ? view_file_camera(&o->view) : gi_scene_camera_at(s, camera, t);
-    gi_view_from_camera(&cf, o->width, o->height, t, v);
-    v->frame_index = frame;
-    v->seed = o->seed;
-    v->exposure = o->exposure;
-}
-
-/* What a step of the scene's animation changes, for update(): transforms
- * when an object is animated (or deforms: its vertices follow the time),
- * lights when a punctual light or an emissive object moves, the camera when
- * the view's camera node is animated, vertices when morph targets deform.
- * A method that rebuilds on a flag is charged only for what moves. */
-static gi_changes animation_changes(const gi_scene *s, const gi_gpu_scene *gs, int camera)
-{
-    gi_changes ch = {0u, 0.0f, 0ull};
-    for (uint32_t k = 0; k < s->object_count; k++)
-        if (s->objects[k].animated || s->objects[k].morph_track.count) {
-            ch.flags |= GI_CHANGED_TRANSFORMS;
-            ch.moved_objects |= k < 64 ? 1ull << k : 0ull;
-        }
-    if (s->object_count > 64 && (ch.flags & GI_CHANGED_TRANSFORMS))
-        ch.moved_objects = ~0ull;
-    if (gs->deforming)
-        ch.flags |= GI_CHANGED_TRANSFORMS | GI_CHANGED_VERTICES;
-    if (gi_scene_lights_animated(s))
-        ch.flags |= GI_CHANGED_LIGHTS;
-    if (gi_scene_camera_animated(s, camera))
-        ch.flags |= GI_CHANGED_CAMERA;
-    return ch;
-}
-
 typedef struct run_state {
     gi_scene *scene;
     gi_gpu *gpu;
@@ -320,9 +286,9 @@ typedef struct run_state {
     cli_host host;
     int host_ready;
     const gi_method *m;
-    void *inst;
     gi_timer *prep_timer, *render_timer;
-    GLuint target_tex, target_fbo;
+    render_loop loop; /* the instance and its target (render_loop.h) */
+    gi_camera_frame view_camera;
     gi_image *image;
     gi_image *curve_ref[MAX_CURVE_REFS];
     uint32_t curve_frame[MAX_CURVE_POINTS]; /* 1-based frame after which the error was taken */
@@ -333,12 +299,7 @@ typedef struct run_state {
 
 static void cleanup(run_state *r)
 {
-    if (r->inst)
-        r->m->destroy(r->inst);
-    if (r->target_fbo)
-        glDeleteFramebuffers(1, &r->target_fbo);
-    if (r->target_tex)
-        glDeleteTextures(1, &r->target_tex);
+    render_loop_free(&r->loop);
     gi_timer_free(r->prep_timer);
     gi_timer_free(r->render_timer);
     gi_gpu_scene_free(r->gs);
@@ -354,16 +315,15 @@ static void cleanup(run_state *r)
     free(r->cache_dir);
 }
 
-/* Reports a method failure with its own message. */
-static int method_fail(run_state *r, const char *what, gi_result res)
+/* Reports a failure of the render loop with its one-line message: bad
+ * usage for invalid arguments and what the method cannot do. */
+static int loop_fail(run_state *r, gi_result res, const gi_error *err)
 {
     if (r->host_ready)
         cli_host_progress_end(&r->host);
-    const char *msg = r->m->last_error(r->inst);
     return cli_fail(res == GI_ERR_INVALID_ARGUMENT || res == GI_ERR_UNSUPPORTED ? EXIT_USAGE
                                                                                 : EXIT_RUN,
-                    "%s: %s failed (%s)%s%s", r->m->id, what, gi_result_name(res),
-                    msg && *msg ? ": " : "", msg ? msg : "");
+                    "%s", err->text);
 }
 
 /* Whether the error is recorded after 1-based frame k of n: every frame of
@@ -424,7 +384,7 @@ static int record_curve_point(run_state *r, const render_opts *o, uint32_t k)
     if (o->curve_ref_count == 0 || !curve_frame_wanted(k, o->frames) ||
         r->curve_n == MAX_CURVE_POINTS)
         return EXIT_OK;
-    gi_image *img = gi_gpu_read_texture(r->target_tex, o->width, o->height);
+    gi_image *img = gi_gpu_read_texture(r->loop.target_tex, o->width, o->height);
     if (!img)
         return cli_fail(EXIT_RUN, "out of memory reading the image back");
     gi_metrics_opts mo = {o->exposure, 0, 1, 0};
@@ -450,7 +410,7 @@ static int write_frame(run_state *r, const render_opts *o, uint32_t f)
     char path[4096];
     if (!cli_frame_path(o->frames_out, f, path, sizeof path))
         return cli_fail(EXIT_USAGE, "render: --frames-out '%s': bad pattern", o->frames_out);
-    gi_image *img = gi_gpu_read_texture(r->target_tex, o->width, o->height);
+    gi_image *img = gi_gpu_read_texture(r->loop.target_tex, o->width, o->height);
     if (!img)
         return cli_fail(EXIT_RUN, "out of memory reading frame %u back", f);
     for (size_t i = 0; i < (size_t)o->width * o->height; i++)
@@ -624,7 +584,7 @@ static int find_camera(const run_state *r, const render_opts *o, int *camera)
 
 /* The cache, the GL context with the scene uploaded, the timers, the host
  * services and the render target (cleared to black). */
-static int setup_gpu(run_state *r, const render_opts *o)
+static int setup_gpu(run_state *r, const render_opts *o, int camera)
 {
     gi_error err;
     /* The cache only saves time: with no usable directory (HOME unset or
@@ -650,12 +610,25 @@ static int setup_gpu(run_state *r, const render_opts *o)
                   gi_gpu_is_software(r->gpu));
     r->host_ready = 1;
 
-    glCreateTextures(GL_TEXTURE_2D, 1, &r->target_tex);
-    glTextureStorage2D(r->target_tex, 1, GL_RGBA32F, (GLsizei)o->width, (GLsizei)o->height);
-    glCreateFramebuffers(1, &r->target_fbo);
-    glNamedFramebufferTexture(r->target_fbo, GL_COLOR_ATTACHMENT0, r->target_tex, 0);
-    const float black[4] = {0, 0, 0, 1};
-    glClearNamedFramebufferfv(r->target_fbo, GL_COLOR, 0, black);
+    render_loop *l = &r->loop;
+    l->m = r->m;
+    l->scene = r->scene;
+    l->gs = r->gs;
+    l->host = &r->host;
+    l->prep_timer = r->prep_timer;
+    l->render_timer = r->render_timer;
+    l->width = o->width;
+    l->height = o->height;
+    l->seed = o->seed;
+    l->time = o->time;
+    l->animate_fps = o->animate_fps;
+    l->exposure = o->exposure;
+    l->camera = camera;
+    if (o->has_view) {
+        r->view_camera = view_file_camera(&o->view);
+        l->fixed_camera = &r->view_camera;
+    }
+    render_loop_target(l);
     return EXIT_OK;
 }
 
@@ -663,21 +636,10 @@ static int setup_gpu(run_state *r, const render_opts *o)
  * a saved view moves. */
 static int create_and_prepare(run_state *r, const render_opts *o, int moves)
 {
-    gi_error cerr;
-    gi_result res = gi_method_create(r->m, &r->host.host, r->params, &r->inst, &cerr);
+    gi_error err;
+    gi_result res = render_loop_prepare(&r->loop, r->params, &err);
     if (res != GI_OK)
-        return cli_fail(res == GI_ERR_INVALID_ARGUMENT || res == GI_ERR_UNSUPPORTED ? EXIT_USAGE
-                                                                                    : EXIT_RUN,
-                        "%s: %s", r->m->id, cerr.text);
-    r->host.timer = r->prep_timer;
-    /* -v: the moment precomputation starts (the cancellation test waits for it) */
-    gi_log(GI_LOG_INFO, "%s: prepare begins", r->m->id);
-    gi_timer_frame_begin(r->prep_timer);
-    res = r->m->prepare(r->inst, r->gs);
-    gi_timer_frame_end(r->prep_timer);
-    cli_host_progress_end(&r->host);
-    if (res != GI_OK)
-        return method_fail(r, "prepare", res);
+        return loop_fail(r, res, &err);
     if (moves) {
         unsigned char *moved = calloc(r->scene->node_count, 1);
         if (!moved)
@@ -689,50 +651,19 @@ static int create_and_prepare(run_state *r, const render_opts *o, int moves)
         free(moved);
         view_file_apply_nodes(&o->view, r->scene);
         gi_gpu_scene_set_time(r->gs, o->time);
-        res = r->m->update(r->inst, r->gs, &ch);
-        if (res != GI_OK)
-            return method_fail(r, "update", res);
-    }
-    return EXIT_OK;
-}
-
-/* Frame f (from 0), timed: update() for a step of an animation, then render(). */
-static int render_frame(run_state *r, const render_opts *o, int camera, uint32_t f)
-{
-    gi_target target = {r->target_tex, r->target_fbo, o->width, o->height};
-    float t = o->time + (o->animate_fps > 0 ? (float)f / o->animate_fps : 0.0f);
-    gi_result res;
-    /* A frame of an animation is update() and render(): what an
-     * interactive program pays per frame (a method that rebuilds data
-     * in update() is charged for it; its stages count in the frame). */
-    gi_timer_frame_begin(r->render_timer);
-    if (f > 0 && o->animate_fps > 0) {
-        gi_gpu_scene_set_time(r->gs, t);
-        gi_changes ch = animation_changes(r->scene, r->gs, o->has_view ? -1 : camera);
-        ch.time = t;
-        res = r->m->update(r->inst, r->gs, &ch);
+        res = r->m->update(r->loop.inst, r->gs, &ch);
         if (res != GI_OK) {
-            gi_timer_frame_end(r->render_timer);
-            return method_fail(r, "update", res);
+            render_loop_method_error(&r->loop, "update", res, &err);
+            return loop_fail(r, res, &err);
         }
     }
-    gi_view view;
-    make_view(r->scene, camera, o, t, o->animate_fps > 0 ? 0 : f, &view);
-    res = r->m->render(r->inst, &view, &target);
-    gi_timer_frame_end(r->render_timer);
-    if (res != GI_OK)
-        return method_fail(r, "render", res);
-    gi_error err;
-    if (gi_gl_check("after render", &err) != GI_OK)
-        return cli_fail(EXIT_RUN, "%s: %s", r->m->id, err.text);
     return EXIT_OK;
 }
 
 /* Every frame (the render timer), with the convergence curve's points and
  * --frames-out taken between them, under a progress line. */
-static int render_frames(run_state *r, const render_opts *o, int camera)
+static int render_frames(run_state *r, const render_opts *o)
 {
-    r->host.timer = r->render_timer;
     cli_progress bar;
     char label[64];
     snprintf(label, sizeof label, "render %s", r->m->id);
@@ -745,10 +676,13 @@ static int render_frames(run_state *r, const render_opts *o, int camera)
             return cli_fail(EXIT_RUN, "render: interrupted after %u of %u frames; no image written",
                             f, o->frames);
         }
-        int rc = render_frame(r, o, camera, f);
-        if (rc != EXIT_OK)
-            return rc;
-        rc = record_curve_point(r, o, f + 1);
+        gi_error err;
+        gi_result res = render_loop_frame(&r->loop, f, &err);
+        if (res != GI_OK) {
+            cli_progress_end(&bar);
+            return loop_fail(r, res, &err);
+        }
+        int rc = record_curve_point(r, o, f + 1);
         if (rc == EXIT_OK)
             rc = write_frame(r, o, f);
         if (rc != EXIT_OK) {
@@ -766,11 +700,9 @@ static int render_frames(run_state *r, const render_opts *o, int camera)
 static int write_results(run_state *r, const render_opts *o)
 {
     gi_error err;
-    r->image = gi_gpu_read_texture(r->target_tex, o->width, o->height);
+    r->image = render_loop_image(&r->loop);
     if (!r->image)
         return cli_fail(EXIT_RUN, "out of memory reading the image back");
-    for (size_t i = 0; i < (size_t)o->width * o->height; i++)
-        r->image->rgba[4 * i + 3] = 1.0f;
     gi_image_write_opts wo = {o->exposure};
     for (int i = 0; i < o->out_count; i++)
         if (gi_image_write(o->outs[i], r->image, &wo, &err) != GI_OK)
@@ -795,13 +727,13 @@ static int run(run_state *r, const render_opts *o)
     if (rc == EXIT_OK)
         rc = find_camera(r, o, &camera);
     if (rc == EXIT_OK)
-        rc = setup_gpu(r, o);
+        rc = setup_gpu(r, o, camera);
     if (rc == EXIT_OK)
         rc = create_and_prepare(r, o, moves);
     if (rc != EXIT_OK)
         return rc;
     r->rss_prepare_mib = peak_rss_mib();
-    rc = render_frames(r, o, camera);
+    rc = render_frames(r, o);
     if (rc == EXIT_OK)
         rc = write_results(r, o);
     return rc;

@@ -147,6 +147,28 @@ void gi_ref_get_stats(const gi_ref *r, gi_ref_stats *out);
 
 /* "embree 3.13.5 cpu": the renderer name recorded with every result. */
 const char *gi_ref_renderer(const gi_ref *r);
+/* When gi_ref_progressive stops: at `spp` samples per pixel, after
+ * `seconds` of rendering, or once gi_ref_mean_rel_se falls to `target_se`
+ * (checked at sample counts that depend on the image alone, so that the
+ * stopping point and the image are reproducible); 0 leaves a limit out,
+ * the first one reached stops. */
+typedef struct gi_ref_until {
+    uint64_t spp;
+    double seconds;
+    double target_se;
+} gi_ref_until;
+/* Called after every pass with the samples so far, the last standard
+ * error checked (with target_se; else the current one) and the samples
+ * it was taken at, and the seconds so far; nonzero cancels. */
+typedef int (*gi_ref_pass_fn)(void *user, uint64_t spp, double rel_se, uint64_t se_spp,
+                              double elapsed);
+/* Passes of about half a second until `u` says stop (*stop: "spp",
+ * "time" or "target-se"). GI_ERR_CANCELLED when fn asked. The loop of
+ * gibench reference; the image after N samples is the same bits however
+ * they were split (see Determinism above). */
+gi_result gi_ref_progressive(gi_ref *r, const gi_ref_until *u, gi_ref_pass_fn fn, void *user,
+                             const char **stop, gi_error *err);
+
 /* Name of a strategy ("mis", "light", "bsdf"), and the reverse (-1 when
  * the name is unknown). */
 const char *gi_ref_strategy_name(gi_ref_strategy s);

@@ -1,0 +1,390 @@
+/* libgibench (gi/gibench.h): the process's GL context, plugins and scenes,
+ * and one render through the CLI's render loop (render_loop.h). */
+#include "gi/gibench.h"
+
+#include "cli.h"
+#include "gibench_internal.h"
+#include "gi/cache.h"
+#include "gi/image.h"
+#include "gi/log.h"
+#include "render_loop.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct gibench_scene {
+    gi_scene *scene;
+    gi_gpu_scene *gs;
+};
+
+/* What one process keeps: the GL context and the plugin registry, made on
+ * first use and kept until exit (the plugins' code must outlive every
+ * instance, and a context per call would cost what the API saves). */
+static gi_gpu *g_gpu;
+static gi_plugins *g_reg;
+
+static gi_result ensure_gpu(gi_error *err)
+{
+    if (g_gpu)
+        return GI_OK;
+    /* the same check the CLI makes before any command (GIBENCH_TIMER) */
+    gi_result res = gi_timer_env_check(err);
+    if (res != GI_OK)
+        return res;
+    g_gpu = gi_gpu_create(NULL, err);
+    return g_gpu ? GI_OK : GI_ERR_GL;
+}
+
+static gi_result ensure_plugins(gi_error *err)
+{
+    if (!g_reg)
+        g_reg = cli_load_plugins(1);
+    return g_reg ? GI_OK : gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory");
+}
+
+gi_result gibench_json_out(json_object *j, char **out, gi_error *err)
+{
+    const char *text =
+        json_object_to_json_string_ext(j, JSON_C_TO_STRING_PLAIN | JSON_C_TO_STRING_NOSLASHESCAPE);
+    size_t n = text ? strlen(text) + 1 : 0;
+    *out = n ? malloc(n) : NULL;
+    if (*out)
+        memcpy(*out, text, n);
+    json_object_put(j);
+    return *out ? GI_OK : gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory");
+}
+
+gibench_render_opts gibench_render_defaults(void)
+{
+    gibench_render_opts o;
+    memset(&o, 0, sizeof o);
+    o.width = o.height = 256;
+    o.frames = 1;
+    o.seed = 1;
+    return o;
+}
+
+gi_result gibench_methods_json(char **out, gi_error *err)
+{
+    *out = NULL;
+    gi_result res = ensure_plugins(err);
+    if (res != GI_OK)
+        return res;
+    json_object *arr = json_object_new_array();
+    for (uint32_t i = 0; i < g_reg->count; i++)
+        json_object_array_add(arr, cli_method_json(&g_reg->items[i]));
+    return gibench_json_out(arr, out, err);
+}
+
+gi_result gibench_scene_open(const char *path, gibench_scene **out, gi_error *err)
+{
+    *out = NULL;
+    gi_result res = ensure_gpu(err);
+    if (res != GI_OK)
+        return res;
+    gibench_scene *s = calloc(1, sizeof *s);
+    if (!s)
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory");
+    /* a scene that does not load is bad input, as for gibench render */
+    s->scene = gi_scene_load(path, err);
+    res = GI_ERR_INVALID_ARGUMENT;
+    if (s->scene) {
+        s->gs = gi_gpu_scene_upload(g_gpu, s->scene, err);
+        res = s->gs ? GI_OK : GI_ERR_GL;
+    }
+    if (res != GI_OK) {
+        gibench_scene_close(s);
+        return res;
+    }
+    *out = s;
+    return GI_OK;
+}
+
+const gi_scene *gibench_scene_of(const gibench_scene *s)
+{
+    return s->scene;
+}
+
+void gibench_scene_close(gibench_scene *s)
+{
+    if (!s)
+        return;
+    gi_gpu_scene_free(s->gs);
+    gi_scene_free(s->scene);
+    free(s);
+}
+
+gi_result gibench_scene_info_json(const gibench_scene *s, char **out, gi_error *err)
+{
+    const gi_scene *sc = s->scene;
+    json_object *j = json_object_new_object();
+    json_object_object_add(j, "path", json_object_new_string(sc->path ? sc->path : ""));
+    json_object *cams = json_object_new_array();
+    for (uint32_t i = 0; i < sc->camera_count; i++)
+        json_object_array_add(
+            cams, json_object_new_string(sc->cameras[i].name ? sc->cameras[i].name : ""));
+    json_object_object_add(j, "cameras", cams);
+    json_object_object_add(j, "duration", json_object_new_double(sc->animation_length));
+    json_object_object_add(j, "objects", json_object_new_int64(sc->object_count));
+    json_object_object_add(j, "lights", json_object_new_int64(sc->light_count));
+    json_object_object_add(j, "triangles", json_object_new_int64(sc->triangle_count));
+    return gibench_json_out(j, out, err);
+}
+
+/* The method, its parameters and the camera, checked as gibench render
+ * checks them, with the CLI's messages. */
+static gi_result resolve(const gibench_scene *s, const gibench_render_opts *o, const gi_method **m,
+                         gi_params **params, int *camera, gi_error *err)
+{
+    char size[32];
+    uint32_t w, h;
+    snprintf(size, sizeof size, "%ux%u", o->width, o->height);
+    if (!cli_parse_size(size, &w, &h))
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "render: --size '%s' is not WxH with " GI_IMAGE_SIZE_RULE, size);
+    if (o->frames < 1 || o->frames > 1000000)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "render: --frames '%u' is not an integer in 1..1000000", o->frames);
+    if (o->warmup >= o->frames && o->frames > 1)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "render: --warmup %u leaves no timed frame of %u", o->warmup,
+                            o->frames);
+    if (!(o->time >= 0) || o->time > 3.4e38f)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "render: --time '%g' is not a non-negative number", (double)o->time);
+    if (!o->method)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "render: --method is required (see gibench methods)");
+    gi_result res = ensure_plugins(err);
+    if (res != GI_OK)
+        return res;
+    *m = gi_plugins_find(g_reg, o->method);
+    if (!*m) {
+        char known[512] = "";
+        for (uint32_t i = 0; i < g_reg->count; i++) {
+            size_t used = strlen(known);
+            snprintf(known + used, sizeof known - used, "%s%s", i ? ", " : "",
+                     g_reg->items[i].method->id);
+        }
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "render: no method '%s' (installed: %s)",
+                            o->method, known[0] ? known : "none");
+    }
+    *params = gi_params_parse((*m)->id, (*m)->params, o->params, o->param_count, err);
+    if (!*params)
+        return GI_ERR_INVALID_ARGUMENT;
+    *camera = s->scene->camera_count ? 0 : -1;
+    if (o->camera) {
+        *camera = gi_scene_find_camera(s->scene, o->camera);
+        if (*camera < 0)
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "render: %s has no camera '%s' (%u cameras; use a name or #k)",
+                                s->scene->path, o->camera, s->scene->camera_count);
+    }
+    return GI_OK;
+}
+
+/* The run's timings, the part of gibench render --timings that concerns
+ * the method (the rest the caller knows). */
+static json_object *timings_json(const render_loop *l, const gi_params *params,
+                                 const cli_host *host)
+{
+    json_object *j = json_object_new_object();
+    char *pstr = gi_params_to_string(params);
+    json_object_object_add(j, "method", json_object_new_string(l->m->id));
+    json_object_object_add(j, "method_version", json_object_new_string(l->m->version));
+    json_object_object_add(j, "params", json_object_new_string(pstr ? pstr : ""));
+    free(pstr);
+    json_object_object_add(j, "gl_renderer", json_object_new_string(gi_gpu_renderer(g_gpu)));
+    json_object_object_add(
+        j, "timer", json_object_new_string(gi_timer_mode_name(gi_timer_get_mode(l->render_timer))));
+    json_object_object_add(j, "prepare", cli_timer_json(l->prep_timer));
+    json_object_object_add(j, "render", cli_timer_json(l->render_timer));
+    json_object_object_add(j, "stats", json_object_get(host->stats));
+    return j;
+}
+
+struct gibench_method {
+    gibench_scene *s;
+    gi_params *params;
+    char *cache_dir;
+    cli_host host;
+    int host_ready;
+    render_loop l;
+    uint32_t next_frame; /* the frame_index of the next frame: 0 after an update */
+    uint32_t warmup;
+    gi_timer_mode mode;
+};
+
+void gibench_method_close(gibench_method *m)
+{
+    if (!m)
+        return;
+    render_loop_free(&m->l);
+    gi_timer_free(m->l.prep_timer);
+    gi_timer_free(m->l.render_timer);
+    if (m->host_ready)
+        cli_host_free(&m->host);
+    free(m->cache_dir);
+    gi_params_free(m->params);
+    free(m);
+}
+
+/* The instance's loop, host and timers, as gibench render sets them up. */
+static void method_setup(gibench_method *m, const gi_method *gm, const gibench_render_opts *o,
+                         int camera)
+{
+    gi_error cerr;
+    gibench_scene *s = m->s;
+    /* as gibench render: without a usable cache folder, precompute afresh */
+    m->cache_dir = o->no_cache ? NULL : gi_cache_dir(&cerr);
+    gi_gpu_scene_set_time(s->gs, o->time);
+    m->mode = gi_timer_mode_for(gi_gpu_is_software(g_gpu));
+    cli_host_init(&m->host, gm->id, m->cache_dir, s->gs, gi_gpu_renderer(g_gpu),
+                  gi_gpu_is_software(g_gpu));
+    m->host_ready = 1;
+    m->warmup = o->warmup;
+    render_loop *l = &m->l;
+    l->m = gm;
+    l->scene = s->scene;
+    l->gs = s->gs;
+    l->host = &m->host;
+    l->prep_timer = gi_timer_create(m->mode, 0);
+    l->width = o->width;
+    l->height = o->height;
+    l->seed = o->seed;
+    l->time = o->time;
+    l->exposure = o->exposure;
+    l->camera = camera;
+    render_loop_target(l);
+}
+
+gi_result gibench_method_open(gibench_scene *s, const gibench_render_opts *o, gibench_method **out,
+                              gi_error *err)
+{
+    *out = NULL;
+    const gi_method *gm = NULL;
+    gi_params *params = NULL;
+    int camera = 0;
+    gi_result res = resolve(s, o, &gm, &params, &camera, err);
+    if (res != GI_OK) {
+        gi_params_free(params);
+        return res;
+    }
+    char why[256];
+    if (!cli_caps_cover(gm, s->scene, 0, why, sizeof why))
+        gi_log(GI_LOG_WARN,
+               "render: %s in %s: the image leaves that out (a study marks this cell n/a)", why,
+               s->scene->path);
+    gibench_method *m = calloc(1, sizeof *m);
+    if (!m) {
+        gi_params_free(params);
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory");
+    }
+    m->s = s;
+    m->params = params;
+    method_setup(m, gm, o, camera);
+    res = render_loop_prepare(&m->l, params, err);
+    if (res != GI_OK) {
+        gibench_method_close(m);
+        return res;
+    }
+    *out = m;
+    return GI_OK;
+}
+
+gi_result gibench_method_update(gibench_method *m, float time, const char *camera, gi_error *err)
+{
+    uint32_t flags = 0;
+    if (camera) {
+        int c = gi_scene_find_camera(m->s->scene, camera);
+        if (c < 0)
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "render: %s has no camera '%s' (%u cameras; use a name or #k)",
+                                m->s->scene->path, camera, m->s->scene->camera_count);
+        flags = c != m->l.camera ? GI_CHANGED_CAMERA : 0u;
+        m->l.camera = c;
+    }
+    if (!(time >= 0) || time > 3.4e38f)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "render: --time '%g' is not a non-negative number", (double)time);
+    m->l.time = time;
+    m->next_frame = 0;
+    return render_loop_update(&m->l, time, flags, err);
+}
+
+gi_result gibench_method_render(gibench_method *m, uint32_t frames, float *rgb, char **timings,
+                                gi_error *err)
+{
+    if (timings)
+        *timings = NULL;
+    if (frames < 1 || frames > 1000000)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "render: --frames '%u' is not an integer in 1..1000000", frames);
+    render_loop *l = &m->l;
+    /* every call's frames timed afresh; the scene at this instance's time
+     * (another instance on the same scene may have moved it) */
+    gi_timer_free(l->render_timer);
+    l->render_timer = gi_timer_create(m->mode, m->warmup < frames ? m->warmup : 0);
+    gi_gpu_scene_set_time(l->gs, l->time);
+    gi_result res = GI_OK;
+    for (uint32_t f = 0; res == GI_OK && f < frames; f++)
+        res = render_loop_frame(l, m->next_frame++, err);
+    if (res != GI_OK)
+        return res;
+    gi_image *img = render_loop_image(l);
+    if (!img)
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory reading the image back");
+    for (size_t i = 0; i < (size_t)l->width * l->height; i++)
+        memcpy(rgb + 3 * i, img->rgba + 4 * i, 3 * sizeof(float));
+    gi_image_free(img);
+    return timings ? gibench_json_out(timings_json(l, m->params, &m->host), timings, err) : GI_OK;
+}
+
+gi_result gibench_render(gibench_scene *s, const gibench_render_opts *o, float *rgb, char **timings,
+                         gi_error *err)
+{
+    gibench_method *m = NULL;
+    gi_result res = gibench_method_open(s, o, &m, err);
+    if (res == GI_OK)
+        res = gibench_method_render(m, o->frames, rgb, timings, err);
+    gibench_method_close(m);
+    return res;
+}
+
+gi_result gibench_image_read(const char *path, float **rgba, uint32_t *width, uint32_t *height,
+                             gi_error *err)
+{
+    *rgba = NULL;
+    gi_image *img = gi_image_read(path, err);
+    if (!img)
+        return GI_ERR_IO;
+    *width = img->width;
+    *height = img->height;
+    /* the pixels handed over; the struct released */
+    *rgba = img->rgba;
+    img->rgba = NULL;
+    gi_image_free(img);
+    return GI_OK;
+}
+
+gi_result gibench_image_write(const char *path, const float *rgb, uint32_t width, uint32_t height,
+                              float exposure, gi_error *err)
+{
+    gi_image *img = gi_image_create(width, height);
+    if (!img)
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory");
+    for (size_t i = 0; i < (size_t)width * height; i++) {
+        memcpy(img->rgba + 4 * i, rgb + 3 * i, 3 * sizeof(float));
+        img->rgba[4 * i + 3] = 1.0f;
+    }
+    gi_image_write_opts wo = {exposure};
+    gi_result res = gi_image_write(path, img, &wo, err);
+    gi_image_free(img);
+    return res;
+}
+
+void gibench_free(void *p)
+{
+    free(p);
+}

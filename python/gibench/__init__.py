@@ -1,0 +1,405 @@
+"""gibench from Python: methods, scenes and renders in one process, images as numpy arrays.
+
+    import gibench
+    scene = gibench.Scene("scenes/cornell_box.gltf")
+    img = scene.render("csm", size=(128, 128), frames=8, seed=1)
+    img.shape, img.dtype      # (128, 128, 3) float32, rows top to bottom
+    img.timings["render"]     # the run's stage timings, as gibench render --timings
+
+The names and defaults are the CLI's (docs/commands.md); the render is the
+same code as `gibench render`, so the images are the same bit for bit.
+One process keeps one GL context (made on first use, on the calling
+thread: use gibench from one thread) and the installed plugins; a Scene
+keeps its loaded scene and GPU upload. docs/python.md has the whole API.
+"""
+import ctypes
+import json
+import os
+import subprocess
+import tempfile
+import weakref
+
+import numpy as np
+
+from . import _build
+from ._lib import (Error, GiError, ReferenceOpts, RenderOpts, RunError, UsageError, check, lib,
+                   take_string)
+
+__all__ = ["Error", "RunError", "UsageError", "Image", "Method", "Scene", "methods", "metrics", "read",
+           "study", "write"]
+
+
+class Image(np.ndarray):
+    """A float32 H x W x 3 numpy array with the run's `timings` (a dict: method,
+    params, prepare and render stage statistics in ms, stats; None for an image
+    that was not rendered)."""
+
+    def __new__(cls, array, timings=None):
+        obj = np.asarray(array, dtype=np.float32).view(cls)
+        obj.timings = timings
+        return obj
+
+    def __array_finalize__(self, obj):
+        self.timings = getattr(obj, "timings", None)
+
+
+def methods():
+    """The installed methods as `gibench methods --json` lists them: dicts with
+    id, title, citation, caps, max_bounces and params (name, type, default,
+    min/max or choices, and "quality" for a quality knob)."""
+    out = ctypes.c_void_p()
+    err = GiError()
+    check(lib.gibench_methods_json(ctypes.byref(out), ctypes.byref(err)), err)
+    return json.loads(take_string(out))
+
+
+def _param_text(value):
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    # 32.0 as "32": the knob steps of gibench.methods() are numbers, an int knob's too
+    if isinstance(value, float) and value.is_integer():
+        return str(int(value))
+    return str(value)
+
+
+def _size(size, cmd="render"):
+    try:
+        w, h = (int(v) for v in size)
+    except (TypeError, ValueError):
+        raise UsageError("%s: size %r is not (width, height)" % (cmd, size)) from None
+    if w < 0 or h < 0 or w > 0xFFFFFFFF or h > 0xFFFFFFFF:
+        raise UsageError("%s: --size '%dx%d' is not a size" % (cmd, w, h))
+    return w, h
+
+
+def _uint(name, value, lo, hi, cmd="render"):
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not lo <= value <= hi:
+        raise UsageError("%s: --%s '%s' is not an integer in %d..%d" % (cmd, name, value, lo, hi))
+    return int(value)
+
+
+class Scene:
+    """A loaded scene and its GPU upload (gibench render --scene PATH).
+
+    cameras: the scene's camera names (camera= takes a name or "#k");
+    duration: the animation's length in seconds (0 for a static scene)."""
+
+    def __init__(self, path):
+        self.path = os.fspath(path)
+        self._handle = ctypes.c_void_p()
+        err = GiError()
+        check(lib.gibench_scene_open(self.path.encode(), ctypes.byref(self._handle),
+                                     ctypes.byref(err)), err)
+        out = ctypes.c_void_p()
+        check(lib.gibench_scene_info_json(self._handle, ctypes.byref(out), ctypes.byref(err)), err)
+        info = json.loads(take_string(out))
+        self.cameras = info["cameras"]
+        self.duration = info["duration"]
+        self.info = info
+        self._methods = weakref.WeakSet()
+
+    def close(self):
+        """Releases the scene and its upload now (also when the object goes),
+        and every Method instance made on it."""
+        for m in list(getattr(self, "_methods", ())):
+            m.close()
+        if getattr(self, "_handle", None) and self._handle.value:
+            lib.gibench_scene_close(self._handle)
+            self._handle = ctypes.c_void_p()
+
+    def __del__(self):
+        self.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def _alive(self):
+        if not self._handle.value:
+            raise UsageError("render: the scene %s is closed" % self.path)
+
+    def render(self, method, size=(256, 256), frames=1, seed=1, params=None, camera=None,
+               time=0.0, warmup=0, exposure=0.0, no_cache=False, isolate=False):
+        """One render as `gibench render --scene S --method M`: an Image (H x W x 3
+        float32, the last frame) with .timings. isolate=True runs it in a child
+        `gibench render` process, so that a crashing plugin raises RunError
+        instead of taking the interpreter down."""
+        w, h = _size(size)
+        frames = _uint("frames", frames, 1, 1000000)
+        seed = _uint("seed", seed, 0, 0xFFFFFFFF)
+        warmup = _uint("warmup", warmup, 0, 1000)
+        texts = ["%s=%s" % (k, _param_text(v)) for k, v in (params or {}).items()]
+        if isolate:
+            return self._render_child(method, w, h, frames, seed, texts, camera, time, warmup,
+                                      exposure, no_cache)
+        self._alive()
+        o, keep = _render_opts(method, w, h, frames, seed, texts, camera, time, warmup, exposure,
+                               no_cache)
+        img = np.empty((h, w, 3), dtype=np.float32)
+        out = ctypes.c_void_p()
+        err = GiError()
+        res = lib.gibench_render(self._handle, ctypes.byref(o),
+                                 img.ctypes.data_as(ctypes.POINTER(ctypes.c_float)),
+                                 ctypes.byref(out), ctypes.byref(err))
+        del keep
+        check(res, err)
+        return Image(img, json.loads(take_string(out)))
+
+    def method(self, method, size=(256, 256), seed=1, params=None, camera=None, time=0.0,
+               warmup=0, exposure=0.0, no_cache=False):
+        """A Method: the instance created and prepared once (the options of
+        render), then updated and rendered frame after frame."""
+        self._alive()
+        return Method(self, method, size, seed, params, camera, time, warmup, exposure, no_cache)
+
+    def reference(self, spp=None, seconds=None, target_se=None, max_bounces=None,
+                  size=(256, 256), seed=1, camera=None, time=0.0, threads=0, pixel="box",
+                  traversal="fast"):
+        """The path-traced reference as `gibench reference`: (mean, variance), two
+        H x W x 3 float32 arrays; mean.timings holds the run's stats (spp, stop,
+        render_seconds, mean_rel_se, ...). Progressive: it stops at spp samples per
+        pixel, after `seconds`, or at the mean relative standard error target_se
+        (--target-se), whichever comes first; with none given, 256 spp.
+        max_bounces None is unlimited; time is the scene's time (--time-of-scene)."""
+        self._alive()
+        w, h = _size(size, "reference")
+        if pixel not in ("box", "center"):
+            raise UsageError("reference: --pixel '%s' is not box or center" % pixel)
+        if traversal not in ("fast", "robust"):
+            raise UsageError("reference: --traversal '%s' is not fast or robust" % traversal)
+        o = ReferenceOpts(camera=None if camera is None else str(camera).encode(), width=w,
+                          height=h, seed=_uint("seed", seed, 0, 0xFFFFFFFF, "reference"),
+                          threads=_uint("threads", threads, 0, 1024, "reference"),
+                          time=float(time), pixel_center=pixel == "center",
+                          robust_traversal=traversal == "robust")
+        o.max_bounces = -1 if max_bounces is None else _uint("max-bounces", max_bounces, 0,
+                                                             1000000, "reference")
+        if spp is not None:
+            o.spp = _uint("spp", spp, 1, 0xFFFFFFFF, "reference")
+        for name, v in (("time", seconds), ("target-se", target_se)):
+            if v is not None and not (isinstance(v, (int, float)) and v > 0 and v < float("inf")):
+                raise UsageError("reference: --%s '%s' is not a positive number" % (name, v))
+        o.seconds = float(seconds or 0.0)
+        o.target_se = float(target_se or 0.0)
+        mean = np.empty((h, w, 3), dtype=np.float32)
+        var = np.empty((h, w, 3), dtype=np.float32)
+        out = ctypes.c_void_p()
+        err = GiError()
+        fp = ctypes.POINTER(ctypes.c_float)
+        check(lib.gibench_reference(self._handle, ctypes.byref(o), mean.ctypes.data_as(fp),
+                                    var.ctypes.data_as(fp), ctypes.byref(out), ctypes.byref(err)),
+              err)
+        return Image(mean, json.loads(take_string(out))), var
+
+    def _render_child(self, method, w, h, frames, seed, texts, camera, time, warmup, exposure,
+                      no_cache):
+        with tempfile.TemporaryDirectory(prefix="gibench-py-") as tmp:
+            out = os.path.join(tmp, "image.exr")
+            timings = os.path.join(tmp, "timings.json")
+            cmd = [os.environ.get("GIBENCH_BIN") or _build.COMMAND, "-q", "render",
+                   "--scene", self.path, "--method", str(method), "--out", out,
+                   "--size", "%dx%d" % (w, h), "--frames", str(frames), "--seed", str(seed),
+                   "--warmup", str(warmup), "--time", repr(float(time)),
+                   "--exposure", repr(float(exposure)), "--timings", timings]
+            for t in texts:
+                cmd += ["--param", t]
+            if camera is not None:
+                cmd += ["--camera", str(camera)]
+            if no_cache:
+                cmd.append("--no-cache")
+            p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            if p.returncode != 0:
+                raise _child_error(p)
+            img = read(out)
+            with open(timings) as f:
+                return Image(img, json.load(f))
+
+
+def study(study, out, jobs=None, resume=False, fresh=False, dry_run=False):
+    """Runs a study as `gibench study STUDY --out OUT` (each run in its own
+    process, as the CLI does) and returns its runs: the records of OUT/runs.json
+    as a list of dicts, or a pandas DataFrame (nested keys flattened, e.g.
+    "metrics.full.relmse") when pandas is installed. study is a study file's
+    path or the study itself as a dict (paths in it are relative to the current
+    folder, as in a file)."""
+    with tempfile.TemporaryDirectory(prefix="gibench-py-") as tmp:
+        path = study
+        if isinstance(study, dict):
+            path = os.path.join(tmp, "%s.json" % study.get("name", "study"))
+            with open(path, "w") as f:
+                json.dump(study, f, indent=1)
+        cmd = [os.environ.get("GIBENCH_BIN") or _build.COMMAND, "-q", "study", os.fspath(path),
+               "--out", os.fspath(out)]
+        if jobs is not None:
+            cmd += ["--jobs", str(jobs)]
+        cmd += (["--resume"] if resume else []) + (["--fresh"] if fresh else [])
+        cmd += ["--dry-run"] if dry_run else []
+        p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    if p.returncode != 0:
+        raise _child_error(p, "study")
+    if dry_run:
+        return p.stdout
+    with open(os.path.join(os.fspath(out), "runs.json")) as f:
+        runs = json.load(f)
+    try:
+        import pandas
+    except ImportError:
+        return runs
+    return pandas.json_normalize(runs)
+
+
+def _render_opts(method, w, h, frames, seed, texts, camera, time, warmup, exposure, no_cache):
+    """The RenderOpts of render(), and what must stay alive while it is used."""
+    if w * h > (1 << 28):
+        raise UsageError("render: --size '%dx%d' is too large" % (w, h))
+    arr = (ctypes.c_char_p * max(1, len(texts)))(*[t.encode() for t in texts])
+    o = RenderOpts(method=str(method).encode(), camera=None if camera is None else
+                   str(camera).encode(), params=arr, param_count=len(texts), width=w, height=h,
+                   frames=frames, warmup=warmup, seed=seed, time=float(time),
+                   exposure=float(exposure), no_cache=1 if no_cache else 0)
+    return o, arr
+
+
+class Method:
+    """A method instance that stays alive across frames (Scene.method): one
+    create() and prepare(), then update() when the scene's time or the camera
+    changes and render() for more frames. What `gibench render --animate FPS`
+    does between frames, driven from Python:
+
+        m = scene.method("csm", size=(64, 64))
+        for k in range(10):
+            if k:
+                m.update(time=k / 30)
+            img = m.render()
+    """
+
+    def __init__(self, scene, method, size, seed, params, camera, time, warmup, exposure,
+                 no_cache):
+        w, h = _size(size)
+        texts = ["%s=%s" % (k, _param_text(v)) for k, v in (params or {}).items()]
+        o, keep = _render_opts(method, w, h, 1, _uint("seed", seed, 0, 0xFFFFFFFF), texts,
+                               camera, time, _uint("warmup", warmup, 0, 1000), exposure,
+                               no_cache)
+        self.scene = scene  # the scene outlives the instance
+        self.id = str(method)
+        self.size = (w, h)
+        self.time = float(time)
+        self._handle = ctypes.c_void_p()
+        err = GiError()
+        check(lib.gibench_method_open(scene._handle, ctypes.byref(o), ctypes.byref(self._handle),
+                                      ctypes.byref(err)), err)
+        del keep
+        scene._methods.add(self)
+
+    def _alive(self):
+        if not self._handle.value:
+            raise UsageError("render: the %s instance is closed" % self.id)
+
+    def update(self, time=None, camera=None):
+        """Moves the scene to `time` (its animated objects, lights and camera)
+        and/or switches to `camera`; the method's update() is told what changed.
+        The next frame starts a still view's accumulation again."""
+        self._alive()
+        if time is not None:
+            self.time = float(time)
+        err = GiError()
+        check(lib.gibench_method_update(self._handle, self.time,
+                                        None if camera is None else str(camera).encode(),
+                                        ctypes.byref(err)), err)
+
+    def render(self, frames=1):
+        """`frames` more frames; the last one as an Image with .timings."""
+        self._alive()
+        frames = _uint("frames", frames, 1, 1000000)
+        w, h = self.size
+        img = np.empty((h, w, 3), dtype=np.float32)
+        out = ctypes.c_void_p()
+        err = GiError()
+        check(lib.gibench_method_render(self._handle, frames,
+                                        img.ctypes.data_as(ctypes.POINTER(ctypes.c_float)),
+                                        ctypes.byref(out), ctypes.byref(err)), err)
+        return Image(img, json.loads(take_string(out)))
+
+    def close(self):
+        """Destroys the instance now (also when the object goes or its scene closes)."""
+        if getattr(self, "_handle", None) and self._handle.value:
+            lib.gibench_method_close(self._handle)
+            self._handle = ctypes.c_void_p()
+
+    def __del__(self):
+        self.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def _child_error(p, cmd="render"):
+    """The exception of a failed child gibench: its last 'gibench: ' line."""
+    lines = [ln[len("gibench: "):] for ln in p.stderr.splitlines() if ln.startswith("gibench: ")]
+    if p.returncode < 0:
+        return RunError("%s: the child process died of signal %d%s" %
+                        (cmd, -p.returncode, (" (" + lines[-1] + ")") if lines else ""))
+    msg = lines[-1] if lines else (p.stderr.strip().splitlines() or ["exit status %d" % p.returncode])[-1]
+    return UsageError(msg) if p.returncode == 2 else RunError(msg)
+
+
+def metrics(test, ref, exposure=0.0, ppd=0.0, maps=False):
+    """gibench diff TEST REF: a dict under diff --json's names (relmse, rmse, mse,
+    mae, psnr, ssim, flip, mean_lum_*, leaked_energy, ...; None where undefined).
+    maps=True adds the per-pixel maps as H x W float32 arrays: "relerr_map"
+    (what diff --heatmap draws) and "flip_map" (diff --flip-map)."""
+    a = np.ascontiguousarray(np.asarray(test, dtype=np.float32))
+    b = np.ascontiguousarray(np.asarray(ref, dtype=np.float32))
+    for x in (a, b):
+        if x.ndim != 3 or x.shape[2] != 3 or x.size == 0:
+            raise UsageError("metrics: an image is not H x W x 3 (shape %s)" % (x.shape,))
+    if a.shape != b.shape:
+        raise UsageError("image sizes differ: test %dx%d, reference %dx%d" %
+                         (a.shape[1], a.shape[0], b.shape[1], b.shape[0]))
+    h, w = a.shape[:2]
+    fp = ctypes.POINTER(ctypes.c_float)
+    rel = np.empty((h, w), dtype=np.float32) if maps else None
+    flip = np.empty((h, w), dtype=np.float32) if maps else None
+    out = ctypes.c_void_p()
+    err = GiError()
+    check(lib.gibench_metrics(a.ctypes.data_as(fp), b.ctypes.data_as(fp), w, h, float(exposure),
+                              float(ppd), rel.ctypes.data_as(fp) if maps else None,
+                              flip.ctypes.data_as(fp) if maps else None, ctypes.byref(out),
+                              ctypes.byref(err)), err)
+    m = json.loads(take_string(out))
+    if maps:
+        m["relerr_map"] = rel
+        m["flip_map"] = flip
+    return m
+
+
+def read(path):
+    """An image file (EXR, PFM, PNG) read by gibench's own reader: H x W x 3 float32."""
+    rgba = ctypes.POINTER(ctypes.c_float)()
+    w, h = ctypes.c_uint32(), ctypes.c_uint32()
+    err = GiError()
+    res = lib.gibench_image_read(os.fspath(path).encode(), ctypes.byref(rgba), ctypes.byref(w),
+                                 ctypes.byref(h), ctypes.byref(err))
+    check(res, err)
+    try:
+        a = np.ctypeslib.as_array(rgba, shape=(h.value, w.value, 4))[:, :, :3].copy()
+    finally:
+        lib.gibench_free(ctypes.cast(rgba, ctypes.c_void_p))
+    return Image(a)
+
+
+def write(path, img, exposure=0.0):
+    """Writes an H x W x 3 image as gibench render writes its --out (EXR/PFM
+    linear; PNG with the exposure in stops, sRGB)."""
+    a = np.ascontiguousarray(np.asarray(img, dtype=np.float32))
+    if a.ndim != 3 or a.shape[2] != 3 or a.shape[0] == 0 or a.shape[1] == 0:
+        raise UsageError("write: the image is not H x W x 3 (shape %s)" % (a.shape,))
+    err = GiError()
+    check(lib.gibench_image_write(os.fspath(path).encode(),
+                                  a.ctypes.data_as(ctypes.POINTER(ctypes.c_float)),
+                                  a.shape[1], a.shape[0], float(exposure), ctypes.byref(err)), err)
