@@ -39,6 +39,7 @@ libstdc++.so.6 libgcc_s.so.1 libEGL.so.1 libOpenGL.so.0 libGLdispatch.so.0 libGL
 glvnd_libs="libEGL.so.1 libOpenGL.so.0 libGLdispatch.so.0"
 is_node_lib() { [[ " ${node_libs//$'\n'/ } " == *" $1 "* ]]; }
 
+mkdir -p "$(dirname "$out")"
 tmp=$(mktemp -d "${out%/}.tmp.XXXXXX")
 trap 'rm -rf "$tmp"' EXIT
 mkdir -p "$tmp"/{bin,lib/glvnd,plugins,bench}

@@ -72,6 +72,14 @@ run "$b/gibench" -q reference --scene "$b/scenes/cornell_box.gltf" --size 32x32 
 [[ -s $work/ref.exr ]] || fail "reference wrote no image"
 run "$b/gibench" -q diff "$work/d.exr" "$work/ref.exr" >/dev/null || fail "diff from the bundle failed"
 
+# Every bench study, at its full size, is one the study loader takes (its
+# scenes are relative to the bundle, where bench.sh runs them).
+for j in "$b"/bench/*.json; do
+    (cd "$b" && env -i PATH=/usr/bin:/bin HOME=/nonexistent GIBENCH_BUNDLE_CACHE="$work/cache" \
+        "$b/gibench" -q study "$j" --out "$work/dry" --dry-run) >/dev/null 2>"$work/dry.err" ||
+        fail "bench study $(basename "$j") is refused: $(cat "$work/dry.err")"
+done
+
 # bench.sh, tiny, two parts: the short one finishes; the limit stops the other cleanly.
 rc=0
 run "$b/bench.sh" --out "$work/bench" --tiny --limit-s 8 --parts vlf_table1,compare \
