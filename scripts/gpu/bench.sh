@@ -57,7 +57,7 @@ if command -v nvidia-smi >/dev/null 2>&1; then
     nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader \
         >>"$out/device.txt" 2>/dev/null || true
 fi
-field() { sed -n "s/^$1: //p" "$out/device.txt" | head -1; }
+field() { sed -n "0,/^$1: /s/^$1: //p" "$out/device.txt"; }
 
 # A part's study, made tiny for --tiny with sed alone (the node may have no
 # python): 32 x 32, one frame, the cheapest settings, AVG's Table II at one

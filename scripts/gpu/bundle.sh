@@ -63,7 +63,8 @@ done < <(LD_LIBRARY_PATH="$build/lib" ldd "${elfs[@]}" |
     awk '$2 == "=>" {print $1, $3} $2 == "=>" && $3 == "not" {print $1, "missing"}')
 
 for name in $glvnd_libs; do
-    path=$(/sbin/ldconfig -p | awk -v n="$name" '$1 == n && /x86-64/ {print $NF; exit}')
+    # awk reads to the end: an early exit would kill ldconfig with SIGPIPE (pipefail)
+    path=$(/sbin/ldconfig -p | awk -v n="$name" '$1 == n && /x86-64/ && !p {p = $NF} END {print p}')
     [[ -n $path ]] || die "no $name here to carry as the fallback libglvnd"
     cp -L "$path" "$tmp/lib/glvnd/$name"
 done

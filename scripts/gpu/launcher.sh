@@ -10,13 +10,17 @@ here=$(cd "$(dirname "$(readlink -f "${BASH_SOURCE[0]}")")" && pwd)
 
 # Where the dynamic loader would find a library: the cache of ldconfig, the
 # folders of LD_LIBRARY_PATH and the usual system folders.
+ld_cache=""
+for ldc in /sbin/ldconfig /usr/sbin/ldconfig; do
+    if [[ -x $ldc ]]; then
+        ld_cache=$("$ldc" -p 2>/dev/null || true)
+        break
+    fi
+done
 node_has() {
-    local name=$1 d ldc
-    for ldc in /sbin/ldconfig /usr/sbin/ldconfig; do
-        if [[ -x $ldc ]] && "$ldc" -p 2>/dev/null | grep -q "^[[:space:]]*$name "; then
-            return 0
-        fi
-    done
+    local name=$1 d
+    # a here-string, not a pipe: grep -q's early exit would SIGPIPE ldconfig
+    grep -q "^[[:space:]]*$name " <<<"$ld_cache" && return 0
     local IFS=:
     for d in ${LD_LIBRARY_PATH:-} /lib/x86_64-linux-gnu /usr/lib/x86_64-linux-gnu /lib64 \
         /usr/lib64 /lib /usr/lib /usr/local/nvidia/lib64 /usr/local/nvidia/lib; do

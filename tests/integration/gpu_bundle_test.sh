@@ -37,7 +37,7 @@ mkdir -p "$emb"
 cp "$emb/libembree3.so.3" "$b/lib/" # beside the others for ldd; removed below
 checked=0
 while IFS= read -r -d '' f; do
-    head -c 4 "$f" | grep -q ELF || continue
+    readelf -h "$f" >/dev/null 2>&1 || continue
     checked=$((checked + 1))
     rpath=$(readelf -d "$f" | sed -n 's/.*(RUNPATH).*\[\(.*\)\]/\1/p')
     case $f in */bin/gi-gunzip) ;; *) [[ $rpath == "\$ORIGIN"* ]] || fail "$f: RUNPATH '$rpath' is not \$ORIGIN-relative" ;; esac
@@ -61,6 +61,31 @@ grep -q 'libEGL.so.1' "$b/EXPECTED_FROM_NODE" || fail "EXPECTED_FROM_NODE does n
 run() { (cd "$work" && env -i PATH=/usr/bin:/bin HOME=/nonexistent GIBENCH_BUNDLE_CACHE="$work/cache" "$@"); }
 run "$b/gibench" -v --version >"$work/version.txt" 2>&1 || fail "gibench --version: $(cat "$work/version.txt")"
 grep -q "EGL device: " "$work/version.txt" || fail "no EGL device named: $(cat "$work/version.txt")"
+# The launcher's check of the node: a missing system library stops it with
+# one line; missing libglvnd makes it use the bundle's copy and say so.
+cp "$b/EXPECTED_FROM_NODE" "$work/expected"
+echo "libgibench-absent.so.9 system" >>"$b/EXPECTED_FROM_NODE"
+rc=0
+run "$b/gibench" --version >"$work/miss.txt" 2>&1 || rc=$?
+if [[ $rc != 127 || $(wc -l <"$work/miss.txt") != 1 ]] ||
+    ! grep -q "lacks libgibench-absent.so.9" "$work/miss.txt"; then
+    fail "a missing node library: exit $rc, $(cat "$work/miss.txt")"
+fi
+cp "$work/expected" "$b/EXPECTED_FROM_NODE"
+echo "libgibench-absent.so.9 glvnd" >>"$b/EXPECTED_FROM_NODE"
+run "$b/gibench" -v --version >"$work/glvnd.txt" 2>&1 || fail "with the bundle's libglvnd: $(cat "$work/glvnd.txt")"
+grep -q "using the bundle's libglvnd" "$work/glvnd.txt" || fail "no note of the bundle's libglvnd"
+grep -q "GL renderer: " "$work/glvnd.txt" || fail "no GL context through the bundle's libglvnd"
+cp "$work/expected" "$b/EXPECTED_FROM_NODE"
+# The device choice: by number (llvmpipe is EGL device 0 here), and a name no
+# device has is an error, not a quiet fall back to llvmpipe.
+run "$b/gibench" --egl-device 0 -v --version 2>&1 | grep -q "EGL device: device 0 of" ||
+    fail "--egl-device 0 did not take EGL device 0"
+rc=0
+run "$b/gibench" --egl-device no-such-gpu -v --version >"$work/nodev.txt" 2>&1 || rc=$?
+if ((rc == 0)) || ! grep -q "no EGL device named like 'no-such-gpu'" "$work/nodev.txt"; then
+    fail "--egl-device no-such-gpu: exit $rc, $(cat "$work/nodev.txt")"
+fi
 run "$b/gibench" -q render --scene "$b/scenes/cornell_box.gltf" --method direct --size 32x32 \
     --out "$work/d.exr" --timings "$work/t.json" || fail "render from the bundle failed"
 [[ -s $work/d.exr ]] || fail "render wrote no image"
