@@ -34,7 +34,7 @@ done
 [[ ! -e $out || -z $(ls -A "$out" 2>/dev/null) ]] || die "$out exists and is not empty"
 gibench=${GIBENCH:-$here/gibench}
 [[ -x $gibench ]] || die "no gibench at $gibench"
-parts=(cssm_table1 vlf_table1 avg_tables ivis_table1 csm_table2 compare)
+parts=(cssm_table1 vlf_table1 avg_tables ivis_table1 csm_table2 timer_check compare)
 if [[ -n $only ]]; then
     IFS=, read -r -a parts <<<"$only"
 fi

@@ -116,6 +116,29 @@ def fmt(x, digits=3):
     return "–" if x is None else ("%.*g" % (digits, x))
 
 
+def timer_check(bench):
+    """The timer_check part: each run's stages by the wall clock around
+    glFinish beside the same run's by GL queries (vlf_table1, avg_tables)."""
+    runs = read_runs(os.path.join(bench, "timer_check", "runs.csv"))
+    if not runs:
+        return ["## timer_check: not in this bench folder (not finished)", ""]
+    pool = read_runs(os.path.join(bench, "vlf_table1", "runs.csv")) + \
+        read_runs(os.path.join(bench, "avg_tables", "runs.csv"))
+    lines = ["## timer_check (GL queries against the wall clock)", "",
+             "| run | size | stage | %s ms | finish ms | query/finish |" % "query", "| --- | --- | --- | --- | --- | --- |"]
+    for run in runs:
+        same = [r for r in pool if r["scene"] == run["scene"] and r["method"] == run["method"]
+                and r.get("params") == run.get("params") and r.get("width") == run.get("width")
+                and r.get("height") == run.get("height")]
+        q = stages(same[0]) if same else {}
+        for st, f in sorted(stages(run).items()):
+            g = q.get(st)
+            lines.append("| %s %s | %sx%s | %s | %s | %s | %s |" % (
+                os.path.basename(run["scene"]), run["method"], run.get("width"), run.get("height"),
+                st, fmt(g), fmt(f), fmt(g / f) if g is not None and f else "–"))
+    return lines + [""]
+
+
 def table(bench, results, root):
     lines = []
     device = os.path.join(bench, "device.txt")
@@ -154,6 +177,7 @@ def table(bench, results, root):
                     "%s (%s)" % (fmt(l), lsize) if l is not None else "–",
                     fmt(g / l) if l else "–", fmt(pst.get(st))))
         lines.append("")
+    lines += timer_check(bench)
     if not found:
         raise SystemExit("gpu_table.py: %s has no finished part (no */runs.csv)" % bench)
     return "\n".join(lines) + "\n"
