@@ -9,7 +9,6 @@
 # names the GPU, the driver, the date, the command and what finished.
 #   --tiny   32 x 32 images, 1 frame, 16-spp references: a check in seconds
 #   --parts a,b,...  only these parts (default: all, in the order below)
-#   GIBENCH  the gibench to run (default: the bundle's launcher beside this)
 set -euo pipefail
 
 here=$(cd "$(dirname "$(readlink -f "${BASH_SOURCE[0]}")")" && pwd)
@@ -32,8 +31,10 @@ done
 [[ -n $out ]] || die "--out DIR is required"
 [[ $limit =~ ^[0-9]+$ && $limit -gt 0 ]] || die "--limit-s needs a whole number of seconds > 0"
 [[ ! -e $out || -z $(ls -A "$out" 2>/dev/null) ]] || die "$out exists and is not empty"
-gibench=${GIBENCH:-$here/gibench}
-[[ -x $gibench ]] || die "no gibench at $gibench"
+command -v timeout >/dev/null || die "needs timeout (coreutils) to keep to --limit-s"
+gibench=$here/gibench
+[[ -x $gibench && -d $here/scenes ]] ||
+    die "runs from a bundle: scripts/gpu/bundle.sh DIR, then DIR/bench.sh (no $gibench here)"
 parts=(cssm_table1 vlf_table1 avg_tables ivis_table1 csm_table2 timer_check compare)
 if [[ -n $only ]]; then
     IFS=, read -r -a parts <<<"$only"
