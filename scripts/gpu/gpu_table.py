@@ -5,8 +5,8 @@ set beside the papers' numbers and the committed llvmpipe runs.
     python3 scripts/gpu/gpu_table.py BENCH_DIR [--results results] [--out FILE.md]
 
 For every finished part of BENCH_DIR (a study folder with runs.csv), each run
-is matched with the committed llvmpipe run of the same scene, method and full
-parameters (results/<plugin>/runs.csv, results/compare_all/runs.csv for the
+is matched with the committed llvmpipe run of the same scene, method and
+parameters (every parameter both name; results/<plugin>/runs.csv, results/compare_all/runs.csv for the
 compare part; the llvmpipe runs are at their own, smaller sizes, named in the
 table). Per stage: the GPU's median ms, llvmpipe's, the ratio GPU/llvmpipe and,
 where the paper gives that stage for that setting, the paper's ms (paper
@@ -100,8 +100,16 @@ def stages(run):
 
 
 def llvmpipe_match(run, pool):
+    # the same values of every parameter both runs name (a parameter added to
+    # the method after the llvmpipe study ran is at its default there)
+    mine = params_of(run)
+
+    def agrees(r):
+        theirs = params_of(r)
+        return all(theirs[k] == v for k, v in mine.items() if k in theirs)
+
     same = [r for r in pool if r["scene"] == run["scene"] and r["method"] == run["method"]
-            and r.get("params") == run.get("params")]
+            and agrees(r)]
     if not same:
         return None
     def area(r):

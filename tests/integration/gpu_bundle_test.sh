@@ -118,4 +118,10 @@ grep -q 'llvmpipe' "$r" || fail "README names no renderer"
 grep -Eq '\| compare \| .* \| (cut off|skipped)' "$r" || fail "compare was not stopped by the limit: $(cat "$r")"
 [[ ! -e $work/bench/compare && ! -e $work/bench/.work ]] || fail "a cut-off part left files"
 "$b/bench.sh" --out "$work/bad" --limit-s x >/dev/null 2>&1 && fail "bench.sh took --limit-s x"
+# The comparison table from that output (here llvmpipe against llvmpipe).
+python3 "$src/scripts/gpu/gpu_table.py" "$work/bench" --results "$src/results" --out "$work/table.md" ||
+    fail "gpu_table.py failed"
+for want in '^## vlf_table1 (vlf)' '| frame |' '^## compare: not in this bench folder'; do
+    grep -q -- "$want" "$work/table.md" || fail "gpu_table.py wrote no '$want': $(head -20 "$work/table.md")"
+done
 echo "gpu bundle: $((size / 1024)) KiB, $checked ELF files, render, reference and bench.sh ok"
