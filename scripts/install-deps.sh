@@ -47,6 +47,8 @@ pkgs=(
   # Studies on a cluster (gibench study --slurm) and their test, a one-node
   # Slurm brought up by hand (tests/integration/slurm_test.sh)
   slurm-wlm munge
+  # scripts/gpu/bundle.sh (the GPU bundle): $ORIGIN rpaths, strip, readelf, static zlib
+  patchelf binutils zlib1g-dev
 )
 # npm for the browser test (and the scene-conversion scripts); a machine that
 # already has a Node.js with npm (not from Debian) keeps it.

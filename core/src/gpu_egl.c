@@ -1,12 +1,15 @@
 /* Headless OpenGL 4.5 core context through EGL (see gpu.h).
  *
- * Order of attempts: EGL devices that are not software (EGL_EXT_device_query
- * without EGL_MESA_device_software), then Mesa's surfaceless platform. Each
- * failed attempt leaves a reason; if all fail the error lists them. */
+ * Order of attempts (GIBENCH_EGL unset or "auto"): EGL devices that are not
+ * software (EGL_EXT_device_query without EGL_MESA_device_software), then
+ * Mesa's surfaceless platform. GIBENCH_EGL=device|surfaceless|<index>|<name>
+ * picks one (see gi/gpu.h). Each failed attempt leaves a reason; if all fail
+ * the error lists them. */
 #include "gi/gpu.h"
 #include "gi/log.h"
 
 #include <epoxy/egl.h>
+#include <ctype.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,6 +19,9 @@ struct gi_gpu {
     EGLContext context;
     char renderer[256];
     char version[256];
+    char vendor[128];
+    char device[192]; /* which EGL device: "device 0 of 2 (NVIDIA Corporation)", "surfaceless
+                         (Mesa)" */
     const char *platform;
     int software;
     int adopted; /* the caller's context (gi_gpu_desc.adopt_current): not ours to destroy */
@@ -99,7 +105,46 @@ static int try_display(gi_gpu *gpu, EGLDisplay dpy, int debug, const char **why)
     return 1;
 }
 
-static int try_devices(gi_gpu *gpu, int debug, char *reasons, size_t size)
+/* Is `want` a device index ("0", "1", ...)? Sets *index. */
+static int parse_index(const char *want, EGLint *index)
+{
+    char *end = NULL;
+    long v = want && *want ? strtol(want, &end, 10) : -1;
+    if (!end || *end != '\0' || v < 0 || v > 1000)
+        return 0;
+    *index = (EGLint)v;
+    return 1;
+}
+
+/* Case-insensitive: does `hay` contain `needle`? */
+static int contains_ci(const char *hay, const char *needle)
+{
+    size_t n = strlen(needle);
+    for (; hay && *hay; hay++) {
+        size_t k = 0;
+        while (k < n && hay[k] &&
+               tolower((unsigned char)hay[k]) == tolower((unsigned char)needle[k]))
+            k++;
+        if (k == n)
+            return 1;
+    }
+    return 0;
+}
+
+/* Drops the context try_display made (a device that did not match a name). */
+static void drop_display(gi_gpu *gpu)
+{
+    eglMakeCurrent(gpu->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    eglDestroyContext(gpu->display, gpu->context);
+    gpu->display = EGL_NO_DISPLAY;
+    gpu->context = EGL_NO_CONTEXT;
+}
+
+/* EGL devices. `want`: NULL/"auto"/"device" = the first that is not software
+ * (llvmpipe then comes through the surfaceless platform, as it always has);
+ * a number = that device, software or not; any other text = the first device
+ * whose GL_VENDOR, GL_RENDERER or EGL driver name contains it. */
+static int try_devices(gi_gpu *gpu, const char *want, int debug, char *reasons, size_t size)
 {
     const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
     if (!has_ext(client, "EGL_EXT_device_enumeration") ||
@@ -113,19 +158,45 @@ static int try_devices(gi_gpu *gpu, int debug, char *reasons, size_t size)
         append(reasons, size, "%s%s; ", "device: no EGL devices", "");
         return 0;
     }
+    EGLint index = -1;
+    int by_index = parse_index(want, &index);
+    int by_name = want && *want && !by_index && strcmp(want, "auto") && strcmp(want, "device");
     for (EGLint i = 0; i < count; i++) {
         const char *dexts = eglQueryDeviceStringEXT(devices[i], EGL_EXTENSIONS);
-        if (has_ext(dexts, "EGL_MESA_device_software"))
+        int software = has_ext(dexts, "EGL_MESA_device_software");
+        if (by_index ? i != index : !by_name && software)
             continue; /* llvmpipe comes through the surfaceless fallback */
         EGLDisplay dpy = eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, devices[i], NULL);
         const char *why = NULL;
-        if (try_display(gpu, dpy, debug, &why)) {
-            gpu->platform = "device";
-            return 1;
+        if (!try_display(gpu, dpy, debug, &why)) {
+            char num[16];
+            snprintf(num, sizeof num, "%d", (int)i);
+            append(reasons, size, "device %s: %s; ", num, why);
+            continue;
         }
-        append(reasons, size, "device %s: %s; ", dexts ? "" : "?", why);
+        const char *driver = has_ext(dexts, "EGL_EXT_device_query_name")
+                                 ? eglQueryDeviceStringEXT(devices[i], EGL_VENDOR)
+                                 : NULL;
+        const char *vendor = (const char *)glGetString(GL_VENDOR);
+        const char *rend = (const char *)glGetString(GL_RENDERER);
+        if (by_name && !contains_ci(vendor, want) && !contains_ci(rend, want) &&
+            !contains_ci(driver, want)) {
+            drop_display(gpu);
+            continue;
+        }
+        snprintf(gpu->device, sizeof gpu->device, "device %d of %d (%s)", (int)i, (int)count,
+                 vendor ? vendor : "?");
+        gpu->platform = "device";
+        return 1;
     }
-    append(reasons, size, "%s%s; ", "device: no hardware EGL device gave GL 4.5", "");
+    if (by_index && index >= count) {
+        char num[64];
+        snprintf(num, sizeof num, "%d (there are %d)", (int)index, (int)count);
+        append(reasons, size, "device: no EGL device %s%s; ", num, "");
+    } else if (by_name)
+        append(reasons, size, "device: no EGL device named like '%s'%s; ", want, "");
+    else
+        append(reasons, size, "%s%s; ", "device: no hardware EGL device gave GL 4.5", "");
     return 0;
 }
 
@@ -141,6 +212,7 @@ static int try_surfaceless(gi_gpu *gpu, int debug, char *reasons, size_t size)
     const char *why = NULL;
     if (try_display(gpu, dpy, debug, &why)) {
         gpu->platform = "surfaceless";
+        snprintf(gpu->device, sizeof gpu->device, "surfaceless (Mesa)");
         return 1;
     }
     append(reasons, size, "surfaceless: %s%s; ", why, "");
@@ -161,6 +233,7 @@ static void finish_setup(gi_gpu *gpu, const gi_gpu_desc *d)
 {
     snprintf(gpu->renderer, sizeof gpu->renderer, "%s", (const char *)glGetString(GL_RENDERER));
     snprintf(gpu->version, sizeof gpu->version, "%s", (const char *)glGetString(GL_VERSION));
+    snprintf(gpu->vendor, sizeof gpu->vendor, "%s", (const char *)glGetString(GL_VENDOR));
     gpu->software = strstr(gpu->renderer, "llvmpipe") || strstr(gpu->renderer, "softpipe") ||
                     strstr(gpu->renderer, "swrast") || strstr(gpu->renderer, "SwiftShader");
     if (d->debug) {
@@ -188,6 +261,7 @@ static gi_gpu *adopt_current(const gi_gpu_desc *d, gi_error *err)
     }
     gpu->adopted = 1;
     gpu->platform = "adopted";
+    snprintf(gpu->device, sizeof gpu->device, "adopted (the caller's context)");
     finish_setup(gpu, d);
     return gpu;
 }
@@ -200,27 +274,28 @@ gi_gpu *gi_gpu_create(const gi_gpu_desc *desc, gi_error *err)
     if (d.adopt_current)
         return adopt_current(&d, err);
     const char *want = d.platform ? d.platform : getenv("GIBENCH_EGL");
-    if (want && *want && strcmp(want, "device") != 0 && strcmp(want, "surfaceless") != 0) {
-        gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
-                     "GIBENCH_EGL='%s' is not one of device, surfaceless", want);
-        return NULL;
-    }
+    if (want && !*want)
+        want = NULL;
     gi_gpu *gpu = calloc(1, sizeof *gpu);
     if (!gpu) {
         gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory");
         return NULL;
     }
     char reasons[1024] = "";
+    int surfaceless_only = want && !strcmp(want, "surfaceless");
     int ok = 0;
-    if (!want || !*want || strcmp(want, "device") == 0)
-        ok = try_devices(gpu, d.debug, reasons, sizeof reasons);
-    if (!ok && (!want || !*want || strcmp(want, "surfaceless") == 0))
+    if (!surfaceless_only)
+        ok = try_devices(gpu, want, d.debug, reasons, sizeof reasons);
+    /* auto falls back to llvmpipe; a device asked for by name or number does not,
+     * so a benchmark meant for a GPU never quietly times the CPU */
+    if (!ok && (!want || surfaceless_only || !strcmp(want, "auto")))
         ok = try_surfaceless(gpu, d.debug, reasons, sizeof reasons);
     if (!ok) {
         size_t n = strlen(reasons);
         if (n >= 2)
             reasons[n - 2] = '\0';
-        gi_error_set(err, GI_ERR_GL, "no OpenGL 4.5 core context through EGL (%s)", reasons);
+        gi_error_set(err, GI_ERR_GL, "no OpenGL 4.5 core context through EGL (%s%s%s)", reasons,
+                     want ? "; GIBENCH_EGL=" : "", want ? want : "");
         free(gpu);
         return NULL;
     }
@@ -252,6 +327,14 @@ const char *gi_gpu_renderer(const gi_gpu *gpu)
 const char *gi_gpu_version(const gi_gpu *gpu)
 {
     return gpu->version;
+}
+const char *gi_gpu_vendor(const gi_gpu *gpu)
+{
+    return gpu->vendor;
+}
+const char *gi_gpu_device(const gi_gpu *gpu)
+{
+    return gpu->device;
 }
 const char *gi_gpu_platform(const gi_gpu *gpu)
 {

@@ -448,6 +448,8 @@ static json_object *timings_json(const run_state *r, const render_opts *o)
     json_object_object_add(j, "gl_renderer", json_object_new_string(gi_gpu_renderer(r->gpu)));
     json_object_object_add(j, "gl_version", json_object_new_string(gi_gpu_version(r->gpu)));
     json_object_object_add(j, "egl_platform", json_object_new_string(gi_gpu_platform(r->gpu)));
+    json_object_object_add(j, "gl_vendor", json_object_new_string(gi_gpu_vendor(r->gpu)));
+    json_object_object_add(j, "egl_device", json_object_new_string(gi_gpu_device(r->gpu)));
     json_object_object_add(
         j, "timer", json_object_new_string(gi_timer_mode_name(gi_timer_get_mode(r->render_timer))));
     json_object_object_add(j, "prepare", cli_timer_json(r->prep_timer));

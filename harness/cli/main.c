@@ -1,4 +1,5 @@
 /* gibench: the command-line front door (docs/commands.md). */
+#define _POSIX_C_SOURCE 200809L /* setenv */
 #include "cli.h"
 
 #include "gi/gpu.h"
@@ -6,11 +7,14 @@
 #include "gibench_version.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static const char usage[] =
-    "usage: gibench [-v|-vv|-q] COMMAND ...   (gibench help COMMAND, gibench COMMAND --help)\n"
+    "usage: gibench [-v|-vv|-q] [--egl-device D] COMMAND ...   (gibench help COMMAND)\n"
     "       gibench --version [-v]\n"
+    "  --egl-device D: auto|device|surfaceless|N|NAME, the GL device (sets GIBENCH_EGL;\n"
+    "                  see docs/gpu.md)\n"
     "commands:\n"
     "  methods [--json]                       list method plugins and their parameters\n"
     "  info SCENE [--json]                    describe a scene file\n"
@@ -53,8 +57,10 @@ static int print_version(void)
         gi_gpu *gpu = gi_gpu_create(NULL, &err);
         if (!gpu)
             return cli_fail(EXIT_RUN, "no GL context: %s", err.text);
-        printf("GL renderer: %s\nGL version: %s\nEGL platform: %s\n", gi_gpu_renderer(gpu),
-               gi_gpu_version(gpu), gi_gpu_platform(gpu));
+        printf("GL renderer: %s\nGL version: %s\nGL vendor: %s\nEGL platform: %s\nEGL device: "
+               "%s\n",
+               gi_gpu_renderer(gpu), gi_gpu_version(gpu), gi_gpu_vendor(gpu), gi_gpu_platform(gpu),
+               gi_gpu_device(gpu));
         gi_gpu_destroy(gpu);
     }
     return EXIT_OK;
@@ -85,7 +91,14 @@ int main(int argc, char **argv)
             return EXIT_OK;
         } else if (!strcmp(argv[i], "--version"))
             version = 1;
-        else
+        else if (!strcmp(argv[i], "--egl-device")) {
+            /* an environment variable, so that the runs a study or compare
+             * starts as child processes use the same device */
+            if (i + 1 >= argc || !argv[i + 1][0])
+                return cli_fail(EXIT_USAGE, "--egl-device needs a value (auto, device, "
+                                            "surfaceless, a number or a name)");
+            setenv("GIBENCH_EGL", argv[++i], 1);
+        } else
             return cli_fail(EXIT_USAGE, "unknown option '%s' (see gibench --help)", argv[i]);
     }
     if (version)

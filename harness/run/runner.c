@@ -193,6 +193,12 @@ static void take_timings(json_object *rec, json_object *t)
         json_object_object_add(rec, "renderer", json_object_get(v));
     if (json_object_object_get_ex(t, "timer", &v))
         json_object_object_add(rec, "timer", json_object_get(v));
+    /* which GPU and driver gave the timings (GL_VERSION carries the driver
+     * version, e.g. "4.6.0 NVIDIA 580.159.03"), and which EGL device */
+    static const char *const device_keys[] = {"gl_version", "gl_vendor", "egl_device"};
+    for (size_t k = 0; k < sizeof device_keys / sizeof *device_keys; k++)
+        if (json_object_object_get_ex(t, device_keys[k], &v))
+            json_object_object_add(rec, device_keys[k], json_object_get(v));
     if (json_object_object_get_ex(t, "params", &v))
         json_object_object_add(rec, "params_full", json_object_get(v));
     if (json_object_object_get_ex(t, "stats", &v))

@@ -11,8 +11,15 @@
  *
  * Device choice: an EGL device that is not software (EGL_EXT_platform_device,
  * e.g. NVIDIA) first, then Mesa's surfaceless platform (llvmpipe). The
- * environment variable GIBENCH_EGL=device|surfaceless forces one. If neither
- * gives a 4.5 core context the error says what each attempt returned.
+ * environment variable GIBENCH_EGL (or gibench --egl-device) chooses:
+ *   auto (or unset)  that order;
+ *   device           a hardware EGL device only, no llvmpipe fallback;
+ *   surfaceless      Mesa's surfaceless platform only (llvmpipe);
+ *   <N>              EGL device number N (eglQueryDevicesEXT order), software too;
+ *   <text>           the first EGL device whose GL_VENDOR, GL_RENDERER or EGL
+ *                    vendor contains <text> (any case), e.g. "nvidia".
+ * Only auto falls back to llvmpipe. If nothing gives a 4.5 core context the
+ * error says what each attempt returned.
  * GL functions come from libepoxy; include <epoxy/gl.h>. The context is
  * current on the creating thread only.
  */
@@ -33,7 +40,7 @@ typedef struct gi_gpu gi_gpu;
 
 typedef struct gi_gpu_desc {
     int debug;            /* GL debug context + KHR_debug messages to the log */
-    const char *platform; /* "device", "surfaceless" or NULL = auto (or $GIBENCH_EGL) */
+    const char *platform; /* a GIBENCH_EGL value (above), or NULL = $GIBENCH_EGL */
     /* 1: make no context; use the OpenGL 4.5 core context current on this
      * thread (a window's, made by the caller, e.g. gibench view through
      * GLFW); gi_gpu_destroy then leaves it alone. platform is ignored. */
@@ -47,6 +54,10 @@ void gi_gpu_destroy(gi_gpu *gpu);
 const char *gi_gpu_renderer(const gi_gpu *gpu);
 const char *gi_gpu_version(const gi_gpu *gpu);
 const char *gi_gpu_platform(const gi_gpu *gpu);
+/* GL_VENDOR, and which EGL device the context is on, in words:
+ * "device 0 of 2 (NVIDIA Corporation)", "surfaceless (Mesa)". */
+const char *gi_gpu_vendor(const gi_gpu *gpu);
+const char *gi_gpu_device(const gi_gpu *gpu);
 /* True on software rasterisers (llvmpipe, softpipe, swrast), where GL timer
  * queries are not trusted for compute work. */
 int gi_gpu_is_software(const gi_gpu *gpu);
