@@ -5,6 +5,7 @@
 #include "cli.h"
 #include "gibench_internal.h"
 #include "metrics.h"
+#include "runner.h"
 #include "reference.h"
 
 #include <math.h>
@@ -126,33 +127,11 @@ static gi_image *image_of(const float *rgb, uint32_t w, uint32_t h)
     return img;
 }
 
-static json_object *num(double v)
-{
-    return isfinite(v) ? json_object_new_double(v) : NULL;
-}
-
 /* The metrics under the names of gibench diff --json. */
 static json_object *metrics_json(const gi_metrics *m)
 {
     json_object *j = json_object_new_object();
-    json_object_object_add(j, "pixels_compared", json_object_new_int64((int64_t)m->pixels));
-    json_object_object_add(j, "pixels_excluded", json_object_new_int64((int64_t)m->excluded));
-    json_object_object_add(j, "exposure", json_object_new_double(m->exposure));
-    json_object_object_add(j, "flip_ppd", json_object_new_double(m->flip_ppd));
-    json_object_object_add(j, "rmse", num(m->rmse));
-    json_object_object_add(j, "mse", num(m->mse));
-    json_object_object_add(j, "relmse", num(m->relmse));
-    json_object_object_add(j, "mae", num(m->mae));
-    json_object_object_add(j, "psnr", num(m->psnr));
-    json_object_object_add(j, "ssim", num(m->ssim));
-    json_object_object_add(j, "mean_lum_test", num(m->mean_lum_test));
-    json_object_object_add(j, "mean_lum_ref", num(m->mean_lum_ref));
-    json_object_object_add(j, "mean_lum_diff_pct", num(m->mean_lum_diff_pct));
-    json_object_object_add(j, "flip", num(m->flip));
-    json_object_object_add(j, "leaked_energy", num(m->leaked_energy));
-    json_object_object_add(j, "dark_fraction", num(m->dark_fraction));
-    json_object_object_add(j, "dark_energy_ref", num(m->dark_energy_ref));
-    json_object_object_add(j, "dark_threshold", json_object_new_double(m->dark_threshold));
+    runner_metrics_json_add(j, m);
     return j;
 }
 

@@ -1,6 +1,7 @@
 /* gibench diff: error metrics of a test image against a reference, and
  * heat maps of the per-pixel errors (metrics.h, heatmap.h). */
 #include "cli.h"
+#include "runner.h"
 
 #include "heatmap.h"
 #include "metrics.h"
@@ -118,11 +119,6 @@ static gi_image *read_linear(const char *path, gi_error *err)
     return img;
 }
 
-static json_object *num(double v)
-{
-    return isfinite(v) ? json_object_new_double(v) : NULL; /* null: infinite or undefined */
-}
-
 static json_object *image_json(const char *path, const gi_image *img, uint64_t nonfinite)
 {
     json_object *o = json_object_new_object();
@@ -139,24 +135,7 @@ static void print_json(const diff_opts *o, const gi_image *t, const gi_image *r,
     json_object *j = json_object_new_object();
     json_object_object_add(j, "test", image_json(o->test, t, m->nonfinite_test));
     json_object_object_add(j, "reference", image_json(o->ref, r, m->nonfinite_ref));
-    json_object_object_add(j, "pixels_compared", json_object_new_int64((int64_t)m->pixels));
-    json_object_object_add(j, "pixels_excluded", json_object_new_int64((int64_t)m->excluded));
-    json_object_object_add(j, "exposure", json_object_new_double(m->exposure));
-    json_object_object_add(j, "flip_ppd", json_object_new_double(m->flip_ppd));
-    json_object_object_add(j, "rmse", num(m->rmse));
-    json_object_object_add(j, "mse", num(m->mse));
-    json_object_object_add(j, "relmse", num(m->relmse));
-    json_object_object_add(j, "mae", num(m->mae));
-    json_object_object_add(j, "psnr", num(m->psnr));
-    json_object_object_add(j, "ssim", num(m->ssim));
-    json_object_object_add(j, "mean_lum_test", num(m->mean_lum_test));
-    json_object_object_add(j, "mean_lum_ref", num(m->mean_lum_ref));
-    json_object_object_add(j, "mean_lum_diff_pct", num(m->mean_lum_diff_pct));
-    json_object_object_add(j, "flip", num(m->flip));
-    json_object_object_add(j, "leaked_energy", num(m->leaked_energy));
-    json_object_object_add(j, "dark_fraction", num(m->dark_fraction));
-    json_object_object_add(j, "dark_energy_ref", num(m->dark_energy_ref));
-    json_object_object_add(j, "dark_threshold", json_object_new_double(m->dark_threshold));
+    runner_metrics_json_add(j, m);
     if (o->heatmap)
         json_object_object_add(j, "heatmap", json_object_new_string(o->heatmap));
     if (o->flip_map)

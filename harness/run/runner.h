@@ -81,4 +81,9 @@ json_object *runner_animation_metrics(const run_spec *spec, const char *frames_p
 json_object *runner_diff(const char *image, const char *reference, const char *heatmap,
                          const char *flip_map, float exposure, char *why, size_t why_size);
 
+struct gi_metrics;
+/* Adds the metrics m to the object j under the names of `gibench diff
+ * --json` (the diff command and the Python API's metrics share them). */
+void runner_metrics_json_add(json_object *j, const struct gi_metrics *m);
+
 #endif
