@@ -78,7 +78,21 @@ def _uint(name, value, lo, hi, cmd="render"):
     return int(value)
 
 
-class Scene:
+class _Closes:
+    """What Scene and Method share: close() when the object goes, and
+    `with` blocks that close on leaving."""
+
+    def __del__(self):
+        self.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+class Scene(_Closes):
     """A loaded scene and its GPU upload (gibench render --scene PATH).
 
     cameras: the scene's camera names (camera= takes a name or "#k");
@@ -106,15 +120,6 @@ class Scene:
         if getattr(self, "_handle", None) and self._handle.value:
             lib.gibench_scene_close(self._handle)
             self._handle = ctypes.c_void_p()
-
-    def __del__(self):
-        self.close()
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
 
     def _alive(self):
         if not self._handle.value:
@@ -262,7 +267,7 @@ def _render_opts(method, w, h, frames, seed, texts, camera, time, warmup, exposu
     return o, arr
 
 
-class Method:
+class Method(_Closes):
     """A method instance that stays alive across frames (Scene.method): one
     create() and prepare(), then update() when the scene's time or the camera
     changes and render() for more frames. What `gibench render --animate FPS`
@@ -327,15 +332,6 @@ class Method:
         if getattr(self, "_handle", None) and self._handle.value:
             lib.gibench_method_close(self._handle)
             self._handle = ctypes.c_void_p()
-
-    def __del__(self):
-        self.close()
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
 
 
 def _child_error(p, cmd="render"):
