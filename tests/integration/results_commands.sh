@@ -2,7 +2,9 @@
 # scripts/regenerate_results.sh covers every committed study: its dry run
 # names a `gibench study ... --out results/<dir>` command for each folder
 # under results/ that has a README.md, runs nothing, and refuses an
-# unknown study with exit 2 and one line.
+# unknown study with exit 2 and one line. results/gpu/ is the exception:
+# it is made on a GPU node by scripts/gpu/bench.sh (docs/gpu.md), which its
+# README must name.
 # Usage: results_commands.sh ROOT
 set -u
 root=$1
@@ -12,6 +14,15 @@ fails=0
 for d in results/*/; do
     d=${d%/}
     [[ -f $d/README.md ]] || continue
+    if [[ $d == results/gpu ]]; then
+        if grep -q "scripts/gpu/bench.sh" "$d/README.md"; then
+            echo "ok: $d (made by scripts/gpu/bench.sh on a GPU node)"
+        else
+            echo "FAIL: $d/README.md does not name scripts/gpu/bench.sh"
+            fails=$((fails + 1))
+        fi
+        continue
+    fi
     if ! grep -q -- "--out $d --jobs" <<< "$out"; then
         echo "FAIL: no study command for $d"
         fails=$((fails + 1))
