@@ -8,7 +8,9 @@
 #include "gi/image.h"
 #include "gi/log.h"
 #include "render_loop.h"
+#include "view_file.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -311,6 +313,96 @@ gi_result gibench_method_update(gibench_method *m, float time, const char *camer
     m->l.time = time;
     m->next_frame = 0;
     return render_loop_update(&m->l, time, flags, err);
+}
+
+/* The node a move names (a name or a decimal index); -1 when none. */
+static int find_node(const gi_scene *s, const char *node)
+{
+    char *end;
+    unsigned long k = strtoul(node, &end, 10);
+    if (*node >= '0' && *node <= '9' && !*end)
+        return k < s->node_count ? (int)k : -1;
+    for (uint32_t i = 0; i < s->node_count; i++)
+        if (s->nodes[i].name && !strcmp(s->nodes[i].name, node))
+            return (int)i;
+    return -1;
+}
+
+/* The moves as a saved view's nodes (each placement complete), checked as
+ * gibench render --view checks them. */
+static gi_result moves_view(const gi_scene *s, const gibench_node_move *mv, uint32_t count,
+                            view_file *v, gi_error *err)
+{
+    if (count > VIEW_FILE_MAX_NODES)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "render: at most %d nodes move at once",
+                            VIEW_FILE_MAX_NODES);
+    for (uint32_t i = 0; i < count; i++) {
+        int k = mv[i].node ? find_node(s, mv[i].node) : -1;
+        if (k < 0)
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "render: %s has no node '%s' (%u nodes; use a name or an index)",
+                                s->path, mv[i].node ? mv[i].node : "", s->node_count);
+        view_node *n = &v->nodes[v->node_count++];
+        const gi_node *d = &s->nodes[k];
+        n->node = (uint32_t)k;
+        snprintf(n->name, sizeof n->name, "%s", d->name ? d->name : "");
+        memcpy(n->translation, mv[i].has_translation ? mv[i].translation : d->translation,
+               sizeof n->translation);
+        memcpy(n->rotation, mv[i].has_rotation ? mv[i].rotation : d->rotation, sizeof n->rotation);
+        memcpy(n->scale, mv[i].has_scale ? mv[i].scale : d->scale, sizeof n->scale);
+        const float *q = n->rotation;
+        float len = sqrtf(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+        if (!(fabsf(len - 1.0f) <= 1e-3f))
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "render: node '%s': rotation is not a unit quaternion", n->name);
+    }
+    char why[600];
+    if (!view_file_check_nodes(v, s, why, sizeof why))
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "render: %s", why);
+    return GI_OK;
+}
+
+/* The instance made again with the scene as it stands (objects newly
+ * marked moving), its prepare timed afresh. */
+static gi_result method_remake(gibench_method *m, gi_error *err)
+{
+    render_loop *l = &m->l;
+    l->m->destroy(l->inst);
+    l->inst = NULL;
+    gi_timer_free(l->prep_timer);
+    l->prep_timer = gi_timer_create(m->mode, 0);
+    gi_gpu_scene_set_time(l->gs, l->time);
+    return render_loop_prepare(l, m->params, err);
+}
+
+gi_result gibench_method_move(gibench_method *m, const gibench_node_move *moves, uint32_t count,
+                              gi_error *err)
+{
+    gi_scene *s = m->s->scene;
+    view_file *v = calloc(1, sizeof *v);
+    unsigned char *moved = calloc(s->node_count ? s->node_count : 1, 1);
+    gi_result res = v && moved ? moves_view(s, moves, count, v, err)
+                               : gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory");
+    int remake = 0;
+    for (uint32_t i = 0; res == GI_OK && i < v->node_count; i++) {
+        remake |= view_scene_mark_moving(s, v->nodes[i].node);
+        moved[v->nodes[i].node] = 1;
+    }
+    if (res == GI_OK && remake)
+        res = method_remake(m, err);
+    if (res == GI_OK) {
+        gi_changes ch = {0, m->l.time, 0};
+        view_scene_changes(s, moved, &ch.flags, &ch.moved_objects);
+        view_file_apply_nodes(v, s);
+        gi_gpu_scene_set_time(m->l.gs, m->l.time);
+        res = m->l.m->update(m->l.inst, m->l.gs, &ch);
+        if (res != GI_OK)
+            res = render_loop_method_error(&m->l, "update", res, err);
+        m->next_frame = 0;
+    }
+    free(moved);
+    free(v);
+    return res;
 }
 
 gi_result gibench_method_render(gibench_method *m, uint32_t frames, float *rgb, char **timings,

@@ -22,8 +22,8 @@ import weakref
 import numpy as np
 
 from . import _build
-from ._lib import (Error, GiError, ReferenceOpts, RenderOpts, RunError, UsageError, check, lib,
-                   take_string)
+from ._lib import (Error, GiError, NodeMove, ReferenceOpts, RenderOpts, RunError, UsageError,
+                   check, lib, take_string)
 
 __all__ = ["Error", "RunError", "UsageError", "Image", "Method", "Scene", "methods", "metrics", "read",
            "study", "write"]
@@ -302,17 +302,29 @@ class Method(_Closes):
         if not self._handle.value:
             raise UsageError("render: the %s instance is closed" % self.id)
 
-    def update(self, time=None, camera=None):
+    def update(self, time=None, camera=None, move=None):
         """Moves the scene to `time` (its animated objects, lights and camera)
         and/or switches to `camera`; the method's update() is told what changed.
+        move={node: placement} places nodes by hand, as gibench view does (a
+        node by name or index; a placement is a translation (x, y, z), a dict
+        of "translation", "rotation" (quaternion x y z w), "scale", or a 4x4
+        matrix); their objects and lights move with them.
         The next frame starts a still view's accumulation again."""
         self._alive()
         if time is not None:
             self.time = float(time)
         err = GiError()
-        check(lib.gibench_method_update(self._handle, self.time,
-                                        None if camera is None else str(camera).encode(),
-                                        ctypes.byref(err)), err)
+        if move is None or time is not None or camera is not None:
+            check(lib.gibench_method_update(self._handle, self.time,
+                                            None if camera is None else str(camera).encode(),
+                                            ctypes.byref(err)), err)
+        if move is not None:
+            if not isinstance(move, dict):
+                raise UsageError("render: move= is a dict {node: placement}")
+            arr = (NodeMove * max(1, len(move)))()
+            for i, (node, place) in enumerate(move.items()):
+                _node_move(arr[i], node, place)
+            check(lib.gibench_method_move(self._handle, arr, len(move), ctypes.byref(err)), err)
 
     def render(self, frames=1):
         """`frames` more frames; the last one as an Image with .timings."""
@@ -332,6 +344,49 @@ class Method(_Closes):
         if getattr(self, "_handle", None) and self._handle.value:
             lib.gibench_method_close(self._handle)
             self._handle = ctypes.c_void_p()
+
+
+def _matrix_trs(m):
+    """A 4x4 matrix (column vectors, translation in the last column) as
+    translation, rotation quaternion (x y z w) and scale; no shear."""
+    t = m[:3, 3]
+    s = np.linalg.norm(m[:3, :3], axis=0)
+    if m.shape != (4, 4) or not np.all(s > 0) or not np.allclose(m[3], [0, 0, 0, 1]):
+        raise UsageError("render: move: a matrix is 4x4 with an affine last row and no zero scale")
+    r = m[:3, :3] / s
+    if np.linalg.det(r) < 0:
+        s[0], r[:, 0] = -s[0], -r[:, 0]
+    w = np.sqrt(max(0.0, 1.0 + r[0, 0] + r[1, 1] + r[2, 2])) / 2
+    x = np.copysign(np.sqrt(max(0.0, 1.0 + r[0, 0] - r[1, 1] - r[2, 2])) / 2, r[2, 1] - r[1, 2])
+    y = np.copysign(np.sqrt(max(0.0, 1.0 - r[0, 0] + r[1, 1] - r[2, 2])) / 2, r[0, 2] - r[2, 0])
+    z = np.copysign(np.sqrt(max(0.0, 1.0 - r[0, 0] - r[1, 1] + r[2, 2])) / 2, r[1, 0] - r[0, 1])
+    return {"translation": t, "rotation": (x, y, z, w), "scale": s}
+
+
+def _node_move(out, node, place):
+    """One entry of update(move=...) into a NodeMove."""
+    out.node = str(node).encode()
+    if isinstance(place, dict):
+        unknown = set(place) - {"translation", "rotation", "scale"}
+        if unknown:
+            raise UsageError("render: move: unknown key '%s' (translation, rotation, scale)"
+                             % sorted(unknown)[0])
+    else:
+        a = np.asarray(place, dtype=np.float64)
+        if a.shape == (4, 4):
+            place = _matrix_trs(a)
+        elif a.shape == (3,):
+            place = {"translation": a}
+        else:
+            raise UsageError("render: move: node %s: a placement is (x, y, z), a dict or a 4x4 "
+                             "matrix" % node)
+    for key, n in (("translation", 3), ("rotation", 4), ("scale", 3)):
+        if key in place:
+            v = np.asarray(place[key], dtype=np.float64).ravel()
+            if v.shape != (n,) or not np.all(np.isfinite(v)):
+                raise UsageError("render: move: node %s: %s is %d numbers" % (node, key, n))
+            getattr(out, key)[:] = [float(x) for x in v]
+            setattr(out, "has_" + key, 1)
 
 
 def _child_error(p, cmd="render"):

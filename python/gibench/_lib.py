@@ -46,6 +46,17 @@ class RenderOpts(ctypes.Structure):
     ]
 
 
+class NodeMove(ctypes.Structure):
+    """gibench_node_move, field for field."""
+    _fields_ = [
+        ("node", ctypes.c_char_p),
+        ("has_translation", ctypes.c_int), ("has_rotation", ctypes.c_int),
+        ("has_scale", ctypes.c_int),
+        ("translation", ctypes.c_float * 3), ("rotation", ctypes.c_float * 4),
+        ("scale", ctypes.c_float * 3),
+    ]
+
+
 class ReferenceOpts(ctypes.Structure):
     """gibench_reference_opts, field for field."""
     _fields_ = [
@@ -91,6 +102,8 @@ def _load():
         "gibench_method_open": ([P, ctypes.POINTER(RenderOpts), ctypes.POINTER(P), err],
                                 ctypes.c_int),
         "gibench_method_update": ([P, ctypes.c_float, ctypes.c_char_p, err], ctypes.c_int),
+        "gibench_method_move": ([P, ctypes.POINTER(NodeMove), ctypes.c_uint32, err],
+                                ctypes.c_int),
         "gibench_method_render": ([P, ctypes.c_uint32, ctypes.POINTER(ctypes.c_float),
                                    ctypes.POINTER(P), err], ctypes.c_int),
         "gibench_method_close": ([P], None),

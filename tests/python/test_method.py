@@ -1,12 +1,13 @@
 """Scene.method: an instance alive across frames, updated for an animation,
 against gibench render --animate; gibench.study against gibench study."""
+import json
 import os
 
 import numpy as np
 import pytest
 
 import gibench
-from conftest import ROOT, run_cli
+from conftest import CORNELL, ROOT, run_cli
 
 MOVING = os.path.join(ROOT, "scenes", "cornell_moving.gltf")
 
@@ -74,3 +75,61 @@ def test_study_returns_its_runs(tmp_path):
                                                  "light_samples=8,env_samples=0"]
     assert all(r["status"] == "ok" for r in runs) and all(x > 0 for x in rel)
     assert "frames" in str(e.value)
+
+
+def _view_file(path, nodes):
+    """A saved view of cornell_box.gltf from its camera (csm, 32x32); nodes:
+    the view file's moved nodes."""
+    view = {"gibench_view": 1, "scene": os.path.join(ROOT, "scenes", "cornell_box.gltf"),
+            "method": "csm", "width": 32, "height": 32, "frames": 1, "seed": 1, "time": 0,
+            "exposure": 0, "params": [],
+            "camera": {"eye": [2.78, 2.73, -8.0], "forward": [0, 0, 1], "up": [0, 1, 0],
+                       "yfov": 0.6860478808414069, "znear": 0.01, "zfar": 1000.0}}
+    if nodes:
+        view["nodes"] = nodes
+    with open(path, "w") as f:
+        json.dump(view, f)
+    return str(path)
+
+
+def test_move_equals_cli_view(tmp_path):
+    """update(move=...) places a node as a saved view's "nodes" do for
+    gibench render --view: the same image bit for bit."""
+    moved = [{"node": 1, "name": "short_block", "translation": [1.5, 0.0, 1.69],
+              "rotation": [0, 0, 0, 1], "scale": [1, 1, 1]}]
+    out, out0 = str(tmp_path / "moved.exr"), str(tmp_path / "unmoved.exr")
+    run_cli("render", "--view", _view_file(tmp_path / "v.json", moved), "--out", out)
+    run_cli("render", "--view", _view_file(tmp_path / "v0.json", None), "--out", out0)
+    scene = gibench.Scene(CORNELL)  # its own: a move stays in the scene
+    m = scene.method("csm", size=(32, 32))
+    still = m.render()
+    assert np.array_equal(still.view(np.uint32), gibench.read(out0).view(np.uint32))
+    m.update(move={"short_block": (1.5, 0.0, 1.69)})
+    img = m.render()
+    assert np.array_equal(img.view(np.uint32), gibench.read(out).view(np.uint32))
+    assert not np.array_equal(img, still)
+    # by index and as a 4x4 matrix: the same placement, the same image
+    mat = np.eye(4)
+    mat[:3, 3] = (1.5, 0.0, 1.69)
+    m.update(move={1: mat})
+    assert np.array_equal(m.render(), img)
+    for move, msg in (({"nope": (0, 0, 0)}, "has no node 'nope'"),
+                      ({"short_block": {"rotation": (0, 0, 0, 2)}}, "not a unit quaternion"),
+                      ({"short_block": (1, 2)}, "a placement is"),
+                      ({"camera": {"scale": (1, 1)}}, "scale is 3 numbers")):
+        with pytest.raises(gibench.UsageError) as e:
+            m.update(move=move)
+        assert msg in str(e.value)
+    m.close()
+    scene.close()
+
+
+def test_move_a_light(tmp_path):
+    """Moving the light's node lights the box differently."""
+    scene = gibench.Scene(CORNELL)
+    m = scene.method("csm", size=(32, 32))
+    still = m.render()
+    m.update(move={"light": {"translation": (2.78, 3.5, 2.795)}})
+    assert not np.array_equal(m.render(), still)
+    m.close()
+    scene.close()

@@ -86,6 +86,22 @@ gi_result gibench_method_open(gibench_scene *s, const gibench_render_opts *o, gi
  * update() told what that changes, as gibench render --animate tells it
  * between frames. The next frame is frame_index 0 again. */
 gi_result gibench_method_update(gibench_method *m, float time, const char *camera, gi_error *err);
+/* One node placed by hand, as gibench view moves it: node is its name or
+ * its index in decimal; the parts whose has_ flag is 0 keep their values. */
+typedef struct gibench_node_move {
+    const char *node;
+    int has_translation, has_rotation, has_scale;
+    float translation[3], rotation[4]; /* rotation: a unit quaternion x y z w */
+    float scale[3];
+} gibench_node_move;
+/* The nodes placed so (their objects and lights with them) and the method
+ * told what that changes, as gibench render --view VIEW does for a view's
+ * moved nodes: objects that were not moving before are marked moving and
+ * the instance is created and prepared again first (as gibench view
+ * remakes it). The scene keeps the placements. The next frame is
+ * frame_index 0 again. */
+gi_result gibench_method_move(gibench_method *m, const gibench_node_move *moves, uint32_t count,
+                              gi_error *err);
 /* `frames` more frames (frame_index counting on from the last update) and
  * the last one's RGB into rgb, timings as for gibench_render. */
 gi_result gibench_method_render(gibench_method *m, uint32_t frames, float *rgb, char **timings,
