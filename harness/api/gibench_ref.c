@@ -54,6 +54,8 @@ static json_object *ref_stats_json(const gi_ref *r, const char *stop)
     json_object_object_add(j, "nonfinite_samples", json_object_new_int64((int64_t)st.nonfinite));
     double rel = gi_ref_mean_rel_se(r);
     json_object_object_add(j, "mean_rel_se", isfinite(rel) ? json_object_new_double(rel) : NULL);
+    double rm = gi_ref_mean_relmse(r);
+    json_object_object_add(j, "relmse_estimate", isfinite(rm) ? json_object_new_double(rm) : NULL);
     return j;
 }
 
@@ -94,8 +96,8 @@ gi_result gibench_reference(gibench_scene *s, const gibench_reference_opts *o, f
     if (res != GI_OK)
         return res;
     /* as gibench reference: with no limit given, DEFAULT_SPP samples */
-    gi_ref_until u = {o->spp, o->seconds, o->target_se};
-    if (!u.spp && u.seconds <= 0.0 && u.target_se <= 0.0)
+    gi_ref_until u = {o->spp, o->seconds, o->target_se, o->target_relmse};
+    if (!u.spp && u.seconds <= 0.0 && u.target_se <= 0.0 && u.target_relmse <= 0.0)
         u.spp = 256;
     const char *stop = NULL;
     res = gi_ref_progressive(r, &u, NULL, NULL, &stop, err);

@@ -27,9 +27,10 @@ typedef struct ref_opts {
     const char *outs[MAX_OUTS];
     int out_count;
     uint32_t width, height, seed, threads;
-    uint64_t spp;      /* 0 = no sample limit */
-    double time_limit; /* seconds; 0 = none */
-    double target_se;  /* 0 = none */
+    uint64_t spp;         /* 0 = no sample limit */
+    double time_limit;    /* seconds; 0 = none */
+    double target_se;     /* 0 = none */
+    double target_relmse; /* 0 = none */
     int max_bounces;
     float scene_time, exposure;
     gi_ref_strategy strategy;
@@ -104,6 +105,11 @@ static int parse_opt(ref_opts *o, const char *a, const char *v)
         if (!cli_parse_float(v, &f) || !(f > 0.0f))
             return cli_fail(EXIT_USAGE, "reference: --target-se '%s' is not a positive number", v);
         o->target_se = f;
+    } else if (!strcmp(a, "--target-relmse")) {
+        if (!cli_parse_float(v, &f) || !(f > 0.0f))
+            return cli_fail(EXIT_USAGE, "reference: --target-relmse '%s' is not a positive number",
+                            v);
+        o->target_relmse = f;
     } else if (!strcmp(a, "--max-bounces")) {
         if (!strcmp(v, "inf") || !strcmp(v, "unlimited") || !strcmp(v, "-1"))
             o->max_bounces = GI_REF_UNLIMITED;
@@ -130,10 +136,11 @@ static int parse_opt(ref_opts *o, const char *a, const char *v)
 
 static int parse_opts(int argc, char **argv, ref_opts *o)
 {
-    static const char *valued[] = {"--scene",    "--camera",        "--size",        "--spp",
-                                   "--time",     "--target-se",     "--max-bounces", "--seed",
-                                   "--threads",  "--time-of-scene", "--out",         "--stats",
-                                   "--exposure", "--strategy",      "--pixel",       "--traversal"};
+    static const char *valued[] = {
+        "--scene",     "--camera",       "--size",     "--spp",      "--time",
+        "--target-se", "--max-bounces",  "--seed",     "--threads",  "--time-of-scene",
+        "--out",       "--stats",        "--exposure", "--strategy", "--pixel",
+        "--traversal", "--target-relmse"};
     memset(o, 0, sizeof *o);
     o->width = o->height = 256;
     o->seed = 1;
@@ -157,7 +164,7 @@ static int parse_opts(int argc, char **argv, ref_opts *o)
         return cli_fail(EXIT_USAGE, "reference: --scene is required");
     if (o->out_count == 0)
         return cli_fail(EXIT_USAGE, "reference: --out is required");
-    if (o->spp == 0 && o->time_limit == 0.0 && o->target_se == 0.0)
+    if (o->spp == 0 && o->time_limit == 0.0 && o->target_se == 0.0 && o->target_relmse == 0.0)
         o->spp = DEFAULT_SPP;
     return EXIT_OK;
 }
@@ -255,6 +262,8 @@ static json_object *stats_json(const run_state *r, const ref_opts *o, int camera
     json_object_object_add(j, "mean_se", json_object_new_double(se_sum / (double)n));
     double rel = gi_ref_mean_rel_se(r->ref);
     json_object_object_add(j, "mean_rel_se", isfinite(rel) ? json_object_new_double(rel) : NULL);
+    double rm = gi_ref_mean_relmse(r->ref);
+    json_object_object_add(j, "relmse_estimate", isfinite(rm) ? json_object_new_double(rm) : NULL);
     double mean[4];
     gi_image_mean(r->mean, mean);
     json_object *mj = json_object_new_array();
@@ -349,7 +358,7 @@ static int after_pass(void *user, uint64_t spp, double se, uint64_t se_spp, doub
     return 0;
 }
 
-/* Progressive passes until --spp, --time or --target-se says stop; *stop
+/* Progressive passes until --spp, --time, --target-se or --target-relmse says stop; *stop
  * names which. */
 static int render_passes(run_state *r, const ref_opts *o, const char **stop)
 {
@@ -360,7 +369,7 @@ static int render_passes(run_state *r, const ref_opts *o, const char **stop)
     const char *every_env = getenv("GIBENCH_PROGRESS_EVERY");
     ps.every = every_env && !ps.bar.on ? atof(every_env) : 0.0;
     const double t_render = gi_now();
-    gi_ref_until u = {o->spp, o->time_limit, o->target_se};
+    gi_ref_until u = {o->spp, o->time_limit, o->target_se, o->target_relmse};
     gi_result res = gi_ref_progressive(r->ref, &u, after_pass, &ps, stop, &err);
     progress_end(&ps.bar);
     if (res == GI_OK && ps.every > 0.0)

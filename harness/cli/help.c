@@ -55,6 +55,7 @@ static const command_help helps[] = {
      "  --spp N                 stop at N samples per pixel\n"
      "  --time S                stop after S seconds of rendering\n"
      "  --target-se E           stop when the mean relative standard error reaches E\n"
+     "  --target-relmse X       stop when the reference's estimated relMSE reaches X\n"
      "  --max-bounces B|inf     path length limit (B = 1: direct light only)\n"
      "  --time-of-scene T       scene time (animation)\n"
      "  --pixel box|center      camera rays spread over the pixel (box) or through its centre\n"

@@ -1,4 +1,5 @@
-/* Progressive rendering until a sample count, a time or a standard error
+/* Progressive rendering until a sample count, a time, a standard error or
+ * an estimated relMSE
  * (reference.h, gi_ref_progressive): the loop of gibench reference and of
  * the Python API's Scene.reference. */
 #include "reference.h"
@@ -41,6 +42,36 @@ static uint64_t pass_size(const gi_ref_until *u, uint64_t spp, uint64_t checkpoi
     return k;
 }
 
+/* The first checkpoint; 0 with neither target (then u->spp decides). */
+static uint64_t first_checkpoint(const gi_ref_until *u)
+{
+    uint64_t c = u->target_se > 0.0 || u->target_relmse > 0.0 ? next_checkpoint(0, 0, 1) : 0;
+    return u->spp && (!c || c > u->spp) ? u->spp : c;
+}
+
+/* At a checkpoint: the targets' statistics taken (*se, the --target-se
+ * one), *stop set when one is reached, else the next checkpoint (relMSE
+ * falls as 1/spp: its square root goes as the standard error). */
+static uint64_t check_targets(const gi_ref *r, const gi_ref_until *u, uint64_t spp, double *se,
+                              const char **stop)
+{
+    uint64_t next = 0;
+    if (u->target_se > 0.0) {
+        *se = gi_ref_mean_rel_se(r);
+        if (*se <= u->target_se)
+            *stop = "target-se";
+        next = next_checkpoint(spp, *se, u->target_se);
+    }
+    if (u->target_relmse > 0.0) {
+        double rm = gi_ref_mean_relmse(r);
+        if (!*stop && rm <= u->target_relmse)
+            *stop = "target-relmse";
+        uint64_t n = next_checkpoint(spp, sqrt(rm), sqrt(u->target_relmse));
+        next = next && next < n ? next : n;
+    }
+    return u->spp && next > u->spp ? u->spp : next;
+}
+
 gi_result gi_ref_progressive(gi_ref *r, const gi_ref_until *u, gi_ref_pass_fn fn, void *user,
                              const char **stop, gi_error *err)
 {
@@ -48,9 +79,8 @@ gi_result gi_ref_progressive(gi_ref *r, const gi_ref_until *u, gi_ref_pass_fn fn
     const double t_render = gi_now();
     double se = INFINITY, per_spp = 0.0; /* seconds a sample per pixel takes */
     uint64_t se_spp = 0;
-    uint64_t checkpoint = u->target_se > 0.0 ? next_checkpoint(0, se, u->target_se) : u->spp;
-    if (u->spp && checkpoint > u->spp)
-        checkpoint = u->spp;
+    uint64_t checkpoint = first_checkpoint(u);
+    const int targets = u->target_se > 0.0 || u->target_relmse > 0.0;
     while (!*stop) {
         uint64_t spp = gi_ref_spp(r);
         uint64_t k = pass_size(u, spp, checkpoint, per_spp, gi_now() - t_render);
@@ -61,15 +91,9 @@ gi_result gi_ref_progressive(gi_ref *r, const gi_ref_until *u, gi_ref_pass_fn fn
         per_spp = (gi_now() - t0) / (double)k;
         spp = gi_ref_spp(r);
         double elapsed = gi_now() - t_render;
-        if (u->target_se > 0.0 && spp == checkpoint) {
-            se = gi_ref_mean_rel_se(r);
+        if (targets && spp == checkpoint) {
+            checkpoint = check_targets(r, u, spp, &se, stop);
             se_spp = spp;
-            if (se <= u->target_se)
-                *stop = "target-se";
-            else
-                checkpoint = next_checkpoint(spp, se, u->target_se);
-            if (u->spp && checkpoint > u->spp)
-                checkpoint = u->spp;
         }
         if (!*stop && u->spp && spp >= u->spp)
             *stop = "spp";

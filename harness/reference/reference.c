@@ -344,6 +344,24 @@ double gi_ref_mean_rel_se(const gi_ref *r)
     return used ? total / (double)used : INFINITY;
 }
 
+double gi_ref_mean_relmse(const gi_ref *r)
+{
+    assert(r);
+    size_t n = (size_t)r->rs.width * r->rs.height, used = 0;
+    double total = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        const double *a = r->acc + i * ACC_SIZE;
+        if (a[ACC_N] < 2.0)
+            continue;
+        for (int c = 0; c < 3; c++) {
+            double q = a[ACC_SUM + c] / a[ACC_N] + 0.01;
+            total += var_of_mean(a[ACC_SUM + c], a[ACC_SQ + c], a[ACC_N]) / (q * q);
+        }
+        used++;
+    }
+    return used ? total / (3.0 * (double)used) : INFINITY;
+}
+
 void gi_ref_get_stats(const gi_ref *r, gi_ref_stats *out)
 {
     assert(r && out);

@@ -131,6 +131,13 @@ gi_image *gi_ref_variance_image(const gi_ref *r);
  * variance.A above). Pixels with fewer than 2 finite samples are left out;
  * +infinity before any pixel has 2. */
 double gi_ref_mean_rel_se(const gi_ref *r);
+/* The stopping statistic of --target-relmse: the reference's own expected
+ * relMSE, the mean over pixels and channels of
+ *     var(mean_c) / (mean_c + 0.01)^2,
+ * gibench's relMSE metric (metrics.h) with the error replaced by the
+ * variance of the mean. Pixels with fewer than 2 finite samples are left
+ * out; +infinity before any pixel has 2. */
+double gi_ref_mean_relmse(const gi_ref *r);
 
 typedef struct gi_ref_stats {
     uint64_t spp;              /* samples per pixel */
@@ -148,7 +155,8 @@ void gi_ref_get_stats(const gi_ref *r, gi_ref_stats *out);
 /* "embree 3.13.5 cpu": the renderer name recorded with every result. */
 const char *gi_ref_renderer(const gi_ref *r);
 /* When gi_ref_progressive stops: at `spp` samples per pixel, after
- * `seconds` of rendering, or once gi_ref_mean_rel_se falls to `target_se`
+ * `seconds` of rendering, once gi_ref_mean_rel_se falls to `target_se`, or
+ * once gi_ref_mean_relmse falls to `target_relmse`
  * (checked at sample counts that depend on the image alone, so that the
  * stopping point and the image are reproducible); 0 leaves a limit out,
  * the first one reached stops. */
@@ -156,6 +164,7 @@ typedef struct gi_ref_until {
     uint64_t spp;
     double seconds;
     double target_se;
+    double target_relmse;
 } gi_ref_until;
 /* Called after every pass with the samples so far, the last standard
  * error checked (with target_se; else the current one) and the samples
@@ -163,7 +172,7 @@ typedef struct gi_ref_until {
 typedef int (*gi_ref_pass_fn)(void *user, uint64_t spp, double rel_se, uint64_t se_spp,
                               double elapsed);
 /* Passes of about half a second until `u` says stop (*stop: "spp",
- * "time" or "target-se"). GI_ERR_CANCELLED when fn asked. The loop of
+ * "time", "target-se" or "target-relmse"). GI_ERR_CANCELLED when fn asked. The loop of
  * gibench reference; the image after N samples is the same bits however
  * they were split (see Determinism above). */
 gi_result gi_ref_progressive(gi_ref *r, const gi_ref_until *u, gi_ref_pass_fn fn, void *user,

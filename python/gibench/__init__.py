@@ -161,12 +161,15 @@ class Scene(_Closes):
 
     def reference(self, spp=None, seconds=None, target_se=None, max_bounces=None,
                   size=(256, 256), seed=1, camera=None, time=0.0, threads=0, pixel="box",
-                  traversal="fast"):
+                  traversal="fast", until_relmse=None):
         """The path-traced reference as `gibench reference`: (mean, variance), two
         H x W x 3 float32 arrays; mean.timings holds the run's stats (spp, stop,
         render_seconds, mean_rel_se, ...). Progressive: it stops at spp samples per
         pixel, after `seconds`, or at the mean relative standard error target_se
-        (--target-se), whichever comes first; with none given, 256 spp.
+        (--target-se), or when its own estimated relMSE falls to until_relmse
+        (--target-relmse: the mean over pixels and channels of the variance of
+        the mean / (mean + 0.01)^2, stats["relmse_estimate"]), whichever comes
+        first; with none given, 256 spp.
         max_bounces None is unlimited; time is the scene's time (--time-of-scene)."""
         self._alive()
         w, h = _size(size, "reference")
@@ -183,11 +186,13 @@ class Scene(_Closes):
                                                              1000000, "reference")
         if spp is not None:
             o.spp = _uint("spp", spp, 1, 0xFFFFFFFF, "reference")
-        for name, v in (("time", seconds), ("target-se", target_se)):
+        for name, v in (("time", seconds), ("target-se", target_se),
+                        ("target-relmse", until_relmse)):
             if v is not None and not (isinstance(v, (int, float)) and v > 0 and v < float("inf")):
                 raise UsageError("reference: --%s '%s' is not a positive number" % (name, v))
         o.seconds = float(seconds or 0.0)
         o.target_se = float(target_se or 0.0)
+        o.target_relmse = float(until_relmse or 0.0)
         mean = np.empty((h, w, 3), dtype=np.float32)
         var = np.empty((h, w, 3), dtype=np.float32)
         out = ctypes.c_void_p()

@@ -72,6 +72,7 @@ class ReferenceOpts(ctypes.Structure):
         ("time", ctypes.c_float),
         ("pixel_center", ctypes.c_int),
         ("robust_traversal", ctypes.c_int),
+        ("target_relmse", ctypes.c_double),
     ]
 
 

@@ -1,5 +1,6 @@
 """Scene.reference and gibench.metrics against gibench reference and gibench diff."""
 import json
+import math
 
 import numpy as np
 import pytest
@@ -36,6 +37,41 @@ def test_progressive_target_se_stops_where_the_cli_stops(cornell, tmp_path):
     assert np.array_equal(mean, gibench.read(out))
     timed, _ = cornell.reference(seconds=0.2, size=(16, 16), max_bounces=1)
     assert timed.timings["stop"] == "time" and timed.timings["spp"] >= 1
+
+
+def test_until_relmse_stops_at_its_checkpoint(cornell, tmp_path):
+    """until_relmse (--target-relmse): the estimate is relMSE's convention on
+    the returned mean and variance; it is <= X where the run stops and > X at
+    the checkpoint before (replayed: the image after n spp does not depend on
+    the passes); a smaller X takes more samples; the CLI stops at the same."""
+    x, kw = 0.05, dict(size=(16, 16), max_bounces=2)
+    mean, var = cornell.reference(until_relmse=x, **kw)
+    est = mean.timings["relmse_estimate"]
+    assert mean.timings["stop"] == "target-relmse" and est <= x
+    assert np.isclose(est, np.mean(var.astype(np.float64) / (mean + 0.01) ** 2), rtol=1e-4)
+    spp, checkpoints = 4, []
+    while True:  # ref_progressive.c's checkpoints: 4, then 10% past the 1/n law, <= doubling
+        checkpoints.append(spp)
+        rm = cornell.reference(spp=spp, **kw)[0].timings["relmse_estimate"]
+        if rm <= x:
+            break
+        want = 1.1 * spp * (math.sqrt(rm) / math.sqrt(x)) * (math.sqrt(rm) / math.sqrt(x))
+        spp = max(spp + 1, 2 * spp if want > 2 * spp else math.ceil(want))
+    assert len(checkpoints) >= 2 and checkpoints[-1] == mean.timings["spp"]
+    assert cornell.reference(spp=checkpoints[-2], **kw)[0].timings["relmse_estimate"] > x
+    finer, _ = cornell.reference(until_relmse=x / 4, **kw)
+    assert finer.timings["spp"] > mean.timings["spp"]
+    out, stats = str(tmp_path / "ref.exr"), str(tmp_path / "stats.json")
+    run_cli("reference", "--scene", CORNELL, "--out", out, "--size", "16x16", "--target-relmse",
+            str(x), "--max-bounces", "2", "--stats", stats)
+    with open(stats) as f:
+        st = json.load(f)
+    assert st["spp"] == mean.timings["spp"] and st["stop"] == "target-relmse"
+    assert np.array_equal(mean, gibench.read(out))
+    msg, rc = cli_error("reference", "--scene", CORNELL, "--out", out, "--target-relmse", "0")
+    with pytest.raises(gibench.UsageError) as e:
+        cornell.reference(until_relmse=0, size=(16, 16))
+    assert str(e.value) == msg and rc == 2
 
 
 def test_reference_errors(cornell, tmp_path):

@@ -111,7 +111,7 @@ void gibench_method_close(gibench_method *m);
 
 /* The options of gibench reference, with its defaults
  * (gibench_reference_defaults): 256x256, seed 1, unlimited bounces. With
- * none of spp, seconds and target_se, 256 samples per pixel. */
+ * none of spp, seconds, target_se and target_relmse, 256 samples per pixel. */
 typedef struct gibench_reference_opts {
     const char *camera; /* a camera name or "#k"; NULL for the first */
     uint32_t width, height;
@@ -124,6 +124,7 @@ typedef struct gibench_reference_opts {
     float time;           /* --time-of-scene */
     int pixel_center;     /* --pixel center (1) or box (0) */
     int robust_traversal; /* --traversal robust (1) or fast (0) */
+    double target_relmse; /* --target-relmse: stop at this estimated relMSE of the mean */
 } gibench_reference_opts;
 
 gibench_reference_opts gibench_reference_defaults(void);
@@ -131,7 +132,8 @@ gibench_reference_opts gibench_reference_defaults(void);
 /* The path-traced reference as gibench reference renders it (the same
  * progressive loop, gi_ref_progressive): the mean into mean and, when not
  * NULL, the variance of the mean into variance (width * height * 3 each);
- * stats: {"spp", "stop", "render_seconds", "mean_rel_se", ...}. */
+ * stats: {"spp", "stop", "render_seconds", "mean_rel_se", "relmse_estimate",
+ * ...}. */
 gi_result gibench_reference(gibench_scene *s, const gibench_reference_opts *o, float *mean,
                             float *variance, char **stats, gi_error *err);
 
