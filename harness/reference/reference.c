@@ -327,7 +327,9 @@ gi_image *gi_ref_variance_image(const gi_ref *r)
     return img;
 }
 
-double gi_ref_mean_rel_se(const gi_ref *r)
+/* The mean of a per-pixel statistic over the pixels with 2 samples or
+ * more (INFINITY when there are none): the stopping rules' estimates. */
+static double mean_over_pixels(const gi_ref *r, double (*per_pixel)(const double *a))
 {
     assert(r);
     size_t n = (size_t)r->rs.width * r->rs.height, used = 0;
@@ -336,30 +338,40 @@ double gi_ref_mean_rel_se(const gi_ref *r)
         const double *a = r->acc + i * ACC_SIZE;
         if (a[ACC_N] < 2.0)
             continue;
-        double lsum = lum_d(a[ACC_SUM], a[ACC_SUM + 1], a[ACC_SUM + 2]);
-        double se = sqrt(var_of_mean(lsum, a[ACC_LUM_SQ], a[ACC_N]));
-        total += se / (fabs(lsum / a[ACC_N]) + 0.01);
+        total += per_pixel(a);
         used++;
     }
     return used ? total / (double)used : INFINITY;
 }
 
+/* The luminance's standard error of the mean relative to the mean. */
+static double pixel_rel_se(const double *a)
+{
+    double lsum = lum_d(a[ACC_SUM], a[ACC_SUM + 1], a[ACC_SUM + 2]);
+    double se = sqrt(var_of_mean(lsum, a[ACC_LUM_SQ], a[ACC_N]));
+    return se / (fabs(lsum / a[ACC_N]) + 0.01);
+}
+
+/* The relMSE metric's term with the squared error replaced by the
+ * variance of the mean, averaged over the three channels. */
+static double pixel_relmse(const double *a)
+{
+    double t = 0.0;
+    for (int c = 0; c < 3; c++) {
+        double q = a[ACC_SUM + c] / a[ACC_N] + 0.01;
+        t += var_of_mean(a[ACC_SUM + c], a[ACC_SQ + c], a[ACC_N]) / (q * q);
+    }
+    return t / 3.0;
+}
+
+double gi_ref_mean_rel_se(const gi_ref *r)
+{
+    return mean_over_pixels(r, pixel_rel_se);
+}
+
 double gi_ref_mean_relmse(const gi_ref *r)
 {
-    assert(r);
-    size_t n = (size_t)r->rs.width * r->rs.height, used = 0;
-    double total = 0.0;
-    for (size_t i = 0; i < n; i++) {
-        const double *a = r->acc + i * ACC_SIZE;
-        if (a[ACC_N] < 2.0)
-            continue;
-        for (int c = 0; c < 3; c++) {
-            double q = a[ACC_SUM + c] / a[ACC_N] + 0.01;
-            total += var_of_mean(a[ACC_SUM + c], a[ACC_SQ + c], a[ACC_N]) / (q * q);
-        }
-        used++;
-    }
-    return used ? total / (3.0 * (double)used) : INFINITY;
+    return mean_over_pixels(r, pixel_relmse);
 }
 
 void gi_ref_get_stats(const gi_ref *r, gi_ref_stats *out)
