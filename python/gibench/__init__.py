@@ -126,11 +126,17 @@ class Scene(_Closes):
             raise UsageError("render: the scene %s is closed" % self.path)
 
     def render(self, method, size=(256, 256), frames=1, seed=1, params=None, camera=None,
-               time=0.0, warmup=0, exposure=0.0, no_cache=False, isolate=False):
+               time=0.0, warmup=0, exposure=0.0, no_cache=False, isolate=False, fresh=False):
         """One render as `gibench render --scene S --method M`: an Image (H x W x 3
         float32, the last frame) with .timings. isolate=True runs it in a child
         `gibench render` process, so that a crashing plugin raises RunError
-        instead of taking the interpreter down."""
+        instead of taking the interpreter down.
+
+        The scene keeps the method instance of its last render: a render with
+        the same method, params, size, camera, time and no_cache (seed, frames,
+        warmup and exposure may differ) uses it again from frame 0 instead of
+        creating and preparing a new one; the image is the same bit for bit.
+        timings["reused"] says which; fresh=True always makes a new one."""
         w, h = _size(size)
         frames = _uint("frames", frames, 1, 1000000)
         seed = _uint("seed", seed, 0, 0xFFFFFFFF)
@@ -142,6 +148,7 @@ class Scene(_Closes):
         self._alive()
         o, keep = _render_opts(method, w, h, frames, seed, texts, camera, time, warmup, exposure,
                                no_cache)
+        o.fresh = 1 if fresh else 0
         img = np.empty((h, w, 3), dtype=np.float32)
         out = ctypes.c_void_p()
         err = GiError()

@@ -43,6 +43,7 @@ class RenderOpts(ctypes.Structure):
         ("time", ctypes.c_float),
         ("exposure", ctypes.c_float),
         ("no_cache", ctypes.c_int),
+        ("fresh", ctypes.c_int),
     ]
 
 

@@ -101,13 +101,20 @@ def test_move_equals_cli_view(tmp_path):
     run_cli("render", "--view", _view_file(tmp_path / "v.json", moved), "--out", out)
     run_cli("render", "--view", _view_file(tmp_path / "v0.json", None), "--out", out0)
     scene = gibench.Scene(CORNELL)  # its own: a move stays in the scene
+    kept = scene.render("csm", size=(32, 32))  # an instance the scene keeps
     m = scene.method("csm", size=(32, 32))
     still = m.render()
     assert np.array_equal(still.view(np.uint32), gibench.read(out0).view(np.uint32))
+    assert np.array_equal(kept, still)
     m.update(move={"short_block": (1.5, 0.0, 1.69)})
     img = m.render()
     assert np.array_equal(img.view(np.uint32), gibench.read(out).view(np.uint32))
     assert not np.array_equal(img, still)
+    # a render after the move is a new instance prepared for the moved scene
+    # (the kept one knew the block as static), the image of the moved Method
+    fresh = scene.render("csm", size=(32, 32))
+    assert fresh.timings["reused"] is False
+    assert np.array_equal(fresh.view(np.uint32), img.view(np.uint32))
     # by index and as a 4x4 matrix: the same placement, the same image
     mat = np.eye(4)
     mat[:3, 3] = (1.5, 0.0, 1.69)
