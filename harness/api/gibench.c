@@ -558,20 +558,32 @@ gi_result gibench_render(gibench_scene *s, const gibench_render_opts *o, float *
     return res;
 }
 
-gi_result gibench_image_read(const char *path, float **rgba, uint32_t *width, uint32_t *height,
-                             gi_error *err)
+/* The pixels of img handed over to the caller (gibench_free) and the
+ * struct released; img NULL after a failed read. */
+static gi_result hand_over(gi_image *img, float **rgba, uint32_t *width, uint32_t *height)
 {
-    *rgba = NULL;
-    gi_image *img = gi_image_read(path, err);
     if (!img)
         return GI_ERR_IO;
     *width = img->width;
     *height = img->height;
-    /* the pixels handed over; the struct released */
     *rgba = img->rgba;
     img->rgba = NULL;
     gi_image_free(img);
     return GI_OK;
+}
+
+gi_result gibench_image_read(const char *path, float **rgba, uint32_t *width, uint32_t *height,
+                             gi_error *err)
+{
+    *rgba = NULL;
+    return hand_over(gi_image_read(path, err), rgba, width, height);
+}
+
+gi_result gibench_image_read_layer(const char *path, const char *layer, float **rgba,
+                                   uint32_t *width, uint32_t *height, gi_error *err)
+{
+    *rgba = NULL;
+    return hand_over(gi_image_read_layer(path, layer, err), rgba, width, height);
 }
 
 gi_result gibench_image_write(const char *path, const float *rgb, uint32_t width, uint32_t height,

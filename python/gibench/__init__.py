@@ -16,6 +16,7 @@ import ctypes
 import json
 import os
 import subprocess
+import sys
 import tempfile
 import weakref
 
@@ -100,6 +101,7 @@ class Scene(_Closes):
 
     def __init__(self, path):
         self.path = os.fspath(path)
+        self._cwd = os.getcwd()  # where self.path is relative to, for isolate's children
         self._handle = ctypes.c_void_p()
         err = GiError()
         check(lib.gibench_scene_open(self.path.encode(), ctypes.byref(self._handle),
@@ -160,15 +162,25 @@ class Scene(_Closes):
         return Image(img, json.loads(take_string(out)))
 
     def method(self, method, size=(256, 256), seed=1, params=None, camera=None, time=0.0,
-               warmup=0, exposure=0.0, no_cache=False):
+               warmup=0, exposure=0.0, no_cache=False, isolate=False):
         """A Method: the instance created and prepared once (the options of
-        render), then updated and rendered frame after frame."""
+        render), then updated and rendered frame after frame.
+
+        isolate=True keeps the instance in a child process (a Python
+        interpreter running gibench._child, with its own GL context and its own
+        copy of this scene, loaded from self.path) for the Method's whole life:
+        update() and render() are requests over a pipe, images come back as
+        arrays. A plugin that crashes kills only the child: that call and every
+        later one on the Method raise RunError("render: the child process died
+        of signal N"), and this interpreter and its other objects go on. Nodes
+        moved by update(move=...) move in the child's copy of the scene only."""
         self._alive()
-        return Method(self, method, size, seed, params, camera, time, warmup, exposure, no_cache)
+        cls = _ChildMethod if isolate else Method
+        return cls(self, method, size, seed, params, camera, time, warmup, exposure, no_cache)
 
     def reference(self, spp=None, seconds=None, target_se=None, max_bounces=None,
                   size=(256, 256), seed=1, camera=None, time=0.0, threads=0, pixel="box",
-                  traversal="fast", until_relmse=None):
+                  traversal="fast", until_relmse=None, isolate=False):
         """The path-traced reference as `gibench reference`: (mean, variance), two
         H x W x 3 float32 arrays; mean.timings holds the run's stats (spp, stop,
         render_seconds, mean_rel_se, ...). Progressive: it stops at spp samples per
@@ -177,8 +189,12 @@ class Scene(_Closes):
         (--target-relmse: the mean over pixels and channels of the variance of
         the mean / (mean + 0.01)^2, stats["relmse_estimate"]), whichever comes
         first; with none given, 256 spp.
-        max_bounces None is unlimited; time is the scene's time (--time-of-scene)."""
-        self._alive()
+        max_bounces None is unlimited; time is the scene's time (--time-of-scene).
+        isolate=True runs it in a child `gibench reference` process (the mean and
+        the variance read back from its EXR, the stats from its --stats), so
+        that a crash raises RunError instead of taking the interpreter down."""
+        if not isolate:
+            self._alive()
         w, h = _size(size, "reference")
         if pixel not in ("box", "center"):
             raise UsageError("reference: --pixel '%s' is not box or center" % pixel)
@@ -200,6 +216,8 @@ class Scene(_Closes):
         o.seconds = float(seconds or 0.0)
         o.target_se = float(target_se or 0.0)
         o.target_relmse = float(until_relmse or 0.0)
+        if isolate:
+            return self._reference_child(o, camera, pixel, traversal)
         mean = np.empty((h, w, 3), dtype=np.float32)
         var = np.empty((h, w, 3), dtype=np.float32)
         out = ctypes.c_void_p()
@@ -210,12 +228,34 @@ class Scene(_Closes):
               err)
         return Image(mean, json.loads(take_string(out))), var
 
+    def _reference_child(self, o, camera, pixel, traversal):
+        with tempfile.TemporaryDirectory(prefix="gibench-py-") as tmp:
+            out = os.path.join(tmp, "reference.exr")
+            stats = os.path.join(tmp, "stats.json")
+            cmd = [_command(), "-q", "reference", "--scene", self.path, "--out", out,
+                   "--size", "%dx%d" % (o.width, o.height), "--seed", str(o.seed),
+                   "--threads", str(o.threads), "--time-of-scene", repr(float(o.time)),
+                   "--pixel", pixel, "--traversal", traversal, "--stats", stats,
+                   "--max-bounces", "inf" if o.max_bounces < 0 else str(o.max_bounces)]
+            for flag, v in (("--spp", o.spp), ("--time", o.seconds), ("--target-se", o.target_se),
+                            ("--target-relmse", o.target_relmse)):
+                if v:
+                    cmd += [flag, repr(v)]
+            if camera is not None:
+                cmd += ["--camera", str(camera)]
+            p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            if p.returncode != 0:
+                raise _child_error(p, "reference")
+            mean, var = read(out), read(out, layer="variance")
+            with open(stats) as f:
+                return Image(mean, json.load(f)), np.asarray(var)
+
     def _render_child(self, method, w, h, frames, seed, texts, camera, time, warmup, exposure,
                       no_cache):
         with tempfile.TemporaryDirectory(prefix="gibench-py-") as tmp:
             out = os.path.join(tmp, "image.exr")
             timings = os.path.join(tmp, "timings.json")
-            cmd = [os.environ.get("GIBENCH_BIN") or _build.COMMAND, "-q", "render",
+            cmd = [_command(), "-q", "render",
                    "--scene", self.path, "--method", str(method), "--out", out,
                    "--size", "%dx%d" % (w, h), "--frames", str(frames), "--seed", str(seed),
                    "--warmup", str(warmup), "--time", repr(float(time)),
@@ -247,7 +287,7 @@ def study(study, out, jobs=None, resume=False, fresh=False, dry_run=False):
             path = os.path.join(tmp, "%s.json" % study.get("name", "study"))
             with open(path, "w") as f:
                 json.dump(study, f, indent=1)
-        cmd = [os.environ.get("GIBENCH_BIN") or _build.COMMAND, "-q", "study", os.fspath(path),
+        cmd = [_command(), "-q", "study", os.fspath(path),
                "--out", os.fspath(out)]
         if jobs is not None:
             cmd += ["--jobs", str(jobs)]
@@ -265,6 +305,11 @@ def study(study, out, jobs=None, resume=False, fresh=False, dry_run=False):
     except ImportError:
         return runs
     return pandas.json_normalize(runs)
+
+
+def _command():
+    """The gibench command of this build (GIBENCH_BIN overrides it)."""
+    return os.environ.get("GIBENCH_BIN") or _build.COMMAND
 
 
 def _render_opts(method, w, h, frames, seed, texts, camera, time, warmup, exposure, no_cache):
@@ -358,6 +403,84 @@ class Method(_Closes):
             self._handle = ctypes.c_void_p()
 
 
+class _ChildMethod(_Closes):
+    """Method(isolate=True): the same interface, the instance in a child
+    process (gibench/_child.py says the protocol)."""
+
+    def __init__(self, scene, method, size, seed, params, camera, time, warmup, exposure,
+                 no_cache):
+        from . import _child
+        self._wire = _child
+        self.scene = scene
+        self.id = str(method)
+        self.size = _size(size)
+        self.time = float(time)
+        self._dead = None
+        pkg_parent = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join(p for p in (pkg_parent, env.get("PYTHONPATH")) if p)
+        self._proc = subprocess.Popen([sys.executable, "-m", "gibench._child"], env=env,
+                                      cwd=scene._cwd, stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+        scene._methods.add(self)
+        try:
+            self._call("open", scene.path, method, size, seed, params, camera,
+                       time, warmup, exposure, no_cache)
+        except Error:
+            self.close()
+            raise
+
+    def _call(self, op, *args, **kwargs):
+        if self._proc is None:
+            raise self._dead or UsageError("render: the %s instance is closed" % self.id)
+        try:
+            self._wire.write_message(self._proc.stdin, (op, args, kwargs))
+            answer = self._wire.read_message(self._proc.stdout)
+        except (BrokenPipeError, OSError):
+            answer = None
+        if answer is None:  # the child is gone: what killed it, for this call and the next
+            rc = self._proc.wait()
+            self._dead = RunError("render: the child process died of signal %d" % -rc if rc < 0
+                                  else "render: the child process ended (exit status %d)" % rc)
+            self._release()
+            raise self._dead
+        if answer[0] == "error":
+            raise (UsageError if answer[1] == "UsageError" else RunError)(answer[2])
+        return answer[1]
+
+    def update(self, time=None, camera=None, move=None):
+        """As Method.update, in the child."""
+        self._call("update", time=time, camera=camera, move=move)
+        if time is not None:
+            self.time = float(time)
+
+    def render(self, frames=1):
+        """As Method.render, in the child."""
+        img, timings = self._call("render", frames)
+        return Image(img, timings)
+
+    def _release(self):
+        for f in (self._proc.stdin, self._proc.stdout):
+            try:
+                f.close()
+            except OSError:
+                pass
+        self._proc = None
+
+    def close(self):
+        """Ends the child (also when the object goes or its scene closes)."""
+        proc = getattr(self, "_proc", None)
+        if proc is None:
+            return
+        try:
+            self._wire.write_message(proc.stdin, ("close", (), {}))
+            self._wire.read_message(proc.stdout)
+        except (BrokenPipeError, OSError):
+            pass
+        # the child ends on its own (its GL context torn down); not waited
+        # for here, subprocess reaps it later
+        self._release()
+
+
 def _matrix_trs(m):
     """A 4x4 matrix (column vectors, translation in the last column) as
     translation, rotation quaternion (x y z w) and scale; no shear."""
@@ -441,13 +564,20 @@ def metrics(test, ref, exposure=0.0, ppd=0.0, maps=False):
     return m
 
 
-def read(path):
-    """An image file (EXR, PFM, PNG) read by gibench's own reader: H x W x 3 float32."""
+def read(path, layer=None):
+    """An image file (EXR, PFM, PNG) read by gibench's own reader: H x W x 3 float32.
+    layer names another layer of an EXR, e.g. "variance" (the variance of the
+    mean that gibench reference writes beside it)."""
     rgba = ctypes.POINTER(ctypes.c_float)()
     w, h = ctypes.c_uint32(), ctypes.c_uint32()
     err = GiError()
-    res = lib.gibench_image_read(os.fspath(path).encode(), ctypes.byref(rgba), ctypes.byref(w),
-                                 ctypes.byref(h), ctypes.byref(err))
+    if layer is None:
+        res = lib.gibench_image_read(os.fspath(path).encode(), ctypes.byref(rgba),
+                                     ctypes.byref(w), ctypes.byref(h), ctypes.byref(err))
+    else:
+        res = lib.gibench_image_read_layer(os.fspath(path).encode(), str(layer).encode(),
+                                           ctypes.byref(rgba), ctypes.byref(w), ctypes.byref(h),
+                                           ctypes.byref(err))
     check(res, err)
     try:
         a = np.ctypeslib.as_array(rgba, shape=(h.value, w.value, 4))[:, :, :3].copy()

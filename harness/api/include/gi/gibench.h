@@ -160,6 +160,11 @@ gi_result gibench_metrics(const float *test, const float *ref, uint32_t width, u
  * width * height * 4 floats (gibench_free). */
 gi_result gibench_image_read(const char *path, float **rgba, uint32_t *width, uint32_t *height,
                              gi_error *err);
+/* Reads layer `layer` of an EXR (e.g. "variance", which gibench reference
+ * writes beside the mean: channels variance.R/G/B) as gibench_image_read
+ * reads the image; a file without that layer is GI_ERR_IO. */
+gi_result gibench_image_read_layer(const char *path, const char *layer, float **rgba,
+                                   uint32_t *width, uint32_t *height, gi_error *err);
 /* Writes an RGB image (alpha 1) as gibench render writes its --out:
  * EXR/PFM linear, PNG with the exposure in stops and sRGB. */
 gi_result gibench_image_write(const char *path, const float *rgb, uint32_t width, uint32_t height,
