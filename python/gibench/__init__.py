@@ -27,7 +27,7 @@ from ._lib import (Error, GiError, NodeMove, ReferenceOpts, RenderOpts, RunError
                    check, lib, take_string)
 
 __all__ = ["Error", "RunError", "UsageError", "Image", "Method", "Scene", "methods", "metrics", "read",
-           "study", "write"]
+           "study", "study_runs", "write"]
 
 
 class Image(np.ndarray):
@@ -274,13 +274,16 @@ class Scene(_Closes):
                 return Image(img, json.load(f))
 
 
-def study(study, out, jobs=None, resume=False, fresh=False, dry_run=False):
+def study(study, out, jobs=None, resume=False, fresh=False, dry_run=False, as_frame=None):
     """Runs a study as `gibench study STUDY --out OUT` (each run in its own
     process, as the CLI does) and returns its runs: the records of OUT/runs.json
-    as a list of dicts, or a pandas DataFrame (nested keys flattened, e.g.
-    "metrics.full.relmse") when pandas is installed. study is a study file's
-    path or the study itself as a dict (paths in it are relative to the current
-    folder, as in a file)."""
+    as a pandas DataFrame (one row per run, nested keys flattened, e.g.
+    "metrics.full.relmse") when pandas is installed (Debian's python3-pandas),
+    a list of dicts otherwise. as_frame=False always gives the list;
+    as_frame=True the DataFrame, or UsageError without pandas. study is a study
+    file's path or the study itself as a dict (paths in it are relative to the
+    current folder, as in a file)."""
+    _pandas(as_frame)  # a bad as_frame fails before the study runs
     with tempfile.TemporaryDirectory(prefix="gibench-py-") as tmp:
         path = study
         if isinstance(study, dict):
@@ -298,13 +301,39 @@ def study(study, out, jobs=None, resume=False, fresh=False, dry_run=False):
         raise _child_error(p, "study")
     if dry_run:
         return p.stdout
-    with open(os.path.join(os.fspath(out), "runs.json")) as f:
-        runs = json.load(f)
+    return study_runs(out, as_frame)
+
+
+def _pandas(as_frame):
+    """The pandas module when as_frame asks for a DataFrame and it is
+    installed; None for a list."""
+    if as_frame not in (None, True, False):
+        raise UsageError("study: as_frame is None, True or False, not %r" % (as_frame,))
+    if as_frame is False:
+        return None
     try:
         import pandas
     except ImportError:
-        return runs
-    return pandas.json_normalize(runs)
+        if as_frame:
+            raise UsageError("study: as_frame=True needs pandas (apt-get install "
+                             "python3-pandas)") from None
+        return None
+    return pandas
+
+
+def study_runs(out, as_frame=None):
+    """The runs of a study's output folder OUT (its runs.json, as study()
+    returns them): a pandas DataFrame when pandas is installed, a list of
+    dicts otherwise or with as_frame=False (as_frame=True: UsageError without
+    pandas). Reads a study run earlier, by study() or by `gibench study`."""
+    pandas = _pandas(as_frame)
+    path = os.path.join(os.fspath(out), "runs.json")
+    try:
+        with open(path) as f:
+            runs = json.load(f)
+    except (OSError, ValueError) as e:
+        raise UsageError("study: cannot read %s: %s" % (path, getattr(e, "strerror", None) or e))
+    return runs if pandas is None else pandas.json_normalize(runs)
 
 
 def _command():

@@ -2,6 +2,7 @@
 against gibench render --animate; gibench.study against gibench study."""
 import json
 import os
+import sys
 
 import numpy as np
 import pytest
@@ -47,7 +48,10 @@ def test_method_frames_accumulate_like_a_render(cornell):
     m.close()
 
 
-def test_study_returns_its_runs(tmp_path):
+def test_study_returns_its_runs(tmp_path, monkeypatch):
+    """A DataFrame with pandas (installed by the set-up: its absence fails
+    here), a list of dicts without it or with as_frame=False."""
+    import pandas
     study = {
         "name": "pytiny",
         "scenes": ["scenes/cornell_box_coarse.gltf"],
@@ -57,20 +61,36 @@ def test_study_returns_its_runs(tmp_path):
         "methods": [{"method": "direct", "params": {"light_samples": [1, 8], "env_samples": 0}}],
         "reference": {"spp": 8, "max_bounces": 2},
     }
+    out = str(tmp_path / "s")
     cwd = os.getcwd()
     os.chdir(ROOT)  # paths in a study are relative to the current folder
     try:
-        runs = gibench.study(study, out=str(tmp_path / "s"))
+        frame = gibench.study(study, out=out)
         bad = dict(study, frames=0)
         with pytest.raises(gibench.UsageError) as e:
             gibench.study(bad, out=str(tmp_path / "bad"))
     finally:
         os.chdir(cwd)
-    if not isinstance(runs, list):  # pandas present: one row per run
-        runs = runs.to_dict("records")
-        rel = [r["metrics.full.relmse"] for r in runs]
-    else:
-        rel = [r["metrics"]["full"]["relmse"] for r in runs]
+    # the same runs read back from the folder, as a list, with and without pandas
+    runs = gibench.study_runs(out, as_frame=False)
+    with monkeypatch.context() as m:
+        m.setitem(sys.modules, "pandas", None)  # import pandas fails: no pandas
+        hidden = gibench.study_runs(out)
+        with pytest.raises(gibench.UsageError) as no_pandas:
+            gibench.study_runs(out, as_frame=True)
+        with pytest.raises(gibench.UsageError) as no_pandas_study:  # before running anything
+            gibench.study(study, out=str(tmp_path / "none"), as_frame=True)
+    assert "python3-pandas" in str(no_pandas.value)
+    assert str(no_pandas_study.value) == str(no_pandas.value)
+    assert not os.path.exists(str(tmp_path / "none"))
+    with pytest.raises(gibench.UsageError) as e_missing:
+        gibench.study_runs(str(tmp_path / "missing"))
+    assert "runs.json" in str(e_missing.value)
+    assert isinstance(frame, pandas.DataFrame) and len(frame) == 2
+    assert isinstance(runs, list) and hidden == runs
+    assert frame.to_dict("records") == pandas.json_normalize(runs).to_dict("records")
+    rel = list(frame["metrics.full.relmse"])
+    assert rel == [r["metrics"]["full"]["relmse"] for r in runs]
     assert sorted(r["params"] for r in runs) == ["light_samples=1,env_samples=0",
                                                  "light_samples=8,env_samples=0"]
     assert all(r["status"] == "ok" for r in runs) and all(x > 0 for x in rel)
