@@ -466,6 +466,11 @@ class _ChildMethod(_Closes):
             answer = self._wire.read_message(self._proc.stdout)
         except (BrokenPipeError, OSError):
             answer = None
+        except BaseException:  # interrupted mid-request: the child's state is unknown
+            self._proc.kill()
+            self._dead = RunError("render: the child process was stopped mid-request")
+            self._release()
+            raise
         if answer is None:  # the child is gone: what killed it, for this call and the next
             rc = self._proc.wait()
             self._dead = RunError("render: the child process died of signal %d" % -rc if rc < 0
@@ -497,16 +502,10 @@ class _ChildMethod(_Closes):
 
     def close(self):
         """Ends the child (also when the object goes or its scene closes)."""
-        proc = getattr(self, "_proc", None)
-        if proc is None:
+        if getattr(self, "_proc", None) is None:
             return
-        try:
-            self._wire.write_message(proc.stdin, ("close", (), {}))
-            self._wire.read_message(proc.stdout)
-        except (BrokenPipeError, OSError):
-            pass
-        # the child ends on its own (its GL context torn down); not waited
-        # for here, subprocess reaps it later
+        # the end of the requests ends the child (its GL context torn down);
+        # not waited for here, subprocess reaps it later
         self._release()
 
 

@@ -6,8 +6,11 @@ a plugin that crashes takes only this process down. Requests come on stdin
 and answers go back on the stdout the parent gave; both are pickled tuples
 behind a 4-byte length:
 
-    request  (op, args, kwargs), op one of "open", "update", "render", "close"
+    request  (op, args, kwargs), op one of "open", "update", "render"
     answer   ("ok", value) | ("error", "UsageError" or "RunError", message)
+
+The end of the requests (the parent closed the pipe: Method.close, or the
+parent died) ends this process.
 
 A plugin that prints to stdout must not break the answers, so this process's
 fd 1 is pointed at stderr and the answers go out on a copy of the old one.
@@ -57,9 +60,6 @@ def _serve(requests, answers):
             elif op == "render":
                 img = method.render(*args, **kwargs)
                 value = (np.asarray(img), img.timings)
-            elif op == "close":
-                write_message(answers, ("ok", None))
-                return
             else:
                 raise gibench.RunError("isolate: unknown request '%s'" % op)
             answer = ("ok", value)
