@@ -10,7 +10,9 @@ The names and defaults are the CLI's (docs/commands.md); the render is the
 same code as `gibench render`, so the images are the same bit for bit.
 One process keeps one GL context (made on first use, on the calling
 thread: use gibench from one thread) and the installed plugins; a Scene
-keeps its loaded scene and GPU upload. docs/python.md has the whole API.
+keeps its loaded scene, its GPU upload and its last render's method
+instance (the next render with the same options uses it again, for the
+same image). docs/python.md has the whole API.
 """
 import ctypes
 import json
