@@ -12,6 +12,7 @@ from conftest import CORNELL, ROOT, cli_error, run_cli
 # (the comparison holds at any settings; these keep the suite fast).
 CHEAP = {
     "avg": {"grid": 16, "vpls": 64, "bounces": 1, "shadow_size": 8},
+    "cssm_hrc": {"atlas": 8, "M": 4, "bounces": 1, "shadow_size": 16},
     "implicit_vis": {"N": 4, "bounces": 1, "direct_samples": 4},
     "vlf": {"l": 16, "N": 16, "iterations": 2},
 }
