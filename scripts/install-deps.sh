@@ -38,6 +38,8 @@ pkgs=(
   python3-numpy
   # its tests under pytest (tests/python, ctest python.*)
   python3-pytest
+  # gibench.study() / study_runs() return a DataFrame with it (tests/python/test_method.py)
+  python3-pandas
   # the tutorial notebook (examples/python) run by its test: plots (Agg) and nbclient
   python3-matplotlib
   python3-nbformat python3-nbclient python3-ipykernel

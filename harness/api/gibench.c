@@ -18,6 +18,13 @@
 struct gibench_scene {
     gi_scene *scene;
     gi_gpu_scene *gs;
+    /* counts the moves of nodes (gibench_method_move): an instance made
+     * before a move was prepared for another scene */
+    uint64_t generation;
+    /* the instance of the last gibench_render, kept for the next render
+     * with the same options (render_key); NULL when none */
+    gibench_method *kept;
+    char *kept_key;
 };
 
 /* What one process keeps: the GL context and the plugin registry, made on
@@ -108,10 +115,13 @@ const gi_scene *gibench_scene_of(const gibench_scene *s)
     return s->scene;
 }
 
+static void drop_kept(gibench_scene *s);
+
 void gibench_scene_close(gibench_scene *s)
 {
     if (!s)
         return;
+    drop_kept(s);
     gi_gpu_scene_free(s->gs);
     gi_scene_free(s->scene);
     free(s);
@@ -189,7 +199,7 @@ static gi_result resolve(const gibench_scene *s, const gibench_render_opts *o, c
 /* The run's timings, the part of gibench render --timings that concerns
  * the method (the rest the caller knows). */
 static json_object *timings_json(const render_loop *l, const gi_params *params,
-                                 const cli_host *host)
+                                 const cli_host *host, int reused)
 {
     json_object *j = json_object_new_object();
     char *pstr = gi_params_to_string(params);
@@ -203,6 +213,7 @@ static json_object *timings_json(const render_loop *l, const gi_params *params,
     json_object_object_add(j, "prepare", cli_timer_json(l->prep_timer));
     json_object_object_add(j, "render", cli_timer_json(l->render_timer));
     json_object_object_add(j, "stats", json_object_get(host->stats));
+    json_object_object_add(j, "reused", json_object_new_boolean(reused));
     return j;
 }
 
@@ -216,6 +227,7 @@ struct gibench_method {
     uint32_t next_frame; /* the frame_index of the next frame: 0 after an update */
     uint32_t warmup;
     gi_timer_mode mode;
+    int reused; /* this render's instance was kept from an earlier gibench_render */
 };
 
 void gibench_method_close(gibench_method *m)
@@ -388,6 +400,13 @@ gi_result gibench_method_move(gibench_method *m, const gibench_node_move *moves,
         remake |= view_scene_mark_moving(s, v->nodes[i].node);
         moved[v->nodes[i].node] = 1;
     }
+    if (res == GI_OK && count) {
+        /* the scene's placements (and perhaps its moving marks) change: an
+         * instance kept by gibench_render was prepared for the old scene */
+        m->s->generation++;
+        if (m->s->kept != m)
+            drop_kept(m->s);
+    }
     if (res == GI_OK && remake)
         res = method_remake(m, err);
     if (res == GI_OK) {
@@ -430,34 +449,141 @@ gi_result gibench_method_render(gibench_method *m, uint32_t frames, float *rgb, 
     for (size_t i = 0; i < (size_t)l->width * l->height; i++)
         memcpy(rgb + 3 * i, img->rgba + 4 * i, 3 * sizeof(float));
     gi_image_free(img);
-    return timings ? gibench_json_out(timings_json(l, m->params, &m->host), timings, err) : GI_OK;
+    return timings ? gibench_json_out(timings_json(l, m->params, &m->host, m->reused), timings, err)
+                   : GI_OK;
+}
+
+/* What an instance made by gibench_render depends on besides the frames it
+ * renders: the method, its parameters as parsed, the target's size, the
+ * scene's time and placements, the camera, and whether the disk cache is
+ * used. The seed, the exposure, the frame count and the warm-up only reach
+ * the views of the frames (render_loop_frame), so a kept instance serves a
+ * render that differs in them. */
+static gi_result render_key(const gibench_scene *s, const gibench_render_opts *o, char **key,
+                            gi_error *err)
+{
+    const gi_method *gm = NULL;
+    gi_params *params = NULL;
+    int camera = 0;
+    *key = NULL;
+    gi_result res = resolve(s, o, &gm, &params, &camera, err);
+    if (res == GI_OK) {
+        char *pstr = gi_params_to_string(params);
+        size_t n = strlen(gm->id) + (pstr ? strlen(pstr) : 0) + 128;
+        *key = malloc(n);
+        if (*key)
+            snprintf(*key, n, "%s|%s|%ux%u|%a|%d|%d|%llu", gm->id, pstr ? pstr : "", o->width,
+                     o->height, (double)o->time, camera, o->no_cache ? 1 : 0,
+                     (unsigned long long)s->generation);
+        else
+            res = gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "out of memory");
+        free(pstr);
+    }
+    gi_params_free(params);
+    return res;
+}
+
+/* Instances whose image depends on how many frames they rendered before,
+ * not only on frame_index, so that a kept one would not make a new one's
+ * image: implicit_vis with direct=traced seeds its shadow rays with a frame
+ * counter that runs on from prepare() (plugins/implicit_vis/traced.c,
+ * tr->frame) and does not start again at frame_index 0. tests/python
+ * checks every other method's reuse bit for bit. */
+static const struct {
+    const char *method, *param;
+} not_kept[] = {{"implicit_vis", "direct=traced"}};
+
+static int keepable(const char *key)
+{
+    for (size_t i = 0; i < sizeof not_kept / sizeof not_kept[0]; i++) {
+        size_t n = strlen(not_kept[i].method), p = strlen(not_kept[i].param);
+        if (strncmp(key, not_kept[i].method, n) || key[n] != '|')
+            continue;
+        /* the parameter as one "k=v" of the comma-separated list */
+        for (const char *at = strstr(key + n + 1, not_kept[i].param); at;
+             at = strstr(at + 1, not_kept[i].param))
+            if ((at[-1] == '|' || at[-1] == ',') && (at[p] == ',' || at[p] == '|'))
+                return 0;
+    }
+    return 1;
+}
+
+static void drop_kept(gibench_scene *s)
+{
+    gibench_method_close(s->kept);
+    free(s->kept_key);
+    s->kept = NULL;
+    s->kept_key = NULL;
+}
+
+/* The kept instance made ready for a render as if it were new: frame 0
+ * next (a method starts its accumulation and its jitter sequence again at
+ * frame_index 0, gi_kit_frame_begin), the target black as
+ * render_loop_target leaves it, and this render's seed, exposure and
+ * warm-up. */
+static void kept_restart(gibench_method *m, const gibench_render_opts *o)
+{
+    m->next_frame = 0;
+    m->warmup = o->warmup;
+    m->l.seed = o->seed;
+    m->l.exposure = o->exposure;
+    const float black[4] = {0, 0, 0, 1};
+    glClearNamedFramebufferfv(m->l.target_fbo, GL_COLOR, 0, black);
 }
 
 gi_result gibench_render(gibench_scene *s, const gibench_render_opts *o, float *rgb, char **timings,
                          gi_error *err)
 {
-    gibench_method *m = NULL;
-    gi_result res = gibench_method_open(s, o, &m, err);
-    if (res == GI_OK)
-        res = gibench_method_render(m, o->frames, rgb, timings, err);
-    gibench_method_close(m);
+    char *key = NULL;
+    gi_result res = render_key(s, o, &key, err);
+    if (res != GI_OK)
+        return res;
+    int reuse = !o->fresh && s->kept && !strcmp(key, s->kept_key) && keepable(key);
+    if (reuse) {
+        free(key);
+        kept_restart(s->kept, o);
+    } else {
+        drop_kept(s);
+        res = gibench_method_open(s, o, &s->kept, err);
+        if (res != GI_OK) {
+            free(key);
+            return res;
+        }
+        s->kept_key = key;
+    }
+    s->kept->reused = reuse;
+    res = gibench_method_render(s->kept, o->frames, rgb, timings, err);
+    if (res != GI_OK) /* an instance that failed is not trusted with another render */
+        drop_kept(s);
     return res;
+}
+
+/* The pixels of img handed over to the caller (gibench_free) and the
+ * struct released; img NULL after a failed read. */
+static gi_result hand_over(gi_image *img, float **rgba, uint32_t *width, uint32_t *height)
+{
+    if (!img)
+        return GI_ERR_IO;
+    *width = img->width;
+    *height = img->height;
+    *rgba = img->rgba;
+    img->rgba = NULL;
+    gi_image_free(img);
+    return GI_OK;
 }
 
 gi_result gibench_image_read(const char *path, float **rgba, uint32_t *width, uint32_t *height,
                              gi_error *err)
 {
     *rgba = NULL;
-    gi_image *img = gi_image_read(path, err);
-    if (!img)
-        return GI_ERR_IO;
-    *width = img->width;
-    *height = img->height;
-    /* the pixels handed over; the struct released */
-    *rgba = img->rgba;
-    img->rgba = NULL;
-    gi_image_free(img);
-    return GI_OK;
+    return hand_over(gi_image_read(path, err), rgba, width, height);
+}
+
+gi_result gibench_image_read_layer(const char *path, const char *layer, float **rgba,
+                                   uint32_t *width, uint32_t *height, gi_error *err)
+{
+    *rgba = NULL;
+    return hand_over(gi_image_read_layer(path, layer, err), rgba, width, height);
 }
 
 gi_result gibench_image_write(const char *path, const float *rgb, uint32_t width, uint32_t height,

@@ -10,12 +10,15 @@ The names and defaults are the CLI's (docs/commands.md); the render is the
 same code as `gibench render`, so the images are the same bit for bit.
 One process keeps one GL context (made on first use, on the calling
 thread: use gibench from one thread) and the installed plugins; a Scene
-keeps its loaded scene and GPU upload. docs/python.md has the whole API.
+keeps its loaded scene, its GPU upload and its last render's method
+instance (the next render with the same options uses it again, for the
+same image). docs/python.md has the whole API.
 """
 import ctypes
 import json
 import os
 import subprocess
+import sys
 import tempfile
 import weakref
 
@@ -26,7 +29,7 @@ from ._lib import (Error, GiError, NodeMove, ReferenceOpts, RenderOpts, RunError
                    check, lib, take_string)
 
 __all__ = ["Error", "RunError", "UsageError", "Image", "Method", "Scene", "methods", "metrics", "read",
-           "study", "write"]
+           "study", "study_runs", "write"]
 
 
 class Image(np.ndarray):
@@ -100,6 +103,7 @@ class Scene(_Closes):
 
     def __init__(self, path):
         self.path = os.fspath(path)
+        self._cwd = os.getcwd()  # where self.path is relative to, for isolate's children
         self._handle = ctypes.c_void_p()
         err = GiError()
         check(lib.gibench_scene_open(self.path.encode(), ctypes.byref(self._handle),
@@ -126,11 +130,17 @@ class Scene(_Closes):
             raise UsageError("render: the scene %s is closed" % self.path)
 
     def render(self, method, size=(256, 256), frames=1, seed=1, params=None, camera=None,
-               time=0.0, warmup=0, exposure=0.0, no_cache=False, isolate=False):
+               time=0.0, warmup=0, exposure=0.0, no_cache=False, isolate=False, fresh=False):
         """One render as `gibench render --scene S --method M`: an Image (H x W x 3
         float32, the last frame) with .timings. isolate=True runs it in a child
         `gibench render` process, so that a crashing plugin raises RunError
-        instead of taking the interpreter down."""
+        instead of taking the interpreter down.
+
+        The scene keeps the method instance of its last render: a render with
+        the same method, params, size, camera, time and no_cache (seed, frames,
+        warmup and exposure may differ) uses it again from frame 0 instead of
+        creating and preparing a new one; the image is the same bit for bit.
+        timings["reused"] says which; fresh=True always makes a new one."""
         w, h = _size(size)
         frames = _uint("frames", frames, 1, 1000000)
         seed = _uint("seed", seed, 0, 0xFFFFFFFF)
@@ -142,6 +152,7 @@ class Scene(_Closes):
         self._alive()
         o, keep = _render_opts(method, w, h, frames, seed, texts, camera, time, warmup, exposure,
                                no_cache)
+        o.fresh = 1 if fresh else 0
         img = np.empty((h, w, 3), dtype=np.float32)
         out = ctypes.c_void_p()
         err = GiError()
@@ -153,15 +164,25 @@ class Scene(_Closes):
         return Image(img, json.loads(take_string(out)))
 
     def method(self, method, size=(256, 256), seed=1, params=None, camera=None, time=0.0,
-               warmup=0, exposure=0.0, no_cache=False):
+               warmup=0, exposure=0.0, no_cache=False, isolate=False):
         """A Method: the instance created and prepared once (the options of
-        render), then updated and rendered frame after frame."""
+        render), then updated and rendered frame after frame.
+
+        isolate=True keeps the instance in a child process (a Python
+        interpreter running gibench._child, with its own GL context and its own
+        copy of this scene, loaded from self.path) for the Method's whole life:
+        update() and render() are requests over a pipe, images come back as
+        arrays. A plugin that crashes kills only the child: that call and every
+        later one on the Method raise RunError("render: the child process died
+        of signal N"), and this interpreter and its other objects go on. Nodes
+        moved by update(move=...) move in the child's copy of the scene only."""
         self._alive()
-        return Method(self, method, size, seed, params, camera, time, warmup, exposure, no_cache)
+        cls = _ChildMethod if isolate else Method
+        return cls(self, method, size, seed, params, camera, time, warmup, exposure, no_cache)
 
     def reference(self, spp=None, seconds=None, target_se=None, max_bounces=None,
                   size=(256, 256), seed=1, camera=None, time=0.0, threads=0, pixel="box",
-                  traversal="fast", until_relmse=None):
+                  traversal="fast", until_relmse=None, isolate=False):
         """The path-traced reference as `gibench reference`: (mean, variance), two
         H x W x 3 float32 arrays; mean.timings holds the run's stats (spp, stop,
         render_seconds, mean_rel_se, ...). Progressive: it stops at spp samples per
@@ -170,8 +191,12 @@ class Scene(_Closes):
         (--target-relmse: the mean over pixels and channels of the variance of
         the mean / (mean + 0.01)^2, stats["relmse_estimate"]), whichever comes
         first; with none given, 256 spp.
-        max_bounces None is unlimited; time is the scene's time (--time-of-scene)."""
-        self._alive()
+        max_bounces None is unlimited; time is the scene's time (--time-of-scene).
+        isolate=True runs it in a child `gibench reference` process (the mean and
+        the variance read back from its EXR, the stats from its --stats), so
+        that a crash raises RunError instead of taking the interpreter down."""
+        if not isolate:
+            self._alive()
         w, h = _size(size, "reference")
         if pixel not in ("box", "center"):
             raise UsageError("reference: --pixel '%s' is not box or center" % pixel)
@@ -193,6 +218,8 @@ class Scene(_Closes):
         o.seconds = float(seconds or 0.0)
         o.target_se = float(target_se or 0.0)
         o.target_relmse = float(until_relmse or 0.0)
+        if isolate:
+            return self._reference_child(o, camera, pixel, traversal)
         mean = np.empty((h, w, 3), dtype=np.float32)
         var = np.empty((h, w, 3), dtype=np.float32)
         out = ctypes.c_void_p()
@@ -203,12 +230,34 @@ class Scene(_Closes):
               err)
         return Image(mean, json.loads(take_string(out))), var
 
+    def _reference_child(self, o, camera, pixel, traversal):
+        with tempfile.TemporaryDirectory(prefix="gibench-py-") as tmp:
+            out = os.path.join(tmp, "reference.exr")
+            stats = os.path.join(tmp, "stats.json")
+            cmd = [_command(), "-q", "reference", "--scene", self.path, "--out", out,
+                   "--size", "%dx%d" % (o.width, o.height), "--seed", str(o.seed),
+                   "--threads", str(o.threads), "--time-of-scene", repr(float(o.time)),
+                   "--pixel", pixel, "--traversal", traversal, "--stats", stats,
+                   "--max-bounces", "inf" if o.max_bounces < 0 else str(o.max_bounces)]
+            for flag, v in (("--spp", o.spp), ("--time", o.seconds), ("--target-se", o.target_se),
+                            ("--target-relmse", o.target_relmse)):
+                if v:
+                    cmd += [flag, repr(v)]
+            if camera is not None:
+                cmd += ["--camera", str(camera)]
+            p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            if p.returncode != 0:
+                raise _child_error(p, "reference")
+            mean, var = read(out), read(out, layer="variance")
+            with open(stats) as f:
+                return Image(mean, json.load(f)), np.asarray(var)
+
     def _render_child(self, method, w, h, frames, seed, texts, camera, time, warmup, exposure,
                       no_cache):
         with tempfile.TemporaryDirectory(prefix="gibench-py-") as tmp:
             out = os.path.join(tmp, "image.exr")
             timings = os.path.join(tmp, "timings.json")
-            cmd = [os.environ.get("GIBENCH_BIN") or _build.COMMAND, "-q", "render",
+            cmd = [_command(), "-q", "render",
                    "--scene", self.path, "--method", str(method), "--out", out,
                    "--size", "%dx%d" % (w, h), "--frames", str(frames), "--seed", str(seed),
                    "--warmup", str(warmup), "--time", repr(float(time)),
@@ -227,20 +276,23 @@ class Scene(_Closes):
                 return Image(img, json.load(f))
 
 
-def study(study, out, jobs=None, resume=False, fresh=False, dry_run=False):
+def study(study, out, jobs=None, resume=False, fresh=False, dry_run=False, as_frame=None):
     """Runs a study as `gibench study STUDY --out OUT` (each run in its own
     process, as the CLI does) and returns its runs: the records of OUT/runs.json
-    as a list of dicts, or a pandas DataFrame (nested keys flattened, e.g.
-    "metrics.full.relmse") when pandas is installed. study is a study file's
-    path or the study itself as a dict (paths in it are relative to the current
-    folder, as in a file)."""
+    as a pandas DataFrame (one row per run, nested keys flattened, e.g.
+    "metrics.full.relmse") when pandas is installed (Debian's python3-pandas),
+    a list of dicts otherwise. as_frame=False always gives the list;
+    as_frame=True the DataFrame, or UsageError without pandas. study is a study
+    file's path or the study itself as a dict (paths in it are relative to the
+    current folder, as in a file)."""
+    _pandas(as_frame)  # a bad as_frame fails before the study runs
     with tempfile.TemporaryDirectory(prefix="gibench-py-") as tmp:
         path = study
         if isinstance(study, dict):
             path = os.path.join(tmp, "%s.json" % study.get("name", "study"))
             with open(path, "w") as f:
                 json.dump(study, f, indent=1)
-        cmd = [os.environ.get("GIBENCH_BIN") or _build.COMMAND, "-q", "study", os.fspath(path),
+        cmd = [_command(), "-q", "study", os.fspath(path),
                "--out", os.fspath(out)]
         if jobs is not None:
             cmd += ["--jobs", str(jobs)]
@@ -251,13 +303,44 @@ def study(study, out, jobs=None, resume=False, fresh=False, dry_run=False):
         raise _child_error(p, "study")
     if dry_run:
         return p.stdout
-    with open(os.path.join(os.fspath(out), "runs.json")) as f:
-        runs = json.load(f)
+    return study_runs(out, as_frame)
+
+
+def _pandas(as_frame):
+    """The pandas module when as_frame asks for a DataFrame and it is
+    installed; None for a list."""
+    if as_frame not in (None, True, False):
+        raise UsageError("study: as_frame is None, True or False, not %r" % (as_frame,))
+    if as_frame is False:
+        return None
     try:
         import pandas
     except ImportError:
-        return runs
-    return pandas.json_normalize(runs)
+        if as_frame:
+            raise UsageError("study: as_frame=True needs pandas (apt-get install "
+                             "python3-pandas)") from None
+        return None
+    return pandas
+
+
+def study_runs(out, as_frame=None):
+    """The runs of a study's output folder OUT (its runs.json, as study()
+    returns them): a pandas DataFrame when pandas is installed, a list of
+    dicts otherwise or with as_frame=False (as_frame=True: UsageError without
+    pandas). Reads a study run earlier, by study() or by `gibench study`."""
+    pandas = _pandas(as_frame)
+    path = os.path.join(os.fspath(out), "runs.json")
+    try:
+        with open(path) as f:
+            runs = json.load(f)
+    except (OSError, ValueError) as e:
+        raise UsageError("study: cannot read %s: %s" % (path, getattr(e, "strerror", None) or e))
+    return runs if pandas is None else pandas.json_normalize(runs)
+
+
+def _command():
+    """The gibench command of this build (GIBENCH_BIN overrides it)."""
+    return os.environ.get("GIBENCH_BIN") or _build.COMMAND
 
 
 def _render_opts(method, w, h, frames, seed, texts, camera, time, warmup, exposure, no_cache):
@@ -351,6 +434,83 @@ class Method(_Closes):
             self._handle = ctypes.c_void_p()
 
 
+class _ChildMethod(_Closes):
+    """Method(isolate=True): the same interface, the instance in a child
+    process (gibench/_child.py says the protocol)."""
+
+    def __init__(self, scene, method, size, seed, params, camera, time, warmup, exposure,
+                 no_cache):
+        from . import _child
+        self._wire = _child
+        self.scene = scene
+        self.id = str(method)
+        self.size = _size(size)
+        self.time = float(time)
+        self._dead = None
+        pkg_parent = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join(p for p in (pkg_parent, env.get("PYTHONPATH")) if p)
+        self._proc = subprocess.Popen([sys.executable, "-m", "gibench._child"], env=env,
+                                      cwd=scene._cwd, stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+        scene._methods.add(self)
+        try:
+            self._call("open", scene.path, method, size, seed, params, camera,
+                       time, warmup, exposure, no_cache)
+        except Error:
+            self.close()
+            raise
+
+    def _call(self, op, *args, **kwargs):
+        if self._proc is None:
+            raise self._dead or UsageError("render: the %s instance is closed" % self.id)
+        try:
+            self._wire.write_message(self._proc.stdin, (op, args, kwargs))
+            answer = self._wire.read_message(self._proc.stdout)
+        except (BrokenPipeError, OSError):
+            answer = None
+        except BaseException:  # interrupted mid-request: the child's state is unknown
+            self._proc.kill()
+            self._dead = RunError("render: the child process was stopped mid-request")
+            self._release()
+            raise
+        if answer is None:  # the child is gone: what killed it, for this call and the next
+            rc = self._proc.wait()
+            self._dead = RunError("render: the child process died of signal %d" % -rc if rc < 0
+                                  else "render: the child process ended (exit status %d)" % rc)
+            self._release()
+            raise self._dead
+        if answer[0] == "error":
+            raise (UsageError if answer[1] == "UsageError" else RunError)(answer[2])
+        return answer[1]
+
+    def update(self, time=None, camera=None, move=None):
+        """As Method.update, in the child."""
+        self._call("update", time=time, camera=camera, move=move)
+        if time is not None:
+            self.time = float(time)
+
+    def render(self, frames=1):
+        """As Method.render, in the child."""
+        img, timings = self._call("render", frames)
+        return Image(img, timings)
+
+    def _release(self):
+        for f in (self._proc.stdin, self._proc.stdout):
+            try:
+                f.close()
+            except OSError:
+                pass
+        self._proc = None
+
+    def close(self):
+        """Ends the child (also when the object goes or its scene closes)."""
+        if getattr(self, "_proc", None) is None:
+            return
+        # the end of the requests ends the child (its GL context torn down);
+        # not waited for here, subprocess reaps it later
+        self._release()
+
+
 def _matrix_trs(m):
     """A 4x4 matrix (column vectors, translation in the last column) as
     translation, rotation quaternion (x y z w) and scale; no shear."""
@@ -434,13 +594,20 @@ def metrics(test, ref, exposure=0.0, ppd=0.0, maps=False):
     return m
 
 
-def read(path):
-    """An image file (EXR, PFM, PNG) read by gibench's own reader: H x W x 3 float32."""
+def read(path, layer=None):
+    """An image file (EXR, PFM, PNG) read by gibench's own reader: H x W x 3 float32.
+    layer names another layer of an EXR, e.g. "variance" (the variance of the
+    mean that gibench reference writes beside it)."""
     rgba = ctypes.POINTER(ctypes.c_float)()
     w, h = ctypes.c_uint32(), ctypes.c_uint32()
     err = GiError()
-    res = lib.gibench_image_read(os.fspath(path).encode(), ctypes.byref(rgba), ctypes.byref(w),
-                                 ctypes.byref(h), ctypes.byref(err))
+    if layer is None:
+        res = lib.gibench_image_read(os.fspath(path).encode(), ctypes.byref(rgba),
+                                     ctypes.byref(w), ctypes.byref(h), ctypes.byref(err))
+    else:
+        res = lib.gibench_image_read_layer(os.fspath(path).encode(), str(layer).encode(),
+                                           ctypes.byref(rgba), ctypes.byref(w), ctypes.byref(h),
+                                           ctypes.byref(err))
     check(res, err)
     try:
         a = np.ctypeslib.as_array(rgba, shape=(h.value, w.value, 4))[:, :, :3].copy()

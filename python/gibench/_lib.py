@@ -43,6 +43,7 @@ class RenderOpts(ctypes.Structure):
         ("time", ctypes.c_float),
         ("exposure", ctypes.c_float),
         ("no_cache", ctypes.c_int),
+        ("fresh", ctypes.c_int),
     ]
 
 
@@ -91,6 +92,10 @@ def _load():
         "gibench_image_read": ([ctypes.c_char_p, ctypes.POINTER(ctypes.POINTER(ctypes.c_float)),
                                 ctypes.POINTER(ctypes.c_uint32), ctypes.POINTER(ctypes.c_uint32),
                                 err], ctypes.c_int),
+        "gibench_image_read_layer": ([ctypes.c_char_p, ctypes.c_char_p,
+                                      ctypes.POINTER(ctypes.POINTER(ctypes.c_float)),
+                                      ctypes.POINTER(ctypes.c_uint32),
+                                      ctypes.POINTER(ctypes.c_uint32), err], ctypes.c_int),
         "gibench_image_write": ([ctypes.c_char_p, ctypes.POINTER(ctypes.c_float), ctypes.c_uint32,
                                  ctypes.c_uint32, ctypes.c_float, err], ctypes.c_int),
         "gibench_reference": ([P, ctypes.POINTER(ReferenceOpts), ctypes.POINTER(ctypes.c_float),

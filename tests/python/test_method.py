@@ -2,6 +2,7 @@
 against gibench render --animate; gibench.study against gibench study."""
 import json
 import os
+import sys
 
 import numpy as np
 import pytest
@@ -47,7 +48,10 @@ def test_method_frames_accumulate_like_a_render(cornell):
     m.close()
 
 
-def test_study_returns_its_runs(tmp_path):
+def test_study_returns_its_runs(tmp_path, monkeypatch):
+    """A DataFrame with pandas (installed by the set-up: its absence fails
+    here), a list of dicts without it or with as_frame=False."""
+    import pandas
     study = {
         "name": "pytiny",
         "scenes": ["scenes/cornell_box_coarse.gltf"],
@@ -57,20 +61,36 @@ def test_study_returns_its_runs(tmp_path):
         "methods": [{"method": "direct", "params": {"light_samples": [1, 8], "env_samples": 0}}],
         "reference": {"spp": 8, "max_bounces": 2},
     }
+    out = str(tmp_path / "s")
     cwd = os.getcwd()
     os.chdir(ROOT)  # paths in a study are relative to the current folder
     try:
-        runs = gibench.study(study, out=str(tmp_path / "s"))
+        frame = gibench.study(study, out=out)
         bad = dict(study, frames=0)
         with pytest.raises(gibench.UsageError) as e:
             gibench.study(bad, out=str(tmp_path / "bad"))
     finally:
         os.chdir(cwd)
-    if not isinstance(runs, list):  # pandas present: one row per run
-        runs = runs.to_dict("records")
-        rel = [r["metrics.full.relmse"] for r in runs]
-    else:
-        rel = [r["metrics"]["full"]["relmse"] for r in runs]
+    # the same runs read back from the folder, as a list, with and without pandas
+    runs = gibench.study_runs(out, as_frame=False)
+    with monkeypatch.context() as m:
+        m.setitem(sys.modules, "pandas", None)  # import pandas fails: no pandas
+        hidden = gibench.study_runs(out)
+        with pytest.raises(gibench.UsageError) as no_pandas:
+            gibench.study_runs(out, as_frame=True)
+        with pytest.raises(gibench.UsageError) as no_pandas_study:  # before running anything
+            gibench.study(study, out=str(tmp_path / "none"), as_frame=True)
+    assert "python3-pandas" in str(no_pandas.value)
+    assert str(no_pandas_study.value) == str(no_pandas.value)
+    assert not os.path.exists(str(tmp_path / "none"))
+    with pytest.raises(gibench.UsageError) as e_missing:
+        gibench.study_runs(str(tmp_path / "missing"))
+    assert "runs.json" in str(e_missing.value)
+    assert isinstance(frame, pandas.DataFrame) and len(frame) == 2
+    assert isinstance(runs, list) and hidden == runs
+    assert frame.to_dict("records") == pandas.json_normalize(runs).to_dict("records")
+    rel = list(frame["metrics.full.relmse"])
+    assert rel == [r["metrics"]["full"]["relmse"] for r in runs]
     assert sorted(r["params"] for r in runs) == ["light_samples=1,env_samples=0",
                                                  "light_samples=8,env_samples=0"]
     assert all(r["status"] == "ok" for r in runs) and all(x > 0 for x in rel)
@@ -101,13 +121,20 @@ def test_move_equals_cli_view(tmp_path):
     run_cli("render", "--view", _view_file(tmp_path / "v.json", moved), "--out", out)
     run_cli("render", "--view", _view_file(tmp_path / "v0.json", None), "--out", out0)
     scene = gibench.Scene(CORNELL)  # its own: a move stays in the scene
+    kept = scene.render("csm", size=(32, 32))  # an instance the scene keeps
     m = scene.method("csm", size=(32, 32))
     still = m.render()
     assert np.array_equal(still.view(np.uint32), gibench.read(out0).view(np.uint32))
+    assert np.array_equal(kept, still)
     m.update(move={"short_block": (1.5, 0.0, 1.69)})
     img = m.render()
     assert np.array_equal(img.view(np.uint32), gibench.read(out).view(np.uint32))
     assert not np.array_equal(img, still)
+    # a render after the move is a new instance prepared for the moved scene
+    # (the kept one knew the block as static), the image of the moved Method
+    fresh = scene.render("csm", size=(32, 32))
+    assert fresh.timings["reused"] is False
+    assert np.array_equal(fresh.view(np.uint32), img.view(np.uint32))
     # by index and as a 4x4 matrix: the same placement, the same image
     mat = np.eye(4)
     mat[:3, 3] = (1.5, 0.0, 1.69)
@@ -131,5 +158,33 @@ def test_move_a_light(tmp_path):
     still = m.render()
     m.update(move={"light": {"translation": (2.78, 3.5, 2.795)}})
     assert not np.array_equal(m.render(), still)
+    m.close()
+    scene.close()
+
+
+def test_first_move_reprepares():
+    """The first update(move=...) of an instance prepared with every object
+    static makes it again for the moved objects (gibench_method_move).
+    cssm_hrc is the method whose prepare() depends on what moves (its
+    moving-object mode; without the new prepare its update() refuses the
+    move), at cheap settings on the 36-triangle box. The image after the
+    move equals, within float rounding, that of a new instance prepared for
+    the moved scene (the scene keeps the placement, so Scene.render(fresh=
+    True) makes one): the remade instance draws the mover's maps at the old
+    placement and moves them; by hand 41 of 256 pixels differ, by at most
+    1.5e-8 (1e-7 relative), against a change of 0.24 that the move makes."""
+    scene = gibench.Scene(os.path.join(ROOT, "scenes", "cornell_box_coarse.gltf"))
+    opts = dict(size=(16, 16), params={"atlas": 8, "M": 4, "bounces": 1, "shadow_size": 16,
+                                       "csm_M": 8, "csm_points": 4, "csm_samples": 1,
+                                       "env_samples": 1})
+    m = scene.method("cssm_hrc", **opts)
+    still = m.render()
+    m.update(move={"short_block": (1.5, 0.0, 1.69)})
+    moved = m.render()
+    assert moved.timings["stats"]["moving_objects"] == 1
+    fresh = scene.render("cssm_hrc", fresh=True, **opts)
+    rel = np.abs(moved - fresh) / (np.abs(fresh) + 1e-3)
+    assert rel.max() <= 1e-5
+    assert np.abs(moved - still).max() > 0.1  # the block moved: far above the bound
     m.close()
     scene.close()

@@ -53,7 +53,8 @@ typedef struct gibench_render_opts {
     uint32_t seed;           /* 1 */
     float time;              /* 0: the scene's time in seconds */
     float exposure;          /* 0 stops (only reaches the method's view) */
-    int no_cache;            /* 1: precompute afresh and keep nothing */
+    int no_cache;            /* 1: precompute afresh and keep nothing on disk */
+    int fresh;               /* 1: a new instance even where gibench_render keeps one */
 } gibench_render_opts;
 
 gibench_render_opts gibench_render_defaults(void);
@@ -71,7 +72,17 @@ gi_result gibench_scene_info_json(const gibench_scene *s, char **out, gi_error *
 /* One render, as gibench render --scene S --method M ... --out: the last
  * frame's RGB into rgb (width * height * 3 floats) and, when timings is
  * not NULL, the run's timings ({"method", "params", "prepare": {stage:
- * stats}, "render": {...}, "stats": {...}, ...}). */
+ * stats}, "render": {...}, "stats": {...}, "reused", ...}).
+ *
+ * The scene keeps the instance of its last render: the next render with
+ * the same method, parameters, size, time, camera and no_cache (seed,
+ * frames, warmup and exposure may differ), and no node moved since, uses
+ * it again from frame 0 instead of creating and preparing a new one
+ * ("reused": true; "prepare" then holds the stats of the prepare it had).
+ * The image is the one a new instance makes, bit for bit (a method starts
+ * its accumulation and sequences again at frame_index 0; tests/python
+ * checks every method). o->fresh = 1 makes a new instance; a failed
+ * render keeps none; gibench_scene_close releases it. */
 gi_result gibench_render(gibench_scene *s, const gibench_render_opts *o, float *rgb, char **timings,
                          gi_error *err);
 
@@ -149,6 +160,11 @@ gi_result gibench_metrics(const float *test, const float *ref, uint32_t width, u
  * width * height * 4 floats (gibench_free). */
 gi_result gibench_image_read(const char *path, float **rgba, uint32_t *width, uint32_t *height,
                              gi_error *err);
+/* Reads layer `layer` of an EXR (e.g. "variance", which gibench reference
+ * writes beside the mean: channels variance.R/G/B) as gibench_image_read
+ * reads the image; a file without that layer is GI_ERR_IO. */
+gi_result gibench_image_read_layer(const char *path, const char *layer, float **rgba,
+                                   uint32_t *width, uint32_t *height, gi_error *err);
 /* Writes an RGB image (alpha 1) as gibench render writes its --out:
  * EXR/PFM linear, PNG with the exposure in stops and sRGB. */
 gi_result gibench_image_write(const char *path, const float *rgb, uint32_t width, uint32_t height,
