@@ -61,8 +61,9 @@ fi
 field() { sed -n "0,/^$1: /s/^$1: //p" "$out/device.txt"; }
 
 # A part's study, made tiny for --tiny with sed alone (the node may have no
-# python), its "base" the bundle (the copy lies in the work folder): 32 x 32, one frame, the cheapest settings, AVG's Table II at one
-# size; the study files keep one method per line for this.
+# python): 32 x 32, one frame, the cheapest settings, AVG's Table II at one
+# size; the study files keep one method per line for this. The copy lies in
+# the work folder, so its "base" becomes the bundle, where the scenes are.
 prepare() {
     local src=$here/bench/$1.json dst=$work/$1.json
     if ((tiny)); then
