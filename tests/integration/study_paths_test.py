@@ -9,7 +9,8 @@ study_paths_test.py GIBENCH ROOT OUTDIR:
   folder and finds it; its runs.csv has hdr_flip_full with a value, and its
   records name the scene as the study does;
 - "base": "../mine" from a sibling folder, and "-" (standard input) with
-  paths from the current folder, plan the same scene;
+  paths from the current folder, plan the same scene; a saved view named
+  "view:v.json" next to the study is found from another folder;
 - a missing scene is refused with exit 2 and one line naming the study
   file and the path as resolved;
 - `diff --json` of the committed HDR pair (tests/data/flip) gives NVIDIA's
@@ -80,6 +81,19 @@ p = run(["study", "-", "--dry-run"], out, json.dumps(dict(tiny, name="stdin", sc
 check(p.returncode == 0 and "reference box: mine/box.gltf " in p.stdout,
       "a study on standard input does not take paths from the current folder: exit %d\n%s%s"
       % (p.returncode, p.stdout, p.stderr))
+
+# a saved view ("camera": "view:FILE") is found the same way
+view = {"gibench_view": 1, "scene": box, "method": "direct", "params": [], "width": 8, "height": 8,
+        "frames": 1, "seed": 1, "time": 0, "exposure": 0, "nodes": [],
+        "camera": {"eye": [4.5, 3.5, -6.0], "forward": [-0.25, -0.1, 1.0], "up": [0, 1, 0], "yfov": 0.7,
+                   "znear": 0.01, "zfar": 100}}
+with open(os.path.join(out, "mine", "v.json"), "w") as f:
+    json.dump(view, f)
+with open(os.path.join(out, "mine", "view.json"), "w") as f:
+    json.dump(dict(tiny, name="view", scenes=["box.gltf"], camera="view:v.json"), f)
+p = run(["study", os.path.join(out, "mine", "view.json"), "--dry-run"], os.path.join(out, "elsewhere"))
+check(p.returncode == 0, "\"camera\": \"view:v.json\" next to the study: exit %d: %s"
+      % (p.returncode, p.stderr.strip()))
 
 # 3. a missing scene: one line, the study file and the resolved path
 missing = os.path.join(out, "studies", "m.json")
