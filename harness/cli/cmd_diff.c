@@ -161,6 +161,8 @@ static void print_human(const diff_opts *o, const gi_metrics *m)
     printf("mean_lum   %+.4g %% (test %.6g, reference %.6g)\n", m->mean_lum_diff_pct,
            m->mean_lum_test, m->mean_lum_ref);
     printf("flip       %.6f (LDR-FLIP at %.2f pixels per degree)\n", m->flip, (double)m->flip_ppd);
+    printf("hdr_flip   %.6f (HDR-FLIP of the linear images, %d exposures %.4f..%.4f stops)\n",
+           m->hdr_flip, m->hdr_flip_exposures, m->hdr_flip_start, m->hdr_flip_stop);
     printf("leak       %.6g of the reference's light, in its dark pixels (%.4g %% of the image: "
            "luminance "
            "below %g x its mean, the reference's own share there %.6g)\n",

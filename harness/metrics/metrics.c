@@ -145,6 +145,25 @@ gi_result gi_metrics_relerr_map(const gi_image *test, const gi_image *ref, float
     return GI_OK;
 }
 
+/* The mean of a per-pixel map over the pixels finite in both images (NaN
+ * if none; mean may be NULL), the others set to NaN. */
+static void mean_of_map(const gi_image *test, const gi_image *ref, size_t n, float *map,
+                        double *mean)
+{
+    double sum = 0.0;
+    uint64_t count = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (finite3(test->rgba + i * 4) && finite3(ref->rgba + i * 4)) {
+            sum += map[i];
+            count++;
+        } else {
+            map[i] = NAN;
+        }
+    }
+    if (mean)
+        *mean = count ? sum / (double)count : NAN;
+}
+
 gi_result gi_metrics_flip_map(const gi_image *test, const gi_image *ref,
                               const gi_metrics_opts *opts, float *map, double *mean, gi_error *err)
 {
@@ -177,22 +196,48 @@ gi_result gi_metrics_flip_map(const gi_image *test, const gi_image *ref,
         }
     }
     res = gi_flip_map(ts, rs, test->width, test->height, ppd_of(o), map, err);
-    if (!res) {
-        double sum = 0.0;
-        uint64_t count = 0;
-        for (size_t i = 0; i < n; i++) {
-            if (finite3(test->rgba + i * 4) && finite3(ref->rgba + i * 4)) {
-                sum += map[i];
-                count++;
-            } else {
-                map[i] = NAN;
-            }
-        }
-        if (mean)
-            *mean = count ? sum / (double)count : NAN;
-    }
+    if (!res)
+        mean_of_map(test, ref, n, map, mean);
     free(ts);
     free(rs);
+    return res;
+}
+
+/* HDR-FLIP (Andersson et al. 2021) takes the linear images themselves: it
+ * picks its exposures from the reference and tone maps each one itself. */
+gi_result gi_metrics_hdr_flip_map(const gi_image *test, const gi_image *ref,
+                                  const gi_metrics_opts *opts, float *map, double *mean,
+                                  gi_flip_hdr_info *info, gi_error *err)
+{
+    gi_metrics_opts defaults = {0};
+    const gi_metrics_opts *o = opts ? opts : &defaults;
+    gi_result res = check_pair(test, ref, err);
+    if (!res)
+        res = check_opts(o, err);
+    if (res)
+        return res;
+    size_t n = (size_t)test->width * test->height;
+    float *tl = malloc(n * 3 * sizeof *tl), *rl = malloc(n * 3 * sizeof *rl);
+    if (!tl || !rl) {
+        free(tl);
+        free(rl);
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "HDR-FLIP: out of memory for a %ux%u image",
+                            test->width, test->height);
+    }
+    for (size_t i = 0; i < n; i++) {
+        const float *x = test->rgba + i * 4, *r = ref->rgba + i * 4;
+        int shared = !(finite3(x) && finite3(r));
+        const float *s = shared ? shared_pixel(x, r) : NULL;
+        for (int c = 0; c < 3; c++) {
+            tl[i * 3 + c] = shared ? (s ? s[c] : 0.0f) : x[c];
+            rl[i * 3 + c] = shared ? (s ? s[c] : 0.0f) : r[c];
+        }
+    }
+    res = gi_flip_hdr_map(tl, rl, test->width, test->height, ppd_of(o), map, info, err);
+    if (!res)
+        mean_of_map(test, ref, n, map, mean);
+    free(tl);
+    free(rl);
     return res;
 }
 
@@ -315,6 +360,7 @@ gi_result gi_metrics_compute(const gi_image *test, const gi_image *ref, const gi
     if (out->pixels == 0) {
         out->mse = out->rmse = out->relmse = out->mae = out->psnr = out->ssim = NAN;
         out->mean_lum_test = out->mean_lum_ref = out->mean_lum_diff_pct = out->flip = NAN;
+        out->hdr_flip = out->hdr_flip_start = out->hdr_flip_stop = NAN;
         out->leaked_energy = out->dark_fraction = out->dark_energy_ref = NAN;
         goto done;
     }
@@ -324,10 +370,16 @@ gi_result gi_metrics_compute(const gi_image *test, const gi_image *ref, const gi
     res = gi_metrics_ssim_plane(lx, lr, mask, test->width, test->height, &out->ssim, err);
     if (res)
         goto done;
-    if (o->skip_flip)
-        out->flip = NAN;
-    else
+    out->flip = out->hdr_flip = out->hdr_flip_start = out->hdr_flip_stop = NAN;
+    if (!o->skip_flip)
         res = gi_metrics_flip_map(test, ref, o, fmap, &out->flip, err);
+    if (!res && !o->skip_flip) {
+        gi_flip_hdr_info info = {0};
+        res = gi_metrics_hdr_flip_map(test, ref, o, fmap, &out->hdr_flip, &info, err);
+        out->hdr_flip_start = info.start;
+        out->hdr_flip_stop = info.stop;
+        out->hdr_flip_exposures = info.count;
+    }
 
 done:
     free(mask);

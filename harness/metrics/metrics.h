@@ -44,6 +44,11 @@
  *   flip           mean over the N pixels of LDR-FLIP (flip.h) of the
  *                  tonemapped sRGB images T(x), T(r) at flip_ppd pixels per
  *                  degree
+ *   hdr_flip       mean over the N pixels of HDR-FLIP (flip.h,
+ *                  gi_flip_hdr_map) of the linear images x, r at flip_ppd:
+ *                  its own exposures from the reference, so `exposure`
+ *                  does not change it; hdr_flip_start, _stop, _exposures
+ *                  the exposures it used
  *   leaked_energy  light the test puts where the reference is dark: the
  *                  dark pixels D are those with Y(r) < dark_threshold *
  *                  mean Y(r) (dark_threshold relative, default 0.01);
@@ -65,7 +70,7 @@
 typedef struct gi_metrics_opts {
     float exposure;       /* stops, applied before tonemapping (psnr, ssim, flip); 0 = none */
     float flip_ppd;       /* FLIP pixels per degree; 0 = GI_FLIP_PPD_DEFAULT (67.02) */
-    int skip_flip;        /* nonzero: leave flip NaN (it is the slowest metric) */
+    int skip_flip;        /* nonzero: leave flip and hdr_flip NaN (the slowest metrics) */
     float dark_threshold; /* leaked energy: dark = Y(r) below this times mean Y(r); 0 =
                              GI_DARK_THRESHOLD_DEFAULT */
 } gi_metrics_opts;
@@ -83,6 +88,8 @@ typedef struct gi_metrics {
     double ssim;
     double mean_lum_test, mean_lum_ref, mean_lum_diff_pct;
     double flip;
+    double hdr_flip, hdr_flip_start, hdr_flip_stop;
+    int hdr_flip_exposures;
     double leaked_energy, dark_fraction, dark_energy_ref;
     float exposure, flip_ppd, dark_threshold; /* the options in effect */
 } gi_metrics;
@@ -108,6 +115,15 @@ gi_result gi_metrics_relerr_map(const gi_image *test, const gi_image *ref, float
  * (NaN if none). */
 gi_result gi_metrics_flip_map(const gi_image *test, const gi_image *ref,
                               const gi_metrics_opts *opts, float *map, double *mean, gi_error *err);
+
+/* Per-pixel HDR-FLIP of the linear images into map[width*height]; NaN at
+ * excluded pixels (which carry no difference into their neighbours, as in
+ * gi_metrics_flip_map). mean (may be NULL) receives the mean over the
+ * others (NaN if none), info (may be NULL) the exposures used. */
+struct gi_flip_hdr_info;
+gi_result gi_metrics_hdr_flip_map(const gi_image *test, const gi_image *ref,
+                                  const gi_metrics_opts *opts, float *map, double *mean,
+                                  struct gi_flip_hdr_info *info, gi_error *err);
 
 /* Mean SSIM of two luminance planes (w*h values each, nominally in [0, 1]),
  * over the pixels where mask is nonzero (mask may be NULL: all). */

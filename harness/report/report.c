@@ -19,7 +19,7 @@
 #include <unistd.h>
 
 const char *const report_metric_keys[] = {
-    "relmse", "rmse", "mae", "psnr", "ssim", "flip", "mean_lum_diff_pct", NULL};
+    "relmse", "rmse", "mae", "psnr", "ssim", "flip", "mean_lum_diff_pct", "hdr_flip", NULL};
 
 /* The machine, for the report: kernel, architecture, cores. */
 static void machine_string(char *buf, size_t size)

@@ -239,8 +239,9 @@ static void html_runs(text *t, json_object *runs)
         "class=\"sortable\"><thead><tr>"
         "<th class=l>run</th><th class=l>method</th><th class=l>params</th><th "
         "class=l>status</th><th>frames</th>"
-        "<th>frame ms</th><th>prepare ms</th><th>relMSE full</th><th>relMSE matched</th><th>FLIP "
-        "full</th>"
+        "<th>frame ms</th><th>prepare ms</th><th>relMSE full</th><th>relMSE "
+        "matched</th><th>HDR-FLIP "
+        "full</th><th>FLIP full</th>"
         "<th>SSIM full</th><th>mean lum. diff %%</th><th>speed-up vs PT</th><th>speed-up vs PT, "
         "matched</th>"
         "<th>leaked energy full</th><th>peak RSS MiB</th><th>data MiB</th></tr></thead><tbody>\n");
@@ -260,6 +261,7 @@ static void html_runs(text *t, json_object *runs)
         html_num(t, report_num(o, "prepare_ms", NULL, NULL));
         html_num(t, report_num(o, "metrics", "full", "relmse"));
         html_num(t, report_num(o, "metrics", "matched", "relmse"));
+        html_num(t, report_num(o, "metrics", "full", "hdr_flip"));
         html_num(t, report_num(o, "metrics", "full", "flip"));
         html_num(t, report_num(o, "metrics", "full", "ssim"));
         html_num(t, report_num(o, "metrics", "full", "mean_lum_diff_pct"));

@@ -105,9 +105,9 @@ void report_write_md(text *t, const char *dir, json_object *runs, json_object *m
            "within one "
            "run mean anything.\n\n");
     put(t, "| run | method | params | status | frame ms | prepare ms | relMSE full | relMSE "
-           "matched | FLIP full "
+           "matched | HDR-FLIP full | FLIP full "
            "| SSIM full | mean lum. diff %% |\n");
-    put(t, "|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    put(t, "|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     size_t count = json_object_array_length(runs);
     for (size_t i = 0; i < count; i++) {
         json_object *o = json_object_array_get_idx(runs, i);
@@ -129,6 +129,7 @@ void report_write_md(text *t, const char *dir, json_object *runs, json_object *m
         md_num(t, report_num(o, "prepare_ms", NULL, NULL));
         md_num(t, report_num(o, "metrics", "full", "relmse"));
         md_num(t, report_num(o, "metrics", "matched", "relmse"));
+        md_num(t, report_num(o, "metrics", "full", "hdr_flip"));
         md_num(t, report_num(o, "metrics", "full", "flip"));
         md_num(t, report_num(o, "metrics", "full", "ssim"));
         md_num(t, report_num(o, "metrics", "full", "mean_lum_diff_pct"));

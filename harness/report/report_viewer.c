@@ -108,12 +108,13 @@ static void run_label(json_object *o, char *buf, size_t size)
 static void run_info(json_object *o, char *buf, size_t size)
 {
     snprintf(buf, size, "run %s, %s", report_str(o, "run"), report_str(o, "status"));
-    const char *names[] = {"frame ms (median)", "prepare ms", "relMSE full",
-                           "relMSE matched",    "FLIP full",  "SSIM full"};
+    const char *names[] = {"frame ms (median)", "prepare ms", "relMSE full", "relMSE matched",
+                           "HDR-FLIP full",     "FLIP full",  "SSIM full"};
     double vals[] = {
-        report_num(o, "frame_ms", "median", NULL),  report_num(o, "prepare_ms", NULL, NULL),
-        report_num(o, "metrics", "full", "relmse"), report_num(o, "metrics", "matched", "relmse"),
-        report_num(o, "metrics", "full", "flip"),   report_num(o, "metrics", "full", "ssim")};
+        report_num(o, "frame_ms", "median", NULL),    report_num(o, "prepare_ms", NULL, NULL),
+        report_num(o, "metrics", "full", "relmse"),   report_num(o, "metrics", "matched", "relmse"),
+        report_num(o, "metrics", "full", "hdr_flip"), report_num(o, "metrics", "full", "flip"),
+        report_num(o, "metrics", "full", "ssim")};
     for (size_t k = 0; k < sizeof vals / sizeof vals[0]; k++)
         if (vals[k] == vals[k]) {
             size_t used = strlen(buf);

@@ -27,6 +27,13 @@ void runner_metrics_json_add(json_object *j, const gi_metrics *m)
     json_object_object_add(j, "mean_lum_ref", metric_num(m->mean_lum_ref));
     json_object_object_add(j, "mean_lum_diff_pct", metric_num(m->mean_lum_diff_pct));
     json_object_object_add(j, "flip", metric_num(m->flip));
+    /* HDR-FLIP of the linear images, and the exposures (stops) it swept */
+    json_object_object_add(j, "hdr_flip", metric_num(m->hdr_flip));
+    json_object_object_add(j, "hdr_flip_start", metric_num(m->hdr_flip_start));
+    json_object_object_add(j, "hdr_flip_stop", metric_num(m->hdr_flip_stop));
+    json_object_object_add(j, "hdr_flip_exposures",
+                           isfinite(m->hdr_flip) ? json_object_new_int(m->hdr_flip_exposures)
+                                                 : NULL);
     json_object_object_add(j, "leaked_energy", metric_num(m->leaked_energy));
     json_object_object_add(j, "dark_fraction", metric_num(m->dark_fraction));
     json_object_object_add(j, "dark_energy_ref", metric_num(m->dark_energy_ref));

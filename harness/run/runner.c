@@ -552,10 +552,10 @@ json_object *runner_animation_metrics(const run_spec *s, const char *frames_patt
     return a;
 }
 
-/* A result made before the metrics had the leaked energy: its image is
- * compared again with the same references and only the new keys are
- * added (every value it had stays as it was), so that resuming a study
- * fills the column without rendering anything. Nothing happens when the
+/* A result made before the metrics had the leaked energy or HDR-FLIP: its
+ * image is compared again with the same references and only the missing
+ * keys are added (every value it had stays as it was), so that resuming a
+ * study fills the columns without rendering anything. Nothing happens when the
  * image is gone (committed results keep PNGs only). */
 static void add_leak_to_cached(json_object *old, const run_spec *s, const char *exr,
                                const char *result)
@@ -566,18 +566,21 @@ static void add_leak_to_cached(json_object *old, const run_spec *s, const char *
         !json_object_object_get_ex(old, "metrics", &metrics) || access(exr, R_OK) != 0)
         return;
     const char *refs[2] = {s->ref_full, s->ref_matched}, *names[2] = {"full", "matched"};
-    static const char *const keys[] = {"leaked_energy", "dark_fraction", "dark_energy_ref",
-                                       "dark_threshold"};
+    static const char *const keys[] = {"leaked_energy",  "dark_fraction",     "dark_energy_ref",
+                                       "dark_threshold", "hdr_flip",          "hdr_flip_start",
+                                       "hdr_flip_stop",  "hdr_flip_exposures"};
     int changed = 0;
     for (int k = 0; k < 2; k++) {
         if (!refs[k] || !json_object_object_get_ex(metrics, names[k], &m) ||
-            json_object_object_get_ex(m, "leaked_energy", NULL))
+            (json_object_object_get_ex(m, "leaked_energy", NULL) &&
+             json_object_object_get_ex(m, "hdr_flip", NULL)))
             continue;
         char why[1024];
         json_object *fresh = runner_diff(exr, refs[k], NULL, NULL, s->exposure, why, sizeof why),
                     *v;
         for (size_t q = 0; fresh && q < sizeof keys / sizeof keys[0]; q++)
-            if (json_object_object_get_ex(fresh, keys[q], &v)) {
+            if (!json_object_object_get_ex(m, keys[q], NULL) &&
+                json_object_object_get_ex(fresh, keys[q], &v)) {
                 json_object_object_add(m, keys[q], json_object_get(v));
                 changed = 1;
             }

@@ -64,9 +64,15 @@ static void study_free(study *st)
 
 int study_check(const char *file, gi_plugins *reg)
 {
+    return study_check_as(file, NULL, reg);
+}
+
+int study_check_as(const char *file, const char *as, gi_plugins *reg)
+{
     study *st = calloc(1, sizeof *st); /* over a megabyte: not on the stack */
     if (!st)
         return cli_fail(EXIT_RUN, "study: out of memory");
+    st->located_as = as;
     int rc = study_load(st, file, ".", reg);
     study_free(st);
     free(st);
@@ -147,7 +153,7 @@ static int parse_args(int argc, char **argv, study_args *a)
             a->retry_failed = 1;
         else if (!strcmp(argv[i], "--dry-run"))
             a->dry = 1;
-        else if (argv[i][0] == '-')
+        else if (argv[i][0] == '-' && argv[i][1]) /* "-" alone: the study on standard input */
             return cli_fail(EXIT_USAGE, "study: unknown or incomplete option '%s'", argv[i]);
         else if (!a->file)
             a->file = argv[i];
@@ -162,6 +168,9 @@ static int parse_args(int argc, char **argv, study_args *a)
             "[--slurm [--partition P] [--gres G] [--time T] [--array-limit K] [--no-wait]]");
     if (!a->out)
         a->out = ".";
+    if (!strcmp(a->file, "-") && (a->so.enabled || a->so.cell || a->so.collect))
+        return cli_fail(EXIT_USAGE, "study: a study on standard input does not go with --slurm "
+                                    "(the jobs read the study file again)");
     a->so.dry_run = a->dry;
     int src = slurm_check(&a->so, a->file, a->out);
     if (src != EXIT_OK)

@@ -8,5 +8,8 @@
 /* The study reader alone (what --dry-run checks, without the plan): EXIT_OK,
  * or EXIT_USAGE after printing one line; for tests/fuzz/fuzz_study.c. */
 int study_check(const char *file, gi_plugins *reg);
+/* The same, with the study's relative paths resolved as if the study were
+ * the file `as` (a fuzzer's temporary copy of a committed study). */
+int study_check_as(const char *file, const char *as, gi_plugins *reg);
 
 #endif

@@ -50,7 +50,8 @@ typedef struct study_run {
 } study_run;
 
 typedef struct study_scene {
-    const char *path;
+    const char *name; /* as the study names it (the records' "scene") */
+    char path[4096];  /* resolved from the study's base folder (study_paths.c) */
     char stem[256];
     uint64_t hash; /* its content: the file, every object's geometry, the environment map */
     uint32_t triangles, vertices; /* for scale studies (records get scene_triangles) */
@@ -84,7 +85,11 @@ typedef struct study {
     int ref_pixel_center; /* "pixel": "center": references sample pixel centres */
     uint32_t conv_spp[32], conv_n;
     float exposure;
-    const char *camera;
+    const char *camera;      /* as the runs get it: a "view:FILE" resolved (study_paths.c) */
+    const char *camera_name; /* as the study names it (in the runs' ids) */
+    char camera_buf[4200];
+    char base_dir[4096];    /* relative paths resolve from here (study_paths.c) */
+    const char *located_as; /* NULL, or the file the study's paths resolve as if from */
     double timeout_s;
     run_settings base;
     study_scene scenes[MAX_SCENES];
@@ -110,6 +115,19 @@ int study_get_string(json_object *o, const char *prefix, const char *key, int nu
 json_object *study_read_strict_json(const char *file);
 int study_check_keys(json_object *o, const char *const *known, const char *prefix,
                      const char *file);
+
+/* ---- paths in the study (study_paths.c) ---- */
+
+/* The study's base folder from its file's name ("-": standard input, the
+ * current folder) and its "base" key: EXIT_OK, or EXIT_USAGE after printing
+ * one line. */
+int study_set_base(study *st, json_object *root, const char *file);
+/* `name` resolved from the study's base folder (absolute names kept). */
+void study_resolve(const study *st, const char *name, char *out, size_t size);
+/* EXIT_OK when `resolved` can be read, else EXIT_USAGE after one line that
+ * names the study file, the JSON path, the resolved path and the base. */
+int study_check_readable(const study *st, const char *file, const char *jpath, const char *name,
+                         const char *resolved);
 
 /* ---- the study read and planned (study_load.c, study_plan.c) ---- */
 

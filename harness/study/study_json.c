@@ -7,6 +7,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+
+#include "gi/limits.h"
 
 int study_fail_json(const char *file, const char *path, const char *what)
 {
@@ -77,10 +80,48 @@ int study_get_string(json_object *o, const char *prefix, const char *key, int nu
  * (cli_read_json_strict: no trailing commas, comments, text after the
  * object, or key given twice, keys compared unescaped); NULL after
  * printing where it goes wrong. */
+/* A study on standard input ("-", e.g. from a program that holds the study
+ * in memory) is copied to a private temporary file first, so that it goes
+ * through the same strict reader and limits as a study file; messages name
+ * it "-". */
+static json_object *read_stdin_json(char *why, size_t why_size)
+{
+    char tmp[] = "/tmp/gibench-study-XXXXXX";
+    int fd = mkstemp(tmp);
+    if (fd < 0) {
+        snprintf(why, why_size, "-: cannot make a temporary file for the study on standard input");
+        return NULL;
+    }
+    FILE *f = fdopen(fd, "wb");
+    char buf[65536];
+    size_t n, total = 0;
+    int ok = f != NULL;
+    while (ok && (n = fread(buf, 1, sizeof buf, stdin)) > 0) {
+        total += n;
+        ok = total <= GI_MAX_JSON_BYTES && fwrite(buf, 1, n, f) == n;
+    }
+    ok = ok && !ferror(stdin);
+    if (f ? fclose(f) != 0 : close(fd) != 0)
+        ok = 0;
+    json_object *o = NULL;
+    if (!ok)
+        snprintf(why, why_size, "-: cannot read the study on standard input (at most %llu bytes)",
+                 (unsigned long long)GI_MAX_JSON_BYTES);
+    else if (!(o = cli_read_json_strict(tmp, why, why_size))) {
+        char text[1024];
+        const char *rest = strncmp(why, tmp, strlen(tmp)) ? why : why + strlen(tmp);
+        snprintf(text, sizeof text, "-%s", rest);
+        snprintf(why, why_size, "%s", text);
+    }
+    unlink(tmp);
+    return o;
+}
+
 json_object *study_read_strict_json(const char *file)
 {
     char why[1024];
-    json_object *o = cli_read_json_strict(file, why, sizeof why);
+    json_object *o = !strcmp(file, "-") ? read_stdin_json(why, sizeof why)
+                                        : cli_read_json_strict(file, why, sizeof why);
     if (!o)
         cli_fail(EXIT_USAGE, "%s", why);
     return o;

@@ -16,15 +16,21 @@ static void stem_of(const char *path, char *out, size_t size)
 {
     const char *b = strrchr(path, '/');
     b = b ? b + 1 : path;
-    snprintf(out, size, "%s", b);
+    size_t n = strlen(b) < size ? strlen(b) : size - 1;
+    memcpy(out, b, n);
+    out[n] = '\0';
     char *dot = strrchr(out, '.');
     if (dot)
         *dot = '\0';
 }
 
-/* The scene's index in the study, loading (and so validating) it once. */
-static int scene_index(study *st, const char *file, const char *jpath, const char *path, int *out)
+/* The scene's index in the study, loading (and so validating) it once;
+ * `name` is the scene as the study names it, resolved from the study's base
+ * folder (study_paths.c). */
+static int scene_index(study *st, const char *file, const char *jpath, const char *name, int *out)
 {
+    char path[4096];
+    study_resolve(st, name, path, sizeof path);
     for (uint32_t i = 0; i < st->scene_count; i++)
         if (!strcmp(st->scenes[i].path, path)) {
             *out = (int)i;
@@ -32,6 +38,9 @@ static int scene_index(study *st, const char *file, const char *jpath, const cha
         }
     if (st->scene_count == MAX_SCENES)
         return study_fail_json(file, jpath, "more than 16 scenes in one study");
+    int rc = study_check_readable(st, file, jpath, name, path);
+    if (rc != EXIT_OK)
+        return rc;
     gi_error err;
     gi_scene *s = gi_scene_load(path, &err);
     if (!s)
@@ -73,9 +82,10 @@ static int scene_index(study *st, const char *file, const char *jpath, const cha
     for (uint32_t i = 0; i < st->scene_count; i++)
         if (st->scenes[i].hash == hash)
             return cli_fail(EXIT_USAGE, "%s: %s: %s has the same content as %s, listed already",
-                            file, jpath, path, st->scenes[i].path);
+                            file, jpath, name, st->scenes[i].name);
     study_scene *sc = &st->scenes[st->scene_count];
-    sc->path = path;
+    sc->name = name;
+    snprintf(sc->path, sizeof sc->path, "%s", path);
     sc->hash = hash;
     sc->triangles = triangles;
     sc->vertices = vertices;
@@ -217,10 +227,10 @@ static int check_charts(json_object *charts, const char *file)
 static int load_top_level(study *st, json_object *o, const char *file)
 {
     json_object *v;
-    static const char *known[] = {"name",    "description", "scenes",  "size",     "frames",
-                                  "warmup",  "repeats",     "seed",    "camera",   "time",
-                                  "animate", "cache",       "compare", "exposure", "timeout",
-                                  "methods", "reference",   "charts",  "timer",    NULL};
+    static const char *known[] = {
+        "name",    "description", "scenes",    "size",    "frames", "warmup",  "repeats",
+        "seed",    "camera",      "time",      "animate", "cache",  "compare", "exposure",
+        "timeout", "methods",     "reference", "charts",  "timer",  "base",    NULL};
     int rc = study_check_keys(o, known, "", file);
     if (rc != EXIT_OK)
         return rc;
@@ -229,6 +239,16 @@ static int load_top_level(study *st, json_object *o, const char *file)
         (rc = study_get_string(o, "", "description", 0, NULL, &desc, file)) ||
         (rc = study_get_string(o, "", "camera", 1, NULL, &st->camera, file)))
         return rc;
+    st->camera_name = st->camera;
+    if (st->camera && !strncmp(st->camera, "view:", 5)) {
+        /* a saved view is a file like the scenes: from the study's base */
+        char path[4096];
+        study_resolve(st, st->camera + 5, path, sizeof path);
+        if ((rc = study_check_readable(st, file, "/camera", st->camera + 5, path)))
+            return rc;
+        snprintf(st->camera_buf, sizeof st->camera_buf, "view:%s", path);
+        st->camera = st->camera_buf;
+    }
     if (!json_object_object_get_ex(o, "scenes", &v))
         return study_fail_json(file, "/scenes", "a list of 1 to 16 scene files is required");
     run_settings *b = &st->base;
@@ -401,7 +421,8 @@ int study_load(study *st, const char *file, const char *out_dir, gi_plugins *reg
     if (!json_object_is_type(st->root, json_type_object))
         return study_fail_json(file, "/", "a study is a JSON object");
     int rc;
-    if ((rc = load_top_level(st, st->root, file)) || (rc = load_reference(st, st->root, file)) ||
+    if ((rc = study_set_base(st, st->root, file)) || (rc = load_top_level(st, st->root, file)) ||
+        (rc = load_reference(st, st->root, file)) ||
         (rc = load_methods(st, st->root, file, out_dir, reg)))
         return rc;
     study_name_refs(st);

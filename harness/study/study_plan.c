@@ -256,8 +256,8 @@ static int add_run(study *st, const char *file, const char *out_dir, const gi_me
         snprintf(key, sizeof key,
                  "%016llx|%s|seed=%u|camera=%s|%ux%u|%u/%u|%.9g|%.9g|ev=%.9g|timer=%s|%d|%d",
                  (unsigned long long)st->scenes[si].hash, m->id, st->seed + repeat,
-                 st->camera ? st->camera : "-", rs->width, rs->height, rs->frames, rs->warmup,
-                 (double)rs->time, (double)rs->animate_fps, (double)st->exposure,
+                 st->camera_name ? st->camera_name : "-", rs->width, rs->height, rs->frames,
+                 rs->warmup, (double)rs->time, (double)rs->animate_fps, (double)st->exposure,
                  st->timer ? st->timer : "-", rs->cache, rs->compare);
         for (int p = 0; p < nk; p++) {
             r->params[p] = strdup(combo[p]);

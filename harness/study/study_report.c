@@ -12,12 +12,14 @@
 #include <stdio.h>
 #include <string.h>
 
-/* the scene's size, for scale studies (cached records too) */
+/* the scene's name and size, for scale studies (cached records too) */
 static void add_scene_sizes(study *st)
 {
     for (uint32_t i = 0; i < st->run_count; i++)
         if (st->runs[i].record) {
             const study_scene *sc = &st->scenes[st->runs[i].scene_index];
+            /* the scene as the study names it, wherever the study ran from */
+            json_object_object_add(st->runs[i].record, "scene", json_object_new_string(sc->name));
             json_object_object_add(st->runs[i].record, "scene_triangles",
                                    json_object_new_int64(sc->triangles));
             json_object_object_add(st->runs[i].record, "scene_vertices",

@@ -283,22 +283,18 @@ def study(study, out, jobs=None, resume=False, fresh=False, dry_run=False, as_fr
     "metrics.full.relmse") when pandas is installed (Debian's python3-pandas),
     a list of dicts otherwise. as_frame=False always gives the list;
     as_frame=True the DataFrame, or UsageError without pandas. study is a study
-    file's path or the study itself as a dict (paths in it are relative to the
-    current folder, as in a file)."""
+    file's path (its relative paths are taken from the file's folder or its
+    "base") or the study itself as a dict (paths in it are relative to the
+    current folder)."""
     _pandas(as_frame)  # a bad as_frame fails before the study runs
-    with tempfile.TemporaryDirectory(prefix="gibench-py-") as tmp:
-        path = study
-        if isinstance(study, dict):
-            path = os.path.join(tmp, "%s.json" % study.get("name", "study"))
-            with open(path, "w") as f:
-                json.dump(study, f, indent=1)
-        cmd = [_command(), "-q", "study", os.fspath(path),
-               "--out", os.fspath(out)]
-        if jobs is not None:
-            cmd += ["--jobs", str(jobs)]
-        cmd += (["--resume"] if resume else []) + (["--fresh"] if fresh else [])
-        cmd += ["--dry-run"] if dry_run else []
-        p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # a dict goes on standard input ("-"), whose paths gibench takes from the current folder
+    path, text = ("-", json.dumps(study)) if isinstance(study, dict) else (study, None)
+    cmd = [_command(), "-q", "study", os.fspath(path), "--out", os.fspath(out)]
+    if jobs is not None:
+        cmd += ["--jobs", str(jobs)]
+    cmd += (["--resume"] if resume else []) + (["--fresh"] if fresh else [])
+    cmd += ["--dry-run"] if dry_run else []
+    p = subprocess.run(cmd, input=text, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     if p.returncode != 0:
         raise _child_error(p, "study")
     if dry_run:

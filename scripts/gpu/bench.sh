@@ -62,7 +62,8 @@ field() { sed -n "0,/^$1: /s/^$1: //p" "$out/device.txt"; }
 
 # A part's study, made tiny for --tiny with sed alone (the node may have no
 # python): 32 x 32, one frame, the cheapest settings, AVG's Table II at one
-# size; the study files keep one method per line for this.
+# size; the study files keep one method per line for this. The copy lies in
+# the work folder, so its "base" becomes the bundle, where the scenes are.
 prepare() {
     local src=$here/bench/$1.json dst=$work/$1.json
     if ((tiny)); then
@@ -75,9 +76,10 @@ prepare() {
             -e 's/"N": \[8, 12, 16\]/"N": 8/' -e 's/"l": (128|512)/"l": 32/' \
             -e 's/"grid": 64, "vpls": 4096/"grid": 16, "vpls": 256/' \
             -e 's/"N": 128, "M": 128/"N": 8, "M": 32/' -e 's/"S": \[16, 64, 625\]/"S": [16]/' \
-            "$src" >"$dst"
+            -e "s|\"base\": \"[^\"]*\"|\"base\": \"$here\"|" "$src" >"$dst"
     else
-        cp "$src" "$dst"
+        # the copy's scenes are the bundle's: its base is the bundle
+        sed "s|\"base\": \"[^\"]*\"|\"base\": \"$here\"|" "$src" >"$dst"
     fi
 }
 

@@ -98,7 +98,11 @@ find "$tmp/bin" "$tmp/lib" "$tmp/plugins" -type f ! -name '*.gz' ! -name '*.id' 
 
 cp "$root/scripts/gpu/launcher.sh" "$tmp/gibench"
 cp "$root/scripts/gpu/bench.sh" "$tmp/bench.sh"
-cp "$root"/scripts/gpu/bench/*.json "$tmp/bench/"
+# the bench studies name their scenes from their "base", the tree's root
+# (../../.. from scripts/gpu/bench/), which is .. from the bundle's bench/
+for j in "$root"/scripts/gpu/bench/*.json; do
+    sed 's|"base": "../../.."|"base": ".."|' "$j" >"$tmp/bench/$(basename "$j")"
+done
 chmod +x "$tmp/gibench" "$tmp/bench.sh"
 mkdir -p "$tmp/scenes"
 (cd "$root/scenes" && tar --exclude=./stress -cf - .) | (cd "$tmp/scenes" && tar -xf -)

@@ -1,11 +1,11 @@
 /* libFuzzer target for the study reader (gibench study's --dry-run checks):
  * any bytes must be taken or refused with one line, never crash, leak,
  * hang or trip a sanitizer. The bytes are written to a temporary regular
- * file (the reader opens only those) and read by study_check() against the
+ * file (the reader opens only those) and read by study_check_as() against the
  * plugins of GIBENCH_PLUGIN_DIR and $GIBENCH_PLUGIN_PATH, loaded once.
- * Relative scene paths resolve from the source tree (GI_FUZZ_ROOT), as the
- * seeds from harness/studies/ expect. The reader's one-line refusals go to
- * stderr: run with -close_fd_mask=2 to hide them. */
+ * Relative scene paths resolve as if the study lay in harness/studies/ of
+ * the source tree (GI_FUZZ_ROOT), where the seeds' "base" keys expect it. The reader's one-line
+ * refusals go to stderr: run with -close_fd_mask=2 to hide them. */
 #define _POSIX_C_SOURCE 200809L
 #include "study.h"
 
@@ -41,6 +41,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     size_t written = size ? fwrite(data, 1, size, f) : 0;
     if (fclose(f) != 0 || written != size)
         return 0;
-    (void)study_check(study_path, registry);
+    (void)study_check_as(study_path, "harness/studies/fuzz.json", registry);
     return 0;
 }

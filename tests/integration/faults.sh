@@ -36,7 +36,7 @@ print(" ".join(r["status"] + ("(" + r["reason"] + ")" if r["reason"] else "") fo
 
 study_file() { # NAME SCENE SPP METHODS_JSON [extra json]
     cat > "$D/$1.json" <<JSON
-{"name": "$1", "scenes": ["$2"], "size": [16, 16], "frames": 1, "warmup": 0, "timeout": 60,
+{"name": "$1", "base": "$ROOT", "scenes": ["$2"], "size": [16, 16], "frames": 1, "warmup": 0, "timeout": 60,
  "methods": $4, "reference": {"spp": $3, "max_bounces": 2}${5:-}}
 JSON
 }

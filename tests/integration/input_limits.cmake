@@ -33,6 +33,10 @@ function(refused name regex)
     set(failures ${failures} PARENT_SCOPE)
 endfunction()
 function(study name text regex)
+    # the study's scenes are named from the tree's root (its "base")
+    if(NOT text MATCHES "\"base\"")
+        string(REGEX REPLACE "^[{]" "{\"base\": \"${ROOT}\", " text "${text}")
+    endif()
     file(WRITE ${D}/${name}.json "${text}")
     refused(${name} "${regex}" study ${D}/${name}.json --dry-run)
     set(failures ${failures} PARENT_SCOPE)
@@ -60,7 +64,7 @@ endfunction()
 write_view(${D}/view_ok.json 64 "")
 write_view(${D}/view_big.json 16384 "")
 write_view(${D}/view_dup.json 64 " \"se\\u0065d\": 8,")
-set(VSTUDY "\"scenes\": [\"${SCENE}\"], \"size\": [16, 16], \"methods\": [{\"method\": \"direct\"}]")
+set(VSTUDY "\"base\": \"${ROOT}\", \"scenes\": [\"${SCENE}\"], \"size\": [16, 16], \"methods\": [{\"method\": \"direct\"}]")
 file(WRITE ${D}/view_ok_study.json "{${VSTUDY}, \"camera\": \"view:${D}/view_ok.json\"}")
 execute_process(COMMAND ${GIB} study ${D}/view_ok_study.json --dry-run WORKING_DIRECTORY ${ROOT} TIMEOUT 60
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
@@ -80,8 +84,8 @@ study(view_dup_study "{${VSTUDY}, \"camera\": \"view:${D}/view_dup.json\"}" "vie
 # ---- item 12: a scene listed twice (one run id for both) ----
 study(scene_twice "{\"scenes\": [\"${SCENE}\", \"${SCENE}\"], \"methods\": \"all\"}"
       "/scenes/1: scene listed twice")
-study(scene_twice_named "{\"scenes\": [\"${SCENE}\", \"./${SCENE}\"], \"methods\": \"all\"}"
-      "/scenes/1: \\./${SCENE} has the same content as ${SCENE}")
+study(scene_twice_named "{\"scenes\": [\"${ROOT}/${SCENE}\", \"${ROOT}/./${SCENE}\"], \"methods\": \"all\"}"
+      "/scenes/1: ${ROOT}/\\./${SCENE} has the same content as ${ROOT}/${SCENE}")
 
 # ---- item 12: plugin folders ----
 # a FIFO named like a plugin: skipped without being opened (was 30 s)
@@ -135,7 +139,7 @@ refused(timer_bogus "GIBENCH_TIMER='bogus' is not a timer mode: query, finish or
 unset(ENV{GIBENCH_TIMER})
 
 # ---- item 12: report.md shows HTML in names as text ----
-file(WRITE ${D}/esc.json "{\"name\": \"<img src=x onerror=alert(1)>\", \"scenes\": [\"${SCENE}\"], \"size\": [8, 8],
+file(WRITE ${D}/esc.json "{\"name\": \"<img src=x onerror=alert(1)>\", \"base\": \"${ROOT}\", \"scenes\": [\"${SCENE}\"], \"size\": [8, 8],
  \"frames\": 1, \"warmup\": 0, \"compare\": false, \"methods\": [{\"method\": \"direct\"}]}")
 execute_process(COMMAND ${GIB} -q study ${D}/esc.json --out ${D}/esc WORKING_DIRECTORY ${ROOT} TIMEOUT 120
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)

@@ -218,8 +218,8 @@ PY
 # only the second scene's runs fail
 P=$OUT/slurm_onescene
 rm -rf "$P"
-cat > "$T/two.json" <<'JSON'
-{"name": "slurm_two", "scenes": ["scenes/cornell_box_coarse.gltf", "scenes/bunny_env.glb"],
+cat > "$T/two.json" <<JSON
+{"name": "slurm_two", "base": "$ROOT", "scenes": ["scenes/cornell_box_coarse.gltf", "scenes/bunny_env.glb"],
  "size": [16, 16], "frames": 1, "warmup": 0, "timeout": 60,
  "methods": [{"method": "direct"}], "reference": {"spp": 2048, "max_bounces": 2}}
 JSON

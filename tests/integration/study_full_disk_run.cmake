@@ -12,7 +12,7 @@ set(M ${OUT}/study_full_disk_run_tmpfs)
 small_tmpfs(${M})
 file(REMOVE_RECURSE ${D})
 file(MAKE_DIRECTORY ${D}/out/runs)
-file(WRITE ${D}/s.json "{\"name\": \"full\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
+file(WRITE ${D}/s.json "{\"name\": \"full\", \"base\": \"${ROOT}\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
   \"size\": [16, 16], \"frames\": 1, \"warmup\": 0, \"compare\": false,
   \"methods\": [{\"method\": \"direct\", \"params\": {\"light_samples\": 1}}]}")
 execute_process(COMMAND ${GIB} study ${D}/s.json --dry-run WORKING_DIRECTORY ${ROOT} OUTPUT_VARIABLE plan)

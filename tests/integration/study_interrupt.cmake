@@ -10,7 +10,7 @@ set(ENV{GIBENCH_PLUGIN_PATH} "${FAKE_RUN}")
 fresh_study_dir(study_interrupt)
 # two hanging runs and one that is never reached before the signal
 function(study_file timeout)
-    file(WRITE ${D}/hang.json "{\"name\": \"hang\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
+    file(WRITE ${D}/hang.json "{\"name\": \"hang\", \"base\": \"${ROOT}\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
   \"size\": [8, 8], \"frames\": 1, \"warmup\": 0, \"compare\": false, \"timeout\": ${timeout},
   \"methods\": [{\"method\": \"fake_hang\", \"params\": {}}, {\"method\": \"fake_hang\", \"label\": \"second\"},
                {\"method\": \"direct\"}]}")

@@ -9,10 +9,10 @@ set(ENV{GIBENCH_PLUGIN_PATH} "${FAKE_RUN}")
 set(D ${OUT}/study_lock)
 file(REMOVE_RECURSE ${D})
 file(MAKE_DIRECTORY ${D})
-file(WRITE ${D}/hang.json "{\"name\": \"hang\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
+file(WRITE ${D}/hang.json "{\"name\": \"hang\", \"base\": \"${ROOT}\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
   \"size\": [8, 8], \"frames\": 1, \"warmup\": 0, \"compare\": false, \"timeout\": 60,
   \"methods\": [{\"method\": \"fake_hang\"}]}")
-file(WRITE ${D}/quick.json "{\"name\": \"quick\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
+file(WRITE ${D}/quick.json "{\"name\": \"quick\", \"base\": \"${ROOT}\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
   \"size\": [8, 8], \"frames\": 1, \"warmup\": 0, \"compare\": false, \"methods\": [{\"method\": \"direct\"}]}")
 set(S ${D}/out)
 

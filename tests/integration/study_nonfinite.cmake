@@ -27,7 +27,7 @@ if(EXISTS ${D}/env_nan.exr OR EXISTS ${D}/env_nan_ref.exr)
 endif()
 
 # NaN output fails the run, compared with the reference or not; direct is ok
-file(WRITE ${D}/s.json "{\"name\": \"nonfinite\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
+file(WRITE ${D}/s.json "{\"name\": \"nonfinite\", \"base\": \"${ROOT}\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
   \"size\": [16, 16], \"frames\": 1, \"warmup\": 0,
   \"methods\": [{\"method\": \"fake_conf_nan\"}, {\"method\": \"fake_conf_nan\", \"compare\": false},
                {\"method\": \"direct\", \"params\": {\"light_samples\": 1}}],

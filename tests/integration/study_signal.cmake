@@ -40,7 +40,7 @@ endmacro()
 # coarse Cornell box at 16 x 16, no warm-up, not compared, with `methods`
 # (its JSON list).
 function(coarse_study file name frames methods)
-    file(WRITE ${file} "{\"name\": \"${name}\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
+    file(WRITE ${file} "{\"name\": \"${name}\", \"base\": \"${ROOT}\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"],
   \"size\": [16, 16], \"frames\": ${frames}, \"warmup\": 0, \"compare\": false,
   \"methods\": ${methods}}")
 endfunction()

@@ -8,7 +8,7 @@ include(${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
 set(D ${OUT}/study_strict)
 file(REMOVE_RECURSE ${D})
 file(MAKE_DIRECTORY ${D})
-set(SCENE "\"scenes\": [\"scenes/cornell_box_coarse.gltf\"]")
+set(SCENE "\"base\": \"${ROOT}\", \"scenes\": [\"scenes/cornell_box_coarse.gltf\"]")
 
 # refuse(<name> <study text> <regex of the message>)
 function(refuse name text regex)
