@@ -253,6 +253,7 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
                   no_gpu);
     c->gpu_on = c->gather == 0 && !no_gpu;
     c->gpu_dirty = 1;
+    c->cpu_frames = 0, c->cpu_process_s = c->cpu_main_s = 0.0;
     host->stat(host, "gather_gpu", c->gpu_on);
     c->prepared = 1;
     return GI_OK;
@@ -311,6 +312,7 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
     gi_kit *kit = &c->kit;
     if (!c->prepared)
         return gi_kit_fail(kit, GI_ERR_INVALID_ARGUMENT, "cssm_hrc: render before prepare");
+    cssm_stats_cpu_begin(c);
     /* frames differ: average them */
     const int random = c->jitter || c->indirect == 1 || (c->texel_E && c->env_pixel) || c->csm;
     const unsigned what = c->gpu_on ? GI_KIT_GBUFFER | GI_KIT_ACCUMULATE : GI_KIT_GBUFFER;
@@ -327,6 +329,7 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
             return r;
         gi_kit_frame_end(kit);
         cssm_stats_cuts(c, &st);
+        cssm_stats_cpu_end(c);
         return GI_OK;
     }
     const uint32_t w = view->width, h = view->height;
@@ -347,6 +350,7 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
     gi_error err;
     if (gi_gl_check("cssm_hrc: upload", &err) != GI_OK)
         return gi_kit_fail_with(kit, GI_ERR_GL, &err);
+    cssm_stats_cpu_end(c);
     return GI_OK;
 }
 

@@ -78,6 +78,9 @@ typedef struct cssm_hrc {
     GLuint gpu_prog;
     GLuint gpu_buf[CSSM_GPU_BUFFERS];
     uint32_t gpu_off_base[6], gpu_seg_base[6]; /* each face's first offset and segment */
+    /* CPU time of the frames after the first since prepare (stats.c, frame_cpu_ms) */
+    uint32_t cpu_frames;
+    double cpu_process_s, cpu_main_s, cpu_t0[2];
     int prepared;
 } cssm_hrc;
 
@@ -167,6 +170,12 @@ void cssm_stats_moving(const cssm_hrc *c);
 void cssm_stats_data_bytes(const cssm_hrc *c);
 /* The last hull check, in all and per pair of objects with a mover. */
 void cssm_stats_hulls(const cssm_hrc *c, const gi_scene *s);
+/* A frame's CPU time: begin at the start of render(), end after it; the
+ * stats frame_cpu_ms (every thread of the process: llvmpipe's included)
+ * and frame_main_share (the main thread's part), means over the frames
+ * after the first since prepare (the first compiles the shaders). */
+void cssm_stats_cpu_begin(cssm_hrc *c);
+void cssm_stats_cpu_end(cssm_hrc *c);
 /* Cut size and clamped share of a frame's gathers. */
 void cssm_stats_cuts(const cssm_hrc *c, const cssm_gather_stats *st);
 
