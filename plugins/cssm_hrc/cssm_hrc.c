@@ -249,8 +249,7 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
         return r;
     const char *no_gpu = c->gather == 0 ? cssm_gpu_unsupported(c, gs->scene) : NULL;
     if (no_gpu)
-        host->log(host, GI_LOG_INFO, "cssm_hrc: gather=gpu does not cover %s: the C gather runs",
-                  no_gpu);
+        host->log(host, GI_LOG_INFO, "gather=gpu does not cover %s: the C gather runs", no_gpu);
     c->gpu_on = c->gather == 0 && !no_gpu;
     c->gpu_dirty = 1;
     c->cpu_frames = 0, c->cpu_process_s = c->cpu_main_s = 0.0;

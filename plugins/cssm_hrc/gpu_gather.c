@@ -10,6 +10,7 @@
 
 #include "shaders/cssm_bindings.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,6 +20,7 @@ typedef struct gpu_node {
     float c_r[4], p_area[4], n_cone[4], I[4];
     int32_t link[4];
     uint32_t rep[4];
+    int32_t walk[4]; /* left, right, the probability of left (float bits), first leaf */
 } gpu_node;
 
 typedef struct gpu_texel {
@@ -85,6 +87,16 @@ static gi_result upload_nodes(cssm_hrc *c)
         memcpy(d->link, (int32_t[4]){v.child, v.skip, (int32_t)v.first, (int32_t)v.count},
                sizeof d->link);
         d->rep[0] = v.rep;
+        d->walk[0] = v.child, d->walk[3] = (int32_t)v.first;
+        if (v.child >= 0) { /* pick_leaf's choice at this node, computed as hrc.c does */
+            cssm_node_view l, r;
+            cssm_node_fetch(&c->tree, c->node_L, ct, v.child, &l);
+            cssm_node_fetch(&c->tree, c->node_L, ct, l.skip, &r);
+            float il = fmaxf(0.0f, gi_luminance(l.I)), ir = fmaxf(0.0f, gi_luminance(r.I));
+            float pl = il + ir > 0.0f ? il / (il + ir) : l.area / fmaxf(l.area + r.area, FLT_MIN);
+            d->walk[1] = l.skip;
+            memcpy(&d->walk[2], &pl, sizeof pl);
+        }
     }
     upload(c->gpu_buf[BUF_NODES], n * sizeof *g, g);
     free(g);

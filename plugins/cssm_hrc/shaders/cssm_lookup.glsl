@@ -66,8 +66,8 @@ void cssm_cube_basis(int face, out vec3 s, out vec3 t, out vec3 f)
 // world point x.
 float cssm_visible(uint j, vec3 x, float bias, bool pcf)
 {
-    CssmTexel tj = cssm_texels[j];
-    vec3 d = x - tj.eye.xyz;
+    vec4 eye = cssm_texels[j].eye;
+    vec3 d = x - eye.xyz;
     float depth = length(d);
     if (!(depth > 0.0))
         return 1.0;
@@ -76,7 +76,7 @@ float cssm_visible(uint j, vec3 x, float bias, bool pcf)
     cssm_cube_basis(face, s, t, f);
     float z = dot(f, d);
     float sx = dot(s, d) / z, sy = dot(t, d) / z;
-    uint i = floatBitsToUint(tj.eye.w);
+    uint i = floatBitsToUint(eye.w);
     float M = float(u_M);
     float fx = (sx * 0.5 + 0.5) * M, fy = (sy * 0.5 + 0.5) * M;
     if (!pcf)

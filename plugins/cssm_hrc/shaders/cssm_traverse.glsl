@@ -23,6 +23,10 @@ struct CssmNode {
     vec4 I;      // radiant intensity (rgb), w its luminance (C's gi_luminance)
     ivec4 link;  // child (-1: leaf), skip (-1: end), first leaf, leaf count
     uvec4 rep;   // x: representative texel
+    // the representative's walk (pick_leaf): left child (-1: leaf), right
+    // child, the probability of going left as pick_leaf computes it in C
+    // (float bits), first leaf
+    ivec4 walk;
 };
 layout(std430, binding = CSSM_SSBO_NODES) readonly buffer CssmNodes { CssmNode cssm_nodes[]; };
 layout(std430, binding = CSSM_SSBO_LEAVES) readonly buffer CssmLeaves { uint cssm_leaves[]; };
@@ -98,17 +102,12 @@ float cssm_bound(int i, CssmReceiver rc)
 uint cssm_pick_leaf(int index, bool jitter, inout uint rng)
 {
     uint fixed_rng = gi_rng_init(uint(index), 0u, 0x2e9u);
-    int v = index, l = cssm_nodes[v].link.x;
-    while (l >= 0) {
-        int r = cssm_nodes[l].link.y;
-        float il = max(0.0, cssm_nodes[l].I.w), ir = max(0.0, cssm_nodes[r].I.w);
-        float al = cssm_nodes[l].p_area.w, ar = cssm_nodes[r].p_area.w;
-        float pl = il + ir > 0.0 ? il / (il + ir) : al / max(al + ar, CSSM_FLT_MIN);
+    ivec4 w = cssm_nodes[index].walk;
+    while (w.x >= 0) {
         float u = jitter ? gi_rng_next_float(rng) : gi_rng_next_float(fixed_rng);
-        v = u < pl ? l : r;
-        l = cssm_nodes[v].link.x;
+        w = cssm_nodes[u < intBitsToFloat(w.z) ? w.x : w.y].walk;
     }
-    return uint(cssm_nodes[v].link.z);
+    return uint(w.w);
 }
 
 // transfer: what node `index` sends to the receiver, f I G V.
