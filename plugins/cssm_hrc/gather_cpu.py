@@ -39,9 +39,9 @@ def thread_times(pid):
 
 def run(gib, scene, size, gather, frames):
     """(wall s, all threads' CPU s, main thread's CPU s) of one render."""
+    img = os.path.join(os.environ.get("TMPDIR", "/tmp"), "gather_cpu_%d.pfm" % os.getpid())
     cmd = [gib, "-q", "render", "--scene", scene, "--method", "cssm_hrc", "--size", size, "--frames",
-           str(frames), "--warmup", "1", "--param", "gather=" + gather, "--out", ""]
-    cmd[-1] = os.path.join(os.environ.get("TMPDIR", "/tmp"), "gather_cpu_%d.pfm" % os.getpid())
+           str(frames), "--warmup", "1", "--param", "gather=" + gather, "--out", img]
     t0 = time.monotonic()
     p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     seen = {}
