@@ -28,6 +28,7 @@
 
 struct cssm_receiver;
 struct cssm_motion;
+struct cssm_ctree;
 
 /* ---------------------------------------------------------------- atlas */
 
@@ -230,6 +231,12 @@ typedef struct cssm_node_view {
     uint32_t first, count; /* leaves below: leaves[first, first + count) */
     uint32_t rep;          /* texel whose CSSM gives the node's visibility */
 } cssm_node_view;
+
+/* Node i as the traversal reads it: the float node with its pulled
+ * radiance node_L (intensity = radiance x area), or with ct not NULL the
+ * packed node decoded (the GPU gather uploads these views). */
+void cssm_node_fetch(const cssm_tree *t, const float *node_L, const struct cssm_ctree *ct,
+                     int32_t i, cssm_node_view *v);
 
 /* Median cut over the texel positions (§4.2): split at the median of the
  * longest axis of the box until one texel is left. With back-side texels

@@ -21,12 +21,16 @@
  * distances clamped; plus emission, the punctual lights and the
  * environment per pixel (final_gather.c).
  * Pixels thus get light paths of 0 .. n + 1 bounces.
- * The traversal, the CSSM look-ups and the shading run on the CPU (the GL
- * is llvmpipe here); the depth cube maps, shadow maps and G-buffer are
- * drawn by the core's GL passes. */
+ * With gather=gpu (the default, as the paper) the final gather of
+ * render() is a compute pass (gpu_gather.c); the HRC bounces, and the final
+ * gather with gather=cpu or where the pass does not cover the scene, run
+ * on the CPU; the depth cube maps, shadow maps and G-buffer are drawn by
+ * the core's GL passes. */
 #include "cssm_hrc.h"
 
 #include <stdlib.h>
+
+extern const gi_shader_source gi_cssm_hrc_shaders[];
 
 static const gi_param_desc cssm_params[] = {
     {"atlas", GI_PARAM_INT, 32, 8, 128, GI_QUALITY_UP(2), "atlas resolution (Sec. 3.2.3, Table 2)",
@@ -108,6 +112,10 @@ static const gi_param_desc cssm_params[] = {
      "cube map"},
     {"csm_M", GI_PARAM_INT, 64, 8, 256, NULL, "M (CSM Sec. 3.3)",
      "direct=csm: cube face size of the lights' maps"},
+    {"gather", GI_PARAM_ENUM, 0, 0, 0, "gpu|cpu", "Sec. 4 (HRC on the GPU), Fig. 10",
+     "where the per-pixel final gather runs: gpu, a compute pass every frame (the paper's); cpu, "
+     "the C traversal (the oracle). gpu falls back to cpu, with a log line and stat gather_gpu 0, "
+     "for mode=texels, indirect=mc, direct=csm, moving objects, punctual lights and environments"},
     {"shadow_size", GI_PARAM_INT, 256, 16, 2048, NULL, NULL,
      "face size of the point/spot lights' shadow cube maps and of directional lights' shadow maps"},
     {0},
@@ -118,7 +126,7 @@ static gi_result cssm_create(const gi_host *host, const gi_params *params, void 
     cssm_hrc *c = calloc(1, sizeof *c);
     if (!c)
         return GI_ERR_OUT_OF_MEMORY;
-    if (gi_kit_init(&c->kit, host, NULL) != GI_OK) {
+    if (gi_kit_init(&c->kit, host, gi_cssm_hrc_shaders) != GI_OK) {
         free(c);
         return GI_ERR_INVALID_ARGUMENT;
     }
@@ -145,6 +153,7 @@ static gi_result cssm_create(const gi_host *host, const gi_params *params, void 
     c->csm_points = gi_params_int(params, "csm_points");
     c->csm_samples = gi_params_int(params, "csm_samples");
     c->csm_M = gi_params_int(params, "csm_M");
+    c->gather = gi_params_enum(params, "gather");
     c->motion.moving = -1;
     *out = c;
     return GI_OK;
@@ -238,6 +247,13 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     r = cssm_lighting(c, gs);
     if (r != GI_OK)
         return r;
+    const char *no_gpu = c->gather == 0 ? cssm_gpu_unsupported(c, gs->scene) : NULL;
+    if (no_gpu)
+        host->log(host, GI_LOG_INFO, "gather=gpu does not cover %s: the C gather runs", no_gpu);
+    c->gpu_on = c->gather == 0 && !no_gpu;
+    c->gpu_dirty = 1;
+    c->cpu_frames = 0, c->cpu_process_s = c->cpu_main_s = 0.0;
+    host->stat(host, "gather_gpu", c->gpu_on);
     c->prepared = 1;
     return GI_OK;
 }
@@ -283,6 +299,7 @@ static gi_result cssm_update(void *inst, const gi_gpu_scene *gs, const gi_change
         r = cssm_lighting(c, gs);
         if (r != GI_OK)
             c->prepared = 0;
+        c->gpu_dirty = 1;
         return r;
     }
     return GI_OK;
@@ -294,21 +311,32 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
     gi_kit *kit = &c->kit;
     if (!c->prepared)
         return gi_kit_fail(kit, GI_ERR_INVALID_ARGUMENT, "cssm_hrc: render before prepare");
+    cssm_stats_cpu_begin(c);
     /* frames differ: average them */
     const int random = c->jitter || c->indirect == 1 || (c->texel_E && c->env_pixel) || c->csm;
-    gi_result r = gi_kit_frame_begin(kit, view, GI_KIT_GBUFFER | (random ? 0u : GI_KIT_NO_AVERAGE));
+    const unsigned what = c->gpu_on ? GI_KIT_GBUFFER | GI_KIT_ACCUMULATE : GI_KIT_GBUFFER;
+    gi_result r = gi_kit_frame_begin(kit, view, what | (random ? 0u : GI_KIT_NO_AVERAGE));
     if (r != GI_OK)
         return r;
     r = gi_kit_render_gbuffer(kit, view, "gbuffer");
     if (r != GI_OK)
         return r;
+    cssm_gather_stats st = {0};
+    if (c->gpu_on) { /* §4: the final gather in a compute pass */
+        r = cssm_gpu_final_gather(c, view, target, random, &st);
+        if (r != GI_OK)
+            return r;
+        gi_kit_frame_end(kit);
+        cssm_stats_cuts(c, &st);
+        cssm_stats_cpu_end(c);
+        return GI_OK;
+    }
     const uint32_t w = view->width, h = view->height;
     r = cssm_read_gbuffer(c, w, h);
     if (r != GI_OK)
         return r;
     const gi_scene *s = kit->scene->scene;
     const uint32_t frame = kit->frames;
-    cssm_gather_stats st = {0};
     if (c->mode == 1)
         cssm_texel_gather(c, view, frame, random, &st);
     cssm_final_gather(c, view, frame, random, &st);
@@ -321,6 +349,7 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
     gi_error err;
     if (gi_gl_check("cssm_hrc: upload", &err) != GI_OK)
         return gi_kit_fail_with(kit, GI_ERR_GL, &err);
+    cssm_stats_cpu_end(c);
     return GI_OK;
 }
 
@@ -330,6 +359,7 @@ static void cssm_destroy(void *inst)
     if (!c)
         return;
     release_prepared(c);
+    cssm_gpu_free(c);
     for (int i = 0; i < 5; i++)
         free(c->gb[i]);
     free(c->accum);

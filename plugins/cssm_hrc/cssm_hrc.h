@@ -9,6 +9,8 @@
  *   maps_cache.c     the CSSM (§3.2) of a static scene, cached on disk;
  *   motion_update.c  moving rigid objects (§3.3) at prepare and update;
  *   final_gather.c   the per-pixel final gather (§4.4, §4.5) and shading;
+ *   gpu_gather.c     the same final gather as a GL compute pass (gather=gpu,
+ *                    shaders/cssm_gather.comp; §4 "HRC on the GPU");
  *   stats.c          the stats the plugin reports.
  * The parts of the paper these call (atlas, CSSM, hierarchy) are in
  * cssm.h, motion.h, env_cssm.h and direct_csm.h. */
@@ -21,7 +23,10 @@
 
 #include "gi/envmap.h"
 #include "gi/kit.h"
+#include "gi/log.h"
 #include "gi/raytrace.h"
+
+#define CSSM_GPU_BUFFERS 7 /* gpu_gather.c: nodes, leaves, texels, offsets, z_avg, i_end, stats */
 
 typedef struct cssm_shadow_map {
     int type; /* GI_LIGHT_* */
@@ -67,6 +72,15 @@ typedef struct cssm_hrc {
                          emission, reflected */
     int direct, csm_points, csm_samples, csm_M; /* §4.7 "Direct Light": direct=csm (direct_csm.h) */
     cssm_csm_direct *csm;                       /* its CSMs, NULL with direct=maps */
+    int gather;    /* gather=gpu (0) or cpu (1): where the per-pixel final gather runs */
+    int gpu_on;    /* gather=gpu and the scene and options are ones the GPU pass covers */
+    int gpu_dirty; /* the lighting changed since the GPU buffers were filled */
+    GLuint gpu_prog;
+    GLuint gpu_buf[CSSM_GPU_BUFFERS];
+    uint32_t gpu_off_base[6], gpu_seg_base[6]; /* each face's first offset and segment */
+    /* CPU time of the frames after the first since prepare (stats.c, frame_cpu_ms) */
+    uint32_t cpu_frames;
+    double cpu_process_s, cpu_main_s, cpu_t0[2];
     int prepared;
 } cssm_hrc;
 
@@ -130,6 +144,20 @@ void cssm_texel_gather(cssm_hrc *c, const gi_view *view, uint32_t frame, int ran
 void cssm_final_gather(cssm_hrc *c, const gi_view *view, uint32_t frame, int random,
                        cssm_gather_stats *st);
 
+/* -------------------------------------------------------- gpu_gather.c */
+
+/* What gather=gpu does not cover in this scene with these options (its
+ * name, for the log line), or NULL: then the C gather runs instead. */
+const char *cssm_gpu_unsupported(const cssm_hrc *c, const gi_scene *s);
+/* The final gather of every pixel by the compute pass, averaged over the
+ * frames in the kit's accumulation image and written to the target; the
+ * buffers filled first when gpu_dirty. Stage timer final_gather. Fails
+ * through the kit. */
+gi_result cssm_gpu_final_gather(cssm_hrc *c, const gi_view *view, const gi_target *target,
+                                int random, cssm_gather_stats *st);
+/* Deletes the program and buffers (a GL context is current). */
+void cssm_gpu_free(cssm_hrc *c);
+
 /* ------------------------------------------------------------- stats.c */
 
 /* atlas_texels, atlas_chart_texels, atlas_charts, atlas_coverage. */
@@ -142,6 +170,12 @@ void cssm_stats_moving(const cssm_hrc *c);
 void cssm_stats_data_bytes(const cssm_hrc *c);
 /* The last hull check, in all and per pair of objects with a mover. */
 void cssm_stats_hulls(const cssm_hrc *c, const gi_scene *s);
+/* A frame's CPU time: begin at the start of render(), end after it; the
+ * stats frame_cpu_ms (every thread of the process: llvmpipe's included)
+ * and frame_main_share (the main thread's part), means over the frames
+ * after the first since prepare (the first compiles the shaders). */
+void cssm_stats_cpu_begin(cssm_hrc *c);
+void cssm_stats_cpu_end(cssm_hrc *c);
 /* Cut size and clamped share of a frame's gathers. */
 void cssm_stats_cuts(const cssm_hrc *c, const cssm_gather_stats *st);
 

@@ -192,10 +192,8 @@ static float cos_bound(gi_vec3 u, gi_vec3 w, float sin_h)
     return fmaxf(0.0f, c * cos_h + s * sin_h);
 }
 
-/* Node i as the traversal reads it: the float node with its pulled
- * radiance (intensity = radiance x area), or the packed node decoded. */
-static void fetch(const cssm_tree *t, const float *node_L, const cssm_ctree *ct, int32_t i,
-                  cssm_node_view *v)
+void cssm_node_fetch(const cssm_tree *t, const float *node_L, const cssm_ctree *ct, int32_t i,
+                     cssm_node_view *v)
 {
     if (ct) {
         cssm_ctree_view(ct, (uint32_t)i, v);
@@ -291,8 +289,8 @@ static uint32_t pick_leaf(const cssm_tree *t, const float *node_L, const cssm_ct
     cssm_node_view v = *S;
     while (v.child >= 0) {
         cssm_node_view l, r;
-        fetch(t, node_L, ct, v.child, &l);
-        fetch(t, node_L, ct, l.skip, &r);
+        cssm_node_fetch(t, node_L, ct, v.child, &l);
+        cssm_node_fetch(t, node_L, ct, l.skip, &r);
         float il = fmaxf(0.0f, gi_luminance(l.I)), ir = fmaxf(0.0f, gi_luminance(r.I));
         float pl = il + ir > 0.0f ? il / (il + ir) : l.area / fmaxf(l.area + r.area, FLT_MIN);
         v = gi_rng_next_float(g) < pl ? l : r;
@@ -402,7 +400,7 @@ static void gather_any(const cssm_tree *t, const float *node_L, const cssm_ctree
     int32_t i = 0;
     while (i >= 0) {
         cssm_node_view S;
-        fetch(t, node_L, ct, i, &S);
+        cssm_node_fetch(t, node_L, ct, i, &S);
         if (S.child < 0 && rc->self >= 0 && leaves[S.first] == (uint32_t)rc->self) {
             pending--;
             i = S.skip; /* no transfer to itself */

@@ -2,9 +2,11 @@
  * (§3.2.3), the CSSM's compression (§3.2, Table 2), the moving objects'
  * maps and hull checks (§3.3), the visibility data kept, the cut sizes of
  * the gathers (§4.3). */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime */
 #include "cssm_hrc.h"
 
 #include <stdio.h>
+#include <time.h>
 
 void cssm_stats_atlas(const cssm_hrc *c)
 {
@@ -93,4 +95,30 @@ void cssm_stats_cuts(const cssm_hrc *c, const cssm_gather_stats *st)
         host->stat(host, "cut_size_pixels", (double)st->nodes / (double)st->receivers);
         host->stat(host, "clamped_share", (double)st->clamped / (double)st->nodes);
     }
+}
+
+static double cpu_seconds(clockid_t id)
+{
+    struct timespec t;
+    return clock_gettime(id, &t) == 0 ? (double)t.tv_sec + 1e-9 * (double)t.tv_nsec : 0.0;
+}
+
+void cssm_stats_cpu_begin(cssm_hrc *c)
+{
+    c->cpu_t0[0] = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID);
+    c->cpu_t0[1] = cpu_seconds(CLOCK_THREAD_CPUTIME_ID);
+}
+
+void cssm_stats_cpu_end(cssm_hrc *c)
+{
+    const double p = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID) - c->cpu_t0[0];
+    const double m = cpu_seconds(CLOCK_THREAD_CPUTIME_ID) - c->cpu_t0[1];
+    if (c->cpu_frames++ == 0) /* the first frame compiles the shaders */
+        return;
+    c->cpu_process_s += p;
+    c->cpu_main_s += m;
+    const gi_host *host = c->kit.host;
+    host->stat(host, "frame_cpu_ms", 1e3 * c->cpu_process_s / (double)(c->cpu_frames - 1));
+    if (c->cpu_process_s > 0.0)
+        host->stat(host, "frame_main_share", c->cpu_main_s / c->cpu_process_s);
 }

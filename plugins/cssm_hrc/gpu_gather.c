@@ -1,0 +1,225 @@
+/* cssm_hrc's per-pixel final gather as a GL compute pass (gather=gpu;
+ * Ritschel et al. 2008, §4: "HRC on the GPU", the stack-less traversal of
+ * §4.2 / Fig. 10 that exists so that the gather runs in a shader). The
+ * hierarchy's nodes (as the C traversal reads them, float or packed and
+ * decoded), the leaves, the atlas texels with their cube-map eyes and the
+ * six faces' compressed CSSM go into SSBOs; shaders/cssm_gather.comp
+ * gathers every pixel every frame with the frame's jitter and averages the
+ * frames. The C path (final_gather.c) stays as the oracle (gather=cpu). */
+#include "cssm_hrc.h"
+
+#include "shaders/cssm_bindings.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* One node as cssm_traverse.glsl's CssmNode lays it out (std430). */
+typedef struct gpu_node {
+    float c_r[4], p_area[4], n_cone[4], I[4];
+    int32_t link[4];
+    uint32_t rep[4];
+    int32_t walk[4]; /* left, right, the probability of left (float bits), first leaf */
+} gpu_node;
+
+typedef struct gpu_texel {
+    float p_area[4], n[4], eye[4]; /* eye w: the sequence index's bits */
+} gpu_texel;
+
+enum { BUF_NODES, BUF_LEAVES, BUF_TEXELS, BUF_OFFSETS, BUF_Z_AVG, BUF_I_END, BUF_STATS };
+static const GLuint buf_binding[CSSM_GPU_BUFFERS] = {
+    CSSM_SSBO_NODES, CSSM_SSBO_LEAVES, CSSM_SSBO_TEXELS, CSSM_SSBO_OFFSETS,
+    CSSM_SSBO_Z_AVG, CSSM_SSBO_I_END,  CSSM_SSBO_STATS};
+
+const char *cssm_gpu_unsupported(const cssm_hrc *c, const gi_scene *s)
+{
+    if (c->mode == 1)
+        return "mode=texels";
+    if (c->indirect == 1)
+        return "indirect=mc";
+    if (c->direct == 1)
+        return "direct=csm";
+    if (c->motion.moving >= 0)
+        return "moving objects";
+    if (c->shadow_count)
+        return "punctual lights";
+    if (c->texel_E || (s->has_environment && s->envmap))
+        return "an environment";
+    return NULL;
+}
+
+void cssm_gpu_free(cssm_hrc *c)
+{
+    if (c->gpu_prog)
+        glDeleteProgram(c->gpu_prog);
+    glDeleteBuffers(CSSM_GPU_BUFFERS, c->gpu_buf);
+    c->gpu_prog = 0;
+    memset(c->gpu_buf, 0, sizeof c->gpu_buf);
+}
+
+static void upload(GLuint buf, size_t bytes, const void *data)
+{
+    /* an empty buffer still binds: one zero word */
+    static const uint32_t zero[4] = {0};
+    glNamedBufferData(buf, bytes ? (GLsizeiptr)bytes : (GLsizeiptr)sizeof zero, bytes ? data : zero,
+                      GL_STATIC_DRAW);
+}
+
+/* The nodes the final gather reads (light set 0, emission + reflected, as
+ * final_gather.c's gather(c, 0, ...)), decoded as the C traversal decodes
+ * them, and the leaves. */
+static gi_result upload_nodes(cssm_hrc *c)
+{
+    const cssm_ctree *ct = c->nodes ? &c->ct[0] : NULL;
+    const uint32_t n = c->tree.count;
+    gpu_node *g = calloc(n, sizeof *g);
+    if (!g)
+        return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the nodes");
+    for (uint32_t i = 0; i < n; i++) {
+        cssm_node_view v;
+        cssm_node_fetch(&c->tree, c->node_L, ct, (int32_t)i, &v);
+        gpu_node *d = &g[i];
+        memcpy(d->c_r, (float[4]){v.c.x, v.c.y, v.c.z, v.r}, sizeof d->c_r);
+        memcpy(d->p_area, (float[4]){v.p.x, v.p.y, v.p.z, v.area}, sizeof d->p_area);
+        memcpy(d->n_cone, (float[4]){v.n.x, v.n.y, v.n.z, v.cos_cone}, sizeof d->n_cone);
+        memcpy(d->I, (float[4]){v.I[0], v.I[1], v.I[2], gi_luminance(v.I)}, sizeof d->I);
+        memcpy(d->link, (int32_t[4]){v.child, v.skip, (int32_t)v.first, (int32_t)v.count},
+               sizeof d->link);
+        d->rep[0] = v.rep;
+        d->walk[0] = v.child, d->walk[3] = (int32_t)v.first;
+        if (v.child >= 0) { /* pick_leaf's choice at this node, computed as hrc.c does */
+            cssm_node_view l, r;
+            cssm_node_fetch(&c->tree, c->node_L, ct, v.child, &l);
+            cssm_node_fetch(&c->tree, c->node_L, ct, l.skip, &r);
+            float il = fmaxf(0.0f, gi_luminance(l.I)), ir = fmaxf(0.0f, gi_luminance(r.I));
+            float pl = il + ir > 0.0f ? il / (il + ir) : l.area / fmaxf(l.area + r.area, FLT_MIN);
+            d->walk[1] = l.skip;
+            memcpy(&d->walk[2], &pl, sizeof pl);
+        }
+    }
+    upload(c->gpu_buf[BUF_NODES], n * sizeof *g, g);
+    free(g);
+    const uint32_t *leaves = ct ? ct->leaves : c->tree.leaves;
+    upload(c->gpu_buf[BUF_LEAVES], c->atlas.count * sizeof *leaves, leaves);
+    return GI_OK;
+}
+
+/* The texels (position, area, normal, cube-map eye and sequence index) and
+ * the six faces' codec data, concatenated face after face. */
+static gi_result upload_maps(cssm_hrc *c)
+{
+    const cssm_atlas *a = &c->atlas;
+    const cssm_maps *m = &c->maps;
+    gpu_texel *t = calloc(a->count, sizeof *t);
+    if (!t)
+        return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the maps");
+    for (uint32_t i = 0; i < a->count; i++) {
+        const cssm_texel *x = &a->texels[i];
+        float seq;
+        memcpy(&seq, &m->seq[i], sizeof seq);
+        memcpy(t[i].p_area, (float[4]){x->p.x, x->p.y, x->p.z, x->area}, sizeof t[i].p_area);
+        memcpy(t[i].n, (float[4]){x->n.x, x->n.y, x->n.z, 0.0f}, sizeof t[i].n);
+        memcpy(t[i].eye, (float[4]){m->eye[i].x, m->eye[i].y, m->eye[i].z, seq}, sizeof t[i].eye);
+    }
+    upload(c->gpu_buf[BUF_TEXELS], a->count * sizeof *t, t);
+    free(t);
+    size_t noff = 0, nseg = 0;
+    for (int f = 0; f < 6; f++) {
+        c->gpu_off_base[f] = (uint32_t)noff;
+        c->gpu_seg_base[f] = (uint32_t)nseg;
+        noff += (size_t)m->face[f].M * m->face[f].M + 1;
+        nseg += m->face[f].segment_count;
+    }
+    GLuint bufs[3] = {c->gpu_buf[BUF_OFFSETS], c->gpu_buf[BUF_Z_AVG], c->gpu_buf[BUF_I_END]};
+    size_t sizes[3] = {noff * sizeof(uint32_t), nseg * sizeof(float), nseg * sizeof(uint32_t)};
+    for (int k = 0; k < 3; k++)
+        glNamedBufferData(bufs[k], (GLsizeiptr)sizes[k], NULL, GL_STATIC_DRAW);
+    for (int f = 0; f < 6; f++) {
+        const gi_csm_data *d = &m->face[f];
+        size_t no = (size_t)d->M * d->M + 1, ns = d->segment_count;
+        glNamedBufferSubData(bufs[0], (GLintptr)(c->gpu_off_base[f] * sizeof(uint32_t)),
+                             (GLsizeiptr)(no * sizeof(uint32_t)), d->offsets);
+        if (!ns)
+            continue;
+        glNamedBufferSubData(bufs[1], (GLintptr)(c->gpu_seg_base[f] * sizeof(float)),
+                             (GLsizeiptr)(ns * sizeof(float)), d->z_avg);
+        glNamedBufferSubData(bufs[2], (GLintptr)(c->gpu_seg_base[f] * sizeof(uint32_t)),
+                             (GLsizeiptr)(ns * sizeof(uint32_t)), d->i_end);
+    }
+    return GI_OK;
+}
+
+/* The program once, the buffers when the lighting changed (prepare,
+ * update). */
+static gi_result gpu_setup(cssm_hrc *c)
+{
+    gi_error err;
+    if (!c->gpu_prog) {
+        c->gpu_prog = gi_program_build_compute("cssm_gather.comp", NULL, &err);
+        if (!c->gpu_prog)
+            return gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
+    }
+    if (!c->gpu_buf[0])
+        glCreateBuffers(CSSM_GPU_BUFFERS, c->gpu_buf);
+    if (c->gpu_dirty) {
+        gi_result r = upload_maps(c);
+        if (r == GI_OK)
+            r = upload_nodes(c);
+        if (r != GI_OK)
+            return r;
+        c->gpu_dirty = 0;
+    }
+    return gi_gl_check("cssm_hrc: gpu gather upload", &err) == GI_OK
+               ? GI_OK
+               : gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
+}
+
+static void set_uniforms(const cssm_hrc *c, GLuint p, const gi_view *view, int random)
+{
+    const cssm_gather_opts o = cssm_hrc_gather_opts(c, view->exposure, NULL);
+    glUniform1f(glGetUniformLocation(p, "u_lim"), cssm_refine_limit(o.threshold));
+    glUniform1f(glGetUniformLocation(p, "u_scale"), exp2f(o.exposure));
+    glUniform1ui(glGetUniformLocation(p, "u_max_cut"), o.max_cut);
+    glUniform1f(glGetUniformLocation(p, "u_clamp"), o.clamp);
+    glUniform1f(glGetUniformLocation(p, "u_bias"), o.bias);
+    glUniform1f(glGetUniformLocation(p, "u_lift"), 2.0f * c->maps.znear);
+    glUniform1i(glGetUniformLocation(p, "u_pcf"), o.pcf);
+    glUniform1i(glGetUniformLocation(p, "u_jitter"), random);
+    glUniform1i(glGetUniformLocation(p, "u_rep_centroid"), o.rep_centroid);
+    glUniform1ui(glGetUniformLocation(p, "u_M"), c->maps.M);
+    glUniform1uiv(glGetUniformLocation(p, "u_off_base"), 6, c->gpu_off_base);
+    glUniform1uiv(glGetUniformLocation(p, "u_seg_base"), 6, c->gpu_seg_base);
+}
+
+gi_result cssm_gpu_final_gather(cssm_hrc *c, const gi_view *view, const gi_target *target,
+                                int random, cssm_gather_stats *st)
+{
+    gi_result r = gpu_setup(c);
+    if (r != GI_OK)
+        return r;
+    const gi_host *host = c->kit.host;
+    host->stage_begin(host, "final_gather");
+    const GLuint p = c->gpu_prog;
+    glUseProgram(p);
+    gi_kit_bind(&c->kit, p, view, target);
+    set_uniforms(c, p, view, random);
+    for (int k = 0; k < CSSM_GPU_BUFFERS; k++)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, buf_binding[k], c->gpu_buf[k]);
+    const uint32_t zero[4] = {0};
+    glNamedBufferData(c->gpu_buf[BUF_STATS], sizeof zero, zero, GL_DYNAMIC_READ);
+    gi_kit_dispatch_8x8(view->width, view->height);
+    glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT |
+                    GL_BUFFER_UPDATE_BARRIER_BIT);
+    glUseProgram(0);
+    uint32_t got[4];
+    glGetNamedBufferSubData(c->gpu_buf[BUF_STATS], 0, sizeof got, got);
+    host->stage_end(host, "final_gather");
+    st->nodes += got[0];
+    st->receivers += got[1];
+    st->clamped += got[2];
+    gi_error err;
+    if (gi_gl_check("cssm_hrc: gpu gather", &err) != GI_OK)
+        return gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
+    return GI_OK;
+}
