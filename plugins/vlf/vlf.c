@@ -72,11 +72,11 @@ static const gi_param_desc vlf_params[] = {
      "each scene triangle cut into subdivide^2 triangles before sorting and transport: the same "
      "surfaces as more "
      "faces (the tessellation sweep of propagation time against faces)"},
-    {"propagate", GI_PARAM_ENUM, 2, 0, 0, "cpu|gpu|raster", "propagation (Sec. 3.2-3.4)",
-     "where propagation runs: raster: the sorted faces drawn by the rasteriser into the radiance "
-     "interface (vlf_raster.c, the paper's); cpu: the sweeps in C over per-ray fragment lists "
-     "(propagate.c); gpu: compute passes over those lists (vlf_gpu.c); gpu needs perturbed = 0, "
-     "raster with perturbed > 0 or order = rays propagates on the CPU"},
+    {"propagate", GI_PARAM_ENUM, 0, 0, 0, "cpu|gpu|raster", "propagation (Sec. 3.2-3.4)",
+     "where propagation runs: cpu: the sweeps in C over per-ray fragment lists (propagate.c); "
+     "gpu: compute passes over those lists (vlf_gpu.c), needs perturbed = 0; raster: the sorted "
+     "faces drawn by the rasteriser into the radiance interface (vlf_raster.c, the paper's way), "
+     "with perturbed > 0 or order = rays the CPU's sweeps"},
     {"hier_min", GI_PARAM_INT, 0, 0, 1000000, NULL, "hierarchical sort (Sec. 3.2)",
      "objects (glTF nodes) of at least this many triangles whose bounding box in a direction's "
      "frame no other "
