@@ -122,7 +122,7 @@ static gi_result vlf_create(const gi_host *host, const gi_params *params, void *
      * such draw, so they take the CPU's sweeps (said once in the log) */
     if (prop == 2 && (v->prm.perturbed > 0 || v->prm.order == VLF_ORDER_RAYS)) {
         host->log(host, GI_LOG_WARN,
-                  "vlf: propagate = raster draws the fixed directions' face order; with %s it "
+                  "propagate = raster draws the fixed directions' face order; with %s it "
                   "propagates on the CPU",
                   v->prm.perturbed > 0 ? "perturbed > 0" : "order = rays");
         v->gpu_propagate = 0;
