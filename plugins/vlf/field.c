@@ -247,7 +247,7 @@ gi_result vlf_field_build(vlf_field *f, const gi_scene *s, float t, const vlf_se
                             "vlf: %u triangles cut into %u^2 each are too many", s->triangle_count,
                             p->subdivide);
     if (vlf_subdivide_triangles(f, p->subdivide < 1 ? 1 : p->subdivide) != GI_OK ||
-        vlf_build_subfields(f) != GI_OK)
+        vlf_merge_faces(f) != GI_OK || vlf_build_subfields(f) != GI_OK)
         return build_cancelled(f) ? gi_error_set(err, GI_ERR_CANCELLED, "vlf: build cancelled")
                                   : vlf_build_out_of_memory(f, err);
     rc = allocate_tiles(f, err);
@@ -265,11 +265,18 @@ void vlf_field_free(vlf_field *f)
         for (uint32_t i = 0; i < f->prm.l; i++) {
             free(f->psf[i].cell_start);
             free(f->psf[i].frag);
+            free(f->psf[i].rorder);
+            free(f->psf[i].rextra);
         }
     free(f->psf);
     vlf_dirs_free(&f->dirs);
     free(f->faces);
     free(f->tri_face);
+    if (f->sort_p != f->tri_p) {
+        free(f->sort_p);
+        free(f->sort_face);
+        free(f->sort_group);
+    }
     free(f->tri_group);
     free(f->tri_p);
     free(f->elem_face);

@@ -162,10 +162,10 @@ gi_result vlf_list_fragments(const vlf_field *f, const vlf_psf *fr, vlf_frag_buf
     int32_t dummy[4];
     buf->n = 0;
     if (f->prm.order == VLF_ORDER_RAYS) {
-        for (uint32_t ti = 0; ti < f->tri_count; ti++) {
-            uint32_t fi = f->tri_face[ti];
+        for (uint32_t ti = 0; ti < f->sort_count; ti++) {
+            uint32_t fi = f->sort_face[ti];
             sort_ctx c = {buf, f, fr, &f->faces[fi], N, bbox ? bbox + 4 * fi : dummy};
-            if (!raster_tri(f, fr, f->tri_p + 3 * (size_t)ti, emit_frag, &c))
+            if (!raster_tri(f, fr, f->sort_p + 3 * (size_t)ti, emit_frag, &c))
                 return GI_ERR_OUT_OF_MEMORY;
         }
         qsort(buf->v, buf->n, sizeof *buf->v, frag_cmp);
@@ -174,7 +174,7 @@ gi_result vlf_list_fragments(const vlf_field *f, const vlf_psf *fr, vlf_frag_buf
     int mode = f->prm.order == VLF_ORDER_PLAIN     ? VLF_SORT_PLAIN
                : f->prm.order == VLF_ORDER_NOSPLIT ? VLF_SORT_NOSPLIT
                                                    : VLF_SORT_NEWELL;
-    if (vlf_sort_faces(so, f->tri_p, f->tri_count, f->tri_group, f->prm.hier_min, fr->u, fr->v,
+    if (vlf_sort_faces(so, f->sort_p, f->sort_count, f->sort_group, f->prm.hier_min, fr->u, fr->v,
                        fr->n, mode, f->prm.bsp_levels, f->prm.bsp_min) != GI_OK)
         return GI_ERR_OUT_OF_MEMORY;
     cnt->pieces += so->nout;
@@ -186,7 +186,7 @@ gi_result vlf_list_fragments(const vlf_field *f, const vlf_psf *fr, vlf_frag_buf
     cnt->fallbacks += so->hier_fallbacks;
     for (uint32_t k = 0; k < so->nout; k++) {
         const vlf_piece *pc = &so->poly[so->out[k]];
-        uint32_t fi = f->tri_face[pc->tri];
+        uint32_t fi = f->sort_face[pc->tri];
         sort_ctx c = {buf, f, fr, &f->faces[fi], N, bbox ? bbox + 4 * fi : dummy};
         /* back from the frame to VLF coordinates; a fan over the convex piece */
         gi_vec3 q[3];
@@ -228,6 +228,85 @@ gi_result vlf_list_fragments(const vlf_field *f, const vlf_psf *fr, vlf_frag_buf
     return GI_OK;
 }
 
+/* 1 if piece pc is its scene triangle whole (the same corners in the same
+ * order), so that the draw can take the triangle itself. */
+static int piece_is_whole(const vlf_field *f, const vlf_psf *fr, const vlf_sorter *so,
+                          const vlf_piece *pc)
+{
+    if (pc->count != 3)
+        return 0;
+    for (uint32_t k = 0; k < 3; k++) {
+        gi_vec3 p = f->sort_p[3 * (size_t)pc->tri + k], w = so->vert[pc->first + k];
+        if (fabsf(gi_v3_dot(p, fr->u) - w.x) > 1e-6f || fabsf(gi_v3_dot(p, fr->v) - w.y) > 1e-6f ||
+            fabsf(gi_v3_dot(p, fr->n) - w.z) > 1e-6f)
+            return 0;
+    }
+    return 1;
+}
+
+static int push_u32(uint32_t **v, uint32_t *n, uint32_t *cap, uint32_t x)
+{
+    if (*n == *cap) {
+        uint32_t c = *cap ? *cap * 2 : 1024;
+        uint32_t *t = realloc(*v, (size_t)c * sizeof *t);
+        if (!t)
+            return 0;
+        *v = t, *cap = c;
+    }
+    (*v)[(*n)++] = x;
+    return 1;
+}
+
+/* Subfield p's face order as the rasteriser draws it (§3.2, vlf_psf.rorder):
+ * the sorter's pieces front to back, a whole triangle by its index, a
+ * split piece as the triangles of its fan; a double-sided face's piece
+ * twice, the side facing against +w first (as emit_frag orders the two
+ * fragments). 1, or 0 out of memory. */
+static int record_raster(const vlf_field *f, vlf_psf *p, const vlf_sorter *so)
+{
+    uint32_t cap = 0, ecap = 0, ne = 0;
+    for (uint32_t k = 0; k < so->nout; k++) {
+        const vlf_piece *pc = &so->poly[so->out[k]];
+        uint32_t fi = f->sort_face[pc->tri];
+        const vlf_face *fc = &f->faces[fi];
+        uint32_t sides[2] = {0, 0}, nsides = 1;
+        if (fc->twin >= 0) {
+            int own_first = gi_v3_dot(fc->n, p->n) < 0.0f;
+            sides[0] = own_first ? 0u : 0x80000000u;
+            sides[1] = own_first ? 0x80000000u : 0u;
+            nsides = 2;
+        }
+        uint32_t first = p->rextra_count, ntri = 0;
+        if (piece_is_whole(f, p, so, pc)) {
+            for (uint32_t s = 0; s < nsides; s++)
+                if (!push_u32(&p->rorder, &p->rorder_count, &cap, pc->tri | sides[s]))
+                    return 0;
+            continue;
+        }
+        const gi_vec3 *v = so->vert + pc->first;
+        for (uint32_t j = 1; j + 1 < pc->count; j++, ntri++) {
+            const gi_vec3 *w[3] = {&v[0], &v[j], &v[j + 1]};
+            for (int a = 0; a < 3; a++) {
+                gi_vec3 q =
+                    gi_v3_add(gi_v3_add(gi_v3_scale(p->u, w[a]->x), gi_v3_scale(p->v, w[a]->y)),
+                              gi_v3_scale(p->n, w[a]->z));
+                uint32_t c[4] = {0, 0, 0, fi};
+                memcpy(c, &q, 3 * sizeof(float));
+                for (int b = 0; b < 4; b++)
+                    if (!push_u32(&p->rextra, &ne, &ecap, c[b]))
+                        return 0;
+            }
+            p->rextra_count++;
+        }
+        for (uint32_t s = 0; s < nsides; s++)
+            for (uint32_t t = 0; t < ntri; t++)
+                if (!push_u32(&p->rorder, &p->rorder_count, &cap,
+                              (first + t) | 0x40000000u | sides[s]))
+                    return 0;
+    }
+    return 1;
+}
+
 /* Depth order of subfield i (the "sort" stage, §3.2): the fragments of
  * every face on the N S x N S rays, each ray's front to back
  * (vlf_list_fragments); the tile rectangles of non-diffuse faces recorded on
@@ -248,7 +327,8 @@ static int build_psf(vlf_field *f, uint32_t i, vlf_frag_buf *buf, vlf_frag_buf *
         bbox[4 * fi] = bbox[4 * fi + 1] = INT32_MAX;
         bbox[4 * fi + 2] = bbox[4 * fi + 3] = -1;
     }
-    if (vlf_list_fragments(f, p, buf, tmp, so, bbox, cnt) != GI_OK) {
+    if (vlf_list_fragments(f, p, buf, tmp, so, bbox, cnt) != GI_OK ||
+        (f->prm.raster && f->prm.order != VLF_ORDER_RAYS && !record_raster(f, p, so))) {
         free(bbox);
         return 0;
     }

@@ -7,10 +7,12 @@
  * render(): the G-buffer and one compute pass reading the irradiance atlas
  * and the non-diffuse tiles (shaders/vlf_render.comp, stage `render`).
  * See plugins/vlf/README.md for what follows the paper and what does not. */
+#define _POSIX_C_SOURCE 200809L
 #include "gi/kit.h"
 #include "gi/log.h"
 
 #include <math.h>
+#include <time.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,7 +29,7 @@ typedef struct vlf {
     vlf_settings prm;
     vlf_field field;
     int have_field;
-    int gpu_propagate; /* propagate = gpu: the compute passes of vlf_gpu.c */
+    int gpu_propagate; /* propagate = gpu or raster: vlf_gpu.c (raster: vlf_raster.c) */
     vlf_gpu gpu;
     int have_gpu;
     GLuint program;
@@ -70,10 +72,11 @@ static const gi_param_desc vlf_params[] = {
      "each scene triangle cut into subdivide^2 triangles before sorting and transport: the same "
      "surfaces as more "
      "faces (the tessellation sweep of propagation time against faces)"},
-    {"propagate", GI_PARAM_ENUM, 0, 0, 0, "cpu|gpu", "propagation (Sec. 3.2-3.4)",
-     "where propagation runs: cpu: the sweeps in C (propagate.c); gpu: GL compute passes over the "
-     "same depth order "
-     "(vlf_gpu.c), the same maps within float rounding; gpu needs perturbed = 0"},
+    {"propagate", GI_PARAM_ENUM, 0, 0, 0, "cpu|gpu|raster", "propagation (Sec. 3.2-3.4)",
+     "where propagation runs: cpu: the sweeps in C over per-ray fragment lists (propagate.c); "
+     "gpu: compute passes over those lists (vlf_gpu.c), needs perturbed = 0; raster: the sorted "
+     "faces drawn by the rasteriser into the radiance interface (vlf_raster.c, the paper's way), "
+     "with perturbed > 0 or order = rays the CPU's sweeps"},
     {"hier_min", GI_PARAM_INT, 0, 0, 1000000, NULL, "hierarchical sort (Sec. 3.2)",
      "objects (glTF nodes) of at least this many triangles whose bounding box in a direction's "
      "frame no other "
@@ -112,7 +115,19 @@ static gi_result vlf_create(const gi_host *host, const gi_params *params, void *
     v->prm.bsp_levels = (uint32_t)gi_params_int(params, "bsp_levels");
     v->prm.bsp_min = (uint32_t)gi_params_int(params, "bsp_min");
     v->prm.hier_min = (uint32_t)gi_params_int(params, "hier_min");
-    v->gpu_propagate = gi_params_enum(params, "propagate") == 1;
+    int prop = gi_params_enum(params, "propagate");
+    v->gpu_propagate = prop != 0;
+    /* the rasteriser draws the fixed directions' face order: the perturbed
+     * directions (sorted beside the sweeps) and the per-ray order have no
+     * such draw, so they take the CPU's sweeps (said once in the log) */
+    if (prop == 2 && (v->prm.perturbed > 0 || v->prm.order == VLF_ORDER_RAYS)) {
+        host->log(host, GI_LOG_WARN,
+                  "propagate = raster draws the fixed directions' face order; with %s it "
+                  "propagates on the CPU",
+                  v->prm.perturbed > 0 ? "perturbed > 0" : "order = rays");
+        v->gpu_propagate = 0;
+    }
+    v->prm.raster = v->gpu_propagate && prop == 2;
     if (v->gpu_propagate && v->prm.perturbed > 0) {
         host->log(host, GI_LOG_ERROR,
                   "vlf: propagate = gpu runs the fixed directions only; set perturbed = 0");
@@ -294,6 +309,54 @@ static gi_result vlf_upload(vlf *v)
     return GI_OK;
 }
 
+/* CPU seconds of the calling thread and of the whole process (llvmpipe's
+ * threads included): the main-thread share of a stage. */
+static void cpu_times(double *thread, double *process)
+{
+    struct timespec a, b;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &a);
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &b);
+    *thread = (double)a.tv_sec + 1e-9 * (double)a.tv_nsec;
+    *process = (double)b.tv_sec + 1e-9 * (double)b.tv_nsec;
+}
+
+/* The "propagate" stage: on the CPU, by the compute passes or by the
+ * rasteriser; its CPU time and the main thread's share of it as stats. */
+static gi_result vlf_propagate_stage(vlf *v)
+{
+    const gi_host *host = v->kit.host;
+    gi_error err;
+    gi_result rc;
+    double th0, pr0, th1, pr1;
+    cpu_times(&th0, &pr0);
+    host->stage_begin(host, "propagate");
+    if (v->gpu_propagate) {
+        /* the depth order and the gather lists uploaded (propagate_setup),
+         * then the passes; the maps read back for the upload below */
+        host->stage_begin(host, "propagate_setup");
+        rc = vlf_gpu_setup(&v->gpu, &v->field, &err);
+        host->stage_end(host, "propagate_setup");
+        if (rc == GI_OK)
+            rc = vlf_gpu_propagate(&v->gpu, &v->field, vlf_cancelled, (void *)host, &err);
+        host->stage_end(host, "propagate");
+        if (rc != GI_OK)
+            rc = gi_kit_fail_with(
+                &v->kit, host->cancelled && host->cancelled(host) ? GI_ERR_CANCELLED : GI_ERR_GL,
+                &err);
+    } else {
+        /* any failure here has been reported as a cancellation */
+        rc = vlf_field_propagate(&v->field, vlf_cancelled, (void *)host, NULL);
+        host->stage_end(host, "propagate");
+        if (rc != GI_OK)
+            rc = gi_kit_fail(&v->kit, GI_ERR_CANCELLED, "vlf: propagation cancelled");
+    }
+    glFinish();
+    cpu_times(&th1, &pr1);
+    host->stat(host, "propagate_cpu_s", pr1 - pr0);
+    host->stat(host, "propagate_main_share", pr1 > pr0 ? (th1 - th0) / (pr1 - pr0) : 1.0);
+    return rc;
+}
+
 /* Builds, propagates and uploads the light field of the scene at its
  * current time. */
 static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
@@ -314,34 +377,19 @@ static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
             &v->kit, rc == GI_ERR_CANCELLED ? GI_ERR_CANCELLED : GI_ERR_INVALID_ARGUMENT, &err);
     }
     v->have_field = 1;
-    host->stage_begin(host, "propagate");
-    if (v->gpu_propagate) {
-        /* the depth order and the gather lists uploaded (propagate_setup),
-         * then the passes; the maps read back for the upload below */
-        host->stage_begin(host, "propagate_setup");
-        rc = vlf_gpu_setup(&v->gpu, &v->field, &err);
-        host->stage_end(host, "propagate_setup");
-        if (rc == GI_OK)
-            rc = vlf_gpu_propagate(&v->gpu, &v->field, vlf_cancelled, (void *)host, &err);
-        host->stage_end(host, "propagate");
-        if (rc != GI_OK)
-            return gi_kit_fail_with(
-                &v->kit, host->cancelled && host->cancelled(host) ? GI_ERR_CANCELLED : GI_ERR_GL,
-                &err);
-    } else {
-        /* any failure here has been reported as a cancellation */
-        rc = vlf_field_propagate(&v->field, vlf_cancelled, (void *)host, NULL);
-        host->stage_end(host, "propagate");
-        if (rc != GI_OK)
-            return gi_kit_fail(&v->kit, GI_ERR_CANCELLED, "vlf: propagation cancelled");
-    }
+    rc = vlf_propagate_stage(v);
+    if (rc != GI_OK)
+        return rc;
     host->stage_begin(host, "gpu_init");
     gi_result r = vlf_upload(v);
     glFinish();
     host->stage_end(host, "gpu_init");
     const vlf_stats *s = &v->field.st;
     host->stat(host, "faces", v->field.face_count);
+    /* where propagation ran: 0 cpu, 1 gpu (compute over lists), 2 raster */
+    host->stat(host, "propagate_path", v->prm.raster ? 2 : v->gpu_propagate ? 1 : 0);
     host->stat(host, "triangles", v->field.tri_count);
+    host->stat(host, "sort_triangles", v->field.sort_count); /* drawn: merged faces (merge.c) */
     host->stat(host, "diffuse_elements", s->diffuse_elements);
     host->stat(host, "nondiffuse_elements", s->nondiffuse_elements);
     host->stat(host, "tiles", s->tiles);
@@ -379,7 +427,7 @@ static gi_result vlf_prepare(void *inst, const gi_gpu_scene *gs)
     }
     if (v->gpu_propagate && !v->have_gpu) {
         gi_error err;
-        if (vlf_gpu_init(&v->gpu, &err) != GI_OK)
+        if (vlf_gpu_init(&v->gpu, (int)v->prm.raster, &err) != GI_OK)
             return gi_kit_fail_with(&v->kit, GI_ERR_GL, &err);
         v->have_gpu = 1;
     }

@@ -57,6 +57,8 @@ typedef struct vlf_settings {
                             (tessellation sweep) */
     uint32_t hier_min; /* hierarchical shortcut (§3.2): objects of at least this many triangles in a
                         * box no other triangle reaches into are sorted on their own; 0: off */
+    uint32_t raster;   /* keep each subfield's face order as triangles to draw (vlf_psf.rorder):
+                        * propagation by the rasteriser (vlf_raster.c); needs order = faces */
     /* Polled between the build's steps and between directions of the sort
      * (also from its worker threads): non-zero stops the build with
      * GI_ERR_CANCELLED. NULL: never. */
@@ -126,6 +128,16 @@ typedef struct vlf_psf {
     uint32_t *cell_start; /* N*N + 1 */
     uint32_t *frag;       /* element index of each fragment */
     uint32_t frag_count;
+    /* With vlf_settings.raster: the face order as triangles to draw, front
+     * to back along +w (a double-sided face's two sides one after the
+     * other, the receiver of the sweep along +w first). Entry bits 0-29:
+     * a scene triangle (tri_p), or with bit 30 a triangle of rextra (a
+     * piece of a split triangle, 12 words: three corners, VLF
+     * coordinates as float bits, each with its face's index as the fourth
+     * word); bit 31: the side of the face's twin. */
+    uint32_t *rorder, rorder_count;
+    uint32_t *rextra;
+    uint32_t rextra_count;
 } vlf_psf;
 
 typedef struct vlf_stats {
@@ -168,6 +180,13 @@ typedef struct vlf_field {
     uint32_t *tri_face;  /* face of each triangle */
     uint32_t *tri_group; /* scene object of each triangle (the hierarchical shortcut's groups) */
     gi_vec3 *tri_p;      /* 3 corners per triangle, VLF coordinates */
+    /* The triangles the sort orders and the subfields rasterise: tri_* (the
+     * pointers shared), or with vlf_settings.raster (subdivide = 1) each
+     * face whose triangles tile a convex polygon drawn as that polygon's
+     * fan (the paper's planar polygons, vlf_merge_faces) */
+    uint32_t sort_count;
+    gi_vec3 *sort_p;
+    uint32_t *sort_face, *sort_group;
     uint32_t *elem_face;
     float *elem_area;
     float *elem_kd;  /* 3 per element: albedo (the material's, or the texture averaged over the

@@ -33,7 +33,7 @@ enum {
     B_FRAMES,
     B_JOBS
 };
-enum { P_SWEEP, P_GATHER, P_SCATTER, P_FINISH };
+enum { P_SWEEP, P_GATHER, P_SCATTER, P_FINISH, P_SETTLE };
 
 static double now_s(void)
 {
@@ -42,9 +42,15 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-gi_result vlf_gpu_init(vlf_gpu *g, gi_error *err)
+gi_result vlf_gpu_init(vlf_gpu *g, int raster, gi_error *err)
 {
     memset(g, 0, sizeof *g);
+    g->raster = raster;
+    if (raster) {
+        gi_result r = vlf_raster_init(&g->ras, err);
+        if (r != GI_OK)
+            return r;
+    }
     for (int p = 0; p < VLF_GPU_PASSES; p++) {
         char defines[64];
         snprintf(defines, sizeof defines, "#define VLF_PASS %d\n", p);
@@ -72,6 +78,7 @@ void vlf_gpu_free(vlf_gpu *g)
     if (g->buf[0])
         glDeleteBuffers(VLF_GPU_BUFFERS, g->buf);
     free_direction_arrays(g);
+    vlf_raster_free(&g->ras);
     memset(g, 0, sizeof *g);
 }
 
@@ -348,12 +355,17 @@ static int upload_lists(vlf_gpu *g, const vlf_field *f, const setup_lists *L, si
                              (GLsizeiptr)((size_t)f->elem_count * sizeof(float)), f->elem_area);
         glNamedBufferSubData(g->buf[B_ELEM_AREA], (GLintptr)((size_t)f->elem_count * sizeof(float)),
                              (GLsizeiptr)((size_t)f->elem_count * 3 * sizeof(float)), f->elem_kd);
-        put(g->buf[B_CELL_START], L->start, (size_t)l * (n2 + 1) * sizeof *L->start);
+        /* the rasterised sweeps need no fragment lists; their receivers
+         * sum into B_RECV (per element, then per tile cell) */
+        size_t nrecv = g->raster ? (size_t)f->elem_count + f->nd_cells : (size_t)max_frags + 1;
+        put(g->buf[B_CELL_START], L->start,
+            g->raster ? 0 : (size_t)l * (n2 + 1) * sizeof *L->start);
         put(g->buf[B_FRAG], L->frag, frags * sizeof *L->frag);
         put(g->buf[B_FRAG_SLOT], L->slot, frags * sizeof *L->slot);
-        put(g->buf[B_RECV], NULL, 0);
-        glNamedBufferData(g->buf[B_RECV], (GLsizeiptr)(((size_t)max_frags + 1) * 3 * sizeof(float)),
-                          NULL, GL_DYNAMIC_DRAW);
+        glNamedBufferData(g->buf[B_RECV],
+                          (GLsizeiptr)((nrecv + 1) * 3 * (g->raster ? 2 : 1) * sizeof(float)), NULL,
+                          GL_DYNAMIC_DRAW);
+        glClearNamedBufferData(g->buf[B_RECV], GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
         put(g->buf[B_GATHER], L->gath.v, L->gath.n * sizeof(gath_entry));
         put(g->buf[B_PERM], L->perm, L->pfill * sizeof *L->perm);
         put(g->buf[B_RECTS], rects, (size_t)f->nd_count * l * 8 * sizeof *rects);
@@ -371,13 +383,14 @@ gi_result vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, gi_error *err)
     uint32_t l = f->prm.l, NS = f->prm.N * f->prm.S, n2 = NS * NS;
     if (f->prm.perturbed > 0)
         return gi_error_set(err, GI_ERR_UNSUPPORTED,
-                            "vlf: propagate = gpu runs the fixed directions only (perturbed = 0)");
+                            "vlf: propagate = %s runs the fixed directions only (perturbed = 0)",
+                            g->raster ? "raster" : "gpu");
     if (!g->buf[0])
         glCreateBuffers(VLF_GPU_BUFFERS, g->buf);
     int ok = alloc_direction_arrays(g, l);
     size_t frags = 0;
     uint32_t max_frags = 0;
-    for (uint32_t i = 0; i < l; i++) {
+    for (uint32_t i = 0; i < l && !g->raster; i++) {
         frags += f->psf[i].frag_count;
         if (f->psf[i].frag_count > max_frags)
             max_frags = f->psf[i].frag_count;
@@ -392,16 +405,21 @@ gi_result vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, gi_error *err)
         const vlf_psf *ps = &f->psf[i];
         g->start_base[i] = i * (n2 + 1);
         g->frag_base[i] = (uint32_t)fbase;
-        memcpy(L.start + (size_t)i * (n2 + 1), ps->cell_start, (n2 + 1) * sizeof *L.start);
-        direction_fragments(f, i, fbase, &L);
-        ok = gather_lists(g, f, i, fbase, &L) && scatter_jobs(g, f, i, &L);
-        fbase += ps->frag_count;
+        if (!g->raster) {
+            memcpy(L.start + (size_t)i * (n2 + 1), ps->cell_start, (n2 + 1) * sizeof *L.start);
+            direction_fragments(f, i, fbase, &L);
+            ok = gather_lists(g, f, i, fbase, &L);
+            fbase += ps->frag_count;
+        }
+        ok = ok && scatter_jobs(g, f, i, &L);
     }
     ok = ok && upload_lists(g, f, &L, frags, max_frags);
     free_lists(&L);
     if (!ok)
         return gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
                             "vlf: out of memory setting up the GPU propagation");
+    if (g->raster && (r = vlf_raster_setup(&g->ras, g->buf, f, err)) != GI_OK)
+        return r;
     r = gi_gl_check("vlf: GPU propagation set-up", err);
     if (r != GI_OK)
         return r;
@@ -493,15 +511,18 @@ static void run_direction(vlf_gpu *g, vlf_field *f, uint32_t i, int first_iterat
         glProgramUniform3fv(P, glGetUniformLocation(P, "u_t"), 2, t);
         glProgramUniform1fv(P, glGetUniformLocation(P, "u_dW"), 2, dW);
     }
-    GLuint P = g->prog[P_SWEEP];
-    glUseProgram(P);
-    set_u(P, "u_count", n2);
-    set_u(P, "u_start_base", g->start_base[i]);
-    set_u(P, "u_frag_base", g->frag_base[i]);
-    glProgramUniform3fv(P, glGetUniformLocation(P, "u_sky"), 2, sky);
-    glProgramUniform1fv(P, glGetUniformLocation(P, "u_w"), 2, w);
-    dispatch(n2, 2);
-    if (g->g_count[i]) {
+    GLuint P;
+    if (!g->raster) {
+        P = g->prog[P_SWEEP];
+        glUseProgram(P);
+        set_u(P, "u_count", n2);
+        set_u(P, "u_start_base", g->start_base[i]);
+        set_u(P, "u_frag_base", g->frag_base[i]);
+        glProgramUniform3fv(P, glGetUniformLocation(P, "u_sky"), 2, sky);
+        glProgramUniform1fv(P, glGetUniformLocation(P, "u_w"), 2, w);
+        dispatch(n2, 2);
+    }
+    if (!g->raster && g->g_count[i]) {
         P = g->prog[P_GATHER];
         glUseProgram(P);
         set_u(P, "u_count", g->g_count[i]);
@@ -518,6 +539,28 @@ static void run_direction(vlf_gpu *g, vlf_field *f, uint32_t i, int first_iterat
         dispatch(g->j_cells[i], 1);
     }
     f->st.samples += 2 * (uint64_t)f->psf[i].frag_count;
+}
+
+/* One iteration by the rasteriser: the sweeps of every direction drawn
+ * (vlf_raster.c), what the receivers brought settled into the maps, then
+ * each direction's scattering as above (the directions of an iteration
+ * read only its current maps, so their sweeps may all come first). */
+static gi_result run_raster_iteration(vlf_gpu *g, vlf_field *f, int first_iteration,
+                                      float cell_area, int (*cancelled)(void *), void *user,
+                                      gi_error *err)
+{
+    gi_result r = vlf_raster_iteration(&g->ras, f, first_iteration, cancelled, user, err);
+    if (r != GI_OK)
+        return r;
+    GLuint P = g->prog[P_SETTLE];
+    glUseProgram(P);
+    uint32_t n = f->elem_count > f->nd_cells ? f->elem_count : f->nd_cells;
+    set_u(P, "u_count", n);
+    dispatch(n, 1);
+    for (uint32_t i = 0; i < f->prm.l; i++)
+        run_direction(g, f, i, first_iteration, cell_area);
+
+    return GI_OK;
 }
 
 /* The end of an iteration (the finish pass). */
@@ -546,6 +589,8 @@ static gi_result read_back(vlf_gpu *g, vlf_field *f, uint32_t n2, gi_error *err)
                             (GLsizeiptr)(nc * sizeof(float)), f->out_tot);
     glGetNamedBufferSubData(g->buf[B_TMAP], (GLintptr)(3 * nc * sizeof(float)),
                             (GLsizeiptr)(nc * sizeof(float)), f->in);
+    if (g->raster)
+        return vlf_raster_counters(&g->ras, f, err);
     float *st = malloc((size_t)2 * n2 * 4 * sizeof *st);
     if (!st)
         return gi_error_set(err, GI_ERR_OUT_OF_MEMORY,
@@ -572,8 +617,14 @@ gi_result vlf_gpu_propagate(vlf_gpu *g, vlf_field *f, int (*cancelled)(void *), 
     upload_maps(g, f, n2);
     float cell_area = (2.0f / (float)NS) * (2.0f / (float)NS);
     set_constants(g, f, cell_area);
+    if (g->raster) {
+        vlf_raster_constants(&g->ras, f, cell_area);
+        vlf_raster_clear_counters(&g->ras);
+    }
     for (uint32_t it = 0; it < f->prm.iterations && rc == GI_OK; it++) {
-        for (uint32_t i = 0; i < f->prm.l; i++) {
+        if (g->raster)
+            rc = run_raster_iteration(g, f, it == 0, cell_area, cancelled, user, err);
+        for (uint32_t i = 0; i < f->prm.l && !g->raster; i++) {
             if (cancelled && cancelled(user)) {
                 rc = gi_error_set(err, GI_ERR_CANCELLED, "vlf: propagation cancelled");
                 break;

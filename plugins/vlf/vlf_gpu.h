@@ -14,19 +14,34 @@
 
 #include "vlf_field.h"
 
-enum { VLF_GPU_PASSES = 4, VLF_GPU_BUFFERS = 16 };
+enum { VLF_GPU_PASSES = 5, VLF_GPU_BUFFERS = 20 };
+
+/* The rasterised sweeps (propagate = raster, vlf_raster.c): the faces of a
+ * subfield drawn in depth order into its radiance interface, a tile of
+ * an atlas holding a batch of directions. */
+typedef struct vlf_raster {
+    GLuint draw, escape, init;  /* programs: the faces; the escape count; the sky */
+    GLuint fbo, tex[2], vao;    /* interfaces (RGB) and per-ray counters, RGBA32F */
+    GLuint dirs, signed_dirs;   /* buffers: per direction its order; per signed one t, dW, sky */
+    uint32_t NS, TX, TY, batch; /* a tile's side, tiles across and down, directions a batch */
+    uint32_t *order_first, *order_count, *extra_first; /* per fixed direction */
+} vlf_raster;
 
 typedef struct vlf_gpu {
-    GLuint prog[VLF_GPU_PASSES]; /* sweep, gather, scatter, finish */
+    GLuint prog[VLF_GPU_PASSES]; /* sweep, gather, scatter, finish, settle */
     GLuint buf[VLF_GPU_BUFFERS];
+    int raster; /* 1: the sweeps by the rasteriser (vlf_raster.c), no fragment lists */
+    vlf_raster ras;
     /* per fixed direction: first cell_start entry and fragment, gather
      * entries (elements then tile cells), scatter jobs and their cells */
     uint32_t *start_base, *frag_base, *g_first, *g_elem, *g_count, *j_first, *j_count, *j_cells;
     double setup_s, readback_s; /* the upload of the depth order and the read-back of the maps */
 } vlf_gpu;
 
-/* Builds the passes' programs. */
-gi_result vlf_gpu_init(vlf_gpu *g, gi_error *err);
+/* Builds the passes' programs; raster = 1 for the rasterised sweeps
+ * (propagate = raster; fails with a one-line reason where the GL lacks
+ * what they need). */
+gi_result vlf_gpu_init(vlf_gpu *g, int raster, gi_error *err);
 /* Uploads field f's depth order, gather lists, tiles and scatter jobs
  * (the paper keeps them on the GPU for the iterations). */
 gi_result vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, gi_error *err);
@@ -37,5 +52,26 @@ gi_result vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, gi_error *err);
 gi_result vlf_gpu_propagate(vlf_gpu *g, vlf_field *f, int (*cancelled)(void *), void *user,
                             gi_error *err);
 void vlf_gpu_free(vlf_gpu *g);
+
+/* ---- The rasterised sweeps (vlf_raster.c) ---------------------------------- */
+
+/* Checks the GL's extensions and builds the draw programs. */
+gi_result vlf_raster_init(vlf_raster *r, gi_error *err);
+/* Uploads f's triangles, face charts and every subfield's face order
+ * (vlf_psf.rorder; f built with vlf_settings.raster) into buf (the buffers
+ * of vlf_gpu), and makes the interface's render target. */
+gi_result vlf_raster_setup(vlf_raster *r, GLuint *buf, const vlf_field *f, gi_error *err);
+/* The sweeps of every fixed direction of one iteration (along +w_i front
+ * to back, along -w_i back to front), a batch of directions a draw:
+ * receivers' flux into the accumulators (buffer 6), senders' radiance on
+ * the interfaces. `cancelled` is polled between batches. */
+gi_result vlf_raster_iteration(vlf_raster *r, const vlf_field *f, int first_iteration,
+                               int (*cancelled)(void *), void *user, gi_error *err);
+void vlf_raster_constants(vlf_raster *r, const vlf_field *f, float cell_area);
+/* Clears the per-ray counters (start of a propagation). */
+void vlf_raster_clear_counters(vlf_raster *r);
+/* The counters summed into f's flux statistics. */
+gi_result vlf_raster_counters(vlf_raster *r, vlf_field *f, gi_error *err);
+void vlf_raster_free(vlf_raster *r);
 
 #endif

@@ -12,7 +12,11 @@
 //              order into the next irradiance map (and the incoming tile);
 //   2 scatter: per cell of the target tiles of subfield i's reflections
 //              (§3.4), the incoming tile read by backward mapping;
-//   3 finish:  the end of an iteration (totals, next unshot radiance).
+//   3 finish:  the end of an iteration (totals, next unshot radiance);
+//   4 settle:  after the raster sweeps of subfield i (vlf_raster.c), what
+//              the receivers brought (recv[] holds it: per element, then
+//              per tile cell) added to the next irradiance map and made
+//              the incoming tiles, in the storage format; recv[] cleared.
 // Every map a pass writes is rounded to the storage format (vlf_quantise).
 #include "glsl_shared.h"
 
@@ -30,7 +34,12 @@ layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 2) readonly buffer VlfElemArea {
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 3) readonly buffer VlfCellStart { uint cell_start[]; };
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 4) readonly buffer VlfFrag { uint frag[]; };
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 5) readonly buffer VlfFragSlot { uint frag_slot[]; };
+#if VLF_PASS == 4
+// the raster sweeps' sums: two words a value (fraction x 2^32, integer part)
+layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 6) buffer VlfAcc { uint acc[]; };
+#else
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 6) buffer VlfRecv { float recv[]; };
+#endif
 // diffuse maps: E_next, E_tot, L_cur (3 floats an element each, u_ne apart)
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 7) buffer VlfEMap { float emap[]; };
 // tile maps: out_cur, out_next, out_tot, in (3 floats a cell each, u_nc apart)
@@ -271,6 +280,29 @@ void main()
     if (!read_in(rects[jb.src], x, y, Lin))
         return;
     t_set(OUT_NEXT, slot, vlf_q(t_get(OUT_NEXT, slot) + jb.c.xyz * Lin));
+}
+#elif VLF_PASS == 4
+// Fixed-point value k of acc as a float, and cleared.
+vec3 take(uint k)
+{
+    vec3 v;
+    for (uint q = 0u; q < 3u; q++) {
+        uint w = 2u * (k + q);
+        v[q] = float(double(acc[w + 1u]) + double(acc[w]) * (1.0LF / 4294967296.0LF));
+        acc[w] = 0u, acc[w + 1u] = 0u;
+    }
+    return v;
+}
+
+void main()
+{
+    uint idx = vlf_index();
+    if (idx >= u_count)
+        return;
+    if (3u * idx < u_ne)
+        e_set(E_NEXT, idx, vlf_q(e_get(E_NEXT, idx) + take(3u * idx)));
+    if (3u * idx < u_nc)
+        t_set(IN, idx, vlf_q(take(u_ne + 3u * idx)));
 }
 #else
 void main()
