@@ -35,7 +35,7 @@ static float node_omega(const iv_hier *h, uint32_t x, uint32_t y)
 float iv_link_share(const iv_links *l, const iv_hier *h, uint32_t x, uint32_t b)
 {
     size_t i = (size_t)x * l->bins + b;
-    int32_t y = l->other[i];
+    int32_t y = l->cell[i].other;
     if (y < 0)
         return 0.0f;
     if (l->coverage > 0.0f) { /* README "Deviations": the share the links' solid angles cover */
@@ -59,7 +59,7 @@ int iv_env_partial(const iv_links *l)
 
 float iv_env_open(const iv_links *l, const iv_hier *h, uint32_t x, uint32_t b)
 {
-    if (l->other[(size_t)x * l->bins + b] < 0)
+    if (l->cell[(size_t)x * l->bins + b].other < 0)
         return 1.0f;
     if (!iv_env_partial(l))
         return 0.0f;
@@ -92,7 +92,7 @@ void iv_links_pack(const iv_links *l, const iv_hier *h, uint32_t *links, uint32_
                 w[0] = bin[j];
                 w[1] = src[j];
                 w[2] = float_bits(iv_link_share(l, h, x, bin[j]));
-                w[3] = float_bits(l->dist[(size_t)x * l->bins + bin[j]]);
+                w[3] = float_bits(l->cell[(size_t)x * l->bins + bin[j]].dist);
             }
         }
     }
@@ -170,7 +170,7 @@ static void punctual(const iv_links *l, const iv_hier *h, const iv_lights *li, u
         if (!gi_punctual_toward(lt, f, x, &wl, &r, &scale))
             continue;
         size_t k = base + iv_bin_of(wl, l->n);
-        if (l->other[k] >= 0 && l->dist[k] < r)
+        if (l->cell[k].other >= 0 && l->cell[k].dist < r)
             continue;
         float c = gi_v3_dot(n, wl);
         double *e = c >= 0.0f ? ep : em;

@@ -37,7 +37,8 @@
 #include <string.h>
 #include <unistd.h>
 
-/* Bins x nodes x 12 bytes (link, distance, coverage) above this are refused with a message. */
+/* Bins x nodes x 12 bytes (link, distance, coverage where read) above this are refused with a
+ * message. */
 #define IV_MAX_LINK_BYTES (3ull << 30)
 /* Brute force compares every two leaves: refused above this many. */
 #define IV_MAX_BRUTE_ELEMENTS 40000u
@@ -375,6 +376,11 @@ static gi_result update_links(implicit_vis *m, const gi_gpu_scene *gs)
     if (!reuse)
         iv_links_build(m->links, m->hier, m->subdiv, m->brute, m->splat);
     host->stage_end(host, "create_links");
+    if (m->links->oom) {
+        m->links_valid = 0;
+        return gi_kit_fail(&m->kit, GI_ERR_OUT_OF_MEMORY,
+                           "implicit_vis: out of memory for the links' coverage");
+    }
     if (m->links->stopped) {
         m->links_valid = 0;
         return gi_kit_fail(&m->kit, GI_ERR_CANCELLED, "implicit_vis: link creation cancelled");
@@ -528,7 +534,7 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
      * links (bin + source). The hierarchy's own arrays are not counted. */
     const iv_links *L = m->links;
     double bin_bytes = (double)L->nodes * (double)L->bins *
-                       (double)(sizeof(int32_t) + sizeof(float) + (L->cover ? sizeof(float) : 0));
+                       (double)(sizeof(iv_cell) + (L->cover ? sizeof(float) : 0));
     double leaf_bytes =
         2.0 * sizeof(uint32_t) *
         ((double)L->leaf_off[m->hier->elem_count] + (double)L->light_off[m->hier->elem_count]);

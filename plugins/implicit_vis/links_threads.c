@@ -19,7 +19,7 @@
 
 typedef struct link_task {
     uint32_t A, B;   /* B == UINT32_MAX: link_self(A) */
-    uint32_t *pairs; /* 2 per pair linked, in order */
+    uint32_t *pairs; /* 4 per pair linked, in order: A, B, A's bin toward B, B's toward A */
     size_t n, cap;
     uint64_t tries;
 } link_task;
@@ -46,18 +46,18 @@ static int par_stop(link_par *p, uint64_t count)
     return atomic_load_explicit(&p->stop, memory_order_relaxed);
 }
 
-static int task_push(link_task *t, uint32_t A, uint32_t B)
+static int task_push(link_task *t, uint32_t A, uint32_t B, const uint32_t bins[2])
 {
     if (t->n == t->cap) {
         size_t c = t->cap ? 2 * t->cap : 256;
-        uint32_t *p = realloc(t->pairs, c * 2 * sizeof *p);
+        uint32_t *p = realloc(t->pairs, c * 4 * sizeof *p);
         if (!p)
             return 0;
         t->pairs = p;
         t->cap = c;
     }
-    t->pairs[2 * t->n] = A;
-    t->pairs[2 * t->n + 1] = B;
+    uint32_t *o = &t->pairs[4 * t->n];
+    o[0] = A, o[1] = B, o[2] = bins[0], o[3] = bins[1];
     t->n++;
     return 1;
 }
@@ -69,7 +69,8 @@ static int collect_pair(link_par *p, link_task *t, uint32_t A, uint32_t B)
         return 0;
     gi_vec3 d;
     float r2;
-    switch (iv_pair_decide(p->l, h, p->subdiv, A, B, &d, &r2)) {
+    uint32_t bins[2];
+    switch (iv_pair_decide(p->l, h, p->subdiv, A, B, &d, &r2, bins)) {
     case IV_PAIR_SPLIT_B:
         for (uint32_t k = 0; k < h->child_count[B]; k++)
             if (!collect_pair(p, t, A, h->first_child[B] + k))
@@ -81,7 +82,7 @@ static int collect_pair(link_par *p, link_task *t, uint32_t A, uint32_t B)
                 return 0;
         return 1;
     case IV_PAIR_LINK:
-        return task_push(t, A, B);
+        return task_push(t, A, B, bins);
     default:
         return 1;
     }
@@ -138,7 +139,8 @@ static link_task *unroll_tasks(link_par *p, link_task *tasks, size_t *count, siz
             (*tries)++;
             gi_vec3 d;
             float r2;
-            int what = iv_pair_decide(p->l, h, p->subdiv, A, B, &d, &r2);
+            uint32_t bins[2];
+            int what = iv_pair_decide(p->l, h, p->subdiv, A, B, &d, &r2, bins);
             if (what == IV_PAIR_SPLIT_B) {
                 for (uint32_t k = 0; k < h->child_count[B]; k++)
                     out[m++] = (link_task){.A = A, .B = h->first_child[B] + k};
@@ -149,7 +151,7 @@ static link_task *unroll_tasks(link_par *p, link_task *tasks, size_t *count, siz
                 grew = 1;
             } else if (what == IV_PAIR_LINK) {
                 out[m] = (link_task){.A = A, .B = B};
-                if (!task_push(&out[m], A, B)) {
+                if (!task_push(&out[m], A, B, bins)) {
                     free(out);
                     return tasks;
                 }
@@ -199,30 +201,31 @@ static void *write_worker(void *arg)
     /* a private copy of the counters: `created` is summed afterwards */
     iv_links mine = *p->l;
     mine.created = 0;
-    for (uint32_t x = me; x < p->l->nodes; x += T) { /* its nodes' bins emptied */
-        size_t base = (size_t)x * p->l->bins;
-        for (uint32_t b = 0; b < p->l->bins; b++) {
-            p->l->other[base + b] = -1;
-            p->l->dist[base + b] = FLT_MAX;
-            p->l->cover[base + b] = 0.0f;
-        }
-    }
+    iv_links_clear_nodes(p->l, me, T); /* its nodes' bins emptied */
     uint64_t steps = 0;
     for (size_t i = 0; i < p->ntasks; i++) {
         const link_task *t = &p->tasks[i];
         for (size_t k = 0; k < t->n; k++) {
             if (par_stop(p, ++steps))
                 return NULL;
-            uint32_t A = t->pairs[2 * k], B = t->pairs[2 * k + 1];
+            if (k + 16 < t->n) { /* the cells 16 pairs ahead, fetched while these are written */
+                const uint32_t *f = &t->pairs[4 * (k + 16)];
+                if (f[0] % T == me)
+                    __builtin_prefetch(&p->l->cell[(size_t)f[0] * p->l->bins + f[2]], 1);
+                if (f[1] % T == me)
+                    __builtin_prefetch(&p->l->cell[(size_t)f[1] * p->l->bins + f[3]], 1);
+            }
+            const uint32_t *q = &t->pairs[4 * k];
+            uint32_t A = q[0], B = q[1];
             int a = A % T == me, b = B % T == me;
             if (!a && !b)
                 continue;
             gi_vec3 d = gi_v3_sub(gi_v3_load(&h->pos[3 * B]), gi_v3_load(&h->pos[3 * A]));
             float r = sqrtf(gi_v3_dot(d, d));
             if (a)
-                iv_put_side(&mine, h, A, B, d, r, p->splat);
+                iv_put_side(&mine, h, A, B, d, r, q[2], p->splat);
             if (b)
-                iv_put_side(&mine, h, B, A, gi_v3_scale(d, -1.0f), r, p->splat);
+                iv_put_side(&mine, h, B, A, gi_v3_scale(d, -1.0f), r, q[3], p->splat);
         }
     }
     w->created = mine.created;
