@@ -243,6 +243,12 @@ typedef struct iv_links {
     const struct gi_host *host;
     int stopped;
     int oom; /* the last build found no memory for the coverage: no links */
+    /* Scratch of the threaded build (links_threads.c), kept from frame to
+     * frame so that listing the pairs writes no fresh pages: per thread
+     * the pairs it listed, 4 words each. */
+    uint32_t **pair_buf;
+    size_t *pair_cap;
+    uint32_t pair_bufs;
 } iv_links;
 
 iv_links *iv_links_create(const iv_hier *h, uint32_t n);

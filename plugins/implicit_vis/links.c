@@ -63,6 +63,9 @@ void iv_links_free(iv_links *l)
     free(l->leaf_off), free(l->leaf_bin), free(l->leaf_src);
     free(l->light_off), free(l->light_bin), free(l->light_src);
     free(l->root), free(l->one_sided);
+    for (uint32_t i = 0; i < l->pair_bufs; i++)
+        free(l->pair_buf[i]);
+    free(l->pair_buf), free(l->pair_cap);
     free(l);
 }
 
