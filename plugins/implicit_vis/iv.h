@@ -276,7 +276,8 @@ void iv_links_refine_push(iv_links *l, const iv_hier *h);
  * bits); first every receiving link (l->receiving of them, each leaf's in
  * bin order), then the light links. off: 2 per element + 1, its first
  * receiving link and its first light link (counted from the light links'
- * start). links holds 4 (receiving + light links) words, off 2 (elements + 1). */
+ * start). links holds 4 (receiving + light links) words, off 2 (elements + 1).
+ * Packed on l->threads threads (the same words). */
 void iv_links_pack(const iv_links *l, const iv_hier *h, uint32_t *links, uint32_t *off);
 
 /* ---- illumination (Sec. 4.3, 4.4) ---- */
