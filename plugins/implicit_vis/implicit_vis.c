@@ -37,8 +37,8 @@
 #include <string.h>
 #include <unistd.h>
 
-/* Bins x nodes x 12 bytes (link, distance, coverage where read) above this are refused with a
- * message. */
+/* Bins x nodes x 8 bytes (link, distance; 12 with the coverage where read) above this are
+ * refused with a message. */
 #define IV_MAX_LINK_BYTES (3ull << 30)
 /* Brute force compares every two leaves: refused above this many. */
 #define IV_MAX_BRUTE_ELEMENTS 40000u
@@ -201,8 +201,11 @@ static void release_prepared(implicit_vis *m)
  * count, refused above their limits. */
 static gi_result check_limits(implicit_vis *m)
 {
+    /* a cell (link and length), and the coverage where the modes read it */
+    unsigned long long cell =
+        sizeof(iv_cell) + (m->coverage > 0.0f || m->weight == IV_WEIGHT_SURFACE ? 4ull : 0ull);
     unsigned long long bytes =
-        6ull * (unsigned long long)m->N * (unsigned long long)m->N * m->hier->node_count * 12ull;
+        6ull * (unsigned long long)m->N * (unsigned long long)m->N * m->hier->node_count * cell;
     if (bytes > IV_MAX_LINK_BYTES)
         return gi_kit_fail(&m->kit, GI_ERR_UNSUPPORTED,
                            "implicit_vis: %u nodes x 6 x %d x %d bins need %.1f GiB of links "
