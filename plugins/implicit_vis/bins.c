@@ -7,22 +7,7 @@
 
 uint32_t iv_bin_of(gi_vec3 d, uint32_t n)
 {
-    float a[3] = {d.x, d.y, d.z};
-    int ax = 0;
-    if (fabsf(a[1]) > fabsf(a[ax]))
-        ax = 1;
-    if (fabsf(a[2]) > fabsf(a[ax]))
-        ax = 2;
-    float m = fabsf(a[ax]);
-    if (!(m > 0.0f))
-        return 0;
-    uint32_t face = 2u * (uint32_t)ax + (a[ax] < 0.0f ? 1u : 0u);
-    float u = a[(ax + 1) % 3] / m, v = a[(ax + 2) % 3] / m;
-    int col = (int)floorf((u + 1.0f) * 0.5f * (float)n),
-        row = (int)floorf((v + 1.0f) * 0.5f * (float)n);
-    col = col < 0 ? 0 : (col >= (int)n ? (int)n - 1 : col);
-    row = row < 0 ? 0 : (row >= (int)n ? (int)n - 1 : row);
-    return face * n * n + (uint32_t)row * n + (uint32_t)col;
+    return iv_bin_fast(d, n);
 }
 
 /* Face, and the texel's square [u0, u1] x [v0, v1] on it. */

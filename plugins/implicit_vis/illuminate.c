@@ -11,6 +11,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -35,7 +36,7 @@ static float node_omega(const iv_hier *h, uint32_t x, uint32_t y)
 float iv_link_share(const iv_links *l, const iv_hier *h, uint32_t x, uint32_t b)
 {
     size_t i = (size_t)x * l->bins + b;
-    int32_t y = l->other[i];
+    int32_t y = l->cell[i].other;
     if (y < 0)
         return 0.0f;
     if (l->coverage > 0.0f) { /* README "Deviations": the share the links' solid angles cover */
@@ -59,7 +60,7 @@ int iv_env_partial(const iv_links *l)
 
 float iv_env_open(const iv_links *l, const iv_hier *h, uint32_t x, uint32_t b)
 {
-    if (l->other[(size_t)x * l->bins + b] < 0)
+    if (l->cell[(size_t)x * l->bins + b].other < 0)
         return 1.0f;
     if (!iv_env_partial(l))
         return 0.0f;
@@ -74,27 +75,67 @@ static uint32_t float_bits(float f)
     return u;
 }
 
-void iv_links_pack(const iv_links *l, const iv_hier *h, uint32_t *links, uint32_t *off)
+/* Elements e0 .. e1 - 1 of iv_links_pack: each writes its own links'
+ * words only, so ranges pack side by side on threads. */
+typedef struct pack_range {
+    const iv_links *l;
+    const iv_hier *h;
+    uint32_t *links;
+    uint32_t e0, e1;
+} pack_range;
+
+static void *pack_elements(void *arg)
 {
-    size_t light_base = l->leaf_off[h->elem_count];
-    for (uint32_t e = 0; e <= h->elem_count; e++) {
-        off[2 * e] = l->leaf_off[e];
-        off[2 * e + 1] = l->light_off[e];
-    }
-    for (uint32_t e = 0; e < h->elem_count; e++) {
-        uint32_t x = h->elem_node[e];
+    const pack_range *r = arg;
+    const iv_links *l = r->l;
+    size_t light_base = l->leaf_off[r->h->elem_count];
+    for (uint32_t e = r->e0; e < r->e1; e++) {
+        uint32_t x = r->h->elem_node[e];
         for (int light = 0; light < 2; light++) {
             const uint32_t *o = light ? l->light_off : l->leaf_off;
             const uint32_t *bin = light ? l->light_bin : l->leaf_bin;
             const uint32_t *src = light ? l->light_src : l->leaf_src;
             for (uint32_t j = o[e]; j < o[e + 1]; j++) {
-                uint32_t *w = &links[4 * ((light ? light_base : 0) + j)];
+                uint32_t *w = &r->links[4 * ((light ? light_base : 0) + j)];
                 w[0] = bin[j];
                 w[1] = src[j];
-                w[2] = float_bits(iv_link_share(l, h, x, bin[j]));
-                w[3] = float_bits(l->dist[(size_t)x * l->bins + bin[j]]);
+                w[2] = float_bits(iv_link_share(l, r->h, x, bin[j]));
+                w[3] = float_bits(l->cell[(size_t)x * l->bins + bin[j]].dist);
             }
         }
+    }
+    return NULL;
+}
+
+/* Most threads iv_links_pack starts. */
+#define IV_PACK_THREADS 16u
+
+void iv_links_pack(const iv_links *l, const iv_hier *h, uint32_t *links, uint32_t *off)
+{
+    for (uint32_t e = 0; e <= h->elem_count; e++) {
+        off[2 * e] = l->leaf_off[e];
+        off[2 * e + 1] = l->light_off[e];
+    }
+    /* on l->threads threads (the link creation's), in element ranges: the
+     * same words; a thread that cannot start packs on this one */
+    uint32_t T = l->threads > 1 ? l->threads : 1, n = h->elem_count;
+    T = T > IV_PACK_THREADS ? IV_PACK_THREADS : T;
+    T = n < 1024u ? 1u : T;
+    pack_range r[IV_PACK_THREADS];
+    pthread_t tid[IV_PACK_THREADS];
+    int made[IV_PACK_THREADS] = {0};
+    for (uint32_t i = 0; i < T; i++) {
+        r[i] = (pack_range){l, h, links, (uint32_t)((uint64_t)n * i / T),
+                            (uint32_t)((uint64_t)n * (i + 1) / T)};
+        if (i > 0)
+            made[i] = pthread_create(&tid[i], NULL, pack_elements, &r[i]) == 0;
+    }
+    pack_elements(&r[0]);
+    for (uint32_t i = 1; i < T; i++) {
+        if (made[i])
+            pthread_join(tid[i], NULL);
+        else
+            pack_elements(&r[i]);
     }
 }
 
@@ -170,7 +211,7 @@ static void punctual(const iv_links *l, const iv_hier *h, const iv_lights *li, u
         if (!gi_punctual_toward(lt, f, x, &wl, &r, &scale))
             continue;
         size_t k = base + iv_bin_of(wl, l->n);
-        if (l->other[k] >= 0 && l->dist[k] < r)
+        if (l->cell[k].other >= 0 && l->cell[k].dist < r)
             continue;
         float c = gi_v3_dot(n, wl);
         double *e = c >= 0.0f ? ep : em;

@@ -37,7 +37,8 @@
 #include <string.h>
 #include <unistd.h>
 
-/* Bins x nodes x 12 bytes (link, distance, coverage) above this are refused with a message. */
+/* Bins x nodes x 8 bytes (link, distance; 12 with the coverage where read) above this are
+ * refused with a message. */
 #define IV_MAX_LINK_BYTES (3ull << 30)
 /* Brute force compares every two leaves: refused above this many. */
 #define IV_MAX_BRUTE_ELEMENTS 40000u
@@ -200,8 +201,11 @@ static void release_prepared(implicit_vis *m)
  * count, refused above their limits. */
 static gi_result check_limits(implicit_vis *m)
 {
+    /* a cell (link and length), and the coverage where the modes read it */
+    unsigned long long cell =
+        sizeof(iv_cell) + (m->coverage > 0.0f || m->weight == IV_WEIGHT_SURFACE ? 4ull : 0ull);
     unsigned long long bytes =
-        6ull * (unsigned long long)m->N * (unsigned long long)m->N * m->hier->node_count * 12ull;
+        6ull * (unsigned long long)m->N * (unsigned long long)m->N * m->hier->node_count * cell;
     if (bytes > IV_MAX_LINK_BYTES)
         return gi_kit_fail(&m->kit, GI_ERR_UNSUPPORTED,
                            "implicit_vis: %u nodes x 6 x %d x %d bins need %.1f GiB of links "
@@ -375,6 +379,11 @@ static gi_result update_links(implicit_vis *m, const gi_gpu_scene *gs)
     if (!reuse)
         iv_links_build(m->links, m->hier, m->subdiv, m->brute, m->splat);
     host->stage_end(host, "create_links");
+    if (m->links->oom) {
+        m->links_valid = 0;
+        return gi_kit_fail(&m->kit, GI_ERR_OUT_OF_MEMORY,
+                           "implicit_vis: out of memory for the links' coverage");
+    }
     if (m->links->stopped) {
         m->links_valid = 0;
         return gi_kit_fail(&m->kit, GI_ERR_CANCELLED, "implicit_vis: link creation cancelled");
@@ -528,7 +537,7 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
      * links (bin + source). The hierarchy's own arrays are not counted. */
     const iv_links *L = m->links;
     double bin_bytes = (double)L->nodes * (double)L->bins *
-                       (double)(sizeof(int32_t) + sizeof(float) + (L->cover ? sizeof(float) : 0));
+                       (double)(sizeof(iv_cell) + (L->cover ? sizeof(float) : 0));
     double leaf_bytes =
         2.0 * sizeof(uint32_t) *
         ((double)L->leaf_off[m->hier->elem_count] + (double)L->light_off[m->hier->elem_count]);

@@ -35,6 +35,44 @@ struct gi_host;
 /* Bin of direction d (any length > 0) in a 6 x n x n world-aligned cube map:
  * face * n * n + row * n + column. Faces +X -X +Y -Y +Z -Z. */
 uint32_t iv_bin_of(gi_vec3 d, uint32_t n);
+
+/* Column or row of a face coordinate u in [-1, 1]: floor((u + 1) n / 2),
+ * clamped. The value is >= 0 (or NaN, clamped to 0 as before), where a
+ * truncating conversion is the floor, without a call to floorf. */
+static inline int iv_bin_cell(float u, uint32_t n)
+{
+    float x = (u + 1.0f) * 0.5f * (float)n;
+    int c = x > 0.0f ? (int)x : 0;
+    return c >= (int)n ? (int)n - 1 : c;
+}
+
+/* iv_bin_of, inlined where link creation asks it millions of times per
+ * frame; and the bins of d and -d at once (*neg: the bin of -d), which
+ * share the axis and the divisions (-a / m is -(a / m) to the bit). */
+static inline uint32_t iv_bin_pair(gi_vec3 d, uint32_t n, uint32_t *neg)
+{
+    float a[3] = {d.x, d.y, d.z};
+    int ax = 0;
+    if (fabsf(a[1]) > fabsf(a[ax]))
+        ax = 1;
+    if (fabsf(a[2]) > fabsf(a[ax]))
+        ax = 2;
+    float m = fabsf(a[ax]);
+    if (!(m > 0.0f)) {
+        *neg = 0;
+        return 0;
+    }
+    uint32_t face = 2u * (uint32_t)ax + (a[ax] < 0.0f ? 1u : 0u);
+    float u = a[(ax + 1) % 3] / m, v = a[(ax + 2) % 3] / m;
+    *neg = (face ^ 1u) * n * n + (uint32_t)iv_bin_cell(-v, n) * n + (uint32_t)iv_bin_cell(-u, n);
+    return face * n * n + (uint32_t)iv_bin_cell(v, n) * n + (uint32_t)iv_bin_cell(u, n);
+}
+
+static inline uint32_t iv_bin_fast(gi_vec3 d, uint32_t n)
+{
+    uint32_t neg;
+    return iv_bin_pair(d, n, &neg);
+}
 /* Unit direction through the centre of bin b. */
 gi_vec3 iv_bin_centre(uint32_t b, uint32_t n);
 /* Solid angle of bin b (exact for a cube-map texel). */
@@ -157,12 +195,19 @@ enum {
                               the nearest node's segment that falls in the bin, summed */
 };
 
+/* One bin of a node: its shortest link, the node at the other end (-1:
+ * empty) and the link's length, side by side so that writing a link
+ * touches one cache line (README "One link stored once"). */
+typedef struct iv_cell {
+    float dist;
+    int32_t other;
+} iv_cell;
+
 typedef struct iv_links {
     uint32_t n;    /* bins per cube side (the paper's N) */
     uint32_t bins; /* 6 n n */
     uint32_t nodes;
-    int32_t *other;   /* nodes x bins: the linked node, -1 empty */
-    float *dist;      /* nodes x bins: its distance */
+    iv_cell *cell;    /* nodes x bins: the bin's link (README "One link stored once") */
     uint32_t threads; /* > 1: links created on this many threads, the same links to the bit (README
                          "Multi-threaded link creation"); 0 or 1: on one */
     int bilinear;   /* links written into the four bins around their direction (README "Deviations")
@@ -171,9 +216,10 @@ typedef struct iv_links {
                        through that part only (README "Deviations"); 0: Eq. 5, the nearest covers
                        all */
     int weight;     /* IV_WEIGHT_*: how a link weighs in its bin */
-    float *cover;   /* nodes x bins: solid angle of every node linked in the bin (Eq. 4's sum; with
-                       IV_WEIGHT_SURFACE only the nodes of the nearest node's segment); after
-                       refinement summed down each leaf's path */
+    float *cover;   /* nodes x bins, only where read (iv_links_need_cover), else NULL: solid angle
+                       of every node linked in the bin (Eq. 4's sum; with IV_WEIGHT_SURFACE only
+                       the nodes of the nearest node's segment); after refinement summed down each
+                       leaf's path */
     uint32_t *root; /* per node: the root of its tree (its segment) */
     uint8_t *one_sided; /* per node: every disc below it is single-sided (seen from behind it is
                            not there: the one rule for sides) */
@@ -196,10 +242,21 @@ typedef struct iv_links {
      * incomplete. */
     const struct gi_host *host;
     int stopped;
+    int oom; /* the last build found no memory for the coverage: no links */
+    /* Scratch of the threaded build (links_threads.c), kept from frame to
+     * frame so that listing the pairs writes no fresh pages: per thread
+     * the pairs it listed, 4 words each. */
+    uint32_t **pair_buf;
+    size_t *pair_cap;
+    uint32_t pair_bufs;
 } iv_links;
 
 iv_links *iv_links_create(const iv_hier *h, uint32_t n);
 void iv_links_free(iv_links *l);
+/* Whether the link modes read the bins' coverage (coverage > 0 or
+ * IV_WEIGHT_SURFACE; iv_link_share): iv_links_build keeps l->cover only
+ * then, and under Eq. 5 writes a link into its cell alone. */
+int iv_links_need_cover(const iv_links *l);
 /* Sec. 4.2.2: links from the top-level pairs down, a node subdivided while
  * its solid angle seen from the other exceeds `subdiv` times the bin's;
  * each bin keeps its shortest link. brute != 0: every leaf against every
@@ -219,7 +276,8 @@ void iv_links_refine_push(iv_links *l, const iv_hier *h);
  * bits); first every receiving link (l->receiving of them, each leaf's in
  * bin order), then the light links. off: 2 per element + 1, its first
  * receiving link and its first light link (counted from the light links'
- * start). links holds 4 (receiving + light links) words, off 2 (elements + 1). */
+ * start). links holds 4 (receiving + light links) words, off 2 (elements + 1).
+ * Packed on l->threads threads (the same words). */
 void iv_links_pack(const iv_links *l, const iv_hier *h, uint32_t *links, uint32_t *off);
 
 /* ---- illumination (Sec. 4.3, 4.4) ---- */

@@ -28,13 +28,17 @@ gi_result iv_hier_fail(const char *reason, gi_error *err);
 enum { IV_PAIR_NONE, IV_PAIR_LINK, IV_PAIR_SPLIT_B, IV_PAIR_SPLIT_A };
 
 /* The IV_PAIR_* for (A, B); d = B - A and r2 = |d|^2 are set unless it
- * is IV_PAIR_NONE. */
+ * is IV_PAIR_NONE, and for IV_PAIR_LINK bins[0] = the bin of d (A's
+ * toward B), bins[1] = the bin of -d (B's toward A). */
 int iv_pair_decide(const iv_links *l, const iv_hier *h, float subdiv, uint32_t A, uint32_t B,
-                   gi_vec3 *dout, float *r2out);
-/* Receiver A's side of the link A-B (d = B - A, r = |d|): B written into
- * A's bin toward it, or with `splat` into every bin a near disc covers. */
+                   gi_vec3 *dout, float *r2out, uint32_t bins[2]);
+/* Receiver A's side of the link A-B (d = B - A, r = |d|, b = the bin of
+ * d): B written into A's bin toward it, or with `splat` into every bin a
+ * near disc covers. */
 void iv_put_side(iv_links *l, const iv_hier *h, uint32_t A, uint32_t B, gi_vec3 d, float r,
-                 int splat);
+                 uint32_t b, int splat);
+/* Empties the bins of nodes first, first + step, ... */
+void iv_links_clear_nodes(iv_links *l, uint32_t first, uint32_t step);
 /* The hierarchical links on `threads` threads (each node's bins emptied
  * first); 0 when it could not (out of memory, no thread), and the caller
  * builds them on one. */

@@ -23,17 +23,15 @@ iv_links *iv_links_create(const iv_hier *h, uint32_t n)
     l->bins = 6 * n * n;
     l->nodes = h->node_count;
     size_t cells = (size_t)l->bins * l->nodes;
-    l->other = malloc(cells * sizeof *l->other);
-    l->dist = malloc(cells * sizeof *l->dist);
-    l->cover = malloc(cells * sizeof *l->cover);
+    l->cell = malloc(cells * sizeof *l->cell);
     l->bin_dir = malloc((size_t)l->bins * 3 * sizeof(float));
     l->bin_omega = malloc(l->bins * sizeof(float));
     l->root = malloc((size_t)l->nodes * sizeof *l->root);
     l->one_sided = calloc(l->nodes ? l->nodes : 1, 1);
     l->leaf_off = calloc((size_t)h->elem_count + 1, sizeof *l->leaf_off);
     l->light_off = calloc((size_t)h->elem_count + 1, sizeof *l->light_off);
-    if (!l->other || !l->dist || !l->cover || !l->bin_dir || !l->bin_omega || !l->leaf_off ||
-        !l->light_off || !l->root || !l->one_sided) {
+    if (!l->cell || !l->bin_dir || !l->bin_omega || !l->leaf_off || !l->light_off || !l->root ||
+        !l->one_sided) {
         iv_links_free(l);
         return NULL;
     }
@@ -61,10 +59,13 @@ void iv_links_free(iv_links *l)
 {
     if (!l)
         return;
-    free(l->other), free(l->dist), free(l->cover), free(l->bin_dir), free(l->bin_omega);
+    free(l->cell), free(l->cover), free(l->bin_dir), free(l->bin_omega);
     free(l->leaf_off), free(l->leaf_bin), free(l->leaf_src);
     free(l->light_off), free(l->light_bin), free(l->light_src);
     free(l->root), free(l->one_sided);
+    for (uint32_t i = 0; i < l->pair_bufs; i++)
+        free(l->pair_buf[i]);
+    free(l->pair_buf), free(l->pair_cap);
     free(l);
 }
 
@@ -76,15 +77,18 @@ void iv_links_free(iv_links *l)
 static void put(iv_links *l, uint32_t A, uint32_t b, uint32_t B, float r, float omega)
 {
     size_t i = (size_t)A * l->bins + b;
-    if (l->weight != IV_WEIGHT_SURFACE)
+    iv_cell *c = &l->cell[i];
+    if (!l->cover)
+        ; /* Eq. 5: no coverage read, none kept */
+    else if (l->weight != IV_WEIGHT_SURFACE)
         l->cover[i] += omega;
-    else if (l->other[i] < 0 || l->root[l->other[i]] == l->root[B])
+    else if (c->other < 0 || l->root[c->other] == l->root[B])
         l->cover[i] += omega;
-    else if (r < l->dist[i])
+    else if (r < c->dist)
         l->cover[i] = omega;
-    if (r < l->dist[i]) {
-        l->dist[i] = r;
-        l->other[i] = (int32_t)B;
+    if (r < c->dist) {
+        c->dist = r;
+        c->other = (int32_t)B;
         l->created++;
     }
 }
@@ -127,9 +131,8 @@ static void put_bilinear(iv_links *l, uint32_t A, gi_vec3 d, uint32_t B, float r
  * oriented by its normal, sampled on a grid as fine as a bin seen at its
  * distance, as a shadow map rasterises a near occluder. */
 void iv_put_side(iv_links *l, const iv_hier *h, uint32_t A, uint32_t B, gi_vec3 d, float r,
-                 int splat)
+                 uint32_t b, int splat)
 {
-    uint32_t b = iv_bin_of(d, l->n);
     float cover = h->area[B] / (r * r) / l->bin_omega[b];
     gi_vec3 n = gi_v3_load(&h->nrm[3 * B]);
     /* the one rule for sides (gi/scene.h): a single-sided node (every disc
@@ -182,16 +185,17 @@ void iv_put_side(iv_links *l, const iv_hier *h, uint32_t A, uint32_t B, gi_vec3 
             gi_vec3 dq = gi_v3_sub(q, pa);
             float rq = gi_v3_length(dq);
             if (rq > 1e-10f)
-                put(l, A, iv_bin_of(dq, l->n), B, rq, omega / (float)inside);
+                put(l, A, iv_bin_fast(dq, l->n), B, rq, omega / (float)inside);
         }
 }
 
-/* Stores the link A-B in A's bin toward B and B's bin toward A. */
+/* Stores the link A-B in A's bin toward B (bins[0]) and B's bin toward A
+ * (bins[1]). */
 static void insert(iv_links *l, const iv_hier *h, uint32_t A, uint32_t B, gi_vec3 d, float r,
-                   int splat)
+                   const uint32_t bins[2], int splat)
 {
-    iv_put_side(l, h, A, B, d, r, splat);
-    iv_put_side(l, h, B, A, gi_v3_scale(d, -1.0f), r, splat);
+    iv_put_side(l, h, A, B, d, r, bins[0], splat);
+    iv_put_side(l, h, B, A, gi_v3_scale(d, -1.0f), r, bins[1], splat);
 }
 
 typedef struct link_ctx {
@@ -214,7 +218,7 @@ static int coplanar(const iv_hier *h, uint32_t A, uint32_t B, gi_vec3 d, float r
 }
 
 int iv_pair_decide(const iv_links *l, const iv_hier *h, float subdiv, uint32_t A, uint32_t B,
-                   gi_vec3 *dout, float *r2out)
+                   gi_vec3 *dout, float *r2out, uint32_t bins[2])
 {
     gi_vec3 d = gi_v3_sub(gi_v3_load(&h->pos[3 * B]), gi_v3_load(&h->pos[3 * A]));
     float r2 = gi_v3_dot(d, d);
@@ -228,8 +232,10 @@ int iv_pair_decide(const iv_links *l, const iv_hier *h, float subdiv, uint32_t A
     } else {
         if (coplanar(h, A, B, d, r2))
             return IV_PAIR_NONE;
-        float oa = subdiv * l->bin_omega[iv_bin_of(gi_v3_scale(d, -1.0f), l->n)];
-        float ob = subdiv * l->bin_omega[iv_bin_of(d, l->n)];
+        /* the bins the link would take on each side, kept for its writes */
+        bins[0] = iv_bin_pair(d, l->n, &bins[1]);
+        float oa = subdiv * l->bin_omega[bins[1]];
+        float ob = subdiv * l->bin_omega[bins[0]];
         needB = !leafB && h->area[B] / r2 > ob;
         needA = !leafA && h->area[A] / r2 > oa;
     }
@@ -259,7 +265,8 @@ static void link_pair(link_ctx *c, uint32_t A, uint32_t B)
         return; /* a cancel: the recursion unwinds */
     gi_vec3 d;
     float r2;
-    switch (iv_pair_decide(c->l, h, c->subdiv, A, B, &d, &r2)) {
+    uint32_t bins[2];
+    switch (iv_pair_decide(c->l, h, c->subdiv, A, B, &d, &r2, bins)) {
     case IV_PAIR_SPLIT_B:
         for (uint32_t k = 0; k < h->child_count[B]; k++)
             link_pair(c, A, h->first_child[B] + k);
@@ -269,7 +276,7 @@ static void link_pair(link_ctx *c, uint32_t A, uint32_t B)
             link_pair(c, h->first_child[A] + k, B);
         break;
     case IV_PAIR_LINK:
-        insert(c->l, h, A, B, d, sqrtf(r2), c->splat);
+        insert(c->l, h, A, B, d, sqrtf(r2), bins, c->splat);
         break;
     default:
         break;
@@ -290,18 +297,47 @@ static void link_self(link_ctx *c, uint32_t A)
 
 static void links_clear(iv_links *l)
 {
-    size_t cells = (size_t)l->bins * l->nodes;
-    for (size_t i = 0; i < cells; i++) {
-        l->other[i] = -1;
-        l->dist[i] = FLT_MAX;
-        l->cover[i] = 0.0f;
-    }
+    iv_links_clear_nodes(l, 0, 1);
     l->tries = l->created = 0;
+}
+
+void iv_links_clear_nodes(iv_links *l, uint32_t first, uint32_t step)
+{
+    for (uint32_t x = first; x < l->nodes; x += step) {
+        size_t base = (size_t)x * l->bins;
+        iv_cell *c = &l->cell[base];
+        for (uint32_t b = 0; b < l->bins; b++) /* plain stores the compiler can widen */
+            c[b].dist = FLT_MAX, c[b].other = -1;
+        if (l->cover)
+            memset(&l->cover[base], 0, l->bins * sizeof *l->cover);
+    }
+}
+
+int iv_links_need_cover(const iv_links *l)
+{
+    return l->coverage > 0.0f || l->weight == IV_WEIGHT_SURFACE;
+}
+
+/* The coverage array where the modes read it, freed where they do not
+ * (the links' writes then touch one cell each); 0 when out of memory. */
+static int links_cover(iv_links *l)
+{
+    if (!iv_links_need_cover(l)) {
+        free(l->cover);
+        l->cover = NULL;
+        return 1;
+    }
+    if (!l->cover)
+        l->cover = malloc((size_t)l->bins * l->nodes * sizeof *l->cover);
+    return l->cover != NULL;
 }
 
 void iv_links_build(iv_links *l, const iv_hier *h, float subdiv, int brute, int splat)
 {
     l->stopped = 0;
+    l->oom = !links_cover(l);
+    if (l->oom)
+        return;
     if (brute) {
         links_clear(l);
         for (uint32_t i = 0; i < h->elem_count && !l->stopped; i++) {
@@ -312,8 +348,10 @@ void iv_links_build(iv_links *l, const iv_hier *h, float subdiv, int brute, int 
                 gi_vec3 d = gi_v3_sub(gi_v3_load(&h->pos[3 * B]), gi_v3_load(&h->pos[3 * A]));
                 float r2 = gi_v3_dot(d, d);
                 l->tries++;
+                uint32_t bins[2];
+                bins[0] = iv_bin_pair(d, l->n, &bins[1]);
                 if (r2 > 1e-20f)
-                    insert(l, h, A, B, d, sqrtf(r2), splat);
+                    insert(l, h, A, B, d, sqrtf(r2), bins, splat);
             }
         }
         return;
@@ -355,18 +393,20 @@ void iv_links_refine_push(iv_links *l, const iv_hier *h)
     /* breadth-first: a parent is final before its children read it */
     for (uint32_t i = h->root_count; i < h->node_count; i++) {
         size_t p = (size_t)h->parent[i] * nb, c = (size_t)i * nb;
+        const iv_cell *pc = &l->cell[p];
+        iv_cell *cc = &l->cell[c];
         for (uint32_t b = 0; b < nb; b++) {
             /* the pairs linked higher up lie in this bin too (with
              * IV_WEIGHT_SURFACE: where they are of the nearer link's segment) */
-            int32_t op = l->other[p + b], oc = l->other[c + b];
-            if (l->weight != IV_WEIGHT_SURFACE || op < 0 || oc < 0 || l->root[op] == l->root[oc])
+            if (!l->cover)
+                ;
+            else if (l->weight != IV_WEIGHT_SURFACE || pc[b].other < 0 || cc[b].other < 0 ||
+                     l->root[pc[b].other] == l->root[cc[b].other])
                 l->cover[c + b] += l->cover[p + b];
-            else if (l->dist[p + b] < l->dist[c + b])
+            else if (pc[b].dist < cc[b].dist)
                 l->cover[c + b] = l->cover[p + b];
-            if (l->dist[p + b] < l->dist[c + b]) {
-                l->dist[c + b] = l->dist[p + b];
-                l->other[c + b] = l->other[p + b];
-            }
+            if (pc[b].dist < cc[b].dist)
+                cc[b] = pc[b];
         }
     }
     /* emitting nodes: a node emits when one of its leaves does */
@@ -384,9 +424,9 @@ void iv_links_refine_push(iv_links *l, const iv_hier *h)
     for (uint32_t e = 0; e < h->elem_count; e++) {
         l->leaf_off[e] = (uint32_t)nl;
         l->light_off[e] = (uint32_t)nli;
-        size_t c = (size_t)h->elem_node[e] * nb;
+        const iv_cell *c = &l->cell[(size_t)h->elem_node[e] * nb];
         for (uint32_t b = 0; b < nb; b++) {
-            int32_t o = l->other[c + b];
+            int32_t o = c[b].other;
             if (o < 0)
                 continue;
             if (!grow(&l->leaf_bin, &l->leaf_src, &l->leaf_cap, nl + 1))

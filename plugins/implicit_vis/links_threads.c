@@ -19,8 +19,11 @@
 
 typedef struct link_task {
     uint32_t A, B;   /* B == UINT32_MAX: link_self(A) */
-    uint32_t *pairs; /* 2 per pair linked, in order */
+    uint32_t *pairs; /* 4 per pair linked, in order: A, B, A's bin toward B, B's toward A; NULL:
+                        in l->pair_buf[buf] from pair `off` on */
     size_t n, cap;
+    uint32_t buf;
+    size_t off;
     uint64_t tries;
 } link_task;
 
@@ -35,7 +38,41 @@ typedef struct link_par {
     int threads;
     int fail;
     atomic_int stop; /* a cancel seen by any thread (issue 32) */
+    size_t *used;    /* per thread: pairs in its l->pair_buf */
 } link_par;
+
+typedef struct write_arg {
+    link_par *p;
+    uint32_t index;
+    uint64_t created;
+} write_arg;
+
+static const uint32_t *task_pairs(const link_par *p, const link_task *t)
+{
+    return t->pairs ? t->pairs : p->l->pair_buf[t->buf] + 4 * t->off;
+}
+
+/* Appends a pair to the buffer of the thread listing task t (its pairs
+ * contiguous there: a thread lists one task at a time). */
+static int buf_push(link_par *p, link_task *t, uint32_t A, uint32_t B, const uint32_t bins[2])
+{
+    iv_links *l = p->l;
+    uint32_t w = t->buf;
+    size_t n = p->used[w];
+    if (n == l->pair_cap[w]) {
+        size_t c = n ? 2 * n : 4096;
+        uint32_t *q = realloc(l->pair_buf[w], c * 4 * sizeof *q);
+        if (!q)
+            return 0;
+        l->pair_buf[w] = q;
+        l->pair_cap[w] = c;
+    }
+    uint32_t *o = &l->pair_buf[w][4 * n];
+    o[0] = A, o[1] = B, o[2] = bins[0], o[3] = bins[1];
+    p->used[w] = n + 1;
+    t->n++;
+    return 1;
+}
 
 /* Whether to stop: the host is asked every 64 k steps of `count`, and a
  * cancel seen by one thread stops them all. */
@@ -46,18 +83,18 @@ static int par_stop(link_par *p, uint64_t count)
     return atomic_load_explicit(&p->stop, memory_order_relaxed);
 }
 
-static int task_push(link_task *t, uint32_t A, uint32_t B)
+static int task_push(link_task *t, uint32_t A, uint32_t B, const uint32_t bins[2])
 {
     if (t->n == t->cap) {
         size_t c = t->cap ? 2 * t->cap : 256;
-        uint32_t *p = realloc(t->pairs, c * 2 * sizeof *p);
+        uint32_t *p = realloc(t->pairs, c * 4 * sizeof *p);
         if (!p)
             return 0;
         t->pairs = p;
         t->cap = c;
     }
-    t->pairs[2 * t->n] = A;
-    t->pairs[2 * t->n + 1] = B;
+    uint32_t *o = &t->pairs[4 * t->n];
+    o[0] = A, o[1] = B, o[2] = bins[0], o[3] = bins[1];
     t->n++;
     return 1;
 }
@@ -69,7 +106,8 @@ static int collect_pair(link_par *p, link_task *t, uint32_t A, uint32_t B)
         return 0;
     gi_vec3 d;
     float r2;
-    switch (iv_pair_decide(p->l, h, p->subdiv, A, B, &d, &r2)) {
+    uint32_t bins[2];
+    switch (iv_pair_decide(p->l, h, p->subdiv, A, B, &d, &r2, bins)) {
     case IV_PAIR_SPLIT_B:
         for (uint32_t k = 0; k < h->child_count[B]; k++)
             if (!collect_pair(p, t, A, h->first_child[B] + k))
@@ -81,7 +119,7 @@ static int collect_pair(link_par *p, link_task *t, uint32_t A, uint32_t B)
                 return 0;
         return 1;
     case IV_PAIR_LINK:
-        return task_push(t, A, B);
+        return buf_push(p, t, A, B, bins);
     default:
         return 1;
     }
@@ -138,7 +176,8 @@ static link_task *unroll_tasks(link_par *p, link_task *tasks, size_t *count, siz
             (*tries)++;
             gi_vec3 d;
             float r2;
-            int what = iv_pair_decide(p->l, h, p->subdiv, A, B, &d, &r2);
+            uint32_t bins[2];
+            int what = iv_pair_decide(p->l, h, p->subdiv, A, B, &d, &r2, bins);
             if (what == IV_PAIR_SPLIT_B) {
                 for (uint32_t k = 0; k < h->child_count[B]; k++)
                     out[m++] = (link_task){.A = A, .B = h->first_child[B] + k};
@@ -149,7 +188,7 @@ static link_task *unroll_tasks(link_par *p, link_task *tasks, size_t *count, siz
                 grew = 1;
             } else if (what == IV_PAIR_LINK) {
                 out[m] = (link_task){.A = A, .B = B};
-                if (!task_push(&out[m], A, B)) {
+                if (!task_push(&out[m], A, B, bins)) {
                     free(out);
                     return tasks;
                 }
@@ -167,7 +206,8 @@ static link_task *unroll_tasks(link_par *p, link_task *tasks, size_t *count, siz
 
 static void *collect_worker(void *arg)
 {
-    link_par *p = arg;
+    write_arg *w = arg;
+    link_par *p = w->p;
     for (;;) {
         size_t i = atomic_fetch_add(&p->next, 1);
         if (i >= p->ntasks)
@@ -177,18 +217,14 @@ static void *collect_worker(void *arg)
         link_task *t = &p->tasks[i];
         if (t->n > 0)
             continue; /* a link found while unrolling */
+        t->buf = w->index;
+        t->off = p->used[w->index];
         int ok = t->B == UINT32_MAX ? collect_self(p, t, t->A) : collect_pair(p, t, t->A, t->B);
         if (!ok)
             p->fail = 1;
     }
     return NULL;
 }
-
-typedef struct write_arg {
-    link_par *p;
-    uint32_t index;
-    uint64_t created;
-} write_arg;
 
 static void *write_worker(void *arg)
 {
@@ -199,34 +235,55 @@ static void *write_worker(void *arg)
     /* a private copy of the counters: `created` is summed afterwards */
     iv_links mine = *p->l;
     mine.created = 0;
-    for (uint32_t x = me; x < p->l->nodes; x += T) { /* its nodes' bins emptied */
-        size_t base = (size_t)x * p->l->bins;
-        for (uint32_t b = 0; b < p->l->bins; b++) {
-            p->l->other[base + b] = -1;
-            p->l->dist[base + b] = FLT_MAX;
-            p->l->cover[base + b] = 0.0f;
-        }
-    }
+    iv_links_clear_nodes(p->l, me, T); /* its nodes' bins emptied */
     uint64_t steps = 0;
     for (size_t i = 0; i < p->ntasks; i++) {
         const link_task *t = &p->tasks[i];
+        const uint32_t *pairs = task_pairs(p, t);
         for (size_t k = 0; k < t->n; k++) {
             if (par_stop(p, ++steps))
                 return NULL;
-            uint32_t A = t->pairs[2 * k], B = t->pairs[2 * k + 1];
+            if (k + 16 < t->n) { /* the cells 16 pairs ahead, fetched while these are written */
+                const uint32_t *f = &pairs[4 * (k + 16)];
+                if (f[0] % T == me)
+                    __builtin_prefetch(&p->l->cell[(size_t)f[0] * p->l->bins + f[2]], 1);
+                if (f[1] % T == me)
+                    __builtin_prefetch(&p->l->cell[(size_t)f[1] * p->l->bins + f[3]], 1);
+            }
+            const uint32_t *q = &pairs[4 * k];
+            uint32_t A = q[0], B = q[1];
             int a = A % T == me, b = B % T == me;
             if (!a && !b)
                 continue;
             gi_vec3 d = gi_v3_sub(gi_v3_load(&h->pos[3 * B]), gi_v3_load(&h->pos[3 * A]));
             float r = sqrtf(gi_v3_dot(d, d));
             if (a)
-                iv_put_side(&mine, h, A, B, d, r, p->splat);
+                iv_put_side(&mine, h, A, B, d, r, q[2], p->splat);
             if (b)
-                iv_put_side(&mine, h, B, A, gi_v3_scale(d, -1.0f), r, p->splat);
+                iv_put_side(&mine, h, B, A, gi_v3_scale(d, -1.0f), r, q[3], p->splat);
         }
     }
     w->created = mine.created;
     return NULL;
+}
+
+/* At least `threads` pair buffers in l (kept from frame to frame). */
+static int pair_bufs(iv_links *l, uint32_t threads)
+{
+    if (l->pair_bufs >= threads)
+        return 1;
+    uint32_t **b = realloc(l->pair_buf, threads * sizeof *b);
+    if (!b)
+        return 0;
+    l->pair_buf = b;
+    size_t *c = realloc(l->pair_cap, threads * sizeof *c);
+    if (!c)
+        return 0;
+    l->pair_cap = c;
+    for (uint32_t i = l->pair_bufs; i < threads; i++)
+        b[i] = NULL, c[i] = 0;
+    l->pair_bufs = threads;
+    return 1;
 }
 
 int iv_links_build_parallel(iv_links *l, const iv_hier *h, float subdiv, int splat, int threads)
@@ -251,12 +308,15 @@ int iv_links_build_parallel(iv_links *l, const iv_hier *h, float subdiv, int spl
     pthread_t *tid = malloc((size_t)threads * sizeof *tid);
     uint8_t *made = calloc((size_t)threads, 1);
     write_arg *wa = calloc((size_t)threads, sizeof *wa);
-    int ok = tid && made && wa;
+    p.used = calloc((size_t)threads, sizeof *p.used);
+    int ok = tid && made && wa && p.used && pair_bufs(l, (uint32_t)threads);
     if (ok) {
         /* this thread works too; a thread that cannot start is not needed */
+        for (int i = 0; i < threads; i++)
+            wa[i] = (write_arg){.p = &p, .index = (uint32_t)i};
         for (int i = 1; i < threads; i++)
-            made[i] = pthread_create(&tid[i], NULL, collect_worker, &p) == 0;
-        collect_worker(&p);
+            made[i] = pthread_create(&tid[i], NULL, collect_worker, &wa[i]) == 0;
+        collect_worker(&wa[0]);
         for (int i = 1; i < threads; i++)
             if (made[i])
                 pthread_join(tid[i], NULL);
@@ -283,7 +343,7 @@ int iv_links_build_parallel(iv_links *l, const iv_hier *h, float subdiv, int spl
     }
     for (size_t i = 0; i < m; i++)
         free(tasks[i].pairs);
-    free(tasks), free(tid), free(made), free(wa);
+    free(tasks), free(tid), free(made), free(wa), free(p.used);
     if (atomic_load(&p.stop)) { /* cancelled: no build on one thread follows */
         l->stopped = 1;
         return 1;

@@ -129,6 +129,8 @@ int main(int argc, char **argv)
         iv_test_remesh(), known = 1;
     if (all || !strcmp(part, "gpu"))
         iv_test_gpu(), known = 1;
+    if (all || !strcmp(part, "layout"))
+        iv_test_layout(), known = 1;
     if (!known) {
         fprintf(stderr, "iv_tests: unknown part '%s'\n", part);
         return 2;

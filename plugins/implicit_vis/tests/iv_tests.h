@@ -59,5 +59,6 @@ void iv_test_leak(void);
 void iv_test_remesh(void);
 void iv_test_threads(void);
 void iv_test_gpu(void);
+void iv_test_layout(void);
 
 #endif

@@ -220,9 +220,11 @@ static void direct_case(const char *scene, float edge_frac, int required)
                     uint32_t src = f.l->light_src[j];
                     printf("    light link bin %u to node %u at dist %.3f (leaf %d) cover %.3f\n",
                            f.l->light_bin[j], src,
-                           f.l->dist[(size_t)x * f.l->bins + f.l->light_bin[j]], iv_is_leaf(h, src),
-                           f.l->cover[(size_t)x * f.l->bins + f.l->light_bin[j]] /
-                               f.l->bin_omega[f.l->light_bin[j]]);
+                           f.l->cell[(size_t)x * f.l->bins + f.l->light_bin[j]].dist,
+                           iv_is_leaf(h, src),
+                           f.l->cover ? f.l->cover[(size_t)x * f.l->bins + f.l->light_bin[j]] /
+                                            f.l->bin_omega[f.l->light_bin[j]]
+                                      : 0.0f);
                 }
             }
         } else if (sh > 0.5 * un && un > 0.0) {

@@ -183,7 +183,7 @@ void iv_test_links(void)
             }
         }
         for (uint32_t b = 0; b < l->bins; b++) {
-            int32_t o = l->other[(size_t)A * l->bins + b];
+            int32_t o = l->cell[(size_t)A * l->bins + b].other;
             if (o < 0) {
                 not_nearest += best[b] != FLT_MAX;
                 continue;
@@ -202,7 +202,7 @@ void iv_test_links(void)
     wrong_bin = 0;
     for (uint32_t A = 0; A < h->node_count; A++)
         for (uint32_t b = 0; b < l->bins; b++) {
-            int32_t o = l->other[(size_t)A * l->bins + b];
+            int32_t o = l->cell[(size_t)A * l->bins + b].other;
             if (o >= 0) {
                 gi_vec3 d = gi_v3_sub(gi_v3_load(&h->pos[3 * o]), gi_v3_load(&h->pos[3 * A]));
                 wrong_bin += iv_bin_of(d, n) != b;
@@ -210,7 +210,8 @@ void iv_test_links(void)
         }
     size_t cells = (size_t)l->bins * h->node_count;
     float *before = malloc(cells * sizeof(float));
-    memcpy(before, l->dist, cells * sizeof(float));
+    for (size_t i = 0; i < cells; i++)
+        before[i] = l->cell[i].dist;
     iv_links_refine_push(l, h);
     int longer = 0, lost = 0;
     for (uint32_t e = 0; e < h->elem_count; e++) {
@@ -219,9 +220,9 @@ void iv_test_links(void)
             float shortest = FLT_MAX;
             for (int32_t a = (int32_t)x; a >= 0; a = h->parent[a])
                 shortest = fminf(shortest, before[(size_t)a * l->bins + b]);
-            float got = l->dist[(size_t)x * l->bins + b];
+            float got = l->cell[(size_t)x * l->bins + b].dist;
             longer += got > shortest;
-            lost += shortest < FLT_MAX && l->other[(size_t)x * l->bins + b] < 0;
+            lost += shortest < FLT_MAX && l->cell[(size_t)x * l->bins + b].other < 0;
         }
         /* the receiving list holds one link per filled bin, in bin order */
         for (uint32_t j = l->leaf_off[e]; j + 1 < l->leaf_off[e + 1]; j++)

@@ -48,9 +48,9 @@ static void threads_case(const char *path, float edge, int remesher, uint32_t N,
             iv_links_build(many, h, 1.0f, 0, splat);
             iv_links_refine_push(many, h);
             int same =
-                !memcmp(one->other, many->other, cells * sizeof *one->other) &&
-                !memcmp(one->dist, many->dist, cells * sizeof *one->dist) &&
-                !memcmp(one->cover, many->cover, cells * sizeof *one->cover) &&
+                !memcmp(one->cell, many->cell, cells * sizeof *one->cell) &&
+                !one->cover == !many->cover &&
+                (!one->cover || !memcmp(one->cover, many->cover, cells * sizeof *one->cover)) &&
                 one->tries == many->tries && one->created == many->created &&
                 one->receiving == many->receiving &&
                 !memcmp(one->leaf_off, many->leaf_off,
