@@ -104,6 +104,7 @@ typedef struct viewer {
     float divider; /* the divider's place, a fraction of the window width */
     int dragging_divider;
     const char *window_shot; /* the next display also writes the window to this PNG */
+    int window_shot_image;   /* ... only its image region */
     char *window_shot_buf;   /* its storage (script) */
     /* the reference */
     view_ref ref;

@@ -95,6 +95,11 @@ int view_build_display(viewer *v)
  * from the back buffer before the swap. */
 static void write_window(viewer *v, int fw, int fh)
 {
+    if (v->window_shot_image) { /* the image region: the left image_w columns */
+        int ww = 0, wh = 0;
+        glfwGetWindowSize(v->win, &ww, &wh);
+        fw = ww > 0 ? (int)((double)v->image_w * fw / ww + 0.5) : fw;
+    }
     gi_image *img = fw > 0 && fh > 0 ? gi_image_create((uint32_t)fw, (uint32_t)fh) : NULL;
     unsigned char *px = malloc((size_t)fw * (size_t)(fh > 0 ? fh : 0) * 4);
     gi_error err;

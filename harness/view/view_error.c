@@ -136,15 +136,16 @@ int view_print_state(viewer *v, const char *prefix)
             v->px_method[c] = v->px_ref[c] = v->px_err = NAN;
     char *params = v->params ? gi_params_to_string(v->params) : NULL;
     printf("state: method=%s method2=%s split=%d source=%s panels=%d image=%ux%u region=%dx%d "
-           "zoom=%g pan=%g,%g frame=%u spp=%llu relmse=%.9g params=%s cursor=%d,%d "
+           "zoom=%g pan=%g,%g frame=%u frame2=%u spp=%llu relmse=%.9g params=%s cursor=%d,%d "
            "pixel_method=%.6g,%.6g,%.6g pixel_ref=%.6g,%.6g,%.6g pixel_err=%.6g\n",
            v->method_index < 0 ? "reference" : v->m->id,
            v->second.method_index >= 0 && v->second.m ? v->second.m->id : "-", v->split,
            source_name(v->source), v->show_panels, v->width, v->height, v->image_w, v->image_h,
            (double)v->zoom, (double)v->pan_x, (double)v->pan_y, v->frame_index,
-           (unsigned long long)v->ref_spp, relmse, params && *params ? params : "-", v->cursor_px,
-           v->cursor_py, (double)v->px_method[0], (double)v->px_method[1], (double)v->px_method[2],
-           (double)v->px_ref[0], (double)v->px_ref[1], (double)v->px_ref[2], (double)v->px_err);
+           v->second.frame_index, (unsigned long long)v->ref_spp, relmse,
+           params && *params ? params : "-", v->cursor_px, v->cursor_py, (double)v->px_method[0],
+           (double)v->px_method[1], (double)v->px_method[2], (double)v->px_ref[0],
+           (double)v->px_ref[1], (double)v->px_ref[2], (double)v->px_err);
     fflush(stdout);
     free(params);
     return EXIT_OK;

@@ -29,7 +29,8 @@
  *     wait-spp N              until the reference (shown or not) has N samples per pixel
  *     save-view FILE.json     the view, as key V saves it
  *     screenshot PREFIX       PREFIX.exr, PREFIX.png and PREFIX.json (its view)
- *     window-shot FILE.png    the window as shown (split view, divider) at the next redraw
+ *     window-shot FILE.png [image]   the window as shown (split view, divider, panels) at
+ *                             the next redraw; with "image" only the image region
  *     resize W H              the image region resized to W x H (the window to W x H and
  *                             the panels' width; the image is rendered again at that size)
  *     quit                    exit 0 (so does the end of the file)
@@ -355,8 +356,9 @@ static int screenshot_line(viewer *v, const script_line *s)
 
 static int window_shot_line(viewer *v, const script_line *s)
 {
-    if (s->n != 2)
-        return bad(v, "window-shot FILE.png");
+    if (s->n < 2 || (s->n == 3 && strcmp(s->b, "image")))
+        return bad(v, "window-shot FILE.png [image]");
+    v->window_shot_image = s->n == 3;
     free(v->window_shot_buf);
     v->window_shot_buf = strdup(s->a);
     if (!v->window_shot_buf)
