@@ -222,7 +222,8 @@ static int make_display(viewer *v)
     if (!view_overlay_init(v))
         return cli_fail(EXIT_RUN, "view: the overlay's shader or buffers could not be made");
     v->show_overlay = 1;
-    if (!view_panels_init(v))
+    /* Dear ImGui starts with the first panels shown (view_panels_draw) */
+    if (v->show_panels && !view_panels_init(v))
         return cli_fail(EXIT_RUN, "view: Dear ImGui could not start on the window's context");
     if (!view_ref_start(&v->ref, v->scene))
         return cli_fail(EXIT_RUN, "view: cannot start the reference's worker thread");

@@ -259,6 +259,8 @@ extern "C" {
 
 int view_panels_init(viewer *v)
 {
+    if (v->panels)
+        return v->panels->ready;
     view_panels *p = static_cast<view_panels *>(std::calloc(1, sizeof *p));
     if (!p)
         return 0;
@@ -323,8 +325,13 @@ void view_panels_char(GLFWwindow *w, unsigned int c)
 
 void view_panels_draw(viewer *v)
 {
+    if (!v->panels && !view_panels_init(v)) { // first shown with key F1 or script line panels
+        std::fprintf(stderr, "gibench: view: Dear ImGui could not start; the panels stay empty\n");
+        v->show_panels = 0;
+        return;
+    }
     view_panels *p = v->panels;
-    if (!p || !p->ready)
+    if (!p->ready)
         return;
     double t0 = gi_now();
     ImGui_ImplOpenGL3_NewFrame();
