@@ -129,7 +129,7 @@ void param_widget(viewer *v, view_panels *p, uint32_t i, actions *a)
     }
 }
 
-void method_section(viewer *v, view_panels *p, actions *a)
+void method_section(viewer *v, actions *a)
 {
     int n = (int)v->reg->count;
     int cur = v->method_index < 0 ? n : v->method_index;
@@ -137,8 +137,15 @@ void method_section(viewer *v, view_panels *p, actions *a)
         a->method = cur == n ? -1 : cur;
     if (v->status[0])
         ImGui::TextWrapped("%s", v->status);
-    if (v->method_index < 0 || !v->params)
+}
+
+// The method's parameters, last: a paper's table can be long.
+void param_section(viewer *v, view_panels *p, actions *a)
+{
+    if (v->method_index < 0 || !v->params) {
+        ImGui::TextDisabled("the reference has no parameters");
         return;
+    }
     if (p->values_of != v->params) { // a new instance: its values
         for (uint32_t i = 0; i < v->params->count && i < 64; i++)
             p->values[i] = v->params->values[i];
@@ -345,15 +352,17 @@ void view_panels_draw(viewer *v)
     ImGui::PushItemWidth(VIEW_PANEL_W * 0.55f);
     actions a;
     if (ImGui::CollapsingHeader("Method", ImGuiTreeNodeFlags_DefaultOpen))
-        method_section(v, p, &a);
-    if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen))
-        view_section(v, &a);
-    if (ImGui::CollapsingHeader("Frame time", ImGuiTreeNodeFlags_DefaultOpen))
-        timing_section(v);
-    if (ImGui::CollapsingHeader("Reference", ImGuiTreeNodeFlags_DefaultOpen))
+        method_section(v, &a);
+    if (ImGui::CollapsingHeader("Reference and error", ImGuiTreeNodeFlags_DefaultOpen))
         reference_section(v);
     if (ImGui::CollapsingHeader("Pixel", ImGuiTreeNodeFlags_DefaultOpen))
         pixel_section(v);
+    if (ImGui::CollapsingHeader("Frame time", ImGuiTreeNodeFlags_DefaultOpen))
+        timing_section(v);
+    if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen))
+        view_section(v, &a);
+    if (ImGui::CollapsingHeader("Parameters", ImGuiTreeNodeFlags_DefaultOpen))
+        param_section(v, p, &a);
     ImGui::PopItemWidth();
     ImGui::End();
     ImGui::Render();
