@@ -131,13 +131,20 @@ int view_second_wants_frame(const viewer *v)
 int view_second_render(viewer *v)
 {
     ensure_target(v);
-    /* the totals of the exit line count the first method's frames only */
+    /* the totals of the exit line and the stage times of the panels and
+     * the overlay are the first method's */
     double sum = v->sum_frame_ms;
     uint64_t n = v->n_frames;
+    char names[GI_TIMER_MAX_STAGES][GI_TIMER_NAME_MAX];
+    double ms[GI_TIMER_MAX_STAGES];
+    memcpy(names, v->stage_name, sizeof names);
+    memcpy(ms, v->stage_ms, sizeof ms);
     view_slot_swap(v);
     v->need_render = 0;
     int rc = view_render_method(v);
     view_slot_swap(v);
+    memcpy(v->stage_name, names, sizeof names);
+    memcpy(v->stage_ms, ms, sizeof ms);
     v->sum_frame_ms = sum;
     v->n_frames = n;
     v->err_dirty = 1;
