@@ -381,6 +381,8 @@ static int loop(viewer *v)
             if (rc != EXIT_OK)
                 return rc;
             v->frames_since_event++;
+            if (v->source == VIEW_SRC_BUFFER)
+                view_buffer_upload(v); /* the buffer of this frame */
         }
         if (view_second_wants_frame(v)) {
             int rc = view_second_render(v);
