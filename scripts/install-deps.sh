@@ -24,6 +24,9 @@ pkgs=(
   # An X server for headless tests of the GLFW viewer; the charts do not need it
   # (VTK draws through EGL, see harness/report/charts.cpp).
   xvfb xauth
+  # gibench view's panels beside the image (harness/view/view_panels.cpp): Dear ImGui
+  # with its GLFW and OpenGL 3 backends, a static libimgui.a
+  libimgui-dev
   libjson-c-dev libxxhash-dev
   # plugins/vlf: the spherical triangulation of the direction set
   libqhull-dev

@@ -11,12 +11,14 @@
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
 #include "view.h"
+#include "view_panels.h"
 
 #include "gi/cache.h"
 #include "gi/log.h"
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -32,13 +34,14 @@ static int parse_opts(int argc, char **argv, viewer *v)
     v->height = 512;
     v->seed = 1;
     v->shot_dir = ".";
+    v->show_panels = -1; /* on, but off under --script unless --panels on */
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         const char *val = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "--scene") || !strcmp(a, "--method") || !strcmp(a, "--size") ||
             !strcmp(a, "--script") || !strcmp(a, "--screenshot-dir") || !strcmp(a, "--param") ||
             !strcmp(a, "--camera") || !strcmp(a, "--exposure") || !strcmp(a, "--time") ||
-            !strcmp(a, "--seed")) {
+            !strcmp(a, "--seed") || !strcmp(a, "--panels")) {
             if (!val)
                 return cli_fail(EXIT_USAGE, "view: %s needs a value", a);
             i++;
@@ -56,7 +59,11 @@ static int parse_opts(int argc, char **argv, viewer *v)
             v->shot_dir = val;
         else if (!strcmp(a, "--camera"))
             v->camera_name = val;
-        else if (!strcmp(a, "--size")) {
+        else if (!strcmp(a, "--panels")) {
+            if (strcmp(val, "on") && strcmp(val, "off"))
+                return cli_fail(EXIT_USAGE, "view: --panels '%s' is not on or off", val);
+            v->show_panels = !strcmp(val, "on");
+        } else if (!strcmp(a, "--size")) {
             if (!cli_parse_size(val, &v->width, &v->height))
                 return cli_fail(EXIT_USAGE, "view: --size '%s' is not WxH with " GI_IMAGE_SIZE_RULE,
                                 val);
@@ -80,6 +87,8 @@ static int parse_opts(int argc, char **argv, viewer *v)
     }
     if (!v->scene_path)
         return cli_fail(EXIT_USAGE, "view: --scene is required");
+    if (v->show_panels < 0)
+        v->show_panels = v->script_path ? 0 : 1;
     return EXIT_OK;
 }
 
@@ -158,7 +167,9 @@ static int open_window(viewer *v)
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
     glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
     glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-    v->win = glfwCreateWindow((int)v->width, (int)v->height, "gibench view", NULL, NULL);
+    /* the panels go right of the image, which keeps the size asked for */
+    int pw = v->show_panels ? VIEW_PANEL_W : 0;
+    v->win = glfwCreateWindow((int)v->width + pw, (int)v->height, "gibench view", NULL, NULL);
     if (!v->win)
         return cli_fail(EXIT_RUN, "view: no window with an OpenGL 4.5 core context (GLFW)");
     glfwMakeContextCurrent(v->win);
@@ -166,6 +177,7 @@ static int open_window(viewer *v)
     glfwSwapInterval(v->script ? 0 : 1);
     view_input_listen(v);
     glfwGetWindowSize(v->win, &v->win_w, &v->win_h);
+    view_region_update(v);
     return EXIT_OK;
 }
 
@@ -206,9 +218,13 @@ static int make_display(viewer *v)
     int rc = view_build_display(v);
     if (rc != EXIT_OK)
         return rc;
+    view_buffer_upload(v);
     if (!view_overlay_init(v))
         return cli_fail(EXIT_RUN, "view: the overlay's shader or buffers could not be made");
     v->show_overlay = 1;
+    /* Dear ImGui starts with the first panels shown (view_panels_draw) */
+    if (v->show_panels && !view_panels_init(v))
+        return cli_fail(EXIT_RUN, "view: Dear ImGui could not start on the window's context");
     if (!view_ref_start(&v->ref, v->scene))
         return cli_fail(EXIT_RUN, "view: cannot start the reference's worker thread");
     return EXIT_OK;
@@ -231,6 +247,11 @@ static int setup(viewer *v)
     if (rc != EXIT_OK)
         return rc;
     v->method_index = -2; /* none yet */
+    v->host = &v->host_store[0];
+    v->second.method_index = -1;
+    v->zoom = 1.0f;
+    v->cursor_px = v->cursor_py = -1;
+    v->relmse = NAN;
     v->divider = 0.5f;
     v->drag_button = -1;
     v->last_method = start >= 0 ? start : 0;
@@ -261,10 +282,36 @@ static void resize_targets(viewer *v, uint32_t w, uint32_t h)
     view_changed(v);
 }
 
+/* The image's size in framebuffer pixels: the window less the panels. */
+static void view_image_size(viewer *v, int *w, int *h)
+{
+    int ww = 0, wh = 0;
+    glfwGetFramebufferSize(v->win, w, h);
+    glfwGetWindowSize(v->win, &ww, &wh);
+    view_region_update(v);
+    if (v->show_panels)
+        *w -= ww > 0 ? (int)lround((double)VIEW_PANEL_W * *w / ww) : VIEW_PANEL_W;
+}
+
+int view_toggle_panels(viewer *v)
+{
+    int ww = 0, wh = 0;
+    glfwGetWindowSize(v->win, &ww, &wh);
+    v->show_panels = !v->show_panels;
+    glfwSetWindowSize(v->win, ww + (v->show_panels ? VIEW_PANEL_W : -VIEW_PANEL_W), wh);
+    view_region_update(v);
+    view_reference_as_needed(v);
+    v->need_display = 1;
+    return EXIT_OK;
+}
+
 static void teardown(viewer *v)
 {
     view_ref_stop(&v->ref);
+    if (v->host)
+        view_second_unload(v);
     view_unload_method(v);
+    gi_image_free(v->ref_img);
     view_move_free(v);
     gi_timer_free(v->timer);
     if (v->win) {
@@ -278,6 +325,10 @@ static void teardown(viewer *v)
             glDeleteTextures(1, &v->target_tex);
         if (v->ref_tex)
             glDeleteTextures(1, &v->ref_tex);
+        GLuint more[3] = {v->second.target_tex, v->buf_tex, v->second.target_fbo};
+        glDeleteTextures(2, more);
+        glDeleteFramebuffers(1, &more[2]);
+        view_panels_free(v);
         view_overlay_free(v);
         gi_gpu_scene_free(v->gs);
         gi_gpu_destroy(v->gpu);
@@ -309,7 +360,7 @@ static int loop(viewer *v)
 {
     while (!v->quit && !glfwWindowShouldClose(v->win) && !cli_interrupted) {
         int fw = 0, fh = 0;
-        glfwGetFramebufferSize(v->win, &fw, &fh);
+        view_image_size(v, &fw, &fh);
         if (fw > 0 && fh > 0 && ((uint32_t)fw != v->width || (uint32_t)fh != v->height) &&
             gi_image_size_ok((unsigned)fw, (unsigned)fh))
             resize_targets(v, (uint32_t)fw, (uint32_t)fh);
@@ -330,11 +381,18 @@ static int loop(viewer *v)
             if (rc != EXIT_OK)
                 return rc;
             v->frames_since_event++;
+            if (v->source == VIEW_SRC_BUFFER)
+                view_buffer_upload(v); /* the buffer of this frame */
+        }
+        if (view_second_wants_frame(v)) {
+            int rc = view_second_render(v);
+            if (rc != EXIT_OK)
+                return rc;
         }
         if (v->method_index < 0 || v->stale)
             v->need_render = 0; /* the worker renders, or the method shows nothing; the change went
                                    with view_changed */
-        if (v->method_index < 0 || v->split) {
+        if (view_needs_reference(v)) {
             view_poll_reference(v);
             char err[GI_ERROR_MAX];
             view_ref_error(&v->ref, err, sizeof err);
@@ -343,6 +401,7 @@ static int loop(viewer *v)
         }
         if (v->need_display)
             view_display(v);
+        view_panels_apply(v);
         if (v->exit_code != EXIT_OK)
             return v->exit_code;
         if (v->script) {
@@ -350,7 +409,8 @@ static int loop(viewer *v)
             int rc = view_script_step(v);
             if (rc != EXIT_OK)
                 return rc;
-        } else if (v->playing || wants_frame(v) || v->dragging_divider) {
+        } else if (v->playing || wants_frame(v) || view_second_wants_frame(v) ||
+                   v->dragging_divider) {
             glfwPollEvents();
         } else {
             glfwWaitEventsTimeout(v->method_index < 0 ? 0.05 : 0.25);

@@ -57,7 +57,11 @@ void view_changed(viewer *v)
     v->frame_index = 0;
     v->need_render = 1;
     v->need_display = 1;
-    if (v->method_index < 0 || v->split) {
+    view_second_changed(v);
+    gi_image_free(v->ref_img); /* of the old view: no error against it */
+    v->ref_img = NULL;
+    v->err_dirty = 1;
+    if (view_needs_reference(v)) {
         gi_camera_frame cf = view_camera(v);
         view_ref_request(&v->ref, &cf, v->time, v->width, v->height, v->seed);
         v->ref_spp = 0;
@@ -66,10 +70,17 @@ void view_changed(viewer *v)
     }
 }
 
-/* The reference runs while it is shown (alone or in split view) and idles otherwise. */
+int view_needs_reference(const viewer *v)
+{
+    return v->method_index < 0 || v->split == 1 || v->split == 2 || v->show_panels ||
+           v->source == VIEW_SRC_ERROR || v->source == VIEW_SRC_REFERENCE;
+}
+
+/* The reference runs while it is shown (alone, in split view, as the error,
+ * or for the panels' live error) and idles otherwise. */
 void view_reference_as_needed(viewer *v)
 {
-    int need = v->method_index < 0 || v->split;
+    int need = view_needs_reference(v);
     if (need && !view_ref_running(&v->ref))
         view_changed(v);
     else if (!need)

@@ -2,6 +2,7 @@
  * mouse motion and the wheel, from the window's callbacks or, in a
  * scripted run, from the script alone (view_script.c). */
 #include "view.h"
+#include "view_panels.h"
 
 #include "gi/vecmath.h"
 
@@ -116,9 +117,15 @@ int view_key(viewer *v, int key, int mods)
     case GLFW_KEY_PAGE_DOWN:
         return method_key(v, key, mods);
     case GLFW_KEY_X:
-        v->split = (v->split + 1) % 3;
+        /* off, reference, error, and the second method where one is chosen */
+        v->split = (v->split + 1) % (v->second.method_index >= 0 ? 4 : 3);
         view_reference_as_needed(v);
         return EXIT_OK;
+    case GLFW_KEY_Z:
+        view_zoom_reset(v);
+        return EXIT_OK;
+    case GLFW_KEY_F1:
+        return view_toggle_panels(v);
     case GLFW_KEY_SPACE:
         v->playing = !v->playing;
         v->last_tick = gi_now();
@@ -151,6 +158,16 @@ int view_key(viewer *v, int key, int mods)
     case GLFW_KEY_RIGHT:
     case GLFW_KEY_UP:
     case GLFW_KEY_DOWN:
+        if (mods & GLFW_MOD_CONTROL) { /* Ctrl + arrows: the image panned by 32 pixels */
+            view_pan(v,
+                     key == GLFW_KEY_LEFT    ? 32
+                     : key == GLFW_KEY_RIGHT ? -32
+                                             : 0,
+                     key == GLFW_KEY_UP     ? 32
+                     : key == GLFW_KEY_DOWN ? -32
+                                            : 0);
+            return EXIT_OK;
+        }
         return camera_key(v, key, mods);
     case GLFW_KEY_P:
     case GLFW_KEY_V:
@@ -160,18 +177,27 @@ int view_key(viewer *v, int key, int mods)
     }
 }
 
+/* Mouse buttons over the image region: left drag orbits (Shift: moves the
+ * object under the mouse or the selected light, Ctrl: rotates the object;
+ * near the split's divider: moves the divider), right drag dollies, middle
+ * drag pans the image (Ctrl + middle: pans the camera). Window points go
+ * through the zoom to image points for picking (view_to_image). */
 void view_button(viewer *v, int button, int press, double x, double y, int mods)
 {
     if (!press && v->drag_object) {
         v->drag_object = 0;
         return;
     }
+    if (press && x >= v->image_w)
+        return; /* on the panels */
     if (press && button == GLFW_MOUSE_BUTTON_LEFT && (mods & (GLFW_MOD_SHIFT | GLFW_MOD_CONTROL))) {
         /* Shift: move the selected light (key L), or else the object under
          * the mouse, in the view plane; Ctrl: rotate the object */
+        double ix, iy;
+        view_to_image(v, x, y, &ix, &iy);
         int rc = v->sel_light >= 0 && !(mods & GLFW_MOD_CONTROL)
-                     ? view_light_pick(v, x, y)
-                     : view_pick(v, x, y, (mods & GLFW_MOD_CONTROL) ? 2 : 1);
+                     ? view_light_pick(v, ix, iy)
+                     : view_pick(v, ix, iy, (mods & GLFW_MOD_CONTROL) ? 2 : 1);
         if (rc != EXIT_OK && v->script)
             v->exit_code = rc;
         v->mx = x;
@@ -179,8 +205,7 @@ void view_button(viewer *v, int button, int press, double x, double y, int mods)
         v->need_display = 1;
         return;
     }
-    int ww = 0, wh = 0;
-    glfwGetWindowSize(v->win, &ww, &wh);
+    int ww = v->image_w;
     if (press && button == GLFW_MOUSE_BUTTON_LEFT && v->split && v->method_index >= 0 && ww > 0 &&
         fabs(x - v->divider * ww) <= 6.0) {
         v->dragging_divider = 1;
@@ -192,6 +217,7 @@ void view_button(viewer *v, int button, int press, double x, double y, int mods)
     }
     if (press) {
         v->drag_button = button;
+        v->drag_mods = mods;
         v->mx = x;
         v->my = y;
     } else if (button == v->drag_button) {
@@ -204,29 +230,40 @@ void view_cursor(viewer *v, double x, double y)
     double dx = x - v->mx, dy = y - v->my;
     v->mx = x;
     v->my = y;
+    double ix, iy;
+    int inside = view_to_image(v, x, y, &ix, &iy);
+    int px = inside ? (int)ix : -1, py = inside ? (int)iy : -1;
+    if (px != v->cursor_px || py != v->cursor_py) {
+        v->cursor_px = px;
+        v->cursor_py = py;
+        v->need_display |= v->show_panels; /* the pixel read-out */
+    }
     if (v->drag_object) {
         if (dx == 0 && dy == 0)
             return;
-        int rc = view_drag_to(v, x, y);
+        int rc = view_drag_to(v, ix, iy);
         if (rc != EXIT_OK)
             v->exit_code = rc;
         return;
     }
     if (v->dragging_divider) {
-        int ww = 0, wh = 0;
-        glfwGetWindowSize(v->win, &ww, &wh);
+        int ww = v->image_w;
         v->divider = ww > 0 ? fminf(1.0f, fmaxf(0.0f, (float)(x / ww))) : 0.5f;
         v->need_display = 1;
         return;
     }
     if (v->drag_button < 0 || (dx == 0 && dy == 0))
         return;
+    if (v->drag_button == GLFW_MOUSE_BUTTON_MIDDLE && !(v->drag_mods & GLFW_MOD_CONTROL)) {
+        view_pan(v, dx, dy); /* the image, not the camera */
+        return;
+    }
     if (v->drag_button == GLFW_MOUSE_BUTTON_LEFT) { /* orbit */
         v->yaw -= (float)dx * 0.01f;
         v->pitch += (float)dy * 0.01f;
     } else if (v->drag_button == GLFW_MOUSE_BUTTON_RIGHT) { /* dolly */
         v->dist *= expf((float)dy * 0.01f);
-    } else { /* pan */
+    } else { /* Ctrl + middle: pan the camera */
         gi_vec3 eye = view_eye(v);
         gi_vec3 fwd = gi_v3_normalize(gi_v3_sub(v->center, eye));
         gi_vec3 right = gi_v3_normalize(gi_v3_cross(fwd, gi_v3(0, 1, 0)));
@@ -238,8 +275,13 @@ void view_cursor(viewer *v, double x, double y)
     view_changed(v);
 }
 
-void view_scroll(viewer *v, double dy)
+/* The wheel zooms the image about the cursor; with Ctrl it dollies the camera. */
+void view_scroll(viewer *v, double dy, int mods)
 {
+    if (!(mods & GLFW_MOD_CONTROL)) {
+        view_zoom_at(v, powf(1.25f, (float)dy), v->mx, v->my);
+        return;
+    }
     v->dist *= expf(-(float)dy * 0.1f);
     view_changed(v);
 }
@@ -253,7 +295,9 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
 {
     (void)scancode;
     viewer *v = from(w);
-    if (action == GLFW_RELEASE || v->script)
+    if (v->show_panels)
+        view_panels_key(w, key, scancode, action, mods);
+    if (action == GLFW_RELEASE || v->script || view_panels_want_keyboard(v))
         return; /* a scripted run takes its events from the script only */
     int rc = view_key(v, key, mods);
     if (rc != EXIT_OK && v->exit_code == EXIT_OK)
@@ -265,6 +309,12 @@ static void on_button(GLFWwindow *w, int button, int action, int mods)
     viewer *v = from(w);
     if (v->script)
         return;
+    if (v->show_panels) {
+        view_panels_button(w, button, action, mods);
+        v->need_display = 1;
+        if (action == GLFW_PRESS && view_panels_want_mouse(v))
+            return;
+    }
     double x, y;
     glfwGetCursorPos(w, &x, &y);
     view_button(v, button, action == GLFW_PRESS, x, y, mods);
@@ -273,16 +323,29 @@ static void on_button(GLFWwindow *w, int button, int action, int mods)
 static void on_cursor(GLFWwindow *w, double x, double y)
 {
     viewer *v = from(w);
-    if (!v->script)
-        view_cursor(v, x, y);
+    if (v->script)
+        return;
+    if (v->show_panels && x >= v->image_w)
+        v->need_display = 1; /* hovered widgets */
+    view_cursor(v, x, y);
 }
 
 static void on_scroll(GLFWwindow *w, double dx, double dy)
 {
-    (void)dx;
     viewer *v = from(w);
-    if (!v->script)
-        view_scroll(v, dy);
+    if (v->script)
+        return;
+    if (v->show_panels) {
+        view_panels_scroll(w, dx, dy);
+        v->need_display = 1;
+        if (view_panels_want_mouse(v))
+            return;
+    }
+    int mods = glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS ||
+                       glfwGetKey(w, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS
+                   ? GLFW_MOD_CONTROL
+                   : 0;
+    view_scroll(v, dy, mods);
 }
 
 static void on_size(GLFWwindow *w, int width, int height)
@@ -291,6 +354,13 @@ static void on_size(GLFWwindow *w, int width, int height)
     v->win_w = width;
     v->win_h = height;
     v->need_display = 1;
+}
+
+static void on_char(GLFWwindow *w, unsigned int c)
+{
+    viewer *v = from(w);
+    if (v->show_panels && !v->script)
+        view_panels_char(w, c);
 }
 
 static void on_refresh(GLFWwindow *w)
@@ -305,6 +375,7 @@ void view_input_listen(viewer *v)
     glfwSetMouseButtonCallback(v->win, on_button);
     glfwSetCursorPosCallback(v->win, on_cursor);
     glfwSetScrollCallback(v->win, on_scroll);
+    glfwSetCharCallback(v->win, on_char);
     glfwSetWindowRefreshCallback(v->win, on_refresh);
     glfwSetWindowSizeCallback(v->win, on_size);
 }

@@ -19,7 +19,7 @@ void view_unload_method(viewer *v)
         v->m->destroy(v->inst);
     v->inst = NULL;
     if (v->host_ready)
-        cli_host_free(&v->host);
+        cli_host_free(v->host);
     v->host_ready = 0;
     gi_params_free(v->params);
     v->params = NULL;
@@ -65,17 +65,18 @@ int view_select(viewer *v, int index)
     char why[256];
     if (!cli_caps_cover(v->m, v->scene, v->playing, why, sizeof why))
         snprintf(v->status, sizeof v->status, "%s", why);
-    cli_host_init(&v->host, v->m->id, v->cache_dir, v->gs, gi_gpu_renderer(v->gpu),
+    cli_host_init(v->host, v->m->id, v->cache_dir, v->gs, gi_gpu_renderer(v->gpu),
                   gi_gpu_is_software(v->gpu));
     v->host_ready = 1;
-    v->host_progress = v->host.host.progress; /* the terminal line, and a bar in the window */
-    v->host.host.progress = view_overlay_progress;
+    v->host_progress = v->host->host.progress; /* the terminal line, and a bar in the window */
+    v->host->host.progress = view_overlay_progress;
+    view_overlay_progress_owner(v);
     gi_timer_free(v->timer);
     v->timer = gi_timer_create(GI_TIMER_CPU_FINISH, 0);
     v->timer_frames = 0;
     v->stage_count = 0;
     gi_error cerr;
-    gi_result res = gi_method_create(v->m, &v->host.host, v->params, &v->inst, &cerr);
+    gi_result res = gi_method_create(v->m, &v->host->host, v->params, &v->inst, &cerr);
     if (res != GI_OK)
         return cli_fail(EXIT_RUN, "view: %s: %s", v->m->id, cerr.text);
     char title[128];
@@ -89,7 +90,7 @@ int view_select(viewer *v, int index)
         view_nodes_swap(v, 1);
     double t0 = gi_now();
     res = v->m->prepare(v->inst, v->gs);
-    cli_host_progress_end(&v->host);
+    cli_host_progress_end(v->host);
     v->prepare_ms = 1e3 * (gi_now() - t0);
     if (moved) {
         view_nodes_swap(v, 0);
@@ -179,7 +180,7 @@ int view_render_method(viewer *v)
         v->timer = gi_timer_create(GI_TIMER_CPU_FINISH, 0);
         v->timer_frames = 0;
     }
-    v->host.timer = v->timer;
+    v->host->timer = v->timer;
     if (v->timer)
         gi_timer_frame_begin(v->timer);
     double t0 = gi_now();
@@ -202,7 +203,7 @@ int view_render_method(viewer *v)
             v->stage_ms[v->stage_count++] = ms[count - 1];
         }
     }
-    v->host.timer = NULL;
+    v->host->timer = NULL;
     v->sum_frame_ms += v->frame_ms;
     v->n_frames++;
     if (res != GI_OK) {
@@ -215,6 +216,9 @@ int view_render_method(viewer *v)
         return cli_fail(EXIT_RUN, "view: %s: %s", v->m->id, err.text);
     v->frame_index++;
     v->need_display = 1;
+    v->err_dirty = 1;
+    if (!v->second_swapped)
+        v->frame_hist[v->frame_hist_n++ % VIEW_FRAME_HISTORY] = v->frame_ms;
     return EXIT_OK;
 }
 
@@ -233,5 +237,5 @@ int view_set_time(viewer *v, float t)
                             gi_result_name(res));
     }
     view_changed(v);
-    return EXIT_OK;
+    return view_second_set_time(v);
 }

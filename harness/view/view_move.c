@@ -146,6 +146,8 @@ static int place_node(viewer *v, int node, const float trs[10])
         return cli_fail(EXIT_RUN, "out of memory");
     one[node] = 1;
     int rc = view_tell_method(v, one);
+    if (rc == EXIT_OK)
+        rc = view_second_tell(v, one);
     free(one);
     view_changed(v);
     return rc;
@@ -161,10 +163,11 @@ static void parent_world(const viewer *v, int node, float out[16])
         gi_mat4_identity(out);
 }
 
-/* The camera ray through window point (x, y) (pixels, top left origin). */
+/* The camera ray through image point (x, y) (pixels, top left origin; the
+ * input maps window points through the zoom to image points, view_zoom.c). */
 static void window_ray(const viewer *v, double x, double y, gi_vec3 *o, gi_vec3 *d)
 {
-    int ww = (int)v->win_w, wh = (int)v->win_h;
+    int ww = (int)v->width, wh = (int)v->height;
     gi_camera_frame cf = view_camera(v);
     float th = tanf(0.5f * cf.yfov), aspect = (float)v->width / (float)v->height;
     float nx = 2.0f * (float)x / (float)(ww > 0 ? ww : 1) - 1.0f,
@@ -232,7 +235,7 @@ int view_pick(viewer *v, double x, double y, int mode)
     v->drag_y0 = y;
     get_trs(&v->scene->nodes[node], v->drag_trs);
     v->drag_origin = gi_v3(world[12], world[13], world[14]);
-    v->drag_scale = 2.0f * depth * tanf(0.5f * cf.yfov) / (float)(v->win_h > 0 ? v->win_h : 1);
+    v->drag_scale = 2.0f * depth * tanf(0.5f * cf.yfov) / (float)(v->height > 0 ? v->height : 1);
     /* the pivot of a rotation: the centre of the object's bounds */
     const float *b = ob->local_bounds;
     float ow[16];
@@ -348,7 +351,7 @@ int view_light_pick(viewer *v, double x, double y)
     v->drag_pivot = pos;
     /* as for an object: a window pixel at the light's depth, so that the
      * light moves on the screen as far as the mouse does */
-    v->drag_scale = 2.0f * depth * tanf(0.5f * cf.yfov) / (float)(v->win_h > 0 ? v->win_h : 1);
+    v->drag_scale = 2.0f * depth * tanf(0.5f * cf.yfov) / (float)(v->height > 0 ? v->height : 1);
     v->status[0] = '\0';
     return EXIT_OK;
 }

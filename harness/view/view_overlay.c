@@ -270,10 +270,18 @@ void view_overlay_draw(viewer *v, int fw, int fh)
 /* The host's progress callback while the viewer's method precomputes:
  * the terminal line as before, and a bar in the window (at most ten
  * redraws a second). The plugin's GL state is saved and put back. */
+/* The viewer whose method precomputes: a process has one viewer, and the
+ * host the callback gets may be either of its two methods' (view_slot). */
+static viewer *progress_owner;
+
+void view_overlay_progress_owner(viewer *v)
+{
+    progress_owner = v;
+}
+
 void view_overlay_progress(const gi_host *h, const char *task, float fraction)
 {
-    cli_host *c = h->user;
-    viewer *v = (viewer *)(void *)((char *)c - offsetof(viewer, host));
+    viewer *v = progress_owner;
     if (v->host_progress)
         v->host_progress(h, task, fraction);
     double now = gi_now();

@@ -11,14 +11,28 @@
  *     press X Y [left|right|middle] [shift|ctrl]   a mouse button pressed at (X, Y)
  *     move X Y                the mouse moved to (X, Y)
  *     release X Y [left|right|middle]              the button released
- *     scroll DY               the mouse wheel
+ *     scroll DY [ctrl]        the mouse wheel at the mouse's place: zooms the image
+ *                             (with ctrl: dollies the camera)
+ *     zoom F X Y              the image zoomed by factor F about window point (X, Y)
+ *     pan DX DY               the image panned by (DX, DY) window pixels
+ *     panels on|off           the panels shown (the window grows by their width) or not
+ *     source NAME             the image shows output, error, reference or buffer
+ *     split N                 split mode 0 off, 1 reference, 2 error, 3 the second method
+ *     split2 ID|none          the second method (split mode 3), or none
+ *     param NAME=VALUE        a parameter of the method shown set, the method made again
+ *     print-state [PREFIX]    one line "state: ..." on stdout (method, split, zoom, the
+ *                             live relMSE, the pixel read-out at the mouse, ...); with
+ *                             PREFIX also PREFIX_method.exr and PREFIX_ref.exr, the pair
+ *                             the relMSE is of
  *     method ID               show method ID (or "reference")
  *     wait N                  N frames; on the reference, N more samples per pixel
+ *     wait-spp N              until the reference (shown or not) has N samples per pixel
  *     save-view FILE.json     the view, as key V saves it
  *     screenshot PREFIX       PREFIX.exr, PREFIX.png and PREFIX.json (its view)
- *     window-shot FILE.png    the window as shown (split view, divider) at the next redraw
- *     resize W H              the window resized to W x H (the image is rendered again at
- *                             that size)
+ *     window-shot FILE.png [image]   the window as shown (split view, divider, panels) at
+ *                             the next redraw; with "image" only the image region
+ *     resize W H              the image region resized to W x H (the window to W x H and
+ *                             the panels' width; the image is rendered again at that size)
  *     quit                    exit 0 (so does the end of the file)
  * Blank lines and lines starting with # are skipped. A line runs only once
  * the frame of the line before it has been rendered. */
@@ -57,6 +71,7 @@ static const key_name keys[] = {
     {"TAB", GLFW_KEY_TAB},
     {"PAGE_UP", GLFW_KEY_PAGE_UP},
     {"PAGE_DOWN", GLFW_KEY_PAGE_DOWN},
+    {"F1", GLFW_KEY_F1},
 };
 
 static int key_code(const char *name)
@@ -194,10 +209,103 @@ static int mouse_line(viewer *v, const script_line *s)
 static int scroll_line(viewer *v, const script_line *s)
 {
     double dy;
-    if (sscanf(s->text, "%*s %lf", &dy) != 1)
-        return bad(v, "scroll DY");
-    view_scroll(v, dy);
+    char mod[16] = "", extra[16] = "";
+    int n = sscanf(s->text, "%*s %lf %15s %15s", &dy, mod, extra);
+    int mods = mod_code(mod);
+    if (n < 1 || extra[0] || (mod[0] && mods != GLFW_MOD_CONTROL))
+        return bad(v, "scroll DY [ctrl]");
+    view_scroll(v, dy, mods);
     return EXIT_OK;
+}
+
+static int zoom_line(viewer *v, const script_line *s)
+{
+    double f, x, y;
+    char extra[8] = "";
+    if (sscanf(s->text, "%*s %lf %lf %lf %7s", &f, &x, &y, extra) != 3 || !(f > 0) || f > 1e3)
+        return bad(v, "zoom F X Y (F > 0)");
+    view_zoom_at(v, (float)f, x, y);
+    return EXIT_OK;
+}
+
+static int pan_line(viewer *v, const script_line *s)
+{
+    double dx, dy;
+    char extra[8] = "";
+    if (sscanf(s->text, "%*s %lf %lf %7s", &dx, &dy, extra) != 2)
+        return bad(v, "pan DX DY");
+    view_pan(v, dx, dy);
+    return EXIT_OK;
+}
+
+static int panels_line(viewer *v, const script_line *s)
+{
+    if (s->n != 2 || (strcmp(s->a, "on") && strcmp(s->a, "off")))
+        return bad(v, "panels on|off");
+    if (v->show_panels == !strcmp(s->a, "on"))
+        return EXIT_OK;
+    int ww = 0, wh = 0, fw = 0, fh = 0;
+    glfwGetWindowSize(v->win, &ww, &wh);
+    int want = ww + (v->show_panels ? -VIEW_PANEL_W : VIEW_PANEL_W);
+    view_toggle_panels(v);
+    /* the X server answers asynchronously: wait for the new size (up to 5 s) */
+    double until = gi_now() + 5.0;
+    do {
+        glfwPollEvents();
+        glfwGetFramebufferSize(v->win, &fw, &fh);
+    } while (fw != want && gi_now() < until);
+    if (fw != want)
+        return bad(v, "panels: the window did not take its new size");
+    view_region_update(v);
+    return EXIT_OK;
+}
+
+static int source_line(viewer *v, const script_line *s)
+{
+    static const char *names[VIEW_SRC_COUNT] = {"output", "error", "reference", "buffer"};
+    for (int i = 0; s->n == 2 && i < VIEW_SRC_COUNT; i++)
+        if (!strcmp(s->a, names[i])) {
+            v->source = i;
+            v->need_display = 1;
+            view_reference_as_needed(v);
+            return EXIT_OK;
+        }
+    return bad(v, "source output|error|reference|buffer");
+}
+
+static int split_line(viewer *v, const script_line *s)
+{
+    unsigned long k;
+    if (s->n != 2 || !cli_parse_uint(s->a, 0, 3, &k))
+        return bad(v, "split N (0 off, 1 reference, 2 error, 3 the second method)");
+    if (k == 3 && v->second.method_index < 0)
+        return bad(v, "split 3: no second method (split2 ID first)");
+    v->split = (int)k;
+    v->need_display = 1;
+    view_reference_as_needed(v);
+    return EXIT_OK;
+}
+
+static int split2_line(viewer *v, const script_line *s)
+{
+    int idx = s->n == 2 ? (!strcmp(s->a, "none") ? -1 : method_by_id(v, s->a)) : -2;
+    if (idx < -1 || (s->n == 2 && !strcmp(s->a, "reference")))
+        return bad(v, "split2: no such method (see gibench methods; or none)");
+    return view_second_select(v, idx);
+}
+
+static int param_line(viewer *v, const script_line *s)
+{
+    if (s->n != 2)
+        return bad(v, "param NAME=VALUE");
+    return view_set_param(v, s->a);
+}
+
+static int print_state_line(viewer *v, const script_line *s)
+{
+    if (s->n > 2)
+        return bad(v, "print-state [PREFIX]");
+    return view_print_state(v, s->n == 2 ? s->a : NULL);
 }
 
 static int method_line(viewer *v, const script_line *s)
@@ -221,6 +329,21 @@ static int wait_line(viewer *v, const script_line *s)
     return EXIT_OK;
 }
 
+static int wait_spp_line(viewer *v, const script_line *s)
+{
+    unsigned long k;
+    if (s->n != 2 || !cli_parse_uint(s->a, 1, 100000, &k))
+        return bad(v, "wait-spp N (samples per pixel, 1..100000)");
+    if (!view_needs_reference(v))
+        return bad(v, "wait-spp: the reference is not running (panels on, split 1 or 2, or "
+                      "source error or reference)");
+    v->wait_left = 1;
+    v->wait_ref = 1;
+    v->wait_spp = k;
+    v->wait_deadline = gi_now() + REF_WAIT_S;
+    return EXIT_OK;
+}
+
 static int save_view_line(viewer *v, const script_line *s)
 {
     return s->n == 2 ? view_save(v, s->a) : bad(v, "save-view FILE.json");
@@ -233,8 +356,9 @@ static int screenshot_line(viewer *v, const script_line *s)
 
 static int window_shot_line(viewer *v, const script_line *s)
 {
-    if (s->n != 2)
-        return bad(v, "window-shot FILE.png");
+    if (s->n < 2 || (s->n == 3 && strcmp(s->b, "image")))
+        return bad(v, "window-shot FILE.png [image]");
+    v->window_shot_image = s->n == 3;
     free(v->window_shot_buf);
     v->window_shot_buf = strdup(s->a);
     if (!v->window_shot_buf)
@@ -250,15 +374,16 @@ static int resize_line(viewer *v, const script_line *s)
     if (s->n != 3 || !cli_parse_uint(s->a, 1, GI_MAX_IMAGE_SIDE, &w) ||
         !cli_parse_uint(s->b, 1, GI_MAX_IMAGE_SIDE, &h) || !gi_image_size_ok(w, h))
         return bad(v, "resize W H (" GI_IMAGE_SIZE_RULE ")");
-    glfwSetWindowSize(v->win, (int)w, (int)h);
+    unsigned long pw = v->show_panels ? VIEW_PANEL_W : 0;
+    glfwSetWindowSize(v->win, (int)(w + pw), (int)h);
     /* the X server answers asynchronously: wait for the new size (up to 5 s) */
     double until = gi_now() + 5.0;
     int fw = 0, fh = 0;
     do {
         glfwPollEvents();
         glfwGetFramebufferSize(v->win, &fw, &fh);
-    } while (((unsigned long)fw != w || (unsigned long)fh != h) && gi_now() < until);
-    if ((unsigned long)fw != w || (unsigned long)fh != h)
+    } while (((unsigned long)fw != w + pw || (unsigned long)fh != h) && gi_now() < until);
+    if ((unsigned long)fw != w + pw || (unsigned long)fh != h)
         return bad(v, "resize: the window did not take the size");
     v->need_render = 1;
     return EXIT_OK;
@@ -282,10 +407,19 @@ static const struct {
     {"scroll", scroll_line},
     {"method", method_line},
     {"wait", wait_line},
+    {"wait-spp", wait_spp_line},
     {"save-view", save_view_line},
     {"screenshot", screenshot_line},
     {"window-shot", window_shot_line},
     {"resize", resize_line},
+    {"zoom", zoom_line},
+    {"pan", pan_line},
+    {"panels", panels_line},
+    {"source", source_line},
+    {"split", split_line},
+    {"split2", split2_line},
+    {"param", param_line},
+    {"print-state", print_state_line},
     {"quit", quit_line},
 };
 
@@ -299,8 +433,10 @@ static int run_line(viewer *v, char *line)
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (!strcmp(cmd, commands[i].name))
             return commands[i].run(v, &s);
-    return bad(v, "unknown command (key, drag, press, move, release, scroll, resize, method, wait, "
-                  "save-view, screenshot, window-shot, quit)");
+    return bad(
+        v, "unknown command (key, drag, press, move, release, scroll, zoom, pan, resize, "
+           "panels, source, split, split2, param, method, wait, wait-spp, save-view, screenshot, "
+           "window-shot, print-state, quit)");
 }
 
 int view_script_step(viewer *v)
@@ -309,9 +445,10 @@ int view_script_step(viewer *v)
     if (v->need_render)
         return EXIT_OK; /* the last line's frame first */
     if (v->wait_left) {
-        if (v->method_index < 0) {
+        if (v->method_index < 0 || v->wait_ref) {
             if (view_ref_spp(&v->ref) >= v->wait_spp) {
                 v->wait_left = 0;
+                v->wait_ref = 0;
             } else if (gi_now() > v->wait_deadline) {
                 return bad(v, "wait: the reference did not reach the samples in time");
             } else {
