@@ -155,14 +155,27 @@ static const gi_departure fake_departures[] = {
 };
 #endif
 
+#if defined(FAKE_ABI12)
+/* Built for ABI 1.2: its descriptor ends before debug_buffers, so the host
+ * must not see the table that lies beyond (in this build's struct). */
+static const gi_debug_buffer_desc fake_buffers[] = {
+    {"beyond", "lies beyond struct_size", GI_DEBUG_SCREEN},
+    {NULL, NULL, 0},
+};
+#endif
+
 static const gi_method fake_method = {
 #if defined(FAKE_SMALL_STRUCT)
     .struct_size = offsetof(gi_method, render),
+#elif defined(FAKE_ABI12)
+    .struct_size = offsetof(gi_method, debug_buffers),
 #else
     .struct_size = sizeof(gi_method),
 #endif
 #if defined(FAKE_WRONG_ABI)
     .abi_version = ((GI_ABI_MAJOR + 1u) << 16),
+#elif defined(FAKE_ABI12)
+    .abi_version = (1u << 16) | 2u,
 #else
     .abi_version = GI_ABI_VERSION,
 #endif
@@ -201,6 +214,9 @@ static const gi_method fake_method = {
     .layout = GI_ABI_LAYOUT,
 #if defined(FAKE_DEPART)
     .departures = fake_departures,
+#endif
+#if defined(FAKE_ABI12)
+    .debug_buffers = fake_buffers,
 #endif
 };
 
