@@ -1,0 +1,160 @@
+#!/usr/bin/env python3
+"""Debug buffers (plugin ABI 1.3, issue 33) through the CLI, at 32x32 on the
+Cornell box with small precomputation settings:
+
+- every paper plugin declares at least two buffers (`gibench methods ID
+  --json`), and each one is written (`render --buffer`), finite and not
+  constant;
+- checks that make them mean what they say: csm's visibility is in [0, 1],
+  dark pixels of it are dark in the csm image where the unshadowed `direct`
+  method lights them (and lit ones lit), which a constant 1 (no shadows,
+  the `direct` answer) or 0 (black) fails; csm's segments are >= 1 wherever
+  a shadow query was made; avg's voxels cover every pixel the avg image
+  shows geometry in; avg's VPLs splat onto the picture;
+- an unknown name fails with exit 2, a one-line error listing the buffers,
+  and writes no file.
+
+  debug_buffers_test.py GIBENCH ROOT OUTDIR
+"""
+import json
+import math
+import os
+import struct
+import subprocess
+import sys
+
+gib, root, out = sys.argv[1:4]
+os.makedirs(out, exist_ok=True)
+scene = os.path.join(root, "scenes/cornell_box.gltf")
+# small settings: each render well under the test's budget, no cache needed
+PARAMS = {
+    "csm": ["N=4", "M=32", "N_local=2", "M_local=32"],
+    "avg": ["grid=32", "vpls=256"],
+    "direct": [],
+}
+PAPERS = ["csm", "avg"]
+fails = 0
+
+
+def fail(msg):
+    global fails
+    fails += 1
+    print("FAIL: " + msg)
+
+
+def read_pfm(path):
+    with open(path, "rb") as f:
+        assert f.readline().strip() == b"PF"
+        w, h = map(int, f.readline().split())
+        scale = float(f.readline())
+        n = w * h * 3
+        v = struct.unpack(("<" if scale < 0 else ">") + "f" * n, f.read(4 * n))
+    # PFM rows run bottom to top; only per-pixel relations matter here
+    return w, h, [v[3 * i] * 0.2126 + v[3 * i + 1] * 0.7152 + v[3 * i + 2] * 0.0722
+                  for i in range(w * h)]
+
+
+def render(method, name, buffers=None, extra=()):
+    path = os.path.join(out, name + ".pfm")
+    args = [gib, "-q", "render", "--scene", scene, "--method", method, "--size", "32x32",
+            "--no-cache", "--out", path]
+    for p in PARAMS.get(method, []):
+        args += ["--param", p]
+    if buffers:
+        args += ["--buffer", ",".join(buffers)]
+    r = subprocess.run(args + list(extra), capture_output=True, text=True)
+    return r, path
+
+
+def render_buffers(method, names):
+    r, path = render(method, method + "_buf", names)
+    if r.returncode != 0:
+        fail("%s --buffer %s: exit %d: %s" % (method, ",".join(names), r.returncode, r.stderr))
+        return {}
+    got = {}
+    for n in names:
+        p = path[:-4] + "." + n + ".pfm" if len(names) > 1 else path
+        if not os.path.exists(p):
+            fail("%s: %s not written" % (method, p))
+            continue
+        w, h, v = read_pfm(p)
+        if (w, h) != (32, 32):
+            fail("%s %s: %dx%d, not 32x32" % (method, n, w, h))
+        if not all(math.isfinite(x) for x in v):
+            fail("%s %s: non-finite values" % (method, n))
+        if max(v) - min(v) <= 1e-6:
+            fail("%s %s: constant %g" % (method, n, v[0]))
+        got[n] = v
+    return got
+
+
+def image(method):
+    r, path = render(method, method + "_img")
+    if r.returncode != 0:
+        fail("%s: exit %d: %s" % (method, r.returncode, r.stderr))
+        return None
+    return read_pfm(path)[2]
+
+
+listing = subprocess.run([gib, "methods", "--json"], capture_output=True, text=True, check=True)
+declared = {m["id"]: [b["name"] for b in m.get("buffers", [])] for m in json.loads(listing.stdout)}
+for m in PAPERS:
+    if len(declared.get(m, [])) < 2:
+        fail("%s declares %d debug buffers, at least 2 wanted" % (m, len(declared.get(m, []))))
+bufs = {m: render_buffers(m, declared[m]) for m in PAPERS if len(declared.get(m, [])) >= 2}
+
+direct = image("direct")
+csm_img = image("csm")
+vis, seg = bufs.get("csm", {}).get("visibility"), bufs.get("csm", {}).get("segments")
+if vis and direct and csm_img:
+    if min(vis) < 0 or max(vis) > 1:
+        fail("csm visibility outside [0, 1]: %g..%g" % (min(vis), max(vis)))
+    lit = [i for i in range(len(direct)) if direct[i] > 1e-3]
+    dark = [i for i in lit if vis[i] < 0.05]
+    bright = [i for i in lit if vis[i] > 0.95]
+    # a shadow term explains the csm image: where it says shadow, csm is
+    # dark beside direct; where it says lit, csm is as bright
+    ok_dark = sum(1 for i in dark if csm_img[i] < 0.25 * direct[i])
+    ok_bright = sum(1 for i in bright if csm_img[i] > 0.5 * direct[i])
+    print("csm visibility: %d lit pixels, %d in shadow (%d dark in csm), %d lit (%d bright)"
+          % (len(lit), len(dark), ok_dark, len(bright), ok_bright))
+    if len(dark) < 20 or len(bright) < 20:
+        fail("csm visibility: %d shadowed and %d lit pixels, at least 20 each wanted"
+             % (len(dark), len(bright)))
+    elif ok_dark < 0.85 * len(dark) or ok_bright < 0.9 * len(bright):
+        fail("csm visibility disagrees with the csm image: %d/%d dark, %d/%d bright"
+             % (ok_dark, len(dark), ok_bright, len(bright)))
+if seg and vis and direct:
+    # a pixel some light reached through the CSMs made at least one query
+    queried = [i for i in range(len(direct)) if direct[i] > 1e-3 and vis[i] > 0.05]
+    low = sum(1 for i in queried if seg[i] < 1)
+    if low or max(seg) <= 1:
+        fail("csm segments: %d queried pixels below 1, max %g" % (low, max(seg)))
+
+avg_img = image("avg")
+vox, vpl = bufs.get("avg", {}).get("voxels"), bufs.get("avg", {}).get("vpls")
+if vox and avg_img:
+    shown = [i for i in range(len(avg_img)) if avg_img[i] > 0]
+    missed = sum(1 for i in shown if vox[i] <= 0)
+    print("avg voxels: %d of %d geometry pixels without a voxel" % (missed, len(shown)))
+    if len(shown) < 100 or missed > 0.02 * len(shown):
+        fail("avg voxels miss %d of %d geometry pixels" % (missed, len(shown)))
+if vpl:
+    splats = sum(1 for x in vpl if x > 0)
+    print("avg vpls: %d pixels hold a VPL" % splats)
+    if splats < 10:
+        fail("avg vpls: only %d pixels hold a VPL" % splats)
+
+# an unknown name: exit 2, one line naming the buffers, no file
+r, path = render("csm", "unknown", ["visibility", "nosuch"])
+line = r.stderr.strip()
+if r.returncode != 2 or "\n" in line or "nosuch" not in line or "visibility, segments" not in line:
+    fail("unknown buffer: exit %d, '%s'" % (r.returncode, line))
+for p in (path, path[:-4] + ".visibility.pfm", path[:-4] + ".nosuch.pfm"):
+    if os.path.exists(p):
+        fail("unknown buffer: %s was written" % p)
+r = subprocess.run([gib, "methods", "csm"], capture_output=True, text=True)
+if r.returncode != 0 or "debug buffers" not in r.stdout or "visibility" not in r.stdout:
+    fail("methods csm lists no debug buffers")
+print("debug_buffers: %s" % ("FAIL" if fails else "ok"))
+sys.exit(1 if fails else 0)
