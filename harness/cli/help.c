@@ -13,7 +13,7 @@ static const command_help helps[] = {
      "usage: gibench methods [ID] [--json]\n"
      "List the method plugins found (the build's plugins/ and GIBENCH_PLUGIN_PATH): id, paper,\n"
      "caps, bounce count, every parameter with its type, default, range and meaning, and the\n"
-     "debug buffers (render --buffer NAME). With ID: that method only.\n"
+     "debug buffers that render writes on request. With ID: that method only.\n"
      "  --json   the same as JSON (what bash completion and scripts read)\n"},
     {"info",
      "usage: gibench info SCENE [--json]\n"
