@@ -30,9 +30,12 @@ scene = os.path.join(root, "scenes/cornell_box.gltf")
 PARAMS = {
     "csm": ["N=4", "M=32", "N_local=2", "M_local=32"],
     "avg": ["grid=32", "vpls=256"],
+    "cssm_hrc": ["atlas=16", "M=8"],
+    "vlf": ["l=64", "N=16", "density=6", "iterations=4"],
+    "implicit_vis": ["N=8"],
     "direct": [],
 }
-PAPERS = ["csm", "avg"]
+PAPERS = ["csm", "cssm_hrc", "implicit_vis", "vlf", "avg"]
 fails = 0
 
 
@@ -67,7 +70,9 @@ def render(method, name, buffers=None, extra=()):
 
 
 def render_buffers(method, names):
-    r, path = render(method, method + "_buf", names)
+    # the image of the same run beside the buffers (--frames-out, one frame)
+    frame = os.path.join(out, method + "_img_%d.pfm")
+    r, path = render(method, method + "_buf", names, ["--frames-out", frame])
     if r.returncode != 0:
         fail("%s --buffer %s: exit %d: %s" % (method, ",".join(names), r.returncode, r.stderr))
         return {}
@@ -78,7 +83,7 @@ def render_buffers(method, names):
             fail("%s: %s not written" % (method, p))
             continue
         w, h, v = read_pfm(p)
-        if (w, h) != (32, 32):
+        if (method, n) in screen and (w, h) != (32, 32):
             fail("%s %s: %dx%d, not 32x32" % (method, n, w, h))
         if not all(math.isfinite(x) for x in v):
             fail("%s %s: non-finite values" % (method, n))
@@ -89,15 +94,28 @@ def render_buffers(method, names):
 
 
 def image(method):
-    r, path = render(method, method + "_img")
-    if r.returncode != 0:
-        fail("%s: exit %d: %s" % (method, r.returncode, r.stderr))
-        return None
-    return read_pfm(path)[2]
+    """The method's image: the buffer run's frame, or (direct) a render."""
+    path = os.path.join(out, method + "_img_0.pfm")
+    if method == "direct":
+        r, path = render(method, method + "_img")
+        if r.returncode != 0:
+            fail("%s: exit %d: %s" % (method, r.returncode, r.stderr))
+            return None
+    return read_pfm(path)[2] if os.path.exists(path) else None
+
+
+def mean(v):
+    return sum(v) / len(v)
+
+
+def mae(a, b):
+    return mean([abs(x - y) for x, y in zip(a, b)])
 
 
 listing = subprocess.run([gib, "methods", "--json"], capture_output=True, text=True, check=True)
-declared = {m["id"]: [b["name"] for b in m.get("buffers", [])] for m in json.loads(listing.stdout)}
+methods = json.loads(listing.stdout)
+declared = {m["id"]: [b["name"] for b in m.get("buffers", [])] for m in methods}
+screen = {(m["id"], b["name"]) for m in methods for b in m.get("buffers", []) if b["space"] == "screen"}
 for m in PAPERS:
     if len(declared.get(m, [])) < 2:
         fail("%s declares %d debug buffers, at least 2 wanted" % (m, len(declared.get(m, []))))
@@ -144,6 +162,46 @@ if vpl:
     print("avg vpls: %d pixels hold a VPL" % splats)
     if splats < 10:
         fail("avg vpls: only %d pixels hold a VPL" % splats)
+
+cssm_img = image("cssm_hrc")
+atlas, ind = bufs.get("cssm_hrc", {}).get("atlas"), bufs.get("cssm_hrc", {}).get("indirect")
+if atlas and ind and cssm_img and direct:
+    shown = [i for i in range(len(cssm_img)) if cssm_img[i] > 0]
+    lit = sum(1 for i in shown if ind[i] > 0)
+    ratio = mean(ind) / mean(cssm_img)
+    print("cssm_hrc: atlas %d of %d texels lit; indirect on %d of %d pixels, %.3f of the image"
+          % (sum(1 for x in atlas if x > 0), len(atlas), lit, len(shown), ratio))
+    # in a closed box every surface the camera sees gets light reflected by the
+    # others; the indirect is a part of the image, not all of it (nor none)
+    if sum(1 for x in atlas if x > 0) < 0.1 * len(atlas):
+        fail("cssm_hrc atlas: fewer than 10 % of its texels lit")
+    if lit < 0.95 * len(shown) or not 0.05 < ratio < 0.8:
+        fail("cssm_hrc indirect: on %d of %d pixels, %.3f of the image" % (lit, len(shown), ratio))
+
+# vlf and implicit_vis: the buffer is what the image is made of (a diffuse
+# scene): closer to the image than the trivial answers, black and direct
+for m, name in (("vlf", "diffuse"), ("implicit_vis", "gathered")):
+    b, img = bufs.get(m, {}).get(name), image(m)
+    if not (b and img and direct):
+        continue
+    err, err_black, err_direct = mae(b, img), mean([abs(x) for x in img]), mae(direct, img)
+    print("%s %s: mean abs difference to the image %.4f (black %.4f, direct %.4f)"
+          % (m, name, err, err_black, err_direct))
+    # the buffer picks one element per pixel, the image filters over several
+    if err > 0.15 * err_black or err > 0.5 * err_direct:
+        fail("%s %s: %.4f from the image, more than 0.15 of black's %.4f or 0.5 of direct's %.4f"
+             % (m, name, err, err_black, err_direct))
+dirn = bufs.get("vlf", {}).get("direction")
+if dirn and sum(1 for x in dirn if x > 0) < 0.1 * len(dirn):
+    fail("vlf direction: fewer than 10 % of its rays carry light")
+links = bufs.get("implicit_vis", {}).get("links")
+iv_img = image("implicit_vis")
+if links and iv_img:
+    shown = [i for i in range(len(iv_img)) if iv_img[i] > 0]
+    # a count (the luminance of a grey pixel: the count within rounding)
+    linked = sum(1 for i in shown if links[i] >= 0.999 and abs(links[i] - round(links[i])) < 1e-3)
+    if linked < 0.95 * len(shown):
+        fail("implicit_vis links: %d of %d surface pixels have a whole number >= 1" % (linked, len(shown)))
 
 # an unknown name: exit 2, one line naming the buffers, no file
 r, path = render("csm", "unknown", ["visibility", "nosuch"])
