@@ -12,9 +12,14 @@ Cornell box with small precomputation settings:
   a shadow query was made; avg's voxels cover every pixel the avg image
   shows geometry in; avg's VPLs splat onto the picture;
 - an unknown name fails with exit 2, a one-line error listing the buffers,
-  and writes no file.
+  and writes no file;
+- fake plugins (FAKEDIR, tests/unit/fake_plugin.c): one built for ABI 1.2
+  has no buffers ("buffers: none"); one whose buffers break the contract is
+  refused with one line and no file (a screen-space buffer of the wrong
+  size, NaN, a failing call, also beside a good buffer), and its good ones
+  are written at their sizes.
 
-  debug_buffers_test.py GIBENCH ROOT OUTDIR
+  debug_buffers_test.py GIBENCH ROOT OUTDIR FAKEDIR
 """
 import json
 import math
@@ -23,7 +28,7 @@ import struct
 import subprocess
 import sys
 
-gib, root, out = sys.argv[1:4]
+gib, root, out, fakedir = sys.argv[1:5]
 os.makedirs(out, exist_ok=True)
 scene = os.path.join(root, "scenes/cornell_box.gltf")
 # small settings: each render well under the test's budget, no cache needed
@@ -214,5 +219,34 @@ for p in (path, path[:-4] + ".visibility.pfm", path[:-4] + ".nosuch.pfm"):
 r = subprocess.run([gib, "methods", "csm"], capture_output=True, text=True)
 if r.returncode != 0 or "debug buffers" not in r.stdout or "visibility" not in r.stdout:
     fail("methods csm lists no debug buffers")
+# the fakes: the contract enforced by the harness (debug_buffer.h)
+env = dict(os.environ, GIBENCH_PLUGIN_PATH=fakedir)
+
+
+def fake(method, names, name):
+    path = os.path.join(out, name + ".pfm")
+    args = [gib, "-q", "render", "--scene", scene, "--method", method, "--size", "32x32",
+            "--out", path, "--buffer", names]
+    return subprocess.run(args, capture_output=True, text=True, env=env), path
+
+
+r = subprocess.run([gib, "methods", "fake_abi12"], capture_output=True, text=True, env=env)
+if r.returncode != 0 or "debug buffers" in r.stdout:
+    fail("methods fake_abi12: exit %d, '%s'" % (r.returncode, r.stdout))
+r, path = fake("fake_abi12", "beyond", "abi12")
+if r.returncode != 2 or "no debug buffer 'beyond' (buffers: none)" not in r.stderr or os.path.exists(path):
+    fail("fake_abi12 --buffer: exit %d, '%s'" % (r.returncode, r.stderr.strip()))
+r, path = fake("fake_buffers", "ramp,tile", "fake_ok")
+sizes = [read_pfm(path[:-4] + "." + n + ".pfm")[:2] for n in ("ramp", "tile")
+         if os.path.exists(path[:-4] + "." + n + ".pfm")]
+if r.returncode != 0 or sizes != [(32, 32), (3, 2)]:
+    fail("fake_buffers ramp,tile: exit %d, sizes %s: %s" % (r.returncode, sizes, r.stderr.strip()))
+for names, why in (("wrong_size", "is 1x1, a screen-space buffer must be 32x32"),
+                   ("nan", "NaN or infinite"), ("ramp,fails", "debug buffer 'fails' failed")):
+    r, path = fake("fake_buffers", names, "fake_" + names.replace(",", "_"))
+    written = [p for p in os.listdir(out) if p.startswith("fake_" + names.replace(",", "_"))]
+    line = r.stderr.strip()
+    if r.returncode != 1 or why not in line or "\n" in line or written:
+        fail("fake_buffers %s: exit %d, '%s', wrote %s" % (names, r.returncode, line, written))
 print("debug_buffers: %s" % ("FAIL" if fails else "ok"))
 sys.exit(1 if fails else 0)
