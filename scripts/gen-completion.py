@@ -47,6 +47,14 @@ def main():
     for m in methods:
         lines.append(f"        {m['id']}) echo '{' '.join(param_words(m))}' ;;")
     lines += ["    esac", "}", "",
+              "# render --buffer NAME: the method's debug buffers (plugin ABI 1.3).",
+              "_gibench_buffers() {",
+              '    case "$1" in']
+    for m in methods:
+        names = " ".join(b["name"] for b in m.get("buffers", []))
+        if names:
+            lines.append(f"        {m['id']}) echo '{names}' ;;")
+    lines += ["    esac", "}", "",
               "# The words as typed, split at blanks only. Bash splits COMP_WORDS at",
               "# every character of COMP_WORDBREAKS too, '=' and ':' among them, so",
               "# that '--param k=v' arrives as '--param' 'k' '=' 'v'; the line up to",
@@ -108,6 +116,7 @@ def main():
               '                COMPREPLY=($(compgen -W "$(_gibench_params "$method")" -- "$cur"))',
               "            fi",
               "            compopt -o nospace 2>/dev/null; return ;;",
+              '        --buffer) COMPREPLY=($(compgen -W "$(_gibench_buffers "$method")" -- "$cur")); return ;;',
               "        --scene) COMPREPLY=($(compgen -f -X '!*.@(gltf|glb)' -- \"$cur\") $(compgen -d -- \"$cur\")); return ;;",
               "        --out|--timings|--stats|--heatmap|--flip-map|--reference|--curve-ref|--view|--script) COMPREPLY=($(compgen -f -- \"$cur\")); return ;;",
               "        --screenshot-dir) COMPREPLY=($(compgen -d -- \"$cur\")); return ;;",

@@ -122,6 +122,20 @@ GLuint gi_kit_scratch_texture(gi_kit *k, unsigned slot, GLenum format, uint32_t 
     return s->texture;
 }
 
+GLuint gi_kit_debug_target(gi_kit *k, GLuint program, unsigned slot, uint32_t width,
+                           uint32_t height)
+{
+    GLuint tex = gi_kit_scratch_texture(k, slot, GL_RGBA32F, width, height);
+    if (!tex)
+        return 0;
+    /* both images at the scratch texture, as a first frame: the average and
+     * the target the next render() continues from stay untouched */
+    glBindImageTexture(GI_IMAGE_ACCUM, tex, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(GI_IMAGE_TARGET, tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glUniform1ui(glGetUniformLocation(program, "u_frame"), 0u);
+    return tex;
+}
+
 void gi_kit_free(gi_kit *k)
 {
     if (!k)

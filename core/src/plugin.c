@@ -160,6 +160,51 @@ static gi_result validate_departures(const gi_method *m, gi_error *err)
     return GI_OK;
 }
 
+const gi_debug_buffer_desc *gi_method_debug_buffers(const gi_method *m)
+{
+    if (!m || !GI_HAS_FIELD(m, gi_method, debug_buffers) || !m->debug_buffers ||
+        !m->debug_buffers[0].name)
+        return NULL;
+    return m->debug_buffers;
+}
+
+const gi_debug_buffer_desc *gi_method_debug_buffer(const gi_method *m, const char *name)
+{
+    const gi_debug_buffer_desc *d = gi_method_debug_buffers(m);
+    for (; d && name && d->name; d++)
+        if (!strcmp(d->name, name))
+            return d;
+    return NULL;
+}
+
+/* Debug buffers (ABI 1.3): names a command line and a file name can carry,
+ * each once, a one-line description, a known space, and the function that
+ * makes them. */
+static gi_result validate_debug_buffers(const gi_method *m, gi_error *err)
+{
+    const gi_debug_buffer_desc *d = gi_method_debug_buffers(m);
+    if (!d)
+        return GI_OK;
+    if (!GI_HAS_FIELD(m, gi_method, debug_buffer) || !m->debug_buffer)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "declares debug buffers but lacks the function debug_buffer()");
+    for (; d->name; d++) {
+        if (!valid_name(d->name, 0))
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "debug buffer name '%s' is not [a-z0-9_]{1,31}", d->name);
+        if (gi_method_debug_buffer(m, d->name) != d)
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "debug buffer '%s' declared twice",
+                                d->name);
+        if (!d->description || !*d->description || strchr(d->description, '\n'))
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "debug buffer '%s' needs a one-line description", d->name);
+        if (d->space != GI_DEBUG_SCREEN && d->space != GI_DEBUG_OWN_SIZE)
+            return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                                "debug buffer '%s' has an unknown space %u", d->name, d->space);
+    }
+    return GI_OK;
+}
+
 gi_result gi_method_validate(const gi_method *m, gi_error *err)
 {
     if (GI_ABI_VERSION_MAJOR(m->abi_version) != GI_ABI_MAJOR)
@@ -205,6 +250,8 @@ gi_result gi_method_validate(const gi_method *m, gi_error *err)
     if (validate_params(m, &perr) != GI_OK)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "method '%s': %s", m->id, perr.text);
     if (validate_departures(m, &perr) != GI_OK)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "method '%s': %s", m->id, perr.text);
+    if (validate_debug_buffers(m, &perr) != GI_OK)
         return gi_error_set(err, GI_ERR_INVALID_ARGUMENT, "method '%s': %s", m->id, perr.text);
     return GI_OK;
 }

@@ -113,6 +113,32 @@ static void print_departures(const gi_method *m)
     }
 }
 
+/* The method's debug buffers (gi_debug_buffer_desc, ABI 1.3): what
+ * `render --buffer NAME` writes and gibench view shows. */
+static json_object *buffers_json(const gi_method *m)
+{
+    json_object *arr = json_object_new_array();
+    for (const gi_debug_buffer_desc *d = gi_method_debug_buffers(m); d && d->name; d++) {
+        json_object *o = json_object_new_object();
+        json_object_object_add(o, "name", json_object_new_string(d->name));
+        json_object_object_add(o, "description", json_object_new_string(d->description));
+        json_object_object_add(
+            o, "space", json_object_new_string(d->space == GI_DEBUG_SCREEN ? "screen" : "own"));
+        json_object_array_add(arr, o);
+    }
+    return arr;
+}
+
+static void print_buffers(const gi_method *m)
+{
+    const gi_debug_buffer_desc *d = gi_method_debug_buffers(m);
+    if (d)
+        printf("  debug buffers (render --buffer NAME):\n");
+    for (; d && d->name; d++)
+        printf("    %-12s %-6s %s\n", d->name, d->space == GI_DEBUG_SCREEN ? "screen" : "own",
+               d->description);
+}
+
 json_object *cli_method_json(const gi_plugin *it)
 {
     const gi_method *m = it->method;
@@ -131,25 +157,34 @@ json_object *cli_method_json(const gi_plugin *it)
         json_object_array_add(ps, param_json(d));
     json_object_object_add(o, "params", ps);
     json_object_object_add(o, "departures", departures_json(m));
+    json_object_object_add(o, "buffers", buffers_json(m));
     return o;
 }
 
 int cmd_methods(int argc, char **argv)
 {
     int json = 0;
+    const char *only = NULL; /* methods ID: that method alone */
     for (int i = 0; i < argc; i++) {
         if (!strcmp(argv[i], "--json"))
             json = 1;
+        else if (argv[i][0] != '-' && !only)
+            only = argv[i];
         else
             return cli_fail(EXIT_USAGE, "methods: unknown argument '%s'", argv[i]);
     }
     gi_plugins *reg = cli_load_plugins(0);
     if (!reg)
         return cli_fail(EXIT_RUN, "out of memory");
+    if (only && !gi_plugins_find(reg, only)) {
+        gi_plugins_free(reg);
+        return cli_fail(EXIT_USAGE, "methods: no method '%s' (gibench methods lists them)", only);
+    }
     if (json) {
         json_object *arr = json_object_new_array();
         for (uint32_t i = 0; i < reg->count; i++)
-            json_object_array_add(arr, cli_method_json(&reg->items[i]));
+            if (!only || !strcmp(reg->items[i].method->id, only))
+                json_object_array_add(arr, cli_method_json(&reg->items[i]));
         puts(json_object_to_json_string_ext(arr, JSON_C_TO_STRING_PRETTY | JSON_C_TO_STRING_SPACED |
                                                      JSON_C_TO_STRING_NOSLASHESCAPE));
         json_object_put(arr);
@@ -159,6 +194,8 @@ int cmd_methods(int argc, char **argv)
                    cli_plugin_dir() ? cli_plugin_dir() : "none");
         for (uint32_t i = 0; i < reg->count; i++) {
             const gi_method *m = reg->items[i].method;
+            if (only && strcmp(m->id, only))
+                continue;
             char caps[256];
             cli_caps_string(m->caps, caps, sizeof caps);
             printf("%s  %s (v%s)\n  %s\n  caps: %s; indirect bounces: %u\n", m->id, m->title,
@@ -169,6 +206,7 @@ int cmd_methods(int argc, char **argv)
                     print_param(d);
             }
             print_departures(m);
+            print_buffers(m);
         }
     }
     gi_plugins_free(reg);

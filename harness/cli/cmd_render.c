@@ -1,6 +1,7 @@
 /* gibench render: one method, one scene, one camera -> image + timings. */
 #include "cli.h"
 
+#include "debug_buffer.h"
 #include "gi/cache.h"
 #include "gi/image.h"
 #include "gi/log.h"
@@ -19,6 +20,7 @@
 #define MAX_OUTS 4
 #define MAX_CURVE_REFS 4
 #define MAX_CURVE_POINTS 64
+#define MAX_BUFFERS 16
 
 typedef struct render_opts {
     const char *scene, *method, *camera, *timings;
@@ -38,6 +40,11 @@ typedef struct render_opts {
     const char *view_path;
     /* --frames-out PATTERN: every frame's linear image, PATTERN with one %d */
     const char *frames_out;
+    /* --buffer NAME[,NAME...] (repeatable): the method's debug buffers
+     * instead of the image (one: into each --out; several: each --out with
+     * .NAME before its extension) */
+    char buffers[MAX_BUFFERS][32];
+    int buffer_count;
     int has_view;
     view_file view;
     int given_size, given_frames, given_seed, given_time, given_exposure;
@@ -90,7 +97,7 @@ static int takes_value(const char *a)
            !strcmp(a, "--frames") || !strcmp(a, "--warmup") || !strcmp(a, "--time") ||
            !strcmp(a, "--animate") || !strcmp(a, "--seed") || !strcmp(a, "--exposure") ||
            !strcmp(a, "--timings") || !strcmp(a, "--curve-ref") || !strcmp(a, "--view") ||
-           !strcmp(a, "--frames-out");
+           !strcmp(a, "--frames-out") || !strcmp(a, "--buffer");
 }
 
 /* --frames-out PATTERN: one %d for the frame index and an image file's extension. */
@@ -109,6 +116,26 @@ static int parse_frames_out(render_opts *o, const char *v)
         return cli_fail(EXIT_USAGE, "render: --frames-out '%s' must end in .exr, .pfm or .png", v);
     o->frames_out = v;
     return EXIT_OK;
+}
+
+/* --buffer NAME[,NAME...]: names are checked against the method later. */
+static int parse_buffer(render_opts *o, const char *v)
+{
+    for (const char *p = v;; p++) {
+        const char *end = strchr(p, ',');
+        size_t n = end ? (size_t)(end - p) : strlen(p);
+        if (n == 0 || n > 31)
+            return cli_fail(EXIT_USAGE,
+                            "render: --buffer '%s' is not NAME[,NAME...] (names of 1..31 "
+                            "characters; gibench methods lists them)",
+                            v);
+        if (o->buffer_count == MAX_BUFFERS)
+            return cli_fail(EXIT_USAGE, "render: at most %d --buffer names", MAX_BUFFERS);
+        snprintf(o->buffers[o->buffer_count++], sizeof o->buffers[0], "%.*s", (int)n, p);
+        if (!end)
+            return EXIT_OK;
+        p = end;
+    }
 }
 
 /* --curve-ref NAME=PATH */
@@ -177,6 +204,8 @@ static int parse_opt(render_opts *o, const char *a, const char *v)
         return parse_frames_out(o, v);
     else if (!strcmp(a, "--curve-ref"))
         return parse_curve_ref(o, v);
+    else if (!strcmp(a, "--buffer"))
+        return parse_buffer(o, v);
     else if (!strcmp(a, "--out")) {
         if (cli_add_out("render", o->outs, &o->out_count, MAX_OUTS, v))
             return EXIT_USAGE;
@@ -515,6 +544,11 @@ static int find_method(run_state *r, const render_opts *o)
         return cli_fail(EXIT_USAGE, "render: no method '%s' (installed: %s)", o->method,
                         known[0] ? known : "none");
     }
+    for (int i = 0; i < o->buffer_count; i++) {
+        gi_error err;
+        if (debug_buffer_check(r->m, o->buffers[i], &err) != GI_OK)
+            return cli_fail(EXIT_USAGE, "render: %s", err.text);
+    }
     return EXIT_OK;
 }
 
@@ -698,7 +732,41 @@ static int render_frames(run_state *r, const render_opts *o)
     return EXIT_OK;
 }
 
-/* The last image (alpha 1) into every --out, the timings file and the summary line. */
+/* --buffer with several names: --out PATH with ".NAME" before its extension. */
+static void buffer_path(const char *out, const char *name, char *path, size_t size)
+{
+    const char *dot = strrchr(out, '.');
+    snprintf(path, size, "%.*s.%s%s", (int)(dot - out), out, name, dot);
+}
+
+/* --buffer: every buffer fetched first (nothing is written when one
+ * fails), then written into the --out files. */
+static int write_buffers(run_state *r, const render_opts *o)
+{
+    gi_image *img[MAX_BUFFERS] = {0};
+    gi_error err;
+    int rc = EXIT_OK;
+    for (int b = 0; b < o->buffer_count && rc == EXIT_OK; b++)
+        if (!(img[b] = render_loop_buffer(&r->loop, o->buffers[b], &err)))
+            rc = cli_fail(EXIT_RUN, "render: %s", err.text);
+    gi_image_write_opts wo = {o->exposure};
+    for (int b = 0; b < o->buffer_count && rc == EXIT_OK; b++)
+        for (int i = 0; i < o->out_count && rc == EXIT_OK; i++) {
+            char path[4096];
+            if (o->buffer_count == 1)
+                snprintf(path, sizeof path, "%s", o->outs[i]);
+            else
+                buffer_path(o->outs[i], o->buffers[b], path, sizeof path);
+            if (gi_image_write(path, img[b], &wo, &err) != GI_OK)
+                rc = cli_fail(EXIT_RUN, "%s", err.text);
+        }
+    for (int b = 0; b < o->buffer_count; b++)
+        gi_image_free(img[b]);
+    return rc;
+}
+
+/* The last image (alpha 1) into every --out (or, with --buffer, the
+ * buffers), the timings file and the summary line. */
 static int write_results(run_state *r, const render_opts *o)
 {
     gi_error err;
@@ -706,7 +774,12 @@ static int write_results(run_state *r, const render_opts *o)
     if (!r->image)
         return cli_fail(EXIT_RUN, "out of memory reading the image back");
     gi_image_write_opts wo = {o->exposure};
-    for (int i = 0; i < o->out_count; i++)
+    if (o->buffer_count) {
+        int brc = write_buffers(r, o);
+        if (brc != EXIT_OK)
+            return brc;
+    }
+    for (int i = 0; i < o->out_count && !o->buffer_count; i++)
         if (gi_image_write(o->outs[i], r->image, &wo, &err) != GI_OK)
             return cli_fail(EXIT_RUN, "%s", err.text);
     uint64_t bad = gi_image_count_nonfinite(r->image);

@@ -10,9 +10,10 @@ typedef struct command_help {
 
 static const command_help helps[] = {
     {"methods",
-     "usage: gibench methods [--json]\n"
+     "usage: gibench methods [ID] [--json]\n"
      "List the method plugins found (the build's plugins/ and GIBENCH_PLUGIN_PATH): id, paper,\n"
-     "caps, bounce count and every parameter with its type, default, range and meaning.\n"
+     "caps, bounce count, every parameter with its type, default, range and meaning, and the\n"
+     "debug buffers that render writes on request. With ID: that method only.\n"
      "  --json   the same as JSON (what bash completion and scripts read)\n"},
     {"info",
      "usage: gibench info SCENE [--json]\n"
@@ -46,6 +47,9 @@ static const command_help helps[] = {
      "  --view VIEW.json       a view saved by gibench view: its camera, and its scene, method,\n"
      "                         parameters, size, frames, seed, time and exposure unless given "
      "here\n"
+     "  --buffer NAME[,NAME]   write the method's debug buffers instead of the image (repeatable;\n"
+     "                         gibench methods M lists them): one into each --out; several into\n"
+     "                         each --out with .NAME before its extension (m.exr: m.NAME.exr)\n"
      "Prints a progress bar on a terminal and a one-line summary at the end (-q: none).\n"},
     {"reference",
      "usage: gibench reference --scene S --out FILE.exr [--out FILE.png] [options]\n"

@@ -1,6 +1,7 @@
 /* The render loop of gibench render and the Python API (render_loop.h). */
 #include "render_loop.h"
 
+#include "debug_buffer.h"
 #include "gi/log.h"
 #include "gi/passes.h"
 #include "gi/plugin.h"
@@ -103,6 +104,7 @@ gi_result render_loop_frame(render_loop *r, uint32_t f, gi_error *err)
     view.frame_index = r->animate_fps > 0 ? 0 : f;
     view.seed = r->seed;
     view.exposure = r->exposure;
+    r->view = view;
     res = r->m->render(r->inst, &view, &target);
     gi_timer_frame_end(r->render_timer);
     if (res != GI_OK)
@@ -120,6 +122,11 @@ gi_image *render_loop_image(const render_loop *r)
         for (size_t i = 0; i < (size_t)r->width * r->height; i++)
             img->rgba[4 * i + 3] = 1.0f;
     return img;
+}
+
+gi_image *render_loop_buffer(const render_loop *r, const char *name, gi_error *err)
+{
+    return debug_buffer_fetch(r->m, r->inst, &r->view, name, err);
 }
 
 void render_loop_free(render_loop *r)

@@ -23,6 +23,7 @@ typedef struct render_loop {
     /* owned by the loop (render_loop_free releases them) */
     void *inst;
     GLuint target_tex, target_fbo;
+    gi_view view; /* the view of the last frame rendered (render_loop_buffer's) */
 } render_loop;
 
 /* The render target (RGBA32F, cleared to black). */
@@ -41,6 +42,9 @@ gi_result render_loop_update(render_loop *r, float t, uint32_t flags, gi_error *
 gi_result render_loop_frame(render_loop *r, uint32_t f, gi_error *err);
 /* The target read back with alpha 1; NULL when out of memory. */
 gi_image *render_loop_image(const render_loop *r);
+/* Debug buffer `name` of the instance after the last frame
+ * (debug_buffer_fetch of debug_buffer.h with that frame's view). */
+gi_image *render_loop_buffer(const render_loop *r, const char *name, gi_error *err);
 /* "M: WHAT failed (RESULT): MESSAGE" of the method's last_error. */
 gi_result render_loop_method_error(const render_loop *r, const char *what, gi_result res,
                                    gi_error *err);

@@ -717,4 +717,5 @@ GI_METHOD_EXPORT(avg, .id = "avg",
                  .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_AREA_LIGHTS |
                          GI_CAP_POINT_LIGHTS | GI_CAP_RIGID_MOTION | GI_CAP_DEFORMATION |
                          GI_CAP_TEXTURES,
-                 .max_bounces = 3, .params = avg_params);
+                 .max_bounces = 3, .params = avg_params, .debug_buffers = avg_debug_buffers,
+                 .debug_buffer = avg_debug_buffer);

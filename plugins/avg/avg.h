@@ -152,6 +152,10 @@ typedef struct avg {
     struct gi_simplified *lod; /* the shadow maps' lower-detail copy (shadow_lod < 1), else NULL */
 } avg;
 
+/* The debug buffers (debug.c, plugin ABI 1.3): vpls and voxels. */
+extern const gi_debug_buffer_desc avg_debug_buffers[];
+gi_result avg_debug_buffer(void *inst, const char *name, const gi_view *view, gi_image **out);
+
 #ifdef __cplusplus
 }
 #endif

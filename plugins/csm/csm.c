@@ -20,7 +20,7 @@
  * (§3.2, §4.5 filters, §4.6 rigid motion through the inverse object
  * transform; for local lights the receiver's own object first), averaged
  * progressively over frames (§5). */
-#include "csm_local.h"
+#include "csm_inst.h"
 
 #include "gi/cache.h"
 #include "gi/kit.h"
@@ -40,46 +40,11 @@ extern const gi_shader_source gi_csm_shaders[];
 #define CSM_LOCAL_FORMAT_VERSION 2u /* 2: the one rule for sides (issue 28) */
 #define CSM_PATTERNS 256u
 
-enum {
-    B_OBJECTS = 8,
-    B_OFFSETS = 9,
-    B_ZAVG = 10,
-    B_IEND = 11,
-    B_CELLS = 12,
-    B_PATTERNS = 13,
-    B_LIGHTS = 14,
-    B_PAIRS = 15,
-    B_LIGHT_CELLS = 16,
-    B_COUNT = 17
-};
-enum { LIGHTS_LOCAL = 0, LIGHTS_SEMILOCAL = 1 };
-enum { RECEIVERS_NONE = 0, RECEIVERS_PLANAR = 1 };
-
 /* std430 CsmLight / CsmPair of shaders/csm_local.glsl (64 bytes). */
 typedef struct csm_gpu_rect {
     float o[4], e1[4], e2[4];
     uint32_t info[4];
 } csm_gpu_rect;
-
-typedef struct csm {
-    gi_kit kit; /* host, scene, G-buffer, accumulation, error text */
-    int N, M, S, z3, filter, mode, open_surfaces;
-    gi_csm_order order;
-    float bias, normal_offset, normal_offset_local, shell_thickness;
-    int lights_mode, n_local, m_local, receivers, distant, warned_moved, local_motion;
-    int dilate_local;  /* occluders=dilated: README "Sub-texel occluders" */
-    uint32_t rebuilds; /* local-light precomputations redone in update() (local_motion=rebuild) */
-    float *prepare_transforms; /* 16 per object: world_from_local at prepare time */
-    gi_csm_order light_order;
-    float linear_aspect;
-    uint32_t object_count, light_count;
-    unsigned char *casts; /* per object: 1 if it has CSMs (not receiver-only) */
-    csm_light *lights;
-    csm_gpu_object *objects;
-    GLuint
-        ssbo[9]; /* objects, offsets, z_avg, i_end, cells, patterns, lights, pairs, light cells */
-    GLuint program, count; /* count: samples taken this frame */
-} csm;
 
 static const gi_param_desc csm_params[] = {
     {"N", GI_PARAM_INT, 16, 2, 256, GI_QUALITY_UP(1.5), "N (Sec. 4.1)",
@@ -888,6 +853,35 @@ static gi_result csm_update(void *inst, const gi_gpu_scene *scene, const gi_chan
     return GI_OK;
 }
 
+/* The shading pass's program in use with its buffers and uniforms (§5),
+ * for render() and the debug buffers (debug.c). */
+void csm_bind_pass(csm *c, const gi_view *view, const gi_target *target)
+{
+    GLuint p = c->program;
+    glUseProgram(p);
+    gi_kit_bind(&c->kit, p, view, target);
+    static const GLuint bindings[9] = {B_OBJECTS,  B_OFFSETS, B_ZAVG,  B_IEND,       B_CELLS,
+                                       B_PATTERNS, B_LIGHTS,  B_PAIRS, B_LIGHT_CELLS};
+    for (int i = 0; i < 9; i++)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, bindings[i], c->ssbo[i]);
+    glUniform1i(glGetUniformLocation(p, "u_S"), c->S);
+    glUniform1i(glGetUniformLocation(p, "u_mode"), c->mode);
+    const GLuint zero = 0;
+    glNamedBufferSubData(c->count, 0, 4, &zero);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, B_COUNT, c->count);
+    glUniform1ui(glGetUniformLocation(p, "csm_n_theta"), (GLuint)c->N);
+    glUniform1ui(glGetUniformLocation(p, "csm_n_phi"), (GLuint)c->N);
+    glUniform1ui(glGetUniformLocation(p, "csm_object_count"), c->object_count);
+    glUniform1f(glGetUniformLocation(p, "csm_normal_offset"), c->normal_offset);
+    glUniform1i(glGetUniformLocation(p, "csm_filter"), c->filter);
+    glUniform1ui(glGetUniformLocation(p, "csm_light_count"), c->light_count);
+    glUniform1i(glGetUniformLocation(p, "csm_semilocal"), c->lights_mode == LIGHTS_SEMILOCAL);
+    glUniform1f(glGetUniformLocation(p, "csm_normal_offset_local"), c->normal_offset_local);
+    glUniform1i(glGetUniformLocation(p, "csm_dilate_local"), c->dilate_local);
+    glUniform1i(glGetUniformLocation(p, "u_distant"), c->distant);
+    glUniform1i(glGetUniformLocation(p, "u_debug"), 0);
+}
+
 static gi_result csm_render(void *inst, const gi_view *view, const gi_target *target)
 {
     csm *c = inst;
@@ -914,28 +908,7 @@ static gi_result csm_render(void *inst, const gi_view *view, const gi_target *ta
         return r;
 
     host->stage_begin(host, "render");
-    GLuint p = c->program;
-    glUseProgram(p);
-    gi_kit_bind(kit, p, view, target);
-    static const GLuint bindings[9] = {B_OBJECTS,  B_OFFSETS, B_ZAVG,  B_IEND,       B_CELLS,
-                                       B_PATTERNS, B_LIGHTS,  B_PAIRS, B_LIGHT_CELLS};
-    for (int i = 0; i < 9; i++)
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, bindings[i], c->ssbo[i]);
-    glUniform1i(glGetUniformLocation(p, "u_S"), c->S);
-    glUniform1i(glGetUniformLocation(p, "u_mode"), c->mode);
-    const GLuint zero = 0;
-    glNamedBufferSubData(c->count, 0, 4, &zero);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, B_COUNT, c->count);
-    glUniform1ui(glGetUniformLocation(p, "csm_n_theta"), (GLuint)c->N);
-    glUniform1ui(glGetUniformLocation(p, "csm_n_phi"), (GLuint)c->N);
-    glUniform1ui(glGetUniformLocation(p, "csm_object_count"), c->object_count);
-    glUniform1f(glGetUniformLocation(p, "csm_normal_offset"), c->normal_offset);
-    glUniform1i(glGetUniformLocation(p, "csm_filter"), c->filter);
-    glUniform1ui(glGetUniformLocation(p, "csm_light_count"), c->light_count);
-    glUniform1i(glGetUniformLocation(p, "csm_semilocal"), c->lights_mode == LIGHTS_SEMILOCAL);
-    glUniform1f(glGetUniformLocation(p, "csm_normal_offset_local"), c->normal_offset_local);
-    glUniform1i(glGetUniformLocation(p, "csm_dilate_local"), c->dilate_local);
-    glUniform1i(glGetUniformLocation(p, "u_distant"), c->distant);
+    csm_bind_pass(c, view, target);
     gi_kit_dispatch_8x8(view->width, view->height);
     glUseProgram(0);
     host->stage_end(host, "render");
@@ -997,4 +970,5 @@ GI_METHOD_EXPORT(csm, .id = "csm", .title = "Coherent Shadow Maps",
                          GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_GLOSSY |
                          GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE | GI_CAP_PRECOMPUTE |
                          GI_CAP_RIGID_MOTION | GI_CAP_TEXTURES,
-                 .max_bounces = 0, .params = csm_params, .departures = csm_departures);
+                 .max_bounces = 0, .params = csm_params, .departures = csm_departures,
+                 .debug_buffers = csm_debug_buffers, .debug_buffer = csm_debug_buffer);

@@ -382,4 +382,5 @@ GI_METHOD_EXPORT(cssm, .id = "cssm_hrc",
                          GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT |
                          GI_CAP_VISIBILITY | GI_CAP_PROGRESSIVE | GI_CAP_PRECOMPUTE |
                          GI_CAP_RIGID_MOTION | GI_CAP_TEXTURES,
-                 .max_bounces = 3, .params = cssm_params);
+                 .max_bounces = 3, .params = cssm_params, .debug_buffers = cssm_debug_buffers,
+                 .debug_buffer = cssm_debug_buffer);

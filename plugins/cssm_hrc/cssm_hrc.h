@@ -158,6 +158,17 @@ gi_result cssm_gpu_final_gather(cssm_hrc *c, const gi_view *view, const gi_targe
 /* Deletes the program and buffers (a GL context is current). */
 void cssm_gpu_free(cssm_hrc *c);
 
+/* Debug buffer "indirect" (debug.c): the reflected light (light set 2:
+ * every bounce after the first) that the hierarchy's cut gathers at pixel
+ * p of the G-buffer read back by the last render(), without jitter. */
+void cssm_pixel_reflected(const cssm_hrc *c, const gi_view *view, size_t p, float out[3]);
+
+/* ------------------------------------------------------------- debug.c */
+
+/* The debug buffers (plugin ABI 1.3): atlas and indirect. */
+extern const gi_debug_buffer_desc cssm_debug_buffers[];
+gi_result cssm_debug_buffer(void *inst, const char *name, const gi_view *view, gi_image **out);
+
 /* ------------------------------------------------------------- stats.c */
 
 /* atlas_texels, atlas_chart_texels, atlas_charts, atlas_coverage. */

@@ -295,3 +295,12 @@ void cssm_final_gather(cssm_hrc *c, const gi_view *view, uint32_t frame, int ran
         }
     host->stage_end(host, "final_gather");
 }
+
+void cssm_pixel_reflected(const cssm_hrc *c, const gi_view *view, size_t p, float out[3])
+{
+    const frame_ctx f = {.view = view, .s = c->kit.scene->scene, .frame = 0, .random = 0};
+    gi_vec3 P, Nn;
+    cssm_receiver rc = pixel_receiver(c, &f, p, &P, &Nn);
+    cssm_gather_opts o = cssm_hrc_gather_opts(c, view->exposure, NULL);
+    gather(c, 2, &rc, &o, out, NULL);
+}

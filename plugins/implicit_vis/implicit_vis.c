@@ -23,6 +23,7 @@
  * gathering and pull-up and the display run on the GPU. */
 #define _POSIX_C_SOURCE 200809L
 #include "iv.h"
+#include "iv_debug.h"
 #include "iv_gpu.h"
 #include "iv_traced.h"
 #include "shaders/iv_bindings.h"
@@ -579,6 +580,15 @@ static const gi_departure iv_departures[] = {
     {NULL, NULL, NULL},
 };
 
+/* For the debug buffers (debug.c): the elements, their links and the
+ * buffer the display reads their light from. */
+void iv_debug_state(void *inst, iv_debug *out)
+{
+    implicit_vis *m = inst;
+    *out = (iv_debug){&m->kit, m->links_valid ? m->hier : NULL, m->links,
+                      m->light_on_cpu || !m->gpu ? m->ssbo_light : m->gpu->ssbo_out};
+}
+
 GI_METHOD_EXPORT(iv, .id = "implicit_vis",
                  .title = "Interactive Global Illumination Using Implicit Visibility",
                  .citation = "Dong, Kautz, Theobalt, Seidel. Pacific Graphics 2007",
@@ -587,4 +597,5 @@ GI_METHOD_EXPORT(iv, .id = "implicit_vis",
                          GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT |
                          GI_CAP_RIGID_MOTION | GI_CAP_DEFORMATION | GI_CAP_VISIBILITY |
                          GI_CAP_TEXTURES,
-                 .max_bounces = 3, .params = iv_params, .departures = iv_departures);
+                 .max_bounces = 3, .params = iv_params, .departures = iv_departures,
+                 .debug_buffers = iv_debug_buffers, .debug_buffer = iv_debug_buffer);

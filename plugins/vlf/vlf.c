@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "vlf_debug.h"
 #include "vlf_field.h"
 #include "vlf_gpu.h"
 
@@ -510,6 +511,15 @@ static const char *vlf_last_error(void *inst)
     return inst ? gi_kit_last_error(&((vlf *)inst)->kit) : "";
 }
 
+/* For the debug buffers (debug.c): the light field (NULL before prepare)
+ * and the kit (its G-buffer, its error). */
+const vlf_field *vlf_debug_field(void *inst, gi_kit **kit)
+{
+    vlf *v = inst;
+    *kit = &v->kit;
+    return v->have_field ? &v->field : NULL;
+}
+
 GI_METHOD_EXPORT(
     vlf, .id = "vlf",
     .title = "Light Field Propagation and Rendering on the GPU (GPU Virtual Light Field)",
@@ -517,4 +527,5 @@ GI_METHOD_EXPORT(
     .caps = GI_CAP_DIRECT | GI_CAP_INDIRECT | GI_CAP_GLOSSY | GI_CAP_MIRROR | GI_CAP_AREA_LIGHTS |
             GI_CAP_POINT_LIGHTS | GI_CAP_DIRECTIONAL | GI_CAP_ENVIRONMENT | GI_CAP_RIGID_MOTION |
             GI_CAP_PRECOMPUTE | GI_CAP_VISIBILITY | GI_CAP_TEXTURES,
-    .max_bounces = 7, .params = vlf_params);
+    .max_bounces = 7, .params = vlf_params, .debug_buffers = vlf_debug_buffers,
+    .debug_buffer = vlf_debug_buffer);

@@ -12,7 +12,10 @@
  * declares the same, but its remedy changes nothing: the suite must fail it.
  * FAKE_BAKED renders a constant grey, lacks GI_CAP_RIGID_MOTION and refuses
  * moved lights in update(), as a method that bakes its lights at prepare
- * would: the viewer's tests of a method that cannot follow a change. */
+ * would: the viewer's tests of a method that cannot follow a change.
+ * FAKE_ABI12 is built for ABI 1.2 (no debug buffers); FAKE_BUFFERS declares
+ * debug buffers (ABI 1.3), some of which break the contract: a
+ * screen-space buffer of the wrong size, one holding NaN, one that fails. */
 #define _POSIX_C_SOURCE 200809L
 #include "gi/kit.h" /* GI_ABI_LAYOUT */
 
@@ -20,6 +23,7 @@
 #include <stdio.h>
 #include <signal.h>
 #include <stddef.h>
+#include <string.h>
 #include <unistd.h>
 
 #if defined(FAKE_CHANGES)
@@ -155,14 +159,57 @@ static const gi_departure fake_departures[] = {
 };
 #endif
 
+#if defined(FAKE_BUFFERS)
+static const gi_debug_buffer_desc fake_buffers[] = {
+    {"ramp", "x / width in red, y / height in green", GI_DEBUG_SCREEN},
+    {"tile", "a 3 x 2 image of its own", GI_DEBUG_OWN_SIZE},
+    {"wrong_size", "1 x 1, though declared in screen space", GI_DEBUG_SCREEN},
+    {"nan", "NaN everywhere", GI_DEBUG_SCREEN},
+    {"fails", "returns an error", GI_DEBUG_SCREEN},
+    {NULL, NULL, 0},
+};
+static gi_result fake_debug_buffer(void *inst, const char *name, const gi_view *view,
+                                   gi_image **out)
+{
+    (void)inst;
+    *out = NULL;
+    if (!strcmp(name, "fails"))
+        return GI_ERR_UNSUPPORTED;
+    int own = !strcmp(name, "tile"), tiny = !strcmp(name, "wrong_size");
+    uint32_t w = own ? 3 : tiny ? 1 : view->width, h = own ? 2 : tiny ? 1 : view->height;
+    if (!(*out = gi_image_create(w, h)))
+        return GI_ERR_OUT_OF_MEMORY;
+    for (uint32_t y = 0; y < h; y++)
+        for (uint32_t x = 0; x < w; x++) {
+            float *p = &(*out)->rgba[4 * ((size_t)y * w + x)];
+            p[0] = !strcmp(name, "nan") ? NAN : (float)x / (float)w;
+            p[1] = (float)y / (float)h;
+        }
+    return GI_OK;
+}
+#endif
+
+#if defined(FAKE_ABI12)
+/* Built for ABI 1.2: its descriptor ends before debug_buffers, so the host
+ * must not see the table that lies beyond (in this build's struct). */
+static const gi_debug_buffer_desc fake_buffers[] = {
+    {"beyond", "lies beyond struct_size", GI_DEBUG_SCREEN},
+    {NULL, NULL, 0},
+};
+#endif
+
 static const gi_method fake_method = {
 #if defined(FAKE_SMALL_STRUCT)
     .struct_size = offsetof(gi_method, render),
+#elif defined(FAKE_ABI12)
+    .struct_size = offsetof(gi_method, debug_buffers),
 #else
     .struct_size = sizeof(gi_method),
 #endif
 #if defined(FAKE_WRONG_ABI)
     .abi_version = ((GI_ABI_MAJOR + 1u) << 16),
+#elif defined(FAKE_ABI12)
+    .abi_version = (1u << 16) | 2u,
 #else
     .abi_version = GI_ABI_VERSION,
 #endif
@@ -201,6 +248,12 @@ static const gi_method fake_method = {
     .layout = GI_ABI_LAYOUT,
 #if defined(FAKE_DEPART)
     .departures = fake_departures,
+#endif
+#if defined(FAKE_ABI12)
+    .debug_buffers = fake_buffers,
+#elif defined(FAKE_BUFFERS)
+    .debug_buffers = fake_buffers,
+    .debug_buffer = fake_debug_buffer,
 #endif
 };
 

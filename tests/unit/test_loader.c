@@ -27,9 +27,16 @@ static void expect_refused(const char *kind, const char *substring)
               err.text);
 }
 
+static gi_result no_buffer(void *inst, const char *name, const gi_view *view, gi_image **out)
+{
+    (void)inst, (void)name, (void)view;
+    *out = NULL;
+    return GI_ERR_UNSUPPORTED;
+}
+
 int main(void)
 {
-    expect_refused("wrong_abi", "built for plugin ABI 2.0, this gibench speaks 1.2");
+    expect_refused("wrong_abi", "built for plugin ABI 2.0, this gibench speaks 1.3");
     expect_refused("missing_fn", "lacks the required function render()");
     expect_refused("bad_id", "method id 'Bad Id!' is not [a-z0-9_]{1,31}");
     expect_refused("null_entry", "gi_method_entry returned NULL");
@@ -133,6 +140,42 @@ int main(void)
         CHECK(gi_method_validate(&bad, &err) == GI_ERR_INVALID_ARGUMENT &&
               strstr(err.text, refused[i].error));
     }
+    /* Debug buffers (ABI 1.3): found by name; a plugin built for ABI 1.2
+     * loads and has none, whatever its build put beyond its struct_size. */
+    CHECK(gi_method_debug_buffers(m) == NULL && gi_method_debug_buffer(m, "x") == NULL);
+    gi_plugins *old = gi_plugins_scan(GI_BINARY_DIR "/tests/fake_plugins_abi12");
+    const gi_method *m12 = old ? gi_plugins_find(old, "fake_abi12") : NULL;
+    CHECK_MSG(m12 && old->error_count == 0, "%s", old && old->error_count ? old->errors[0] : "");
+    CHECK(m12 && m12->struct_size == offsetof(gi_method, debug_buffers));
+    CHECK(m12 && gi_method_debug_buffers(m12) == NULL && !gi_method_debug_buffer(m12, "beyond"));
+    gi_plugins_free(old);
+    static const gi_debug_buffer_desc ok_buf[] = {
+        {"vis", "one line", GI_DEBUG_SCREEN}, {"map", "m", GI_DEBUG_OWN_SIZE}, {NULL, NULL, 0}};
+    bad = *m;
+    bad.debug_buffers = ok_buf;
+    bad.debug_buffer = no_buffer;
+    CHECK(gi_method_validate(&bad, &err) == GI_OK);
+    CHECK(gi_method_debug_buffer(&bad, "map") == &ok_buf[1] && !gi_method_debug_buffer(&bad, "x"));
+    static const struct {
+        gi_debug_buffer_desc d[3];
+        const char *error;
+    } bad_bufs[] = {
+        {{{"Vis", "x", 0}, {NULL, NULL, 0}}, "is not [a-z0-9_]"},
+        {{{"vis", "", 0}, {NULL, NULL, 0}}, "one-line description"},
+        {{{"vis", "a\nb", 0}, {NULL, NULL, 0}}, "one-line description"},
+        {{{"vis", "x", 7}, {NULL, NULL, 0}}, "unknown space"},
+        {{{"vis", "x", 0}, {"vis", "y", 0}, {NULL, NULL, 0}}, "declared twice"},
+    };
+    for (size_t i = 0; i < sizeof bad_bufs / sizeof bad_bufs[0]; i++) {
+        bad.debug_buffers = bad_bufs[i].d;
+        CHECK_MSG(gi_method_validate(&bad, &err) == GI_ERR_INVALID_ARGUMENT &&
+                      strstr(err.text, bad_bufs[i].error),
+                  "%s", err.text);
+    }
+    bad.debug_buffers = ok_buf;
+    bad.debug_buffer = NULL;
+    CHECK(gi_method_validate(&bad, &err) == GI_ERR_INVALID_ARGUMENT &&
+          strstr(err.text, "lacks the function debug_buffer()"));
     /* A plugin built against the current headers passes the check. */
     static const gi_abi_layout current = GI_ABI_LAYOUT;
     CHECK(gi_abi_layout_check(&current, &err) == GI_OK);

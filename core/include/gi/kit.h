@@ -94,6 +94,14 @@ void gi_kit_frame_end(gi_kit *k);
  * re-made when either changed (contents then undefined); 0 on a bad slot. */
 GLuint gi_kit_scratch_texture(gi_kit *k, unsigned slot, GLenum format, uint32_t width,
                               uint32_t height);
+/* For a method's debug buffers (gi_method.debug_buffer, ABI 1.3): with
+ * `program` in use and bound by gi_kit_bind, sends the shader's
+ * gi_accumulate_store to scratch texture `slot` (RGBA32F, width x height)
+ * instead of the accumulation and the target, as a first frame (u_frame 0),
+ * so that the next render() makes what it would have made. Returns the
+ * texture, 0 on a bad slot. */
+GLuint gi_kit_debug_target(gi_kit *k, GLuint program, unsigned slot, uint32_t width,
+                           uint32_t height);
 void gi_kit_free(gi_kit *k);
 
 /* Keeps "fmt ..." as the error and returns r. */

@@ -11,6 +11,8 @@
  *                                       read/write host->cache_dir)
  *     { update(inst, gs, changes) }     between frames when something moved
  *     render(inst, view, target)        once per frame
+ *     { debug_buffer(inst, name, view, &img) }  optional, after a render()
+ *                                       of the same view (ABI 1.3)
  *     destroy(inst)                     always, also after a failed call
  * After any call returns an error the host reads last_error(inst) (never
  * NULL; "" when there is nothing to say) and then calls destroy(inst). When
@@ -39,6 +41,7 @@
 
 #include "gi/common.h"
 #include "gi/gpu.h"
+#include "gi/image.h"
 #include "gi/params.h"
 #include "gi/scene.h"
 
@@ -47,7 +50,8 @@ extern "C" {
 #endif
 
 #define GI_ABI_MAJOR 1u
-#define GI_ABI_MINOR 2u /* 1.1: gi_method.layout; 1.2: gi_method.departures */
+#define GI_ABI_MINOR                                                                               \
+    3u /* 1.1: gi_method.layout; 1.2: gi_method.departures; 1.3: debug_buffers, debug_buffer */
 #define GI_ABI_VERSION ((GI_ABI_MAJOR << 16) | GI_ABI_MINOR)
 #define GI_ABI_VERSION_MAJOR(v) ((v) >> 16)
 
@@ -216,6 +220,20 @@ typedef struct gi_departure {
     const char *remedy;
 } gi_departure;
 
+/* ABI 1.3: a named intermediate image of the method (issue 33), which
+ * gibench view shows and `gibench render --buffer NAME` writes: what
+ * explains the method (a shadow term, a map, an atlas, the VPLs, the
+ * gathered indirect light), not the final image again. */
+typedef struct gi_debug_buffer_desc {
+    const char *name;        /* [a-z0-9_]{1,31}, unique in the method */
+    const char *description; /* one line: what a pixel holds and its unit */
+    /* GI_DEBUG_SCREEN: view->width x view->height, pixel for pixel with
+     * the target (a G-buffer quantity); GI_DEBUG_OWN_SIZE: its own size (a
+     * map, an atlas, a slice), which the plugin chooses */
+    uint32_t space;
+} gi_debug_buffer_desc;
+enum { GI_DEBUG_SCREEN = 0, GI_DEBUG_OWN_SIZE = 1 };
+
 typedef struct gi_method {
     uint32_t struct_size;        /* sizeof(gi_method) the plugin was built with */
     uint32_t abi_version;        /* GI_ABI_VERSION the plugin was built with */
@@ -241,6 +259,20 @@ typedef struct gi_method {
      * struct_size ends before this field) declares none. Read it through
      * gi_method_departure (gi/plugin.h), which guards with GI_HAS_FIELD. */
     const gi_departure *departures;
+    /* ABI 1.3: the method's debug buffers, terminated by an entry with
+     * name NULL; NULL (or a plugin built before ABI 1.3, whose struct_size
+     * ends before this field) declares none. Read them through
+     * gi_method_debug_buffers (gi/plugin.h), which guards with GI_HAS_FIELD. */
+    const gi_debug_buffer_desc *debug_buffers;
+    /* ABI 1.3, required when debug_buffers declares any: buffer `name` (one
+     * of debug_buffers) as it stands after the last render(), which was
+     * given `view`. *out: a new image from gi_image_create (gi/image.h; the
+     * host frees it with gi_image_free), row 0 the top row, RGB in rgba
+     * (alpha ignored), view->width x view->height for a GI_DEBUG_SCREEN
+     * buffer. May render (GL is current) but must not change what the next
+     * render() makes. On error *out is NULL and last_error says why. */
+    gi_result (*debug_buffer)(void *instance, const char *name, const gi_view *view,
+                              gi_image **out);
 } gi_method;
 
 typedef const gi_method *(*gi_method_entry_fn)(uint32_t host_abi_version);

@@ -8,11 +8,12 @@
  * struct_size at least the 1.0 size, every required function inside
  * struct_size and non-NULL, a valid id, a valid parameter table, valid
  * declared departures (a known check, a one-line reason, a remedy that
- * parses against the parameter table), no duplicate id (the first found wins). All of this, and
- * unloading it (dlclose: its destructors), is first tried in a child process, so that a plugin that
- * crashes or hangs there is refused. A refused plugin gives one line "path: reason" in the
- * registry's error list and is skipped. Libraries are never dlclose'd (shims with C++/TLS
- * destructors crash after unload); gi_plugins_free releases only the registry.
+ * parses against the parameter table), valid debug buffers (names [a-z0-9_]{1,31}, unique, a
+ * one-line description, a known space, debug_buffer() present), no duplicate id (the first found
+ * wins). All of this, and unloading it (dlclose: its destructors), is first tried in a child
+ * process, so that a plugin that crashes or hangs there is refused. A refused plugin gives one line
+ * "path: reason" in the registry's error list and is skipped. Libraries are never dlclose'd (shims
+ * with C++/TLS destructors crash after unload); gi_plugins_free releases only the registry.
  */
 #ifndef GI_PLUGIN_H
 #define GI_PLUGIN_H
@@ -48,6 +49,11 @@ gi_result gi_method_validate(const gi_method *m, gi_error *err);
 /* The departure method m declares for `check` ("furnace", "held_out"), or
  * NULL when it declares none (or was built before ABI 1.2). */
 const gi_departure *gi_method_departure(const gi_method *m, const char *check);
+/* The debug buffers method m declares (ABI 1.3; terminated by name
+ * NULL), or NULL when it declares none (or was built before ABI 1.3). */
+const gi_debug_buffer_desc *gi_method_debug_buffers(const gi_method *m);
+/* The debug buffer of m named `name`, or NULL. */
+const gi_debug_buffer_desc *gi_method_debug_buffer(const gi_method *m, const char *name);
 /* Splits d->remedy into at most `max` "k=v" strings kv[], pointing into
  * buf (size bytes); returns how many, or -1 when it does not fit. */
 int gi_departure_remedy_args(const gi_departure *d, char *buf, size_t size, const char **kv,

@@ -22,6 +22,10 @@ layout(std430, binding = 13) readonly buffer CsmPatterns { vec2 csm_patterns[]; 
 uniform int u_S;
 uniform int u_distant; // 1: the objects have orthographic CSMs
 uniform int u_mode; // 0 shade; Table 2 visibility benchmarks: 1 random, 2 coherent
+// Debug buffers (debug.c): 0 the image; 1 the shaded direct light without
+// emission; 2 the same unshadowed (every visibility 1); 3 the mean length of
+// the CSM texel lists (segments) the pixel's queries read.
+uniform int u_debug;
 
 // Monte Carlo samples taken this frame (S per surface pixel), for the
 // samples-per-second figure of Table 2.
@@ -82,7 +86,7 @@ vec3 environment(gi_brdf b, vec3 x, vec3 N, vec3 wo, uint pattern, vec2 cp, inou
         }
         if (all(equal(c, vec3(0.0))))
             continue;
-        float v = csm_visibility(x, N, w, rng);
+        float v = u_debug == 2 ? 1.0 : csm_visibility(x, N, w, rng);
         if (v > 0.0)
             sum += c * v * gi_envmap_eval(w);
     }
@@ -121,7 +125,7 @@ vec3 area_lights(gi_brdf b, vec3 x, vec3 N, vec3 wo, uint own, uint pattern, vec
         if (cos_x <= 0.0 || cos_y <= 0.0)
             continue;
         uint j = csm_light_cells[gi_vertices[gi_indices[3u * em.triangle]].object];
-        float v = j < csm_light_count ? csm_light_visibility(j, x, N, y, own, rng) : 1.0;
+        float v = j < csm_light_count && u_debug != 2 ? csm_light_visibility(j, x, N, y, own, rng) : 1.0;
         if (v > 0.0)
             sum += gi_brdf_eval(b, N, wo, w) * lm.emission * cos_x * cos_y * v * area / (dist2 * em.pdf);
     }
@@ -152,11 +156,11 @@ vec3 punctual_lights(gi_brdf b, vec3 x, vec3 N, vec3 wo, uint own, inout uint rn
             continue;
         float v = 1.0;
         if (l.type == GI_LIGHT_DIRECTIONAL) {
-            if (u_distant != 0)
+            if (u_distant != 0 && u_debug != 2)
                 v = csm_visibility(x, N, w, rng);
         } else {
             for (uint j = 0u; j < csm_light_count; j++)
-                if (csm_lights[j].info.w == (0x80000000u | i)) {
+                if (csm_lights[j].info.w == (0x80000000u | i) && u_debug != 2) {
                     v = csm_light_visibility(j, x, N, l.position, own, rng);
                     break;
                 }
@@ -201,6 +205,12 @@ void main()
                 L += area_lights(b, x, N, wo, own, (pattern + 97u) & 255u, cp, rng);
             L += punctual_lights(b, x, N, wo, own, rng);
         }
+        if (u_debug == 1 || u_debug == 2)
+            L -= sf.emission;
+        if (u_debug == 3)
+            L = vec3(csm_dbg_lookups > 0.0 ? csm_dbg_segments / csm_dbg_lookups : 0.0);
+    } else if (u_debug != 0) {
+        L = vec3(0.0);
     }
     gi_accumulate_store(px, L);
 }

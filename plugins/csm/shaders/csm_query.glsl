@@ -34,12 +34,20 @@ uniform uint csm_object_count;
 uniform float csm_normal_offset;
 uniform int csm_filter;
 
+// Debug buffer "segments" (plugins/csm/debug.c): segments in the texel
+// lists this invocation's lookups read, and how many lookups; unused (and
+// compiled away) in the image.
+float csm_dbg_segments = 0.0, csm_dbg_lookups = 0.0;
+
 // §3.2: the z_avg of the segment of texel (x, y) that holds map i, in the
 // CSM whose offsets and segments start at offsets_base and segments_base.
 float csm_lookup_at(uint offsets_base, uint segments_base, uint M, ivec2 tex, uint i)
 {
     uint t = uint(tex.y) * M + uint(tex.x);
     uint lo = csm_offsets[offsets_base + t], hi = csm_offsets[offsets_base + t + 1u];
+    // debug buffer "segments" (debug.c): the length of the lists read
+    csm_dbg_segments += float(hi - lo);
+    csm_dbg_lookups += 1.0;
     // first segment j in [lo, hi) with i_end[j] >= i (the last one has N - 1)
     while (lo < hi) {
         uint mid = (lo + hi) >> 1;
