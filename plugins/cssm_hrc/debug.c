@@ -56,6 +56,13 @@ gi_result cssm_debug_buffer(void *inst, const char *name, const gi_view *view, g
 {
     cssm_hrc *c = inst;
     *out = NULL;
+    /* gather=gpu keeps the G-buffer on the GPU: read the last frame's back */
+    if (c->prepared && c->gpu_on && c->kit.frames > 0 && c->kit.width == view->width &&
+        c->kit.height == view->height) {
+        gi_result r = cssm_read_gbuffer(c, view->width, view->height);
+        if (r != GI_OK)
+            return r;
+    }
     if (!c->prepared || !c->gb[0] || c->acc_w != view->width || c->acc_h != view->height)
         return gi_kit_fail(&c->kit, GI_ERR_INVALID_ARGUMENT,
                            "cssm_hrc: debug buffer '%s' needs a render() of this view first", name);
