@@ -34,6 +34,7 @@ typedef struct view_slot {
     int method_index;
     const gi_method *m;
     void *inst;
+    gi_view last_view;
     gi_params *params;
     cli_host *host;
     int host_ready;
@@ -68,6 +69,7 @@ typedef struct viewer {
     int method_index, last_method;
     const gi_method *m;
     void *inst;
+    gi_view last_view; /* the view of the method's last render(), for its debug buffers */
     gi_params *params;
     cli_host *host; /* host_store[0]; host_store[1] while the second method is swapped in */
     cli_host host_store[2];

@@ -1,42 +1,48 @@
 /* gibench view: the method's debug buffers (named intermediate images, the
- * "Buffers" combo of the panels and the viewport's source "buffer"). The
- * method ABI's optional list of named images and the harness function that
- * fetches one as a float RGB image come with the debug-buffer work (branch
- * s7-dbg); until it is merged, GIBENCH_VIEW_DEBUG_BUFFERS is 0 and the list
- * is empty: the combo shows "(none)" and the source shows black. */
+ * "Buffers" combo of the panels and the viewport's source "buffer"): the
+ * plugin ABI 1.3 list gi_method.debug_buffers, fetched after each frame by
+ * the harness's debug_buffer_fetch (harness/run/debug_buffer.h), the same
+ * function as `gibench render --buffer`. */
 #include "view.h"
 
+#include "debug_buffer.h"
 #include "gi/image.h"
+#include "gi/log.h"
+#include "gi/plugin.h"
 
-#ifndef GIBENCH_VIEW_DEBUG_BUFFERS
-#define GIBENCH_VIEW_DEBUG_BUFFERS 0
-#endif
+/* The buffers the method shown declares (none before plugin ABI 1.3). */
+static const gi_debug_buffer_desc *buffers(const viewer *v)
+{
+    return v->m ? gi_method_debug_buffers(v->m) : NULL;
+}
 
-#if GIBENCH_VIEW_DEBUG_BUFFERS
-#error                                                                                             \
-    "wire view_buffer_count, view_buffer_name and view_buffer_fetch to the method ABI's debug buffers (s7-dbg)"
-#else
-/* No debug buffers yet: an empty list. */
 uint32_t view_buffer_count(const viewer *v)
 {
-    (void)v;
-    return 0;
+    const gi_debug_buffer_desc *d = buffers(v);
+    uint32_t n = 0;
+    while (d && d[n].name)
+        n++;
+    return n;
 }
 
 const char *view_buffer_name(const viewer *v, uint32_t i)
 {
-    (void)v;
-    (void)i;
-    return NULL;
+    return i < view_buffer_count(v) ? buffers(v)[i].name : NULL;
 }
 
+/* Buffer i of the instance shown, after its last render(); NULL (black, and
+ * the one-line reason logged) when the method fails to give it. */
 gi_image *view_buffer_fetch(viewer *v, uint32_t i)
 {
-    (void)v;
-    (void)i;
-    return NULL;
+    const char *name = view_buffer_name(v, i);
+    if (!name || !v->inst)
+        return NULL;
+    gi_error err = {{0}};
+    gi_image *img = debug_buffer_fetch(v->m, v->inst, &v->last_view, name, &err);
+    if (!img)
+        gi_log(GI_LOG_WARN, "view: %s", err.text);
+    return img;
 }
-#endif
 
 void view_buffer_upload(viewer *v)
 {

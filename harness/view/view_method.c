@@ -186,6 +186,7 @@ int view_render_method(viewer *v)
     double t0 = gi_now();
     gi_result res = v->m->render(v->inst, &view, &target);
     glFinish();
+    v->last_view = view;
     v->frame_ms = 1e3 * (gi_now() - t0);
     if (v->timer) {
         gi_timer_frame_end(v->timer);

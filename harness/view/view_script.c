@@ -17,6 +17,7 @@
  *     pan DX DY               the image panned by (DX, DY) window pixels
  *     panels on|off           the panels shown (the window grows by their width) or not
  *     source NAME             the image shows output, error, reference or buffer
+ *     source buffer NAME      the image shows the method's debug buffer NAME
  *     split N                 split mode 0 off, 1 reference, 2 error, 3 the second method
  *     split2 ID|none          the second method (split mode 3), or none
  *     param NAME=VALUE        a parameter of the method shown set, the method made again
@@ -38,6 +39,8 @@
  * the frame of the line before it has been rendered. */
 #define _POSIX_C_SOURCE 200809L
 #include "view.h"
+
+#include "debug_buffer.h"
 
 #include "gi/timer.h"
 
@@ -260,9 +263,28 @@ static int panels_line(viewer *v, const script_line *s)
     return EXIT_OK;
 }
 
+/* `source buffer NAME`: the method's debug buffer NAME selected. */
+static int buffer_select(viewer *v, const char *name)
+{
+    for (uint32_t i = 0; i < view_buffer_count(v); i++)
+        if (!strcmp(view_buffer_name(v, i), name)) {
+            v->buffer_sel = (int)i;
+            v->source = VIEW_SRC_BUFFER;
+            v->need_display = 1;
+            view_buffer_upload(v);
+            return EXIT_OK;
+        }
+    char names[512];
+    debug_buffer_names(v->m, names, sizeof names);
+    return cli_fail(EXIT_USAGE, "view: %s:%d: %s has no debug buffer '%s' (buffers: %s)",
+                    v->script_path, v->script_line, v->m ? v->m->id : "reference", name, names);
+}
+
 static int source_line(viewer *v, const script_line *s)
 {
     static const char *names[VIEW_SRC_COUNT] = {"output", "error", "reference", "buffer"};
+    if (s->n == 3 && !strcmp(s->a, "buffer"))
+        return buffer_select(v, s->b);
     for (int i = 0; s->n == 2 && i < VIEW_SRC_COUNT; i++)
         if (!strcmp(s->a, names[i])) {
             v->source = i;
@@ -270,7 +292,7 @@ static int source_line(viewer *v, const script_line *s)
             view_reference_as_needed(v);
             return EXIT_OK;
         }
-    return bad(v, "source output|error|reference|buffer");
+    return bad(v, "source output|error|reference|buffer [NAME]");
 }
 
 static int split_line(viewer *v, const script_line *s)

@@ -27,6 +27,7 @@ void view_slot_swap(viewer *v)
     SWAP(int, v->method_index, s->method_index);
     SWAP(const gi_method *, v->m, s->m);
     SWAP(void *, v->inst, s->inst);
+    SWAP(gi_view, v->last_view, s->last_view);
     SWAP(gi_params *, v->params, s->params);
     SWAP(cli_host *, v->host, s->host);
     SWAP(int, v->host_ready, s->host_ready);

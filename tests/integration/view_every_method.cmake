@@ -2,6 +2,11 @@
 # shows each installed method (and the reference), orbits a little and
 # takes a screenshot; the viewer exits 0, every screenshot's view names its
 # method, and every method's screenshot equals `gibench render --view`.
+# Debug buffers (issue 33): for every method that declares one, the first
+# screen-space buffer is shown in the image region (panels on, beside it)
+# and must equal `gibench render --view --buffer NAME` of the same view to
+# 1/255; a name the method does not declare fails the script with one line
+# listing its buffers.
 # Run by ctest as: cmake -DGIB=... -DROOT=... -DOUT=... -P view_every_method.cmake
 include(${CMAKE_CURRENT_LIST_DIR}/view_common.cmake)
 view_require_xvfb()
@@ -23,11 +28,26 @@ foreach(i RANGE ${last})
     string(JSON id GET "${methods}" ${i} id)
     list(APPEND ids ${id})
     string(APPEND script "method ${id}\ndrag 30 30 40 34\nwait 1\nscreenshot shot_${id}\n")
+    string(JSON nb LENGTH "${methods}" ${i} buffers)
+    if(nb GREATER 0)
+        math(EXPR lb "${nb} - 1")
+        foreach(b RANGE ${lb})
+            string(JSON space GET "${methods}" ${i} buffers ${b} space)
+            if(space STREQUAL "screen")
+                string(JSON bname GET "${methods}" ${i} buffers ${b} name)
+                list(APPEND buffered "${id}:${bname}")
+                string(APPEND script "source buffer ${bname}\nwindow-shot buf_${id}.png image\n"
+                                     "screenshot bshot_${id}\nsource output\n")
+                break()
+            endif()
+        endforeach()
+    endif()
 endforeach()
 string(APPEND script "method reference\nwait 2\nscreenshot shot_reference\nkey ESCAPE\n")
 file(WRITE ${W}/script.txt "${script}")
 list(GET ids 0 first)
-view_run(${W}/script.txt --scene ${ROOT}/scenes/cornell_box_coarse.gltf --method ${first} --size 48x48)
+view_run(${W}/script.txt --scene ${ROOT}/scenes/cornell_box_coarse.gltf --method ${first} --size 48x48
+    --panels on)
 
 foreach(id ${ids} reference)
     if(NOT EXISTS ${W}/shot_${id}.exr OR NOT EXISTS ${W}/shot_${id}.json)
@@ -45,3 +65,33 @@ foreach(id ${ids})
     string(APPEND summary " ${id}:${RENDER_RMSE}")
 endforeach()
 message(STATUS "every method's screenshot vs render --view, rmse:${summary}")
+
+# every paper plugin's first screen-space debug buffer as the viewer shows it
+foreach(pair ${buffered})
+    string(REPLACE ":" ";" pair "${pair}")
+    list(GET pair 0 id)
+    list(GET pair 1 bname)
+    execute_process(COMMAND ${GIB} -q render --view ${W}/bshot_${id}.json --buffer ${bname}
+                            --out ${W}/cli_${id}.png RESULT_VARIABLE rc ERROR_VARIABLE err)
+    if(NOT rc EQUAL 0)
+        message(FATAL_ERROR "render --buffer ${bname} of ${id}: exit ${rc}\n${err}")
+    endif()
+    execute_process(COMMAND ${PYTHON} ${CMAKE_CURRENT_LIST_DIR}/view_png.py same ${W}/buf_${id}.png
+                            ${W}/cli_${id}.png RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    if(NOT rc EQUAL 0)
+        message(FATAL_ERROR "${id}'s debug buffer ${bname} in the viewer against render --buffer: ${out}${err}")
+    endif()
+    message(STATUS "${id} buffer ${bname} in the viewer vs render --buffer: ${out}")
+endforeach()
+foreach(need csm cssm_hrc implicit_vis vlf avg)
+    if(NOT ";${buffered};" MATCHES ";${need}:")
+        message(FATAL_ERROR "no screen-space debug buffer of ${need} was shown")
+    endif()
+endforeach()
+# a name the method does not declare: exit 2, one line naming its buffers
+file(WRITE ${W}/bad.txt "source buffer nope\n")
+execute_process(COMMAND ${XVFB_RUN} -a ${GIB} view --script ${W}/bad.txt --scene ${ROOT}/scenes/cornell_box_coarse.gltf
+                        --method csm --size 16x16 WORKING_DIRECTORY ${W} RESULT_VARIABLE rc ERROR_VARIABLE err TIMEOUT 120)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "csm has no debug buffer 'nope' \\(buffers: visibility, segments\\)")
+    message(FATAL_ERROR "source buffer nope on csm: exit ${rc}, expected 2 and the list of its buffers:\n${err}")
+endif()
