@@ -164,40 +164,54 @@ static void mean_of_map(const gi_image *test, const gi_image *ref, size_t n, flo
         *mean = count ? sum / (double)count : NAN;
 }
 
-gi_result gi_metrics_flip_map(const gi_image *test, const gi_image *ref,
-                              const gi_metrics_opts *opts, float *map, double *mean, gi_error *err)
+/* The RGB planes FLIP compares (new arrays in *ts and *rs), checked first:
+ * each image's pixels, tone mapped at the exposure when `tonemap` (LDR-FLIP)
+ * or linear (HDR-FLIP picks its own exposures); a pixel that is not finite
+ * in one image takes the other's value in both (shared_pixel), or 0. */
+static gi_result flip_planes(const gi_image *test, const gi_image *ref, const gi_metrics_opts *o,
+                             int tonemap, const char *what, float **ts, float **rs, gi_error *err)
 {
-    gi_metrics_opts defaults = {0};
-    const gi_metrics_opts *o = opts ? opts : &defaults;
     gi_result res = check_pair(test, ref, err);
     if (!res)
         res = check_opts(o, err);
     if (res)
         return res;
     size_t n = (size_t)test->width * test->height;
-    float *ts = malloc(n * 3 * sizeof *ts), *rs = malloc(n * 3 * sizeof *rs);
-    if (!ts || !rs) {
-        free(ts);
-        free(rs);
-        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "FLIP: out of memory for a %ux%u image",
+    float *t = malloc(n * 3 * sizeof *t), *r = malloc(n * 3 * sizeof *r);
+    if (!t || !r) {
+        free(t);
+        free(r);
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "%s: out of memory for a %ux%u image", what,
                             test->width, test->height);
     }
     for (size_t i = 0; i < n; i++) {
-        const float *x = test->rgba + i * 4, *r = ref->rgba + i * 4;
-        if (finite3(x) && finite3(r)) {
-            for (int c = 0; c < 3; c++) {
-                ts[i * 3 + c] = gi_tonemap(x[c], o->exposure);
-                rs[i * 3 + c] = gi_tonemap(r[c], o->exposure);
-            }
-        } else {
-            const float *s = shared_pixel(x, r);
-            for (int c = 0; c < 3; c++)
-                ts[i * 3 + c] = rs[i * 3 + c] = s ? gi_tonemap(s[c], o->exposure) : 0.0f;
+        const float *x = test->rgba + i * 4, *y = ref->rgba + i * 4;
+        int shared = !(finite3(x) && finite3(y));
+        const float *s = shared ? shared_pixel(x, y) : NULL;
+        for (int c = 0; c < 3; c++) {
+            float a = shared ? (s ? s[c] : 0.0f) : x[c], b = shared ? (s ? s[c] : 0.0f) : y[c];
+            int keep = shared && !s; /* no value in either: 0 in both, not tone mapped */
+            t[i * 3 + c] = tonemap && !keep ? gi_tonemap(a, o->exposure) : a;
+            r[i * 3 + c] = tonemap && !keep ? gi_tonemap(b, o->exposure) : b;
         }
     }
+    *ts = t;
+    *rs = r;
+    return GI_OK;
+}
+
+gi_result gi_metrics_flip_map(const gi_image *test, const gi_image *ref,
+                              const gi_metrics_opts *opts, float *map, double *mean, gi_error *err)
+{
+    gi_metrics_opts defaults = {0};
+    const gi_metrics_opts *o = opts ? opts : &defaults;
+    float *ts = NULL, *rs = NULL;
+    gi_result res = flip_planes(test, ref, o, 1, "FLIP", &ts, &rs, err);
+    if (res)
+        return res;
     res = gi_flip_map(ts, rs, test->width, test->height, ppd_of(o), map, err);
     if (!res)
-        mean_of_map(test, ref, n, map, mean);
+        mean_of_map(test, ref, (size_t)test->width * test->height, map, mean);
     free(ts);
     free(rs);
     return res;
@@ -211,31 +225,13 @@ gi_result gi_metrics_hdr_flip_map(const gi_image *test, const gi_image *ref,
 {
     gi_metrics_opts defaults = {0};
     const gi_metrics_opts *o = opts ? opts : &defaults;
-    gi_result res = check_pair(test, ref, err);
-    if (!res)
-        res = check_opts(o, err);
+    float *tl = NULL, *rl = NULL;
+    gi_result res = flip_planes(test, ref, o, 0, "HDR-FLIP", &tl, &rl, err);
     if (res)
         return res;
-    size_t n = (size_t)test->width * test->height;
-    float *tl = malloc(n * 3 * sizeof *tl), *rl = malloc(n * 3 * sizeof *rl);
-    if (!tl || !rl) {
-        free(tl);
-        free(rl);
-        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "HDR-FLIP: out of memory for a %ux%u image",
-                            test->width, test->height);
-    }
-    for (size_t i = 0; i < n; i++) {
-        const float *x = test->rgba + i * 4, *r = ref->rgba + i * 4;
-        int shared = !(finite3(x) && finite3(r));
-        const float *s = shared ? shared_pixel(x, r) : NULL;
-        for (int c = 0; c < 3; c++) {
-            tl[i * 3 + c] = shared ? (s ? s[c] : 0.0f) : x[c];
-            rl[i * 3 + c] = shared ? (s ? s[c] : 0.0f) : r[c];
-        }
-    }
     res = gi_flip_hdr_map(tl, rl, test->width, test->height, ppd_of(o), map, info, err);
     if (!res)
-        mean_of_map(test, ref, n, map, mean);
+        mean_of_map(test, ref, (size_t)test->width * test->height, map, mean);
     free(tl);
     free(rl);
     return res;
