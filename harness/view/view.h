@@ -198,6 +198,10 @@ void view_camera_from_scene(viewer *v, int index);
 int view_needs_reference(const viewer *v);
 void view_reference_as_needed(viewer *v);
 
+/* The method shown made again (create + prepare) with `params` ("k=v,...",
+ * taken and freed; NULL: out of memory), the selected parameter kept. */
+int view_remake(viewer *v, char *params);
+
 /* The method shown (view_method.c): unloaded (none shown), a parameter
  * stepped (keys PAGE_UP and PAGE_DOWN), a frame rendered, the animation
  * at time t; they return EXIT_OK or an exit code after printing why. */

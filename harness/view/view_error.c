@@ -190,14 +190,5 @@ int view_set_param(viewer *v, const char *kv)
     char *all = gi_params_to_string(v->params);
     char *s = all ? replace_param(all, kv) : NULL;
     free(all);
-    if (!s || !view_file_set_params(&v->kv, s)) {
-        free(s);
-        return cli_fail(EXIT_RUN, "out of memory");
-    }
-    free(s);
-    snprintf(v->kv_method, sizeof v->kv_method, "%s", v->m->id);
-    int sel = v->param_sel;
-    int rc = view_select(v, v->method_index);
-    v->param_sel = sel;
-    return rc;
+    return view_remake(v, s);
 }

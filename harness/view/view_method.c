@@ -153,11 +153,16 @@ int view_step_param(viewer *v, int dir)
     v->params->values[i] = x;
     char *s = gi_params_to_string(v->params);
     v->params->values[i] = old;
-    if (!s || !view_file_set_params(&v->kv, s)) {
-        free(s);
+    return view_remake(v, s);
+}
+
+int view_remake(viewer *v, char *params)
+{
+    if (!params || !view_file_set_params(&v->kv, params)) {
+        free(params);
         return cli_fail(EXIT_RUN, "out of memory");
     }
-    free(s);
+    free(params);
     snprintf(v->kv_method, sizeof v->kv_method, "%s", v->m->id);
     int sel = v->param_sel;
     int rc = view_select(v, v->method_index);
