@@ -46,17 +46,25 @@ static inline int iv_bin_cell(float u, uint32_t n)
     return c >= (int)n ? (int)n - 1 : c;
 }
 
+/* The axis of a's largest |component| (the first on a tie): the cube face
+ * axis of the bins. */
+static inline int iv_major_axis(const float a[3])
+{
+    int ax = 0;
+    if (fabsf(a[1]) > fabsf(a[ax]))
+        ax = 1;
+    if (fabsf(a[2]) > fabsf(a[ax]))
+        ax = 2;
+    return ax;
+}
+
 /* iv_bin_of, inlined where link creation asks it millions of times per
  * frame; and the bins of d and -d at once (*neg: the bin of -d), which
  * share the axis and the divisions (-a / m is -(a / m) to the bit). */
 static inline uint32_t iv_bin_pair(gi_vec3 d, uint32_t n, uint32_t *neg)
 {
     float a[3] = {d.x, d.y, d.z};
-    int ax = 0;
-    if (fabsf(a[1]) > fabsf(a[ax]))
-        ax = 1;
-    if (fabsf(a[2]) > fabsf(a[ax]))
-        ax = 2;
+    int ax = iv_major_axis(a);
     float m = fabsf(a[ax]);
     if (!(m > 0.0f)) {
         *neg = 0;

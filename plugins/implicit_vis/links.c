@@ -99,11 +99,7 @@ static void put(iv_links *l, uint32_t A, uint32_t b, uint32_t B, float r, float 
 static void put_bilinear(iv_links *l, uint32_t A, gi_vec3 d, uint32_t B, float r, float omega)
 {
     float a[3] = {d.x, d.y, d.z};
-    int ax = 0;
-    if (fabsf(a[1]) > fabsf(a[ax]))
-        ax = 1;
-    if (fabsf(a[2]) > fabsf(a[ax]))
-        ax = 2;
+    int ax = iv_major_axis(a);
     float m = fabsf(a[ax]);
     if (!(m > 0.0f))
         return;
