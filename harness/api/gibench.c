@@ -3,6 +3,7 @@
 #include "gi/gibench.h"
 
 #include "cli.h"
+#include "debug_buffer.h"
 #include "gibench_internal.h"
 #include "gi/cache.h"
 #include "gi/image.h"
@@ -570,6 +571,21 @@ static gi_result hand_over(gi_image *img, float **rgba, uint32_t *width, uint32_
     img->rgba = NULL;
     gi_image_free(img);
     return GI_OK;
+}
+
+gi_result gibench_method_buffer(gibench_method *m, const char *name, float **rgba, uint32_t *width,
+                                uint32_t *height, gi_error *err)
+{
+    *rgba = NULL;
+    gi_result res = debug_buffer_check(m->l.m, name, err);
+    if (res != GI_OK)
+        return res;
+    if (m->next_frame == 0)
+        return gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                            "buffer: %s: %s: render a frame first (after the last update)",
+                            m->l.m->id, name);
+    gi_image *img = render_loop_buffer(&m->l, name, err);
+    return img ? hand_over(img, rgba, width, height) : GI_ERR_IO;
 }
 
 gi_result gibench_image_read(const char *path, float **rgba, uint32_t *width, uint32_t *height,

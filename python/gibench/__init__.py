@@ -48,8 +48,9 @@ class Image(np.ndarray):
 
 def methods():
     """The installed methods as `gibench methods --json` lists them: dicts with
-    id, title, citation, caps, max_bounces and params (name, type, default,
-    min/max or choices, and "quality" for a quality knob)."""
+    id, title, citation, caps, max_bounces, params (name, type, default,
+    min/max or choices, and "quality" for a quality knob) and buffers (the
+    debug buffers Method.buffer gives: name, description, space)."""
     out = ctypes.c_void_p()
     err = GiError()
     check(lib.gibench_methods_json(ctypes.byref(out), ctypes.byref(err)), err)
@@ -423,6 +424,20 @@ class Method(_Closes):
                                         ctypes.byref(out), ctypes.byref(err)), err)
         return Image(img, json.loads(take_string(out)))
 
+    def buffer(self, name):
+        """The method's debug buffer `name` after the last frame (as `gibench
+        render --buffer NAME`; gibench.methods() lists each method's buffers):
+        H x W x 3 float32, the view's size for a screen-space buffer, its own
+        otherwise. UsageError for a name the method does not declare, or
+        before a frame was rendered since the last update."""
+        self._alive()
+        rgba = ctypes.POINTER(ctypes.c_float)()
+        w, h = ctypes.c_uint32(), ctypes.c_uint32()
+        err = GiError()
+        check(lib.gibench_method_buffer(self._handle, str(name).encode(), ctypes.byref(rgba),
+                                        ctypes.byref(w), ctypes.byref(h), ctypes.byref(err)), err)
+        return Image(_take_rgb(rgba, w.value, h.value))
+
     def close(self):
         """Destroys the instance now (also when the object goes or its scene closes)."""
         if getattr(self, "_handle", None) and self._handle.value:
@@ -489,6 +504,10 @@ class _ChildMethod(_Closes):
         """As Method.render, in the child."""
         img, timings = self._call("render", frames)
         return Image(img, timings)
+
+    def buffer(self, name):
+        """As Method.buffer, in the child."""
+        return Image(self._call("buffer", name))
 
     def _release(self):
         for f in (self._proc.stdin, self._proc.stdout):
@@ -605,11 +624,15 @@ def read(path, layer=None):
                                            ctypes.byref(rgba), ctypes.byref(w), ctypes.byref(h),
                                            ctypes.byref(err))
     check(res, err)
+    return Image(_take_rgb(rgba, w.value, h.value))
+
+
+def _take_rgb(rgba, w, h):
+    """The RGB of an h x w RGBA float array from libgibench, released."""
     try:
-        a = np.ctypeslib.as_array(rgba, shape=(h.value, w.value, 4))[:, :, :3].copy()
+        return np.ctypeslib.as_array(rgba, shape=(h, w, 4))[:, :, :3].copy()
     finally:
         lib.gibench_free(ctypes.cast(rgba, ctypes.c_void_p))
-    return Image(a)
 
 
 def write(path, img, exposure=0.0):

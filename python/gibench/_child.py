@@ -60,6 +60,8 @@ def _serve(requests, answers):
             elif op == "render":
                 img = method.render(*args, **kwargs)
                 value = (np.asarray(img), img.timings)
+            elif op == "buffer":
+                value = np.asarray(method.buffer(*args))
             else:
                 raise gibench.RunError("isolate: unknown request '%s'" % op)
             answer = ("ok", value)

@@ -112,6 +112,9 @@ def _load():
                                 ctypes.c_int),
         "gibench_method_render": ([P, ctypes.c_uint32, ctypes.POINTER(ctypes.c_float),
                                    ctypes.POINTER(P), err], ctypes.c_int),
+        "gibench_method_buffer": ([P, ctypes.c_char_p, ctypes.POINTER(ctypes.POINTER(ctypes.c_float)),
+                                   ctypes.POINTER(ctypes.c_uint32), ctypes.POINTER(ctypes.c_uint32),
+                                   err], ctypes.c_int),
         "gibench_method_close": ([P], None),
         "gibench_free": ([P], None),
     }

@@ -48,6 +48,30 @@ def test_method_frames_accumulate_like_a_render(cornell):
     m.close()
 
 
+def test_buffer_equals_cli_buffer(tmp_path, cornell):
+    """Method.buffer(name) is `gibench render --buffer name` of the same
+    frames, bit for bit; an unknown name lists the method's buffers; a
+    buffer asked for before a frame (or after an update) is refused."""
+    out = str(tmp_path / "vis.exr")
+    run_cli("render", "--scene", CORNELL, "--method", "csm", "--out", out, "--size", "32x32",
+            "--frames", "2", "--buffer", "visibility")
+    names = [b["name"] for b in next(m for m in gibench.methods() if m["id"] == "csm")["buffers"]]
+    assert "visibility" in names
+    m = cornell.method("csm", size=(32, 32))
+    with pytest.raises(gibench.UsageError) as e:
+        m.buffer("visibility")
+    assert "render a frame first" in str(e.value)
+    m.render(frames=2)
+    vis = m.buffer("visibility")
+    assert vis.shape == (32, 32, 3)
+    assert np.array_equal(vis.view(np.uint32), gibench.read(out).view(np.uint32))
+    assert 0.0 < float(vis.mean()) < 1.0  # a shadow term: some pixels lit, some not
+    with pytest.raises(gibench.UsageError) as e:
+        m.buffer("nope")
+    assert "(buffers: %s)" % ", ".join(names) in str(e.value)
+    m.close()
+
+
 def test_study_returns_its_runs(tmp_path, monkeypatch):
     """A DataFrame with pandas (installed by the set-up: its absence fails
     here), a list of dicts without it or with as_frame=False."""

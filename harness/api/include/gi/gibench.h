@@ -117,6 +117,14 @@ gi_result gibench_method_move(gibench_method *m, const gibench_node_move *moves,
  * the last one's RGB into rgb, timings as for gibench_render. */
 gi_result gibench_method_render(gibench_method *m, uint32_t frames, float *rgb, char **timings,
                                 gi_error *err);
+/* Debug buffer `name` (plugin ABI 1.3, `gibench render --buffer`) of the
+ * instance after its last frame, as gibench_image_read returns an image
+ * (RGBA, row 0 the top row; free *rgba with gibench_free): the view's size
+ * for a screen-space buffer, its own otherwise. An unknown name
+ * (GI_ERR_INVALID_ARGUMENT) lists the method's buffers; so does a call
+ * before a frame was rendered since the last update. */
+gi_result gibench_method_buffer(gibench_method *m, const char *name, float **rgba, uint32_t *width,
+                                uint32_t *height, gi_error *err);
 /* The instance destroyed; the scene must outlive it. */
 void gibench_method_close(gibench_method *m);
 
