@@ -6,6 +6,7 @@
 # view_panels.png:  csm with its parameters, frame times, the reference's
 #                   progress, the live relMSE and the pixel read-out under the mouse
 # view_split.png:   csm left of the divider, direct right (split2), zoomed 2x
+# view_buffer.png:  csm's debug buffer "visibility" (its shadow term) in the image region
 set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
 gib=${1:-$root/build/release}/bin/gibench
@@ -25,7 +26,11 @@ split2 direct
 zoom 2 470 420
 wait 1
 window-shot $out/view_split.png
+split2 none
+key Z
+source buffer visibility
+window-shot $out/view_buffer.png
 SCRIPT
 xvfb-run -a -s "-screen 0 1400x800x24" "$gib" -q view --scene "$root/scenes/cornell_box.gltf" \
     --method csm --size 940x720 --panels on --script "$tmp/script.txt"
-ls -l "$out"/view_panels.png "$out"/view_split.png
+ls -l "$out"/view_panels.png "$out"/view_split.png "$out"/view_buffer.png
