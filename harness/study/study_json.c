@@ -76,17 +76,16 @@ int study_get_string(json_object *o, const char *prefix, const char *key, int nu
     return EXIT_OK;
 }
 
-/* The study file through the strict reader of every hand-written JSON file
- * (cli_read_json_strict: no trailing commas, comments, text after the
- * object, or key given twice, keys compared unescaped); NULL after
- * printing where it goes wrong. */
 /* A study on standard input ("-", e.g. from a program that holds the study
  * in memory) is copied to a private temporary file first, so that it goes
  * through the same strict reader and limits as a study file; messages name
  * it "-". */
 static json_object *read_stdin_json(char *why, size_t why_size)
 {
-    char tmp[] = "/tmp/gibench-study-XXXXXX";
+    /* in $TMPDIR, as every other temporary file of the harness */
+    const char *dir = getenv("TMPDIR");
+    char tmp[4096];
+    snprintf(tmp, sizeof tmp, "%s/gibench-study-XXXXXX", dir && *dir ? dir : "/tmp");
     int fd = mkstemp(tmp);
     if (fd < 0) {
         snprintf(why, why_size, "-: cannot make a temporary file for the study on standard input");
@@ -117,6 +116,10 @@ static json_object *read_stdin_json(char *why, size_t why_size)
     return o;
 }
 
+/* The study file through the strict reader of every hand-written JSON file
+ * (cli_read_json_strict: no trailing commas, comments, text after the
+ * object, or key given twice, keys compared unescaped); NULL after
+ * printing where it goes wrong. */
 json_object *study_read_strict_json(const char *file)
 {
     char why[1024];
