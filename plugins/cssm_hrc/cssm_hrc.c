@@ -116,6 +116,9 @@ static const gi_param_desc cssm_params[] = {
      "where the per-pixel final gather runs: gpu, a compute pass every frame (the paper's); cpu, "
      "the C traversal (the oracle). gpu falls back to cpu, with a log line and stat gather_gpu 0, "
      "for mode=texels, indirect=mc, direct=csm, moving objects, punctual lights and environments"},
+    {"bounces_on", GI_PARAM_ENUM, 0, 0, 0, "gpu|cpu", "Sec. 4.1.1 (HRC on the GPU), Fig. 8",
+     "where the HRC bounces' per-texel gathers run (prepare, and when lights or materials "
+     "change): gpu, a compute pass per bounce (the paper's); cpu, the C loop (the oracle)"},
     {"shadow_size", GI_PARAM_INT, 256, 16, 2048, NULL, NULL,
      "face size of the point/spot lights' shadow cube maps and of directional lights' shadow maps"},
     {0},
@@ -154,6 +157,7 @@ static gi_result cssm_create(const gi_host *host, const gi_params *params, void 
     c->csm_samples = gi_params_int(params, "csm_samples");
     c->csm_M = gi_params_int(params, "csm_M");
     c->gather = gi_params_enum(params, "gather");
+    c->bounces_on = gi_params_enum(params, "bounces_on");
     c->motion.moving = -1;
     *out = c;
     return GI_OK;

@@ -232,6 +232,9 @@ gi_result cssm_lighting(cssm_hrc *c, const gi_gpu_scene *gs)
     }
     cssm_gather_opts o = cssm_hrc_gather_opts(c, 0.0f, NULL);
     o.no_emission = c->csm != NULL; /* R1 = the CSMs' direct light alone */
+    if (c->bounces_on == 0) /* §4.1.1 "HRC on the GPU": the per-texel gathers in a compute pass */
+        cssm_gpu_bounces(c, &o);
+    host->stat(host, "bounces_gpu", c->bounces_on == 0);
     cssm_gather_stats st = {0};
     gi_error err;
     const float *direct = c->shadow_count || env || c->csm ? D : NULL;
