@@ -22,10 +22,11 @@
  * environment per pixel (final_gather.c).
  * Pixels thus get light paths of 0 .. n + 1 bounces.
  * With gather=gpu (the default, as the paper) the final gather of
- * render() is a compute pass (gpu_gather.c); the HRC bounces, and the final
- * gather with gather=cpu or where the pass does not cover the scene, run
- * on the CPU; the depth cube maps, shadow maps and G-buffer are drawn by
- * the core's GL passes. */
+ * render() is a compute pass (gpu_gather.c), and with bounces_on=gpu (the
+ * default) so are the HRC bounces' per-texel gathers; the pulls, and the
+ * gathers with gather=cpu / bounces_on=cpu or where the final gather's pass
+ * does not cover the scene, run on the CPU; the depth cube maps, shadow maps and G-buffer are drawn
+ * by the core's GL passes. */
 #include "cssm_hrc.h"
 
 #include <stdlib.h>

@@ -313,10 +313,17 @@ static gi_result bounce_gather(void *ctx, const float *node_L, const cssm_ctree 
     return gi_gl_check("cssm_hrc: gpu bounce", err);
 }
 
-void cssm_gpu_bounces(cssm_hrc *c, cssm_gather_opts *o)
+gi_result cssm_gpu_bounces(cssm_hrc *c, cssm_gather_opts *o)
 {
+    gi_error err;
+    if (!c->gpu_bounce_prog) {
+        c->gpu_bounce_prog = gi_program_build_compute("cssm_bounce.comp", NULL, &err);
+        if (!c->gpu_bounce_prog)
+            return gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
+    }
     c->bounce_opts = *o;
     c->gpu_bounce_maps = 0;
     o->atlas_gather = bounce_gather;
     o->atlas_ctx = c;
+    return GI_OK;
 }
