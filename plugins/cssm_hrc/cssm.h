@@ -328,6 +328,8 @@ typedef struct cssm_receiver {
     gi_vec3 wo;
 } cssm_receiver;
 
+struct cssm_gather_stats;
+
 typedef struct cssm_gather_opts {
     float threshold;  /* refine while the tone-mapped bound exceeds it (§4.3) */
     uint32_t max_cut; /* maximum nodes in the cut */
@@ -341,6 +343,13 @@ typedef struct cssm_gather_opts {
                        * (lightcuts' representative, hrc.c pick_leaf) */
     int no_emission; /* cssm_solve: R_1 = direct only, the emitting texels not gathered (their light
                       * comes from the direct light of direct=csm, §4.7) */
+    /* set: cssm_solve_ex's per-texel gathers (§4.1.1) run there instead of
+     * the C loop (bounces_on=gpu, gpu_gather.c): every texel of the atlas
+     * gathered from node_L (or the packed nodes ct) into out[3 N], the
+     * counts added to st; a failure sets err */
+    gi_result (*atlas_gather)(void *ctx, const float *node_L, const struct cssm_ctree *ct,
+                              float *out, struct cssm_gather_stats *st, gi_error *err);
+    void *atlas_ctx;
 } cssm_gather_opts;
 
 typedef struct cssm_gather_stats {

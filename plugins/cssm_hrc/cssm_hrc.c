@@ -22,10 +22,11 @@
  * environment per pixel (final_gather.c).
  * Pixels thus get light paths of 0 .. n + 1 bounces.
  * With gather=gpu (the default, as the paper) the final gather of
- * render() is a compute pass (gpu_gather.c); the HRC bounces, and the final
- * gather with gather=cpu or where the pass does not cover the scene, run
- * on the CPU; the depth cube maps, shadow maps and G-buffer are drawn by
- * the core's GL passes. */
+ * render() is a compute pass (gpu_gather.c), and with bounces_on=gpu (the
+ * default) so are the HRC bounces' per-texel gathers; the pulls, and the
+ * gathers with gather=cpu / bounces_on=cpu or where the final gather's pass
+ * does not cover the scene, run on the CPU; the depth cube maps, shadow maps and G-buffer are drawn
+ * by the core's GL passes. */
 #include "cssm_hrc.h"
 
 #include <stdlib.h>
@@ -116,6 +117,9 @@ static const gi_param_desc cssm_params[] = {
      "where the per-pixel final gather runs: gpu, a compute pass every frame (the paper's); cpu, "
      "the C traversal (the oracle). gpu falls back to cpu, with a log line and stat gather_gpu 0, "
      "for mode=texels, indirect=mc, direct=csm, moving objects, punctual lights and environments"},
+    {"bounces_on", GI_PARAM_ENUM, 0, 0, 0, "gpu|cpu", "Sec. 4.1.1 (HRC on the GPU), Fig. 8",
+     "where the HRC bounces' per-texel gathers run (prepare, and when lights or materials "
+     "change): gpu, a compute pass per bounce (the paper's); cpu, the C loop (the oracle)"},
     {"shadow_size", GI_PARAM_INT, 256, 16, 2048, NULL, NULL,
      "face size of the point/spot lights' shadow cube maps and of directional lights' shadow maps"},
     {0},
@@ -154,6 +158,7 @@ static gi_result cssm_create(const gi_host *host, const gi_params *params, void 
     c->csm_samples = gi_params_int(params, "csm_samples");
     c->csm_M = gi_params_int(params, "csm_M");
     c->gather = gi_params_enum(params, "gather");
+    c->bounces_on = gi_params_enum(params, "bounces_on");
     c->motion.moving = -1;
     *out = c;
     return GI_OK;

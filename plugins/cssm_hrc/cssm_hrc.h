@@ -10,7 +10,9 @@
  *   motion_update.c  moving rigid objects (§3.3) at prepare and update;
  *   final_gather.c   the per-pixel final gather (§4.4, §4.5) and shading;
  *   gpu_gather.c     the same final gather as a GL compute pass (gather=gpu,
- *                    shaders/cssm_gather.comp; §4 "HRC on the GPU");
+ *                    shaders/cssm_gather.comp; §4 "HRC on the GPU"), and
+ *                    the HRC bounces' per-texel gathers (bounces_on=gpu,
+ *                    shaders/cssm_bounce.comp; §4.1.1);
  *   stats.c          the stats the plugin reports.
  * The parts of the paper these call (atlas, CSSM, hierarchy) are in
  * cssm.h, motion.h, env_cssm.h and direct_csm.h. */
@@ -76,6 +78,11 @@ typedef struct cssm_hrc {
     int gpu_on;    /* gather=gpu and the scene and options are ones the GPU pass covers */
     int gpu_dirty; /* the lighting changed since the GPU buffers were filled */
     GLuint gpu_prog;
+    int bounces_on;         /* bounces_on=gpu (0) or cpu (1): where the HRC bounces' gathers run */
+    GLuint gpu_bounce_prog; /* cssm_bounce.comp */
+    GLuint gpu_bounce_buf[2];     /* texels' albedo, gathered radiance */
+    int gpu_bounce_maps;          /* this solve's maps and albedo are uploaded */
+    cssm_gather_opts bounce_opts; /* the solve's gather options, for the compute pass */
     GLuint gpu_buf[CSSM_GPU_BUFFERS];
     uint32_t gpu_off_base[6], gpu_seg_base[6]; /* each face's first offset and segment */
     /* CPU time of the frames after the first since prepare (stats.c, frame_cpu_ms) */
@@ -157,6 +164,12 @@ gi_result cssm_gpu_final_gather(cssm_hrc *c, const gi_view *view, const gi_targe
                                 int random, cssm_gather_stats *st);
 /* Deletes the program and buffers (a GL context is current). */
 void cssm_gpu_free(cssm_hrc *c);
+/* bounces_on=gpu: points o's atlas_gather at the compute pass of the HRC
+ * bounces (shaders/cssm_bounce.comp, §4.1.1), so that cssm_solve_ex runs
+ * each per-texel gather there and reads the radiance back; the program is
+ * built here, before the solve's timer. Fails (set on the kit) when it
+ * does not build. */
+gi_result cssm_gpu_bounces(cssm_hrc *c, cssm_gather_opts *o);
 
 /* Debug buffer "indirect" (debug.c): the reflected light (light set 2:
  * every bounce after the first) that the hierarchy's cut gathers at pixel
@@ -187,6 +200,9 @@ void cssm_stats_hulls(const cssm_hrc *c, const gi_scene *s);
  * after the first since prepare (the first compiles the shaders). */
 void cssm_stats_cpu_begin(cssm_hrc *c);
 void cssm_stats_cpu_end(cssm_hrc *c);
+/* The process's CPU seconds (every thread, llvmpipe's included) and the
+ * calling thread's, now: the stats solve_cpu_ms / solve_main_share. */
+void cssm_cpu_now(double t[2]);
 /* Cut size and clamped share of a frame's gathers. */
 void cssm_stats_cuts(const cssm_hrc *c, const cssm_gather_stats *st);
 

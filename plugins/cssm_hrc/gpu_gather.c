@@ -53,8 +53,12 @@ void cssm_gpu_free(cssm_hrc *c)
 {
     if (c->gpu_prog)
         glDeleteProgram(c->gpu_prog);
+    if (c->gpu_bounce_prog)
+        glDeleteProgram(c->gpu_bounce_prog);
     glDeleteBuffers(CSSM_GPU_BUFFERS, c->gpu_buf);
-    c->gpu_prog = 0;
+    glDeleteBuffers(2, c->gpu_bounce_buf);
+    c->gpu_prog = c->gpu_bounce_prog = 0;
+    memset(c->gpu_bounce_buf, 0, sizeof c->gpu_bounce_buf);
     memset(c->gpu_buf, 0, sizeof c->gpu_buf);
 }
 
@@ -66,19 +70,19 @@ static void upload(GLuint buf, size_t bytes, const void *data)
                       GL_STATIC_DRAW);
 }
 
-/* The nodes the final gather reads (light set 0, emission + reflected, as
- * final_gather.c's gather(c, 0, ...)), decoded as the C traversal decodes
- * them, and the leaves. */
-static gi_result upload_nodes(cssm_hrc *c)
+/* The nodes a gather reads (node_L, or the packed nodes ct), decoded as
+ * the C traversal decodes them, and the leaves: for the final gather light
+ * set 0 (emission + reflected, as final_gather.c's gather(c, 0, ...)), for
+ * a bounce the previous bounce pulled. */
+static gi_result upload_nodes(cssm_hrc *c, const float *node_L, const cssm_ctree *ct)
 {
-    const cssm_ctree *ct = c->nodes ? &c->ct[0] : NULL;
     const uint32_t n = c->tree.count;
     gpu_node *g = calloc(n, sizeof *g);
     if (!g)
         return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the nodes");
     for (uint32_t i = 0; i < n; i++) {
         cssm_node_view v;
-        cssm_node_fetch(&c->tree, c->node_L, ct, (int32_t)i, &v);
+        cssm_node_fetch(&c->tree, node_L, ct, (int32_t)i, &v);
         gpu_node *d = &g[i];
         memcpy(d->c_r, (float[4]){v.c.x, v.c.y, v.c.z, v.r}, sizeof d->c_r);
         memcpy(d->p_area, (float[4]){v.p.x, v.p.y, v.p.z, v.area}, sizeof d->p_area);
@@ -90,8 +94,8 @@ static gi_result upload_nodes(cssm_hrc *c)
         d->walk[0] = v.child, d->walk[3] = (int32_t)v.first;
         if (v.child >= 0) { /* pick_leaf's choice at this node, computed as hrc.c does */
             cssm_node_view l, r;
-            cssm_node_fetch(&c->tree, c->node_L, ct, v.child, &l);
-            cssm_node_fetch(&c->tree, c->node_L, ct, l.skip, &r);
+            cssm_node_fetch(&c->tree, node_L, ct, v.child, &l);
+            cssm_node_fetch(&c->tree, node_L, ct, l.skip, &r);
             float il = fmaxf(0.0f, gi_luminance(l.I)), ir = fmaxf(0.0f, gi_luminance(r.I));
             float pl = il + ir > 0.0f ? il / (il + ir) : l.area / fmaxf(l.area + r.area, FLT_MIN);
             d->walk[1] = l.skip;
@@ -165,7 +169,7 @@ static gi_result gpu_setup(cssm_hrc *c)
     if (c->gpu_dirty) {
         gi_result r = upload_maps(c);
         if (r == GI_OK)
-            r = upload_nodes(c);
+            r = upload_nodes(c, c->node_L, c->nodes ? &c->ct[0] : NULL);
         if (r != GI_OK)
             return r;
         c->gpu_dirty = 0;
@@ -221,5 +225,105 @@ gi_result cssm_gpu_final_gather(cssm_hrc *c, const gi_view *view, const gi_targe
     gi_error err;
     if (gi_gl_check("cssm_hrc: gpu gather", &err) != GI_OK)
         return gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
+    return GI_OK;
+}
+
+/* bounces_on=gpu: the program, the buffers, the maps and the texels'
+ * albedo, once per cssm_solve_ex (the first gather of the solve). */
+static gi_result bounce_setup(cssm_hrc *c, gi_error *err)
+{
+    if (!c->gpu_bounce_prog) {
+        c->gpu_bounce_prog = gi_program_build_compute("cssm_bounce.comp", NULL, err);
+        if (!c->gpu_bounce_prog)
+            return GI_ERR_GL;
+    }
+    if (!c->gpu_buf[0])
+        glCreateBuffers(CSSM_GPU_BUFFERS, c->gpu_buf);
+    if (!c->gpu_bounce_buf[0])
+        glCreateBuffers(2, c->gpu_bounce_buf);
+    if (c->gpu_bounce_maps)
+        return GI_OK;
+    const cssm_atlas *a = &c->atlas;
+    float *alb = calloc(4 * (size_t)a->count + 4, sizeof *alb);
+    if (!alb)
+        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the bounces");
+    for (uint32_t i = 0; i < a->count; i++)
+        memcpy(&alb[4 * i], a->texels[i].albedo, 3 * sizeof(float));
+    upload(c->gpu_bounce_buf[0], 4 * (size_t)a->count * sizeof *alb, alb);
+    free(alb);
+    glNamedBufferData(c->gpu_bounce_buf[1], (GLsizeiptr)(3 * (size_t)a->count + 4) * 4, NULL,
+                      GL_DYNAMIC_READ);
+    gi_result r = upload_maps(c);
+    if (r != GI_OK)
+        return gi_error_set(err, r, "cssm_hrc: out of memory for the bounces");
+    c->gpu_bounce_maps = 1;
+    c->gpu_dirty = 1; /* the final gather's node buffer is overwritten by the bounces' */
+    return GI_OK;
+}
+
+static void bounce_uniforms(const cssm_hrc *c, GLuint p, const cssm_gather_opts *o)
+{
+    glUniform1ui(glGetUniformLocation(p, "u_count"), c->atlas.count);
+    glUniform1f(glGetUniformLocation(p, "u_lim"), cssm_refine_limit(o->threshold));
+    glUniform1f(glGetUniformLocation(p, "u_scale"), exp2f(o->exposure));
+    glUniform1ui(glGetUniformLocation(p, "u_max_cut"), o->max_cut);
+    glUniform1f(glGetUniformLocation(p, "u_clamp"), o->clamp);
+    glUniform1f(glGetUniformLocation(p, "u_bias"), o->bias);
+    glUniform1f(glGetUniformLocation(p, "u_lift"), 2.0f * c->maps.znear);
+    glUniform1i(glGetUniformLocation(p, "u_pcf"), o->pcf);
+    glUniform1i(glGetUniformLocation(p, "u_rep_centroid"), o->rep_centroid);
+    glUniform1ui(glGetUniformLocation(p, "u_M"), c->maps.M);
+    glUniform1uiv(glGetUniformLocation(p, "u_off_base"), 6, c->gpu_off_base);
+    glUniform1uiv(glGetUniformLocation(p, "u_seg_base"), 6, c->gpu_seg_base);
+}
+
+/* §4.1.1: one gather step for every atlas texel (cssm_gather_opts'
+ * atlas_gather): the nodes of the previous bounce uploaded, one invocation
+ * per texel (cssm_bounce.comp), the radiance read back into out. */
+static gi_result bounce_gather(void *ctx, const float *node_L, const cssm_ctree *ct, float *out,
+                               cssm_gather_stats *st, gi_error *err)
+{
+    cssm_hrc *c = ctx;
+    gi_result r = bounce_setup(c, err);
+    if (r == GI_OK && (r = upload_nodes(c, node_L, ct)) != GI_OK)
+        return gi_error_set(err, r, "cssm_hrc: out of memory for the bounces");
+    if (r != GI_OK)
+        return r;
+    const GLuint p = c->gpu_bounce_prog;
+    glUseProgram(p);
+    bounce_uniforms(c, p, &c->bounce_opts);
+    for (int k = 0; k < CSSM_GPU_BUFFERS; k++)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, buf_binding[k], c->gpu_buf[k]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CSSM_SSBO_ALBEDO, c->gpu_bounce_buf[0]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CSSM_SSBO_OUT, c->gpu_bounce_buf[1]);
+    const uint32_t zero[4] = {0};
+    glNamedBufferData(c->gpu_buf[BUF_STATS], sizeof zero, zero, GL_DYNAMIC_READ);
+    glDispatchCompute((c->atlas.count + 63) / 64, 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glUseProgram(0);
+    glGetNamedBufferSubData(c->gpu_bounce_buf[1], 0,
+                            (GLsizeiptr)(3 * (size_t)c->atlas.count * sizeof *out), out);
+    uint32_t got[4];
+    glGetNamedBufferSubData(c->gpu_buf[BUF_STATS], 0, sizeof got, got);
+    if (st) {
+        st->nodes += got[0];
+        st->receivers += got[1];
+        st->clamped += got[2];
+    }
+    return gi_gl_check("cssm_hrc: gpu bounce", err);
+}
+
+gi_result cssm_gpu_bounces(cssm_hrc *c, cssm_gather_opts *o)
+{
+    gi_error err;
+    if (!c->gpu_bounce_prog) {
+        c->gpu_bounce_prog = gi_program_build_compute("cssm_bounce.comp", NULL, &err);
+        if (!c->gpu_bounce_prog)
+            return gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
+    }
+    c->bounce_opts = *o;
+    c->gpu_bounce_maps = 0;
+    o->atlas_gather = bounce_gather;
+    o->atlas_ctx = c;
     return GI_OK;
 }

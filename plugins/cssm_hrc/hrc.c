@@ -445,10 +445,12 @@ void cssm_cgather(const cssm_ctree *ct, const cssm_atlas *a, const cssm_maps *ma
 
 /* One gather over every texel of the atlas from node radiance node_L (or
  * the packed nodes ct). */
-static void gather_atlas(const cssm_tree *t, const float *node_L, const cssm_ctree *ct,
-                         const cssm_atlas *a, const cssm_maps *maps, const cssm_gather_opts *o,
-                         float *out, cssm_gather_stats *st)
+static gi_result gather_atlas(const cssm_tree *t, const float *node_L, const cssm_ctree *ct,
+                              const cssm_atlas *a, const cssm_maps *maps, const cssm_gather_opts *o,
+                              float *out, cssm_gather_stats *st, gi_error *err)
 {
+    if (o->atlas_gather) /* the same gathers in a compute pass (bounces_on=gpu) */
+        return o->atlas_gather(o->atlas_ctx, node_L, ct, out, st, err);
     for (uint32_t i = 0; i < a->count; i++) {
         const cssm_texel *x = &a->texels[i];
         cssm_receiver rc = {
@@ -456,6 +458,7 @@ static void gather_atlas(const cssm_tree *t, const float *node_L, const cssm_ctr
         memcpy(rc.kd, x->albedo, sizeof rc.kd);
         gather_any(t, node_L, ct, a, maps, &rc, o, &out[3 * i], st);
     }
+    return GI_OK;
 }
 
 gi_vec3 cssm_receiver_point(const cssm_maps *maps, const cssm_atlas *a, gi_vec3 p, gi_vec3 n)
@@ -498,12 +501,13 @@ gi_result cssm_solve_ex(const cssm_tree *t, cssm_ctree *ct, const cssm_atlas *a,
     for (uint32_t i = 0; i < N; i++)
         memcpy(&Le[3 * i], a->texels[i].emission, 3 * sizeof(float));
     memcpy(texel_L, Le, 3 * (size_t)N * sizeof *texel_L);
+    gi_result r = GI_OK;
     if (bounces >= 1) {
         /* direct: the emitting texels gathered like any sender, plus the rest */
         gi_host_stage(host, "direct", 1);
         if (!o->no_emission) {
             pull_any(t, ct, a, Le, nodes);
-            gather_atlas(t, nodes, ct, a, maps, o, Rk, st);
+            r = gather_atlas(t, nodes, ct, a, maps, o, Rk, st, err);
         }
         if (direct)
             for (size_t k = 0; k < 3 * (size_t)N; k++)
@@ -512,13 +516,13 @@ gi_result cssm_solve_ex(const cssm_tree *t, cssm_ctree *ct, const cssm_atlas *a,
             texel_L[k] += Rk[k];
         gi_host_stage(host, "direct", 0);
     }
-    for (uint32_t b = 2; b <= bounces; b++) {
+    for (uint32_t b = 2; b <= bounces && r == GI_OK; b++) {
         gi_host_stage(host, "pull", 1);
         pull_any(t, ct, a, Rk, nodes);
         gi_host_stage(host, "pull", 0);
         gi_host_stage(host, "bounce", 1);
         memset(Rn, 0, 3 * (size_t)N * sizeof *Rn);
-        gather_atlas(t, nodes, ct, a, maps, o, Rn, st);
+        r = gather_atlas(t, nodes, ct, a, maps, o, Rn, st, err);
         for (size_t k = 0; k < 3 * (size_t)N; k++)
             texel_L[k] += Rn[k];
         float *sw = Rk;
@@ -532,7 +536,7 @@ gi_result cssm_solve_ex(const cssm_tree *t, cssm_ctree *ct, const cssm_atlas *a,
         cssm_ctree_pull(ct, a, texel_L);
     gi_host_stage(host, "pull", 0);
     free(Le), free(Rk), free(Rn), free(nodes);
-    return GI_OK;
+    return r;
 }
 
 double cssm_pdf_build(const cssm_atlas *a, const float *texel_values, double *cdf)

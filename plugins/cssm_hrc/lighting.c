@@ -232,11 +232,23 @@ gi_result cssm_lighting(cssm_hrc *c, const gi_gpu_scene *gs)
     }
     cssm_gather_opts o = cssm_hrc_gather_opts(c, 0.0f, NULL);
     o.no_emission = c->csm != NULL; /* R1 = the CSMs' direct light alone */
+    /* §4.1.1 "HRC on the GPU": the per-texel gathers in a compute pass */
+    if (c->bounces_on == 0 && (r = cssm_gpu_bounces(c, &o)) != GI_OK) {
+        free(D);
+        return r;
+    }
+    host->stat(host, "bounces_gpu", c->bounces_on == 0);
     cssm_gather_stats st = {0};
     gi_error err;
     const float *direct = c->shadow_count || env || c->csm ? D : NULL;
+    double t0[2], t1[2];
+    cssm_cpu_now(t0);
     r = cssm_solve_ex(&c->tree, c->nodes ? &c->ct[0] : NULL, a, &c->maps, &o, (uint32_t)c->bounces,
                       direct, host, c->texel_L, c->node_L, &st, &err);
+    cssm_cpu_now(t1);
+    host->stat(host, "solve_cpu_ms", 1e3 * (t1[0] - t0[0]));
+    if (t1[0] > t0[0])
+        host->stat(host, "solve_main_share", (t1[1] - t0[1]) / (t1[0] - t0[0]));
     free(D);
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);

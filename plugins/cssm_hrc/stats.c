@@ -122,3 +122,9 @@ void cssm_stats_cpu_end(cssm_hrc *c)
     if (c->cpu_process_s > 0.0)
         host->stat(host, "frame_main_share", c->cpu_main_s / c->cpu_process_s);
 }
+
+void cssm_cpu_now(double t[2])
+{
+    t[0] = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID);
+    t[1] = cpu_seconds(CLOCK_THREAD_CPUTIME_ID);
+}

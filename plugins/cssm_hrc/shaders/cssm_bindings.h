@@ -13,4 +13,7 @@
 #define CSSM_SSBO_Z_AVG 12   /* the six faces' segments, concatenated */
 #define CSSM_SSBO_I_END 13
 #define CSSM_SSBO_STATS 14 /* gathered nodes, receivers, clamped gathers (one frame) */
+/* the HRC bounces' per-texel gather (bounces_on=gpu, cssm_bounce.comp) */
+#define CSSM_SSBO_ALBEDO 15 /* per texel: albedo (rgb) */
+#define CSSM_SSBO_OUT 16    /* per texel: the gathered radiance, 3 floats */
 #endif

@@ -40,6 +40,7 @@ void main()
         CssmReceiver rc;
         rc.n = normalize(nor);
         rc.x = P.xyz + rc.n * u_lift;
+        rc.self = -1;
         rc.kd = alb.rgb;
         rc.ks = ph.rgb;
         rc.lum_kd = gi_luminance(rc.kd);

@@ -31,9 +31,11 @@ struct CssmNode {
 layout(std430, binding = CSSM_SSBO_NODES) readonly buffer CssmNodes { CssmNode cssm_nodes[]; };
 layout(std430, binding = CSSM_SSBO_LEAVES) readonly buffer CssmLeaves { uint cssm_leaves[]; };
 
-// cssm_receiver (cssm.h) of a pixel: always glossy, no texel of its own.
+// cssm_receiver (cssm.h): a pixel (glossy, self -1) or an atlas texel of
+// an HRC bounce (diffuse: ks 0, self its index, skipped as a sender).
 struct CssmReceiver {
     vec3 x, n;
+    int self;
     vec3 kd, ks;
     float lum_kd, lum_ks; // their luminance
     float exponent;
@@ -175,7 +177,12 @@ vec3 cssm_gather(CssmReceiver rc, CssmOpts o, inout uint rng, out uint gathered,
     gathered = 0u;
     int i = 0;
     while (i >= 0) {
-        ivec2 link = cssm_nodes[i].link.xy;
+        ivec4 link = cssm_nodes[i].link;
+        if (link.x < 0 && rc.self >= 0 && cssm_leaves[link.z] == uint(rc.self)) {
+            pending--;
+            i = link.y; // no transfer to itself
+            continue;
+        }
         bool lit = any(greaterThan(cssm_nodes[i].I.rgb, vec3(0.0)));
         bool refine = false;
         if (link.x >= 0 && gathered + pending + 1u <= o.max_cut && lit) {
