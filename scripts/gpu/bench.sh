@@ -35,7 +35,7 @@ command -v timeout >/dev/null || die "needs timeout (coreutils) to keep to --lim
 gibench=$here/gibench
 [[ -x $gibench && -d $here/scenes ]] ||
     die "runs from a bundle: scripts/gpu/bundle.sh DIR, then DIR/bench.sh (no $gibench here)"
-parts=(cssm_table1 vlf_table1 avg_tables ivis_table1 csm_table2 timer_check compare)
+parts=(gpu_paths cssm_table1 vlf_table1 avg_tables ivis_table1 csm_table2 timer_check compare)
 if [[ -n $only ]]; then
     IFS=, read -r -a parts <<<"$only"
 fi
@@ -104,6 +104,11 @@ for p in "${parts[@]}"; do
     if ((rc == 0)); then
         mv "$work/$p" "$out/$p"
         status[$p]="finished"
+    elif ((rc == 1)) && [[ -f $work/$p/report.md && -f $work/$p/runs.csv ]]; then
+        # the study ran to its end and wrote its report, but some runs failed
+        # (e.g. a path this GL lacks): the other runs' timings are kept
+        mv "$work/$p" "$out/$p"
+        status[$p]="finished with failed runs: $(grep -c ',failed,' "$out/$p/runs.csv" || true) (see $p/report.md, logs/$p.log)"
     else
         rm -rf "${work:?}/$p"
         if ((rc == 124 || rc == 137)); then

@@ -18,6 +18,7 @@ import os
 import sys
 
 PARTS = {  # part -> (plugin whose committed llvmpipe runs and paper numbers apply)
+    "gpu_paths": "gpu_paths",  # no paper table: matched with results/gpu_paths/ if committed
     "cssm_table1": "cssm_hrc", "vlf_table1": "vlf", "avg_tables": "avg",
     "ivis_table1": "implicit_vis", "csm_table2": "csm", "compare": None,
 }
@@ -147,6 +148,37 @@ def timer_check(bench):
     return lines + [""]
 
 
+def gpu_paths(bench):
+    """Issue 29's question on this GPU: each GPU path against its C oracle,
+    both timed in the one run of the gpu_paths part (frame and preparation
+    ms, relMSE to the full reference, equal-error speed-up over the path
+    tracer), with the ratio C / GPU of the frame and of the preparation."""
+    runs = read_runs(os.path.join(bench, "gpu_paths", "runs.csv"))
+    if not runs:
+        return []
+    lines = ["## gpu_paths: GPU paths against their C oracles (one run)", "",
+             "| method | setting | frame ms | prepare ms | relMSE | speed-up vs PT | C/GPU frame | C/GPU prepare |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    pairs = {"cssm_hrc": ("gather", "cpu"), "implicit_vis": ("relink", "always"),
+             "vlf": ("propagate", "cpu")}
+    for run in runs:
+        m = run.get("method", "")
+        key, oracle = pairs.get(m, (None, None))
+        setting = "%s=%s" % (key, params_of(run).get(key)) if key else run.get("label", "")
+        ratio_f = ratio_p = "–"
+        base = [r for r in runs if key and r.get("method") == m and
+                params_of(r).get(key) == oracle and r is not run]
+        if base:
+            f0, f1 = num(base[0].get("frame_ms_median")), num(run.get("frame_ms_median"))
+            p0, p1 = num(base[0].get("prepare_ms")), num(run.get("prepare_ms"))
+            ratio_f = fmt(f0 / f1) if f0 and f1 else "–"
+            ratio_p = fmt(p0 / p1) if p0 and p1 else "–"
+        lines.append("| %s | %s | %s | %s | %s | %s | %s | %s |" % (
+            m, setting, fmt(num(run.get("frame_ms_median"))), fmt(num(run.get("prepare_ms"))),
+            fmt(num(run.get("relmse_full"))), fmt(num(run.get("speedup_vs_pt"))), ratio_f, ratio_p))
+    return lines + [""]
+
+
 def table(bench, results, root):
     lines = []
     device = os.path.join(bench, "device.txt")
@@ -185,6 +217,7 @@ def table(bench, results, root):
                     "%s (%s)" % (fmt(l), lsize) if l is not None else "–",
                     fmt(g / l) if l else "–", fmt(pst.get(st))))
         lines.append("")
+    lines += gpu_paths(bench)
     lines += timer_check(bench)
     if not found:
         raise SystemExit("gpu_table.py: %s has no finished part (no */runs.csv)" % bench)

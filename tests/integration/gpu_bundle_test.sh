@@ -118,10 +118,17 @@ grep -q 'llvmpipe' "$r" || fail "README names no renderer"
 grep -Eq '\| compare \| .* \| (cut off|skipped)' "$r" || fail "compare was not stopped by the limit: $(cat "$r")"
 [[ ! -e $work/bench/compare && ! -e $work/bench/.work ]] || fail "a cut-off part left files"
 "$b/bench.sh" --out "$work/bad" --limit-s x >/dev/null 2>&1 && fail "bench.sh took --limit-s x"
+# The gpu_paths part's pairs (a hand-made runs.csv: the C gather 4x the
+# GPU's frame time) are set side by side with their C/GPU ratio.
+mkdir -p "$work/bench/gpu_paths"
+printf '%s\n' 'run,scene,method,params,status,frame_ms_median,prepare_ms,relmse_full,speedup_vs_pt' \
+    'a,s,cssm_hrc,"gather=cpu,M=8",ok,200,90,0.03,0.5' 'b,s,cssm_hrc,"gather=gpu,M=8",ok,50,30,0.03,2' \
+    >"$work/bench/gpu_paths/runs.csv"
 # The comparison table from that output (here llvmpipe against llvmpipe).
 python3 "$src/scripts/gpu/gpu_table.py" "$work/bench" --results "$src/results" --out "$work/table.md" ||
     fail "gpu_table.py failed"
-for want in '^## vlf_table1 (vlf)' '| frame |' '^## compare: not in this bench folder'; do
+for want in '^## vlf_table1 (vlf)' '| frame |' '^## compare: not in this bench folder' \
+    '^| cssm_hrc | gather=gpu | 50 | 30 | 0.03 | 2 | 4 | 3 |$'; do
     grep -q -- "$want" "$work/table.md" || fail "gpu_table.py wrote no '$want': $(head -20 "$work/table.md")"
 done
 echo "gpu bundle: $((size / 1024)) KiB, $checked ELF files, render, reference and bench.sh ok"
