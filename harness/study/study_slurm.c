@@ -44,7 +44,8 @@ int study_slurm_cell(study *st, const char *out, gi_plugins *reg, const char *ce
         return cli_fail(EXIT_USAGE, "study: --cell %s: the study has %u such cells", cell, n);
     char why[1024];
     if (!strcmp(kind, "ref")) {
-        if (!study_build_reference_set(st, out, (uint32_t)k, 1, why, sizeof why))
+        /* a reference cell times the path tracer's curve in this submission */
+        if (!study_build_reference_set(st, out, (uint32_t)k, STUDY_CURVES_TIME, why, sizeof why))
             return cli_fail(EXIT_RUN, "study: %s", why);
         fprintf(stderr, "study: reference set %s done\n", st->refs[k].name);
         return EXIT_OK;
@@ -59,7 +60,7 @@ int study_slurm_cell(study *st, const char *out, gi_plugins *reg, const char *ce
     }
     study_attach_refs(st, r);
     double t0 = gi_now();
-    r->record = study_run_or_skip(r, reg, 1);
+    r->record = study_run_or_skip(st, r, reg, 1);
     json_object *v;
     const char *status =
         json_object_object_get_ex(r->record, "status", &v) ? json_object_get_string(v) : "?";
@@ -86,23 +87,38 @@ int study_slurm_submit(study *st, const char *file, const char *out, gi_plugins 
     uint32_t nref = 0, nrun = 0, cached = 0, na = 0;
     char why[1024];
     runner_set_collect_only(1);
+    /* one submission is one invocation (docs/studies.md "One clock per
+     * comparison"): its cells inherit the id through sbatch's environment */
+    study_new_invocation(st->invocation, sizeof st->invocation);
+    setenv("GIBENCH_STUDY_INVOCATION", st->invocation, 1);
+    uint8_t *retime = calloc(st->ref_count + 1, 1);
     for (uint32_t i = 0; i < st->ref_count; i++)
         if (!study_build_reference_set(st, out, i, 0, why, sizeof why))
             ref_tasks[nref++] = i;
+        else
+            retime[i] = 1; /* made: a cell only if a run compared with it runs now */
     for (uint32_t i = 0; i < st->run_count; i++) {
         study_run *r = &st->runs[i];
         study_attach_refs(st, r);
-        json_object *rec = study_run_or_skip(r, reg, 1), *v;
+        json_object *rec = study_run_or_skip(st, r, reg, 1), *v;
         const char *status =
             json_object_object_get_ex(rec, "status", &v) ? json_object_get_string(v) : "";
         if (json_object_object_get_ex(rec, "cached", &v))
             cached++;
         else if (!strcmp(status, "n/a"))
             na++;
-        else
+        else {
             run_tasks[nrun++] = i;
+            /* the curve its speed-up divides by is timed in this submission too */
+            if (r->ref_index >= 0 && retime && retime[r->ref_index] == 1 && st->conv_n > 0 &&
+                !st->refs[r->ref_index].frame_only) {
+                retime[r->ref_index] = 2;
+                ref_tasks[nref++] = (uint32_t)r->ref_index;
+            }
+        }
         json_object_put(rec);
     }
+    free(retime);
     runner_set_collect_only(0);
     fprintf(stderr,
             "study: %s: %u reference sets (%u to make), %u runs (%u done before, %u not "
@@ -128,7 +144,7 @@ void study_slurm_collect_runs(study *st, gi_plugins *reg, const char *out, const
     for (uint32_t i = 0; i < st->run_count; i++) {
         study_run *r = &st->runs[i];
         study_attach_refs(st, r);
-        json_object *rec = study_run_or_skip(r, reg, 1), *v;
+        json_object *rec = study_run_or_skip(st, r, reg, 1), *v;
         if (json_object_object_get_ex(rec, "cached", &v)) {
             json_object_object_del(rec, "cached");
         } else if (json_object_object_get_ex(rec, "status", &v) &&

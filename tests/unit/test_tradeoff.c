@@ -87,7 +87,7 @@ static gi_result fake_chart(const char *path, const gi_chart_desc *desc, const g
 static void test_pt_time(void)
 {
     /* relMSE = 1 / time: log-log interpolation is exact on it */
-    tradeoff_pt_curve c = {65, 3, {1, 4, 16}, {1, 0.25, 0.0625}};
+    tradeoff_pt_curve c = {.bounces = 65, .n = 3, .t = {1, 4, 16}, .e = {1, 0.25, 0.0625}};
     int ex = -1;
     CHECK_NEAR(tradeoff_pt_time_at(&c, 0.5, &ex), 2.0, 1e-12);
     CHECK(ex == 0);
@@ -97,7 +97,7 @@ static void test_pt_time(void)
     CHECK_NEAR(tradeoff_pt_time_at(&c, 0.01, &ex), 100.0, 1e-9);
     CHECK(ex == 1);
     CHECK(isnan(tradeoff_pt_time_at(&c, 0.0, &ex)));
-    tradeoff_pt_curve empty = {65, 0, {0}, {0}};
+    tradeoff_pt_curve empty = {.bounces = 65, .n = 0, .t = {0}, .e = {0}};
     CHECK(isnan(tradeoff_pt_time_at(&empty, 0.5, &ex)));
 }
 
@@ -115,8 +115,8 @@ static void test_report(void)
         {record("fast", "B", tb, eb, eb, 3, 0), 65, 2},
         {record("prog", "P", tp, ep, epm, 3, 0), 1, 3},
     };
-    tradeoff_pt_curve full = {65, 3, {1, 4, 16}, {1, 0.25, 0.0625}};
-    tradeoff_pt_curve matched = {1, 2, {0.5, 2}, {0.1, 0.025}};
+    tradeoff_pt_curve full = {.bounces = 65, .n = 3, .t = {1, 4, 16}, .e = {1, 0.25, 0.0625}};
+    tradeoff_pt_curve matched = {.bounces = 1, .n = 2, .t = {0.5, 2}, .e = {0.1, 0.025}};
     /* memory: "fast" A's repeats peaked at 100 and 300 MiB and keep 1 MiB of data */
     for (int r = 0; r < 2; r++) {
         json_object *st = json_object_new_object();
@@ -127,7 +127,8 @@ static void test_report(void)
     }
     gi_text md = {0};
     json_object *charts = json_object_new_array();
-    tradeoff_report("/nonexistent", "box", &full, &matched, 1, runs, 4, fake_chart, charts, &md);
+    tradeoff_report("/nonexistent", "box", &full, &matched, 1, runs, 4, fake_chart, charts, &md,
+                    NULL);
     CHECK(md.s != NULL);
     const char *s = md.s ? md.s : "";
 
@@ -199,10 +200,10 @@ static void test_renderers(void)
         json_object_object_add(runs[0].record, "renderer", json_object_new_string("NVIDIA H100"));
         json_object_object_add(runs[1].record, "renderer",
                                json_object_new_string(mixed ? "llvmpipe" : "NVIDIA H100"));
-        tradeoff_pt_curve full = {65, 3, {1, 4, 16}, {1, 0.25, 0.0625}};
+        tradeoff_pt_curve full = {.bounces = 65, .n = 3, .t = {1, 4, 16}, .e = {1, 0.25, 0.0625}};
         gi_text md = {0};
         json_object *charts = json_object_new_array();
-        tradeoff_report("/nonexistent", "box", &full, NULL, 0, runs, 2, NULL, charts, &md);
+        tradeoff_report("/nonexistent", "box", &full, NULL, 0, runs, 2, NULL, charts, &md, NULL);
         const char *s = md.s ? md.s : "";
         if (mixed) {
             CHECK_MSG(strstr(s, "| fast [NVIDIA H100] | `A` | 1 | 0.01 | 0.3 |") != NULL, "%s", s);
