@@ -174,6 +174,7 @@ static int parse_args(int argc, char **argv, study_args *a)
         return cli_fail(EXIT_USAGE, "study: a study on standard input does not go with --slurm "
                                     "(the jobs read the study file again)");
     a->so.dry_run = a->dry;
+    a->so.mix_clocks = a->mix_clocks;
     int src = slurm_check(&a->so, a->file, a->out);
     if (src != EXIT_OK)
         return src;

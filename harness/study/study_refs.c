@@ -154,8 +154,9 @@ static int pt_time_point(study *st, const study_ref *sc, const char *scene, uint
     snprintf(cfg, sizeof cfg, "%s.config", img);
     *n = 0;
     for (uint32_t r = 0; r < st->conv_repeats; r++) {
-        snprintf(label, sizeof label, "convergence %s (%u bounces, %u spp, time %u of %u)",
-                 sc->name, bounces, spp, r + 1, st->conv_repeats);
+        /* one line per timing: "convergence S (B bounces, K spp): K spp in T s" */
+        snprintf(label, sizeof label, "convergence %s (%u bounces, %u spp)", sc->name, bounces,
+                 spp);
         unlink(cfg);
         ref_watch w;
         watch_start(&w, label, img);
