@@ -93,6 +93,20 @@ static void clock_add(clock_set *cs, const char *id, const char *what, int is_cu
         snprintf(cs->named[k] + used, sizeof cs->named[k] - used, "%s%s", listed ? ", " : "", what);
 }
 
+int study_runs_mixed(const study *st)
+{
+    const char *first = NULL;
+    for (uint32_t i = 0; i < st->run_count; i++)
+        if (run_on_curve(st, &st->runs[i])) {
+            const char *id = record_invocation(st->runs[i].record);
+            if (!first)
+                first = id;
+            else if (strcmp(first, id))
+                return 1;
+        }
+    return 0;
+}
+
 int study_check_clocks(const study *st, int *mixed)
 {
     clock_set *cs = calloc(1, sizeof *cs);

@@ -164,6 +164,8 @@ int study_build_references(study *st, const char *out_dir, int slurm_collecting)
  * timed now when this invocation timed a run compared with them (or no
  * earlier curve fits), else as recorded. EXIT_OK or EXIT_RUN after one line. */
 int study_build_curves(study *st, const char *out_dir, int slurm_collecting);
+/* Whether the runs compared with a curve come from several invocations. */
+int study_runs_mixed(const study *st);
 /* Whether this invocation timed run r (its record names the invocation). */
 int study_timed_now(const study *st, const study_run *r);
 /* The refusal of mixed clocks: EXIT_OK when every run compared with a

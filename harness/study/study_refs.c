@@ -356,9 +356,13 @@ int study_build_curves(study *st, const char *out_dir, int slurm_collecting)
     for (uint32_t i = 0; i < st->run_count; i++)
         timed |= st->runs[i].ref_index >= 0 && st->runs[i].spec.animate_fps <= 0 &&
                  study_timed_now(st, &st->runs[i]);
-    int mode = slurm_collecting ? STUDY_CURVES_RECORDED
-               : timed          ? STUDY_CURVES_TIME
-                                : STUDY_CURVES_LOAD;
+    /* runs of several invocations are refused anyway (study_check_clocks),
+     * unless --mix-clocks: no curve is timed for a report that will not be
+     * written */
+    int refused = timed && !st->mix_clocks && study_runs_mixed(st);
+    int mode = slurm_collecting || refused ? STUDY_CURVES_RECORDED
+               : timed                     ? STUDY_CURVES_TIME
+                                           : STUDY_CURVES_LOAD;
     char why[1024];
     for (uint32_t ri = 0; ri < st->ref_count && !cli_interrupted; ri++) {
         if (st->refs[ri].frame_only || st->refs[ri].missing[0] || st->conv_n == 0)
@@ -370,9 +374,10 @@ int study_build_curves(study *st, const char *out_dir, int slurm_collecting)
             st->refs[ri].pt_full.invocation[0] = '\0';
             break;
         }
-        if (!slurm_collecting)
+        if (mode != STUDY_CURVES_RECORDED)
             return cli_fail(EXIT_RUN, "study: %s", why);
-        fprintf(stderr, "study: %s\n", why); /* no speed-ups for this set */
+        if (slurm_collecting)
+            fprintf(stderr, "study: %s\n", why); /* no speed-ups for this set */
     }
     return EXIT_OK;
 }
