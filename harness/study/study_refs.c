@@ -325,7 +325,7 @@ int study_build_reference_set(study *st, const char *out_dir, uint32_t ri, int c
             sc->matched_count++;
         }
     }
-    if (curves == STUDY_CURVES_NONE || sc->frame_only)
+    if (curves == STUDY_CURVES_NONE || sc->frame_only || st->conv_n == 0)
         return 1;
     return set_curves(st, out_dir, ri, curves, why, why_size);
 }
