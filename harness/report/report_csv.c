@@ -34,6 +34,10 @@ static const char *const tradeoff_keys[] = {"seed",
                                             "speedup_vs_pt",
                                             "speedup_vs_pt_matched",
                                             "speedup_extrapolated",
+                                            "speedup_vs_pt_min",
+                                            "speedup_vs_pt_max",
+                                            "speedup_vs_pt_matched_min",
+                                            "speedup_vs_pt_matched_max",
                                             NULL};
 
 /* The columns after those: leaked energy (metrics), memory, the scene's
@@ -87,6 +91,7 @@ void report_write_csv(text *t, json_object *runs)
         put(t, ",stat_%s", stats[k]);
     for (int k = 0; tradeoff_keys[k]; k++)
         put(t, ",%s", tradeoff_keys[k]);
+    put(t, ",invocation"); /* the study invocation that timed the run (issue 34) */
     for (size_t k = 0; k < EXTRA_COLUMNS; k++)
         put(t, ",%s", extra_columns[k].column);
     put(t, "\n");
@@ -120,6 +125,7 @@ void report_write_csv(text *t, json_object *runs)
             csv_num(t, report_num(o, "stats", stats[k], NULL), 0);
         for (int k = 0; tradeoff_keys[k]; k++)
             csv_num(t, report_num(o, tradeoff_keys[k], NULL, NULL), 0);
+        csv_field(t, report_str(o, "invocation"), 0);
         for (size_t k = 0; k < EXTRA_COLUMNS; k++)
             csv_num(t, report_num(o, extra_columns[k].k1, extra_columns[k].k2, extra_columns[k].k3),
                     k + 1 == EXTRA_COLUMNS);

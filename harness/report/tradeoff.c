@@ -40,6 +40,38 @@ double tradeoff_pt_time_at(const tradeoff_pt_curve *c, double e, int *extrapolat
     return c->t[k] * c->e[k] / e;
 }
 
+/* The curve at one end of its spread: every point's fastest (hi = 0) or
+ * slowest (hi = 1) of its repeats. A point timed once (or a curve made
+ * before repeats) is its own spread. */
+static tradeoff_pt_curve curve_bound(const tradeoff_pt_curve *c, int hi)
+{
+    tradeoff_pt_curve b = *c;
+    for (uint32_t i = 0; i < c->n; i++) {
+        double v = hi ? c->t_hi[i] : c->t_lo[i];
+        if (v > 0 && isfinite(v))
+            b.t[i] = v;
+    }
+    return b;
+}
+
+/* The spread of a speed-up t_pt(e) / t (issue 34): at its low end the
+ * path tracer's fastest repeats reaching the run's highest error, over the
+ * run's slowest time; at its high end the path tracer's slowest repeats
+ * reaching the run's lowest error, over the run's fastest time. The
+ * median speed-up `mid` is kept inside the range. */
+static void speedup_range(const tradeoff_pt_curve *c, double e_lo, double e_hi, double t_lo,
+                          double t_hi, double mid, double *lo, double *hi)
+{
+    int ex;
+    tradeoff_pt_curve fast = curve_bound(c, 0), slow = curve_bound(c, 1);
+    *lo = tradeoff_pt_time_at(&fast, e_hi, &ex) / t_hi;
+    *hi = tradeoff_pt_time_at(&slow, e_lo, &ex) / t_lo;
+    if (!(*lo <= mid))
+        *lo = mid;
+    if (!(*hi >= mid))
+        *hi = mid;
+}
+
 static double num(json_object *o, const char *k1, const char *k2, const char *k3)
 {
     const char *keys[3] = {k1, k2, k3};
@@ -442,6 +474,24 @@ static void put_error(gi_text *md, const setting *g, uint32_t k)
         gi_text_put(md, " %.4g |", g->ef[k]);
 }
 
+/* A speed-up cell: the median, and [min–max] from the spreads of the
+ * path tracer's curve and of the setting's repeats (time and error). */
+static void put_speedup(gi_text *md, const tradeoff_pt_curve *c, const setting *g, uint32_t k,
+                        int matched, double tpt, int ex)
+{
+    double mid = tpt / g->t[k], lo, hi;
+    double e_lo = matched ? g->em_lo[k] : g->ef_lo[k], e_hi = matched ? g->em_hi[k] : g->ef_hi[k];
+    if (!(e_lo > 0) || !(e_hi > 0))
+        e_lo = e_hi = matched ? g->em[k] : g->ef[k];
+    double t_lo = g->t_lo[k] > 0 ? g->t_lo[k] : g->t[k],
+           t_hi = g->t_hi[k] > 0 ? g->t_hi[k] : g->t[k];
+    speedup_range(c, e_lo, e_hi, t_lo, t_hi, mid, &lo, &hi);
+    if (isfinite(lo) && isfinite(hi) && hi > lo)
+        gi_text_put(md, " %.3g [%.3g–%.3g]%s |", mid, lo, hi, ex ? "*" : "");
+    else
+        gi_text_put(md, " %.3g%s |", mid, ex ? "*" : "");
+}
+
 static void params_cell(gi_text *md, json_object *rec)
 {
     const char *p = str(rec, "params");
@@ -476,13 +526,22 @@ static void annotate_records(const tradeoff_run *runs, uint32_t run_n,
         double tpt = tradeoff_pt_time_at(full, ef[n - 1], &ex);
         const tradeoff_pt_curve *mc = curve_for(full, matched, matched_n, runs[i].bounces);
         double tptm = tradeoff_pt_time_at(mc, em[n - 1], &exm);
+        double lo, hi;
         if (isfinite(tpt) && t[k] > 0) {
             json_object_object_add(rec, "pt_time_at_equal_error_s", json_object_new_double(tpt));
             json_object_object_add(rec, "speedup_vs_pt", json_object_new_double(tpt / t[k]));
+            /* one run is one sample: the spread is the curve's */
+            speedup_range(full, ef[n - 1], ef[n - 1], t[k], t[k], tpt / t[k], &lo, &hi);
+            json_object_object_add(rec, "speedup_vs_pt_min", json_object_new_double(lo));
+            json_object_object_add(rec, "speedup_vs_pt_max", json_object_new_double(hi));
         }
-        if (isfinite(tptm) && t[k] > 0)
+        if (isfinite(tptm) && t[k] > 0) {
             json_object_object_add(rec, "speedup_vs_pt_matched",
                                    json_object_new_double(tptm / t[k]));
+            speedup_range(mc, em[n - 1], em[n - 1], t[k], t[k], tptm / t[k], &lo, &hi);
+            json_object_object_add(rec, "speedup_vs_pt_matched_min", json_object_new_double(lo));
+            json_object_object_add(rec, "speedup_vs_pt_matched_max", json_object_new_double(hi));
+        }
         json_object_object_add(rec, "speedup_extrapolated",
                                json_object_new_int(ex || exm)); /* 1: beyond the measured curve */
     }
@@ -508,7 +567,9 @@ static void equal_error_table(gi_text *md, const char *name, const tradeoff_pt_c
         "on a hardware GPU they do not) and the size of the method's own precomputed data (its "
         "`data_bytes` statistic; \"–\" where it reports none), medians over repeats. "
         "\"*\": the path tracer's time is extrapolated beyond its measured curve (slope −1). "
-        "relMSE over repeats: median [min–max].\n\n");
+        "relMSE over repeats: median [min–max]. Speed-up: median [min–max], the range from the "
+        "spread of the path tracer's repeated curve points and of the method's repeats (time "
+        "and relMSE).\n\n");
     gi_text_put(
         md,
         "| method | params | frames | time to image (s) | relMSE full | path tracer, same error "
@@ -532,10 +593,11 @@ static void equal_error_table(gi_text *md, const char *name, const tradeoff_pt_c
             params_cell(md, g->first);
             gi_text_put(md, " %u | %.4g |", g->frame[p], g->t[p]);
             put_error(md, g, p);
-            gi_text_put(md,
-                        " %.4g%s | %.3g%s | %.4g | %.4g%s | %.3g%s | %.4g | %.4g | %.4g | %.4g |",
-                        tpt, ex ? "*" : "", tpt / g->t[p], ex ? "*" : "", g->em[p], tptm,
-                        exm ? "*" : "", tptm / g->t[p], exm ? "*" : "", prep, g->t[p] + prep,
+            gi_text_put(md, " %.4g%s |", tpt, ex ? "*" : "");
+            put_speedup(md, full, g, p, 0, tpt, ex);
+            gi_text_put(md, " %.4g | %.4g%s |", g->em[p], tptm, exm ? "*" : "");
+            put_speedup(md, mc, g, p, 1, tptm, exm);
+            gi_text_put(md, " %.4g | %.4g | %.4g | %.4g |", prep, g->t[p] + prep,
                         g->t[p] + prep / 100.0, g->t[p] + prep / 1e4);
             put_mib(md, g->rss_mib);
             put_mib(md, g->data_mib);
@@ -643,10 +705,50 @@ static void equal_time_table(gi_text *md, const char *name, const tradeoff_pt_cu
     gi_text_put(md, "\n");
 }
 
+/* gibench study --mix-clocks: which invocations this set's tables take
+ * their times from (the curves', then the runs' with their counts). */
+static void clock_note(gi_text *md, const tradeoff_pt_curve *full, const tradeoff_pt_curve *matched,
+                       uint32_t matched_n, const tradeoff_run *runs, uint32_t run_n)
+{
+    const char *inv[64];
+    uint32_t count[64], ni = 0;
+    int curve[64] = {0};
+    for (uint32_t i = 0; i < matched_n + 1 + run_n; i++) {
+        const char *v;
+        if (i == 0)
+            v = full->invocation;
+        else if (i <= matched_n)
+            v = matched[i - 1].invocation;
+        else if (!strcmp(str(runs[i - 1 - matched_n].record, "status"), "ok"))
+            v = str(runs[i - 1 - matched_n].record, "invocation");
+        else
+            continue;
+        uint32_t k = 0;
+        while (k < ni && strcmp(inv[k], v))
+            k++;
+        if (k == ni && ni < 64) {
+            inv[ni] = v;
+            count[ni++] = 0;
+        }
+        if (k < ni && i > matched_n)
+            count[k]++;
+        else if (k < ni)
+            curve[k] = 1;
+    }
+    gi_text_put(md, "**Clocks are mixed** (gibench study --mix-clocks): the study's times come "
+                    "from several invocations; this set's from");
+    for (uint32_t k = 0; k < ni; k++) {
+        gi_text_put(md, "%s ", k ? ";" : "");
+        gi_text_md(md, *inv[k] ? inv[k] : "(not recorded)");
+        gi_text_put(md, " (%s%u runs)", curve[k] ? "the path tracer's curve, " : "", count[k]);
+    }
+    gi_text_put(md, ". Speed-ups across invocations compare different clocks.\n\n");
+}
+
 void tradeoff_report(const char *out_dir, const char *name, const tradeoff_pt_curve *full,
                      const tradeoff_pt_curve *matched, uint32_t matched_n, const tradeoff_run *runs,
                      uint32_t run_n, tradeoff_chart_fn write_chart, json_object *chart_list,
-                     gi_text *md)
+                     gi_text *md, const tradeoff_clock_note *clocks)
 {
     setting *set = calloc(run_n + 1, sizeof *set);
     const char **methods = calloc(run_n + 1, sizeof *methods);
@@ -668,18 +770,26 @@ void tradeoff_report(const char *out_dir, const char *name, const tradeoff_pt_cu
               chart_list);
     gi_text_put(md, "Path tracer convergence on ");
     gi_text_md(md, name);
-    gi_text_put(md, " (relMSE against the reference, another seed):");
+    gi_text_put(md,
+                " (relMSE against the reference, another seed; time: median [min–max] of "
+                "%u repeats in the study's invocation):",
+                full->samples[0] ? full->samples[0] : 1);
     const tradeoff_pt_curve *curves[9] = {full};
     uint32_t nc = 1;
     for (uint32_t i = 0; i < matched_n && nc < 9; i++)
         curves[nc++] = &matched[i];
     for (uint32_t c = 0; c < nc; c++) {
         gi_text_put(md, "%s max_bounces %u:", c ? ";" : "", curves[c]->bounces);
-        for (uint32_t i = 0; i < curves[c]->n; i++)
-            gi_text_put(md, " %.3g s → %.3g%s", curves[c]->t[i], curves[c]->e[i],
-                        i + 1 < curves[c]->n ? "," : "");
+        for (uint32_t i = 0; i < curves[c]->n; i++) {
+            gi_text_put(md, " %.3g s", curves[c]->t[i]);
+            if (curves[c]->t_hi[i] > curves[c]->t_lo[i] && curves[c]->t_lo[i] > 0)
+                gi_text_put(md, " [%.3g–%.3g]", curves[c]->t_lo[i], curves[c]->t_hi[i]);
+            gi_text_put(md, " → %.3g%s", curves[c]->e[i], i + 1 < curves[c]->n ? "," : "");
+        }
     }
     gi_text_put(md, ".\n\n");
+    if (clocks && clocks->mixed)
+        clock_note(md, full, matched, matched_n, runs, run_n);
     equal_error_table(md, name, full, matched, matched_n, set, ns, methods, nm, fp);
     equal_time_table(md, name, full, matched, matched_n, set, ns, methods, nm);
     free(set), free(methods), free(fp);

@@ -125,7 +125,7 @@ static int lock_out_dir(const char *out, int *rc)
 typedef struct study_args {
     const char *file, *out;
     unsigned long jobs;
-    int fresh, dry, retry_failed;
+    int fresh, dry, retry_failed, mix_clocks;
     slurm_options so;
 } study_args;
 
@@ -153,6 +153,8 @@ static int parse_args(int argc, char **argv, study_args *a)
             a->retry_failed = 1;
         else if (!strcmp(argv[i], "--dry-run"))
             a->dry = 1;
+        else if (!strcmp(argv[i], "--mix-clocks"))
+            a->mix_clocks = 1;
         else if (argv[i][0] == '-' && argv[i][1]) /* "-" alone: the study on standard input */
             return cli_fail(EXIT_USAGE, "study: unknown or incomplete option '%s'", argv[i]);
         else if (!a->file)
@@ -164,7 +166,7 @@ static int parse_args(int argc, char **argv, study_args *a)
         return cli_fail(
             EXIT_USAGE,
             "study: usage: gibench study STUDY.json --out DIR [--jobs N] "
-            "[--resume|--fresh|--retry-failed] [--dry-run] "
+            "[--resume|--fresh|--retry-failed] [--mix-clocks] [--dry-run] "
             "[--slurm [--partition P] [--gres G] [--time T] [--array-limit K] [--no-wait]]");
     if (!a->out)
         a->out = ".";
@@ -172,6 +174,7 @@ static int parse_args(int argc, char **argv, study_args *a)
         return cli_fail(EXIT_USAGE, "study: a study on standard input does not go with --slurm "
                                     "(the jobs read the study file again)");
     a->so.dry_run = a->dry;
+    a->so.mix_clocks = a->mix_clocks;
     int src = slurm_check(&a->so, a->file, a->out);
     if (src != EXIT_OK)
         return src;
@@ -240,6 +243,11 @@ static int run_here(study *st, const study_args *a, gi_plugins *reg, int argc, c
                            : a->retry_failed ? RUNNER_RETRY_FAILED
                                              : RUNNER_RESUME,
                            reg);
+    /* the path tracer's curves after the runs: timed again when this
+     * invocation timed runs compared with them (one clock per comparison) */
+    rc = study_build_curves(st, a->out, a->so.collect != NULL);
+    if (rc != EXIT_OK)
+        return rc;
     return study_write_report(st, a->out, argc, argv, a->so.collect != NULL);
 }
 
@@ -255,6 +263,14 @@ int cmd_study(int argc, char **argv)
     memset(&st, 0, sizeof st);
     int lock_fd = -1;
     rc = study_load(&st, a.file, a.out, reg);
+    st.mix_clocks = a.mix_clocks;
+    /* a Slurm submission is one invocation: its cells and its collect job
+     * take the id it set (study_slurm_submit); anything else is a new one */
+    const char *given = getenv("GIBENCH_STUDY_INVOCATION");
+    if ((a.so.cell || a.so.collect) && given && *given && strlen(given) < sizeof st.invocation)
+        snprintf(st.invocation, sizeof st.invocation, "%s", given);
+    else
+        study_new_invocation(st.invocation, sizeof st.invocation);
     if (rc == EXIT_OK && (a.so.enabled || a.so.cell))
         rc = run_on_slurm(&st, &a, reg);
     else if (rc == EXIT_OK)

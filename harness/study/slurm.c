@@ -227,6 +227,18 @@ static void common_lines(gi_text *t, const slurm_options *o, const char *name, c
         gi_text_put(t, "#SBATCH --time=%s\n", o->time);
 }
 
+/* The submission's invocation id for the cells and the collect job, after
+ * the #SBATCH lines (set in the script: a site's SBATCH_EXPORT=NONE would
+ * drop it from the environment). The id is [0-9A-Za-z-] only. */
+static void put_invocation(gi_text *t, const slurm_options *o)
+{
+    if (o->invocation && o->invocation[0] &&
+        strspn(o->invocation, "0123456789ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz-") ==
+            strlen(o->invocation))
+        gi_text_put(t, "GIBENCH_STUDY_INVOCATION=%s\nexport GIBENCH_STUDY_INVOCATION\n",
+                    o->invocation);
+}
+
 /* The script of one stage's array: each task runs one cell (--cell). */
 static char *stage_script(const slurm_options *o, const char *file, const char *out,
                           const char *name, uint64_t plan, const slurm_stage *s, const char *cwd)
@@ -247,6 +259,7 @@ static char *stage_script(const slurm_options *o, const char *file, const char *
         own.gres = NULL; /* the reference renders on the CPU (Embree): --gres is for the runs */
     common_lines(&t, &own, name, !strcmp(s->kind, "ref") ? "refs" : "runs", out, log, cwd);
     gi_text_put(&t, "#SBATCH --array=%s\n", spec);
+    put_invocation(&t, o);
     gi_text_put(&t,
                 "'%s' study '%s' --out '%s' --cell %s:\"$SLURM_ARRAY_TASK_ID\":%016llx\n"
                 "rc=$?\necho \"gibench-cell-exit $rc\"\nexit $rc\n",
@@ -268,10 +281,11 @@ static char *collect_script(const slurm_options *o, const char *file, const char
     slurm_options plain = *o;
     plain.gres = NULL; /* the report needs no GPU */
     common_lines(&t, &plain, name, "collect", out, "collect-%j.log", cwd);
+    put_invocation(&t, o);
     gi_text_put(&t,
-                "'%s' study '%s' --out '%s' --slurm-collect \"$1,$2\"\nrc=$?\necho "
+                "'%s' study '%s' --out '%s' --slurm-collect \"$1,$2\"%s\nrc=$?\necho "
                 "\"gibench-cell-exit $rc\"\nexit $rc\n",
-                cli_self_exe(), file, out);
+                cli_self_exe(), file, out, o->mix_clocks ? " --mix-clocks" : "");
     return t.s;
 }
 

@@ -22,6 +22,10 @@ typedef struct slurm_options {
     int dry_run;         /* --dry-run with --slurm: print the scripts */
     const char *cell;    /* hidden --cell ref:K:PLAN or run:K:PLAN: one array task */
     const char *collect; /* hidden --slurm-collect REFJOB,RUNJOB: the collect job */
+    int mix_clocks;      /* gibench study --mix-clocks: passed on to the collect job */
+    /* the submission's invocation id, given to every cell and the collect job
+     * (GIBENCH_STUDY_INVOCATION: one submission is one clock, docs/studies.md) */
+    const char *invocation;
 } slurm_options;
 
 /* Takes argv[*i] (and its value) when it is one of the options above,

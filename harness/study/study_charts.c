@@ -6,6 +6,7 @@
 #include "study_internal.h"
 
 #include "charts.h"
+#include "gi/cache.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -15,9 +16,37 @@
 /* Per reference set: the error-against-time charts with every run's
  * convergence curve, the Pareto fronts and the path tracer's curves, and
  * the equal-error and equal-time tables (tradeoff.h). */
-void study_charts_and_speedups(study *st, const char *out_dir, json_object *meta,
-                               json_object *chart_list)
+/* pt_curves.csv: every point of the path tracer's curves with its timed
+ * spread and the invocation that timed it (issue 34). */
+static void write_pt_curves(const study *st, const char *out_dir)
 {
+    char path[4200];
+    snprintf(path, sizeof path, "%s/pt_curves.csv", out_dir);
+    gi_text t = {0};
+    gi_text_put(&t, "reference_set,bounces,spp,relmse,time_s_median,time_s_min,time_s_max,"
+                    "samples,invocation\n");
+    for (uint32_t ri = 0; ri < st->ref_count; ri++) {
+        const study_ref *sc = &st->refs[ri];
+        for (uint32_t c = 0; c <= sc->matched_count && !sc->frame_only; c++) {
+            const tradeoff_pt_curve *cv = c ? &sc->pt_matched[c - 1] : &sc->pt_full;
+            for (uint32_t k = 0; k < cv->n; k++)
+                gi_text_put(&t, "\"%s\",%u,%u,%.6g,%.6g,%.6g,%.6g,%u,%s\n", sc->name, cv->bounces,
+                            cv->spp[k], cv->e[k], cv->t[k], cv->t_lo[k], cv->t_hi[k],
+                            cv->samples[k], cv->invocation);
+        }
+    }
+    gi_error err;
+    if (gi_file_write_atomic(path, t.s ? t.s : "", t.s ? strlen(t.s) : 0, &err) != GI_OK)
+        fprintf(stderr, "study: %s\n", err.text);
+    free(t.s);
+}
+
+void study_charts_and_speedups(study *st, const char *out_dir, json_object *meta,
+                               json_object *chart_list, int mixed)
+{
+    tradeoff_clock_note clocks = {mixed};
+    if (st->conv_n > 0)
+        write_pt_curves(st, out_dir);
     gi_text md = {0};
     tradeoff_run *tr = calloc(st->run_count + 1, sizeof *tr);
     for (uint32_t ri = 0; ri < st->ref_count && tr; ri++) {
@@ -32,7 +61,7 @@ void study_charts_and_speedups(study *st, const char *out_dir, json_object *meta
                 tr[n++] =
                     (tradeoff_run){st->runs[i].record, st->runs[i].bounces, st->runs[i].setting};
         tradeoff_report(out_dir, sc->name, &sc->pt_full, sc->pt_matched, sc->matched_count, tr, n,
-                        gi_chart_write_png, chart_list, &md);
+                        gi_chart_write_png, chart_list, &md, &clocks);
     }
     free(tr);
     json_object_object_add(meta, "markdown", json_object_new_string(md.s ? md.s : ""));

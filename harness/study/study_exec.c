@@ -14,8 +14,24 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+/* An executed run's record names the invocation that timed it, in its
+ * result.json too, so that a later report knows which clock its times
+ * come from (issue 34, docs/studies.md "One clock per comparison"). */
+static void stamp_invocation(const study *st, const study_run *r, json_object *rec)
+{
+    json_object *v;
+    if (json_object_object_get_ex(rec, "cached", &v) ||
+        !json_object_object_get_ex(rec, "status", &v) || strcmp(json_object_get_string(v), "ok"))
+        return;
+    json_object_object_add(rec, "invocation", json_object_new_string(st->invocation));
+    char path[4200], why[GI_ERROR_MAX];
+    snprintf(path, sizeof path, "%s/result.json", r->spec.dir);
+    if (!cli_write_json(path, rec, why, sizeof why))
+        fprintf(stderr, "study: %s\n", why);
+}
+
 /* A record for a run, or "n/a" when the method's caps do not cover its scene. */
-json_object *study_run_or_skip(study_run *r, gi_plugins *reg, int resume)
+json_object *study_run_or_skip(const study *st, study_run *r, gi_plugins *reg, int resume)
 {
     gi_error err;
     gi_scene *s = gi_scene_load(r->spec.scene, &err);
@@ -26,6 +42,7 @@ json_object *study_run_or_skip(study_run *r, gi_plugins *reg, int resume)
         rec = runner_not_applicable(&r->spec, why);
     else
         rec = runner_execute(&r->spec, resume);
+    stamp_invocation(st, r, rec);
     gi_scene_free(s);
     return rec;
 }
@@ -81,7 +98,7 @@ void study_execute_runs(study *st, uint32_t jobs, int mode, gi_plugins *reg)
         for (uint32_t i = 0; i < st->run_count; i++) {
             double t0 = gi_now();
             st->runs[i].record =
-                study_run_or_skip(&st->runs[i], reg, cli_interrupted ? RUNNER_RESUME : mode);
+                study_run_or_skip(st, &st->runs[i], reg, cli_interrupted ? RUNNER_RESUME : mode);
             if (!cli_interrupted)
                 report_run(&p, st, i, st->runs[i].record, gi_now() - t0, "");
             else
@@ -98,7 +115,7 @@ void study_execute_runs(study *st, uint32_t jobs, int mode, gi_plugins *reg)
             snprintf(who, sizeof who, "worker %u ", j);
             for (uint32_t i = j; i < st->run_count && !cli_interrupted; i += jobs) {
                 double t0 = gi_now();
-                json_object *rec = study_run_or_skip(&st->runs[i], reg, mode);
+                json_object *rec = study_run_or_skip(st, &st->runs[i], reg, mode);
                 if (!cli_interrupted)
                     report_run(&p, st, i, rec, gi_now() - t0, who);
                 json_object_put(rec);
@@ -124,7 +141,7 @@ void study_execute_runs(study *st, uint32_t jobs, int mode, gi_plugins *reg)
     free(pids);
     /* collect: every worker wrote result.json; resume picks them up */
     for (uint32_t i = 0; i < st->run_count; i++) {
-        st->runs[i].record = study_run_or_skip(&st->runs[i], reg, RUNNER_RESUME);
+        st->runs[i].record = study_run_or_skip(st, &st->runs[i], reg, RUNNER_RESUME);
         json_object_object_del(st->runs[i].record, "cached");
     }
 }

@@ -84,6 +84,11 @@ typedef struct study {
     double ref_target_se; /* 0: none */
     int ref_pixel_center; /* "pixel": "center": references sample pixel centres */
     uint32_t conv_spp[32], conv_n;
+    uint32_t conv_repeats; /* "convergence_repeats": times each curve point is timed */
+    /* this invocation of gibench study (issue 34, one clock per comparison):
+     * recorded in every run it times and in the curves it times */
+    char invocation[64];
+    int mix_clocks; /* --mix-clocks: report timings of several invocations, flagged */
     float exposure;
     const char *camera;      /* as the runs get it: a "view:FILE" resolved (study_paths.c) */
     const char *camera_name; /* as the study names it (in the runs' ids) */
@@ -141,25 +146,62 @@ void study_name_refs(study *st);
 
 /* ---- references (study_refs.c) ---- */
 
+/* curves: STUDY_CURVES_NONE (the images only), STUDY_CURVES_LOAD (the path
+ * tracer's curves as an earlier invocation timed them, timed now when none
+ * fits), STUDY_CURVES_TIME (timed now, in this invocation). */
+enum {
+    STUDY_CURVES_NONE = 0,
+    STUDY_CURVES_LOAD = 1,
+    STUDY_CURVES_TIME = 2,
+    STUDY_CURVES_RECORDED = 3 /* as recorded only, never timed (--slurm-collect) */
+};
 int study_build_reference_set(study *st, const char *out_dir, uint32_t ri, int curves, char *why,
                               size_t why_size);
-/* Every reference set. With slurm_collecting (gibench study
+/* Every reference set's images. With slurm_collecting (gibench study
  * --slurm-collect) a missing set is reported with its runs, not fatal. */
 int study_build_references(study *st, const char *out_dir, int slurm_collecting);
+/* The path tracer's curves of every set that has them, after the runs:
+ * timed now when this invocation timed a run compared with them (or no
+ * earlier curve fits), else as recorded. EXIT_OK or EXIT_RUN after one line. */
+int study_build_curves(study *st, const char *out_dir, int slurm_collecting);
+/* Whether the runs compared with a curve come from several invocations. */
+int study_runs_mixed(const study *st);
+/* Whether this invocation timed run r (its record names the invocation). */
+int study_timed_now(const study *st, const study_run *r);
+/* The refusal of mixed clocks: EXIT_OK when every run compared with a
+ * path tracer's curve, and the curves, were timed in one invocation (or
+ * --mix-clocks, *mixed set); else EXIT_USAGE after one line naming them. */
+int study_check_clocks(const study *st, int *mixed);
+/* A new invocation id: UTC time, pid and random bits. */
+void study_new_invocation(char *out, size_t size);
+/* The path tracer's curve of set sc at a bounce limit as an invocation
+ * timed it (study_clock.c): its file, the key of its settings, and the
+ * file read (1 when it holds a curve of that key) and written. */
+void study_curve_record_path(const study *st, const char *out_dir, const study_ref *sc,
+                             uint32_t bounces, char *path, size_t size);
+void study_curve_key(const study *st, const char *reference, uint32_t bounces, char *key,
+                     size_t size);
+int study_curve_load(const char *path, const char *key, tradeoff_pt_curve *curve);
+int study_curve_save(const char *path, const char *key, const tradeoff_pt_curve *curve,
+                     double samples[][64], char *why, size_t why_size);
 /* Points run r's spec at the reference files of its set(s). */
 void study_attach_refs(study *st, study_run *r);
 void study_reference_sets(study *st, json_object *meta);
 
 /* ---- execution (study_exec.c) ---- */
 
-json_object *study_run_or_skip(study_run *r, gi_plugins *reg, int resume);
+/* A run's record (cached, executed, or "n/a"); an executed one gets the
+ * study's invocation, in its result.json too. */
+json_object *study_run_or_skip(const study *st, study_run *r, gi_plugins *reg, int resume);
 /* mode: RUNNER_FRESH (--fresh), RUNNER_RESUME, RUNNER_RETRY_FAILED (--retry-failed). */
 void study_execute_runs(study *st, uint32_t jobs, int mode, gi_plugins *reg);
 
 /* ---- the report's charts and tables (study_charts.c, study_anim.c) ---- */
 
+/* mixed: the study's clocks are mixed (--mix-clocks): each table says so.
+ * Also writes pt_curves.csv, every timed sample of the path tracer's curves. */
 void study_charts_and_speedups(study *st, const char *out_dir, json_object *meta,
-                               json_object *chart_list);
+                               json_object *chart_list, int mixed);
 void study_user_charts(study *st, const char *out_dir, json_object *runs, json_object *chart_list);
 void study_animation_report(study *st, const char *out_dir, json_object *meta,
                             json_object *chart_list);

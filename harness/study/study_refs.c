@@ -121,60 +121,110 @@ static void watch_stop(ref_watch *w, int ok)
         fprintf(stderr, "study: %s: %.0f spp in %.2f s\n", w->label, spp, t);
 }
 
-/* The path tracer's convergence curve at one bounce limit: an image of
- * each convergence_spp count (another seed) against `reference`. The
- * full-GI images keep their old names (references made before per-bounce
- * curves are reused). */
-static int pt_convergence(study *st, const char *out_dir, const study_ref *sc, const char *scene,
-                          uint32_t bounces, const char *reference, tradeoff_pt_curve *curve,
-                          char *why, size_t why_size)
+/* One timed sample of a convergence image: its render's CPU time (every
+ * thread) in studies timed by CPU time, else its render's wall time (all
+ * threads), as the methods' frames are measured; the BVH build, like a
+ * method's prepare, is not in it. NaN when the statistics lack it. */
+static double pt_sample_seconds(const study *st, const char *img)
 {
-    const char *px = st->ref_pixel_center ? "_center" : "";
+    char stats[4200];
+    snprintf(stats, sizeof stats, "%s.json", img);
+    json_object *sj = cli_read_json(stats);
+    double t = rec_num(
+        sj, st->timer && !strcmp(st->timer, "cputime") ? "render_cpu_seconds" : "render_seconds",
+        NULL, NULL);
+    json_object_put(sj);
+    return t;
+}
+
+static int cmp_seconds(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* One point of the curve timed now: the image rendered conv_repeats times
+ * (its cached key removed first, so that each is a new render; the seed is
+ * the same, so is the image), every render's time a sample. 1, or 0 with why. */
+static int pt_time_point(study *st, const study_ref *sc, const char *scene, uint32_t bounces,
+                         uint32_t spp, const char *img, double *samples, uint32_t *n, char *why,
+                         size_t why_size)
+{
+    char cfg[4200], label[400];
+    snprintf(cfg, sizeof cfg, "%s.config", img);
+    *n = 0;
+    for (uint32_t r = 0; r < st->conv_repeats; r++) {
+        /* one line per timing: "convergence S (B bounces, K spp): K spp in T s" */
+        snprintf(label, sizeof label, "convergence %s (%u bounces, %u spp)", sc->name, bounces,
+                 spp);
+        unlink(cfg);
+        ref_watch w;
+        watch_start(&w, label, img);
+        int ok = runner_reference(scene, st->scenes[sc->scene_index].hash, st->camera, sc->width,
+                                  sc->height, spp, 0.0, bounces, st->seed + 7919, sc->time,
+                                  st->ref_pixel_center, st->timeout_s, img, why, why_size);
+        watch_stop(&w, ok);
+        if (!ok)
+            return 0;
+        double t = pt_sample_seconds(st, img);
+        if (isfinite(t) && t > 0)
+            samples[(*n)++] = t;
+    }
+    return 1;
+}
+
+/* The path tracer's convergence curve at one bounce limit: an image of
+ * each convergence_spp count (another seed) against `reference`, each
+ * timed conv_repeats times in this invocation (issue 34: median and
+ * min-max kept), or with STUDY_CURVES_LOAD / _RECORDED the curve an
+ * earlier invocation timed (its record, when its settings are these).
+ * The full-GI images keep their old names. */
+static int pt_convergence(study *st, const char *out_dir, const study_ref *sc, const char *scene,
+                          uint32_t bounces, const char *reference, int mode,
+                          tradeoff_pt_curve *curve, char *why, size_t why_size)
+{
+    char record[4200], key[8192];
+    study_curve_record_path(st, out_dir, sc, bounces, record, sizeof record);
+    study_curve_key(st, reference, bounces, key, sizeof key);
     curve->n = 0;
+    curve->invocation[0] = '\0';
+    if (mode != STUDY_CURVES_TIME && study_curve_load(record, key, curve))
+        return 1;
+    if (mode == STUDY_CURVES_RECORDED) {
+        snprintf(why, why_size, "the path tracer's curve %s was not timed", record);
+        return 0;
+    }
+    const char *px = st->ref_pixel_center ? "_center" : "";
+    static double samples[TRADEOFF_PT_POINTS][64];
     for (uint32_t c = 0; c < st->conv_n; c++) {
-        char img[4096], stats[4200], b[32] = "";
+        char img[4096], b[32] = "";
         if (bounces != st->ref_bounces)
             snprintf(b, sizeof b, "b%u_", bounces);
         char stem[320];
         snprintf(stem, sizeof stem, "%s", sc->name);
         snprintf(img, sizeof img, "%s/references/%s_conv_%s%uspp%s.exr", out_dir, stem, b,
                  st->conv_spp[c], px);
-        char label[400];
-        snprintf(label, sizeof label, "convergence %s (%u bounces, %u spp)", stem, bounces,
-                 st->conv_spp[c]);
-        ref_watch w;
-        watch_start(&w, label, img);
-        int ok =
-            runner_reference(scene, st->scenes[sc->scene_index].hash, st->camera, sc->width,
-                             sc->height, st->conv_spp[c], 0.0, bounces, st->seed + 7919, sc->time,
-                             st->ref_pixel_center, st->timeout_s, img, why, why_size);
-        watch_stop(&w, ok);
-        if (!ok)
+        double t[64];
+        uint32_t nt = 0;
+        if (!pt_time_point(st, sc, scene, bounces, st->conv_spp[c], img, t, &nt, why, why_size))
             return 0;
-        snprintf(stats, sizeof stats, "%s.json", img);
-        json_object *sj = cli_read_json(stats);
         json_object *m = runner_diff(img, reference, NULL, NULL, st->exposure, why, why_size);
-        /* the path tracer's time to the image, measured as the methods'
-         * frames are: its render's CPU time (every thread) in studies timed
-         * by CPU time, else its render's wall time (all threads); the BVH
-         * build, like a method's prepare, is not in it. Images made before
-         * the CPU time was recorded give their whole wall time. */
-        double t = rec_num(sj,
-                           st->timer && !strcmp(st->timer, "cputime") ? "render_cpu_seconds"
-                                                                      : "render_seconds",
-                           NULL, NULL);
-        if (!isfinite(t))
-            t = rec_num(sj, "wall_seconds", NULL, NULL);
         double e = rec_num(m, "relmse", NULL, NULL);
-        if (isfinite(t) && isfinite(e) && t > 0 && e > 0 && curve->n < TRADEOFF_PT_POINTS) {
-            curve->t[curve->n] = t;
-            curve->e[curve->n] = e;
-            curve->n++;
-        }
-        json_object_put(sj);
         json_object_put(m);
+        if (nt == 0 || !isfinite(e) || !(e > 0) || curve->n >= TRADEOFF_PT_POINTS)
+            continue;
+        uint32_t k = curve->n++;
+        memcpy(samples[k], t, nt * sizeof *t);
+        qsort(t, nt, sizeof *t, cmp_seconds);
+        curve->t[k] = nt % 2 ? t[nt / 2] : 0.5 * (t[nt / 2 - 1] + t[nt / 2]);
+        curve->t_lo[k] = t[0];
+        curve->t_hi[k] = t[nt - 1];
+        curve->samples[k] = nt;
+        curve->e[k] = e;
+        curve->spp[k] = st->conv_spp[c];
     }
-    return 1;
+    snprintf(curve->invocation, sizeof curve->invocation, "%s", st->invocation);
+    return study_curve_save(record, key, curve, samples, why, why_size);
 }
 
 /* Whether run r compares with reference set ri (its final image, or one of its frames). */
@@ -186,6 +236,27 @@ static int run_uses_ref(const study_run *r, uint32_t ri)
         if (r->frame_ref[f] == (int)ri)
             return 1;
     return 0;
+}
+
+/* The path tracer's convergence of set ri, for full GI and for each
+ * bounce count in use: k-spp images (another seed) against the reference
+ * of the same bounce count, timed or loaded as `mode` says. */
+static int set_curves(study *st, const char *out_dir, uint32_t ri, int mode, char *why,
+                      size_t why_size)
+{
+    study_ref *sc = &st->refs[ri];
+    const char *path = st->scenes[sc->scene_index].path;
+    sc->pt_full.bounces = st->ref_bounces;
+    if (!pt_convergence(st, out_dir, sc, path, st->ref_bounces, sc->ref_full, mode, &sc->pt_full,
+                        why, why_size))
+        return 0;
+    for (uint32_t k = 0; k < sc->matched_count; k++) {
+        sc->pt_matched[k].bounces = sc->matched_bounces[k];
+        if (!pt_convergence(st, out_dir, sc, path, sc->matched_bounces[k], sc->ref_matched[k], mode,
+                            &sc->pt_matched[k], why, why_size))
+            return 0;
+    }
+    return 1;
 }
 
 /* One reference set: the full-GI reference, the bounce-matched ones for
@@ -254,22 +325,9 @@ int study_build_reference_set(study *st, const char *out_dir, uint32_t ri, int c
             sc->matched_count++;
         }
     }
-    if (!curves || sc->frame_only)
+    if (curves == STUDY_CURVES_NONE || sc->frame_only || st->conv_n == 0)
         return 1;
-    /* the path tracer's convergence, for full GI and for each bounce
-     * count in use: k-spp images (another seed) against the reference
-     * of the same bounce count */
-    sc->pt_full.bounces = st->ref_bounces;
-    if (!pt_convergence(st, out_dir, sc, path, st->ref_bounces, sc->ref_full, &sc->pt_full, why,
-                        why_size))
-        return 0;
-    for (uint32_t k = 0; k < sc->matched_count; k++) {
-        sc->pt_matched[k].bounces = sc->matched_bounces[k];
-        if (!pt_convergence(st, out_dir, sc, path, sc->matched_bounces[k], sc->ref_matched[k],
-                            &sc->pt_matched[k], why, why_size))
-            return 0;
-    }
-    return 1;
+    return set_curves(st, out_dir, ri, curves, why, why_size);
 }
 
 static void slurm_mark_missing_ref(study *st, uint32_t ri, const char *why)
@@ -281,11 +339,45 @@ int study_build_references(study *st, const char *out_dir, int slurm_collecting)
 {
     char why[1024];
     for (uint32_t ri = 0; ri < st->ref_count; ri++) {
-        if (study_build_reference_set(st, out_dir, ri, 1, why, sizeof why))
+        if (study_build_reference_set(st, out_dir, ri, STUDY_CURVES_NONE, why, sizeof why))
             continue;
         if (!slurm_collecting)
             return cli_fail(EXIT_RUN, "study: %s", why);
         slurm_mark_missing_ref(st, ri, why);
+    }
+    return EXIT_OK;
+}
+
+int study_build_curves(study *st, const char *out_dir, int slurm_collecting)
+{
+    /* the curve is timed with the runs it is compared with (issue 34): when
+     * this invocation timed one of them, every curve is timed again now */
+    int timed = 0;
+    for (uint32_t i = 0; i < st->run_count; i++)
+        timed |= st->runs[i].ref_index >= 0 && st->runs[i].spec.animate_fps <= 0 &&
+                 study_timed_now(st, &st->runs[i]);
+    /* runs of several invocations are refused anyway (study_check_clocks),
+     * unless --mix-clocks: no curve is timed for a report that will not be
+     * written */
+    int refused = timed && !st->mix_clocks && study_runs_mixed(st);
+    int mode = slurm_collecting || refused ? STUDY_CURVES_RECORDED
+               : timed                     ? STUDY_CURVES_TIME
+                                           : STUDY_CURVES_LOAD;
+    char why[1024];
+    for (uint32_t ri = 0; ri < st->ref_count && !cli_interrupted; ri++) {
+        if (st->refs[ri].frame_only || st->refs[ri].missing[0] || st->conv_n == 0)
+            continue;
+        if (set_curves(st, out_dir, ri, mode, why, sizeof why))
+            continue;
+        if (cli_interrupted) { /* the report says the study was interrupted */
+            st->refs[ri].pt_full.n = 0;
+            st->refs[ri].pt_full.invocation[0] = '\0';
+            break;
+        }
+        if (mode != STUDY_CURVES_RECORDED)
+            return cli_fail(EXIT_RUN, "study: %s", why);
+        if (slurm_collecting)
+            fprintf(stderr, "study: %s\n", why); /* no speed-ups for this set */
     }
     return EXIT_OK;
 }

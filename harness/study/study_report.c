@@ -11,6 +11,7 @@
 
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 /* the scene's name and size, for scale studies (cached records too) */
 static void add_scene_sizes(study *st)
@@ -98,9 +99,28 @@ static int report_failures(const study *st, int failed)
                     st->run_count);
 }
 
+/* A refused report leaves no report of an earlier invocation behind to
+ * be read as this one's. */
+static void remove_report(const char *out)
+{
+    static const char *const files[] = {"report.md",  "index.html", "runs.csv",     "runs.json",
+                                        "frames.csv", "curves.csv", "pt_curves.csv"};
+    char path[4200];
+    for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
+        snprintf(path, sizeof path, "%s/%s", out, files[i]);
+        unlink(path);
+    }
+}
+
 int study_write_report(study *st, const char *out, int argc, char **argv, int slurm_collect)
 {
-    int rc = EXIT_OK;
+    int rc = EXIT_OK, mixed = 0;
+    /* one clock per comparison (issue 34): timings of several invocations
+     * are refused unless --mix-clocks */
+    if ((rc = study_check_clocks(st, &mixed)) != EXIT_OK) {
+        remove_report(out);
+        return rc;
+    }
     add_scene_sizes(st);
     char renderer[256] = "";
     int failed = 0, interrupted = 0;
@@ -108,7 +128,7 @@ int study_write_report(study *st, const char *out, int argc, char **argv, int sl
     json_object *meta = meta_of_study(st, argc, argv, renderer);
     study_reference_sets(st, meta);
     json_object *chart_list = json_object_new_array();
-    study_charts_and_speedups(st, out, meta, chart_list);
+    study_charts_and_speedups(st, out, meta, chart_list, mixed);
     study_animation_report(st, out, meta, chart_list);
     study_user_charts(st, out, runs, chart_list);
     json_object_object_add(meta, "charts", chart_list);

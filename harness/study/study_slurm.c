@@ -44,7 +44,8 @@ int study_slurm_cell(study *st, const char *out, gi_plugins *reg, const char *ce
         return cli_fail(EXIT_USAGE, "study: --cell %s: the study has %u such cells", cell, n);
     char why[1024];
     if (!strcmp(kind, "ref")) {
-        if (!study_build_reference_set(st, out, (uint32_t)k, 1, why, sizeof why))
+        /* a reference cell times the path tracer's curve in this submission */
+        if (!study_build_reference_set(st, out, (uint32_t)k, STUDY_CURVES_TIME, why, sizeof why))
             return cli_fail(EXIT_RUN, "study: %s", why);
         fprintf(stderr, "study: reference set %s done\n", st->refs[k].name);
         return EXIT_OK;
@@ -59,7 +60,7 @@ int study_slurm_cell(study *st, const char *out, gi_plugins *reg, const char *ce
     }
     study_attach_refs(st, r);
     double t0 = gi_now();
-    r->record = study_run_or_skip(r, reg, 1);
+    r->record = study_run_or_skip(st, r, reg, 1);
     json_object *v;
     const char *status =
         json_object_object_get_ex(r->record, "status", &v) ? json_object_get_string(v) : "?";
@@ -83,33 +84,63 @@ int study_slurm_submit(study *st, const char *file, const char *out, gi_plugins 
         free(run_tasks);
         return cli_fail(EXIT_RUN, "study: out of memory");
     }
-    uint32_t nref = 0, nrun = 0, cached = 0, na = 0;
+    uint32_t nref = 0, nrun = 0, cached = 0, na = 0, nmade = 0;
     char why[1024];
     runner_set_collect_only(1);
+    /* one submission is one invocation (docs/studies.md "One clock per
+     * comparison"): its cells inherit the id through sbatch's environment */
+    uint8_t *retime = calloc(st->ref_count + 1, 1);
     for (uint32_t i = 0; i < st->ref_count; i++)
         if (!study_build_reference_set(st, out, i, 0, why, sizeof why))
             ref_tasks[nref++] = i;
+        else
+            retime[i] = 1; /* made: a cell only if a run compared with it runs now */
+    nmade = nref;
     for (uint32_t i = 0; i < st->run_count; i++) {
         study_run *r = &st->runs[i];
         study_attach_refs(st, r);
-        json_object *rec = study_run_or_skip(r, reg, 1), *v;
+        json_object *rec = study_run_or_skip(st, r, reg, 1), *v;
         const char *status =
             json_object_object_get_ex(rec, "status", &v) ? json_object_get_string(v) : "";
         if (json_object_object_get_ex(rec, "cached", &v))
             cached++;
         else if (!strcmp(status, "n/a"))
             na++;
-        else
+        else {
             run_tasks[nrun++] = i;
+            /* the curve its speed-up divides by is timed in this submission too */
+            if (r->ref_index >= 0 && retime && retime[r->ref_index] == 1 && st->conv_n > 0 &&
+                !st->refs[r->ref_index].frame_only) {
+                retime[r->ref_index] = 2;
+                ref_tasks[nref++] = (uint32_t)r->ref_index;
+            }
+        }
         json_object_put(rec);
     }
+    free(retime);
+    for (uint32_t i = 1; i < nref; i++) /* in order: the array spec joins runs of indices */
+        for (uint32_t j = i; j > 0 && ref_tasks[j] < ref_tasks[j - 1]; j--) {
+            uint32_t tmp = ref_tasks[j];
+            ref_tasks[j] = ref_tasks[j - 1];
+            ref_tasks[j - 1] = tmp;
+        }
     runner_set_collect_only(0);
     fprintf(stderr,
             "study: %s: %u reference sets (%u to make), %u runs (%u done before, %u not "
             "applicable, %u to run)\n",
-            st->name, st->ref_count, nref, st->run_count, cached, na, nrun);
+            st->name, st->ref_count, nmade, st->run_count, cached, na, nrun);
+    if (nref > nmade)
+        fprintf(stderr,
+                "study: %u reference sets' convergence curves are timed again with the runs "
+                "(one clock per comparison)\n",
+                nref - nmade);
+    /* one submission is one invocation (docs/studies.md "One clock per
+     * comparison"): its cells and collect job take its id */
+    study_new_invocation(st->invocation, sizeof st->invocation);
+    slurm_options own = *so;
+    own.invocation = st->invocation;
     slurm_stage refs = {"ref", ref_tasks, nref}, runs = {"run", run_tasks, nrun};
-    int rc = slurm_run(so, file, out, st->name, slurm_plan_hash(st), &refs, &runs);
+    int rc = slurm_run(&own, file, out, st->name, slurm_plan_hash(st), &refs, &runs);
     free(ref_tasks);
     free(run_tasks);
     return rc;
@@ -128,7 +159,7 @@ void study_slurm_collect_runs(study *st, gi_plugins *reg, const char *out, const
     for (uint32_t i = 0; i < st->run_count; i++) {
         study_run *r = &st->runs[i];
         study_attach_refs(st, r);
-        json_object *rec = study_run_or_skip(r, reg, 1), *v;
+        json_object *rec = study_run_or_skip(st, r, reg, 1), *v;
         if (json_object_object_get_ex(rec, "cached", &v)) {
             json_object_object_del(rec, "cached");
         } else if (json_object_object_get_ex(rec, "status", &v) &&

@@ -67,15 +67,8 @@ file(GLOB conv ${S}/references/cornell_moving_24x24_t*_conv_*)
 if(conv)
     fail("a frame's reference set got a convergence curve: ${conv}")
 endif()
-# resuming runs nothing again
-run(0 study tests/data/studies/anim_tiny.json --out ${S})
-string(REGEX MATCHALL "cached cornell_moving-" hits "${last_err}") # not through a function: the text holds semicolons
-list(LENGTH hits n)
-if(NOT n EQUAL 3)
-    fail("a resumed study reran runs (${n} of 3 cached):\n${last_err}")
-endif()
-
-# a result made before the leaked energy existed gets it on resume, without a render
+# resuming runs nothing again, and a result made before the leaked energy
+# existed gets it on resume, without a render (one resume for both: CI time)
 file(GLOB results ${S}/runs/*/result.json)
 list(GET results 0 res)
 file(READ ${res} j)
@@ -85,12 +78,15 @@ string(JSON j REMOVE "${j}" metrics matched leaked_energy)
 file(WRITE ${res} "${j}")
 file(TIMESTAMP ${res} before)
 run(0 study tests/data/studies/anim_tiny.json --out ${S})
-string(REGEX MATCHALL "cached cornell_moving-" hits "${last_err}")
+string(REGEX MATCHALL "cached cornell_moving-" hits "${last_err}") # not through a function: the text holds semicolons
 list(LENGTH hits n)
+if(NOT n EQUAL 3)
+    fail("a resumed study reran runs (${n} of 3 cached):\n${last_err}")
+endif()
 file(READ ${res} j)
 string(JSON leak2 ERROR_VARIABLE e GET "${j}" metrics full leaked_energy)
-if(NOT n EQUAL 3 OR NOT leak2 STREQUAL leak)
-    fail("an old result did not get its leaked energy back on resume (${n} cached, ${leak2} vs ${leak})")
+if(NOT leak2 STREQUAL leak)
+    fail("an old result did not get its leaked energy back on resume (${leak2} vs ${leak})")
 endif()
 
 if(failures GREATER 0)

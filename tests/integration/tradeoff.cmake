@@ -8,8 +8,7 @@ set(D ${OUT}/tradeoff)
 file(REMOVE_RECURSE ${D})
 file(MAKE_DIRECTORY ${D})
 
-# A reference for render's own curve.
-run(0 reference --scene scenes/cornell_box.gltf --size 16x16 --spp 16 --max-bounces 1 --out ${D}/ref.exr)
+# A reference of another size, for the refusals.
 run(0 reference --scene scenes/cornell_box.gltf --size 8x8 --spp 4 --out ${D}/small.exr)
 
 # Bad --curve-ref: one line, exit 2, nothing rendered.
@@ -25,13 +24,38 @@ if(EXISTS ${D}/x.exr)
     fail("a refused render wrote its image")
 endif()
 
+# The study: 2 settings x 2 repeats, curves, tables, both charts.
+set(S ${D}/study)
+run(0 study tests/data/studies/tradeoff_tiny.json --out ${S})
+file(READ ${S}/curves.csv curves)
+match_count("${curves}" "\ncornell_box-direct-[^\n]+" 24 "curves.csv: 4 runs x 6 points")
+file(READ ${S}/report.md md)
+match("${md}" "equal error" "report.md has no equal-error table")
+match("${md}" "equal time" "report.md has no equal-time table")
+match("${md}" "\\| direct \\| `light_samples=[14]` \\| [0-9]+ \\| [0-9.e-]+ \\| [0-9.e-]+ \\[[0-9.e-]+–[0-9.e-]+\\] \\|"
+      "no Pareto row with its spread over the repeats:\n${md}")
+match("${md}" "\\| direct \\(matched\\) \\|" "no bounce-matched equal-time row for a direct-only method")
+match("${md}" "max_bounces 8:[^;]*; max_bounces 1:" "the path tracer's curves for full GI and 1 bounce are not both given")
+foreach(f chart_cornell_box_error_vs_time.png chart_cornell_box_error_vs_time_matched.png)
+    if(NOT EXISTS ${S}/${f})
+        fail("the study did not draw ${f}")
+    endif()
+endforeach()
 # 20 frames: the error after frames 1, 2, 4, 8, 16 and 20; the time to each
-# image grows; a progressive method's error falls.
-run(0 render --scene scenes/cornell_box.gltf --method direct --param light_samples=1 --size 16x16 --frames 20
-    --warmup 1 --out ${D}/img.exr --timings ${D}/t.json --curve-ref matched=${D}/ref.exr)
-file(READ ${D}/t.json tj)
-string(JSON n LENGTH "${tj}" curve)
-if(NOT n EQUAL 6)
+# image grows; a progressive method's error falls (render --curve-ref, as the
+# study ran it: the curve of the first light_samples=1 run's record).
+file(READ ${S}/runs.json rj)
+string(JSON nr LENGTH "${rj}")
+math(EXPR last "${nr} - 1")
+set(tj "")
+foreach(i RANGE ${last})
+    string(JSON p GET "${rj}" ${i} params)
+    if(p STREQUAL "light_samples=1" AND tj STREQUAL "")
+        string(JSON tj GET "${rj}" ${i})
+    endif()
+endforeach()
+string(JSON n ERROR_VARIABLE no_curve LENGTH "${tj}" curve)
+if(no_curve OR NOT n EQUAL 6)
     fail("20 frames: ${n} curve points, expected 6 (1 2 4 8 16 20)")
 else()
     set(prev_t 0)
@@ -55,23 +79,6 @@ else()
     endif()
 endif()
 
-# The study: 2 settings x 2 repeats, curves, tables, both charts.
-set(S ${D}/study)
-run(0 study tests/data/studies/tradeoff_tiny.json --out ${S})
-file(READ ${S}/curves.csv curves)
-match_count("${curves}" "\ncornell_box-direct-[^\n]+" 24 "curves.csv: 4 runs x 6 points")
-file(READ ${S}/report.md md)
-match("${md}" "equal error" "report.md has no equal-error table")
-match("${md}" "equal time" "report.md has no equal-time table")
-match("${md}" "\\| direct \\| `light_samples=[14]` \\| [0-9]+ \\| [0-9.e-]+ \\| [0-9.e-]+ \\[[0-9.e-]+–[0-9.e-]+\\] \\|"
-      "no Pareto row with its spread over the repeats:\n${md}")
-match("${md}" "\\| direct \\(matched\\) \\|" "no bounce-matched equal-time row for a direct-only method")
-match("${md}" "max_bounces 8:[^;]*; max_bounces 1:" "the path tracer's curves for full GI and 1 bounce are not both given")
-foreach(f chart_cornell_box_error_vs_time.png chart_cornell_box_error_vs_time_matched.png)
-    if(NOT EXISTS ${S}/${f})
-        fail("the study did not draw ${f}")
-    endif()
-endforeach()
 # runs.csv: per run, the time its error needed (a method with an error
 # floor is charged fewer frames than it ran), both speed-ups and whether the
 # path tracer's time was extrapolated beyond its curve.
@@ -80,6 +87,107 @@ match("${csv}" ",seed,time_to_final_error_s,frames_to_final_error,speedup_vs_pt,
       "runs.csv lacks the speed-against-accuracy columns:\n${csv}")
 match_count("${csv}" "\ncornell_box-direct-[^\n]*,[34],[0-9.e-]+,[0-9]+,[0-9.e+-]+,[0-9.e+-]+,[01]," 4
             "runs.csv: every run with its seed, time, frames and speed-ups")
+
+# One clock per comparison (issue 34, docs/studies.md "One clock per
+# comparison"). The path tracer's curve: every point timed 3 times in this
+# invocation, median inside [min, max], written to pt_curves.csv and to the
+# curve's record with every sample.
+if(NOT EXISTS ${S}/pt_curves.csv)
+    fail("the study wrote no pt_curves.csv")
+else()
+    file(STRINGS ${S}/pt_curves.csv pt)
+    list(LENGTH pt pt_n)
+    if(NOT pt_n EQUAL 5)
+        fail("pt_curves.csv: ${pt_n} lines, expected a header and 2 bounce limits x 2 points")
+    endif()
+    list(REMOVE_AT pt 0)
+    foreach(line IN LISTS pt)
+        string(REPLACE "," ";" f "${line}")
+        list(GET f 4 med)
+        list(GET f 5 lo)
+        list(GET f 6 hi)
+        list(GET f 7 n)
+        list(GET f 8 inv)
+        if(n LESS 3 OR lo GREATER med OR med GREATER hi OR NOT hi GREATER lo OR inv STREQUAL "")
+            fail("pt_curves.csv: a point not timed 3 times with a spread in one invocation: ${line}")
+        endif()
+    endforeach()
+endif()
+file(GLOB curve_records ${S}/references/*_curve_center.json)
+list(LENGTH curve_records ncr)
+if(NOT ncr EQUAL 2)
+    fail("${ncr} curve records in references/, expected 2 (8 and 1 bounces)")
+endif()
+foreach(cr IN LISTS curve_records)
+    file(READ ${cr} cj)
+    string(JSON ns LENGTH "${cj}" points 0 seconds)
+    if(NOT ns EQUAL 3)
+        fail("${cr}: ${ns} samples at its first point, expected 3")
+    endif()
+endforeach()
+# runs.json: each run names the invocation that timed it (all the same one)
+# and its speed-ups carry the curve's spread, min <= speed-up <= max.
+file(READ ${S}/runs.json rj)
+string(JSON nr LENGTH "${rj}")
+math(EXPR last "${nr} - 1")
+set(invs "")
+foreach(i RANGE ${last})
+    string(JSON inv ERROR_VARIABLE e1 GET "${rj}" ${i} invocation)
+    list(APPEND invs "${inv}")
+    foreach(k speedup_vs_pt speedup_vs_pt_matched)
+        string(JSON mid ERROR_VARIABLE e2 GET "${rj}" ${i} ${k})
+        string(JSON lo ERROR_VARIABLE e3 GET "${rj}" ${i} ${k}_min)
+        string(JSON hi ERROR_VARIABLE e4 GET "${rj}" ${i} ${k}_max)
+        if(e1 OR e2 OR e3 OR e4 OR lo GREATER mid OR mid GREATER hi OR NOT hi GREATER lo)
+            fail("run ${i}: ${k} ${lo} <= ${mid} <= ${hi} with a spread, invocation '${inv}' expected")
+        endif()
+    endforeach()
+endforeach()
+list(REMOVE_DUPLICATES invs)
+list(LENGTH invs ninv)
+if(NOT ninv EQUAL 1)
+    fail("the runs of one invocation name ${ninv} invocations: ${invs}")
+endif()
+set(curve_record ${S}/references/cornell_box_conv_curve_center.json)
+set(cinv "no curve record")
+if(EXISTS ${curve_record})
+    file(READ ${curve_record} cj)
+    string(JSON cinv GET "${cj}" invocation)
+endif()
+if(NOT cinv STREQUAL invs)
+    fail("the curve was timed in ${cinv}, the runs in ${invs}")
+endif()
+match("${md}" "\\| [0-9.e+-]+ \\[[0-9.e+-]+–[0-9.e+-]+\\]\\*? \\| [0-9.e+-]+ \\| [0-9.e+-]+\\*? \\| [0-9.e+-]+ \\[[0-9.e+-]+–[0-9.e+-]+\\]"
+      "report.md: the speed-ups lack their [min–max]:\n${md}")
+# One run timed again in a second invocation: the report would divide the
+# other runs' times by a curve of another clock and is refused, with one
+# line naming the invocations; no report of the earlier invocation is left.
+file(GLOB one_run ${S}/runs/*)
+list(GET one_run 0 one_run)
+file(REMOVE ${one_run}/result.json)
+execute_process(COMMAND ${GIB} study tests/data/studies/tradeoff_tiny.json --out ${S} WORKING_DIRECTORY ${ROOT}
+                RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+string(REGEX MATCH "[^\n]*would mix clocks[^\n]*" refusal "${err}")
+expect_refusal("a study mixing two invocations" "mix clocks of 2 invocations \\(.*${cinv}.*--mix-clocks"
+               "${rc}" "${refusal}")
+if(EXISTS ${S}/report.md)
+    fail("a refused study left report.md behind")
+endif()
+# --mix-clocks: reported, and the table says the clocks are mixed. This
+# rerun times no run: it keeps the curve of the first invocation (the
+# refused one did not time it again either).
+run(0 study tests/data/studies/tradeoff_tiny.json --out ${S} --mix-clocks)
+file(READ ${S}/report.md md)
+match("${md}" "Clocks are mixed[^\n]*${cinv} \\(the path tracer's curve, 3 runs\\); [0-9TZa-f-]+ \\(1 runs\\)"
+      "--mix-clocks: no note of the mixed clocks:\n${md}")
+set(cinv2 "no curve record")
+if(EXISTS ${curve_record})
+    file(READ ${curve_record} cj)
+    string(JSON cinv2 GET "${cj}" invocation)
+endif()
+if(NOT cinv2 STREQUAL cinv)
+    fail("the curve was timed again by a refused study or one that timed no run (${cinv} -> ${cinv2})")
+endif()
 
 if(failures GREATER 0)
     message(FATAL_ERROR "${failures} tradeoff expectation(s) failed")

@@ -140,10 +140,10 @@ int main(void)
     json_object_array_add(runs, record(NASTY "-1", "ok"));
     json_object_array_add(runs, record(NASTY "-2", "failed"));
     tradeoff_run tr[1] = {{json_object_array_get_idx(runs, 0), 65, 1}};
-    tradeoff_pt_curve full = {65, 2, {1, 4}, {1, 0.25}};
+    tradeoff_pt_curve full = {.bounces = 65, .n = 2, .t = {1, 4}, .e = {1, 0.25}};
     gi_text md = {0};
     json_object *charts = json_object_new_array();
-    tradeoff_report(d, NASTY, &full, NULL, 0, tr, 1, NULL, charts, &md);
+    tradeoff_report(d, NASTY, &full, NULL, 0, tr, 1, NULL, charts, &md, NULL);
     CHECK(md.s != NULL && !md.failed);
 
     char *argv[] = {NASTY};

@@ -87,7 +87,7 @@ static gi_result fake_chart(const char *path, const gi_chart_desc *desc, const g
 static void test_pt_time(void)
 {
     /* relMSE = 1 / time: log-log interpolation is exact on it */
-    tradeoff_pt_curve c = {65, 3, {1, 4, 16}, {1, 0.25, 0.0625}};
+    tradeoff_pt_curve c = {.bounces = 65, .n = 3, .t = {1, 4, 16}, .e = {1, 0.25, 0.0625}};
     int ex = -1;
     CHECK_NEAR(tradeoff_pt_time_at(&c, 0.5, &ex), 2.0, 1e-12);
     CHECK(ex == 0);
@@ -97,7 +97,7 @@ static void test_pt_time(void)
     CHECK_NEAR(tradeoff_pt_time_at(&c, 0.01, &ex), 100.0, 1e-9);
     CHECK(ex == 1);
     CHECK(isnan(tradeoff_pt_time_at(&c, 0.0, &ex)));
-    tradeoff_pt_curve empty = {65, 0, {0}, {0}};
+    tradeoff_pt_curve empty = {.bounces = 65, .n = 0, .t = {0}, .e = {0}};
     CHECK(isnan(tradeoff_pt_time_at(&empty, 0.5, &ex)));
 }
 
@@ -115,8 +115,8 @@ static void test_report(void)
         {record("fast", "B", tb, eb, eb, 3, 0), 65, 2},
         {record("prog", "P", tp, ep, epm, 3, 0), 1, 3},
     };
-    tradeoff_pt_curve full = {65, 3, {1, 4, 16}, {1, 0.25, 0.0625}};
-    tradeoff_pt_curve matched = {1, 2, {0.5, 2}, {0.1, 0.025}};
+    tradeoff_pt_curve full = {.bounces = 65, .n = 3, .t = {1, 4, 16}, .e = {1, 0.25, 0.0625}};
+    tradeoff_pt_curve matched = {.bounces = 1, .n = 2, .t = {0.5, 2}, .e = {0.1, 0.025}};
     /* memory: "fast" A's repeats peaked at 100 and 300 MiB and keep 1 MiB of data */
     for (int r = 0; r < 2; r++) {
         json_object *st = json_object_new_object();
@@ -127,7 +127,8 @@ static void test_report(void)
     }
     gi_text md = {0};
     json_object *charts = json_object_new_array();
-    tradeoff_report("/nonexistent", "box", &full, &matched, 1, runs, 4, fake_chart, charts, &md);
+    tradeoff_report("/nonexistent", "box", &full, &matched, 1, runs, 4, fake_chart, charts, &md,
+                    NULL);
     CHECK(md.s != NULL);
     const char *s = md.s ? md.s : "";
 
@@ -199,10 +200,10 @@ static void test_renderers(void)
         json_object_object_add(runs[0].record, "renderer", json_object_new_string("NVIDIA H100"));
         json_object_object_add(runs[1].record, "renderer",
                                json_object_new_string(mixed ? "llvmpipe" : "NVIDIA H100"));
-        tradeoff_pt_curve full = {65, 3, {1, 4, 16}, {1, 0.25, 0.0625}};
+        tradeoff_pt_curve full = {.bounces = 65, .n = 3, .t = {1, 4, 16}, .e = {1, 0.25, 0.0625}};
         gi_text md = {0};
         json_object *charts = json_object_new_array();
-        tradeoff_report("/nonexistent", "box", &full, NULL, 0, runs, 2, NULL, charts, &md);
+        tradeoff_report("/nonexistent", "box", &full, NULL, 0, runs, 2, NULL, charts, &md, NULL);
         const char *s = md.s ? md.s : "";
         if (mixed) {
             CHECK_MSG(strstr(s, "| fast [NVIDIA H100] | `A` | 1 | 0.01 | 0.3 |") != NULL, "%s", s);
@@ -220,10 +221,52 @@ static void test_renderers(void)
     }
 }
 
+/* Issue 34: the speed-up carries the spread of the path tracer's repeated
+ * curve points (here each point's fastest and slowest timing half and twice
+ * its median) and of the method's repeats; a mixed-clock report says so. */
+static void test_speedup_spread(void)
+{
+    double t1[1] = {0.1}, t2[1] = {0.2}, e[1] = {0.25};
+    tradeoff_run runs[2] = {
+        {record("m", "A", t1, e, e, 1, 0), 65, 7},
+        {record("m", "A", t2, e, e, 1, 0), 65, 7},
+    };
+    json_object_object_add(runs[0].record, "invocation", json_object_new_string("inv-A"));
+    json_object_object_add(runs[1].record, "invocation", json_object_new_string("inv-B"));
+    tradeoff_pt_curve full = {.bounces = 65,
+                              .n = 3,
+                              .t = {1, 4, 16},
+                              .e = {1, 0.25, 0.0625},
+                              .t_lo = {0.5, 2, 8},
+                              .t_hi = {2, 8, 32},
+                              .samples = {3, 3, 3},
+                              .invocation = "inv-A"};
+    gi_text md = {0};
+    json_object *charts = json_object_new_array();
+    tradeoff_clock_note clocks = {1};
+    tradeoff_report("/nonexistent", "box", &full, NULL, 0, runs, 2, NULL, charts, &md, &clocks);
+    const char *s = md.s ? md.s : "";
+    /* per run: the path tracer needs 4 s [2-8] for 0.25; run 0 took 0.1 s */
+    CHECK_NEAR(field(runs[0].record, "speedup_vs_pt"), 40.0, 1e-9);
+    CHECK_NEAR(field(runs[0].record, "speedup_vs_pt_min"), 20.0, 1e-9);
+    CHECK_NEAR(field(runs[0].record, "speedup_vs_pt_max"), 80.0, 1e-9);
+    /* the table: median time 0.15 s, so 26.7; low end 2 / 0.2, high end 8 / 0.1 */
+    CHECK_MSG(strstr(s, "| 26.7 [10–80] |") != NULL, "no speed-up spread in:\n%s", s);
+    CHECK_MSG(strstr(s, "4 s [2–8] → 0.25") != NULL, "no curve spread in:\n%s", s);
+    CHECK_MSG(strstr(s, "**Clocks are mixed**") != NULL &&
+                  strstr(s, "inv-A (the path tracer's curve, 1 runs); inv-B (1 runs)") != NULL,
+              "no mixed-clock note in:\n%s", s);
+    free(md.s);
+    json_object_put(charts);
+    json_object_put(runs[0].record);
+    json_object_put(runs[1].record);
+}
+
 int main(void)
 {
     test_pt_time();
     test_report();
     test_renderers();
+    test_speedup_spread();
     return gi_test_finish();
 }
