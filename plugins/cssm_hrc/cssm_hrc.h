@@ -84,6 +84,9 @@ typedef struct cssm_hrc {
     int gpu_bounce_maps;          /* this solve's maps and albedo are uploaded */
     cssm_gather_opts bounce_opts; /* the solve's gather options, for the compute pass */
     GLuint gpu_buf[CSSM_GPU_BUFFERS];
+    /* the read-only buffers as buffer textures (the shaders read those):
+     * nodes, leaves, texels, offsets, z_avg, i_end; then the albedo */
+    GLuint gpu_tex[CSSM_GPU_BUFFERS];
     uint32_t gpu_off_base[6], gpu_seg_base[6]; /* each face's first offset and segment */
     /* CPU time of the frames after the first since prepare (stats.c, frame_cpu_ms) */
     uint32_t cpu_frames;

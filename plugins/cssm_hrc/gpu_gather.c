@@ -28,9 +28,30 @@ typedef struct gpu_texel {
 } gpu_texel;
 
 enum { BUF_NODES, BUF_LEAVES, BUF_TEXELS, BUF_OFFSETS, BUF_Z_AVG, BUF_I_END, BUF_STATS };
-static const GLuint buf_binding[CSSM_GPU_BUFFERS] = {
-    CSSM_SSBO_NODES, CSSM_SSBO_LEAVES, CSSM_SSBO_TEXELS, CSSM_SSBO_OFFSETS,
-    CSSM_SSBO_Z_AVG, CSSM_SSBO_I_END,  CSSM_SSBO_STATS};
+
+/* The buffer textures the shaders read (cssm_bindings.h), in the order of
+ * gpu_buf, the stats' slot taken by the albedo: units and formats. */
+enum { TEX_ALBEDO = BUF_STATS };
+static const GLuint tex_unit[CSSM_GPU_BUFFERS] = {
+    CSSM_TEX_NODES, CSSM_TEX_LEAVES, CSSM_TEX_TEXELS, CSSM_TEX_OFFSETS,
+    CSSM_TEX_Z_AVG, CSSM_TEX_I_END,  CSSM_TEX_ALBEDO};
+static const GLenum tex_format[CSSM_GPU_BUFFERS] = {GL_RGBA32UI, GL_R32UI, GL_RGBA32UI, GL_R32UI,
+                                                    GL_R32UI,    GL_R32UI, GL_RGBA32UI};
+
+/* Each buffer texture attached to its buffer again (after the buffers'
+ * storage was made anew) and bound to its unit. */
+static void bind_textures(cssm_hrc *c)
+{
+    if (!c->gpu_tex[0])
+        glCreateTextures(GL_TEXTURE_BUFFER, CSSM_GPU_BUFFERS, c->gpu_tex);
+    for (int k = 0; k < CSSM_GPU_BUFFERS; k++) {
+        GLuint buf = k == TEX_ALBEDO ? c->gpu_bounce_buf[0] : c->gpu_buf[k];
+        if (!buf)
+            continue;
+        glTextureBuffer(c->gpu_tex[k], tex_format[k], buf);
+        glBindTextureUnit(tex_unit[k], c->gpu_tex[k]);
+    }
+}
 
 const char *cssm_gpu_unsupported(const cssm_hrc *c, const gi_scene *s)
 {
@@ -56,6 +77,8 @@ void cssm_gpu_free(cssm_hrc *c)
     if (c->gpu_bounce_prog)
         glDeleteProgram(c->gpu_bounce_prog);
     glDeleteBuffers(CSSM_GPU_BUFFERS, c->gpu_buf);
+    glDeleteTextures(CSSM_GPU_BUFFERS, c->gpu_tex);
+    memset(c->gpu_tex, 0, sizeof c->gpu_tex);
     glDeleteBuffers(2, c->gpu_bounce_buf);
     c->gpu_prog = c->gpu_bounce_prog = 0;
     memset(c->gpu_bounce_buf, 0, sizeof c->gpu_bounce_buf);
@@ -208,8 +231,8 @@ gi_result cssm_gpu_final_gather(cssm_hrc *c, const gi_view *view, const gi_targe
     glUseProgram(p);
     gi_kit_bind(&c->kit, p, view, target);
     set_uniforms(c, p, view, random);
-    for (int k = 0; k < CSSM_GPU_BUFFERS; k++)
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, buf_binding[k], c->gpu_buf[k]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CSSM_SSBO_STATS, c->gpu_buf[BUF_STATS]);
+    bind_textures(c);
     const uint32_t zero[4] = {0};
     glNamedBufferData(c->gpu_buf[BUF_STATS], sizeof zero, zero, GL_DYNAMIC_READ);
     gi_kit_dispatch_8x8(view->width, view->height);
@@ -292,9 +315,8 @@ static gi_result bounce_gather(void *ctx, const float *node_L, const cssm_ctree 
     const GLuint p = c->gpu_bounce_prog;
     glUseProgram(p);
     bounce_uniforms(c, p, &c->bounce_opts);
-    for (int k = 0; k < CSSM_GPU_BUFFERS; k++)
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, buf_binding[k], c->gpu_buf[k]);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CSSM_SSBO_ALBEDO, c->gpu_bounce_buf[0]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CSSM_SSBO_STATS, c->gpu_buf[BUF_STATS]);
+    bind_textures(c);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CSSM_SSBO_OUT, c->gpu_bounce_buf[1]);
     const uint32_t zero[4] = {0};
     glNamedBufferData(c->gpu_buf[BUF_STATS], sizeof zero, zero, GL_DYNAMIC_READ);

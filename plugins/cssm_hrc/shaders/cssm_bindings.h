@@ -1,19 +1,24 @@
-/* Binding points of the cssm_hrc plugin's GPU final gather (gather=gpu),
- * read by its C code (gpu_gather.c) and its shaders alike (only #define
- * lines). SSBOs from GI_SSBO_PLUGIN_FIRST (8). */
+/* Binding points of the cssm_hrc plugin's GPU final gather (gather=gpu)
+ * and bounces (bounces_on=gpu), read by its C code (gpu_gather.c) and its
+ * shaders alike (only #define lines). The read-only data are buffer
+ * textures, from GI_TEX_PLUGIN_FIRST (14): on llvmpipe a texelFetch is one
+ * vector gather, an SSBO read a loop over the eight lanes with a branch
+ * and a bounds check each (issue 29). Floats travel as their bits. */
 #ifndef CSSM_BINDINGS_H
 #define CSSM_BINDINGS_H
-/* per node (§4.2): sphere, gather position and area, normal and cone,
- * radiant intensity, child / skip / first leaf / leaf count, representative */
-#define CSSM_SSBO_NODES 8
-#define CSSM_SSBO_LEAVES 9 /* leaf rank -> texel (the median-cut order) */
-/* per texel: position and area, normal, cube-map eye and sequence index */
-#define CSSM_SSBO_TEXELS 10
-#define CSSM_SSBO_OFFSETS 11 /* the six faces' codec offsets[M^2 + 1], concatenated */
-#define CSSM_SSBO_Z_AVG 12   /* the six faces' segments, concatenated */
-#define CSSM_SSBO_I_END 13
+/* per node (§4.2), 7 RGBA32UI texels: sphere, gather position and area,
+ * normal and cone, radiant intensity, child / skip / first leaf / leaf
+ * count, representative, the representative's walk */
+#define CSSM_TEX_NODES 14
+#define CSSM_TEX_LEAVES 15 /* R32UI: leaf rank -> texel (the median-cut order) */
+/* per texel, 3 RGBA32UI texels: position and area, normal, cube-map eye
+ * and sequence index */
+#define CSSM_TEX_TEXELS 16
+#define CSSM_TEX_OFFSETS 17 /* R32UI: the six faces' codec offsets[M^2 + 1], concatenated */
+#define CSSM_TEX_Z_AVG 18   /* R32UI: the six faces' segments, concatenated */
+#define CSSM_TEX_I_END 19   /* R32UI */
+#define CSSM_TEX_ALBEDO 20  /* RGBA32UI: per texel its albedo (bounces_on=gpu) */
+/* written: SSBOs from GI_SSBO_PLUGIN_FIRST (8) */
 #define CSSM_SSBO_STATS 14 /* gathered nodes, receivers, clamped gathers (one frame) */
-/* the HRC bounces' per-texel gather (bounces_on=gpu, cssm_bounce.comp) */
-#define CSSM_SSBO_ALBEDO 15 /* per texel: albedo (rgb) */
-#define CSSM_SSBO_OUT 16    /* per texel: the gathered radiance, 3 floats */
+#define CSSM_SSBO_OUT 16   /* bounces_on=gpu: per texel the gathered radiance, 3 floats */
 #endif

@@ -13,7 +13,7 @@
 layout(local_size_x = 64) in;
 
 layout(std430, binding = CSSM_SSBO_STATS) buffer CssmStats { uint cssm_stats[]; };
-layout(std430, binding = CSSM_SSBO_ALBEDO) readonly buffer CssmAlbedo { vec4 cssm_albedo[]; };
+layout(binding = CSSM_TEX_ALBEDO) uniform usamplerBuffer cssm_albedo; // float bits
 layout(std430, binding = CSSM_SSBO_OUT) writeonly buffer CssmOut { float cssm_out[]; };
 
 uniform uint u_count;   // atlas texels
@@ -32,10 +32,10 @@ void main()
     if (t >= u_count)
         return;
     CssmReceiver rc;
-    rc.n = cssm_texels[t].n.xyz;
-    rc.x = cssm_texels[t].p_area.xyz + rc.n * u_lift;
+    rc.n = cssm_texel_n(t).xyz;
+    rc.x = cssm_texel_p_area(t).xyz + rc.n * u_lift;
     rc.self = int(t);
-    rc.kd = cssm_albedo[t].rgb;
+    rc.kd = uintBitsToFloat(texelFetch(cssm_albedo, int(t)).rgb);
     rc.ks = vec3(0.0);
     rc.lum_kd = gi_luminance(rc.kd);
     rc.lum_ks = 0.0;

@@ -11,7 +11,23 @@
 #include "accumulate.glsl"
 #include "cssm_traverse.glsl"
 
-layout(local_size_x = 8, local_size_y = 8) in;
+#ifndef CSSM_VEC_W
+#define CSSM_VEC_W 8
+#endif
+layout(local_size_x = 64) in;
+
+// The pixel of this invocation in its 8 x 8 tile: llvmpipe runs eight
+// consecutive invocations as one vector, so eight consecutive ones cover
+// a CSSM_VEC_W x (8 / CSSM_VEC_W) block of neighbours, whose cuts are
+// alike (issue 29: a vector runs as long as its longest traversal).
+ivec2 cssm_pixel()
+{
+    uint l = gl_LocalInvocationIndex, lane = l & 7u, block = l >> 3u;
+    const uint vh = 8u / CSSM_VEC_W, bx = 8u / CSSM_VEC_W;
+    uvec2 in_tile = uvec2((block % bx) * CSSM_VEC_W + lane % CSSM_VEC_W,
+                          (block / bx) * vh + lane / CSSM_VEC_W);
+    return ivec2(gl_WorkGroupID.xy * 8u + in_tile);
+}
 
 layout(std430, binding = CSSM_SSBO_STATS) buffer CssmStats { uint cssm_stats[]; };
 
@@ -27,7 +43,7 @@ uniform int u_rep_centroid;
 
 void main()
 {
-    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 px = cssm_pixel();
     if (px.x >= u_size.x || px.y >= u_size.y)
         return;
     uint p = uint(px.y) * uint(u_size.x) + uint(px.x);
