@@ -21,4 +21,11 @@
 /* written: SSBOs from GI_SSBO_PLUGIN_FIRST (8) */
 #define CSSM_SSBO_STATS 14 /* gathered nodes, receivers, clamped gathers (one frame) */
 #define CSSM_SSBO_OUT 16   /* bounces_on=gpu: per texel the gathered radiance, 3 floats */
+#define CSSM_IMG_NODES 2
+#define CSSM_IMG_LEAVES 3
+#define CSSM_IMG_TEXELS 4
+#define CSSM_IMG_OFFSETS 5
+#define CSSM_IMG_Z_AVG 6
+#define CSSM_IMG_I_END 7
+#define CSSM_IMG_ALBEDO 8
 #endif

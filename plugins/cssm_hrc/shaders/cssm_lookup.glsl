@@ -15,22 +15,22 @@
 // Buffer textures, not SSBOs (issue 29, cssm_bindings.h). Per texel
 // three texels: world position and area, unit normal, cube-map
 // centre with the sequence index (uint bits) in w.
-layout(binding = CSSM_TEX_TEXELS) uniform usamplerBuffer cssm_texels;
-layout(binding = CSSM_TEX_OFFSETS) uniform usamplerBuffer cssm_offsets;
-layout(binding = CSSM_TEX_Z_AVG) uniform usamplerBuffer cssm_z_avg;
-layout(binding = CSSM_TEX_I_END) uniform usamplerBuffer cssm_i_end;
+layout(binding = CSSM_IMG_TEXELS, rgba32ui) readonly restrict uniform uimageBuffer cssm_texels;
+layout(binding = CSSM_IMG_OFFSETS, r32ui) readonly restrict uniform uimageBuffer cssm_offsets;
+layout(binding = CSSM_IMG_Z_AVG, r32ui) readonly restrict uniform uimageBuffer cssm_z_avg;
+layout(binding = CSSM_IMG_I_END, r32ui) readonly restrict uniform uimageBuffer cssm_i_end;
 
 vec4 cssm_texel_p_area(uint j)
 {
-    return uintBitsToFloat(texelFetch(cssm_texels, int(3u * j)));
+    return uintBitsToFloat(imageLoad(cssm_texels, int(3u * j)));
 }
 vec4 cssm_texel_n(uint j)
 {
-    return uintBitsToFloat(texelFetch(cssm_texels, int(3u * j + 1u)));
+    return uintBitsToFloat(imageLoad(cssm_texels, int(3u * j + 1u)));
 }
 uvec4 cssm_texel_eye(uint j) // bits
 {
-    return texelFetch(cssm_texels, int(3u * j + 2u));
+    return imageLoad(cssm_texels, int(3u * j + 2u));
 }
 
 uniform uint u_M;           // cube faces M x M
@@ -41,15 +41,15 @@ uniform uint u_seg_base[6]; // and its segments at u_seg_base[f]
 float cssm_csm_lookup(int face, uint texel, uint i)
 {
     uint ob = u_off_base[face] + texel, sb = u_seg_base[face];
-    uint lo = texelFetch(cssm_offsets, int(ob)).x, hi = texelFetch(cssm_offsets, int(ob + 1u)).x - 1u;
+    uint lo = imageLoad(cssm_offsets, int(ob)).x, hi = imageLoad(cssm_offsets, int(ob + 1u)).x - 1u;
     while (lo < hi) {
         uint mid = lo + (hi - lo) / 2u;
-        if (texelFetch(cssm_i_end, int(sb + mid)).x < i)
+        if (imageLoad(cssm_i_end, int(sb + mid)).x < i)
             lo = mid + 1u;
         else
             hi = mid;
     }
-    return uintBitsToFloat(texelFetch(cssm_z_avg, int(sb + lo)).x);
+    return uintBitsToFloat(imageLoad(cssm_z_avg, int(sb + lo)).x);
 }
 
 // gi_csm_visible at texel (tx, ty) of face `face`, clamped to the face.

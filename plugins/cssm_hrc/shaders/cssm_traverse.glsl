@@ -12,6 +12,9 @@
 #include "sampling.glsl"
 #include "cssm_lookup.glsl"
 
+#if !defined(CSSM_PCF) || !defined(CSSM_JITTER) || !defined(CSSM_REP_CENTROID) || !defined(CSSM_GLOSSY)
+#error "cssm_traverse.glsl: CSSM_PCF, CSSM_JITTER, CSSM_REP_CENTROID and CSSM_GLOSSY must be defined"
+#endif
 #define CSSM_FLT_MAX 3.402823466e38
 #define CSSM_FLT_MIN 1.175494351e-38
 
@@ -28,20 +31,20 @@
 // child, the probability of going left as pick_leaf computes it in C
 // (float bits), first leaf
 #define CSSM_WALK 6
-layout(binding = CSSM_TEX_NODES) uniform usamplerBuffer cssm_nodes;
-layout(binding = CSSM_TEX_LEAVES) uniform usamplerBuffer cssm_leaves_tex;
+layout(binding = CSSM_IMG_NODES, rgba32ui) readonly restrict uniform uimageBuffer cssm_nodes;
+layout(binding = CSSM_IMG_LEAVES, r32ui) readonly restrict uniform uimageBuffer cssm_leaves_tex;
 
 vec4 cssm_node_f(int i, int k)
 {
-    return uintBitsToFloat(texelFetch(cssm_nodes, 7 * i + k));
+    return uintBitsToFloat(imageLoad(cssm_nodes, 7 * i + k));
 }
 ivec4 cssm_node_i(int i, int k)
 {
-    return ivec4(texelFetch(cssm_nodes, 7 * i + k));
+    return ivec4(imageLoad(cssm_nodes, 7 * i + k));
 }
 uint cssm_leaf(uint k)
 {
-    return texelFetch(cssm_leaves_tex, int(k)).x;
+    return imageLoad(cssm_leaves_tex, int(k)).x;
 }
 
 // cssm_receiver (cssm.h): a pixel (glossy, self -1) or an atlas texel of
@@ -56,7 +59,11 @@ struct CssmReceiver {
 };
 
 // cssm_gather_opts (cssm.h); the refinement limit and 2^exposure as
-// gather_any computes them once per receiver.
+// gather_any computes them once per receiver. pcf, jitter and rep_centroid
+// come from the program's defines (CSSM_PCF, CSSM_JITTER,
+// CSSM_REP_CENTROID; gpu_gather.c builds one program per set), and
+// CSSM_GLOSSY 0 leaves out the Phong lobe where no receiver has one: on
+// llvmpipe a branch no lane takes still costs its whole body (issue 29).
 struct CssmOpts {
     float lim, scale;
     uint max_cut;
@@ -104,7 +111,7 @@ float cssm_bound(int i, CssmReceiver rc)
         cs = c >= cw ? 1.0 : max(0.0, c * cw + s * sw);
     }
     float f = rc.lum_kd / GI_PI;
-    if (rc.lum_ks > 0.0) {
+    if (CSSM_GLOSSY != 0 && rc.lum_ks > 0.0) {
         vec3 r = rc.n * (2.0 * dot(rc.n, rc.wo)) - rc.wo;
         float cl = cssm_cos_bound(r, w, sin_h);
         f += rc.lum_ks * (rc.exponent + 2.0) / (2.0 * GI_PI) * cssm_pow(cl, rc.exponent);
@@ -171,7 +178,7 @@ vec3 cssm_transfer(int index, CssmReceiver rc, CssmOpts o, inout uint rng, inout
         return vec3(0.0);
     float g = cr * cs / d2 * v;
     vec3 f = rc.kd / GI_PI;
-    if (rc.lum_ks > 0.0) {
+    if (CSSM_GLOSSY != 0 && rc.lum_ks > 0.0) {
         vec3 r = rc.n * (2.0 * dot(rc.n, rc.wo)) - rc.wo;
         float cl = dot(r, w);
         float lobe = cl > 0.0 ? (rc.exponent + 2.0) / (2.0 * GI_PI) * pow(cl, rc.exponent) : 0.0;
