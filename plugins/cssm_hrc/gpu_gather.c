@@ -30,17 +30,18 @@ typedef struct gpu_texel {
 
 enum { BUF_NODES, BUF_LEAVES, BUF_TEXELS, BUF_OFFSETS, BUF_Z_AVG, BUF_I_END, BUF_STATS };
 
-/* The buffer textures the shaders read (cssm_bindings.h), in the order of
- * gpu_buf, the stats' slot taken by the albedo: units and formats. */
+/* The buffer textures the shaders read as images (cssm_bindings.h), in
+ * the order of gpu_buf, the stats' slot taken by the albedo: units and
+ * formats. */
 enum { TEX_ALBEDO = BUF_STATS };
 static const GLuint tex_unit[CSSM_GPU_BUFFERS] = {
-    CSSM_TEX_NODES, CSSM_TEX_LEAVES, CSSM_TEX_TEXELS, CSSM_TEX_OFFSETS,
-    CSSM_TEX_Z_AVG, CSSM_TEX_I_END,  CSSM_TEX_ALBEDO};
+    CSSM_IMG_NODES, CSSM_IMG_LEAVES, CSSM_IMG_TEXELS, CSSM_IMG_OFFSETS,
+    CSSM_IMG_Z_AVG, CSSM_IMG_I_END,  CSSM_IMG_ALBEDO};
 static const GLenum tex_format[CSSM_GPU_BUFFERS] = {GL_RGBA32UI, GL_R32UI, GL_RGBA32UI, GL_R32UI,
                                                     GL_R32UI,    GL_R32UI, GL_RGBA32UI};
 
 /* Each buffer texture attached to its buffer again (after the buffers'
- * storage was made anew) and bound to its unit. */
+ * storage was made anew) and bound to its image unit. */
 static void bind_textures(cssm_hrc *c)
 {
     if (!c->gpu_tex[0])
@@ -50,9 +51,7 @@ static void bind_textures(cssm_hrc *c)
         if (!buf)
             continue;
         glTextureBuffer(c->gpu_tex[k], tex_format[k], buf);
-        glBindImageTexture(2 + (GLuint)k, c->gpu_tex[k], 0, GL_FALSE, 0, GL_READ_ONLY,
-                           tex_format[k]);
-        (void)tex_unit;
+        glBindImageTexture(tex_unit[k], c->gpu_tex[k], 0, GL_FALSE, 0, GL_READ_ONLY, tex_format[k]);
     }
 }
 

@@ -12,7 +12,7 @@
 #include "common.glsl"
 #include "cssm_bindings.h"
 
-// Buffer textures, not SSBOs (issue 29, cssm_bindings.h). Per texel
+// Buffer textures read as images, not SSBOs (issue 29, cssm_bindings.h). Per texel
 // three texels: world position and area, unit normal, cube-map
 // centre with the sequence index (uint bits) in w.
 layout(binding = CSSM_IMG_TEXELS, rgba32ui) readonly restrict uniform uimageBuffer cssm_texels;

@@ -32,7 +32,7 @@
 // (float bits), first leaf
 #define CSSM_WALK 6
 layout(binding = CSSM_IMG_NODES, rgba32ui) readonly restrict uniform uimageBuffer cssm_nodes;
-layout(binding = CSSM_IMG_LEAVES, r32ui) readonly restrict uniform uimageBuffer cssm_leaves_tex;
+layout(binding = CSSM_IMG_LEAVES, r32ui) readonly restrict uniform uimageBuffer cssm_leaves;
 
 vec4 cssm_node_f(int i, int k)
 {
@@ -44,7 +44,7 @@ ivec4 cssm_node_i(int i, int k)
 }
 uint cssm_leaf(uint k)
 {
-    return imageLoad(cssm_leaves_tex, int(k)).x;
+    return imageLoad(cssm_leaves, int(k)).x;
 }
 
 // cssm_receiver (cssm.h): a pixel (glossy, self -1) or an atlas texel of
