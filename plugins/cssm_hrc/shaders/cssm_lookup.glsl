@@ -64,12 +64,12 @@ float cssm_face_test(int face, int tx, int ty, uint i, float depth, float bias)
 // gi_cube_basis: the face's right s, up t and forward f.
 void cssm_cube_basis(int face, out vec3 s, out vec3 t, out vec3 f)
 {
-    const vec3 dir[6] = vec3[6](vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 1, 0), vec3(0, -1, 0),
-                                vec3(0, 0, 1), vec3(0, 0, -1));
-    const vec3 up[6] = vec3[6](vec3(0, -1, 0), vec3(0, -1, 0), vec3(0, 0, 1), vec3(0, 0, -1),
-                               vec3(0, -1, 0), vec3(0, -1, 0));
-    f = dir[face];
-    s = cross(f, up[face]);
+    // selects, not constant arrays indexed per lane (issue 29): the same
+    // unit vectors, +x, -x, +y, -y, +z, -z, up -y but for +y (+z), -y (-z)
+    float sg = (face & 1) == 0 ? 1.0 : -1.0;
+    f = vec3(face < 2 ? sg : 0.0, face == 2 || face == 3 ? sg : 0.0, face > 3 ? sg : 0.0);
+    vec3 up = face == 2 || face == 3 ? vec3(0.0, 0.0, sg) : vec3(0.0, -1.0, 0.0);
+    s = cross(f, up);
     t = cross(s, f);
 }
 
