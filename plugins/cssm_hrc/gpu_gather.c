@@ -3,9 +3,11 @@
  * §4.2 / Fig. 10 that exists so that the gather runs in a shader). The
  * hierarchy's nodes (as the C traversal reads them, float or packed and
  * decoded), the leaves, the atlas texels with their cube-map eyes and the
- * six faces' compressed CSSM go into SSBOs; shaders/cssm_gather.comp
- * gathers every pixel every frame with the frame's jitter and averages the
- * frames. The C path (final_gather.c) stays as the oracle (gather=cpu). */
+ * six faces' compressed CSSM go into buffers the shaders read as buffer
+ * images (cssm_bindings.h says why); shaders/cssm_gather.comp gathers
+ * every pixel every frame with the frame's jitter and averages the frames,
+ * one program per set of the options compiled in (program_for). The C
+ * path (final_gather.c) stays as the oracle (gather=cpu). */
 #include "cssm_hrc.h"
 
 #include "shaders/cssm_bindings.h"
