@@ -28,6 +28,8 @@
 #include "gi/log.h"
 #include "gi/raytrace.h"
 
+/* gpu_gather.c: a program per set of the defines pcf, jitter, rep_centroid, glossy */
+#define CSSM_GPU_PROGS 16
 #define CSSM_GPU_BUFFERS 7 /* gpu_gather.c: nodes, leaves, texels, offsets, z_avg, i_end, stats */
 
 typedef struct cssm_shadow_map {
@@ -77,13 +79,16 @@ typedef struct cssm_hrc {
     int gather;    /* gather=gpu (0) or cpu (1): where the per-pixel final gather runs */
     int gpu_on;    /* gather=gpu and the scene and options are ones the GPU pass covers */
     int gpu_dirty; /* the lighting changed since the GPU buffers were filled */
-    GLuint gpu_prog;
-    int bounces_on;         /* bounces_on=gpu (0) or cpu (1): where the HRC bounces' gathers run */
-    GLuint gpu_bounce_prog; /* cssm_bounce.comp */
-    GLuint gpu_bounce_buf[2];     /* texels' albedo, gathered radiance */
-    int gpu_bounce_maps;          /* this solve's maps and albedo are uploaded */
-    cssm_gather_opts bounce_opts; /* the solve's gather options, for the compute pass */
+    GLuint gpu_prog[CSSM_GPU_PROGS]; /* cssm_gather.comp per define set (gpu_gather.c) */
+    int bounces_on; /* bounces_on=gpu (0) or cpu (1): where the HRC bounces' gathers run */
+    GLuint gpu_bounce_prog[CSSM_GPU_PROGS]; /* cssm_bounce.comp per define set */
+    GLuint gpu_bounce_buf[2];               /* texels' albedo, gathered radiance */
+    int gpu_bounce_maps;                    /* this solve's maps and albedo are uploaded */
+    cssm_gather_opts bounce_opts;           /* the solve's gather options, for the compute pass */
     GLuint gpu_buf[CSSM_GPU_BUFFERS];
+    /* the read-only buffers as buffer textures (the shaders read those):
+     * nodes, leaves, texels, offsets, z_avg, i_end; then the albedo */
+    GLuint gpu_tex[CSSM_GPU_BUFFERS];
     uint32_t gpu_off_base[6], gpu_seg_base[6]; /* each face's first offset and segment */
     /* CPU time of the frames after the first since prepare (stats.c, frame_cpu_ms) */
     uint32_t cpu_frames;

@@ -3,15 +3,18 @@
  * §4.2 / Fig. 10 that exists so that the gather runs in a shader). The
  * hierarchy's nodes (as the C traversal reads them, float or packed and
  * decoded), the leaves, the atlas texels with their cube-map eyes and the
- * six faces' compressed CSSM go into SSBOs; shaders/cssm_gather.comp
- * gathers every pixel every frame with the frame's jitter and averages the
- * frames. The C path (final_gather.c) stays as the oracle (gather=cpu). */
+ * six faces' compressed CSSM go into buffers the shaders read as buffer
+ * images (cssm_bindings.h says why); shaders/cssm_gather.comp gathers
+ * every pixel every frame with the frame's jitter and averages the frames,
+ * one program per set of the options compiled in (program_for). The C
+ * path (final_gather.c) stays as the oracle (gather=cpu). */
 #include "cssm_hrc.h"
 
 #include "shaders/cssm_bindings.h"
 
 #include <float.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -28,9 +31,31 @@ typedef struct gpu_texel {
 } gpu_texel;
 
 enum { BUF_NODES, BUF_LEAVES, BUF_TEXELS, BUF_OFFSETS, BUF_Z_AVG, BUF_I_END, BUF_STATS };
-static const GLuint buf_binding[CSSM_GPU_BUFFERS] = {
-    CSSM_SSBO_NODES, CSSM_SSBO_LEAVES, CSSM_SSBO_TEXELS, CSSM_SSBO_OFFSETS,
-    CSSM_SSBO_Z_AVG, CSSM_SSBO_I_END,  CSSM_SSBO_STATS};
+
+/* The buffer textures the shaders read as images (cssm_bindings.h), in
+ * the order of gpu_buf, the stats' slot taken by the albedo: units and
+ * formats. */
+enum { TEX_ALBEDO = BUF_STATS };
+static const GLuint tex_unit[CSSM_GPU_BUFFERS] = {
+    CSSM_IMG_NODES, CSSM_IMG_LEAVES, CSSM_IMG_TEXELS, CSSM_IMG_OFFSETS,
+    CSSM_IMG_Z_AVG, CSSM_IMG_I_END,  CSSM_IMG_ALBEDO};
+static const GLenum tex_format[CSSM_GPU_BUFFERS] = {GL_RGBA32UI, GL_R32UI, GL_RGBA32UI, GL_R32UI,
+                                                    GL_R32UI,    GL_R32UI, GL_RGBA32UI};
+
+/* Each buffer texture attached to its buffer again (after the buffers'
+ * storage was made anew) and bound to its image unit. */
+static void bind_textures(cssm_hrc *c)
+{
+    if (!c->gpu_tex[0])
+        glCreateTextures(GL_TEXTURE_BUFFER, CSSM_GPU_BUFFERS, c->gpu_tex);
+    for (int k = 0; k < CSSM_GPU_BUFFERS; k++) {
+        GLuint buf = k == TEX_ALBEDO ? c->gpu_bounce_buf[0] : c->gpu_buf[k];
+        if (!buf)
+            continue;
+        glTextureBuffer(c->gpu_tex[k], tex_format[k], buf);
+        glBindImageTexture(tex_unit[k], c->gpu_tex[k], 0, GL_FALSE, 0, GL_READ_ONLY, tex_format[k]);
+    }
+}
 
 const char *cssm_gpu_unsupported(const cssm_hrc *c, const gi_scene *s)
 {
@@ -51,13 +76,18 @@ const char *cssm_gpu_unsupported(const cssm_hrc *c, const gi_scene *s)
 
 void cssm_gpu_free(cssm_hrc *c)
 {
-    if (c->gpu_prog)
-        glDeleteProgram(c->gpu_prog);
-    if (c->gpu_bounce_prog)
-        glDeleteProgram(c->gpu_bounce_prog);
+    for (int k = 0; k < CSSM_GPU_PROGS; k++)
+        if (c->gpu_prog[k])
+            glDeleteProgram(c->gpu_prog[k]);
+    for (int k = 0; k < CSSM_GPU_PROGS; k++)
+        if (c->gpu_bounce_prog[k])
+            glDeleteProgram(c->gpu_bounce_prog[k]);
     glDeleteBuffers(CSSM_GPU_BUFFERS, c->gpu_buf);
+    glDeleteTextures(CSSM_GPU_BUFFERS, c->gpu_tex);
+    memset(c->gpu_tex, 0, sizeof c->gpu_tex);
     glDeleteBuffers(2, c->gpu_bounce_buf);
-    c->gpu_prog = c->gpu_bounce_prog = 0;
+    memset(c->gpu_prog, 0, sizeof c->gpu_prog);
+    memset(c->gpu_bounce_prog, 0, sizeof c->gpu_bounce_prog);
     memset(c->gpu_bounce_buf, 0, sizeof c->gpu_bounce_buf);
     memset(c->gpu_buf, 0, sizeof c->gpu_buf);
 }
@@ -154,16 +184,42 @@ static gi_result upload_maps(cssm_hrc *c)
     return GI_OK;
 }
 
-/* The program once, the buffers when the lighting changed (prepare,
- * update). */
+/* Any receiver with a Phong lobe: a material with ks (the G-buffer's
+ * phong texture is the material's ks). */
+static int scene_glossy(const cssm_hrc *c)
+{
+    const gi_scene *s = c->kit.scene ? c->kit.scene->scene : NULL;
+    if (!s)
+        return 1;
+    for (uint32_t m = 0; m < s->material_count; m++)
+        for (int k = 0; k < 3; k++)
+            if (s->materials[m].ks[k] != 0.0f)
+                return 1;
+    return 0;
+}
+
+/* The program of one set of the options that are defines (issue 29: on
+ * llvmpipe a branch no lane takes still costs its body, so the options'
+ * branches are compiled out): built on first use, kept in progs[index]. */
+static GLuint program_for(GLuint *progs, const char *comp, int pcf, int jitter, int rep_centroid,
+                          int glossy, gi_error *err)
+{
+    const int index = pcf | jitter << 1 | rep_centroid << 2 | glossy << 3;
+    if (!progs[index]) {
+        char defines[160];
+        snprintf(defines, sizeof defines,
+                 "#define CSSM_PCF %d\n#define CSSM_JITTER %d\n#define CSSM_REP_CENTROID %d\n"
+                 "#define CSSM_GLOSSY %d\n",
+                 pcf, jitter, rep_centroid, glossy);
+        progs[index] = gi_program_build_compute(comp, defines, err);
+    }
+    return progs[index];
+}
+
+/* The buffers when the lighting changed (prepare, update). */
 static gi_result gpu_setup(cssm_hrc *c)
 {
     gi_error err;
-    if (!c->gpu_prog) {
-        c->gpu_prog = gi_program_build_compute("cssm_gather.comp", NULL, &err);
-        if (!c->gpu_prog)
-            return gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
-    }
     if (!c->gpu_buf[0])
         glCreateBuffers(CSSM_GPU_BUFFERS, c->gpu_buf);
     if (c->gpu_dirty) {
@@ -179,18 +235,14 @@ static gi_result gpu_setup(cssm_hrc *c)
                : gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
 }
 
-static void set_uniforms(const cssm_hrc *c, GLuint p, const gi_view *view, int random)
+static void set_uniforms(const cssm_hrc *c, GLuint p, const cssm_gather_opts o)
 {
-    const cssm_gather_opts o = cssm_hrc_gather_opts(c, view->exposure, NULL);
     glUniform1f(glGetUniformLocation(p, "u_lim"), cssm_refine_limit(o.threshold));
     glUniform1f(glGetUniformLocation(p, "u_scale"), exp2f(o.exposure));
     glUniform1ui(glGetUniformLocation(p, "u_max_cut"), o.max_cut);
     glUniform1f(glGetUniformLocation(p, "u_clamp"), o.clamp);
     glUniform1f(glGetUniformLocation(p, "u_bias"), o.bias);
     glUniform1f(glGetUniformLocation(p, "u_lift"), 2.0f * c->maps.znear);
-    glUniform1i(glGetUniformLocation(p, "u_pcf"), o.pcf);
-    glUniform1i(glGetUniformLocation(p, "u_jitter"), random);
-    glUniform1i(glGetUniformLocation(p, "u_rep_centroid"), o.rep_centroid);
     glUniform1ui(glGetUniformLocation(p, "u_M"), c->maps.M);
     glUniform1uiv(glGetUniformLocation(p, "u_off_base"), 6, c->gpu_off_base);
     glUniform1uiv(glGetUniformLocation(p, "u_seg_base"), 6, c->gpu_seg_base);
@@ -202,14 +254,19 @@ gi_result cssm_gpu_final_gather(cssm_hrc *c, const gi_view *view, const gi_targe
     gi_result r = gpu_setup(c);
     if (r != GI_OK)
         return r;
+    const cssm_gather_opts o = cssm_hrc_gather_opts(c, view->exposure, NULL);
+    gi_error err;
+    const GLuint p = program_for(c->gpu_prog, "cssm_gather.comp", o.pcf != 0, random != 0,
+                                 o.rep_centroid != 0, scene_glossy(c), &err);
+    if (!p)
+        return gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
     const gi_host *host = c->kit.host;
     host->stage_begin(host, "final_gather");
-    const GLuint p = c->gpu_prog;
     glUseProgram(p);
     gi_kit_bind(&c->kit, p, view, target);
-    set_uniforms(c, p, view, random);
-    for (int k = 0; k < CSSM_GPU_BUFFERS; k++)
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, buf_binding[k], c->gpu_buf[k]);
+    set_uniforms(c, p, o);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CSSM_SSBO_STATS, c->gpu_buf[BUF_STATS]);
+    bind_textures(c);
     const uint32_t zero[4] = {0};
     glNamedBufferData(c->gpu_buf[BUF_STATS], sizeof zero, zero, GL_DYNAMIC_READ);
     gi_kit_dispatch_8x8(view->width, view->height);
@@ -222,7 +279,6 @@ gi_result cssm_gpu_final_gather(cssm_hrc *c, const gi_view *view, const gi_targe
     st->nodes += got[0];
     st->receivers += got[1];
     st->clamped += got[2];
-    gi_error err;
     if (gi_gl_check("cssm_hrc: gpu gather", &err) != GI_OK)
         return gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
     return GI_OK;
@@ -232,11 +288,9 @@ gi_result cssm_gpu_final_gather(cssm_hrc *c, const gi_view *view, const gi_targe
  * albedo, once per cssm_solve_ex (the first gather of the solve). */
 static gi_result bounce_setup(cssm_hrc *c, gi_error *err)
 {
-    if (!c->gpu_bounce_prog) {
-        c->gpu_bounce_prog = gi_program_build_compute("cssm_bounce.comp", NULL, err);
-        if (!c->gpu_bounce_prog)
-            return GI_ERR_GL;
-    }
+    if (!program_for(c->gpu_bounce_prog, "cssm_bounce.comp", c->bounce_opts.pcf != 0, 0,
+                     c->bounce_opts.rep_centroid != 0, 0, err))
+        return GI_ERR_GL;
     if (!c->gpu_buf[0])
         glCreateBuffers(CSSM_GPU_BUFFERS, c->gpu_buf);
     if (!c->gpu_bounce_buf[0])
@@ -270,8 +324,6 @@ static void bounce_uniforms(const cssm_hrc *c, GLuint p, const cssm_gather_opts 
     glUniform1f(glGetUniformLocation(p, "u_clamp"), o->clamp);
     glUniform1f(glGetUniformLocation(p, "u_bias"), o->bias);
     glUniform1f(glGetUniformLocation(p, "u_lift"), 2.0f * c->maps.znear);
-    glUniform1i(glGetUniformLocation(p, "u_pcf"), o->pcf);
-    glUniform1i(glGetUniformLocation(p, "u_rep_centroid"), o->rep_centroid);
     glUniform1ui(glGetUniformLocation(p, "u_M"), c->maps.M);
     glUniform1uiv(glGetUniformLocation(p, "u_off_base"), 6, c->gpu_off_base);
     glUniform1uiv(glGetUniformLocation(p, "u_seg_base"), 6, c->gpu_seg_base);
@@ -289,12 +341,13 @@ static gi_result bounce_gather(void *ctx, const float *node_L, const cssm_ctree 
         return gi_error_set(err, r, "cssm_hrc: out of memory for the bounces");
     if (r != GI_OK)
         return r;
-    const GLuint p = c->gpu_bounce_prog;
+    const GLuint p =
+        program_for(c->gpu_bounce_prog, "cssm_bounce.comp", c->bounce_opts.pcf != 0, 0,
+                    c->bounce_opts.rep_centroid != 0, 0, err); /* built by bounce_setup */
     glUseProgram(p);
     bounce_uniforms(c, p, &c->bounce_opts);
-    for (int k = 0; k < CSSM_GPU_BUFFERS; k++)
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, buf_binding[k], c->gpu_buf[k]);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CSSM_SSBO_ALBEDO, c->gpu_bounce_buf[0]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CSSM_SSBO_STATS, c->gpu_buf[BUF_STATS]);
+    bind_textures(c);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CSSM_SSBO_OUT, c->gpu_bounce_buf[1]);
     const uint32_t zero[4] = {0};
     glNamedBufferData(c->gpu_buf[BUF_STATS], sizeof zero, zero, GL_DYNAMIC_READ);
@@ -316,11 +369,9 @@ static gi_result bounce_gather(void *ctx, const float *node_L, const cssm_ctree 
 gi_result cssm_gpu_bounces(cssm_hrc *c, cssm_gather_opts *o)
 {
     gi_error err;
-    if (!c->gpu_bounce_prog) {
-        c->gpu_bounce_prog = gi_program_build_compute("cssm_bounce.comp", NULL, &err);
-        if (!c->gpu_bounce_prog)
-            return gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
-    }
+    if (!program_for(c->gpu_bounce_prog, "cssm_bounce.comp", o->pcf != 0, 0, o->rep_centroid != 0,
+                     0, &err))
+        return gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
     c->bounce_opts = *o;
     c->gpu_bounce_maps = 0;
     o->atlas_gather = bounce_gather;

@@ -7,13 +7,15 @@
 // jitter, the reflected radiance kd/pi sum written per texel. GLSL twin
 // of hrc.c's gather_atlas; gpu_gather.c reads the result back where the
 // C loop keeps it.
+#define CSSM_JITTER 0 // no jitter in the bounces
+#define CSSM_GLOSSY 0 // diffuse receivers
 #include "common.glsl"
 #include "cssm_traverse.glsl"
 
 layout(local_size_x = 64) in;
 
 layout(std430, binding = CSSM_SSBO_STATS) buffer CssmStats { uint cssm_stats[]; };
-layout(std430, binding = CSSM_SSBO_ALBEDO) readonly buffer CssmAlbedo { vec4 cssm_albedo[]; };
+layout(binding = CSSM_IMG_ALBEDO, rgba32ui) readonly restrict uniform uimageBuffer cssm_albedo; // float bits
 layout(std430, binding = CSSM_SSBO_OUT) writeonly buffer CssmOut { float cssm_out[]; };
 
 uniform uint u_count;   // atlas texels
@@ -23,8 +25,6 @@ uniform uint u_max_cut; // maximum cut size (§4.4)
 uniform float u_clamp;  // clamp distance, world units
 uniform float u_bias;   // CSSM depth bias, world units
 uniform float u_lift;   // receivers lifted 2 near planes along the normal
-uniform int u_pcf;      // 2 x 2 PCF
-uniform int u_rep_centroid;
 
 void main()
 {
@@ -32,10 +32,10 @@ void main()
     if (t >= u_count)
         return;
     CssmReceiver rc;
-    rc.n = cssm_texels[t].n.xyz;
-    rc.x = cssm_texels[t].p_area.xyz + rc.n * u_lift;
+    rc.n = cssm_texel_n(t).xyz;
+    rc.x = cssm_texel_p_area(t).xyz + rc.n * u_lift;
     rc.self = int(t);
-    rc.kd = cssm_albedo[t].rgb;
+    rc.kd = uintBitsToFloat(imageLoad(cssm_albedo, int(t)).rgb);
     rc.ks = vec3(0.0);
     rc.lum_kd = gi_luminance(rc.kd);
     rc.lum_ks = 0.0;
@@ -47,9 +47,9 @@ void main()
     o.max_cut = u_max_cut;
     o.clamp_d = u_clamp;
     o.bias = u_bias;
-    o.pcf = u_pcf != 0;
+    o.pcf = CSSM_PCF != 0; // 2 x 2 PCF (the program's defines)
     o.jitter = false;
-    o.rep_centroid = u_rep_centroid != 0;
+    o.rep_centroid = CSSM_REP_CENTROID != 0;
     uint rng = 0u, gathered, clamped = 0u;
     vec3 L = cssm_gather(rc, o, rng, gathered, clamped);
     cssm_out[3u * t + 0u] = L.r;

@@ -11,7 +11,22 @@
 #include "accumulate.glsl"
 #include "cssm_traverse.glsl"
 
-layout(local_size_x = 8, local_size_y = 8) in;
+
+#define CSSM_VEC_W 4u
+layout(local_size_x = 64) in;
+
+// The pixel of this invocation in its 8 x 8 tile: llvmpipe runs eight
+// consecutive invocations as one vector, so eight consecutive ones cover
+// a CSSM_VEC_W x (8 / CSSM_VEC_W) block of neighbours, whose cuts are
+// alike (issue 29: a vector runs as long as its longest traversal).
+ivec2 cssm_pixel()
+{
+    uint l = gl_LocalInvocationIndex, lane = l & 7u, block = l >> 3u;
+    const uint vh = 8u / CSSM_VEC_W, bx = 8u / CSSM_VEC_W; // vector rows, vectors a row
+    uvec2 in_tile = uvec2((block % bx) * CSSM_VEC_W + lane % CSSM_VEC_W,
+                          (block / bx) * vh + lane / CSSM_VEC_W);
+    return ivec2(gl_WorkGroupID.xy * 8u + in_tile);
+}
 
 layout(std430, binding = CSSM_SSBO_STATS) buffer CssmStats { uint cssm_stats[]; };
 
@@ -21,13 +36,10 @@ uniform uint u_max_cut;   // maximum cut size (§4.4)
 uniform float u_clamp;    // clamp distance, world units
 uniform float u_bias;     // CSSM depth bias, world units
 uniform float u_lift;     // receivers lifted 2 near planes along the normal (cssm_receiver_point)
-uniform int u_pcf;        // 2 x 2 PCF
-uniform int u_jitter;     // frames differ: jitter (§4.5)
-uniform int u_rep_centroid;
 
 void main()
 {
-    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 px = cssm_pixel();
     if (px.x >= u_size.x || px.y >= u_size.y)
         return;
     uint p = uint(px.y) * uint(u_size.x) + uint(px.x);
@@ -53,9 +65,9 @@ void main()
         o.max_cut = u_max_cut;
         o.clamp_d = u_clamp;
         o.bias = u_bias;
-        o.pcf = u_pcf != 0;
-        o.jitter = u_jitter != 0;
-        o.rep_centroid = u_rep_centroid != 0;
+        o.pcf = CSSM_PCF != 0;                   // 2 x 2 PCF
+        o.jitter = CSSM_JITTER != 0;             // frames differ: jitter (§4.5)
+        o.rep_centroid = CSSM_REP_CENTROID != 0; // rep=centroid
         uint rng = gi_rng_init(p, u_frame, u_seed ^ 0xc55u);
         uint gathered, clamped = 0u;
         L = cssm_gather(rc, o, rng, gathered, clamped);

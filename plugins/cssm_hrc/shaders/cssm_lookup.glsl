@@ -12,15 +12,26 @@
 #include "common.glsl"
 #include "cssm_bindings.h"
 
-struct CssmTexel {
-    vec4 p_area; // world position, area
-    vec4 n;      // unit normal
-    vec4 eye;    // cube-map centre, w: the sequence index (uint bits)
-};
-layout(std430, binding = CSSM_SSBO_TEXELS) readonly buffer CssmTexels { CssmTexel cssm_texels[]; };
-layout(std430, binding = CSSM_SSBO_OFFSETS) readonly buffer CssmOffsets { uint cssm_offsets[]; };
-layout(std430, binding = CSSM_SSBO_Z_AVG) readonly buffer CssmZAvg { float cssm_z_avg[]; };
-layout(std430, binding = CSSM_SSBO_I_END) readonly buffer CssmIEnd { uint cssm_i_end[]; };
+// Buffer textures read as images, not SSBOs (issue 29, cssm_bindings.h). Per texel
+// three texels: world position and area, unit normal, cube-map
+// centre with the sequence index (uint bits) in w.
+layout(binding = CSSM_IMG_TEXELS, rgba32ui) readonly restrict uniform uimageBuffer cssm_texels;
+layout(binding = CSSM_IMG_OFFSETS, r32ui) readonly restrict uniform uimageBuffer cssm_offsets;
+layout(binding = CSSM_IMG_Z_AVG, r32ui) readonly restrict uniform uimageBuffer cssm_z_avg;
+layout(binding = CSSM_IMG_I_END, r32ui) readonly restrict uniform uimageBuffer cssm_i_end;
+
+vec4 cssm_texel_p_area(uint j)
+{
+    return uintBitsToFloat(imageLoad(cssm_texels, int(3u * j)));
+}
+vec4 cssm_texel_n(uint j)
+{
+    return uintBitsToFloat(imageLoad(cssm_texels, int(3u * j + 1u)));
+}
+uvec4 cssm_texel_eye(uint j) // bits
+{
+    return imageLoad(cssm_texels, int(3u * j + 2u));
+}
 
 uniform uint u_M;           // cube faces M x M
 uniform uint u_off_base[6]; // face f's offsets start at u_off_base[f]
@@ -30,15 +41,15 @@ uniform uint u_seg_base[6]; // and its segments at u_seg_base[f]
 float cssm_csm_lookup(int face, uint texel, uint i)
 {
     uint ob = u_off_base[face] + texel, sb = u_seg_base[face];
-    uint lo = cssm_offsets[ob], hi = cssm_offsets[ob + 1u] - 1u;
+    uint lo = imageLoad(cssm_offsets, int(ob)).x, hi = imageLoad(cssm_offsets, int(ob + 1u)).x - 1u;
     while (lo < hi) {
         uint mid = lo + (hi - lo) / 2u;
-        if (cssm_i_end[sb + mid] < i)
+        if (imageLoad(cssm_i_end, int(sb + mid)).x < i)
             lo = mid + 1u;
         else
             hi = mid;
     }
-    return cssm_z_avg[sb + lo];
+    return uintBitsToFloat(imageLoad(cssm_z_avg, int(sb + lo)).x);
 }
 
 // gi_csm_visible at texel (tx, ty) of face `face`, clamped to the face.
@@ -53,12 +64,12 @@ float cssm_face_test(int face, int tx, int ty, uint i, float depth, float bias)
 // gi_cube_basis: the face's right s, up t and forward f.
 void cssm_cube_basis(int face, out vec3 s, out vec3 t, out vec3 f)
 {
-    const vec3 dir[6] = vec3[6](vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 1, 0), vec3(0, -1, 0),
-                                vec3(0, 0, 1), vec3(0, 0, -1));
-    const vec3 up[6] = vec3[6](vec3(0, -1, 0), vec3(0, -1, 0), vec3(0, 0, 1), vec3(0, 0, -1),
-                               vec3(0, -1, 0), vec3(0, -1, 0));
-    f = dir[face];
-    s = cross(f, up[face]);
+    // selects, not constant arrays indexed per lane (issue 29): the same
+    // unit vectors, +x, -x, +y, -y, +z, -z, up -y but for +y (+z), -y (-z)
+    float sg = (face & 1) == 0 ? 1.0 : -1.0;
+    f = vec3(face < 2 ? sg : 0.0, face == 2 || face == 3 ? sg : 0.0, face > 3 ? sg : 0.0);
+    vec3 up = face == 2 || face == 3 ? vec3(0.0, 0.0, sg) : vec3(0.0, -1.0, 0.0);
+    s = cross(f, up);
     t = cross(s, f);
 }
 
@@ -66,8 +77,8 @@ void cssm_cube_basis(int face, out vec3 s, out vec3 t, out vec3 f)
 // world point x.
 float cssm_visible(uint j, vec3 x, float bias, bool pcf)
 {
-    vec4 eye = cssm_texels[j].eye;
-    vec3 d = x - eye.xyz;
+    uvec4 eye = cssm_texel_eye(j);
+    vec3 d = x - uintBitsToFloat(eye.xyz);
     float depth = length(d);
     if (!(depth > 0.0))
         return 1.0;
@@ -76,7 +87,7 @@ float cssm_visible(uint j, vec3 x, float bias, bool pcf)
     cssm_cube_basis(face, s, t, f);
     float z = dot(f, d);
     float sx = dot(s, d) / z, sy = dot(t, d) / z;
-    uint i = floatBitsToUint(eye.w);
+    uint i = eye.w;
     float M = float(u_M);
     float fx = (sx * 0.5 + 0.5) * M, fy = (sy * 0.5 + 0.5) * M;
     if (!pcf)
