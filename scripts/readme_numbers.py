@@ -21,10 +21,17 @@ comments, references (§4.2, Fig. 8, Figure 8, Table 1, Eq. 3, Section 4,
 issue 28), sizes (64x64, 128², 2k), dates and clock times, versions (GL 4.5,
 glTF 2.0), settings written key=value, and numbers quoted from a paper:
 inside a parenthesis that starts with "paper" -- "(paper: 6.7 s)" -- or in
-a table column whose header says "paper".
+a table column whose header says "paper"; numbers no committed file
+holds, kept with the way to measure them, inside a parenthesis that starts
+with "not in the tables" (the rerun of issue 34 is to move them into the
+tables); and numbers a README's
+note of what changed quotes from its earlier prose, inside a parenthesis
+that starts with "earlier prose" -- "(earlier prose: 3.4 s)".
 A README number matches a generated one when both are the same value at
 the README's precision (the README may round; a sign written as a word,
-"7.9 % darker", matches -7.9).
+"7.9 % darker", matches -7.9; a percentage also matches the same fraction,
+1.6 % matching 0.016, and a time in s or ms matches the same time printed
+in the other unit).
 """
 
 import os
@@ -43,7 +50,7 @@ EXEMPT = [
     re.compile(r"`[^`]*`"),                                    # code spans
     re.compile(r"\]\([^)]*\)"),                                # link targets
     re.compile(r"<!--.*?-->"),                                 # comments
-    re.compile(r"\((?:the |on the |in the )?paper\b[^)]*\)", re.I),
+    re.compile(r"\((?:the |on the |in the )?(?:paper|earlier prose|not in the tables)\b[^)]*\)", re.I),
     re.compile(r"§\s?\d+(?:\.\d+)*"),
     re.compile(r"\b(?:Figs?\.|Figures?|Tables?|Tab\.|Eqs?\.|Equations?|Sections?|Sec\.|[Ii]ssues?|"
                r"PR|step|part|round|Alg\.|Algorithm|Listing|Appendix|line|lines|s\d)"
@@ -84,6 +91,11 @@ def generated_values(folder):
     return vals
 
 
+# Other ways a generated table may print the same value: a percentage as a
+# fraction, seconds in milliseconds and back.
+SCALES = {"%": [(1, 0), (0.01, -2)], "s": [(1, 0), (1000, 3)], "ms": [(1, 0), (0.001, -3)]}
+
+
 def matches(v, dec, vals):
     """True when some generated value equals v at the README's precision."""
     half = 0.5 * 10.0 ** (-dec) * (1 + 1e-9)
@@ -108,7 +120,8 @@ def measured(line):
     for m in TOKEN.finditer(strip(line)):
         num, exp, unit = m.group("num"), m.group("exp"), m.group("unit")
         if "." in num or "," in num or exp or unit:
-            out.append((m.group(0).strip(), value(num, exp)))
+            v, dec = value(num, exp)
+            out.append((m.group(0).strip(), v, dec, (unit or "").strip()))
     return out
 
 
@@ -135,8 +148,8 @@ def offenders(readme, vals):
             cells = line.strip().strip("|").split("|")
             text = "|".join(c for i, c in enumerate(cells) if i not in paper_cols)
         prev = line
-        for tok, (v, dec) in measured(text):
-            if not matches(v, dec, vals):
+        for tok, v, dec, unit in measured(text):
+            if not any(matches(v * k, dec - e, vals) for k, e in SCALES.get(unit, [(1, 0)])):
                 bad.append((no, tok, line.strip()))
     return bad
 
