@@ -46,11 +46,14 @@ TOKEN = re.compile(NUM + r"(?P<unit>\s?(?:" + UNITS + r"\b|%)|[×x](?![\w]))?(?!
 
 # Spans removed before numbers are looked for: the reason each is exempt is
 # in the module docstring.
+# A quoted number's parenthesis may run over several lines: blanked over
+# the whole README before it is read line by line.
+QUOTED = re.compile(r"\((?:the |on the |in the )?(?:paper|earlier prose|not in the tables)\b[^)]*\)", re.I)
+
 EXEMPT = [
     re.compile(r"`[^`]*`"),                                    # code spans
     re.compile(r"\]\([^)]*\)"),                                # link targets
     re.compile(r"<!--.*?-->"),                                 # comments
-    re.compile(r"\((?:the |on the |in the )?(?:paper|earlier prose|not in the tables)\b[^)]*\)", re.I),
     re.compile(r"§\s?\d+(?:\.\d+)*"),
     re.compile(r"\b(?:Figs?\.|Figures?|Tables?|Tab\.|Eqs?\.|Equations?|Sections?|Sec\.|[Ii]ssues?|"
                r"PR|step|part|round|Alg\.|Algorithm|Listing|Appendix|line|lines|s\d)"
@@ -130,7 +133,8 @@ def offenders(readme, vals):
     bad = []
     in_fence, paper_cols, prev = False, set(), ""
     with open(readme, encoding="utf-8") as f:
-        lines = f.read().splitlines()
+        text = QUOTED.sub(lambda m: re.sub(r"[^\n]", " ", m.group(0)), f.read())
+    lines = text.splitlines()
     for no, line in enumerate(lines, 1):
         if line.lstrip().startswith("```"):
             in_fence = not in_fence
