@@ -26,7 +26,9 @@ holds, kept with the way to measure them, inside a parenthesis that starts
 with "not in the tables" (the rerun of issue 34 is to move them into the
 tables); and numbers a README's
 note of what changed quotes from its earlier prose, inside a parenthesis
-that starts with "earlier prose" -- "(earlier prose: 3.4 s)".
+that starts with "earlier prose" -- "(earlier prose: 3.4 s)"; and a whole
+section whose heading says "not in the tables" (side measurements that no
+study records), up to the next heading of its level or above.
 A README number matches a generated one when both are the same value at
 the README's precision (the README may round; a sign written as a word,
 "7.9 % darker", matches -7.9; a percentage also matches the same fraction,
@@ -131,15 +133,24 @@ def measured(line):
 def offenders(readme, vals):
     """(line number, token, line) for each README number not generated."""
     bad = []
-    in_fence, paper_cols, prev = False, set(), ""
+    in_fence, paper_cols, prev, skip_level = False, set(), "", 0
     with open(readme, encoding="utf-8") as f:
-        text = QUOTED.sub(lambda m: re.sub(r"[^\n]", " ", m.group(0)), f.read())
-    lines = text.splitlines()
-    for no, line in enumerate(lines, 1):
+        raw = f.read()
+    lines = QUOTED.sub(lambda m: re.sub(r"[^\n]", " ", m.group(0)), raw).splitlines()
+    for no, (line, orig) in enumerate(zip(lines, raw.splitlines()), 1):
         if line.lstrip().startswith("```"):
             in_fence = not in_fence
             continue
-        if in_fence or line.lstrip().startswith("#"):
+        if in_fence:
+            continue
+        if line.lstrip().startswith("#"):
+            level = len(line.lstrip()) - len(line.lstrip().lstrip("#"))
+            if skip_level and level <= skip_level:
+                skip_level = 0
+            if not skip_level and re.search(r"not in the tables", orig, re.I):
+                skip_level = level
+            continue
+        if skip_level:
             continue
         text = line
         if line.lstrip().startswith("|"):

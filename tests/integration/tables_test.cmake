@@ -45,8 +45,7 @@ endforeach()
 #   avg: 381 prose numbers from earlier runs, not yet in plugins/avg/tables.py
 #   csm: 156 prose numbers from earlier runs, not yet in plugins/csm/tables.py
 #   implicit_vis: no tables script yet; its prose mixes three runs
-#   vlf: 53 prose numbers from earlier runs, not yet in plugins/vlf/tables.py
-set(checked csm_local compare_all stress cssm_hrc)
+set(checked csm_local compare_all stress cssm_hrc vlf)
 foreach(study ${checked})
     execute_process(COMMAND ${PYTHON} ${ROOT}/scripts/readme_numbers.py ${ROOT}/results/${study}
         RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
