@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Every measured number in a results README must be a generated number.
 
-Usage: readme_numbers.py RESULTS_FOLDER [README]
+Usage: readme_numbers.py RESULTS_FOLDER[:README]...
 
 Issue 34: a results README may only quote numbers that the study's tables
 script prints.  This checker reads README.md (or README, when given) of a
@@ -169,27 +169,36 @@ def offenders(readme, vals):
     return bad
 
 
-def main(argv):
-    if len(argv) not in (2, 3):
-        print("usage: readme_numbers.py RESULTS_FOLDER [README]", file=sys.stderr)
-        return 2
-    folder = argv[1]
-    readme = argv[2] if len(argv) == 3 else os.path.join(folder, "README.md")
+def check(folder, readme):
+    """Prints a folder's offenders; returns how many there are (-1: no tables)."""
     if not os.path.isfile(readme):
         print(f"readme_numbers: {readme}: no such file", file=sys.stderr)
-        return 2
+        return -1
     vals = generated_values(folder)
     if not vals:
         print(f"readme_numbers: {folder}: no generated tables.md or values.md", file=sys.stderr)
-        return 2
+        return -1
     bad = offenders(readme, vals)
     for no, tok, line in bad:
         print(f"{readme}:{no}: {tok} is not in the generated tables: {line[:120]}")
     if bad:
         print(f"readme_numbers: {len(bad)} number(s) in {readme} are not generated", file=sys.stderr)
-        return 1
-    print(f"readme_numbers: every measured number in {readme} is generated")
-    return 0
+    else:
+        print(f"readme_numbers: every measured number in {readme} is generated")
+    return len(bad)
+
+
+def main(argv):
+    """Each argument is a results folder, or FOLDER:README to check another README against it."""
+    if len(argv) < 2:
+        print("usage: readme_numbers.py RESULTS_FOLDER[:README]...", file=sys.stderr)
+        return 2
+    worst = 0
+    for arg in argv[1:]:
+        folder, _, readme = arg.partition(":")
+        n = check(folder, readme or os.path.join(folder, "README.md"))
+        worst = 2 if n < 0 else max(worst, min(n, 1))
+    return worst
 
 
 if __name__ == "__main__":
