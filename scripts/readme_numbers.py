@@ -4,7 +4,7 @@
 Usage: readme_numbers.py RESULTS_FOLDER[:README]...
 
 Issue 34: a results README may only quote numbers that the study's tables
-script prints.  This checker reads README.md (or README, when given) of a
+script prints.  This checker reads README.md (or the README after the colon) of each
 results folder and every generated file beside it -- tables.md and, where a
 tables script writes one, values.md -- and prints each measured number of
 the README that no generated file holds, with its line, then exits 1.
@@ -18,16 +18,15 @@ READMEs"):
 Plain integers without a unit (4 bounces, N = 12, 64 VPLs) are settings.
 Exempt: headings, code spans and fenced blocks, link targets, HTML
 comments, references (§4.2, Fig. 8, Figure 8, Table 1, Eq. 3, Section 4,
-issue 28), sizes (64x64, 128², 2k), dates and clock times, versions (GL 4.5,
+issue 28), sizes (64x64, 128²; "2k" has no unit), dates and clock times, versions (GL 4.5,
 glTF 2.0), settings written key=value, and numbers quoted from a paper:
 inside a parenthesis that starts with "paper" -- "(paper: 6.7 s)" -- or in
 a table column whose header says "paper"; numbers no committed file
 holds, kept with the way to measure them, inside a parenthesis that starts
 with "not in the tables" (the rerun of issue 34 is to move them into the
-tables); and numbers a README's
-note of what changed quotes from its earlier prose, inside a parenthesis
-that starts with "earlier prose" -- "(earlier prose: 3.4 s)"; and a whole
-section whose heading says "not in the tables" (side measurements that no
+tables); numbers a README's note of what changed quotes from its earlier
+prose, inside a parenthesis that starts with "earlier prose" --
+"(earlier prose: 3.4 s)"; and a whole section whose heading says "not in the tables" (side measurements that no
 study records), up to the next heading of its level or above.
 A README number matches a generated one when both are the same value at
 the README's precision (the README may round; a sign written as a word,
@@ -46,19 +45,19 @@ NUM = (r"(?<![\w.,])(?P<num>[-−]?(?:\d{1,3}(?:,\d{3})+|\d+)(?:\.\d+)?)"
        r"(?P<exp>(?:e[-+]?\d+(?!\w))|(?:\s?[·×]\s?10[⁻⁰¹²³⁴⁵⁶⁷⁸⁹]+))?")
 TOKEN = re.compile(NUM + r"(?P<unit>\s?(?:" + UNITS + r"\b|%)|[×x](?![\w]))?(?!\w)(?!\.\d)")
 
-# Spans removed before numbers are looked for: the reason each is exempt is
-# in the module docstring.
 # A quoted number's parenthesis may run over several lines: blanked over
 # the whole README before it is read line by line.
 QUOTED = re.compile(r"\((?:the |on the |in the )?(?:paper|earlier prose|not in the tables)\b[^)]*\)", re.I)
 
+# Spans removed before numbers are looked for: the reason each is exempt is
+# in the module docstring.
 EXEMPT = [
     re.compile(r"`[^`]*`"),                                    # code spans
     re.compile(r"\]\([^)]*\)"),                                # link targets
     re.compile(r"<!--.*?-->"),                                 # comments
     re.compile(r"§\s?\d+(?:\.\d+)*"),
     re.compile(r"\b(?:Figs?\.|Figures?|Tables?|Tab\.|Eqs?\.|Equations?|Sections?|Sec\.|[Ii]ssues?|"
-               r"PR|step|part|round|Alg\.|Algorithm|Listing|Appendix|line|lines|s\d)"
+               r"PR|step|part|round|Alg\.|Algorithm|Listing|Appendix|line|lines)"
                r"\s?\d+(?:\.\d+)*[a-z]?(?:\s?(?:,|and|–|-|/|&)\s?\d+[a-z]?)*"),
     re.compile(r"\b(?:GL|OpenGL|GLSL|glTF|EGL|C|C\+\+|Python|python|LLVM|Mesa|CMake|Embree|version|v)"
                r"\s?\d+(?:\.\d+)*"),
