@@ -119,6 +119,49 @@ def main():
                   timing + [("node bytes", "stat_node_bytes", "%.0f")])
     metrics_table("alt_env", ["env"], "Environment light: ray traced (trace) or from the texels' own CSSMs (env=cssm)",
                   timing + [("compression", "stat_compression_ratio", "%.1f : 1"), ("CSSM bytes", "stat_cssm_bytes", "%.0f")])
+    atlas_use(ok)
+    motion_table(ok)
+
+
+def atlas_use(ok):
+    """Sec. 4.1's atlases: the share of texels the charts use, and the U room's compression."""
+    print("\n## Atlas use and the U room's compression\n")
+    print("| scene | atlas | texels | share of the atlas (%) | compression |")
+    print("|---|---|---|---|---|")
+    seen = set()
+    for r in ok:
+        p = params(r)
+        lab = r["label"]
+        if not ((lab == "table2" and p.get("traversal") == "spiral") or (lab == "table1" and "u_room" in r["scene"])):
+            continue
+        key = (r["scene"], p.get("atlas"))
+        if key in seen:
+            continue
+        seen.add(key)
+        a = int(p["atlas"])
+        print("| %s | %d² | %d | %.0f | %.1f : 1 |" % (os.path.basename(r["scene"]), a, num(r, "stat_atlas_texels"),
+                                                     100 * num(r, "stat_atlas_texels") / (a * a),
+                                                     num(r, "stat_compression_ratio")))
+
+
+def motion_table(ok):
+    """Sec. 3.3, moving objects: the update's per-frame cost beside the still scene."""
+    by = {r["label"]: r for r in ok}
+    names = [n for n in ("moving", "moving_still", "hull_intrusion", "moving2") if n in by]
+    if not names:
+        return
+    stages = ["bounce", "direct", "hierarchy", "hull", "motion"]
+    print("\n## Sec. 3.3: moving objects, per-frame update against the still scene\n")
+    print("| run | frames | frame (median, ms) | " + " | ".join("%s (ms)" % s for s in stages) + " | prepare (s) |")
+    print("|---|---|---|" + "---|" * len(stages) + "---|")
+    for n in names:
+        r = by[n]
+        cells = ["%.3g" % num(r, "stage_%s_ms_median" % s) if r.get("stage_%s_ms_median" % s) else "—" for s in stages]
+        print("| %s | %s | %.1f | %s | %.1f |" % (n, r["frames"], num(r, "frame_ms_median"), " | ".join(cells),
+                                                num(r, "prepare_ms") * 1e-3))
+    if "moving" in by and "moving_still" in by:
+        print("\nFrame of the moving scene over the still one: %.2f x" %
+              (num(by["moving"], "frame_ms_median") / num(by["moving_still"], "frame_ms_median")))
 
 
 if __name__ == "__main__":
