@@ -88,7 +88,7 @@ static const gi_param_desc iv_params[] = {
     {"keep_pairs", GI_PARAM_BOOL, 1, 0, 1, NULL, "Algorithm 1, line 5 (the same links)",
      "the pairs Sec. 4.2.2 links between two segments of which neither moved since the last "
      "build are taken from it, not tested anew; every pair is still written into the bins, the "
-     "links are the same (README \"Pairs of still segments\")"},
+     "links are the same; not with relink=always (README \"Pairs of still segments\")"},
     {"glossy", GI_PARAM_BOOL, 1, 0, 1, NULL, "Sec. 4.3 (glossy direct light, Fig. 11)",
      "glossy (Phong) materials reflect the direct light through their lobe, the BRDF-weighted sum "
      "over each element's bins; false: diffuse only"},
@@ -304,7 +304,9 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
         m->links->coverage = m->coverage;
         m->links->weight = m->weight;
         m->links->threads = (uint32_t)m->threads;
-        m->links->keep_pairs = m->keep_pairs;
+        /* relink=always is Algorithm 1 as printed, every pair tested every
+         * frame (the stage times of Table 1): nothing kept */
+        m->links->keep_pairs = m->keep_pairs && !m->relink_always;
         m->links->host = host; /* link creation stops on a cancel (issue 32) */
     }
     m->irr = calloc((size_t)m->hier->elem_count * 6, sizeof(float));
