@@ -79,6 +79,8 @@ int iv_kept_usable(const iv_kept *k, uint32_t A, uint32_t B)
 int iv_kept_append(iv_kept *k, uint32_t t, const uint32_t *pairs, size_t n)
 {
     iv_pair_list *p = &k->list[t];
+    if (n == 0)
+        return 1; /* a task that linked nothing: no list to grow (p->pairs may be NULL) */
     if (p->n + n > p->cap) {
         size_t c = p->cap ? p->cap : 256;
         while (c < p->n + n)
