@@ -85,6 +85,10 @@ static const gi_param_desc iv_params[] = {
     {"threads", GI_PARAM_INT, 0, 0, 256, NULL, "Table 1 (create_links on the CPU)",
      "threads that create the hierarchical links (the same links as on one); 0 = every online "
      "core"},
+    {"keep_pairs", GI_PARAM_BOOL, 1, 0, 1, NULL, "Algorithm 1, line 5 (the same links)",
+     "the pairs Sec. 4.2.2 links between two segments of which neither moved since the last "
+     "build are taken from it, not tested anew; every pair is still written into the bins, the "
+     "links are the same; not with relink=always (README \"Pairs of still segments\")"},
     {"glossy", GI_PARAM_BOOL, 1, 0, 1, NULL, "Sec. 4.3 (glossy direct light, Fig. 11)",
      "glossy (Phong) materials reflect the direct light through their lobe, the BRDF-weighted sum "
      "over each element's bins; false: diffuse only"},
@@ -107,7 +111,7 @@ static const gi_param_desc iv_params[] = {
 
 typedef struct implicit_vis {
     gi_kit kit;
-    int N, bounces, brute, splat, bilinear, cpu_illum, remesher, threads;
+    int N, bounces, brute, splat, bilinear, cpu_illum, remesher, threads, keep_pairs;
     int weight; /* IV_WEIGHT_* */
     int glossy; /* the display adds the glossy direct light (a glossy material, glossy=true) */
     int traced; /* direct=traced: the direct light by shadow rays (iv_traced.h) */
@@ -148,6 +152,7 @@ static gi_result iv_create(const gi_host *host, const gi_params *params, void **
     m->splat = gi_params_bool(params, "splat");
     m->weight = gi_params_enum(params, "weight");
     m->bilinear = gi_params_bool(params, "bilinear");
+    m->keep_pairs = gi_params_bool(params, "keep_pairs");
     m->coverage = gi_params_float(params, "coverage");
     m->cpu_illum = gi_params_enum(params, "illum") == 1;
     m->threads = gi_params_int(params, "threads");
@@ -299,6 +304,9 @@ static gi_result iv_prepare(void *inst, const gi_gpu_scene *gs)
         m->links->coverage = m->coverage;
         m->links->weight = m->weight;
         m->links->threads = (uint32_t)m->threads;
+        /* relink=always is Algorithm 1 as printed, every pair tested every
+         * frame (the stage times of Table 1): nothing kept */
+        m->links->keep_pairs = m->keep_pairs && !m->relink_always;
         m->links->host = host; /* link creation stops on a cancel (issue 32) */
     }
     m->irr = calloc((size_t)m->hier->elem_count * 6, sizeof(float));
@@ -530,6 +538,7 @@ static gi_result iv_render(void *inst, const gi_view *view, const gi_target *tar
     gi_kit_frame_end(&m->kit);
 
     host->stat(host, "link_tries", (double)m->links->tries);
+    host->stat(host, "link_tries_kept", (double)m->links->kept_tries);
     host->stat(host, "links_created", (double)m->links->created);
     host->stat(host, "leaf_links", (double)m->links->receiving);
     host->stat(host, "light_links", (double)m->links->light_off[m->hier->elem_count]);

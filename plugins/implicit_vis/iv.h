@@ -257,6 +257,14 @@ typedef struct iv_links {
     uint32_t **pair_buf;
     size_t *pair_cap;
     uint32_t pair_bufs;
+    /* keep_pairs (README "Pairs of still segments"): the pairs Sec. 4.2.2
+     * linked between two segments of which neither moved since the last
+     * build are taken from it, not tested anew (the same pairs: a pair's
+     * subdivision depends on its two trees only). kept_tries: of `tries`,
+     * those taken so. */
+    int keep_pairs;
+    struct iv_kept *kept;
+    uint64_t kept_tries;
 } iv_links;
 
 iv_links *iv_links_create(const iv_hier *h, uint32_t n);

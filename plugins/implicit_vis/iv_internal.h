@@ -43,6 +43,37 @@ void iv_links_clear_nodes(iv_links *l, uint32_t first, uint32_t step);
  * first); 0 when it could not (out of memory, no thread), and the caller
  * builds them on one. */
 int iv_links_build_parallel(iv_links *l, const iv_hier *h, float subdiv, int splat, int threads);
+/* The pairs linked from one top-level task (a segment with itself, or two
+ * segments) at the last build, 4 words each as the threaded build lists
+ * them, and the pair tests they took. */
+typedef struct iv_pair_list {
+    uint32_t *pairs;
+    size_t n, cap;
+    uint64_t tries;
+} iv_pair_list;
+
+/* What keep_pairs keeps from build to build (links_kept.c). */
+typedef struct iv_kept {
+    uint32_t roots;
+    float *geom;        /* per node at the last build: position, normal, area (7 floats) */
+    uint8_t *still;     /* per segment: every node of it the same to the bit as at the last build */
+    iv_pair_list *list; /* per top-level task, in the order the build makes them: segment i
+                           with itself (i), then segments i < j */
+    int valid;          /* geom and list are of one completed build */
+} iv_kept;
+
+/* Marks the segments that did not move since the last completed build
+ * (all moved when there was none) and records the current geometry; the
+ * lists are invalid until iv_kept_done. NULL when out of memory (then
+ * nothing is kept). */
+iv_kept *iv_kept_begin(iv_links *l, const iv_hier *h);
+/* Whether the top-level task of segments A and B (A with itself when B
+ * is UINT32_MAX) can take its kept list: neither segment moved. */
+int iv_kept_usable(const iv_kept *k, uint32_t A, uint32_t B);
+/* Appends n pairs to task t's list; 0 when out of memory. */
+int iv_kept_append(iv_kept *k, uint32_t t, const uint32_t *pairs, size_t n);
+void iv_kept_free(iv_kept *k);
+
 /* Whether l->host asks to stop (issue 32); thread-safe as the host's
  * cancelled() is (a flag set by a signal handler). */
 int iv_links_cancelled(const iv_links *l);

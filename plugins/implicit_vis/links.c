@@ -66,6 +66,7 @@ void iv_links_free(iv_links *l)
     for (uint32_t i = 0; i < l->pair_bufs; i++)
         free(l->pair_buf[i]);
     free(l->pair_buf), free(l->pair_cap);
+    iv_kept_free(l->kept);
     free(l);
 }
 
@@ -353,7 +354,10 @@ void iv_links_build(iv_links *l, const iv_hier *h, float subdiv, int brute, int 
         return;
     }
     l->tries = l->created = 0;
-    if (l->threads > 1 && iv_links_build_parallel(l, h, subdiv, splat, (int)l->threads))
+    /* keep_pairs lists the pairs by top-level task, as the threaded build
+     * does: on one thread too (the same links to the bit) */
+    if ((l->threads > 1 || l->keep_pairs) &&
+        iv_links_build_parallel(l, h, subdiv, splat, l->threads > 1 ? (int)l->threads : 1))
         return;     /* the writers emptied their nodes' bins first */
     links_clear(l); /* one thread (or the parallel build could not run) */
     link_ctx c = {l, h, subdiv, splat};

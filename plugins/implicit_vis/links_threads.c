@@ -25,6 +25,8 @@ typedef struct link_task {
     uint32_t buf;
     size_t off;
     uint64_t tries;
+    uint32_t root; /* the top-level task it comes from (its index among them) */
+    int kept;      /* its pairs are the kept list of a task between two still segments */
 } link_task;
 
 typedef struct link_par {
@@ -37,8 +39,10 @@ typedef struct link_par {
     atomic_size_t next;
     int threads;
     int fail;
-    atomic_int stop; /* a cancel seen by any thread (issue 32) */
-    size_t *used;    /* per thread: pairs in its l->pair_buf */
+    atomic_int stop;      /* a cancel seen by any thread (issue 32) */
+    size_t *used;         /* per thread: pairs in its l->pair_buf */
+    iv_kept *kept;        /* keep_pairs: the lists of the last build; NULL: none */
+    uint64_t *root_tries; /* with kept: per top-level task, the tests made while unrolling it */
 } link_par;
 
 typedef struct write_arg {
@@ -159,35 +163,40 @@ static link_task *unroll_tasks(link_par *p, link_task *tasks, size_t *count, siz
         int grew = 0;
         for (size_t i = 0; i < n; i++) {
             uint32_t A = tasks[i].A, B = tasks[i].B;
-            if (tasks[i].n > 0) { /* a link found while unrolling: kept as it is */
+            if (tasks[i].n > 0 || tasks[i].kept) { /* a link found while unrolling, or a kept
+                                                      list: as it is */
                 out[m++] = tasks[i];
                 continue;
             }
             if (B == UINT32_MAX) {
                 uint32_t f = h->first_child[A], c = h->child_count[A];
                 for (uint32_t k = 0; k < c; k++)
-                    out[m++] = (link_task){.A = f + k, .B = UINT32_MAX};
+                    out[m++] = (link_task){.A = f + k, .B = UINT32_MAX, .root = tasks[i].root};
                 for (uint32_t x = 0; x < c; x++)
                     for (uint32_t y = x + 1; y < c; y++)
-                        out[m++] = (link_task){.A = f + x, .B = f + y};
+                        out[m++] = (link_task){.A = f + x, .B = f + y, .root = tasks[i].root};
                 grew = 1;
                 continue;
             }
             (*tries)++;
+            if (p->root_tries)
+                p->root_tries[tasks[i].root]++;
             gi_vec3 d;
             float r2;
             uint32_t bins[2];
             int what = iv_pair_decide(p->l, h, p->subdiv, A, B, &d, &r2, bins);
             if (what == IV_PAIR_SPLIT_B) {
                 for (uint32_t k = 0; k < h->child_count[B]; k++)
-                    out[m++] = (link_task){.A = A, .B = h->first_child[B] + k};
+                    out[m++] =
+                        (link_task){.A = A, .B = h->first_child[B] + k, .root = tasks[i].root};
                 grew = 1;
             } else if (what == IV_PAIR_SPLIT_A) {
                 for (uint32_t k = 0; k < h->child_count[A]; k++)
-                    out[m++] = (link_task){.A = h->first_child[A] + k, .B = B};
+                    out[m++] =
+                        (link_task){.A = h->first_child[A] + k, .B = B, .root = tasks[i].root};
                 grew = 1;
             } else if (what == IV_PAIR_LINK) {
-                out[m] = (link_task){.A = A, .B = B};
+                out[m] = (link_task){.A = A, .B = B, .root = tasks[i].root};
                 if (!task_push(&out[m], A, B, bins)) {
                     free(out);
                     return tasks;
@@ -215,8 +224,8 @@ static void *collect_worker(void *arg)
         if (par_stop(p, 0)) /* the host asked before each task, and every 64 k pairs in it */
             break;
         link_task *t = &p->tasks[i];
-        if (t->n > 0)
-            continue; /* a link found while unrolling */
+        if (t->n > 0 || t->kept)
+            continue; /* a link found while unrolling, or a kept list */
         t->buf = w->index;
         t->off = p->used[w->index];
         int ok = t->B == UINT32_MAX ? collect_self(p, t, t->A) : collect_pair(p, t, t->A, t->B);
@@ -286,20 +295,85 @@ static int pair_bufs(iv_links *l, uint32_t threads)
     return 1;
 }
 
-int iv_links_build_parallel(iv_links *l, const iv_hier *h, float subdiv, int splat, int threads)
+/* The top-level tasks as the recursion makes them: each segment with
+ * itself, then every two segments. With keep_pairs a task between two
+ * still segments takes its kept list (its pair tests counted as made). */
+static link_task *top_tasks(link_par *p, size_t *count, uint64_t *tries)
 {
-    link_par p = {.l = l, .h = h, .subdiv = subdiv, .splat = splat, .threads = threads};
+    const iv_hier *h = p->h;
     size_t n = h->root_count + (size_t)h->root_count * (h->root_count - 1) / 2;
     link_task *tasks = calloc(n + 1, sizeof *tasks);
     if (!tasks)
-        return 0;
+        return NULL;
     size_t m = 0;
     for (uint32_t i = 0; i < h->root_count; i++)
         tasks[m++] = (link_task){.A = i, .B = UINT32_MAX};
     for (uint32_t i = 0; i < h->root_count; i++)
         for (uint32_t j = i + 1; j < h->root_count; j++)
             tasks[m++] = (link_task){.A = i, .B = j};
+    for (size_t t = 0; t < m; t++) {
+        tasks[t].root = (uint32_t)t;
+        if (!p->kept || !iv_kept_usable(p->kept, tasks[t].A, tasks[t].B))
+            continue;
+        const iv_pair_list *k = &p->kept->list[t];
+        tasks[t].kept = 1;
+        tasks[t].pairs = k->pairs;
+        tasks[t].n = k->n;
+        *tries += k->tries;
+        p->l->kept_tries += k->tries;
+    }
+    *count = m;
+    return tasks;
+}
+
+/* After a completed build: every task that was tested anew gives its
+ * top-level task's list for the next build (a kept list stays as it is);
+ * the task's tests are counted with it. */
+static void keep_lists(link_par *p)
+{
+    iv_kept *k = p->kept;
+    size_t top = p->h->root_count + (size_t)p->h->root_count * (p->h->root_count - 1) / 2;
+    uint8_t *fresh = calloc(top + 1, 1);
+    if (!fresh)
+        return; /* k->valid stays 0: the next build tests every pair */
+    for (size_t i = 0; i < p->ntasks; i++)
+        if (!p->tasks[i].kept)
+            fresh[p->tasks[i].root] = 1;
+    for (size_t t = 0; t < top; t++)
+        if (fresh[t]) {
+            k->list[t].n = 0;
+            k->list[t].tries = p->root_tries[t];
+        }
+    int ok = 1;
+    for (size_t i = 0; i < p->ntasks && ok; i++) {
+        const link_task *t = &p->tasks[i];
+        if (t->kept)
+            continue;
+        k->list[t->root].tries += t->tries;
+        ok = iv_kept_append(k, t->root, task_pairs(p, t), t->n);
+    }
+    free(fresh);
+    k->valid = ok;
+}
+
+int iv_links_build_parallel(iv_links *l, const iv_hier *h, float subdiv, int splat, int threads)
+{
+    link_par p = {.l = l, .h = h, .subdiv = subdiv, .splat = splat, .threads = threads};
+    l->kept_tries = 0;
+    if (l->keep_pairs) {
+        p.kept = iv_kept_begin(l, h);
+        size_t top = h->root_count + (size_t)h->root_count * (h->root_count - 1) / 2;
+        p.root_tries = calloc(top + 1, sizeof *p.root_tries);
+        if (!p.root_tries)
+            p.kept = NULL;
+    }
     uint64_t tries = 0;
+    size_t m = 0;
+    link_task *tasks = top_tasks(&p, &m, &tries);
+    if (!tasks) {
+        free(p.root_tries);
+        return 0;
+    }
     tasks = unroll_tasks(&p, tasks, &m, (size_t)64 * (size_t)threads, &tries);
     p.tasks = tasks;
     p.ntasks = m;
@@ -340,10 +414,13 @@ int iv_links_build_parallel(iv_links *l, const iv_hier *h, float subdiv, int spl
         for (int i = 0; i < threads; i++)
             l->created += wa[i].created;
         l->tries = tries;
+        if (p.kept && !atomic_load(&p.stop))
+            keep_lists(&p);
     }
     for (size_t i = 0; i < m; i++)
-        free(tasks[i].pairs);
-    free(tasks), free(tid), free(made), free(wa), free(p.used);
+        if (!tasks[i].kept)
+            free(tasks[i].pairs);
+    free(tasks), free(tid), free(made), free(wa), free(p.used), free(p.root_tries);
     if (atomic_load(&p.stop)) { /* cancelled: no build on one thread follows */
         l->stopped = 1;
         return 1;

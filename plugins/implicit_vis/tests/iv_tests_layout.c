@@ -79,6 +79,57 @@ static void layout_case_run(const layout_case *c)
     gi_scene_free(s);
 }
 
+/* keep_pairs (README "Pairs of still segments"): builds at t0, then at t1
+ * (a segment moved: the still pairs' lists are taken, the others tested
+ * anew), then at t1 again (nothing moved: every list taken), each giving
+ * the links of a build from scratch at that time, to the bit. */
+static uint64_t kept_build(iv_links *l, iv_hier *h, const gi_scene *s, float t)
+{
+    iv_hier_update(h, s, t);
+    iv_links_build(l, h, 1.0f, 0, 0);
+    iv_links_refine_push(l, h);
+    return links_hash(l, h);
+}
+
+static void kept_case(const char *path, uint32_t threads)
+{
+    gi_scene *s = iv_test_load(path);
+    if (!s)
+        return;
+    gi_error err;
+    iv_hier *h = iv_hier_create(s, 0.0f, IV_REMESH_GRID, &err);
+    EXPECT(h != NULL, "%s: %s", path, err.text);
+    iv_links *k = h ? iv_links_create(h, 4) : NULL, *f = h ? iv_links_create(h, 4) : NULL;
+    EXPECT(!h || (k && f), "%s: out of memory for the links", path);
+    if (k && f) {
+        k->keep_pairs = 1;
+        k->threads = f->threads = threads;
+        uint64_t fresh1 = kept_build(f, h, s, 0.5f);
+        EXPECT(f->kept_tries == 0, "keep_pairs off: %llu pair tests kept",
+               (unsigned long long)f->kept_tries);
+        uint64_t got0 = kept_build(k, h, s, 0.0f);
+        EXPECT(got0 != fresh1 && k->kept_tries == 0,
+               "first build: the same links at t 0 and 0.5, or %llu tests kept",
+               (unsigned long long)k->kept_tries);
+        uint64_t got1 = kept_build(k, h, s, 0.5f);
+        printf("keep_pairs, %u thread(s): t 0.5 after 0: %llu of %llu pair tests kept, hash "
+               "0x%016llx (from scratch 0x%016llx)\n",
+               threads, (unsigned long long)k->kept_tries, (unsigned long long)k->tries,
+               (unsigned long long)got1, (unsigned long long)fresh1);
+        EXPECT(got1 == fresh1, "a segment moved: the links differ from a build from scratch");
+        EXPECT(k->kept_tries > 0 && k->kept_tries < k->tries,
+               "a segment moved: %llu of %llu tests kept (some, not all)",
+               (unsigned long long)k->kept_tries, (unsigned long long)k->tries);
+        uint64_t got2 = kept_build(k, h, s, 0.5f);
+        EXPECT(got2 == fresh1 && k->kept_tries == k->tries,
+               "nothing moved: hash %016llx, %llu of %llu tests kept", (unsigned long long)got2,
+               (unsigned long long)k->kept_tries, (unsigned long long)k->tries);
+    }
+    iv_links_free(k), iv_links_free(f);
+    iv_hier_free(h);
+    gi_scene_free(s);
+}
+
 void iv_test_layout(void)
 {
     static const char *box = GI_SOURCE_DIR "/scenes/cornell_box_coarse.gltf",
@@ -96,4 +147,5 @@ void iv_test_layout(void)
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
         layout_case_run(&cases[i]);
+    kept_case(GI_SOURCE_DIR "/scenes/cornell_moving.gltf", 2);
 }

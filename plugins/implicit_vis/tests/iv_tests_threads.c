@@ -1,28 +1,19 @@
 /* The implicit_vis tests of the multi-threaded link creation (README
  * "Multi-threaded link creation"): the links on 2, 3 and 4 threads equal
- * those on one to the bit; create_links on 1 and 2 threads timed. */
-#define _POSIX_C_SOURCE 200809L
+ * those on one to the bit. */
 #include "iv_tests.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
-#include <unistd.h>
-
-static double wall_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
 
 /* One scene: the links built on 1 thread and on 2, 3 and 4 must be the
  * same to the bit (every bin's link, distance and coverage, the counters,
- * the receiving and light links after refinement); then the wall time of
- * the link creation on 1 and on 2 threads, side by side in this run. */
+ * the receiving and light links after refinement). The time on 1 and 2
+ * threads is measured in the README, not here (issue 29: heavy measurement
+ * stays out of ctest). */
 static void threads_case(const char *path, float edge, int remesher, uint32_t N, int bilinear,
-                         int splat, float t, int timed)
+                         int splat, float t)
 {
     gi_scene *s = iv_test_load(path);
     if (!s)
@@ -65,24 +56,10 @@ static void threads_case(const char *path, float edge, int remesher, uint32_t N,
                    path, T, (unsigned long long)one->tries, (unsigned long long)many->tries,
                    (unsigned long long)one->created, (unsigned long long)many->created);
         }
-        /* side by side: best of 3 of each, alternating */
-        double best[2] = {1e30, 1e30};
-        for (int rep = 0; rep < (timed ? 3 : 0); rep++)
-            for (int k = 0; k < 2; k++) {
-                many->threads = k ? 2 : 1;
-                double t0 = wall_ms();
-                iv_links_build(many, h, 1.0f, 0, splat);
-                double dt = wall_ms() - t0;
-                best[k] = dt < best[k] ? dt : best[k];
-            }
         printf("%s (N = %u, %u elements, %llu link tries, %llu bin writes): identical on 1-4 "
                "threads\n",
                strrchr(path, '/') + 1, N, h->elem_count, (unsigned long long)one->tries,
                (unsigned long long)one->created);
-        if (timed)
-            printf("  create_links, best of 3, wall: %.1f ms on 1 thread, %.1f ms on 2 (%.2fx; %ld "
-                   "cores online)\n",
-                   best[0], best[1], best[0] / best[1], sysconf(_SC_NPROCESSORS_ONLN));
     }
     iv_links_free(one), iv_links_free(many);
     iv_hier_free(h);
@@ -92,10 +69,9 @@ static void threads_case(const char *path, float edge, int remesher, uint32_t N,
 void iv_test_threads(void)
 {
     threads_case(GI_SOURCE_DIR "/scenes/cornell_box_coarse.gltf", 0.0f, IV_REMESH_GRID, 12, 0, 1,
-                 0.0f, 0);
-    threads_case(GI_SOURCE_DIR "/scenes/cornell_deform.gltf", 0.0f, IV_REMESH_GRID, 8, 1, 1, 1.5f,
-                 0);
-    threads_case(GI_SOURCE_DIR "/scenes/teapot_area.glb", 0.3f, IV_REMESH_ISOTROPIC, 12, 0, 1, 0.0f,
-                 0);
-    threads_case(GI_SOURCE_DIR "/scenes/teapot_plane.glb", 0.0f, IV_REMESH_GRID, 12, 0, 0, 0.0f, 1);
+                 0.0f);
+    threads_case(GI_SOURCE_DIR "/scenes/cornell_deform.gltf", 0.0f, IV_REMESH_GRID, 8, 1, 1, 1.5f);
+    threads_case(GI_SOURCE_DIR "/scenes/teapot_area.glb", 0.3f, IV_REMESH_ISOTROPIC, 12, 0, 1,
+                 0.0f);
+    threads_case(GI_SOURCE_DIR "/scenes/teapot_plane.glb", 0.0f, IV_REMESH_GRID, 12, 0, 0, 0.0f);
 }
