@@ -1,4 +1,3 @@
-#extension GL_EXT_shader_framebuffer_fetch : require
 // Propagation by the rasteriser (plugins/vlf/vlf_raster.c, paper §3.2,
 // §3.3, Fig. 5): one fragment per interface ray and face, in the order the
 // faces are drawn (the depth order), each reading the radiance interface
@@ -13,11 +12,29 @@
 // rule for sides, as propagate.c's sweep()). Counters per ray (shot,
 // received, back, escaped) accumulate in the second attachment over the
 // whole propagation. VLF_INIT: each tile's interface set to its sky;
-// VLF_ESCAPE: what is left on it counted as escaped.
+// VLF_ESCAPE: what is left on it counted as escaped. VLF_BARRIER: the
+// portable variant (GL 4.5 core): the interface and the counters read as
+// textures at the fragment's own texel, the faces drawn in layers in which
+// no two cover a pixel, a texture barrier between (vlf_layers.c), so each
+// texel is read and written once between barriers (GL 4.5 §9.3.1).
+#if !defined(VLF_BARRIER)
+#extension GL_EXT_shader_framebuffer_fetch : require
+#endif
 #include "glsl_shared.h"
 
+#if defined(VLF_BARRIER)
+layout(location = 0) out vec4 ri;
+layout(location = 1) out vec4 cnt;
+layout(binding = GI_TEX_PLUGIN_FIRST + 1) uniform sampler2D vlf_ri;
+layout(binding = GI_TEX_PLUGIN_FIRST + 2) uniform sampler2D vlf_cnt;
+#define VLF_LOAD()                                      \
+    ri = texelFetch(vlf_ri, ivec2(gl_FragCoord.xy), 0); \
+    cnt = texelFetch(vlf_cnt, ivec2(gl_FragCoord.xy), 0)
+#else
 layout(location = 0) inout vec4 ri;
 layout(location = 1) inout vec4 cnt;
+#define VLF_LOAD()
+#endif
 
 // per signed direction: travel direction, solid angle; sky radiance
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 21) readonly buffer VlfSigned { vec4 sdir[]; };
@@ -46,6 +63,7 @@ void main()
 #elif defined(VLF_ESCAPE)
 void main()
 {
+    VLF_LOAD();
     uint sd = tile_dir(uvec2(gl_FragCoord.xy));
     if (sd < 2u * u_l)
         cnt.w += (ri.r + ri.g + ri.b) * u_cell_area * sdir[2u * sd].w / 3.0;
@@ -91,6 +109,7 @@ void acc_add(uint k, float v)
 
 void main()
 {
+    VLF_LOAD();
     uint fi = v_face & 0x7fffffffu;
     VlfChart ch = charts[fi];
     // the element holding the ray's point (vlf_element_at): the face's

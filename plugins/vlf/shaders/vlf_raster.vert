@@ -47,7 +47,11 @@ void main()
     }
     uvec4 d = dirs[lo];
     uint local = k - d.x;
+#if defined(VLF_BARRIER)
+    uint e = order[k]; // in layers, drawn in reverse by the draws for -w_i
+#else
     uint e = order[d.x + (u_sign != 0u ? d.y - 1u - local : local)];
+#endif
     uint idx = e & 0x3fffffffu;
     vec4 p = (e & 0x40000000u) != 0u ? extra[3u * (d.z + idx) + c] : tri_p[3u * idx + c];
     v_q = p.xyz;
