@@ -75,16 +75,17 @@ static const gi_param_desc vlf_params[] = {
      "each scene triangle cut into subdivide^2 triangles before sorting and transport: the same "
      "surfaces as more "
      "faces (the tessellation sweep of propagation time against faces)"},
-    {"propagate", GI_PARAM_ENUM, 0, 0, 0, "cpu|gpu|raster|auto", "propagation (Sec. 3.2-3.4)",
+    {"propagate", GI_PARAM_ENUM, 3, 0, 0, "cpu|gpu|raster|auto", "propagation (Sec. 3.2-3.4)",
      "where propagation runs: cpu: the sweeps in C over per-ray fragment lists (propagate.c); "
      "gpu: compute passes over those lists (vlf_gpu.c), needs perturbed = 0; raster: the sorted "
      "faces drawn by the rasteriser into the radiance interface (vlf_raster.c, the paper's way), "
      "with perturbed > 0 or order = rays the CPU's sweeps; auto: raster on a hardware GL, cpu on "
      "a software rasteriser (llvmpipe, softpipe, swrast: there raster costs more CPU)"},
-    {"raster_sync", GI_PARAM_ENUM, 0, 0, 0, "auto|fetch|barrier", "raster ordering (Sec. 3.3)",
-     "how propagate = raster keeps each ray's faces in depth order: fetch: "
-     "GL_EXT_shader_framebuffer_fetch; barrier: GL 4.5 core, the order in layers of faces that do "
-     "not overlap, a texture barrier between (vlf_layers.c); auto: fetch where the GL has it"},
+    {"raster_sync", GI_PARAM_ENUM, 0, 0, 0, "auto|barrier", "raster ordering (Sec. 3.3)",
+     "how propagate = raster keeps each ray's faces in depth order: auto: "
+     "GL_EXT_shader_framebuffer_fetch where the GL has it, else barrier; barrier: GL 4.5 core "
+     "only, the order in layers of faces that do not overlap, a texture barrier between "
+     "(vlf_layers.c)"},
     {"hier_min", GI_PARAM_INT, 0, 0, 1000000, NULL, "hierarchical sort (Sec. 3.2)",
      "objects (glTF nodes) of at least this many triangles whose bounding box in a direction's "
      "frame no other "
@@ -124,7 +125,7 @@ static gi_result vlf_create(const gi_host *host, const gi_params *params, void *
     v->prm.bsp_min = (uint32_t)gi_params_int(params, "bsp_min");
     v->prm.hier_min = (uint32_t)gi_params_int(params, "hier_min");
     int prop = gi_params_enum(params, "propagate");
-    v->raster_sync = gi_params_enum(params, "raster_sync");
+    v->raster_sync = gi_params_enum(params, "raster_sync") == 1 ? VLF_SYNC_BARRIER : VLF_SYNC_AUTO;
     v->prop_auto = prop == 3;
     if (v->prop_auto && (v->prm.perturbed > 0 || v->prm.order == VLF_ORDER_RAYS))
         prop = 0, v->prop_auto = 0; /* nothing to draw: the CPU's sweeps (below) */

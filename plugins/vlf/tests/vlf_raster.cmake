@@ -5,7 +5,7 @@
 # both against the 8-bounce Embree reference (256 spp) beside the trivial
 # answers scored on the same reference (the black image and the
 # unshadowed `direct` plugin). Both ways of ordering each ray's faces:
-# GL_EXT_shader_framebuffer_fetch (raster_sync = fetch) on the Cornell box,
+# GL_EXT_shader_framebuffer_fetch (raster_sync = auto on llvmpipe) on the Cornell box,
 # the portable GL 4.5 core variant (raster_sync = barrier: the order in
 # layers, texture barriers between; vlf_layers.c) on both scenes:
 #   - the raster runs really rasterised (stat propagate_path = 2) the way
@@ -37,7 +37,9 @@ foreach(scene ${SCENES}/cornell_box_coarse.gltf ${TRUTH}/box_light.gltf)
         if(path STREQUAL "cpu")
             set(how propagate=cpu)
         else()
-            set(how propagate=raster --param raster_sync=${path})
+            # auto takes the fetch extension where the GL has it (llvmpipe)
+            string(REPLACE fetch auto sync ${path})
+            set(how propagate=raster --param raster_sync=${sync})
         endif()
         expect(0 "" render --scene ${scene} --method vlf --size 32x32 --no-cache --param l=128 --param N=32
                --param ${how} --out ${OUT}/vlf_raster_${path}_${name}.exr
