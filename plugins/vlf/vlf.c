@@ -449,7 +449,7 @@ static void choose_path(vlf *v)
     v->prop_auto = 0;
     v->gpu_propagate = !soft;
     v->prm.raster = (uint32_t)!soft;
-    v->kit.host->log(v->kit.host, GI_LOG_INFO, "vlf: propagate = auto: %s on %s",
+    v->kit.host->log(v->kit.host, GI_LOG_INFO, "propagate = auto: %s on %s",
                      soft ? "cpu (a software rasteriser)" : "raster", rd ? rd : "an unnamed GL");
 }
 
