@@ -31,6 +31,8 @@ typedef struct vlf {
     vlf_field field;
     int have_field;
     int gpu_propagate; /* propagate = gpu or raster: vlf_gpu.c (raster: vlf_raster.c) */
+    int prop_auto;     /* propagate = auto, decided at prepare() from GL_RENDERER */
+    int raster_sync;   /* VLF_SYNC_* */
     vlf_gpu gpu;
     int have_gpu;
     GLuint program;
@@ -73,11 +75,17 @@ static const gi_param_desc vlf_params[] = {
      "each scene triangle cut into subdivide^2 triangles before sorting and transport: the same "
      "surfaces as more "
      "faces (the tessellation sweep of propagation time against faces)"},
-    {"propagate", GI_PARAM_ENUM, 0, 0, 0, "cpu|gpu|raster", "propagation (Sec. 3.2-3.4)",
+    {"propagate", GI_PARAM_ENUM, 3, 0, 0, "cpu|gpu|raster|auto", "propagation (Sec. 3.2-3.4)",
      "where propagation runs: cpu: the sweeps in C over per-ray fragment lists (propagate.c); "
      "gpu: compute passes over those lists (vlf_gpu.c), needs perturbed = 0; raster: the sorted "
      "faces drawn by the rasteriser into the radiance interface (vlf_raster.c, the paper's way), "
-     "with perturbed > 0 or order = rays the CPU's sweeps"},
+     "with perturbed > 0 or order = rays the CPU's sweeps; auto: raster on a hardware GL, cpu on "
+     "a software rasteriser (llvmpipe, softpipe, swrast: there raster costs more CPU)"},
+    {"raster_sync", GI_PARAM_ENUM, 0, 0, 0, "auto|barrier", "raster ordering (Sec. 3.3)",
+     "how propagate = raster keeps each ray's faces in depth order: auto: "
+     "GL_EXT_shader_framebuffer_fetch where the GL has it, else barrier; barrier: GL 4.5 core "
+     "only, the order in layers of faces that do not overlap, a texture barrier between "
+     "(vlf_layers.c)"},
     {"hier_min", GI_PARAM_INT, 0, 0, 1000000, NULL, "hierarchical sort (Sec. 3.2)",
      "objects (glTF nodes) of at least this many triangles whose bounding box in a direction's "
      "frame no other "
@@ -117,6 +125,12 @@ static gi_result vlf_create(const gi_host *host, const gi_params *params, void *
     v->prm.bsp_min = (uint32_t)gi_params_int(params, "bsp_min");
     v->prm.hier_min = (uint32_t)gi_params_int(params, "hier_min");
     int prop = gi_params_enum(params, "propagate");
+    v->raster_sync = gi_params_enum(params, "raster_sync") == 1 ? VLF_SYNC_BARRIER : VLF_SYNC_AUTO;
+    v->prop_auto = prop == 3;
+    if (v->prop_auto && (v->prm.perturbed > 0 || v->prm.order == VLF_ORDER_RAYS))
+        prop = 0, v->prop_auto = 0; /* nothing to draw: the CPU's sweeps (below) */
+    if (v->prop_auto)
+        prop = 2; /* until prepare() sees the renderer */
     v->gpu_propagate = prop != 0;
     /* the rasteriser draws the fixed directions' face order: the perturbed
      * directions (sorted beside the sweeps) and the per-ray order have no
@@ -389,6 +403,14 @@ static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
     host->stat(host, "faces", v->field.face_count);
     /* where propagation ran: 0 cpu, 1 gpu (compute over lists), 2 raster */
     host->stat(host, "propagate_path", v->prm.raster ? 2 : v->gpu_propagate ? 1 : 0);
+    /* how the raster path ordered each ray's faces: 1 fetch, 2 barrier
+     * (then its layers: the most of a direction, the mean) */
+    int ras = v->prm.raster && v->have_gpu;
+    host->stat(host, "raster_sync", ras ? (v->gpu.ras.barrier ? 2 : 1) : 0);
+    if (ras && v->gpu.ras.barrier) {
+        host->stat(host, "raster_layers_max", (double)v->gpu.ras.max_layers);
+        host->stat(host, "raster_layers_mean", (double)v->gpu.ras.layer_total / v->prm.l);
+    }
     host->stat(host, "triangles", v->field.tri_count);
     host->stat(host, "sort_triangles", v->field.sort_count); /* drawn: merged faces (merge.c) */
     host->stat(host, "diffuse_elements", s->diffuse_elements);
@@ -416,6 +438,21 @@ static gi_result vlf_build(vlf *v, const gi_gpu_scene *gs)
     return r;
 }
 
+/* propagate = auto: the rasteriser (the paper's propagation, §3.2) on a
+ * hardware GL; on a software one (Mesa's llvmpipe, softpipe, swrast) the C
+ * sweeps, which there cost a fraction of its CPU time (plugins/vlf/README.md
+ * "Where each stage runs"). Decided once, said in the log. */
+static void choose_path(vlf *v)
+{
+    const char *rd = (const char *)glGetString(GL_RENDERER);
+    int soft = !rd || strstr(rd, "llvmpipe") || strstr(rd, "softpipe") || strstr(rd, "swrast");
+    v->prop_auto = 0;
+    v->gpu_propagate = !soft;
+    v->prm.raster = (uint32_t)!soft;
+    v->kit.host->log(v->kit.host, GI_LOG_INFO, "propagate = auto: %s on %s",
+                     soft ? "cpu (a software rasteriser)" : "raster", rd ? rd : "an unnamed GL");
+}
+
 static gi_result vlf_prepare(void *inst, const gi_gpu_scene *gs)
 {
     vlf *v = inst;
@@ -426,9 +463,11 @@ static gi_result vlf_prepare(void *inst, const gi_gpu_scene *gs)
         if (!v->program)
             return gi_kit_fail_with(&v->kit, GI_ERR_GL, &err);
     }
+    if (v->prop_auto)
+        choose_path(v);
     if (v->gpu_propagate && !v->have_gpu) {
         gi_error err;
-        if (vlf_gpu_init(&v->gpu, (int)v->prm.raster, &err) != GI_OK)
+        if (vlf_gpu_init(&v->gpu, (int)v->prm.raster, v->raster_sync, &err) != GI_OK)
             return gi_kit_fail_with(&v->kit, GI_ERR_GL, &err);
         v->have_gpu = 1;
     }

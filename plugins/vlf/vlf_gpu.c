@@ -42,12 +42,12 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-gi_result vlf_gpu_init(vlf_gpu *g, int raster, gi_error *err)
+gi_result vlf_gpu_init(vlf_gpu *g, int raster, int sync, gi_error *err)
 {
     memset(g, 0, sizeof *g);
     g->raster = raster;
     if (raster) {
-        gi_result r = vlf_raster_init(&g->ras, err);
+        gi_result r = vlf_raster_init(&g->ras, sync, err);
         if (r != GI_OK)
             return r;
     }

@@ -25,7 +25,17 @@ typedef struct vlf_raster {
     GLuint dirs, signed_dirs;   /* buffers: per direction its order; per signed one t, dW, sky */
     uint32_t NS, TX, TY, batch; /* a tile's side, tiles across and down, directions a batch */
     uint32_t *order_first, *order_count, *extra_first; /* per fixed direction */
+    int barrier; /* 1: GL 4.5 core, the order in layers and glTextureBarrier (vlf_layers.c);
+                  * 0: GL_EXT_shader_framebuffer_fetch */
+    uint32_t *layer_first; /* per fixed direction: its first entry of layer_start */
+    uint32_t *layer_start; /* per direction its layers' first entries in its order, and the end */
+    uint32_t max_layers;   /* the most layers of a direction */
+    uint64_t layer_total;  /* layers over all directions */
 } vlf_raster;
+
+/* How the raster path orders each pixel's read-modify-write (parameter
+ * raster_sync): the fetch extension where the GL has it, else barriers. */
+enum { VLF_SYNC_AUTO = 0, VLF_SYNC_FETCH = 1, VLF_SYNC_BARRIER = 2 };
 
 typedef struct vlf_gpu {
     GLuint prog[VLF_GPU_PASSES]; /* sweep, gather, scatter, finish, settle */
@@ -41,7 +51,7 @@ typedef struct vlf_gpu {
 /* Builds the passes' programs; raster = 1 for the rasterised sweeps
  * (propagate = raster; fails with a one-line reason where the GL lacks
  * what they need). */
-gi_result vlf_gpu_init(vlf_gpu *g, int raster, gi_error *err);
+gi_result vlf_gpu_init(vlf_gpu *g, int raster, int sync, gi_error *err);
 /* Uploads field f's depth order, gather lists, tiles and scatter jobs
  * (the paper keeps them on the GPU for the iterations). */
 gi_result vlf_gpu_setup(vlf_gpu *g, const vlf_field *f, gi_error *err);
@@ -56,7 +66,11 @@ void vlf_gpu_free(vlf_gpu *g);
 /* ---- The rasterised sweeps (vlf_raster.c) ---------------------------------- */
 
 /* Checks the GL's extensions and builds the draw programs. */
-gi_result vlf_raster_init(vlf_raster *r, gi_error *err);
+gi_result vlf_raster_init(vlf_raster *r, int sync, gi_error *err);
+/* The barrier variant's layers (vlf_layers.c): each direction's entries of
+ * f->psf[i].rorder sorted by layer into order + r->order_first[i], the
+ * layers' bounds into r->layer_first / layer_start. */
+gi_result vlf_raster_layers(vlf_raster *r, const vlf_field *f, uint32_t *order, gi_error *err);
 /* Uploads f's triangles, face charts and every subfield's face order
  * (vlf_psf.rorder; f built with vlf_settings.raster) into buf (the buffers
  * of vlf_gpu), and makes the interface's render target. */

@@ -22,6 +22,9 @@
 /* Buffers of vlf_gpu this file fills (their binding after
  * GI_SSBO_PLUGIN_FIRST, as in shaders/vlf_raster.vert and .frag). */
 enum { B_TRI_P = 16, B_ORDER = 17, B_EXTRA = 18, B_CHARTS = 19 };
+/* The barrier variant's texture units for the interfaces and the counters
+ * (GI_TEX_PLUGIN_FIRST + 1 and + 2 in shaders/vlf_raster.frag). */
+enum { VLF_TEX_RI = GI_TEX_PLUGIN_FIRST + 1 };
 
 static int has_extension(const char *name)
 {
@@ -33,24 +36,36 @@ static int has_extension(const char *name)
     return 0;
 }
 
-gi_result vlf_raster_init(vlf_raster *r, gi_error *err)
+/* The three programs with the variant's define. 1, or 0 with e set. */
+static int build_programs(vlf_raster *r, gi_error *e)
+{
+    const char *v = r->barrier ? "#define VLF_BARRIER 1\n" : "";
+    char d[3][96];
+    snprintf(d[0], sizeof d[0], "%s", v);
+    snprintf(d[1], sizeof d[1], "%s#define VLF_ESCAPE 1\n", v);
+    snprintf(d[2], sizeof d[2], "%s#define VLF_INIT 1\n", v);
+    GLuint *p[3] = {&r->draw, &r->escape, &r->init};
+    for (int k = 0; k < 3; k++)
+        if (!(*p[k] = gi_program_build("vlf_raster.vert", NULL, "vlf_raster.frag", d[k], e)))
+            return 0;
+    return 1;
+}
+
+gi_result vlf_raster_init(vlf_raster *r, int sync, gi_error *err)
 {
     memset(r, 0, sizeof *r);
-    /* the interface's read-modify-write in draw order */
-    if (!has_extension("GL_EXT_shader_framebuffer_fetch"))
+    /* the interface's read-modify-write in draw order: by the fetch
+     * extension where the GL has it (or it is asked for), else in layers
+     * between texture barriers (GL 4.5 core, vlf_layers.c) */
+    int fetch = has_extension("GL_EXT_shader_framebuffer_fetch");
+    if (sync == VLF_SYNC_FETCH && !fetch)
         return gi_error_set(err, GI_ERR_UNSUPPORTED,
-                            "vlf: propagate = raster needs GL_EXT_shader_framebuffer_fetch, which "
+                            "vlf: raster_sync = fetch needs GL_EXT_shader_framebuffer_fetch, which "
                             "this GL (%s) lacks",
                             (const char *)glGetString(GL_RENDERER));
+    r->barrier = sync == VLF_SYNC_BARRIER || !fetch;
     gi_error e;
-    r->draw = gi_program_build("vlf_raster.vert", NULL, "vlf_raster.frag", NULL, &e);
-    if (r->draw)
-        r->escape = gi_program_build("vlf_raster.vert", NULL, "vlf_raster.frag",
-                                     "#define VLF_ESCAPE 1\n", &e);
-    if (r->escape)
-        r->init = gi_program_build("vlf_raster.vert", NULL, "vlf_raster.frag",
-                                   "#define VLF_INIT 1\n", &e);
-    if (!r->draw || !r->escape || !r->init) {
+    if (!build_programs(r, &e)) {
         vlf_raster_free(r);
         return gi_error_set(err, GI_ERR_GL, "vlf: raster propagation: %s", e.text);
     }
@@ -76,6 +91,7 @@ void vlf_raster_free(vlf_raster *r)
     if (r->vao)
         glDeleteVertexArrays(1, &r->vao);
     free(r->order_first), free(r->order_count), free(r->extra_first);
+    free(r->layer_first), free(r->layer_start);
     memset(r, 0, sizeof *r);
 }
 
@@ -140,9 +156,20 @@ static int upload_orders(vlf_raster *r, GLuint *buf, const vlf_field *f)
                       GL_DYNAMIC_DRAW);
     glNamedBufferData(buf[B_EXTRA], (GLsizeiptr)((ne * 12 + 4) * sizeof(uint32_t)), NULL,
                       GL_DYNAMIC_DRAW);
+    if (r->barrier) {
+        /* the entries in layers (vlf_layers.c), drawn without reversal */
+        uint32_t *ord = malloc((no + 1) * sizeof *ord);
+        gi_error e;
+        if (!ord || vlf_raster_layers(r, f, ord, &e) != GI_OK) {
+            free(ord);
+            return 0;
+        }
+        glNamedBufferSubData(buf[B_ORDER], 0, (GLsizeiptr)(no * sizeof *ord), ord);
+        free(ord);
+    }
     for (uint32_t i = 0; i < l; i++) {
         const vlf_psf *p = &f->psf[i];
-        if (p->rorder_count)
+        if (p->rorder_count && !r->barrier)
             glNamedBufferSubData(buf[B_ORDER], (GLintptr)(r->order_first[i] * sizeof(uint32_t)),
                                  (GLsizeiptr)(p->rorder_count * sizeof(uint32_t)), p->rorder);
         if (p->rextra_count)
@@ -175,6 +202,8 @@ static gi_result make_target(vlf_raster *r, uint32_t NS, uint32_t l, gi_error *e
     glCreateFramebuffers(1, &r->fbo);
     for (int k = 0; k < 2; k++) {
         glTextureStorage2D(r->tex[k], 1, GL_RGBA32F, (GLsizei)(TX * NS), (GLsizei)(TY * NS));
+        glTextureParameteri(r->tex[k], GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTextureParameteri(r->tex[k], GL_TEXTURE_MAG_FILTER, GL_NEAREST);
         glNamedFramebufferTexture(r->fbo, GL_COLOR_ATTACHMENT0 + (GLenum)k, r->tex[k], 0);
     }
     static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
@@ -264,6 +293,8 @@ void vlf_raster_clear_counters(vlf_raster *r)
 {
     static const float zero[4] = {0, 0, 0, 0};
     glClearNamedFramebufferfv(r->fbo, GL_COLOR, 1, zero);
+    if (r->barrier)
+        glTextureBarrier();
 }
 
 /* The sky each signed direction's interface starts with this iteration
@@ -280,8 +311,45 @@ static void upload_sky(vlf_raster *r, const vlf_field *f, int first_iteration)
     }
 }
 
+/* The faces of directions first .. first + n, sign s. Fetch: one
+ * sub-draw a direction, its order as vertex ids (the vertex shader
+ * reverses it for s = 1). Barrier: one multi-draw a layer, each
+ * direction's layers in turn (in reverse for s = 1), a texture barrier
+ * after each, so that each pixel is read and written once between
+ * barriers (GL 4.5 §9.3.1). */
+static void draw_faces(vlf_raster *r, uint32_t first, uint32_t n, int s, GLint *starts,
+                       GLsizei *counts)
+{
+    if (!r->barrier) {
+        for (uint32_t j = 0; j < n; j++) {
+            starts[j] = (GLint)(3 * r->order_first[first + j]);
+            counts[j] = (GLsizei)(3 * r->order_count[first + j]);
+        }
+        glMultiDrawArrays(GL_TRIANGLES, starts, counts, (GLsizei)n);
+        return;
+    }
+    uint32_t most = 0;
+    for (uint32_t j = 0; j < n; j++) {
+        uint32_t d = first + j, L = r->layer_first[d + 1] - r->layer_first[d] - 1;
+        most = L > most ? L : most;
+    }
+    for (uint32_t t = 0; t < most; t++) {
+        GLsizei m = 0;
+        for (uint32_t j = 0; j < n; j++) {
+            uint32_t d = first + j, L = r->layer_first[d + 1] - r->layer_first[d] - 1;
+            if (t >= L)
+                continue;
+            const uint32_t *ls = r->layer_start + r->layer_first[d] + (s ? L - 1 - t : t);
+            starts[m] = (GLint)(3 * (r->order_first[d] + ls[0]));
+            counts[m++] = (GLsizei)(3 * (ls[1] - ls[0]));
+        }
+        glMultiDrawArrays(GL_TRIANGLES, starts, counts, m);
+        glTextureBarrier();
+    }
+}
+
 /* One sweep (sign s) of directions first .. first + n: the skies, the
- * faces (one sub-draw a direction, its order as vertex ids), the escape. */
+ * faces, the escape. */
 static void draw_batch(vlf_raster *r, uint32_t first, uint32_t n, int s, GLint *starts,
                        GLsizei *counts)
 {
@@ -297,16 +365,16 @@ static void draw_batch(vlf_raster *r, uint32_t first, uint32_t n, int s, GLint *
     glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     glUseProgram(r->init);
     glDrawArrays(GL_TRIANGLES, 0, 3);
+    if (r->barrier)
+        glTextureBarrier();
     glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    for (uint32_t j = 0; j < n; j++) {
-        starts[j] = (GLint)(3 * r->order_first[first + j]);
-        counts[j] = (GLsizei)(3 * r->order_count[first + j]);
-    }
     glUseProgram(r->draw);
-    glMultiDrawArrays(GL_TRIANGLES, starts, counts, (GLsizei)n);
+    draw_faces(r, first, n, s, starts, counts);
     glColorMaski(0, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     glUseProgram(r->escape);
     glDrawArrays(GL_TRIANGLES, 0, 3);
+    if (r->barrier)
+        glTextureBarrier();
     glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 }
 
@@ -324,6 +392,8 @@ gi_result vlf_raster_iteration(vlf_raster *r, const vlf_field *f, int first_iter
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, GI_SSBO_PLUGIN_FIRST + 20, r->dirs);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, GI_SSBO_PLUGIN_FIRST + 21, r->signed_dirs);
     glBindFramebuffer(GL_FRAMEBUFFER, r->fbo);
+    if (r->barrier) /* the interfaces read as textures (shaders/vlf_raster.frag) */
+        glBindTextures(VLF_TEX_RI, 2, r->tex);
     glDisable(GL_DEPTH_TEST), glDisable(GL_CULL_FACE), glDisable(GL_BLEND);
     for (int k = 0; k < 4; k++)
         glEnable(GL_CLIP_DISTANCE0 + (GLenum)k);
@@ -341,6 +411,8 @@ gi_result vlf_raster_iteration(vlf_raster *r, const vlf_field *f, int first_iter
     for (int k = 0; k < 4; k++)
         glDisable(GL_CLIP_DISTANCE0 + (GLenum)k);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (r->barrier)
+        glBindTextures(VLF_TEX_RI, 2, NULL);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     free(starts), free(counts);
     return rc;

@@ -1,4 +1,3 @@
-#extension GL_EXT_shader_framebuffer_fetch : require
 // Propagation by the rasteriser (plugins/vlf/vlf_raster.c, paper §3.2,
 // §3.3, Fig. 5): one fragment per interface ray and face, in the order the
 // faces are drawn (the depth order), each reading the radiance interface
@@ -13,11 +12,29 @@
 // rule for sides, as propagate.c's sweep()). Counters per ray (shot,
 // received, back, escaped) accumulate in the second attachment over the
 // whole propagation. VLF_INIT: each tile's interface set to its sky;
-// VLF_ESCAPE: what is left on it counted as escaped.
+// VLF_ESCAPE: what is left on it counted as escaped. VLF_BARRIER: the
+// portable variant (GL 4.5 core): the interface and the counters read as
+// textures at the fragment's own texel, the faces drawn in layers in which
+// no two cover a pixel, a texture barrier between (vlf_layers.c), so each
+// texel is read and written once between barriers (GL 4.5 §9.3.1).
+#if !defined(VLF_BARRIER)
+#extension GL_EXT_shader_framebuffer_fetch : require
+#endif
 #include "glsl_shared.h"
 
+#if defined(VLF_BARRIER)
+layout(location = 0) out vec4 ri;
+layout(location = 1) out vec4 cnt;
+layout(binding = GI_TEX_PLUGIN_FIRST + 1) uniform sampler2D vlf_ri;
+layout(binding = GI_TEX_PLUGIN_FIRST + 2) uniform sampler2D vlf_cnt;
+#define VLF_LOAD()                                      \
+    ri = texelFetch(vlf_ri, ivec2(gl_FragCoord.xy), 0); \
+    cnt = texelFetch(vlf_cnt, ivec2(gl_FragCoord.xy), 0)
+#else
 layout(location = 0) inout vec4 ri;
 layout(location = 1) inout vec4 cnt;
+#define VLF_LOAD()
+#endif
 
 // per signed direction: travel direction, solid angle; sky radiance
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 21) readonly buffer VlfSigned { vec4 sdir[]; };
@@ -46,74 +63,68 @@ void main()
 #elif defined(VLF_ESCAPE)
 void main()
 {
+    VLF_LOAD();
     uint sd = tile_dir(uvec2(gl_FragCoord.xy));
     if (sd < 2u * u_l)
         cnt.w += (ri.r + ri.g + ri.b) * u_cell_area * sdir[2u * sd].w / 3.0;
 }
 #else
-struct VlfFace { vec3 n; float send_scale; vec3 kd; int nd; vec3 origin; float pad; };
-struct VlfChart { vec4 t; vec4 b; uvec4 whft; }; // axes (w: density); W, H, first element, twin
-struct VlfRect { ivec4 r; uvec4 o; };
-
-layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 0) readonly buffer VlfFaces { VlfFace faces[]; };
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 2) readonly buffer VlfElemArea { float elem_area[]; };
 // what the receivers bring: per element (u_ne values), then per tile
 // cell, each value two words (fraction x 2^32, integer part)
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 6) buffer VlfAcc { uint acc[]; };
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 7) readonly buffer VlfEMap { float emap[]; };
 layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 8) readonly buffer VlfTMap { float tmap[]; };
-layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 12) readonly buffer VlfRects { VlfRect rects[]; };
-layout(std430, binding = GI_SSBO_PLUGIN_FIRST + 19) readonly buffer VlfCharts { VlfChart charts[]; };
 
 uniform uint u_S;           // interface rays per subfield cell and side
 uniform uint u_ne;          // 3 x elements
 uniform float u_min_area;   // smallest element area used as divisor
 uniform float u_inv_s2;     // 1 / S^2
 
-in vec3 v_q;
-flat in uint v_face;
-flat in uint v_dir;
+// what is constant over a triangle comes flat from the vertex shader
+// (shaders/vlf_raster.vert), so a fragment reads only its element's and
+// tile cell's values
+in vec2 v_uv;         // the point in its chart's texels
+flat in uvec4 v_el;   // chart W, H, first element (the side's), tile offset (~0: none)
+flat in ivec4 v_rect; // the tile's rectangle of the direction: x0, y0, w
+flat in vec4 v_k;     // cos to the travel direction, send scale, dOmega
 
 // Adds v >= 0 to value k of acc: a 64-bit fixed-point add from two 32-bit
 // atomics, the carry out of the low word into the high one (integer sums
-// are exact, hence independent of order).
+// are exact, hence independent of order; a zero word is not added).
 void acc_add(uint k, float v)
 {
     float fl = floor(v);
     uint hi = uint(fl);
     uint lo = uint(min((v - fl) * 4294967296.0, 4294967040.0));
-    uint old = atomicAdd(acc[2u * k], lo);
-    if (old + lo < old)
-        hi++;
+    if (lo != 0u) {
+        uint old = atomicAdd(acc[2u * k], lo);
+        if (old + lo < old)
+            hi++;
+    }
     if (hi != 0u)
         atomicAdd(acc[2u * k + 1u], hi);
 }
 
 void main()
 {
-    uint fi = v_face & 0x7fffffffu;
-    VlfChart ch = charts[fi];
+    VLF_LOAD();
     // the element holding the ray's point (vlf_element_at): the face's
     // chart, on the twin's side its twin's elements (the same chart)
-    vec3 d = v_q - faces[fi].origin;
-    int ix = clamp(int(floor(dot(d, ch.t.xyz) * ch.t.w)), 0, int(ch.whft.x) - 1);
-    int iy = clamp(int(floor(dot(d, ch.b.xyz) * ch.t.w)), 0, int(ch.whft.y) - 1);
-    uint tf = (v_face & 0x80000000u) != 0u ? ch.whft.w : fi;
-    uint el = charts[tf].whft.z + uint(iy) * ch.whft.x + uint(ix);
-    VlfFace fc = faces[tf];
-    vec4 sd = sdir[2u * (v_dir + u_sign * u_l)];
-    float cs = dot(fc.n, sd.xyz), w = u_cell_area * sd.w / 3.0;
+    int ix = clamp(int(floor(v_uv.x)), 0, int(v_el.x) - 1);
+    int iy = clamp(int(floor(v_uv.y)), 0, int(v_el.y) - 1);
+    uint el = v_el.z + uint(iy) * v_el.x + uint(ix);
+    float cs = v_k.x, w = u_cell_area * v_k.z / 3.0;
     uint slot = 0xffffffffu;
-    if (fc.nd >= 0) {
-        VlfRect r = rects[uint(fc.nd) * u_l + v_dir];
+    if (v_el.w != 0xffffffffu) {
         ivec2 c = ivec2((uvec2(gl_FragCoord.xy) % u_NS) / u_S);
-        slot = r.o.x + uint(c.y - r.r.y) * uint(r.r.z) + uint(c.x - r.r.x);
+        slot = v_el.w + uint(c.y - v_rect.y) * uint(v_rect.z) + uint(c.x - v_rect.x);
     }
     vec3 L = ri.rgb;
     vec4 k = cnt;
     float lum = L.r + L.g + L.b;
     if (cs < 0.0) {
-        float s = u_cell_area * sd.w / max(elem_area[el], u_min_area);
+        float s = u_cell_area * v_k.z / max(elem_area[el], u_min_area);
         for (uint q = 0u; q < 3u; q++)
             acc_add(3u * el + q, L[q] * s);
         if (slot != 0xffffffffu)
@@ -123,7 +134,7 @@ void main()
     } else if (cs > 0.0) {
         k.z += lum * w;
         uint b = 2u * u_ne + 3u * el; // L_cur
-        vec3 own = vec3(emap[b], emap[b + 1u], emap[b + 2u]) * fc.send_scale;
+        vec3 own = vec3(emap[b], emap[b + 1u], emap[b + 2u]) * v_k.y;
         if (slot != 0xffffffffu)
             own += vec3(tmap[3u * slot], tmap[3u * slot + 1u], tmap[3u * slot + 2u]); // out_cur
         L = own;

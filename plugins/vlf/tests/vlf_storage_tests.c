@@ -230,7 +230,7 @@ static void test_gpu(void)
     printf("gpu: GL renderer %s\n", gi_gpu_renderer(ctx));
     vlf_gpu g;
     gi_error err;
-    int ok = vlf_gpu_init(&g, 0, &err) == GI_OK;
+    int ok = vlf_gpu_init(&g, 0, VLF_SYNC_AUTO, &err) == GI_OK;
     EXPECT(ok, "%s", err.text);
     if (ok) {
         gpu_case(&g, "scenes/cornell_glossy.gltf", VLF_PREC_32F, 1e-4);

@@ -2,7 +2,7 @@
 # glossy Cornell box at 128x128 from four cameras in one run — the scene's
 # camera, a close-up of the mirror block (three tile lookups a pixel), one
 # of the red wall alone (diffuse: one atlas read a pixel) and one from
-# above onto the glossy block — in three interleaved rounds of 8 frames
+# above onto the glossy block — in two interleaved rounds of 8 frames
 # after 2 warm-up frames each (the field is propagated once and taken from
 # the cache after). Prints each view's fastest frame time over the rounds
 # and its medians, and the ratio max / min of the fastest frames (the least
@@ -13,6 +13,8 @@
 # a loaded 2-core machine. Each view's
 # image must show the box (mean luminance > 0.01) and differ from the
 # others (the views are really different).
+# Two rounds (three until issue 29): 16 frames a view give its fastest
+# frame as well, and CI time was needed for the raster test's new run.
 # Run by ctest as: cmake -DGIB=... -DSCENES=... -DOUT=... -P vlf_views.cmake
 
 set(W ${OUT}/vlf_views)
@@ -34,10 +36,10 @@ set(images "")
 foreach(cam ${views})
     set(fast_${cam} 1e30)
 endforeach()
-# three rounds over the four views, interleaved, so that a change of the
+# two rounds over the four views, interleaved, so that a change of the
 # machine's load touches every view alike; each view's fastest frame over
 # the rounds
-foreach(round 1 2 3)
+foreach(round 1 2)
     foreach(cam ${views})
         # l = 128, not the default 512: the frame time read here does not depend on l, the propagation does (speed)
         set(args --scene ${SCENE} --method vlf --param l=128 --size 128x128 --frames 10 --warmup 2
@@ -82,7 +84,7 @@ set(min 1e30)
 set(max 0)
 set(report "")
 foreach(cam ${views})
-    string(APPEND report " ${cam} fastest ${fast_${cam}} ms, medians ${med_${cam}_1} / ${med_${cam}_2} / ${med_${cam}_3} ms"
+    string(APPEND report " ${cam} fastest ${fast_${cam}} ms, medians ${med_${cam}_1} / ${med_${cam}_2} ms"
                          " (mean luminance ${lum_${cam}});")
     if(fast_${cam} LESS min)
         set(min ${fast_${cam}})
@@ -108,7 +110,7 @@ if(n EQUAL 1)
 elseif(n EQUAL 2)
     set(r_frac "0${r_frac}")
 endif()
-message(STATUS "vlf frame time by view (glossy Cornell box, 128x128, 3 rounds of 8 frames, ${renderer}):${report} "
+message(STATUS "vlf frame time by view (glossy Cornell box, 128x128, 2 rounds of 8 frames, ${renderer}):${report} "
                "fastest frames max / min = ${r_int}.${r_frac}")
 if(NOT ratio_milli LESS 4000)
     message(FATAL_ERROR "vlf frame time depends on the view: max / min = ${r_int}.${r_frac} (bound 4)")
