@@ -26,6 +26,12 @@ typedef struct vlf_dirs {
     uint32_t tri_count;
     uint32_t *tris; /* 3 per spherical triangle, counter-clockwise seen from outside */
     float *tri_inv; /* 9 per triangle: inverse of the matrix with columns a, b, c (row-major) */
+    /* The search grid of vlf_dirs_locate: a cube map of 6 grid_n^2 cells,
+     * each listing in index order the triangles that may hold a direction
+     * of the cell (cell c: cell_tris[cell_start[c] .. cell_start[c + 1])). */
+    uint32_t grid_n;
+    uint32_t *cell_start; /* 6 grid_n^2 + 1 */
+    uint32_t *cell_tris;
 } vlf_dirs;
 
 /* Builds the set with qhull. */
@@ -35,6 +41,9 @@ void vlf_dirs_free(vlf_dirs *d);
  * weights (non-negative, summing to 1) of its three nodes; returns the
  * triangle index. */
 uint32_t vlf_dirs_locate(const vlf_dirs *d, gi_vec3 w, uint32_t node[3], float alpha[3]);
+/* The same by testing every triangle in index order, without the grid: the
+ * definition vlf_dirs_locate's answer equals (the tests compare them). */
+uint32_t vlf_dirs_locate_all(const vlf_dirs *d, gi_vec3 w, uint32_t node[3], float alpha[3]);
 
 /* Settings: the parameters' values (names of the paper where it has them). */
 typedef struct vlf_settings {

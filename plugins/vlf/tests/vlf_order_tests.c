@@ -10,6 +10,12 @@
  *                          barycentric weights of random directions are
  *                          non-negative, sum to 1 and reproduce the
  *                          direction; a node gets weight 1 itself;
+ *   vlf_order_tests locate the grid search of vlf_dirs_locate gives exactly
+ *                          the brute force's triangle and weights (random
+ *                          directions, nodes, edge midpoints and points just
+ *                          off them, the grid's cell seams, axes, signed
+ *                          zeros, unnormalised, zero and NaN directions) and
+ *                          its lists are short;
  *   vlf_order_tests order  the depth order on random non-intersecting
  *                          triangles, pinwheels of cyclically overlapping
  *                          sticks among them: the faces along every ray of
@@ -115,6 +121,85 @@ static void test_dirs(void)
                 node_ok = 0;
         }
         EXPECT(node_ok, "l=%u: a node does not get weight 1 at itself", l);
+        vlf_dirs_free(&d);
+    }
+}
+
+/* One direction through both searches: the same triangle, nodes and
+ * weights, bit for bit. 1 when equal. */
+static int locate_same(const vlf_dirs *d, gi_vec3 w)
+{
+    uint32_t n1[3], n2[3];
+    float a1[3], a2[3];
+    uint32_t t1 = vlf_dirs_locate(d, w, n1, a1), t2 = vlf_dirs_locate_all(d, w, n2, a2);
+    return t1 == t2 && !memcmp(n1, n2, sizeof n1) && !memcmp(a1, a2, sizeof a1);
+}
+
+/* The directions of locate's test for set d into locate_same; the count of
+ * disagreements. */
+static uint32_t locate_cases(const vlf_dirs *d, uint32_t *tried)
+{
+    uint32_t bad = 0, seed = 777u, k = 0;
+    for (int q = 0; q < 5000; q++, k++)
+        bad += !locate_same(d, gi_v3_scale(rand_dir(&seed), q % 2 ? 1.0f : 3.5f));
+    for (uint32_t t = 0; t < d->tri_count; t++)
+        for (int j = 0; j < 3; j++) {
+            gi_vec3 a = d->signed_dirs[d->tris[3 * t + j]];
+            gi_vec3 b = d->signed_dirs[d->tris[3 * t + (j + 1) % 3]];
+            gi_vec3 mid = gi_v3_normalize(gi_v3_add(a, b)), off = gi_v3_cross(a, b);
+            bad += !locate_same(d, a) + !locate_same(d, mid);
+            bad += !locate_same(d, gi_v3_add(mid, gi_v3_scale(off, 1e-6f)));
+            bad += !locate_same(d, gi_v3_add(mid, gi_v3_scale(off, -1e-6f)));
+            k += 4;
+        }
+    /* the seams of the grid's cells, and beside them */
+    uint32_t n = d->grid_n;
+    for (uint32_t f = 0; f < 6; f++)
+        for (uint32_t i = 0; i <= n; i++)
+            for (uint32_t j = 0; j <= 4 * n; j++) {
+                float u = -1.0f + 2.0f * (float)i / (float)n, v = -1.0f + 0.5f * (float)j / n;
+                for (int e = -1; e <= 1; e++) {
+                    float p[3], ue = u + (float)e * 1e-7f;
+                    p[f / 2] = (f & 1) ? -1.0f : 1.0f;
+                    p[(f / 2 + 1) % 3] = (k & 1) ? ue : v;
+                    p[(f / 2 + 2) % 3] = (k & 1) ? v : ue;
+                    bad += !locate_same(d, gi_v3(p[0], p[1], p[2]));
+                    k++;
+                }
+            }
+    const gi_vec3 odd[] = {gi_v3(1, 0, 0),        gi_v3(-1, 0, 0),     gi_v3(0, 1, 0),
+                           gi_v3(0, -1, 0),       gi_v3(0, 0, 1),      gi_v3(0, 0, -1),
+                           gi_v3(-0.0f, 0, 1),    gi_v3(1, 1, 1),      gi_v3(-1, 1, -1),
+                           gi_v3(0, 0, 0),        gi_v3(NAN, 0, 1),    gi_v3(1, NAN, 0),
+                           gi_v3(INFINITY, 0, 0), gi_v3(1e-30f, 0, 0), gi_v3(1e30f, 1e30f, 0)};
+    for (size_t q = 0; q < sizeof odd / sizeof odd[0]; q++, k++)
+        bad += !locate_same(d, odd[q]);
+    *tried = k;
+    return bad;
+}
+
+static void test_locate(void)
+{
+    uint32_t ls[] = {4, 8, 32, 512};
+    for (size_t li = 0; li < sizeof ls / sizeof ls[0]; li++) {
+        vlf_dirs d;
+        gi_error err;
+        EXPECT(vlf_dirs_build(&d, ls[li], &err) == GI_OK, "%s", err.text);
+        uint32_t tried = 0, bad = locate_cases(&d, &tried);
+        uint32_t cells = 6 * d.grid_n * d.grid_n, longest = 0;
+        for (uint32_t c = 0; c < cells; c++)
+            longest = d.cell_start[c + 1] - d.cell_start[c] > longest
+                          ? d.cell_start[c + 1] - d.cell_start[c]
+                          : longest;
+        double mean = (double)d.cell_start[cells] / cells;
+        printf("locate l=%u: %u triangles, %u cells, lists %.1f on average, %u at most; %u of %u "
+               "directions differ\n",
+               ls[li], d.tri_count, cells, mean, longest, bad, tried);
+        EXPECT(bad == 0, "l=%u: the grid differs from the brute force on %u of %u directions",
+               ls[li], bad, tried);
+        /* the grid must save work where it matters (l of the default) */
+        EXPECT(ls[li] < 512 || mean < 0.02 * d.tri_count, "l=%u: lists of %.1f of %u triangles",
+               ls[li], mean, d.tri_count);
         vlf_dirs_free(&d);
     }
 }
@@ -452,6 +537,6 @@ static void test_hier(void)
 int main(int argc, char **argv)
 {
     static const vlf_test_part parts[] = {
-        {"dirs", test_dirs}, {"order", test_order}, {"hier", test_hier}};
+        {"dirs", test_dirs}, {"locate", test_locate}, {"order", test_order}, {"hier", test_hier}};
     return vlf_test_main("vlf_order_tests", parts, sizeof parts / sizeof parts[0], argc, argv);
 }
