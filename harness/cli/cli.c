@@ -499,7 +499,9 @@ int cli_mkdirs(const char *path)
     return mkdir(buf, 0755) == 0 || errno == EEXIST;
 }
 
-int cli_temp_dir(const char *stem, char *out, size_t size)
+/* "$TMPDIR/<stem>-XXXXXX" (/tmp when TMPDIR is unset or empty) into out;
+ * 0 with errno ENAMETOOLONG when it does not fit. */
+static int temp_template(const char *stem, char *out, size_t size)
 {
     const char *dir = getenv("TMPDIR");
     if (!dir || !dir[0])
@@ -509,12 +511,32 @@ int cli_temp_dir(const char *stem, char *out, size_t size)
         errno = ENAMETOOLONG;
         return 0;
     }
+    return 1;
+}
+
+int cli_temp_dir(const char *stem, char *out, size_t size)
+{
+    if (!temp_template(stem, out, size))
+        return 0;
     if (mkdtemp(out))
         return 1;
     int e = errno; /* glibc leaves its last guess in out: name the template */
-    snprintf(out, size, "%s/%s-XXXXXX", dir, stem);
+    temp_template(stem, out, size);
     errno = e;
     return 0;
+}
+
+int cli_temp_file(const char *stem, char *out, size_t size)
+{
+    if (!temp_template(stem, out, size))
+        return -1;
+    int fd = mkstemp(out);
+    if (fd < 0) {
+        int e = errno; /* as cli_temp_dir: name the template, not glibc's guess */
+        temp_template(stem, out, size);
+        errno = e;
+    }
+    return fd;
 }
 
 json_object *cli_read_json(const char *path)

@@ -48,6 +48,10 @@ int cli_mkdirs(const char *path);
  * success; 0 with errno set and out holding the template that failed, for
  * the caller's error message. */
 int cli_temp_dir(const char *stem, char *out, size_t size);
+/* Makes and opens a fresh private file "$TMPDIR/<stem>-XXXXXX" the same
+ * way; returns its descriptor, or -1 with errno set and out holding the
+ * template that failed. */
+int cli_temp_file(const char *stem, char *out, size_t size);
 /* Reads a JSON file (NULL if absent or malformed). */
 json_object *cli_read_json(const char *path);
 /* Reads a JSON file a user wrote (a study, a saved view) strictly

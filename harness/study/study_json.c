@@ -4,6 +4,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "study_internal.h"
 
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -83,12 +84,11 @@ int study_get_string(json_object *o, const char *prefix, const char *key, int nu
 static json_object *read_stdin_json(char *why, size_t why_size)
 {
     /* in $TMPDIR, as every other temporary file of the harness */
-    const char *dir = getenv("TMPDIR");
     char tmp[4096];
-    snprintf(tmp, sizeof tmp, "%s/gibench-study-XXXXXX", dir && *dir ? dir : "/tmp");
-    int fd = mkstemp(tmp);
+    int fd = cli_temp_file("gibench-study", tmp, sizeof tmp);
     if (fd < 0) {
-        snprintf(why, why_size, "-: cannot make a temporary file for the study on standard input");
+        snprintf(why, why_size, "-: cannot make %s for the study on standard input: %s", tmp,
+                 strerror(errno));
         return NULL;
     }
     FILE *f = fdopen(fd, "wb");

@@ -81,6 +81,13 @@ p = run(["study", "-", "--dry-run"], out, json.dumps(dict(tiny, name="stdin", sc
 check(p.returncode == 0 and "reference box: mine/box.gltf " in p.stdout,
       "a study on standard input does not take paths from the current folder: exit %d\n%s%s"
       % (p.returncode, p.stdout, p.stderr))
+# its private copy goes under $TMPDIR; one that cannot be made is one line naming it
+bad = dict(os.environ, TMPDIR=os.path.join(out, "no_such_dir"))
+p = subprocess.run([gib, "-q", "study", "-", "--dry-run"], cwd=out, env=bad, capture_output=True,
+                   text=True, timeout=120, input=json.dumps(dict(tiny, name="stdin", scenes=["mine/box.gltf"])))
+check(p.returncode == 2 and p.stderr.count("\n") == 1 and "no_such_dir/gibench-study-XXXXXX" in p.stderr
+      and "No such file or directory" in p.stderr,
+      "an unusable TMPDIR for a study on standard input: exit %d: %s" % (p.returncode, p.stderr))
 
 # a saved view ("camera": "view:FILE") is found the same way
 view = {"gibench_view": 1, "scene": box, "method": "direct", "params": [], "width": 8, "height": 8,
