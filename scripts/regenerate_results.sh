@@ -5,7 +5,9 @@
 #   scripts/regenerate_results.sh [--dry-run] [STUDY...]
 #
 # STUDY is a folder name under results/ (default: all of them, in the order
-# below; the five-way comparison and the stress study last). --dry-run
+# below; the five-way comparison (at 128x128 and 256x256 first, so that the
+# 64x64 folder's tables set all three sizes side by side) and the stress
+# study last). --dry-run
 # prints the commands without running them. GIBENCH names the binary
 # (default build/release/bin/gibench; `make results` builds it first).
 # Each paper's study and tables script live in its plugin folder
@@ -22,7 +24,7 @@ if [[ ${1:-} == --dry-run ]]; then
     dry=1
     shift
 fi
-all=(csm csm_local avg cssm_hrc implicit_vis vlf compare_all stress)
+all=(csm csm_local avg cssm_hrc implicit_vis vlf compare_all_128 compare_all_256 compare_all stress)
 studies=("$@")
 [[ ${#studies[@]} -gt 0 ]] || studies=("${all[@]}")
 
@@ -64,10 +66,20 @@ for s in "${studies[@]}"; do
     vlf)
         study vlf plugins/vlf/study.json
         tables plugins/vlf/tables.py vlf ;;
+    compare_all_128 | compare_all_256)
+        study "$s" "harness/studies/$s.json"
+        run scripts/trivial_scores.py "results/$s" --gibench "$G"
+        tables harness/studies/compare_all_tables.py "$s" ;;
     compare_all)
+        # 64x64, with the other sizes' studies beside it where they were run
         study compare_all harness/studies/compare_all.json
         run scripts/trivial_scores.py results/compare_all --gibench "$G"
-        tables harness/studies/compare_all_tables.py compare_all ;;
+        sizes=()
+        for z in 128 256; do
+            [[ ! -f results/compare_all_$z/runs.csv ]] || sizes+=(--size-dir "results/compare_all_$z")
+        done
+        [[ ${#sizes[@]} == 0 ]] || sizes+=(--chart results/compare_all/speedup_vs_size.svg)
+        tables harness/studies/compare_all_tables.py compare_all "${sizes[@]}" ;;
     stress)
         study stress harness/studies/stress.json
         run scripts/trivial_scores.py results/stress --gibench "$G"

@@ -19,9 +19,19 @@ The per-scene Pareto fronts, equal-error and equal-time tables and charts
 are in DIR/report.md (written by the study itself). Stdlib only; runs from
 the committed runs.csv alone.
 
-Usage: harness/studies/compare_all_tables.py DIR > DIR/tables.md
+With --size-dir (repeatable), the same comparison at other image sizes
+(compare_all_128.json, compare_all_256.json, each its own invocation and so
+its own path-tracer clock) is set beside DIR's: per method and scene the
+best equal-error speed-up at each size, over the settings every size ran,
+with its spread over the path tracer's repeated curve points; --chart
+draws it as an SVG, one panel per method, one line per scene.
+
+Usage: harness/studies/compare_all_tables.py DIR [--size-dir DIR2]...
+                                                 [--chart FILE.svg] > DIR/tables.md
 """
 
+import argparse
+import math
 import os
 import sys
 
@@ -54,23 +64,161 @@ def with_prep(r):
     return sp * t / (t + prep / 1000.0)
 
 
+def spread(r, prep):
+    """The speed-up's spread over the path tracer's repeated curve points,
+    (min, max), scaled like with_prep when prep; None when not measured."""
+    lo, hi, sp = num(r.get("speedup_vs_pt_min")), num(r.get("speedup_vs_pt_max")), num(r.get("speedup_vs_pt"))
+    if lo is None or hi is None or not sp:
+        return None
+    k = with_prep(r) / sp if prep else 1.0
+    return lo * k, hi * k
+
+
 def speedup_cell(r, prep):
-    """A speed-up, with "*" where the path tracer's time is extrapolated
-    outside its measured convergence curve."""
+    """A speed-up, with its spread "(min–max)" where the study repeated the
+    path tracer's curve, and "*" where the path tracer's time is
+    extrapolated outside its measured convergence curve."""
     v = with_prep(r) if prep else num(r["speedup_vs_pt"])
-    return "%.3g%s" % (v, "*" if num(r.get("speedup_extrapolated")) == 1 else "")
+    sp = spread(r, prep)
+    return "%.3g%s%s" % (v, " (%.3g–%.3g)" % sp if sp and sp[1] > sp[0] else "",
+                         "*" if num(r.get("speedup_extrapolated")) == 1 else "")
+
+
+def size_of(rows):
+    """The one image size of a study's runs, as "WxH"."""
+    sizes = sorted({"%sx%s" % (r["width"], r["height"]) for r in rows if r.get("width")})
+    if len(sizes) != 1:
+        sys.exit("compare_all_tables.py: expected one image size per study, found %s" % (sizes or "none"))
+    return sizes[0]
+
+
+def setting(r):
+    """A run's setting: its method and parameters without the label."""
+    return (r["method"], r["params"].split(",label=")[0])
+
+
+def short_setting(r, varying):
+    """The parameters of a run that vary over its method's runs, "k=v,..."."""
+    kv = [p.split("=", 1) for p in setting(r)[1].split(",") if "=" in p]
+    return ",".join("%s=%s" % (k, v) for k, v in kv if k in varying.get(r["method"], ())) or "defaults"
+
+
+def varying_keys(studies):
+    """method -> the parameter names whose values differ between its runs."""
+    seen = {}
+    for _, rows in studies:
+        for r in rows:
+            for p in setting(r)[1].split(","):
+                if "=" in p:
+                    k, v = p.split("=", 1)
+                    seen.setdefault(r["method"], {}).setdefault(k, set()).add(v)
+    return {m: {k for k, vs in d.items() if len(vs) > 1} for m, d in seen.items()}
+
+
+def by_size(studies):
+    """studies: [(size, rows)]. Per (method, scene): at each size the run
+    with the best equal-error speed-up among the settings every size ran
+    for that method and scene."""
+    common = None
+    for _, rows in studies:
+        have = {(setting(r), scene_name(r["scene"])) for r in rows
+                if r["status"] == "ok" and num(r.get("speedup_vs_pt")) is not None}
+        common = have if common is None else common & have
+    out = {}
+    for size, rows in studies:
+        for r in rows:
+            s = scene_name(r["scene"])
+            if (setting(r), s) not in common or r["status"] != "ok" or num(r.get("speedup_vs_pt")) is None:
+                continue
+            key = (r["method"], s)
+            cur = out.setdefault(key, {}).get(size)
+            if cur is None or num(r["speedup_vs_pt"]) > num(cur["speedup_vs_pt"]):
+                out[key][size] = r
+    return out
+
+
+def svg_chart(path, sizes, table, methods, scenes):
+    """Speed-up against image size: a panel per method (log-log), a line
+    per scene, the spread as a vertical bar at each point."""
+    pw, ph, m = 300, 220, 46
+    cols = 3
+    rows_n = (len(methods) + cols - 1) // cols
+    colours = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
+               "#7f7f7f", "#bcbd22", "#17becf", "#000000", "#aec7e8"]
+    vals = [v for key in table for r in table[key].values()
+            for v in (num(r.get("speedup_vs_pt")), num(r.get("speedup_vs_pt_min")), num(r.get("speedup_vs_pt_max")))
+            if v is not None and v > 0]
+    if not vals:
+        sys.exit("compare_all_tables.py: no speed-ups to draw")
+    lo, hi = math.floor(math.log10(min(vals))), math.ceil(math.log10(max(vals)))
+    hi = max(hi, lo + 1)
+    px = [int(z.split("x")[0]) for z in sizes]
+    x0, x1 = math.log2(min(px)), math.log2(max(px))
+    x1 = max(x1, x0 + 1)
+    legend_h = 16 * ((len(scenes) + 3) // 4) + 10
+    W, H = cols * (pw + m) + m, rows_n * (ph + m) + m + legend_h
+    o = ['<svg xmlns="http://www.w3.org/2000/svg" width="%d" height="%d" font-family="sans-serif" '
+         'font-size="11"><rect width="100%%" height="100%%" fill="white"/>' % (W, H)]
+    for i, meth in enumerate(methods):
+        ox, oy = m + (i % cols) * (pw + m), m + (i // cols) * (ph + m)
+        X = lambda z: ox + (math.log2(z) - x0) / (x1 - x0) * pw  # noqa: E731
+        Y = lambda v: oy + ph - (math.log10(v) - lo) / (hi - lo) * ph  # noqa: E731
+        o.append('<rect x="%d" y="%d" width="%d" height="%d" fill="none" stroke="#888"/>' % (ox, oy, pw, ph))
+        o.append('<text x="%d" y="%d" font-weight="bold">%s</text>' % (ox, oy - 6, meth))
+        for e in range(lo, hi + 1):
+            y = Y(10.0 ** e)
+            o.append('<line x1="%d" x2="%d" y1="%.1f" y2="%.1f" stroke="#ddd"/>' % (ox, ox + pw, y, y))
+            o.append('<text x="%d" y="%.1f" text-anchor="end">1e%d</text>' % (ox - 4, y + 4, e))
+        y1 = Y(1.0)
+        o.append('<line x1="%d" x2="%d" y1="%.1f" y2="%.1f" stroke="#888" stroke-dasharray="4"/>' % (ox, ox + pw, y1, y1))
+        for z in px:
+            o.append('<text x="%.1f" y="%d" text-anchor="middle">%d²</text>' % (X(z), oy + ph + 14, z))
+        for j, s in enumerate(scenes):
+            pts = [(int(z.split("x")[0]), table.get((meth, s), {}).get(z)) for z in sizes]
+            pts = [(z, r) for z, r in pts if r is not None and num(r.get("speedup_vs_pt"))]
+            c = colours[j % len(colours)]
+            if len(pts) > 1:
+                o.append('<polyline fill="none" stroke="%s" points="%s"/>' % (c, " ".join(
+                    "%.1f,%.1f" % (X(z), Y(num(r["speedup_vs_pt"]))) for z, r in pts)))
+            for z, r in pts:
+                o.append('<circle cx="%.1f" cy="%.1f" r="2.5" fill="%s"/>' % (X(z), Y(num(r["speedup_vs_pt"])), c))
+                a, b = num(r.get("speedup_vs_pt_min")), num(r.get("speedup_vs_pt_max"))
+                if a and b:
+                    o.append('<line x1="%.1f" x2="%.1f" y1="%.1f" y2="%.1f" stroke="%s"/>' % (X(z), X(z), Y(a), Y(b), c))
+    ly = rows_n * (ph + m) + m
+    o.append('<text x="%d" y="%d">Equal-error speed-up over path tracing (log) against image size; '
+             'dashed: 1; bars: spread over the path tracer\'s repeated curve points.</text>' % (m, ly - 8))
+    for j, s in enumerate(scenes):
+        x, y = m + (j % 4) * 230, ly + 10 + 16 * (j // 4)
+        o.append('<line x1="%d" x2="%d" y1="%d" y2="%d" stroke="%s" stroke-width="3"/>'
+                 '<text x="%d" y="%d">%s</text>' % (x, x + 18, y, y, colours[j % len(colours)], x + 22, y + 4, s))
+    o.append("</svg>")
+    tmp = path + ".tmp"
+    with open(tmp, "w") as fh:
+        fh.write("\n".join(o) + "\n")
+    os.replace(tmp, path)
 
 
 def main():
-    if len(sys.argv) != 2:
-        sys.exit("usage: compare_all_tables.py DIR")
-    d = sys.argv[1]
-    try:
-        rows = load_runs_csv(d)
-    except OSError as e:
-        sys.exit("compare_all_tables.py: %s" % e)
-    if not rows:
-        sys.exit("compare_all_tables.py: %s/runs.csv has no runs" % d)
+    ap = argparse.ArgumentParser(prog="compare_all_tables.py")
+    ap.add_argument("dir")
+    ap.add_argument("--size-dir", action="append", default=[])
+    ap.add_argument("--chart")
+    a = ap.parse_args()
+    d = a.dir
+
+    def load(dd):
+        try:
+            got = load_runs_csv(dd)
+        except OSError as e:
+            sys.exit("compare_all_tables.py: %s" % e)
+        if not got:
+            sys.exit("compare_all_tables.py: %s/runs.csv has no runs" % dd)
+        return got
+    rows = load(d)
+    others = [load(dd) for dd in a.size_dir]
+    if a.chart and not others:
+        sys.exit("compare_all_tables.py: --chart needs at least one --size-dir")
 
     scenes = []
     for r in rows:
@@ -98,11 +246,12 @@ def main():
     w = out.append
     w("# The five-way comparison: summary\n")
     w("Made by `harness/studies/compare_all_tables.py %s` from `runs.csv` of "
-      "`gibench study harness/studies/compare_all.json --out %s --jobs 1`. "
+      "`gibench study harness/studies/%s --out %s --jobs 1`. "
       "GL renderer: %s; timer: %s; image size %s. Lower relMSE is better. "
       "The per-scene Pareto fronts, equal-error and equal-time tables and "
       "the error-against-time charts are in [report.md](report.md).\n"
-      % (shown, shown, ", ".join(renderers) or "?", ", ".join(timers) or "?", ", ".join(sizes)))
+      % (shown, "compare_all.json" if sizes == ["64x64"] else "compare_all_%s.json" % sizes[0].split("x")[0]
+         if len(sizes) == 1 else "?", shown, ", ".join(renderers) or "?", ", ".join(timers) or "?", ", ".join(sizes)))
 
     def best(key):
         runs = ok.get(key)
@@ -198,6 +347,47 @@ def main():
                 fmt(num(b.get("speedup_vs_pt_matched"))),
                 fmt(None if prep is None else prep / 1000.0, "%.3g"), *memory_cells(b)))
         w("")
+
+    # 4. the same comparison at other sizes
+    if others:
+        studies = sorted([(size_of(rows), rows)] + [(size_of(o), o) for o in others],
+                         key=lambda t: int(t[0].split("x")[0]))
+        sizes = [z for z, _ in studies]
+        if len(set(sizes)) != len(sizes):
+            sys.exit("compare_all_tables.py: two studies at the same size %s" % sizes)
+        table = by_size(studies)
+        w("## Equal-error speed-up against image size\n")
+        w("Each study (%s) is its own invocation: its path-tracer curve and its "
+          "methods are timed together, never across studies. Each cell: the best "
+          "speed-up at that size over the settings that every size ran for the "
+          "method and scene, with its spread (min–max over the path tracer's "
+          "repeated curve points) and its setting (the swept parameters); "
+          "\"*\": extrapolated, as above.%s\n"
+          % (", ".join("`%s` %s" % (os.path.relpath(dd), z) for dd, z in
+                      sorted(zip([d] + a.size_dir, [size_of(rows)] + [size_of(o) for o in others]),
+                             key=lambda t: int(t[1].split("x")[0]))),
+             " Chart: [%s](%s)." % (os.path.basename(a.chart), os.path.relpath(a.chart, d)) if a.chart else ""))
+        varying = varying_keys(studies)
+        w("| method | scene | " + " | ".join(sizes) + " | setting at %s |" % sizes[-1])
+        w("|---|---|" + "---:|" * len(sizes) + "---|")
+        all_scenes = []
+        for _, rr in studies:
+            for r in rr:
+                if scene_name(r["scene"]) not in all_scenes:
+                    all_scenes.append(scene_name(r["scene"]))
+        for m in methods:
+            for s in all_scenes:
+                got = table.get((m, s))
+                if not got:
+                    continue
+                last = got.get(sizes[-1])
+                w("| %s | %s | %s | `%s` |" % (m, s, " | ".join(
+                    speedup_cell(got[z], 0) if z in got else "–" for z in sizes),
+                    short_setting(last, varying) if last else "–"))
+        w("")
+        if a.chart:
+            svg_chart(a.chart, sizes, table, [m for m in methods if any(k[0] == m for k in table)],
+                      [s for s in all_scenes if any(k[1] == s for k in table)])
     sys.stdout.write("\n".join(out) + "\n")
 
 
