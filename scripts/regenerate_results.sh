@@ -15,6 +15,9 @@
 # harness/studies/. Steps done by hand and described in the study's README
 # (avg's VPL region dumps and speed table, cssm_hrc's Fig. 16) are not part
 # of this script.
+# Each finished study's wall and CPU time (of its commands, in seconds) goes
+# into results/regenerate_times.csv, one line per study, replacing the
+# study's earlier line: the time `make results` takes on this machine.
 # Exit status: that of the first command that fails; 2 on an unknown study.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -47,7 +50,32 @@ study() {
     run "$G" study "$2" --out "results/$1" --jobs 1 --fresh
 }
 
+# child_cpu VAR: VAR = seconds of user and system CPU time of this shell's
+# finished children so far (bash's `times`, run in this shell: in a command
+# substitution it would count the subshell's children only).
+cpu_tmp=$(mktemp)
+trap 'rm -f "$cpu_tmp"' EXIT
+child_cpu() {
+    times > "$cpu_tmp"
+    printf -v "$1" '%s' "$(tail -n 1 "$cpu_tmp" |
+        awk '{ for (i = 1; i <= 2; i++) { split($i, a, /[ms]/); t += a[1] * 60 + a[2] } print t }')"
+}
+# record STUDY WALL CPU: the study's line of results/regenerate_times.csv
+# (the time `make results` takes, per study, on this machine) replaced.
+record() {
+    local f=results/regenerate_times.csv
+    {
+        echo "study,date,commit,wall_s,cpu_s,cores"
+        [[ ! -f $f ]] || tail -n +2 "$f" | grep -v "^$1," || true
+        printf '%s,%s,%s,%s,%s,%s\n' "$1" "$(date -u +%Y-%m-%dT%H:%MZ)" "$(git rev-parse --short HEAD 2>/dev/null || echo ?)" \
+            "$2" "$3" "$(nproc)"
+    } > "$f.tmp"
+    mv "$f.tmp" "$f"
+}
+
 for s in "${studies[@]}"; do
+    t0=$(date +%s.%N)
+    child_cpu c0
     case $s in
     csm)
         study csm plugins/csm/study.json
@@ -88,4 +116,7 @@ for s in "${studies[@]}"; do
         echo "regenerate_results.sh: unknown study '$s' (one of: ${all[*]})" >&2
         exit 2 ;;
     esac
+    child_cpu c1
+    [[ $dry == 1 ]] || record "$s" "$(awk -v a="$(date +%s.%N)" -v b="$t0" 'BEGIN { printf "%.0f", a - b }')" \
+        "$(awk -v a="$c1" -v b="$c0" 'BEGIN { printf "%.0f", a - b }')"
 done
