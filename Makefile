@@ -42,6 +42,7 @@ demo: build
 # Every committed study under results/ afresh, with its tables (hours on
 # llvmpipe; scripts/regenerate_results.sh STUDY... for one).
 results: build
+	@bash scripts/install-deps.sh --sources
 	GIBENCH=$(GIBENCH) scripts/regenerate_results.sh
 
 clean:

@@ -6,7 +6,8 @@ Usage: readme_numbers.py RESULTS_FOLDER[:README]...
 Issue 34: a results README may only quote numbers that the study's tables
 script prints.  This checker reads README.md (or the README after the colon) of each
 results folder and every generated file beside it -- tables.md and, where a
-tables script writes one, values.md -- and prints each measured number of
+tables script writes one, values.md; for results/ itself also startup.md,
+reference_speed.md and each study folder's tables.md -- and prints each measured number of
 the README that no generated file holds, with its line, then exits 1.
 
 What counts as a measured number (docs/studies.md, "Numbers in results
@@ -82,11 +83,29 @@ def value(num, exp):
     return v, dec
 
 
+# The files a results folder's scripts generate: the tables scripts'
+# tables.md and values.md; at the top of results/ also the start-up and
+# reference-speed measurements (scripts/startup_time.py,
+# scripts/ref-vs-embree.sh) written by scripts/regenerate_results.sh.
+GENERATED = ("tables.md", "values.md", "startup.md", "reference_speed.md")
+
+
+def generated_files(folder):
+    """The generated files a folder's README may quote: its own, and where
+    the folder holds study folders (results/ itself, whose README sums
+    them up) each study folder's tables.md."""
+    out = [os.path.join(folder, n) for n in GENERATED]
+    if os.path.isdir(folder):
+        for sub in sorted(os.listdir(folder)):
+            if os.path.isfile(os.path.join(folder, sub, "README.md")):
+                out.append(os.path.join(folder, sub, "tables.md"))
+    return out
+
+
 def generated_values(folder):
-    """All numbers in the folder's generated files (tables.md, values.md)."""
+    """All numbers in the folder's generated files (generated_files)."""
     vals = []
-    for name in ("tables.md", "values.md"):
-        path = os.path.join(folder, name)
+    for path in generated_files(folder):
         if not os.path.exists(path):
             continue
         with open(path, encoding="utf-8") as f:
@@ -175,7 +194,7 @@ def check(folder, readme):
         return -1
     vals = generated_values(folder)
     if not vals:
-        print(f"readme_numbers: {folder}: no generated tables.md or values.md", file=sys.stderr)
+        print(f"readme_numbers: {folder}: no generated tables (%s)" % ", ".join(GENERATED), file=sys.stderr)
         return -1
     bad = offenders(readme, vals)
     for no, tok, line in bad:

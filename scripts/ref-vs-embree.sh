@@ -25,7 +25,9 @@
 # system, getrusage; less sensitive to other processes) and wall time are
 # reported, as medians over the rounds, and the ratio of our samples/s to
 # Embree's. Several gibench builds may be given (e.g. before and after);
-# each also runs with --traversal robust when it knows the option.
+# each also runs with --traversal robust when it knows the option. The report
+# is Markdown on standard output (`make results` keeps it as
+# results/reference_speed.md).
 # Needs: embree-tools (scripts/install-deps.sh --sources), python3.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -78,7 +80,7 @@ EOF
   *) echo "ref-vs-embree: --scene '$scene' is not point or area" >&2; exit 2 ;;
 esac
 
-python3 - "$tmp" "$rounds" "$spp" "$size" "$length" "$ours_scene" "${builds[@]}" <<'EOF'
+REF_SCENE_KIND=$scene python3 - "$tmp" "$rounds" "$spp" "$size" "$length" "$ours_scene" "${builds[@]}" <<'EOF'
 import json, os, random, resource, statistics, subprocess, sys, time
 
 tmp, rounds, spp, size, length = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4]), int(sys.argv[5])
@@ -140,10 +142,17 @@ for _ in range(rounds):
             render_s[k].append(st["render_seconds"])
 
 samples = (spp - 1) * size * size
-print("%dx%d, %d vs 1 spp, path length %d, 1 thread, %d interleaved rounds (medians); ours: %s" % (size, size, spp, length, rounds, os.path.basename(ours_scene)))
+load = os.getloadavg()
+print("# Reference speed against Embree's tutorial path tracer\n")
+print("Made by `scripts/ref-vs-embree.sh --rounds %d --spp %d --size %d --length %d --scene %s %s`: "
+      "%dx%d, %d against 1 spp (the difference cancels start-up, loading and the BVH build), path length %d, "
+      "1 thread, %d interleaved rounds, medians; ours on %s. Load average at the end: %.1f, %.1f, %.1f.\n"
+      % (rounds, spp, size, length, os.environ.get("REF_SCENE_KIND", "?"),
+         " ".join(builds), size, size, spp, length, rounds, os.path.basename(ours_scene), load[0], load[1], load[2]))
 for i, b in enumerate(builds):
-    print("  gibench[%d] = %s" % (i, b))
-print("%-26s %14s %14s %14s" % ("program", "Msamples/s cpu", "Msamples/s wall", "ratio cpu (wall)"))
+    print("- gibench[%d] = `%s`" % (i, b))
+print("\n| program | Msamples/s (CPU) | Msamples/s (wall) | ratio to Embree, CPU (wall) | own render_seconds at %d spp (Msamples/s) |" % spp)
+print("|---|---:|---:|---:|---:|")
 rates = {}
 for k, (name, _) in enumerate(programs):
     # per round: (time at spp) - (time at 1 spp) of the same round
@@ -152,9 +161,9 @@ for k, (name, _) in enumerate(programs):
     rates[k] = (samples / dc / 1e6, samples / dw / 1e6)
 for k, (name, _) in enumerate(programs):
     rc, rw = rates[k]
-    print("%-26s %14.3f %14.3f %8.2fx (%.2fx)" % (name, rc, rw, rc / rates[0][0], rw / rates[0][1]))
-for k, (name, _) in enumerate(programs):
+    own = "–"
     if k > 0:
         med = statistics.median(render_s[k])
-        print("  %s: its own render_seconds at %d spp, median %.3f s = %.3f Msamples/s" % (name, spp, med, spp * size * size / med / 1e6))
+        own = "%.3f" % (spp * size * size / med / 1e6)
+    print("| %s | %.3f | %.3f | %.2f× (%.2f×) | %s |" % (name, rc, rw, rc / rates[0][0], rw / rates[0][1], own))
 EOF

@@ -4,10 +4,11 @@
 #
 #   scripts/regenerate_results.sh [--dry-run] [STUDY...]
 #
-# STUDY is a folder name under results/ (default: all of them, in the order
-# below; the five-way comparison (at 128x128 and 256x256 first, so that the
-# 64x64 folder's tables set all three sizes side by side) and the stress
-# study last). --dry-run
+# STUDY is a folder name under results/, or startup / reference_speed (the
+# Markdown reports results/startup.md and results/reference_speed.md);
+# default: all of them, in the order below (the five-way comparison at
+# 128x128 and 256x256 before 64x64, so that the 64x64 folder's tables set
+# the three sizes side by side; start-up and reference speed last). --dry-run
 # prints the commands without running them. GIBENCH names the binary
 # (default build/release/bin/gibench; `make results` builds it first).
 # Each paper's study and tables script live in its plugin folder
@@ -27,7 +28,8 @@ if [[ ${1:-} == --dry-run ]]; then
     dry=1
     shift
 fi
-all=(csm csm_local avg cssm_hrc implicit_vis vlf compare_all_128 compare_all_256 compare_all stress)
+all=(csm csm_local avg cssm_hrc implicit_vis vlf compare_all_128 compare_all_256 compare_all stress startup
+     reference_speed)
 studies=("$@")
 [[ ${#studies[@]} -gt 0 ]] || studies=("${all[@]}")
 
@@ -112,6 +114,21 @@ for s in "${studies[@]}"; do
         study stress harness/studies/stress.json
         run scripts/trivial_scores.py results/stress --gibench "$G"
         tables harness/studies/stress_tables.py stress ;;
+    startup | reference_speed)
+        # results/startup.md, results/reference_speed.md: start-up time and
+        # the reference's speed against Embree's tutorial path tracer
+        # (embree-tools: scripts/install-deps.sh --sources), Markdown
+        # reports that results/README.md quotes
+        if [[ $s == startup ]]; then
+            cmd=(python3 scripts/startup_time.py --runs 20 "now=$G")
+        else
+            cmd=(scripts/ref-vs-embree.sh --rounds 12 "$G")
+        fi
+        echo "+ ${cmd[*]} > results/$s.md"
+        if [[ $dry == 0 ]]; then
+            "${cmd[@]}" > "results/$s.md.tmp"
+            mv "results/$s.md.tmp" "results/$s.md"
+        fi ;;
     *)
         echo "regenerate_results.sh: unknown study '$s' (one of: ${all[*]})" >&2
         exit 2 ;;

@@ -6,9 +6,12 @@
 Every round runs, in a fresh random order, `/bin/true` (a process that does
 nothing), and for each build `gibench methods` and a 16x16 one-frame render
 of the Cornell box with the `direct` method writing an EXR and a PNG (what
-a study cell writes). Wall time per run and CPU time (user + system of the
-child, from getrusage) are kept; the report gives medians and the overhead
-over /bin/true, and the ratio of each build to the first one. CPU time is
+a study cell writes), once with Mesa's shader cache as the earlier runs
+left it (warm) and once with it disabled (MESA_SHADER_CACHE_DISABLE=true:
+every shader compiled, as on a machine's first run). Wall time per run and CPU time (user + system of the
+child, from getrusage) are kept; the report (Markdown, on standard output:
+`make results` keeps it as results/startup.md) gives medians and the
+overhead over /bin/true, and the ratio of each build to the first one. CPU time is
 less sensitive than wall time to other processes sharing the machine.
 Run from the repository root (the scene path is relative to it).
 """
@@ -22,10 +25,11 @@ import tempfile
 import time
 
 
-def run(argv):
+def run(argv, env=None):
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    p = subprocess.run(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    p = subprocess.run(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                       env=None if env is None else dict(os.environ, **env))
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if p.returncode != 0:
@@ -50,16 +54,17 @@ def main():
     if not builds:
         sys.exit(__doc__)
     tmp = tempfile.mkdtemp(prefix="gibench-startup-")
-    cmds = [("true", "-", ["/bin/true"])]
+    cmds = [("true", "-", ["/bin/true"], None)]
+    cold = {"MESA_SHADER_CACHE_DISABLE": "true"}
     for name, path in builds:
-        cmds.append(("methods", name, [path, "methods"]))
-        cmds.append(("render 16x16", name,
-                     [path, "render", "--scene", "scenes/cornell_box.gltf", "--method", "direct",
-                      "--size", "16x16", "--frames", "1", "--warmup", "0",
-                      "--out", os.path.join(tmp, name + ".exr"),
-                      "--out", os.path.join(tmp, name + ".png")]))
+        cmds.append(("methods", name, [path, "methods"], None))
+        render = [path, "render", "--scene", "scenes/cornell_box.gltf", "--method", "direct",
+                  "--size", "16x16", "--frames", "1", "--warmup", "0",
+                  "--out", os.path.join(tmp, name + ".exr"), "--out", os.path.join(tmp, name + ".png")]
+        cmds.append(("render 16x16, warm shader cache", name, render, None))
+        cmds.append(("render 16x16, cold shader cache", name, render, cold))
     for c in cmds:  # one untimed run each: page cache, shader cache
-        run(c[2])
+        run(c[2], c[3])
     wall = {i: [] for i in range(len(cmds))}
     cpu = {i: [] for i in range(len(cmds))}
     rng = random.Random(1)
@@ -67,27 +72,35 @@ def main():
         order = list(range(len(cmds)))
         rng.shuffle(order)
         for i in order:
-            w, c = run(cmds[i][2])
+            w, c = run(cmds[i][2], cmds[i][3])
             wall[i].append(w)
             cpu[i].append(c)
     med_w = {i: statistics.median(v) for i, v in wall.items()}
     med_c = {i: statistics.median(v) for i, v in cpu.items()}
-    print("%d interleaved rounds; medians; overhead = command - /bin/true" % runs)
-    print("%-14s %-10s %10s %10s %12s %12s" % ("command", "build", "wall s", "cpu s",
-                                              "wall ovh s", "cpu ovh s"))
-    for i, (what, name, _) in enumerate(cmds):
-        print("%-14s %-10s %10.4f %10.4f %12.4f %12.4f" % (what, name, med_w[i], med_c[i],
-                                                          med_w[i] - med_w[0], med_c[i] - med_c[0]))
+    load = os.getloadavg()
+    print("# Start-up time\n")
+    print("Made by `scripts/startup_time.py --runs %d %s`: %d interleaved rounds in a random order, "
+          "medians; CPU time = user + system of the child; overhead = the command's median "
+          "minus `/bin/true`'s. Load average at the end: %.1f, %.1f, %.1f (1, 5, 15 min); %d cores.\n"
+          % (runs, " ".join("%s=%s" % b for b in builds), runs, load[0], load[1], load[2],
+             os.cpu_count() or 0))
+    print("| command | build | wall (s) | CPU (s) | wall overhead (s) | CPU overhead (s) |")
+    print("|---|---|---:|---:|---:|---:|")
+    for i, (what, name, _, _) in enumerate(cmds):
+        print("| %s | %s | %.4f | %.4f | %.4f | %.4f |" % (what, name, med_w[i], med_c[i],
+                                                        med_w[i] - med_w[0], med_c[i] - med_c[0]))
     if len(builds) > 1:
-        print("ratios of paired medians (each round's run of build 1 / the same round's run of build k):")
-        for what in ("methods", "render 16x16"):
+        print("\nRatios of paired medians (each round's run of the first build / the same round's "
+              "run of the other):\n")
+        print("| command | builds | wall | CPU |")
+        print("|---|---|---:|---:|")
+        for what in sorted({c[0] for c in cmds if c[1] != "-"}):
             first = [i for i, c in enumerate(cmds) if c[0] == what][0]
             for i, c in enumerate(cmds):
                 if c[0] == what and i != first:
                     rw = statistics.median(a / b for a, b in zip(wall[first], wall[i]))
                     rc = statistics.median(a / b for a, b in zip(cpu[first], cpu[i]) if b > 0)
-                    print("  %-14s %s / %s: wall %.2fx, cpu %.2fx" % (what, cmds[first][1], c[1], rw, rc))
-
+                    print("| %s | %s / %s | %.2f× | %.2f× |" % (what, cmds[first][1], c[1], rw, rc))
 
 if __name__ == "__main__":
     main()
