@@ -6,7 +6,7 @@ Usage: readme_numbers.py RESULTS_FOLDER[:README]...
 Issue 34: a results README may only quote numbers that the study's tables
 script prints.  This checker reads README.md (or the README after the colon) of each
 results folder and every generated file beside it -- tables.md and, where a
-tables script writes one, values.md; for results/ itself also startup.md,
+tables script writes one, values.md, and the rerun's changes.md; for results/ itself also startup.md,
 reference_speed.md and each study folder's tables.md -- and prints each measured number of
 the README that no generated file holds, with its line, then exits 1.
 
@@ -84,10 +84,11 @@ def value(num, exp):
 
 
 # The files a results folder's scripts generate: the tables scripts'
-# tables.md and values.md; at the top of results/ also the start-up and
+# tables.md and values.md, the rerun's changes.md (scripts/results_changes.py);
+# at the top of results/ also the start-up and
 # reference-speed measurements (scripts/startup_time.py,
 # scripts/ref-vs-embree.sh) written by scripts/regenerate_results.sh.
-GENERATED = ("tables.md", "values.md", "startup.md", "reference_speed.md")
+GENERATED = ("tables.md", "values.md", "changes.md", "startup.md", "reference_speed.md")
 
 
 def generated_files(folder):

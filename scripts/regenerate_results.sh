@@ -16,6 +16,8 @@
 # harness/studies/. Steps done by hand and described in the study's README
 # (avg's VPL region dumps and speed table, cssm_hrc's Fig. 16) are not part
 # of this script.
+# After each study, results/STUDY/changes.md: what the rerun changed against
+# the committed runs.csv (scripts/results_changes.py, base HEAD).
 # Each finished study's wall and CPU time (of its commands, in seconds) goes
 # into results/regenerate_times.csv, one line per study, replacing the
 # study's earlier line: the time `make results` takes on this machine.
@@ -133,6 +135,14 @@ for s in "${studies[@]}"; do
         echo "regenerate_results.sh: unknown study '$s' (one of: ${all[*]})" >&2
         exit 2 ;;
     esac
+    # what the rerun changed against the committed run (results/STUDY/changes.md)
+    if [[ -f results/$s/README.md ]] && git cat-file -e "HEAD:results/$s/runs.csv" 2> /dev/null; then
+        echo "+ scripts/results_changes.py results/$s > results/$s/changes.md"
+        if [[ $dry == 0 ]]; then
+            python3 scripts/results_changes.py "results/$s" > "results/$s/changes.md.tmp"
+            mv "results/$s/changes.md.tmp" "results/$s/changes.md"
+        fi
+    fi
     child_cpu c1
     [[ $dry == 1 ]] || record "$s" "$(awk -v a="$(date +%s.%N)" -v b="$t0" 'BEGIN { printf "%.0f", a - b }')" \
         "$(awk -v a="$c1" -v b="$c0" 'BEGIN { printf "%.0f", a - b }')"
