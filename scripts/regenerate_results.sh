@@ -60,7 +60,8 @@ for s in "${studies[@]}"; do
         study cssm_hrc plugins/cssm_hrc/study.json
         tables plugins/cssm_hrc/tables.py cssm_hrc ;;
     implicit_vis)
-        study implicit_vis plugins/implicit_vis/study.json ;;
+        study implicit_vis plugins/implicit_vis/study.json
+        tables plugins/implicit_vis/tables.py implicit_vis ;;
     vlf)
         study vlf plugins/vlf/study.json
         tables plugins/vlf/tables.py vlf ;;

@@ -9,6 +9,7 @@ set(failures 0)
 # study folder, script, extra arguments
 set(cases "avg|plugins/avg/tables.py|${GIB}" "csm|plugins/csm/tables.py|" "csm_local|plugins/csm/tables.py|"
           "vlf|plugins/vlf/tables.py|" "cssm_hrc|plugins/cssm_hrc/tables.py|"
+          "implicit_vis|plugins/implicit_vis/tables.py|"
           "stress|harness/studies/stress_tables.py|"
           "compare_all|harness/studies/compare_all_tables.py|")
 foreach(c ${cases})
@@ -44,8 +45,7 @@ endforeach()
 # Folders left out, with the reason:
 #   avg: 371 prose numbers from earlier runs, not yet in plugins/avg/tables.py
 #   csm: 155 prose numbers from earlier runs, not yet in plugins/csm/tables.py
-#   implicit_vis: no tables script yet; its prose mixes three runs
-set(checked csm_local compare_all stress cssm_hrc vlf)
+set(checked csm_local compare_all stress cssm_hrc vlf implicit_vis)
 set(folders "")
 foreach(study ${checked})
     list(APPEND folders ${ROOT}/results/${study})
