@@ -6,7 +6,8 @@ Usage: readme_numbers.py RESULTS_FOLDER[:README]...
 Issue 34: a results README may only quote numbers that the study's tables
 script prints.  This checker reads README.md (or the README after the colon) of each
 results folder and every generated file beside it -- tables.md and, where a
-tables script writes one, values.md -- and prints each measured number of
+tables script writes one, values.md, and the tables.md of a sub-study folder
+one level down (results/avg/speed/tables.md) -- and prints each measured number of
 the README that no generated file holds, with its line, then exits 1.
 
 What counts as a measured number (docs/studies.md, "Numbers in results
@@ -82,11 +83,20 @@ def value(num, exp):
     return v, dec
 
 
+def generated_files(folder):
+    """The folder's generated files: tables.md, values.md, and the tables.md
+    of each sub-study folder one level down."""
+    out = [os.path.join(folder, n) for n in ("tables.md", "values.md")]
+    if os.path.isdir(folder):
+        out += [os.path.join(folder, d, "tables.md") for d in sorted(os.listdir(folder))
+                if os.path.isdir(os.path.join(folder, d))]
+    return [p for p in out if os.path.isfile(p)]
+
+
 def generated_values(folder):
-    """All numbers in the folder's generated files (tables.md, values.md)."""
+    """All numbers in the folder's generated files."""
     vals = []
-    for name in ("tables.md", "values.md"):
-        path = os.path.join(folder, name)
+    for path in generated_files(folder):
         if not os.path.exists(path):
             continue
         with open(path, encoding="utf-8") as f:

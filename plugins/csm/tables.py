@@ -17,6 +17,9 @@ import os
 import statistics
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
+from study_tables import report_fronts  # noqa: E402
+
 # Paper, Table 1, "Distant Lat-long Bunny", M = 128: total maps ->
 # (uncompressed, compressed, time, ratio) as printed.
 PAPER_T1 = {1024: ("32.0 MB", "3.9 MB", "4 s", 8.2),
@@ -87,37 +90,6 @@ def fit_line(points):
 
 def mb(b):
     return "%.1f MB" % (b / 2 ** 20) if b < 2 ** 30 else "%.2f GB" % (b / 2 ** 30)
-
-
-def report_fronts(d):
-    """The path tracer's convergence lines and the equal-error tables of the
-    study's report.md (written by gibench study from curves.csv), copied so
-    that the README's speed-against-accuracy numbers are generated ones."""
-    path = os.path.join(d, "report.md")
-    if not os.path.exists(path):
-        return []
-    with open(path, encoding="utf-8") as f:
-        lines = f.read().split("\n")
-    out = ["\n### Speed against accuracy (copied from report.md: the path tracer's convergence, the equal-error "
-           "fronts)\n"]
-    i = 0
-    while i < len(lines):
-        ln = lines[i]
-        if ln.startswith("Path tracer convergence on "):
-            out.append(ln + "\n")
-        elif ln.startswith("#### ") and ": equal error" in ln:
-            out.append(ln + "\n")
-            j = i + 1
-            while j < len(lines) and not lines[j].startswith("|"):
-                j += 1
-            while j < len(lines) and lines[j].startswith("|"):
-                out.append(lines[j])
-                j += 1
-            out.append("")
-            i = j
-            continue
-        i += 1
-    return out if len(out) > 1 else []
 
 
 def main():
