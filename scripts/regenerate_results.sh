@@ -12,7 +12,8 @@
 # (plugins/<id>/study.json, tables.py); the cross-method ones in
 # harness/studies/. Steps done by hand and described in the study's README
 # (avg's VPL region dumps and speed table, cssm_hrc's Fig. 16) are not part
-# of this script.
+# of this script. vlf's Fig. 8 image is plugins/vlf/fig8.py's, from the
+# study's EXR images (the gibench Python module next to the binary).
 # Exit status: that of the first command that fails; 2 on an unknown study.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -64,6 +65,8 @@ for s in "${studies[@]}"; do
         tables plugins/implicit_vis/tables.py implicit_vis ;;
     vlf)
         study vlf plugins/vlf/study.json
+        run env PYTHONPATH="$(dirname "$G")/../python" /usr/bin/python3 plugins/vlf/fig8.py results/vlf \
+            --label fig8_paper --out results/vlf/fig8_paper.png
         tables plugins/vlf/tables.py vlf ;;
     compare_all)
         study compare_all harness/studies/compare_all.json
