@@ -6,8 +6,10 @@ Usage: readme_numbers.py RESULTS_FOLDER[:README]...
 Issue 34: a results README may only quote numbers that the study's tables
 script prints.  This checker reads README.md (or the README after the colon) of each
 results folder and every generated file beside it -- tables.md and, where a
-tables script writes one, values.md, and the rerun's changes.md; for results/ itself also startup.md,
-reference_speed.md and each study folder's tables.md -- and prints each measured number of
+tables script writes one, values.md, and the rerun's changes.md; the
+tables.md of each sub-study folder one level down (results/avg/speed/, and
+for results/ itself each study folder); for results/ also startup.md and
+reference_speed.md -- and prints each measured number of
 the README that no generated file holds, with its line, then exits 1.
 
 What counts as a measured number (docs/studies.md, "Numbers in results
@@ -85,22 +87,22 @@ def value(num, exp):
 
 # The files a results folder's scripts generate: the tables scripts'
 # tables.md and values.md, the rerun's changes.md (scripts/results_changes.py);
-# at the top of results/ also the start-up and
-# reference-speed measurements (scripts/startup_time.py,
-# scripts/ref-vs-embree.sh) written by scripts/regenerate_results.sh.
+# at the top of results/ also the start-up and reference-speed measurements
+# (scripts/startup_time.py, scripts/ref-vs-embree.sh) written by
+# scripts/regenerate_results.sh.
 GENERATED = ("tables.md", "values.md", "changes.md", "startup.md", "reference_speed.md")
 
 
 def generated_files(folder):
-    """The generated files a folder's README may quote: its own, and where
-    the folder holds study folders (results/ itself, whose README sums
-    them up) each study folder's tables.md."""
+    """The generated files a folder's README may quote: its own (GENERATED)
+    and the tables.md of each folder one level down (a sub-study such as
+    results/avg/speed/; for results/ itself, whose README sums the studies
+    up, each study's tables)."""
     out = [os.path.join(folder, n) for n in GENERATED]
     if os.path.isdir(folder):
-        for sub in sorted(os.listdir(folder)):
-            if os.path.isfile(os.path.join(folder, sub, "README.md")):
-                out.append(os.path.join(folder, sub, "tables.md"))
-    return out
+        out += [os.path.join(folder, d, "tables.md") for d in sorted(os.listdir(folder))
+                if os.path.isdir(os.path.join(folder, d))]
+    return [p for p in out if os.path.isfile(p)]
 
 
 def generated_values(folder):

@@ -15,7 +15,8 @@
 # (plugins/<id>/study.json, tables.py); the cross-method ones in
 # harness/studies/. Steps done by hand and described in the study's README
 # (avg's VPL region dumps and speed table, cssm_hrc's Fig. 16) are not part
-# of this script.
+# of this script. vlf's Fig. 8 image is plugins/vlf/fig8.py's, from the
+# study's EXR images (the gibench Python module next to the binary).
 # After each study, results/STUDY/changes.md: what the rerun changed against
 # the committed runs.csv (scripts/results_changes.py, base HEAD).
 # Each finished study's wall and CPU time (of its commands, in seconds) goes
@@ -94,9 +95,12 @@ for s in "${studies[@]}"; do
         study cssm_hrc plugins/cssm_hrc/study.json
         tables plugins/cssm_hrc/tables.py cssm_hrc ;;
     implicit_vis)
-        study implicit_vis plugins/implicit_vis/study.json ;;
+        study implicit_vis plugins/implicit_vis/study.json
+        tables plugins/implicit_vis/tables.py implicit_vis ;;
     vlf)
         study vlf plugins/vlf/study.json
+        run env PYTHONPATH="$(dirname "$G")/../python" /usr/bin/python3 plugins/vlf/fig8.py results/vlf \
+            --label fig8_paper --out results/vlf/fig8_paper.png
         tables plugins/vlf/tables.py vlf ;;
     compare_all_128 | compare_all_256)
         study "$s" "harness/studies/$s.json"

@@ -63,3 +63,34 @@ def load_trivial(d):
             return {r["reference"]: num(r["relmse"]) for r in csv.DictReader(fh)}
     except OSError:
         return {}
+
+
+def report_fronts(d):
+    """The path tracer's convergence lines and the equal-error tables of the
+    study's report.md (written by gibench study from curves.csv), copied so
+    that the README's speed-against-accuracy numbers are generated ones."""
+    path = os.path.join(d, "report.md")
+    if not os.path.exists(path):
+        return []
+    with open(path, encoding="utf-8") as f:
+        lines = f.read().split("\n")
+    out = ["\n### Speed against accuracy (copied from report.md: the path tracer's convergence, the equal-error "
+           "fronts)\n"]
+    i = 0
+    while i < len(lines):
+        ln = lines[i]
+        if ln.startswith("Path tracer convergence on "):
+            out.append(ln + "\n")
+        elif ln.startswith("#### ") and ": equal error" in ln:
+            out.append(ln + "\n")
+            j = i + 1
+            while j < len(lines) and not lines[j].startswith("|"):
+                j += 1
+            while j < len(lines) and lines[j].startswith("|"):
+                out.append(lines[j])
+                j += 1
+            out.append("")
+            i = j
+            continue
+        i += 1
+    return out if len(out) > 1 else []

@@ -29,6 +29,9 @@ import os
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
+from study_tables import report_fronts  # noqa: E402
+
 # Paper, Table I (1024x768, GeForce 8800 GTX): ms per stage and FPS.
 PAPER_T1 = [("U Room", 156, 0.4, 1.8, 19.9, 19.1, 62.1, 22.3),
             ("Elephant", 2113, 1.4, 1.9, 28.6, 19.7, 61.8, 21.1),
@@ -256,6 +259,7 @@ def main():
                 diff = num(r, "mean_lum_diff_pct")
                 w("| %s | %s | %.1f %% | %.0f | %s |" % (sname, r["bounces"], 100 * num(r, "mean_rel_se"),
                                                       num(r, "wall_seconds"), pct(diff) if diff == diff else "–"))
+    out.extend(report_fronts(d))
     print("\n".join(out))
     return 0
 

@@ -17,6 +17,9 @@ import os
 import statistics
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
+from study_tables import report_fronts  # noqa: E402
+
 # Paper, Table 1, "Distant Lat-long Bunny", M = 128: total maps ->
 # (uncompressed, compressed, time, ratio) as printed.
 PAPER_T1 = {1024: ("32.0 MB", "3.9 MB", "4 s", 8.2),
@@ -293,6 +296,7 @@ def main():
             w("| %s (`%s`) | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f |" % (
                 r["label"], r["run"], len(fr), statistics.median(fr), min(fr), max(fr), statistics.mean(fr),
                 num(r, "stage_render_ms_median"), num(r, "prepare_ms") / 1000.0))
+    out.extend(report_fronts(d))
     print("\n".join(out))
 
 
