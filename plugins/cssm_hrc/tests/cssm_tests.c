@@ -4,6 +4,9 @@
  *               box charts, the furnace sphere's surface samples); zig-zag
  *               and spiral steps stay between neighbouring texels of a
  *               chart except at a stated few jumps
+ *   order       Table 2: the walk order over the same chart texels changes
+ *               the segments little, the greedy walk's surface samples
+ *               much (order_tests.c)
  *   tree        the skip-pointer traversal equals a recursive depth-first
  *               traversal, for full traversals and for selective ones
  *               with pseudo-random refine decisions; spheres hold their
@@ -73,13 +76,15 @@ int main(int argc, char **argv)
         fprintf(
             stderr,
             "usage: cssm_tests "
-            "traversal|tree|visibility|furnace|hull|motion|motion2|texture|compact|compact_furnace|"
+            "traversal|order|tree|visibility|furnace|hull|motion|motion2|texture|compact|compact_furnace|"
             "compact_limit|escape|representative|refine_limit\n");
         return 2;
     }
     int r;
     if (!strcmp(argv[1], "traversal"))
         r = cssm_test_traversal();
+    else if (!strcmp(argv[1], "order"))
+        r = cssm_test_order();
     else if (!strcmp(argv[1], "tree"))
         r = cssm_test_tree();
     else if (!strcmp(argv[1], "refine_limit"))
