@@ -87,10 +87,11 @@ def main():
                 pp = PAPER_T1[("texels", n)] / PAPER_T1[("pixels", n)]
                 print("| %s | time(pixels) / time(texels), n = %d | %.2f | %.2f | %.2f |" % (scene, n, a[1] / b[1], a[0] / b[0], pp))
 
-    def metrics_table(label_prefix, keys, title, extra=()):
-        """Runs whose label starts with label_prefix: their parameters `keys`,
-        the errors, and `extra` columns (header, runs.csv column, format[, scale])."""
-        sel = [r for r in ok if r["label"].startswith(label_prefix)]
+    def metrics_table(label_prefix, keys, title, extra=(), where=None):
+        """Runs whose label starts with label_prefix (or, given, for which
+        where(run) holds): their parameters `keys`, the errors, and `extra`
+        columns (header, runs.csv column, format[, scale])."""
+        sel = [r for r in ok if (where(r) if where else r["label"].startswith(label_prefix))]
         if not sel:
             return
         print("\n## %s\n" % title)
@@ -109,7 +110,9 @@ def main():
     metrics_table("fig15", ["atlas", "M", "bounces", "clamp"], "Fig. 15: against the path-traced reference")
     metrics_table("fig16", ["atlas", "bounces"], "Fig. 16: bounce count n (pixels get 0 .. n + 1 bounces)")
     fig14(d, ok)
-    metrics_table("fig14_pcf", ["atlas", "pcf"], "Fig. 14: nearest against PCF look-ups")
+    # the PCF runs: label fig14_pcf (runs before issue 34: fig14 without vis)
+    metrics_table("fig14_pcf", ["atlas", "pcf"], "Fig. 14: nearest against PCF look-ups",
+                  where=lambda r: r["label"] == "fig14_pcf" or (r["label"] == "fig14" and "vis" not in params(r)))
     metrics_table("fig12", ["jitter"], "Fig. 12: highly glossy Cornell box, jittering, error over accumulated frames")
     metrics_table("mc", ["indirect", "mc_samples"], "Sec. 4.6: indirect light by Monte Carlo from the atlas as a pdf, against the cuts")
     metrics_table("clamp", ["clamp"], "Clamping: darkening against the clamp distance")
