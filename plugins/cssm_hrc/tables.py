@@ -114,6 +114,9 @@ def main():
     metrics_table("fig14_pcf", ["atlas", "pcf"], "Fig. 14: nearest against PCF look-ups",
                   where=lambda r: r["label"] == "fig14_pcf" or (r["label"] == "fig14" and "vis" not in params(r)))
     metrics_table("fig12", ["jitter"], "Fig. 12: highly glossy Cornell box, jittering, error over accumulated frames")
+    metrics_table("deficit12", ["atlas", "threshold", "max_cut", "vis", "clamp"],
+                  "Fig. 12's mean-luminance deficit: one candidate changed at a time; the blocks black (kd = ks = 0)",
+                  [("cut (pixels)", "stat_cut_size_pixels", "%.0f")])
     metrics_table("mc", ["indirect", "mc_samples"], "Sec. 4.6: indirect light by Monte Carlo from the atlas as a pdf, against the cuts")
     metrics_table("clamp", ["clamp"], "Clamping: darkening against the clamp distance")
     timing = [("prepare (s; CSSMs read from the cache where an earlier run made them)", "prepare_ms", "%.1f", 1e-3), ("frame (ms)", "frame_ms_median", "%.0f")]
