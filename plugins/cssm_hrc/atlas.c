@@ -787,7 +787,8 @@ void cssm_traversal_measures(const cssm_atlas *a, const uint32_t *order, cssm_tr
             m->jumps++;
             jumped += d;
         }
-        if (gi_v3_dot(p->n, q->n) < 0.999f || fabsf(gi_v3_dot(p->n, gi_v3_sub(q->p, p->p))) > 1e-3f * h)
+        if (gi_v3_dot(p->n, q->n) < 0.999f ||
+            fabsf(gi_v3_dot(p->n, gi_v3_sub(q->p, p->p))) > 1e-3f * h)
             m->plane_changes++;
     }
     m->step_mean = a->count > 1 ? total / (a->count - 1) : 0.0;

@@ -73,11 +73,10 @@ int cssm_test_load_gpu(const char *rel, gi_gpu **gpu, gi_scene **s, gi_gpu_scene
 int main(int argc, char **argv)
 {
     if (argc != 2) {
-        fprintf(
-            stderr,
-            "usage: cssm_tests "
-            "traversal|order|tree|visibility|furnace|hull|motion|motion2|texture|compact|compact_furnace|"
-            "compact_limit|escape|representative|refine_limit\n");
+        fprintf(stderr, "usage: cssm_tests "
+                        "traversal|order|tree|visibility|furnace|hull|motion|motion2|texture|"
+                        "compact|compact_furnace|"
+                        "compact_limit|escape|representative|refine_limit\n");
         return 2;
     }
     int r;

@@ -46,10 +46,12 @@ static int order_segments(const gi_gpu_scene *gs, const cssm_atlas *a, cssm_trav
     cssm_traversal_measures(a, order, &tm);
     *seg = (double)cssm_maps_segments(&m) / (6.0 * ORDER_M * ORDER_M);
     *step = tm.step_mean;
-    printf("%-14s %4u texels: %.2f segments per face texel, compression %.2f : 1, mean step %.3f h, "
-           "%u jumps (%.0f %% of the path), %u plane changes\n",
-           name, a->count, *seg, (double)cssm_maps_bytes_uncompressed(&m) / (double)cssm_maps_bytes(&m),
-           tm.step_mean, tm.jumps, 100.0 * tm.jump_length_share, tm.plane_changes);
+    printf(
+        "%-14s %4u texels: %.2f segments per face texel, compression %.2f : 1, mean step %.3f h, "
+        "%u jumps (%.0f %% of the path), %u plane changes\n",
+        name, a->count, *seg,
+        (double)cssm_maps_bytes_uncompressed(&m) / (double)cssm_maps_bytes(&m), tm.step_mean,
+        tm.jumps, 100.0 * tm.jump_length_share, tm.plane_changes);
     cssm_maps_free(&m);
     free(order);
     return 1;
@@ -72,7 +74,7 @@ static int iid_samples(const gi_scene *s, cssm_atlas *a)
             gi_vec3 p[3];
             gi_scene_triangle_world(s, ob->first_triangle + k, 0.0f, p);
             cdf[k + 1] = cdf[k] + 0.5 * gi_v3_length(gi_v3_cross(gi_v3_sub(p[1], p[0]),
-                                                                  gi_v3_sub(p[2], p[0])));
+                                                                 gi_v3_sub(p[2], p[0])));
         }
         for (uint32_t i = 0; i < a->count; i++) {
             cssm_texel *x = &a->texels[i];
@@ -101,7 +103,8 @@ static int iid_samples(const gi_scene *s, cssm_atlas *a)
 
 int cssm_test_order(void)
 {
-    const char *scene = getenv("ORDER_SCENE") ? getenv("ORDER_SCENE") : "scenes/cornell_box_coarse.gltf";
+    const char *scene =
+        getenv("ORDER_SCENE") ? getenv("ORDER_SCENE") : "scenes/cornell_box_coarse.gltf";
     const uint32_t R = getenv("ORDER_R") ? (uint32_t)atoi(getenv("ORDER_R")) : 32;
     gi_gpu *gpu = NULL;
     gi_scene *s = NULL;
@@ -128,17 +131,19 @@ int cssm_test_order(void)
         const double chart_best = fmin(seg[2], seg[3]);
         const double walk = fabs(chart_best - seg[1]) / seg[1], points = 1.0 - seg[0] / seg[1];
         printf("walk order over the same texels: %.1f %% of the greedy walk's segments; "
-               "samples instead of texels: %.1f %% fewer; the samples re-placed at random: %.1f %% fewer\n",
+               "samples instead of texels: %.1f %% fewer; the samples re-placed at random: %.1f %% "
+               "fewer\n",
                100.0 * walk, 100.0 * points, 100.0 * (1.0 - seg[4] / seg[1]));
         const double texels_max = fmax(seg[1], fmax(seg[2], seg[3]));
         const double texels_min = fmin(seg[1], fmin(seg[2], seg[3]));
-        CHECK_MSG(walk <= 0.10, "the walk order over the same texels changes the segments by %.1f %%",
+        CHECK_MSG(walk <= 0.10,
+                  "the walk order over the same texels changes the segments by %.1f %%",
                   100.0 * walk);
         CHECK_MSG(seg[0] < texels_min, "the systematic samples' walk (%.2f) is not the best (%.2f)",
                   seg[0], texels_min);
         CHECK_MSG(seg[4] >= 1.15 * texels_max,
-                  "the random samples' walk (%.2f) is not 15 %% above every texel order (%.2f)", seg[4],
-                  texels_max);
+                  "the random samples' walk (%.2f) is not 15 %% above every texel order (%.2f)",
+                  seg[4], texels_max);
     } else {
         CHECK_MSG(0, "set-up failed");
     }
