@@ -56,6 +56,7 @@ set(GI_TEST_COSTS
     integration.cli 11
     integration.implicit_vis_truth_box 11
     integration.anim_study 11
+    integration.cssm_vis_trace 10
     integration.cssm_gpu_gather_cornell_box 9
     integration.tradeoff 9
     unit.fuzz_study_brief 9
