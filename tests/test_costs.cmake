@@ -91,6 +91,7 @@ set(GI_TEST_COSTS_ASAN
     integration.implicit_vis_furnace 10
     unit.test_csm_codec 10
     integration.avg_visibility 10
+    integration.cssm_order 10
     integration.csm_visibility 9
     integration.view_stale 9
     integration.view_light_drag 9
