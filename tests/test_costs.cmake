@@ -56,6 +56,7 @@ set(GI_TEST_COSTS
     integration.cli 11
     integration.implicit_vis_truth_box 11
     integration.anim_study 11
+    integration.cssm_vis_trace 10
     integration.cssm_gpu_gather_cornell_box 9
     integration.tradeoff 9
     unit.fuzz_study_brief 9
@@ -90,6 +91,7 @@ set(GI_TEST_COSTS_ASAN
     integration.implicit_vis_furnace 10
     unit.test_csm_codec 10
     integration.avg_visibility 10
+    integration.cssm_order 10
     integration.csm_visibility 9
     integration.view_stale 9
     integration.view_light_drag 9

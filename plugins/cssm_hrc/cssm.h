@@ -24,6 +24,7 @@
 #include "gi/algo/csm_codec.h"
 #include "gi/method.h"
 #include "gi/passes.h"
+#include "gi/raytrace.h"
 #include "gi/vecmath.h"
 
 struct cssm_receiver;
@@ -116,6 +117,17 @@ int cssm_chart_bicubic(const cssm_atlas *a, uint32_t chart, float u, float v, co
  * along the path when stuck (spiral); surface samples follow, greedily.
  * Returns a malloc'd array or NULL on no memory. */
 uint32_t *cssm_traverse(const cssm_atlas *a, cssm_traversal how);
+/* How a traversal steps through the atlas (Table 2's explanation): the mean
+ * 3D step between consecutive cube maps in texel sizes h, the steps longer
+ * than 2 h (jumps: a chart change, a sample far off) and their share of the
+ * path's length, the steps that leave a plane (normal or plane changes). */
+typedef struct cssm_traversal_measure {
+    double step_mean;
+    uint32_t jumps;
+    double jump_length_share;
+    uint32_t plane_changes;
+} cssm_traversal_measure;
+void cssm_traversal_measures(const cssm_atlas *a, const uint32_t *order, cssm_traversal_measure *m);
 const char *cssm_traversal_name(cssm_traversal how);
 
 /* ----------------------------------------------------------------- CSSM */
@@ -343,6 +355,11 @@ typedef struct cssm_gather_opts {
                        * (lightcuts' representative, hrc.c pick_leaf) */
     int no_emission; /* cssm_solve: R_1 = direct only, the emitting texels not gathered (their light
                       * comes from the direct light of direct=csm, §4.7) */
+    /* set (vis=trace): every gather's visibility is an exact ray query from the
+     * receiver to the point it gathers from (the VPL, jittered or not) instead of
+     * the CSSM look-up: the paper's Fig. 14 comparison; the ray ends `bias`
+     * short of that point */
+    const gi_rt *trace;
     /* set: cssm_solve_ex's per-texel gathers (§4.1.1) run there instead of
      * the C loop (bounces_on=gpu, gpu_gather.c): every texel of the atlas
      * gathered from node_L (or the packed nodes ct) into out[3 N], the

@@ -66,6 +66,10 @@ static const gi_param_desc cssm_params[] = {
      "CSSM depth bias as a fraction of the scene diameter"},
     {"pcf", GI_PARAM_BOOL, 0, 0, 1, NULL, "PCF (Sec. 3.2.2)",
      "CSSM look-ups filtered over 2 x 2 texels"},
+    {"vis", GI_PARAM_ENUM, 0, 0, 0, "cssm|trace", "visibility (Fig. 14)",
+     "cssm: the CSSM look-up (the paper's method); trace: an exact ray query (the core's ray "
+     "tracer) from the receiver to each gathered point, in the bounces and the final gather, "
+     "the paper's Fig. 14 comparison; runs the C gathers (gather and bounces_on ignored)"},
     {"mode", GI_PARAM_ENUM, 0, 0, 0, "pixels|texels", "samples (Table 1, Fig. 17)",
      "pixels: final gather per pixel; texels: view-dependent lightmap, the final (glossy) gather "
      "of the indirect light "
@@ -148,6 +152,7 @@ static gi_result cssm_create(const gi_host *host, const gi_params *params, void 
     c->env_pixel = gi_params_bool(params, "env_pixel");
     c->env_mode = gi_params_enum(params, "env");
     c->pcf = gi_params_bool(params, "pcf");
+    c->vis = gi_params_enum(params, "vis");
     c->shadow_size = gi_params_int(params, "shadow_size");
     c->mode = gi_params_enum(params, "mode");
     c->indirect = gi_params_enum(params, "indirect");
@@ -185,6 +190,8 @@ static void release_prepared(cssm_hrc *c)
     c->texel_Le = c->texel_B = c->texel_E = NULL;
     gi_rt_free(c->rt);
     c->rt = NULL;
+    gi_rt_free(c->vis_rt);
+    c->vis_rt = NULL;
     for (int i = 0; i < 3; i++) {
         free(c->cdf[i]);
         c->cdf[i] = NULL;
@@ -249,13 +256,17 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);
     cssm_stats_data_bytes(c);
+    if (c->vis && (r = gi_rt_create(gs->scene, gs->time, &c->vis_rt, &err)) != GI_OK)
+        return gi_kit_fail_with(&c->kit, r, &err);
+    if (c->vis && (c->gather == 0 || c->bounces_on == 0))
+        host->log(host, GI_LOG_INFO, "vis=trace: the C gathers run (gather=cpu, bounces_on=cpu)");
     r = cssm_lighting(c, gs);
     if (r != GI_OK)
         return r;
-    const char *no_gpu = c->gather == 0 ? cssm_gpu_unsupported(c, gs->scene) : NULL;
+    const char *no_gpu = c->gather == 0 && !c->vis ? cssm_gpu_unsupported(c, gs->scene) : NULL;
     if (no_gpu)
         host->log(host, GI_LOG_INFO, "gather=gpu does not cover %s: the C gather runs", no_gpu);
-    c->gpu_on = c->gather == 0 && !no_gpu;
+    c->gpu_on = c->gather == 0 && !c->vis && !no_gpu;
     c->gpu_dirty = 1;
     c->cpu_frames = 0, c->cpu_process_s = c->cpu_main_s = 0.0;
     host->stat(host, "gather_gpu", c->gpu_on);
@@ -280,6 +291,11 @@ static gi_result cssm_update(void *inst, const gi_gpu_scene *gs, const gi_change
         gi_result r = cssm_place_movers(c, gs); /* §3.3, the atlas lit again below */
         if (r != GI_OK)
             return r;
+        gi_error err;
+        if (c->vis_rt && (r = gi_rt_set_time(c->vis_rt, gs->time, &err)) != GI_OK) {
+            c->prepared = 0;
+            return gi_kit_fail_with(&c->kit, r, &err);
+        }
         moved = 1;
     }
     if (moved || (changes->flags & (GI_CHANGED_LIGHTS | GI_CHANGED_MATERIALS))) {

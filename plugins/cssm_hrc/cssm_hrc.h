@@ -66,6 +66,8 @@ typedef struct cssm_hrc {
     int env_pixel;  /* 1: environment light traced per pixel; 0: the texels' irradiance looked up */
     int env_mode;   /* environment visibility: 0 ray tracer, 1 the texels' own CSSMs (env_cssm.c) */
     gi_rt *rt;      /* the scene for the environment's occlusion, NULL without environment */
+    int vis;        /* 1: vis=trace, the gathers' visibility by ray queries (Fig. 14) */
+    gi_rt *vis_rt;  /* vis=trace: the scene for those queries */
     float *texel_E; /* environment irradiance per texel, 3 per texel; NULL: no environment */
     float *accum;   /* running average, 4 per pixel */
     float *gb[5];   /* G-buffer read-back: position, normal, albedo, phong, emission */

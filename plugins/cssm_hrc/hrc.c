@@ -298,6 +298,17 @@ static uint32_t pick_leaf(const cssm_tree *t, const float *node_L, const cssm_ct
     return v.first;
 }
 
+/* vis=trace (Fig. 14): 1 when nothing lies on the segment from the receiver
+ * x along unit w to the gathered point at distance d, less the depth bias at
+ * the sender's end (the point lies on its own surface), else 0. */
+static float trace_visible(const cssm_gather_opts *o, gi_vec3 x, gi_vec3 w, float d)
+{
+    float tmax = d - o->bias;
+    if (!(tmax > 0.0f))
+        return 1.0f;
+    return gi_rt_occluded(o->trace, x, w, 0.0f, tmax) ? 0.0f : 1.0f;
+}
+
 /* One gathered node: sample position (the node's gather position, or with
  * jitter a random point of a leaf texel below it, §4.5), visibility
  * through that texel's CSSM (the leaf: pick_leaf). leaves: leaf rank ->
@@ -347,7 +358,9 @@ static void transfer(const cssm_tree *t, const float *node_L, const cssm_ctree *
         if (st)
             st->clamped++;
     }
-    float v = maps ? cssm_visible_rc(maps, vis_texel, rc, o->bias, o->pcf) : 1.0f;
+    float v = o->trace ? trace_visible(o, rc->x, w, d)
+              : maps   ? cssm_visible_rc(maps, vis_texel, rc, o->bias, o->pcf)
+                       : 1.0f;
     if (v <= 0.0f)
         return;
     float g = cr * cs / d2 * v;
@@ -582,12 +595,15 @@ void cssm_gather_mc(const cssm_atlas *a, const cssm_maps *maps, const float *tex
         float d2 = gi_v3_dot(w, w);
         if (!(d2 > 0.0f))
             continue;
-        w = gi_v3_scale(w, 1.0f / sqrtf(d2));
+        const float d = sqrtf(d2);
+        w = gi_v3_scale(w, 1.0f / d);
         float cr = gi_v3_dot(rc->n, w), cs = -gi_v3_dot(x->n, w);
         if (cr <= 0.0f || cs <= 0.0f)
             continue;
         d2 = fmaxf(d2, o->clamp * o->clamp);
-        float v = maps ? cssm_visible_rc(maps, lo, rc, o->bias, o->pcf) : 1.0f;
+        float v = o->trace ? trace_visible(o, rc->x, w, d)
+                  : maps   ? cssm_visible_rc(maps, lo, rc, o->bias, o->pcf)
+                           : 1.0f;
         if (v <= 0.0f)
             continue;
         float g = (float)(x->area * cr * cs / d2 * v / (p * S));

@@ -24,7 +24,8 @@ cssm_gather_opts cssm_hrc_gather_opts(const cssm_hrc *c, float exposure, uint32_
                           .bias = c->bias_f * c->atlas.diameter,
                           .pcf = c->pcf,
                           .rng = rng,
-                          .rep_centroid = c->rep_centroid};
+                          .rep_centroid = c->rep_centroid,
+                          .trace = c->vis ? c->vis_rt : NULL};
     return o;
 }
 
@@ -233,11 +234,12 @@ gi_result cssm_lighting(cssm_hrc *c, const gi_gpu_scene *gs)
     cssm_gather_opts o = cssm_hrc_gather_opts(c, 0.0f, NULL);
     o.no_emission = c->csm != NULL; /* R1 = the CSMs' direct light alone */
     /* §4.1.1 "HRC on the GPU": the per-texel gathers in a compute pass */
-    if (c->bounces_on == 0 && (r = cssm_gpu_bounces(c, &o)) != GI_OK) {
+    const int gpu_bounces = c->bounces_on == 0 && !c->vis; /* vis=trace: the C loop */
+    if (gpu_bounces && (r = cssm_gpu_bounces(c, &o)) != GI_OK) {
         free(D);
         return r;
     }
-    host->stat(host, "bounces_gpu", c->bounces_on == 0);
+    host->stat(host, "bounces_gpu", gpu_bounces);
     cssm_gather_stats st = {0};
     gi_error err;
     const float *direct = c->shadow_count || env || c->csm ? D : NULL;
