@@ -118,8 +118,12 @@ static const gi_param_desc cssm_params[] = {
      "the C traversal (the oracle). gpu falls back to cpu, with a log line and stat gather_gpu 0, "
      "for mode=texels, indirect=mc, direct=csm, moving objects, punctual lights and environments"},
     {"bounces_on", GI_PARAM_ENUM, 0, 0, 0, "gpu|cpu", "Sec. 4.1.1 (HRC on the GPU), Fig. 8",
-     "where the HRC bounces' per-texel gathers run (prepare, and when lights or materials "
-     "change): gpu, a compute pass per bounce (the paper's); cpu, the C loop (the oracle)"},
+     "where the HRC bounces' per-texel gathers run (see bounces_every): gpu, a compute pass "
+     "per bounce (the paper's); cpu, the C loop (the oracle)"},
+    {"bounces_every", GI_PARAM_ENUM, 0, 0, 0, "frame|change", "Sec. 4.1.1, Table 1",
+     "when the HRC bounces are solved: frame, every frame (the paper's: its fps depend on the "
+     "bounces), with jitter the senders drawn anew each frame as in the final gather (Sec. "
+     "4.5); change, at prepare and when lights, materials or objects change"},
     {"shadow_size", GI_PARAM_INT, 256, 16, 2048, NULL, NULL,
      "face size of the point/spot lights' shadow cube maps and of directional lights' shadow maps"},
     {0},
@@ -159,6 +163,7 @@ static gi_result cssm_create(const gi_host *host, const gi_params *params, void 
     c->csm_M = gi_params_int(params, "csm_M");
     c->gather = gi_params_enum(params, "gather");
     c->bounces_on = gi_params_enum(params, "bounces_on");
+    c->bounces_every = gi_params_enum(params, "bounces_every");
     c->motion.moving = -1;
     *out = c;
     return GI_OK;
@@ -172,12 +177,14 @@ static void release_prepared(cssm_hrc *c)
     for (int i = 0; i < 3; i++)
         cssm_ctree_free(&c->ct[i]);
     free(c->order);
+    free(c->texel_D);
     free(c->texel_L);
     free(c->node_L);
     free(c->node_Le);
     free(c->node_B);
     free(c->texel_T);
     c->order = NULL;
+    c->texel_D = NULL;
     c->texel_L = c->node_L = c->node_Le = c->node_B = c->texel_T = NULL;
     free(c->texel_Le);
     free(c->texel_B);
@@ -323,6 +330,13 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
     gi_result r = gi_kit_frame_begin(kit, view, what | (random ? 0u : GI_KIT_NO_AVERAGE));
     if (r != GI_OK)
         return r;
+    /* bounces_every=frame: the n HRC bounces solved every frame (§4.1.1;
+     * Table 1's fps fall with n), the senders jittered per frame (§4.5) */
+    if (c->bounces_every == 0 &&
+        (r = cssm_bounces_solve(c, c->jitter, kit->frames, view->seed)) != GI_OK) {
+        c->prepared = 0; /* the light sets may be gone: render refuses until the next prepare */
+        return r;
+    }
     r = gi_kit_render_gbuffer(kit, view, "gbuffer");
     if (r != GI_OK)
         return r;

@@ -216,16 +216,44 @@ static GLuint program_for(GLuint *progs, const char *comp, int pcf, int jitter, 
     return progs[index];
 }
 
-/* The buffers when the lighting changed (prepare, update). */
+/* The texels, their albedo and the six CSSM faces, uploaded once per
+ * prepare or update (c->gpu_maps_ok; cssm_lighting clears it), shared by
+ * the final gather and the bounces; the buffers made on first use. */
+static gi_result maps_setup(cssm_hrc *c)
+{
+    if (!c->gpu_buf[0])
+        glCreateBuffers(CSSM_GPU_BUFFERS, c->gpu_buf);
+    if (!c->gpu_bounce_buf[0])
+        glCreateBuffers(2, c->gpu_bounce_buf);
+    if (c->gpu_maps_ok)
+        return GI_OK;
+    const cssm_atlas *a = &c->atlas;
+    float *alb = calloc(4 * (size_t)a->count + 4, sizeof *alb);
+    if (!alb)
+        return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the maps");
+    for (uint32_t i = 0; i < a->count; i++)
+        memcpy(&alb[4 * i], a->texels[i].albedo, 3 * sizeof(float));
+    upload(c->gpu_bounce_buf[0], 4 * (size_t)a->count * sizeof *alb, alb);
+    free(alb);
+    glNamedBufferData(c->gpu_bounce_buf[1], (GLsizeiptr)(3 * (size_t)a->count + 4) * 4, NULL,
+                      GL_DYNAMIC_READ);
+    gi_result r = upload_maps(c);
+    if (r != GI_OK)
+        return r;
+    c->gpu_maps_ok = 1;
+    return GI_OK;
+}
+
+/* The buffers: the maps when the scene or materials changed, the nodes
+ * when the lighting did (every frame with bounces_every=frame). */
 static gi_result gpu_setup(cssm_hrc *c)
 {
     gi_error err;
-    if (!c->gpu_buf[0])
-        glCreateBuffers(CSSM_GPU_BUFFERS, c->gpu_buf);
+    gi_result r = maps_setup(c);
+    if (r != GI_OK)
+        return r;
     if (c->gpu_dirty) {
-        gi_result r = upload_maps(c);
-        if (r == GI_OK)
-            r = upload_nodes(c, c->node_L, c->nodes ? &c->ct[0] : NULL);
+        r = upload_nodes(c, c->node_L, c->nodes ? &c->ct[0] : NULL);
         if (r != GI_OK)
             return r;
         c->gpu_dirty = 0;
@@ -284,37 +312,6 @@ gi_result cssm_gpu_final_gather(cssm_hrc *c, const gi_view *view, const gi_targe
     return GI_OK;
 }
 
-/* bounces_on=gpu: the program, the buffers, the maps and the texels'
- * albedo, once per cssm_solve_ex (the first gather of the solve). */
-static gi_result bounce_setup(cssm_hrc *c, gi_error *err)
-{
-    if (!program_for(c->gpu_bounce_prog, "cssm_bounce.comp", c->bounce_opts.pcf != 0, 0,
-                     c->bounce_opts.rep_centroid != 0, 0, err))
-        return GI_ERR_GL;
-    if (!c->gpu_buf[0])
-        glCreateBuffers(CSSM_GPU_BUFFERS, c->gpu_buf);
-    if (!c->gpu_bounce_buf[0])
-        glCreateBuffers(2, c->gpu_bounce_buf);
-    if (c->gpu_bounce_maps)
-        return GI_OK;
-    const cssm_atlas *a = &c->atlas;
-    float *alb = calloc(4 * (size_t)a->count + 4, sizeof *alb);
-    if (!alb)
-        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the bounces");
-    for (uint32_t i = 0; i < a->count; i++)
-        memcpy(&alb[4 * i], a->texels[i].albedo, 3 * sizeof(float));
-    upload(c->gpu_bounce_buf[0], 4 * (size_t)a->count * sizeof *alb, alb);
-    free(alb);
-    glNamedBufferData(c->gpu_bounce_buf[1], (GLsizeiptr)(3 * (size_t)a->count + 4) * 4, NULL,
-                      GL_DYNAMIC_READ);
-    gi_result r = upload_maps(c);
-    if (r != GI_OK)
-        return gi_error_set(err, r, "cssm_hrc: out of memory for the bounces");
-    c->gpu_bounce_maps = 1;
-    c->gpu_dirty = 1; /* the final gather's node buffer is overwritten by the bounces' */
-    return GI_OK;
-}
-
 static void bounce_uniforms(const cssm_hrc *c, GLuint p, const cssm_gather_opts *o)
 {
     glUniform1ui(glGetUniformLocation(p, "u_count"), c->atlas.count);
@@ -327,26 +324,32 @@ static void bounce_uniforms(const cssm_hrc *c, GLuint p, const cssm_gather_opts 
     glUniform1ui(glGetUniformLocation(p, "u_M"), c->maps.M);
     glUniform1uiv(glGetUniformLocation(p, "u_off_base"), 6, c->gpu_off_base);
     glUniform1uiv(glGetUniformLocation(p, "u_seg_base"), 6, c->gpu_seg_base);
+    glUniform1ui(glGetUniformLocation(p, "u_frame"), o->atlas_frame);
+    glUniform1ui(glGetUniformLocation(p, "u_seed"), o->atlas_seed);
 }
 
 /* §4.1.1: one gather step for every atlas texel (cssm_gather_opts'
  * atlas_gather): the nodes of the previous bounce uploaded, one invocation
- * per texel (cssm_bounce.comp), the radiance read back into out. */
-static gi_result bounce_gather(void *ctx, const float *node_L, const cssm_ctree *ct, float *out,
-                               cssm_gather_stats *st, gi_error *err)
+ * per texel (cssm_bounce.comp), the radiance read back into out. pass:
+ * the gather's jitter stream (hrc.c gather_atlas). */
+static gi_result bounce_gather(void *ctx, const float *node_L, const cssm_ctree *ct,
+                               uint32_t pass, float *out, cssm_gather_stats *st, gi_error *err)
 {
     cssm_hrc *c = ctx;
-    gi_result r = bounce_setup(c, err);
-    if (r == GI_OK && (r = upload_nodes(c, node_L, ct)) != GI_OK)
-        return gi_error_set(err, r, "cssm_hrc: out of memory for the bounces");
+    const cssm_gather_opts *o = &c->bounce_opts;
+    gi_result r = maps_setup(c);
+    if (r == GI_OK)
+        r = upload_nodes(c, node_L, ct);
     if (r != GI_OK)
-        return r;
+        return gi_error_set(err, r, "%s", gi_kit_last_error(&c->kit));
+    c->gpu_dirty = 1; /* the final gather's node buffer is overwritten by the bounces' */
     const GLuint p =
-        program_for(c->gpu_bounce_prog, "cssm_bounce.comp", c->bounce_opts.pcf != 0, 0,
-                    c->bounce_opts.rep_centroid != 0, 0, err); /* built by bounce_setup */
+        program_for(c->gpu_bounce_prog, "cssm_bounce.comp", o->pcf != 0, o->atlas_jitter != 0,
+                    o->rep_centroid != 0, 0, err); /* built by cssm_gpu_bounces */
     glUseProgram(p);
     bounce_uniforms(c, p, &c->bounce_opts);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CSSM_SSBO_STATS, c->gpu_buf[BUF_STATS]);
+    glUniform1ui(glGetUniformLocation(p, "u_pass"), pass);
     bind_textures(c);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CSSM_SSBO_OUT, c->gpu_bounce_buf[1]);
     const uint32_t zero[4] = {0};
@@ -369,11 +372,10 @@ static gi_result bounce_gather(void *ctx, const float *node_L, const cssm_ctree 
 gi_result cssm_gpu_bounces(cssm_hrc *c, cssm_gather_opts *o)
 {
     gi_error err;
-    if (!program_for(c->gpu_bounce_prog, "cssm_bounce.comp", o->pcf != 0, 0, o->rep_centroid != 0,
-                     0, &err))
+    if (!program_for(c->gpu_bounce_prog, "cssm_bounce.comp", o->pcf != 0, o->atlas_jitter != 0,
+                     o->rep_centroid != 0, 0, &err))
         return gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
     c->bounce_opts = *o;
-    c->gpu_bounce_maps = 0;
     o->atlas_gather = bounce_gather;
     o->atlas_ctx = c;
     return GI_OK;

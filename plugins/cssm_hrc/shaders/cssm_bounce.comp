@@ -3,12 +3,13 @@
 // pass (bounces_on=gpu): per atlas texel the receiver lifted along its
 // normal (cssm_receiver_point), diffuse with the texel's albedo, itself
 // skipped as a sender, the stack-less traversal of Fig. 10 over the
-// pulled radiance of the previous bounce (cssm_traverse.glsl) without
-// jitter, the reflected radiance kd/pi sum written per texel. GLSL twin
-// of hrc.c's gather_atlas; gpu_gather.c reads the result back where the
-// C loop keeps it.
-#define CSSM_JITTER 0 // no jitter in the bounces
-#define CSSM_GLOSSY 0 // diffuse receivers
+// pulled radiance of the previous bounce (cssm_traverse.glsl, the final
+// gather's code), with CSSM_JITTER the senders jittered as the final
+// gather's (§4.5, bounces_every=frame: fresh streams per frame), the
+// reflected radiance kd/pi sum written per texel. GLSL twin of hrc.c's
+// gather_atlas; gpu_gather.c reads the result back where the C loop keeps
+// it. Defines (gpu_gather.c program_for): CSSM_PCF, CSSM_JITTER,
+// CSSM_REP_CENTROID, CSSM_GLOSSY 0 (diffuse receivers).
 #include "common.glsl"
 #include "cssm_traverse.glsl"
 
@@ -25,12 +26,22 @@ uniform uint u_max_cut; // maximum cut size (§4.4)
 uniform float u_clamp;  // clamp distance, world units
 uniform float u_bias;   // CSSM depth bias, world units
 uniform float u_lift;   // receivers lifted 2 near planes along the normal
+uniform uint u_frame;   // CSSM_JITTER: the frame of the jitter streams
+uniform uint u_seed;    // and the view's seed
+uniform uint u_pass;    // 1: the direct gather, b: bounce b (hrc.c gather_atlas)
+#define CSSM_ATLAS_SALT 0xa71u // cssm.h
+
+// Invocation k gathers the texel of leaf rank k (the median cut's order,
+// not the atlas'): llvmpipe runs eight invocations as one vector, and
+// neighbours in the tree have alike cuts (a vector runs as long as its
+// longest traversal, issue 29).
 
 void main()
 {
-    uint t = gl_GlobalInvocationID.x;
-    if (t >= u_count)
+    uint k = gl_GlobalInvocationID.x;
+    if (k >= u_count)
         return;
+    uint t = cssm_leaf(k);
     CssmReceiver rc;
     rc.n = cssm_texel_n(t).xyz;
     rc.x = cssm_texel_p_area(t).xyz + rc.n * u_lift;
@@ -48,9 +59,9 @@ void main()
     o.clamp_d = u_clamp;
     o.bias = u_bias;
     o.pcf = CSSM_PCF != 0; // 2 x 2 PCF (the program's defines)
-    o.jitter = false;
+    o.jitter = CSSM_JITTER != 0;
     o.rep_centroid = CSSM_REP_CENTROID != 0;
-    uint rng = 0u, gathered, clamped = 0u;
+    uint rng = gi_rng_init(t, u_frame, u_seed ^ (CSSM_ATLAS_SALT + u_pass)), gathered, clamped = 0u;
     vec3 L = cssm_gather(rc, o, rng, gathered, clamped);
     cssm_out[3u * t + 0u] = L.r;
     cssm_out[3u * t + 1u] = L.g;
