@@ -263,6 +263,8 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     if (no_gpu)
         host->log(host, GI_LOG_INFO, "gather=gpu does not cover %s: the C gather runs", no_gpu);
     c->gpu_on = c->gather == 0 && !no_gpu;
+    c->gpu_texels = c->gather == 0 && c->mode == 1 && c->indirect == 0 && !moving;
+    host->stat(host, "texel_gather_gpu", c->gpu_texels);
     c->gpu_dirty = 1;
     c->cpu_frames = 0, c->cpu_process_s = c->cpu_main_s = 0.0;
     host->stat(host, "gather_gpu", c->gpu_on);
@@ -356,7 +358,9 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
         return r;
     const gi_scene *s = kit->scene->scene;
     const uint32_t frame = kit->frames;
-    if (c->mode == 1)
+    if (c->gpu_texels && (r = cssm_gpu_texel_gather(c, view, frame, random, &st)) != GI_OK)
+        return r;
+    if (c->mode == 1 && !c->gpu_texels)
         cssm_texel_gather(c, view, frame, random, &st);
     cssm_final_gather(c, view, frame, random, &st);
     glTextureSubImage2D(target->texture, 0, 0, 0, (GLsizei)w, (GLsizei)h, GL_RGBA, GL_FLOAT,

@@ -81,6 +81,7 @@ typedef struct cssm_hrc {
     cssm_csm_direct *csm;                       /* its CSMs, NULL with direct=maps */
     int gather;    /* gather=gpu (0) or cpu (1): where the per-pixel final gather runs */
     int gpu_on;    /* gather=gpu and the scene and options are ones the GPU pass covers */
+    int gpu_texels; /* gather=gpu, mode=texels: the per-texel gather is a pass (static, hrc) */
     int gpu_dirty; /* the lighting changed since the GPU node buffer was filled */
     int gpu_maps_ok; /* the texels, albedo and CSSM faces are in the GPU buffers */
     GLuint gpu_prog[CSSM_GPU_PROGS]; /* cssm_gather.comp per define set (gpu_gather.c) */
@@ -176,6 +177,13 @@ const char *cssm_gpu_unsupported(const cssm_hrc *c, const gi_scene *s);
  * through the kit. */
 gi_result cssm_gpu_final_gather(cssm_hrc *c, const gi_view *view, const gi_target *target,
                                 int random, cssm_gather_stats *st);
+/* gather=gpu in texel mode (static scenes, indirect=hrc): the glossy
+ * gather of the reflected light per atlas texel toward the eye as a pass
+ * of shaders/cssm_bounce.comp (CSSM_GLOSSY 1), read back into c->texel_T;
+ * the twin of cssm_texel_gather, same streams. Stage timer texel_gather.
+ * Fails through the kit. */
+gi_result cssm_gpu_texel_gather(cssm_hrc *c, const gi_view *view, uint32_t frame, int random,
+                                cssm_gather_stats *st);
 /* Deletes the program and buffers (a GL context is current). */
 void cssm_gpu_free(cssm_hrc *c);
 /* bounces_on=gpu: points o's atlas_gather at the compute pass of the HRC

@@ -60,7 +60,7 @@ static void bind_textures(cssm_hrc *c)
 const char *cssm_gpu_unsupported(const cssm_hrc *c, const gi_scene *s)
 {
     if (c->mode == 1)
-        return "mode=texels";
+        return "mode=texels (its per-pixel part; the per-texel gather runs as a pass)";
     if (c->indirect == 1)
         return "indirect=mc";
     if (c->direct == 1)
@@ -228,12 +228,15 @@ static gi_result maps_setup(cssm_hrc *c)
     if (c->gpu_maps_ok)
         return GI_OK;
     const cssm_atlas *a = &c->atlas;
-    float *alb = calloc(4 * (size_t)a->count + 4, sizeof *alb);
+    float *alb = calloc(8 * (size_t)a->count + 4, sizeof *alb);
     if (!alb)
         return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the maps");
-    for (uint32_t i = 0; i < a->count; i++)
-        memcpy(&alb[4 * i], a->texels[i].albedo, 3 * sizeof(float));
-    upload(c->gpu_bounce_buf[0], 4 * (size_t)a->count * sizeof *alb, alb);
+    for (uint32_t i = 0; i < a->count; i++) { /* albedo, then Phong ks and exponent */
+        memcpy(&alb[8 * i], a->texels[i].albedo, 3 * sizeof(float));
+        memcpy(&alb[8 * i + 4], a->texels[i].ks, 3 * sizeof(float));
+        alb[8 * i + 7] = a->texels[i].exponent;
+    }
+    upload(c->gpu_bounce_buf[0], 8 * (size_t)a->count * sizeof *alb, alb);
     free(alb);
     glNamedBufferData(c->gpu_bounce_buf[1], (GLsizeiptr)(3 * (size_t)a->count + 4) * 4, NULL,
                       GL_DYNAMIC_READ);
@@ -312,8 +315,16 @@ gi_result cssm_gpu_final_gather(cssm_hrc *c, const gi_view *view, const gi_targe
     return GI_OK;
 }
 
-static void bounce_uniforms(const cssm_hrc *c, GLuint p, const cssm_gather_opts *o)
+/* One per-texel pass of cssm_bounce.comp over the nodes in the node
+ * buffer: program p (its defines chosen by the caller), o's options, texel
+ * t's generator gi_rng_init(t, frame, stream), eye for the glossy texels
+ * (NULL: a diffuse bounce); the radiance read back into out[3 N] and the
+ * counts added to st. */
+static gi_result texel_pass(cssm_hrc *c, GLuint p, const cssm_gather_opts *o, uint32_t frame,
+                            uint32_t stream, const gi_vec3 *eye, float *out,
+                            cssm_gather_stats *st, gi_error *err)
 {
+    glUseProgram(p);
     glUniform1ui(glGetUniformLocation(p, "u_count"), c->atlas.count);
     glUniform1f(glGetUniformLocation(p, "u_lim"), cssm_refine_limit(o->threshold));
     glUniform1f(glGetUniformLocation(p, "u_scale"), exp2f(o->exposure));
@@ -324,8 +335,28 @@ static void bounce_uniforms(const cssm_hrc *c, GLuint p, const cssm_gather_opts 
     glUniform1ui(glGetUniformLocation(p, "u_M"), c->maps.M);
     glUniform1uiv(glGetUniformLocation(p, "u_off_base"), 6, c->gpu_off_base);
     glUniform1uiv(glGetUniformLocation(p, "u_seg_base"), 6, c->gpu_seg_base);
-    glUniform1ui(glGetUniformLocation(p, "u_frame"), o->atlas_frame);
-    glUniform1ui(glGetUniformLocation(p, "u_seed"), o->atlas_seed);
+    glUniform1ui(glGetUniformLocation(p, "u_frame"), frame);
+    glUniform1ui(glGetUniformLocation(p, "u_stream"), stream);
+    if (eye)
+        glUniform3f(glGetUniformLocation(p, "u_eye"), eye->x, eye->y, eye->z);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CSSM_SSBO_STATS, c->gpu_buf[BUF_STATS]);
+    bind_textures(c);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CSSM_SSBO_OUT, c->gpu_bounce_buf[1]);
+    const uint32_t zero[4] = {0};
+    glNamedBufferData(c->gpu_buf[BUF_STATS], sizeof zero, zero, GL_DYNAMIC_READ);
+    glDispatchCompute((c->atlas.count + 63) / 64, 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glUseProgram(0);
+    glGetNamedBufferSubData(c->gpu_bounce_buf[1], 0,
+                            (GLsizeiptr)(3 * (size_t)c->atlas.count * sizeof *out), out);
+    uint32_t got[4];
+    glGetNamedBufferSubData(c->gpu_buf[BUF_STATS], 0, sizeof got, got);
+    if (st) {
+        st->nodes += got[0];
+        st->receivers += got[1];
+        st->clamped += got[2];
+    }
+    return gi_gl_check("cssm_hrc: gpu texel pass", err);
 }
 
 /* §4.1.1: one gather step for every atlas texel (cssm_gather_opts'
@@ -346,27 +377,32 @@ static gi_result bounce_gather(void *ctx, const float *node_L, const cssm_ctree 
     const GLuint p =
         program_for(c->gpu_bounce_prog, "cssm_bounce.comp", o->pcf != 0, o->atlas_jitter != 0,
                     o->rep_centroid != 0, 0, err); /* built by cssm_gpu_bounces */
-    glUseProgram(p);
-    bounce_uniforms(c, p, &c->bounce_opts);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CSSM_SSBO_STATS, c->gpu_buf[BUF_STATS]);
-    glUniform1ui(glGetUniformLocation(p, "u_pass"), pass);
-    bind_textures(c);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CSSM_SSBO_OUT, c->gpu_bounce_buf[1]);
-    const uint32_t zero[4] = {0};
-    glNamedBufferData(c->gpu_buf[BUF_STATS], sizeof zero, zero, GL_DYNAMIC_READ);
-    glDispatchCompute((c->atlas.count + 63) / 64, 1, 1);
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    glUseProgram(0);
-    glGetNamedBufferSubData(c->gpu_bounce_buf[1], 0,
-                            (GLsizeiptr)(3 * (size_t)c->atlas.count * sizeof *out), out);
-    uint32_t got[4];
-    glGetNamedBufferSubData(c->gpu_buf[BUF_STATS], 0, sizeof got, got);
-    if (st) {
-        st->nodes += got[0];
-        st->receivers += got[1];
-        st->clamped += got[2];
-    }
-    return gi_gl_check("cssm_hrc: gpu bounce", err);
+    return texel_pass(c, p, o, o->atlas_frame, o->atlas_seed ^ (CSSM_ATLAS_SALT + pass), NULL, out,
+                      st, err);
+}
+
+gi_result cssm_gpu_texel_gather(cssm_hrc *c, const gi_view *view, uint32_t frame, int random,
+                                cssm_gather_stats *st)
+{
+    const gi_host *host = c->kit.host;
+    host->stage_begin(host, "texel_gather");
+    const cssm_gather_opts o = cssm_hrc_gather_opts(c, view->exposure, NULL);
+    gi_error err;
+    gi_result r = maps_setup(c);
+    if (r == GI_OK)
+        r = upload_nodes(c, c->node_B, c->nodes ? &c->ct[2] : NULL); /* light set 2: reflected */
+    c->gpu_dirty = 1;
+    const GLuint p = r == GI_OK ? program_for(c->gpu_bounce_prog, "cssm_bounce.comp", o.pcf != 0,
+                                              random != 0, o.rep_centroid != 0, 1, &err)
+                                : 0;
+    if (r == GI_OK && !p)
+        r = gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
+    if (r == GI_OK &&
+        (r = texel_pass(c, p, &o, frame, view->seed ^ 0x7e1u, &view->eye, c->texel_T, st, &err)) !=
+            GI_OK)
+        r = gi_kit_fail_with(&c->kit, r, &err);
+    host->stage_end(host, "texel_gather");
+    return r;
 }
 
 gi_result cssm_gpu_bounces(cssm_hrc *c, cssm_gather_opts *o)
