@@ -96,8 +96,13 @@ static void upload(GLuint buf, size_t bytes, const void *data)
 {
     /* an empty buffer still binds: one zero word */
     static const uint32_t zero[4] = {0};
-    glNamedBufferData(buf, bytes ? (GLsizeiptr)bytes : (GLsizeiptr)sizeof zero, bytes ? data : zero,
-                      GL_STATIC_DRAW);
+    const GLsizeiptr n = bytes ? (GLsizeiptr)bytes : (GLsizeiptr)sizeof zero;
+    GLint64 have = -1;
+    glGetNamedBufferParameteri64v(buf, GL_BUFFER_SIZE, &have);
+    if (have == (GLint64)n) /* same size (the nodes of each bounce and frame): keep the storage */
+        glNamedBufferSubData(buf, 0, n, bytes ? data : zero);
+    else
+        glNamedBufferData(buf, n, bytes ? data : zero, GL_STATIC_DRAW);
 }
 
 /* The nodes a gather reads (node_L, or the packed nodes ct), decoded as
