@@ -23,7 +23,9 @@
  * Pixels thus get light paths of 0 .. n + 1 bounces.
  * With gather=gpu (the default, as the paper) the final gather of
  * render() is a compute pass (gpu_gather.c), and with bounces_on=gpu (the
- * default) so are the HRC bounces' per-texel gathers; the pulls, and the
+ * default) so are the HRC bounces' per-texel gathers, solved again in
+ * every frame with bounces_every=frame (the default; jittered with
+ * jitter=true, §4.5), and texel mode's per-texel gather; the pulls, and the
  * gathers with gather=cpu / bounces_on=cpu or where the final gather's pass
  * does not cover the scene, run on the CPU; the depth cube maps, shadow maps and G-buffer are drawn
  * by the core's GL passes. */
