@@ -118,7 +118,8 @@ static const gi_param_desc cssm_params[] = {
     {"gather", GI_PARAM_ENUM, 0, 0, 0, "gpu|cpu", "Sec. 4 (HRC on the GPU), Fig. 10",
      "where the per-pixel final gather runs: gpu, a compute pass every frame (the paper's); cpu, "
      "the C traversal (the oracle). gpu falls back to cpu, with a log line and stat gather_gpu 0, "
-     "for mode=texels, indirect=mc, direct=csm, moving objects, punctual lights and environments"},
+     "for mode=texels' per-pixel part (its per-texel gather is a pass), indirect=mc, direct=csm, "
+     "moving objects, punctual lights and environments"},
     {"bounces_on", GI_PARAM_ENUM, 0, 0, 0, "gpu|cpu", "Sec. 4.1.1 (HRC on the GPU), Fig. 8",
      "where the HRC bounces' per-texel gathers run (see bounces_every): gpu, a compute pass "
      "per bounce (the paper's); cpu, the C loop (the oracle)"},
