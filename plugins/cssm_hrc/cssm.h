@@ -342,6 +342,10 @@ typedef struct cssm_receiver {
 
 struct cssm_gather_stats;
 
+/* The salt of the HRC bounces' jitter streams (cssm_gather_opts.atlas_jitter;
+ * the GLSL twin in shaders/cssm_bounce.comp). */
+#define CSSM_ATLAS_SALT 0xa71u
+
 typedef struct cssm_gather_opts {
     float threshold;  /* refine while the tone-mapped bound exceeds it (§4.3) */
     uint32_t max_cut; /* maximum nodes in the cut */
@@ -360,12 +364,20 @@ typedef struct cssm_gather_opts {
      * the CSSM look-up: the paper's Fig. 14 comparison; the ray ends `bias`
      * short of that point */
     const gi_rt *trace;
+    /* cssm_solve_ex with atlas_jitter: the HRC bounces' gathers jittered as
+     * the final gather's (§4.5, bounces_every=frame): texel i's generator
+     * of gather pass k (1: the direct gather, b: bounce b) is
+     * gi_rng_init(i, atlas_frame, atlas_seed ^ (CSSM_ATLAS_SALT + k)), so
+     * that each frame's bounces draw anew and the frames' average converges */
+    int atlas_jitter;
+    uint32_t atlas_frame, atlas_seed;
     /* set: cssm_solve_ex's per-texel gathers (§4.1.1) run there instead of
      * the C loop (bounces_on=gpu, gpu_gather.c): every texel of the atlas
      * gathered from node_L (or the packed nodes ct) into out[3 N], the
      * counts added to st; a failure sets err */
     gi_result (*atlas_gather)(void *ctx, const float *node_L, const struct cssm_ctree *ct,
-                              float *out, struct cssm_gather_stats *st, gi_error *err);
+                              uint32_t pass, float *out, struct cssm_gather_stats *st,
+                              gi_error *err);
     void *atlas_ctx;
 } cssm_gather_opts;
 
