@@ -53,12 +53,12 @@ typedef struct cssm_hrc {
     float *texel_D; /* direct light not from emitting texels (punctual, environment, direct=csm) */
     int has_direct; /* texel_D is not all zero: a light that is not an atlas texel */
     int bounces_every; /* 0 frame: render() solves the HRC bounces every frame; 1 change */
-    float *texel_L; /* emission + reflected, 3 per texel */
-    float *node_L;  /* pulled texel_L */
-    float *node_Le; /* pulled emission (texel mode: direct light per pixel) */
-    float *node_B;  /* pulled reflected light (texel mode: indirect) */
-    float *texel_T; /* texel mode: view-dependent indirect light per texel, 3 per texel */
-    uint32_t *ids;  /* G-buffer ids read-back (texel mode) */
+    float *texel_L;    /* emission + reflected, 3 per texel */
+    float *node_L;     /* pulled texel_L */
+    float *node_Le;    /* pulled emission (texel mode: direct light per pixel) */
+    float *node_B;     /* pulled reflected light (texel mode: indirect) */
+    float *texel_T;    /* texel mode: view-dependent indirect light per texel, 3 per texel */
+    uint32_t *ids;     /* G-buffer ids read-back (texel mode) */
     int mode;
     int indirect, mc_samples;  /* §4.6 alternative: Monte Carlo from the atlas as a pdf */
     float *texel_Le, *texel_B; /* emission and reflected light per texel */
@@ -81,10 +81,10 @@ typedef struct cssm_hrc {
                          emission, reflected */
     int direct, csm_points, csm_samples, csm_M; /* §4.7 "Direct Light": direct=csm (direct_csm.h) */
     cssm_csm_direct *csm;                       /* its CSMs, NULL with direct=maps */
-    int gather;    /* gather=gpu (0) or cpu (1): where the per-pixel final gather runs */
-    int gpu_on;    /* gather=gpu and the scene and options are ones the GPU pass covers */
-    int gpu_texels; /* gather=gpu, mode=texels: the per-texel gather is a pass (static, hrc) */
-    int gpu_dirty; /* the lighting changed since the GPU node buffer was filled */
+    int gather;      /* gather=gpu (0) or cpu (1): where the per-pixel final gather runs */
+    int gpu_on;      /* gather=gpu and the scene and options are ones the GPU pass covers */
+    int gpu_texels;  /* gather=gpu, mode=texels: the per-texel gather is a pass (static, hrc) */
+    int gpu_dirty;   /* the lighting changed since the GPU node buffer was filled */
     int gpu_maps_ok; /* the texels, albedo and CSSM faces are in the GPU buffers */
     GLuint gpu_prog[CSSM_GPU_PROGS]; /* cssm_gather.comp per define set (gpu_gather.c) */
     int bounces_on; /* bounces_on=gpu (0) or cpu (1): where the HRC bounces' gathers run */

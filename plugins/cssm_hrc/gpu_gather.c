@@ -326,8 +326,8 @@ gi_result cssm_gpu_final_gather(cssm_hrc *c, const gi_view *view, const gi_targe
  * (NULL: a diffuse bounce); the radiance read back into out[3 N] and the
  * counts added to st. */
 static gi_result texel_pass(cssm_hrc *c, GLuint p, const cssm_gather_opts *o, uint32_t frame,
-                            uint32_t stream, const gi_vec3 *eye, float *out,
-                            cssm_gather_stats *st, gi_error *err)
+                            uint32_t stream, const gi_vec3 *eye, float *out, cssm_gather_stats *st,
+                            gi_error *err)
 {
     glUseProgram(p);
     glUniform1ui(glGetUniformLocation(p, "u_count"), c->atlas.count);
@@ -368,8 +368,8 @@ static gi_result texel_pass(cssm_hrc *c, GLuint p, const cssm_gather_opts *o, ui
  * atlas_gather): the nodes of the previous bounce uploaded, one invocation
  * per texel (cssm_bounce.comp), the radiance read back into out. pass:
  * the gather's jitter stream (hrc.c gather_atlas). */
-static gi_result bounce_gather(void *ctx, const float *node_L, const cssm_ctree *ct,
-                               uint32_t pass, float *out, cssm_gather_stats *st, gi_error *err)
+static gi_result bounce_gather(void *ctx, const float *node_L, const cssm_ctree *ct, uint32_t pass,
+                               float *out, cssm_gather_stats *st, gi_error *err)
 {
     cssm_hrc *c = ctx;
     const cssm_gather_opts *o = &c->bounce_opts;
@@ -402,9 +402,8 @@ gi_result cssm_gpu_texel_gather(cssm_hrc *c, const gi_view *view, uint32_t frame
                                 : 0;
     if (r == GI_OK && !p)
         r = gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
-    if (r == GI_OK &&
-        (r = texel_pass(c, p, &o, frame, view->seed ^ 0x7e1u, &view->eye, c->texel_T, st, &err)) !=
-            GI_OK)
+    if (r == GI_OK && (r = texel_pass(c, p, &o, frame, view->seed ^ 0x7e1u, &view->eye, c->texel_T,
+                                      st, &err)) != GI_OK)
         r = gi_kit_fail_with(&c->kit, r, &err);
     host->stage_end(host, "texel_gather");
     return r;
