@@ -19,6 +19,9 @@ import math
 import os
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
+from study_tables import num  # noqa: E402
+
 # The bounce-matched reference of each method: its declared bounce count + 1
 # (implicit_vis declares 3, direct 0; docs/studies.md), the study's b4 and b1.
 MATCHED_BOUNCES = {"implicit_vis": 4, "direct": 1}
@@ -35,13 +38,6 @@ PAPER_T1 = {
     "frame": "112 / 148 / 218",
     "ratio": "1 / 1.32 / 1.95",
 }
-
-
-def num(x):
-    try:
-        return float(x)
-    except (TypeError, ValueError):
-        return None
 
 
 def params(s):
