@@ -50,9 +50,20 @@ tables() {
         mv "results/$study/tables.md.tmp" "results/$study/tables.md"
     fi
 }
-# study NAME FILE: the study FILE afresh into results/NAME.
+# study NAME FILE: the study FILE afresh into results/NAME, and the run
+# folders of runs the study no longer has (an earlier run id) removed.
 study() {
     run "$G" study "$2" --out "results/$1" --jobs 1 --fresh
+    [[ $dry == 0 && -f results/$1/runs.csv ]] || return 0
+    local keep r
+    keep=$(cut -d, -f1 "results/$1/runs.csv" | tail -n +2)
+    for r in "results/$1"/runs/*/; do
+        [[ -d $r ]] || continue
+        if ! grep -qxF "$(basename "$r")" <<< "$keep"; then
+            echo "+ rm -r $r (not a run of the study any more)"
+            rm -r "$r"
+        fi
+    done
 }
 
 # child_cpu VAR: VAR = seconds of user and system CPU time of this shell's

@@ -6,7 +6,8 @@
 # it is made on a GPU node by scripts/gpu/bench.sh (docs/gpu.md), which its
 # README must name. A real run (in a scratch tree, with a stand-in gibench)
 # records each finished study's time in results/regenerate_times.csv, one
-# line per study, and a failed study records nothing.
+# line per study, and a failed study records nothing; run folders of runs
+# the study no longer has are removed.
 # Usage: results_commands.sh ROOT
 set -u
 root=$1
@@ -48,8 +49,16 @@ printf '#!/bin/sh\necho "tables of $1"\n' > "$tmp/plugins/csm/tables.py"
 printf '#!/bin/sh\nexit 0\n' > "$tmp/ok"
 printf '#!/bin/sh\nexit 3\n' > "$tmp/bad"
 chmod +x "$tmp/plugins/csm/tables.py" "$tmp/ok" "$tmp/bad"
+mkdir -p "$tmp/results/csm_local/runs/kept" "$tmp/results/csm_local/runs/stale"
+printf 'run,scene\nkept,scenes/x.gltf\n' > "$tmp/results/csm_local/runs.csv"
 GIBENCH=$tmp/ok "$tmp/scripts/regenerate_results.sh" csm_local csm_local > /dev/null 2>&1
 rc=$?
+if [[ ! -d $tmp/results/csm_local/runs/kept || -d $tmp/results/csm_local/runs/stale ]]; then
+    echo "FAIL: the run folder of a run the study no longer has was not removed, or a run's was"
+    fails=$((fails + 1))
+else
+    echo "ok: run folders of runs the study no longer has are removed"
+fi
 times_csv=$tmp/results/regenerate_times.csv
 if [[ $rc != 0 || ! -f $times_csv || $(head -n 1 "$times_csv") != study,date,commit,wall_s,cpu_s,cores ||
       $(grep -c '^csm_local,' "$times_csv") != 1 || $(wc -l < "$times_csv") != 2 ]] ||
