@@ -3,6 +3,7 @@ Markdown tables (compare_all_tables.py, stress_tables.py). Stdlib only."""
 
 import csv
 import json
+import math
 import os
 
 
@@ -94,3 +95,15 @@ def report_fronts(d):
             continue
         i += 1
     return out if len(out) > 1 else []
+
+
+def fit_exponent(xs, ys):
+    """Least-squares slope of log y against log x (y ~ x^slope); None with
+    fewer than two usable points."""
+    pts = [(math.log(x), math.log(y)) for x, y in zip(xs, ys) if x and y and x > 0 and y > 0]
+    if len(pts) < 2:
+        return None
+    mx = sum(a for a, _ in pts) / len(pts)
+    my = sum(b for _, b in pts) / len(pts)
+    sxx = sum((a - mx) ** 2 for a, _ in pts)
+    return sum((a - mx) * (b - my) for a, b in pts) / sxx if sxx > 0 else None

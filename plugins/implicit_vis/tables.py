@@ -20,7 +20,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
-from study_tables import num  # noqa: E402
+from study_tables import fit_exponent, num  # noqa: E402
 
 # The bounce-matched reference of each method: its declared bounce count + 1
 # (implicit_vis declares 3, direct 0; docs/studies.md), the study's b4 and b1.
@@ -81,15 +81,6 @@ def pct(x, nd=1):
     return "–" if x is None else f"{x:+.{nd}f}"
 
 
-def fit_exponent(xs, ys):
-    """Least-squares slope of log y against log x; None with fewer than two points."""
-    pts = [(math.log(x), math.log(y)) for x, y in zip(xs, ys) if x and y and x > 0 and y > 0]
-    if len(pts) < 2:
-        return None
-    mx = sum(a for a, _ in pts) / len(pts)
-    my = sum(b for _, b in pts) / len(pts)
-    sxx = sum((a - mx) ** 2 for a, _ in pts)
-    return sum((a - mx) * (b - my) for a, b in pts) / sxx if sxx > 0 else None
 
 
 def ratio(a, b):

@@ -22,6 +22,9 @@ import math
 import os
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
+from study_tables import fit_exponent  # noqa: E402
+
 # Paper, Table 1 (GeForce 8800 GTX, 3 iterations, 512 directions, 1024x768).
 PAPER_T1 = [
     ("Cornellbox", 19, 34816, 931136, 0.031, 0.041, 3.995, 23.2, 2.9, 122),
@@ -103,16 +106,6 @@ def fmt(x, nd=3):
     return str(x)
 
 
-def fit_exponent(xs, ys):
-    """Least-squares slope of log y against log x (y ~ x^slope); None with
-    fewer than two usable points."""
-    pts = [(math.log(x), math.log(y)) for x, y in zip(xs, ys) if x and y and x > 0 and y > 0]
-    if len(pts) < 2:
-        return None
-    mx = sum(a for a, _ in pts) / len(pts)
-    my = sum(b for _, b in pts) / len(pts)
-    sxx = sum((a - mx) ** 2 for a, _ in pts)
-    return sum((a - mx) * (b - my) for a, b in pts) / sxx if sxx > 0 else None
 
 
 def main():
