@@ -773,3 +773,24 @@ uint32_t *cssm_traverse(const cssm_atlas *a, cssm_traversal how)
     free(visited), free(chart_done), free(stack);
     return order;
 }
+
+void cssm_traversal_measures(const cssm_atlas *a, const uint32_t *order, cssm_traversal_measure *m)
+{
+    memset(m, 0, sizeof *m);
+    double total = 0.0, jumped = 0.0;
+    const double h = a->h > 0.0f ? a->h : 1.0;
+    for (uint32_t i = 1; order && i < a->count; i++) {
+        const cssm_texel *p = &a->texels[order[i - 1]], *q = &a->texels[order[i]];
+        double d = sqrt((double)dist2(p->p, q->p)) / h;
+        total += d;
+        if (d > 2.0) {
+            m->jumps++;
+            jumped += d;
+        }
+        if (gi_v3_dot(p->n, q->n) < 0.999f ||
+            fabsf(gi_v3_dot(p->n, gi_v3_sub(q->p, p->p))) > 1e-3f * h)
+            m->plane_changes++;
+    }
+    m->step_mean = a->count > 1 ? total / (a->count - 1) : 0.0;
+    m->jump_length_share = total > 0.0 ? jumped / total : 0.0;
+}

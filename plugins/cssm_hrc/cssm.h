@@ -24,6 +24,7 @@
 #include "gi/algo/csm_codec.h"
 #include "gi/method.h"
 #include "gi/passes.h"
+#include "gi/raytrace.h"
 #include "gi/vecmath.h"
 
 struct cssm_receiver;
@@ -116,6 +117,17 @@ int cssm_chart_bicubic(const cssm_atlas *a, uint32_t chart, float u, float v, co
  * along the path when stuck (spiral); surface samples follow, greedily.
  * Returns a malloc'd array or NULL on no memory. */
 uint32_t *cssm_traverse(const cssm_atlas *a, cssm_traversal how);
+/* How a traversal steps through the atlas (Table 2's explanation): the mean
+ * 3D step between consecutive cube maps in texel sizes h, the steps longer
+ * than 2 h (jumps: a chart change, a sample far off) and their share of the
+ * path's length, the steps that leave a plane (normal or plane changes). */
+typedef struct cssm_traversal_measure {
+    double step_mean;
+    uint32_t jumps;
+    double jump_length_share;
+    uint32_t plane_changes;
+} cssm_traversal_measure;
+void cssm_traversal_measures(const cssm_atlas *a, const uint32_t *order, cssm_traversal_measure *m);
 const char *cssm_traversal_name(cssm_traversal how);
 
 /* ----------------------------------------------------------------- CSSM */
@@ -330,6 +342,10 @@ typedef struct cssm_receiver {
 
 struct cssm_gather_stats;
 
+/* The salt of the HRC bounces' jitter streams (cssm_gather_opts.atlas_jitter;
+ * the GLSL twin in shaders/cssm_bounce.comp). */
+#define CSSM_ATLAS_SALT 0xa71u
+
 typedef struct cssm_gather_opts {
     float threshold;  /* refine while the tone-mapped bound exceeds it (§4.3) */
     uint32_t max_cut; /* maximum nodes in the cut */
@@ -343,12 +359,25 @@ typedef struct cssm_gather_opts {
                        * (lightcuts' representative, hrc.c pick_leaf) */
     int no_emission; /* cssm_solve: R_1 = direct only, the emitting texels not gathered (their light
                       * comes from the direct light of direct=csm, §4.7) */
+    /* set (vis=trace): every gather's visibility is an exact ray query from the
+     * receiver to the point it gathers from (the VPL, jittered or not) instead of
+     * the CSSM look-up: the paper's Fig. 14 comparison; the ray ends `bias`
+     * short of that point */
+    const gi_rt *trace;
+    /* cssm_solve_ex with atlas_jitter: the HRC bounces' gathers jittered as
+     * the final gather's (§4.5, bounces_every=frame): texel i's generator
+     * of gather pass k (1: the direct gather, b: bounce b) is
+     * gi_rng_init(i, atlas_frame, atlas_seed ^ (CSSM_ATLAS_SALT + k)), so
+     * that each frame's bounces draw anew and the frames' average converges */
+    int atlas_jitter;
+    uint32_t atlas_frame, atlas_seed;
     /* set: cssm_solve_ex's per-texel gathers (§4.1.1) run there instead of
      * the C loop (bounces_on=gpu, gpu_gather.c): every texel of the atlas
      * gathered from node_L (or the packed nodes ct) into out[3 N], the
      * counts added to st; a failure sets err */
     gi_result (*atlas_gather)(void *ctx, const float *node_L, const struct cssm_ctree *ct,
-                              float *out, struct cssm_gather_stats *st, gi_error *err);
+                              uint32_t pass, float *out, struct cssm_gather_stats *st,
+                              gi_error *err);
     void *atlas_ctx;
 } cssm_gather_opts;
 

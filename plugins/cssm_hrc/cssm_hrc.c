@@ -23,7 +23,9 @@
  * Pixels thus get light paths of 0 .. n + 1 bounces.
  * With gather=gpu (the default, as the paper) the final gather of
  * render() is a compute pass (gpu_gather.c), and with bounces_on=gpu (the
- * default) so are the HRC bounces' per-texel gathers; the pulls, and the
+ * default) so are the HRC bounces' per-texel gathers, solved again in
+ * every frame with bounces_every=frame (not the default yet; jittered with
+ * jitter=true, §4.5), and texel mode's per-texel gather; the pulls, and the
  * gathers with gather=cpu / bounces_on=cpu or where the final gather's pass
  * does not cover the scene, run on the CPU; the depth cube maps, shadow maps and G-buffer are drawn
  * by the core's GL passes. */
@@ -66,6 +68,10 @@ static const gi_param_desc cssm_params[] = {
      "CSSM depth bias as a fraction of the scene diameter"},
     {"pcf", GI_PARAM_BOOL, 0, 0, 1, NULL, "PCF (Sec. 3.2.2)",
      "CSSM look-ups filtered over 2 x 2 texels"},
+    {"vis", GI_PARAM_ENUM, 0, 0, 0, "cssm|trace", "visibility (Fig. 14)",
+     "cssm: the CSSM look-up (the paper's method); trace: an exact ray query (the core's ray "
+     "tracer) from the receiver to each gathered point, in the bounces and the final gather, "
+     "the paper's Fig. 14 comparison; runs the C gathers (gather and bounces_on ignored)"},
     {"mode", GI_PARAM_ENUM, 0, 0, 0, "pixels|texels", "samples (Table 1, Fig. 17)",
      "pixels: final gather per pixel; texels: view-dependent lightmap, the final (glossy) gather "
      "of the indirect light "
@@ -116,10 +122,16 @@ static const gi_param_desc cssm_params[] = {
     {"gather", GI_PARAM_ENUM, 0, 0, 0, "gpu|cpu", "Sec. 4 (HRC on the GPU), Fig. 10",
      "where the per-pixel final gather runs: gpu, a compute pass every frame (the paper's); cpu, "
      "the C traversal (the oracle). gpu falls back to cpu, with a log line and stat gather_gpu 0, "
-     "for mode=texels, indirect=mc, direct=csm, moving objects, punctual lights and environments"},
+     "for mode=texels' per-pixel part (its per-texel gather is a pass), indirect=mc, direct=csm, "
+     "moving objects, punctual lights and environments"},
     {"bounces_on", GI_PARAM_ENUM, 0, 0, 0, "gpu|cpu", "Sec. 4.1.1 (HRC on the GPU), Fig. 8",
-     "where the HRC bounces' per-texel gathers run (prepare, and when lights or materials "
-     "change): gpu, a compute pass per bounce (the paper's); cpu, the C loop (the oracle)"},
+     "where the HRC bounces' per-texel gathers run (see bounces_every): gpu, a compute pass "
+     "per bounce (the paper's); cpu, the C loop (the oracle)"},
+    {"bounces_every", GI_PARAM_ENUM, 0, 0, 0, "change|frame", "Sec. 4.1.1, Table 1",
+     "when the HRC bounces are solved: change, at prepare and when lights, materials or objects "
+     "change; frame, every frame (the paper's: its fps depend on the bounces), with jitter the "
+     "senders drawn anew each frame as in the final gather (Sec. 4.5; not the default yet: "
+     "README \"Bounces every frame\")"},
     {"shadow_size", GI_PARAM_INT, 256, 16, 2048, NULL, NULL,
      "face size of the point/spot lights' shadow cube maps and of directional lights' shadow maps"},
     {0},
@@ -148,6 +160,7 @@ static gi_result cssm_create(const gi_host *host, const gi_params *params, void 
     c->env_pixel = gi_params_bool(params, "env_pixel");
     c->env_mode = gi_params_enum(params, "env");
     c->pcf = gi_params_bool(params, "pcf");
+    c->vis = gi_params_enum(params, "vis");
     c->shadow_size = gi_params_int(params, "shadow_size");
     c->mode = gi_params_enum(params, "mode");
     c->indirect = gi_params_enum(params, "indirect");
@@ -159,6 +172,7 @@ static gi_result cssm_create(const gi_host *host, const gi_params *params, void 
     c->csm_M = gi_params_int(params, "csm_M");
     c->gather = gi_params_enum(params, "gather");
     c->bounces_on = gi_params_enum(params, "bounces_on");
+    c->bounces_every = gi_params_enum(params, "bounces_every");
     c->motion.moving = -1;
     *out = c;
     return GI_OK;
@@ -172,12 +186,14 @@ static void release_prepared(cssm_hrc *c)
     for (int i = 0; i < 3; i++)
         cssm_ctree_free(&c->ct[i]);
     free(c->order);
+    free(c->texel_D);
     free(c->texel_L);
     free(c->node_L);
     free(c->node_Le);
     free(c->node_B);
     free(c->texel_T);
     c->order = NULL;
+    c->texel_D = NULL;
     c->texel_L = c->node_L = c->node_Le = c->node_B = c->texel_T = NULL;
     free(c->texel_Le);
     free(c->texel_B);
@@ -185,6 +201,8 @@ static void release_prepared(cssm_hrc *c)
     c->texel_Le = c->texel_B = c->texel_E = NULL;
     gi_rt_free(c->rt);
     c->rt = NULL;
+    gi_rt_free(c->vis_rt);
+    c->vis_rt = NULL;
     for (int i = 0; i < 3; i++) {
         free(c->cdf[i]);
         c->cdf[i] = NULL;
@@ -249,13 +267,19 @@ static gi_result cssm_prepare(void *inst, const gi_gpu_scene *gs)
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);
     cssm_stats_data_bytes(c);
+    if (c->vis && (r = gi_rt_create(gs->scene, gs->time, &c->vis_rt, &err)) != GI_OK)
+        return gi_kit_fail_with(&c->kit, r, &err);
+    if (c->vis && (c->gather == 0 || c->bounces_on == 0))
+        host->log(host, GI_LOG_INFO, "vis=trace: the C gathers run (gather=cpu, bounces_on=cpu)");
     r = cssm_lighting(c, gs);
     if (r != GI_OK)
         return r;
-    const char *no_gpu = c->gather == 0 ? cssm_gpu_unsupported(c, gs->scene) : NULL;
+    const char *no_gpu = c->gather == 0 && !c->vis ? cssm_gpu_unsupported(c, gs->scene) : NULL;
     if (no_gpu)
         host->log(host, GI_LOG_INFO, "gather=gpu does not cover %s: the C gather runs", no_gpu);
-    c->gpu_on = c->gather == 0 && !no_gpu;
+    c->gpu_on = c->gather == 0 && !c->vis && !no_gpu;
+    c->gpu_texels = c->gather == 0 && !c->vis && c->mode == 1 && c->indirect == 0 && !moving;
+    host->stat(host, "texel_gather_gpu", c->gpu_texels);
     c->gpu_dirty = 1;
     c->cpu_frames = 0, c->cpu_process_s = c->cpu_main_s = 0.0;
     host->stat(host, "gather_gpu", c->gpu_on);
@@ -280,6 +304,11 @@ static gi_result cssm_update(void *inst, const gi_gpu_scene *gs, const gi_change
         gi_result r = cssm_place_movers(c, gs); /* §3.3, the atlas lit again below */
         if (r != GI_OK)
             return r;
+        gi_error err;
+        if (c->vis_rt && (r = gi_rt_set_time(c->vis_rt, gs->time, &err)) != GI_OK) {
+            c->prepared = 0;
+            return gi_kit_fail_with(&c->kit, r, &err);
+        }
         moved = 1;
     }
     if (moved || (changes->flags & (GI_CHANGED_LIGHTS | GI_CHANGED_MATERIALS))) {
@@ -323,6 +352,13 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
     gi_result r = gi_kit_frame_begin(kit, view, what | (random ? 0u : GI_KIT_NO_AVERAGE));
     if (r != GI_OK)
         return r;
+    /* bounces_every=frame: the n HRC bounces solved every frame (§4.1.1;
+     * Table 1's fps fall with n), the senders jittered per frame (§4.5) */
+    if (c->bounces_every == 1 &&
+        (r = cssm_bounces_solve(c, c->jitter, kit->frames, view->seed)) != GI_OK) {
+        c->prepared = 0; /* the light sets may be gone: render refuses until the next prepare */
+        return r;
+    }
     r = gi_kit_render_gbuffer(kit, view, "gbuffer");
     if (r != GI_OK)
         return r;
@@ -342,7 +378,9 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
         return r;
     const gi_scene *s = kit->scene->scene;
     const uint32_t frame = kit->frames;
-    if (c->mode == 1)
+    if (c->gpu_texels && (r = cssm_gpu_texel_gather(c, view, frame, random, &st)) != GI_OK)
+        return r;
+    if (c->mode == 1 && !c->gpu_texels)
         cssm_texel_gather(c, view, frame, random, &st);
     cssm_final_gather(c, view, frame, random, &st);
     glTextureSubImage2D(target->texture, 0, 0, 0, (GLsizei)w, (GLsizei)h, GL_RGBA, GL_FLOAT,

@@ -50,12 +50,15 @@ typedef struct cssm_hrc {
     uint32_t *order;
     cssm_maps maps;
     cssm_tree tree;
-    float *texel_L; /* emission + reflected, 3 per texel */
-    float *node_L;  /* pulled texel_L */
-    float *node_Le; /* pulled emission (texel mode: direct light per pixel) */
-    float *node_B;  /* pulled reflected light (texel mode: indirect) */
-    float *texel_T; /* texel mode: view-dependent indirect light per texel, 3 per texel */
-    uint32_t *ids;  /* G-buffer ids read-back (texel mode) */
+    float *texel_D; /* direct light not from emitting texels (punctual, environment, direct=csm) */
+    int has_direct; /* texel_D is not all zero: a light that is not an atlas texel */
+    int bounces_every; /* 0 change; 1 frame: render() solves the HRC bounces every frame */
+    float *texel_L;    /* emission + reflected, 3 per texel */
+    float *node_L;     /* pulled texel_L */
+    float *node_Le;    /* pulled emission (texel mode: direct light per pixel) */
+    float *node_B;     /* pulled reflected light (texel mode: indirect) */
+    float *texel_T;    /* texel mode: view-dependent indirect light per texel, 3 per texel */
+    uint32_t *ids;     /* G-buffer ids read-back (texel mode) */
     int mode;
     int indirect, mc_samples;  /* §4.6 alternative: Monte Carlo from the atlas as a pdf */
     float *texel_Le, *texel_B; /* emission and reflected light per texel */
@@ -66,6 +69,8 @@ typedef struct cssm_hrc {
     int env_pixel;  /* 1: environment light traced per pixel; 0: the texels' irradiance looked up */
     int env_mode;   /* environment visibility: 0 ray tracer, 1 the texels' own CSSMs (env_cssm.c) */
     gi_rt *rt;      /* the scene for the environment's occlusion, NULL without environment */
+    int vis;        /* 1: vis=trace, the gathers' visibility by ray queries (Fig. 14) */
+    gi_rt *vis_rt;  /* vis=trace: the scene for those queries */
     float *texel_E; /* environment irradiance per texel, 3 per texel; NULL: no environment */
     float *accum;   /* running average, 4 per pixel */
     float *gb[5];   /* G-buffer read-back: position, normal, albedo, phong, emission */
@@ -76,14 +81,15 @@ typedef struct cssm_hrc {
                          emission, reflected */
     int direct, csm_points, csm_samples, csm_M; /* §4.7 "Direct Light": direct=csm (direct_csm.h) */
     cssm_csm_direct *csm;                       /* its CSMs, NULL with direct=maps */
-    int gather;    /* gather=gpu (0) or cpu (1): where the per-pixel final gather runs */
-    int gpu_on;    /* gather=gpu and the scene and options are ones the GPU pass covers */
-    int gpu_dirty; /* the lighting changed since the GPU buffers were filled */
+    int gather;      /* gather=gpu (0) or cpu (1): where the per-pixel final gather runs */
+    int gpu_on;      /* gather=gpu and the scene and options are ones the GPU pass covers */
+    int gpu_texels;  /* gather=gpu, mode=texels: the per-texel gather is a pass (static, hrc) */
+    int gpu_dirty;   /* the lighting changed since the GPU node buffer was filled */
+    int gpu_maps_ok; /* the texels, albedo and CSSM faces are in the GPU buffers */
     GLuint gpu_prog[CSSM_GPU_PROGS]; /* cssm_gather.comp per define set (gpu_gather.c) */
     int bounces_on; /* bounces_on=gpu (0) or cpu (1): where the HRC bounces' gathers run */
     GLuint gpu_bounce_prog[CSSM_GPU_PROGS]; /* cssm_bounce.comp per define set */
     GLuint gpu_bounce_buf[2];               /* texels' albedo, gathered radiance */
-    int gpu_bounce_maps;                    /* this solve's maps and albedo are uploaded */
     cssm_gather_opts bounce_opts;           /* the solve's gather options, for the compute pass */
     GLuint gpu_buf[CSSM_GPU_BUFFERS];
     /* the read-only buffers as buffer textures (the shaders read those):
@@ -127,6 +133,12 @@ gi_result cssm_make_compact(cssm_hrc *c, gi_error *err);
 /* The atlas' lighting (§4.1, Fig. 8) with the punctual lights' direct
  * light per texel added to the first bounce. Fails through the kit. */
 gi_result cssm_lighting(cssm_hrc *c, const gi_gpu_scene *gs);
+/* The HRC bounces (§4.1, Fig. 8) over the direct light cssm_lighting
+ * kept (texel_D): texel_L, node_L and the light sets made anew; with
+ * jitter each gather's senders jittered by the streams of (frame, seed)
+ * (cssm_gather_opts.atlas_jitter). cssm_lighting calls it without jitter;
+ * render() every frame with bounces_every=frame. Fails through the kit. */
+gi_result cssm_bounces_solve(cssm_hrc *c, int jitter, uint32_t frame, uint32_t seed);
 
 /* -------------------------------------------------------- maps_cache.c */
 
@@ -167,6 +179,13 @@ const char *cssm_gpu_unsupported(const cssm_hrc *c, const gi_scene *s);
  * through the kit. */
 gi_result cssm_gpu_final_gather(cssm_hrc *c, const gi_view *view, const gi_target *target,
                                 int random, cssm_gather_stats *st);
+/* gather=gpu in texel mode (static scenes, indirect=hrc): the glossy
+ * gather of the reflected light per atlas texel toward the eye as a pass
+ * of shaders/cssm_bounce.comp (CSSM_GLOSSY 1), read back into c->texel_T;
+ * the twin of cssm_texel_gather, same streams. Stage timer texel_gather.
+ * Fails through the kit. */
+gi_result cssm_gpu_texel_gather(cssm_hrc *c, const gi_view *view, uint32_t frame, int random,
+                                cssm_gather_stats *st);
 /* Deletes the program and buffers (a GL context is current). */
 void cssm_gpu_free(cssm_hrc *c);
 /* bounces_on=gpu: points o's atlas_gather at the compute pass of the HRC

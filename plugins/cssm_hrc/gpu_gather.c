@@ -60,7 +60,7 @@ static void bind_textures(cssm_hrc *c)
 const char *cssm_gpu_unsupported(const cssm_hrc *c, const gi_scene *s)
 {
     if (c->mode == 1)
-        return "mode=texels";
+        return "mode=texels (its per-pixel part; the per-texel gather runs as a pass)";
     if (c->indirect == 1)
         return "indirect=mc";
     if (c->direct == 1)
@@ -96,8 +96,13 @@ static void upload(GLuint buf, size_t bytes, const void *data)
 {
     /* an empty buffer still binds: one zero word */
     static const uint32_t zero[4] = {0};
-    glNamedBufferData(buf, bytes ? (GLsizeiptr)bytes : (GLsizeiptr)sizeof zero, bytes ? data : zero,
-                      GL_STATIC_DRAW);
+    const GLsizeiptr n = bytes ? (GLsizeiptr)bytes : (GLsizeiptr)sizeof zero;
+    GLint64 have = -1;
+    glGetNamedBufferParameteri64v(buf, GL_BUFFER_SIZE, &have);
+    if (have == (GLint64)n) /* same size (the nodes of each bounce and frame): keep the storage */
+        glNamedBufferSubData(buf, 0, n, bytes ? data : zero);
+    else
+        glNamedBufferData(buf, n, bytes ? data : zero, GL_STATIC_DRAW);
 }
 
 /* The nodes a gather reads (node_L, or the packed nodes ct), decoded as
@@ -216,16 +221,47 @@ static GLuint program_for(GLuint *progs, const char *comp, int pcf, int jitter, 
     return progs[index];
 }
 
-/* The buffers when the lighting changed (prepare, update). */
+/* The texels, their albedo and the six CSSM faces, uploaded once per
+ * prepare or update (c->gpu_maps_ok; cssm_lighting clears it), shared by
+ * the final gather and the bounces; the buffers made on first use. */
+static gi_result maps_setup(cssm_hrc *c)
+{
+    if (!c->gpu_buf[0])
+        glCreateBuffers(CSSM_GPU_BUFFERS, c->gpu_buf);
+    if (!c->gpu_bounce_buf[0])
+        glCreateBuffers(2, c->gpu_bounce_buf);
+    if (c->gpu_maps_ok)
+        return GI_OK;
+    const cssm_atlas *a = &c->atlas;
+    float *alb = calloc(8 * (size_t)a->count + 4, sizeof *alb);
+    if (!alb)
+        return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the maps");
+    for (uint32_t i = 0; i < a->count; i++) { /* albedo, then Phong ks and exponent */
+        memcpy(&alb[8 * i], a->texels[i].albedo, 3 * sizeof(float));
+        memcpy(&alb[8 * i + 4], a->texels[i].ks, 3 * sizeof(float));
+        alb[8 * i + 7] = a->texels[i].exponent;
+    }
+    upload(c->gpu_bounce_buf[0], 8 * (size_t)a->count * sizeof *alb, alb);
+    free(alb);
+    glNamedBufferData(c->gpu_bounce_buf[1], (GLsizeiptr)(3 * (size_t)a->count + 4) * 4, NULL,
+                      GL_DYNAMIC_READ);
+    gi_result r = upload_maps(c);
+    if (r != GI_OK)
+        return r;
+    c->gpu_maps_ok = 1;
+    return GI_OK;
+}
+
+/* The buffers: the maps when the scene or materials changed, the nodes
+ * when the lighting did (every frame with bounces_every=frame). */
 static gi_result gpu_setup(cssm_hrc *c)
 {
     gi_error err;
-    if (!c->gpu_buf[0])
-        glCreateBuffers(CSSM_GPU_BUFFERS, c->gpu_buf);
+    gi_result r = maps_setup(c);
+    if (r != GI_OK)
+        return r;
     if (c->gpu_dirty) {
-        gi_result r = upload_maps(c);
-        if (r == GI_OK)
-            r = upload_nodes(c, c->node_L, c->nodes ? &c->ct[0] : NULL);
+        r = upload_nodes(c, c->node_L, c->nodes ? &c->ct[0] : NULL);
         if (r != GI_OK)
             return r;
         c->gpu_dirty = 0;
@@ -284,39 +320,16 @@ gi_result cssm_gpu_final_gather(cssm_hrc *c, const gi_view *view, const gi_targe
     return GI_OK;
 }
 
-/* bounces_on=gpu: the program, the buffers, the maps and the texels'
- * albedo, once per cssm_solve_ex (the first gather of the solve). */
-static gi_result bounce_setup(cssm_hrc *c, gi_error *err)
+/* One per-texel pass of cssm_bounce.comp over the nodes in the node
+ * buffer: program p (its defines chosen by the caller), o's options, texel
+ * t's generator gi_rng_init(t, frame, stream), eye for the glossy texels
+ * (NULL: a diffuse bounce); the radiance read back into out[3 N] and the
+ * counts added to st. */
+static gi_result texel_pass(cssm_hrc *c, GLuint p, const cssm_gather_opts *o, uint32_t frame,
+                            uint32_t stream, const gi_vec3 *eye, float *out, cssm_gather_stats *st,
+                            gi_error *err)
 {
-    if (!program_for(c->gpu_bounce_prog, "cssm_bounce.comp", c->bounce_opts.pcf != 0, 0,
-                     c->bounce_opts.rep_centroid != 0, 0, err))
-        return GI_ERR_GL;
-    if (!c->gpu_buf[0])
-        glCreateBuffers(CSSM_GPU_BUFFERS, c->gpu_buf);
-    if (!c->gpu_bounce_buf[0])
-        glCreateBuffers(2, c->gpu_bounce_buf);
-    if (c->gpu_bounce_maps)
-        return GI_OK;
-    const cssm_atlas *a = &c->atlas;
-    float *alb = calloc(4 * (size_t)a->count + 4, sizeof *alb);
-    if (!alb)
-        return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "cssm_hrc: out of memory for the bounces");
-    for (uint32_t i = 0; i < a->count; i++)
-        memcpy(&alb[4 * i], a->texels[i].albedo, 3 * sizeof(float));
-    upload(c->gpu_bounce_buf[0], 4 * (size_t)a->count * sizeof *alb, alb);
-    free(alb);
-    glNamedBufferData(c->gpu_bounce_buf[1], (GLsizeiptr)(3 * (size_t)a->count + 4) * 4, NULL,
-                      GL_DYNAMIC_READ);
-    gi_result r = upload_maps(c);
-    if (r != GI_OK)
-        return gi_error_set(err, r, "cssm_hrc: out of memory for the bounces");
-    c->gpu_bounce_maps = 1;
-    c->gpu_dirty = 1; /* the final gather's node buffer is overwritten by the bounces' */
-    return GI_OK;
-}
-
-static void bounce_uniforms(const cssm_hrc *c, GLuint p, const cssm_gather_opts *o)
-{
+    glUseProgram(p);
     glUniform1ui(glGetUniformLocation(p, "u_count"), c->atlas.count);
     glUniform1f(glGetUniformLocation(p, "u_lim"), cssm_refine_limit(o->threshold));
     glUniform1f(glGetUniformLocation(p, "u_scale"), exp2f(o->exposure));
@@ -327,25 +340,10 @@ static void bounce_uniforms(const cssm_hrc *c, GLuint p, const cssm_gather_opts 
     glUniform1ui(glGetUniformLocation(p, "u_M"), c->maps.M);
     glUniform1uiv(glGetUniformLocation(p, "u_off_base"), 6, c->gpu_off_base);
     glUniform1uiv(glGetUniformLocation(p, "u_seg_base"), 6, c->gpu_seg_base);
-}
-
-/* §4.1.1: one gather step for every atlas texel (cssm_gather_opts'
- * atlas_gather): the nodes of the previous bounce uploaded, one invocation
- * per texel (cssm_bounce.comp), the radiance read back into out. */
-static gi_result bounce_gather(void *ctx, const float *node_L, const cssm_ctree *ct, float *out,
-                               cssm_gather_stats *st, gi_error *err)
-{
-    cssm_hrc *c = ctx;
-    gi_result r = bounce_setup(c, err);
-    if (r == GI_OK && (r = upload_nodes(c, node_L, ct)) != GI_OK)
-        return gi_error_set(err, r, "cssm_hrc: out of memory for the bounces");
-    if (r != GI_OK)
-        return r;
-    const GLuint p =
-        program_for(c->gpu_bounce_prog, "cssm_bounce.comp", c->bounce_opts.pcf != 0, 0,
-                    c->bounce_opts.rep_centroid != 0, 0, err); /* built by bounce_setup */
-    glUseProgram(p);
-    bounce_uniforms(c, p, &c->bounce_opts);
+    glUniform1ui(glGetUniformLocation(p, "u_frame"), frame);
+    glUniform1ui(glGetUniformLocation(p, "u_stream"), stream);
+    if (eye)
+        glUniform3f(glGetUniformLocation(p, "u_eye"), eye->x, eye->y, eye->z);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CSSM_SSBO_STATS, c->gpu_buf[BUF_STATS]);
     bind_textures(c);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CSSM_SSBO_OUT, c->gpu_bounce_buf[1]);
@@ -363,17 +361,61 @@ static gi_result bounce_gather(void *ctx, const float *node_L, const cssm_ctree 
         st->receivers += got[1];
         st->clamped += got[2];
     }
-    return gi_gl_check("cssm_hrc: gpu bounce", err);
+    return gi_gl_check("cssm_hrc: gpu texel pass", err);
+}
+
+/* §4.1.1: one gather step for every atlas texel (cssm_gather_opts'
+ * atlas_gather): the nodes of the previous bounce uploaded, one invocation
+ * per texel (cssm_bounce.comp), the radiance read back into out. pass:
+ * the gather's jitter stream (hrc.c gather_atlas). */
+static gi_result bounce_gather(void *ctx, const float *node_L, const cssm_ctree *ct, uint32_t pass,
+                               float *out, cssm_gather_stats *st, gi_error *err)
+{
+    cssm_hrc *c = ctx;
+    const cssm_gather_opts *o = &c->bounce_opts;
+    gi_result r = maps_setup(c);
+    if (r == GI_OK)
+        r = upload_nodes(c, node_L, ct);
+    if (r != GI_OK)
+        return gi_error_set(err, r, "%s", gi_kit_last_error(&c->kit));
+    c->gpu_dirty = 1; /* the final gather's node buffer is overwritten by the bounces' */
+    const GLuint p =
+        program_for(c->gpu_bounce_prog, "cssm_bounce.comp", o->pcf != 0, o->atlas_jitter != 0,
+                    o->rep_centroid != 0, 0, err); /* built by cssm_gpu_bounces */
+    return texel_pass(c, p, o, o->atlas_frame, o->atlas_seed ^ (CSSM_ATLAS_SALT + pass), NULL, out,
+                      st, err);
+}
+
+gi_result cssm_gpu_texel_gather(cssm_hrc *c, const gi_view *view, uint32_t frame, int random,
+                                cssm_gather_stats *st)
+{
+    const gi_host *host = c->kit.host;
+    host->stage_begin(host, "texel_gather");
+    const cssm_gather_opts o = cssm_hrc_gather_opts(c, view->exposure, NULL);
+    gi_error err;
+    gi_result r = maps_setup(c);
+    if (r == GI_OK)
+        r = upload_nodes(c, c->node_B, c->nodes ? &c->ct[2] : NULL); /* light set 2: reflected */
+    c->gpu_dirty = 1;
+    const GLuint p = r == GI_OK ? program_for(c->gpu_bounce_prog, "cssm_bounce.comp", o.pcf != 0,
+                                              random != 0, o.rep_centroid != 0, 1, &err)
+                                : 0;
+    if (r == GI_OK && !p)
+        r = gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
+    if (r == GI_OK && (r = texel_pass(c, p, &o, frame, view->seed ^ 0x7e1u, &view->eye, c->texel_T,
+                                      st, &err)) != GI_OK)
+        r = gi_kit_fail_with(&c->kit, r, &err);
+    host->stage_end(host, "texel_gather");
+    return r;
 }
 
 gi_result cssm_gpu_bounces(cssm_hrc *c, cssm_gather_opts *o)
 {
     gi_error err;
-    if (!program_for(c->gpu_bounce_prog, "cssm_bounce.comp", o->pcf != 0, 0, o->rep_centroid != 0,
-                     0, &err))
+    if (!program_for(c->gpu_bounce_prog, "cssm_bounce.comp", o->pcf != 0, o->atlas_jitter != 0,
+                     o->rep_centroid != 0, 0, &err))
         return gi_kit_fail_with(&c->kit, GI_ERR_GL, &err);
     c->bounce_opts = *o;
-    c->gpu_bounce_maps = 0;
     o->atlas_gather = bounce_gather;
     o->atlas_ctx = c;
     return GI_OK;

@@ -298,6 +298,17 @@ static uint32_t pick_leaf(const cssm_tree *t, const float *node_L, const cssm_ct
     return v.first;
 }
 
+/* vis=trace (Fig. 14): 1 when nothing lies on the segment from the receiver
+ * x along unit w to the gathered point at distance d, less the depth bias at
+ * the sender's end (the point lies on its own surface), else 0. */
+static float trace_visible(const cssm_gather_opts *o, gi_vec3 x, gi_vec3 w, float d)
+{
+    float tmax = d - o->bias;
+    if (!(tmax > 0.0f))
+        return 1.0f;
+    return gi_rt_occluded(o->trace, x, w, 0.0f, tmax) ? 0.0f : 1.0f;
+}
+
 /* One gathered node: sample position (the node's gather position, or with
  * jitter a random point of a leaf texel below it, §4.5), visibility
  * through that texel's CSSM (the leaf: pick_leaf). leaves: leaf rank ->
@@ -347,7 +358,9 @@ static void transfer(const cssm_tree *t, const float *node_L, const cssm_ctree *
         if (st)
             st->clamped++;
     }
-    float v = maps ? cssm_visible_rc(maps, vis_texel, rc, o->bias, o->pcf) : 1.0f;
+    float v = o->trace ? trace_visible(o, rc->x, w, d)
+              : maps   ? cssm_visible_rc(maps, vis_texel, rc, o->bias, o->pcf)
+                       : 1.0f;
     if (v <= 0.0f)
         return;
     float g = cr * cs / d2 * v;
@@ -444,19 +457,24 @@ void cssm_cgather(const cssm_ctree *ct, const cssm_atlas *a, const cssm_maps *ma
 }
 
 /* One gather over every texel of the atlas from node radiance node_L (or
- * the packed nodes ct). */
+ * the packed nodes ct); pass: 1 the direct gather, b bounce b (the
+ * jitter's stream with o->atlas_jitter). */
 static gi_result gather_atlas(const cssm_tree *t, const float *node_L, const cssm_ctree *ct,
                               const cssm_atlas *a, const cssm_maps *maps, const cssm_gather_opts *o,
-                              float *out, cssm_gather_stats *st, gi_error *err)
+                              uint32_t pass, float *out, cssm_gather_stats *st, gi_error *err)
 {
     if (o->atlas_gather) /* the same gathers in a compute pass (bounces_on=gpu) */
-        return o->atlas_gather(o->atlas_ctx, node_L, ct, out, st, err);
+        return o->atlas_gather(o->atlas_ctx, node_L, ct, pass, out, st, err);
+    cssm_gather_opts oj = *o;
+    uint32_t rng = 0;
+    oj.rng = o->atlas_jitter ? &rng : NULL;
     for (uint32_t i = 0; i < a->count; i++) {
         const cssm_texel *x = &a->texels[i];
         cssm_receiver rc = {
             .x = cssm_receiver_point(maps, a, x->p, x->n), .n = x->n, .self = (int32_t)i};
         memcpy(rc.kd, x->albedo, sizeof rc.kd);
-        gather_any(t, node_L, ct, a, maps, &rc, o, &out[3 * i], st);
+        rng = gi_rng_init(i, o->atlas_frame, o->atlas_seed ^ (CSSM_ATLAS_SALT + pass));
+        gather_any(t, node_L, ct, a, maps, &rc, &oj, &out[3 * i], st);
     }
     return GI_OK;
 }
@@ -507,7 +525,7 @@ gi_result cssm_solve_ex(const cssm_tree *t, cssm_ctree *ct, const cssm_atlas *a,
         gi_host_stage(host, "direct", 1);
         if (!o->no_emission) {
             pull_any(t, ct, a, Le, nodes);
-            r = gather_atlas(t, nodes, ct, a, maps, o, Rk, st, err);
+            r = gather_atlas(t, nodes, ct, a, maps, o, 1, Rk, st, err);
         }
         if (direct)
             for (size_t k = 0; k < 3 * (size_t)N; k++)
@@ -522,7 +540,7 @@ gi_result cssm_solve_ex(const cssm_tree *t, cssm_ctree *ct, const cssm_atlas *a,
         gi_host_stage(host, "pull", 0);
         gi_host_stage(host, "bounce", 1);
         memset(Rn, 0, 3 * (size_t)N * sizeof *Rn);
-        r = gather_atlas(t, nodes, ct, a, maps, o, Rn, st, err);
+        r = gather_atlas(t, nodes, ct, a, maps, o, b, Rn, st, err);
         for (size_t k = 0; k < 3 * (size_t)N; k++)
             texel_L[k] += Rn[k];
         float *sw = Rk;
@@ -582,12 +600,15 @@ void cssm_gather_mc(const cssm_atlas *a, const cssm_maps *maps, const float *tex
         float d2 = gi_v3_dot(w, w);
         if (!(d2 > 0.0f))
             continue;
-        w = gi_v3_scale(w, 1.0f / sqrtf(d2));
+        const float d = sqrtf(d2);
+        w = gi_v3_scale(w, 1.0f / d);
         float cr = gi_v3_dot(rc->n, w), cs = -gi_v3_dot(x->n, w);
         if (cr <= 0.0f || cs <= 0.0f)
             continue;
         d2 = fmaxf(d2, o->clamp * o->clamp);
-        float v = maps ? cssm_visible_rc(maps, lo, rc, o->bias, o->pcf) : 1.0f;
+        float v = o->trace ? trace_visible(o, rc->x, w, d)
+                  : maps   ? cssm_visible_rc(maps, lo, rc, o->bias, o->pcf)
+                           : 1.0f;
         if (v <= 0.0f)
             continue;
         float g = (float)(x->area * cr * cs / d2 * v / (p * S));

@@ -24,7 +24,8 @@ cssm_gather_opts cssm_hrc_gather_opts(const cssm_hrc *c, float exposure, uint32_
                           .bias = c->bias_f * c->atlas.diameter,
                           .pcf = c->pcf,
                           .rng = rng,
-                          .rep_centroid = c->rep_centroid};
+                          .rep_centroid = c->rep_centroid,
+                          .trace = c->vis ? c->vis_rt : NULL};
     return o;
 }
 
@@ -211,50 +212,57 @@ static gi_result mc_tables(cssm_hrc *c)
 
 gi_result cssm_lighting(cssm_hrc *c, const gi_gpu_scene *gs)
 {
-    const gi_host *host = c->kit.host;
     const cssm_atlas *a = &c->atlas;
     const uint32_t N = a->count, NN = c->tree.count;
-    float *D = calloc(3 * (size_t)N, sizeof *D);
+    free(c->texel_D);
     free(c->texel_L);
     free(c->node_L);
+    c->texel_D = calloc(3 * (size_t)N, sizeof *c->texel_D);
     c->texel_L = calloc(3 * (size_t)N, sizeof *c->texel_L);
     c->node_L = calloc(3 * (size_t)NN, sizeof *c->node_L);
-    if (!D || !c->texel_L || !c->node_L) {
-        free(D);
+    if (!c->texel_D || !c->texel_L || !c->node_L)
         return gi_kit_fail(&c->kit, GI_ERR_OUT_OF_MEMORY,
                            "cssm_hrc: out of memory for the lighting");
-    }
     const gi_envmap *env;
-    gi_result r = texels_direct(c, gs, D, &env);
-    if (r != GI_OK) {
-        free(D);
+    gi_result r = texels_direct(c, gs, c->texel_D, &env);
+    if (r != GI_OK)
         return r;
-    }
+    c->has_direct = c->shadow_count || env || c->csm;
+    c->gpu_maps_ok = 0; /* the texels or their albedo may have changed */
+    c->kit.host->stat(c->kit.host, "bounces_gpu", c->bounces_on == 0 && !c->vis);
+    return cssm_bounces_solve(c, 0, 0, 0);
+}
+
+gi_result cssm_bounces_solve(cssm_hrc *c, int jitter, uint32_t frame, uint32_t seed)
+{
+    const gi_host *host = c->kit.host;
     cssm_gather_opts o = cssm_hrc_gather_opts(c, 0.0f, NULL);
     o.no_emission = c->csm != NULL; /* R1 = the CSMs' direct light alone */
+    o.atlas_jitter = jitter;
+    o.atlas_frame = frame;
+    o.atlas_seed = seed;
+    gi_result r;
     /* §4.1.1 "HRC on the GPU": the per-texel gathers in a compute pass */
-    if (c->bounces_on == 0 && (r = cssm_gpu_bounces(c, &o)) != GI_OK) {
-        free(D);
+    const int gpu_bounces = c->bounces_on == 0 && !c->vis; /* vis=trace: the C loop */
+    if (gpu_bounces && (r = cssm_gpu_bounces(c, &o)) != GI_OK)
         return r;
-    }
-    host->stat(host, "bounces_gpu", c->bounces_on == 0);
     cssm_gather_stats st = {0};
     gi_error err;
-    const float *direct = c->shadow_count || env || c->csm ? D : NULL;
     double t0[2], t1[2];
     cssm_cpu_now(t0);
-    r = cssm_solve_ex(&c->tree, c->nodes ? &c->ct[0] : NULL, a, &c->maps, &o, (uint32_t)c->bounces,
-                      direct, host, c->texel_L, c->node_L, &st, &err);
+    r = cssm_solve_ex(&c->tree, c->nodes ? &c->ct[0] : NULL, &c->atlas, &c->maps, &o,
+                      (uint32_t)c->bounces, c->has_direct ? c->texel_D : NULL, host, c->texel_L,
+                      c->node_L, &st, &err);
     cssm_cpu_now(t1);
     host->stat(host, "solve_cpu_ms", 1e3 * (t1[0] - t0[0]));
     if (t1[0] > t0[0])
         host->stat(host, "solve_main_share", (t1[1] - t0[1]) / (t1[0] - t0[0]));
-    free(D);
     if (r != GI_OK)
         return gi_kit_fail_with(&c->kit, r, &err);
     if ((r = light_sets(c)) != GI_OK || (r = mc_tables(c)) != GI_OK)
         return r;
     if (st.receivers)
         host->stat(host, "cut_size_atlas", (double)st.nodes / (double)st.receivers);
+    c->gpu_dirty = 1; /* the final gather's nodes */
     return GI_OK;
 }

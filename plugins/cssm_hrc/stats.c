@@ -28,6 +28,12 @@ void cssm_stats_maps(const cssm_hrc *c)
     host->stat(host, "segments_per_texel",
                (double)cssm_maps_segments(&c->maps) / (6.0 * c->M * c->M));
     host->stat(host, "dont_care_share", (double)c->maps.dont_care / (double)c->maps.face_texels);
+    cssm_traversal_measure m;
+    cssm_traversal_measures(&c->atlas, c->order, &m);
+    host->stat(host, "traversal_step_mean", m.step_mean);
+    host->stat(host, "traversal_jumps", (double)m.jumps);
+    host->stat(host, "traversal_jump_length_share", m.jump_length_share);
+    host->stat(host, "traversal_plane_changes", (double)m.plane_changes);
 }
 
 /* Compressed sizes of the §3.3 maps of moving objects: their own CSSMs,

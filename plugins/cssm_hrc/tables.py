@@ -87,10 +87,11 @@ def main():
                 pp = PAPER_T1[("texels", n)] / PAPER_T1[("pixels", n)]
                 print("| %s | time(pixels) / time(texels), n = %d | %.2f | %.2f | %.2f |" % (scene, n, a[1] / b[1], a[0] / b[0], pp))
 
-    def metrics_table(label_prefix, keys, title, extra=()):
-        """Runs whose label starts with label_prefix: their parameters `keys`,
-        the errors, and `extra` columns (header, runs.csv column, format[, scale])."""
-        sel = [r for r in ok if r["label"].startswith(label_prefix)]
+    def metrics_table(label_prefix, keys, title, extra=(), where=None):
+        """Runs whose label starts with label_prefix (or, given, for which
+        where(run) holds): their parameters `keys`, the errors, and `extra`
+        columns (header, runs.csv column, format[, scale])."""
+        sel = [r for r in ok if (where(r) if where else r["label"].startswith(label_prefix))]
         if not sel:
             return
         print("\n## %s\n" % title)
@@ -108,8 +109,14 @@ def main():
 
     metrics_table("fig15", ["atlas", "M", "bounces", "clamp"], "Fig. 15: against the path-traced reference")
     metrics_table("fig16", ["atlas", "bounces"], "Fig. 16: bounce count n (pixels get 0 .. n + 1 bounces)")
-    metrics_table("fig14", ["atlas", "pcf"], "Fig. 14: nearest against PCF look-ups")
+    fig14(d, ok)
+    # the PCF runs: label fig14_pcf (runs before issue 34: fig14 without vis)
+    metrics_table("fig14_pcf", ["atlas", "pcf"], "Fig. 14: nearest against PCF look-ups",
+                  where=lambda r: r["label"] == "fig14_pcf" or (r["label"] == "fig14" and "vis" not in params(r)))
     metrics_table("fig12", ["jitter"], "Fig. 12: highly glossy Cornell box, jittering, error over accumulated frames")
+    metrics_table("deficit12", ["atlas", "threshold", "max_cut", "vis", "clamp"],
+                  "Fig. 12's mean-luminance deficit: one candidate changed at a time; the blocks black (kd = ks = 0)",
+                  [("cut (pixels)", "stat_cut_size_pixels", "%.0f")])
     metrics_table("mc", ["indirect", "mc_samples"], "Sec. 4.6: indirect light by Monte Carlo from the atlas as a pdf, against the cuts")
     metrics_table("clamp", ["clamp"], "Clamping: darkening against the clamp distance")
     timing = [("prepare (s; CSSMs read from the cache where an earlier run made them)", "prepare_ms", "%.1f", 1e-3), ("frame (ms)", "frame_ms_median", "%.0f")]
@@ -121,6 +128,61 @@ def main():
                   timing + [("compression", "stat_compression_ratio", "%.1f : 1"), ("CSSM bytes", "stat_cssm_bytes", "%.0f")])
     atlas_use(ok)
     motion_table(ok)
+
+
+def trivial_black(d):
+    """relMSE of a black image against each reference (trivial.csv of the study)."""
+    path = os.path.join(d, "trivial.csv")
+    if not os.path.exists(path):
+        return {}
+    return {r["reference"]: float(r["relmse"]) for r in csv.DictReader(open(path))}
+
+
+def pair_relmse(d, a, b):
+    """relMSE of run a's image against run b's (gibench diff; the EXRs are not
+    committed, so only where the study ran here), else None."""
+    gib = os.environ.get("GIBENCH", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
+                                                  "build", "release", "bin", "gibench"))
+    ia, ib = (os.path.join(d, "runs", r["run"], "image.exr") for r in (a, b))
+    if not (os.path.exists(ia) and os.path.exists(ib) and os.path.exists(gib)):
+        return None
+    import json
+    import subprocess
+    out = subprocess.run([gib, "diff", "--json", ia, ib], capture_output=True, text=True)
+    return json.loads(out.stdout)["relmse"] if out.returncode == 0 else None
+
+
+def fig14(d, ok):
+    """Fig. 14: the CSSM visibility against an exact ray query to each gathered
+    point (vis=trace), same atlas, maps and cuts; the trivial black image
+    scored against the same references."""
+    sel = {params(r)["vis"]: r for r in ok if r["label"] == "fig14" and "vis" in params(r)}
+    if not sel:
+        return
+    print("\n## Fig. 14: CSSM visibility against exact ray-cast visibility (vis=trace)\n")
+    print("| vis | scene | atlas | M | relMSE full | relMSE matched (4 bounces) | FLIP matched | mean lum. diff. matched (%) |")
+    print("|---|---|---|---|---|---|---|---|")
+    for v in ("cssm", "trace"):
+        r = sel.get(v)
+        if r:
+            p = params(r)
+            print("| %s | %s | %s² | %s | %.4f | %.4f | %.4f | %+.2f |" % (
+                v, os.path.basename(r["scene"]), p.get("atlas"), p.get("M"), num(r, "relmse_full"),
+                num(r, "relmse_matched"), num(r, "flip_matched"), num(r, "mean_lum_diff_pct_matched")))
+    black = trivial_black(d)
+    stem = os.path.splitext(os.path.basename(next(iter(sel.values()))["scene"]))[0]
+    bm = [v for k, v in black.items() if k.startswith(stem + "_b4_")]
+    bf = [v for k, v in black.items() if k.startswith(stem + "_b64_")]
+    if bm or bf:
+        print("| (black) | %s | | | %s | %s | | -100 |" % (stem, "%.4f" % bf[0] if bf else "—", "%.4f" % bm[0] if bm else "—"))
+    if "cssm" in sel and "trace" in sel:
+        c, t = sel["cssm"], sel["trace"]
+        e = pair_relmse(d, c, t)
+        print("\nBetween them: relMSE(cssm image, trace image) %s; mean luminance cssm against trace %+.2f %% "
+              "(from the two differences to the matched reference); relMSE cssm / trace against it %.3f" % (
+                  "%.4f" % e if e is not None else "— (EXRs not here)",
+                  100 * ((1 + num(c, "mean_lum_diff_pct_matched") / 100) / (1 + num(t, "mean_lum_diff_pct_matched") / 100) - 1),
+                  num(c, "relmse_matched") / num(t, "relmse_matched")))
 
 
 def atlas_use(ok):

@@ -19,7 +19,7 @@
 #define CSSM_IMG_OFFSETS 5 /* R32UI: the six faces' codec offsets[M^2 + 1], concatenated */
 #define CSSM_IMG_Z_AVG 6   /* R32UI: the six faces' segments, concatenated */
 #define CSSM_IMG_I_END 7   /* R32UI */
-#define CSSM_IMG_ALBEDO 8  /* RGBA32UI: per texel its albedo (bounces_on=gpu) */
+#define CSSM_IMG_ALBEDO 8  /* RGBA32UI: per texel its albedo, then Phong ks and exponent */
 /* written: SSBOs from GI_SSBO_PLUGIN_FIRST (8) */
 #define CSSM_SSBO_STATS 14 /* gathered nodes, receivers, clamped gathers (one frame) */
 #define CSSM_SSBO_OUT 16   /* bounces_on=gpu: per texel the gathered radiance, 3 floats */

@@ -4,6 +4,9 @@
  *               box charts, the furnace sphere's surface samples); zig-zag
  *               and spiral steps stay between neighbouring texels of a
  *               chart except at a stated few jumps
+ *   order       Table 2: the walk order over the same chart texels changes
+ *               the segments little, the greedy walk's surface samples
+ *               much (order_tests.c)
  *   tree        the skip-pointer traversal equals a recursive depth-first
  *               traversal, for full traversals and for selective ones
  *               with pseudo-random refine decisions; spheres hold their
@@ -70,16 +73,17 @@ int cssm_test_load_gpu(const char *rel, gi_gpu **gpu, gi_scene **s, gi_gpu_scene
 int main(int argc, char **argv)
 {
     if (argc != 2) {
-        fprintf(
-            stderr,
-            "usage: cssm_tests "
-            "traversal|tree|visibility|furnace|hull|motion|motion2|texture|compact|compact_furnace|"
-            "compact_limit|escape|representative|refine_limit\n");
+        fprintf(stderr, "usage: cssm_tests "
+                        "traversal|order|tree|visibility|furnace|hull|motion|motion2|texture|"
+                        "compact|compact_furnace|"
+                        "compact_limit|escape|representative|refine_limit\n");
         return 2;
     }
     int r;
     if (!strcmp(argv[1], "traversal"))
         r = cssm_test_traversal();
+    else if (!strcmp(argv[1], "order"))
+        r = cssm_test_order();
     else if (!strcmp(argv[1], "tree"))
         r = cssm_test_tree();
     else if (!strcmp(argv[1], "refine_limit"))

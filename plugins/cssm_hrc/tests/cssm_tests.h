@@ -67,6 +67,7 @@ int cssm_test_decide(uint32_t node, uint32_t salt);
 /* ---------------------------------------------------------- the parts */
 
 int cssm_test_traversal(void);      /* atlas_tests.c */
+int cssm_test_order(void);          /* order_tests.c */
 int cssm_test_texture(void);        /* atlas_tests.c */
 int cssm_test_tree(void);           /* tree_tests.c */
 int cssm_test_refine_limit(void);   /* tree_tests.c */

@@ -1,13 +1,17 @@
 #!/usr/bin/env python3
 """gather=gpu against gather=cpu (issue 29), through gibench.
 
-gpu_gather_test.py GIBENCH ROOT OUT SCENE
+gpu_gather_test.py GIBENCH ROOT OUT SCENE [NAME=VALUE ...]
 
 The per-pixel final gather of cssm_hrc as a compute pass
 (shaders/cssm_gather.comp, the GLSL twin of final_gather.c / hrc.c /
 cssm.c's look-up) and the C gather, on SCENE (relative to ROOT) at 32 x 32,
 4 jittered frames, atlas 32^2 (the default), M = 8, the maps built once (a fresh cache
-directory under OUT). Passes when
+directory under OUT), the parameters given after SCENE added to both runs
+(mode=texels: texel mode, whose per-texel glossy gather is the pass,
+shaders/cssm_bounce.comp with CSSM_GLOSSY 1, the twin of
+final_gather.c's cssm_texel_gather; its stat texel_gather_gpu is checked
+instead of gather_gpu). Passes when
   - the GPU run ran the compute pass (stat gather_gpu 1) and the C run did
     not (gather_gpu 0);
   - the two images agree far below their noise: relMSE(gpu, cpu) at most
@@ -61,30 +65,32 @@ def finish(fails):
     print("PASS")
 
 
-def render(gib, scene, out, name, gather, cache):
+def render(gib, scene, out, name, gather, cache, extra=(), stat="gather_gpu"):
     img, tim = os.path.join(out, name + ".pfm"), os.path.join(out, name + ".json")
     os.environ["GIBENCH_CACHE"] = cache
+    params = [a for p in extra for a in ("--param", p)]
     run([gib, "-q", "render", "--scene", scene, "--method", "cssm_hrc", "--size", SIZE, "--frames", "4",
-         "--param", "M=8", "--param", "gather=" + gather, "--out", img,
+         "--param", "M=8", "--param", "gather=" + gather] + params + ["--out", img,
          "--timings", tim])
     with open(tim) as f:
-        return img, json.load(f)["stats"].get("gather_gpu")
+        return img, json.load(f)["stats"].get(stat)
 
 
-def main(gib, root, out, rel):
+def main(gib, root, out, rel, *extra):
     shutil.rmtree(out, ignore_errors=True)
     os.makedirs(out)
     cache = os.path.join(out, "cache")
     scene = os.path.join(root, rel)
     ref, trivial = truth(gib, scene, out)
-    gpu, on_gpu = render(gib, scene, out, "gpu", "gpu", cache)
-    cpu, on_cpu = render(gib, scene, out, "cpu", "cpu", cache)
+    stat = "texel_gather_gpu" if "mode=texels" in extra else "gather_gpu"
+    gpu, on_gpu = render(gib, scene, out, "gpu", "gpu", cache, extra, stat)
+    cpu, on_cpu = render(gib, scene, out, "cpu", "cpu", cache, extra, stat)
     e_gpu, e_cpu, e_pair = relmse(gib, gpu, ref), relmse(gib, cpu, ref), relmse(gib, gpu, cpu)
     print("%s: relMSE gpu %.4g, cpu %.4g to the reference; gpu to cpu %.3g; better trivial %.4g"
           % (rel, e_gpu, e_cpu, e_pair, trivial))
     fails = []
     if on_gpu != 1 or on_cpu != 0:
-        fails.append("stat gather_gpu %s (gpu) and %s (cpu), expected 1 and 0" % (on_gpu, on_cpu))
+        fails.append("stat %s %s (gpu) and %s (cpu), expected 1 and 0" % (stat, on_gpu, on_cpu))
     if not e_pair <= 0.01 * min(e_gpu, e_cpu):
         fails.append("the two gathers differ by more than 1/100 of their error")
     if not max(e_gpu, e_cpu) <= 0.5 * trivial:
@@ -93,6 +99,6 @@ def main(gib, root, out, rel):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 5:
-        sys.exit("usage: gpu_gather_test.py GIBENCH ROOT OUT SCENE")
-    main(*sys.argv[1:5])
+    if len(sys.argv) < 5:
+        sys.exit("usage: gpu_gather_test.py GIBENCH ROOT OUT SCENE [NAME=VALUE ...]")
+    main(*sys.argv[1:])
