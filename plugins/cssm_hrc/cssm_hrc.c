@@ -24,7 +24,7 @@
  * With gather=gpu (the default, as the paper) the final gather of
  * render() is a compute pass (gpu_gather.c), and with bounces_on=gpu (the
  * default) so are the HRC bounces' per-texel gathers, solved again in
- * every frame with bounces_every=frame (not the default yet; jittered with
+ * every frame with bounces_every=frame (the default; jittered with
  * jitter=true, §4.5), and texel mode's per-texel gather; the pulls, and the
  * gathers with gather=cpu / bounces_on=cpu or where the final gather's pass
  * does not cover the scene, run on the CPU; the depth cube maps, shadow maps and G-buffer are drawn
@@ -127,11 +127,10 @@ static const gi_param_desc cssm_params[] = {
     {"bounces_on", GI_PARAM_ENUM, 0, 0, 0, "gpu|cpu", "Sec. 4.1.1 (HRC on the GPU), Fig. 8",
      "where the HRC bounces' per-texel gathers run (see bounces_every): gpu, a compute pass "
      "per bounce (the paper's); cpu, the C loop (the oracle)"},
-    {"bounces_every", GI_PARAM_ENUM, 0, 0, 0, "change|frame", "Sec. 4.1.1, Table 1",
-     "when the HRC bounces are solved: change, at prepare and when lights, materials or objects "
-     "change; frame, every frame (the paper's: its fps depend on the bounces), with jitter the "
-     "senders drawn anew each frame as in the final gather (Sec. 4.5; not the default yet: "
-     "README \"Bounces every frame\")"},
+    {"bounces_every", GI_PARAM_ENUM, 0, 0, 0, "frame|change", "Sec. 4.1.1, Table 1",
+     "when the HRC bounces are solved: frame, every frame (the paper's: its fps depend on the "
+     "bounces), with jitter the senders drawn anew each frame as in the final gather (Sec. "
+     "4.5); change, at prepare and when lights, materials or objects change"},
     {"shadow_size", GI_PARAM_INT, 256, 16, 2048, NULL, NULL,
      "face size of the point/spot lights' shadow cube maps and of directional lights' shadow maps"},
     {0},
@@ -354,7 +353,7 @@ static gi_result cssm_render(void *inst, const gi_view *view, const gi_target *t
         return r;
     /* bounces_every=frame: the n HRC bounces solved every frame (§4.1.1;
      * Table 1's fps fall with n), the senders jittered per frame (§4.5) */
-    if (c->bounces_every == 1 &&
+    if (c->bounces_every == 0 &&
         (r = cssm_bounces_solve(c, c->jitter, kit->frames, view->seed)) != GI_OK) {
         c->prepared = 0; /* the light sets may be gone: render refuses until the next prepare */
         return r;

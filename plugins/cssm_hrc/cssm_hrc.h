@@ -52,7 +52,7 @@ typedef struct cssm_hrc {
     cssm_tree tree;
     float *texel_D; /* direct light not from emitting texels (punctual, environment, direct=csm) */
     int has_direct; /* texel_D is not all zero: a light that is not an atlas texel */
-    int bounces_every; /* 0 change; 1 frame: render() solves the HRC bounces every frame */
+    int bounces_every; /* 0 frame: render() solves the HRC bounces every frame; 1 change */
     float *texel_L;    /* emission + reflected, 3 per texel */
     float *node_L;     /* pulled texel_L */
     float *node_Le;    /* pulled emission (texel mode: direct light per pixel) */

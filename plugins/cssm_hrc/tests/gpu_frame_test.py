@@ -4,7 +4,7 @@ issue 29), GPU against C, through gibench.
 
 gpu_frame_test.py GIBENCH ROOT OUT SCENE
 
-cssm_hrc with bounces_every=frame (the paper's; not the default yet) re-solves its n bounces in
+cssm_hrc with bounces_every=frame (the default) re-solves its n bounces in
 every frame, the senders of each bounce jittered with the frame's streams
 (§4.5 applied to the atlas' gathers). On SCENE (relative to ROOT) at
 32 x 32, atlas 32^2, M = 8, the maps built once (a fresh cache directory
