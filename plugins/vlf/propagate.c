@@ -28,82 +28,115 @@ void vlf_sweep_sky(const vlf_field *f, uint32_t i, int sign, int first_iteration
             sky[q] += f->sun[3 * sd + (uint32_t)q];
 }
 
+/* What one sweep needs of its direction, and the fluxes it sums. */
+typedef struct {
+    vlf_field *f;
+    uint32_t i, l;
+    int sign;
+    gi_vec3 t;    /* the travel direction */
+    float sky[3]; /* the radiance each ray starts with */
+    float recv_scale, inv_s2, min_area;
+    double shot, recv, back;
+} sweep_ctx;
+
+/* One ray of a sweep, in subfield cell (cx, cy), through its fragments
+ * a..e-1 in travel order; returns the radiance that escapes at its end. Receivers (front side
+ * facing against t) take the interface's radiance and let it go on, senders (front side along t)
+ * stop what arrived on their back (flux_back counts it) and send their unshot radiance on. */
+static float sweep_ray(sweep_ctx *x, const uint32_t *frag, uint32_t a, uint32_t e, uint32_t cx,
+                       uint32_t cy)
+{
+    vlf_field *f = x->f;
+    float L[3] = {x->sky[0], x->sky[1], x->sky[2]};
+    int32_t step = x->sign > 0 ? 1 : -1;
+    int32_t k = x->sign > 0 ? (int32_t)a : (int32_t)e - 1,
+            end = x->sign > 0 ? (int32_t)e : (int32_t)a - 1;
+    for (; k != end; k += step) {
+        uint32_t el = frag[k];
+        const vlf_face *fc = &f->faces[f->elem_face[el]];
+        float cs = gi_v3_dot(fc->n, x->t);
+        float lum = L[0] + L[1] + L[2];
+        if (cs < 0.0f) {
+            /* receiver */
+            float s = x->recv_scale / fmaxf(f->elem_area[el], x->min_area);
+            for (int q = 0; q < 3; q++)
+                f->E_next[3 * (size_t)el + q] += L[q] * s;
+            if (fc->nd >= 0) {
+                size_t slot = vlf_rect_slot(&f->rects[(size_t)fc->nd * x->l + x->i], cx, cy);
+                for (int q = 0; q < 3; q++)
+                    f->in[3 * slot + q] += L[q] * x->inv_s2;
+            }
+            x->recv += lum;
+            /* and it goes on: a ray from a point further along back toward
+             * the light meets this face's back, which does not exist (the
+             * one rule for sides, gi/scene.h, as the reference casts that
+             * ray); a closed surface's exit face stops it below */
+        } else if (cs > 0.0f) {
+            /* sender: a ray from downstream meets its front, so what
+             * arrived on its back stops here (flux_back), and its front
+             * sends its unshot radiance on */
+            x->back += lum;
+            L[0] = L[1] = L[2] = 0.0f;
+            float own[3];
+            for (int q = 0; q < 3; q++)
+                own[q] = f->L_cur[3 * (size_t)el + q] * fc->send_scale;
+            if (fc->nd >= 0) {
+                size_t slot = vlf_rect_slot(&f->rects[(size_t)fc->nd * x->l + x->i], cx, cy);
+                for (int q = 0; q < 3; q++)
+                    own[q] += f->out_cur[3 * slot + q];
+            }
+            for (int q = 0; q < 3; q++)
+                L[q] += own[q];
+            x->shot += own[0] + own[1] + own[2];
+        }
+    }
+    f->st.samples += e - a;
+    return L[0] + L[1] + L[2];
+}
+
 /* One sweep of subfield i along travel direction t = sign * w_i, front to
- * back along t through every ray's fragments with the radiance interface:
- * receivers (front side facing against t) take the interface's radiance
- * and let it go on, senders (front side along t) stop what arrived on their
- * back (flux_back counts it) and send their unshot radiance on. This is the
- * one rule for sides (gi/scene.h) as the reference applies it to a ray cast
- * from a point back toward the light: it meets a single-sided face only on
- * its front. A closed surface receives at its entry and stops at its exit. */
+ * back along t through every ray's fragments with the radiance interface
+ * (sweep_ray). This is the one rule for sides (gi/scene.h) as the
+ * reference applies it to a ray cast from a point back toward the light:
+ * it meets a single-sided face only on its front. A closed surface
+ * receives at its entry and stops at its exit. */
 static void sweep(vlf_field *f, uint32_t i, int sign, int first_iteration)
 {
     const vlf_psf *p = &f->psf[i];
-    uint32_t S = f->prm.S, N = f->prm.N * S, l = f->prm.l;
-    float inv_s2 = 1.0f / (float)(S * S);
+    uint32_t S = f->prm.S, Nf = f->prm.N, N = Nf * S, l = f->prm.l;
     uint32_t sd = sign > 0 ? i : i + l;
-    gi_vec3 t = f->dirs.signed_dirs[sd];
-    float dW = f->dirs.solid_angle[sd];
     float cell_area = (2.0f / (float)N) * (2.0f / (float)N);
-    float sky[3];
-    vlf_sweep_sky(f, i, sign, first_iteration, sky);
-    double shot = 0, recv = 0, back = 0, esc = 0;
-    float min_area = 1.0f / (64.0f * f->prm.density * f->prm.density);
-    for (uint32_t c = 0; c < N * N; c++) {
-        uint32_t a = p->cell_start[c], e = p->cell_start[c + 1];
-        float L[3] = {sky[0], sky[1], sky[2]};
-        int32_t step = sign > 0 ? 1 : -1;
-        int32_t k = sign > 0 ? (int32_t)a : (int32_t)e - 1,
-                end = sign > 0 ? (int32_t)e : (int32_t)a - 1;
-        uint32_t cx = (c % N) / S,
-                 cy = (c / N) / S; /* the subfield's cell of this interface cell */
-        for (; k != end; k += step) {
-            uint32_t el = p->frag[k];
-            const vlf_face *fc = &f->faces[f->elem_face[el]];
-            float cs = gi_v3_dot(fc->n, t);
-            float lum = L[0] + L[1] + L[2];
-            if (cs < 0.0f) {
-                /* receiver */
-                float s = cell_area * dW / fmaxf(f->elem_area[el], min_area);
-                for (int q = 0; q < 3; q++)
-                    f->E_next[3 * (size_t)el + q] += L[q] * s;
-                if (fc->nd >= 0) {
-                    size_t slot = vlf_rect_slot(&f->rects[(size_t)fc->nd * l + i], cx, cy);
-                    for (int q = 0; q < 3; q++)
-                        f->in[3 * slot + q] += L[q] * inv_s2;
+    float dW = f->dirs.solid_angle[sd];
+    sweep_ctx x = {.f = f,
+                   .i = i,
+                   .l = l,
+                   .sign = sign,
+                   .t = f->dirs.signed_dirs[sd],
+                   .recv_scale = cell_area * dW,
+                   .inv_s2 = 1.0f / (float)(S * S),
+                   .min_area = 1.0f / (64.0f * f->prm.density * f->prm.density)};
+    vlf_sweep_sky(f, i, sign, first_iteration, x.sky);
+    float sky_sum = x.sky[0] + x.sky[1] + x.sky[2];
+    double esc = 0;
+    /* the interface cells in row-major order (c counts them), walked by
+     * subfield cell (cx, cy) and sub-cell (sx, sy) so that no cell needs a
+     * division; an empty cell only lets the sky's radiance escape (nothing
+     * after the first iteration) */
+    uint32_t c = 0;
+    for (uint32_t cy = 0; cy < Nf; cy++)
+        for (uint32_t sy = 0; sy < S; sy++)
+            for (uint32_t cx = 0; cx < Nf; cx++)
+                for (uint32_t sx = 0; sx < S; sx++, c++) {
+                    uint32_t a = p->cell_start[c], e = p->cell_start[c + 1];
+                    if (a != e)
+                        esc += sweep_ray(&x, p->frag, a, e, cx, cy);
+                    else if (sky_sum != 0.0f)
+                        esc += sky_sum;
                 }
-                recv += lum;
-                /* and it goes on: a ray from a point further along back
-                 * toward the light meets this face's back, which does not
-                 * exist (the one rule for sides, gi/scene.h, as the
-                 * reference casts that ray); a closed surface's exit face
-                 * stops it below */
-            } else if (cs > 0.0f) {
-                /* sender: a ray from downstream meets its front, so what
-                 * arrived on its back stops here (flux_back), and its
-                 * front sends its unshot radiance on */
-                back += lum;
-                L[0] = L[1] = L[2] = 0.0f;
-                float own[3];
-                for (int q = 0; q < 3; q++)
-                    own[q] = f->L_cur[3 * (size_t)el + q] * fc->send_scale;
-                if (fc->nd >= 0) {
-                    size_t slot = vlf_rect_slot(&f->rects[(size_t)fc->nd * l + i], cx, cy);
-                    for (int q = 0; q < 3; q++)
-                        own[q] += f->out_cur[3 * slot + q];
-                }
-                for (int q = 0; q < 3; q++)
-                    L[q] += own[q];
-                shot += own[0] + own[1] + own[2];
-            }
-            f->st.samples++;
-        }
-        esc += L[0] + L[1] + L[2];
-    }
     double w = (double)cell_area * dW / 3.0;
-    f->st.flux_shot += shot * w;
-    f->st.flux_received += recv * w;
-    f->st.flux_back += back * w;
+    f->st.flux_shot += x.shot * w;
+    f->st.flux_received += x.recv * w;
+    f->st.flux_back += x.back * w;
     f->st.flux_escaped += esc * w;
 }
 
