@@ -8,10 +8,10 @@
 # it starts the costliest first, and the short tests fill the other job.
 #
 # The costs are seconds, each test's time in one CI run (a clean clone,
-# two jobs, the 2-core machine shared with other work; 2026-11-28, main at
-# cce0819): the release suite's in GI_TEST_COSTS, the asan preset's (label
-# unit, several times slower under the sanitizers, and in another order)
-# in GI_TEST_COSTS_ASAN. Only their order matters; tests not listed (under
+# two jobs, LP_NUM_THREADS=0, the 2-core machine; 2026-11-29): the release
+# suite's in GI_TEST_COSTS, the asan preset's (label unit, -O1, several
+# times slower under the sanitizers, and in another order) in
+# GI_TEST_COSTS_ASAN. Only their order matters; tests not listed (under
 # 8 s) cost 0 and keep their declaration order after the listed ones.
 # A new slow test belongs here; a name that no longer exists does nothing.
 # RUN_SERIAL tests (integration.vlf_views) need no cost: ctest starts one
@@ -23,78 +23,83 @@
 # that added it), so every CMakeLists.txt that registers tests calls it at
 # its end.
 set(GI_TEST_COSTS
-    conformance.vlf 285
-    conformance.cssm_hrc 159
-    conformance.csm 136
-    conformance.held_out 86
-    conformance.avg 83
-    integration.slurm 71
-    integration.avg_cli 55
-    unit.fuzz_scene_brief 46
-    integration.cssm_escape 36
-    integration.view_drag 32
-    integration.vlf_views 32
-    python.api 30
-    integration.gpu_bundle 28
-    integration.vlf_reference 28
-    integration.vlf_gpu 26
-    integration.compare_study 21
-    integration.csm_cli 19
-    integration.study_interrupt 18
-    integration.implicit_vis_leak 17
-    conformance.suite 17
-    integration.report_browser 17
-    integration.view_every_method 17
-    integration.implicit_vis_glossy 16
-    integration.cssm_motion2 15
-    integration.cancel 15
-    integration.diff 15
-    conformance.implicit_vis 15
-    integration.vlf_furnace 15
-    integration.vlf_energy 13
-    integration.faults 12
-    integration.cli 11
-    integration.implicit_vis_truth_box 11
-    integration.anim_study 11
-    integration.cssm_vis_trace 10
-    integration.cssm_gpu_gather_cornell_box 9
-    integration.tradeoff 9
-    unit.fuzz_study_brief 9
-    integration.debug_buffers 9
-    integration.vlf_image_mirror 9
-    integration.implicit_vis_gpu 8)
+    conformance.vlf 533
+    conformance.cssm_hrc 309
+    conformance.csm 270
+    conformance.held_out 137
+    integration.cssm_escape 130
+    integration.view_drag 74
+    integration.slurm 73
+    conformance.avg 71
+    integration.avg_cli 67
+    integration.vlf_gpu 63
+    integration.vlf_reference 55
+    integration.cssm_motion2 46
+    python.api 41
+    integration.diff 37
+    integration.cssm_csm_direct_env 35
+    integration.view_every_method 35
+    integration.implicit_vis_leak 31
+    integration.vlf_energy 31
+    integration.vlf_furnace 30
+    integration.report_browser 27
+    integration.study_interrupt 26
+    integration.gpu_bundle 25
+    conformance.implicit_vis 25
+    integration.cssm_motion 23
+    integration.compare_study 22
+    conformance.suite 22
+    integration.cssm_gpu_bounce_cornell_box 21
+    integration.cssm_gpu_texels_cornell_glossy 20
+    integration.cssm_vis_trace 20
+    integration.csm_local 20
+    integration.implicit_vis_glossy 19
+    integration.cssm_gpu_frame_box_light 19
+    integration.cssm_gpu_gather_cornell_box 18
+    integration.csm_cli 18
+    integration.anim_study 17
+    integration.vlf_raster 17
+    integration.implicit_vis_truth_box 16
+    integration.implicit_vis_gpu 16
+    integration.avg_vpls 16
+    integration.cssm_visibility 14)
 # The asan preset's suite (the label unit), timed the same way under ASan.
 set(GI_TEST_COSTS_ASAN
-    integration.csm_local 74
-    integration.vlf_gpu 65
-    integration.view_drag 64
-    integration.cssm_escape 58
+    integration.cssm_escape 228
+    integration.view_drag 138
+    integration.cssm_motion2 109
+    integration.implicit_vis_remesh 107
+    integration.vlf_gpu 99
+    integration.cssm_csm_direct_env 69
+    integration.vlf_furnace 59
+    integration.vlf_energy 57
+    integration.csm_local 54
+    integration.cssm_texture 51
+    integration.cssm_motion 46
     integration.implicit_vis_gpu 46
-    integration.implicit_vis_remesh 26
-    integration.cssm_motion2 25
-    integration.vlf_energy 24
-    integration.implicit_vis_direct 23
-    integration.vlf_furnace 23
-    integration.avg_deform 21
-    integration.study_strict 18
-    integration.cssm_csm_direct_env 18
-    integration.implicit_vis_threads 16
-    integration.study_identity 15
-    integration.cssm_texture 14
-    integration.avg_vpls 13
-    integration.cssm_csm_direct_all 12
-    integration.input_limits 12
-    unit.fuzz_study_brief 12
-    unit.test_passes 11
-    unit.fuzz_scene_brief 10
-    integration.cssm_motion 10
-    integration.implicit_vis_furnace 10
-    unit.test_csm_codec 10
+    unit.test_passes 36
+    integration.cssm_csm_direct_all 33
+    unit.test_csm_codec 30
+    integration.avg_deform 26
+    integration.avg_vpls 26
+    integration.cssm_visibility 26
+    integration.implicit_vis_direct 24
+    integration.implicit_vis_threads 21
+    unit.test_raytrace 21
+    integration.cssm_compact_furnace 17
+    integration.cssm_order 15
+    integration.view_stale 15
+    integration.cssm_furnace 14
+    unit.fuzz_study_brief 14
+    integration.implicit_vis_furnace 14
+    integration.csm_visibility 14
+    integration.cssm_csm_direct_cornell 13
+    integration.study_identity 13
+    unit.fuzz_scene_brief 11
+    integration.view_light_drag 11
+    integration.vlf_precision 10
     integration.avg_visibility 10
-    integration.cssm_order 10
-    integration.csm_visibility 9
-    integration.view_stale 9
-    integration.view_light_drag 9
+    integration.study_strict 9
     integration.avg_voxel 9)
 
 function(gi_test_costs)
