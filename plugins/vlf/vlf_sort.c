@@ -289,7 +289,12 @@ static int scan_one(vlf_sorter *s, uint32_t q, uint32_t cand, float zmax)
 }
 
 /* A waiting piece that may lie in front of cand, or UINT32_MAX: the pieces
- * of the grid cells cand's projection meets, and the wide ones. */
+ * of the grid cells cand's projection meets, and the wide ones. A piece
+ * no longer waiting (placed or split; states only move away from waiting)
+ * can obstruct nothing again, so the scan drops it from the wide list and
+ * from each cell's list it walks (the order of the rest kept): late in a
+ * sort most of the grid is placed pieces, and walking them again for every
+ * candidate was most of the sort's time. */
 static uint32_t find_obstruction(vlf_sorter *s, uint32_t cand)
 {
     if (++s->scan == 0) {
@@ -297,16 +302,35 @@ static uint32_t find_obstruction(vlf_sorter *s, uint32_t cand)
         s->scan = 1;
     }
     float zmax = s->poly[cand].hi[2];
-    for (uint32_t k = 0; k < s->nwide; k++)
-        if (scan_one(s, s->wide[k], cand, zmax))
-            return s->wide[k];
+    uint32_t kept = 0, found = UINT32_MAX, k = 0;
+    for (; k < s->nwide && found == UINT32_MAX; k++) {
+        uint32_t q = s->wide[k];
+        if (s->state[q] != 0)
+            continue;
+        s->wide[kept++] = q;
+        if (scan_one(s, q, cand, zmax))
+            found = q;
+    }
+    memmove(s->wide + kept, s->wide + k, (size_t)(s->nwide - k) * sizeof *s->wide);
+    s->nwide = kept + (s->nwide - k);
+    if (found != UINT32_MAX)
+        return found;
     uint32_t r[4];
     grid_range(s, cand, r);
     for (uint32_t y = r[1]; y <= r[3]; y++)
-        for (uint32_t x = r[0]; x <= r[2]; x++)
-            for (uint32_t nd = s->cell_first[y * s->G + x]; nd != UINT32_MAX; nd = s->node_next[nd])
-                if (scan_one(s, s->node_piece[nd], cand, zmax))
-                    return s->node_piece[nd];
+        for (uint32_t x = r[0]; x <= r[2]; x++) {
+            uint32_t *link = &s->cell_first[y * s->G + x];
+            while (*link != UINT32_MAX) {
+                uint32_t nd = *link, q = s->node_piece[nd];
+                if (s->state[q] != 0) {
+                    *link = s->node_next[nd];
+                    continue;
+                }
+                if (scan_one(s, q, cand, zmax))
+                    return q;
+                link = &s->node_next[nd];
+            }
+        }
     return UINT32_MAX;
 }
 
