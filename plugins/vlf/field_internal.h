@@ -94,7 +94,7 @@ void vlf_element_areas(vlf_field *f, const gi_scene *s);
  * paper's claim that propagation is linear in the number of faces. */
 gi_result vlf_subdivide_triangles(vlf_field *f, uint32_t k);
 /* The triangles to sort (f->sort_*, see vlf_field.h): tri_*, or with
- * f->prm.raster and subdivide = 1 the faces that tile a convex polygon
+ * any order but rays (any path) and subdivide = 1 the faces that tile a convex polygon
  * as its fan (the rasteriser then draws tens, not thousands, of triangles
  * a direction). Fails only out of memory. */
 gi_result vlf_merge_faces(vlf_field *f);

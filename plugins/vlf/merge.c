@@ -5,7 +5,10 @@
  * triangles. The surface is the same (the polygon is the union of the
  * triangles: its area equals theirs), so the rays meet the same faces;
  * what changes is how many primitives the sort orders and the rasteriser
- * sets up per direction. */
+ * sets up per direction. Every path that sorts faces uses them (the C
+ * sweeps too, so that a hardware GL's raster default and llvmpipe's cpu
+ * default start from the same lists); order = rays and subdivide > 1
+ * (whose point is more faces) keep the triangles. */
 #define _POSIX_C_SOURCE 200809L
 #include "field_internal.h"
 
@@ -111,7 +114,7 @@ gi_result vlf_merge_faces(vlf_field *f)
 {
     f->sort_count = f->tri_count;
     f->sort_p = f->tri_p, f->sort_face = f->tri_face, f->sort_group = f->tri_group;
-    if (!f->prm.raster || f->prm.order == VLF_ORDER_RAYS || f->tri_sub > 1 || f->tri_count == 0)
+    if (f->prm.order == VLF_ORDER_RAYS || f->tri_sub > 1 || f->tri_count == 0)
         return GI_OK;
     uint32_t *first = NULL, *order = NULL;
     size_t T = f->tri_count;
