@@ -112,9 +112,10 @@ gi_result gi_csm_distant_build(const gi_gpu_scene *gs, uint32_t object,
     GLuint tex = gi_depth_texture_create(dr, BATCH);
     gi_depth_view views[BATCH];
     float *z1 = malloc((size_t)M * M * sizeof *z1), *z2 = malloc((size_t)M * M * sizeof *z2);
+    float *map = malloc((size_t)M * M * 4 * sizeof *map);
     gi_csm_codec *enc = NULL;
     gi_result r = GI_ERR_OUT_OF_MEMORY;
-    if (!z1 || !z2) {
+    if (!z1 || !z2 || !map) {
         r = gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "csm_distant: out of memory for %u x %u maps",
                          M, M);
         goto done;
@@ -128,12 +129,7 @@ gi_result gi_csm_distant_build(const gi_gpu_scene *gs, uint32_t object,
         if ((r = gi_depth_render(dr, gs, views, count, tex, 0, err)) != GI_OK)
             break;
         for (uint32_t k = 0; k < count && r == GI_OK; k++) {
-            float *map = gi_depth_read_layer(tex, M, k);
-            if (!map) {
-                r = gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "csm_distant: reading map %u failed",
-                                 first + k);
-                break;
-            }
+            gi_depth_read_layer_into(tex, M, k, map);
             for (size_t t = 0; t < (size_t)M * M; t++) {
                 float a = map[4 * t], b = map[4 * t + 1];
                 if (a >= FLT_MAX) { /* empty texel */
@@ -145,7 +141,6 @@ gi_result gi_csm_distant_build(const gi_gpu_scene *gs, uint32_t object,
                 z1[t] = a;
                 z2[t] = b >= FLT_MAX ? a + shell : fmaxf(a, b);
             }
-            free(map);
             r = gi_csm_codec_add_map(enc, first + k, z1, z2, err);
         }
     }
@@ -158,6 +153,7 @@ done:
     gi_csm_codec_free(enc);
     free(z1);
     free(z2);
+    free(map);
     glDeleteTextures(1, &tex);
     gi_depth_renderer_free(dr);
     if (r != GI_OK)

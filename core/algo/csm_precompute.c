@@ -16,8 +16,8 @@ typedef struct precompute_run {
     gi_depth_renderer *dr;
     GLuint tex;
     gi_depth_view *views;
-    uint32_t *slot; /* map k of a batch: its layer, UINT32_MAX not drawn */
-    float *z1, *z2;
+    uint32_t *slot;       /* map k of a batch: its layer, UINT32_MAX not drawn */
+    float *z1, *z2, *map; /* map: one layer read back (M*M*4) */
     gi_csm_codec *enc[GI_CSM_MAX_STREAMS];
 } precompute_run;
 
@@ -45,16 +45,12 @@ static gi_result encode_batch(precompute_run *pr, uint32_t first, uint32_t count
         float *map = NULL;
         if (pr->slot[k] != UINT32_MAX) {
             gi_host_stage(host, pr->render_stage, 1);
-            map = gi_depth_read_layer(pr->tex, pr->M, pr->slot[k]);
+            gi_depth_read_layer_into(pr->tex, pr->M, pr->slot[k], pr->map);
             gi_host_stage(host, pr->render_stage, 0);
-            if (!map) {
-                return gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "%s: reading %s %u failed", pr->who,
-                                    pr->what, q);
-            }
+            map = pr->map;
         }
         gi_host_stage(host, "compress", 1);
         d->depths(d->ctx, q, map ? &pr->views[pr->slot[k]] : NULL, map, pr->z1, pr->z2);
-        free(map);
         r = gi_csm_codec_add_map(pr->enc[q % pr->S], q / pr->S, pr->z1, pr->z2, err);
         gi_host_stage(host, "compress", 0);
         if (r != GI_OK)
@@ -96,8 +92,9 @@ gi_result gi_csm_precompute(const gi_gpu_scene *gs, const gi_csm_precompute_desc
     pr.slot = calloc(batch, sizeof *pr.slot);
     pr.z1 = malloc((size_t)M * M * sizeof *pr.z1);
     pr.z2 = malloc((size_t)M * M * sizeof *pr.z2);
+    pr.map = malloc((size_t)M * M * 4 * sizeof *pr.map);
     gi_result r = GI_ERR_OUT_OF_MEMORY;
-    if (!pr.views || !pr.slot || !pr.z1 || !pr.z2) {
+    if (!pr.views || !pr.slot || !pr.z1 || !pr.z2 || !pr.map) {
         r = gi_error_set(err, GI_ERR_OUT_OF_MEMORY, "%s: out of memory for %u x %u %s", who, M, M,
                          what);
         goto done;
@@ -135,6 +132,7 @@ done:
     free(pr.slot);
     free(pr.z1);
     free(pr.z2);
+    free(pr.map);
     glDeleteTextures(1, &pr.tex);
     gi_depth_renderer_free(pr.dr);
     return r;

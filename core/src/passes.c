@@ -256,13 +256,17 @@ gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi
     return gi_gl_check("depth-map pass", err);
 }
 
-float *gi_depth_read_layer(GLuint array_tex, uint32_t size, uint32_t layer)
+void gi_depth_read_layer_into(GLuint array_tex, uint32_t size, uint32_t layer, float *out)
 {
     size_t n = (size_t)size * size * 4;
-    float *out = malloc(n * sizeof *out);
-    if (!out)
-        return NULL;
     glGetTextureSubImage(array_tex, 0, 0, 0, (GLint)layer, (GLsizei)size, (GLsizei)size, 1, GL_RGBA,
                          GL_FLOAT, (GLsizei)(n * sizeof *out), out);
+}
+
+float *gi_depth_read_layer(GLuint array_tex, uint32_t size, uint32_t layer)
+{
+    float *out = malloc((size_t)size * size * 4 * sizeof *out);
+    if (out)
+        gi_depth_read_layer_into(array_tex, size, layer, out);
     return out;
 }
