@@ -311,7 +311,8 @@ static uint32_t find_obstruction(vlf_sorter *s, uint32_t cand)
         if (scan_one(s, q, cand, zmax))
             found = q;
     }
-    memmove(s->wide + kept, s->wide + k, (size_t)(s->nwide - k) * sizeof *s->wide);
+    if (kept < k && k < s->nwide) /* the rest, not scanned, closes the gap */
+        memmove(s->wide + kept, s->wide + k, (size_t)(s->nwide - k) * sizeof *s->wide);
     s->nwide = kept + (s->nwide - k);
     if (found != UINT32_MAX)
         return found;
