@@ -97,8 +97,12 @@ static void face_chart(const vlf_field *f, vlf_face *fc, const tri_key *keys, ui
 }
 
 /* Face fc's material (the scene's material m) with its lobe's albedo
- * table, and the emission of its triangle t0. */
-static void face_material(vlf_face *fc, const gi_scene *s, uint32_t m, uint32_t t0)
+ * table, and the emission of its triangle t0. The table depends on the
+ * material alone: computed at its first face into tables[m] (have[m] set),
+ * copied for the others (a mesh like the bunny is thousands of faces of one
+ * material, and each table is 135 168 cosines). */
+static void face_material(vlf_face *fc, const gi_scene *s, uint32_t m, uint32_t t0, float *tables,
+                          unsigned char *have)
 {
     const gi_material *mt = &s->materials[m];
     memcpy(fc->kd, mt->albedo, sizeof fc->kd);
@@ -107,11 +111,14 @@ static void face_material(vlf_face *fc, const gi_scene *s, uint32_t m, uint32_t 
     fc->material = m;
     fc->textured = mt->albedo_texture >= 0 && (uint32_t)mt->albedo_texture < s->texture_count;
     fc->mirror = mt->mirror || mt->exponent >= GI_MIRROR_EXPONENT;
-    for (int k = 0; k < VLF_ALBEDO_TABLE; k++)
-        fc->albedo[k] =
-            fc->mirror
-                ? 1.0f
-                : (float)vlf_phong_albedo(fc->exponent, (float)k / (float)(VLF_ALBEDO_TABLE - 1));
+    float *tab = tables + (size_t)m * VLF_ALBEDO_TABLE;
+    if (!have[m])
+        for (int k = 0; k < VLF_ALBEDO_TABLE; k++)
+            tab[k] = fc->mirror ? 1.0f
+                                : (float)vlf_phong_albedo(fc->exponent,
+                                                          (float)k / (float)(VLF_ALBEDO_TABLE - 1));
+    have[m] = 1;
+    memcpy(fc->albedo, tab, sizeof fc->albedo);
     const float *le = gi_scene_triangle_emission(s, t0);
     for (int k = 0; k < 3; k++)
         fc->emission[k] = le ? le[k] : 0.0f;
@@ -127,19 +134,22 @@ gi_result vlf_group_faces(vlf_field *f, const gi_scene *s, float t)
     tri_key *keys = malloc((size_t)T * sizeof *keys);
     gi_vec3 *nrm = malloc((size_t)T * sizeof *nrm);
     f->faces = calloc((size_t)T * 2, sizeof *f->faces); /* double-sided faces take two */
-    if (!f->tri_face || !f->tri_group || !f->tri_p || !keys || !nrm || !f->faces) {
-        free(keys);
-        free(nrm);
+    size_t nm = s->material_count ? s->material_count : 1;
+    float *tables = malloc(nm * VLF_ALBEDO_TABLE * sizeof *tables);
+    unsigned char *have = calloc(nm, 1);
+    if (!f->tri_face || !f->tri_group || !f->tri_p || !keys || !nrm || !f->faces || !tables ||
+        !have) {
+        free(keys), free(nrm), free(tables), free(have);
         return GI_ERR_OUT_OF_MEMORY;
     }
     key_triangles(f, s, t, keys, nrm);
     qsort(keys, T, sizeof *keys, key_cmp);
     uint32_t nf = 0, groups = 0;
     for (uint32_t a = 0; a < T;) {
-        /* a face's albedo table costs about 1 ms of CPU on llvmpipe's
+        /* a material's albedo table costs about 1 ms of CPU on llvmpipe's
          * machine (measured, issue 32): asked every 64 faces */
         if ((groups++ & 63) == 0 && f->prm.cancelled && f->prm.cancelled(f->prm.cancel_user)) {
-            free(keys), free(nrm);
+            free(keys), free(nrm), free(tables), free(have);
             f->face_count = nf;
             return GI_ERR_CANCELLED;
         }
@@ -149,7 +159,7 @@ gi_result vlf_group_faces(vlf_field *f, const gi_scene *s, float t)
         vlf_face *fc = &f->faces[nf];
         face_plane(f, nf, keys + a, b - a, nrm);
         face_chart(f, fc, keys + a, b - a);
-        face_material(fc, s, keys[a].material, keys[a].tri);
+        face_material(fc, s, keys[a].material, keys[a].tri, tables, have);
         fc->twin = -1;
         if (s->materials[keys[a].material].double_sided) {
             /* the back side (§3.1: receiver faces store values for both
@@ -167,8 +177,7 @@ gi_result vlf_group_faces(vlf_field *f, const gi_scene *s, float t)
         a = b;
     }
     f->face_count = nf;
-    free(keys);
-    free(nrm);
+    free(keys), free(nrm), free(tables), free(have);
     return GI_OK;
 }
 
