@@ -178,8 +178,9 @@ void gi_depth_cube_view(gi_vec3 eye, float znear, float zfar, int face, gi_depth
  * the bottom), for tests and CPU-side compression. Caller frees. */
 float *gi_depth_read_layer(GLuint array_tex, uint32_t size, uint32_t layer);
 /* The same into out (size*size*4 floats), for loops that read many maps:
- * one buffer for all of them, not a fresh mapping of a quarter megabyte
- * (128^2) per map, whose page faults were a tenth of a precomputation. */
+ * one buffer for all of them, not a fresh allocation of a quarter megabyte
+ * (128^2) per map, which glibc maps and unmaps each time (above its mmap
+ * threshold). */
 void gi_depth_read_layer_into(GLuint array_tex, uint32_t size, uint32_t layer, float *out);
 
 /* ---- depth atlas (see the manual above) ---- */
