@@ -8,7 +8,8 @@
 # it starts the costliest first, and the short tests fill the other job.
 #
 # The costs are seconds, each test's time in one CI run (a clean clone,
-# two jobs, LP_NUM_THREADS=0, the 2-core machine; 2026-11-29): the release
+# two jobs, LP_NUM_THREADS=0, the 2-core machine; the run at 2b32bd4 on
+# 2026-11-29, docs/testing.md "Time budget"): the release
 # suite's in GI_TEST_COSTS, the asan preset's (label unit, -O1, several
 # times slower under the sanitizers, and in another order) in
 # GI_TEST_COSTS_ASAN. Only their order matters; tests not listed (under
@@ -23,84 +24,75 @@
 # that added it), so every CMakeLists.txt that registers tests calls it at
 # its end.
 set(GI_TEST_COSTS
-    conformance.vlf 533
-    conformance.cssm_hrc 309
-    conformance.csm 270
-    conformance.held_out 137
-    integration.cssm_escape 130
-    integration.view_drag 74
-    integration.slurm 73
-    conformance.avg 71
-    integration.avg_cli 67
-    integration.vlf_gpu 63
-    integration.vlf_reference 55
-    integration.cssm_motion2 46
-    python.api 41
-    integration.diff 37
-    integration.cssm_csm_direct_env 35
-    integration.view_every_method 35
-    integration.implicit_vis_leak 31
-    integration.vlf_energy 31
-    integration.vlf_furnace 30
-    integration.report_browser 27
-    integration.study_interrupt 26
-    integration.gpu_bundle 25
-    conformance.implicit_vis 25
-    integration.cssm_motion 23
-    integration.compare_study 22
-    conformance.suite 22
-    integration.cssm_gpu_bounce_cornell_box 21
-    integration.cssm_gpu_texels_cornell_glossy 20
-    integration.cssm_vis_trace 20
-    integration.csm_local 20
-    integration.implicit_vis_glossy 19
-    integration.cssm_gpu_frame_box_light 19
-    integration.cssm_gpu_gather_cornell_box 18
-    integration.csm_cli 18
-    integration.anim_study 17
-    integration.vlf_raster 17
-    integration.implicit_vis_truth_box 16
-    integration.implicit_vis_gpu 16
-    integration.avg_vpls 16
-    integration.cssm_visibility 14)
+    conformance.vlf 383
+    conformance.cssm_hrc 303
+    conformance.csm 222
+    conformance.held_out 118
+    integration.view_drag 68
+    integration.slurm 65
+    conformance.avg 55
+    integration.avg_cli 54
+    unit.fuzz_scene_brief 39
+    integration.diff 36
+    integration.vlf_reference 33
+    python.api 32
+    integration.implicit_vis_leak 29
+    integration.vlf_views 28
+    integration.view_every_method 27
+    integration.study_interrupt 25
+    integration.gpu_bundle 24
+    integration.compare_study 18
+    conformance.implicit_vis 18
+    conformance.suite 18
+    integration.report_browser 17
+    integration.cssm_vis_trace 16
+    integration.cssm_gpu_bounce_cornell_box 16
+    integration.csm_cli 16
+    integration.cssm_gpu_gather_cornell_box 16
+    integration.implicit_vis_glossy 15
+    integration.vlf_raster 15
+    integration.cssm_gpu_texels_cornell_glossy 14
+    integration.faults 14
+    integration.implicit_vis_truth_box 14
+    integration.cssm_gpu_frame_box_light 14
+    integration.anim_study 12
+    integration.cancel 12
+    unit.fuzz_study_brief 9
+    unit.test_csm_codec 9
+    integration.vlf_image_mirror 9
+    integration.tradeoff 9
+    unit.test_reference_cornell 9
+    integration.debug_buffers 8)
 # The asan preset's suite (the label unit), timed the same way under ASan.
 set(GI_TEST_COSTS_ASAN
-    integration.cssm_escape 228
-    integration.view_drag 138
-    integration.cssm_motion2 109
-    integration.implicit_vis_remesh 107
-    integration.vlf_gpu 99
-    integration.cssm_csm_direct_env 69
-    integration.vlf_furnace 59
-    integration.vlf_energy 57
-    integration.csm_local 54
-    integration.cssm_texture 51
-    integration.cssm_motion 46
-    integration.implicit_vis_gpu 46
-    unit.test_passes 36
-    integration.cssm_csm_direct_all 33
-    unit.test_csm_codec 30
-    integration.avg_deform 26
-    integration.avg_vpls 26
-    integration.cssm_visibility 26
-    integration.implicit_vis_direct 24
-    integration.implicit_vis_threads 21
-    unit.test_raytrace 21
-    integration.cssm_compact_furnace 17
-    integration.cssm_order 15
-    integration.view_stale 15
-    integration.cssm_furnace 14
-    unit.fuzz_study_brief 14
-    integration.implicit_vis_furnace 14
-    integration.csm_visibility 14
-    integration.cssm_csm_direct_cornell 13
-    integration.study_identity 13
+    integration.cssm_escape 131
+    integration.cssm_motion2 61
+    integration.csm_local 48
+    integration.cssm_csm_direct_env 47
+    integration.implicit_vis_gpu 35
+    integration.cssm_texture 34
+    integration.cssm_motion 29
+    unit.test_raytrace 22
+    unit.test_csm_codec 22
+    integration.vlf_gpu 21
+    unit.test_passes 19
+    integration.implicit_vis_direct 19
+    integration.cssm_visibility 19
+    integration.avg_vpls 18
+    integration.avg_deform 18
+    integration.cssm_csm_direct_all 17
+    unit.fuzz_study_brief 15
+    integration.implicit_vis_threads 13
+    integration.implicit_vis_remesh 13
+    integration.vlf_energy 11
     unit.fuzz_scene_brief 11
-    integration.view_light_drag 11
-    integration.vlf_precision 10
-    integration.avg_visibility 10
-    integration.study_strict 9
-    integration.avg_voxel 9)
+    integration.study_identity 11
+    integration.implicit_vis_furnace 11
+    integration.csm_visibility 9
+    integration.view_stale 9
+    integration.vlf_furnace 9
+    integration.cssm_csm_direct_cornell 9
+    integration.view_light_drag 8)
 
 function(gi_test_costs)
     set(table ${GI_TEST_COSTS})

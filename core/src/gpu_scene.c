@@ -402,6 +402,16 @@ void gi_gpu_scene_draw(const gi_gpu_scene *gs, int object, GLsizei instances)
     glBindVertexArray(0);
 }
 
+void gi_gpu_scene_draw_ranges(const gi_gpu_scene *gs, const GLsizei *counts,
+                              const void *const *offsets, GLsizei ranges)
+{
+    if (ranges <= 0)
+        return;
+    glBindVertexArray(gs->vao);
+    glMultiDrawElements(GL_TRIANGLES, counts, GL_UNSIGNED_INT, offsets, ranges);
+    glBindVertexArray(0);
+}
+
 void gi_gpu_scene_draw_indices(const gi_gpu_scene *gs, GLuint ibo, uint32_t index_count,
                                GLsizei instances)
 {

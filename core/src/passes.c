@@ -3,6 +3,7 @@
 #include "gi/image.h"
 
 #include <float.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -101,11 +102,156 @@ void gi_gbuffer_bind(const gi_gbuffer *gb, GLuint first_unit)
 
 /* ---- depth maps ---- */
 
+/* Frustum culling of the depth pass. The triangles an object draws are
+ * taken in runs of DEPTH_RUN (in the index buffer's order, never across
+ * objects), each with its box; a view draws only the runs whose box is not
+ * wholly outside one of its six clip planes. A triangle in such a box lies
+ * outside the view volume, where the rasteriser would clip it whole, so
+ * the maps are the same bits as drawing everything (tests/unit/
+ * test_passes.c compares them), with fewer vertices shaded and set up: a
+ * cube map's face sees about a sixth of the directions around its eye. */
+enum { DEPTH_RUN = 128 };
+
+typedef struct depth_run {
+    uint32_t first, count; /* indices into the scene's index buffer */
+    float box[8][4];       /* the box's corners, as drawn (world or local space) */
+} depth_run;
+
 struct gi_depth_renderer {
     gi_depth_desc desc;
     GLuint program, fbo, depth_rb;
     GLuint peel[2]; /* R32F ping-pong of the previous surface */
+    int cull_views; /* frustum culling on (the default) */
+    depth_run *runs;
+    uint32_t nruns, cap_runs;
+    GLsizei *counts;       /* per draw: the visible runs merged where adjacent */
+    const void **offsets;  /* nruns each */
+    uint64_t drawn, total; /* triangles drawn and offered, over the views so far */
 };
+
+static int object_drawn(const gi_depth_desc *d, const gi_scene *s, uint32_t o)
+{
+    if (d->only_object) /* one past the objects draws them all, as gi_gpu_scene_draw does */
+        return d->only_object > s->object_count || o + 1 == d->only_object;
+    return o + 1 != d->skip_object && !(d->skip_objects && d->skip_objects[o]);
+}
+
+/* The runs of every drawn object with their boxes now: from the CPU copy of
+ * the vertices (kept in step with the GPU's by the caller of
+ * gi_gpu_scene_update_vertices), placed by the objects' current transforms;
+ * an object with morph targets is one run with its local bounds, which
+ * cover every weight. 0 when out of memory. */
+static int depth_runs_build(gi_depth_renderer *r, const gi_gpu_scene *gs)
+{
+    const gi_scene *s = gs->scene;
+    r->nruns = 0;
+    for (uint32_t o = 0; o < s->object_count; o++) {
+        const gi_object *obj = &s->objects[o];
+        if (!object_drawn(&r->desc, s, o) || !obj->triangle_count)
+            continue;
+        uint32_t per = obj->morph_count ? obj->triangle_count : DEPTH_RUN;
+        for (uint32_t t0 = 0; t0 < obj->triangle_count; t0 += per) {
+            uint32_t n = obj->triangle_count - t0 < per ? obj->triangle_count - t0 : per;
+            if (r->nruns == r->cap_runs) {
+                uint32_t cap = r->cap_runs ? 2 * r->cap_runs : 64;
+                depth_run *nr = realloc(r->runs, cap * sizeof *nr);
+                GLsizei *nc = realloc(r->counts, cap * sizeof *nc);
+                if (nr)
+                    r->runs = nr;
+                if (nc)
+                    r->counts = nc;
+                const void **no = realloc(r->offsets, cap * sizeof *no);
+                if (no)
+                    r->offsets = no;
+                if (!nr || !nc || !no)
+                    return 0;
+                r->cap_runs = cap;
+            }
+            depth_run *run = &r->runs[r->nruns++];
+            run->first = 3 * (obj->first_triangle + t0);
+            run->count = 3 * n;
+            float lo[3], hi[3];
+            if (obj->morph_count) {
+                memcpy(lo, obj->local_bounds, sizeof lo);
+                memcpy(hi, obj->local_bounds + 3, sizeof hi);
+            } else {
+                lo[0] = lo[1] = lo[2] = FLT_MAX;
+                hi[0] = hi[1] = hi[2] = -FLT_MAX;
+                for (uint32_t i = run->first; i < run->first + run->count; i++) {
+                    const float *x = s->vertices[s->indices[i]].position;
+                    for (int k = 0; k < 3; k++)
+                        lo[k] = x[k] < lo[k] ? x[k] : lo[k], hi[k] = x[k] > hi[k] ? x[k] : hi[k];
+                }
+            }
+            for (int c = 0; c < 8; c++) {
+                gi_vec3 p = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]};
+                if (!r->desc.local)
+                    p = gi_mat4_point(gs->world_from_local[o], p);
+                run->box[c][0] = p.x, run->box[c][1] = p.y, run->box[c][2] = p.z,
+                run->box[c][3] = 1.0f;
+            }
+        }
+    }
+    return 1;
+}
+
+/* 1 when every corner of the box lies outside one clip plane of clip =
+ * proj x view (-w <= x, y, z <= w), with a margin for the GPU's rounding. */
+static int depth_box_outside(const float clip[16], const float box[8][4])
+{
+    double c[8][4];
+    for (int k = 0; k < 8; k++)
+        for (int i = 0; i < 4; i++)
+            c[k][i] = (double)clip[i] * box[k][0] + (double)clip[4 + i] * box[k][1] +
+                      (double)clip[8 + i] * box[k][2] + (double)clip[12 + i];
+    for (int axis = 0; axis < 3; axis++)
+        for (int sign = -1; sign <= 1; sign += 2) {
+            int out = 0;
+            for (int k = 0; k < 8; k++) {
+                double v = sign * c[k][axis], w = c[k][3];
+                out += v - w > 1e-4 * (fabs(v) + fabs(w)) + 1e-12;
+            }
+            if (out == 8)
+                return 1;
+        }
+    return 0;
+}
+
+/* Draws what view dv can see of the runs, in the scene's order. */
+static void depth_draw_view(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi_depth_view *dv)
+{
+    float clip[16];
+    gi_mat4_mul(clip, dv->proj, dv->view);
+    GLsizei n = 0;
+    uint32_t end = UINT32_MAX;
+    for (uint32_t k = 0; k < r->nruns; k++) {
+        const depth_run *run = &r->runs[k];
+        r->total += run->count / 3;
+        if (depth_box_outside(clip, run->box))
+            continue;
+        r->drawn += run->count / 3;
+        if (n > 0 && run->first == end) {
+            r->counts[n - 1] += (GLsizei)run->count;
+        } else {
+            r->counts[n] = (GLsizei)run->count;
+            r->offsets[n] = (const void *)((size_t)run->first * sizeof(uint32_t));
+            n++;
+        }
+        end = run->first + run->count;
+    }
+    gi_gpu_scene_draw_ranges(gs, r->counts, r->offsets, n);
+}
+
+void gi_depth_renderer_set_culling(gi_depth_renderer *r, int on)
+{
+    r->cull_views = on;
+}
+
+void gi_depth_renderer_drawn(const gi_depth_renderer *r, uint64_t *drawn, uint64_t *total)
+{
+    *drawn = r->drawn;
+    *total = r->total;
+}
 
 gi_depth_renderer *gi_depth_renderer_create(const gi_depth_desc *desc, gi_error *err)
 {
@@ -129,6 +275,7 @@ gi_depth_renderer *gi_depth_renderer_create(const gi_depth_desc *desc, gi_error 
         return NULL;
     }
     r->desc = d;
+    r->cull_views = 1;
     r->program = gi_program_build("depth.vert", NULL, "depth.frag", NULL, err);
     if (!r->program) {
         free(r);
@@ -152,6 +299,9 @@ void gi_depth_renderer_free(gi_depth_renderer *r)
     glDeleteFramebuffers(1, &r->fbo);
     glDeleteRenderbuffers(1, &r->depth_rb);
     glDeleteTextures(2, r->peel);
+    free(r->runs);
+    free(r->counts);
+    free(r->offsets);
     free(r);
 }
 
@@ -213,6 +363,9 @@ gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi
     const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
     glNamedFramebufferDrawBuffers(r->fbo, 2, bufs);
     const float far_value[4] = {FLT_MAX, FLT_MAX, FLT_MAX, FLT_MAX};
+    int culled = r->cull_views && count > 0;
+    if (culled && !depth_runs_build(r, gs))
+        culled = 0; /* out of memory for the runs: everything is drawn */
     for (uint32_t v = 0; v < count; v++) {
         const gi_depth_view *dv = &views[v];
         int para = dv->projection == GI_PROJ_PARABOLOID;
@@ -238,7 +391,9 @@ gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi
             glClear(GL_DEPTH_BUFFER_BIT);
             glBindTextureUnit(GI_TEX_CORE_DEPTH_PEEL, prev);
             glUniform1i(loc_peel, (GLint)k);
-            if ((d->skip_object || d->skip_objects) && !d->only_object) {
+            if (culled && !para) { /* a paraboloid's volume is not a frustum: drawn whole */
+                depth_draw_view(r, gs, dv);
+            } else if ((d->skip_object || d->skip_objects) && !d->only_object) {
                 for (uint32_t o = 0; o < gs->scene->object_count; o++)
                     if (o + 1 != d->skip_object && !(d->skip_objects && d->skip_objects[o]))
                         gi_gpu_scene_draw(gs, (int)o, 1);

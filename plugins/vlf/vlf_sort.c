@@ -118,11 +118,17 @@ static int split_piece(vlf_sorter *s, uint32_t idx, const float *pl, uint32_t *a
 }
 
 /* Area and centroid of the overlap of the projections (x, y) of pieces p
- * and q: p's polygon clipped by each edge of q's (Sutherland-Hodgman). */
+ * and q: p's polygon clipped by each edge of q's (Sutherland-Hodgman).
+ * Each vertex's signed distance to the edge is computed once per edge; an
+ * edge with every vertex strictly outside ends the clip (nothing is left)
+ * and one with none outside leaves the polygon as it is, which is what the
+ * clip itself would give, in fewer steps. */
 static float overlap(const vlf_sorter *s, const vlf_piece *p, const vlf_piece *q, float *cx,
                      float *cy)
 {
-    float x[2 * MAX_VERTS + 8], y[2 * MAX_VERTS + 8], ox[2 * MAX_VERTS + 8], oy[2 * MAX_VERTS + 8];
+    enum { CAP = 2 * MAX_VERTS + 8 };
+    float bx[2][CAP], by[2][CAP], d[CAP];
+    float *x = bx[0], *y = by[0], *ox = bx[1], *oy = by[1];
     int n = (int)p->count;
     for (int k = 0; k < n; k++)
         x[k] = s->vert[p->first + (uint32_t)k].x, y[k] = s->vert[p->first + (uint32_t)k].y;
@@ -139,21 +145,32 @@ static float overlap(const vlf_sorter *s, const vlf_piece *p, const vlf_piece *q
     for (int e = 0; e < m && n > 0; e++) {
         gi_vec3 e0 = Q[e], e1 = Q[(e + 1) % m];
         float ex = e1.x - e0.x, ey = e1.y - e0.y;
+        int inside = 0, outside = 0;
+        for (int k = 0; k < n; k++) {
+            d[k] = orient * (ex * (y[k] - e0.y) - ey * (x[k] - e0.x));
+            inside += d[k] >= 0.0f;
+            outside += d[k] < 0.0f;
+        }
+        if (outside == n) {
+            n = 0;
+            break;
+        }
+        if (inside == n)
+            continue;
         int o = 0;
         for (int k = 0; k < n; k++) {
-            int j = (k + 1) % n;
-            float dk = orient * (ex * (y[k] - e0.y) - ey * (x[k] - e0.x));
-            float dj = orient * (ex * (y[j] - e0.y) - ey * (x[j] - e0.x));
-            if (dk >= 0.0f && o < 2 * MAX_VERTS + 8)
+            int j = k + 1 == n ? 0 : k + 1;
+            float dk = d[k], dj = d[j];
+            if (dk >= 0.0f && o < CAP)
                 ox[o] = x[k], oy[o] = y[k], o++;
-            if (((dk < 0.0f && dj > 0.0f) || (dk > 0.0f && dj < 0.0f)) && o < 2 * MAX_VERTS + 8) {
+            if (((dk < 0.0f && dj > 0.0f) || (dk > 0.0f && dj < 0.0f)) && o < CAP) {
                 float t = dk / (dk - dj);
                 ox[o] = x[k] + t * (x[j] - x[k]), oy[o] = y[k] + t * (y[j] - y[k]), o++;
             }
         }
         n = o;
-        memcpy(x, ox, (size_t)n * sizeof *x);
-        memcpy(y, oy, (size_t)n * sizeof *y);
+        float *tx = x, *ty = y;
+        x = ox, y = oy, ox = tx, oy = ty;
     }
     double a = 0.0, sx = 0.0, sy = 0.0;
     for (int k = 0; k < n; k++) {

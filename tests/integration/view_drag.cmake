@@ -20,7 +20,7 @@
 #    within rmse 1e-4, while the same view without the moves (the trivial
 #    answer: the scene as the file has it) is farther than 1e-3 from it.
 # Run by ctest as: cmake -DGIB=... -DROOT=... -DOUT=... -P view_drag.cmake
-# (the asan build runs it too: LeakSanitizer is on there, and a leak fails the run).
+# (in the release suite only: tests/integration/CMakeLists.txt says why).
 include(${CMAKE_CURRENT_LIST_DIR}/view_common.cmake)
 view_require_xvfb()
 set(W ${OUT}/view_drag)

@@ -111,6 +111,88 @@ static float compare_map(const gi_scene *s, const float *map, uint32_t size, int
     return total ? (float)agree / total : 0.0f;
 }
 
+/* Frustum culling of the depth pass (passes.c): the views rendered with
+ * culling on and off must give the same bits, and culling must have left
+ * triangles out. Cube faces around `eye` and, where `ortho_half` > 0, an
+ * orthographic view down onto it; each with `desc` (objects skipped or
+ * drawn alone, local space). Returns the share of triangles drawn. */
+static double culled_equals_whole(const gi_gpu_scene *gs, gi_depth_desc desc, gi_vec3 eye,
+                                  float ortho_half, const char *what)
+{
+    gi_error err;
+    const uint32_t S = 32;
+    gi_depth_view v[7];
+    gi_depth_cube_views(eye, 0.01f, 50.0f, v);
+    uint32_t nv = 6;
+    if (ortho_half > 0.0f) {
+        memset(&v[6], 0, sizeof v[6]);
+        gi_mat4_look_at(v[6].view, gi_v3(eye.x, eye.y + 2.0f, eye.z), eye, gi_v3(0, 0, -1));
+        gi_mat4_ortho(v[6].proj, -ortho_half, ortho_half, -ortho_half, ortho_half, 0.01f, 20.0f);
+        v[6].projection = GI_PROJ_ORTHOGRAPHIC;
+        nv = 7;
+    }
+    gi_depth_renderer *on = gi_depth_renderer_create(&desc, &err);
+    gi_depth_renderer *off = on ? gi_depth_renderer_create(&desc, &err) : NULL;
+    CHECK_MSG(on && off, "%s", err.text);
+    if (!on || !off) {
+        gi_depth_renderer_free(on);
+        return 1.0;
+    }
+    gi_depth_renderer_set_culling(off, 0);
+    GLuint ta = gi_depth_texture_create(on, nv), tb = gi_depth_texture_create(off, nv);
+    CHECK(gi_depth_render(on, gs, v, nv, ta, 0, &err) == GI_OK);
+    CHECK(gi_depth_render(off, gs, v, nv, tb, 0, &err) == GI_OK);
+    uint32_t differ = 0;
+    for (uint32_t k = 0; k < nv; k++) {
+        float *a = gi_depth_read_layer(ta, S, k), *b = gi_depth_read_layer(tb, S, k);
+        CHECK(a && b);
+        if (a && b)
+            differ += memcmp(a, b, (size_t)S * S * 4 * sizeof(float)) != 0;
+        free(a);
+        free(b);
+    }
+    uint64_t drawn = 0, total = 0, d2 = 0, t2 = 0;
+    gi_depth_renderer_drawn(on, &drawn, &total);
+    gi_depth_renderer_drawn(off, &d2, &t2);
+    double share = total ? (double)drawn / (double)total : 1.0;
+    printf("culling, %s: %u of %u views differ from drawing everything; %.1f%% of %llu triangles "
+           "drawn\n",
+           what, differ, nv, 100.0 * share, (unsigned long long)total);
+    CHECK_MSG(differ == 0, "%s: %u views differ with culling", what, differ);
+    CHECK_MSG(total > 0 && drawn < total, "%s: culling left nothing out (%llu of %llu)", what,
+              (unsigned long long)drawn, (unsigned long long)total);
+    CHECK_MSG(d2 == 0 && t2 == 0, "%s: the renderer without culling counted triangles", what);
+    glDeleteTextures(1, &ta);
+    glDeleteTextures(1, &tb);
+    gi_depth_renderer_free(on);
+    gi_depth_renderer_free(off);
+    return share;
+}
+
+/* The same on scenes whose objects move (rigid animation at t = 0.7 s) and
+ * deform (morph targets), where the runs' boxes must follow the transforms
+ * and the weights. */
+static void culling_moved(gi_gpu *gpu, const char *name, float t)
+{
+    gi_error err;
+    char path[512];
+    snprintf(path, sizeof path, "%s/scenes/%s", GI_SOURCE_DIR, name);
+    gi_scene *s = gi_scene_load(path, &err);
+    CHECK_MSG(s != NULL, "%s", err.text);
+    gi_gpu_scene *gs = s ? gi_gpu_scene_upload(gpu, s, &err) : NULL;
+    CHECK_MSG(gs != NULL, "%s", err.text);
+    if (gs) {
+        gi_gpu_scene_set_time(gs, t);
+        gi_depth_desc desc = {.size = 32, .surfaces = 2, .metric = GI_DEPTH_RADIAL};
+        gi_vec3 mid =
+            gi_v3(0.5f * (s->bounds[0] + s->bounds[3]), 0.5f * (s->bounds[1] + s->bounds[4]),
+                  0.5f * (s->bounds[2] + s->bounds[5]));
+        culled_equals_whole(gs, desc, mid, 0.0f, name);
+    }
+    gi_gpu_scene_free(gs);
+    gi_scene_free(s);
+}
+
 int main(void)
 {
     gi_error err;
@@ -231,6 +313,21 @@ int main(void)
     free(map);
     glDeleteTextures(1, &tex);
     gi_depth_renderer_free(dr);
+
+    /* ---- frustum culling: the same bits as drawing everything ---- */
+    gi_depth_desc cd = {.size = 32, .surfaces = 2, .metric = GI_DEPTH_RADIAL};
+    double share = culled_equals_whole(gs, cd, inside, half, "Cornell box, cube and ortho");
+    CHECK_MSG(share < 0.6, "culling drew %.0f%% of the triangles from the box's centre",
+              100.0 * share);
+    cd.skip_object = 1;
+    culled_equals_whole(gs, cd, inside, half, "first object skipped");
+    cd.skip_object = 0;
+    cd.only_object = s->object_count;
+    culled_equals_whole(gs, cd, inside, half, "last object alone");
+    cd.local = 1;
+    culled_equals_whole(gs, cd, inside, half, "last object alone, local space");
+    culling_moved(gpu, "cornell_moving.gltf", 0.7f);
+    culling_moved(gpu, "cornell_deform.gltf", 0.7f);
     CHECK(gi_gl_check("passes", &err) == GI_OK);
     gi_gpu_scene_free(gs);
     gi_scene_free(s);

@@ -158,6 +158,11 @@ void gi_gpu_scene_bind(const gi_gpu_scene *gs);
 /* Draws all triangles (or only object `object` when >= 0) with the scene
  * VAO; the caller has a program bound. `instances` > 1 draws instanced. */
 void gi_gpu_scene_draw(const gi_gpu_scene *gs, int object, GLsizei instances);
+/* Draws `ranges` runs of the scene's own index buffer in one call
+ * (glMultiDrawElements): run k is counts[k] indices from byte offset
+ * offsets[k]; the caller has a program bound. */
+void gi_gpu_scene_draw_ranges(const gi_gpu_scene *gs, const GLsizei *counts,
+                              const void *const *offsets, GLsizei ranges);
 /* Draws `index_count` indices of another element buffer `ibo` (indices into
  * the scene's vertices, e.g. gi/algo/simplify.h's lower-detail copy) with
  * the scene's VAO and vertex attributes, then gives the VAO its own

@@ -164,6 +164,14 @@ typedef struct gi_depth_renderer gi_depth_renderer;
 
 gi_depth_renderer *gi_depth_renderer_create(const gi_depth_desc *desc, gi_error *err);
 void gi_depth_renderer_free(gi_depth_renderer *r);
+/* Frustum culling (on by default): each view draws only the runs of
+ * triangles whose boxes are not wholly outside its clip volume, which
+ * gives the same maps as drawing everything (paraboloid views are drawn
+ * whole). Off draws every triangle of every view, for tests and timing. */
+void gi_depth_renderer_set_culling(gi_depth_renderer *r, int on);
+/* Triangles drawn and offered, summed over the views and surfaces so far
+ * (with culling off, or paraboloid views, neither counts). */
+void gi_depth_renderer_drawn(const gi_depth_renderer *r, uint64_t *drawn, uint64_t *total);
 /* Allocates an RGBA32F 2D array texture with `layers` maps for this renderer. */
 GLuint gi_depth_texture_create(const gi_depth_renderer *r, uint32_t layers);
 /* Renders `count` views into layers first_layer .. first_layer+count-1 of
