@@ -144,7 +144,7 @@ def main():
 
     out.append("\n## Fig. 8 and the sweeps: glossy Cornell box against the path tracer\n")
     out.append("full = the 64-bounce reference, matched = the reference with each method's bounce count (vlf 8, direct 1); MSE in linear "
-               "radiance over all pixels (the paper's measure), relMSE = mean of (x − r)² / (r² + 0.01).\n")
+               "radiance over all pixels (the paper's measure), relMSE = mean of (x − r)² / (r + 0.01)².\n")
     out.append("| label | method | l | N | perturbed | MSE full | MSE matched | relMSE matched | mean diff matched (%) | "
                "propagation (ms) | render (ms) |")
     out.append("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
