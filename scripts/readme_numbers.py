@@ -6,7 +6,8 @@ Usage: readme_numbers.py RESULTS_FOLDER[:README]...
 Issue 34: a results README may only quote numbers that the study's tables
 script prints.  This checker reads README.md (or the README after the colon) of each
 results folder and every generated file beside it -- tables.md and, where a
-tables script writes one, values.md, and the rerun's changes.md; the
+tables script writes one, values.md, and the rerun's changes.md (whose numbers, the previous run's
+among them, count only in a section headed "What changed ..."); the
 tables.md of each sub-study folder one level down (results/avg/speed/, and
 for results/ itself each study folder); for results/ also startup.md and
 reference_speed.md -- and prints each measured number of
@@ -106,15 +107,19 @@ def generated_files(folder):
 
 
 def generated_values(folder):
-    """All numbers in the folder's generated files (generated_files)."""
-    vals = []
+    """The numbers in the folder's generated files (generated_files): those
+    of every file but changes.md, and those of changes.md (the previous
+    run's numbers among them, which only a "What changed" section may
+    quote)."""
+    vals, change_vals = [], []
     for path in generated_files(folder):
         if not os.path.exists(path):
             continue
+        into = change_vals if os.path.basename(path) == "changes.md" else vals
         with open(path, encoding="utf-8") as f:
             for m in TOKEN.finditer(f.read()):
-                vals.append(abs(value(m.group("num"), m.group("exp"))[0]))
-    return vals
+                into.append(abs(value(m.group("num"), m.group("exp"))[0]))
+    return vals, change_vals
 
 
 # Other ways a generated table may print the same value: a percentage as a
@@ -151,10 +156,14 @@ def measured(line):
     return out
 
 
-def offenders(readme, vals):
-    """(line number, token, line) for each README number not generated."""
+def offenders(readme, vals, change_vals=()):
+    """(line number, token, line) for each README number not generated. The
+    numbers of changes.md (change_vals) count only inside a section whose
+    heading starts with "What changed": elsewhere a README quoting the
+    previous run would pass on the "before" columns."""
     bad = []
-    in_fence, paper_cols, prev, skip_level = False, set(), "", 0
+    in_fence, paper_cols, prev, skip_level, changes_level = False, set(), "", 0, 0
+    both = list(vals) + list(change_vals)
     with open(readme, encoding="utf-8") as f:
         raw = f.read()
     lines = QUOTED.sub(lambda m: re.sub(r"[^\n]", " ", m.group(0)), raw).splitlines()
@@ -170,6 +179,10 @@ def offenders(readme, vals):
                 skip_level = 0
             if not skip_level and re.search(r"not in the tables", orig, re.I):
                 skip_level = level
+            if changes_level and level <= changes_level:
+                changes_level = 0
+            if re.match(r"^\s*#+\s*what changed", orig, re.I):
+                changes_level = level
             continue
         if skip_level:
             continue
@@ -184,8 +197,9 @@ def offenders(readme, vals):
             cells = line.strip().strip("|").split("|")
             text = "|".join(c for i, c in enumerate(cells) if i not in paper_cols)
         prev = line
+        pool = both if changes_level else vals
         for tok, v, dec, unit in measured(text):
-            if not any(matches(v * k, dec - e, vals) for k, e in SCALES.get(unit, [(1, 0)])):
+            if not any(matches(v * k, dec - e, pool) for k, e in SCALES.get(unit, [(1, 0)])):
                 bad.append((no, tok, line.strip()))
     return bad
 
@@ -195,11 +209,11 @@ def check(folder, readme):
     if not os.path.isfile(readme):
         print(f"readme_numbers: {readme}: no such file", file=sys.stderr)
         return -1
-    vals = generated_values(folder)
-    if not vals:
+    vals, change_vals = generated_values(folder)
+    if not vals and not change_vals:
         print(f"readme_numbers: {folder}: no generated tables (%s)" % ", ".join(GENERATED), file=sys.stderr)
         return -1
-    bad = offenders(readme, vals)
+    bad = offenders(readme, vals, change_vals)
     for no, tok, line in bad:
         print(f"{readme}:{no}: {tok} is not in the generated tables: {line[:120]}")
     if bad:
