@@ -1,7 +1,14 @@
 #!/usr/bin/env python3
 """Tables of the cssm_hrc study (results/cssm_hrc/README.md) from its runs.csv.
 
-Usage: plugins/cssm_hrc/tables.py results/cssm_hrc > results/cssm_hrc/tables.md
+Usage: plugins/cssm_hrc/tables.py results/cssm_hrc [--measure] > results/cssm_hrc/tables.md
+
+--measure: measure what needs the study's EXR images, which are not
+committed (Fig. 14's relMSE between the cssm and the trace image, with
+gibench diff; GIBENCH names the binary), into the committed
+pair_relmse.csv; without it the tables read that file, so that they
+regenerate the same from a clean clone (scripts/regenerate_results.sh
+passes --measure after a study).
 """
 import csv
 import os
@@ -33,6 +40,7 @@ def params(r):
 
 def main():
     d = sys.argv[1]
+    measure = "--measure" in sys.argv[2:]
     rows = list(csv.DictReader(open(os.path.join(d, "runs.csv"))))
     ok = [r for r in rows if r["status"] == "ok"]
     print("# cssm_hrc study tables (made by plugins/cssm_hrc/tables.py from runs.csv)\n")
@@ -109,7 +117,7 @@ def main():
 
     metrics_table("fig15", ["atlas", "M", "bounces", "clamp"], "Fig. 15: against the path-traced reference")
     metrics_table("fig16", ["atlas", "bounces"], "Fig. 16: bounce count n (pixels get 0 .. n + 1 bounces)")
-    fig14(d, ok)
+    fig14(d, ok, measure)
     # the PCF runs: label fig14_pcf (runs before issue 34: fig14 without vis)
     metrics_table("fig14_pcf", ["atlas", "pcf"], "Fig. 14: nearest against PCF look-ups",
                   where=lambda r: r["label"] == "fig14_pcf" or (r["label"] == "fig14" and "vis" not in params(r)))
@@ -138,21 +146,32 @@ def trivial_black(d):
     return {r["reference"]: float(r["relmse"]) for r in csv.DictReader(open(path))}
 
 
-def pair_relmse(d, a, b):
-    """relMSE of run a's image against run b's (gibench diff; the EXRs are not
-    committed, so only where the study ran here), else None."""
-    gib = os.environ.get("GIBENCH", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
-                                                  "build", "release", "bin", "gibench"))
-    ia, ib = (os.path.join(d, "runs", r["run"], "image.exr") for r in (a, b))
-    if not (os.path.exists(ia) and os.path.exists(ib) and os.path.exists(gib)):
-        return None
-    import json
-    import subprocess
-    out = subprocess.run([gib, "diff", "--json", ia, ib], capture_output=True, text=True)
-    return json.loads(out.stdout)["relmse"] if out.returncode == 0 else None
+def pair_relmse(d, a, b, measure):
+    """relMSE of run a's image against run b's, read from the committed
+    pair_relmse.csv; with measure, first measured by gibench diff of the
+    study's EXR images (not committed) and written there. None where the
+    file has no such pair."""
+    saved = os.path.join(d, "pair_relmse.csv")
+    if measure:
+        gib = os.environ.get("GIBENCH", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
+                                                      "build", "release", "bin", "gibench"))
+        ia, ib = (os.path.join(d, "runs", r["run"], "image.exr") for r in (a, b))
+        import json
+        import subprocess
+        out = subprocess.run([gib, "diff", "--json", ia, ib], capture_output=True, text=True)
+        if out.returncode != 0:
+            sys.exit("tables.py: gibench diff %s %s: %s" % (ia, ib, out.stderr.strip()))
+        with open(saved + ".tmp", "w") as f:
+            f.write("test,reference,relmse\n%s,%s,%.17g\n" % (a["run"], b["run"], json.loads(out.stdout)["relmse"]))
+        os.replace(saved + ".tmp", saved)
+    if os.path.exists(saved):
+        for row in csv.DictReader(open(saved)):
+            if row["test"] == a["run"] and row["reference"] == b["run"]:
+                return float(row["relmse"])
+    return None
 
 
-def fig14(d, ok):
+def fig14(d, ok, measure):
     """Fig. 14: the CSSM visibility against an exact ray query to each gathered
     point (vis=trace), same atlas, maps and cuts; the trivial black image
     scored against the same references."""
@@ -177,10 +196,10 @@ def fig14(d, ok):
         print("| (black) | %s | | | %s | %s | | -100 |" % (stem, "%.4f" % bf[0] if bf else "—", "%.4f" % bm[0] if bm else "—"))
     if "cssm" in sel and "trace" in sel:
         c, t = sel["cssm"], sel["trace"]
-        e = pair_relmse(d, c, t)
+        e = pair_relmse(d, c, t, measure)
         print("\nBetween them: relMSE(cssm image, trace image) %s; mean luminance cssm against trace %+.2f %% "
               "(from the two differences to the matched reference); relMSE cssm / trace against it %.3f" % (
-                  "%.4f" % e if e is not None else "— (EXRs not here)",
+                  "%.4f" % e if e is not None else "— (not measured: tables.py --measure where the EXRs are)",
                   100 * ((1 + num(c, "mean_lum_diff_pct_matched") / 100) / (1 + num(t, "mean_lum_diff_pct_matched") / 100) - 1),
                   num(c, "relmse_matched") / num(t, "relmse_matched")))
 
