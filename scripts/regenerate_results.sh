@@ -104,7 +104,7 @@ for s in "${studies[@]}"; do
         tables plugins/avg/tables.py avg "$G" --measure ;;
     cssm_hrc)
         study cssm_hrc plugins/cssm_hrc/study.json
-        tables plugins/cssm_hrc/tables.py cssm_hrc ;;
+        tables plugins/cssm_hrc/tables.py cssm_hrc --measure ;;
     implicit_vis)
         study implicit_vis plugins/implicit_vis/study.json
         tables plugins/implicit_vis/tables.py implicit_vis ;;
