@@ -174,9 +174,12 @@ gi_result vlf_list_fragments(const vlf_field *f, const vlf_psf *fr, vlf_frag_buf
     int mode = f->prm.order == VLF_ORDER_PLAIN     ? VLF_SORT_PLAIN
                : f->prm.order == VLF_ORDER_NOSPLIT ? VLF_SORT_NOSPLIT
                                                    : VLF_SORT_NEWELL;
-    if (vlf_sort_faces(so, f->sort_p, f->sort_count, f->sort_group, f->prm.hier_min, fr->u, fr->v,
-                       fr->n, mode, f->prm.bsp_levels, f->prm.bsp_min) != GI_OK)
-        return GI_ERR_OUT_OF_MEMORY;
+    so->cancelled = f->prm.cancelled; /* a cancel stops the sort within 1024 candidates */
+    so->cancel_user = f->prm.cancel_user;
+    gi_result sr = vlf_sort_faces(so, f->sort_p, f->sort_count, f->sort_group, f->prm.hier_min,
+                                  fr->u, fr->v, fr->n, mode, f->prm.bsp_levels, f->prm.bsp_min);
+    if (sr != GI_OK)
+        return sr;
     cnt->pieces += so->nout;
     cnt->splits += so->splits;
     cnt->bsp_cuts += so->bsp_cuts;

@@ -461,6 +461,10 @@ static int order_list(vlf_sorter *s, const uint32_t *items, uint32_t n, int mode
         return -1;
     uint32_t head = 0, chain_len = 0;
     for (;;) {
+        if (s->cancelled && (++s->polls & 1023u) == 0 && s->cancelled(s->cancel_user)) {
+            s->stopped = 1;
+            return -1;
+        }
         while (head < s->nlist && s->state[s->list[head]] != 0)
             head++;
         if (head == s->nlist)
@@ -808,10 +812,11 @@ gi_result vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count
     s->tests = 0;
     s->splits = s->bsp_cuts = s->unresolved = 0;
     s->groups = s->hier_fallbacks = 0;
+    s->stopped = 0;
     if (group && hier_min > 0) {
         int r = sort_hier(s, tri_p, tri_count, group, hier_min, u, v, n, mode, bsp_levels, bsp_min);
         if (r <= 0)
-            return r == 0 ? GI_OK : GI_ERR_OUT_OF_MEMORY;
+            return r == 0 ? GI_OK : s->stopped ? GI_ERR_CANCELLED : GI_ERR_OUT_OF_MEMORY;
         if (s->nout > 0) /* it ran and a stand-in was split: again without the shortcut */
             s->hier_fallbacks++;
         s->tests = 0;
@@ -831,7 +836,7 @@ gi_result vlf_sort_faces(vlf_sorter *s, const gi_vec3 *tri_p, uint32_t tri_count
     int rc =
         order_bsp(s, items, tri_count, mode, 0, bsp_levels, bsp_min ? bsp_min : 2, split_limit);
     free(items);
-    return rc == 0 ? GI_OK : GI_ERR_OUT_OF_MEMORY;
+    return rc == 0 ? GI_OK : s->stopped ? GI_ERR_CANCELLED : GI_ERR_OUT_OF_MEMORY;
 }
 
 void vlf_sorter_free(vlf_sorter *s)

@@ -54,6 +54,14 @@ typedef struct vlf_sorter {
     uint32_t unresolved;     /* cycles left in place when the split limit was reached */
     uint32_t groups;         /* groups sorted on their own (the hierarchical shortcut) */
     uint32_t hier_fallbacks; /* sorts redone without the shortcut (a stand-in split by a cycle) */
+    /* Polled every 1024 candidates while ordering (NULL: never): when it
+     * returns non-zero the sort stops and vlf_sort_faces returns
+     * GI_ERR_CANCELLED, so that a cancel does not wait for a whole
+     * direction's sort. */
+    int (*cancelled)(void *);
+    void *cancel_user;
+    uint32_t polls;
+    int stopped;
 } vlf_sorter;
 
 enum { VLF_SORT_NEWELL = 0, VLF_SORT_PLAIN = 1, VLF_SORT_NOSPLIT = 2 };
