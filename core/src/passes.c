@@ -217,8 +217,11 @@ static int depth_box_outside(const float clip[16], const float box[8][4])
     return 0;
 }
 
-/* Draws what view dv can see of the runs, in the scene's order. */
-static void depth_draw_view(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi_depth_view *dv)
+/* The draws of what view dv can see of the runs, in the scene's order: the
+ * runs inside its volume, adjacent ones merged, into r->counts and
+ * r->offsets; returns how many. Found once per view, drawn once per peeled
+ * surface. */
+static GLsizei depth_cull_view(gi_depth_renderer *r, const gi_depth_view *dv)
 {
     float clip[16];
     gi_mat4_mul(clip, dv->proj, dv->view);
@@ -239,7 +242,7 @@ static void depth_draw_view(gi_depth_renderer *r, const gi_gpu_scene *gs, const 
         }
         end = run->first + run->count;
     }
-    gi_gpu_scene_draw_ranges(gs, r->counts, r->offsets, n);
+    return n;
 }
 
 void gi_depth_renderer_set_culling(gi_depth_renderer *r, int on)
@@ -382,6 +385,8 @@ gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi
         /* Every channel starts at +inf: fewer surfaces than channels. */
         glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
         glClearBufferfv(GL_COLOR, 0, far_value);
+        /* a paraboloid's volume is not a frustum: drawn whole */
+        GLsizei draws = culled && !para ? depth_cull_view(r, dv) : 0;
         for (uint32_t k = 0; k < d->surfaces; k++) {
             GLuint cur = r->peel[k & 1], prev = r->peel[(k + 1) & 1];
             glNamedFramebufferTexture(r->fbo, GL_COLOR_ATTACHMENT1, cur, 0);
@@ -391,11 +396,11 @@ gi_result gi_depth_render(gi_depth_renderer *r, const gi_gpu_scene *gs, const gi
             glClear(GL_DEPTH_BUFFER_BIT);
             glBindTextureUnit(GI_TEX_CORE_DEPTH_PEEL, prev);
             glUniform1i(loc_peel, (GLint)k);
-            if (culled && !para) { /* a paraboloid's volume is not a frustum: drawn whole */
-                depth_draw_view(r, gs, dv);
+            if (culled && !para) {
+                gi_gpu_scene_draw_ranges(gs, r->counts, r->offsets, draws);
             } else if ((d->skip_object || d->skip_objects) && !d->only_object) {
                 for (uint32_t o = 0; o < gs->scene->object_count; o++)
-                    if (o + 1 != d->skip_object && !(d->skip_objects && d->skip_objects[o]))
+                    if (object_drawn(d, gs->scene, o))
                         gi_gpu_scene_draw(gs, (int)o, 1);
             } else {
                 gi_gpu_scene_draw(gs, d->only_object ? (int)d->only_object - 1 : -1, 1);

@@ -169,8 +169,9 @@ void gi_depth_renderer_free(gi_depth_renderer *r);
  * gives the same maps as drawing everything (paraboloid views are drawn
  * whole). Off draws every triangle of every view, for tests and timing. */
 void gi_depth_renderer_set_culling(gi_depth_renderer *r, int on);
-/* Triangles drawn and offered, summed over the views and surfaces so far
- * (with culling off, or paraboloid views, neither counts). */
+/* Triangles drawn and offered, summed over the views so far; a view's
+ * visible runs are found once and drawn for each peeled surface, counted
+ * once. With culling off, or for paraboloid views, neither counts. */
 void gi_depth_renderer_drawn(const gi_depth_renderer *r, uint64_t *drawn, uint64_t *total);
 /* Allocates an RGBA32F 2D array texture with `layers` maps for this renderer. */
 GLuint gi_depth_texture_create(const gi_depth_renderer *r, uint32_t layers);
