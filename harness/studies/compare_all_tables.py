@@ -24,7 +24,9 @@ With --size-dir (repeatable), the same comparison at other image sizes
 its own path-tracer clock) is set beside DIR's: per method and scene the
 best equal-error speed-up at each size, over the settings every size ran,
 with its spread over the path tracer's repeated curve points; --chart
-draws it as an SVG, one panel per method, one line per scene.
+draws it as an SVG, one panel per method, one line per scene; tables.md
+links it by its file name, as a file beside it in DIR (the test writes it
+elsewhere and compares it with the committed one).
 
 Usage: harness/studies/compare_all_tables.py DIR [--size-dir DIR2]...
                                                  [--chart FILE.svg] > DIR/tables.md
@@ -366,7 +368,7 @@ def main():
           % (", ".join("`%s` %s" % (os.path.relpath(dd), z) for dd, z in
                       sorted(zip([d] + a.size_dir, [size_of(rows)] + [size_of(o) for o in others]),
                              key=lambda t: int(t[1].split("x")[0]))),
-             " Chart: [%s](%s)." % (os.path.basename(a.chart), os.path.relpath(a.chart, d)) if a.chart else ""))
+             " Chart: [%s](%s)." % ((os.path.basename(a.chart),) * 2) if a.chart else ""))
         varying = varying_keys(studies)
         w("| method | scene | " + " | ".join(sizes) + " | setting at %s |" % sizes[-1])
         w("|---|---|" + "---:|" * len(sizes) + "---|")
