@@ -10,8 +10,7 @@ set(failures 0)
 set(cases "avg|plugins/avg/tables.py|${GIB}" "csm|plugins/csm/tables.py|" "csm_local|plugins/csm/tables.py|"
           "vlf|plugins/vlf/tables.py|" "cssm_hrc|plugins/cssm_hrc/tables.py|"
           "implicit_vis|plugins/implicit_vis/tables.py|" "avg/speed|plugins/avg/speed_table.py|"
-          "stress|harness/studies/stress_tables.py|"
-          "compare_all_128|harness/studies/compare_all_tables.py|")
+          "stress|harness/studies/stress_tables.py|")
 # The five-way comparison at 64x64 sets the other sizes' studies beside it
 # where they are committed, as scripts/regenerate_results.sh does, and draws
 # the speed-up against size (compared with the committed chart below).
@@ -25,9 +24,11 @@ if(sizes)
     string(APPEND sizes " --chart ${OUT}/speedup_vs_size.svg")
 endif()
 list(APPEND cases "compare_all|harness/studies/compare_all_tables.py|${sizes}")
-if(EXISTS ${ROOT}/results/compare_all_256/runs.csv)
-    list(APPEND cases "compare_all_256|harness/studies/compare_all_tables.py|")
-endif()
+foreach(z 128 256)
+    if(EXISTS ${ROOT}/results/compare_all_${z}/runs.csv)
+        list(APPEND cases "compare_all_${z}|harness/studies/compare_all_tables.py|")
+    endif()
+endforeach()
 foreach(c ${cases})
     string(REPLACE "|" ";" parts "${c}")
     list(GET parts 0 study)
@@ -71,10 +72,12 @@ endif()
 # Issue 34: every measured number in a results README must be one the
 # tables script prints (scripts/readme_numbers.py states the rule).
 # Every results folder with a study (results/gpu/ has none).
-set(checked avg csm csm_local compare_all compare_all_128 stress cssm_hrc vlf implicit_vis)
-if(EXISTS ${ROOT}/results/compare_all_256/README.md)
-    list(APPEND checked compare_all_256)
-endif()
+set(checked avg csm csm_local compare_all stress cssm_hrc vlf implicit_vis)
+foreach(z 128 256)
+    if(EXISTS ${ROOT}/results/compare_all_${z}/runs.csv)
+        list(APPEND checked compare_all_${z})
+    endif()
+endforeach()
 set(folders "")
 foreach(study ${checked})
     list(APPEND folders ${ROOT}/results/${study})
