@@ -9,8 +9,9 @@ results folder and every generated file beside it -- tables.md and, where a
 tables script writes one, values.md, and the rerun's changes.md (whose numbers, the previous run's
 among them, count only in a section headed "What changed ..."); the
 tables.md of each sub-study folder one level down (results/avg/speed/, and
-for results/ itself each study folder); for results/ also startup.md and
-reference_speed.md -- and prints each measured number of
+for results/ itself each study folder); for results/ also startup.md,
+reference_speed.md and regenerate_times.csv (each step's time as `make
+results` ran it) -- and prints each measured number of
 the README that no generated file holds, with its line, then exits 1.
 
 What counts as a measured number (docs/studies.md, "Numbers in results
@@ -91,7 +92,8 @@ def value(num, exp):
 # at the top of results/ also the start-up and reference-speed measurements
 # (scripts/startup_time.py, scripts/ref-vs-embree.sh) written by
 # scripts/regenerate_results.sh.
-GENERATED = ("tables.md", "values.md", "changes.md", "startup.md", "reference_speed.md")
+GENERATED = ("tables.md", "values.md", "changes.md", "startup.md", "reference_speed.md",
+             "regenerate_times.csv")
 
 
 def generated_files(folder):
@@ -117,8 +119,11 @@ def generated_values(folder):
             continue
         into = change_vals if os.path.basename(path) == "changes.md" else vals
         with open(path, encoding="utf-8") as f:
-            for m in TOKEN.finditer(f.read()):
-                into.append(abs(value(m.group("num"), m.group("exp"))[0]))
+            text = f.read()
+        if path.endswith(".csv"):  # a field's comma is no thousands separator
+            text = text.replace(",", " ")
+        for m in TOKEN.finditer(text):
+            into.append(abs(value(m.group("num"), m.group("exp"))[0]))
     return vals, change_vals
 
 
