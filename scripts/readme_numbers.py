@@ -40,6 +40,8 @@ the README's precision (the README may round; a sign written as a word,
 in the other unit).
 """
 
+import csv
+import io
 import os
 import re
 import sys
@@ -120,8 +122,9 @@ def generated_values(folder):
         into = change_vals if os.path.basename(path) == "changes.md" else vals
         with open(path, encoding="utf-8") as f:
             text = f.read()
-        if path.endswith(".csv"):  # a field's comma is no thousands separator
-            text = text.replace(",", " ")
+        if path.endswith(".csv"):  # only the measured columns (*_s), not dates or commits
+            rows = list(csv.DictReader(io.StringIO(text)))
+            text = " ".join(v for r in rows for k, v in r.items() if k and k.endswith("_s") and v)
         for m in TOKEN.finditer(text):
             into.append(abs(value(m.group("num"), m.group("exp"))[0]))
     return vals, change_vals
