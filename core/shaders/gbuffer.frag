@@ -25,12 +25,21 @@ void main()
     int side = gi_side_of(v_material, gl_FrontFacing);
     if (side == 0)
         discard;
-    // The back of a double-sided one has reversed normals; a shading normal
-    // that still faces away (smooth normals at a silhouette, a file whose
-    // normals disagree with its winding) is turned to the eye as well.
+    // The back of a double-sided one has reversed normals; where the
+    // shading normal still faces away from the eye (smooth normals at a
+    // silhouette, a file whose normals disagree with its winding) the
+    // triangle's geometric normal on the eye's side stands in for it, as
+    // in the reference (gi_facing_normal, gi/scene.h).
+    vec3 wo = u_eye - v_world;
     vec3 n = normalize(v_normal) * float(side);
-    if (dot(n, u_eye - v_world) < 0.0)
-        n = -n;
+    if (dot(n, wo) <= 0.0) {
+        vec3 p0, p1, p2;
+        gi_triangle_world(uint(gl_PrimitiveID), p0, p1, p2);
+        vec3 ng = cross(p1 - p0, p2 - p0);
+        float len = length(ng);
+        ng = len > 0.0 ? ng / len : -n;
+        n = gi_facing_normal(n, dot(ng, wo) < 0.0 ? -ng : ng, wo);
+    }
     bool mirror = (m.flags & GI_MATERIAL_MIRROR) != 0u;
     // Front faces emit; back faces exist only when double-sided, and emit.
     bool emits = true;

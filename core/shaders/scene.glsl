@@ -83,6 +83,10 @@ int gi_side_of(uint m, bool front)
     return gi_material_double_sided(m) ? -1 : 0;
 }
 
+// The shading normal seen along wo (gi_facing_normal in gi/scene.h): n on
+// the seen side where it faces wo, else the geometric normal ng on wo's side.
+vec3 gi_facing_normal(vec3 n, vec3 ng, vec3 wo) { return dot(n, wo) > 0.0 ? n : ng; }
+
 uint gi_triangle_material(uint tri) { return gi_vertices[gi_indices[3u * tri]].material; }
 
 // Lambert albedo of a material at texture coordinate uv.

@@ -138,12 +138,31 @@ static void mirror_winding(gi_scene *s)
     }
 }
 
+/* 1 when text data could begin a JSON value (after white space): anything
+ * else (an image, an OBJ file) is named as not glTF instead of reaching the
+ * JSON parser's error. */
+static int may_be_json(const unsigned char *p, size_t size)
+{
+    size_t i = 0;
+    while (i < size && (p[i] == ' ' || p[i] == '\t' || p[i] == '\n' || p[i] == '\r'))
+        i++;
+    if (i == size)
+        return 1; /* empty: the parser says so */
+    return strchr("{[\"-0123456789tfn", p[i]) != NULL && p[i] != '\0';
+}
+
 gi_scene *gi_scene_load_memory(const void *data, size_t size, int binary, const char *base_dir,
                                const char *name, gi_error *err)
 {
     if (err)
         err->text[0] = '\0';
     name = name ? name : "(memory)";
+    if (!binary && !may_be_json(data, size)) {
+        gi_error_set(err, GI_ERR_INVALID_ARGUMENT,
+                     "%s: not a glTF file (neither glTF JSON nor GLB; scenes are .gltf or .glb)",
+                     name);
+        return NULL;
+    }
     gi_gltf_source src = {data, size, binary, base_dir, name};
     char pointer[GI_GLTF_POINTER_MAX];
     gi_scene *s = gi_gltf_parse(&src, pointer, err);

@@ -4,10 +4,13 @@
  * power heuristic with beta = 2), Russian roulette after the third bounce.
  *
  * Conventions shared with every GPU method (docs/scenes.md "Scene conventions"):
- *  - the shading normal is the interpolated vertex normal turned to the
- *    side of wo (reflection is two-sided); the geometric normal decides
- *    which side a ray leaves from: a sampled direction on the other
- *    geometric side than wo carries nothing (no light through surfaces);
+ *  - the shading normal is the interpolated vertex normal on the side of
+ *    wo (reversed on a double-sided triangle's back); where it still faces
+ *    away from wo (smooth normals near a silhouette) the geometric normal
+ *    stands in (gi_facing_normal, gi/scene.h; the G-buffer does the same);
+ *    the geometric normal decides which side a ray leaves from: a sampled
+ *    direction on the other geometric side than wo carries nothing (no
+ *    light through surfaces);
  *  - the one rule for sides (gi/scene.h): gi_rt never reports the back of
  *    a single-sided triangle (camera, bounce and shadow rays pass through
  *    it), so a hit seen from behind is double-sided: its normals are turned
@@ -111,7 +114,9 @@ static void make_surface(const ref_scene *rs, const ref_hit *h, gi_vec3 dir, sur
                       b0 * n0[2] + b1 * n1[2] + b2 * n2[2]);
     float len = gi_v3_length(n);
     n = len > 1e-12f && isfinite(len) ? gi_v3_scale(n, 1.0f / len) : s->ng;
-    s->n = gi_v3_dot(n, s->wo) < 0.0f ? gi_v3_scale(n, -1.0f) : n;
+    /* Reversed on a double-sided triangle's back; where it still faces
+     * away from wo, the geometric normal (the G-buffer's rule too). */
+    s->n = gi_facing_normal(s->front ? n : gi_v3_scale(n, -1.0f), s->ng, s->wo);
     s->brdf = s->mat->brdf;
     if (s->mat->textured) {
         const float *t0 = sc->vertices[idx[0]].uv, *t1 = sc->vertices[idx[1]].uv,

@@ -899,6 +899,9 @@ CORPUS = [
     # tinygltf's own errors, passed through
     ("json-syntax.gltf", "parse error", lambda: b'{"asset": {"version": "2.0"}, "nodes": [,]}\n'),
     ("json-not-object.gltf", "Root element is not a JSON object", lambda: b"[1, 2, 3]\n"),
+    # not JSON at all (an OpenEXR header): named as not glTF
+    ("not-gltf.gltf", "not a glTF file (neither glTF JSON nor GLB",
+     lambda: b"v/1\x01\x02\x00\x00\x00channels\x00chlist\x00"),
     ("accessor-type.gltf", "Unsupported `type` for accessor object",
      mutate(set_path(["accessors", 0, "type"], "VEC7"))),
     # GLB container

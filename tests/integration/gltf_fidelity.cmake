@@ -13,6 +13,14 @@
 #  - single-sided back faces: sphere_in_ss.gltf seen from outside; its
 #    centre pixel shows the far half's inside, darker than the outside the
 #    old code drew (checked in tests/unit/test_sides.c on the geometry).
+#  - shading normals facing away from the eye: tilted_normals.gltf (a
+#    floor whose vertex normals lean away from the camera everywhere, as
+#    smooth normals do near a silhouette) renders as tilted_normals_flat.gltf
+#    (normals straight up), both being shaded with the geometric normal
+#    (gi_facing_normal): the reference bit for bit (the same paths: relMSE
+#    0), `direct` from the G-buffer within 1e-4 relMSE, each lit (mean over
+#    half the flat one's, where turning the normal round, the old rule, left
+#    the reference black and the G-buffer's shading dark).
 #  - no camera: box_light.gltf without its camera node renders through the
 #    default camera with one warning; the default camera stands outside the
 #    closed room, whose single-sided walls it sees from the back, so the
@@ -85,6 +93,19 @@ run(-q render --method direct --size 32x32 --scene ${T}/sphere_out_ds.gltf --out
 diff(${W}/ds.exr ${W}/dsd.exr)
 check_expr("sphere_out_ds reference, B = 4" "${mean_test} > 0.99 * 1.9375 && ${mean_test} < 1.01 * 1.9375")
 check_expr("sphere_out_ds direct" "${mean_ref} > 0.99 * 1.5 && ${mean_ref} < 1.01 * 1.5")
+
+# Shading normals facing away from the eye: the geometric normal stands in,
+# in the reference and in the G-buffer alike.
+foreach(v tilted_normals tilted_normals_flat)
+    run(-q reference --size 32x32 --spp 16 --max-bounces 1 --scene ${T}/${v}.gltf --out ${W}/${v}_ref.exr)
+    run(-q render --method direct --size 32x32 --scene ${T}/${v}.gltf --out ${W}/${v}_direct.exr)
+endforeach()
+diff(${W}/tilted_normals_ref.exr ${W}/tilted_normals_flat_ref.exr)
+check_expr("tilted normals, reference: as the flat floor" "${relmse} == 0 && ${mean_ref} > 0.01")
+check_expr("tilted normals, reference: lit" "${mean_test} > 0.5 * ${mean_ref}")
+diff(${W}/tilted_normals_direct.exr ${W}/tilted_normals_flat_direct.exr)
+check_expr("tilted normals, direct: as the flat floor" "${relmse} < 1e-4 && ${mean_ref} > 0.01")
+check_expr("tilted normals, direct: lit" "${mean_test} > 0.5 * ${mean_ref}")
 
 # No camera, and reduced material features.
 file(READ ${T}/box_light.gltf g)

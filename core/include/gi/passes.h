@@ -4,7 +4,9 @@
  * row 0 at the bottom (GL):
  *   tex_position  RGBA32F  world position xyz, w = linear eye depth (> 0),
  *                          w = 0 where no surface was hit
- *   tex_normal    RGBA16F  world shading normal xyz (unit, facing the eye), w = 0
+ *   tex_normal    RGBA16F  world shading normal xyz (unit, facing the eye: the
+ *                          geometric normal where the vertex normal does not,
+ *                          gi_facing_normal in gi/scene.h), w = 0
  *   tex_albedo    RGBA16F  Lambert albedo (texture applied), a = 1 if mirror
  *   tex_phong     RGBA16F  ks rgb, exponent
  *   tex_emission  RGBA16F  emitted radiance toward the eye (area lights seen

@@ -234,6 +234,22 @@ static inline gi_vec3 gi_side_normal(gi_side_kind side, gi_vec3 n)
     return side == GI_SIDE_BACK ? gi_v3_scale(n, -1.0f) : n;
 }
 
+/* The shading normal a surface is lit with, seen along wo (from the
+ * surface towards the viewer; any length): n, the interpolated vertex
+ * normal on the seen side (gi_side_normal), where it faces wo; otherwise
+ * ng, the unit geometric normal on wo's side. Smooth normals face away
+ * from the eye near a silhouette (and everywhere on a triangle whose file
+ * normals disagree with its winding); lit with such a normal turned
+ * round, the reference rendered those pixels nearly black (light from
+ * the other geometric side carries nothing) while a method shading from
+ * the G-buffer lit them. The reference (ref_path.c) and the G-buffer
+ * (gbuffer.frag) both use this rule; GLSL twin gi_facing_normal in
+ * core/shaders/scene.glsl. */
+static inline gi_vec3 gi_facing_normal(gi_vec3 n, gi_vec3 ng, gi_vec3 wo)
+{
+    return gi_v3_dot(n, wo) > 0.0f ? n : ng;
+}
+
 /* Loads and validates a .gltf or .glb file. On failure returns NULL and
  * writes "file: /json/path: reason" into err. */
 gi_scene *gi_scene_load(const char *path, gi_error *err);

@@ -19,6 +19,14 @@ issue reports and are the fixed cases of the regression tests:
   sphere_in_ss.gltf     a sphere wound inward, single-sided, on the floor of a
                         lit room, seen from outside: its near half is culled
                         (back faces), its far half's inside is seen
+  tilted_normals.gltf   a floor lit by an area light above it, seen at a slant,
+                        whose vertex normals lean away from the camera (each
+                        n . wo < 0 at every pixel, as smooth normals are near a
+                        silhouette): the reference and the G-buffer both shade
+                        it with the geometric normal (gi_facing_normal), so it
+                        renders as tilted_normals_flat.gltf, the same floor with
+                        normals (0, 1, 0); turning such a normal round instead
+                        left it nearly black in the reference only
 
 Run: python3 tests/data/truth/gen_truth.py (deterministic; files committed).
 """
@@ -140,11 +148,29 @@ def sphere_in_ss():
     g.write_gltf(os.path.join(HERE, "sphere_in_ss.gltf"), "sphere_in_ss.bin")
 
 
+def tilted_normals(name, lean):
+    """A 2 x 2 floor (normals leaning by `lean` towards -z) under a 0.5 x 0.5
+    area light, the camera at +z looking down at it."""
+    g = Writer(GEN)
+    m_floor = g.material("floor", (0.6, 0.6, 0.6))
+    m_lamp = g.material("lamp", (0.0, 0.0, 0.0), emission=(1.0, 1.0, 1.0), emission_strength=10.0)
+    floor = quad(0.0, 0.0, 0.0, 1.0, 1.0)
+    ln = (1.0 + lean * lean) ** 0.5
+    floor.nrm = [c for _ in range(len(floor.pos) // 3) for c in (0.0, 1.0 / ln, -lean / ln)]
+    nodes = [g.node("floor", mesh=g.mesh("floor", [(floor, m_floor)]))]
+    nodes.append(g.node("lamp", mesh=g.mesh("lamp", [(quad(0.0, 1.0, -0.3, 0.25, 0.25, down=True), m_lamp)])))
+    nodes.append(g.camera_node("camera", (0.0, 0.8, 2.2), (0.0, 0.0, -0.2), 45.0, znear=0.05, zfar=20.0))
+    g.scene(name, nodes)
+    g.write_gltf(os.path.join(HERE, name + ".gltf"), name + ".bin")
+
+
 def main():
     box_light("box_light", flat=False)
     box_light("box_light_flat", flat=True)
     sphere_out_ds()
     sphere_in_ss()
+    tilted_normals("tilted_normals", 3.0)
+    tilted_normals("tilted_normals_flat", 0.0)
 
 
 if __name__ == "__main__":
