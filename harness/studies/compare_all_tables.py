@@ -305,7 +305,8 @@ def main():
       "image (the frames it needs; precomputation not included: see the "
       "per-scene tables). Below 1: path tracing reaches that error sooner. "
       "\"*\": the error (full or bounce-matched) lies outside the path "
-      "tracer's measured curve (4 to 256 samples per pixel), below its most "
+      "tracer's measured curve (the study's `convergence_spp`; report.md's "
+      "\"Path tracer convergence\" lines), below its most "
       "converged image or above its least converged one, and the path "
       "tracer's time is extrapolated (slope -1 on log-log axes).\n")
     def speedup(m, s, prep):
