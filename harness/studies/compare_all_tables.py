@@ -33,6 +33,7 @@ Usage: harness/studies/compare_all_tables.py DIR [--size-dir DIR2]...
 """
 
 import argparse
+import csv
 import math
 import os
 import sys
@@ -219,6 +220,16 @@ def main():
         return got
     rows = load(d)
     others = [load(dd) for dd in a.size_dir]
+    # The samples per pixel of the path tracer's measured curve, from the
+    # study's pt_curves.csv (each size's study sets its own).
+    curve_spp = []
+    try:
+        with open(os.path.join(d, "pt_curves.csv"), newline="") as f:
+            curve_spp = sorted({int(r["spp"]) for r in csv.DictReader(f) if r.get("spp", "").isdigit()})
+    except OSError:
+        pass
+    curve_range = ("%d to %d samples per pixel" % (curve_spp[0], curve_spp[-1]) if curve_spp
+                   else "the study's `convergence_spp`")
     if a.chart and not others:
         sys.exit("compare_all_tables.py: --chart needs at least one --size-dir")
 
@@ -305,10 +316,10 @@ def main():
       "image (the frames it needs; precomputation not included: see the "
       "per-scene tables). Below 1: path tracing reaches that error sooner. "
       "\"*\": the error (full or bounce-matched) lies outside the path "
-      "tracer's measured curve (the study's `convergence_spp`; report.md's "
-      "\"Path tracer convergence\" lines), below its most "
+      "tracer's measured curve (%s; report.md's \"Path tracer convergence\" "
+      "lines), below its most "
       "converged image or above its least converged one, and the path "
-      "tracer's time is extrapolated (slope -1 on log-log axes).\n")
+      "tracer's time is extrapolated (slope -1 on log-log axes).\n" % curve_range)
     def speedup(m, s, prep):
         runs = [r for r in ok.get((m, s), []) if (with_prep(r) if prep else num(r.get("speedup_vs_pt"))) is not None]
         if not runs:
